@@ -1,0 +1,48 @@
+"""User-facing errors.
+
+Every mistake a user can make (a bad scene file, an unknown preset, a missing mesh) raises an
+:class:`ExplorerError`. The CLI prints its message and exits non-zero without a traceback. A
+validation pass collects every :class:`Problem` in a document before raising one
+:class:`ValidationError`, so the user sees all of them at once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+class ExplorerError(Exception):
+    """Base class of every error caused by user input (never by a bug)."""
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong with a document.
+
+    message : what is wrong and what is allowed, e.g. ``"must be in [0, 1], got 1.5"``
+    file : the file it came from, or None for in-memory mappings
+    line : 1-based line in ``file`` or None
+    key : the key path inside the document, e.g. ``lights[1].attenuation``
+    """
+
+    message: str
+    file: str | None = None
+    line: int | None = None
+    key: str | None = None
+
+    def __str__(self) -> str:
+        where = ""
+        if self.file:
+            where = f"{self.file}:{self.line}: " if self.line else f"{self.file}: "
+        elif self.line:
+            where = f"line {self.line}: "
+        key = f"{self.key}: " if self.key else ""
+        return f"{where}{key}{self.message}"
+
+
+class ValidationError(ExplorerError, ValueError):
+    """One or more :class:`Problem` found in a document; ``str()`` gives one line each."""
+
+    def __init__(self, problems: list[Problem]):
+        self.problems = list(problems)
+        super().__init__("\n".join(str(p) for p in self.problems))
