@@ -1,0 +1,391 @@
+"""The engine's front: :func:`shade` for one-shot colours, :class:`Shader` for interaction.
+
+A :class:`Shader` keeps the per-vertex light sums of
+:func:`explorer.reference.reference_terms` cached by what they depend on:
+
+=====================  =======================================================================
+change                 work done on the next ``colors``
+=====================  =======================================================================
+material colours       compose only: ``e + a_m·A + d_m·D + s_m·S`` (no dot product)
+shininess              the lobe only: ``Σ ws·base^n·s`` from stored per-light bases (no
+                       distances, no normalisations), then compose
+viewer                 the specular sum (and, when two-sided, everything: N·V flips normals)
+model (phong/blinn)    the specular sum
+lights                 every sum the material needs
+geometry               every sum the material needs
+=====================  =======================================================================
+
+A term the material does not need (``s_m = 0``, say) is not computed until it is needed.
+``stats`` counts each kind of pass, so tests can check that a change costs what it should.
+Cached arrays are read-only.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+
+from . import kernels as K
+from .errors import ExplorerError
+from .frame import check_vertices, frame_of, to_frame
+from .lights import DirectionalLight, SpotLight
+from .plan import Plan, make_plan
+from .scene import Scene, Viewer, load_scene
+
+PRECISIONS = ("float64", "float32")
+
+
+def shade(
+    scene,
+    positions,
+    normals,
+    *,
+    precision: str = "float64",
+    clamp: bool = True,
+    materials_dirs=(),
+) -> np.ndarray:
+    """Per-vertex colours of a mesh under a scene.
+
+    scene : a scene-file path, a mapping in the scene schema, or a :class:`~explorer.scene.Scene`
+    positions : (n, 3) float vertex positions
+    normals : (n, 3) float vertex normals (any length; zero means "no normal")
+    precision : "float64" (exact path) or "float32" (fast path, within 1/255 of float64)
+    clamp : clamp to [0, 1] (OpenGL); False keeps the unclamped sums (>= 0) for HDR
+    Returns colours : (n, 3) float64.
+    """
+    s = Shader(scene, positions, normals, precision=precision, clamp=clamp,
+               materials_dirs=materials_dirs, keep=False)
+    return np.asarray(s.colors, dtype=np.float64)
+
+
+class Shader:
+    """Cached, stateful shading of one mesh (see the module docstring).
+
+    positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation)
+    precision : "float32" (default here: the interactive path) or "float64"
+    keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
+    """
+
+    def __init__(self, scene, positions, normals, *, precision: str = "float32",
+                 clamp: bool = True, materials_dirs=(), keep: bool = True):
+        if precision not in PRECISIONS:
+            raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+        self._T = np.float32 if precision == "float32" else np.float64
+        self.precision = precision
+        self.clamp = bool(clamp)
+        self.keep = bool(keep)
+        self.stats: Counter = Counter()
+        self._scene = load_scene(scene, materials_dirs=materials_dirs)
+        self._plan: Plan = make_plan(self._scene)
+        self._k = K.constants(self._T)
+        self._powf = K.pow32 if self._T is np.float32 else K.pow64
+        self._k64 = K.constants(np.float64)
+        self.set_geometry(positions, normals)
+
+    # -- inputs ------------------------------------------------------------------------------
+    @property
+    def scene(self) -> Scene:
+        return self._scene
+
+    @property
+    def plan(self) -> Plan:
+        return self._plan
+
+    @property
+    def n(self) -> int:
+        return len(self._P)
+
+    def set_geometry(self, positions, normals) -> None:
+        """New vertices: every cached sum is invalid."""
+        self._P, self._N = check_vertices(positions, normals)
+        self._centre, self._scale = frame_of(self._P)
+        n = len(self._P)
+        self._A = self._D = self._S = None
+        self._base = self._ws = None
+        self._colors = None
+        self._out = np.empty((n, 3), self._T)
+        self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
+        self._lights_changed()
+
+    def set_scene(self, scene) -> None:
+        """Apply a new scene, invalidating only what its differences touch."""
+        new = load_scene(scene)
+        old = self._scene
+        if new == old:
+            return
+        self._scene = new
+        self._plan = make_plan(new)
+        if new.lights != old.lights or new.two_sided != old.two_sided:
+            self._lights_changed()
+            return
+        if new.viewer != old.viewer or new.model != old.model:
+            self._viewer_changed()
+        if new.material.shininess != old.material.shininess:
+            self._shininess_changed()
+        self._colors = None  # material colours and scene ambient: compose only
+        self._aconst = self._ambient_constant()
+
+    def set_material(self, material) -> None:
+        self.set_scene(self._scene.replace(material=material))
+
+    def set_model(self, model: str) -> None:
+        self.set_scene(self._scene.replace(model=model))
+
+    def set_viewer(self, viewer: Viewer) -> None:
+        self.set_scene(self._scene.replace(viewer=viewer))
+
+    def set_lights(self, lights) -> None:
+        self.set_scene(self._scene.replace(lights=tuple(lights)))
+
+    # -- outputs -----------------------------------------------------------------------------
+    @property
+    def colors(self) -> np.ndarray:
+        """(n, 3) colours in the working precision, read-only."""
+        if self._colors is None:
+            self._update()
+        return self._colors
+
+    @property
+    def terms(self) -> dict[str, np.ndarray]:
+        """Per-vertex sums (n, 3), read-only: ``ambient`` (scene ambient included),
+        ``diffuse``, ``specular``, so that colour = e + a_m·ambient + d_m·diffuse +
+        s_m·specular. Terms the plan skips are zeros."""
+        if not self.keep:
+            raise ExplorerError("terms need a Shader with keep=True")
+        # every sum the lights can produce, whatever the current material needs
+        self._update(force=(True, True, True))
+        n = self.n
+        A = np.broadcast_to(self._aconst.astype(self._T), (n, 3)).copy()
+        if self._A is not None:
+            A += self._A
+        out = {
+            "ambient": A,
+            "diffuse": self._D if self._D is not None else np.zeros((n, 3), self._T),
+            "specular": self._S if self._S is not None else np.zeros((n, 3), self._T),
+        }
+        return {k: _readonly(v) for k, v in out.items()}
+
+    # -- invalidation --------------------------------------------------------------------------
+    def _lights_changed(self):
+        self._A = self._D = self._S = None
+        self._base = self._ws = None
+        self._spec_shininess = None
+        self._colors = None
+        self._params = None
+        self._aconst = self._ambient_constant()
+
+    def _viewer_changed(self):
+        if self._scene.two_sided:  # N·V decides which normals flip: every sum depends on V
+            self._lights_changed()
+            return
+        self._S = None
+        self._base = self._ws = None
+        self._spec_shininess = None
+        self._params = None  # constant halfway vectors depend on V
+
+    def _shininess_changed(self):
+        self._S = None  # the stored bases and weights stay valid
+
+    # -- the work ------------------------------------------------------------------------------
+    def _ambient_constant(self) -> np.ndarray:
+        """Scene ambient plus the ambient of lights whose weight is constant, (3,) float64."""
+        a = np.asarray(self._scene.ambient, dtype=np.float64).copy()
+        for lp, light in zip(self._plan.lights, self._scene.lights):
+            if lp.ambient and not lp.varying_weight:
+                a += lp.factor * np.asarray(light.ambient)
+        return a
+
+    def _light_params(self, dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Kernel inputs for the lights and viewer in the normalised frame."""
+        scene, plan = self._scene, self._plan
+        c, s = self._centre, self._scale
+        L = len(scene.lights)
+        params = np.zeros((L, K.N_PARAMS))
+        flags = np.zeros(L, np.int32)
+        if scene.viewer.local:
+            view = to_frame(scene.viewer.eye, c, s)
+        else:
+            view = np.asarray(scene.viewer.direction, dtype=np.float64)
+        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights)):
+            f = 0
+            q = params[i]
+            if isinstance(light, DirectionalLight):
+                q[K.P_POS:K.P_POS + 3] = light.direction
+                if scene.model == "blinn" and not scene.viewer.local:
+                    h = np.asarray(light.direction) + view
+                    hn = math.sqrt(float(h @ h))
+                    if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
+                        q[K.P_H:K.P_H + 3] = h / hn
+                    f |= K.CONST_H
+            else:
+                f |= K.POSITIONAL
+                q[K.P_POS:K.P_POS + 3] = to_frame(light.position, c, s)
+                kc, kl, kq = light.attenuation
+                q[K.P_ATT:K.P_ATT + 3] = (kc, kl * s, kq * s * s)
+                if lp.attenuation == "per-vertex":
+                    f |= K.ATTEN
+            if isinstance(light, SpotLight) and lp.spot != "none":
+                f |= K.SPOT
+                q[K.P_AXIS:K.P_AXIS + 3] = light.direction
+                q[K.P_COS] = math.cos(math.radians(light.cutoff))
+                q[K.P_EXP] = light.exponent
+                if lp.spot == "cone+exponent":
+                    f |= K.SPOT_EXP
+            q[K.P_AMB:K.P_AMB + 3] = lp.factor * np.asarray(light.ambient)
+            q[K.P_DIF:K.P_DIF + 3] = lp.factor * np.asarray(light.diffuse)
+            q[K.P_SPEC:K.P_SPEC + 3] = lp.factor * np.asarray(light.specular)
+            if lp.ambient and lp.varying_weight:
+                f |= K.AMBIENT
+            if lp.diffuse:
+                f |= K.DIFFUSE
+            if lp.specular:
+                f |= K.SPECULAR
+            flags[i] = f
+        return params.astype(dtype), flags, view.astype(dtype)
+
+    def _material_vector(self, dtype) -> np.ndarray:
+        m = self._scene.material
+        return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
+
+    def _update(self, force=(False, False, False)):
+        plan, scene, T = self._plan, self._scene, self._T
+        n = self.n
+        need_amb = plan.ambient_per_vertex or force[0]
+        need_dif = plan.diffuse or force[1]
+        need_spec = plan.specular or force[2]
+        shininess = scene.material.shininess
+        do_amb = need_amb and self._A is None
+        do_dif = need_dif and self._D is None
+        do_spec = need_spec and self._S is None
+        flat = shininess == 0.0
+        if do_spec and self._ws is not None and (flat or self._base is not None):
+            # the lobe alone: bases and weights are stored, only n changed
+            params, flags, _ = self._params_for(T)
+            S = np.empty((n, 3), T)
+            K.lobe(self._base if self._base is not None else self._ws, self._ws, params,
+                   flags, T(shininess), self._k, S, self._powf)
+            self._S = S
+            self._spec_shininess = shininess
+            self.stats["lobe"] += 1
+            do_spec = False
+        mat = self._material_vector(T)
+        aconst = self._aconst.astype(T)
+        if do_amb or do_dif or do_spec:
+            self._run(do_amb, do_dif, do_spec, flat, mat, aconst)
+        else:
+            empty = np.zeros((0, 3), T)
+            K.compose(mat, aconst,
+                      self._A if self._A is not None and need_amb else empty,
+                      self._D if self._D is not None and need_dif else empty,
+                      self._S if self._S is not None and need_spec else empty,
+                      self.clamp, self._k, self._out)
+            self.stats["compose"] += 1
+        self._colors = _readonly(self._out)
+        self._out = np.empty_like(self._out)  # never write into colours already handed out
+
+    def _params_for(self, dtype):
+        if self._params is None:
+            self._params = {}
+        if dtype not in self._params:
+            self._params[dtype] = self._light_params(dtype)
+        return self._params[dtype]
+
+    def _run(self, do_amb, do_dif, do_spec, flat, mat, aconst):
+        """One fused pass of the shading kernel over every vertex (+ float64 fix-ups)."""
+        scene, T, n = self._scene, self._T, self.n
+        params, flags, view = self._params_for(T)
+        L = len(params)
+        keep = self.keep
+        opts = np.zeros(K.N_OPTS, np.int64)
+        opts[K.O_LOCAL] = scene.viewer.local
+        opts[K.O_TWO_SIDED] = scene.two_sided
+        opts[K.O_PHONG] = scene.model == "phong"
+        opts[K.O_FLAT] = flat
+        opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do_amb, do_dif, do_spec
+        opts[K.O_STORE] = keep
+        opts[K.O_STORE_LOBE] = keep and do_spec
+        opts[K.O_COMPOSE] = 1
+        opts[K.O_CLAMP] = self.clamp
+        opts[K.O_TRACK] = T is np.float32
+        empty3 = np.zeros((0, 3), T)
+
+        def cache(current, do):
+            if not keep:
+                return empty3
+            if do:
+                return np.empty((n, 3), T)
+            return current if current is not None else empty3
+
+        A = cache(self._A, do_amb)
+        D = cache(self._D, do_dif)
+        S = cache(self._S, do_spec)
+        if keep and do_spec:
+            base = np.zeros((L, n), T)
+            ws = np.zeros((L, n), T)
+        else:
+            base = ws = np.zeros((L, 0), T)
+        amb = self._amb
+        if opts[K.O_TRACK]:
+            amb[:] = 0
+        shin = T(scene.material.shininess)
+        K.shade(self._P, self._N, self._centre, 1.0 / self._scale, params, flags, view, opts,
+                mat, aconst, shin, self._k, A, D, S, base, ws, amb, self._out, self._powf)
+        self.stats["pass"] += 1
+        for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
+            self.stats[name] += int(bool(do))
+        if opts[K.O_TRACK]:
+            idx = np.flatnonzero(amb)
+            if idx.size:
+                self._fixup(idx, opts, A, D, S, base, ws)
+        if keep:
+            if do_amb:
+                self._A = A
+            if do_dif:
+                self._D = D
+            if do_spec:
+                self._S = S
+                self._base = base if not flat else None
+                self._ws = ws
+                self._spec_shininess = scene.material.shininess
+
+    def _fixup(self, idx, opts, A, D, S, base, ws):
+        """Redo ambiguous float32 lanes in float64 and scatter the results back."""
+        scene = self._scene
+        f64 = np.float64
+        params, flags, view = self._params_for(f64)
+        m = len(idx)
+        o = opts.copy()
+        o[K.O_TRACK] = 0
+
+        def sub(X):
+            return X[idx].astype(f64) if X.shape[0] else np.zeros((0, 3))
+
+        A64, D64, S64 = sub(A), sub(D), sub(S)
+        keep_lobe = base.shape[1] > 0
+        b64 = np.zeros((len(params), m if keep_lobe else 0))
+        w64 = np.zeros((len(params), m if keep_lobe else 0))
+        out64 = np.empty((m, 3))
+        mat = self._material_vector(f64)
+        aconst = self._aconst
+        K.shade(np.ascontiguousarray(self._P[idx]), np.ascontiguousarray(self._N[idx]),
+                self._centre, 1.0 / self._scale, params, flags, view, o, mat, aconst,
+                f64(scene.material.shininess), self._k64, A64, D64, S64, b64, w64,
+                np.zeros(0, np.bool_), out64, K.pow64)
+        self._out[idx] = out64
+        for X, X64 in ((A, A64), (D, D64), (S, S64)):
+            if X.shape[0]:
+                X[idx] = X64
+        if keep_lobe:
+            base[:, idx] = b64
+            ws[:, idx] = w64
+        self.stats["fixup_vertices"] += m
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """A read-only view (the engine keeps the writable base private, so kernels get one
+    array type and compile once)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v

@@ -1,0 +1,543 @@
+"""Compiled shading kernels (numba): blocked, fused, one code for float32 and float64.
+
+Vertices are processed in blocks of :data:`BLOCK`. Each block is converted once to the
+normalised frame (:mod:`explorer.frame`) in float64 and then to the working precision ``T``
+(the dtype of ``params``: float32 for the fast path, float64 for the exact path), stored as
+structure-of-arrays scratch rows that stay in cache. Every light then runs a few short stage loops
+over the block (direction, weight, diffuse, lobe), each a branch-free loop the compiler turns into
+SIMD code; decisions the plan makes per light are taken once per block, outside those loops.
+
+The light sums (ambient, diffuse, specular; see :func:`explorer.reference.reference_terms`) are
+stored when asked, so a material change only recomposes (:func:`compose`), and each light's
+specular base and weight can be stored so a shininess change only re-runs the lobe
+(:func:`lobe`).
+
+float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
+:data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
+in float64.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic
+
+from . import tolerances as tol
+
+BLOCK = 256
+_FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
+_OPTS = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True)
+
+# per-light flag bits (int32)
+POSITIONAL = 1
+ATTEN = 2
+SPOT = 4
+SPOT_EXP = 8
+AMBIENT = 16  # per-vertex (attenuated) ambient
+DIFFUSE = 32
+SPECULAR = 64
+CONST_H = 128  # Blinn with a directional light and an infinite viewer
+
+# per-light parameter columns
+P_POS = 0  # position, or direction toward a directional light (3)
+P_AXIS = 3  # spot axis (3)
+P_ATT = 6  # kc, kl·scale, kq·scale² (3)
+P_COS = 9  # cos(cutoff)
+P_EXP = 10  # spot exponent
+P_AMB = 11  # ambient colour × constant factor (3)
+P_DIF = 14  # diffuse colour × constant factor (3)
+P_SPEC = 17  # specular colour × constant factor (3)
+P_H = 20  # constant halfway vector (3)
+N_PARAMS = 23
+
+# option slots (int64 array)
+O_LOCAL, O_TWO_SIDED, O_PHONG, O_FLAT = 0, 1, 2, 3
+O_DO_AMB, O_DO_DIF, O_DO_SPEC = 4, 5, 6  # recompute these sums in this pass
+O_STORE, O_STORE_LOBE, O_COMPOSE, O_CLAMP, O_TRACK = 7, 8, 9, 10, 11
+N_OPTS = 12
+
+# scratch rows
+(R_PX, R_PY, R_PZ, R_NX, R_NY, R_NZ, R_VX, R_VY, R_VZ, R_AX, R_AY, R_AZ, R_DX, R_DY, R_DZ,
+ R_SX, R_SY, R_SZ) = range(18)
+N_ROWS = 18
+
+
+# constants passed in the working precision (a float literal would promote float32 to float64)
+(K_ZERO, K_ONE, K_TWO, K_POINT_EPS, K_HALF_EPS2, K_ATT_FLOOR, K_AMB_DOT, K_AMB_LEN2,
+ K_AMB_DIST, K_INF, K_NORMAL_EPS2) = range(11)
+N_CONSTS = 11
+
+
+def constants(dtype) -> np.ndarray:
+    """The kernel's constants (see :mod:`explorer.tolerances`) in ``dtype``."""
+    return np.array(
+        [0.0, 1.0, 2.0, tol.POINT_EPS, tol.HALFWAY_EPS2, tol.ATTENUATION_FLOOR,
+         tol.AMBIGUOUS_DOT, tol.AMBIGUOUS_LEN2, tol.AMBIGUOUS_DIST, np.inf, tol.NORMAL_EPS**2],
+        dtype=dtype,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
+# log2 x from the exponent bits plus ln(1 + z) on z in [-0.29, 0.41] (Cephes logf polynomial);
+# 2**t = 2**k · 2**f with f in [-0.5, 0.5] (Cephes exp2f polynomial) and 2**k written as exponent
+# bits. Measured absolute error <= 1e-7 for y in [1e-6, 1e4] (tests/test_kernels.py). Results
+# below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per element, which
+# does not vectorise (~15x slower here); this one inlines into the shading loop.
+
+
+@intrinsic
+def f2i(typingctx, x):
+    """The bits of a float32 as int32 (no memory round trip)."""
+    if x != types.float32:
+        return None
+    def codegen(context, builder, sig, args):
+        return builder.bitcast(args[0], ir.IntType(32))
+    return types.int32(types.float32), codegen
+@intrinsic
+def i2f(typingctx, x):
+    """An integer's low 32 bits read as a float32."""
+    if not isinstance(x, types.Integer):
+        return None
+    def codegen(context, builder, sig, args):
+        v = args[0]
+        if v.type.width > 32:
+            v = builder.trunc(v, ir.IntType(32))
+        return builder.bitcast(v, ir.FloatType())
+    return types.float32(x), codegen
+FM = {'nsz','arcp','contract','afn','reassoc'}
+O=dict(fastmath=FM, error_model='numpy', boundscheck=False)
+@nb.njit(**_OPTS)
+def pow32(x, y):
+    """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
+    b = f2i(x)
+    e = np.float32(((b >> 23) & 0xFF) - 127)
+    f = i2f((b & 0x007FFFFF) | 0x3F800000)
+    big = f > np.float32(1.4142135)
+    f = f * np.float32(0.5) if big else f
+    e = e + np.float32(1.0) if big else e
+    z = f - np.float32(1.0)
+    p = np.float32(7.0376836292e-2)
+    p = p * z + np.float32(-1.1514610310e-1)
+    p = p * z + np.float32(1.1676998740e-1)
+    p = p * z + np.float32(-1.2420140846e-1)
+    p = p * z + np.float32(1.4249322787e-1)
+    p = p * z + np.float32(-1.6668057665e-1)
+    p = p * z + np.float32(2.0000714765e-1)
+    p = p * z + np.float32(-2.4999993993e-1)
+    p = p * z + np.float32(3.3333331174e-1)
+    ln = z + z * z * (z * p - np.float32(0.5))
+    t = y * (e + ln * np.float32(1.4426950408889634))
+    t = t if x > np.float32(0.0) else np.float32(-200.0)
+    t = max(t, np.float32(-127.0))
+    k = np.floor(t + np.float32(0.5))
+    fr = t - k
+    q = np.float32(1.535336188319500e-4)
+    q = q * fr + np.float32(1.339887440266574e-3)
+    q = q * fr + np.float32(9.618437357674640e-3)
+    q = q * fr + np.float32(5.550332471162809e-2)
+    q = q * fr + np.float32(2.402264791363012e-1)
+    q = q * fr + np.float32(6.931472028550421e-1)
+    q = q * fr + np.float32(1.0)
+    return q * i2f((np.int32(k) + np.int32(127)) << 23)
+
+
+@nb.njit(**_OPTS)
+def pow64(x, y):
+    """x**y by libm (the exact path)."""
+    return x ** y
+
+
+@nb.njit(**_OPTS)
+def _fill(a, v):
+    for i in range(a.shape[0]):
+        a[i] = v
+
+
+@nb.njit(**_OPTS)
+def _load_positions(P, centre, inv_scale, px, py, pz):
+    """Positions into the normalised frame: subtract in float64, then round to T."""
+    for i in range(P.shape[0]):
+        px[i] = (np.float64(P[i, 0]) - centre[0]) * inv_scale
+        py[i] = (np.float64(P[i, 1]) - centre[1]) * inv_scale
+        pz[i] = (np.float64(P[i, 2]) - centre[2]) * inv_scale
+
+
+@nb.njit(**_OPTS)
+def _load_normals(N, nx, ny, nz, k):
+    """Unit normals in T; zero where |N|² <= NORMAL_EPS² (no diffuse, no specular there)."""
+    zero, one, eps2 = k[K_ZERO], k[K_ONE], k[K_NORMAL_EPS2]
+    for i in range(N.shape[0]):
+        a = N[i, 0] * one
+        b = N[i, 1] * one
+        c = N[i, 2] * one
+        nn = a * a + b * b + c * c
+        ok = nn > eps2
+        inv = one / np.sqrt(nn if ok else one)
+        nx[i] = a * inv if ok else zero
+        ny[i] = b * inv if ok else zero
+        nz[i] = c * inv if ok else zero
+
+
+@nb.njit(**_OPTS)
+def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
+    """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
+    one, eps = k[K_ONE], k[K_POINT_EPS]
+    for i in range(px.shape[0]):
+        x = ex - px[i]
+        y = ey - py[i]
+        z = ez - pz[i]
+        dd = np.sqrt(x * x + y * y + z * z)
+        at = dd < eps
+        inv = one / (one if at else dd)
+        a, b, c = nx[i], ny[i], nz[i]
+        vx[i] = a if at else x * inv
+        vy[i] = b if at else y * inv
+        vz[i] = c if at else z * inv
+
+
+@nb.njit(**_OPTS)
+def _two_sided(nx, ny, nz, vx, vy, vz, trk, track, k):
+    """N -> -N where N·V < 0 (the vertex shows its back face)."""
+    zero, amb = k[K_ZERO], k[K_AMB_DOT]
+    for i in range(nx.shape[0]):
+        ndv = nx[i] * vx[i] + ny[i] * vy[i] + nz[i] * vz[i]
+        s = ndv < zero
+        nx[i] = -nx[i] if s else nx[i]
+        ny[i] = -ny[i] if s else ny[i]
+        nz[i] = -nz[i] if s else nz[i]
+        if track:
+            trk[i] |= abs(ndv) < amb
+
+
+@nb.njit(**_OPTS)
+def _light(px, py, pz, nx, ny, nz, vx, vy, vz, q, fl, l_amb, l_dif, l_spec, flat, phong,
+           shininess, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, base_out, ws_out, store_lobe,
+           trk, track, k, powf):
+    """One light over one block: every term the plan asks for, in one fused loop.
+
+    Flags are loop-invariant, so the compiler hoists the tests out of the loop; the loop body
+    is branch-free arithmetic and selects, and becomes SIMD code.
+    """
+    zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
+    eps, h_eps2, floor = k[K_POINT_EPS], k[K_HALF_EPS2], k[K_ATT_FLOOR]
+    amb_dot, amb_len2, amb_dist = k[K_AMB_DOT], k[K_AMB_LEN2], k[K_AMB_DIST]
+    positional = (fl & POSITIONAL) != 0
+    atten = (fl & ATTEN) != 0
+    spot = (fl & SPOT) != 0
+    spot_exp = (fl & SPOT_EXP) != 0
+    const_h = (fl & CONST_H) != 0
+    lobe_on = l_spec and not flat
+    blinn_v = lobe_on and not const_h and not phong
+    phong_v = lobe_on and phong
+    qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+    ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
+    kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
+    cosc, sexp = q[P_COS], q[P_EXP]
+    ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
+    dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
+    sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
+    hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
+    for i in range(px.shape[0]):
+        a, b, c = nx[i], ny[i], nz[i]
+        xs = zero
+        # L toward the light (positional: per vertex; at the vertex: L = N)
+        if positional:
+            x = qx - px[i]
+            y = qy - py[i]
+            z = qz - pz[i]
+            d = np.sqrt(x * x + y * y + z * z)
+            at = d < eps
+            inv = one / (one if at else d)
+            lx = a if at else x * inv
+            ly = b if at else y * inv
+            lz = c if at else z * inv
+        else:
+            d = one
+            lx, ly, lz = qx, qy, qz
+        w = one
+        if atten:  # 1 / (kc + kl·d + kq·d²), floored
+            w = one / max(kc + (kl + kq * d) * d, floor)
+        if spot:  # cone test, then x^exponent
+            xs = -(lx * ax + ly * ay + lz * az)
+            inside = xs >= cosc
+            if spot_exp:
+                w = w * powf(max(xs, zero), sexp) if inside else zero
+            else:
+                w = w if inside else zero
+        ndl = a * lx + b * ly + c * lz
+        if l_amb:  # w·a_i
+            Ax[i] += w * ar
+            Ay[i] += w * ag
+            Az[i] += w * ab
+        if l_dif:  # w·max(N·L, 0)·d_i
+            t = w * max(ndl, zero)
+            Dx[i] += t * dr
+            Dy[i] += t * dg
+            Dz[i] += t * db
+        if l_spec:  # w·f·base^n·s_i, f = [N·L > 0]
+            ws = w if ndl > zero else zero
+            lob = one  # flat lobe: 0**0 = 1
+            base = zero
+            h2 = one
+            if lobe_on:
+                if const_h:  # Blinn, constant H
+                    base = a * hx + b * hy + c * hz
+                elif phong_v:  # Phong: R·V, R = 2(N·L)N - L
+                    ndv = a * vx[i] + b * vy[i] + c * vz[i]
+                    ldv = lx * vx[i] + ly * vy[i] + lz * vz[i]
+                    base = two * ndl * ndv - ldv
+                elif blinn_v:  # Blinn: N·normalize(L + V); 0 where L = -V
+                    ux = lx + vx[i]
+                    uy = ly + vy[i]
+                    uz = lz + vz[i]
+                    h2 = ux * ux + uy * uy + uz * uz
+                    ok = h2 > h_eps2
+                    hn = one / np.sqrt(h2 if ok else one)
+                    base = (a * ux + b * uy + c * uz) * hn if ok else zero
+                if track:
+                    trk[i] |= (abs(base) < amb_dot) | (h2 < amb_len2)
+                base = max(base, zero)
+                lob = powf(base, shininess)
+                if store_lobe:
+                    base_out[i] = base
+            if store_lobe:
+                ws_out[i] = ws
+            t = ws * lob
+            Sx[i] += t * sr
+            Sy[i] += t * sg
+            Sz[i] += t * sb
+            if track:
+                trk[i] |= abs(ndl) < amb_dot
+        if track:
+            if positional:
+                trk[i] |= d < amb_dist
+            if spot:
+                trk[i] |= abs(xs - cosc) < amb_dot
+
+
+@nb.njit(**_OPTS)
+def _load_rows(src, rx, ry, rz, zero):
+    """Rows from a cached (m, 3) block, or zeros when the cache is empty."""
+    if src.shape[0] == 0:
+        _fill(rx, zero)
+        _fill(ry, zero)
+        _fill(rz, zero)
+    else:
+        for i in range(rx.shape[0]):
+            rx[i] = src[i, 0]
+            ry[i] = src[i, 1]
+            rz[i] = src[i, 2]
+
+
+@nb.njit(**_OPTS)
+def _store_rows(dst, rx, ry, rz):
+    for i in range(dst.shape[0]):
+        dst[i, 0] = rx[i]
+        dst[i, 1] = ry[i]
+        dst[i, 2] = rz[i]
+
+
+@nb.njit(**_OPTS)
+def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k):
+    """colour = e_m + a_m·(ambient) + d_m·diffuse + s_m·specular, clamped to [0, 1]."""
+    lo = k[K_ZERO]
+    hi = k[K_ONE] if clamp else k[K_INF]
+    e0 = mat[0] + mat[3] * aconst[0]
+    e1 = mat[1] + mat[4] * aconst[1]
+    e2 = mat[2] + mat[5] * aconst[2]
+    a0, a1, a2, d0, d1, d2, s0, s1, s2 = (mat[3], mat[4], mat[5], mat[6], mat[7], mat[8],
+                                          mat[9], mat[10], mat[11])
+    for i in range(out.shape[0]):
+        r = e0 + a0 * Ax[i] + d0 * Dx[i] + s0 * Sx[i]  # e + a_m·(a_const + A) + d_m·D + s_m·S
+        g = e1 + a1 * Ay[i] + d1 * Dy[i] + s1 * Sy[i]
+        b = e2 + a2 * Az[i] + d2 * Dz[i] + s2 * Sz[i]
+        out[i, 0] = min(max(r, lo), hi)
+        out[i, 1] = min(max(g, lo), hi)
+        out[i, 2] = min(max(b, lo), hi)
+
+
+@nb.njit(**_OPTS)
+def _block(P, N, centre, inv_scale, params, flags, view, opts, mat, aconst, shininess, k,
+           A, D, S, base_out, ws_out, trk, out, scr, powf):
+    """One block; every array argument is already sliced to the block's vertices."""
+    m = P.shape[0]
+    zero = k[K_ZERO]
+    px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
+    nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
+    vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
+    Ax, Ay, Az = scr[R_AX, :m], scr[R_AY, :m], scr[R_AZ, :m]
+    Dx, Dy, Dz = scr[R_DX, :m], scr[R_DY, :m], scr[R_DZ, :m]
+    Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
+    two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
+    do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
+    track = opts[O_TRACK] != 0
+    store_lobe = opts[O_STORE_LOBE] != 0
+
+    _load_positions(P, centre, inv_scale, px, py, pz)
+    _load_normals(N, nx, ny, nz, k)
+    if two_sided or (do_spec and not flat):  # V toward the viewer
+        if opts[O_LOCAL]:
+            _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
+        else:
+            _fill(vx, view[0])
+            _fill(vy, view[1])
+            _fill(vz, view[2])
+    if two_sided:
+        _two_sided(nx, ny, nz, vx, vy, vz, trk, track, k)
+
+    # the sums: recomputed ones start at 0, the others come from the caches
+    if do_amb:
+        _load_rows(A[:0], Ax, Ay, Az, zero)
+    else:
+        _load_rows(A, Ax, Ay, Az, zero)
+    if do_dif:
+        _load_rows(D[:0], Dx, Dy, Dz, zero)
+    else:
+        _load_rows(D, Dx, Dy, Dz, zero)
+    if do_spec:
+        _load_rows(S[:0], Sx, Sy, Sz, zero)
+    else:
+        _load_rows(S, Sx, Sy, Sz, zero)
+
+    for li in range(params.shape[0]):
+        fl = flags[li]
+        l_amb = do_amb and (fl & AMBIENT) != 0
+        l_dif = do_dif and (fl & DIFFUSE) != 0
+        l_spec = do_spec and (fl & SPECULAR) != 0
+        if l_amb or l_dif or l_spec:
+            _light(px, py, pz, nx, ny, nz, vx, vy, vz, params[li, :], fl, l_amb, l_dif, l_spec,
+                   flat, phong, shininess, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz,
+                   base_out[li, :], ws_out[li, :], store_lobe, trk, track, k, powf)
+
+    if opts[O_STORE]:
+        if do_amb and A.shape[0] > 0:
+            _store_rows(A, Ax, Ay, Az)
+        if do_dif and D.shape[0] > 0:
+            _store_rows(D, Dx, Dy, Dz)
+        if do_spec and S.shape[0] > 0:
+            _store_rows(S, Sx, Sy, Sz)
+    if opts[O_COMPOSE]:
+        _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz,
+                      opts[O_CLAMP] != 0, k)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def shade(P, N, centre, inv_scale, params, flags, view, opts, mat, aconst, shininess, k,
+          A, D, S, base_out, ws_out, amb, out, powf):
+    """Shade every vertex (see the module docstring).
+
+    P, N : (n, 3) float32/float64 positions and normals (world space)
+    centre : (3,) float64, inv_scale : float  the normalised frame
+    params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
+    opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
+    shininess : T; k : constants(T); powf : pow32 (float32) or pow64 (float64)
+    A, D, S : (n, 3) T caches (or (0, 3)); base_out, ws_out : (L, n) T (or (L, 0))
+    amb : (n,) bool ambiguity marks (or (0,) when not tracking); out : (n, 3) colours
+    """
+    n = P.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    for b in nb.prange(nblocks):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        scr = np.empty((N_ROWS, BLOCK), params.dtype)
+        _block(P[s:e], N[s:e], centre, inv_scale, params, flags, view, opts, mat, aconst,
+               shininess, k, A[s:e], D[s:e], S[s:e], base_out[:, s:e], ws_out[:, s:e],
+               amb[s:e], out[s:e], scr, powf)
+
+
+@nb.njit(**_OPTS)
+def _lobe_rows(base, ws, y, flat, cr, cg, cb, Sx, Sy, Sz, powf):
+    for i in range(ws.shape[0]):
+        t = ws[i] if flat else ws[i] * powf(base[i], y)
+        Sx[i] += t * cr
+        Sy[i] += t * cg
+        Sz[i] += t * cb
+
+
+@nb.njit(parallel=True, **_OPTS)
+def lobe(base, ws, params, flags, shininess, k, S, powf):
+    """S = Σ_l ws_l·base_l^n·s_l from stored per-light bases (a shininess change).
+
+    base, ws : (L, n) T (base unused when shininess is 0); params : (L, N_PARAMS) T;
+    flags : (L,) int32; S : (n, 3) T out
+    """
+    n = S.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    flat = shininess == k[K_ZERO]
+    for b in nb.prange(nblocks):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        m = e - s
+        scr = np.zeros((3, BLOCK), params.dtype)
+        Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
+        for li in range(params.shape[0]):
+            if flags[li] & SPECULAR:
+                _lobe_rows(base[li, s:e], ws[li, s:e], shininess, flat, params[li, P_SPEC],
+                           params[li, P_SPEC + 1], params[li, P_SPEC + 2], Sx, Sy, Sz, powf)
+        _store_rows(S[s:e], Sx, Sy, Sz)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def compose(mat, aconst, A, D, S, clamp, k, out):
+    """Colours from cached sums: out = e + a_m·(aconst + A) + d_m·D + s_m·S, clamped.
+
+    A, D, S : (n, 3) T or (0, 3) for "all zero"; out : (n, 3)
+    """
+    n = out.shape[0]
+    hasA, hasD, hasS = A.shape[0] > 0, D.shape[0] > 0, S.shape[0] > 0
+    lo = k[K_ZERO]
+    hi = k[K_ONE] if clamp else k[K_INF]
+    a0 = mat[0] + mat[3] * aconst[0]
+    a1 = mat[1] + mat[4] * aconst[1]
+    a2 = mat[2] + mat[5] * aconst[2]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    for b in nb.prange(nblocks):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        o = out[s:e]
+        for i in range(e - s):
+            o[i, 0] = a0
+            o[i, 1] = a1
+            o[i, 2] = a2
+        if hasA:
+            _madd(o, A[s:e], mat[3], mat[4], mat[5])
+        if hasD:
+            _madd(o, D[s:e], mat[6], mat[7], mat[8])
+        if hasS:
+            _madd(o, S[s:e], mat[9], mat[10], mat[11])
+        for i in range(e - s):
+            o[i, 0] = min(max(o[i, 0], lo), hi)
+            o[i, 1] = min(max(o[i, 1], lo), hi)
+            o[i, 2] = min(max(o[i, 2], lo), hi)
+
+
+@nb.njit(**_OPTS)
+def _madd(o, X, c0, c1, c2):
+    for i in range(o.shape[0]):
+        o[i, 0] += c0 * X[i, 0]
+        o[i, 1] += c1 * X[i, 1]
+        o[i, 2] += c2 * X[i, 2]
+
+
+@nb.njit(parallel=True, **_OPTS)
+def stream(P, N, out):
+    """The memory-bandwidth floor of a recolour: read positions and normals once, write
+    colours once (out = P + N). Used only by the benchmark, as the yardstick."""
+    n = out.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    for b in nb.prange(nblocks):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        _add(P[s:e], N[s:e], out[s:e])
+
+
+@nb.njit(**_OPTS)
+def _add(p, q, o):
+    for i in range(o.shape[0]):
+        o[i, 0] = p[i, 0] + q[i, 0]
+        o[i, 1] = p[i, 1] + q[i, 1]
+        o[i, 2] = p[i, 2] + q[i, 2]

@@ -1,0 +1,58 @@
+"""Every epsilon and tolerance the project uses, in one place, each with its reason.
+
+Engine epsilons are applied to *normalised* coordinates: before shading, the engine moves the
+scene so the mesh's bounding-box centre is the origin and divides by its largest half-extent
+(see :func:`explorer.frame.frame_of`), so "small" below means small relative to the mesh.
+"""
+
+from __future__ import annotations
+
+# --- engine policies (float64 and float32 paths alike) -------------------------------------
+
+#: A normal shorter than this is treated as absent: the vertex gets emission and ambient only
+#: (no diffuse, no specular). Unit-length normals are 1; mesh writers emit 0 for "unknown".
+NORMAL_EPS = 1e-12
+
+#: A light (or the eye) closer to a vertex than this (in normalised units) is "at" the vertex:
+#: the direction to it is undefined, so the engine uses the vertex normal (fully facing).
+#: The distance used for attenuation is still the true distance.
+POINT_EPS = 1e-12
+
+#: Blinn's halfway vector H = normalize(L + V) is undefined when L = -V. Below this squared
+#: length of L + V the engine takes N·H = 0 (no highlight; with shininess 0, 0**0 = 1 applies).
+HALFWAY_EPS2 = 1e-24
+
+#: Floor of the attenuation denominator kc + kl·d + kq·d². All-zero attenuation is rejected when
+#: a scene is loaded; with kc = 0 a light exactly at a vertex would divide by zero, so the
+#: attenuation factor is capped at 1 / ATTENUATION_FLOOR (and colours stay finite).
+ATTENUATION_FLOOR = 1e-6
+
+# --- float32 fast path ----------------------------------------------------------------------
+
+#: A float32 dot product of unit vectors is within about 1e-6 of the float64 one after the
+#: engine's recentring (a few ulps of 2**-24 per term, plus the normalisations). A vertex where
+#: a decision flips on the sign of such a dot (N·L > 0 for the specular step, N·V < 0 for
+#: two-sided, the spot cone test x >= cos(cutoff), the clamp of N·H or R·V at 0 that decides
+#: 0**n) lies within AMBIGUOUS_DOT of the threshold is recomputed in float64, so float32 never
+#: switches a highlight or a cone edge on or off where float64 does not. 10x margin over the
+#: error bound; such vertices are a measure-zero set in practice.
+AMBIGUOUS_DOT = 1e-5
+
+#: Likewise for |L + V|² near HALFWAY_EPS2 and distances near POINT_EPS (in normalised units).
+AMBIGUOUS_LEN2 = 1e-9
+
+#: A light or eye within this distance (normalised units) of a vertex is redone in float64:
+#: float32 positions are accurate to ~1e-7 there, so "at the vertex" is decided in float64.
+AMBIGUOUS_DIST = 1e-5
+
+#: The fast path must stay within this of the float64 path everywhere (one 8-bit level).
+FLOAT32_MAX_ABS_ERROR = 1.0 / 255.0
+
+# --- tests ----------------------------------------------------------------------------------
+
+#: Engine (float64) against the independent OpenGL 2.1 oracle in the tests.
+ORACLE_ABS_TOL = 1e-5
+#: Planned result against the full-generality reference (both float64).
+PLAN_ABS_TOL = 1e-9
+#: Colours after rotating/translating the whole scene (float64; the rotation itself rounds).
+INVARIANCE_ABS_TOL = 1e-6
