@@ -173,20 +173,18 @@ def _read_bytes(name: str, what: str) -> bytes:
 
 
 def _decode(raw: bytes, file: str | None) -> str:
-    if raw.startswith(b"\xef\xbb\xbf"):
-        raw = raw[3:]
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8-sig")  # a leading byte-order mark is dropped
     except UnicodeDecodeError as exc:
-        line = raw.count(b"\n", 0, exc.start) + 1
+        start = exc.start + (3 if raw.startswith(b"\xef\xbb\xbf") else 0)
+        line = raw.count(b"\n", 0, start) + 1
         hint = ""
         if raw[:2] in (b"\xff\xfe", b"\xfe\xff"):
             hint = " (it looks like UTF-16: save it as UTF-8)"
         _fail(
             file,
             line,
-            f"is not UTF-8 text: invalid byte 0x{raw[exc.start]:02x} at byte offset "
-            f"{exc.start}{hint}",
+            f"is not UTF-8 text: invalid byte 0x{raw[start]:02x} at byte offset {start}{hint}",
         )
 
 
