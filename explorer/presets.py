@@ -124,14 +124,15 @@ def check_name(name) -> str:
 
 # -- reading ---------------------------------------------------------------------------------
 def load_material_file(path) -> Material:
-    """Load one material file (either form); every problem is reported in one
-    :class:`~explorer.errors.ValidationError`. The material's name is the file stem."""
-    doc = load_yaml(path, what="material file")
+    """Load one material file (either form). Every problem in it, from YAML duplicate keys to
+    out-of-range values, is reported in one :class:`~explorer.errors.ValidationError`, in
+    line order. The material's name is the file stem."""
+    doc = load_yaml(path, what="material file", collect=True)
     checker = doc.checker()
-    if checker.mapping(doc.data, (), "a mapping of material keys") is None:
-        checker.raise_if_any()
-    material = parse_material(doc.data, checker, ())
-    checker.raise_if_any()
+    if checker.mapping(doc.data, (), "a mapping of material keys") is not None:
+        material = parse_material(doc.data, checker, ())
+    if checker.problems:
+        raise ValidationError(sorted(checker.problems, key=lambda p: p.line or 0))
     return material.replace(name=Path(os.fspath(path)).stem)
 
 

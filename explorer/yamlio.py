@@ -66,11 +66,14 @@ class YamlDocument:
     data : plain Python values (dict / list / str / int / float / bool / None)
     lines : key path tuple -> 1-based line number (``()`` -> first line of the document)
     file : the path it was read from (as given), or None for in-memory text
+    problems : with ``collect=True`` only, the problems that did not stop parsing (duplicate
+        keys, keys that are not text, refused tags); empty otherwise
     """
 
     data: object
     lines: dict = field(default_factory=dict)
     file: str | None = None
+    problems: tuple = ()
 
     def line(self, path: tuple) -> int | None:
         """Line of ``path`` or of its nearest enclosing key."""
@@ -83,22 +86,36 @@ class YamlDocument:
             path = path[:-1]
 
     def checker(self):
-        """A :class:`~explorer.validate.Checker` reporting against this document's lines."""
+        """A :class:`~explorer.validate.Checker` reporting against this document's lines,
+        already holding :attr:`problems` (so one ``raise_if_any()`` reports everything)."""
         from .validate import Checker
 
-        return Checker(self.file, self.lines)
+        checker = Checker(self.file, self.lines)
+        checker.problems.extend(self.problems)
+        return checker
 
 
 # -- reading ---------------------------------------------------------------------------------
-def load_yaml(path, *, what: str = "file") -> YamlDocument:
-    """Read and parse the YAML file at ``path``; ``what`` names it in messages ("scene")."""
+def load_yaml(path, *, what: str = "file", collect: bool = False) -> YamlDocument:
+    """Read and parse the YAML file at ``path``; ``what`` names it in messages ("scene").
+
+    collect : False raises every problem at once. True raises only for problems that leave no
+        document (unreadable, not UTF-8, too large, empty, syntax errors, aliases, too deep)
+        and returns the rest in ``doc.problems``, so that a validator can add its own and
+        report everything in one pass (``checker = doc.checker()``). The data then holds the
+        first value of a duplicated key, and leaves out keys that are not text or whose value
+        was refused.
+    """
     name = os.fspath(path)
     data = _read_bytes(name, what)
-    return parse_yaml(data, file=name)
+    return parse_yaml(data, file=name, collect=collect)
 
 
-def parse_yaml(text: str | bytes, *, file: str | None = None) -> YamlDocument:
-    """Parse YAML from a string (or UTF-8 bytes); ``file`` is only used in messages."""
+def parse_yaml(
+    text: str | bytes, *, file: str | None = None, collect: bool = False
+) -> YamlDocument:
+    """Parse YAML from a string (or UTF-8 bytes); ``file`` is only used in messages.
+    ``collect``: see :func:`load_yaml`."""
     file = None if file is None else os.fspath(file)
     if isinstance(text, (bytes, bytearray, memoryview)):
         raw = bytes(text)
@@ -147,9 +164,9 @@ def parse_yaml(text: str | bytes, *, file: str | None = None) -> YamlDocument:
         builder.problems.append(
             Problem("is empty: the document holds only null", file, node.start_mark.line + 1)
         )
-    if builder.problems:
+    if builder.problems and (not collect or data is None):
         raise ValidationError(builder.problems)
-    return YamlDocument(data, builder.lines, file)
+    return YamlDocument(data, builder.lines, file, tuple(builder.problems))
 
 
 def _read_bytes(name: str, what: str) -> bytes:
@@ -319,7 +336,9 @@ class _Builder:
                 continue
             first[key] = line
             self.lines[path + (key,)] = line
-            out[key] = self.build(value_node, path + (key,))
+            value = self._build(value_node, path + (key,))
+            if value is not _BAD:
+                out[key] = value
         return out
 
     def _key(self, node, path):
