@@ -27,7 +27,8 @@ Scalars of an RGB material (:meth:`Material.scalars`, :meth:`Material.with_scala
 the ka / kd / ks sliders): the scalar of a term is its largest channel, ``k = max(r, g, b)``,
 and its hue is the term divided by ``k`` (largest channel exactly 1). Setting a scalar keeps
 the hue: ``term' = hue * k'``, so ``with_scalars(kd=k).scalars()[1] == k`` exactly and setting
-the old value back restores the term to within rounding (a couple of ulps). A black term has no
+the old value back restores the term to within rounding (a couple of ulps, unless a channel
+times the scalar underflows to a subnormal number). A black term has no
 hue of its own: ambient and diffuse then borrow the hue of the other one of the two (white if
 both are black), specular uses white.
 """
