@@ -394,3 +394,29 @@ def test_fuzz_mutations_of_a_valid_document(edits):
         pos = min(pos, len(text))
         text = text[:pos] + insert + text[pos + cut :]
     _parse_or_validation_error(text)
+
+
+# -- collect mode (one pass with a validator) ------------------------------------------------
+def test_collect_returns_non_fatal_problems_with_the_data():
+    doc = parse_yaml("a: 1\na: 2\nb: !!binary aGk=\n3: x\nc: [1, !foo 2]\n", collect=True)
+    assert doc.data == {"a": 1, "c": [1, None]}  # first value kept, refused entries left out
+    assert [p.line for p in doc.problems] == [2, 3, 4, 5]
+    checker = doc.checker()
+    checker.problem(("a",), "a validator's own problem")
+    assert len(checker.problems) == 5
+    with pytest.raises(ValidationError) as info:
+        checker.raise_if_any()
+    assert "duplicate key 'a'" in str(info.value) and "validator's own" in str(info.value)
+
+
+def test_collect_still_raises_when_there_is_no_document():
+    for text in ("", "a: [1,\n", "a: &x 1\nb: *x\n", "!!binary aGk="):
+        with pytest.raises(ValidationError):
+            parse_yaml(text, collect=True)
+
+
+def test_clean_document_has_no_problems(tmp_path):
+    path = tmp_path / "s.yaml"
+    path.write_text(SCENE)
+    assert load_yaml(path, collect=True).problems == ()
+    assert load_yaml(path).problems == ()
