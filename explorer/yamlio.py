@@ -22,7 +22,8 @@ all problems of one document in one pass; YAML syntax errors stop at the first o
 * every tag except the plain YAML ones (``!!str``, ``!!int``, ``!!float``, ``!!bool``,
   ``!!null``, ``!!seq``, ``!!map``; so no ``!!python/...``, ``!!binary``, ``!!set``, custom
   ``!tags``); dates and times (``2024-05-01``) are kept as the text written;
-* nesting deeper than :data:`MAX_DEPTH` and integers longer than :data:`MAX_INT_DIGITS` digits.
+* nesting deeper than :data:`MAX_DEPTH`, integers longer than :data:`MAX_INT_DIGITS` digits or
+  beyond the float range (no number a user writes can overflow a ``float()`` later).
 
 One YAML 1.1 surprise is fixed: ``1e5`` and ``2E-3`` are read as numbers (PyYAML keeps them as
 text unless written ``1.0e+5``), as every YAML 1.2 reader and every person would.
@@ -384,6 +385,12 @@ class _Builder:
             reason = getattr(exc, "problem", None) or str(exc)
             self.problem(path, node, f"cannot read {node.value!r} as {tag[len(_TAG) :]}: {reason}")
             return _BAD
+        if isinstance(value, int) and not isinstance(value, bool):
+            try:
+                float(value)
+            except OverflowError:
+                self.problem(path, node, "number is too large (beyond the float range, ~1.8e308)")
+                return _BAD
         return value
 
 

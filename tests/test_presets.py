@@ -335,6 +335,7 @@ def test_save_refuses_a_material_no_file_could_hold(tmp_path):
         ("kd: -1\n", ":1: kd: must be in [0, 1], got -1"),
         ("", ": is empty"),
         ("- 1\n- 2\n", ":1: must be a mapping of material keys"),
+        ("shininess: 1" + "0" * 350 + "\n", ":1: shininess: number is too large"),
         ("ambient: !!python/tuple [1, 1, 1]\n", ":1: ambient: the tag '!!python/tuple'"),
     ],
 )
@@ -398,6 +399,8 @@ scalars = st.one_of(
     st.none(),
     st.booleans(),
     st.integers(-5, 2000),
+    st.integers(),
+    st.integers(10**300, 10**400),
     st.floats(allow_nan=True, allow_infinity=True),
     st.text(max_size=8),
 )

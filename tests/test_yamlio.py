@@ -211,6 +211,13 @@ def test_too_long_integer():
     assert p.key == "a" and "too long" in p.message
 
 
+@pytest.mark.parametrize("literal", ["9" * 309, "-" + "9" * 350, "0x" + "f" * 300])
+def test_integer_beyond_float_range(literal):
+    p = only_problem(f"a: {literal}\n")
+    assert p.key == "a" and "too large" in p.message
+    assert parse_yaml("a: " + "9" * 300).data["a"] == int("9" * 300)  # still fits a float
+
+
 # -- duplicate and bad keys ------------------------------------------------------------------
 def test_duplicate_key_names_both_lines():
     p = only_problem("shininess: 10\ndiffuse: [1, 1, 1]\nshininess: 20\n")
