@@ -273,12 +273,6 @@ class _Loader(yaml.SafeLoader):
             self._depth -= 1
 
 
-_Loader.add_implicit_resolver(
-    _TAG + "float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
-    list("-+0123456789."),
-)
-
 _BAD = object()  # stands for a value already reported as a problem
 
 
@@ -403,6 +397,13 @@ class _Dumper(yaml.SafeDumper):
         return super().represent_sequence(tag, sequence, flow_style=flat)
 
 
+# YAML 1.1 reads ``1e5`` (no dot, no exponent sign) as text; read it as the number meant, and
+# quote such text when writing so it reads back as text.
+_EXP_FLOAT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$")
+for _cls in (_Loader, _Dumper):
+    _cls.add_implicit_resolver(_TAG + "float", _EXP_FLOAT, list("-+0123456789."))
+
+
 def _plain(value, path="document"):
     """Plain YAML-ready copy of ``value`` (tuples -> lists, numpy scalars -> float/int)."""
     if value is None or isinstance(value, (bool, str)):
@@ -424,9 +425,23 @@ def _plain(value, path="document"):
     raise TypeError(f"{path}: cannot write {type(value).__name__} to YAML")
 
 
+def _has_nel(value) -> bool:
+    if isinstance(value, str):
+        return "\x85" in value
+    if isinstance(value, dict):
+        return any(_has_nel(k) or _has_nel(v) for k, v in value.items())
+    if isinstance(value, list):
+        return any(_has_nel(v) for v in value)
+    return False
+
+
 def dump_yaml(data, *, header: str | None = None) -> str:
     """The YAML text :func:`write_yaml_atomic` writes (``header`` becomes ``#`` comments)."""
-    text = yaml.dump(_plain(data), Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=100)
+    plain = _plain(data)
+    # U+0085 (NEL) would be written raw and read back as a line break: escape all then
+    text = yaml.dump(
+        plain, Dumper=_Dumper, sort_keys=False, allow_unicode=not _has_nel(plain), width=100
+    )
     if header:
         lines = [("# " + ln).rstrip() for ln in header.splitlines()]
         text = "\n".join(lines) + "\n" + text
