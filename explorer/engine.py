@@ -80,7 +80,6 @@ class Shader:
         self._scene = load_scene(scene, materials_dirs=materials_dirs)
         self._plan: Plan = make_plan(self._scene)
         self._k = K.constants(self._T)
-        self._powf = K.pow32 if self._T is np.float32 else K.pow64
         self._k64 = K.constants(np.float64)
         self.set_geometry(positions, normals)
 
@@ -102,6 +101,9 @@ class Shader:
         self._P, self._N = check_vertices(positions, normals)
         self._centre, self._scale = frame_of(self._P)
         n = len(self._P)
+        self._G = np.empty((6, n), self._T)  # frame positions and unit normals, SoA
+        K.prepare(self._P, self._N, self._centre, 1.0 / self._scale, self._k, self._G)
+        self.stats["geometry"] += 1
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._colors = None
@@ -192,7 +194,7 @@ class Shader:
     def _ambient_constant(self) -> np.ndarray:
         """Scene ambient plus the ambient of lights whose weight is constant, (3,) float64."""
         a = np.asarray(self._scene.ambient, dtype=np.float64).copy()
-        for lp, light in zip(self._plan.lights, self._scene.lights):
+        for lp, light in zip(self._plan.lights, self._scene.lights, strict=True):
             if lp.ambient and not lp.varying_weight:
                 a += lp.factor * np.asarray(light.ambient)
         return a
@@ -208,7 +210,7 @@ class Shader:
             view = to_frame(scene.viewer.eye, c, s)
         else:
             view = np.asarray(scene.viewer.direction, dtype=np.float64)
-        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights)):
+        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights, strict=True)):
             f = 0
             q = params[i]
             if isinstance(light, DirectionalLight):
@@ -265,7 +267,7 @@ class Shader:
             params, flags, _ = self._params_for(T)
             S = np.empty((n, 3), T)
             K.lobe(self._base if self._base is not None else self._ws, self._ws, params,
-                   flags, T(shininess), self._k, S, self._powf)
+                   flags, T(shininess), self._k, S)
             self._S = S
             self._spec_shininess = shininess
             self.stats["lobe"] += 1
@@ -330,8 +332,8 @@ class Shader:
         if opts[K.O_TRACK]:
             amb[:] = 0
         shin = T(scene.material.shininess)
-        K.shade(self._P, self._N, self._centre, 1.0 / self._scale, params, flags, view, opts,
-                mat, aconst, shin, self._k, A, D, S, base, ws, amb, self._out, self._powf)
+        K.shade(self._G, params, flags, view, opts, mat, aconst, shin, self._k, A, D, S, base,
+                ws, amb, self._out)
         self.stats["pass"] += 1
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
@@ -369,10 +371,11 @@ class Shader:
         out64 = np.empty((m, 3))
         mat = self._material_vector(f64)
         aconst = self._aconst
-        K.shade(np.ascontiguousarray(self._P[idx]), np.ascontiguousarray(self._N[idx]),
-                self._centre, 1.0 / self._scale, params, flags, view, o, mat, aconst,
-                f64(scene.material.shininess), self._k64, A64, D64, S64, b64, w64,
-                np.zeros(0, np.bool_), out64, K.pow64)
+        G64 = np.empty((6, m))
+        K.prepare(np.ascontiguousarray(self._P[idx]), np.ascontiguousarray(self._N[idx]),
+                  self._centre, 1.0 / self._scale, self._k64, G64)
+        K.shade(G64, params, flags, view, o, mat, aconst, f64(scene.material.shininess),
+                self._k64, A64, D64, S64, b64, w64, np.zeros(0, np.bool_), out64)
         self._out[idx] = out64
         for X, X64 in ((A, A64), (D, D64), (S, S64)):
             if X.shape[0]:

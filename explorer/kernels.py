@@ -23,7 +23,8 @@ import numba as nb
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.extending import intrinsic
+from numba.core.errors import TypingError
+from numba.extending import intrinsic, overload
 
 from . import tolerances as tol
 
@@ -61,8 +62,11 @@ N_OPTS = 12
 
 # scratch rows
 (R_PX, R_PY, R_PZ, R_NX, R_NY, R_NZ, R_VX, R_VY, R_VZ, R_AX, R_AY, R_AZ, R_DX, R_DY, R_DZ,
- R_SX, R_SY, R_SZ) = range(18)
-N_ROWS = 18
+ R_SX, R_SY, R_SZ, R_LX, R_LY, R_LZ, R_D, R_W, R_BASE, R_WS, R_TRK) = range(26)
+N_ROWS = 26
+
+# lobe modes
+LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
 
 
 # constants passed in the working precision (a float literal would promote float32 to float64)
@@ -145,10 +149,16 @@ def pow32(x, y):
     return q * i2f((np.int32(k) + np.int32(127)) << 23)
 
 
-@nb.njit(**_OPTS)
-def pow64(x, y):
-    """x**y by libm (the exact path)."""
-    return x ** y
+def fpow(x, y):
+    """x**y in the working precision: :func:`pow32` for float32, libm for float64."""
+    return x**y
+
+
+@overload(fpow, jit_options=_OPTS)
+def _fpow_overload(x, y):
+    if x == types.float32:
+        return lambda x, y: pow32(x, y)
+    return lambda x, y: x**y
 
 
 @nb.njit(**_OPTS)
@@ -164,6 +174,22 @@ def _load_positions(P, centre, inv_scale, px, py, pz):
         px[i] = (np.float64(P[i, 0]) - centre[0]) * inv_scale
         py[i] = (np.float64(P[i, 1]) - centre[1]) * inv_scale
         pz[i] = (np.float64(P[i, 2]) - centre[2]) * inv_scale
+
+
+@nb.njit(parallel=True, **_OPTS)
+def prepare(P, N, centre, inv_scale, k, G):
+    """Geometry in the normalised frame, structure of arrays, working precision.
+
+    P, N : (n, 3) float32/float64 world positions and normals
+    G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
+    """
+    n = P.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    for b in nb.prange(nblocks):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        _load_positions(P[s:e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
+        _load_normals(N[s:e], G[3, s:e], G[4, s:e], G[5, s:e], k)
 
 
 @nb.njit(**_OPTS)
@@ -200,123 +226,214 @@ def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
 
 
 @nb.njit(**_OPTS)
-def _two_sided(nx, ny, nz, vx, vy, vz, trk, track, k):
+def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
     """N -> -N where N·V < 0 (the vertex shows its back face)."""
-    zero, amb = k[K_ZERO], k[K_AMB_DOT]
+    zero, one, amb = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
     for i in range(nx.shape[0]):
         ndv = nx[i] * vx[i] + ny[i] * vy[i] + nz[i] * vz[i]
         s = ndv < zero
         nx[i] = -nx[i] if s else nx[i]
         ny[i] = -ny[i] if s else ny[i]
         nz[i] = -nz[i] if s else nz[i]
-        if track:
-            trk[i] |= abs(ndv) < amb
+        trk[i] = max(trk[i], one if abs(ndv) < amb else zero)
+
+
+# --------------------------------------------------------------------------------------------
+# One light over one block. The loop is specialised at compile time: `_light` is overloaded on a
+# literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular), so each
+# combination gets a loop that holds exactly the terms the plan asks for and no run-time test:
+# where L comes from (constant, or the rows a positional pre-pass filled), how the lobe's base is
+# found (flat, constant H, Blinn, Phong), and whether the diffuse and specular sums are touched.
+
+
+def _light(r, m, q, y, k, variant):  # pragma: no cover - replaced by the overload below
+    raise NotImplementedError
+
+
+@overload(_light, prefer_literal=True, jit_options=_OPTS)
+def _light_overload(r, m, q, y, k, variant):
+    if not isinstance(variant, types.IntegerLiteral):
+        raise TypingError("_light needs a literal variant")
+    v = variant.literal_value
+    positional = bool(v & 1)
+    mode = (v >> 1) & 3
+    dif = bool(v & 8)
+    spec = bool(v & 16)
+    lobe_on = spec and mode != LOBE_FLAT
+
+    def impl(r, m, q, y, k, variant):
+        # rows as separate 1-D arrays: lets the compiler check overlap once and vectorise
+        nx, ny, nz, vx, vy, vz = r[R_NX], r[R_NY], r[R_NZ], r[R_VX], r[R_VY], r[R_VZ]
+        Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
+        Dx, Dy, Dz, Sx, Sy, Sz = r[R_DX], r[R_DY], r[R_DZ], r[R_SX], r[R_SY], r[R_SZ]
+        B, WS, TRK = r[R_BASE], r[R_WS], r[R_TRK]
+        zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
+        h_eps2, amb_dot, amb_len2 = k[K_HALF_EPS2], k[K_AMB_DOT], k[K_AMB_LEN2]
+        dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
+        sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
+        qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+        hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
+        for i in range(m):
+            a, b, c = nx[i], ny[i], nz[i]
+            if positional:  # L and w = att·spot from the pre-pass rows
+                lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
+            else:  # directional: constant L, never attenuated
+                lx, ly, lz, w = qx, qy, qz, one
+            ndl = a * lx + b * ly + c * lz
+            if dif:  # w·max(N·L, 0)·d_i
+                t = w * max(ndl, zero)
+                Dx[i] += t * dr
+                Dy[i] += t * dg
+                Dz[i] += t * db
+            if spec:
+                ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
+                amb = abs(ndl) < amb_dot
+                lob = one  # flat lobe: 0**0 = 1
+                if lobe_on:
+                    if mode == LOBE_CONST_H:  # Blinn, constant H: N·H
+                        base = a * hx + b * hy + c * hz
+                    elif mode == LOBE_PHONG:  # Phong: R·V, R = 2(N·L)N - L
+                        ex, ey, ez = vx[i], vy[i], vz[i]
+                        ndv = a * ex + b * ey + c * ez
+                        base = two * ndl * ndv - (lx * ex + ly * ey + lz * ez)
+                    else:  # Blinn: N·normalize(L + V); 0 where L = -V
+                        ux = lx + vx[i]
+                        uy = ly + vy[i]
+                        uz = lz + vz[i]
+                        h2 = ux * ux + uy * uy + uz * uz
+                        ok = h2 > h_eps2
+                        hn = one / np.sqrt(h2 if ok else one)
+                        base = (a * ux + b * uy + c * uz) * hn if ok else zero
+                        amb = amb | (h2 < amb_len2)
+                    amb = amb | (abs(base) < amb_dot)
+                    base = max(base, zero)
+                    lob = fpow(base, y)  # base^n
+                    B[i] = base
+                t = ws * lob  # w·f·base^n·s_i
+                Sx[i] += t * sr
+                Sy[i] += t * sg
+                Sz[i] += t * sb
+                WS[i] = ws
+                TRK[i] = max(TRK[i], one if amb else zero)
+
+    return impl
 
 
 @nb.njit(**_OPTS)
-def _light(px, py, pz, nx, ny, nz, vx, vy, vz, q, fl, l_amb, l_dif, l_spec, flat, phong,
-           shininess, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, base_out, ws_out, store_lobe,
-           trk, track, k, powf):
-    """One light over one block: every term the plan asks for, in one fused loop.
-
-    Flags are loop-invariant, so the compiler hoists the tests out of the loop; the loop body
-    is branch-free arithmetic and selects, and becomes SIMD code.
-    """
-    zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
-    eps, h_eps2, floor = k[K_POINT_EPS], k[K_HALF_EPS2], k[K_ATT_FLOOR]
-    amb_dot, amb_len2, amb_dist = k[K_AMB_DOT], k[K_AMB_LEN2], k[K_AMB_DIST]
-    positional = (fl & POSITIONAL) != 0
-    atten = (fl & ATTEN) != 0
-    spot = (fl & SPOT) != 0
-    spot_exp = (fl & SPOT_EXP) != 0
-    const_h = (fl & CONST_H) != 0
-    lobe_on = l_spec and not flat
-    blinn_v = lobe_on and not const_h and not phong
-    phong_v = lobe_on and phong
-    qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
-    ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
-    kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
-    cosc, sexp = q[P_COS], q[P_EXP]
-    ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
-    dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
-    sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
-    hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
-    for i in range(px.shape[0]):
-        a, b, c = nx[i], ny[i], nz[i]
-        xs = zero
-        # L toward the light (positional: per vertex; at the vertex: L = N)
-        if positional:
-            x = qx - px[i]
-            y = qy - py[i]
-            z = qz - pz[i]
-            d = np.sqrt(x * x + y * y + z * z)
-            at = d < eps
-            inv = one / (one if at else d)
-            lx = a if at else x * inv
-            ly = b if at else y * inv
-            lz = c if at else z * inv
-        else:
-            d = one
-            lx, ly, lz = qx, qy, qz
-        w = one
-        if atten:  # 1 / (kc + kl·d + kq·d²), floored
-            w = one / max(kc + (kl + kq * d) * d, floor)
-        if spot:  # cone test, then x^exponent
-            xs = -(lx * ax + ly * ay + lz * az)
-            inside = xs >= cosc
-            if spot_exp:
-                w = w * powf(max(xs, zero), sexp) if inside else zero
+def _light_any(r, m, q, y, k, positional, mode, l_dif, l_spec):
+    """Call the light loop compiled for this combination (each call site passes a literal)."""
+    if not positional:
+        if not l_spec:
+            if l_dif:
+                _light(r, m, q, y, k, 8)
+        elif mode == LOBE_FLAT:
+            if l_dif:
+                _light(r, m, q, y, k, 24)
             else:
-                w = w if inside else zero
-        ndl = a * lx + b * ly + c * lz
-        if l_amb:  # w·a_i
-            Ax[i] += w * ar
-            Ay[i] += w * ag
-            Az[i] += w * ab
-        if l_dif:  # w·max(N·L, 0)·d_i
-            t = w * max(ndl, zero)
-            Dx[i] += t * dr
-            Dy[i] += t * dg
-            Dz[i] += t * db
-        if l_spec:  # w·f·base^n·s_i, f = [N·L > 0]
-            ws = w if ndl > zero else zero
-            lob = one  # flat lobe: 0**0 = 1
-            base = zero
-            h2 = one
-            if lobe_on:
-                if const_h:  # Blinn, constant H
-                    base = a * hx + b * hy + c * hz
-                elif phong_v:  # Phong: R·V, R = 2(N·L)N - L
-                    ndv = a * vx[i] + b * vy[i] + c * vz[i]
-                    ldv = lx * vx[i] + ly * vy[i] + lz * vz[i]
-                    base = two * ndl * ndv - ldv
-                elif blinn_v:  # Blinn: N·normalize(L + V); 0 where L = -V
-                    ux = lx + vx[i]
-                    uy = ly + vy[i]
-                    uz = lz + vz[i]
-                    h2 = ux * ux + uy * uy + uz * uz
-                    ok = h2 > h_eps2
-                    hn = one / np.sqrt(h2 if ok else one)
-                    base = (a * ux + b * uy + c * uz) * hn if ok else zero
-                if track:
-                    trk[i] |= (abs(base) < amb_dot) | (h2 < amb_len2)
-                base = max(base, zero)
-                lob = powf(base, shininess)
-                if store_lobe:
-                    base_out[i] = base
-            if store_lobe:
-                ws_out[i] = ws
-            t = ws * lob
-            Sx[i] += t * sr
-            Sy[i] += t * sg
-            Sz[i] += t * sb
-            if track:
-                trk[i] |= abs(ndl) < amb_dot
-        if track:
-            if positional:
-                trk[i] |= d < amb_dist
-            if spot:
-                trk[i] |= abs(xs - cosc) < amb_dot
+                _light(r, m, q, y, k, 16)
+        elif mode == LOBE_CONST_H:
+            if l_dif:
+                _light(r, m, q, y, k, 26)
+            else:
+                _light(r, m, q, y, k, 18)
+        elif mode == LOBE_BLINN:
+            if l_dif:
+                _light(r, m, q, y, k, 28)
+            else:
+                _light(r, m, q, y, k, 20)
+        elif mode == LOBE_PHONG:
+            if l_dif:
+                _light(r, m, q, y, k, 30)
+            else:
+                _light(r, m, q, y, k, 22)
+    else:
+        if not l_spec:
+            if l_dif:
+                _light(r, m, q, y, k, 9)
+        elif mode == LOBE_FLAT:
+            if l_dif:
+                _light(r, m, q, y, k, 25)
+            else:
+                _light(r, m, q, y, k, 17)
+        elif mode == LOBE_CONST_H:
+            if l_dif:
+                _light(r, m, q, y, k, 27)
+            else:
+                _light(r, m, q, y, k, 19)
+        elif mode == LOBE_BLINN:
+            if l_dif:
+                _light(r, m, q, y, k, 29)
+            else:
+                _light(r, m, q, y, k, 21)
+        elif mode == LOBE_PHONG:
+            if l_dif:
+                _light(r, m, q, y, k, 31)
+            else:
+                _light(r, m, q, y, k, 23)
+
+
+@nb.njit(**_OPTS)
+def _to_light(r, m, q, k):
+    """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex), d, w = 1."""
+    one, eps, amb_dist = k[K_ONE], k[K_POINT_EPS], k[K_AMB_DIST]
+    zero = k[K_ZERO]
+    qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+    px, py, pz, nx, ny, nz = r[R_PX], r[R_PY], r[R_PZ], r[R_NX], r[R_NY], r[R_NZ]
+    Lx, Ly, Lz, D, W, TRK = r[R_LX], r[R_LY], r[R_LZ], r[R_D], r[R_W], r[R_TRK]
+    for i in range(m):
+        x = qx - px[i]
+        y = qy - py[i]
+        z = qz - pz[i]
+        d = np.sqrt(x * x + y * y + z * z)
+        at = d < eps
+        inv = one / (one if at else d)
+        a, b, c = nx[i], ny[i], nz[i]
+        Lx[i] = a if at else x * inv
+        Ly[i] = b if at else y * inv
+        Lz[i] = c if at else z * inv
+        D[i] = d
+        W[i] = one
+        TRK[i] = max(TRK[i], one if d < amb_dist else zero)
+
+
+@nb.njit(**_OPTS)
+def _attenuate(r, m, q, k):
+    """w = 1 / max(kc + kl·d + kq·d², floor) (kl, kq already scaled to the frame)."""
+    one, floor = k[K_ONE], k[K_ATT_FLOOR]
+    kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
+    D, W = r[R_D], r[R_W]
+    for i in range(m):
+        d = D[i]
+        W[i] = one / max(kc + (kl + kq * d) * d, floor)
+
+
+@nb.njit(**_OPTS)
+def _spot(r, m, q, k, exponent):
+    """w *= x**exponent inside the cone (x = (-L)·axis >= cos cutoff), else 0."""
+    zero, one, amb_dot = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
+    ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
+    cosc, e = q[P_COS], q[P_EXP]
+    Lx, Ly, Lz, W, TRK = r[R_LX], r[R_LY], r[R_LZ], r[R_W], r[R_TRK]
+    for i in range(m):
+        x = -(Lx[i] * ax + Ly[i] * ay + Lz[i] * az)
+        if exponent:
+            f = fpow(max(x, zero), e)
+            W[i] = W[i] * f if x >= cosc else zero
+        else:
+            W[i] = W[i] if x >= cosc else zero
+        TRK[i] = max(TRK[i], one if abs(x - cosc) < amb_dot else zero)
+
+
+@nb.njit(**_OPTS)
+def _ambient(r, m, q):
+    """A += w·a_i (an attenuated or cone-cut light ambient)."""
+    ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
+    W, Ax, Ay, Az = r[R_W], r[R_AX], r[R_AY], r[R_AZ]
+    for i in range(m):
+        w = W[i]
+        Ax[i] += w * ar
+        Ay[i] += w * ag
+        Az[i] += w * ab
 
 
 @nb.njit(**_OPTS)
@@ -361,24 +478,34 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 
 
 @nb.njit(**_OPTS)
-def _block(P, N, centre, inv_scale, params, flags, view, opts, mat, aconst, shininess, k,
-           A, D, S, base_out, ws_out, trk, out, scr, powf):
-    """One block; every array argument is already sliced to the block's vertices."""
-    m = P.shape[0]
+def _block(px, py, pz, gx, gy, gz, params, flags, view, opts, mat, aconst, shininess, k,
+           A, D, S, base_out, ws_out, amb, out, scr):
+    """One block; every array argument is already sliced to the block's vertices.
+
+    px, py, pz, gx, gy, gz : (m,) T prepared positions and normals (read only)
+    """
+    m = px.shape[0]
     zero = k[K_ZERO]
-    px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
-    nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
+    two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
+    do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
+    store_lobe = opts[O_STORE_LOBE] != 0
+    if two_sided:  # normals may flip: work on copies
+        nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
+        nx[:] = gx
+        ny[:] = gy
+        nz[:] = gz
+    else:
+        nx, ny, nz = gx, gy, gz
     vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
     Ax, Ay, Az = scr[R_AX, :m], scr[R_AY, :m], scr[R_AZ, :m]
     Dx, Dy, Dz = scr[R_DX, :m], scr[R_DY, :m], scr[R_DZ, :m]
     Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
-    two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
-    do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
-    track = opts[O_TRACK] != 0
-    store_lobe = opts[O_STORE_LOBE] != 0
+    trk = scr[R_TRK, :m]
+    r = (px, py, pz, nx, ny, nz, vx, vy, vz, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz,
+         scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_D, :m], scr[R_W, :m],
+         scr[R_BASE, :m], scr[R_WS, :m], trk)
 
-    _load_positions(P, centre, inv_scale, px, py, pz)
-    _load_normals(N, nx, ny, nz, k)
+    _fill(trk, zero)
     if two_sided or (do_spec and not flat):  # V toward the viewer
         if opts[O_LOCAL]:
             _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
@@ -387,32 +514,46 @@ def _block(P, N, centre, inv_scale, params, flags, view, opts, mat, aconst, shin
             _fill(vy, view[1])
             _fill(vz, view[2])
     if two_sided:
-        _two_sided(nx, ny, nz, vx, vy, vz, trk, track, k)
+        _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
 
     # the sums: recomputed ones start at 0, the others come from the caches
-    if do_amb:
-        _load_rows(A[:0], Ax, Ay, Az, zero)
-    else:
-        _load_rows(A, Ax, Ay, Az, zero)
-    if do_dif:
-        _load_rows(D[:0], Dx, Dy, Dz, zero)
-    else:
-        _load_rows(D, Dx, Dy, Dz, zero)
-    if do_spec:
-        _load_rows(S[:0], Sx, Sy, Sz, zero)
-    else:
-        _load_rows(S, Sx, Sy, Sz, zero)
+    _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
+    _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero)
+    _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero)
 
     for li in range(params.shape[0]):
         fl = flags[li]
+        q = params[li, :]
         l_amb = do_amb and (fl & AMBIENT) != 0
         l_dif = do_dif and (fl & DIFFUSE) != 0
         l_spec = do_spec and (fl & SPECULAR) != 0
-        if l_amb or l_dif or l_spec:
-            _light(px, py, pz, nx, ny, nz, vx, vy, vz, params[li, :], fl, l_amb, l_dif, l_spec,
-                   flat, phong, shininess, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz,
-                   base_out[li, :], ws_out[li, :], store_lobe, trk, track, k, powf)
+        if not (l_amb or l_dif or l_spec):
+            continue
+        if flat:
+            mode = LOBE_FLAT
+        elif fl & CONST_H:
+            mode = LOBE_CONST_H
+        elif phong:
+            mode = LOBE_PHONG
+        else:
+            mode = LOBE_BLINN
+        if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
+            _to_light(r, m, q, k)
+            if fl & ATTEN:
+                _attenuate(r, m, q, k)
+            if fl & SPOT:
+                _spot(r, m, q, k, (fl & SPOT_EXP) != 0)
+            if l_amb:
+                _ambient(r, m, q)
+        _light_any(r, m, q, shininess, k, (fl & POSITIONAL) != 0, mode, l_dif, l_spec)
+        if store_lobe and l_spec:
+            if not flat:
+                base_out[li, :] = scr[R_BASE, :m]
+            ws_out[li, :] = scr[R_WS, :m]
 
+    if opts[O_TRACK]:
+        for i in range(m):
+            amb[i] = trk[i] > zero
     if opts[O_STORE]:
         if do_amb and A.shape[0] > 0:
             _store_rows(A, Ax, Ay, Az)
@@ -426,40 +567,40 @@ def _block(P, N, centre, inv_scale, params, flags, view, opts, mat, aconst, shin
 
 
 @nb.njit(parallel=True, **_OPTS)
-def shade(P, N, centre, inv_scale, params, flags, view, opts, mat, aconst, shininess, k,
-          A, D, S, base_out, ws_out, amb, out, powf):
+def shade(G, params, flags, view, opts, mat, aconst, shininess, k,
+          A, D, S, base_out, ws_out, amb, out):
     """Shade every vertex (see the module docstring).
 
-    P, N : (n, 3) float32/float64 positions and normals (world space)
-    centre : (3,) float64, inv_scale : float  the normalised frame
+    G : (6, n) T prepared geometry (see :func:`prepare`)
     params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
     opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
-    shininess : T; k : constants(T); powf : pow32 (float32) or pow64 (float64)
+    shininess : T; k : constants(T)
     A, D, S : (n, 3) T caches (or (0, 3)); base_out, ws_out : (L, n) T (or (L, 0))
     amb : (n,) bool ambiguity marks (or (0,) when not tracking); out : (n, 3) colours
     """
-    n = P.shape[0]
+    n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
     for b in nb.prange(nblocks):
         s = b * BLOCK
         e = min(n, s + BLOCK)
         scr = np.empty((N_ROWS, BLOCK), params.dtype)
-        _block(P[s:e], N[s:e], centre, inv_scale, params, flags, view, opts, mat, aconst,
-               shininess, k, A[s:e], D[s:e], S[s:e], base_out[:, s:e], ws_out[:, s:e],
-               amb[s:e], out[s:e], scr, powf)
+        _block(G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e],
+               params, flags, view, opts, mat, aconst, shininess, k,
+               A[s:e], D[s:e], S[s:e], base_out[:, s:e], ws_out[:, s:e], amb[s:e], out[s:e],
+               scr)
 
 
 @nb.njit(**_OPTS)
-def _lobe_rows(base, ws, y, flat, cr, cg, cb, Sx, Sy, Sz, powf):
+def _lobe_rows(base, ws, y, flat, cr, cg, cb, Sx, Sy, Sz):
     for i in range(ws.shape[0]):
-        t = ws[i] if flat else ws[i] * powf(base[i], y)
+        t = ws[i] if flat else ws[i] * fpow(base[i], y)
         Sx[i] += t * cr
         Sy[i] += t * cg
         Sz[i] += t * cb
 
 
 @nb.njit(parallel=True, **_OPTS)
-def lobe(base, ws, params, flags, shininess, k, S, powf):
+def lobe(base, ws, params, flags, shininess, k, S):
     """S = Σ_l ws_l·base_l^n·s_l from stored per-light bases (a shininess change).
 
     base, ws : (L, n) T (base unused when shininess is 0); params : (L, N_PARAMS) T;
@@ -477,7 +618,7 @@ def lobe(base, ws, params, flags, shininess, k, S, powf):
         for li in range(params.shape[0]):
             if flags[li] & SPECULAR:
                 _lobe_rows(base[li, s:e], ws[li, s:e], shininess, flat, params[li, P_SPEC],
-                           params[li, P_SPEC + 1], params[li, P_SPEC + 2], Sx, Sy, Sz, powf)
+                           params[li, P_SPEC + 1], params[li, P_SPEC + 2], Sx, Sy, Sz)
         _store_rows(S[s:e], Sx, Sy, Sz)
 
 
