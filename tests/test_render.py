@@ -198,6 +198,20 @@ def test_render_twice_identical(renderer):
     assert np.array_equal(a, b) and np.array_equal(a, c)
 
 
+def test_reused_window_matches_fresh_one(renderer):
+    """One window drawing one mesh under changing materials (new colours, opacity, sorted
+    faces) gives what a fresh window gives each time."""
+    mesh = M.teapot(6)
+    for mapping in (
+        {"material": "gold"},
+        {"material": "emerald"},  # translucent: faces sorted
+        {"material": "chalk", "viewer": {"eye": [2, 1, 3]}},
+        {"material": "ruby", "model": "phong"},
+    ):
+        scene = explorer.load_scene(mapping)
+        assert np.array_equal(renderer.render(scene, mesh), R.render_image(scene, mesh, SIZE))
+
+
 def test_size_and_label():
     mesh = M.cube()
     black = np.zeros((mesh.n_vertices, 3))
