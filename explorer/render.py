@@ -198,13 +198,24 @@ def to_bytes(colors, opacity: float | None = None) -> np.ndarray:
 # -- the off-screen renderer ---------------------------------------------------------------
 
 
+_WINDOW_ENV = "VTK_DEFAULT_OPENGL_WINDOW"
+
+
 def _plotter(size: tuple[int, int], background):
-    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
-        # no display: VTK would probe X, log "bad X server connection" and fall back to EGL
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import pyvista as pv
 
-    pl = pv.Plotter(off_screen=True, window_size=list(size), lighting=None)
+    # No display: VTK would probe X, log "bad X server connection" and fall back to EGL; ask
+    # for EGL directly. Only while the window is created, so nothing else in the process
+    # (a GUI started later with a display) inherits the setting.
+    headless = not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
+    added = headless and _WINDOW_ENV not in os.environ
+    if added:
+        os.environ[_WINDOW_ENV] = "vtkEGLRenderWindow"
+    try:
+        pl = pv.Plotter(off_screen=True, window_size=list(size), lighting=None)
+    finally:
+        if added:
+            del os.environ[_WINDOW_ENV]
     pl.render_window.SetMultiSamples(0)  # before the first render: no multisampling
     pl.disable_anti_aliasing()
     # translucency: plain "over" blending in the order the triangles are drawn (sorted back to

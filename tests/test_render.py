@@ -34,8 +34,6 @@ from explorer.lights import DirectionalLight
 from explorer.material import Material
 from explorer.scene import Viewer
 
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-
 SIZE = (400, 400)
 BG = np.rint(np.asarray(R.BACKGROUND) * 255).astype(np.uint8)
 
@@ -756,3 +754,15 @@ def test_renders_without_display(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "X server" not in proc.stderr and "Traceback" not in proc.stderr
     assert R.read_png(out).shape == (64, 64, 3)
+
+
+def test_window_setting_not_left_behind(monkeypatch):
+    """The EGL choice is made for the renderer's own window only: the process environment
+    is unchanged afterwards (a GUI opened later with a display must get an X window)."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.delenv("VTK_DEFAULT_OPENGL_WINDOW", raising=False)
+    with R.OffscreenRenderer((32, 32)) as r:
+        r.render(explorer.Scene(), M.cube())
+        assert type(r.plotter.render_window).__name__ == "vtkEGLRenderWindow"
+    assert "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ
