@@ -14,6 +14,17 @@ from .plan import make_plan  # noqa: E402
 from .scene import Scene, Viewer, load_scene  # noqa: E402
 
 __all__ = [
-    "DirectionalLight", "ExplorerError", "Material", "PointLight", "Scene", "Shader",
-    "SpotLight", "ValidationError", "Viewer", "__version__", "load_scene", "make_plan", "shade",
+    "DirectionalLight",
+    "ExplorerError",
+    "Material",
+    "PointLight",
+    "Scene",
+    "Shader",
+    "SpotLight",
+    "ValidationError",
+    "Viewer",
+    "__version__",
+    "load_scene",
+    "make_plan",
+    "shade",
 ]

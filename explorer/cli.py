@@ -56,7 +56,25 @@ def _version() -> str:
     return f"phong-explorer {__version__}"
 
 
+def _show_notices() -> None:
+    """Print preset notices as one ``notice: ...`` line on stderr, not as Python warnings."""
+    import warnings
+
+    from .presets import PresetNotice
+
+    original = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, PresetNotice):
+            print(f"notice: {message}", file=sys.stderr)
+        else:
+            original(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
+    _show_notices()
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:

@@ -55,8 +55,15 @@ def shade(
     clamp : clamp to [0, 1] (OpenGL); False keeps the unclamped sums (>= 0) for HDR
     Returns colours : (n, 3) float64.
     """
-    s = Shader(scene, positions, normals, precision=precision, clamp=clamp,
-               materials_dirs=materials_dirs, keep=False)
+    s = Shader(
+        scene,
+        positions,
+        normals,
+        precision=precision,
+        clamp=clamp,
+        materials_dirs=materials_dirs,
+        keep=False,
+    )
     return np.asarray(s.colors, dtype=np.float64)
 
 
@@ -68,8 +75,17 @@ class Shader:
     keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
     """
 
-    def __init__(self, scene, positions, normals, *, precision: str = "float32",
-                 clamp: bool = True, materials_dirs=(), keep: bool = True):
+    def __init__(
+        self,
+        scene,
+        positions,
+        normals,
+        *,
+        precision: str = "float32",
+        clamp: bool = True,
+        materials_dirs=(),
+        keep: bool = True,
+    ):
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
         self._T = np.float32 if precision == "float32" else np.float64
@@ -214,30 +230,30 @@ class Shader:
             f = 0
             q = params[i]
             if isinstance(light, DirectionalLight):
-                q[K.P_POS:K.P_POS + 3] = light.direction
+                q[K.P_POS : K.P_POS + 3] = light.direction
                 if scene.model == "blinn" and not scene.viewer.local:
                     h = np.asarray(light.direction) + view
                     hn = math.sqrt(float(h @ h))
                     if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
-                        q[K.P_H:K.P_H + 3] = h / hn
+                        q[K.P_H : K.P_H + 3] = h / hn
                     f |= K.CONST_H
             else:
                 f |= K.POSITIONAL
-                q[K.P_POS:K.P_POS + 3] = to_frame(light.position, c, s)
+                q[K.P_POS : K.P_POS + 3] = to_frame(light.position, c, s)
                 kc, kl, kq = light.attenuation
-                q[K.P_ATT:K.P_ATT + 3] = (kc, kl * s, kq * s * s)
+                q[K.P_ATT : K.P_ATT + 3] = (kc, kl * s, kq * s * s)
                 if lp.attenuation == "per-vertex":
                     f |= K.ATTEN
             if isinstance(light, SpotLight) and lp.spot != "none":
                 f |= K.SPOT
-                q[K.P_AXIS:K.P_AXIS + 3] = light.direction
+                q[K.P_AXIS : K.P_AXIS + 3] = light.direction
                 q[K.P_COS] = math.cos(math.radians(light.cutoff))
                 q[K.P_EXP] = light.exponent
                 if lp.spot == "cone+exponent":
                     f |= K.SPOT_EXP
-            q[K.P_AMB:K.P_AMB + 3] = lp.factor * np.asarray(light.ambient)
-            q[K.P_DIF:K.P_DIF + 3] = lp.factor * np.asarray(light.diffuse)
-            q[K.P_SPEC:K.P_SPEC + 3] = lp.factor * np.asarray(light.specular)
+            q[K.P_AMB : K.P_AMB + 3] = lp.factor * np.asarray(light.ambient)
+            q[K.P_DIF : K.P_DIF + 3] = lp.factor * np.asarray(light.diffuse)
+            q[K.P_SPEC : K.P_SPEC + 3] = lp.factor * np.asarray(light.specular)
             if lp.ambient and lp.varying_weight:
                 f |= K.AMBIENT
             if lp.diffuse:
@@ -266,8 +282,15 @@ class Shader:
             # the lobe alone: bases and weights are stored, only n changed
             params, flags, _ = self._params_for(T)
             S = np.empty((n, 3), T)
-            K.lobe(self._base if self._base is not None else self._ws, self._ws, params,
-                   flags, T(shininess), self._k, S)
+            K.lobe(
+                self._base if self._base is not None else self._ws,
+                self._ws,
+                params,
+                flags,
+                T(shininess),
+                self._k,
+                S,
+            )
             self._S = S
             self._spec_shininess = shininess
             self.stats["lobe"] += 1
@@ -278,11 +301,16 @@ class Shader:
             self._run(do_amb, do_dif, do_spec, flat, mat, aconst)
         else:
             empty = np.zeros((0, 3), T)
-            K.compose(mat, aconst,
-                      self._A if self._A is not None and need_amb else empty,
-                      self._D if self._D is not None and need_dif else empty,
-                      self._S if self._S is not None and need_spec else empty,
-                      self.clamp, self._k, self._out)
+            K.compose(
+                mat,
+                aconst,
+                self._A if self._A is not None and need_amb else empty,
+                self._D if self._D is not None and need_dif else empty,
+                self._S if self._S is not None and need_spec else empty,
+                self.clamp,
+                self._k,
+                self._out,
+            )
             self.stats["compose"] += 1
         self._colors = _readonly(self._out)
         self._out = np.empty_like(self._out)  # never write into colours already handed out
@@ -332,8 +360,24 @@ class Shader:
         if opts[K.O_TRACK]:
             amb[:] = 0
         shin = T(scene.material.shininess)
-        K.shade(self._G, params, flags, view, opts, mat, aconst, shin, self._k, A, D, S, base,
-                ws, amb, self._out)
+        K.shade(
+            self._G,
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shin,
+            self._k,
+            A,
+            D,
+            S,
+            base,
+            ws,
+            amb,
+            self._out,
+        )
         self.stats["pass"] += 1
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
@@ -372,10 +416,32 @@ class Shader:
         mat = self._material_vector(f64)
         aconst = self._aconst
         G64 = np.empty((6, m))
-        K.prepare(np.ascontiguousarray(self._P[idx]), np.ascontiguousarray(self._N[idx]),
-                  self._centre, 1.0 / self._scale, self._k64, G64)
-        K.shade(G64, params, flags, view, o, mat, aconst, f64(scene.material.shininess),
-                self._k64, A64, D64, S64, b64, w64, np.zeros(0, np.bool_), out64)
+        K.prepare(
+            np.ascontiguousarray(self._P[idx]),
+            np.ascontiguousarray(self._N[idx]),
+            self._centre,
+            1.0 / self._scale,
+            self._k64,
+            G64,
+        )
+        K.shade(
+            G64,
+            params,
+            flags,
+            view,
+            o,
+            mat,
+            aconst,
+            f64(scene.material.shininess),
+            self._k64,
+            A64,
+            D64,
+            S64,
+            b64,
+            w64,
+            np.zeros(0, np.bool_),
+            out64,
+        )
         self._out[idx] = out64
         for X, X64 in ((A, A64), (D, D64), (S, S64)):
             if X.shape[0]:

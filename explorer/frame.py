@@ -66,7 +66,6 @@ def check_vertices(positions, normals) -> tuple[np.ndarray, np.ndarray]:
         out.append(np.ascontiguousarray(arr))
     if len(out[0]) != len(out[1]):
         raise ExplorerError(
-            f"positions and normals must have the same length, got {len(out[0])} and "
-            f"{len(out[1])}"
+            f"positions and normals must have the same length, got {len(out[0])} and {len(out[1])}"
         )
     return out[0], out[1]

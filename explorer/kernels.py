@@ -61,8 +61,34 @@ O_STORE, O_STORE_LOBE, O_COMPOSE, O_CLAMP, O_TRACK = 7, 8, 9, 10, 11
 N_OPTS = 12
 
 # scratch rows
-(R_PX, R_PY, R_PZ, R_NX, R_NY, R_NZ, R_VX, R_VY, R_VZ, R_AX, R_AY, R_AZ, R_DX, R_DY, R_DZ,
- R_SX, R_SY, R_SZ, R_LX, R_LY, R_LZ, R_D, R_W, R_BASE, R_WS, R_TRK) = range(26)
+(
+    R_PX,
+    R_PY,
+    R_PZ,
+    R_NX,
+    R_NY,
+    R_NZ,
+    R_VX,
+    R_VY,
+    R_VZ,
+    R_AX,
+    R_AY,
+    R_AZ,
+    R_DX,
+    R_DY,
+    R_DZ,
+    R_SX,
+    R_SY,
+    R_SZ,
+    R_LX,
+    R_LY,
+    R_LZ,
+    R_D,
+    R_W,
+    R_BASE,
+    R_WS,
+    R_TRK,
+) = range(26)
 N_ROWS = 26
 
 # lobe modes
@@ -70,16 +96,38 @@ LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
 
 
 # constants passed in the working precision (a float literal would promote float32 to float64)
-(K_ZERO, K_ONE, K_TWO, K_POINT_EPS, K_HALF_EPS2, K_ATT_FLOOR, K_AMB_DOT, K_AMB_LEN2,
- K_AMB_DIST, K_INF, K_NORMAL_EPS2) = range(11)
+(
+    K_ZERO,
+    K_ONE,
+    K_TWO,
+    K_POINT_EPS,
+    K_HALF_EPS2,
+    K_ATT_FLOOR,
+    K_AMB_DOT,
+    K_AMB_LEN2,
+    K_AMB_DIST,
+    K_INF,
+    K_NORMAL_EPS2,
+) = range(11)
 N_CONSTS = 11
 
 
 def constants(dtype) -> np.ndarray:
     """The kernel's constants (see :mod:`explorer.tolerances`) in ``dtype``."""
     return np.array(
-        [0.0, 1.0, 2.0, tol.POINT_EPS, tol.HALFWAY_EPS2, tol.ATTENUATION_FLOOR,
-         tol.AMBIGUOUS_DOT, tol.AMBIGUOUS_LEN2, tol.AMBIGUOUS_DIST, np.inf, tol.NORMAL_EPS**2],
+        [
+            0.0,
+            1.0,
+            2.0,
+            tol.POINT_EPS,
+            tol.HALFWAY_EPS2,
+            tol.ATTENUATION_FLOOR,
+            tol.AMBIGUOUS_DOT,
+            tol.AMBIGUOUS_LEN2,
+            tol.AMBIGUOUS_DIST,
+            np.inf,
+            tol.NORMAL_EPS**2,
+        ],
         dtype=dtype,
     )
 
@@ -98,22 +146,32 @@ def f2i(typingctx, x):
     """The bits of a float32 as int32 (no memory round trip)."""
     if x != types.float32:
         return None
+
     def codegen(context, builder, sig, args):
         return builder.bitcast(args[0], ir.IntType(32))
+
     return types.int32(types.float32), codegen
+
+
 @intrinsic
 def i2f(typingctx, x):
     """An integer's low 32 bits read as a float32."""
     if not isinstance(x, types.Integer):
         return None
+
     def codegen(context, builder, sig, args):
         v = args[0]
         if v.type.width > 32:
             v = builder.trunc(v, ir.IntType(32))
         return builder.bitcast(v, ir.FloatType())
+
     return types.float32(x), codegen
-FM = {'nsz','arcp','contract','afn','reassoc'}
-O=dict(fastmath=FM, error_model='numpy', boundscheck=False)
+
+
+FM = {"nsz", "arcp", "contract", "afn", "reassoc"}
+O = dict(fastmath=FM, error_model="numpy", boundscheck=False)
+
+
 @nb.njit(**_OPTS)
 def pow32(x, y):
     """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
@@ -466,8 +524,17 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
     e0 = mat[0] + mat[3] * aconst[0]
     e1 = mat[1] + mat[4] * aconst[1]
     e2 = mat[2] + mat[5] * aconst[2]
-    a0, a1, a2, d0, d1, d2, s0, s1, s2 = (mat[3], mat[4], mat[5], mat[6], mat[7], mat[8],
-                                          mat[9], mat[10], mat[11])
+    a0, a1, a2, d0, d1, d2, s0, s1, s2 = (
+        mat[3],
+        mat[4],
+        mat[5],
+        mat[6],
+        mat[7],
+        mat[8],
+        mat[9],
+        mat[10],
+        mat[11],
+    )
     for i in range(out.shape[0]):
         r = e0 + a0 * Ax[i] + d0 * Dx[i] + s0 * Sx[i]  # e + a_m·(a_const + A) + d_m·D + s_m·S
         g = e1 + a1 * Ay[i] + d1 * Dy[i] + s1 * Sy[i]
@@ -478,8 +545,30 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 
 
 @nb.njit(**_OPTS)
-def _block(px, py, pz, gx, gy, gz, params, flags, view, opts, mat, aconst, shininess, k,
-           A, D, S, base_out, ws_out, amb, out, scr):
+def _block(
+    px,
+    py,
+    pz,
+    gx,
+    gy,
+    gz,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    amb,
+    out,
+    scr,
+):
     """One block; every array argument is already sliced to the block's vertices.
 
     px, py, pz, gx, gy, gz : (m,) T prepared positions and normals (read only)
@@ -501,9 +590,34 @@ def _block(px, py, pz, gx, gy, gz, params, flags, view, opts, mat, aconst, shini
     Dx, Dy, Dz = scr[R_DX, :m], scr[R_DY, :m], scr[R_DZ, :m]
     Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
     trk = scr[R_TRK, :m]
-    r = (px, py, pz, nx, ny, nz, vx, vy, vz, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz,
-         scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_D, :m], scr[R_W, :m],
-         scr[R_BASE, :m], scr[R_WS, :m], trk)
+    r = (
+        px,
+        py,
+        pz,
+        nx,
+        ny,
+        nz,
+        vx,
+        vy,
+        vz,
+        Ax,
+        Ay,
+        Az,
+        Dx,
+        Dy,
+        Dz,
+        Sx,
+        Sy,
+        Sz,
+        scr[R_LX, :m],
+        scr[R_LY, :m],
+        scr[R_LZ, :m],
+        scr[R_D, :m],
+        scr[R_W, :m],
+        scr[R_BASE, :m],
+        scr[R_WS, :m],
+        trk,
+    )
 
     _fill(trk, zero)
     if two_sided or (do_spec and not flat):  # V toward the viewer
@@ -562,13 +676,13 @@ def _block(px, py, pz, gx, gy, gz, params, flags, view, opts, mat, aconst, shini
         if do_spec and S.shape[0] > 0:
             _store_rows(S, Sx, Sy, Sz)
     if opts[O_COMPOSE]:
-        _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz,
-                      opts[O_CLAMP] != 0, k)
+        _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, opts[O_CLAMP] != 0, k)
 
 
 @nb.njit(parallel=True, **_OPTS)
-def shade(G, params, flags, view, opts, mat, aconst, shininess, k,
-          A, D, S, base_out, ws_out, amb, out):
+def shade(
+    G, params, flags, view, opts, mat, aconst, shininess, k, A, D, S, base_out, ws_out, amb, out
+):
     """Shade every vertex (see the module docstring).
 
     G : (6, n) T prepared geometry (see :func:`prepare`)
@@ -584,10 +698,30 @@ def shade(G, params, flags, view, opts, mat, aconst, shininess, k,
         s = b * BLOCK
         e = min(n, s + BLOCK)
         scr = np.empty((N_ROWS, BLOCK), params.dtype)
-        _block(G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e],
-               params, flags, view, opts, mat, aconst, shininess, k,
-               A[s:e], D[s:e], S[s:e], base_out[:, s:e], ws_out[:, s:e], amb[s:e], out[s:e],
-               scr)
+        _block(
+            G[0, s:e],
+            G[1, s:e],
+            G[2, s:e],
+            G[3, s:e],
+            G[4, s:e],
+            G[5, s:e],
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shininess,
+            k,
+            A[s:e],
+            D[s:e],
+            S[s:e],
+            base_out[:, s:e],
+            ws_out[:, s:e],
+            amb[s:e],
+            out[s:e],
+            scr,
+        )
 
 
 @nb.njit(**_OPTS)
@@ -617,8 +751,18 @@ def lobe(base, ws, params, flags, shininess, k, S):
         Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
         for li in range(params.shape[0]):
             if flags[li] & SPECULAR:
-                _lobe_rows(base[li, s:e], ws[li, s:e], shininess, flat, params[li, P_SPEC],
-                           params[li, P_SPEC + 1], params[li, P_SPEC + 2], Sx, Sy, Sz)
+                _lobe_rows(
+                    base[li, s:e],
+                    ws[li, s:e],
+                    shininess,
+                    flat,
+                    params[li, P_SPEC],
+                    params[li, P_SPEC + 1],
+                    params[li, P_SPEC + 2],
+                    Sx,
+                    Sy,
+                    Sz,
+                )
         _store_rows(S[s:e], Sx, Sy, Sz)
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import ClassVar, Union
+from typing import ClassVar
 
 from .validate import Checker
 
@@ -129,7 +129,7 @@ class SpotLight(PointLight):
         object.__setattr__(self, "exponent", e)
 
 
-Light = Union[DirectionalLight, PointLight, SpotLight]
+Light = DirectionalLight | PointLight | SpotLight
 
 _COMMON = ("type", "ambient", "diffuse", "specular", "color", "intensity")
 LIGHT_KEYS = {
@@ -194,9 +194,7 @@ def parse_light(value, checker: Checker, path: tuple) -> Light | None:
         if "cutoff" in m:
             c = checker.number(m["cutoff"], path + ("cutoff",), 0.0, 180.0)
             if c is not None and 90.0 < c < 180.0:
-                checker.problem(
-                    path + ("cutoff",), f"must be in [0, 90] or exactly 180, got {c:g}"
-                )
+                checker.problem(path + ("cutoff",), f"must be in [0, 90] or exactly 180, got {c:g}")
             kw["cutoff"] = c
         if "exponent" in m:
             kw["exponent"] = checker.number(m["exponent"], path + ("exponent",), 0.0, 128.0)

@@ -111,32 +111,41 @@ def make_plan(scene: Scene) -> Plan:
         return on
 
     emission = why(
-        "emission", _nonzero(m.emission),
+        "emission",
+        _nonzero(m.emission),
         "material emission is non-zero" if _nonzero(m.emission) else "material emission is 0",
     )
     any_amb = _nonzero(scene.ambient) or any(_nonzero(lt.ambient) for lt in lights)
     ambient = why(
-        "ambient", _nonzero(m.ambient) and any_amb,
-        "material ambient 0" if not _nonzero(m.ambient)
+        "ambient",
+        _nonzero(m.ambient) and any_amb,
+        "material ambient 0"
+        if not _nonzero(m.ambient)
         else ("scene and light ambient are 0" if not any_amb else "a_m and an ambient light"),
     )
     any_dif = any(_nonzero(lt.diffuse) for lt in lights)
     diffuse = why(
-        "diffuse", _nonzero(m.diffuse) and any_dif,
-        "material diffuse 0" if not _nonzero(m.diffuse)
+        "diffuse",
+        _nonzero(m.diffuse) and any_dif,
+        "material diffuse 0"
+        if not _nonzero(m.diffuse)
         else ("no light has diffuse colour" if not any_dif else "d_m and a light's diffuse"),
     )
     any_spec = any(_nonzero(lt.specular) for lt in lights)
     specular = why(
-        "specular", _nonzero(m.specular) and any_spec,
-        "material specular 0" if not _nonzero(m.specular)
+        "specular",
+        _nonzero(m.specular) and any_spec,
+        "material specular 0"
+        if not _nonzero(m.specular)
         else ("no light has specular colour" if not any_spec else "s_m and a light's specular"),
     )
     flat = specular and m.shininess == 0.0
     if specular:
         why(
-            "lobe", not flat,
-            "shininess 0: 0^0 = 1, the lobe is 1 wherever N·L > 0 (no H, no R, no pow)" if flat
+            "lobe",
+            not flat,
+            "shininess 0: 0^0 = 1, the lobe is 1 wherever N·L > 0 (no H, no R, no pow)"
+            if flat
             else f"pow(base, {m.shininess:g}) per vertex",
         )
 
@@ -151,7 +160,8 @@ def make_plan(scene: Scene) -> Plan:
         view = "constant"
         why("view vector", True, "infinite viewer: V is constant")
     why(
-        "two-sided", scene.two_sided,
+        "two-sided",
+        scene.two_sided,
         "flip N where N·V < 0" if scene.two_sided else "two_sided is false",
     )
 
@@ -228,13 +238,16 @@ def _light_plan(i: int, lt, scene: Scene, m) -> LightPlan:
         why("ambient", False, "light ambient 0")
     else:
         why(
-            "ambient", True,
+            "ambient",
+            True,
             "attenuated per vertex" if varying else "constant: added once to the scene ambient",
         )
     why(
-        "diffuse", dif and _nonzero(m.diffuse),
-        "light diffuse 0" if not dif else ("material diffuse 0" if not _nonzero(m.diffuse)
-                                           else "max(N·L, 0)·d_i"),
+        "diffuse",
+        dif and _nonzero(m.diffuse),
+        "light diffuse 0"
+        if not dif
+        else ("material diffuse 0" if not _nonzero(m.diffuse) else "max(N·L, 0)·d_i"),
     )
     if not spec:
         why("specular", False, "light specular 0")
@@ -250,5 +263,6 @@ def _light_plan(i: int, lt, scene: Scene, m) -> LightPlan:
         why("specular", True, "Blinn: H = normalize(L + V) per vertex")
     if not (amb or dif or spec):
         why("light", False, "all colours 0: skipped entirely")
-    return LightPlan(i, lt.type, amb, dif, spec, positional, attenuation, spot, factor,
-                     tuple(reasons))
+    return LightPlan(
+        i, lt.type, amb, dif, spec, positional, attenuation, spot, factor, tuple(reasons)
+    )

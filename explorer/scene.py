@@ -22,7 +22,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from .errors import ExplorerError
-from .lights import DirectionalLight, Light, light_to_mapping, parse_light
+from .lights import DirectionalLight, light_to_mapping, parse_light
 from .material import MODELS, Material, parse_material
 from .validate import Checker
 
@@ -136,8 +136,8 @@ def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
     if isinstance(scene, (str, os.PathLike)):
         from .yamlio import load_yaml
 
-        doc = load_yaml(scene, what="scene")
-        checker = Checker(doc.file, doc.lines)
+        doc = load_yaml(scene, what="scene", collect=True)
+        checker = doc.checker()  # already holds duplicate keys etc.: one pass reports all
         return _parse(doc.data, checker, materials_dirs, os.path.dirname(os.fspath(scene)))
     if isinstance(scene, Mapping):
         return _parse(scene, Checker(None), materials_dirs, None)

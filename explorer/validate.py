@@ -121,7 +121,11 @@ class Checker:
         if isinstance(value, bool) or not isinstance(value, Real):
             self.problem(path, f"must be a number{rng}, got {_type(value)} {_fmt(value)}")
             return None
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:  # an int beyond the float range
+            self.problem(path, f"must be a number{rng}, got an integer too large for a float")
+            return None
         if not math.isfinite(x):
             self.problem(path, f"must be a finite number{rng}, got {_fmt(x)}")
             return None
@@ -140,9 +144,7 @@ class Checker:
         if isinstance(value, str) and value in options:
             return value
         hint = suggest(value, options) if isinstance(value, str) else ""
-        self.problem(
-            path, f"must be one of {', '.join(options)}, got {_fmt(value)}{hint}"
-        )
+        self.problem(path, f"must be one of {', '.join(options)}, got {_fmt(value)}{hint}")
         return None
 
     def string(self, value, path: Path) -> str | None:
@@ -162,8 +164,9 @@ class Checker:
             or len(value) != 3
         ):
             self.problem(
-                path, f"must be a list of 3 numbers{' each' + rng if rng else ''}, "
-                f"got {_type(value)} {_fmt(value)}"
+                path,
+                f"must be a list of 3 numbers{' each' + rng if rng else ''}, "
+                f"got {_type(value)} {_fmt(value)}",
             )
             return None
         out = []

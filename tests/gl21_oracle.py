@@ -66,9 +66,13 @@ def gl_vertex_color(vertex, normal, scene: dict) -> list[float]:
         ndh = max(_dot(n, h), 0.0)
         spec = f * (ndh ** m["shininess"] if m["shininess"] != 0.0 else 1.0)
         for j in range(3):
-            c[j] += att * spot * (
-                m["ambient"][j] * light["ambient"][j]
-                + max(ndl, 0.0) * m["diffuse"][j] * light["diffuse"][j]
-                + spec * m["specular"][j] * light["specular"][j]
+            c[j] += (
+                att
+                * spot
+                * (
+                    m["ambient"][j] * light["ambient"][j]
+                    + max(ndl, 0.0) * m["diffuse"][j] * light["diffuse"][j]
+                    + spec * m["specular"][j] * light["specular"][j]
+                )
             )
     return [min(max(x, 0.0), 1.0) for x in c]

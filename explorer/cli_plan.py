@@ -1,0 +1,36 @@
+"""``phong-explorer plan SCENE``: the work the engine will do for a scene, and why."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene file (YAML)")
+    parser.add_argument(
+        "--materials",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="extra preset directory (repeatable), searched before the built-in presets",
+    )
+
+
+def run(args) -> int:
+    from .plan import make_plan
+    from .scene import load_scene
+
+    scene = load_scene(args.scene, materials_dirs=args.materials)
+    plan = make_plan(scene)
+    m = scene.material
+    viewer = (
+        f"eye {list(scene.viewer.eye)}"
+        if scene.viewer.local
+        else (f"direction {[round(c, 6) for c in scene.viewer.direction]}")
+    )
+    print(
+        f"scene {args.scene}: {len(scene.lights)} light(s), model {scene.model}, "
+        f"shininess {m.shininess:g}, viewer {viewer}"
+    )
+    print(plan.describe())
+    return 0

@@ -1,0 +1,68 @@
+"""Random scenes for property tests (hypothesis strategies), in the scene-file schema."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import strategies as st
+
+unit_float = st.floats(0, 1, allow_nan=False, allow_infinity=False)
+maybe_zero_rgb = st.one_of(st.just([0.0, 0.0, 0.0]), st.lists(unit_float, min_size=3, max_size=3))
+vec = st.lists(st.floats(-3, 3, allow_nan=False), min_size=3, max_size=3).filter(
+    lambda v: sum(c * c for c in v) > 1e-2
+)
+
+
+@st.composite
+def lights(draw):
+    kind = draw(st.sampled_from(["directional", "point", "spot"]))
+    light = {
+        "type": kind,
+        "ambient": draw(maybe_zero_rgb),
+        "diffuse": draw(maybe_zero_rgb),
+        "specular": draw(maybe_zero_rgb),
+    }
+    if kind == "directional":
+        light["direction"] = draw(vec)
+    else:
+        light["position"] = [c * 2 for c in draw(vec)]
+        light["attenuation"] = draw(
+            st.sampled_from(
+                [[1, 0, 0], [2, 0, 0], [0.5, 0, 0], [1, 0.3, 0], [1, 0.1, 0.05], [0.2, 0, 0.3]]
+            )
+        )
+    if kind == "spot":
+        light["direction"] = draw(vec)
+        light["cutoff"] = draw(st.sampled_from([180.0, 90.0, 60.0, 25.0]))
+        light["exponent"] = draw(st.sampled_from([0.0, 1.0, 7.5, 128.0]))
+    return light
+
+
+@st.composite
+def scenes(draw, max_lights=4):
+    material = {
+        "ambient": draw(maybe_zero_rgb),
+        "diffuse": draw(maybe_zero_rgb),
+        "specular": draw(maybe_zero_rgb),
+        "emission": draw(maybe_zero_rgb),
+        "shininess": draw(st.sampled_from([0.0, 1.0, 12.8, 76.8, 500.0])),
+    }
+    viewer = draw(
+        st.one_of(
+            st.builds(lambda v: {"eye": [c * 3 for c in v]}, vec),
+            st.builds(lambda v: {"direction": v}, vec),
+        )
+    )
+    return {
+        "material": material,
+        "model": draw(st.sampled_from(["blinn", "phong"])),
+        "ambient": draw(maybe_zero_rgb),
+        "viewer": viewer,
+        "two_sided": draw(st.booleans()),
+        "lights": draw(st.lists(lights(), min_size=0, max_size=max_lights)),
+    }
+
+
+def vertices(seed: int, n: int = 64):
+    """Positions in a unit-ish ball and random (non-unit) normals."""
+    rng = np.random.default_rng(seed)
+    return rng.normal(size=(n, 3)), rng.normal(size=(n, 3)) * rng.uniform(0.2, 3, (n, 1))

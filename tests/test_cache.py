@@ -1,0 +1,187 @@
+"""The Shader's cache: each kind of change costs what it should, and nothing stale leaks."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import explorer
+from explorer import tolerances as tol
+from explorer.lights import DirectionalLight, PointLight
+from explorer.scene import Viewer, load_scene
+
+SCENE = {
+    "material": {
+        "ambient": [0.2, 0.1, 0.1],
+        "diffuse": [0.6, 0.5, 0.4],
+        "specular": [0.7, 0.7, 0.7],
+        "shininess": 30,
+    },
+    "viewer": {"eye": [0, 0, 5]},
+    "lights": [
+        {
+            "type": "point",
+            "position": [2, 3, 1],
+            "attenuation": [1, 0.1, 0.01],
+            "ambient": [0.1, 0.1, 0.1],
+        },
+        {"type": "directional", "direction": [-1, 1, 1]},
+    ],
+}
+
+
+@pytest.fixture(params=["float32", "float64"])
+def shader(request):
+    rng = np.random.default_rng(0)
+    P, N = rng.normal(size=(2000, 3)), rng.normal(size=(2000, 3))
+    return explorer.Shader(SCENE, P, N, precision=request.param)
+
+
+def fresh(shader):
+    return explorer.shade(shader.scene, shader._P, shader._N, precision=shader.precision)
+
+
+def counts(shader):
+    s = shader.stats
+    return {
+        k: s[k] for k in ("pass", "ambient", "diffuse", "specular", "lobe", "compose", "geometry")
+    }
+
+
+def delta(before, after):
+    return {k: after[k] - before[k] for k in before if after[k] != before[k]}
+
+
+def check(shader):
+    tol_ = 1e-12 if shader.precision == "float64" else 1e-6
+    assert np.abs(shader.colors - fresh(shader)).max() <= tol_
+
+
+def test_first_colours_take_one_pass(shader):
+    _ = shader.colors
+    c = counts(shader)
+    assert c["pass"] == 1 and c["diffuse"] == 1 and c["specular"] == 1 and c["geometry"] == 1
+    check(shader)
+
+
+def test_material_colours_only_recompose(shader):
+    _ = shader.colors
+    before = counts(shader)
+    m = shader.scene.material
+    shader.set_material(
+        m.replace(
+            diffuse=(0.1, 0.9, 0.3),
+            ambient=(0, 0, 0.4),
+            specular=(0.2, 0.2, 0.9),
+            emission=(0.1, 0, 0),
+        )
+    )
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"compose": 1}
+    check(shader)
+
+
+def test_shininess_only_reruns_the_lobe(shader):
+    _ = shader.colors
+    before = counts(shader)
+    for n in (5.0, 120.0, 0.0, 64.0):
+        shader.set_material(shader.scene.material.replace(shininess=n))
+        _ = shader.colors
+        check(shader)
+    assert delta(before, counts(shader)) == {"lobe": 4, "compose": 4}
+
+
+def test_viewer_change_recomputes_specular_not_diffuse(shader):
+    _ = shader.colors
+    before = counts(shader)
+    shader.set_viewer(Viewer(eye=(1, 2, 6)))
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1}
+    check(shader)
+    shader.set_model("phong")
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"pass": 2, "specular": 2}
+    check(shader)
+
+
+def test_two_sided_viewer_change_recomputes_everything(shader):
+    shader.set_scene(shader.scene.replace(two_sided=True))
+    _ = shader.colors
+    before = counts(shader)
+    shader.set_viewer(Viewer(direction=(0, 1, 0)))
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"pass": 1, "ambient": 1, "diffuse": 1, "specular": 1}
+    check(shader)
+
+
+def test_light_change_invalidates(shader):
+    _ = shader.colors
+    before = counts(shader)
+    shader.set_lights([PointLight(position=(0, 0, 3)), DirectionalLight(direction=(1, 0, 0))])
+    _ = shader.colors
+    assert delta(before, counts(shader))["pass"] == 1
+    check(shader)
+
+
+def test_geometry_change_invalidates(shader):
+    _ = shader.colors
+    rng = np.random.default_rng(1)
+    shader.set_geometry(rng.normal(size=(700, 3)), rng.normal(size=(700, 3)))
+    assert shader.colors.shape == (700, 3)
+    assert counts(shader)["geometry"] == 2 and counts(shader)["pass"] == 2
+    check(shader)
+
+
+def test_terms_are_computed_only_when_the_material_needs_them(shader):
+    shader.set_material(shader.scene.material.replace(specular=(0, 0, 0)))
+    _ = shader.colors
+    assert counts(shader)["specular"] == 0
+    before = counts(shader)
+    shader.set_material(shader.scene.material.replace(specular=(1, 1, 1)))
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1}
+    check(shader)
+
+
+def test_cached_arrays_are_read_only_and_never_rewritten(shader):
+    first = shader.colors
+    kept = first.copy()
+    with pytest.raises(ValueError):
+        first[0, 0] = 1.0
+    for term in shader.terms.values():
+        with pytest.raises(ValueError):
+            term[0, 0] = 1.0
+    shader.set_material(shader.scene.material.replace(diffuse=(0, 0, 0)))
+    _ = shader.colors
+    assert np.array_equal(first, kept)  # colours handed out earlier did not change
+
+
+def test_terms_recompose_to_the_colours(shader):
+    t = shader.terms
+    m = shader.scene.material
+    c = (
+        np.asarray(m.emission)
+        + np.asarray(m.ambient) * t["ambient"]
+        + np.asarray(m.diffuse) * t["diffuse"]
+        + np.asarray(m.specular) * t["specular"]
+    )
+    assert np.abs(np.clip(c, 0, 1) - shader.colors).max() <= 1e-6
+
+
+def test_setting_the_same_scene_costs_nothing(shader):
+    _ = shader.colors
+    before = counts(shader)
+    shader.set_scene(load_scene(SCENE))
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {}
+
+
+def test_float32_shader_stays_within_one_level_of_float64():
+    rng = np.random.default_rng(2)
+    P, N = rng.normal(size=(3000, 3)), rng.normal(size=(3000, 3))
+    s32 = explorer.Shader(SCENE, P, N, precision="float32")
+    s64 = explorer.Shader(SCENE, P, N, precision="float64")
+    for n in (1.0, 30.0, 200.0):
+        for s in (s32, s64):
+            s.set_material(s.scene.material.replace(shininess=n))
+        assert np.abs(s32.colors - s64.colors).max() <= tol.FLOAT32_MAX_ABS_ERROR
