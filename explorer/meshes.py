@@ -504,15 +504,26 @@ def load_mesh(path) -> Mesh:
         )
     positions, normals, faces, has_normals = [], [], [], True
     base = 0
-    for m in parts:
-        positions.append(np.asarray(m.vertices, np.float64))
-        faces.append(np.asarray(m.faces, np.int64) + base)
-        base += len(m.vertices)
-        if "vertex_normals" in m._cache and len(m._cache["vertex_normals"]) == len(m.vertices):
-            normals.append(np.asarray(m._cache["vertex_normals"], np.float64))
-        else:
+    for m, matrix in parts:
+        p = np.asarray(m.vertices, np.float64)
+        f = np.asarray(m.faces, np.int64)
+        n = None
+        if "vertex_normals" in m._cache and len(m._cache["vertex_normals"]) == len(p):
+            n = np.asarray(m._cache["vertex_normals"], np.float64)
+        if matrix is not None:
+            linear = matrix[:3, :3]
+            p = p @ linear.T + matrix[:3, 3]
+            if n is not None:
+                n = n @ np.linalg.inv(linear)  # normals take the inverse transpose
+            if np.linalg.det(linear) < 0:  # a mirroring transform turns the winding over
+                f = f[:, ::-1]
+        positions.append(p)
+        faces.append(f + base)
+        base += len(p)
+        if n is None:
             has_normals = False
-            normals.append(np.zeros((len(m.vertices), 3)))
+            n = np.zeros_like(p)
+        normals.append(n)
     pos = np.vstack(positions)
     faces = np.vstack(faces)
     if not np.isfinite(pos).all():
@@ -532,15 +543,22 @@ def load_mesh(path) -> Mesh:
 
 
 def _triangle_parts(loaded) -> list:
+    """``[(Trimesh, 4x4 transform or None), ...]`` of the triangle meshes in what trimesh
+    loaded; scene nodes keep their own geometry (and its normals) with the node's transform."""
     import trimesh
 
     if isinstance(loaded, trimesh.Trimesh):
-        items = [loaded]
+        items = [(loaded, None)]
     elif isinstance(loaded, trimesh.Scene):
-        items = loaded.dump() if len(loaded.geometry) else []
+        items = []
+        for node in loaded.graph.nodes_geometry:
+            matrix, name = loaded.graph[node]
+            geometry = loaded.geometry.get(name)
+            matrix = np.asarray(matrix, np.float64)
+            items.append((geometry, None if np.allclose(matrix, np.eye(4)) else matrix))
     else:
         items = []
-    return [m for m in items if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    return [(m, t) for m, t in items if isinstance(m, trimesh.Trimesh) and len(m.faces)]
 
 
 def _drop_unused(pos, nrm, faces):

@@ -373,6 +373,41 @@ def test_glb_scene_flattened_with_transforms(tmp_path):
     assert np.isclose(m.bounds[1][0], 5.5) and np.isclose(m.bounds[0][0], -0.5)
 
 
+@pytest.mark.parametrize("ext", ["glb", "ply", "obj"])
+def test_file_split_normals_kept(tmp_path, ext):
+    """A flat-shaded cube (vertices split per face, normals in the file) stays flat."""
+    c = M.cube()
+    path = tmp_path / f"cube.{ext}"
+    tm = trimesh.Trimesh(c.positions, c.faces, vertex_normals=c.normals, process=False)
+    data = tm.export(file_type=ext, **({} if ext == "ply" else {"include_normals": True}))
+    path.write_bytes(data.encode() if isinstance(data, str) else data)
+    m = M.load_mesh(path)
+    assert m.n_vertices == 24
+    assert np.allclose(np.abs(m.normals).max(axis=1), 1.0)
+    agree = np.einsum("ij,ij->i", m.face_normals(), m.normals[m.faces].mean(axis=1))
+    assert np.allclose(agree, 1.0)
+
+
+def test_glb_node_transforms_apply_to_normals_and_winding(tmp_path):
+    """A node that scales and mirrors its geometry: positions, normals (inverse transpose) and
+    the triangles' winding all follow, so normals still point out of the solid."""
+    src = M.icosphere(1)
+    tm = trimesh.Trimesh(src.positions, src.faces, vertex_normals=src.normals, process=False)
+    scene = trimesh.Scene()
+    matrix = np.diag([-2.0, 1.0, 0.5, 1.0])  # mirror x, stretch
+    scene.add_geometry(tm, node_name="a", transform=matrix)
+    path = tmp_path / "mirrored.glb"
+    scene.export(path)
+    m = M.load_mesh(path)
+    assert np.allclose(m.positions, src.positions * [-2.0, 1.0, 0.5], atol=1e-6)
+    # an ellipsoid's outward normal at p is proportional to p / axes²
+    want = m.positions / np.array([2.0, 1.0, 0.5]) ** 2
+    want /= np.linalg.norm(want, axis=1, keepdims=True)
+    assert np.allclose(m.normals, want, atol=1e-5)
+    fc = m.positions[m.faces].mean(axis=1)
+    assert (np.einsum("ij,ij->i", m.face_normals(), fc) > 0).all()
+
+
 @pytest.mark.parametrize(
     "name, content, reason",
     [
