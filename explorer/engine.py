@@ -96,6 +96,7 @@ class Shader:
         self._scene = load_scene(scene, materials_dirs=materials_dirs)
         self._plan: Plan = make_plan(self._scene)
         self._k = K.constants(self._T)
+        self._keep_lobe = False
         self._k64 = K.constants(np.float64)
         self.set_geometry(positions, normals)
 
@@ -205,6 +206,9 @@ class Shader:
 
     def _shininess_changed(self):
         self._S = None  # the stored bases and weights stay valid
+        # from now on keep each light's base and weight, so the next shininess change only
+        # re-runs the lobe (kept on demand: storing them costs 8 bytes per vertex and light)
+        self._keep_lobe = True
 
     # -- the work ------------------------------------------------------------------------------
     def _ambient_constant(self) -> np.ndarray:
@@ -335,7 +339,7 @@ class Shader:
         opts[K.O_FLAT] = flat
         opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do_amb, do_dif, do_spec
         opts[K.O_STORE] = keep
-        opts[K.O_STORE_LOBE] = keep and do_spec
+        opts[K.O_STORE_LOBE] = keep and do_spec and self._keep_lobe
         opts[K.O_COMPOSE] = 1
         opts[K.O_CLAMP] = self.clamp
         opts[K.O_TRACK] = T is np.float32
@@ -351,7 +355,7 @@ class Shader:
         A = cache(self._A, do_amb)
         D = cache(self._D, do_dif)
         S = cache(self._S, do_spec)
-        if keep and do_spec:
+        if opts[K.O_STORE_LOBE]:
             base = np.zeros((L, n), T)
             ws = np.zeros((L, n), T)
         else:
@@ -392,8 +396,9 @@ class Shader:
                 self._D = D
             if do_spec:
                 self._S = S
-                self._base = base if not flat else None
-                self._ws = ws
+                if opts[K.O_STORE_LOBE]:
+                    self._base = base if not flat else None
+                    self._ws = ws
                 self._spec_shininess = scene.material.shininess
 
     def _fixup(self, idx, opts, A, D, S, base, ws):

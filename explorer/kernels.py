@@ -28,7 +28,7 @@ from numba.extending import intrinsic, overload
 
 from . import tolerances as tol
 
-BLOCK = 256
+BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
 _OPTS = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True)
 
@@ -134,9 +134,9 @@ def constants(dtype) -> np.ndarray:
 
 # --------------------------------------------------------------------------------------------
 # pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
-# log2 x from the exponent bits plus ln(1 + z) on z in [-0.29, 0.41] (Cephes logf polynomial);
-# 2**t = 2**k · 2**f with f in [-0.5, 0.5] (Cephes exp2f polynomial) and 2**k written as exponent
-# bits. Measured absolute error <= 1e-7 for y in [1e-6, 1e4] (tests/test_kernels.py). Results
+# log2 x from the exponent bits plus ln(1 + z) = z - z²/2 + z³·P(z), z in [-0.29, 0.41] (P of
+# degree 5, fitted like Cephes logf); 2**t = 2**k · 2**f with f in [-0.5, 0.5] (degree-5 fit)
+# and 2**k written as exponent bits. Relative error about 1e-6 (tests/test_kernels.py). Results
 # below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per element, which
 # does not vectorise (~15x slower here); this one inlines into the shading loop.
 
@@ -182,28 +182,24 @@ def pow32(x, y):
     f = f * np.float32(0.5) if big else f
     e = e + np.float32(1.0) if big else e
     z = f - np.float32(1.0)
-    p = np.float32(7.0376836292e-2)
-    p = p * z + np.float32(-1.1514610310e-1)
-    p = p * z + np.float32(1.1676998740e-1)
-    p = p * z + np.float32(-1.2420140846e-1)
-    p = p * z + np.float32(1.4249322787e-1)
-    p = p * z + np.float32(-1.6668057665e-1)
-    p = p * z + np.float32(2.0000714765e-1)
-    p = p * z + np.float32(-2.4999993993e-1)
-    p = p * z + np.float32(3.3333331174e-1)
+    p = np.float32(-0.10746953303517079)  # least-squares fit, |error| <= 3.5e-7 on the range
+    p = p * z + np.float32(0.15904727806564242)
+    p = p * z + np.float32(-0.16972990678158706)
+    p = p * z + np.float32(0.1993995441108155)
+    p = p * z + np.float32(-0.24992546983782263)
+    p = p * z + np.float32(0.33333703609427834)
     ln = z + z * z * (z * p - np.float32(0.5))
     t = y * (e + ln * np.float32(1.4426950408889634))
     t = t if x > np.float32(0.0) else np.float32(-200.0)
     t = max(t, np.float32(-127.0))
     k = np.floor(t + np.float32(0.5))
     fr = t - k
-    q = np.float32(1.535336188319500e-4)
-    q = q * fr + np.float32(1.339887440266574e-3)
-    q = q * fr + np.float32(9.618437357674640e-3)
-    q = q * fr + np.float32(5.550332471162809e-2)
-    q = q * fr + np.float32(2.402264791363012e-1)
-    q = q * fr + np.float32(6.931472028550421e-1)
-    q = q * fr + np.float32(1.0)
+    q = np.float32(0.0013390867352163702)  # 2**f = 1 + f·Q(f), least squares, rel. err 2e-7
+    q = q * fr + np.float32(0.00966637369320816)
+    q = q * fr + np.float32(0.05550357104250901)
+    q = q * fr + np.float32(0.24022348940946955)
+    q = q * fr + np.float32(0.6931471880293432)
+    q = q * fr + np.float32(1.0)  # exact at f = 0: 1**y == 1
     return q * i2f((np.int32(k) + np.int32(127)) << 23)
 
 
@@ -431,38 +427,44 @@ def _light_any(r, m, q, y, k, positional, mode, l_dif, l_spec):
 
 
 @nb.njit(**_OPTS)
-def _to_light(r, m, q, k):
-    """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex), d, w = 1."""
-    one, eps, amb_dist = k[K_ONE], k[K_POINT_EPS], k[K_AMB_DIST]
-    zero = k[K_ZERO]
+def _to_light(r, m, q, k, atten):
+    """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex) and the weight
+    w = 1 / max(kc + kl·d + kq·d², floor) when ``atten`` (kl, kq scaled to the frame), else 1."""
+    one, eps2, amb_dist2 = k[K_ONE], k[K_POINT_EPS] * k[K_POINT_EPS], k[K_AMB_DIST] ** 2
+    zero, floor = k[K_ZERO], k[K_ATT_FLOOR]
+    kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
     qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
     px, py, pz, nx, ny, nz = r[R_PX], r[R_PY], r[R_PZ], r[R_NX], r[R_NY], r[R_NZ]
-    Lx, Ly, Lz, D, W, TRK = r[R_LX], r[R_LY], r[R_LZ], r[R_D], r[R_W], r[R_TRK]
-    for i in range(m):
-        x = qx - px[i]
-        y = qy - py[i]
-        z = qz - pz[i]
-        d = np.sqrt(x * x + y * y + z * z)
-        at = d < eps
-        inv = one / (one if at else d)
-        a, b, c = nx[i], ny[i], nz[i]
-        Lx[i] = a if at else x * inv
-        Ly[i] = b if at else y * inv
-        Lz[i] = c if at else z * inv
-        D[i] = d
-        W[i] = one
-        TRK[i] = max(TRK[i], one if d < amb_dist else zero)
-
-
-@nb.njit(**_OPTS)
-def _attenuate(r, m, q, k):
-    """w = 1 / max(kc + kl·d + kq·d², floor) (kl, kq already scaled to the frame)."""
-    one, floor = k[K_ONE], k[K_ATT_FLOOR]
-    kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
-    D, W = r[R_D], r[R_W]
-    for i in range(m):
-        d = D[i]
-        W[i] = one / max(kc + (kl + kq * d) * d, floor)
+    Lx, Ly, Lz, W, TRK = r[R_LX], r[R_LY], r[R_LZ], r[R_W], r[R_TRK]
+    if atten:
+        for i in range(m):
+            x = qx - px[i]
+            y = qy - py[i]
+            z = qz - pz[i]
+            d2 = x * x + y * y + z * z
+            at = d2 < eps2
+            inv = one / np.sqrt(one if at else d2)
+            d = np.sqrt(d2) if at else d2 * inv
+            a, b, c = nx[i], ny[i], nz[i]
+            Lx[i] = a if at else x * inv
+            Ly[i] = b if at else y * inv
+            Lz[i] = c if at else z * inv
+            W[i] = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
+            TRK[i] = max(TRK[i], one if d2 < amb_dist2 else zero)
+    else:
+        for i in range(m):
+            x = qx - px[i]
+            y = qy - py[i]
+            z = qz - pz[i]
+            d2 = x * x + y * y + z * z
+            at = d2 < eps2
+            inv = one / np.sqrt(one if at else d2)
+            a, b, c = nx[i], ny[i], nz[i]
+            Lx[i] = a if at else x * inv
+            Ly[i] = b if at else y * inv
+            Lz[i] = c if at else z * inv
+            W[i] = one
+            TRK[i] = max(TRK[i], one if d2 < amb_dist2 else zero)
 
 
 @nb.njit(**_OPTS)
@@ -652,9 +654,7 @@ def _block(
         else:
             mode = LOBE_BLINN
         if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
-            _to_light(r, m, q, k)
-            if fl & ATTEN:
-                _attenuate(r, m, q, k)
+            _to_light(r, m, q, k, (fl & ATTEN) != 0)
             if fl & SPOT:
                 _spot(r, m, q, k, (fl & SPOT_EXP) != 0)
             if l_amb:

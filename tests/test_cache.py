@@ -84,7 +84,14 @@ def test_material_colours_only_recompose(shader):
 def test_shininess_only_reruns_the_lobe(shader):
     _ = shader.colors
     before = counts(shader)
-    for n in (5.0, 120.0, 0.0, 64.0):
+    # the first shininess change recomputes the specular sum once, keeping each light's base
+    # and weight; from then on a shininess change only re-runs the lobe
+    shader.set_material(shader.scene.material.replace(shininess=5.0))
+    _ = shader.colors
+    check(shader)
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1}
+    before = counts(shader)
+    for n in (120.0, 0.0, 64.0, 1.5):
         shader.set_material(shader.scene.material.replace(shininess=n))
         _ = shader.colors
         check(shader)
