@@ -1,0 +1,170 @@
+"""Engine benchmark: throughput of full shading and the cost of each interactive update.
+
+    python benchmarks/bench_engine.py                # 1M vertices, 8 point lights
+    python benchmarks/bench_engine.py --vertices 200000 --lights 4 --repeat 15
+
+Prints the machine, then one row per case: median and best wall time over ``--repeat`` runs (the
+first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
+floor of a recolour (read positions and normals once, write colours once) is measured in the
+same run, on the same arrays, so "recolour / floor" is a like-for-like ratio.
+Timings are wall-clock and vary with machine load: the load average is printed with the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+
+import numba
+import numpy as np
+
+import explorer
+from explorer import kernels as K
+from explorer.lights import PointLight
+from explorer.material import Material
+from explorer.reference import reference_shade
+from explorer.scene import Scene, Viewer
+
+
+def machine() -> str:
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    return (
+        f"{cpu}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
+        f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
+        f"load average {load:.2f}"
+    )
+
+
+def timed(fn, repeat: int) -> tuple[float, float]:
+    fn()  # compile / warm up
+    ts = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t)
+    return statistics.median(ts), min(ts)
+
+
+def sphere_points(n: int, rng) -> tuple[np.ndarray, np.ndarray]:
+    N = rng.normal(size=(n, 3))
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    return N.astype(np.float32), N.astype(np.float32)
+
+
+def scene_with(lights: int, rng) -> Scene:
+    return Scene(
+        material=Material(
+            ambient=(0.2, 0.1, 0.05), diffuse=(0.7, 0.4, 0.2), specular=(0.4, 0.3, 0.2),
+            shininess=25.6,
+        ),
+        viewer=Viewer(eye=(0.0, 0.0, 5.0)),
+        lights=tuple(
+            PointLight(position=tuple(rng.normal(size=3) * 3), attenuation=(1.0, 0.1, 0.01))
+            for _ in range(lights)
+        ),
+    )
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--vertices", type=int, default=1_000_000)
+    ap.add_argument("--lights", type=int, default=8)
+    ap.add_argument("--repeat", type=int, default=11)
+    args = ap.parse_args(argv)
+    n, L, R = args.vertices, args.lights, args.repeat
+    rng = np.random.default_rng(0)
+    P, N = sphere_points(n, rng)
+    scene = scene_with(L, rng)
+    other = scene_with(L, np.random.default_rng(1)).lights
+
+    rows = []
+
+    def row(name, med, best, work=None, note=""):
+        rate = f"{work / med / 1e9:.2f}" if work else ""
+        rows.append((name, med * 1e3, best * 1e3, rate, note))
+
+    # full shading after a light change (geometry prepared once, as in the explorer)
+    for precision in ("float32", "float64"):
+        sh = explorer.Shader(scene, P, N, precision=precision)
+        flip = [scene.lights, other]
+
+        def relight(sh=sh, flip=flip):
+            flip.reverse()
+            sh.set_lights(flip[0])
+            return sh.colors
+
+        med, best = timed(relight, R)
+        row(f"full shading, {precision} ({L} point lights, Blinn, local viewer)", med, best,
+            n * L, "light change: every term recomputed")
+        if precision == "float32":
+            full32 = med
+
+    one_shot = timed(lambda: explorer.shade(scene, P, N, precision="float32"), R)
+    row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
+
+    # interactive updates, float32 Shader
+    sh = explorer.Shader(scene, P, N, precision="float32")
+    _ = sh.colors
+    mats = [scene.material, scene.material.replace(diffuse=(0.3, 0.6, 0.2))]
+
+    def recolour():
+        mats.reverse()
+        sh.set_material(mats[0])
+        return sh.colors
+
+    recol = timed(recolour, R)
+    row("material colour change (recompose only)", *recol)
+    shin = [25.6, 80.0]
+
+    def reshine():
+        shin.reverse()
+        sh.set_material(sh.scene.material.replace(shininess=shin[0]))
+        return sh.colors
+
+    row("shininess change (lobe only)", *timed(reshine, R), n * L)
+    eyes = [Viewer(eye=(0.0, 0.0, 5.0)), Viewer(eye=(1.0, 2.0, 5.0))]
+
+    def review():
+        eyes.reverse()
+        sh.set_viewer(eyes[0])
+        return sh.colors
+
+    row("viewer change (specular only)", *timed(review, R), n * L)
+
+    out = np.empty((n, 3), np.float32)
+    floor = timed(lambda: K.stream(P, N, out), R)
+    row("bandwidth floor: read P, N once + write colours once", *floor)
+
+    sub = max(n // 20, 1)
+    ref = timed(lambda: reference_shade(scene, P[:sub], N[:sub]), max(3, R // 3))
+    row(f"plain numpy float64 reference (full generality; on {sub} vertices, scaled)",
+        ref[0] * n / sub, ref[1] * n / sub, n * L)
+
+    print(f"machine: {machine()}")
+    print(f"mesh: {n} vertices, {L} point lights; median and best of {R} runs\n")
+    print("| case | median ms | best ms | G vertex-lights/s | note |")
+    print("|---|---:|---:|---:|---|")
+    for name, med, best, rate, note in rows:
+        print(f"| {name} | {med:.2f} | {best:.2f} | {rate} | {note} |")
+    print()
+    print(f"recolour / bandwidth floor: {recol[0] / floor[0]:.2f}x (median), "
+          f"{recol[1] / floor[1]:.2f}x (best)")
+    print(f"full float32 shading vs plain numpy reference: {ref[0] * n / sub / full32:.1f}x faster")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
