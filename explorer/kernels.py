@@ -314,6 +314,7 @@ def _light_overload(r, m, q, y, k, variant):
     dif = bool(v & 8)
     spec = bool(v & 16)
     lobe_on = spec and mode != LOBE_FLAT
+    track = r.dtype.dtype == types.float32  # only the float32 path marks ambiguous lanes
 
     def impl(r, m, q, y, k, variant):
         # rows as separate 1-D arrays: lets the compiler check overlap once and vectorise
@@ -368,7 +369,8 @@ def _light_overload(r, m, q, y, k, variant):
                 Sy[i] += t * sg
                 Sz[i] += t * sb
                 WS[i] = ws
-                TRK[i] = max(TRK[i], one if amb else zero)
+                if track:
+                    TRK[i] = max(TRK[i], one if amb else zero)
 
     return impl
 
