@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import ExplorerError
+from .fileio import write_atomic
 from .meshes import Mesh
 
 Vec3 = tuple[float, float, float]
@@ -551,47 +551,6 @@ def mesh_file_bytes(mesh: Mesh, colors, suffix: str, opacity: float = 1.0) -> by
 
 
 def write_file_atomic(path, data: bytes, *, force: bool = False) -> Path:
-    """Write bytes to ``path`` atomically (a temporary file in the same directory, flushed,
-    then renamed into place). An existing file is replaced only with ``force``; the directory
-    must exist. Errors are :class:`ExplorerError` naming the path."""
-    target = Path(os.fspath(path))
-    if target.is_dir():
-        raise ExplorerError(f"{target}: is a directory; give a file name to write")
-    parent = target.parent
-    if not parent.is_dir():
-        raise ExplorerError(f"{target}: directory {str(parent)!r} does not exist")
-    if target.exists() and not force:
-        raise ExplorerError(f"{target}: already exists; not overwriting it (use --force)")
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        if force:
-            os.replace(tmp, target)
-        else:
-            try:
-                os.link(tmp, target)  # fails if the target appeared meanwhile
-            except FileExistsError:
-                raise ExplorerError(
-                    f"{target}: already exists; not overwriting it (use --force)"
-                ) from None
-            except OSError:  # file systems without hard links
-                os.replace(tmp, target)
-                tmp = None
-    except ExplorerError:
-        raise
-    except OSError as exc:
-        raise ExplorerError(f"{target}: cannot write: {exc.strerror or exc}") from None
-    finally:
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-    return target
+    """Write bytes to ``path`` atomically (:func:`explorer.fileio.write_atomic`). An existing
+    file is replaced only with ``force``; the directory must exist."""
+    return write_atomic(path, data, overwrite=force, make_dirs=False)

@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import os
 import re
-import tempfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
@@ -45,7 +44,8 @@ from pathlib import Path
 
 import yaml
 
-from .errors import ExplorerError, Problem, ValidationError
+from .errors import Problem, ValidationError
+from .fileio import write_atomic
 
 #: Largest document accepted, in bytes (1 MiB: presets and scenes are a few hundred bytes).
 MAX_BYTES = 1 << 20
@@ -449,88 +449,8 @@ def dump_yaml(data, *, header: str | None = None) -> str:
 
 
 def write_yaml_atomic(path, data, *, overwrite: bool = False, header: str | None = None) -> Path:
-    """Write ``data`` as YAML to ``path`` atomically; returns the path written.
-
-    A temporary file is written in the target directory, flushed to disk and renamed over the
-    target, so a reader sees either the old file or the complete new one, never a torn one.
-    Parent directories are created. An existing file is only replaced with ``overwrite=True``
-    (otherwise :class:`~explorer.errors.ExplorerError`); the temporary file is removed if
-    anything fails.
-    """
-    target = Path(os.fspath(path))
+    """Write ``data`` as YAML to ``path`` atomically (see :func:`explorer.fileio.write_atomic`);
+    returns the path written. Parent directories are created; an existing file is only replaced
+    with ``overwrite=True`` (otherwise :class:`~explorer.errors.ExplorerError`)."""
     text = dump_yaml(data, header=header)  # before touching the disk: bad data fails first
-    if target.is_dir():
-        raise ExplorerError(f"{target}: is a directory; give a file name to write")
-    if target.exists() and not overwrite:
-        raise _exists(target)
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ExplorerError(
-            f"{target.parent}: cannot create directory: {exc.strerror or exc}"
-        ) from None
-    tmp = None
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        if overwrite:
-            os.replace(tmp, target)
-        else:
-            _link_no_clobber(tmp, target)
-        tmp = None
-        _fsync_dir(target.parent)
-    except ExplorerError:
-        raise
-    except OSError as exc:
-        raise ExplorerError(f"{target}: cannot write: {exc.strerror or exc}") from None
-    finally:
-        if tmp is not None:
-            try:
-                os.unlink(tmp)
-            except OSError:
-                pass
-    return target
-
-
-def _exists(target: Path) -> ExplorerError:
-    return ExplorerError(
-        f"{target}: already exists; not overwriting it. Choose another name, or overwrite "
-        "explicitly (overwrite=True / the --force option)"
-    )
-
-
-def _link_no_clobber(tmp: str, target: Path) -> None:
-    """Move ``tmp`` to ``target`` only if ``target`` does not exist (atomic where possible)."""
-    try:
-        os.link(tmp, target)
-    except FileExistsError:
-        raise _exists(target) from None
-    except OSError:  # no hard links here (some network / FAT file systems)
-        if target.exists():
-            raise _exists(target) from None
-        os.replace(tmp, target)
-        return
-    os.unlink(tmp)
-
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _fsync_dir(directory: Path) -> None:
-    try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
+    return write_atomic(path, text.encode("utf-8"), overwrite=overwrite, make_dirs=True)
