@@ -21,6 +21,17 @@ from .errors import Problem, ValidationError
 Path = tuple
 
 
+def line_of(lines: Mapping[Path, int], path: Path) -> int | None:
+    """Line of ``path`` in ``lines``, or of its nearest enclosing key (None if none)."""
+    path = tuple(path)
+    while True:
+        if path in lines:
+            return lines[path]
+        if not path:
+            return None
+        path = path[:-1]
+
+
 def format_path(path: Path) -> str:
     """``("lights", 1, "position")`` -> ``"lights[1].position"``."""
     out = ""
@@ -59,13 +70,7 @@ class Checker:
 
     # -- bookkeeping -------------------------------------------------------------------------
     def line(self, path: Path) -> int | None:
-        path = tuple(path)
-        while True:
-            if path in self.lines:
-                return self.lines[path]
-            if not path:
-                return None
-            path = path[:-1]
+        return line_of(self.lines, path)
 
     def problem(self, path: Path, message: str) -> None:
         self.problems.append(

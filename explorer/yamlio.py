@@ -78,13 +78,9 @@ class YamlDocument:
 
     def line(self, path: tuple) -> int | None:
         """Line of ``path`` or of its nearest enclosing key."""
-        path = tuple(path)
-        while True:
-            if path in self.lines:
-                return self.lines[path]
-            if not path:
-                return None
-            path = path[:-1]
+        from .validate import line_of
+
+        return line_of(self.lines, path)
 
     def checker(self):
         """A :class:`~explorer.validate.Checker` reporting against this document's lines,
