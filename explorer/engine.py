@@ -11,9 +11,15 @@ shininess              the lobe only: ``Σ ws·base^n·s`` from stored per-light
                        distances, no normalisations), then compose
 viewer                 the specular sum (and, when two-sided, everything: N·V flips normals)
 model (phong/blinn)    the specular sum
-lights                 every sum the material needs
-geometry               every sum the material needs
+fresnel (F0)           the specular sum (F is stored in each light's lobe weight)
+energy_conserving      the lobe only, as for a shininess change (a constant per scene)
+lights                 every sum the material needs (shadow visibility is kept per light
+                       position and direction: only a moved light casts new rays)
+geometry               every sum the material needs, and new shadow rays
 =====================  =======================================================================
+
+Shadows need the mesh's triangles: pass ``faces`` (default None: no shadows, and the plan says
+so). ``force_all=True`` makes the plan skip nothing (same colours; for the benchmark only).
 
 A term the material does not need (``s_m = 0``, say) is not computed until it is needed.
 ``stats`` counts each kind of pass, so tests can check that a change costs what it should.
@@ -33,8 +39,11 @@ from .frame import check_vertices, frame_of, to_frame
 from .lights import DirectionalLight, SpotLight
 from .plan import Plan, make_plan
 from .scene import Scene, Viewer, load_scene
+from .shadows import is_convex, visibility
 
 PRECISIONS = ("float64", "float32")
+#: shadow rays are cast where N·L > -this (rounding of N·L must never skip a lit vertex)
+SHADOW_NDL_MARGIN = 1e-6
 
 
 def shade(
@@ -45,6 +54,7 @@ def shade(
     precision: str = "float64",
     clamp: bool = True,
     materials_dirs=(),
+    faces=None,
 ) -> np.ndarray:
     """Per-vertex colours of a mesh under a scene.
 
@@ -53,6 +63,7 @@ def shade(
     normals : (n, 3) float vertex normals (any length; zero means "no normal")
     precision : "float64" (exact path) or "float32" (fast path, within 1/255 of float64)
     clamp : clamp to [0, 1] (OpenGL); False keeps the unclamped sums (>= 0) for HDR
+    faces : (m, 3) int triangles, needed for shadows (None: no shadows)
     Returns colours : (n, 3) float64.
     """
     s = Shader(
@@ -63,6 +74,7 @@ def shade(
         clamp=clamp,
         materials_dirs=materials_dirs,
         keep=False,
+        faces=faces,
     )
     return np.asarray(s.colors, dtype=np.float64)
 
@@ -73,6 +85,8 @@ class Shader:
     positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation)
     precision : "float32" (default here: the interactive path) or "float64"
     keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
+    faces : (m, 3) int triangles for shadows (None: no shadows)
+    force_all : the plan skips nothing (same colours; benchmark only)
     """
 
     def __init__(
@@ -85,6 +99,8 @@ class Shader:
         clamp: bool = True,
         materials_dirs=(),
         keep: bool = True,
+        faces=None,
+        force_all: bool = False,
     ):
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
@@ -93,12 +109,12 @@ class Shader:
         self.clamp = bool(clamp)
         self.keep = bool(keep)
         self.stats: Counter = Counter()
+        self.force_all = bool(force_all)
         self._scene = load_scene(scene, materials_dirs=materials_dirs)
-        self._plan: Plan = make_plan(self._scene)
         self._k = K.constants(self._T)
         self._keep_lobe = False
         self._k64 = K.constants(np.float64)
-        self.set_geometry(positions, normals)
+        self.set_geometry(positions, normals, faces)
 
     # -- inputs ------------------------------------------------------------------------------
     @property
@@ -113,9 +129,17 @@ class Shader:
     def n(self) -> int:
         return len(self._P)
 
-    def set_geometry(self, positions, normals) -> None:
-        """New vertices: every cached sum is invalid."""
+    def set_geometry(self, positions, normals, faces=None) -> None:
+        """New vertices (and triangles, for shadows): every cached sum is invalid."""
         self._P, self._N = check_vertices(positions, normals)
+        if faces is not None:
+            faces = np.asarray(faces, np.int64).reshape(-1, 3)
+            if len(faces) and (faces.min() < 0 or faces.max() >= len(self._P)):
+                raise ExplorerError("faces index vertices that do not exist")
+        self._faces = faces
+        self._convex = None  # decided when a light first asks for shadows
+        self._vis_cache: dict = {}
+        self._plan = self._make_plan(self._scene)
         self._centre, self._scale = frame_of(self._P)
         n = len(self._P)
         self._G = np.empty((6, n), self._T)  # frame positions and unit normals, SoA
@@ -135,13 +159,14 @@ class Shader:
         if new == old:
             return
         self._scene = new
-        self._plan = make_plan(new)
+        self._plan = self._make_plan(new)
         if new.lights != old.lights or new.two_sided != old.two_sided:
             self._lights_changed()
             return
-        if new.viewer != old.viewer or new.model != old.model:
+        nm, om = new.material, old.material
+        if new.viewer != old.viewer or new.model != old.model or nm.fresnel != om.fresnel:
             self._viewer_changed()
-        if new.material.shininess != old.material.shininess:
+        if nm.shininess != om.shininess or nm.energy_conserving != om.energy_conserving:
             self._shininess_changed()
         self._colors = None  # material colours and scene ambient: compose only
         self._aconst = self._ambient_constant()
@@ -206,9 +231,58 @@ class Shader:
 
     def _shininess_changed(self):
         self._S = None  # the stored bases and weights stay valid
+        self._params = None  # an energy-conserving factor changes with n (cheap to redo)
         # from now on keep each light's base and weight, so the next shininess change only
         # re-runs the lobe (kept on demand: storing them costs 8 bytes per vertex and light)
         self._keep_lobe = True
+
+    # -- shadows -------------------------------------------------------------------------------
+    def _mesh_kind(self, scene) -> str | None:
+        """What the plan knows of the mesh: None (no faces), "convex" or "concave"."""
+        if self._faces is None:
+            return None
+        if not any(lt.shadows for lt in scene.lights):
+            return "concave"  # not asked: no need to decide
+        if self._convex is None:
+            self._convex = is_convex(self._P, self._faces)
+        return "convex" if self._convex else "concave"
+
+    def _make_plan(self, scene) -> Plan:
+        return make_plan(scene, mesh=self._mesh_kind(scene), force_all=self.force_all)
+
+    def _visibility(self, dtype) -> np.ndarray:
+        """(L, n) visibility rows of the lights the plan shadows, or (L, 0) when none."""
+        scene, plan = self._scene, self._plan
+        L, n = len(scene.lights), self.n
+        if not plan.shadows:
+            return np.zeros((L, 0), dtype)
+        vis = np.ones((L, n), dtype)
+        N = np.asarray(self._N, np.float64)
+        length = np.sqrt(np.einsum("ij,ij->i", N, N))
+        unit = (N / np.where(length > 0, length, 1.0)[:, None]).T  # (3, n)
+        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights, strict=True)):
+            if not lp.shadows:
+                continue
+            if isinstance(light, DirectionalLight):
+                where = ("d", light.direction)
+            else:
+                where = ("p", light.position)
+            key = (where, scene.two_sided, self.force_all)
+            v = self._vis_cache.get(key)
+            if v is None:
+                only = None
+                if not self.force_all:  # rays only where N·L can be > 0 (either side if 2-sided)
+                    if isinstance(light, DirectionalLight):
+                        ndl = np.asarray(light.direction) @ unit
+                    else:
+                        ndl = np.einsum("ij,ji->i", np.asarray(light.position) - self._P, unit)
+                    # a margin: a ray more than needed is harmless, one fewer is not
+                    only = length > 0 if scene.two_sided else ndl > -SHADOW_NDL_MARGIN
+                v = visibility(self._P, self._faces, light, only=only)
+                self._vis_cache[key] = v
+                self.stats["shadow_rays"] += int(n if only is None else only.sum())
+            vis[i] = v
+        return vis
 
     # -- the work ------------------------------------------------------------------------------
     def _ambient_constant(self) -> np.ndarray:
@@ -235,7 +309,7 @@ class Shader:
             q = params[i]
             if isinstance(light, DirectionalLight):
                 q[K.P_POS : K.P_POS + 3] = light.direction
-                if scene.model == "blinn" and not scene.viewer.local:
+                if scene.model == "blinn" and not scene.viewer.local and not plan.force_all:
                     h = np.asarray(light.direction) + view
                     hn = math.sqrt(float(h @ h))
                     if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
@@ -257,7 +331,14 @@ class Shader:
                     f |= K.SPOT_EXP
             q[K.P_AMB : K.P_AMB + 3] = lp.factor * np.asarray(light.ambient)
             q[K.P_DIF : K.P_DIF + 3] = lp.factor * np.asarray(light.diffuse)
-            q[K.P_SPEC : K.P_SPEC + 3] = lp.factor * np.asarray(light.specular)
+            q[K.P_SPEC : K.P_SPEC + 3] = (
+                lp.factor * plan.specular_scale * np.asarray(light.specular)
+            )
+            if lp.shadows:
+                f |= K.SHADOW
+            if plan.fresnel is not None and lp.specular:
+                f |= K.FRESNEL
+                q[K.P_F0] = plan.fresnel
             if lp.ambient and lp.varying_weight:
                 f |= K.AMBIENT
             if lp.diffuse:
@@ -343,6 +424,7 @@ class Shader:
         opts[K.O_COMPOSE] = 1
         opts[K.O_CLAMP] = self.clamp
         opts[K.O_TRACK] = T is np.float32
+        opts[K.O_VIEW] = self._plan.fresnel is not None
         empty3 = np.zeros((0, 3), T)
 
         def cache(current, do):
@@ -363,6 +445,7 @@ class Shader:
         amb = self._amb
         if opts[K.O_TRACK]:
             amb[:] = 0
+        vis = self._visibility(T)
         shin = T(scene.material.shininess)
         K.shade(
             self._G,
@@ -379,6 +462,7 @@ class Shader:
             S,
             base,
             ws,
+            vis,
             amb,
             self._out,
         )
@@ -388,7 +472,7 @@ class Shader:
         if opts[K.O_TRACK]:
             idx = np.flatnonzero(amb)
             if idx.size:
-                self._fixup(idx, opts, A, D, S, base, ws)
+                self._fixup(idx, opts, A, D, S, base, ws, vis)
         if keep:
             if do_amb:
                 self._A = A
@@ -401,7 +485,7 @@ class Shader:
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
 
-    def _fixup(self, idx, opts, A, D, S, base, ws):
+    def _fixup(self, idx, opts, A, D, S, base, ws, vis):
         """Redo ambiguous float32 lanes in float64 and scatter the results back."""
         scene = self._scene
         f64 = np.float64
@@ -444,6 +528,7 @@ class Shader:
             S64,
             b64,
             w64,
+            np.ascontiguousarray(vis[:, idx] if vis.shape[1] else vis, dtype=f64),
             np.zeros(0, np.bool_),
             out64,
         )

@@ -41,6 +41,8 @@ AMBIENT = 16  # per-vertex (attenuated) ambient
 DIFFUSE = 32
 SPECULAR = 64
 CONST_H = 128  # Blinn with a directional light and an infinite viewer
+SHADOW = 256  # w *= visibility row (explorer.shadows) for diffuse and specular
+FRESNEL = 512  # specular weight *= Schlick F = F0 + (1 - F0)(1 - V·H)^5
 
 # per-light parameter columns
 P_POS = 0  # position, or direction toward a directional light (3)
@@ -52,13 +54,15 @@ P_AMB = 11  # ambient colour × constant factor (3)
 P_DIF = 14  # diffuse colour × constant factor (3)
 P_SPEC = 17  # specular colour × constant factor (3)
 P_H = 20  # constant halfway vector (3)
-N_PARAMS = 23
+P_F0 = 23  # Schlick F0 (Fresnel)
+N_PARAMS = 24
 
 # option slots (int64 array)
 O_LOCAL, O_TWO_SIDED, O_PHONG, O_FLAT = 0, 1, 2, 3
 O_DO_AMB, O_DO_DIF, O_DO_SPEC = 4, 5, 6  # recompute these sums in this pass
 O_STORE, O_STORE_LOBE, O_COMPOSE, O_CLAMP, O_TRACK = 7, 8, 9, 10, 11
-N_OPTS = 12
+O_VIEW = 12  # V rows are needed even for a flat lobe (Fresnel)
+N_OPTS = 13
 
 # scratch rows
 (
@@ -487,6 +491,42 @@ def _spot(r, m, q, k, exponent):
 
 
 @nb.njit(**_OPTS)
+def _dir_rows(r, m, q, one):
+    """Directional light on the row path (shadows, Fresnel): rows L = constant, w = 1."""
+    Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
+    qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+    for i in range(m):
+        Lx[i] = qx
+        Ly[i] = qy
+        Lz[i] = qz
+        W[i] = one
+
+
+@nb.njit(**_OPTS)
+def _shadow(r, m, vis):
+    """w *= visibility (0 or 1 per vertex, from explorer.shadows)."""
+    W = r[R_W]
+    for i in range(m):
+        W[i] = W[i] * vis[i]
+
+
+@nb.njit(**_OPTS)
+def _fresnel(r, m, q, k):
+    """w *= F = F0 + (1 - F0)(1 - V·H)^5 with V·H = sqrt((1 + V·L) / 2) (unit L, V)."""
+    zero, one = k[K_ZERO], k[K_ONE]
+    half = one / k[K_TWO]
+    f0 = q[P_F0]
+    Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
+    vx, vy, vz = r[R_VX], r[R_VY], r[R_VZ]
+    for i in range(m):
+        vl = Lx[i] * vx[i] + Ly[i] * vy[i] + Lz[i] * vz[i]
+        c = np.sqrt(max((one + vl) * half, zero))
+        x = one - c
+        x2 = x * x
+        W[i] = W[i] * (f0 + (one - f0) * (x2 * x2 * x))
+
+
+@nb.njit(**_OPTS)
 def _ambient(r, m, q):
     """A += w·a_i (an attenuated or cone-cut light ambient)."""
     ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
@@ -569,6 +609,7 @@ def _block(
     S,
     base_out,
     ws_out,
+    vis,
     amb,
     out,
     scr,
@@ -624,7 +665,7 @@ def _block(
     )
 
     _fill(trk, zero)
-    if two_sided or (do_spec and not flat):  # V toward the viewer
+    if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
         if opts[O_LOCAL]:
             _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
         else:
@@ -655,13 +696,25 @@ def _block(
             mode = LOBE_PHONG
         else:
             mode = LOBE_BLINN
+        fres = l_spec and (fl & FRESNEL) != 0
+        rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
         if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
             _to_light(r, m, q, k, (fl & ATTEN) != 0)
             if fl & SPOT:
                 _spot(r, m, q, k, (fl & SPOT_EXP) != 0)
             if l_amb:
                 _ambient(r, m, q)
-        _light_any(r, m, q, shininess, k, (fl & POSITIONAL) != 0, mode, l_dif, l_spec)
+        elif rows:  # a directional light on the row path
+            _dir_rows(r, m, q, k[K_ONE])
+        if fl & SHADOW:  # after the ambient: ambient light is not shadowed
+            _shadow(r, m, vis[li, :])
+        if fres:  # diffuse with w, then specular with w·F
+            if l_dif:
+                _light_any(r, m, q, shininess, k, True, mode, True, False)
+            _fresnel(r, m, q, k)
+            _light_any(r, m, q, shininess, k, True, mode, False, True)
+        else:
+            _light_any(r, m, q, shininess, k, rows, mode, l_dif, l_spec)
         if store_lobe and l_spec:
             if not flat:
                 base_out[li, :] = scr[R_BASE, :m]
@@ -683,7 +736,23 @@ def _block(
 
 @nb.njit(parallel=True, **_OPTS)
 def shade(
-    G, params, flags, view, opts, mat, aconst, shininess, k, A, D, S, base_out, ws_out, amb, out
+    G,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    vis,
+    amb,
+    out,
 ):
     """Shade every vertex (see the module docstring).
 
@@ -692,6 +761,7 @@ def shade(
     opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
     shininess : T; k : constants(T)
     A, D, S : (n, 3) T caches (or (0, 3)); base_out, ws_out : (L, n) T (or (L, 0))
+    vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
     amb : (n,) bool ambiguity marks (or (0,) when not tracking); out : (n, 3) colours
     """
     n = G.shape[1]
@@ -720,6 +790,7 @@ def shade(
             S[s:e],
             base_out[:, s:e],
             ws_out[:, s:e],
+            vis[:, s:e],
             amb[s:e],
             out[s:e],
             scr,

@@ -14,7 +14,7 @@ and ``specular`` RGB colours (defaults 0, 1, 1: OpenGL's ``GL_LIGHT0``); the ``c
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
 from .validate import Checker
@@ -55,12 +55,15 @@ class _Light:
     ambient: RGB = (0.0, 0.0, 0.0)
     diffuse: RGB = (1.0, 1.0, 1.0)
     specular: RGB = (1.0, 1.0, 1.0)
+    #: cast hard shadows on the mesh (see :mod:`explorer.shadows`); keyword only
+    shadows: bool = field(default=False, kw_only=True)
 
     type: ClassVar[str] = ""
 
     def _check_colours(self):
         for key in ("ambient", "diffuse", "specular"):
             object.__setattr__(self, key, _colour(getattr(self, key), f"light {key}"))
+        object.__setattr__(self, "shadows", bool(self.shadows))
 
     def replace(self, **changes):
         """A copy with some fields changed."""
@@ -131,7 +134,7 @@ class SpotLight(PointLight):
 
 Light = DirectionalLight | PointLight | SpotLight
 
-_COMMON = ("type", "ambient", "diffuse", "specular", "color", "intensity")
+_COMMON = ("type", "ambient", "diffuse", "specular", "color", "intensity", "shadows")
 LIGHT_KEYS = {
     "directional": _COMMON + ("direction",),
     "point": _COMMON + ("position", "attenuation"),
@@ -173,6 +176,8 @@ def parse_light(value, checker: Checker, path: tuple) -> Light | None:
             k = checker.number(m["intensity"], path + ("intensity",), 0.0, MAX_LIGHT_VALUE)
         if color is not None and k is not None:
             kw["diffuse"] = kw["specular"] = tuple(k * c for c in color)
+    if "shadows" in m:
+        kw["shadows"] = checker.boolean(m["shadows"], path + ("shadows",))
     if kind == "directional":
         if "direction" in m:
             kw["direction"] = checker.direction(m["direction"], path + ("direction",))
@@ -223,4 +228,6 @@ def light_to_mapping(light: Light) -> dict:
         out["exponent"] = light.exponent
     for key in ("ambient", "diffuse", "specular"):
         out[key] = list(getattr(light, key))
+    if light.shadows:
+        out["shadows"] = True
     return out

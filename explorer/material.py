@@ -49,12 +49,25 @@ RGB_KEYS = ("ambient", "diffuse", "specular", "emission")
 #: Keys of the scalar form (ka * color, kd * color, ks * specular_color).
 SCALAR_KEYS = ("ka", "kd", "ks", "color", "specular_color")
 #: Every key a material mapping may have.
-MATERIAL_KEYS = RGB_KEYS + SCALAR_KEYS + ("shininess", "opacity", "model", "description")
+MATERIAL_KEYS = (
+    RGB_KEYS
+    + SCALAR_KEYS
+    + (
+        "shininess",
+        "opacity",
+        "model",
+        "description",
+        "fresnel",
+        "energy_conserving",
+    )
+)
 #: Allowed shininess in files and sliders (the engine itself accepts any finite value >= 0).
 SHININESS_RANGE = (0.0, 1000.0)
 #: Allowed range of every reflection coefficient (RGB channels, ka, kd, ks) in files.
 COEFFICIENT_RANGE = (0.0, 1.0)
 OPACITY_RANGE = (0.0, 1.0)
+#: Allowed Schlick reflectance at normal incidence ``F0`` (``fresnel``).
+FRESNEL_RANGE = (0.0, 1.0)
 MODELS = ("blinn", "phong")
 
 #: term -> its scalar key, and the scalar defaults applied to ``color`` (OpenGL's 0.2 / 0.8).
@@ -72,6 +85,10 @@ class Material:
     opacity : alpha in [0, 1]; 1 is opaque
     model : default specular model for this material (``"blinn"`` / ``"phong"``) or None
     name, description : for people; never affect colours (and never affect ``==``)
+    fresnel : Schlick's F0 in [0, 1], or None (off): the specular term of each light is
+        weighted by ``F = F0 + (1 - F0)·(1 - V·H)^5`` (see :mod:`explorer.effects`)
+    energy_conserving : normalise the specular lobe, ``(n + 2)/(2π)`` (Phong) or
+        ``(n + 8)/(8π)`` (Blinn), so a higher shininess narrows the highlight without dimming it
     """
 
     ambient: RGB = (0.2, 0.2, 0.2)
@@ -83,6 +100,8 @@ class Material:
     model: str | None = None
     name: str | None = field(default=None, compare=False)
     description: str = field(default="", compare=False)
+    fresnel: float | None = None
+    energy_conserving: bool = False
 
     def __post_init__(self):
         for key in RGB_KEYS:
@@ -101,6 +120,12 @@ class Material:
         if self.model is not None and self.model not in MODELS:
             raise ValueError(f"material model must be one of {MODELS}, got {self.model!r}")
         object.__setattr__(self, "description", str(self.description or ""))
+        if self.fresnel is not None:
+            f = float(self.fresnel)
+            if not (FRESNEL_RANGE[0] <= f <= FRESNEL_RANGE[1]):
+                raise ValueError(f"material fresnel (F0) must be in [0, 1], got {f}")
+            object.__setattr__(self, "fresnel", f)
+        object.__setattr__(self, "energy_conserving", bool(self.energy_conserving))
 
     def replace(self, **changes) -> Material:
         """A copy with some fields changed (``m.replace(shininess=64)``)."""
@@ -122,6 +147,10 @@ class Material:
             out["opacity"] = float(self.opacity)
         if self.model is not None:
             out["model"] = self.model
+        if self.fresnel is not None:
+            out["fresnel"] = float(self.fresnel)
+        if self.energy_conserving:
+            out["energy_conserving"] = True
         return out
 
     # -- scalar view (ka / kd / ks sliders) ---------------------------------------------------
@@ -235,6 +264,12 @@ def parse_material(value, checker: Checker, path: tuple = ()) -> Material | None
         kw["model"] = checker.choice(m["model"], path + ("model",), MODELS)
     if "description" in m:
         kw["description"] = checker.string(m["description"], path + ("description",))
+    if "fresnel" in m:
+        kw["fresnel"] = checker.number(m["fresnel"], path + ("fresnel",), *FRESNEL_RANGE)
+    if "energy_conserving" in m:
+        kw["energy_conserving"] = checker.boolean(
+            m["energy_conserving"], path + ("energy_conserving",)
+        )
     if len(checker.problems) > before or any(v is None for v in kw.values()):
         return None
     return Material(**kw)

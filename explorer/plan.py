@@ -32,6 +32,8 @@ class LightPlan:
     attenuation : "none" | "constant" (folded into the colours) | "per-vertex"
     spot : "none" | "cone" | "cone+exponent"
     factor : constant attenuation 1/kc folded into the light's colours
+    shadows : shadow rays are cast for this light (``shadows: true``, faces given, the mesh
+        can shadow itself, the light has diffuse or specular)
     reasons : (item, "in"|"out", why) rows for people
     """
 
@@ -45,6 +47,7 @@ class LightPlan:
     spot: str
     factor: float
     reasons: tuple = ()
+    shadows: bool = False
 
     @property
     def varying_weight(self) -> bool:
@@ -64,6 +67,11 @@ class Plan:
     two_sided : flip N where N·V < 0
     lights : one LightPlan per scene light, in scene order
     reasons : (item, "in"|"out", why) rows for the scene-level decisions
+    fresnel : Schlick's F0 weighting the specular term, or None
+    specular_scale : energy-conserving lobe normalisation folded into the specular colours
+        (1 when off)
+    hdr : colours are displayed unclamped with exposure and a tone map
+    force_all : nothing is skipped (benchmark only; same colours)
     """
 
     emission: bool
@@ -78,6 +86,15 @@ class Plan:
     model: str
     lights: tuple[LightPlan, ...] = ()
     reasons: tuple = field(default=())
+    fresnel: float | None = None
+    specular_scale: float = 1.0
+    hdr: bool = False
+    force_all: bool = False
+
+    @property
+    def shadows(self) -> bool:
+        """Some light casts shadow rays."""
+        return any(lp.shadows for lp in self.lights)
 
     def light_does(self, lp: LightPlan) -> dict[str, bool]:
         """Which terms light ``lp`` computes under this plan."""
@@ -100,8 +117,61 @@ class Plan:
         return "\n".join(out)
 
 
-def make_plan(scene: Scene) -> Plan:
-    """Decide the work for ``scene`` (see the module docstring)."""
+#: what :func:`make_plan` knows of the mesh for shadows
+MESH_KINDS = (None, "convex", "concave")
+
+
+def make_plan(scene: Scene, *, mesh: str | None = None, force_all: bool = False) -> Plan:
+    """Decide the work for ``scene`` (see the module docstring).
+
+    mesh : what the shader knows of the mesh, for shadows: None (no faces given: nothing can
+        cast a shadow), "convex" (cannot shadow itself) or "concave"
+    force_all : skip nothing (every term of every light per vertex, shadow rays from every
+        vertex even on a convex mesh); the colours are the same. For the benchmark only.
+    """
+    if mesh not in MESH_KINDS:
+        raise ValueError(f"mesh must be one of {MESH_KINDS}, got {mesh!r}")
+    plan = _make_plan(scene, mesh)
+    if force_all:
+        plan = _forced(plan, scene, mesh)
+    return plan
+
+
+def _forced(plan: Plan, scene: Scene, mesh) -> Plan:
+    from dataclasses import replace
+
+    lights = []
+    for lp, lt in zip(plan.lights, scene.lights, strict=True):
+        att = "per-vertex" if lp.positional else "none"
+        lights.append(
+            replace(
+                lp,
+                ambient=True,
+                diffuse=True,
+                specular=True,
+                attenuation=att,
+                factor=1.0,
+                shadows=lt.shadows and mesh is not None,
+                reasons=lp.reasons + (("forced", "in", "force_all: nothing skipped"),),
+            )
+        )
+    flat = scene.material.shininess == 0.0
+    return replace(
+        plan,
+        ambient=True,
+        ambient_per_vertex=any(lp.varying_weight for lp in lights),
+        diffuse=True,
+        specular=True,
+        flat_specular=flat,
+        view="per-vertex" if scene.viewer.local else "constant",
+        halfway="none" if flat else ("reflection" if scene.model == "phong" else "per-vertex"),
+        lights=tuple(lights),
+        reasons=plan.reasons + (("forced", "in", "force_all: nothing skipped (benchmark)"),),
+        force_all=True,
+    )
+
+
+def _make_plan(scene: Scene, mesh) -> Plan:
     m = scene.material
     lights = scene.lights
     reasons = []
@@ -149,10 +219,10 @@ def make_plan(scene: Scene) -> Plan:
             else f"pow(base, {m.shininess:g}) per vertex",
         )
 
-    needs_view = (specular and not flat) or scene.two_sided
+    needs_view = (specular and (not flat or m.fresnel is not None)) or scene.two_sided
     if not needs_view:
         view = "none"
-        why("view vector", False, "no lobe and one-sided: V is never used")
+        why("view vector", False, "no lobe, no Fresnel and one-sided: V is never used")
     elif scene.viewer.local:
         view = "per-vertex"
         why("view vector", True, "local viewer: V = normalize(eye - P) per vertex")
@@ -165,9 +235,40 @@ def make_plan(scene: Scene) -> Plan:
         "flip N where N·V < 0" if scene.two_sided else "two_sided is false",
     )
 
+    fresnel = m.fresnel if specular else None
+    if m.fresnel is None:
+        why("fresnel", False, "material fresnel not set")
+    elif not specular:
+        why("fresnel", False, f"F0 = {m.fresnel:g} but there is no specular term to weight")
+    else:
+        why("fresnel", True, f"Schlick F0 = {m.fresnel:g}: specular × F0 + (1-F0)(1-V·H)^5")
+    from .effects import specular_scale
+
+    scale = specular_scale(scene)
+    if not m.energy_conserving:
+        why("energy", False, "material energy_conserving is false")
+    elif not specular:
+        why("energy", False, "energy_conserving, but there is no specular term to normalise")
+    else:
+        form = "(n+2)/(2π)" if scene.model == "phong" else "(n+8)/(8π)"
+        why("energy", True, f"energy_conserving: {form} = {scale:.4g} folded into s_i")
+    if scene.hdr is None:
+        why("hdr", False, "no hdr: colours clamped to [0, 1] (OpenGL)")
+    else:
+        why(
+            "hdr",
+            True,
+            f"unclamped, exposure {scene.hdr.exposure:g} stops, {scene.hdr.tone_map} tone "
+            "map, sRGB",
+        )
+        from .tonemap import energy_warnings
+
+        for w in energy_warnings(m):
+            why("kd + ks", False, "warning: " + w)
+
     lplans = []
     for i, lt in enumerate(lights):
-        lplans.append(_light_plan(i, lt, scene, m))
+        lplans.append(_light_plan(i, lt, scene, m, mesh, diffuse, specular))
     per_vertex_amb = ambient and any(lp.ambient and lp.varying_weight for lp in lplans)
 
     halfway = "none"
@@ -191,10 +292,13 @@ def make_plan(scene: Scene) -> Plan:
         model=scene.model,
         lights=tuple(lplans),
         reasons=tuple(reasons),
+        fresnel=fresnel,
+        specular_scale=scale if specular else 1.0,
+        hdr=scene.hdr is not None,
     )
 
 
-def _light_plan(i: int, lt, scene: Scene, m) -> LightPlan:
+def _light_plan(i: int, lt, scene: Scene, m, mesh, diffuse: bool, specular: bool) -> LightPlan:
     reasons = []
 
     def why(item, on, reason):
@@ -261,8 +365,20 @@ def _light_plan(i: int, lt, scene: Scene, m) -> LightPlan:
         why("specular", True, "Blinn: constant H (directional light, infinite viewer), N·H")
     else:
         why("specular", True, "Blinn: H = normalize(L + V) per vertex")
+    shadows = False
+    if not lt.shadows:
+        why("shadows", False, "shadows is false")
+    elif mesh is None:
+        why("shadows", False, "no mesh faces given: nothing can cast a shadow")
+    elif mesh == "convex":
+        why("shadows", False, "convex mesh: it cannot shadow itself")
+    elif not ((dif and diffuse) or (spec and specular)):
+        why("shadows", False, "no diffuse or specular from this light to shadow")
+    else:
+        shadows = True
+        why("shadows", True, "rays toward the light from vertices with N·L > 0 (others: none)")
     if not (amb or dif or spec):
         why("light", False, "all colours 0: skipped entirely")
     return LightPlan(
-        i, lt.type, amb, dif, spec, positional, attenuation, spot, factor, tuple(reasons)
+        i, lt.type, amb, dif, spec, positional, attenuation, spot, factor, tuple(reasons), shadows
     )

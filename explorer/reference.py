@@ -5,7 +5,14 @@ non-zero, so the planned fast path (:mod:`explorer.kernels`) is tested against i
 same documented policies (:mod:`explorer.tolerances`) for the cases the equation leaves undefined.
 
     c = e_m + a_m·a_scene
-      + Σ_i att_i · spot_i · ( a_m·a_i + max(N·L_i, 0)·d_m·d_i + f_i·max(N·H_i, 0)^n · s_m·s_i )
+      + Σ_i att_i · spot_i · ( a_m·a_i
+                               + vis_i · ( max(N·L_i, 0)·d_m·d_i
+                                           + f_i·F_i·E·max(N·H_i, 0)^n · s_m·s_i ) )
+
+with the effects of :mod:`explorer.effects` and :mod:`explorer.shadows`: ``vis_i`` the shadow
+visibility (1 without ``shadows: true`` or without faces; rays from every vertex, even on a
+convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and ``E`` the
+energy-conserving normalisation (1 without ``energy_conserving``).
 """
 
 from __future__ import annotations
@@ -15,6 +22,7 @@ import math
 import numpy as np
 
 from . import tolerances as tol
+from .effects import schlick, specular_scale
 from .frame import check_vertices, frame_of, to_frame
 from .lights import DirectionalLight, SpotLight
 from .scene import Scene
@@ -29,14 +37,18 @@ def _unit_or(v: np.ndarray, eps: float, fallback: np.ndarray) -> tuple[np.ndarra
     return unit, length
 
 
-def reference_terms(scene: Scene, positions, normals) -> dict[str, np.ndarray]:
+def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
     """Per-vertex light sums, independent of the material.
 
     Returns ``ambient``, ``diffuse``, ``specular`` : (n, 3) float64 such that the colour is
     ``e_m + a_m·ambient + d_m·diffuse + s_m·specular`` (``ambient`` includes the scene ambient).
     The specular sum uses the scene material's shininess and the scene's model.
+    faces : (m, 3) int triangles for shadows, or None
     """
+    from .shadows import visibility
+
     P, N = check_vertices(positions, normals)
+    world = P.astype(np.float64)
     P = P.astype(np.float64)
     N = N.astype(np.float64)
     n = len(P)
@@ -57,6 +69,8 @@ def reference_terms(scene: Scene, positions, normals) -> dict[str, np.ndarray]:
         N = np.where((np.einsum("ij,ij->i", N, V) < 0.0)[:, None], -N, N)
 
     shininess = scene.material.shininess
+    f0 = scene.material.fresnel
+    escale = specular_scale(scene)
     ambient = np.tile(np.asarray(scene.ambient, dtype=np.float64), (n, 1))
     diffuse = np.zeros((n, 3))
     specular = np.zeros((n, 3))
@@ -76,6 +90,10 @@ def reference_terms(scene: Scene, positions, normals) -> dict[str, np.ndarray]:
             inside = x >= math.cos(math.radians(light.cutoff))
             spot = np.where(inside, np.maximum(x, 0.0) ** light.exponent, 0.0)
         w = att * spot
+        vis = np.ones(n)
+        if light.shadows and faces is not None:
+            vis = visibility(world, faces, light)
+        fres = np.ones(n) if f0 is None else schlick(f0, np.einsum("ij,ij->i", V, L))
 
         ndl = np.einsum("ij,ij->i", N, L)
         lit = ndl > 0.0  # f_i: specular only where N·L > 0
@@ -90,14 +108,17 @@ def reference_terms(scene: Scene, positions, normals) -> dict[str, np.ndarray]:
         lobe = np.maximum(base, 0.0) ** shininess  # numpy: 0.0 ** 0.0 == 1.0
 
         ambient += w[:, None] * np.asarray(light.ambient)  # a_i (attenuated)
-        diffuse += (w * np.maximum(ndl, 0.0))[:, None] * np.asarray(light.diffuse)  # d_i
-        specular += (w * lit * lobe)[:, None] * np.asarray(light.specular)  # s_i
+        diffuse += (w * vis * np.maximum(ndl, 0.0))[:, None] * np.asarray(light.diffuse)  # d_i
+        spec_w = w * vis * lit * fres * escale
+        specular += (spec_w * lobe)[:, None] * np.asarray(light.specular)  # s_i
     return {"ambient": ambient, "diffuse": diffuse, "specular": specular}
 
 
-def reference_shade(scene: Scene, positions, normals, *, clamp: bool = True) -> np.ndarray:
+def reference_shade(
+    scene: Scene, positions, normals, *, clamp: bool = True, faces=None
+) -> np.ndarray:
     """Colours (n, 3) float64 by the full-generality reference (see module docstring)."""
-    t = reference_terms(scene, positions, normals)
+    t = reference_terms(scene, positions, normals, faces)
     m = scene.material
     c = (
         np.asarray(m.emission)  # e_m

@@ -12,6 +12,10 @@ The scene-file schema (every key optional)::
       - {type: point, position: [2, 3, 1], attenuation: [1, 0.1, 0.01]}
       - {type: spot, position: [0, 4, 0], direction: [0, -1, 0], cutoff: 30, exponent: 8}
     mesh: sphere              # built-in name or mesh file (relative to the scene file)
+    hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
+
+Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
+light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
 """
 
 from __future__ import annotations
@@ -24,11 +28,12 @@ from dataclasses import dataclass, field, replace
 from .errors import ExplorerError
 from .lights import DirectionalLight, light_to_mapping, parse_light
 from .material import MODELS, Material, parse_material
+from .tonemap import HDR, parse_hdr
 from .validate import Checker
 
 Vec3 = tuple[float, float, float]
 
-SCENE_KEYS = ("material", "model", "ambient", "viewer", "two_sided", "lights", "mesh")
+SCENE_KEYS = ("material", "model", "ambient", "viewer", "two_sided", "lights", "mesh", "hdr")
 VIEWER_KEYS = ("eye", "direction")
 DEFAULT_AMBIENT = (0.2, 0.2, 0.2)
 
@@ -81,6 +86,8 @@ class Scene:
     two_sided : light back faces with -N
     lights : tuple of lights
     mesh : built-in mesh name or a file path, or None where arrays are given
+    hdr : display unclamped colours with this exposure and tone map (:mod:`explorer.tonemap`),
+        or None (OpenGL: clamp to [0, 1])
     source : the file the scene came from (for messages), or None
     """
 
@@ -92,6 +99,7 @@ class Scene:
     lights: tuple = DEFAULT_LIGHTS
     mesh: str | None = None
     source: str | None = field(default=None, compare=False)
+    hdr: HDR | None = None
 
     def __post_init__(self):
         if self.model not in MODELS:
@@ -119,6 +127,8 @@ class Scene:
         }
         if self.mesh is not None:
             out["mesh"] = self.mesh
+        if self.hdr is not None:
+            out["hdr"] = self.hdr.to_mapping()
         return out
 
 
@@ -185,6 +195,8 @@ def _parse(data, checker: Checker, materials_dirs, base_dir) -> Scene:
         if mesh is not None and base_dir and _looks_like_path(mesh):
             mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
         kw["mesh"] = mesh
+    if "hdr" in m:
+        kw["hdr"] = parse_hdr(m["hdr"], checker, ("hdr",))
     checker.raise_if_any()
     return Scene(source=checker.file, **kw)
 
