@@ -21,7 +21,15 @@ def run(args) -> int:
     from .scene import load_scene
 
     scene = load_scene(args.scene, materials_dirs=args.materials)
-    plan = make_plan(scene)
+    mesh_kind = None
+    if any(lt.shadows for lt in scene.lights):  # shadows depend on the mesh: look at it
+        from .meshes import DEFAULT_MESH, get_mesh
+        from .shadows import is_convex
+
+        mesh = get_mesh(scene.mesh or DEFAULT_MESH)
+        mesh_kind = "convex" if is_convex(mesh.positions, mesh.faces) else "concave"
+        print(f"mesh {mesh.name}: {mesh_kind} ({mesh.n_faces} triangles)")
+    plan = make_plan(scene, mesh=mesh_kind)
     m = scene.material
     viewer = (
         f"eye {list(scene.viewer.eye)}"

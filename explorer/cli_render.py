@@ -87,6 +87,17 @@ def _scene_arguments(p: argparse.ArgumentParser, *, mesh_default: str | None) ->
         "--background", nargs=3, type=float, metavar=("R", "G", "B"),
         help="background colour, each in [0, 1] (default 0.32 0.32 0.32)",
     )  # fmt: skip
+    h = p.add_argument_group("HDR (scene key hdr: {exposure, tone_map}); either option turns it on")
+    h.add_argument(
+        "--exposure", type=float, metavar="STOPS", default=None,
+        help="HDR exposure in stops, -16 to 16 (colour x 2**STOPS; default 0)",
+    )  # fmt: skip
+    from .tonemap import TONE_MAPS
+
+    h.add_argument(
+        "--tone-map", dest="tone_map", choices=TONE_MAPS, default=None,
+        help="HDR tone map (default reinhard); the result is sRGB-encoded",
+    )  # fmt: skip
     p.add_argument("--force", action="store_true", help="replace the output file if it exists")
 
 
@@ -215,6 +226,17 @@ def build_scene(args, *, default_light=None):
     viewer = _viewer(args)
     if viewer is not None:
         changes["viewer"] = viewer
+    if args.exposure is not None or args.tone_map is not None:
+        from .tonemap import HDR
+
+        old = scene.hdr or HDR()
+        try:
+            changes["hdr"] = HDR(
+                exposure=old.exposure if args.exposure is None else args.exposure,
+                tone_map=old.tone_map if args.tone_map is None else args.tone_map,
+            )
+        except ValueError as exc:
+            raise ExplorerError(f"--exposure: {exc}") from None
     scene = scene.replace(**changes)
     spec = args.mesh if args.mesh is not None else scene.mesh
     if spec is None:
@@ -261,6 +283,13 @@ def run_render(args) -> int:
     background = _background(args)
     args.mesh_default = "sphere"
     scene, mesh = build_scene(args)
+    if scene.hdr is not None:
+        import sys
+
+        from .tonemap import energy_warnings
+
+        for w in energy_warnings(scene.material):
+            print(f"warning: {w}", file=sys.stderr)
     colors = R.vertex_colors(scene, mesh)
     if suffix == ".png":
         image = R.render_image(scene, mesh, size, background=background, colors=colors)

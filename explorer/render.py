@@ -178,10 +178,27 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
 
 
 def vertex_colors(scene, mesh: Mesh, *, precision: str = "float64") -> np.ndarray:
-    """Engine colours of the mesh's vertices under the scene: (n, 3) float64 in [0, 1]."""
+    """Engine colours of the mesh's vertices under the scene: (n, 3) float64 in [0, 1].
+
+    The mesh's triangles go to the engine too (shadows). A scene with ``hdr`` is shaded
+    unclamped and shown through its exposure, tone map and the sRGB encoding
+    (:func:`explorer.tonemap.display`); the renderer then interpolates the encoded values."""
     import explorer
 
-    return explorer.shade(scene, mesh.positions, mesh.normals, precision=precision)
+    hdr = getattr(scene, "hdr", None)
+    c = explorer.shade(
+        scene,
+        mesh.positions,
+        mesh.normals,
+        precision=precision,
+        clamp=hdr is None,
+        faces=mesh.faces,
+    )
+    if hdr is not None:
+        from .tonemap import display
+
+        c = display(c, hdr)
+    return c
 
 
 def to_bytes(colors, opacity: float | None = None) -> np.ndarray:
@@ -272,6 +289,7 @@ class OffscreenRenderer:
         label: str | None = None,
         label_size: int | None = None,
         camera: Camera | None = None,
+        backdrop=None,
     ) -> np.ndarray:
         """Draw the mesh in the engine's colours and return the picture.
 
@@ -281,6 +299,9 @@ class OffscreenRenderer:
             keeps the bottom of the picture free for it
         label_size : its font size in pixels (default: the largest that fits)
         camera : overrides :func:`camera_for`
+        backdrop : an opaque second object drawn with the mesh, ``(Mesh, colors (k, 3))``; a
+            translucent mesh in front of it blends over it (VTK draws opaque geometry first,
+            then the translucent triangles back to front with the depth test on)
         Returns (height, width, 3) uint8.
         """
         pl = self.plotter
@@ -325,8 +346,23 @@ class OffscreenRenderer:
             cells = np.hstack([np.full((len(faces), 1), 3, np.int64), faces]).ravel()
             self._poly.faces = cells
             self._sorted = order is not None
-        pl.render()
-        img = pl.screenshot(return_img=True)
+        extra = None
+        if backdrop is not None:
+            bmesh, bcolors = backdrop
+            extra = pl.add_mesh(
+                bmesh.to_polydata(to_bytes(bcolors)),
+                scalars="colors",
+                rgb=True,
+                lighting=False,
+                show_scalar_bar=False,
+                reset_camera=False,
+            )
+        try:
+            pl.render()
+            img = pl.screenshot(return_img=True)
+        finally:
+            if extra is not None:
+                pl.remove_actor(extra)
         return np.ascontiguousarray(img[:, :, :3])
 
     def _text_actor(self):
@@ -411,13 +447,14 @@ def render_image(
     colors=None,
     label: str | None = None,
     camera: Camera | None = None,
+    backdrop=None,
 ) -> np.ndarray:
     """One off-screen picture of the mesh under the scene: (height, width, 3) uint8.
 
     See :meth:`OffscreenRenderer.render`; the window is closed before returning.
     """
     with OffscreenRenderer(size, background) as r:
-        return r.render(scene, mesh, colors, label=label, camera=camera)
+        return r.render(scene, mesh, colors, label=label, camera=camera, backdrop=backdrop)
 
 
 def sheet(
