@@ -29,6 +29,7 @@ Cached arrays are read-only.
 from __future__ import annotations
 
 import math
+import sys
 from collections import Counter
 
 import numpy as np
@@ -113,6 +114,7 @@ class Shader:
         self._scene = load_scene(scene, materials_dirs=materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
+        self._lobe_memory = None  # (base, ws) arrays kept for reuse
         self._k64 = K.constants(np.float64)
         self.set_geometry(positions, normals, faces)
 
@@ -148,7 +150,7 @@ class Shader:
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._colors = None
-        self._out = np.empty((n, 3), self._T)
+        self._pool: list[np.ndarray] = []  # colour buffers, reused once nothing views them
         self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
         self._lights_changed()
 
@@ -352,9 +354,26 @@ class Shader:
         m = self._scene.material
         return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
 
+    def _take_buffer(self) -> np.ndarray:
+        """An (n, 3) colour buffer that no array handed out still views.
+
+        Colours already returned are never overwritten; a buffer whose views are all gone is
+        reused instead of allocating (a fresh 12 MB array costs its page faults on every update).
+        """
+        for buf in self._pool:
+            # references: the pool's list, the loop variable, getrefcount's argument
+            if sys.getrefcount(buf) <= 3:
+                return buf
+        buf = np.empty((self.n, 3), self._T)
+        if len(self._pool) < 2:
+            self._pool.append(buf)
+        return buf
+
     def _update(self, force=(False, False, False)):
         plan, scene, T = self._plan, self._scene, self._T
         n = self.n
+        self._colors = None
+        self._out = self._take_buffer()
         need_amb = plan.ambient_per_vertex or force[0]
         need_dif = plan.diffuse or force[1]
         need_spec = plan.specular or force[2]
@@ -398,7 +417,7 @@ class Shader:
             )
             self.stats["compose"] += 1
         self._colors = _readonly(self._out)
-        self._out = np.empty_like(self._out)  # never write into colours already handed out
+        self._out = None
 
     def _params_for(self, dtype):
         if self._params is None:
@@ -438,8 +457,14 @@ class Shader:
         D = cache(self._D, do_dif)
         S = cache(self._S, do_spec)
         if opts[K.O_STORE_LOBE]:
-            base = np.zeros((L, n), T)
-            ws = np.zeros((L, n), T)
+            # every row the lobe kernel reads (lights with specular) is written by this pass;
+            # the memory of the previous, now invalid, lobes is reused (no page faults)
+            old = self._lobe_memory
+            if old is not None and old[0].shape == (L, n):
+                base, ws = old
+            else:
+                base, ws = np.empty((L, n), T), np.empty((L, n), T)
+            self._lobe_memory = (base, ws)
         else:
             base = ws = np.zeros((L, 0), T)
         amb = self._amb

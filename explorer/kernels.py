@@ -839,6 +839,62 @@ def lobe(base, ws, params, flags, shininess, k, S):
         _store_rows(S[s:e], Sx, Sy, Sz)
 
 
+def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overloaded below
+    raise NotImplementedError
+
+
+@overload(_compose_block, prefer_literal=True, jit_options=_OPTS)
+def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
+    """One fused pass: o = c0 + cA·A + cD·D + cS·S, clamped; the sums a material does not use
+    are not read at all (``variant`` bits 0, 1, 2: A, D, S present)."""
+    if not isinstance(variant, types.IntegerLiteral):
+        raise TypingError("_compose_block needs a literal variant")
+    has_a, has_d, has_s = (bool(variant.literal_value & bit) for bit in (1, 2, 4))
+
+    def impl(o, A, D, S, c, lo, hi, variant):
+        c0, c1, c2 = c[0], c[1], c[2]
+        a0, a1, a2, d0, d1, d2, s0, s1, s2 = c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11]
+        for i in range(o.shape[0]):
+            r, g, b = c0, c1, c2  # e_m + a_m·(scene and constant light ambient)
+            if has_a:  # a_m·A (attenuated light ambient)
+                r += a0 * A[i, 0]
+                g += a1 * A[i, 1]
+                b += a2 * A[i, 2]
+            if has_d:  # d_m·D
+                r += d0 * D[i, 0]
+                g += d1 * D[i, 1]
+                b += d2 * D[i, 2]
+            if has_s:  # s_m·S
+                r += s0 * S[i, 0]
+                g += s1 * S[i, 1]
+                b += s2 * S[i, 2]
+            o[i, 0] = min(max(r, lo), hi)
+            o[i, 1] = min(max(g, lo), hi)
+            o[i, 2] = min(max(b, lo), hi)
+
+    return impl
+
+
+@nb.njit(**_OPTS)
+def _compose_any(o, A, D, S, c, lo, hi, v):
+    if v == 0:
+        _compose_block(o, A, D, S, c, lo, hi, 0)
+    elif v == 1:
+        _compose_block(o, A, D, S, c, lo, hi, 1)
+    elif v == 2:
+        _compose_block(o, A, D, S, c, lo, hi, 2)
+    elif v == 3:
+        _compose_block(o, A, D, S, c, lo, hi, 3)
+    elif v == 4:
+        _compose_block(o, A, D, S, c, lo, hi, 4)
+    elif v == 5:
+        _compose_block(o, A, D, S, c, lo, hi, 5)
+    elif v == 6:
+        _compose_block(o, A, D, S, c, lo, hi, 6)
+    else:
+        _compose_block(o, A, D, S, c, lo, hi, 7)
+
+
 @nb.njit(parallel=True, **_OPTS)
 def compose(mat, aconst, A, D, S, clamp, k, out):
     """Colours from cached sums: out = e + a_m·(aconst + A) + d_m·D + s_m·S, clamped.
@@ -846,39 +902,31 @@ def compose(mat, aconst, A, D, S, clamp, k, out):
     A, D, S : (n, 3) T or (0, 3) for "all zero"; out : (n, 3)
     """
     n = out.shape[0]
-    hasA, hasD, hasS = A.shape[0] > 0, D.shape[0] > 0, S.shape[0] > 0
+    v = (1 if A.shape[0] > 0 else 0) | (2 if D.shape[0] > 0 else 0) | (4 if S.shape[0] > 0 else 0)
     lo = k[K_ZERO]
     hi = k[K_ONE] if clamp else k[K_INF]
-    a0 = mat[0] + mat[3] * aconst[0]
-    a1 = mat[1] + mat[4] * aconst[1]
-    a2 = mat[2] + mat[5] * aconst[2]
-    nblocks = (n + BLOCK - 1) // BLOCK
+    c = mat.copy()
+    for ch in range(3):
+        c[ch] = mat[ch] + mat[3 + ch] * aconst[ch]
+    chunk = COMPOSE_BLOCK
+    nblocks = (n + chunk - 1) // chunk
     for b in nb.prange(nblocks):
-        s = b * BLOCK
-        e = min(n, s + BLOCK)
-        o = out[s:e]
-        for i in range(e - s):
-            o[i, 0] = a0
-            o[i, 1] = a1
-            o[i, 2] = a2
-        if hasA:
-            _madd(o, A[s:e], mat[3], mat[4], mat[5])
-        if hasD:
-            _madd(o, D[s:e], mat[6], mat[7], mat[8])
-        if hasS:
-            _madd(o, S[s:e], mat[9], mat[10], mat[11])
-        for i in range(e - s):
-            o[i, 0] = min(max(o[i, 0], lo), hi)
-            o[i, 1] = min(max(o[i, 1], lo), hi)
-            o[i, 2] = min(max(o[i, 2], lo), hi)
+        s = b * chunk
+        e = min(n, s + chunk)
+        _compose_any(
+            out[s:e],
+            A[s:e] if v & 1 else A,
+            D[s:e] if v & 2 else D,
+            S[s:e] if v & 4 else S,
+            c,
+            lo,
+            hi,
+            v,
+        )
 
 
-@nb.njit(**_OPTS)
-def _madd(o, X, c0, c1, c2):
-    for i in range(o.shape[0]):
-        o[i, 0] += c0 * X[i, 0]
-        o[i, 1] += c1 * X[i, 1]
-        o[i, 2] += c2 * X[i, 2]
+#: vertices per parallel task of a recompose (a streaming pass: large chunks, few tasks)
+COMPOSE_BLOCK = 16384
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -886,10 +934,10 @@ def stream(P, N, out):
     """The memory-bandwidth floor of a recolour: read positions and normals once, write
     colours once (out = P + N). Used only by the benchmark, as the yardstick."""
     n = out.shape[0]
-    nblocks = (n + BLOCK - 1) // BLOCK
+    nblocks = (n + COMPOSE_BLOCK - 1) // COMPOSE_BLOCK
     for b in nb.prange(nblocks):
-        s = b * BLOCK
-        e = min(n, s + BLOCK)
+        s = b * COMPOSE_BLOCK
+        e = min(n, s + COMPOSE_BLOCK)
         _add(P[s:e], N[s:e], out[s:e])
 
 
