@@ -21,6 +21,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "render": ("explorer.cli_render", "render a scene off-screen to PNG, PLY or GLB"),
     "sheet": ("explorer.cli_render", "render every preset in one labelled grid"),
     "gui": ("explorer.cli_gui", "open the interactive explorer window"),
+    "bench": ("explorer.cli_bench", "measure what accuracy costs in time"),
 }
 
 

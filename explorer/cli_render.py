@@ -110,6 +110,11 @@ def add_render_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--size", default="400x400", metavar="WxH", help="picture size in pixels (default 400x400)"
     )
+    p.add_argument(
+        "--per-pixel", action="store_true",
+        help="light every pixel instead of every vertex (exact sphere for the built-in spheres, "
+        "else ray casting with interpolated normals): the accuracy reference; .png only",
+    )  # fmt: skip
     _scene_arguments(p, mesh_default="sphere")
 
 
@@ -290,6 +295,10 @@ def run_render(args) -> int:
 
         for w in energy_warnings(scene.material):
             print(f"warning: {w}", file=sys.stderr)
+    if args.per_pixel:
+        from .perpixel import run_per_pixel
+
+        return run_per_pixel(args, scene, mesh, size, background, suffix)
     colors = R.vertex_colors(scene, mesh)
     if suffix == ".png":
         image = R.render_image(scene, mesh, size, background=background, colors=colors)
