@@ -114,21 +114,26 @@ def light_direction(azimuth: float, elevation: float) -> np.ndarray:
     return np.array([math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a)])
 
 
+def placement_of_vector(v) -> tuple[float, float, float]:
+    """``(azimuth, elevation, length)`` of a vector (degrees, degrees, its length); the zero
+    vector gives (0, 0, 0)."""
+    v = np.asarray(v, dtype=np.float64)
+    length = float(np.linalg.norm(v))
+    if length == 0.0:
+        return 0.0, 0.0, 0.0
+    x, y, z = v / length
+    azimuth = math.degrees(math.atan2(x, z)) if abs(y) < 1.0 else 0.0
+    elevation = math.degrees(math.asin(min(max(y, -1.0), 1.0)))
+    return azimuth, elevation, length
+
+
 def placement_of(light, centre) -> tuple[float, float, float | None]:
     """``(azimuth, elevation, distance)`` of a light around ``centre`` (degrees, degrees,
     world units); a directional light has no distance (None)."""
     if isinstance(light, DirectionalLight):
-        v = np.asarray(light.direction, dtype=np.float64)
-        dist = None
-    else:
-        v = np.asarray(light.position, dtype=np.float64) - np.asarray(centre, dtype=np.float64)
-        dist = float(np.linalg.norm(v))
-        if dist == 0.0:
-            return 0.0, 0.0, 0.0
-    x, y, z = v / np.linalg.norm(v)
-    azimuth = math.degrees(math.atan2(x, z)) if abs(y) < 1.0 else 0.0
-    elevation = math.degrees(math.asin(min(max(y, -1.0), 1.0)))
-    return azimuth, elevation, dist
+        az, el, _ = placement_of_vector(light.direction)
+        return az, el, None
+    return placement_of_vector(np.subtract(light.position, centre))
 
 
 def place_light(light, azimuth: float, elevation: float, distance: float, centre):
@@ -307,10 +312,19 @@ def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
         q.Update()
         return q.GetOutput()
 
-    d = 64
+    # a surface's vertex count grows as the divisions squared, until it saturates at the
+    # mesh's own count: a few corrections reach the target within ~25 %
+    d = max(4, int(0.5 * math.sqrt(target)))
     out = cluster(d)
-    if out.GetNumberOfPoints() > 0:  # a surface's vertex count grows as divisions squared
-        d = max(4, int(round(d * math.sqrt(target / out.GetNumberOfPoints()))))
+    for _ in range(6):
+        count = out.GetNumberOfPoints()
+        if count == 0 or abs(count - target) <= 0.25 * target:
+            break
+        if count >= 0.8 * mesh.n_vertices:
+            step = 0.5
+        else:
+            step = math.sqrt(target / count)
+        d = max(4, int(round(d * step)))
         out = cluster(d)
     pos = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
     faces = vtk_to_numpy(out.GetPolys().GetConnectivityArray()).astype(np.int64).reshape(-1, 3)
@@ -399,6 +413,8 @@ class Explorer:
     output_dir : where screenshots go (default: the current directory)
     preset_dir : where saved presets go (default: the user's preset directory)
     lod_vertices : meshes with more vertices get a level of detail while dragging
+    lod_target : about how many vertices the level of detail has
+    background : RGB in [0, 1] (default: the renderer's background)
     """
 
     def __init__(
@@ -414,6 +430,7 @@ class Explorer:
         output_dir=None,
         preset_dir=None,
         lod_vertices: int = LOD_VERTICES,
+        lod_target: int = LOD_TARGET,
         background=None,
     ):
         import pyvista as pv
@@ -426,6 +443,7 @@ class Explorer:
         self.output_dir = Path(output_dir) if output_dir else Path.cwd()
         self.preset_dir = preset_dir
         self.lod_vertices = int(lod_vertices)
+        self.lod_target = int(lod_target)
         self.notices: list[str] = []
         self.presets = list_presets(self.materials_dirs, notices=self.notices)
         self.errors: list[str] = []
@@ -437,6 +455,7 @@ class Explorer:
         self.help_visible = False
         self._t0: float | None = None
         self._building = True
+        self._deferred = False
         self._dragging = 0
 
         self.scene = scene
@@ -759,7 +778,7 @@ class Explorer:
             "r": self.reset,
         }
         for key, fn in actions.items():
-            guarded = self._guard(fn, name=f"key {key}")
+            guarded = self._guard(fn, name=f"key {key}", renders_after=False)
             pl.add_key_event(key, lambda g=guarded: g())
         iren = pl.iren.interactor
         blocked = set(actions)
@@ -771,19 +790,29 @@ class Explorer:
         self._char_tag = iren.AddObserver("CharEvent", block, 10.0)
 
     # -- error handling --------------------------------------------------------------------
-    def _guard(self, fn, *bound, name: str | None = None):
+    def _guard(self, fn, *bound, name: str | None = None, renders_after: bool = True):
         """``fn`` made safe for VTK: any exception is logged and shown in the window's message
-        line (never lost in VTK's or PyVista's callback machinery)."""
+        line (never lost in VTK's or PyVista's callback machinery).
+
+        renders_after : VTK draws a frame right after this callback (widgets after their
+            events, the camera style after an interaction, and callbacks inside a frame), so
+            ``fn``'s own :meth:`render` calls are left to it: one frame per event, not two.
+            Key callbacks render themselves.
+        """
         label = name or getattr(fn, "__name__", "callback").lstrip("_")
         if bound:
             label = f"{label} {bound[0]}"
 
         def call(*args):
+            outer = self._deferred
+            self._deferred = renders_after
             try:
                 return fn(*bound, *args)
             except Exception as exc:  # noqa: BLE001 - every error is shown, none is lost
                 self._report(exc, label)
                 return None
+            finally:
+                self._deferred = outer
 
         return call
 
@@ -859,11 +888,12 @@ class Explorer:
             self.render()
 
     def render(self) -> None:
-        """Draw a frame now (works before and during the event loop, on- and off-screen)."""
+        """Draw a frame now (works before and during the event loop, on- and off-screen);
+        inside a widget callback the widget draws it right after."""
+        if self._deferred:
+            return
         if self._t0 is None:
             self._t0 = time.perf_counter()
-        self._update_status()
-        self.plotter.renderer.ResetCameraClippingRange()
         self.plotter.render_window.Render()
 
     def _before_frame(self, *_) -> None:
@@ -884,6 +914,9 @@ class Explorer:
             view.upload()
         if self.scene.material.opacity < 1.0:
             self._sort(view)
+        self._update_status()
+        # the handle may be nearer the camera than the mesh: keep it inside the clipping range
+        self.plotter.renderer.ResetCameraClippingRange()
 
     def _sort(self, view: _View) -> None:
         from .render import Camera, back_to_front
@@ -950,7 +983,7 @@ class Explorer:
         self._views = [_View(self.plotter, mesh, shown)]
         if mesh.n_vertices > self.lod_vertices:
             if mesh.name not in self._lods or self._meshes.get(mesh.name) is not mesh:
-                self._lods[mesh.name] = lod_mesh(mesh)
+                self._lods[mesh.name] = lod_mesh(mesh, self.lod_target)
             lod = _View(self.plotter, self._lods[mesh.name], shown)
             lod.show(False)
             self._views.append(lod)
@@ -1195,12 +1228,10 @@ class Explorer:
             return
         if self._t0 is None:
             self._t0 = time.perf_counter()
-        v = np.asarray(center, dtype=np.float64) - self.mesh.centre
-        d = float(np.linalg.norm(v))
+        az, el, d = placement_of_vector(np.subtract(center, self.mesh.centre))
         if d == 0.0:
             return
         lo, hi = self._slider_range("distance")
-        az, el, _ = placement_of(PointLight(position=tuple(v)), (0.0, 0.0, 0.0))
         self.place_light(az, el, min(max(d, lo), hi))
 
     # -- showing the state in the controls -----------------------------------------------------
