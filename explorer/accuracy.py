@@ -751,26 +751,36 @@ def mesh_for_error(
 
 def advice(shininess: float, size: Sequence[int], *, model: str = "blinn",
            max_error: float = 1.0, table: dict | None = None) -> str:  # fmt: skip
-    """One line for the GUI: which tessellations keep the error within ``max_error`` levels
-    for this shininess and picture size (every pixel, and the RMSE)."""
+    """One line for the GUI: which tessellation keeps the error within ``max_error`` levels for
+    this shininess and picture size: the RMSE (the picture as a whole), then every pixel
+    (:func:`mesh_for_error` with ``metric="rmse"`` and ``"max"``, UV sphere and icosphere)."""
     try:
-        worst = mesh_for_error(shininess, size, max_error, model=model, table=table)
-        ico = mesh_for_error(shininess, size, max_error, model=model, mesh="icosphere",
-                             table=table)  # fmt: skip
-        mean = mesh_for_error(shininess, size, max_error, model=model, metric="rmse",
-                              table=table)  # fmt: skip
+        recs = {
+            (metric, mesh): mesh_for_error(
+                shininess, size, max_error, model=model, metric=metric, mesh=mesh, table=table
+            )  # fmt: skip
+            for metric in ("rmse", "max")
+            for mesh in ("sphere", "icosphere")
+        }
     except ExplorerError as exc:
         return f"accuracy: {exc}"
     lv = f"{max_error:g} level" + ("s" if max_error != 1 else "")
 
-    def name(r: Recommendation) -> str:
-        if r.resolution is None:
-            return f"finer than {r.mesh} {r.finest[0]}"
-        return f"{r.mesh} {r.resolution} ({_count(r.vertices)} vertices)"
+    def both(metric: str) -> str:
+        a, b = recs[(metric, "sphere")], recs[(metric, "icosphere")]
+        if a.resolution is None and b.resolution is None:
+            return f"no measured mesh (finest: {a.mesh} {a.finest[0]}, {b.mesh} {b.finest[0]})"
+        names = [
+            f"{r.mesh} {r.resolution} ({_count(r.vertices)} vertices)"
+            if r.resolution is not None
+            else f"finer than {r.mesh} {r.finest[0]}"
+            for r in (a, b)
+        ]
+        return " or ".join(names)
 
     return (
-        f"shininess {float(shininess):g}, {model}: every pixel within {lv} needs {name(worst)} "
-        f"or {name(ico)}; RMSE within {lv}: {name(mean)}"
+        f"shininess {float(shininess):g} ({model}), error within {lv}: RMSE from {both('rmse')}; "
+        f"every pixel: {both('max')}"
     )
 
 
@@ -843,7 +853,16 @@ def markdown(table: dict, *, plot: str | None, command: str) -> str:
     la, lb = m.get("load_before"), m.get("load_after")
     if la or lb:
         add(f"- Load average (1, 5, 15 min): {la} before, {lb} after")
-    add(f"- Times are wall-clock medians of {table['repeats']} runs after a warm-up run.")
+        cores = m.get("usable_cores") or 1
+        if max((la or [0])[0], (lb or [0])[0]) > 0.5 * cores:
+            add(
+                "- **Other work was running.** Each call of the engine's parallel kernels "
+                "waits until all its threads have had a core, so the shading times of small "
+                "meshes include scheduler waits (milliseconds) rather than work; the errors "
+                "are unaffected."
+            )
+    runs = "1 run" if table["repeats"] == 1 else f"{table['repeats']} runs"
+    add(f"- Times are wall-clock medians of {runs} after a warm-up run.")
     add("")
     add("## What is measured")
     add("")
@@ -1116,8 +1135,10 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        from matplotlib.ticker import FuncFormatter, NullFormatter
     except ImportError:
         return False
+    plain = FuncFormatter(lambda x, _pos: f"{x:g}")
     main = table["main_side"]
     labels = [x["label"] for x in table["scene"]["materials"]]
     series = [
@@ -1152,6 +1173,9 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
             ax.axhline(1.0, color="grey", ls=":", lw=0.8)
             ax.set_xscale("log")
             ax.set_yscale("log")
+            for axis in (ax.xaxis, ax.yaxis):
+                axis.set_major_formatter(plain)
+                axis.set_minor_formatter(NullFormatter())
             ax.grid(True, which="both", alpha=0.2)
             if row == 0:
                 n = table["scene"]["materials"][col]["shininess"]
@@ -1160,14 +1184,15 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
                 ax.set_xlabel("shade + render per frame (ms)")
             if col == 0:
                 ax.set_ylabel(("RMSE" if metric == "rmse" else "worst pixel") + " (1/255 levels)")
-    axes[0][0].legend(fontsize=7, loc="upper right")
+    handles, names = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="lower center", ncol=len(names), fontsize=8, frameon=False)
     m = table["machine"] or {}
     fig.suptitle(
         f"Per-vertex shading against the per-pixel reference, {main}x{main} "
         f"({m.get('cpu', '?')}, {m.get('usable_cores', '?')} cores)",
         fontsize=10,
     )
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
     import io
 
     buf = io.BytesIO()
