@@ -82,6 +82,11 @@ VARIANTS: dict[str, tuple[str, float, str, str]] = {
 }
 #: variants measured at every size of the sweep (the others only at the main size)
 SWEEP_VARIANTS = ("blinn", "phong")
+#: adaptive refinement (:func:`refine_highlights`, Blinn float64, main size only): the base
+#: mesh and the edge-midpoint thresholds (levels)
+ADAPTIVE_BASE = ("icosphere", 3)
+ADAPTIVE_THRESHOLDS = (8.0, 4.0, 2.0, 1.0)
+QUICK_ADAPTIVE_THRESHOLDS = (4.0,)
 
 DATA_FILE = "accuracy.json"
 TABLE_VERSION = 1
@@ -358,9 +363,10 @@ class BenchConfig:
     """What :func:`run_bench` measures.
 
     materials : (label, preset, shininess or None) rows; meshes : (name, resolutions)
-    sides : picture sides (square pictures); the first one listed in ``main_side`` gets every
-        variant, the others :data:`SWEEP_VARIANTS`
+    sides : picture sides (square pictures); ``main_side`` gets every variant, the others
+        :data:`SWEEP_VARIANTS`
     repeats : timed calls per median
+    adaptive : thresholds of the adaptive rows (main side only; empty: none)
     """
 
     materials: tuple = BENCH_MATERIALS
@@ -369,10 +375,12 @@ class BenchConfig:
     main_side: int = MAIN_SIDE
     repeats: int = 5
     quick: bool = False
+    adaptive: tuple[float, ...] = ADAPTIVE_THRESHOLDS
 
     @classmethod
     def quick_run(cls) -> BenchConfig:
-        return cls(QUICK_MATERIALS, QUICK_MESHES, QUICK_SIDES, QUICK_SIDES[0], 1, True)
+        return cls(QUICK_MATERIALS, QUICK_MESHES, QUICK_SIDES, QUICK_SIDES[0], 1, True,
+                   QUICK_ADAPTIVE_THRESHOLDS)  # fmt: skip
 
 
 class _References:
@@ -490,6 +498,55 @@ def _measure_per_pixel(refs, mats, repeats: int) -> tuple[list[dict], list[dict]
     return cost, match
 
 
+def _measure_adaptive(r, rc, refs, mats, thresholds, repeats: int) -> list[dict]:
+    """Adaptive refinement of :data:`ADAPTIVE_BASE` (Blinn, float64): the shading time is
+    refinement plus shading (a refined mesh is only good for the scene it was refined for)."""
+    from .meshes import get_mesh
+    from .render import vertex_colors
+
+    base_name, base_res = ADAPTIVE_BASE
+    base = get_mesh(base_name, base_res)
+    rows = []
+    for label, preset, material in mats:
+        scene = bench_scene(material, "blinn")
+        for thr in thresholds:
+
+            def make(s=scene, t=thr):
+                mesh = refine_highlights(s, base, t)
+                return mesh, vertex_colors(s, mesh)
+
+            mesh, colors = make()
+            shade_ms = median_ms(make, repeats)
+            img = r.render(scene, mesh, colors, camera=refs.camera)
+            render_ms = median_ms(
+                lambda m=mesh, c=colors, s=scene: r.render(s, m, c, camera=refs.camera), repeats
+            )
+            cmp = compare(img, refs(material, "blinn"), coverage(rc, scene, mesh, refs.camera))
+            rows.append(
+                {
+                    "material": label,
+                    "preset": preset,
+                    "shininess": material.shininess,
+                    "variant": "blinn",
+                    "model": "blinn",
+                    "exponent": material.shininess,
+                    "reference": "blinn",
+                    "path": "float64",
+                    "mesh": "adaptive",
+                    "base": f"{base_name} {base_res}",
+                    "resolution": thr,
+                    "vertices": mesh.n_vertices,
+                    "side": refs.size[0],
+                    "shade_ms": round(shade_ms, 4),
+                    "render_ms": round(render_ms, 4),
+                    "rmse": round(cmp.rmse, 4),
+                    "max": cmp.max,
+                    "peak": cmp.peak,
+                }
+            )
+    return rows
+
+
 def run_bench(config: BenchConfig = BenchConfig(), *, progress: Progress | None = None) -> dict:
     """Measure the accuracy table (see the module docstring). Returns the table as a dict
     (the content of ``accuracy.json``): ``machine``, ``scene``, ``rows`` (per-vertex),
@@ -503,7 +560,7 @@ def run_bench(config: BenchConfig = BenchConfig(), *, progress: Progress | None 
     meshes = [(name, res) for name, resolutions in config.meshes for res in resolutions]
     if progress is None:
         progress = Progress(enabled=False)
-    progress.total = max(1, len(config.sides) * len(meshes) + 1)
+    progress.total = max(1, len(config.sides) * len(meshes) + 2)
     rows: list[dict] = []
     per_pixel: list[dict] = []
     model_match: list[dict] = []
@@ -532,6 +589,9 @@ def run_bench(config: BenchConfig = BenchConfig(), *, progress: Progress | None 
                     row["render_ms"] = round(render_ms, 4)
                     rows.append(row)
                 progress.step(f"{side}px {name} {res}")
+            if main and config.adaptive:
+                rows += _measure_adaptive(r, rc, refs, mats, config.adaptive, config.repeats)
+                progress.step(f"{side}px adaptive")
         if main:
             cost, match = _measure_per_pixel(refs, mats, config.repeats)
             per_pixel += cost
@@ -792,6 +852,131 @@ def _count(n: int | None) -> str:
     return f"{n:,}"
 
 
+# -- adaptive refinement ------------------------------------------------------------------------
+
+#: vertex budget of :func:`refine_highlights`
+REFINE_MAX_VERTICES = 400_000
+
+
+def _split_longest_edge(faces: np.ndarray, mid: np.ndarray, longest: np.ndarray) -> np.ndarray:
+    """Split triangles by longest-edge bisection (Rivara): a triangle with marked edges is
+    first cut from its longest edge's midpoint to the opposite corner, then each half is cut
+    again if its outer edge is marked. Triangles keep their winding and their angles stay
+    bounded (no slivers); an edge is split in both of its triangles, so no cracks.
+
+    faces : (m, 3) int; mid : (m, 3) int, the new vertex on edge k = (v_k, v_k+1) or -1 where
+    the edge is kept (the longest edge of every triangle with a marked edge is marked);
+    longest : (m,) which edge (0, 1, 2) is each triangle's longest. Returns (m', 3) int.
+    """
+    split = (mid >= 0).any(1)
+    out = [faces[~split]]
+    sel = np.flatnonzero(split)
+    if len(sel):
+        rows = np.arange(len(sel))[:, None]
+        idx = (np.arange(3)[None, :] + longest[sel][:, None]) % 3  # longest edge -> edge 0
+        V = faces[sel][rows, idx]
+        E = mid[sel][rows, idx]
+        a, b, c = V[:, 0], V[:, 1], V[:, 2]
+        m, mbc, mca = E[:, 0], E[:, 1], E[:, 2]
+        one = mca < 0  # the half (a, m, c), cut again along c->a when marked
+        out += [np.stack([a, m, c], 1)[one]]
+        out += [np.stack([m, c, mca], 1)[~one], np.stack([m, mca, a], 1)[~one]]
+        two = mbc < 0  # the half (m, b, c), cut again along b->c when marked
+        out += [np.stack([m, b, c], 1)[two]]
+        out += [np.stack([m, b, mbc], 1)[~two], np.stack([m, mbc, c], 1)[~two]]
+    return np.concatenate(out).astype(np.int64)
+
+
+def _seen_on_sphere(viewer, points: np.ndarray, normals: np.ndarray):
+    """Where the line of sight through each point (inside the unit sphere) leaves the sphere
+    toward the viewer: the sphere point a pixel showing that point sees, (k, 3) float64; and
+    (k,) bool, True where the surface there (``normals``) faces the viewer (elsewhere the
+    line of sight shows another part of the sphere)."""
+    if viewer.local:
+        v = np.asarray(viewer.eye, np.float64) - points
+        v /= np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-300)
+    else:
+        v = np.broadcast_to(np.asarray(viewer.direction, np.float64), points.shape)
+    b = np.einsum("ij,ij->i", points, v)
+    c = np.einsum("ij,ij->i", points, points) - 1.0
+    t = -b + np.sqrt(np.maximum(b * b - c, 0.0))
+    q = points + t[:, None] * v
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return q, np.einsum("ij,ij->i", normals, v) > 0.0
+
+
+def refine_highlights(scene, mesh, max_error: float = 1.0, *, min_edge: float = 0.0,
+                      max_rounds: int = 16, max_vertices: int = REFINE_MAX_VERTICES):  # fmt: skip
+    """Refine a mesh only where per-vertex shading misses: the adaptive alternative to a
+    uniformly finer mesh (it splits at the highlight, the terminator and the clip at 1).
+
+    Each round shades every edge's midpoint exactly and compares it with the average of the
+    edge's two vertex colours (what Gouraud interpolation shows there); the edges off by more
+    than ``max_error`` levels (largest channel) are split by longest-edge bisection (no
+    cracks, no slivers). A built-in unit sphere's new vertices go onto the sphere; any other
+    mesh's stay on the triangle with the normalised average of the two normals (the
+    interpolated normal the per-pixel ray caster uses). Stops when no edge is off, after
+    ``max_rounds`` rounds, or before the mesh would exceed ``max_vertices``. On a sphere the
+    comparison is with what the pixel showing the edge's midpoint sees on the true sphere, so
+    the silhouette, where the flat triangles lag behind the sphere, is refined too; give
+    ``min_edge`` (world units, about a pixel) so edges smaller than a pixel stay whole.
+
+    Returns a new :class:`~explorer.meshes.Mesh` (same name) whose first vertices are the
+    original ones. The result depends on the scene (lights, viewer, material): refine again
+    when they change.
+    """
+    from . import perpixel
+    from .meshes import Mesh
+
+    sphere = perpixel.is_unit_sphere(mesh)
+    P = np.array(mesh.positions)
+    N = np.array(mesh.normals)
+    F = np.array(mesh.faces)
+    colors = perpixel.point_colors(scene, P, N, mesh=mesh)
+    for _ in range(max_rounds):
+        if not len(F):
+            break
+        edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+        unique, inverse = np.unique(np.sort(edges, axis=1), axis=0, return_inverse=True)
+        tri_edge = inverse.ravel().reshape(3, -1).T  # (m, 3): edges 01, 12, 20
+        mid_n = N[unique[:, 0]] + N[unique[:, 1]]
+        length = np.linalg.norm(mid_n, axis=1, keepdims=True)
+        mid_n = np.divide(mid_n, length, out=np.zeros_like(mid_n), where=length > 1e-12)
+        chord = 0.5 * (P[unique[:, 0]] + P[unique[:, 1]])
+        mid_p = mid_n.copy() if sphere else chord
+        exact = perpixel.point_colors(scene, mid_p, mid_n, mesh=mesh)
+        seen = exact
+        if sphere:  # what the pixel showing the chord's midpoint sees on the true sphere
+            q, front = _seen_on_sphere(scene.viewer, chord, mid_n)
+            if front.any():
+                seen = exact.copy()
+                seen[front] = perpixel.point_colors(scene, q[front], q[front], mesh=mesh)
+        lerp = 0.5 * (colors[unique[:, 0]] + colors[unique[:, 1]])
+        elen = np.linalg.norm(P[unique[:, 0]] - P[unique[:, 1]], axis=1)
+        marked = (np.abs(seen - lerp).max(axis=1) * 255.0 > max_error) & (elen > min_edge)
+        if not marked.any():
+            break
+        # each triangle's longest edge (ties broken by edge number), marked with any other
+        key = elen[tri_edge] * (1.0 + 1e-12 * tri_edge / max(len(unique), 1))
+        longest = np.argmax(key, axis=1)
+        longest_id = tri_edge[np.arange(len(F)), longest]
+        while True:
+            need = marked[tri_edge].any(1) & ~marked[longest_id]
+            if not need.any():
+                break
+            marked[longest_id[need]] = True
+        n_new = int(marked.sum())
+        if len(P) + n_new > max_vertices:
+            break
+        new_index = np.full(len(unique), -1, np.int64)
+        new_index[marked] = len(P) + np.arange(n_new)
+        F = _split_longest_edge(F, new_index[tri_edge], longest)
+        P = np.vstack([P, mid_p[marked]])
+        N = np.vstack([N, mid_n[marked]])
+        colors = np.vstack([colors, exact[marked]])
+    return Mesh(P, N, F, mesh.name)
+
+
 # -- reading the table --------------------------------------------------------------------------
 
 
@@ -820,8 +1005,13 @@ def _fmt(x, digits: int = 3) -> str:
     return f"{x:.{digits}g}"
 
 
-def _rows(table, **match) -> list[dict]:
-    return [r for r in table["rows"] if all(r.get(k) == v for k, v in match.items())]
+def _rows(table, *, adaptive: bool = False, **match) -> list[dict]:
+    """Rows matching every ``key=value``; adaptive rows only with ``adaptive=True``."""
+    return [
+        r
+        for r in table["rows"]
+        if all(r.get(k) == v for k, v in match.items()) and (r["mesh"] == "adaptive") == adaptive
+    ]
 
 
 def markdown(table: dict, *, plot: str | None, command: str) -> str:
@@ -945,6 +1135,32 @@ def markdown(table: dict, *, plot: str | None, command: str) -> str:
         add("|---|---:|---:|")
         for x in pp:
             add(f"| {x['material']} | {x['pixels']:,} | {_fmt(x['shade_ms'])} |")
+    adaptive = _rows(table, adaptive=True, side=main)
+    if adaptive:
+        add("")
+        add(f"## Adaptive refinement ({main}x{main}, Blinn, float64)")
+        add("")
+        add(
+            f"`explorer.accuracy.refine_highlights(scene, mesh, max_error)` starting from "
+            f"{adaptive[0]['base']}: each round shades every edge's midpoint exactly and splits "
+            "the edges where the interpolated colour is off by more than the threshold "
+            "(levels), crack-free, new vertices on the sphere. It refines where the shading "
+            "changes fast (highlight, terminator, the clip at 1), not the silhouette. **Shade** "
+            "is refinement plus shading: a refined mesh fits one scene (lights, viewer, "
+            "material)."
+        )
+        for label in labels:
+            add("")
+            add(f"### {label}")
+            add("")
+            add("| threshold | vertices | refine + shade ms | render ms | RMSE | max | peak |")
+            add("|---:|---:|---:|---:|---:|---:|---:|")
+            for r in _rows(table, adaptive=True, side=main, material=label):
+                add(
+                    f"| {r['resolution']:g} | {r['vertices']:,} | {_fmt(r['shade_ms'])} "
+                    f"| {_fmt(r['render_ms'])} | {_fmt(r['rmse'])} | {r['max']} "
+                    f"| {_fmt(r['peak'])} |"
+                )
     add("")
     add(f"## Phong against Blinn with the exponent matched ({main}x{main})")
     add("")
@@ -1100,6 +1316,27 @@ def findings(table: dict) -> list[str]:
                 "planned float64 time on 10k+ vertices (median)"
             )
         out.append(s + ".")
+    for label in labels:
+        ada = _rows(table, adaptive=True, side=main, material=label)
+        uni = _rows(table, variant="blinn", side=main, material=label)
+        if not ada or not uni:
+            continue
+        best = min(ada, key=lambda r: r["rmse"])
+        match = [r for r in uni if r["rmse"] <= best["rmse"]]
+        s = (
+            f"{label}, adaptive: threshold {best['resolution']:g} gives RMSE "
+            f"{_fmt(best['rmse'])} (worst pixel {best['max']}) with {best['vertices']:,} "
+            f"vertices in {_fmt(best['shade_ms'])} ms; "
+        )
+        if match:
+            u = min(match, key=lambda r: r["vertices"])
+            s += (
+                f"the smallest uniform mesh as good, {u['mesh']} {u['resolution']}, has "
+                f"{u['vertices']:,} vertices (worst pixel {u['max']})."
+            )
+        else:
+            s += "no measured uniform mesh is as good."
+        out.append(s)
     for x in table["model_match"]:
         out.append(
             f"{x['material']}: Blinn with exponent 4n against Phong n, both per pixel: RMSE "
@@ -1147,6 +1384,7 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
         ("sphere", "blinn plan off", "x", "C3", "UV sphere, plan off"),
         ("icosphere", "blinn", "^", "C2", "icosphere, float64"),
         ("icosphere", "blinn float32", "v", "C4", "icosphere, float32"),
+        ("adaptive", "blinn", "*", "k", "adaptive (refine_highlights)"),
     ]
     fig, axes = plt.subplots(2, len(labels), figsize=(4.2 * len(labels), 7.5), squeeze=False)
     for col, label in enumerate(labels):
@@ -1155,7 +1393,8 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
             ax = axes[row][col]
             ts, es = [], []
             for mesh, variant, marker, color, name in series:
-                rows = _rows(table, material=label, variant=variant, side=main, mesh=mesh)
+                rows = _rows(table, material=label, variant=variant, side=main, mesh=mesh,
+                             adaptive=mesh == "adaptive")  # fmt: skip
                 t = [r["shade_ms"] + r["render_ms"] for r in rows]
                 e = [max(float(r[metric]), 0.05) for r in rows]
                 ax.scatter(t, e, marker=marker, color=color, s=22, label=name, alpha=0.8)
