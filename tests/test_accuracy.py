@@ -334,7 +334,11 @@ def test_quick_bench_writes_table_doc_and_plot(quick, capsys):
     assert table["quick"] and table["command"] == "phong-explorer bench accuracy --quick"
     assert table["machine"]["cpu"] and "load_after" in table["machine"]
     n_mesh = sum(len(r) for _, r in A.QUICK_MESHES)
-    assert len(table["rows"]) == n_mesh * len(A.QUICK_MATERIALS) * len(A.VARIANTS)
+    uniform = [r for r in table["rows"] if r["mesh"] != "adaptive"]
+    adaptive = [r for r in table["rows"] if r["mesh"] == "adaptive"]
+    assert len(uniform) == n_mesh * len(A.QUICK_MATERIALS) * len(A.VARIANTS)
+    assert len(adaptive) == len(A.QUICK_ADAPTIVE_THRESHOLDS) * len(A.QUICK_MATERIALS)
+    assert "## Adaptive refinement" in (out / "accuracy.md").read_text()
     for label, _, _ in A.QUICK_MATERIALS:
         rows = [r for r in table["rows"] if r["material"] == label and r["variant"] == "blinn"
                 and r["mesh"] == "sphere"]  # fmt: skip
