@@ -34,7 +34,15 @@ BENCHES = {"accuracy": "per-vertex shading against the per-pixel reference: erro
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     sub = parser.add_subparsers(dest="bench", metavar="BENCH")
-    p = sub.add_parser("accuracy", help=BENCHES["accuracy"], description=BENCHES["accuracy"])
+    p = sub.add_parser(
+        "accuracy",
+        help=BENCHES["accuracy"],
+        description=BENCHES["accuracy"],
+        epilog="Without --out-dir (in a source checkout) it replaces docs/accuracy.md, "
+        "docs/accuracy.png and explorer/data/accuracy.json: those files belong to this command. "
+        "In --out-dir it never replaces an existing file without --force. A progress bar is "
+        "shown on a terminal. The plot needs matplotlib (pip install 'phong-explorer[bench]').",
+    )
     p.add_argument(
         "--quick",
         action="store_true",
