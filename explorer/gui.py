@@ -1343,11 +1343,13 @@ class Explorer:
         for name, wdg in self.sliders.items():
             rep = wdg.GetRepresentation()
             value = rep.GetValue()
+            lo, hi = rep.GetMinimumValue(), rep.GetMaximumValue()
             sliders[name] = {
                 "value": value,
                 "title": rep.GetTitleText(),
-                "range": [rep.GetMinimumValue(), rep.GetMaximumValue()],
+                "range": [lo, hi],
                 "knob_px": self.slider_pixels(name, value),
+                "ends_px": [self.slider_pixels(name, lo), self.slider_pixels(name, hi)],
             }
         buttons = {}
         s = G.BUTTON_SIZE
@@ -1371,6 +1373,7 @@ class Explorer:
             "presets": [p.name for p in self.presets],
             "mesh": self.mesh.name,
             "n_vertices": self.mesh.n_vertices,
+            "dragging": self._dragging > 0,
             "lod": self._lod_active,
             "scene": self.scene.to_mapping(),
             "material": {"ka": ka, "kd": kd, "ks": ks, "shininess": m.shininess},
