@@ -1144,10 +1144,11 @@ def markdown(table: dict, *, plot: str | None, command: str) -> str:
             f"`explorer.accuracy.refine_highlights(scene, mesh, max_error)` starting from "
             f"{adaptive[0]['base']}: each round shades every edge's midpoint exactly and splits "
             "the edges where the interpolated colour is off by more than the threshold "
-            "(levels), crack-free, new vertices on the sphere. It refines where the shading "
-            "changes fast (highlight, terminator, the clip at 1), not the silhouette. **Shade** "
-            "is refinement plus shading: a refined mesh fits one scene (lights, viewer, "
-            "material)."
+            "(levels), by longest-edge bisection (no cracks, no slivers), new vertices on the "
+            "sphere. On a sphere the midpoint is compared with what its pixel shows of the true "
+            "sphere, so the silhouette is refined as well as the highlight, the terminator and "
+            "the clip at 1. **Shade** is refinement plus shading: a refined mesh fits one scene "
+            "(lights, viewer, material)."
         )
         for label in labels:
             add("")
@@ -1337,6 +1338,24 @@ def findings(table: dict) -> list[str]:
         else:
             s += "no measured uniform mesh is as good."
         out.append(s)
+    sizes = sorted(table["sides"])
+    if len(sizes) > 1:
+        lo, hi = sizes[0], sizes[-1]
+        change, growth = [], []
+        for r in _rows(table, variant="blinn", side=lo):
+            (h,) = _rows(table, variant="blinn", side=hi, material=r["material"],
+                         mesh=r["mesh"], resolution=r["resolution"]) or (None,)  # fmt: skip
+            if h is not None and r["rmse"] >= 0.5:
+                change.append(abs(h["rmse"] / r["rmse"] - 1.0))
+                growth.append(h["max"] - r["max"])
+        if change:
+            out.append(
+                f"picture size: between {lo}x{lo} and {hi}x{hi} the RMSE of a tessellation "
+                f"changes by {100 * statistics.median(change):.2g}% (median; at most "
+                f"{100 * max(change):.2g}%): the error belongs to the surface, not to the "
+                f"pixels; the worst pixel grows by up to {max(growth)} levels with the size "
+                "(more pixels sample the worst spot)."
+            )
     for x in table["model_match"]:
         out.append(
             f"{x['material']}: Blinn with exponent 4n against Phong n, both per pixel: RMSE "
