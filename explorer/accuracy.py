@@ -171,6 +171,47 @@ def coverage(renderer, scene, mesh, camera) -> np.ndarray:
     return img.max(axis=2) > 127
 
 
+class ViewComparer:
+    """Reusable off-screen windows for :func:`compare_view` (a GUI toggling its heat map
+    pays for the OpenGL contexts once). Use as a context manager, or call :meth:`close`.
+
+    size : (width, height) of the pictures compared
+    """
+
+    def __init__(self, size: Sequence[int]):
+        from . import render as R
+
+        self.size = R.check_size(size)
+        self._picture = R.OffscreenRenderer(self.size)
+        self._cover = R.OffscreenRenderer(self.size, (0, 0, 0))
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def close(self) -> None:
+        self._picture.close()
+        self._cover.close()
+
+    def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto"):
+        """See :func:`compare_view`."""
+        from . import perpixel
+        from . import render as R
+
+        w, h = self.size
+        if camera is None:
+            camera = R.camera_for(scene, mesh, w / h)
+        if colors is None:
+            colors = R.vertex_colors(scene, mesh)
+        opaque = scene.replace(material=scene.material.replace(opacity=1.0))
+        img = self._picture.render(opaque, mesh, colors, camera=camera)
+        cov = coverage(self._cover, scene, mesh, camera)
+        ref = perpixel.reference(scene, mesh, (w, h), camera=camera, method=method)
+        return compare(img, ref, cov)
+
+
 def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
                  method: str = "auto") -> Comparison:  # fmt: skip
     """The per-pixel difference of a view (the GUI's heat map toggle).
@@ -180,23 +221,13 @@ def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
     size : (width, height) of the picture to compare
     camera : an :class:`explorer.render.Camera` (default :func:`explorer.render.camera_for`);
         for a live VTK camera use :func:`explorer.perpixel.camera_from_vtk`
+    method : the per-pixel reference's (:func:`explorer.perpixel.hits`)
     Renders the per-vertex picture and the coverage off-screen, so the GUI's own overlays
-    never enter the comparison.
+    never enter the comparison; :class:`ViewComparer` keeps the windows for repeated calls.
+    Translucent materials are compared as if opaque.
     """
-    from . import perpixel
-    from . import render as R
-
-    w, h = R.check_size(size)
-    if camera is None:
-        camera = R.camera_for(scene, mesh, w / h)
-    if colors is None:
-        colors = R.vertex_colors(scene, mesh)
-    opaque = scene.replace(material=scene.material.replace(opacity=1.0))
-    with R.OffscreenRenderer((w, h)) as r, R.OffscreenRenderer((w, h), (0, 0, 0)) as rc:
-        img = r.render(opaque, mesh, colors, camera=camera)
-        cov = coverage(rc, scene, mesh, camera)
-    ref = perpixel.reference(scene, mesh, (w, h), camera=camera, method=method)
-    return compare(img, ref, cov)
+    with ViewComparer(size) as v:
+        return v.compare(scene, mesh, camera=camera, colors=colors, method=method)
 
 
 #: the heat map's colour ramp: 0 levels black, then blue, green, yellow, red, white at ``vmax``

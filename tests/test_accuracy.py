@@ -315,6 +315,10 @@ def test_compare_view_for_the_gui():
     assert (heat[coarse.mask].sum(axis=1) > 0).mean() > 0.3
     teapot = A.compare_view(scene, M.teapot(4), size)  # any mesh: ray cast reference
     assert teapot.mask.sum() > 1000 and teapot.rmse > 0
+    with A.ViewComparer(size) as v:  # reused windows give the same answers
+        again = [v.compare(scene, M.sphere(12), camera=cam), v.compare(scene, M.teapot(4))]
+    assert np.array_equal(again[0].levels, coarse.levels)
+    assert np.array_equal(again[1].levels, teapot.levels)
 
 
 # -- the command ---------------------------------------------------------------------------
