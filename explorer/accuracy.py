@@ -347,22 +347,27 @@ def _versions() -> dict[str, str]:
     return out
 
 
-def _opengl(renderer) -> dict[str, str]:
-    """OpenGL vendor/renderer/version strings of a live off-screen window."""
-    out = {}
+def _opengl() -> dict[str, str]:
+    """OpenGL vendor/renderer/version of an off-screen window (pyvista's GPU report)."""
     try:
-        report = renderer.plotter.render_window.ReportCapabilities()
+        import pyvista as pv
+
+        headless = not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
+        key = "VTK_DEFAULT_OPENGL_WINDOW"
+        added = headless and key not in os.environ
+        if added:
+            os.environ[key] = "vtkEGLRenderWindow"
+        try:
+            info = pv.GPUInfo()
+        finally:
+            if added:
+                del os.environ[key]
+        return {"vendor": info.vendor, "renderer": info.renderer, "version": info.version}
     except Exception:  # noqa: BLE001 - only informative
-        return out
-    for line in str(report).splitlines():
-        for key in ("vendor", "renderer", "version"):
-            tag = f"OpenGL {key} string:"
-            if line.strip().startswith(tag):
-                out[key] = line.split(":", 1)[1].strip()
-    return out
+        return {}
 
 
-def machine_info(renderer=None) -> dict:
+def machine_info(opengl: bool = False) -> dict:
     """The machine a measurement ran on: CPU, cores, memory, OS, versions, OpenGL, load."""
     try:
         usable = len(os.sched_getaffinity(0))
@@ -377,8 +382,8 @@ def machine_info(renderer=None) -> dict:
         "versions": _versions(),
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
     }
-    if renderer is not None:
-        info["opengl"] = _opengl(renderer)
+    if opengl:
+        info["opengl"] = _opengl()
     try:
         info["load_before"] = [round(x, 2) for x in os.getloadavg()]
     except OSError:
@@ -604,7 +609,7 @@ def run_bench(config: BenchConfig = BenchConfig(), *, progress: Progress | None 
         refs = _References(perpixel.sphere_camera(base, 1.0), size)
         with R.OffscreenRenderer(size) as r, R.OffscreenRenderer(size, (0, 0, 0)) as rc:
             if machine is None:
-                machine = machine_info(r)
+                machine = machine_info(opengl=True)
             for name, res in meshes:
                 if (name, res) not in mesh_cache:
                     mesh_cache[(name, res)] = get_mesh(name, res)

@@ -337,6 +337,7 @@ def test_quick_bench_writes_table_doc_and_plot(quick, capsys):
     table = json.loads((out / "accuracy.json").read_text())
     assert table["quick"] and table["command"] == "phong-explorer bench accuracy --quick"
     assert table["machine"]["cpu"] and "load_after" in table["machine"]
+    assert table["machine"]["opengl"]["renderer"]  # e.g. llvmpipe: what drew the pictures
     n_mesh = sum(len(r) for _, r in A.QUICK_MESHES)
     uniform = [r for r in table["rows"] if r["mesh"] != "adaptive"]
     adaptive = [r for r in table["rows"] if r["mesh"] == "adaptive"]
