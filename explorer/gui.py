@@ -354,6 +354,8 @@ class _View:
         import explorer
 
         self.mesh = mesh
+        self.centre = mesh.centre  # (3,): Mesh computes these on every call
+        self.radius = mesh.radius or 1.0
         self.hdr = getattr(scene, "hdr", None)
         self.shader = explorer.Shader(
             scene,
@@ -531,7 +533,7 @@ class Explorer:
             lo, hi = self._slider_range(name)
             value = lo
             if name == "distance":  # a directional light's handle sits at this distance
-                value = min(max(DEFAULT_PLACEMENT[2] * (self.mesh.radius or 1.0), lo), hi)
+                value = min(max(DEFAULT_PLACEMENT[2] * self.radius, lo), hi)
             w = pl.add_slider_widget(
                 self._guard(self._on_slider, name),
                 (lo, hi),
@@ -575,11 +577,11 @@ class Explorer:
             return G.AZIMUTH_RANGE
         if name == "elevation":
             return G.ELEVATION_RANGE
-        r = self.mesh.radius or 1.0
+        r = self.radius
         lo, hi = G.DISTANCE_RANGE[0] * r, G.DISTANCE_RANGE[1] * r
         light = self.light
         if light is not None and not isinstance(light, DirectionalLight):
-            d = placement_of(light, self.mesh.centre)[2]
+            d = placement_of(light, self.centre)[2]
             lo, hi = min(lo, d), max(hi, d)
         return (lo, hi)
 
@@ -608,11 +610,13 @@ class Explorer:
             self.buttons[name].GetRepresentation().PlaceWidget([x0, x0 + s, y0, y0 + s, 0, 0])
 
     def _build_handle(self) -> None:
-        r = G.HANDLE_RADIUS * (self.mesh.radius or 1.0)
+        r = G.HANDLE_RADIUS * self.radius
         self.handle = self.plotter.add_sphere_widget(
             self._guard(self._on_handle),
             center=(0.0, 0.0, 0.0),
             radius=r,
+            theta_resolution=20,
+            phi_resolution=12,
             color=G.HANDLE_COLOR,
             selected_color=(1.0, 1.0, 1.0),
             test_callback=False,
@@ -732,9 +736,9 @@ class Explorer:
         cam = camera_for(self.scene, self.mesh, aspect)
         if self.light is not None:  # widen the view to show the light's handle, if near
             az, el, d = self._placement()
-            if d <= HANDLE_FRAMING * (self.mesh.radius or 1.0):
-                handle = self.mesh.centre + d * light_direction(az, el)
-                r = G.HANDLE_RADIUS * (self.mesh.radius or 1.0)
+            if d <= HANDLE_FRAMING * self.radius:
+                handle = self.centre + d * light_direction(az, el)
+                r = G.HANDLE_RADIUS * self.radius
                 cam = widen_to_show(cam, [handle], aspect, pad=r)
         c = self.plotter.camera
         self.plotter.camera_set = True
@@ -842,6 +846,16 @@ class Explorer:
     @property
     def mesh(self) -> Mesh:
         return self._views[0].mesh
+
+    @property
+    def centre(self) -> np.ndarray:
+        """(3,) centre of the mesh's bounding box (computed once per mesh)."""
+        return self._views[0].centre
+
+    @property
+    def radius(self) -> float:
+        """The mesh's bounding radius about :attr:`centre` (1 for a single point)."""
+        return self._views[0].radius
 
     @property
     def shader(self):
@@ -996,16 +1010,16 @@ class Explorer:
         mesh = self._meshes.get(name)
         if mesh is None:
             mesh = get_mesh(name, self.mesh_choices.get(name))
-        old = self.mesh
+        old_centre, old_radius = self.centre, self.radius
         self._set_mesh(mesh)
         # keep each light where it is relative to the mesh, scaled to the new mesh's size
-        ratio = (mesh.radius or 1.0) / (old.radius or 1.0)
         lights = []
         for light in self.scene.lights:
-            az, el, d = placement_of(light, old.centre)
-            lights.append(place_light(light, az, el, (d or 0.0) * ratio, mesh.centre))
+            az, el, d = placement_of(light, old_centre)
+            d = (d or 0.0) * self.radius / old_radius
+            lights.append(place_light(light, az, el, d, self.centre))
         self.scene = self.scene.replace(lights=tuple(lights), mesh=name)
-        self.handle.SetRadius(G.HANDLE_RADIUS * (mesh.radius or 1.0))
+        self.handle.SetRadius(G.HANDLE_RADIUS * self.radius)
         self._frame_camera()
         self._reset_distance_range()
         self._push_scene(render=False)
@@ -1067,7 +1081,7 @@ class Explorer:
     def _placement(self) -> tuple[float, float, float]:
         """The controlled light's placement; a directional light's distance is the distance
         slider's (it only places the handle)."""
-        az, el, d = placement_of(self.light, self.mesh.centre)
+        az, el, d = placement_of(self.light, self.centre)
         if d is None:
             d = self.sliders["distance"].GetRepresentation().GetValue()
         return az, el, d
@@ -1086,7 +1100,7 @@ class Explorer:
         az = az if azimuth is None else float(azimuth)
         el = el if elevation is None else float(elevation)
         d = d if distance is None else float(distance)
-        self._set_light(place_light(self.light, az, el, d, self.mesh.centre))
+        self._set_light(place_light(self.light, az, el, d, self.centre))
         self._sync_controls(placement=(az, el, d))
         self.render()
 
@@ -1094,7 +1108,7 @@ class Explorer:
         if self.light is None:
             raise ExplorerError("the scene has no lights to change")
         az, el, d = self._placement()
-        self._set_light(convert_light(self.light, kind, az, el, d, self.mesh.centre))
+        self._set_light(convert_light(self.light, kind, az, el, d, self.centre))
         self._sync_controls(placement=(az, el, d))
         self.render()
 
@@ -1166,7 +1180,7 @@ class Explorer:
         self.preset_name = preset
         if mesh_name != self.mesh.name:
             self._set_mesh(self._meshes[mesh_name])
-            self.handle.SetRadius(G.HANDLE_RADIUS * (self.mesh.radius or 1.0))
+            self.handle.SetRadius(G.HANDLE_RADIUS * self.radius)
         self.scene = scene
         c = self.plotter.camera
         pos, focal, up, parallel, scale, angle = camera
@@ -1228,7 +1242,7 @@ class Explorer:
             return
         if self._t0 is None:
             self._t0 = time.perf_counter()
-        az, el, d = placement_of_vector(np.subtract(center, self.mesh.centre))
+        az, el, d = placement_of_vector(np.subtract(center, self.centre))
         if d == 0.0:
             return
         lo, hi = self._slider_range("distance")
@@ -1248,7 +1262,7 @@ class Explorer:
         if light is not None:
             az, el, d = placement if placement is not None else self._placement()
             values.update(azimuth=az, elevation=el, distance=d)
-            self.handle.SetCenter(*(self.mesh.centre + d * light_direction(az, el)))
+            self.handle.SetCenter(*(self.centre + d * light_direction(az, el)))
             self.handle.On()
             kind = light.type
             if kind == "directional":

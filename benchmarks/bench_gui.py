@@ -1,0 +1,360 @@
+"""GUI benchmark: time from a slider change to the rendered frame, beside VTK's own lighting.
+
+    python benchmarks/bench_gui.py                    # prints the table, writes docs/gui_bench.md
+    python benchmarks/bench_gui.py --repeat 15 --no-write
+
+Everything runs off-screen in one process, 800x600, anti-aliasing and multisampling off, on the
+same meshes:
+
+- 100k vertices (the Utah teapot at tessellation 56), 1, 4 and 8 point lights:
+  * ``explorer``: the explorer window (sliders, buttons, texts, lobe inset) as a slider fires:
+    the engine's update (kd: compose only; shininess: the lobe; azimuth: every light sum), the
+    uint8 colour upload and the frame;
+  * ``engine + unlit mesh``: the same engine update and upload on a bare window (no widgets);
+  * ``VTK lighting``: VTK's own per-pixel Phong lighting of the same mesh with as many
+    positional lights, a material property changed (what a slider would do) and the frame.
+- 1M vertices (a UV sphere): a slider frame while dragging (the level of detail is drawn), the
+  frame on release (the full mesh shaded and drawn), and a slider frame with no level of detail.
+
+Each row: median and best over ``--repeat`` frames after a warm-up (the first, compiling frame is
+never timed), and the ratio to VTK's lighting. A frame ends when VTK's ``Render()`` returns and
+``WaitForCompletion()`` (``glFinish``) says the GPU (here Mesa llvmpipe) is done. Wall times
+vary with load: the load average before and after is printed with the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+import explorer  # noqa: E402
+from explorer import gui  # noqa: E402
+from explorer import meshes as M  # noqa: E402
+from explorer.lights import PointLight  # noqa: E402
+from explorer.presets import find_preset  # noqa: E402
+from explorer.render import BACKGROUND, to_bytes  # noqa: E402
+from explorer.scene import Scene, Viewer  # noqa: E402
+
+SIZE = (800, 600)
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "gui_bench.md"
+
+
+def machine(plotter) -> list[str]:
+    import numba
+    import pyvista as pv
+    import vtk
+
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(ln.split(":", 1)[1].strip() for ln in f if ln.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    gl = "unknown"
+    for line in plotter.render_window.ReportCapabilities().splitlines():
+        if line.startswith("OpenGL renderer string:"):
+            gl = line.split(":", 1)[1].strip()
+    return [
+        f"CPU: {cpu}; {os.cpu_count()} cores",
+        f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}, "
+        f"VTK {vtk.vtkVersion.GetVTKVersion()}, PyVista {pv.__version__}",
+        f"OpenGL renderer: {gl}; window {SIZE[0]}x{SIZE[1]} off-screen, no anti-aliasing",
+    ]
+
+
+def load() -> str:
+    if not hasattr(os, "getloadavg"):
+        return "n/a"
+    return " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def timed(step, repeat: int, warm: int = 2) -> tuple[float, float]:
+    """Median and best wall time (ms) of ``step(i)`` over ``repeat`` calls after ``warm``."""
+    for i in range(warm):
+        step(i)
+    ts = []
+    for i in range(repeat):
+        t = time.perf_counter()
+        step(warm + i)
+        ts.append(1000.0 * (time.perf_counter() - t))
+    return statistics.median(ts), min(ts)
+
+
+def lights_around(mesh, count: int) -> tuple:
+    """``count`` white point lights spread over the upper front of the mesh."""
+    out = []
+    for i in range(count):
+        az = -60.0 + 120.0 * (i + 0.5) / count
+        el = 20.0 + 25.0 * (i % 2)
+        out.append(gui.place_light(PointLight(), az, el, 3.0 * mesh.radius, mesh.centre))
+    return tuple(out)
+
+
+def scene_for(mesh, count: int) -> Scene:
+    eye = mesh.centre + 6.0 * mesh.radius * np.array([0.0, 0.3, 1.0]) / np.hypot(0.3, 1.0)
+    return Scene(
+        material=find_preset("gold"),
+        lights=lights_around(mesh, count),
+        viewer=Viewer(eye=tuple(eye)),
+    )
+
+
+def uv_sphere(around: int, rings: int) -> M.Mesh:
+    """A UV sphere with ``around * (rings + 1)`` vertices (seam duplicated)."""
+    theta = np.linspace(0.0, np.pi, rings + 1)
+    phi = np.linspace(0.0, 2.0 * np.pi, around, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    pos = np.stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(rings), np.arange(around), indexing="ij")
+    a = i * around + j
+    b = i * around + (j + 1) % around
+    c, d = a + around, b + around
+    faces = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)]).reshape(-1, 3)
+    return M.Mesh(pos, pos.copy(), faces, "uv_sphere")
+
+
+def finish(plotter) -> None:
+    plotter.render_window.WaitForCompletion()
+
+
+# -- the three ways of drawing a slider change ----------------------------------------------------
+
+
+def explorer_frames(mesh, count: int, repeat: int, **kw) -> dict:
+    """The explorer window: a slider's InteractionEvent, then the frame."""
+    from vtkmodules.vtkCommonCore import vtkCommand
+
+    app = gui.Explorer(scene_for(mesh, count), mesh, off_screen=True, window_size=SIZE, **kw)
+    app.render()
+    out = {}
+    values = {
+        "kd": lambda i: 0.3 + 0.4 * (i % 2),
+        "shininess": lambda i: 1.2 + 0.8 * (i % 2),
+        "azimuth": lambda i: 20.0 + 30.0 * (i % 2),
+    }
+    for name, value in values.items():
+        w = app.sliders[name]
+
+        def step(i, w=w, value=value):
+            w.GetRepresentation().SetValue(value(i))
+            w.InvokeEvent(vtkCommand.InteractionEvent)
+            app.render()
+            finish(app.plotter)
+
+        out[name] = timed(step, repeat)
+
+    def rotate(i):
+        app.plotter.camera.Azimuth(3.0 if i % 2 else -3.0)
+        app.render()
+        finish(app.plotter)
+
+    out["camera"] = timed(rotate, repeat)
+    out["app"] = app
+    return out
+
+
+def bare_engine_frames(mesh, count: int, repeat: int) -> dict:
+    """The engine's update and upload on a bare window: the cost without the widgets."""
+    import pyvista as pv
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    scene = scene_for(mesh, count)
+    shader = explorer.Shader(scene, mesh.positions, mesh.normals, precision="float32")
+    pl = pv.Plotter(off_screen=True, window_size=list(SIZE), lighting=None)
+    pl.render_window.SetMultiSamples(0)
+    pl.disable_anti_aliasing()
+    pl.set_background(BACKGROUND)
+    poly = gui._polydata(mesh, to_bytes(shader.colors))
+    pl.add_mesh(poly, scalars="colors", rgb=True, lighting=False, show_scalar_bar=False)
+    pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
+    arr = poly.GetPointData().GetArray("colors")
+    rgb = vtk_to_numpy(arr)
+    buf = np.empty((mesh.n_vertices, 3), np.float32)
+    m = scene.material
+
+    def step(i):
+        shader.set_material(m.with_scalars(kd=0.3 + 0.4 * (i % 2)))
+        np.multiply(shader.colors, 255.0, out=buf)
+        np.rint(buf, out=buf)
+        rgb[...] = buf
+        arr.Modified()
+        pl.render_window.Render()
+        finish(pl)
+
+    result = timed(step, repeat)
+    pl.close()
+    return {"kd": result}
+
+
+def vtk_lighting_frames(mesh, count: int, repeat: int) -> dict:
+    """VTK's own per-pixel lighting of the same mesh, a material property changed per frame."""
+    import pyvista as pv
+
+    scene = scene_for(mesh, count)
+    m = scene.material
+    pl = pv.Plotter(off_screen=True, window_size=list(SIZE), lighting=None)
+    pl.render_window.SetMultiSamples(0)
+    pl.disable_anti_aliasing()
+    pl.set_background(BACKGROUND)
+    poly = mesh.to_polydata()
+    actor = pl.add_mesh(
+        poly,
+        color=m.diffuse,
+        ambient=max(m.ambient) / max(m.diffuse),
+        diffuse=1.0,
+        specular=max(m.specular),
+        specular_power=m.shininess,
+        smooth_shading=True,
+        interpolation="phong",
+    )
+    for light in scene.lights:
+        pl.add_light(
+            pv.Light(position=light.position, focal_point=tuple(mesh.centre), positional=True,
+                     cone_angle=180.0, light_type="scene light")
+        )  # fmt: skip
+    pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
+    prop = actor.GetProperty()
+
+    def step(i):
+        prop.SetDiffuse(0.4 + 0.5 * (i % 2))
+        pl.render_window.Render()
+        finish(pl)
+
+    result = timed(step, repeat)
+    assert pl.renderer.GetLights().GetNumberOfItems() == count
+    pl.close()
+    return {"kd": result}
+
+
+def lod_frames(mesh, repeat: int) -> dict:
+    """1M vertices: slider frames while dragging (LOD), the frame on release, and slider frames
+    drawn on the full mesh (no LOD)."""
+    from vtkmodules.vtkCommonCore import vtkCommand
+
+    out = {}
+    app = gui.Explorer(scene_for(mesh, 1), mesh, off_screen=True, window_size=SIZE)
+    app.render()
+    w = app.sliders["kd"]
+    rep = w.GetRepresentation()
+
+    def drag(i):
+        rep.SetValue(0.3 + 0.4 * (i % 2))
+        w.InvokeEvent(vtkCommand.InteractionEvent)
+        app.render()
+        finish(app.plotter)
+
+    def rotate(i):
+        app.plotter.camera.Azimuth(3.0 if i % 2 else -3.0)
+        app.render()
+        finish(app.plotter)
+
+    w.InvokeEvent(vtkCommand.StartInteractionEvent)
+    out["lod vertices"] = app._views[1].mesh.n_vertices
+    out["drag kd (LOD)"] = timed(drag, repeat)
+    out["drag camera (LOD)"] = timed(rotate, repeat)
+
+    def release(i):
+        w.InvokeEvent(vtkCommand.StartInteractionEvent)
+        drag(i)
+        t = time.perf_counter()
+        w.InvokeEvent(vtkCommand.EndInteractionEvent)
+        app.render()
+        finish(app.plotter)
+        return 1000.0 * (time.perf_counter() - t)
+
+    w.InvokeEvent(vtkCommand.EndInteractionEvent)
+    app.render()
+    ts = [release(i) for i in range(max(3, repeat // 3))]
+    out["release (full mesh)"] = (statistics.median(ts), min(ts))
+    app.close()
+    full = explorer_frames(mesh, 1, max(3, repeat // 3), lod_vertices=10**9)
+    out["kd, no LOD (full mesh)"] = full["kd"]
+    full["app"].close()
+    return out
+
+
+def fmt(t) -> str:
+    return f"{t[0]:.1f} ({t[1]:.1f})"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeat", type=int, default=21, help="timed frames per row (21)")
+    ap.add_argument("--lights", type=int, nargs="+", default=[1, 4, 8])
+    ap.add_argument("--no-write", action="store_true", help="do not write docs/gui_bench.md")
+    ap.add_argument("--skip-1m", action="store_true", help="leave out the 1M-vertex rows")
+    args = ap.parse_args(argv)
+
+    before = load()
+    teapot = M.teapot(56)
+    rows = []  # (case, lights, median/best ms, ratio to VTK)
+    info = None
+    for count in args.lights:
+        ex = explorer_frames(teapot, count, args.repeat)
+        if info is None:
+            info = machine(ex["app"].plotter)
+        ex["app"].close()
+        bare = bare_engine_frames(teapot, count, args.repeat)
+        vtk_ = vtk_lighting_frames(teapot, count, args.repeat)
+        ref = vtk_["kd"][0]
+        rows.append(("VTK per-pixel lighting, property change", count, vtk_["kd"], 1.0))
+        rows.append(
+            ("engine + unlit mesh (bare window), kd", count, bare["kd"], bare["kd"][0] / ref)
+        )
+        for name, label in (
+            ("kd", "explorer window, kd slider (compose)"),
+            ("shininess", "explorer window, shininess slider (lobe)"),
+            ("azimuth", "explorer window, azimuth slider (all light sums)"),
+            ("camera", "explorer window, camera rotation (specular)"),
+        ):
+            rows.append((label, count, ex[name], ex[name][0] / ref))
+    lod = None
+    sphere = None
+    if not args.skip_1m:
+        sphere = uv_sphere(1000, 999)
+        lod = lod_frames(sphere, args.repeat)
+    after = load()
+
+    lines = ["# GUI benchmark", "", "Machine:", ""]
+    lines += [f"- {x}" for x in info]
+    lines += [f"- load average before / after: {before} / {after}", ""]
+    lines += [
+        f"Slider change to rendered frame, {teapot.n_vertices:,}-vertex teapot, point lights; "
+        f"median (best) ms over {args.repeat} frames:",
+        "",
+        "| case | lights | ms | / VTK |",
+        "|---|---:|---:|---:|",
+    ]
+    lines += [f"| {c} | {n} | {fmt(t)} | {r:.2f} |" for c, n, t, r in rows]
+    if lod is not None:
+        lines += [
+            "",
+            f"1M vertices ({sphere.n_vertices:,}-vertex UV sphere, 1 point light; level of "
+            f"detail {lod['lod vertices']:,} vertices); median (best) ms:",
+            "",
+            "| case | ms | frames/s |",
+            "|---|---:|---:|",
+        ]
+        for k, t in lod.items():
+            if k != "lod vertices":
+                lines.append(f"| {k} | {fmt(t)} | {1000.0 / t[0]:.0f} |")
+    lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}`"]
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if not args.no_write:
+        DOCS.write_text(text)
+        print(f"wrote {DOCS}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
