@@ -438,7 +438,6 @@ class Explorer:
         import pyvista as pv
 
         from . import render as R
-        from .presets import list_presets
 
         self.materials_dirs = tuple(materials_dirs)
         self.state_file = Path(state_file) if state_file else None
@@ -446,8 +445,7 @@ class Explorer:
         self.preset_dir = preset_dir
         self.lod_vertices = int(lod_vertices)
         self.lod_target = int(lod_target)
-        self.notices: list[str] = []
-        self.presets = list_presets(self.materials_dirs, notices=self.notices)
+        self.presets = self._list_presets()
         self.errors: list[str] = []
         self.message = ""
         self.frames = 0
@@ -468,6 +466,7 @@ class Explorer:
         if mesh.name not in self.mesh_choices:  # a file: first in the chooser
             self.mesh_choices = {mesh.name: None, **self.mesh_choices}
         self._meshes = {mesh.name: mesh}
+        self._mesh_specs = {mesh.name: scene.mesh or mesh.name}  # name -> scene.mesh value
         self._lods: dict[str, Mesh] = {}
 
         w, h = (int(v) for v in window_size)
@@ -535,7 +534,7 @@ class Explorer:
             if name == "distance":  # a directional light's handle sits at this distance
                 value = min(max(DEFAULT_PLACEMENT[2] * self.radius, lo), hi)
             w = pl.add_slider_widget(
-                self._guard(self._on_slider, name),
+                self._guard(self._on_slider, name, name="slider"),
                 (lo, hi),
                 value=value,
                 title=name,
@@ -590,7 +589,7 @@ class Explorer:
         self.buttons = {}
         for name in G.BUTTONS:
             w = pl.add_checkbox_button_widget(
-                self._guard(self._on_button, name),
+                self._guard(self._on_button, name, name="button"),
                 value=False,
                 position=(0, 0),
                 size=G.BUTTON_SIZE,
@@ -612,7 +611,7 @@ class Explorer:
     def _build_handle(self) -> None:
         r = G.HANDLE_RADIUS * self.radius
         self.handle = self.plotter.add_sphere_widget(
-            self._guard(self._on_handle),
+            self._guard(self._on_handle, name="light handle"),
             center=(0.0, 0.0, 0.0),
             radius=r,
             theta_resolution=20,
@@ -793,6 +792,15 @@ class Explorer:
 
         self._char_tag = iren.AddObserver("CharEvent", block, 10.0)
 
+    def _list_presets(self) -> list:
+        from .presets import list_presets
+
+        notices: list[str] = []
+        presets = list_presets(self.materials_dirs, notices=notices)
+        for text in notices:
+            log.warning("%s", text)
+        return presets
+
     # -- error handling --------------------------------------------------------------------
     def _guard(self, fn, *bound, name: str | None = None, renders_after: bool = True):
         """``fn`` made safe for VTK: any exception is logged and shown in the window's message
@@ -898,6 +906,7 @@ class Explorer:
             v.actor.GetProperty().SetOpacity(opacity)
         self.active_view.upload()
         self._update_lobe()
+        self._update_preset_text()
         if render:
             self.render()
 
@@ -1018,7 +1027,8 @@ class Explorer:
             az, el, d = placement_of(light, old_centre)
             d = (d or 0.0) * self.radius / old_radius
             lights.append(place_light(light, az, el, d, self.centre))
-        self.scene = self.scene.replace(lights=tuple(lights), mesh=name)
+        spec = self._mesh_specs.get(name, name)
+        self.scene = self.scene.replace(lights=tuple(lights), mesh=spec)
         self.handle.SetRadius(G.HANDLE_RADIUS * self.radius)
         self._frame_camera()
         self._reset_distance_range()
@@ -1134,7 +1144,7 @@ class Explorer:
     def save_preset(self) -> Path:
         """Save the material (with the current specular model) as a new preset in the user's
         preset directory: ``<preset>_1``, ``<preset>_2``..., never over an existing file."""
-        from .presets import list_presets, save_preset, user_dir
+        from .presets import save_preset, user_dir
 
         directory = Path(self.preset_dir) if self.preset_dir else user_dir()
         stem = self.preset_name or "material"
@@ -1148,7 +1158,7 @@ class Explorer:
             description=f"{stem} as edited in phong-explorer",
         )
         path = save_preset(material, name, directory)
-        self.presets = list_presets(self.materials_dirs, notices=self.notices)
+        self.presets = self._list_presets()
         self.last_saved = str(path)
         self.preset_name = name if any(p.name == name for p in self.presets) else None
         self._say(f"saved preset '{name}' to {path}")
@@ -1285,11 +1295,17 @@ class Explorer:
         }
         for name, on in states.items():
             self.buttons[name].GetRepresentation().SetState(int(on))
-        preset = self.preset_name or "(scene material)"
-        i = self.preset_index
-        count = f" ({i + 1}/{len(self.presets)})" if i is not None else ""
-        self.texts["preset"].SetInput(f"{preset}{count}")
+        self._update_preset_text()
         self.texts["mesh"].SetInput(f"{self.mesh.name}, {self.mesh.n_vertices:,} vertices")
+
+    def _update_preset_text(self) -> None:
+        """The preset's name and place in the chooser; ``*`` once the material is edited."""
+        i = self.preset_index
+        if i is None:
+            self.texts["preset"].SetInput(self.preset_name or "(scene material)")
+            return
+        edited = "*" if self.scene.material != self.presets[i].material else ""
+        self.texts["preset"].SetInput(f"{self.preset_name}{edited} ({i + 1}/{len(self.presets)})")
 
     def _update_lobe(self) -> None:
         n = self.scene.material.shininess

@@ -28,7 +28,7 @@ from explorer import gui_layout as G  # noqa: E402
 from explorer import meshes as M  # noqa: E402
 from explorer.lights import DirectionalLight, PointLight, SpotLight  # noqa: E402
 from explorer.material import Material  # noqa: E402
-from explorer.presets import find_preset, list_presets  # noqa: E402
+from explorer.presets import find_preset  # noqa: E402
 from explorer.render import read_png, to_bytes  # noqa: E402
 from explorer.scene import Scene, Viewer  # noqa: E402
 
@@ -123,7 +123,7 @@ def app(shared_app, user_presets):
     """The shared window, back at its start, with no messages or errors."""
     for p in user_presets.glob("*.yaml"):
         p.unlink()
-    shared_app.presets = list_presets()
+    shared_app.presets = shared_app._list_presets()
     shared_app.reset()
     shared_app.errors.clear()
     shared_app._say("")
@@ -418,6 +418,39 @@ def test_preset_chooser(app):
     press(app, "n")
     assert app.preset_name == "gold"
     assert_shows_engine_colours(app)
+
+
+def test_preset_name_is_marked_once_edited(app):
+    assert app.texts["preset"].GetInput().startswith("gold (")
+    fire_slider(app, "ks", 0.2)
+    assert app.texts["preset"].GetInput().startswith("gold* (")
+    press(app, "n")
+    press(app, "p")
+    assert app.texts["preset"].GetInput().startswith("gold (")
+
+
+def test_buttons_follow_a_resized_window(app):
+    on = np.rint(np.asarray(G.ACCENT_COLOR) * 255).astype(int)
+
+    def centre_pixel(name, size):
+        x, y = G.BUTTONS[name]
+        w, h = size
+        img = app.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+        px = round(x * w) + G.BUTTON_SIZE // 2
+        py = h - 1 - (round(y * h) + G.BUTTON_SIZE // 2)
+        return img[py, px]
+
+    assert app.scene.model == "blinn"
+    assert np.abs(centre_pixel("blinn", SIZE) - on).max() <= 2
+    try:
+        app.plotter.window_size = (1200, 800)
+        app.render()
+        assert np.abs(centre_pixel("blinn", (1200, 800)) - on).max() <= 2
+        click_at = app.state()["buttons"]["phong"]["px"]
+        assert click_at[0] == round(G.BUTTONS["phong"][0] * 1200) + G.BUTTON_SIZE // 2
+    finally:
+        app.plotter.window_size = SIZE
+        app.render()
 
 
 def test_translucent_preset_is_drawn_back_to_front(app):
