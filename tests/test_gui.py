@@ -380,6 +380,7 @@ def test_model_switch(app):
 
 @pytest.mark.parametrize("shown", ["ambient", "diffuse", "specular"])
 def test_show_only_one_term(app, shown):
+    stats = dict(app.shader.stats)
     for term in gui.TERMS:
         if term != shown:
             click(app, term)
@@ -397,6 +398,9 @@ def test_show_only_one_term(app, shown):
         press(app, key)
     assert app.terms == {t: t != shown for t in gui.TERMS}
     assert_shows_engine_colours(app)
+    # hiding and showing terms is a compose pass: the light sums stay cached
+    for kind in ("geometry", "pass", "lobe"):
+        assert app.shader.stats[kind] == stats.get(kind, 0), kind
 
 
 def test_preset_chooser(app):
