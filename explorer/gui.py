@@ -333,8 +333,7 @@ def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
 
 def _polydata(mesh: Mesh, colors=None):
     """A PolyData of the mesh's triangles with float32 points and no normals (the colours are
-    drawn unlit: normals would only cost upload and vertex work), and ``colors`` as uint8
-    point data."""
+    drawn unlit, so VTK has no use for normals), and ``colors`` as uint8 point data."""
     import pyvista as pv
 
     cells = np.hstack([np.full((mesh.n_faces, 1), 3, np.int64), mesh.faces]).ravel()
@@ -653,6 +652,7 @@ class Explorer:
         frame = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side), (x0, y0)]
         axes = [(x0 + pad, y0 + side / 2), (x0 + side - pad, y0 + side / 2)]
         self._set_lines(self._lobe_polys["frame"], [frame, axes])
+        self._lobe_n = None  # the exponent the lobe is drawn for
         self._set_lines(self._lobe_polys["reference"], [self._lobe_points(1.0)])
 
     @staticmethod
@@ -910,6 +910,12 @@ class Explorer:
         if render:
             self.render()
 
+    def _refresh(self) -> None:
+        """After a change of state: the engine, every control, and a frame."""
+        self._push_scene(render=False)
+        self._sync_controls()
+        self.render()
+
     def render(self) -> None:
         """Draw a frame now (works before and during the event loop, on- and off-screen);
         inside a widget callback the widget draws it right after."""
@@ -1032,9 +1038,7 @@ class Explorer:
         self.handle.SetRadius(G.HANDLE_RADIUS * self.radius)
         self._frame_camera()
         self._reset_distance_range()
-        self._push_scene(render=False)
-        self._sync_controls()
-        self.render()
+        self._refresh()
 
     def next_mesh(self, step: int = 1) -> None:
         names = list(self.mesh_choices)
@@ -1046,9 +1050,7 @@ class Explorer:
         self.scene = self.scene.replace(material=material)
         if preset is not None:
             self.preset_name = preset
-        self._push_scene(render=False)
-        self._sync_controls()
-        self.render()
+        self._refresh()
 
     def set_preset(self, name: str) -> None:
         """Show preset ``name`` (and its specular model, when it has one)."""
@@ -1069,9 +1071,7 @@ class Explorer:
 
     def set_model(self, model: str) -> None:
         self.scene = self.scene.replace(model=model)
-        self._push_scene(render=False)
-        self._sync_controls()
-        self.render()
+        self._refresh()
 
     def toggle_model(self) -> None:
         self.set_model("phong" if self.scene.model == "blinn" else "blinn")
@@ -1080,9 +1080,7 @@ class Explorer:
         if term not in TERMS:
             raise ExplorerError(f"term must be one of {TERMS}, got {term!r}")
         self.terms[term] = bool(on)
-        self._push_scene(render=False)
-        self._sync_controls()
-        self.render()
+        self._refresh()
 
     def toggle_term(self, term: str) -> None:
         self.set_term(term, not self.terms[term])
@@ -1201,10 +1199,8 @@ class Explorer:
         c.SetParallelScale(scale)
         c.SetViewAngle(angle)
         self._reset_distance_range()
-        self._push_scene(render=False)
-        self._sync_controls()
         self._say("reset to the start")
-        self.render()
+        self._refresh()
 
     def toggle_help(self) -> None:
         self.help_visible = not self.help_visible
@@ -1309,6 +1305,9 @@ class Explorer:
 
     def _update_lobe(self) -> None:
         n = self.scene.material.shininess
+        if n == self._lobe_n:
+            return
+        self._lobe_n = n
         self._set_lines(self._lobe_polys["lobe"], [self._lobe_points(n)])
         self.texts["lobe"].SetInput(f"specular lobe cos^n t, n = {n:g}")
 
