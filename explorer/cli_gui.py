@@ -75,12 +75,10 @@ def start(args):
     args.mesh_default = gui.DEFAULT_MESH
     placeholder = PointLight(position=(0.0, 0.0, 0.0), diffuse=(1.0, 1.0, 1.0))
     scene, mesh = build_scene(args, default_light=placeholder)
-    if (
-        args.resolution is None
-        and mesh.name in gui.MESH_CHOICES
-        and mesh.name == (args.mesh if args.mesh is not None else (scene.mesh or gui.DEFAULT_MESH))
-    ):
-        mesh = get_mesh(mesh.name, gui.MESH_CHOICES[mesh.name])
+    spec = args.mesh if args.mesh is not None else (scene.mesh or gui.DEFAULT_MESH)
+    scene = scene.replace(mesh=spec)  # the state names the mesh shown
+    if args.resolution is None and spec in gui.MESH_CHOICES:
+        mesh = get_mesh(spec, gui.MESH_CHOICES[spec])
     r = mesh.radius or 1.0
     if scene.lights == (placeholder,):  # no scene lights and no --light-* option
         az, el, d = gui.DEFAULT_PLACEMENT

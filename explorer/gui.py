@@ -469,20 +469,20 @@ class Explorer:
         self._lods: dict[str, Mesh] = {}
 
         w, h = (int(v) for v in window_size)
-        self.plotter = pl = pv.Plotter(
-            off_screen=off_screen, window_size=[w, h], lighting=None, title=G.TITLE
-        )
-        pl.render_window.SetMultiSamples(0)
-        pl.disable_anti_aliasing()
-        pl.renderer.SetUseOIT(False)
-        pl.renderer.SetUseDepthPeeling(False)
-        pl.set_background(R.BACKGROUND if background is None else background)
-        if not off_screen:
+        background = R.BACKGROUND if background is None else background
+        if off_screen:  # the renderer's off-screen window (EGL when there is no display)
+            self.plotter = pl = R._plotter((w, h), background)
+        else:  # the same settings in a window on the screen
+            self.plotter = pl = pv.Plotter(window_size=[w, h], lighting=None, title=G.TITLE)
+            pl.render_window.SetMultiSamples(0)
+            pl.disable_anti_aliasing()
+            pl.renderer.SetUseOIT(False)
+            pl.renderer.SetUseDepthPeeling(False)
+            pl.set_background(background)
             reason = _window_problem(pl.render_window)
             if reason:
                 pl.close()
                 raise NoDisplayError(reason)
-
         self._build_panel()
         self._views: list[_View] = []
         self._set_mesh(mesh)

@@ -20,17 +20,15 @@ import warnings
 import numpy as np
 import pytest
 
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-
-import explorer  # noqa: E402
-from explorer import gui  # noqa: E402
-from explorer import gui_layout as G  # noqa: E402
-from explorer import meshes as M  # noqa: E402
-from explorer.lights import DirectionalLight, PointLight, SpotLight  # noqa: E402
-from explorer.material import Material  # noqa: E402
-from explorer.presets import find_preset  # noqa: E402
-from explorer.render import read_png, to_bytes  # noqa: E402
-from explorer.scene import Scene, Viewer  # noqa: E402
+import explorer
+from explorer import gui
+from explorer import gui_layout as G
+from explorer import meshes as M
+from explorer.lights import DirectionalLight, PointLight, SpotLight
+from explorer.material import Material
+from explorer.presets import find_preset
+from explorer.render import read_png, to_bytes
+from explorer.scene import Scene, Viewer
 
 vtk = pytest.importorskip("vtkmodules.vtkCommonCore")
 InteractionEvent = vtk.vtkCommand.InteractionEvent
@@ -487,6 +485,32 @@ def test_mesh_chooser(app):
     press(app, "M")
     assert app.mesh.name == start
     assert_shows_engine_colours(app)
+
+
+def test_mesh_file_joins_the_chooser(tmp_path, user_presets):
+    import trimesh
+
+    from explorer.cli_gui import start
+
+    path = tmp_path / "ball.obj"
+    trimesh.creation.icosphere(subdivisions=2, radius=3.0).export(path)
+    scene, mesh, preset = start(_gui_args("--mesh", str(path), "--preset", "jade"))
+    assert mesh.name == "ball.obj" and scene.mesh == str(path)
+    a = gui.Explorer(scene, mesh, preset=preset, off_screen=True, window_size=SIZE)
+    try:
+        a.render()
+        assert list(a.mesh_choices)[0] == "ball.obj"
+        assert_shows_engine_colours(a)
+        # the start light sits 2.5 radii from the file mesh's centre, whatever its size
+        assert a._placement()[2] == pytest.approx(gui.DEFAULT_PLACEMENT[2] * a.radius)
+        press(a, "m")
+        assert a.mesh.name == list(a.mesh_choices)[1]
+        press(a, "M")
+        assert a.mesh is mesh and a.scene.mesh == str(path)
+        assert a._placement()[2] == pytest.approx(gui.DEFAULT_PLACEMENT[2] * a.radius)
+        assert_shows_engine_colours(a)
+    finally:
+        a.close()
 
 
 # -- the window: lights ----------------------------------------------------------------------
