@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import statistics
 import sys
 import time
@@ -49,25 +48,19 @@ DOCS = Path(__file__).resolve().parent.parent / "docs" / "gui_bench.md"
 
 
 def machine(plotter) -> list[str]:
-    import numba
+    """The engine benchmark's machine line, plus VTK, PyVista and the OpenGL renderer."""
     import pyvista as pv
     import vtk
+    from bench_engine import machine as engine_machine  # this script's directory is on sys.path
 
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(ln.split(":", 1)[1].strip() for ln in f if ln.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
     gl = "unknown"
     for line in plotter.render_window.ReportCapabilities().splitlines():
         if line.startswith("OpenGL renderer string:"):
             gl = line.split(":", 1)[1].strip()
     return [
-        f"CPU: {cpu}; {os.cpu_count()} cores",
-        f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}, "
-        f"VTK {vtk.vtkVersion.GetVTKVersion()}, PyVista {pv.__version__}",
-        f"OpenGL renderer: {gl}; window {SIZE[0]}x{SIZE[1]} off-screen, no anti-aliasing",
+        engine_machine(),
+        f"VTK {vtk.vtkVersion.GetVTKVersion()}, PyVista {pv.__version__}; OpenGL renderer: {gl}; "
+        f"window {SIZE[0]}x{SIZE[1]} off-screen, no anti-aliasing",
     ]
 
 
