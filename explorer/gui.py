@@ -1220,7 +1220,7 @@ class Explorer:
         elif name == "shininess":
             n = slider_to_shininess(value)
             self.scene = self.scene.replace(material=self.scene.material.replace(shininess=n))
-            self._sync_controls(only=("shininess",))
+            self._show_shininess()
             self._push_scene()
         else:
             self.place_light(**{name: value})
@@ -1255,15 +1255,18 @@ class Explorer:
         self.place_light(az, el, min(max(d, lo), hi))
 
     # -- showing the state in the controls -----------------------------------------------------
-    def _sync_controls(self, *, placement=None, only: Iterable[str] | None = None) -> None:
+    def _show_shininess(self) -> None:
+        """The shininess slider's title: the material's real exponent."""
+        n = self.scene.material.shininess
+        self.sliders["shininess"].GetRepresentation().SetTitleText(f"shininess {n:g}")
+
+    def _sync_controls(self, *, placement=None) -> None:
         """Sliders, buttons, handle and texts from the state (no widget events fire)."""
         m = self.scene.material
         ka, kd, ks = m.scalars()
         values = {"ka": ka, "kd": kd, "ks": ks, "shininess": shininess_to_slider(m.shininess)}
         sliders = self.sliders
-        sliders["shininess"].GetRepresentation().SetTitleText(f"shininess {m.shininess:g}")
-        if only is not None:
-            return
+        self._show_shininess()
         light = self.light
         if light is not None:
             az, el, d = placement if placement is not None else self._placement()
