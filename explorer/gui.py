@@ -1142,11 +1142,10 @@ class Explorer:
     def save_preset(self) -> Path:
         """Save the material (with the current specular model) as a new preset in the user's
         preset directory: ``<preset>_1``, ``<preset>_2``..., never over an existing file."""
-        from .presets import save_preset, user_dir
+        from .presets import MAX_NAME_LENGTH, save_preset, user_dir
 
         directory = Path(self.preset_dir) if self.preset_dir else user_dir()
-        stem = self.preset_name or "material"
-        stem = stem[:56]
+        stem = (self.preset_name or "material")[: MAX_NAME_LENGTH - 8]  # room for "_<k>"
         taken = {p.name for p in self.presets}
         if directory.is_dir():
             taken |= {p.stem for p in directory.glob("*.yaml")}
