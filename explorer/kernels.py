@@ -172,15 +172,27 @@ def i2f(typingctx, x):
     return types.float32(x), codegen
 
 
-FM = {"nsz", "arcp", "contract", "afn", "reassoc"}
-O = dict(fastmath=FM, error_model="numpy", boundscheck=False)
+@intrinsic
+def exponent32(typingctx, x):
+    """The unbiased exponent field of a float32, as float32, in 32-bit integer ops (numba's own
+    integer arithmetic widens to int64, which costs cross-lane conversions in SIMD code)."""
+    if x != types.float32:
+        return None
+
+    def codegen(context, builder, sig, args):
+        i32 = ir.IntType(32)
+        e = builder.lshr(builder.bitcast(args[0], i32), ir.Constant(i32, 23))
+        e = builder.and_(e, ir.Constant(i32, 0xFF))
+        return builder.sitofp(builder.sub(e, ir.Constant(i32, 127)), ir.FloatType())
+
+    return types.float32(types.float32), codegen
 
 
 @nb.njit(**_OPTS)
 def pow32(x, y):
     """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
     b = f2i(x)
-    e = np.float32(((b >> 23) & 0xFF) - 127)
+    e = exponent32(x)
     f = i2f((b & 0x007FFFFF) | 0x3F800000)
     big = f > np.float32(1.4142135)
     f = f * np.float32(0.5) if big else f
@@ -298,10 +310,17 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 
 # --------------------------------------------------------------------------------------------
 # One light over one block. The loop is specialised at compile time: `_light` is overloaded on a
-# literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular), so each
-# combination gets a loop that holds exactly the terms the plan asks for and no run-time test:
-# where L comes from (constant, or the rows a positional pre-pass filled), how the lobe's base is
-# found (flat, constant H, Blinn, Phong), and whether the diffuse and specular sums are touched.
+# literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular, bit 5
+# inline, bit 6 attenuated), so each combination gets a loop that holds exactly the terms the plan
+# asks for and no run-time test: where L comes from (constant, the rows a positional pre-pass
+# filled, or computed inline), how the lobe's base is found (flat, constant H, Blinn, Phong), and
+# whether the diffuse and specular sums are touched.
+#
+# Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
+# and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
+# or per-vertex ambient: no rows are written or read. They also drop the exact policies inside
+# the ambiguity bands (a light at the vertex, L = -V): there they only keep every value finite,
+# and mark the lane, which the engine redoes in float64 where the policies hold.
 
 
 def _light(r, m, q, y, k, variant):  # pragma: no cover - replaced by the overload below
@@ -317,24 +336,49 @@ def _light_overload(r, m, q, y, k, variant):
     mode = (v >> 1) & 3
     dif = bool(v & 8)
     spec = bool(v & 16)
+    inline = bool(v & 32)
+    atten = bool(v & 64)
     lobe_on = spec and mode != LOBE_FLAT
     track = r.dtype.dtype == types.float32  # only the float32 path marks ambiguous lanes
+    if inline and not track:
+
+        def never(r, m, q, y, k, variant):
+            raise AssertionError("inline light loops are float32 only")
+
+        return never
 
     def impl(r, m, q, y, k, variant):
         # rows as separate 1-D arrays: lets the compiler check overlap once and vectorise
+        px, py, pz = r[R_PX], r[R_PY], r[R_PZ]
         nx, ny, nz, vx, vy, vz = r[R_NX], r[R_NY], r[R_NZ], r[R_VX], r[R_VY], r[R_VZ]
         Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
         Dx, Dy, Dz, Sx, Sy, Sz = r[R_DX], r[R_DY], r[R_DZ], r[R_SX], r[R_SY], r[R_SZ]
         B, WS, TRK = r[R_BASE], r[R_WS], r[R_TRK]
         zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
         h_eps2, amb_dot, amb_len2 = k[K_HALF_EPS2], k[K_AMB_DOT], k[K_AMB_LEN2]
+        p_eps2, amb_dist2, floor = k[K_POINT_EPS] ** 2, k[K_AMB_DIST] ** 2, k[K_ATT_FLOOR]
+        kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
         dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
         sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
         qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
         hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
         for i in range(m):
             a, b, c = nx[i], ny[i], nz[i]
-            if positional:  # L and w = att·spot from the pre-pass rows
+            amb = False
+            if inline:  # L = normalize(position - P), finite even at the light (then marked)
+                x = qx - px[i]
+                yy = qy - py[i]
+                z = qz - pz[i]
+                d2 = x * x + yy * yy + z * z
+                inv = one / np.sqrt(max(d2, p_eps2))
+                lx, ly, lz = x * inv, yy * inv, z * inv
+                if atten:  # w = 1 / (kc + kl·d + kq·d²)
+                    d = d2 * inv
+                    w = one / max(kc + (kl + kq * d) * d, floor)
+                else:
+                    w = one
+                amb = d2 < amb_dist2
+            elif positional:  # L and w = att·spot from the pre-pass rows
                 lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
             else:  # directional: constant L, never attenuated
                 lx, ly, lz, w = qx, qy, qz, one
@@ -346,7 +390,7 @@ def _light_overload(r, m, q, y, k, variant):
                 Dz[i] += t * db
             if spec:
                 ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
-                amb = abs(ndl) < amb_dot
+                amb = amb | (abs(ndl) < amb_dot)
                 lob = one  # flat lobe: 0**0 = 1
                 if lobe_on:
                     if mode == LOBE_CONST_H:  # Blinn, constant H: N·H
@@ -360,9 +404,12 @@ def _light_overload(r, m, q, y, k, variant):
                         uy = ly + vy[i]
                         uz = lz + vz[i]
                         h2 = ux * ux + uy * uy + uz * uz
-                        ok = h2 > h_eps2
-                        hn = one / np.sqrt(h2 if ok else one)
-                        base = (a * ux + b * uy + c * uz) * hn if ok else zero
+                        if track:  # lanes near L = -V are marked and redone in float64
+                            base = (a * ux + b * uy + c * uz) * (one / np.sqrt(max(h2, h_eps2)))
+                        else:
+                            ok = h2 > h_eps2
+                            hn = one / np.sqrt(h2 if ok else one)
+                            base = (a * ux + b * uy + c * uz) * hn if ok else zero
                         amb = amb | (h2 < amb_len2)
                     amb = amb | (abs(base) < amb_dot)
                     base = max(base, zero)
@@ -373,10 +420,33 @@ def _light_overload(r, m, q, y, k, variant):
                 Sy[i] += t * sg
                 Sz[i] += t * sb
                 WS[i] = ws
-                if track:
-                    TRK[i] = max(TRK[i], one if amb else zero)
+            if track and (spec or inline):
+                TRK[i] = max(TRK[i], one if amb else zero)
 
     return impl
+
+
+@nb.njit(**_OPTS)
+def _light_inline(r, m, q, y, k, atten, mode, l_spec):
+    """Call the inline point-light loop compiled for this combination (diffuse always on)."""
+    if atten:
+        if not l_spec:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64)
+        elif mode == LOBE_FLAT:
+            _light(r, m, q, y, k, 1 | 8 | 16 | 32 | 64)
+        elif mode == LOBE_PHONG:
+            _light(r, m, q, y, k, 1 | 6 | 8 | 16 | 32 | 64)
+        else:
+            _light(r, m, q, y, k, 1 | 4 | 8 | 16 | 32 | 64)
+    else:
+        if not l_spec:
+            _light(r, m, q, y, k, 1 | 8 | 32)
+        elif mode == LOBE_FLAT:
+            _light(r, m, q, y, k, 1 | 8 | 16 | 32)
+        elif mode == LOBE_PHONG:
+            _light(r, m, q, y, k, 1 | 6 | 8 | 16 | 32)
+        else:
+            _light(r, m, q, y, k, 1 | 4 | 8 | 16 | 32)
 
 
 @nb.njit(**_OPTS)
@@ -623,6 +693,7 @@ def _block(
     two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
     do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
     store_lobe = opts[O_STORE_LOBE] != 0
+    track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
     if two_sided:  # normals may flip: work on copies
         nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
         nx[:] = gx
@@ -697,6 +768,20 @@ def _block(
         else:
             mode = LOBE_BLINN
         fres = l_spec and (fl & FRESNEL) != 0
+        if (
+            track
+            and l_dif
+            and not l_amb
+            and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
+            and not fres
+            and mode != LOBE_CONST_H
+        ):  # a plain point light: L and attenuation inline, no rows
+            _light_inline(r, m, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec)
+            if store_lobe and l_spec:
+                if not flat:
+                    base_out[li, :] = scr[R_BASE, :m]
+                ws_out[li, :] = scr[R_WS, :m]
+            continue
         rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
         if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
             _to_light(r, m, q, k, (fl & ATTEN) != 0)
