@@ -367,6 +367,9 @@ class Shader:
                 f |= K.DIFFUSE
             if lp.specular:
                 f |= K.SPECULAR
+            dif, spec = q[K.P_DIF : K.P_DIF + 3], q[K.P_SPEC : K.P_SPEC + 3]
+            if dif.min() == dif.max() and spec.min() == spec.max():
+                f |= K.GREY  # one sum per vertex instead of three (the kernel may use it)
             flags[i] = f
         return params.astype(dtype), flags, view.astype(dtype)
 

@@ -43,6 +43,7 @@ SPECULAR = 64
 CONST_H = 128  # Blinn with a directional light and an infinite viewer
 SHADOW = 256  # w *= visibility row (explorer.shadows) for diffuse and specular
 FRESNEL = 512  # specular weight *= Schlick F = F0 + (1 - F0)(1 - V·H)^5
+GREY = 1024  # diffuse and specular colours have r = g = b (one sum per vertex, not three)
 
 # per-light parameter columns
 P_POS = 0  # position, or direction toward a directional light (3)
@@ -92,8 +93,10 @@ N_OPTS = 13
     R_BASE,
     R_WS,
     R_TRK,
-) = range(26)
-N_ROWS = 26
+    R_GD,
+    R_GS,
+) = range(28)
+N_ROWS = 28
 
 # lobe modes
 LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
@@ -189,8 +192,8 @@ def exponent32(typingctx, x):
 
 
 @nb.njit(**_OPTS)
-def pow32(x, y):
-    """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
+def log2_32(x):
+    """log2 x for a positive, finite float32 x (-127 for x = 0)."""
     b = f2i(x)
     e = exponent32(x)
     f = i2f((b & 0x007FFFFF) | 0x3F800000)
@@ -205,10 +208,14 @@ def pow32(x, y):
     p = p * z + np.float32(-0.24992546983782263)
     p = p * z + np.float32(0.33333703609427834)
     ln = z + z * z * (z * p - np.float32(0.5))
-    t = y * (e + ln * np.float32(1.4426950408889634))
-    t = t if x > np.float32(0.0) else np.float32(-200.0)
+    return e + ln * np.float32(1.4426950408889634)
+
+
+@nb.njit(**_OPTS)
+def exp2_32(t):
+    """2**t for float32 t; 0 for t <= -127."""
     t = max(t, np.float32(-127.0))
-    k = np.floor(t + np.float32(0.5))
+    k = np.rint(t)
     fr = t - k
     q = np.float32(0.0013390867352163702)  # 2**f = 1 + f·Q(f), least squares, rel. err 2e-7
     q = q * fr + np.float32(0.00966637369320816)
@@ -217,6 +224,13 @@ def pow32(x, y):
     q = q * fr + np.float32(0.6931471880293432)
     q = q * fr + np.float32(1.0)  # exact at f = 0: 1**y == 1
     return q * i2f((np.int32(k) + np.int32(127)) << 23)
+
+
+@nb.njit(**_OPTS)
+def pow32(x, y):
+    """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
+    t = y * log2_32(x)
+    return exp2_32(t if x > np.float32(0.0) else np.float32(-200.0))
 
 
 def fpow(x, y):
@@ -311,16 +325,19 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 # --------------------------------------------------------------------------------------------
 # One light over one block. The loop is specialised at compile time: `_light` is overloaded on a
 # literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular, bit 5
-# inline, bit 6 attenuated), so each combination gets a loop that holds exactly the terms the plan
-# asks for and no run-time test: where L comes from (constant, the rows a positional pre-pass
-# filled, or computed inline), how the lobe's base is found (flat, constant H, Blinn, Phong), and
-# whether the diffuse and specular sums are touched.
+# inline, bit 6 attenuated, bit 7 grey), so each combination gets a loop that holds exactly the
+# terms the plan asks for and no run-time test: where L comes from (constant, the rows a
+# positional pre-pass filled, or computed inline), how the lobe's base is found (flat, constant H,
+# Blinn, Phong), and whether the diffuse and specular sums are touched.
 #
 # Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
 # and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
-# or per-vertex ambient: no rows are written or read. They also drop the exact policies inside
-# the ambiguity bands (a light at the vertex, L = -V): there they only keep every value finite,
-# and mark the lane, which the engine redoes in float64 where the policies hold.
+# or per-vertex ambient: no rows are written or read. A grey light (r = g = b for its diffuse and
+# its specular colour, as most lights are) adds one number per vertex to a grey row instead of
+# three to the RGB rows; the block adds the grey rows to every channel once. Inline variants also
+# drop the exact policies inside the ambiguity bands (a light at the vertex, L = -V): there they
+# only keep every value finite and mark the lane, which the engine redoes in float64, where the
+# policies hold.
 
 
 def _light(r, m, q, y, k, variant):  # pragma: no cover - replaced by the overload below
@@ -338,6 +355,7 @@ def _light_overload(r, m, q, y, k, variant):
     spec = bool(v & 16)
     inline = bool(v & 32)
     atten = bool(v & 64)
+    grey = bool(v & 128)
     lobe_on = spec and mode != LOBE_FLAT
     track = r.dtype.dtype == types.float32  # only the float32 path marks ambiguous lanes
     if inline and not track:
@@ -354,6 +372,7 @@ def _light_overload(r, m, q, y, k, variant):
         Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
         Dx, Dy, Dz, Sx, Sy, Sz = r[R_DX], r[R_DY], r[R_DZ], r[R_SX], r[R_SY], r[R_SZ]
         B, WS, TRK = r[R_BASE], r[R_WS], r[R_TRK]
+        GD, GS = r[R_GD], r[R_GS]
         zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
         h_eps2, amb_dot, amb_len2 = k[K_HALF_EPS2], k[K_AMB_DOT], k[K_AMB_LEN2]
         p_eps2, amb_dist2, floor = k[K_POINT_EPS] ** 2, k[K_AMB_DIST] ** 2, k[K_ATT_FLOOR]
@@ -385,9 +404,12 @@ def _light_overload(r, m, q, y, k, variant):
             ndl = a * lx + b * ly + c * lz
             if dif:  # w·max(N·L, 0)·d_i
                 t = w * max(ndl, zero)
-                Dx[i] += t * dr
-                Dy[i] += t * dg
-                Dz[i] += t * db
+                if grey:
+                    GD[i] += t * dr
+                else:
+                    Dx[i] += t * dr
+                    Dy[i] += t * dg
+                    Dz[i] += t * db
             if spec:
                 ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
                 amb = amb | (abs(ndl) < amb_dot)
@@ -416,9 +438,12 @@ def _light_overload(r, m, q, y, k, variant):
                     lob = fpow(base, y)  # base^n
                     B[i] = base
                 t = ws * lob  # w·f·base^n·s_i
-                Sx[i] += t * sr
-                Sy[i] += t * sg
-                Sz[i] += t * sb
+                if grey:
+                    GS[i] += t * sr
+                else:
+                    Sx[i] += t * sr
+                    Sy[i] += t * sg
+                    Sz[i] += t * sb
                 WS[i] = ws
             if track and (spec or inline):
                 TRK[i] = max(TRK[i], one if amb else zero)
@@ -427,26 +452,44 @@ def _light_overload(r, m, q, y, k, variant):
 
 
 @nb.njit(**_OPTS)
-def _light_inline(r, m, q, y, k, atten, mode, l_spec):
+def _light_inline(r, m, q, y, k, atten, mode, l_spec, grey):
     """Call the inline point-light loop compiled for this combination (diffuse always on)."""
-    if atten:
+    if grey and atten:
+        if not l_spec:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128)
+        elif mode == LOBE_FLAT:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128 | 16)
+        elif mode == LOBE_PHONG:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 6)
+        else:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 4)
+    elif grey and not atten:
+        if not l_spec:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 128)
+        elif mode == LOBE_FLAT:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 128 | 16)
+        elif mode == LOBE_PHONG:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 128 | 16 | 6)
+        else:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 128 | 16 | 4)
+    elif not grey and atten:
         if not l_spec:
             _light(r, m, q, y, k, 1 | 8 | 32 | 64)
         elif mode == LOBE_FLAT:
-            _light(r, m, q, y, k, 1 | 8 | 16 | 32 | 64)
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 16)
         elif mode == LOBE_PHONG:
-            _light(r, m, q, y, k, 1 | 6 | 8 | 16 | 32 | 64)
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 16 | 6)
         else:
-            _light(r, m, q, y, k, 1 | 4 | 8 | 16 | 32 | 64)
-    else:
+            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 16 | 4)
+    elif not grey and not atten:
         if not l_spec:
             _light(r, m, q, y, k, 1 | 8 | 32)
         elif mode == LOBE_FLAT:
-            _light(r, m, q, y, k, 1 | 8 | 16 | 32)
+            _light(r, m, q, y, k, 1 | 8 | 32 | 16)
         elif mode == LOBE_PHONG:
-            _light(r, m, q, y, k, 1 | 6 | 8 | 16 | 32)
+            _light(r, m, q, y, k, 1 | 8 | 32 | 16 | 6)
         else:
-            _light(r, m, q, y, k, 1 | 4 | 8 | 16 | 32)
+            _light(r, m, q, y, k, 1 | 8 | 32 | 16 | 4)
 
 
 @nb.njit(**_OPTS)
@@ -623,6 +666,14 @@ def _load_rows(src, rx, ry, rz, zero):
 
 
 @nb.njit(**_OPTS)
+def _add_grey(rx, ry, rz, g):
+    for i in range(g.shape[0]):
+        rx[i] += g[i]
+        ry[i] += g[i]
+        rz[i] += g[i]
+
+
+@nb.njit(**_OPTS)
 def _store_rows(dst, rx, ry, rz):
     for i in range(dst.shape[0]):
         dst[i, 0] = rx[i]
@@ -733,9 +784,12 @@ def _block(
         scr[R_BASE, :m],
         scr[R_WS, :m],
         trk,
+        scr[R_GD, :m],
+        scr[R_GS, :m],
     )
 
     _fill(trk, zero)
+    used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
         if opts[O_LOCAL]:
             _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
@@ -776,7 +830,12 @@ def _block(
             and not fres
             and mode != LOBE_CONST_H
         ):  # a plain point light: L and attenuation inline, no rows
-            _light_inline(r, m, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec)
+            grey = (fl & GREY) != 0
+            if grey and not used_grey:
+                _fill(scr[R_GD, :m], zero)
+                _fill(scr[R_GS, :m], zero)
+            _light_inline(r, m, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec, grey)
+            used_grey = used_grey or grey
             if store_lobe and l_spec:
                 if not flat:
                     base_out[li, :] = scr[R_BASE, :m]
@@ -805,6 +864,9 @@ def _block(
                 base_out[li, :] = scr[R_BASE, :m]
             ws_out[li, :] = scr[R_WS, :m]
 
+    if used_grey:  # the grey sums count in every channel
+        _add_grey(Dx, Dy, Dz, scr[R_GD, :m])
+        _add_grey(Sx, Sy, Sz, scr[R_GS, :m])
     if opts[O_TRACK]:
         for i in range(m):
             amb[i] = trk[i] > zero

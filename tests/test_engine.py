@@ -570,3 +570,32 @@ def test_python_objects_work_as_scenes():
         ),
     )
     assert one_vertex(scene) == pytest.approx([1 / 1, 0, 0])
+
+
+@pytest.mark.parametrize("model", ["blinn", "phong"])
+def test_grey_and_coloured_point_lights_together(model):
+    # the float32 kernel sums grey lights (r = g = b) in one channel and coloured ones in three,
+    # inline or through the pre-pass rows (a spot); every mix must give the reference colours
+    rng = np.random.default_rng(11)
+    n = 3000
+    P = rng.normal(size=(n, 3))
+    N = rng.normal(size=(n, 3))
+    P[0] = [2.0, 3.0, 1.0]  # a vertex exactly at the first light
+    scene = {
+        "material": {**MAT, "shininess": 40.0},
+        "model": model,
+        "viewer": {"eye": [0.0, 0.5, 4.0]},
+        "lights": [
+            {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
+            {"type": "point", "position": [-2, 1, 2], "diffuse": [1, 0.5, 0.2]},
+            {"type": "point", "position": [0, -3, 1], "color": [0.4, 0.4, 0.4], "intensity": 2},
+            {"type": "spot", "position": [0, 4, 0], "direction": [0, -1, 0], "cutoff": 40},
+            {"type": "directional", "direction": [1, 1, 1], "specular": [0.2, 0.9, 0.3]},
+        ],
+    }
+    ref = reference_shade(load_scene(scene), P, N)
+    c64 = explorer.shade(scene, P, N)
+    c32 = explorer.shade(scene, P, N, precision="float32")
+    assert np.abs(c64 - ref).max() <= 1e-9
+    assert np.abs(c32 - ref).max() <= tol.FLOAT32_MAX_ABS_ERROR
+    assert np.abs(c32 - ref).mean() <= 1e-5
