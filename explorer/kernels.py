@@ -788,6 +788,40 @@ def _block(
         scr[R_GS, :m],
     )
 
+    # the inline loops always add a diffuse term: for a specular-only pass they get these rows,
+    # whose diffuse sums (RGB and grey) land in scratch rows the inline loops never read
+    r_spec = (
+        px,
+        py,
+        pz,
+        nx,
+        ny,
+        nz,
+        vx,
+        vy,
+        vz,
+        Ax,
+        Ay,
+        Az,
+        scr[R_LX, :m],
+        scr[R_LY, :m],
+        scr[R_LZ, :m],
+        Sx,
+        Sy,
+        Sz,
+        scr[R_LX, :m],
+        scr[R_LY, :m],
+        scr[R_LZ, :m],
+        scr[R_D, :m],
+        scr[R_W, :m],
+        scr[R_BASE, :m],
+        scr[R_WS, :m],
+        trk,
+        scr[R_D, :m],
+        scr[R_GS, :m],
+    )
+    junk_zeroed = False
+
     _fill(trk, zero)
     used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
@@ -824,8 +858,8 @@ def _block(
         fres = l_spec and (fl & FRESNEL) != 0
         if (
             track
-            and l_dif
-            and not l_amb
+            and (l_dif or l_spec)
+            and (fl & AMBIENT) == 0  # the path depends on the light only, not on the pass
             and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
             and not fres
             and mode != LOBE_CONST_H
@@ -834,8 +868,15 @@ def _block(
             if grey and not used_grey:
                 _fill(scr[R_GD, :m], zero)
                 _fill(scr[R_GS, :m], zero)
-            _light_inline(r, m, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec, grey)
             used_grey = used_grey or grey
+            if l_dif:
+                _light_inline(r, m, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec, grey)
+            else:  # specular only (a viewer change): the diffuse goes to rows nobody reads
+                if not junk_zeroed:
+                    for row in (R_LX, R_LY, R_LZ, R_D):
+                        _fill(scr[row, :m], zero)
+                    junk_zeroed = True
+                _light_inline(r_spec, m, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey)
             if store_lobe and l_spec:
                 if not flat:
                     base_out[li, :] = scr[R_BASE, :m]
