@@ -249,6 +249,9 @@ class Shader:
         self._base = self._ws = None
         self._spec_shininess = None
         self._params = None  # constant halfway vectors depend on V
+        # a moving camera changes V every frame: stop storing lobes (8 bytes per vertex and
+        # light per frame) until shininess moves again
+        self._keep_lobe = False
 
     def _shininess_changed(self):
         self._retire(self._S)

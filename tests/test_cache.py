@@ -98,6 +98,26 @@ def test_shininess_only_reruns_the_lobe(shader):
     assert delta(before, counts(shader)) == {"lobe": 4, "compose": 4}
 
 
+def test_a_moving_camera_stops_storing_lobes(shader):
+    # lobes (a base and a weight per vertex and light) are stored only while shininess moves:
+    # a viewer change makes them invalid, and a camera moves every frame
+    _ = shader.colors
+    shader.set_material(shader.scene.material.replace(shininess=5.0))
+    _ = shader.colors
+    assert shader._ws is not None
+    for eye in ((1, 2, 6), (0, 1, 5)):
+        shader.set_viewer(Viewer(eye=eye))
+        _ = shader.colors
+        assert shader._ws is None and shader._base is None
+        check(shader)
+    before = counts(shader)
+    for n in (30.0, 60.0):  # one specular pass that stores them again, then the lobe alone
+        shader.set_material(shader.scene.material.replace(shininess=n))
+        _ = shader.colors
+        check(shader)
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1, "lobe": 1, "compose": 1}
+
+
 def test_viewer_change_recomputes_specular_not_diffuse(shader):
     _ = shader.colors
     before = counts(shader)
