@@ -710,6 +710,42 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 
 
 @nb.njit(**_OPTS)
+def _rows(px, py, pz, nx, ny, nz, scr, m, dx, dy, dz, gd):
+    """The rows a light loop works on, indexed by the R_* constants; the diffuse sums (RGB and
+    grey) go to the scratch rows ``dx, dy, dz, gd``."""
+    return (
+        px,
+        py,
+        pz,
+        nx,
+        ny,
+        nz,
+        scr[R_VX, :m],
+        scr[R_VY, :m],
+        scr[R_VZ, :m],
+        scr[R_AX, :m],
+        scr[R_AY, :m],
+        scr[R_AZ, :m],
+        scr[dx, :m],
+        scr[dy, :m],
+        scr[dz, :m],
+        scr[R_SX, :m],
+        scr[R_SY, :m],
+        scr[R_SZ, :m],
+        scr[R_LX, :m],
+        scr[R_LY, :m],
+        scr[R_LZ, :m],
+        scr[R_D, :m],
+        scr[R_W, :m],
+        scr[R_BASE, :m],
+        scr[R_WS, :m],
+        scr[R_TRK, :m],
+        scr[gd, :m],
+        scr[R_GS, :m],
+    )
+
+
+@nb.njit(**_OPTS)
 def _block(
     px,
     py,
@@ -757,69 +793,10 @@ def _block(
     Dx, Dy, Dz = scr[R_DX, :m], scr[R_DY, :m], scr[R_DZ, :m]
     Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
     trk = scr[R_TRK, :m]
-    r = (
-        px,
-        py,
-        pz,
-        nx,
-        ny,
-        nz,
-        vx,
-        vy,
-        vz,
-        Ax,
-        Ay,
-        Az,
-        Dx,
-        Dy,
-        Dz,
-        Sx,
-        Sy,
-        Sz,
-        scr[R_LX, :m],
-        scr[R_LY, :m],
-        scr[R_LZ, :m],
-        scr[R_D, :m],
-        scr[R_W, :m],
-        scr[R_BASE, :m],
-        scr[R_WS, :m],
-        trk,
-        scr[R_GD, :m],
-        scr[R_GS, :m],
-    )
-
+    r = _rows(px, py, pz, nx, ny, nz, scr, m, R_DX, R_DY, R_DZ, R_GD)
     # the inline loops always add a diffuse term: for a specular-only pass they get these rows,
     # whose diffuse sums (RGB and grey) land in scratch rows the inline loops never read
-    r_spec = (
-        px,
-        py,
-        pz,
-        nx,
-        ny,
-        nz,
-        vx,
-        vy,
-        vz,
-        Ax,
-        Ay,
-        Az,
-        scr[R_LX, :m],
-        scr[R_LY, :m],
-        scr[R_LZ, :m],
-        Sx,
-        Sy,
-        Sz,
-        scr[R_LX, :m],
-        scr[R_LY, :m],
-        scr[R_LZ, :m],
-        scr[R_D, :m],
-        scr[R_W, :m],
-        scr[R_BASE, :m],
-        scr[R_WS, :m],
-        trk,
-        scr[R_D, :m],
-        scr[R_GS, :m],
-    )
+    r_spec = _rows(px, py, pz, nx, ny, nz, scr, m, R_LX, R_LY, R_LZ, R_D)
     junk_zeroed = False
 
     _fill(trk, zero)
