@@ -34,6 +34,7 @@ import numpy as np
 
 from . import gui_layout as G
 from .errors import ExplorerError
+from .gui_difference import PENDING, DifferenceView, advice_lines
 from .lights import DirectionalLight, PointLight, SpotLight
 from .material import Material
 from .meshes import Mesh
@@ -491,6 +492,12 @@ class Explorer:
         self._build_handle()
         self._build_lobe()
         self._build_texts()
+        self.difference = DifferenceView(pl.renderer)
+        self.difference_ms = float("nan")  # time of the last comparison
+        self.advice = ""
+        self._diff_pending = False  # the shown map is stale: compute it when the change ends
+        self._diff_timer = None
+        self._on_screen = not off_screen
         self._frame_camera()
         self._observe()
         self._start = (self.scene, mesh.name, self.preset_name, self._camera_tuple())
@@ -725,6 +732,10 @@ class Explorer:
         prop.SetBackgroundColor(0.0, 0.0, 0.0)
         prop.SetBackgroundOpacity(0.75)
         h.SetVisibility(False)
+        for name in ("difference", "advice"):  # shown with the difference view
+            self.texts[name].SetVisibility(False)
+            self.texts[name].GetTextProperty().SetBackgroundColor(0.0, 0.0, 0.0)
+            self.texts[name].GetTextProperty().SetBackgroundOpacity(0.6)
 
     def _frame_camera(self) -> None:
         """The camera at the scene's viewer, the mesh framed in the area left of the panel."""
@@ -776,6 +787,7 @@ class Explorer:
             "1": lambda: self.toggle_term("ambient"),
             "2": lambda: self.toggle_term("diffuse"),
             "3": lambda: self.toggle_term("specular"),
+            "d": self.toggle_difference,
             "s": self.save_preset,
             "i": self.screenshot,
             "r": self.reset,
@@ -791,6 +803,7 @@ class Explorer:
                 obj.GetCommand(self._char_tag).SetAbortFlag(1)
 
         self._char_tag = iren.AddObserver("CharEvent", block, 10.0)
+        iren.AddObserver("TimerEvent", self._guard(self._on_timer, renders_after=False))
 
     def _list_presets(self) -> list:
         from .presets import list_presets
@@ -923,6 +936,7 @@ class Explorer:
             return
         if self._t0 is None:
             self._t0 = time.perf_counter()
+        self._update_difference()
         self.plotter.render_window.Render()
 
     def _before_frame(self, *_) -> None:
@@ -932,20 +946,25 @@ class Explorer:
             return
         if self._t0 is None:
             self._t0 = time.perf_counter()
+        self._sync_viewer()
+        view = self.active_view
+        if self.scene.material.opacity < 1.0:
+            self._sort(view)
+        self._show_difference()
+        self._update_status()
+        # the handle may be nearer the camera than the mesh: keep it inside the clipping range
+        self.plotter.renderer.ResetCameraClippingRange()
+
+    def _sync_viewer(self) -> None:
+        """The camera is the viewer: a moved camera moves the highlights."""
         c = self.plotter.camera
         viewer = viewer_of_camera(c.GetPosition(), c.GetFocalPoint(), c.GetParallelProjection())
-        view = self.active_view
         if viewer != self.scene.viewer:
             self.scene = self.scene.replace(viewer=viewer)
             shown = self.shown_scene()
             for v in self._views:
                 v.shader.set_viewer(shown.viewer)
-            view.upload()
-        if self.scene.material.opacity < 1.0:
-            self._sort(view)
-        self._update_status()
-        # the handle may be nearer the camera than the mesh: keep it inside the clipping range
-        self.plotter.renderer.ResetCameraClippingRange()
+            self.active_view.upload()
 
     def _sort(self, view: _View) -> None:
         from .render import Camera, back_to_front
@@ -969,6 +988,9 @@ class Explorer:
         if self._t0 is not None:
             self.frame_ms = 1000.0 * (time.perf_counter() - self._t0)
             self._t0 = None
+        if self._diff_pending and self._on_screen and self._diff_timer is None:
+            # a widget or the camera drew this frame: compare once the event loop is free
+            self._diff_timer = self.plotter.iren.interactor.CreateOneShotTimer(20)
         if self.state_file is not None:
             self.write_state()
 
@@ -1085,6 +1107,97 @@ class Explorer:
     def toggle_term(self, term: str) -> None:
         self.set_term(term, not self.terms[term])
 
+    # -- the difference view (see explorer.gui_difference) ---------------------------------
+    def set_difference(self, on: bool) -> None:
+        """Show the per-pixel difference of the view as a heat map, and the mesh advice."""
+        self._set_difference_on(on)
+        self._refresh()
+
+    def toggle_difference(self) -> None:
+        self.set_difference(not self.difference.on)
+
+    def _set_difference_on(self, on: bool) -> None:
+        self.difference.on = bool(on)
+        for name in ("difference", "advice"):
+            self.texts[name].SetVisibility(self.difference.on)
+        if not self.difference.on:
+            self.difference.show(False)
+            self.active_view.show(True)
+            self._diff_pending = False
+
+    def _difference_key(self) -> tuple:
+        """What the heat map depends on: the shown scene (camera included, as the viewer), the
+        mesh, the camera and the window's size."""
+        return (
+            repr(self.shown_scene()),
+            self.mesh.name,
+            self.mesh.n_vertices,
+            self._camera_tuple(),
+            tuple(self.plotter.window_size),
+        )
+
+    def _update_difference(self) -> None:
+        """Compare the view now if the difference view is on, nothing is being dragged and
+        the shown map is stale (called before a frame the app draws itself)."""
+        d = self.difference
+        if not d.on or self._dragging:
+            return
+        self._sync_viewer()
+        key = self._difference_key()
+        if not d.stale(key):
+            return
+        from . import accuracy as A
+        from .perpixel import camera_from_vtk
+
+        t = time.perf_counter()
+        scene = self.shown_scene()
+        try:
+            d.compute(
+                scene,
+                self.mesh,
+                self._views[0].colors(),
+                self._mesh_camera(camera_from_vtk(self.plotter.camera)),
+                self.plotter.window_size,
+                key,
+                self.plotter.renderer.GetBackground(),
+            )
+            w, h = self.plotter.window_size
+            view_size = (max(1, round(G.PANEL_X * w)), h)  # the view, left of the panel
+            self.advice = A.advice(scene.material.shininess, view_size, model=scene.model)
+        except Exception:
+            self._set_difference_on(False)
+            raise
+        self.difference_ms = 1000.0 * (time.perf_counter() - t)
+        self.texts["advice"].SetInput(advice_lines(self.advice))
+        self._diff_pending = False
+
+    def _mesh_camera(self, cam):
+        """``cam`` with a clipping range around the mesh (the window's own range follows what
+        is visible, and the mesh is hidden while the heat map shows)."""
+        import dataclasses
+
+        pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
+        ahead = (focal - pos) / max(float(np.linalg.norm(focal - pos)), 1e-300)
+        d = float((self.centre - pos) @ ahead)
+        r = 1.01 * self.radius
+        return dataclasses.replace(cam, clipping_range=(max(d - r, 1e-3 * r), max(d + r, 2e-3 * r)))
+
+    def _show_difference(self) -> None:
+        """Before a frame: the heat map if it matches the view, else the live view."""
+        d = self.difference
+        if not d.on:
+            return
+        live = self._dragging > 0 or d.stale(self._difference_key())
+        d.show(not live)
+        self.active_view.show(live)
+        self.texts["difference"].SetInput(PENDING if live else d.legend())
+        self._diff_pending = live and self._dragging == 0
+
+    def _on_timer(self, obj, _event) -> None:
+        if self._diff_timer is not None and obj.GetTimerEventId() == self._diff_timer:
+            self._diff_timer = None
+            self.render()
+
     # -- lights ----------------------------------------------------------------------------
     def _placement(self) -> tuple[float, float, float]:
         """The controlled light's placement; a directional light's distance is the distance
@@ -1183,6 +1296,7 @@ class Explorer:
         """Back to the start: scene, mesh, preset, terms, light, camera."""
         scene, mesh_name, preset, camera = self._start
         self.terms = {t: True for t in TERMS}
+        self._set_difference_on(False)
         self.light_index = 0
         self.preset_name = preset
         if mesh_name != self.mesh.name:
@@ -1241,6 +1355,8 @@ class Explorer:
             self.set_light_type(name)
         elif name in TERMS:
             self.set_term(name, state)
+        elif name == "difference":
+            self.set_difference(bool(state))
 
     def _on_handle(self, center) -> None:
         if self._building or self.light is None:
@@ -1289,6 +1405,7 @@ class Explorer:
             "blinn": self.scene.model == "blinn",
             "phong": self.scene.model == "phong",
             **{t: self.terms[t] for t in TERMS},
+            "difference": self.difference.on,
             **{k: light is not None and light.type == k for k in G.RADIO_GROUPS["light_type"]},
         }
         for name, on in states.items():
@@ -1421,6 +1538,11 @@ class Explorer:
             },
             "probe": {"vertex": probe, "px": self._world_to_window(self.mesh.positions[probe])},
             "help_visible": self.help_visible,
+            "difference": {
+                **self.difference.state(),
+                "ms": self.difference_ms if math.isfinite(self.difference_ms) else None,
+                "advice": self.advice,
+            },
             "message": self.message,
             "errors": list(self.errors),
             "last_saved": self.last_saved,
@@ -1441,16 +1563,19 @@ class Explorer:
         if exit_after is not None:
             iren = pl.iren.interactor
 
-            def expire(*_):
+            def expire(obj, _event):
+                if obj.GetTimerEventId() != timer:  # another timer (the difference view)
+                    return
                 log.warning("closing after %g s (--exit-after)", exit_after)
                 pl.iren.terminate_app()
 
             iren.AddObserver("TimerEvent", expire)
             pl.iren.initialize()
-            iren.CreateOneShotTimer(max(1, int(float(exit_after) * 1000)))
+            timer = iren.CreateOneShotTimer(max(1, int(float(exit_after) * 1000)))
         pl.show(auto_close=True)
 
     def close(self) -> None:
+        self.difference.close()
         self.plotter.close()
 
 

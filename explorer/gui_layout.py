@@ -88,6 +88,7 @@ BUTTONS = {
     "spot": (0.915, 0.350),
     "mesh_previous": (0.715, 0.040),
     "mesh_next": (0.955, 0.040),
+    "difference": (0.010, 0.905),  # top left of the view: the heat map's toggle
 }
 #: radio groups: exactly one button of a group is on
 RADIO_GROUPS = {"model": ("blinn", "phong"), "light_type": ("directional", "point", "spot")}
@@ -109,6 +110,7 @@ BUTTON_LABELS = {
     "preset_next": ">",
     "mesh_previous": "<",
     "mesh_next": ">",
+    "difference": "difference",
 }
 #: gap between a button and its label, normalised display
 LABEL_GAP = 0.022
@@ -124,6 +126,8 @@ TEXT = {
     "status": (0.010, 0.012),  # one line: preset, mesh, model, light, frame time
     "message": (0.010, 0.045),  # the last message (saved..., error: ...)
     "hint": (0.010, 0.960),
+    "difference": (0.010, 0.835),  # the heat map's legend (two lines), while it is on
+    "advice": (0.010, 0.765),  # which mesh is fine enough (two lines), while it is on
 }
 
 # -- the specular lobe inset (pixels from the bottom-left corner) -----------------------------
@@ -154,6 +158,7 @@ KEYS = {
     "1": "show / hide the ambient term",
     "2": "show / hide the diffuse term",
     "3": "show / hide the specular term",
+    "d": "show / hide the per-pixel difference (heat map) and which mesh is fine enough",
     "s": "save the material as a new preset (never overwrites)",
     "i": "save a screenshot (PNG, never overwrites)",
     "r": "reset to the start",

@@ -646,6 +646,68 @@ def test_help_overlay_lists_every_key(app):
 # -- errors ------------------------------------------------------------------------------------
 
 
+def screen(app):
+    """The window's pixels: (h, w, 3) uint8."""
+    return np.asarray(app.plotter.screenshot(return_img=True))[..., :3]
+
+
+def test_difference_view_shows_the_heat_map_of_this_view(app):
+    from explorer import accuracy as A
+    from explorer.perpixel import camera_from_vtk
+
+    w, h = SIZE
+    left = (slice(None), slice(0, int(G.PANEL_X * w) - 5))  # the view, left of the panel
+    normal = screen(app)
+    press(app, "d")
+    st = app.state()["difference"]
+    assert st["on"] and st["shown"] and not app.errors
+    # the same comparison, made independently for the same scene, camera and size
+    cam = app._mesh_camera(camera_from_vtk(app.plotter.camera))
+    want = A.compare_view(app.shown_scene(), app.mesh, (w, h), camera=cam)
+    assert st["max"] == want.max and st["rmse"] == pytest.approx(want.rmse, abs=0.05)
+    assert st["pixels"] == int(want.mask.sum()) > 10_000
+    shot = screen(app)
+    assert np.abs(shot[left].astype(int) - normal[left]).max() > 50  # the map, not the mesh
+    heat = A.heat_map(want.levels, want.mask, background=(0, 0, 0))
+    glowing = (heat.sum(axis=2) > 0) & want.mask
+    assert glowing[left].sum() > 100  # some pixels err by a level or more on this mesh
+    assert "RMSE" in app.texts["difference"].GetInput()
+    assert "every pixel" in app.texts["advice"].GetInput()
+    # the button shows the state; the key turns it off again and the mesh is back
+    assert app.state()["buttons"]["difference"]["state"]
+    press(app, "d")
+    assert not app.state()["difference"]["shown"]
+    middle = (slice(40, h - 60), left[1])  # the view without the status and hint lines
+    assert np.array_equal(screen(app)[middle], normal[middle])
+    assert_shows_engine_colours(app)
+
+
+def test_difference_view_follows_the_shininess_and_the_camera(app):
+    def drag(name, value):  # press, move, release: as a mouse drags a slider
+        fire_slider(app, name, value, StartInteractionEvent)
+        fire_slider(app, name, value)
+        assert not app.state()["difference"]["shown"]  # the live view while dragging
+        fire_slider(app, name, value, EndInteractionEvent)
+        assert app.state()["difference"]["shown"]  # the map again on release
+        return app.state()["difference"]
+
+    click(app, "difference")
+    assert app.state()["difference"]["shown"]
+    low = drag("shininess", gui.shininess_to_slider(10.0))
+    high = drag("shininess", gui.shininess_to_slider(1000.0))
+    assert "shininess 10 " in low["advice"] and "shininess 1000 " in high["advice"]
+    assert low["advice"] != high["advice"]
+    assert high["rmse"] != low["rmse"]  # the map was made again for the new exponent
+    before = app.state()["difference"]["rmse"]
+    app.plotter.camera.Azimuth(40)
+    app.render()
+    after = app.state()["difference"]
+    assert after["shown"] and after["rmse"] != before
+    click(app, "difference")
+    assert not app.state()["difference"]["on"]
+    assert_shows_engine_colours(app)
+
+
 def test_error_in_a_callback_is_shown_and_logged(app, user_presets, caplog, monkeypatch):
     not_a_dir = user_presets / "a-file"
     not_a_dir.write_text("")
