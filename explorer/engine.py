@@ -225,8 +225,9 @@ class Shader:
         """An (n, 3) array for a sum being recomputed: the memory of an invalidated sum that
         no array handed out (``terms``) still views, else a new one. Reuse saves the page
         faults of fresh memory (three 12 MB sums per light change at 1M vertices)."""
-        for i, buf in enumerate(self._spares):
-            # references: the list, the loop variable, getrefcount's argument
+        for i in range(len(self._spares)):
+            buf = self._spares[i]  # (not enumerate: its tuple would hold one more reference)
+            # references: the list, ``buf``, getrefcount's argument
             if buf.shape == (self.n, 3) and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
                 return self._spares.pop(i)
         return np.empty((self.n, 3), self._T)

@@ -183,6 +183,32 @@ def test_cached_arrays_are_read_only_and_never_rewritten(shader):
     assert np.array_equal(first, kept)  # colours handed out earlier did not change
 
 
+def test_sums_reuse_memory_only_when_nothing_views_it(shader):
+    # a light change recomputes the sums into the memory of the invalidated ones (no page
+    # faults at 1M vertices) unless an array handed out (terms) still views that memory
+    lights = [PointLight(position=(0, 0, 3)), DirectionalLight(direction=(1, 0, 0))]
+    _ = shader.colors
+
+    def addresses():  # not references: holding the arrays would keep them from reuse
+        return {a.__array_interface__["data"][0] for a in (shader._A, shader._D, shader._S)
+                if a is not None}  # fmt: skip
+
+    old = addresses()
+    shader.set_lights(lights)
+    _ = shader.colors
+    new = addresses()
+    assert new and new <= old  # the sums the new lights need, in the old sums' memory
+    check(shader)
+    held = shader.terms
+    kept = {k: v.copy() for k, v in held.items()}
+    shader.set_lights(lights[::-1])
+    _ = shader.colors
+    check(shader)
+    for k, v in held.items():
+        assert np.array_equal(v, kept[k])  # what was handed out never changes
+    assert not any(np.shares_memory(v, shader._D) for v in held.values())
+
+
 def test_terms_recompose_to_the_colours(shader):
     t = shader.terms
     m = shader.scene.material
