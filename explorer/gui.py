@@ -739,7 +739,9 @@ class Explorer:
 
     def _frame_camera(self) -> None:
         """The camera at the scene's viewer, the mesh framed in the area left of the panel."""
-        from .render import camera_for
+        from dataclasses import replace
+
+        from .render import apply_camera, camera_for
 
         w, h = self.plotter.window_size
         aspect = G.PANEL_X * w / h
@@ -750,16 +752,9 @@ class Explorer:
                 handle = self.centre + d * light_direction(az, el)
                 r = G.HANDLE_RADIUS * self.radius
                 cam = widen_to_show(cam, [handle], aspect, pad=r)
-        c = self.plotter.camera
         self.plotter.camera_set = True
-        c.SetPosition(*cam.position)
-        c.SetFocalPoint(*cam.focal_point)
-        c.SetViewUp(*cam.view_up)
-        c.SetParallelProjection(bool(cam.parallel))
-        c.SetParallelScale(cam.parallel_scale)
-        c.SetViewAngle(cam.view_angle)
-        # move the picture left by half the panel's width, without turning the camera
-        c.SetWindowCenter(1.0 - G.PANEL_X, 0.0)
+        # the picture moved left by half the panel's width, without turning the camera
+        apply_camera(self.plotter.camera, replace(cam, window_center=(1.0 - G.PANEL_X, 0.0)))
         self.plotter.renderer.ResetCameraClippingRange()
 
     def _observe(self) -> None:

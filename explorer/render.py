@@ -415,16 +415,21 @@ class OffscreenRenderer:
         t.SetVisibility(True)
 
     def _set_camera(self, cam: Camera) -> None:
-        c = self.plotter.camera
         self.plotter.camera_set = True
-        c.SetPosition(*cam.position)
-        c.SetFocalPoint(*cam.focal_point)
-        c.SetViewUp(*cam.view_up)
-        c.SetParallelProjection(bool(cam.parallel))
-        c.SetParallelScale(cam.parallel_scale)
-        c.SetViewAngle(cam.view_angle)
-        c.SetClippingRange(*cam.clipping_range)
-        c.SetWindowCenter(*cam.window_center)
+        apply_camera(self.plotter.camera, cam)
+
+
+def apply_camera(vtk_camera, cam: Camera) -> None:
+    """Set a ``vtkCamera`` to ``cam`` (every field, clipping range and window centre too)."""
+    c = vtk_camera
+    c.SetPosition(*cam.position)
+    c.SetFocalPoint(*cam.focal_point)
+    c.SetViewUp(*cam.view_up)
+    c.SetParallelProjection(bool(cam.parallel))
+    c.SetParallelScale(cam.parallel_scale)
+    c.SetViewAngle(cam.view_angle)
+    c.SetClippingRange(*cam.clipping_range)
+    c.SetWindowCenter(*cam.window_center)
 
 
 def back_to_front(mesh: Mesh, camera: Camera) -> np.ndarray:

@@ -42,14 +42,7 @@ def _vtk_camera(cam: R.Camera):
     from vtkmodules.vtkRenderingCore import vtkCamera
 
     c = vtkCamera()
-    c.SetPosition(*cam.position)
-    c.SetFocalPoint(*cam.focal_point)
-    c.SetViewUp(*cam.view_up)
-    c.SetParallelProjection(bool(cam.parallel))
-    c.SetParallelScale(cam.parallel_scale)
-    c.SetViewAngle(cam.view_angle)
-    c.SetClippingRange(*cam.clipping_range)
-    c.SetWindowCenter(*cam.window_center)
+    R.apply_camera(c, cam)
     return c
 
 
