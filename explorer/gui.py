@@ -1188,8 +1188,9 @@ class Explorer:
         self.texts["difference"].SetInput(PENDING if live else d.legend())
         self._diff_pending = live and self._dragging == 0
 
-    def _on_timer(self, obj, _event) -> None:
-        if self._diff_timer is not None and obj.GetTimerEventId() == self._diff_timer:
+    def _on_timer(self, *_) -> None:
+        # (VTK's X interactor does not say which timer fired: any timer may do this)
+        if self._diff_timer is not None:
             self._diff_timer = None
             self.render()
 
@@ -1558,15 +1559,19 @@ class Explorer:
         if exit_after is not None:
             iren = pl.iren.interactor
 
-            def expire(obj, _event):
-                if obj.GetTimerEventId() != timer:  # another timer (the difference view)
+            started = time.monotonic()
+
+            def expire(*_):
+                # every timer's event comes here (the difference view has one too), and VTK's X
+                # interactor does not say which timer fired: go by the time
+                if time.monotonic() - started < float(exit_after) - 0.01:
                     return
                 log.warning("closing after %g s (--exit-after)", exit_after)
                 pl.iren.terminate_app()
 
             iren.AddObserver("TimerEvent", expire)
             pl.iren.initialize()
-            timer = iren.CreateOneShotTimer(max(1, int(float(exit_after) * 1000)))
+            iren.CreateOneShotTimer(max(1, int(float(exit_after) * 1000)))
         pl.show(auto_close=True)
 
     def close(self) -> None:

@@ -1,7 +1,8 @@
 """The explorer in a real X window (Xvfb), driven by xdotool like a person would.
 
 One run of ``phong-explorer gui`` on a private Xvfb server: drag the kd slider, drag the light
-handle, rotate the camera, switch the preset with its button, open the help with a key, quit
+handle, rotate the camera, switch the preset with its button, show and hide the difference view
+(its button, then key d), open the help with a key, quit
 with ``q``. After each step the test polls the app's state file (written atomically after each
 frame) and the window's pixels (``xwd``), never sleeping a fixed time: the pixel where the vertex
 facing the camera lands must lie within the colours the engine gives the triangles around that
@@ -249,6 +250,15 @@ def test_real_window(display, tmp_path):
         nxt = s["presets"][s["presets"].index(s["preset"]) + 1]
         win.click(s["buttons"]["preset_next"]["px"])
         s = win.wait(f"preset {nxt}", lambda s: s["preset"] == nxt)
+        check_probe(win, mesh)
+
+        # the difference view: its button (the map is made once the event loop is free), then
+        # the key turns it off and the engine's colours are on the screen again
+        win.click(s["buttons"]["difference"]["px"])
+        s = win.wait("the heat map", lambda s: s["difference"]["shown"])
+        assert s["difference"]["pixels"] > 1000 and "every pixel" in s["difference"]["advice"]
+        win.key("d")
+        s = win.wait("the live view", lambda s: not s["difference"]["on"])
         check_probe(win, mesh)
 
         win.key("h")
