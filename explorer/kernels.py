@@ -332,7 +332,8 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 #
 # Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
 # and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
-# or per-vertex ambient: no rows are written or read. A grey light (r = g = b for its diffuse and
+# or per-vertex ambient, in a pass that does not store lobes (the first pass of a shininess drag
+# takes the row path): no rows are written or read. A grey light (r = g = b for its diffuse and
 # its specular colour, as most lights are) adds one number per vertex to a grey row instead of
 # three to the RGB rows; the block adds the grey rows to every channel once. Inline variants also
 # drop the exact policies inside the ambiguity bands (a light at the vertex, L = -V): there they
@@ -436,7 +437,8 @@ def _light_overload(r, m, q, y, k, variant):
                     amb = amb | (abs(base) < amb_dot)
                     base = max(base, zero)
                     lob = fpow(base, y)  # base^n
-                    B[i] = base
+                    if not inline:  # kept for a lobe store (inline loops never store lobes)
+                        B[i] = base
                 t = ws * lob  # w·f·base^n·s_i
                 if grey:
                     GS[i] += t * sr
@@ -444,7 +446,8 @@ def _light_overload(r, m, q, y, k, variant):
                     Sx[i] += t * sr
                     Sy[i] += t * sg
                     Sz[i] += t * sb
-                WS[i] = ws
+                if not inline:
+                    WS[i] = ws
             if track and (spec or inline):
                 TRK[i] = max(TRK[i], one if amb else zero)
 
@@ -840,6 +843,7 @@ def _block(
             and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
             and not fres
             and mode != LOBE_CONST_H
+            and not (store_lobe and l_spec)  # inline loops keep no lobe rows
         ):  # a plain point light: L and attenuation inline, no rows
             grey = (fl & GREY) != 0
             if grey and not used_grey:
@@ -854,10 +858,6 @@ def _block(
                         _fill(scr[row, :m], zero)
                     junk_zeroed = True
                 _light_inline(r_spec, m, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey)
-            if store_lobe and l_spec:
-                if not flat:
-                    base_out[li, :] = scr[R_BASE, :m]
-                ws_out[li, :] = scr[R_WS, :m]
             continue
         rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
         if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
@@ -899,6 +899,16 @@ def _block(
         _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, opts[O_CLAMP] != 0, k)
 
 
+#: parallel tasks of a pass: blocks are dealt out in this many contiguous runs (enough to keep
+#: every thread busy to the end); a task allocates its scratch rows once, not once per block
+TASKS = 64
+
+
+@nb.njit(**_OPTS)
+def _tasks(nblocks):
+    return max(1, min(nblocks, TASKS))
+
+
 @nb.njit(parallel=True, **_OPTS)
 def shade(
     G,
@@ -931,35 +941,37 @@ def shade(
     """
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
-    for b in nb.prange(nblocks):
-        s = b * BLOCK
-        e = min(n, s + BLOCK)
-        scr = np.empty((N_ROWS, BLOCK), params.dtype)
-        _block(
-            G[0, s:e],
-            G[1, s:e],
-            G[2, s:e],
-            G[3, s:e],
-            G[4, s:e],
-            G[5, s:e],
-            params,
-            flags,
-            view,
-            opts,
-            mat,
-            aconst,
-            shininess,
-            k,
-            A[s:e],
-            D[s:e],
-            S[s:e],
-            base_out[:, s:e],
-            ws_out[:, s:e],
-            vis[:, s:e],
-            amb[s:e],
-            out[s:e],
-            scr,
-        )
+    ntasks = _tasks(nblocks)
+    for t in nb.prange(ntasks):
+        scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
+        for b in range(t * nblocks // ntasks, (t + 1) * nblocks // ntasks):
+            s = b * BLOCK
+            e = min(n, s + BLOCK)
+            _block(
+                G[0, s:e],
+                G[1, s:e],
+                G[2, s:e],
+                G[3, s:e],
+                G[4, s:e],
+                G[5, s:e],
+                params,
+                flags,
+                view,
+                opts,
+                mat,
+                aconst,
+                shininess,
+                k,
+                A[s:e],
+                D[s:e],
+                S[s:e],
+                base_out[:, s:e],
+                ws_out[:, s:e],
+                vis[:, s:e],
+                amb[s:e],
+                out[s:e],
+                scr,
+            )
 
 
 @nb.njit(**_OPTS)
@@ -981,27 +993,32 @@ def lobe(base, ws, params, flags, shininess, k, S):
     n = S.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
     flat = shininess == k[K_ZERO]
-    for b in nb.prange(nblocks):
-        s = b * BLOCK
-        e = min(n, s + BLOCK)
-        m = e - s
-        scr = np.zeros((3, BLOCK), params.dtype)
-        Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
-        for li in range(params.shape[0]):
-            if flags[li] & SPECULAR:
-                _lobe_rows(
-                    base[li, s:e],
-                    ws[li, s:e],
-                    shininess,
-                    flat,
-                    params[li, P_SPEC],
-                    params[li, P_SPEC + 1],
-                    params[li, P_SPEC + 2],
-                    Sx,
-                    Sy,
-                    Sz,
-                )
-        _store_rows(S[s:e], Sx, Sy, Sz)
+    ntasks = _tasks(nblocks)
+    for t in nb.prange(ntasks):
+        scr = np.empty((3, BLOCK), params.dtype)
+        for b in range(t * nblocks // ntasks, (t + 1) * nblocks // ntasks):
+            s = b * BLOCK
+            e = min(n, s + BLOCK)
+            m = e - s
+            Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
+            _fill(Sx, k[K_ZERO])
+            _fill(Sy, k[K_ZERO])
+            _fill(Sz, k[K_ZERO])
+            for li in range(params.shape[0]):
+                if flags[li] & SPECULAR:
+                    _lobe_rows(
+                        base[li, s:e],
+                        ws[li, s:e],
+                        shininess,
+                        flat,
+                        params[li, P_SPEC],
+                        params[li, P_SPEC + 1],
+                        params[li, P_SPEC + 2],
+                        Sx,
+                        Sy,
+                        Sz,
+                    )
+            _store_rows(S[s:e], Sx, Sy, Sz)
 
 
 def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overloaded below
