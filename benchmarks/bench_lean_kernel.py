@@ -28,7 +28,7 @@ import time
 
 import numba as nb
 import numpy as np
-from bench_engine import machine, scene_with  # the engine benchmark's machine line and scene
+from bench_engine import machine, scene_with, sphere_points  # its machine line, scene, mesh
 
 import explorer
 from explorer import tolerances as tol
@@ -136,9 +136,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     n, L = args.vertices, args.lights
     rng = np.random.default_rng(0)
-    N = rng.normal(size=(n, 3))
-    N /= np.linalg.norm(N, axis=1, keepdims=True)
-    G = np.ascontiguousarray(np.vstack([N.T, N.T]), dtype=F)  # unit sphere: P = N
+    P, _ = sphere_points(n, rng)  # the engine benchmark's mesh: unit sphere, P = N
+    G = np.ascontiguousarray(np.vstack([P.T, P.T]))
     # the engine benchmark's scene: its lights, Blinn, eye at (0, 0, 5)
     lights = np.array(
         [[*pl.position, *pl.attenuation] for pl in scene_with(L, np.random.default_rng(0)).lights],
@@ -163,7 +162,6 @@ def main(argv=None) -> int:
         fns[name] = lambda fn=fn, D=D, S=S: fn(G, lights, eye, F(25.6), mat, out, D, S)
         fns[name]()  # compile
     # the engine itself, in the same rounds: a light change on a float32 Shader, as bench_engine
-    P = N.astype(F)
     scene = scene_with(L, np.random.default_rng(0))
     flip = [scene.lights, scene_with(L, np.random.default_rng(1)).lights]
     sh = explorer.Shader(scene, P, P, precision="float32")
