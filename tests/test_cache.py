@@ -238,3 +238,24 @@ def test_float32_shader_stays_within_one_level_of_float64():
         for s in (s32, s64):
             s.set_material(s.scene.material.replace(shininess=n))
         assert np.abs(s32.colors - s64.colors).max() <= tol.FLOAT32_MAX_ABS_ERROR
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_lobes_of_plain_point_lights(precision):
+    # plain point lights (no cone, no light ambient) take the float32 inline loops, which keep no
+    # lobe rows: the pass that starts a shininess drag stores them on the row path instead
+    scene = dict(SCENE)
+    scene["lights"] = [
+        {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
+        {"type": "point", "position": [-3, 1, 2], "diffuse": [1, 0.5, 0.2]},  # coloured
+    ]
+    rng = np.random.default_rng(3)
+    P, N = rng.normal(size=(3000, 3)), rng.normal(size=(3000, 3))
+    shader = explorer.Shader(scene, P, N, precision=precision)
+    _ = shader.colors
+    before = counts(shader)
+    for n in (5.0, 120.0, 0.0, 64.0):
+        shader.set_material(shader.scene.material.replace(shininess=n))
+        _ = shader.colors
+        check(shader)
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1, "lobe": 3, "compose": 3}

@@ -35,3 +35,23 @@ def test_stream_is_the_bandwidth_yardstick():
     out = np.empty_like(P)
     K.stream(P, P, out)
     assert np.array_equal(out, 2 * P)
+
+
+def test_every_block_of_every_task_is_shaded():
+    # more blocks than parallel tasks, and a last block that is not full: each vertex is shaded
+    # once, whichever task it falls to (compared with the independent numpy reference)
+    import explorer
+    from explorer.reference import reference_shade
+
+    n = K.TASKS * K.BLOCK + K.BLOCK // 2 + 3
+    rng = np.random.default_rng(5)
+    P, N = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    scene = {
+        "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20},
+        "viewer": {"eye": [0, 0, 6]},
+        "lights": [{"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]}],
+    }
+    ref = reference_shade(explorer.load_scene(scene), P, N)
+    for precision in ("float32", "float64"):
+        got = explorer.shade(scene, P, N, precision=precision)
+        assert np.abs(got - ref).max() <= 1 / 255
