@@ -31,6 +31,7 @@ from . import tolerances as tol
 BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
 _OPTS = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True)
+_LEAF = dict(_OPTS, _nrt=False)
 
 # per-light flag bits (int32)
 POSITIONAL = 1
@@ -191,7 +192,7 @@ def exponent32(typingctx, x):
     return types.float32(types.float32), codegen
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def log2_32(x):
     """log2 x for a positive, finite float32 x (-127 for x = 0)."""
     b = f2i(x)
@@ -211,7 +212,7 @@ def log2_32(x):
     return e + ln * np.float32(1.4426950408889634)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def exp2_32(t):
     """2**t for float32 t; 0 for t <= -127."""
     t = max(t, np.float32(-127.0))
@@ -226,7 +227,7 @@ def exp2_32(t):
     return q * i2f((np.int32(k) + np.int32(127)) << 23)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def pow32(x, y):
     """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
     t = y * log2_32(x)
@@ -238,20 +239,26 @@ def fpow(x, y):
     return x**y
 
 
-@overload(fpow, jit_options=_OPTS)
+@overload(fpow, jit_options=_LEAF)
 def _fpow_overload(x, y):
     if x == types.float32:
         return lambda x, y: pow32(x, y)
     return lambda x, y: x**y
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
+def _copy(dst, src):
+    for i in range(dst.shape[0]):
+        dst[i] = src[i]
+
+
+@nb.njit(**_LEAF)
 def _fill(a, v):
     for i in range(a.shape[0]):
         a[i] = v
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _load_positions(P, centre, inv_scale, px, py, pz):
     """Positions into the normalised frame: subtract in float64, then round to T."""
     for i in range(P.shape[0]):
@@ -276,7 +283,7 @@ def prepare(P, N, centre, inv_scale, k, G):
         _load_normals(N[s:e], G[3, s:e], G[4, s:e], G[5, s:e], k)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _load_normals(N, nx, ny, nz, k):
     """Unit normals in T; zero where |N|² <= NORMAL_EPS² (no diffuse, no specular there)."""
     zero, one, eps2 = k[K_ZERO], k[K_ONE], k[K_NORMAL_EPS2]
@@ -292,7 +299,7 @@ def _load_normals(N, nx, ny, nz, k):
         nz[i] = c * inv if ok else zero
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
     """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
     one, eps = k[K_ONE], k[K_POINT_EPS]
@@ -309,7 +316,7 @@ def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
         vz[i] = c if at else z * inv
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
     """N -> -N where N·V < 0 (the vertex shows its back face)."""
     zero, one, amb = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
@@ -345,7 +352,7 @@ def _light(r, m, q, y, k, variant):  # pragma: no cover - replaced by the overlo
     raise NotImplementedError
 
 
-@overload(_light, prefer_literal=True, jit_options=_OPTS)
+@overload(_light, prefer_literal=True, jit_options=_LEAF)
 def _light_overload(r, m, q, y, k, variant):
     if not isinstance(variant, types.IntegerLiteral):
         raise TypingError("_light needs a literal variant")
@@ -454,7 +461,7 @@ def _light_overload(r, m, q, y, k, variant):
     return impl
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _light_inline(r, m, q, y, k, atten, mode, l_spec, grey):
     """Call the inline point-light loop compiled for this combination (diffuse always on)."""
     if grey and atten:
@@ -495,7 +502,7 @@ def _light_inline(r, m, q, y, k, atten, mode, l_spec, grey):
             _light(r, m, q, y, k, 1 | 8 | 32 | 16 | 4)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _light_any(r, m, q, y, k, positional, mode, l_dif, l_spec):
     """Call the light loop compiled for this combination (each call site passes a literal)."""
     if not positional:
@@ -548,7 +555,7 @@ def _light_any(r, m, q, y, k, positional, mode, l_dif, l_spec):
                 _light(r, m, q, y, k, 23)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _to_light(r, m, q, k, atten):
     """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex) and the weight
     w = 1 / max(kc + kl·d + kq·d², floor) when ``atten`` (kl, kq scaled to the frame), else 1."""
@@ -589,7 +596,7 @@ def _to_light(r, m, q, k, atten):
             TRK[i] = max(TRK[i], one if d2 < amb_dist2 else zero)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _spot(r, m, q, k, exponent):
     """w *= x**exponent inside the cone (x = (-L)·axis >= cos cutoff), else 0."""
     zero, one, amb_dot = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
@@ -606,7 +613,7 @@ def _spot(r, m, q, k, exponent):
         TRK[i] = max(TRK[i], one if abs(x - cosc) < amb_dot else zero)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _dir_rows(r, m, q, one):
     """Directional light on the row path (shadows, Fresnel): rows L = constant, w = 1."""
     Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
@@ -618,7 +625,7 @@ def _dir_rows(r, m, q, one):
         W[i] = one
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _shadow(r, m, vis):
     """w *= visibility (0 or 1 per vertex, from explorer.shadows)."""
     W = r[R_W]
@@ -626,7 +633,7 @@ def _shadow(r, m, vis):
         W[i] = W[i] * vis[i]
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _fresnel(r, m, q, k):
     """w *= F = F0 + (1 - F0)(1 - V·H)^5 with V·H = sqrt((1 + V·L) / 2) (unit L, V)."""
     zero, one = k[K_ZERO], k[K_ONE]
@@ -642,7 +649,7 @@ def _fresnel(r, m, q, k):
         W[i] = W[i] * (f0 + (one - f0) * (x2 * x2 * x))
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _ambient(r, m, q):
     """A += w·a_i (an attenuated or cone-cut light ambient)."""
     ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
@@ -654,7 +661,7 @@ def _ambient(r, m, q):
         Az[i] += w * ab
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _load_rows(src, rx, ry, rz, zero):
     """Rows from a cached (m, 3) block, or zeros when the cache is empty."""
     if src.shape[0] == 0:
@@ -668,7 +675,7 @@ def _load_rows(src, rx, ry, rz, zero):
             rz[i] = src[i, 2]
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _add_grey(rx, ry, rz, g):
     for i in range(g.shape[0]):
         rx[i] += g[i]
@@ -676,7 +683,7 @@ def _add_grey(rx, ry, rz, g):
         rz[i] += g[i]
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _store_rows(dst, rx, ry, rz):
     for i in range(dst.shape[0]):
         dst[i, 0] = rx[i]
@@ -684,7 +691,7 @@ def _store_rows(dst, rx, ry, rz):
         dst[i, 2] = rz[i]
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k):
     """colour = e_m + a_m·(ambient) + d_m·diffuse + s_m·specular, clamped to [0, 1]."""
     lo = k[K_ZERO]
@@ -712,7 +719,7 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
         out[i, 2] = min(max(b, lo), hi)
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _rows(px, py, pz, nx, ny, nz, scr, m, dx, dy, dz, gd):
     """The rows a light loop works on, indexed by the R_* constants; the diffuse sums (RGB and
     grey) go to the scratch rows ``dx, dy, dz, gd``."""
@@ -748,7 +755,7 @@ def _rows(px, py, pz, nx, ny, nz, scr, m, dx, dy, dz, gd):
     )
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _block(
     px,
     py,
@@ -786,9 +793,9 @@ def _block(
     track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
     if two_sided:  # normals may flip: work on copies
         nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
-        nx[:] = gx
-        ny[:] = gy
-        nz[:] = gz
+        _copy(nx, gx)
+        _copy(ny, gy)
+        _copy(nz, gz)
     else:
         nx, ny, nz = gx, gy, gz
     vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
@@ -879,8 +886,8 @@ def _block(
             _light_any(r, m, q, shininess, k, rows, mode, l_dif, l_spec)
         if store_lobe and l_spec:
             if not flat:
-                base_out[li, :] = scr[R_BASE, :m]
-            ws_out[li, :] = scr[R_WS, :m]
+                _copy(base_out[li, :], scr[R_BASE, :m])
+            _copy(ws_out[li, :], scr[R_WS, :m])
 
     if used_grey:  # the grey sums count in every channel
         _add_grey(Dx, Dy, Dz, scr[R_GD, :m])
@@ -899,12 +906,68 @@ def _block(
         _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, opts[O_CLAMP] != 0, k)
 
 
+@nb.njit(**_LEAF)
+def _task(
+    G,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    vis,
+    amb,
+    out,
+    scr,
+    b0,
+    b1,
+):
+    """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
+    arrays here costs no atomic operations on their counts, which both threads would contend)."""
+    n = G.shape[1]
+    for b in range(b0, b1):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        _block(
+            G[0, s:e],
+            G[1, s:e],
+            G[2, s:e],
+            G[3, s:e],
+            G[4, s:e],
+            G[5, s:e],
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shininess,
+            k,
+            A[s:e],
+            D[s:e],
+            S[s:e],
+            base_out[:, s:e],
+            ws_out[:, s:e],
+            vis[:, s:e],
+            amb[s:e],
+            out[s:e],
+            scr,
+        )
+
+
 #: parallel tasks of a pass: blocks are dealt out in this many contiguous runs (enough to keep
 #: every thread busy to the end); a task allocates its scratch rows once, not once per block
 TASKS = 64
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _tasks(nblocks):
     return max(1, min(nblocks, TASKS))
 
@@ -944,37 +1007,31 @@ def shade(
     ntasks = _tasks(nblocks)
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
-        for b in range(t * nblocks // ntasks, (t + 1) * nblocks // ntasks):
-            s = b * BLOCK
-            e = min(n, s + BLOCK)
-            _block(
-                G[0, s:e],
-                G[1, s:e],
-                G[2, s:e],
-                G[3, s:e],
-                G[4, s:e],
-                G[5, s:e],
-                params,
-                flags,
-                view,
-                opts,
-                mat,
-                aconst,
-                shininess,
-                k,
-                A[s:e],
-                D[s:e],
-                S[s:e],
-                base_out[:, s:e],
-                ws_out[:, s:e],
-                vis[:, s:e],
-                amb[s:e],
-                out[s:e],
-                scr,
-            )
+        _task(
+            G,
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shininess,
+            k,
+            A,
+            D,
+            S,
+            base_out,
+            ws_out,
+            vis,
+            amb,
+            out,
+            scr,
+            t * nblocks // ntasks,
+            (t + 1) * nblocks // ntasks,
+        )
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _lobe_rows(base, ws, y, flat, cr, cg, cb, Sx, Sy, Sz):
     for i in range(ws.shape[0]):
         t = ws[i] if flat else ws[i] * fpow(base[i], y)
@@ -1025,7 +1082,7 @@ def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overlo
     raise NotImplementedError
 
 
-@overload(_compose_block, prefer_literal=True, jit_options=_OPTS)
+@overload(_compose_block, prefer_literal=True, jit_options=_LEAF)
 def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     """One fused pass: o = c0 + cA·A + cD·D + cS·S, clamped; the sums a material does not use
     are not read at all (``variant`` bits 0, 1, 2: A, D, S present)."""
@@ -1057,7 +1114,7 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     return impl
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _compose_any(o, A, D, S, c, lo, hi, v):
     if v == 0:
         _compose_block(o, A, D, S, c, lo, hi, 0)
@@ -1123,7 +1180,7 @@ def stream(P, N, out):
         _add(P[s:e], N[s:e], out[s:e])
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_LEAF)
 def _add(p, q, o):
     for i in range(o.shape[0]):
         o[i, 0] = p[i, 0] + q[i, 0]
