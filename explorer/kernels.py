@@ -16,6 +16,11 @@ float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
 :data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
 in float64.
 
+(n, 3) arrays (positions, normals, the cached sums, colours) are read and written through flat
+(3n,) views, indexed ``3 * i + c``: LLVM then knows the stride and vectorises the interleaved
+accesses; through numba's 2-D indexing (a run-time stride) those loops stayed scalar, at half
+the speed or less.
+
 Leaf kernels are compiled without numba's reference counting (``_nrt=False``): every slice of a
 shared array would otherwise be an atomic increment and decrement of its count, which the two
 threads of a pass contend for (about a fifth of a full pass at 1M vertices).
@@ -164,18 +169,6 @@ def constants(dtype) -> np.ndarray:
 
 
 @intrinsic
-def f2i(typingctx, x):
-    """The bits of a float32 as int32 (no memory round trip)."""
-    if x != types.float32:
-        return None
-
-    def codegen(context, builder, sig, args):
-        return builder.bitcast(args[0], ir.IntType(32))
-
-    return types.int32(types.float32), codegen
-
-
-@intrinsic
 def i2f(typingctx, x):
     """An integer's low 32 bits read as a float32."""
     if not isinstance(x, types.Integer):
@@ -190,31 +183,40 @@ def i2f(typingctx, x):
     return types.float32(x), codegen
 
 
+#: log2's split point: x = 2**k · m with m in [sqrt(1/2), sqrt(2)), so ln m = ln(1 + z) has
+#: |z| <= 0.41 (the range of the polynomial below)
+_SPLIT = 0x3F3504F3  # the bits of float32 sqrt(1/2)
+
+
 @intrinsic
-def exponent32(typingctx, x):
-    """The unbiased exponent field of a float32, as float32, in 32-bit integer ops (numba's own
-    integer arithmetic widens to int64, which costs cross-lane conversions in SIMD code)."""
+def split32(typingctx, x):
+    """x = 2**k · m for a positive float32 x, m in [sqrt(1/2), sqrt(2)): (k, m) as float32.
+
+    In 32-bit integer operations and without a branch or blend (numba's own integer arithmetic
+    widens to int64, which costs cross-lane conversions in SIMD code): subtracting the bits of
+    sqrt(1/2) moves the split point to an exponent boundary, so the shifted difference is k and
+    the bits of x minus k's exponent bits are m. x = 0 gives k = -127, m = 1.
+    """
     if x != types.float32:
         return None
 
     def codegen(context, builder, sig, args):
         i32 = ir.IntType(32)
-        e = builder.lshr(builder.bitcast(args[0], i32), ir.Constant(i32, 23))
-        e = builder.and_(e, ir.Constant(i32, 0xFF))
-        return builder.sitofp(builder.sub(e, ir.Constant(i32, 127)), ir.FloatType())
+        ix = builder.bitcast(args[0], i32)
+        tmp = builder.sub(ix, ir.Constant(i32, _SPLIT))
+        k = builder.ashr(tmp, ir.Constant(i32, 23))
+        im = builder.sub(ix, builder.and_(tmp, ir.Constant(i32, -(1 << 23))))
+        kf = builder.sitofp(k, ir.FloatType())
+        m = builder.bitcast(im, ir.FloatType())
+        return context.make_tuple(builder, sig.return_type, (kf, m))
 
-    return types.float32(types.float32), codegen
+    return types.UniTuple(types.float32, 2)(types.float32), codegen
 
 
 @nb.njit(**_LEAF)
 def log2_32(x):
     """log2 x for a positive, finite float32 x (-127 for x = 0)."""
-    b = f2i(x)
-    e = exponent32(x)
-    f = i2f((b & 0x007FFFFF) | 0x3F800000)
-    big = f > np.float32(1.4142135)
-    f = f * np.float32(0.5) if big else f
-    e = e + np.float32(1.0) if big else e
+    e, f = split32(x)
     z = f - np.float32(1.0)
     p = np.float32(-0.10746953303517079)  # least-squares fit, |error| <= 3.5e-7 on the range
     p = p * z + np.float32(0.15904727806564242)
@@ -274,11 +276,12 @@ def _fill(a, v):
 
 @nb.njit(**_LEAF)
 def _load_positions(P, centre, inv_scale, px, py, pz):
-    """Positions into the normalised frame: subtract in float64, then round to T."""
-    for i in range(P.shape[0]):
-        px[i] = (np.float64(P[i, 0]) - centre[0]) * inv_scale
-        py[i] = (np.float64(P[i, 1]) - centre[1]) * inv_scale
-        pz[i] = (np.float64(P[i, 2]) - centre[2]) * inv_scale
+    """Positions (flat x0 y0 z0 x1 ...) into the normalised frame: subtract in float64, then
+    round to T."""
+    for i in range(px.shape[0]):
+        px[i] = (np.float64(P[3 * i]) - centre[0]) * inv_scale
+        py[i] = (np.float64(P[3 * i + 1]) - centre[1]) * inv_scale
+        pz[i] = (np.float64(P[3 * i + 2]) - centre[2]) * inv_scale
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -289,22 +292,23 @@ def prepare(P, N, centre, inv_scale, k, G):
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
     """
     n = P.shape[0]
+    Pf, Nf = P.reshape(-1), N.reshape(-1)  # flat: x0 y0 z0 x1 ... (see the module docstring)
     nblocks = (n + BLOCK - 1) // BLOCK
     for b in nb.prange(nblocks):
         s = b * BLOCK
         e = min(n, s + BLOCK)
-        _load_positions(P[s:e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
-        _load_normals(N[s:e], G[3, s:e], G[4, s:e], G[5, s:e], k)
+        _load_positions(Pf[3 * s : 3 * e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
+        _load_normals(Nf[3 * s : 3 * e], G[3, s:e], G[4, s:e], G[5, s:e], k)
 
 
 @nb.njit(**_LEAF)
 def _load_normals(N, nx, ny, nz, k):
     """Unit normals in T; zero where |N|² <= NORMAL_EPS² (no diffuse, no specular there)."""
     zero, one, eps2 = k[K_ZERO], k[K_ONE], k[K_NORMAL_EPS2]
-    for i in range(N.shape[0]):
-        a = N[i, 0] * one
-        b = N[i, 1] * one
-        c = N[i, 2] * one
+    for i in range(nx.shape[0]):
+        a = N[3 * i] * one
+        b = N[3 * i + 1] * one
+        c = N[3 * i + 2] * one
         nn = a * a + b * b + c * c
         ok = nn > eps2
         inv = one / np.sqrt(nn if ok else one)
@@ -677,16 +681,16 @@ def _ambient(r, m, q):
 
 @nb.njit(**_LEAF)
 def _load_rows(src, rx, ry, rz, zero):
-    """Rows from a cached (m, 3) block, or zeros when the cache is empty."""
+    """Rows from a cached block (flat (3m,)), or zeros when the cache is empty."""
     if src.shape[0] == 0:
         _fill(rx, zero)
         _fill(ry, zero)
         _fill(rz, zero)
     else:
         for i in range(rx.shape[0]):
-            rx[i] = src[i, 0]
-            ry[i] = src[i, 1]
-            rz[i] = src[i, 2]
+            rx[i] = src[3 * i]
+            ry[i] = src[3 * i + 1]
+            rz[i] = src[3 * i + 2]
 
 
 @nb.njit(**_LEAF)
@@ -699,10 +703,11 @@ def _add_grey(rx, ry, rz, g):
 
 @nb.njit(**_LEAF)
 def _store_rows(dst, rx, ry, rz):
-    for i in range(dst.shape[0]):
-        dst[i, 0] = rx[i]
-        dst[i, 1] = ry[i]
-        dst[i, 2] = rz[i]
+    """Rows into a flat (3m,) block of an (n, 3) array."""
+    for i in range(rx.shape[0]):
+        dst[3 * i] = rx[i]
+        dst[3 * i + 1] = ry[i]
+        dst[3 * i + 2] = rz[i]
 
 
 @nb.njit(**_LEAF)
@@ -724,13 +729,13 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
         mat[10],
         mat[11],
     )
-    for i in range(out.shape[0]):
+    for i in range(Ax.shape[0]):
         r = e0 + a0 * Ax[i] + d0 * Dx[i] + s0 * Sx[i]  # e + a_m·(a_const + A) + d_m·D + s_m·S
         g = e1 + a1 * Ay[i] + d1 * Dy[i] + s1 * Sy[i]
         b = e2 + a2 * Az[i] + d2 * Dz[i] + s2 * Sz[i]
-        out[i, 0] = min(max(r, lo), hi)
-        out[i, 1] = min(max(g, lo), hi)
-        out[i, 2] = min(max(b, lo), hi)
+        out[3 * i] = min(max(r, lo), hi)
+        out[3 * i + 1] = min(max(g, lo), hi)
+        out[3 * i + 2] = min(max(b, lo), hi)
 
 
 @nb.njit(**_LEAF)
@@ -964,14 +969,14 @@ def _task(
             aconst,
             shininess,
             k,
-            A[s:e],
-            D[s:e],
-            S[s:e],
+            A[3 * s : 3 * e],
+            D[3 * s : 3 * e],
+            S[3 * s : 3 * e],
             base_out[:, s:e],
             ws_out[:, s:e],
             vis[:, s:e],
             amb[s:e],
-            out[s:e],
+            out[3 * s : 3 * e],
             scr,
         )
 
@@ -1086,6 +1091,12 @@ def shade(
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
+    Af, Df, Sf, outf = (
+        A.reshape(-1),
+        D.reshape(-1),
+        S.reshape(-1),
+        out.reshape(-1),
+    )  # flat views (module docstring)
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
         _task(
@@ -1098,14 +1109,14 @@ def shade(
             aconst,
             shininess,
             k,
-            A,
-            D,
-            S,
+            Af,
+            Df,
+            Sf,
             base_out,
             ws_out,
             vis,
             amb,
-            out,
+            outf,
             scr,
             t * nblocks // ntasks,
             (t + 1) * nblocks // ntasks,
@@ -1130,33 +1141,52 @@ def lobe(base, ws, params, flags, shininess, k, S):
     """
     n = S.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
-    flat = shininess == k[K_ZERO]
     ntasks = _tasks(nblocks)
+    Sf = S.reshape(-1)
     for t in nb.prange(ntasks):
         scr = np.empty((3, BLOCK), params.dtype)
-        for b in range(t * nblocks // ntasks, (t + 1) * nblocks // ntasks):
-            s = b * BLOCK
-            e = min(n, s + BLOCK)
-            m = e - s
-            Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
-            _fill(Sx, k[K_ZERO])
-            _fill(Sy, k[K_ZERO])
-            _fill(Sz, k[K_ZERO])
-            for li in range(params.shape[0]):
-                if flags[li] & SPECULAR:
-                    _lobe_rows(
-                        base[li, s:e],
-                        ws[li, s:e],
-                        shininess,
-                        flat,
-                        params[li, P_SPEC],
-                        params[li, P_SPEC + 1],
-                        params[li, P_SPEC + 2],
-                        Sx,
-                        Sy,
-                        Sz,
-                    )
-            _store_rows(S[s:e], Sx, Sy, Sz)
+        _lobe_task(
+            base,
+            ws,
+            params,
+            flags,
+            shininess,
+            k,
+            Sf,
+            scr,
+            t * nblocks // ntasks,
+            (t + 1) * nblocks // ntasks,
+        )
+
+
+@nb.njit(**_LEAF)
+def _lobe_task(base, ws, params, flags, shininess, k, Sf, scr, b0, b1):
+    """Blocks b0 to b1 - 1 of :func:`lobe` (a leaf: no reference counting, see _task)."""
+    n = Sf.shape[0] // 3
+    flat = shininess == k[K_ZERO]
+    for b in range(b0, b1):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        m = e - s
+        Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
+        _fill(Sx, k[K_ZERO])
+        _fill(Sy, k[K_ZERO])
+        _fill(Sz, k[K_ZERO])
+        for li in range(params.shape[0]):
+            if flags[li] & SPECULAR:
+                _lobe_rows(
+                    base[li, s:e],
+                    ws[li, s:e],
+                    shininess,
+                    flat,
+                    params[li, P_SPEC],
+                    params[li, P_SPEC + 1],
+                    params[li, P_SPEC + 2],
+                    Sx,
+                    Sy,
+                    Sz,
+                )
+        _store_rows(Sf[3 * s : 3 * e], Sx, Sy, Sz)
 
 
 def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overloaded below
@@ -1174,23 +1204,23 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     def impl(o, A, D, S, c, lo, hi, variant):
         c0, c1, c2 = c[0], c[1], c[2]
         a0, a1, a2, d0, d1, d2, s0, s1, s2 = c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11]
-        for i in range(o.shape[0]):
+        for i in range(o.shape[0] // 3):  # flat (3m,) blocks of (n, 3) arrays
             r, g, b = c0, c1, c2  # e_m + a_m·(scene and constant light ambient)
             if has_a:  # a_m·A (attenuated light ambient)
-                r += a0 * A[i, 0]
-                g += a1 * A[i, 1]
-                b += a2 * A[i, 2]
+                r += a0 * A[3 * i]
+                g += a1 * A[3 * i + 1]
+                b += a2 * A[3 * i + 2]
             if has_d:  # d_m·D
-                r += d0 * D[i, 0]
-                g += d1 * D[i, 1]
-                b += d2 * D[i, 2]
+                r += d0 * D[3 * i]
+                g += d1 * D[3 * i + 1]
+                b += d2 * D[3 * i + 2]
             if has_s:  # s_m·S
-                r += s0 * S[i, 0]
-                g += s1 * S[i, 1]
-                b += s2 * S[i, 2]
-            o[i, 0] = min(max(r, lo), hi)
-            o[i, 1] = min(max(g, lo), hi)
-            o[i, 2] = min(max(b, lo), hi)
+                r += s0 * S[3 * i]
+                g += s1 * S[3 * i + 1]
+                b += s2 * S[3 * i + 2]
+            o[3 * i] = min(max(r, lo), hi)
+            o[3 * i + 1] = min(max(g, lo), hi)
+            o[3 * i + 2] = min(max(b, lo), hi)
 
     return impl
 
@@ -1230,14 +1260,20 @@ def compose(mat, aconst, A, D, S, clamp, k, out):
         c[ch] = mat[ch] + mat[3 + ch] * aconst[ch]
     chunk = COMPOSE_BLOCK
     nblocks = (n + chunk - 1) // chunk
+    Af, Df, Sf, outf = (
+        A.reshape(-1),
+        D.reshape(-1),
+        S.reshape(-1),
+        out.reshape(-1),
+    )  # flat views (module docstring)
     for b in nb.prange(nblocks):
-        s = b * chunk
-        e = min(n, s + chunk)
+        s = 3 * b * chunk
+        e = 3 * min(n, b * chunk + chunk)
         _compose_any(
-            out[s:e],
-            A[s:e] if v & 1 else A,
-            D[s:e] if v & 2 else D,
-            S[s:e] if v & 4 else S,
+            outf[s:e],
+            Af[s:e] if v & 1 else Af,
+            Df[s:e] if v & 2 else Df,
+            Sf[s:e] if v & 4 else Sf,
             c,
             lo,
             hi,
@@ -1253,20 +1289,20 @@ COMPOSE_BLOCK = 16384
 def stream(P, N, out):
     """The memory-bandwidth floor of a recolour: read positions and normals once, write
     colours once (out = P + N). Used only by the benchmark, as the yardstick."""
-    n = out.shape[0]
-    nblocks = (n + COMPOSE_BLOCK - 1) // COMPOSE_BLOCK
+    Pf, Nf, outf = P.reshape(-1), N.reshape(-1), out.reshape(-1)  # flat views (module docstring)
+    n = outf.shape[0]
+    chunk = 3 * COMPOSE_BLOCK
+    nblocks = (n + chunk - 1) // chunk
     for b in nb.prange(nblocks):
-        s = b * COMPOSE_BLOCK
-        e = min(n, s + COMPOSE_BLOCK)
-        _add(P[s:e], N[s:e], out[s:e])
+        s = b * chunk
+        e = min(n, s + chunk)
+        _add(Pf[s:e], Nf[s:e], outf[s:e])
 
 
 @nb.njit(**_LEAF)
 def _add(p, q, o):
     for i in range(o.shape[0]):
-        o[i, 0] = p[i, 0] + q[i, 0]
-        o[i, 1] = p[i, 1] + q[i, 1]
-        o[i, 2] = p[i, 2] + q[i, 2]
+        o[i] = p[i] + q[i]
 
 
 # the entry points, each compiled with wide float32 vectors where the CPU has them (see _wide);
