@@ -320,14 +320,14 @@ def _load_normals(N, nx, ny, nz, k):
 @nb.njit(**_LEAF)
 def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
     """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
-    one, eps = k[K_ONE], k[K_POINT_EPS]
+    one, eps2 = k[K_ONE], k[K_POINT_EPS] * k[K_POINT_EPS]
     for i in range(px.shape[0]):
         x = ex - px[i]
         y = ey - py[i]
         z = ez - pz[i]
-        dd = np.sqrt(x * x + y * y + z * z)
-        at = dd < eps
-        inv = one / (one if at else dd)
+        d2 = x * x + y * y + z * z
+        at = d2 < eps2
+        inv = one / np.sqrt(max(d2, eps2))  # (a reciprocal square root: no divide)
         a, b, c = nx[i], ny[i], nz[i]
         vx[i] = a if at else x * inv
         vy[i] = b if at else y * inv
@@ -366,12 +366,12 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 # policies hold.
 
 
-def _light(r, m, q, y, k, variant):  # pragma: no cover - replaced by the overload below
+def _light(scr, m, dx, gd, q, y, k, variant):  # pragma: no cover - replaced by the overload below
     raise NotImplementedError
 
 
 @overload(_light, prefer_literal=True, jit_options=_LEAF)
-def _light_overload(r, m, q, y, k, variant):
+def _light_overload(scr, m, dx, gd, q, y, k, variant):
     if not isinstance(variant, types.IntegerLiteral):
         raise TypingError("_light needs a literal variant")
     v = variant.literal_value
@@ -383,22 +383,24 @@ def _light_overload(r, m, q, y, k, variant):
     atten = bool(v & 64)
     grey = bool(v & 128)
     lobe_on = spec and mode != LOBE_FLAT
-    track = r.dtype.dtype == types.float32  # only the float32 path marks ambiguous lanes
+    track = scr.dtype == types.float32  # only the float32 path marks ambiguous lanes
     if inline and not track:
 
-        def never(r, m, q, y, k, variant):
+        def never(scr, m, dx, gd, q, y, k, variant):
             raise AssertionError("inline light loops are float32 only")
 
         return never
 
-    def impl(r, m, q, y, k, variant):
+    def impl(scr, m, dx, gd, q, y, k, variant):
         # rows as separate 1-D arrays: lets the compiler check overlap once and vectorise
-        px, py, pz = r[R_PX], r[R_PY], r[R_PZ]
-        nx, ny, nz, vx, vy, vz = r[R_NX], r[R_NY], r[R_NZ], r[R_VX], r[R_VY], r[R_VZ]
-        Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
-        Dx, Dy, Dz, Sx, Sy, Sz = r[R_DX], r[R_DY], r[R_DZ], r[R_SX], r[R_SY], r[R_SZ]
-        B, WS, TRK = r[R_BASE], r[R_WS], r[R_TRK]
-        GD, GS = r[R_GD], r[R_GS]
+        px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
+        nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
+        vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
+        Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
+        Dx, Dy, Dz = scr[dx, :m], scr[dx + 1, :m], scr[dx + 2, :m]
+        Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
+        B, WS, TRK = scr[R_BASE, :m], scr[R_WS, :m], scr[R_TRK, :m]
+        GD, GS = scr[gd, :m], scr[R_GS, :m]
         zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
         h_eps2, amb_dot, amb_len2 = k[K_HALF_EPS2], k[K_AMB_DOT], k[K_AMB_LEN2]
         p_eps2, amb_dist2, floor = k[K_POINT_EPS] ** 2, k[K_AMB_DIST] ** 2, k[K_ATT_FLOOR]
@@ -480,109 +482,110 @@ def _light_overload(r, m, q, y, k, variant):
 
 
 @nb.njit(**_LEAF)
-def _light_inline(r, m, q, y, k, atten, mode, l_spec, grey):
+def _light_inline(scr, m, dx, gd, q, y, k, atten, mode, l_spec, grey):
     """Call the inline point-light loop compiled for this combination (diffuse always on)."""
     if grey and atten:
         if not l_spec:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128)
         elif mode == LOBE_FLAT:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128 | 16)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16)
         elif mode == LOBE_PHONG:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 6)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 6)
         else:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 4)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 4)
     elif grey and not atten:
         if not l_spec:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 128)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128)
         elif mode == LOBE_FLAT:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 128 | 16)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16)
         elif mode == LOBE_PHONG:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 128 | 16 | 6)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 6)
         else:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 128 | 16 | 4)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 4)
     elif not grey and atten:
         if not l_spec:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64)
         elif mode == LOBE_FLAT:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 16)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16)
         elif mode == LOBE_PHONG:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 16 | 6)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 6)
         else:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 64 | 16 | 4)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 4)
     elif not grey and not atten:
         if not l_spec:
-            _light(r, m, q, y, k, 1 | 8 | 32)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32)
         elif mode == LOBE_FLAT:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 16)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16)
         elif mode == LOBE_PHONG:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 16 | 6)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 6)
         else:
-            _light(r, m, q, y, k, 1 | 8 | 32 | 16 | 4)
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 4)
 
 
 @nb.njit(**_LEAF)
-def _light_any(r, m, q, y, k, positional, mode, l_dif, l_spec):
+def _light_any(scr, m, q, y, k, positional, mode, l_dif, l_spec):
     """Call the light loop compiled for this combination (each call site passes a literal)."""
     if not positional:
         if not l_spec:
             if l_dif:
-                _light(r, m, q, y, k, 8)
+                _light(scr, m, R_DX, R_GD, q, y, k, 8)
         elif mode == LOBE_FLAT:
             if l_dif:
-                _light(r, m, q, y, k, 24)
+                _light(scr, m, R_DX, R_GD, q, y, k, 24)
             else:
-                _light(r, m, q, y, k, 16)
+                _light(scr, m, R_DX, R_GD, q, y, k, 16)
         elif mode == LOBE_CONST_H:
             if l_dif:
-                _light(r, m, q, y, k, 26)
+                _light(scr, m, R_DX, R_GD, q, y, k, 26)
             else:
-                _light(r, m, q, y, k, 18)
+                _light(scr, m, R_DX, R_GD, q, y, k, 18)
         elif mode == LOBE_BLINN:
             if l_dif:
-                _light(r, m, q, y, k, 28)
+                _light(scr, m, R_DX, R_GD, q, y, k, 28)
             else:
-                _light(r, m, q, y, k, 20)
+                _light(scr, m, R_DX, R_GD, q, y, k, 20)
         elif mode == LOBE_PHONG:
             if l_dif:
-                _light(r, m, q, y, k, 30)
+                _light(scr, m, R_DX, R_GD, q, y, k, 30)
             else:
-                _light(r, m, q, y, k, 22)
+                _light(scr, m, R_DX, R_GD, q, y, k, 22)
     else:
         if not l_spec:
             if l_dif:
-                _light(r, m, q, y, k, 9)
+                _light(scr, m, R_DX, R_GD, q, y, k, 9)
         elif mode == LOBE_FLAT:
             if l_dif:
-                _light(r, m, q, y, k, 25)
+                _light(scr, m, R_DX, R_GD, q, y, k, 25)
             else:
-                _light(r, m, q, y, k, 17)
+                _light(scr, m, R_DX, R_GD, q, y, k, 17)
         elif mode == LOBE_CONST_H:
             if l_dif:
-                _light(r, m, q, y, k, 27)
+                _light(scr, m, R_DX, R_GD, q, y, k, 27)
             else:
-                _light(r, m, q, y, k, 19)
+                _light(scr, m, R_DX, R_GD, q, y, k, 19)
         elif mode == LOBE_BLINN:
             if l_dif:
-                _light(r, m, q, y, k, 29)
+                _light(scr, m, R_DX, R_GD, q, y, k, 29)
             else:
-                _light(r, m, q, y, k, 21)
+                _light(scr, m, R_DX, R_GD, q, y, k, 21)
         elif mode == LOBE_PHONG:
             if l_dif:
-                _light(r, m, q, y, k, 31)
+                _light(scr, m, R_DX, R_GD, q, y, k, 31)
             else:
-                _light(r, m, q, y, k, 23)
+                _light(scr, m, R_DX, R_GD, q, y, k, 23)
 
 
 @nb.njit(**_LEAF)
-def _to_light(r, m, q, k, atten):
+def _to_light(scr, m, q, k, atten):
     """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex) and the weight
     w = 1 / max(kc + kl·d + kq·d², floor) when ``atten`` (kl, kq scaled to the frame), else 1."""
     one, eps2, amb_dist2 = k[K_ONE], k[K_POINT_EPS] * k[K_POINT_EPS], k[K_AMB_DIST] ** 2
     zero, floor = k[K_ZERO], k[K_ATT_FLOOR]
     kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
     qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
-    px, py, pz, nx, ny, nz = r[R_PX], r[R_PY], r[R_PZ], r[R_NX], r[R_NY], r[R_NZ]
-    Lx, Ly, Lz, W, TRK = r[R_LX], r[R_LY], r[R_LZ], r[R_W], r[R_TRK]
+    px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
+    nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
+    Lx, Ly, Lz, W, TRK = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m], scr[R_TRK, :m]
     if atten:
         for i in range(m):
             x = qx - px[i]
@@ -615,12 +618,12 @@ def _to_light(r, m, q, k, atten):
 
 
 @nb.njit(**_LEAF)
-def _spot(r, m, q, k, exponent):
+def _spot(scr, m, q, k, exponent):
     """w *= x**exponent inside the cone (x = (-L)·axis >= cos cutoff), else 0."""
     zero, one, amb_dot = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
     ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
     cosc, e = q[P_COS], q[P_EXP]
-    Lx, Ly, Lz, W, TRK = r[R_LX], r[R_LY], r[R_LZ], r[R_W], r[R_TRK]
+    Lx, Ly, Lz, W, TRK = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m], scr[R_TRK, :m]
     for i in range(m):
         x = -(Lx[i] * ax + Ly[i] * ay + Lz[i] * az)
         if exponent:
@@ -632,9 +635,9 @@ def _spot(r, m, q, k, exponent):
 
 
 @nb.njit(**_LEAF)
-def _dir_rows(r, m, q, one):
+def _dir_rows(scr, m, q, one):
     """Directional light on the row path (shadows, Fresnel): rows L = constant, w = 1."""
-    Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
+    Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
     qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
     for i in range(m):
         Lx[i] = qx
@@ -644,21 +647,21 @@ def _dir_rows(r, m, q, one):
 
 
 @nb.njit(**_LEAF)
-def _shadow(r, m, vis):
+def _shadow(scr, m, vis):
     """w *= visibility (0 or 1 per vertex, from explorer.shadows)."""
-    W = r[R_W]
+    W = scr[R_W, :m]
     for i in range(m):
         W[i] = W[i] * vis[i]
 
 
 @nb.njit(**_LEAF)
-def _fresnel(r, m, q, k):
+def _fresnel(scr, m, q, k):
     """w *= F = F0 + (1 - F0)(1 - V·H)^5 with V·H = sqrt((1 + V·L) / 2) (unit L, V)."""
     zero, one = k[K_ZERO], k[K_ONE]
     half = one / k[K_TWO]
     f0 = q[P_F0]
-    Lx, Ly, Lz, W = r[R_LX], r[R_LY], r[R_LZ], r[R_W]
-    vx, vy, vz = r[R_VX], r[R_VY], r[R_VZ]
+    Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
+    vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
     for i in range(m):
         vl = Lx[i] * vx[i] + Ly[i] * vy[i] + Lz[i] * vz[i]
         c = np.sqrt(max((one + vl) * half, zero))
@@ -668,10 +671,10 @@ def _fresnel(r, m, q, k):
 
 
 @nb.njit(**_LEAF)
-def _ambient(r, m, q):
+def _ambient(scr, m, q):
     """A += w·a_i (an attenuated or cone-cut light ambient)."""
     ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
-    W, Ax, Ay, Az = r[R_W], r[R_AX], r[R_AY], r[R_AZ]
+    W, Ax, Ay, Az = scr[R_W, :m], scr[R_AX, :m], scr[R_AY, :m], scr[R_AZ, :m]
     for i in range(m):
         w = W[i]
         Ax[i] += w * ar
@@ -739,46 +742,10 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 
 
 @nb.njit(**_LEAF)
-def _rows(px, py, pz, nx, ny, nz, scr, m, dx, dy, dz, gd):
-    """The rows a light loop works on, indexed by the R_* constants; the diffuse sums (RGB and
-    grey) go to the scratch rows ``dx, dy, dz, gd``."""
-    return (
-        px,
-        py,
-        pz,
-        nx,
-        ny,
-        nz,
-        scr[R_VX, :m],
-        scr[R_VY, :m],
-        scr[R_VZ, :m],
-        scr[R_AX, :m],
-        scr[R_AY, :m],
-        scr[R_AZ, :m],
-        scr[dx, :m],
-        scr[dy, :m],
-        scr[dz, :m],
-        scr[R_SX, :m],
-        scr[R_SY, :m],
-        scr[R_SZ, :m],
-        scr[R_LX, :m],
-        scr[R_LY, :m],
-        scr[R_LZ, :m],
-        scr[R_D, :m],
-        scr[R_W, :m],
-        scr[R_BASE, :m],
-        scr[R_WS, :m],
-        scr[R_TRK, :m],
-        scr[gd, :m],
-        scr[R_GS, :m],
-    )
-
-
-@nb.njit(**_LEAF)
 def _block(
-    px,
-    py,
-    pz,
+    gpx,
+    gpy,
+    gpz,
     gx,
     gy,
     gz,
@@ -802,30 +769,31 @@ def _block(
 ):
     """One block; every array argument is already sliced to the block's vertices.
 
-    px, py, pz, gx, gy, gz : (m,) T prepared positions and normals (read only)
+    gpx, gpy, gpz, gx, gy, gz : (m,) T prepared positions and normals (read only), copied into
+    the scratch rows, so that every light loop takes the scratch array alone (a call that passes
+    a tuple of rows copies each row's array structure: ~1 µs per light and block)
     """
-    m = px.shape[0]
+    m = gpx.shape[0]
     zero = k[K_ZERO]
     two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
     do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
     store_lobe = opts[O_STORE_LOBE] != 0
     track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
-    if two_sided:  # normals may flip: work on copies
-        nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
-        _copy(nx, gx)
-        _copy(ny, gy)
-        _copy(nz, gz)
-    else:
-        nx, ny, nz = gx, gy, gz
+    px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
+    nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]  # (two-sided flips these copies)
+    _copy(px, gpx)
+    _copy(py, gpy)
+    _copy(pz, gpz)
+    _copy(nx, gx)
+    _copy(ny, gy)
+    _copy(nz, gz)
     vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
     Ax, Ay, Az = scr[R_AX, :m], scr[R_AY, :m], scr[R_AZ, :m]
     Dx, Dy, Dz = scr[R_DX, :m], scr[R_DY, :m], scr[R_DZ, :m]
     Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
     trk = scr[R_TRK, :m]
-    r = _rows(px, py, pz, nx, ny, nz, scr, m, R_DX, R_DY, R_DZ, R_GD)
-    # the inline loops always add a diffuse term: for a specular-only pass they get these rows,
-    # whose diffuse sums (RGB and grey) land in scratch rows the inline loops never read
-    r_spec = _rows(px, py, pz, nx, ny, nz, scr, m, R_LX, R_LY, R_LZ, R_D)
+    # the inline loops always add a diffuse term: for a specular-only pass it goes to the rows
+    # R_LX, R_LY, R_LZ (RGB) and R_D (grey), which the inline loops never read
     junk_zeroed = False
 
     _fill(trk, zero)
@@ -877,32 +845,36 @@ def _block(
                 _fill(scr[R_GS, :m], zero)
             used_grey = used_grey or grey
             if l_dif:
-                _light_inline(r, m, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec, grey)
+                _light_inline(
+                    scr, m, R_DX, R_GD, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec, grey
+                )
             else:  # specular only (a viewer change): the diffuse goes to rows nobody reads
                 if not junk_zeroed:
                     for row in (R_LX, R_LY, R_LZ, R_D):
                         _fill(scr[row, :m], zero)
                     junk_zeroed = True
-                _light_inline(r_spec, m, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey)
+                _light_inline(
+                    scr, m, R_LX, R_D, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey
+                )
             continue
         rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
         if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
-            _to_light(r, m, q, k, (fl & ATTEN) != 0)
+            _to_light(scr, m, q, k, (fl & ATTEN) != 0)
             if fl & SPOT:
-                _spot(r, m, q, k, (fl & SPOT_EXP) != 0)
+                _spot(scr, m, q, k, (fl & SPOT_EXP) != 0)
             if l_amb:
-                _ambient(r, m, q)
+                _ambient(scr, m, q)
         elif rows:  # a directional light on the row path
-            _dir_rows(r, m, q, k[K_ONE])
+            _dir_rows(scr, m, q, k[K_ONE])
         if fl & SHADOW:  # after the ambient: ambient light is not shadowed
-            _shadow(r, m, vis[li, :])
+            _shadow(scr, m, vis[li, :])
         if fres:  # diffuse with w, then specular with w·F
             if l_dif:
-                _light_any(r, m, q, shininess, k, True, mode, True, False)
-            _fresnel(r, m, q, k)
-            _light_any(r, m, q, shininess, k, True, mode, False, True)
+                _light_any(scr, m, q, shininess, k, True, mode, True, False)
+            _fresnel(scr, m, q, k)
+            _light_any(scr, m, q, shininess, k, True, mode, False, True)
         else:
-            _light_any(r, m, q, shininess, k, rows, mode, l_dif, l_spec)
+            _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
         if store_lobe and l_spec:
             if not flat:
                 _copy(base_out[li, :], scr[R_BASE, :m])
