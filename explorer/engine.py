@@ -449,7 +449,11 @@ class Shader:
         if self._params is None:
             self._params = {}
         if dtype not in self._params:
-            self._params[dtype] = self._light_params(dtype)
+            # built once in float64 (the float64 redo of ambiguous lanes needs those too)
+            if np.float64 not in self._params:
+                self._params[np.float64] = self._light_params(np.float64)
+            params, flags, view = self._params[np.float64]
+            self._params[dtype] = (params.astype(dtype), flags, view.astype(dtype))
         return self._params[dtype]
 
     def _run(self, do_amb, do_dif, do_spec, flat, mat, aconst):
@@ -556,7 +560,7 @@ class Shader:
         mat = self._material_vector(f64)
         aconst = self._aconst
         G64 = np.empty((6, m))
-        K.prepare(
+        K.prepare_small(
             np.ascontiguousarray(self._P[idx]),
             np.ascontiguousarray(self._N[idx]),
             self._centre,
@@ -564,7 +568,7 @@ class Shader:
             self._k64,
             G64,
         )
-        K.shade(
+        K.shade_small(
             G64,
             params,
             flags,
