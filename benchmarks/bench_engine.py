@@ -44,6 +44,7 @@ def machine() -> str:
     return (
         f"{cpu}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
+        f"float32 vectors: {'16 lanes (AVX-512)' if K.WIDE_FLOAT32 else 'LLVM default width'}; "
         f"load average {load:.2f}"
     )
 

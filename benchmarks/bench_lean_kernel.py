@@ -31,12 +31,16 @@ import numpy as np
 from bench_engine import machine, scene_with, sphere_points  # its machine line, scene, mesh
 
 import explorer
+from explorer import kernels as K
 from explorer import tolerances as tol
-from explorer.kernels import _OPTS, pow32
+from explorer.kernels import _LEAF, _OPTS, pow32
 
 BLOCK = 512
 F = np.float32
+# compiled as the engine's kernels are: the light loop without reference counting, both with
+# 16-lane vectors where the engine gets them (explorer.kernels.wide_vectors)
 _JIT = {k: v for k, v in _OPTS.items() if k != "cache"}
+_JIT_LEAF = {k: v for k, v in _LEAF.items() if k != "cache"}
 # the engine's tolerances, in float32 (frozen into the kernels as constants)
 AMB_DOT, AMB_LEN2 = F(tol.AMBIGUOUS_DOT), F(tol.AMBIGUOUS_LEN2)
 AMB_DIST2, P_EPS2 = F(tol.AMBIGUOUS_DIST**2), F(tol.POINT_EPS**2)
@@ -46,7 +50,7 @@ H_EPS2, ATT_FLOOR = F(tol.HALFWAY_EPS2), F(tol.ATTENUATION_FLOOR)
 def make(track: bool, floors: bool, store: int):
     """A shading kernel with the given guarantees compiled in (store: 0 none, 1 (n,3), 2 (3,n))."""
 
-    @nb.njit(**_JIT)
+    @nb.njit(**_JIT_LEAF)
     def light(px, py, pz, nx, ny, nz, vx, vy, vz, GD, GS, TRK, q, y, m):
         one, zero = F(1), F(0)
         qx, qy, qz, kc, kl, kq = q[0], q[1], q[2], q[3], q[4], q[5]
@@ -160,7 +164,8 @@ def main(argv=None) -> int:
         fn = make(track, floors, store)
         D, S = sums.get(store, sums[1])
         fns[name] = lambda fn=fn, D=D, S=S: fn(G, lights, eye, F(25.6), mat, out, D, S)
-        fns[name]()  # compile
+        with K.wide_vectors():
+            fns[name]()  # compile
     # the engine itself, in the same rounds: a light change on a float32 Shader, as bench_engine
     scene = scene_with(L, np.random.default_rng(0))
     flip = [scene.lights, scene_with(L, np.random.default_rng(1)).lights]

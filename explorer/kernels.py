@@ -1003,14 +1003,27 @@ def _quiet_llvm_remarks():
                 os.write(2, b"".join(rest))
 
 
+@contextlib.contextmanager
+def wide_vectors():
+    """Compile numba code inside this block with 16-lane vectors where :data:`WIDE_FLOAT32`
+    (else a no-op). LLVM's ``-force-vector-width`` is a process-wide option: it is set for the
+    block only and reset to 0 (LLVM's own choice) after, so other numba code is not affected."""
+    if not WIDE_FLOAT32:
+        yield
+        return
+    with _quiet_llvm_remarks():
+        llvm.set_option("", "-force-vector-width=16")
+        try:
+            yield
+        finally:
+            llvm.set_option("", "-force-vector-width=0")
+
+
 def _wide(kernel, dtype_arg: int):
     """Call ``kernel`` so that a signature it meets for the first time with float32 data (the
-    dtype of positional argument ``dtype_arg``) is compiled with 16-lane vectors.
-
-    LLVM's ``-force-vector-width`` is a process-wide option: it is set only around such first
-    calls (compiling, or loading from numba's cache) and reset to 0 (LLVM's own choice) after,
-    so other numba code in the process is not affected. Later calls go straight to the kernel.
-    """
+    dtype of positional argument ``dtype_arg``) is compiled with 16-lane vectors
+    (:func:`wide_vectors` around such first calls, which compile or load from numba's cache);
+    later calls go straight to the kernel."""
     if not WIDE_FLOAT32:
         return kernel
     seen: set = set()
@@ -1023,12 +1036,10 @@ def _wide(kernel, dtype_arg: int):
         if dt != np.float32:
             seen.add(dt)
             return kernel(*args)
-        with _quiet_llvm_remarks():
-            llvm.set_option("", "-force-vector-width=16")
+        with wide_vectors():
             try:
                 return kernel(*args)
             finally:
-                llvm.set_option("", "-force-vector-width=0")
                 seen.add(dt)
 
     call.dispatcher = kernel  # the numba dispatcher itself (signatures, inspection)
