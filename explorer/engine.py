@@ -560,7 +560,7 @@ class Shader:
         mat = self._material_vector(f64)
         aconst = self._aconst
         G64 = np.empty((6, m))
-        K.prepare_small(
+        K.prepare(
             np.ascontiguousarray(self._P[idx]),
             np.ascontiguousarray(self._N[idx]),
             self._centre,
@@ -568,7 +568,7 @@ class Shader:
             self._k64,
             G64,
         )
-        K.shade_small(
+        K.shade(
             G64,
             params,
             flags,

@@ -298,14 +298,6 @@ def prepare(P, N, centre, inv_scale, k, G):
         _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
 
 
-@nb.njit(**_OPTS)
-def prepare_small(P, N, centre, inv_scale, k, G):
-    """:func:`prepare` in the calling thread, for a few vertices (the float64 redo of ambiguous
-    lanes): starting a parallel pass costs more than the work."""
-    Pf, Nf = P.reshape(-1), N.reshape(-1)
-    _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, 0, (P.shape[0] + BLOCK - 1) // BLOCK)
-
-
 @nb.njit(**_LEAF)
 def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
     n = G.shape[1]
@@ -1119,53 +1111,6 @@ def shade(
             t * nblocks // ntasks,
             (t + 1) * nblocks // ntasks,
         )
-
-
-@nb.njit(**_OPTS)
-def shade_small(
-    G,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    amb,
-    out,
-):
-    """:func:`shade` in the calling thread, for a few vertices (the float64 redo of ambiguous
-    lanes): starting a parallel pass costs more than the work."""
-    scr = np.empty((N_ROWS, BLOCK), params.dtype)
-    _task(
-        G,
-        params,
-        flags,
-        view,
-        opts,
-        mat,
-        aconst,
-        shininess,
-        k,
-        A.reshape(-1),
-        D.reshape(-1),
-        S.reshape(-1),
-        base_out,
-        ws_out,
-        vis,
-        amb,
-        out.reshape(-1),
-        scr,
-        0,
-        (G.shape[1] + BLOCK - 1) // BLOCK,
-    )
 
 
 @nb.njit(**_LEAF)
