@@ -110,24 +110,24 @@ def make(track: bool, floors: bool, store: int):
                 TRK[i] = 0
             for li in range(lights.shape[0]):
                 light(px, py, pz, nx, ny, nz, vx, vy, vz, GD, GS, TRK, lights[li], y, m)
-            if store == 1:
-                Db, Sb = D[s:e], S[s:e]
+            if store == 1:  # flat views of the (n, 3) sums, as the engine writes them
+                Db, Sb = D[3 * s : 3 * e], S[3 * s : 3 * e]
                 for i in range(m):
-                    Db[i, 0] = GD[i]
-                    Db[i, 1] = GD[i]
-                    Db[i, 2] = GD[i]
-                    Sb[i, 0] = GS[i]
-                    Sb[i, 1] = GS[i]
-                    Sb[i, 2] = GS[i]
+                    Db[3 * i] = GD[i]
+                    Db[3 * i + 1] = GD[i]
+                    Db[3 * i + 2] = GD[i]
+                    Sb[3 * i] = GS[i]
+                    Sb[3 * i + 1] = GS[i]
+                    Sb[3 * i + 2] = GS[i]
             elif store == 2:
                 for ch in range(3):
                     D[ch, s:e] = GD
                     S[ch, s:e] = GS
-            o = out[s:e]
+            o = out[3 * s : 3 * e]  # a flat view of the (n, 3) colours, as the engine's
             for i in range(m):  # compose: a + d·D + s·S, clamped
-                o[i, 0] = min(mat[0] + mat[3] * GD[i] + mat[6] * GS[i], F(1))
-                o[i, 1] = min(mat[1] + mat[4] * GD[i] + mat[7] * GS[i], F(1))
-                o[i, 2] = min(mat[2] + mat[5] * GD[i] + mat[8] * GS[i], F(1))
+                o[3 * i] = min(mat[0] + mat[3] * GD[i] + mat[6] * GS[i], F(1))
+                o[3 * i + 1] = min(mat[1] + mat[4] * GD[i] + mat[7] * GS[i], F(1))
+                o[3 * i + 2] = min(mat[2] + mat[5] * GD[i] + mat[8] * GS[i], F(1))
 
     return shade
 
@@ -149,8 +149,8 @@ def main(argv=None) -> int:
     )
     eye = np.array([0, 0, 5], F)
     mat = np.array([0.1, 0.1, 0.1, 0.5, 0.4, 0.3, 0.8, 0.8, 0.8], F)
-    out = np.empty((n, 3), F)
-    sums = {1: (np.empty((n, 3), F), np.empty((n, 3), F)), 2: (np.empty((3, n), F),) * 2}
+    out = np.empty(3 * n, F)  # (n, 3) arrays as flat views (see explorer.kernels)
+    sums = {1: (np.empty(3 * n, F), np.empty(3 * n, F)), 2: (np.empty((3, n), F),) * 2}
     variants = {
         "lean": (False, False, 0),
         "floors": (False, True, 0),
