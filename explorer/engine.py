@@ -206,11 +206,11 @@ class Shader:
         n = self.n
         A = np.broadcast_to(self._aconst.astype(self._T), (n, 3)).copy()
         if self._A is not None:
-            A += self._A.T
-        out = {  # the cached (3, n) rows, transposed (views: never copied)
+            A += self._A
+        out = {
             "ambient": A,
-            "diffuse": self._D.T if self._D is not None else np.zeros((n, 3), self._T),
-            "specular": self._S.T if self._S is not None else np.zeros((n, 3), self._T),
+            "diffuse": self._D if self._D is not None else np.zeros((n, 3), self._T),
+            "specular": self._S if self._S is not None else np.zeros((n, 3), self._T),
         }
         return {k: _readonly(v) for k, v in out.items()}
 
@@ -222,16 +222,15 @@ class Shader:
                 self._spares.append(a)
 
     def _fresh_sum(self) -> np.ndarray:
-        """A (3, n) array (one row per channel: the kernels store a block's sums as three
-        contiguous copies) for a sum being recomputed: the memory of an invalidated sum that
+        """An (n, 3) array for a sum being recomputed: the memory of an invalidated sum that
         no array handed out (``terms``) still views, else a new one. Reuse saves the page
         faults of fresh memory (three 12 MB sums per light change at 1M vertices)."""
         for i in range(len(self._spares)):
             buf = self._spares[i]  # (not enumerate: its tuple would hold one more reference)
             # references: the list, ``buf``, getrefcount's argument
-            if buf.shape == (3, self.n) and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
+            if buf.shape == (self.n, 3) and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
                 return self._spares.pop(i)
-        return np.empty((3, self.n), self._T)
+        return np.empty((self.n, 3), self._T)
 
     def _lights_changed(self):
         self._retire(self._A, self._D, self._S)
@@ -431,7 +430,7 @@ class Shader:
         if do_amb or do_dif or do_spec:
             self._run(do_amb, do_dif, do_spec, flat, mat, aconst)
         else:
-            empty = np.zeros((3, 0), T)
+            empty = np.zeros((0, 3), T)
             K.compose(
                 mat,
                 aconst,
@@ -475,7 +474,7 @@ class Shader:
         opts[K.O_CLAMP] = self.clamp
         opts[K.O_TRACK] = T is np.float32
         opts[K.O_VIEW] = self._plan.fresnel is not None
-        empty3 = np.zeros((3, 0), T)
+        empty3 = np.zeros((0, 3), T)
 
         def cache(current, do):
             if not keep:
@@ -550,8 +549,8 @@ class Shader:
         o = opts.copy()
         o[K.O_TRACK] = 0
 
-        def sub(X):  # the lanes' columns of a (3, n) sum, in float64
-            return X[:, idx].astype(f64) if X.shape[1] else np.zeros((3, 0))
+        def sub(X):
+            return X[idx].astype(f64) if X.shape[0] else np.zeros((0, 3))
 
         A64, D64, S64 = sub(A), sub(D), sub(S)
         keep_lobe = base.shape[1] > 0
@@ -590,8 +589,8 @@ class Shader:
         )
         self._out[idx] = out64
         for X, X64 in ((A, A64), (D, D64), (S, S64)):
-            if X.shape[1]:
-                X[:, idx] = X64
+            if X.shape[0]:
+                X[idx] = X64
         if keep_lobe:
             base[:, idx] = b64
             ws[:, idx] = w64

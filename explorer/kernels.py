@@ -16,12 +16,10 @@ float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
 :data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
 in float64.
 
-The cached sums are (3, n) rows (the engine hands out their transposes): a block's sums are
-stored as three contiguous copies, where interleaving them into (n, 3) costs shuffles (about a
-tenth of a full pass). (n, 3) arrays (positions, normals, colours) are read and written through
-flat (3n,) views, indexed ``3 * i + c``: LLVM then knows the stride and vectorises the
-interleaved accesses; through numba's 2-D indexing (a run-time stride) those loops stayed
-scalar, at half the speed or less.
+(n, 3) arrays (positions, normals, the cached sums, colours) are read and written through flat
+(3n,) views, indexed ``3 * i + c``: LLVM then knows the stride and vectorises the interleaved
+accesses; through numba's 2-D indexing (a run-time stride) those loops stayed scalar, at half
+the speed or less.
 
 Leaf kernels are compiled without numba's reference counting (``_nrt=False``): every slice of a
 shared array would otherwise be an atomic increment and decrement of its count, which the two
@@ -693,15 +691,16 @@ def _ambient(scr, m, q):
 
 @nb.njit(**_LEAF)
 def _load_rows(src, rx, ry, rz, zero):
-    """Rows from a cached (3, m) block, or zeros when the cache is empty ((3, 0))."""
-    if src.shape[1] == 0:
+    """Rows from a cached block (flat (3m,)), or zeros when the cache is empty."""
+    if src.shape[0] == 0:
         _fill(rx, zero)
         _fill(ry, zero)
         _fill(rz, zero)
     else:
-        _copy(rx, src[0])
-        _copy(ry, src[1])
-        _copy(rz, src[2])
+        for i in range(rx.shape[0]):
+            rx[i] = src[3 * i]
+            ry[i] = src[3 * i + 1]
+            rz[i] = src[3 * i + 2]
 
 
 @nb.njit(**_LEAF)
@@ -714,10 +713,11 @@ def _add_grey(rx, ry, rz, g):
 
 @nb.njit(**_LEAF)
 def _store_rows(dst, rx, ry, rz):
-    """Rows into a (3, m) block of a cached sum."""
-    _copy(dst[0], rx)
-    _copy(dst[1], ry)
-    _copy(dst[2], rz)
+    """Rows into a flat (3m,) block of an (n, 3) array."""
+    for i in range(rx.shape[0]):
+        dst[3 * i] = rx[i]
+        dst[3 * i + 1] = ry[i]
+        dst[3 * i + 2] = rz[i]
 
 
 @nb.njit(**_LEAF)
@@ -816,9 +816,9 @@ def _block(
         _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
 
     # the sums: recomputed ones start at 0, the others come from the caches
-    _load_rows(A[:, :0] if do_amb else A, Ax, Ay, Az, zero)
-    _load_rows(D[:, :0] if do_dif else D, Dx, Dy, Dz, zero)
-    _load_rows(S[:, :0] if do_spec else S, Sx, Sy, Sz, zero)
+    _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
+    _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero)
+    _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero)
 
     for li in range(params.shape[0]):
         fl = flags[li]
@@ -894,11 +894,11 @@ def _block(
         for i in range(m):
             amb[i] = trk[i] > zero
     if opts[O_STORE]:
-        if do_amb and A.shape[1] > 0:
+        if do_amb and A.shape[0] > 0:
             _store_rows(A, Ax, Ay, Az)
-        if do_dif and D.shape[1] > 0:
+        if do_dif and D.shape[0] > 0:
             _store_rows(D, Dx, Dy, Dz)
-        if do_spec and S.shape[1] > 0:
+        if do_spec and S.shape[0] > 0:
             _store_rows(S, Sx, Sy, Sz)
     if opts[O_COMPOSE]:
         _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, opts[O_CLAMP] != 0, k)
@@ -948,9 +948,9 @@ def _task(
             aconst,
             shininess,
             k,
-            A[:, s:e],
-            D[:, s:e],
-            S[:, s:e],
+            A[3 * s : 3 * e],
+            D[3 * s : 3 * e],
+            S[3 * s : 3 * e],
             base_out[:, s:e],
             ws_out[:, s:e],
             vis[:, s:e],
@@ -1074,14 +1074,19 @@ def shade(
     params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
     opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
     shininess : T; k : constants(T)
-    A, D, S : (3, n) T cached sums as rows (or (3, 0)); base_out, ws_out : (L, n) T (or (L, 0))
+    A, D, S : (n, 3) T caches (or (0, 3)); base_out, ws_out : (L, n) T (or (L, 0))
     vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
     amb : (n,) bool ambiguity marks (or (0,) when not tracking); out : (n, 3) colours
     """
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
-    outf = out.reshape(-1)  # a flat view (module docstring)
+    Af, Df, Sf, outf = (
+        A.reshape(-1),
+        D.reshape(-1),
+        S.reshape(-1),
+        out.reshape(-1),
+    )  # flat views (module docstring)
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
         _task(
@@ -1094,9 +1099,9 @@ def shade(
             aconst,
             shininess,
             k,
-            A,
-            D,
-            S,
+            Af,
+            Df,
+            Sf,
             base_out,
             ws_out,
             vis,
@@ -1122,11 +1127,12 @@ def lobe(base, ws, params, flags, shininess, k, S):
     """S = Σ_l ws_l·base_l^n·s_l from stored per-light bases (a shininess change).
 
     base, ws : (L, n) T (base unused when shininess is 0); params : (L, N_PARAMS) T;
-    flags : (L,) int32; S : (3, n) T out (rows)
+    flags : (L,) int32; S : (n, 3) T out
     """
-    n = S.shape[1]
+    n = S.shape[0]
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
+    Sf = S.reshape(-1)
     for t in nb.prange(ntasks):
         scr = np.empty((3, BLOCK), params.dtype)
         _lobe_task(
@@ -1136,7 +1142,7 @@ def lobe(base, ws, params, flags, shininess, k, S):
             flags,
             shininess,
             k,
-            S,
+            Sf,
             scr,
             t * nblocks // ntasks,
             (t + 1) * nblocks // ntasks,
@@ -1144,9 +1150,9 @@ def lobe(base, ws, params, flags, shininess, k, S):
 
 
 @nb.njit(**_LEAF)
-def _lobe_task(base, ws, params, flags, shininess, k, S, scr, b0, b1):
+def _lobe_task(base, ws, params, flags, shininess, k, Sf, scr, b0, b1):
     """Blocks b0 to b1 - 1 of :func:`lobe` (a leaf: no reference counting, see _task)."""
-    n = S.shape[1]
+    n = Sf.shape[0] // 3
     flat = shininess == k[K_ZERO]
     for b in range(b0, b1):
         s = b * BLOCK
@@ -1170,7 +1176,7 @@ def _lobe_task(base, ws, params, flags, shininess, k, S, scr, b0, b1):
                     Sy,
                     Sz,
                 )
-        _store_rows(S[:, s:e], Sx, Sy, Sz)
+        _store_rows(Sf[3 * s : 3 * e], Sx, Sy, Sz)
 
 
 def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overloaded below
@@ -1188,21 +1194,20 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     def impl(o, A, D, S, c, lo, hi, variant):
         c0, c1, c2 = c[0], c[1], c[2]
         a0, a1, a2, d0, d1, d2, s0, s1, s2 = c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11]
-        Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz = A[0], A[1], A[2], D[0], D[1], D[2], S[0], S[1], S[2]
-        for i in range(o.shape[0] // 3):  # o: a flat (3m,) block of the (n, 3) colours
+        for i in range(o.shape[0] // 3):  # flat (3m,) blocks of (n, 3) arrays
             r, g, b = c0, c1, c2  # e_m + a_m·(scene and constant light ambient)
             if has_a:  # a_m·A (attenuated light ambient)
-                r += a0 * Ax[i]
-                g += a1 * Ay[i]
-                b += a2 * Az[i]
+                r += a0 * A[3 * i]
+                g += a1 * A[3 * i + 1]
+                b += a2 * A[3 * i + 2]
             if has_d:  # d_m·D
-                r += d0 * Dx[i]
-                g += d1 * Dy[i]
-                b += d2 * Dz[i]
+                r += d0 * D[3 * i]
+                g += d1 * D[3 * i + 1]
+                b += d2 * D[3 * i + 2]
             if has_s:  # s_m·S
-                r += s0 * Sx[i]
-                g += s1 * Sy[i]
-                b += s2 * Sz[i]
+                r += s0 * S[3 * i]
+                g += s1 * S[3 * i + 1]
+                b += s2 * S[3 * i + 2]
             o[3 * i] = min(max(r, lo), hi)
             o[3 * i + 1] = min(max(g, lo), hi)
             o[3 * i + 2] = min(max(b, lo), hi)
@@ -1234,10 +1239,10 @@ def _compose_any(o, A, D, S, c, lo, hi, v):
 def compose(mat, aconst, A, D, S, clamp, k, out):
     """Colours from cached sums: out = e + a_m·(aconst + A) + d_m·D + s_m·S, clamped.
 
-    A, D, S : (3, n) T rows, or (3, 0) for "all zero"; out : (n, 3)
+    A, D, S : (n, 3) T or (0, 3) for "all zero"; out : (n, 3)
     """
     n = out.shape[0]
-    v = (1 if A.shape[1] > 0 else 0) | (2 if D.shape[1] > 0 else 0) | (4 if S.shape[1] > 0 else 0)
+    v = (1 if A.shape[0] > 0 else 0) | (2 if D.shape[0] > 0 else 0) | (4 if S.shape[0] > 0 else 0)
     lo = k[K_ZERO]
     hi = k[K_ONE] if clamp else k[K_INF]
     c = mat.copy()
@@ -1245,15 +1250,20 @@ def compose(mat, aconst, A, D, S, clamp, k, out):
         c[ch] = mat[ch] + mat[3 + ch] * aconst[ch]
     chunk = COMPOSE_BLOCK
     nblocks = (n + chunk - 1) // chunk
-    outf = out.reshape(-1)  # a flat view (module docstring)
+    Af, Df, Sf, outf = (
+        A.reshape(-1),
+        D.reshape(-1),
+        S.reshape(-1),
+        out.reshape(-1),
+    )  # flat views (module docstring)
     for b in nb.prange(nblocks):
-        s = b * chunk
-        e = min(n, s + chunk)
+        s = 3 * b * chunk
+        e = 3 * min(n, b * chunk + chunk)
         _compose_any(
-            outf[3 * s : 3 * e],
-            A[:, s:e] if v & 1 else A,
-            D[:, s:e] if v & 2 else D,
-            S[:, s:e] if v & 4 else S,
+            outf[s:e],
+            Af[s:e] if v & 1 else Af,
+            Df[s:e] if v & 2 else Df,
+            Sf[s:e] if v & 4 else Sf,
             c,
             lo,
             hi,
