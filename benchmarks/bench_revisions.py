@@ -1,0 +1,113 @@
+"""The engine's full float32 pass at two git revisions, in alternating processes.
+
+    python benchmarks/bench_revisions.py 5c40425 HEAD            # before / after a change
+    python benchmarks/bench_revisions.py HEAD~3 HEAD --rounds 5
+
+Each revision is checked out in a temporary git worktree (its numba cache is its own, so the
+first process of each compiles: not timed) and imported from there. Processes alternate A, B,
+A, B, ... so that this VM's drift from one minute to the next falls on both alike. Each process
+times a light change on a float32 ``Shader`` (1M vertices, 8 point lights, Blinn, local viewer:
+``bench_engine.py``'s first row) 25 times; the table gives the best and the median of the
+per-process medians, and the ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+#: run in a child process with the revision's package first on sys.path
+CHILD = r"""
+import statistics, sys, time
+sys.path.insert(0, {bench!r})
+import numpy as np
+from bench_engine import scene_with, sphere_points
+import explorer
+assert explorer.__file__.startswith({root!r}), explorer.__file__
+P, N = sphere_points({n}, np.random.default_rng(0))
+scene = scene_with(8, np.random.default_rng(0))
+flip = [scene.lights, scene_with(8, np.random.default_rng(1)).lights]
+sh = explorer.Shader(scene, P, N, precision="float32")
+def relight():
+    flip.reverse()
+    sh.set_lights(flip[0])
+    return sh.colors
+relight(); relight()  # compile (or load from the cache), warm up
+ts = []
+for _ in range(25):
+    t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
+print(min(ts) * 1e3, statistics.median(ts) * 1e3)
+"""
+
+
+def run(root: Path, n: int) -> tuple[float, float]:
+    env = dict(os.environ, PYTHONPATH=str(root))
+    code = CHILD.format(bench=str(HERE), root=str(root), n=n)
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
+    )
+    if out.returncode != 0:
+        sys.exit(f"{root}: the benchmark failed:\n{out.stderr[-3000:]}")
+    best, median = map(float, out.stdout.split())
+    return best, median
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("a", help="a git revision (the baseline)")
+    ap.add_argument("b", help="another git revision")
+    ap.add_argument("--rounds", type=int, default=3, help="processes per revision")
+    ap.add_argument("--vertices", type=int, default=1_000_000)
+    args = ap.parse_args(argv)
+    repo = subprocess.run(
+        ["git", "rev-parse", "--show-toplevel"], cwd=HERE, capture_output=True, text=True
+    ).stdout.strip()
+    with tempfile.TemporaryDirectory() as tmp:
+        roots = {}
+        for rev in (args.a, args.b):
+            root = Path(tmp) / f"rev{len(roots)}"
+            subprocess.run(
+                ["git", "-C", repo, "worktree", "add", "--detach", "-f", str(root), rev],
+                check=True,
+                capture_output=True,
+            )
+            roots[rev] = root
+        try:
+            for root in roots.values():
+                run(root, 1000)  # compile each revision's kernels once, untimed
+            res: dict[str, list[tuple[float, float]]] = {rev: [] for rev in roots}
+            for _ in range(args.rounds):
+                for rev, root in roots.items():
+                    res[rev].append(run(root, args.vertices))
+        finally:
+            for root in roots.values():
+                subprocess.run(
+                    ["git", "-C", repo, "worktree", "remove", "--force", str(root)],
+                    capture_output=True,
+                )
+    from bench_engine import machine
+
+    print(f"machine: {machine()}")
+    print(f"full float32 pass, {args.vertices} vertices x 8 point lights; {args.rounds} ")
+    print("alternating processes per revision, 25 light changes each\n")
+    print("| revision | best ms | median of medians ms | G vertex-lights/s (median) |")
+    print("|---|---:|---:|---:|")
+    med = {}
+    for rev, rows in res.items():
+        best = min(r[0] for r in rows)
+        med[rev] = statistics.median(r[1] for r in rows)
+        rate = args.vertices * 8 / med[rev] / 1e6
+        print(f"| {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
+    print(f"\n{args.a} / {args.b} (median): {med[args.a] / med[args.b]:.2f}x")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
