@@ -95,8 +95,10 @@ def main(argv=None) -> int:
     from bench_engine import machine
 
     print(f"machine: {machine()}")
-    print(f"full float32 pass, {args.vertices} vertices x 8 point lights; {args.rounds} ")
-    print("alternating processes per revision, 25 light changes each\n")
+    print(
+        f"full float32 pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
+        "alternating processes per revision, 25 light changes each\n"
+    )
     print("| revision | best ms | median of medians ms | G vertex-lights/s (median) |")
     print("|---|---:|---:|---:|")
     med = {}
