@@ -749,6 +749,59 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 
 
 @nb.njit(**_LEAF)
+def _mode(fl, flat, phong):
+    """How a light's lobe base is found (LOBE_*)."""
+    if flat:
+        return LOBE_FLAT
+    if fl & CONST_H:
+        return LOBE_CONST_H
+    return LOBE_PHONG if phong else LOBE_BLINN
+
+
+@nb.njit(**_LEAF)
+def _is_inline(fl, track, l_dif, l_spec, mode, store_lobe):
+    """A plain point light on the float32 path: L and attenuation computed in the light loop."""
+    return (
+        track
+        and (l_dif or l_spec)
+        and (fl & AMBIENT) == 0  # the path depends on the light only, not on the pass
+        and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
+        and not (l_spec and (fl & FRESNEL) != 0)
+        and mode != LOBE_CONST_H
+        and not (store_lobe and l_spec)  # inline loops keep no lobe rows
+    )
+
+
+@nb.njit(**_LEAF)
+def _store_grey(dst, g):
+    """A grey row into every channel of a flat (3m,) block of an (n, 3) array."""
+    for i in range(g.shape[0]):
+        dst[3 * i] = g[i]
+        dst[3 * i + 1] = g[i]
+        dst[3 * i + 2] = g[i]
+
+
+@nb.njit(**_LEAF)
+def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k):
+    """:func:`_compose_rows` when the diffuse and specular sums are grey rows alone."""
+    lo = k[K_ZERO]
+    hi = k[K_ONE] if clamp else k[K_INF]
+    e0 = mat[0] + mat[3] * aconst[0]
+    e1 = mat[1] + mat[4] * aconst[1]
+    e2 = mat[2] + mat[5] * aconst[2]
+    a0, a1, a2, d0, d1, d2 = mat[3], mat[4], mat[5], mat[6], mat[7], mat[8]
+    s0, s1, s2 = mat[9], mat[10], mat[11]
+    for i in range(Ax.shape[0]):
+        gd, gs = GD[i], GS[i]
+        r = e0 + a0 * Ax[i] + d0 * gd + s0 * gs  # e + a_m·(a_const + A) + d_m·D + s_m·S
+        g = e1 + a1 * Ay[i] + d1 * gd + s1 * gs
+        b = e2 + a2 * Az[i] + d2 * gd + s2 * gs
+        out[3 * i] = min(max(r, lo), hi)
+        out[3 * i + 1] = min(max(g, lo), hi)
+        out[3 * i + 2] = min(max(b, lo), hi)
+
+
+@nb.njit(**_LEAF)
 def _block(
     gpx,
     gpy,
@@ -805,6 +858,21 @@ def _block(
 
     _fill(trk, zero)
     used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
+    # a full pass whose every diffuse and specular light is an inline grey one keeps those sums
+    # in the grey rows alone: no RGB rows to zero, add to, store or compose from
+    grey_only = do_dif and do_spec
+    for li in range(params.shape[0]):
+        fl = flags[li]
+        l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
+        if (l_dif or l_spec) and not (
+            (fl & GREY) != 0
+            and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong), store_lobe)
+        ):
+            grey_only = False
+    if grey_only:
+        _fill(scr[R_GD, :m], zero)
+        _fill(scr[R_GS, :m], zero)
+        used_grey = True
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
         if opts[O_LOCAL]:
             _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
@@ -817,8 +885,9 @@ def _block(
 
     # the sums: recomputed ones start at 0, the others come from the caches
     _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
-    _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero)
-    _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero)
+    if not grey_only:
+        _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero)
+        _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero)
 
     for li in range(params.shape[0]):
         fl = flags[li]
@@ -828,24 +897,9 @@ def _block(
         l_spec = do_spec and (fl & SPECULAR) != 0
         if not (l_amb or l_dif or l_spec):
             continue
-        if flat:
-            mode = LOBE_FLAT
-        elif fl & CONST_H:
-            mode = LOBE_CONST_H
-        elif phong:
-            mode = LOBE_PHONG
-        else:
-            mode = LOBE_BLINN
+        mode = _mode(fl, flat, phong)
         fres = l_spec and (fl & FRESNEL) != 0
-        if (
-            track
-            and (l_dif or l_spec)
-            and (fl & AMBIENT) == 0  # the path depends on the light only, not on the pass
-            and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
-            and not fres
-            and mode != LOBE_CONST_H
-            and not (store_lobe and l_spec)  # inline loops keep no lobe rows
-        ):  # a plain point light: L and attenuation inline, no rows
+        if _is_inline(fl, track, l_dif, l_spec, mode, store_lobe):  # L, attenuation inline
             grey = (fl & GREY) != 0
             if grey and not used_grey:
                 _fill(scr[R_GD, :m], zero)
@@ -887,12 +941,24 @@ def _block(
                 _copy(base_out[li, :], scr[R_BASE, :m])
             _copy(ws_out[li, :], scr[R_WS, :m])
 
-    if used_grey:  # the grey sums count in every channel
-        _add_grey(Dx, Dy, Dz, scr[R_GD, :m])
-        _add_grey(Sx, Sy, Sz, scr[R_GS, :m])
     if opts[O_TRACK]:
         for i in range(m):
             amb[i] = trk[i] > zero
+    if grey_only:
+        GD, GS = scr[R_GD, :m], scr[R_GS, :m]
+        if opts[O_STORE]:
+            if do_amb and A.shape[0] > 0:
+                _store_rows(A, Ax, Ay, Az)
+            if D.shape[0] > 0:
+                _store_grey(D, GD)
+            if S.shape[0] > 0:
+                _store_grey(S, GS)
+        if opts[O_COMPOSE]:
+            _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k)
+        return
+    if used_grey:  # the grey sums count in every channel
+        _add_grey(Dx, Dy, Dz, scr[R_GD, :m])
+        _add_grey(Sx, Sy, Sz, scr[R_GS, :m])
     if opts[O_STORE]:
         if do_amb and A.shape[0] > 0:
             _store_rows(A, Ax, Ay, Az)

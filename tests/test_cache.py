@@ -259,3 +259,29 @@ def test_lobes_of_plain_point_lights(precision):
         _ = shader.colors
         check(shader)
     assert delta(before, counts(shader)) == {"pass": 1, "specular": 1, "lobe": 3, "compose": 3}
+
+
+def test_grey_only_pass_stores_sums_a_recolour_reuses():
+    # white plain point lights only: the float32 pass keeps the diffuse and specular sums in one
+    # grey row each; the stored (n, 3) sums must still recompose a new material exactly
+    scene = dict(SCENE)
+    scene["lights"] = [
+        {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
+        {"type": "point", "position": [-3, 1, 2]},
+    ]
+    rng = np.random.default_rng(4)
+    P, N = rng.normal(size=(3000, 3)), rng.normal(size=(3000, 3))
+    shader = explorer.Shader(scene, P, N, precision="float32")
+    _ = shader.colors
+    t = shader.terms
+    for name in ("diffuse", "specular"):  # grey lights: every channel alike, and not all zero
+        assert np.array_equal(t[name][:, 0], t[name][:, 1])
+        assert np.array_equal(t[name][:, 0], t[name][:, 2])
+        assert t[name].max() > 0
+    before = counts(shader)
+    shader.set_material(shader.scene.material.replace(diffuse=(0.1, 0.8, 0.3)))
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"compose": 1}
+    check(shader)
+    ref = explorer.shade(shader.scene, P, N, precision="float64")
+    assert np.abs(shader.colors - ref).max() <= tol.FLOAT32_MAX_ABS_ERROR
