@@ -497,9 +497,7 @@ class Shader:
             self._lobe_memory = (base, ws)
         else:
             base = ws = np.zeros((L, 0), T)
-        amb = self._amb
-        if opts[K.O_TRACK]:
-            amb[:] = 0
+        amb = self._amb  # every block writes all of its marks (no need to clear them first)
         vis = self._visibility(T)
         shin = T(scene.material.shininess)
         K.shade(
