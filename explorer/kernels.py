@@ -1030,10 +1030,17 @@ def _task(
 #: prefer 256-bit vectors; 512-bit ones shade about 12% faster here). Set the environment
 #: variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's choice (numba's on-disk cache keeps
 #: whichever was compiled first: clear it, or use another NUMBA_CACHE_DIR, to compare).
+def _host_has_avx512() -> bool:
+    try:
+        return bool(llvm.get_host_cpu_features().get("avx512f", False))
+    except RuntimeError:  # llvmlite cannot read this host's features: keep LLVM's choice
+        return False
+
+
 WIDE_FLOAT32 = (
     os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
     and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
-    and bool(llvm.get_host_cpu_features().get("avx512f", False))
+    and _host_has_avx512()
 )
 
 

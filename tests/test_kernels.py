@@ -66,3 +66,20 @@ def test_llvm_remarks_are_dropped_and_other_stderr_kept(capfd):
         os.write(2, b"remark: <unknown>:0:0: loop not vectorized: call instruction\n")
         os.write(2, b"a real warning\n")
     assert capfd.readouterr().err == "a real warning\n"
+
+
+def test_wide_vectors_can_be_switched_off():
+    # PHONG_EXPLORER_WIDE_VECTORS=0 keeps LLVM's own vector width: the entry points are the numba
+    # dispatchers themselves, with no first-call wrapper
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "from explorer import kernels as K; import numba; "
+        "assert not K.WIDE_FLOAT32; "
+        "assert isinstance(K.shade, numba.core.registry.CPUDispatcher); print('ok')"
+    )
+    env = dict(os.environ, PHONG_EXPLORER_WIDE_VECTORS="0")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == "ok", out.stderr
