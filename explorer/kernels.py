@@ -26,7 +26,8 @@ shared array would otherwise be an atomic increment and decrement of its count, 
 threads of a pass contend for (about a fifth of a full pass at 1M vertices).
 
 On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many Intel cores still picks 256-bit
-ones; the float32 entry points are compiled with 16-lane vectors there (see :func:`_wide`).
+ones; the float32 entry points are compiled with 16-lane vectors there (see
+:func:`wide_vectors`).
 """
 
 from __future__ import annotations
@@ -773,6 +774,26 @@ def _is_inline(fl, track, l_dif, l_spec, mode, store_lobe):
 
 
 @nb.njit(**_LEAF)
+def _grey_only(flags, opts):
+    """Whether a pass keeps its diffuse and specular sums in the grey rows alone: a full pass
+    (both recomputed) whose every diffuse or specular light is an inline grey one. Decided once
+    per pass (it depends on the lights and the options only)."""
+    if opts[O_DO_DIF] == 0 or opts[O_DO_SPEC] == 0:
+        return False
+    track, store_lobe = opts[O_TRACK] != 0, opts[O_STORE_LOBE] != 0
+    flat, phong = opts[O_FLAT] != 0, opts[O_PHONG] != 0
+    for li in range(flags.shape[0]):
+        fl = flags[li]
+        l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
+        if (l_dif or l_spec) and not (
+            (fl & GREY) != 0
+            and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong), store_lobe)
+        ):
+            return False
+    return True
+
+
+@nb.njit(**_LEAF)
 def _store_grey(dst, g):
     """A grey row into every channel of a flat (3m,) block of an (n, 3) array."""
     for i in range(g.shape[0]):
@@ -826,6 +847,7 @@ def _block(
     amb,
     out,
     scr,
+    grey_only,
 ):
     """One block; every array argument is already sliced to the block's vertices.
 
@@ -858,17 +880,8 @@ def _block(
 
     _fill(trk, zero)
     used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
-    # a full pass whose every diffuse and specular light is an inline grey one keeps those sums
-    # in the grey rows alone: no RGB rows to zero, add to, store or compose from
-    grey_only = do_dif and do_spec
-    for li in range(params.shape[0]):
-        fl = flags[li]
-        l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
-        if (l_dif or l_spec) and not (
-            (fl & GREY) != 0
-            and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong), store_lobe)
-        ):
-            grey_only = False
+    # grey_only (see _grey_only): the diffuse and specular sums live in the grey rows alone, so
+    # there are no RGB rows to zero, add to, store or compose from
     if grey_only:
         _fill(scr[R_GD, :m], zero)
         _fill(scr[R_GS, :m], zero)
@@ -992,6 +1005,7 @@ def _task(
     scr,
     b0,
     b1,
+    grey_only,
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
     arrays here costs no atomic operations on their counts, which both threads would contend)."""
@@ -1023,13 +1037,10 @@ def _task(
             amb[s:e],
             out[3 * s : 3 * e],
             scr,
+            grey_only,
         )
 
 
-#: float32 loops are vectorised 16 lanes wide where the CPU has AVX-512 (LLVM's Intel tunings
-#: prefer 256-bit vectors; 512-bit ones shade about 12% faster here). Set the environment
-#: variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's choice (numba's on-disk cache keeps
-#: whichever was compiled first: clear it, or use another NUMBA_CACHE_DIR, to compare).
 def _host_has_avx512() -> bool:
     try:
         return bool(llvm.get_host_cpu_features().get("avx512f", False))
@@ -1037,6 +1048,10 @@ def _host_has_avx512() -> bool:
         return False
 
 
+#: float32 loops are vectorised 16 lanes wide where the CPU has AVX-512 (LLVM's Intel tunings
+#: prefer 256-bit vectors; 512-bit ones shade about 12% faster here). Set the environment
+#: variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's choice (numba's on-disk cache keeps
+#: whichever was compiled first: clear it, or use another NUMBA_CACHE_DIR, to compare).
 WIDE_FLOAT32 = (
     os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
     and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
@@ -1160,6 +1175,7 @@ def shade(
         S.reshape(-1),
         out.reshape(-1),
     )  # flat views (module docstring)
+    grey_only = _grey_only(flags, opts)  # once per pass
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
         _task(
@@ -1183,6 +1199,7 @@ def shade(
             scr,
             t * nblocks // ntasks,
             (t + 1) * nblocks // ntasks,
+            grey_only,
         )
 
 
