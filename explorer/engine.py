@@ -153,6 +153,7 @@ class Shader:
         self._pool: list[np.ndarray] = []  # colour buffers, reused once nothing views them
         self._spares: list[np.ndarray] = []  # memory of invalidated sums, reused likewise
         self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
+        self._marks = np.zeros(-(-self._amb.size // K.BLOCK), np.int32)  # per block
         self._lights_changed()
 
     def set_scene(self, scene) -> None:
@@ -209,28 +210,33 @@ class Shader:
             A += self._A
         out = {
             "ambient": A,
-            "diffuse": self._D if self._D is not None else np.zeros((n, 3), self._T),
-            "specular": self._S if self._S is not None else np.zeros((n, 3), self._T),
+            "diffuse": self._D if self._D is not None else np.zeros((n, 1), self._T),
+            "specular": self._S if self._S is not None else np.zeros((n, 1), self._T),
         }
+        # grey sums (n, 1) are shown as (n, 3), every channel the same (a read-only view)
+        out = {k: np.broadcast_to(v, (n, 3)) for k, v in out.items()}
         return {k: _readonly(v) for k, v in out.items()}
 
     # -- invalidation --------------------------------------------------------------------------
     def _retire(self, *sums) -> None:
         """Keep the memory of invalidated sums for the next pass (see :meth:`_fresh_sum`)."""
         for a in sums:
-            if a is not None and len(self._spares) < 3:
+            if a is not None and len(self._spares) < 5:
                 self._spares.append(a)
 
-    def _fresh_sum(self) -> np.ndarray:
-        """An (n, 3) array for a sum being recomputed: the memory of an invalidated sum that
-        no array handed out (``terms``) still views, else a new one. Reuse saves the page
-        faults of fresh memory (three 12 MB sums per light change at 1M vertices)."""
+    def _fresh_sum(self, grey: bool = False) -> np.ndarray:
+        """An (n, 3) array for a sum being recomputed, or (n, 1) for a grey one (every
+        channel the same, see :func:`explorer.kernels.grey_pass`): the memory of an invalidated
+        sum of that shape that no array handed out (``terms``) still views, else a new one.
+        Reuse saves the page faults of fresh memory (three 12 MB sums per light change at 1M
+        vertices)."""
+        shape = (self.n, 1 if grey else 3)
         for i in range(len(self._spares)):
             buf = self._spares[i]  # (not enumerate: its tuple would hold one more reference)
             # references: the list, ``buf``, getrefcount's argument
-            if buf.shape == (self.n, 3) and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
+            if buf.shape == shape and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
                 return self._spares.pop(i)
-        return np.empty((self.n, 3), self._T)
+        return np.empty(shape, self._T)
 
     def _lights_changed(self):
         self._retire(self._A, self._D, self._S)
@@ -320,30 +326,35 @@ class Shader:
         return a
 
     def _light_params(self, dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Kernel inputs for the lights and viewer in the normalised frame."""
+        """Kernel inputs for the lights and viewer in the normalised frame.
+
+        Built in Python floats, one row per light, and made an array once (a light drag
+        rebuilds them every frame: small numpy operations per light cost more than the row)."""
         scene, plan = self._scene, self._plan
         c, s = self._centre, self._scale
-        L = len(scene.lights)
-        params = np.zeros((L, K.N_PARAMS))
-        flags = np.zeros(L, np.int32)
+        cx, cy, cz = (float(v) for v in c)
         if scene.viewer.local:
             view = to_frame(scene.viewer.eye, c, s)
         else:
             view = np.asarray(scene.viewer.direction, dtype=np.float64)
-        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights, strict=True)):
+        vx, vy, vz = (float(v) for v in view)
+        rows, flags = [], []
+        for lp, light in zip(plan.lights, scene.lights, strict=True):
             f = 0
-            q = params[i]
+            q = [0.0] * K.N_PARAMS
             if isinstance(light, DirectionalLight):
                 q[K.P_POS : K.P_POS + 3] = light.direction
                 if scene.model == "blinn" and not scene.viewer.local and not plan.force_all:
-                    h = np.asarray(light.direction) + view
-                    hn = math.sqrt(float(h @ h))
+                    dx, dy, dz = light.direction
+                    hx, hy, hz = dx + vx, dy + vy, dz + vz
+                    hn = math.sqrt(hx * hx + hy * hy + hz * hz)
                     if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
-                        q[K.P_H : K.P_H + 3] = h / hn
+                        q[K.P_H : K.P_H + 3] = (hx / hn, hy / hn, hz / hn)
                     f |= K.CONST_H
             else:
                 f |= K.POSITIONAL
-                q[K.P_POS : K.P_POS + 3] = to_frame(light.position, c, s)
+                px, py, pz = light.position
+                q[K.P_POS : K.P_POS + 3] = ((px - cx) / s, (py - cy) / s, (pz - cz) / s)
                 kc, kl, kq = light.attenuation
                 q[K.P_ATT : K.P_ATT + 3] = (kc, kl * s, kq * s * s)
                 if lp.attenuation == "per-vertex":
@@ -355,11 +366,12 @@ class Shader:
                 q[K.P_EXP] = light.exponent
                 if lp.spot == "cone+exponent":
                     f |= K.SPOT_EXP
-            q[K.P_AMB : K.P_AMB + 3] = lp.factor * np.asarray(light.ambient)
-            q[K.P_DIF : K.P_DIF + 3] = lp.factor * np.asarray(light.diffuse)
-            q[K.P_SPEC : K.P_SPEC + 3] = (
-                lp.factor * plan.specular_scale * np.asarray(light.specular)
-            )
+            fa, fs = lp.factor, lp.factor * plan.specular_scale
+            dif = [fa * v for v in light.diffuse]
+            spec = [fs * v for v in light.specular]
+            q[K.P_AMB : K.P_AMB + 3] = [fa * v for v in light.ambient]
+            q[K.P_DIF : K.P_DIF + 3] = dif
+            q[K.P_SPEC : K.P_SPEC + 3] = spec
             if lp.shadows:
                 f |= K.SHADOW
             if plan.fresnel is not None and lp.specular:
@@ -371,11 +383,12 @@ class Shader:
                 f |= K.DIFFUSE
             if lp.specular:
                 f |= K.SPECULAR
-            dif, spec = q[K.P_DIF : K.P_DIF + 3], q[K.P_SPEC : K.P_SPEC + 3]
-            if dif.min() == dif.max() and spec.min() == spec.max():
+            if min(dif) == max(dif) and min(spec) == max(spec):
                 f |= K.GREY  # one sum per vertex instead of three (the kernel may use it)
-            flags[i] = f
-        return params.astype(dtype), flags, view.astype(dtype)
+            rows.append(q)
+            flags.append(f)
+        params = np.array(rows, dtype=np.float64).reshape(len(rows), K.N_PARAMS)
+        return params.astype(dtype), np.array(flags, np.int32), view.astype(dtype)
 
     def _material_vector(self, dtype) -> np.ndarray:
         m = self._scene.material
@@ -475,17 +488,19 @@ class Shader:
         opts[K.O_TRACK] = T is np.float32
         opts[K.O_VIEW] = self._plan.fresnel is not None
         empty3 = np.zeros((0, 3), T)
+        # a pass whose diffuse and specular sums are grey stores them as (n, 1)
+        grey = keep and K.grey_pass(flags, opts)
 
-        def cache(current, do):
+        def cache(current, do, grey=False):
             if not keep:
                 return empty3
             if do:
-                return self._fresh_sum()
+                return self._fresh_sum(grey)
             return current if current is not None else empty3
 
         A = cache(self._A, do_amb)
-        D = cache(self._D, do_dif)
-        S = cache(self._S, do_spec)
+        D = cache(self._D, do_dif, grey)
+        S = cache(self._S, do_spec, grey)
         if opts[K.O_STORE_LOBE]:
             # every row the lobe kernel reads (lights with specular) is written by this pass;
             # the memory of the previous, now invalid, lobes is reused (no page faults)
@@ -497,7 +512,7 @@ class Shader:
             self._lobe_memory = (base, ws)
         else:
             base = ws = np.zeros((L, 0), T)
-        amb = self._amb  # every block writes all of its marks (no need to clear them first)
+        amb = self._amb  # every block writes its count, and its marks if it counts any
         vis = self._visibility(T)
         shin = T(scene.material.shininess)
         K.shade(
@@ -517,13 +532,14 @@ class Shader:
             ws,
             vis,
             amb,
+            self._marks,
             self._out,
         )
         self.stats["pass"] += 1
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
         if opts[K.O_TRACK]:
-            idx = np.flatnonzero(amb)
+            idx = K.marked(amb, self._marks)
             if idx.size:
                 self._fixup(idx, opts, A, D, S, base, ws, vis)
         if keep:
@@ -547,8 +563,10 @@ class Shader:
         o = opts.copy()
         o[K.O_TRACK] = 0
 
-        def sub(X):
-            return X[idx].astype(f64) if X.shape[0] else np.zeros((0, 3))
+        def sub(X):  # the float64 pass keeps RGB sums: a grey one is spread to 3 channels
+            if not X.shape[0]:
+                return np.zeros((0, 3))
+            return np.ascontiguousarray(np.broadcast_to(X[idx], (m, 3)), dtype=f64)
 
         A64, D64, S64 = sub(A), sub(D), sub(S)
         keep_lobe = base.shape[1] > 0
@@ -583,12 +601,13 @@ class Shader:
             w64,
             np.ascontiguousarray(vis[:, idx] if vis.shape[1] else vis, dtype=f64),
             np.zeros(0, np.bool_),
+            np.zeros(0, np.int32),
             out64,
         )
         self._out[idx] = out64
         for X, X64 in ((A, A64), (D, D64), (S, S64)):
-            if X.shape[0]:
-                X[idx] = X64
+            if X.shape[0]:  # (a grey sum's lights are grey: its float64 channels are equal)
+                X[idx] = X64[:, : X.shape[1]]
         if keep_lobe:
             base[:, idx] = b64
             ws[:, idx] = w64

@@ -10,11 +10,13 @@ SIMD code; decisions the plan makes per light are taken once per block, outside 
 The light sums (ambient, diffuse, specular; see :func:`explorer.reference.reference_terms`) are
 stored when asked, so a material change only recomposes (:func:`compose`), and each light's
 specular base and weight can be stored so a shininess change only re-runs the lobe
-(:func:`lobe`).
+(:func:`lobe`). A pass whose lights are all grey (r = g = b) stores its diffuse and specular
+sums grey, (n, 1) (:func:`grey_pass`): at 1M vertices the (n, 3) stores were a fifth of the pass.
 
 float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
 :data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
-in float64.
+in float64. Each lane keeps the smallest margin to such a decision (row R_TRK, a min per light,
+no mask logic); the mark is "margin below 1".
 
 (n, 3) arrays (positions, normals, the cached sums, colours) are read and written through flat
 (3n,) views, indexed ``3 * i + c``: LLVM then knows the stride and vectorises the interleaved
@@ -26,8 +28,8 @@ shared array would otherwise be an atomic increment and decrement of its count, 
 threads of a pass contend for (about a fifth of a full pass at 1M vertices).
 
 On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many Intel cores still picks 256-bit
-ones; the float32 entry points are compiled with 16-lane vectors there (see
-:func:`wide_vectors`).
+ones; the float32 entry points are compiled with 16-lane vectors there, two vector iterations
+interleaved (see :func:`wide_vectors`).
 """
 
 from __future__ import annotations
@@ -116,8 +118,13 @@ N_OPTS = 13
     R_TRK,
     R_GD,
     R_GS,
-) = range(28)
-N_ROWS = 28
+    R_NV,
+) = range(29)
+N_ROWS = 29
+# R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
+# policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
+# (explorer.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
+# R_NV holds N·V (after a two-sided flip), for the inline lobes.
 
 # lobe modes
 LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
@@ -136,8 +143,11 @@ LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
     K_AMB_DIST,
     K_INF,
     K_NORMAL_EPS2,
-) = range(11)
-N_CONSTS = 11
+    K_MARGIN_DOT,
+    K_MARGIN_LEN2,
+    K_MARGIN_DIST2,
+) = range(14)
+N_CONSTS = 14
 
 
 def constants(dtype) -> np.ndarray:
@@ -155,6 +165,9 @@ def constants(dtype) -> np.ndarray:
             tol.AMBIGUOUS_DIST,
             np.inf,
             tol.NORMAL_EPS**2,
+            1.0 / tol.AMBIGUOUS_DOT,  # margins: a quantity over its band's width (< 1: inside)
+            1.0 / tol.AMBIGUOUS_LEN2,
+            1.0 / tol.AMBIGUOUS_DIST**2,
         ],
         dtype=dtype,
     )
@@ -251,6 +264,19 @@ def pow32(x, y):
     return exp2_32(t if x > np.float32(0.0) else np.float32(-200.0))
 
 
+def unit(k):
+    """1 in the precision of ``k`` (an array), as a compile-time constant: ``k[K_ONE]`` is a
+    run-time value, so ``k[K_ONE] / np.sqrt(x)`` costs a multiply the constant does not."""
+    return k.dtype.type(1)
+
+
+@overload(unit, jit_options=_LEAF)
+def _unit_overload(k):
+    if k.dtype == types.float32:
+        return lambda k: np.float32(1.0)
+    return lambda k: np.float64(1.0)
+
+
 def fpow(x, y):
     """x**y in the working precision: :func:`pow32` for float32, libm for float64."""
     return x**y
@@ -328,7 +354,7 @@ def _load_normals(N, nx, ny, nz, k):
 @nb.njit(**_LEAF)
 def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
     """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
-    one, eps2 = k[K_ONE], k[K_POINT_EPS] * k[K_POINT_EPS]
+    one, eps2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS]
     for i in range(px.shape[0]):
         x = ex - px[i]
         y = ey - py[i]
@@ -343,16 +369,22 @@ def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
 
 
 @nb.njit(**_LEAF)
+def _dot(ax, ay, az, bx, by, bz, out):
+    for i in range(out.shape[0]):
+        out[i] = ax[i] * bx[i] + ay[i] * by[i] + az[i] * bz[i]
+
+
+@nb.njit(**_LEAF)
 def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
     """N -> -N where N·V < 0 (the vertex shows its back face)."""
-    zero, one, amb = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
+    zero, c_dot = k[K_ZERO], k[K_MARGIN_DOT]
     for i in range(nx.shape[0]):
         ndv = nx[i] * vx[i] + ny[i] * vy[i] + nz[i] * vz[i]
         s = ndv < zero
         nx[i] = -nx[i] if s else nx[i]
         ny[i] = -ny[i] if s else ny[i]
         nz[i] = -nz[i] if s else nz[i]
-        trk[i] = max(trk[i], one if abs(ndv) < amb else zero)
+        trk[i] = min(trk[i], abs(ndv) * c_dot)
 
 
 # --------------------------------------------------------------------------------------------
@@ -365,8 +397,12 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 #
 # Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
 # and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
-# or per-vertex ambient, in a pass that does not store lobes (the first pass of a shininess drag
-# takes the row path): no rows are written or read. A grey light (r = g = b for its diffuse and
+# or per-vertex ambient: no L or weight rows are written or read. They keep l = position - P
+# unnormalised (N·L = (N·l)/|l|, L + V = l/|l| + V in one fused step each) and take N·H's
+# numerator as N·L + N·V, with N·V computed once per block (row R_NV). Every light that
+# stores its lobe (the first pass of a shininess drag) writes base and weight rows from the same
+# arithmetic as a pass that does not, so a shininess change and a fresh pass agree bit for bit
+# in the base. A grey light (r = g = b for its diffuse and
 # its specular colour, as most lights are) adds one number per vertex to a grey row instead of
 # three to the RGB rows; the block adds the grey rows to every channel once. Inline variants also
 # drop the exact policies inside the ambiguity bands (a light at the vertex, L = -V): there they
@@ -403,15 +439,15 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
         # rows as separate 1-D arrays: lets the compiler check overlap once and vectorise
         px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
         nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
-        vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
+        vx, vy, vz, NV = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m], scr[R_NV, :m]
         Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
         Dx, Dy, Dz = scr[dx, :m], scr[dx + 1, :m], scr[dx + 2, :m]
         Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
         B, WS, TRK = scr[R_BASE, :m], scr[R_WS, :m], scr[R_TRK, :m]
         GD, GS = scr[gd, :m], scr[R_GS, :m]
-        zero, one, two = k[K_ZERO], k[K_ONE], k[K_TWO]
-        h_eps2, amb_dot, amb_len2 = k[K_HALF_EPS2], k[K_AMB_DOT], k[K_AMB_LEN2]
-        p_eps2, amb_dist2, floor = k[K_POINT_EPS] ** 2, k[K_AMB_DIST] ** 2, k[K_ATT_FLOOR]
+        zero, one, two = k[K_ZERO], unit(k), k[K_TWO]
+        h_eps2, p_eps2, floor = k[K_HALF_EPS2], k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
+        c_dot, c_len2, c_dist2 = k[K_MARGIN_DOT], k[K_MARGIN_LEN2], k[K_MARGIN_DIST2]
         kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
         dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
         sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
@@ -419,25 +455,28 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
         hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
         for i in range(m):
             a, b, c = nx[i], ny[i], nz[i]
-            amb = False
-            if inline:  # L = normalize(position - P), finite even at the light (then marked)
+            # margin: how far this lane is from every decision that hangs on a nearly-zero
+            # quantity, in units of its ambiguity band (< 1: inside a band; see TRK)
+            margin = k[K_INF]
+            if inline:  # l = position - P, unnormalised; L = l / |l|
                 x = qx - px[i]
                 yy = qy - py[i]
                 z = qz - pz[i]
                 d2 = x * x + yy * yy + z * z
-                inv = one / np.sqrt(max(d2, p_eps2))
-                lx, ly, lz = x * inv, yy * inv, z * inv
+                inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (then marked)
                 if atten:  # w = 1 / (kc + kl·d + kq·d²)
                     d = d2 * inv
                     w = one / max(kc + (kl + kq * d) * d, floor)
                 else:
                     w = one
-                amb = d2 < amb_dist2
-            elif positional:  # L and w = att·spot from the pre-pass rows
-                lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
-            else:  # directional: constant L, never attenuated
-                lx, ly, lz, w = qx, qy, qz, one
-            ndl = a * lx + b * ly + c * lz
+                ndl = (a * x + b * yy + c * z) * inv  # N·L
+                margin = d2 * c_dist2
+            else:
+                if positional:  # L and w = att·spot from the pre-pass rows
+                    lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
+                else:  # directional: constant L, never attenuated
+                    lx, ly, lz, w = qx, qy, qz, one
+                ndl = a * lx + b * ly + c * lz  # N·L
             if dif:  # w·max(N·L, 0)·d_i
                 t = w * max(ndl, zero)
                 if grey:
@@ -448,32 +487,42 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
                     Dz[i] += t * db
             if spec:
                 ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
-                amb = amb | (abs(ndl) < amb_dot)
+                margin = min(margin, abs(ndl) * c_dot)
                 lob = one  # flat lobe: 0**0 = 1
                 if lobe_on:
                     if mode == LOBE_CONST_H:  # Blinn, constant H: N·H
                         base = a * hx + b * hy + c * hz
                     elif mode == LOBE_PHONG:  # Phong: R·V, R = 2(N·L)N - L
                         ex, ey, ez = vx[i], vy[i], vz[i]
-                        ndv = a * ex + b * ey + c * ez
-                        base = two * ndl * ndv - (lx * ex + ly * ey + lz * ez)
+                        if inline:  # N·V from the block's row, L·V from l
+                            ldv = (x * ex + yy * ey + z * ez) * inv
+                            base = two * ndl * NV[i] - ldv
+                        else:
+                            ndv = a * ex + b * ey + c * ez
+                            base = two * ndl * ndv - (lx * ex + ly * ey + lz * ez)
                     else:  # Blinn: N·normalize(L + V); 0 where L = -V
-                        ux = lx + vx[i]
-                        uy = ly + vy[i]
-                        uz = lz + vz[i]
+                        if inline:  # u = L + V; N·u = N·L + N·V (the block's row)
+                            ux = x * inv + vx[i]
+                            uy = yy * inv + vy[i]
+                            uz = z * inv + vz[i]
+                            ndu = ndl + NV[i]
+                        else:
+                            ux = lx + vx[i]
+                            uy = ly + vy[i]
+                            uz = lz + vz[i]
+                            ndu = a * ux + b * uy + c * uz
                         h2 = ux * ux + uy * uy + uz * uz
                         if track:  # lanes near L = -V are marked and redone in float64
-                            base = (a * ux + b * uy + c * uz) * (one / np.sqrt(max(h2, h_eps2)))
+                            base = ndu * (one / np.sqrt(max(h2, h_eps2)))
                         else:
                             ok = h2 > h_eps2
                             hn = one / np.sqrt(h2 if ok else one)
-                            base = (a * ux + b * uy + c * uz) * hn if ok else zero
-                        amb = amb | (h2 < amb_len2)
-                    amb = amb | (abs(base) < amb_dot)
+                            base = ndu * hn if ok else zero
+                        margin = min(margin, h2 * c_len2)
+                    margin = min(margin, abs(base) * c_dot)
                     base = max(base, zero)
                     lob = fpow(base, y)  # base^n
-                    if not inline:  # kept for a lobe store (inline loops never store lobes)
-                        B[i] = base
+                    B[i] = base  # kept for a lobe store
                 t = ws * lob  # w·f·base^n·s_i
                 if grey:
                     GS[i] += t * sr
@@ -481,10 +530,9 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
                     Sx[i] += t * sr
                     Sy[i] += t * sg
                     Sz[i] += t * sb
-                if not inline:
-                    WS[i] = ws
+                WS[i] = ws
             if track and (spec or inline):
-                TRK[i] = max(TRK[i], one if amb else zero)
+                TRK[i] = min(TRK[i], margin)
 
     return impl
 
@@ -587,8 +635,8 @@ def _light_any(scr, m, q, y, k, positional, mode, l_dif, l_spec):
 def _to_light(scr, m, q, k, atten):
     """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex) and the weight
     w = 1 / max(kc + kl·d + kq·d², floor) when ``atten`` (kl, kq scaled to the frame), else 1."""
-    one, eps2, amb_dist2 = k[K_ONE], k[K_POINT_EPS] * k[K_POINT_EPS], k[K_AMB_DIST] ** 2
-    zero, floor = k[K_ZERO], k[K_ATT_FLOOR]
+    one, eps2, c_dist2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS], k[K_MARGIN_DIST2]
+    floor = k[K_ATT_FLOOR]
     kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
     qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
     px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
@@ -608,7 +656,7 @@ def _to_light(scr, m, q, k, atten):
             Ly[i] = b if at else y * inv
             Lz[i] = c if at else z * inv
             W[i] = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
-            TRK[i] = max(TRK[i], one if d2 < amb_dist2 else zero)
+            TRK[i] = min(TRK[i], d2 * c_dist2)
     else:
         for i in range(m):
             x = qx - px[i]
@@ -622,13 +670,13 @@ def _to_light(scr, m, q, k, atten):
             Ly[i] = b if at else y * inv
             Lz[i] = c if at else z * inv
             W[i] = one
-            TRK[i] = max(TRK[i], one if d2 < amb_dist2 else zero)
+            TRK[i] = min(TRK[i], d2 * c_dist2)
 
 
 @nb.njit(**_LEAF)
 def _spot(scr, m, q, k, exponent):
     """w *= x**exponent inside the cone (x = (-L)·axis >= cos cutoff), else 0."""
-    zero, one, amb_dot = k[K_ZERO], k[K_ONE], k[K_AMB_DOT]
+    zero, c_dot = k[K_ZERO], k[K_MARGIN_DOT]
     ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
     cosc, e = q[P_COS], q[P_EXP]
     Lx, Ly, Lz, W, TRK = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m], scr[R_TRK, :m]
@@ -639,7 +687,7 @@ def _spot(scr, m, q, k, exponent):
             W[i] = W[i] * f if x >= cosc else zero
         else:
             W[i] = W[i] if x >= cosc else zero
-        TRK[i] = max(TRK[i], one if abs(x - cosc) < amb_dot else zero)
+        TRK[i] = min(TRK[i], abs(x - cosc) * c_dot)
 
 
 @nb.njit(**_LEAF)
@@ -691,12 +739,17 @@ def _ambient(scr, m, q):
 
 
 @nb.njit(**_LEAF)
-def _load_rows(src, rx, ry, rz, zero):
-    """Rows from a cached block (flat (3m,)), or zeros when the cache is empty."""
+def _load_rows(src, rx, ry, rz, zero, width=3):
+    """Rows from a cached block (flat (3m,), or (m,) for a grey sum: ``width`` 1), or zeros
+    when the cache is empty."""
     if src.shape[0] == 0:
         _fill(rx, zero)
         _fill(ry, zero)
         _fill(rz, zero)
+    elif width == 1:
+        _copy(rx, src)
+        _copy(ry, src)
+        _copy(rz, src)
     else:
         for i in range(rx.shape[0]):
             rx[i] = src[3 * i]
@@ -750,6 +803,14 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 
 
 @nb.njit(**_LEAF)
+def _keep_lobe(scr, m, base, ws, flat):
+    """A light's lobe base (unless the lobe is flat) and weight rows into the lobe store."""
+    if not flat:
+        _copy(base, scr[R_BASE, :m])
+    _copy(ws, scr[R_WS, :m])
+
+
+@nb.njit(**_LEAF)
 def _mode(fl, flat, phong):
     """How a light's lobe base is found (LOBE_*)."""
     if flat:
@@ -760,7 +821,7 @@ def _mode(fl, flat, phong):
 
 
 @nb.njit(**_LEAF)
-def _is_inline(fl, track, l_dif, l_spec, mode, store_lobe):
+def _is_inline(fl, track, l_dif, l_spec, mode):
     """A plain point light on the float32 path: L and attenuation computed in the light loop."""
     return (
         track
@@ -769,33 +830,38 @@ def _is_inline(fl, track, l_dif, l_spec, mode, store_lobe):
         and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
         and not (l_spec and (fl & FRESNEL) != 0)
         and mode != LOBE_CONST_H
-        and not (store_lobe and l_spec)  # inline loops keep no lobe rows
     )
 
 
 @nb.njit(**_LEAF)
-def _grey_only(flags, opts):
+def grey_pass(flags, opts):
     """Whether a pass keeps its diffuse and specular sums in the grey rows alone: a full pass
     (both recomputed) whose every diffuse or specular light is an inline grey one. Decided once
-    per pass (it depends on the lights and the options only)."""
+    per pass (it depends on the lights and the options only); the engine asks too, and gives
+    such a pass grey (n, 1) sums to store: a third of the memory traffic of (n, 3) ones."""
     if opts[O_DO_DIF] == 0 or opts[O_DO_SPEC] == 0:
         return False
-    track, store_lobe = opts[O_TRACK] != 0, opts[O_STORE_LOBE] != 0
+    track = opts[O_TRACK] != 0
     flat, phong = opts[O_FLAT] != 0, opts[O_PHONG] != 0
     for li in range(flags.shape[0]):
         fl = flags[li]
         l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
         if (l_dif or l_spec) and not (
-            (fl & GREY) != 0
-            and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong), store_lobe)
+            (fl & GREY) != 0 and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong))
         ):
             return False
     return True
 
 
 @nb.njit(**_LEAF)
-def _store_grey(dst, g):
-    """A grey row into every channel of a flat (3m,) block of an (n, 3) array."""
+def _store_grey(dst, g, width):
+    """A grey row into a block of a cached sum: as it is into a grey (n, 1) sum (``width`` 1),
+    into every channel of an (n, 3) one (flat (3m,)); nothing into an empty one."""
+    if dst.shape[0] == 0:
+        return
+    if width == 1:
+        _copy(dst, g)
+        return
     for i in range(g.shape[0]):
         dst[3 * i] = g[i]
         dst[3 * i + 1] = g[i]
@@ -845,11 +911,15 @@ def _block(
     ws_out,
     vis,
     amb,
+    mark,
     out,
     scr,
     grey_only,
+    dw,
+    sw,
 ):
-    """One block; every array argument is already sliced to the block's vertices.
+    """One block; every array argument is already sliced to the block's vertices (``mark``:
+    this block's one-element slice of the marked-lane counts).
 
     gpx, gpy, gpz, gx, gy, gz : (m,) T prepared positions and normals (read only), copied into
     the scratch rows, so that every light loop takes the scratch array alone (a call that passes
@@ -878,9 +948,9 @@ def _block(
     # R_LX, R_LY, R_LZ (RGB) and R_D (grey), which the inline loops never read
     junk_zeroed = False
 
-    _fill(trk, zero)
+    _fill(trk, k[K_INF])  # no lane is near a decision until a light says so
     used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
-    # grey_only (see _grey_only): the diffuse and specular sums live in the grey rows alone, so
+    # grey_only (see grey_pass): the diffuse and specular sums live in the grey rows alone, so
     # there are no RGB rows to zero, add to, store or compose from
     if grey_only:
         _fill(scr[R_GD, :m], zero)
@@ -895,12 +965,14 @@ def _block(
             _fill(vz, view[2])
     if two_sided:
         _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
+    if track and do_spec and not flat:  # N·V, for the inline lobes
+        _dot(nx, ny, nz, vx, vy, vz, scr[R_NV, :m])
 
     # the sums: recomputed ones start at 0, the others come from the caches
     _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
     if not grey_only:
-        _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero)
-        _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero)
+        _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero, dw)
+        _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero, sw)
 
     for li in range(params.shape[0]):
         fl = flags[li]
@@ -912,7 +984,7 @@ def _block(
             continue
         mode = _mode(fl, flat, phong)
         fres = l_spec and (fl & FRESNEL) != 0
-        if _is_inline(fl, track, l_dif, l_spec, mode, store_lobe):  # L, attenuation inline
+        if _is_inline(fl, track, l_dif, l_spec, mode):  # L, attenuation inline
             grey = (fl & GREY) != 0
             if grey and not used_grey:
                 _fill(scr[R_GD, :m], zero)
@@ -930,6 +1002,8 @@ def _block(
                 _light_inline(
                     scr, m, R_LX, R_D, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey
                 )
+            if store_lobe and l_spec:
+                _keep_lobe(scr, m, base_out[li, :], ws_out[li, :], flat)
             continue
         rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
         if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
@@ -950,22 +1024,24 @@ def _block(
         else:
             _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
         if store_lobe and l_spec:
-            if not flat:
-                _copy(base_out[li, :], scr[R_BASE, :m])
-            _copy(ws_out[li, :], scr[R_WS, :m])
+            _keep_lobe(scr, m, base_out[li, :], ws_out[li, :], flat)
 
-    if opts[O_TRACK]:
+    if opts[O_TRACK]:  # mark the lanes inside some ambiguity band, if any
+        lim = unit(k)
+        count = 0
         for i in range(m):
-            amb[i] = trk[i] > zero
+            count += 1 if trk[i] < lim else 0
+        mark[0] = count
+        if count:  # (the marks of a block that counts none are never read)
+            for i in range(m):
+                amb[i] = trk[i] < lim
     if grey_only:
         GD, GS = scr[R_GD, :m], scr[R_GS, :m]
         if opts[O_STORE]:
             if do_amb and A.shape[0] > 0:
                 _store_rows(A, Ax, Ay, Az)
-            if D.shape[0] > 0:
-                _store_grey(D, GD)
-            if S.shape[0] > 0:
-                _store_grey(S, GS)
+            _store_grey(D, GD, dw)
+            _store_grey(S, GS, sw)
         if opts[O_COMPOSE]:
             _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k)
         return
@@ -1001,11 +1077,14 @@ def _task(
     ws_out,
     vis,
     amb,
+    marks,
     out,
     scr,
     b0,
     b1,
     grey_only,
+    dw,
+    sw,
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
     arrays here costs no atomic operations on their counts, which both threads would contend)."""
@@ -1029,15 +1108,18 @@ def _task(
             shininess,
             k,
             A[3 * s : 3 * e],
-            D[3 * s : 3 * e],
-            S[3 * s : 3 * e],
+            D[dw * s : dw * e],
+            S[sw * s : sw * e],
             base_out[:, s:e],
             ws_out[:, s:e],
             vis[:, s:e],
             amb[s:e],
+            marks[b : b + 1],
             out[3 * s : 3 * e],
             scr,
             grey_only,
+            dw,
+            sw,
         )
 
 
@@ -1083,6 +1165,13 @@ def _quiet_llvm_remarks():
                 os.write(2, b"".join(rest))
 
 
+#: and their loops run two vector iterations interleaved (LLVM's -force-vector-interleave): a
+#: light loop is one long dependency chain per iteration (two square roots, pow), which the
+#: out-of-order core overlaps too little on its own; two independent chains side by side make
+#: the light loop about 15% faster here (LLVM picks 1 for a loop that large)
+INTERLEAVE = 2
+
+
 @contextlib.contextmanager
 def wide_vectors():
     """Compile numba code inside this block with 16-lane vectors where :data:`WIDE_FLOAT32`
@@ -1093,10 +1182,12 @@ def wide_vectors():
         return
     with _quiet_llvm_remarks():
         llvm.set_option("", "-force-vector-width=16")
+        llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
         try:
             yield
         finally:
             llvm.set_option("", "-force-vector-width=0")
+            llvm.set_option("", "-force-vector-interleave=0")
 
 
 def _wide(kernel, dtype_arg: int):
@@ -1154,6 +1245,7 @@ def shade(
     ws_out,
     vis,
     amb,
+    marks,
     out,
 ):
     """Shade every vertex (see the module docstring).
@@ -1162,9 +1254,15 @@ def shade(
     params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
     opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
     shininess : T; k : constants(T)
-    A, D, S : (n, 3) T caches (or (0, 3)); base_out, ws_out : (L, n) T (or (L, 0))
+    A, D, S : (n, 3) T caches (or (0, 3)); D and S may be grey, (n, 1): read as one value
+    for every channel, and written only by a pass that keeps its sums in the grey rows alone
+    (:func:`grey_pass`, which the caller asks before it allocates them)
+    base_out, ws_out : (L, n) T (or (L, 0))
     vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
-    amb : (n,) bool ambiguity marks (or (0,) when not tracking); out : (n, 3) colours
+    amb : (n,) bool ambiguity marks, marks : (nblocks,) int32 marked lanes per block of BLOCK
+    vertices (both (0,) when not tracking); a block that marks none leaves its part of ``amb``
+    as it was: read the marks with :func:`marked`
+    out : (n, 3) colours
     """
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
@@ -1175,7 +1273,8 @@ def shade(
         S.reshape(-1),
         out.reshape(-1),
     )  # flat views (module docstring)
-    grey_only = _grey_only(flags, opts)  # once per pass
+    grey_only = grey_pass(flags, opts)  # once per pass
+    dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
         _task(
@@ -1195,12 +1294,30 @@ def shade(
             ws_out,
             vis,
             amb,
+            marks,
             outf,
             scr,
             t * nblocks // ntasks,
             (t + 1) * nblocks // ntasks,
             grey_only,
+            dw,
+            sw,
         )
+
+
+@nb.njit(**_OPTS)
+def marked(amb, marks):
+    """Indices of the marked lanes, (k,) int64, from a pass's marks and per-block counts:
+    only the blocks that counted some are read."""
+    idx = np.empty(marks.sum(), np.int64)
+    j = 0
+    for b in range(marks.shape[0]):
+        if marks[b]:
+            for i in range(b * BLOCK, min(amb.shape[0], b * BLOCK + BLOCK)):
+                if amb[i]:
+                    idx[j] = i
+                    j += 1
+    return idx
 
 
 @nb.njit(**_LEAF)
@@ -1276,10 +1393,13 @@ def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overlo
 @overload(_compose_block, prefer_literal=True, jit_options=_LEAF)
 def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     """One fused pass: o = c0 + cA·A + cD·D + cS·S, clamped; the sums a material does not use
-    are not read at all (``variant`` bits 0, 1, 2: A, D, S present)."""
+    are not read at all (``variant`` bits 0, 1, 2: A, D, S present; bits 3, 4: D, S grey, one
+    value per vertex for every channel)."""
     if not isinstance(variant, types.IntegerLiteral):
         raise TypingError("_compose_block needs a literal variant")
-    has_a, has_d, has_s = (bool(variant.literal_value & bit) for bit in (1, 2, 4))
+    v = variant.literal_value
+    has_a, has_d, has_s = bool(v & 1), bool(v & 2), bool(v & 4)
+    grey_d, grey_s = bool(v & 8), bool(v & 16)
 
     def impl(o, A, D, S, c, lo, hi, variant):
         c0, c1, c2 = c[0], c[1], c[2]
@@ -1290,11 +1410,19 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
                 r += a0 * A[3 * i]
                 g += a1 * A[3 * i + 1]
                 b += a2 * A[3 * i + 2]
-            if has_d:  # d_m·D
+            if has_d and grey_d:  # d_m·D, D grey
+                r += d0 * D[i]
+                g += d1 * D[i]
+                b += d2 * D[i]
+            elif has_d:  # d_m·D
                 r += d0 * D[3 * i]
                 g += d1 * D[3 * i + 1]
                 b += d2 * D[3 * i + 2]
-            if has_s:  # s_m·S
+            if has_s and grey_s:  # s_m·S, S grey
+                r += s0 * S[i]
+                g += s1 * S[i]
+                b += s2 * S[i]
+            elif has_s:  # s_m·S
                 r += s0 * S[3 * i]
                 g += s1 * S[3 * i + 1]
                 b += s2 * S[3 * i + 2]
@@ -1307,6 +1435,20 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
 
 @nb.njit(**_LEAF)
 def _compose_any(o, A, D, S, c, lo, hi, v):
+    """Call the compose loop compiled for variant ``v`` (A present or not; D and S absent, RGB
+    or grey)."""
+    if v & 8 == 0 and v & 16 == 0:
+        _compose_rgb(o, A, D, S, c, lo, hi, v)
+    elif v & 8 and v & 16:
+        _compose_grey_ds(o, A, D, S, c, lo, hi, v)
+    elif v & 8:
+        _compose_grey_d(o, A, D, S, c, lo, hi, v)
+    else:
+        _compose_grey_s(o, A, D, S, c, lo, hi, v)
+
+
+@nb.njit(**_LEAF)
+def _compose_rgb(o, A, D, S, c, lo, hi, v):
     if v == 0:
         _compose_block(o, A, D, S, c, lo, hi, 0)
     elif v == 1:
@@ -1325,14 +1467,48 @@ def _compose_any(o, A, D, S, c, lo, hi, v):
         _compose_block(o, A, D, S, c, lo, hi, 7)
 
 
+@nb.njit(**_LEAF)
+def _compose_grey_ds(o, A, D, S, c, lo, hi, v):  # D and S grey, both present
+    if v & 1:
+        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 4 | 8 | 16)
+    else:
+        _compose_block(o, A, D, S, c, lo, hi, 2 | 4 | 8 | 16)
+
+
+@nb.njit(**_LEAF)
+def _compose_grey_d(o, A, D, S, c, lo, hi, v):  # D grey and present; S RGB or absent
+    if v & 1 and v & 4:
+        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 4 | 8)
+    elif v & 1:
+        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 8)
+    elif v & 4:
+        _compose_block(o, A, D, S, c, lo, hi, 2 | 4 | 8)
+    else:
+        _compose_block(o, A, D, S, c, lo, hi, 2 | 8)
+
+
+@nb.njit(**_LEAF)
+def _compose_grey_s(o, A, D, S, c, lo, hi, v):  # S grey and present; D RGB or absent
+    if v & 1 and v & 2:
+        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 4 | 16)
+    elif v & 1:
+        _compose_block(o, A, D, S, c, lo, hi, 1 | 4 | 16)
+    elif v & 2:
+        _compose_block(o, A, D, S, c, lo, hi, 2 | 4 | 16)
+    else:
+        _compose_block(o, A, D, S, c, lo, hi, 4 | 16)
+
+
 @nb.njit(parallel=True, **_OPTS)
 def compose(mat, aconst, A, D, S, clamp, k, out):
     """Colours from cached sums: out = e + a_m·(aconst + A) + d_m·D + s_m·S, clamped.
 
-    A, D, S : (n, 3) T or (0, 3) for "all zero"; out : (n, 3)
+    A, D, S : (n, 3) T or (0, 3) for "all zero"; D and S may be grey, (n, 1); out : (n, 3)
     """
     n = out.shape[0]
     v = (1 if A.shape[0] > 0 else 0) | (2 if D.shape[0] > 0 else 0) | (4 if S.shape[0] > 0 else 0)
+    dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
+    v |= (8 if v & 2 and dw == 1 else 0) | (16 if v & 4 and sw == 1 else 0)
     lo = k[K_ZERO]
     hi = k[K_ONE] if clamp else k[K_INF]
     c = mat.copy()
@@ -1347,13 +1523,13 @@ def compose(mat, aconst, A, D, S, clamp, k, out):
         out.reshape(-1),
     )  # flat views (module docstring)
     for b in nb.prange(nblocks):
-        s = 3 * b * chunk
-        e = 3 * min(n, b * chunk + chunk)
+        s = b * chunk
+        e = min(n, s + chunk)
         _compose_any(
-            outf[s:e],
-            Af[s:e] if v & 1 else Af,
-            Df[s:e] if v & 2 else Df,
-            Sf[s:e] if v & 4 else Sf,
+            outf[3 * s : 3 * e],
+            Af[3 * s : 3 * e] if v & 1 else Af,
+            Df[dw * s : dw * e] if v & 2 else Df,
+            Sf[sw * s : sw * e] if v & 4 else Sf,
             c,
             lo,
             hi,

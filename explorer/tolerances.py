@@ -56,3 +56,8 @@ ORACLE_ABS_TOL = 1e-5
 PLAN_ABS_TOL = 1e-9
 #: Colours after rotating/translating the whole scene (float64; the rotation itself rounds).
 INVARIANCE_ABS_TOL = 1e-6
+#: float32 colours reached by two routes (a fresh pass, or cached sums brought up to date by a
+#: lobe re-run or a recompose) agree to this times max(1, shininess): the routes run different
+#: compiled loops, and a last-bit difference in a lobe's base (2**-24 relative) grows n-fold
+#: through base**n. A stale cache entry is orders of magnitude larger.
+FLOAT32_ROUTE_ABS_TOL = 1e-6

@@ -53,7 +53,8 @@ def delta(before, after):
 
 
 def check(shader):
-    tol_ = 1e-12 if shader.precision == "float64" else 1e-6
+    n = max(1.0, shader.scene.material.shininess)
+    tol_ = 1e-12 if shader.precision == "float64" else tol.FLOAT32_ROUTE_ABS_TOL * n
     assert np.abs(shader.colors - fresh(shader)).max() <= tol_
 
 
@@ -242,8 +243,8 @@ def test_float32_shader_stays_within_one_level_of_float64():
 
 @pytest.mark.parametrize("precision", ["float32", "float64"])
 def test_lobes_of_plain_point_lights(precision):
-    # plain point lights (no cone, no light ambient) take the float32 inline loops, which keep no
-    # lobe rows: the pass that starts a shininess drag stores them on the row path instead
+    # plain point lights (no cone, no light ambient) take the float32 inline loops, which also
+    # store the lobe rows when a pass starts a shininess drag (one grey light, one coloured)
     scene = dict(SCENE)
     scene["lights"] = [
         {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
@@ -263,7 +264,8 @@ def test_lobes_of_plain_point_lights(precision):
 
 def test_grey_only_pass_stores_sums_a_recolour_reuses():
     # white plain point lights only: the float32 pass keeps the diffuse and specular sums in one
-    # grey row each; the stored (n, 3) sums must still recompose a new material exactly
+    # grey row each and stores them as grey (n, 1) sums, which must still recompose a new
+    # material exactly, and serve the passes that recompute the specular sum alone
     scene = dict(SCENE)
     scene["lights"] = [
         {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
@@ -271,8 +273,14 @@ def test_grey_only_pass_stores_sums_a_recolour_reuses():
     ]
     rng = np.random.default_rng(4)
     P, N = rng.normal(size=(3000, 3)), rng.normal(size=(3000, 3))
+    # and a few vertices lit exactly edge-on (N·L = 0): ambiguous, redone in float64
+    P[:4] = 0.0
+    N[:4] = np.cross([2.0, 3.0, 1.0], rng.normal(size=(4, 3)))
     shader = explorer.Shader(scene, P, N, precision="float32")
     _ = shader.colors
+    assert shader._D.shape == shader._S.shape == (3000, 1)
+    assert shader.stats["fixup_vertices"] >= 4
+    check(shader)
     t = shader.terms
     for name in ("diffuse", "specular"):  # grey lights: every channel alike, and not all zero
         assert np.array_equal(t[name][:, 0], t[name][:, 1])
@@ -285,3 +293,12 @@ def test_grey_only_pass_stores_sums_a_recolour_reuses():
     check(shader)
     ref = explorer.shade(shader.scene, P, N, precision="float64")
     assert np.abs(shader.colors - ref).max() <= tol.FLOAT32_MAX_ABS_ERROR
+    # the specular sum alone (a viewer change, a shininess drag) reads the grey diffuse sum
+    shader.set_viewer(Viewer(eye=(1.0, 2.0, 6.0)))
+    _ = shader.colors
+    assert shader._D.shape == (3000, 1) and shader._S.shape == (3000, 3)
+    check(shader)
+    for n in (5.0, 60.0):
+        shader.set_material(shader.scene.material.replace(shininess=n))
+        _ = shader.colors
+        check(shader)

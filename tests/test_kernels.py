@@ -83,3 +83,16 @@ def test_wide_vectors_can_be_switched_off():
     env = dict(os.environ, PHONG_EXPLORER_WIDE_VECTORS="0")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert out.stdout.strip() == "ok", out.stderr
+
+
+def test_marked_reads_only_the_blocks_that_count_marks():
+    # a block that counts no marks does not write them: what its part of the array holds is
+    # stale and must not be read
+    n = 2 * K.BLOCK + 7
+    amb = np.ones(n, np.bool_)  # stale everywhere
+    amb[K.BLOCK :] = False  # blocks 1 and 2 write their marks: three in all
+    amb[[K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]] = True
+    marks = np.array([0, 2, 1], np.int32)
+    idx = K.marked(amb, marks)
+    assert idx.tolist() == [K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]
+    assert K.marked(amb, np.zeros(3, np.int32)).size == 0
