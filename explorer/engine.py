@@ -488,8 +488,6 @@ class Shader:
         opts[K.O_TRACK] = T is np.float32
         opts[K.O_VIEW] = self._plan.fresnel is not None
         empty3 = np.zeros((0, 3), T)
-        # a pass whose diffuse and specular sums are grey stores them as (n, 1)
-        grey = keep and K.grey_pass(flags, opts)
 
         def cache(current, do, grey=False):
             if not keep:
@@ -498,8 +496,13 @@ class Shader:
                 return self._fresh_sum(grey)
             return current if current is not None else empty3
 
+        # a pass whose diffuse and specular sums are grey stores them as (n, 1) (the kernel
+        # decides alike, from the diffuse sum it is given when that is not recomputed)
+        D = None if do_dif else cache(self._D, False)
+        diffuse_grey = D is None or D.shape[0] == 0 or D.shape[1] == 1
+        grey = keep and K.grey_pass(flags, opts, diffuse_grey)
         A = cache(self._A, do_amb)
-        D = cache(self._D, do_dif, grey)
+        D = cache(self._D, True, grey) if do_dif else D
         S = cache(self._S, do_spec, grey)
         if opts[K.O_STORE_LOBE]:
             # every row the lobe kernel reads (lights with specular) is written by this pass;

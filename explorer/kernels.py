@@ -834,12 +834,13 @@ def _is_inline(fl, track, l_dif, l_spec, mode):
 
 
 @nb.njit(**_LEAF)
-def grey_pass(flags, opts):
-    """Whether a pass keeps its diffuse and specular sums in the grey rows alone: a full pass
-    (both recomputed) whose every diffuse or specular light is an inline grey one. Decided once
-    per pass (it depends on the lights and the options only); the engine asks too, and gives
-    such a pass grey (n, 1) sums to store: a third of the memory traffic of (n, 3) ones."""
-    if opts[O_DO_DIF] == 0 or opts[O_DO_SPEC] == 0:
+def grey_pass(flags, opts, diffuse_grey):
+    """Whether a pass keeps its diffuse and specular sums in the grey rows alone: the specular
+    sum is recomputed, every diffuse or specular light is an inline grey one, and the diffuse
+    sum is recomputed too or grey already (``diffuse_grey``: cached (n, 1), or absent). Decided
+    once per pass; the engine asks too, and gives such a pass grey (n, 1) sums to store: a
+    third of the memory traffic of (n, 3) ones."""
+    if opts[O_DO_SPEC] == 0 or not (opts[O_DO_DIF] != 0 or diffuse_grey):
         return False
     track = opts[O_TRACK] != 0
     flat, phong = opts[O_FLAT] != 0, opts[O_PHONG] != 0
@@ -953,7 +954,10 @@ def _block(
     # grey_only (see grey_pass): the diffuse and specular sums live in the grey rows alone, so
     # there are no RGB rows to zero, add to, store or compose from
     if grey_only:
-        _fill(scr[R_GD, :m], zero)
+        if do_dif or D.shape[0] == 0:
+            _fill(scr[R_GD, :m], zero)
+        else:  # the cached diffuse sum (grey: see grey_pass)
+            _copy(scr[R_GD, :m], D)
         _fill(scr[R_GS, :m], zero)
         used_grey = True
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
@@ -1040,7 +1044,8 @@ def _block(
         if opts[O_STORE]:
             if do_amb and A.shape[0] > 0:
                 _store_rows(A, Ax, Ay, Az)
-            _store_grey(D, GD, dw)
+            if do_dif:
+                _store_grey(D, GD, dw)
             _store_grey(S, GS, sw)
         if opts[O_COMPOSE]:
             _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k)
@@ -1273,7 +1278,8 @@ def shade(
         S.reshape(-1),
         out.reshape(-1),
     )  # flat views (module docstring)
-    grey_only = grey_pass(flags, opts)  # once per pass
+    # once per pass: a diffuse sum not recomputed here must be grey already, or absent
+    grey_only = grey_pass(flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
     dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block

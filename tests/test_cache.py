@@ -293,12 +293,44 @@ def test_grey_only_pass_stores_sums_a_recolour_reuses():
     check(shader)
     ref = explorer.shade(shader.scene, P, N, precision="float64")
     assert np.abs(shader.colors - ref).max() <= tol.FLOAT32_MAX_ABS_ERROR
-    # the specular sum alone (a viewer change, a shininess drag) reads the grey diffuse sum
+    # the specular sum alone (a viewer change) is a grey pass too, on the grey diffuse sum
+    before = counts(shader)
     shader.set_viewer(Viewer(eye=(1.0, 2.0, 6.0)))
     _ = shader.colors
-    assert shader._D.shape == (3000, 1) and shader._S.shape == (3000, 3)
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1}
+    assert shader._D.shape == shader._S.shape == (3000, 1)
     check(shader)
-    for n in (5.0, 60.0):
+    # a shininess drag: one grey specular pass that keeps the lobes, then the lobe alone,
+    # which writes an (n, 3) sum; a viewer change then reads it no more (recomputed grey)
+    for n, shape in ((5.0, (3000, 1)), (60.0, (3000, 3))):
         shader.set_material(shader.scene.material.replace(shininess=n))
         _ = shader.colors
+        assert shader._S.shape == shape
         check(shader)
+    shader.set_viewer(Viewer(eye=(0.0, 1.0, 5.0)))
+    _ = shader.colors
+    assert shader._S.shape == (3000, 1)
+    check(shader)
+
+
+def test_an_rgb_diffuse_sum_keeps_a_specular_pass_rgb():
+    # grey lights, but no specular at first (material specular 0): that pass is not a grey
+    # pass, so its diffuse sum is (n, 3); the specular-only pass that follows, when the
+    # material gains a specular colour, cannot keep its sums in the grey rows alone
+    scene = dict(SCENE)
+    scene["material"] = dict(SCENE["material"], specular=[0, 0, 0])
+    scene["lights"] = [
+        {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
+        {"type": "point", "position": [-3, 1, 2]},
+    ]
+    rng = np.random.default_rng(6)
+    P, N = rng.normal(size=(2000, 3)), rng.normal(size=(2000, 3))
+    shader = explorer.Shader(scene, P, N, precision="float32")
+    _ = shader.colors
+    assert shader._D.shape == (2000, 3) and shader._S is None
+    before = counts(shader)
+    shader.set_material(shader.scene.material.replace(specular=(0.5, 0.5, 0.5)))
+    _ = shader.colors
+    assert delta(before, counts(shader)) == {"pass": 1, "specular": 1}
+    assert shader._S.shape == (2000, 3)
+    check(shader)
