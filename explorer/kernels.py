@@ -1439,70 +1439,49 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     return impl
 
 
+def _compose_a(o, A, D, S, c, lo, hi, base, has_a):  # pragma: no cover - overloaded below
+    raise NotImplementedError
+
+
+@overload(_compose_a, prefer_literal=True, jit_options=_LEAF)
+def _compose_a_overload(o, A, D, S, c, lo, hi, base, has_a):
+    """The compose loop for the D and S layout ``base`` (a literal), with or without A."""
+    if not isinstance(base, types.IntegerLiteral):
+        raise TypingError("_compose_a needs a literal base variant")
+    without, with_a = base.literal_value, base.literal_value | 1
+
+    def impl(o, A, D, S, c, lo, hi, base, has_a):
+        if has_a:
+            _compose_block(o, A, D, S, c, lo, hi, with_a)
+        else:
+            _compose_block(o, A, D, S, c, lo, hi, without)
+
+    return impl
+
+
 @nb.njit(**_LEAF)
 def _compose_any(o, A, D, S, c, lo, hi, v):
-    """Call the compose loop compiled for variant ``v`` (A present or not; D and S absent, RGB
-    or grey)."""
-    if v & 8 == 0 and v & 16 == 0:
-        _compose_rgb(o, A, D, S, c, lo, hi, v)
-    elif v & 8 and v & 16:
-        _compose_grey_ds(o, A, D, S, c, lo, hi, v)
-    elif v & 8:
-        _compose_grey_d(o, A, D, S, c, lo, hi, v)
-    else:
-        _compose_grey_s(o, A, D, S, c, lo, hi, v)
-
-
-@nb.njit(**_LEAF)
-def _compose_rgb(o, A, D, S, c, lo, hi, v):
-    if v == 0:
-        _compose_block(o, A, D, S, c, lo, hi, 0)
-    elif v == 1:
-        _compose_block(o, A, D, S, c, lo, hi, 1)
-    elif v == 2:
-        _compose_block(o, A, D, S, c, lo, hi, 2)
-    elif v == 3:
-        _compose_block(o, A, D, S, c, lo, hi, 3)
-    elif v == 4:
-        _compose_block(o, A, D, S, c, lo, hi, 4)
-    elif v == 5:
-        _compose_block(o, A, D, S, c, lo, hi, 5)
-    elif v == 6:
-        _compose_block(o, A, D, S, c, lo, hi, 6)
-    else:
-        _compose_block(o, A, D, S, c, lo, hi, 7)
-
-
-@nb.njit(**_LEAF)
-def _compose_grey_ds(o, A, D, S, c, lo, hi, v):  # D and S grey, both present
-    if v & 1:
-        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 4 | 8 | 16)
-    else:
-        _compose_block(o, A, D, S, c, lo, hi, 2 | 4 | 8 | 16)
-
-
-@nb.njit(**_LEAF)
-def _compose_grey_d(o, A, D, S, c, lo, hi, v):  # D grey and present; S RGB or absent
-    if v & 1 and v & 4:
-        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 4 | 8)
-    elif v & 1:
-        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 8)
-    elif v & 4:
-        _compose_block(o, A, D, S, c, lo, hi, 2 | 4 | 8)
-    else:
-        _compose_block(o, A, D, S, c, lo, hi, 2 | 8)
-
-
-@nb.njit(**_LEAF)
-def _compose_grey_s(o, A, D, S, c, lo, hi, v):  # S grey and present; D RGB or absent
-    if v & 1 and v & 2:
-        _compose_block(o, A, D, S, c, lo, hi, 1 | 2 | 4 | 16)
-    elif v & 1:
-        _compose_block(o, A, D, S, c, lo, hi, 1 | 4 | 16)
-    elif v & 2:
-        _compose_block(o, A, D, S, c, lo, hi, 2 | 4 | 16)
-    else:
-        _compose_block(o, A, D, S, c, lo, hi, 4 | 16)
+    """Call the compose loop compiled for variant ``v`` (see :func:`_compose_block`): D and S
+    each absent, RGB or grey, A present or not."""
+    a, ds = v & 1, v & ~1
+    if ds == 0:
+        _compose_a(o, A, D, S, c, lo, hi, 0, a)
+    elif ds == 2:  # D
+        _compose_a(o, A, D, S, c, lo, hi, 2, a)
+    elif ds == 4:  # S
+        _compose_a(o, A, D, S, c, lo, hi, 4, a)
+    elif ds == 6:  # D, S
+        _compose_a(o, A, D, S, c, lo, hi, 6, a)
+    elif ds == 2 | 8:  # D grey
+        _compose_a(o, A, D, S, c, lo, hi, 2 | 8, a)
+    elif ds == 6 | 8:  # D grey, S
+        _compose_a(o, A, D, S, c, lo, hi, 6 | 8, a)
+    elif ds == 4 | 16:  # S grey
+        _compose_a(o, A, D, S, c, lo, hi, 4 | 16, a)
+    elif ds == 6 | 16:  # D, S grey
+        _compose_a(o, A, D, S, c, lo, hi, 6 | 16, a)
+    else:  # D grey, S grey
+        _compose_a(o, A, D, S, c, lo, hi, 6 | 8 | 16, a)
 
 
 @nb.njit(parallel=True, **_OPTS)

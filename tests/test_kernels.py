@@ -96,3 +96,28 @@ def test_marked_reads_only_the_blocks_that_count_marks():
     idx = K.marked(amb, marks)
     assert idx.tolist() == [K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]
     assert K.marked(amb, np.zeros(3, np.int32)).size == 0
+
+
+@pytest.mark.parametrize("precision", [np.float32, np.float64])
+def test_compose_reads_every_layout_of_the_sums(precision):
+    # A absent or (n, 3); D and S each absent, (n, 3) or grey (n, 1): every combination gives
+    # e + a_m·(aconst + A) + d_m·D + s_m·S, clamped, with a grey sum counted in every channel
+    import itertools
+
+    rng = np.random.default_rng(7)
+    n = K.COMPOSE_BLOCK + 5  # two parallel chunks, the second short
+    mat = rng.uniform(0, 0.5, 12).astype(precision)
+    aconst = rng.uniform(0, 0.3, 3).astype(precision)
+    k = K.constants(precision)
+    layouts = {"absent": (0, 3), "rgb": (n, 3), "grey": (n, 1)}
+    for a, d, s in itertools.product(("absent", "rgb"), layouts, layouts):
+        A, D, S = (rng.uniform(0, 1, layouts[x]).astype(precision) for x in (a, d, s))
+        out = np.empty((n, 3), precision)
+        K.compose(mat, aconst, A, D, S, True, k, out)
+        want = mat[0:3] + mat[3:6] * aconst
+        for X, m in ((A, mat[3:6]), (D, mat[6:9]), (S, mat[9:12])):
+            if X.shape[0]:
+                want = want + m * X  # (n, 1) broadcasts over the channels
+        want = np.clip(np.broadcast_to(want, (n, 3)), 0, 1)
+        tol_ = 1e-6 if precision == np.float32 else 1e-12
+        assert np.abs(out - want).max() <= tol_, (a, d, s)
