@@ -138,16 +138,13 @@ LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
     K_POINT_EPS,
     K_HALF_EPS2,
     K_ATT_FLOOR,
-    K_AMB_DOT,
-    K_AMB_LEN2,
-    K_AMB_DIST,
     K_INF,
     K_NORMAL_EPS2,
     K_MARGIN_DOT,
     K_MARGIN_LEN2,
     K_MARGIN_DIST2,
-) = range(14)
-N_CONSTS = 14
+) = range(11)
+N_CONSTS = 11
 
 
 def constants(dtype) -> np.ndarray:
@@ -160,9 +157,6 @@ def constants(dtype) -> np.ndarray:
             tol.POINT_EPS,
             tol.HALFWAY_EPS2,
             tol.ATTENUATION_FLOOR,
-            tol.AMBIGUOUS_DOT,
-            tol.AMBIGUOUS_LEN2,
-            tol.AMBIGUOUS_DIST,
             np.inf,
             tol.NORMAL_EPS**2,
             1.0 / tol.AMBIGUOUS_DOT,  # margins: a quantity over its band's width (< 1: inside)
