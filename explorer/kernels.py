@@ -1226,6 +1226,13 @@ def _tasks(nblocks):
     return max(1, min(nblocks, TASKS))
 
 
+@nb.njit(**_OPTS)
+def _flat(A, D, S, out):
+    """Flat (3n,) views of the (n, 3) sums and colours (see the module docstring); a grey
+    (n, 1) sum gives (n,)."""
+    return A.reshape(-1), D.reshape(-1), S.reshape(-1), out.reshape(-1)
+
+
 @nb.njit(parallel=True, **_OPTS)
 def shade(
     G,
@@ -1266,12 +1273,7 @@ def shade(
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
-    Af, Df, Sf, outf = (
-        A.reshape(-1),
-        D.reshape(-1),
-        S.reshape(-1),
-        out.reshape(-1),
-    )  # flat views (module docstring)
+    Af, Df, Sf, outf = _flat(A, D, S, out)
     # once per pass: a diffuse sum not recomputed here must be grey already, or absent
     grey_only = grey_pass(flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
     dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
@@ -1386,6 +1388,15 @@ def _lobe_task(base, ws, params, flags, shininess, k, Sf, scr, b0, b1):
         _store_rows(Sf[3 * s : 3 * e], Sx, Sy, Sz)
 
 
+@nb.njit(**_LEAF)
+def _channels(X, i, grey):
+    """Vertex i's three values in a flat block of a sum: (n, 3), or grey (n, 1) (one value for
+    every channel)."""
+    if grey:
+        return X[i], X[i], X[i]
+    return X[3 * i], X[3 * i + 1], X[3 * i + 2]
+
+
 def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overloaded below
     raise NotImplementedError
 
@@ -1407,25 +1418,14 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
         for i in range(o.shape[0] // 3):  # flat (3m,) blocks of (n, 3) arrays
             r, g, b = c0, c1, c2  # e_m + a_m·(scene and constant light ambient)
             if has_a:  # a_m·A (attenuated light ambient)
-                r += a0 * A[3 * i]
-                g += a1 * A[3 * i + 1]
-                b += a2 * A[3 * i + 2]
-            if has_d and grey_d:  # d_m·D, D grey
-                r += d0 * D[i]
-                g += d1 * D[i]
-                b += d2 * D[i]
-            elif has_d:  # d_m·D
-                r += d0 * D[3 * i]
-                g += d1 * D[3 * i + 1]
-                b += d2 * D[3 * i + 2]
-            if has_s and grey_s:  # s_m·S, S grey
-                r += s0 * S[i]
-                g += s1 * S[i]
-                b += s2 * S[i]
-            elif has_s:  # s_m·S
-                r += s0 * S[3 * i]
-                g += s1 * S[3 * i + 1]
-                b += s2 * S[3 * i + 2]
+                x, y, z = _channels(A, i, False)
+                r, g, b = r + a0 * x, g + a1 * y, b + a2 * z
+            if has_d:  # d_m·D
+                x, y, z = _channels(D, i, grey_d)
+                r, g, b = r + d0 * x, g + d1 * y, b + d2 * z
+            if has_s:  # s_m·S
+                x, y, z = _channels(S, i, grey_s)
+                r, g, b = r + s0 * x, g + s1 * y, b + s2 * z
             o[3 * i] = min(max(r, lo), hi)
             o[3 * i + 1] = min(max(g, lo), hi)
             o[3 * i + 2] = min(max(b, lo), hi)
@@ -1495,12 +1495,7 @@ def compose(mat, aconst, A, D, S, clamp, k, out):
         c[ch] = mat[ch] + mat[3 + ch] * aconst[ch]
     chunk = COMPOSE_BLOCK
     nblocks = (n + chunk - 1) // chunk
-    Af, Df, Sf, outf = (
-        A.reshape(-1),
-        D.reshape(-1),
-        S.reshape(-1),
-        out.reshape(-1),
-    )  # flat views (module docstring)
+    Af, Df, Sf, outf = _flat(A, D, S, out)
     for b in nb.prange(nblocks):
         s = b * chunk
         e = min(n, s + chunk)
