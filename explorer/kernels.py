@@ -864,8 +864,9 @@ def _store_grey(dst, g, width):
 
 
 @nb.njit(**_LEAF)
-def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k):
-    """:func:`_compose_rows` when the diffuse and specular sums are grey rows alone."""
+def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
+    """:func:`_compose_rows` when the diffuse and specular sums are grey rows alone (and
+    without per-vertex ambient rows unless ``has_a``)."""
     lo = k[K_ZERO]
     hi = k[K_ONE] if clamp else k[K_INF]
     e0 = mat[0] + mat[3] * aconst[0]
@@ -873,6 +874,16 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k):
     e2 = mat[2] + mat[5] * aconst[2]
     a0, a1, a2, d0, d1, d2 = mat[3], mat[4], mat[5], mat[6], mat[7], mat[8]
     s0, s1, s2 = mat[9], mat[10], mat[11]
+    if not has_a:
+        for i in range(GD.shape[0]):
+            gd, gs = GD[i], GS[i]
+            r = e0 + d0 * gd + s0 * gs  # e + a_m·a_const + d_m·D + s_m·S
+            g = e1 + d1 * gd + s1 * gs
+            b = e2 + d2 * gd + s2 * gs
+            out[3 * i] = min(max(r, lo), hi)
+            out[3 * i + 1] = min(max(g, lo), hi)
+            out[3 * i + 2] = min(max(b, lo), hi)
+        return
     for i in range(Ax.shape[0]):
         gd, gs = GD[i], GS[i]
         r = e0 + a0 * Ax[i] + d0 * gd + s0 * gs  # e + a_m·(a_const + A) + d_m·D + s_m·S
@@ -967,7 +978,9 @@ def _block(
         _dot(nx, ny, nz, vx, vy, vz, scr[R_NV, :m])
 
     # the sums: recomputed ones start at 0, the others come from the caches
-    _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
+    has_a = do_amb or A.shape[0] > 0  # else no per-vertex ambient: its rows stay unused
+    if has_a:
+        _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
     if not grey_only:
         _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero, dw)
         _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero, sw)
@@ -1026,13 +1039,15 @@ def _block(
 
     if opts[O_TRACK]:  # mark the lanes inside some ambiguity band, if any
         lim = unit(k)
+        hit = np.int32(0)
+        for i in range(m):  # (an OR: vectorises; a count does not)
+            hit |= np.int32(1) if trk[i] < lim else np.int32(0)
         count = 0
-        for i in range(m):
-            count += 1 if trk[i] < lim else 0
-        mark[0] = count
-        if count:  # (the marks of a block that counts none are never read)
+        if hit:  # (the marks of a block that counts none are never read)
             for i in range(m):
                 amb[i] = trk[i] < lim
+                count += 1 if trk[i] < lim else 0
+        mark[0] = count
     if grey_only:
         GD, GS = scr[R_GD, :m], scr[R_GS, :m]
         if opts[O_STORE]:
@@ -1042,7 +1057,7 @@ def _block(
                 _store_grey(D, GD, dw)
             _store_grey(S, GS, sw)
         if opts[O_COMPOSE]:
-            _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k)
+            _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k, has_a)
         return
     if used_grey:  # the grey sums count in every channel
         _add_grey(Dx, Dy, Dz, scr[R_GD, :m])
@@ -1055,6 +1070,8 @@ def _block(
         if do_spec and S.shape[0] > 0:
             _store_rows(S, Sx, Sy, Sz)
     if opts[O_COMPOSE]:
+        if not has_a:
+            _load_rows(A[:0], Ax, Ay, Az, zero)
         _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, opts[O_CLAMP] != 0, k)
 
 
@@ -1277,6 +1294,12 @@ def shade(
     # once per pass: a diffuse sum not recomputed here must be grey already, or absent
     grey_only = grey_pass(flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
     dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
+    # a pass that is not grey writes three values per vertex: a grey sum would overflow
+    if not grey_only and opts[O_STORE] != 0:
+        if (opts[O_DO_DIF] != 0 and dw == 1 and D.shape[0]) or (
+            opts[O_DO_SPEC] != 0 and sw == 1 and S.shape[0]
+        ):
+            raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
     for t in nb.prange(ntasks):
         scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
         _task(

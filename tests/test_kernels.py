@@ -121,3 +121,29 @@ def test_compose_reads_every_layout_of_the_sums(precision):
         want = np.clip(np.broadcast_to(want, (n, 3)), 0, 1)
         tol_ = 1e-6 if precision == np.float32 else 1e-12
         assert np.abs(out - want).max() <= tol_, (a, d, s)
+
+
+def test_shade_refuses_grey_sums_for_a_pass_that_is_not_grey(monkeypatch):
+    # the caller asks grey_pass before allocating grey (n, 1) sums; a pass whose options make
+    # it RGB would write three values per vertex into them: the kernel refuses, not overflows
+    import explorer
+
+    P = np.random.default_rng(2).normal(size=(700, 3))
+    scene = {
+        "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20},
+        "viewer": {"eye": [0, 0, 6]},
+        "lights": [{"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]}],
+    }
+    sh = explorer.Shader(scene, P, P, precision="float32")
+    seen = []
+    shade = K.shade
+    monkeypatch.setattr(K, "shade", lambda *a: (seen.append(a), shade(*a))[1])
+    _ = sh.colors
+    args = list(seen[0])
+    D, S = args[10], args[11]
+    assert D.shape == S.shape == (700, 1)  # a grey pass (white light)
+    opts = args[4].copy()
+    opts[K.O_TRACK] = 0  # no inline loops: not a grey pass
+    args[4] = opts
+    with pytest.raises(ValueError, match="grey pass"):
+        shade(*args)
