@@ -541,10 +541,31 @@ class Shader:
         self.stats["pass"] += 1
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
-        if opts[K.O_TRACK]:
-            idx = K.marked(amb, self._marks)
-            if idx.size:
-                self._fixup(idx, opts, A, D, S, base, ws, vis)
+        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
+            params64, _, view64 = self._params_for(np.float64)
+            self.stats["fixup_vertices"] += K.fixup(
+                amb,
+                self._marks,
+                self._P,
+                self._N,
+                self._centre,
+                1.0 / self._scale,
+                params64,
+                flags,
+                view64,
+                opts,
+                self._material_vector(np.float64),
+                self._aconst,
+                np.float64(scene.material.shininess),
+                self._k64,
+                A,
+                D,
+                S,
+                base,
+                ws,
+                vis,
+                self._out,
+            )
         if keep:
             if do_amb:
                 self._A = A
@@ -556,65 +577,6 @@ class Shader:
                     self._base = base if not flat else None
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
-
-    def _fixup(self, idx, opts, A, D, S, base, ws, vis):
-        """Redo ambiguous float32 lanes in float64 and scatter the results back."""
-        scene = self._scene
-        f64 = np.float64
-        params, flags, view = self._params_for(f64)
-        m = len(idx)
-        o = opts.copy()
-        o[K.O_TRACK] = 0
-
-        def sub(X):  # the float64 pass keeps RGB sums: a grey one is spread to 3 channels
-            if not X.shape[0]:
-                return np.zeros((0, 3))
-            return np.ascontiguousarray(np.broadcast_to(X[idx], (m, 3)), dtype=f64)
-
-        A64, D64, S64 = sub(A), sub(D), sub(S)
-        keep_lobe = base.shape[1] > 0
-        b64 = np.zeros((len(params), m if keep_lobe else 0))
-        w64 = np.zeros((len(params), m if keep_lobe else 0))
-        out64 = np.empty((m, 3))
-        mat = self._material_vector(f64)
-        aconst = self._aconst
-        G64 = np.empty((6, m))
-        K.prepare(
-            np.ascontiguousarray(self._P[idx]),
-            np.ascontiguousarray(self._N[idx]),
-            self._centre,
-            1.0 / self._scale,
-            self._k64,
-            G64,
-        )
-        K.shade(
-            G64,
-            params,
-            flags,
-            view,
-            o,
-            mat,
-            aconst,
-            f64(scene.material.shininess),
-            self._k64,
-            A64,
-            D64,
-            S64,
-            b64,
-            w64,
-            np.ascontiguousarray(vis[:, idx] if vis.shape[1] else vis, dtype=f64),
-            np.zeros(0, np.bool_),
-            np.zeros(0, np.int32),
-            out64,
-        )
-        self._out[idx] = out64
-        for X, X64 in ((A, A64), (D, D64), (S, S64)):
-            if X.shape[0]:  # (a grey sum's lights are grey: its float64 channels are equal)
-                X[idx] = X64[:, : X.shape[1]]
-        if keep_lobe:
-            base[:, idx] = b64
-            ws[:, idx] = w64
-        self.stats["fixup_vertices"] += m
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:

@@ -334,3 +334,33 @@ def test_an_rgb_diffuse_sum_keeps_a_specular_pass_rgb():
     assert delta(before, counts(shader)) == {"pass": 1, "specular": 1}
     assert shader._S.shape == (2000, 3)
     check(shader)
+
+
+def test_redone_lanes_keep_their_float64_lobes_for_a_shininess_drag():
+    # vertices a hair off a plane, a light far away in that plane (N·L = ±1e-9): float32 gets
+    # the sign of N·L wrong on about half of them, so the float64 redo must also replace the
+    # lobe rows (base, weight) a shininess drag re-runs from, not only the colours
+    rng = np.random.default_rng(7)
+    n_hat = np.array([1.0, 1.0, 1.0]) / np.sqrt(3.0)
+    u = np.cross(n_hat, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(n_hat, u)
+    a, b = rng.uniform(-1, 1, size=(2, 2000))
+    off = rng.choice([-1e-6, 1e-6], size=2000)
+    P = a[:, None] * u + b[:, None] * v + off[:, None] * n_hat
+    N = np.tile(n_hat, (2000, 1))
+    q = (1e3 * u).tolist()  # in the plane: N·(q - P) = -off
+    scene = {
+        "material": {"ambient": [0, 0, 0], "diffuse": [0, 0, 0], "specular": [1, 1, 1]},
+        "ambient": [0, 0, 0],
+        "viewer": {"eye": q},  # V = L: N·H = N·L, and a tiny exponent makes the lobe ~1
+        "lights": [{"type": "point", "position": q}],
+    }
+    s32 = explorer.Shader(scene, P, N, precision="float32")
+    s64 = explorer.Shader(scene, P, N, precision="float64")
+    for shininess in (1e-3, 1e-6, 2e-6):  # a pass that keeps the lobes, then the lobe alone
+        for s in (s32, s64):
+            s.set_material(s.scene.material.replace(shininess=shininess))
+        assert np.abs(s32.colors - s64.colors).max() <= tol.FLOAT32_MAX_ABS_ERROR
+        assert (s64.colors > 0.5).any() and (s64.colors == 0).any()  # both signs occur
+    assert s32.stats["lobe"] == 2 and s32.stats["fixup_vertices"] >= 1000
