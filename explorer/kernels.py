@@ -283,6 +283,15 @@ def _fpow_overload(x, y):
     return lambda x, y: x**y
 
 
+@nb.njit(inline="always", **_LEAF)
+def _row(scr, r, m):
+    """Row ``r`` of a block's scratch, its first ``m`` lanes. The rows lie BLOCK apart in one
+    flat array, so each is the scratch's start plus a constant: LLVM then proves the rows of a
+    loop disjoint without run-time overlap checks, and addresses them all from one register
+    (with a 2-D scratch each row was a pointer of its own: more than the registers)."""
+    return scr[r * BLOCK : r * BLOCK + m]
+
+
 @nb.njit(**_LEAF)
 def _copy(dst, src):
     for i in range(dst.shape[0]):
@@ -431,14 +440,14 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
 
     def impl(scr, m, dx, gd, q, y, k, variant):
         # rows as separate 1-D arrays: lets the compiler check overlap once and vectorise
-        px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
-        nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
-        vx, vy, vz, NV = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m], scr[R_NV, :m]
-        Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
-        Dx, Dy, Dz = scr[dx, :m], scr[dx + 1, :m], scr[dx + 2, :m]
-        Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
-        B, WS, TRK = scr[R_BASE, :m], scr[R_WS, :m], scr[R_TRK, :m]
-        GD, GS = scr[gd, :m], scr[R_GS, :m]
+        px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
+        nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
+        vx, vy, vz, NV = _row(scr, R_VX, m), _row(scr, R_VY, m), _row(scr, R_VZ, m), _row(scr, R_NV, m)
+        Lx, Ly, Lz, W = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m)
+        Dx, Dy, Dz = _row(scr, dx, m), _row(scr, dx + 1, m), _row(scr, dx + 2, m)
+        Sx, Sy, Sz = _row(scr, R_SX, m), _row(scr, R_SY, m), _row(scr, R_SZ, m)
+        B, WS, TRK = _row(scr, R_BASE, m), _row(scr, R_WS, m), _row(scr, R_TRK, m)
+        GD, GS = _row(scr, gd, m), _row(scr, R_GS, m)
         zero, one, two = k[K_ZERO], unit(k), k[K_TWO]
         h_eps2, p_eps2, floor = k[K_HALF_EPS2], k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
         c_dot, c_len2, c_dist2 = k[K_MARGIN_DOT], k[K_MARGIN_LEN2], k[K_MARGIN_DIST2]
@@ -633,9 +642,9 @@ def _to_light(scr, m, q, k, atten):
     floor = k[K_ATT_FLOOR]
     kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
     qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
-    px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
-    nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]
-    Lx, Ly, Lz, W, TRK = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m], scr[R_TRK, :m]
+    px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
+    nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
+    Lx, Ly, Lz, W, TRK = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m), _row(scr, R_TRK, m)
     if atten:
         for i in range(m):
             x = qx - px[i]
@@ -673,7 +682,7 @@ def _spot(scr, m, q, k, exponent):
     zero, c_dot = k[K_ZERO], k[K_MARGIN_DOT]
     ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
     cosc, e = q[P_COS], q[P_EXP]
-    Lx, Ly, Lz, W, TRK = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m], scr[R_TRK, :m]
+    Lx, Ly, Lz, W, TRK = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m), _row(scr, R_TRK, m)
     for i in range(m):
         x = -(Lx[i] * ax + Ly[i] * ay + Lz[i] * az)
         if exponent:
@@ -687,7 +696,7 @@ def _spot(scr, m, q, k, exponent):
 @nb.njit(**_LEAF)
 def _dir_rows(scr, m, q, one):
     """Directional light on the row path (shadows, Fresnel): rows L = constant, w = 1."""
-    Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
+    Lx, Ly, Lz, W = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m)
     qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
     for i in range(m):
         Lx[i] = qx
@@ -699,7 +708,7 @@ def _dir_rows(scr, m, q, one):
 @nb.njit(**_LEAF)
 def _shadow(scr, m, vis):
     """w *= visibility (0 or 1 per vertex, from explorer.shadows)."""
-    W = scr[R_W, :m]
+    W = _row(scr, R_W, m)
     for i in range(m):
         W[i] = W[i] * vis[i]
 
@@ -710,8 +719,8 @@ def _fresnel(scr, m, q, k):
     zero, one = k[K_ZERO], k[K_ONE]
     half = one / k[K_TWO]
     f0 = q[P_F0]
-    Lx, Ly, Lz, W = scr[R_LX, :m], scr[R_LY, :m], scr[R_LZ, :m], scr[R_W, :m]
-    vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
+    Lx, Ly, Lz, W = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m)
+    vx, vy, vz = _row(scr, R_VX, m), _row(scr, R_VY, m), _row(scr, R_VZ, m)
     for i in range(m):
         vl = Lx[i] * vx[i] + Ly[i] * vy[i] + Lz[i] * vz[i]
         c = np.sqrt(max((one + vl) * half, zero))
@@ -724,7 +733,7 @@ def _fresnel(scr, m, q, k):
 def _ambient(scr, m, q):
     """A += w·a_i (an attenuated or cone-cut light ambient)."""
     ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
-    W, Ax, Ay, Az = scr[R_W, :m], scr[R_AX, :m], scr[R_AY, :m], scr[R_AZ, :m]
+    W, Ax, Ay, Az = _row(scr, R_W, m), _row(scr, R_AX, m), _row(scr, R_AY, m), _row(scr, R_AZ, m)
     for i in range(m):
         w = W[i]
         Ax[i] += w * ar
@@ -800,8 +809,8 @@ def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k
 def _keep_lobe(scr, m, base, ws, flat):
     """A light's lobe base (unless the lobe is flat) and weight rows into the lobe store."""
     if not flat:
-        _copy(base, scr[R_BASE, :m])
-    _copy(ws, scr[R_WS, :m])
+        _copy(base, _row(scr, R_BASE, m))
+    _copy(ws, _row(scr, R_WS, m))
 
 
 @nb.njit(**_LEAF)
@@ -937,19 +946,19 @@ def _block(
     do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
     store_lobe = opts[O_STORE_LOBE] != 0
     track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
-    px, py, pz = scr[R_PX, :m], scr[R_PY, :m], scr[R_PZ, :m]
-    nx, ny, nz = scr[R_NX, :m], scr[R_NY, :m], scr[R_NZ, :m]  # (two-sided flips these copies)
+    px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
+    nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)  # (two-sided flips these copies)
     _copy(px, gpx)
     _copy(py, gpy)
     _copy(pz, gpz)
     _copy(nx, gx)
     _copy(ny, gy)
     _copy(nz, gz)
-    vx, vy, vz = scr[R_VX, :m], scr[R_VY, :m], scr[R_VZ, :m]
-    Ax, Ay, Az = scr[R_AX, :m], scr[R_AY, :m], scr[R_AZ, :m]
-    Dx, Dy, Dz = scr[R_DX, :m], scr[R_DY, :m], scr[R_DZ, :m]
-    Sx, Sy, Sz = scr[R_SX, :m], scr[R_SY, :m], scr[R_SZ, :m]
-    trk = scr[R_TRK, :m]
+    vx, vy, vz = _row(scr, R_VX, m), _row(scr, R_VY, m), _row(scr, R_VZ, m)
+    Ax, Ay, Az = _row(scr, R_AX, m), _row(scr, R_AY, m), _row(scr, R_AZ, m)
+    Dx, Dy, Dz = _row(scr, R_DX, m), _row(scr, R_DY, m), _row(scr, R_DZ, m)
+    Sx, Sy, Sz = _row(scr, R_SX, m), _row(scr, R_SY, m), _row(scr, R_SZ, m)
+    trk = _row(scr, R_TRK, m)
     # the inline loops always add a diffuse term: for a specular-only pass it goes to the rows
     # R_LX, R_LY, R_LZ (RGB) and R_D (grey), which the inline loops never read
     junk_zeroed = False
@@ -960,10 +969,10 @@ def _block(
     # there are no RGB rows to zero, add to, store or compose from
     if grey_only:
         if do_dif or D.shape[0] == 0:
-            _fill(scr[R_GD, :m], zero)
+            _fill(_row(scr, R_GD, m), zero)
         else:  # the cached diffuse sum (grey: see grey_pass)
-            _copy(scr[R_GD, :m], D)
-        _fill(scr[R_GS, :m], zero)
+            _copy(_row(scr, R_GD, m), D)
+        _fill(_row(scr, R_GS, m), zero)
         used_grey = True
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
         if opts[O_LOCAL]:
@@ -975,7 +984,7 @@ def _block(
     if two_sided:
         _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
     if track and do_spec and not flat:  # N·V, for the inline lobes
-        _dot(nx, ny, nz, vx, vy, vz, scr[R_NV, :m])
+        _dot(nx, ny, nz, vx, vy, vz, _row(scr, R_NV, m))
 
     # the sums: recomputed ones start at 0, the others come from the caches
     has_a = do_amb or A.shape[0] > 0  # else no per-vertex ambient: its rows stay unused
@@ -998,8 +1007,8 @@ def _block(
         if _is_inline(fl, track, l_dif, l_spec, mode):  # L, attenuation inline
             grey = (fl & GREY) != 0
             if grey and not used_grey:
-                _fill(scr[R_GD, :m], zero)
-                _fill(scr[R_GS, :m], zero)
+                _fill(_row(scr, R_GD, m), zero)
+                _fill(_row(scr, R_GS, m), zero)
             used_grey = used_grey or grey
             if l_dif:
                 _light_inline(
@@ -1008,7 +1017,7 @@ def _block(
             else:  # specular only (a viewer change): the diffuse goes to rows nobody reads
                 if not junk_zeroed:
                     for row in (R_LX, R_LY, R_LZ, R_D):
-                        _fill(scr[row, :m], zero)
+                        _fill(_row(scr, row, m), zero)
                     junk_zeroed = True
                 _light_inline(
                     scr, m, R_LX, R_D, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey
@@ -1049,7 +1058,7 @@ def _block(
                 count += 1 if trk[i] < lim else 0
         mark[0] = count
     if grey_only:
-        GD, GS = scr[R_GD, :m], scr[R_GS, :m]
+        GD, GS = _row(scr, R_GD, m), _row(scr, R_GS, m)
         if opts[O_STORE]:
             if do_amb and A.shape[0] > 0:
                 _store_rows(A, Ax, Ay, Az)
@@ -1060,8 +1069,8 @@ def _block(
             _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k, has_a)
         return
     if used_grey:  # the grey sums count in every channel
-        _add_grey(Dx, Dy, Dz, scr[R_GD, :m])
-        _add_grey(Sx, Sy, Sz, scr[R_GS, :m])
+        _add_grey(Dx, Dy, Dz, _row(scr, R_GD, m))
+        _add_grey(Sx, Sy, Sz, _row(scr, R_GS, m))
     if opts[O_STORE]:
         if do_amb and A.shape[0] > 0:
             _store_rows(A, Ax, Ay, Az)
@@ -1301,7 +1310,7 @@ def shade(
         ):
             raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
     for t in nb.prange(ntasks):
-        scr = np.empty((N_ROWS, BLOCK), params.dtype)  # once per task: no allocation per block
+        scr = np.empty(N_ROWS * BLOCK, params.dtype)  # once per task: no allocation per block
         _task(
             G,
             params,
@@ -1435,7 +1444,7 @@ def fixup(
         np.zeros(0, np.bool_),
         np.zeros(0, np.int32),
         om.reshape(-1),
-        np.empty((N_ROWS, BLOCK)),
+        np.empty(N_ROWS * BLOCK),
         0,
         nblocks,
         grey,
@@ -1479,7 +1488,7 @@ def lobe(base, ws, params, flags, shininess, k, S):
     ntasks = _tasks(nblocks)
     Sf = S.reshape(-1)
     for t in nb.prange(ntasks):
-        scr = np.empty((3, BLOCK), params.dtype)
+        scr = np.empty(3 * BLOCK, params.dtype)
         _lobe_task(
             base,
             ws,
@@ -1503,7 +1512,7 @@ def _lobe_task(base, ws, params, flags, shininess, k, Sf, scr, b0, b1):
         s = b * BLOCK
         e = min(n, s + BLOCK)
         m = e - s
-        Sx, Sy, Sz = scr[0, :m], scr[1, :m], scr[2, :m]
+        Sx, Sy, Sz = _row(scr, 0, m), _row(scr, 1, m), _row(scr, 2, m)
         _fill(Sx, k[K_ZERO])
         _fill(Sy, k[K_ZERO])
         _fill(Sz, k[K_ZERO])
