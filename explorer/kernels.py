@@ -221,7 +221,7 @@ def split32(typingctx, x):
     return types.UniTuple(types.float32, 2)(types.float32), codegen
 
 
-@nb.njit(**_LEAF)
+@nb.njit(inline="always", **_LEAF)
 def log2_32(x):
     """log2 x for a positive, finite float32 x (-127 for x = 0)."""
     e, f = split32(x)
@@ -236,7 +236,7 @@ def log2_32(x):
     return e + ln * np.float32(1.4426950408889634)
 
 
-@nb.njit(**_LEAF)
+@nb.njit(inline="always", **_LEAF)
 def exp2_32(t):
     """2**t for float32 t; 0 for t <= -127."""
     t = max(t, np.float32(-127.0))
@@ -251,7 +251,7 @@ def exp2_32(t):
     return q * i2f((np.int32(k) + np.int32(127)) << 23)
 
 
-@nb.njit(**_LEAF)
+@nb.njit(inline="always", **_LEAF)
 def pow32(x, y):
     """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
     t = y * log2_32(x)
@@ -271,6 +271,21 @@ def _unit_overload(k):
     return lambda k: np.float64(1.0)
 
 
+def nil(k):
+    """0 in the precision of ``k``, as a compile-time constant (see :func:`unit`). A square
+    root's argument must be provably >= 0 (``max(x, nil(k))``, not ``max(x, k[K_ZERO])``):
+    LLVM then makes it an instruction; otherwise it stays a call to libm's sqrtf (which may set
+    errno), and a loop with a call does not vectorise."""
+    return k.dtype.type(0)
+
+
+@overload(nil, jit_options=_LEAF)
+def _nil_overload(k):
+    if k.dtype == types.float32:
+        return lambda k: np.float32(0.0)
+    return lambda k: np.float64(0.0)
+
+
 def fpow(x, y):
     """x**y in the working precision: :func:`pow32` for float32, libm for float64."""
     return x**y
@@ -283,12 +298,32 @@ def _fpow_overload(x, y):
     return lambda x, y: x**y
 
 
+@intrinsic
+def _assume(typingctx, cond):
+    """Tell LLVM ``cond`` holds (``llvm.assume``): no code, only facts for the optimiser."""
+    if not isinstance(cond, types.Boolean):
+        return None
+
+    def codegen(context, builder, sig, args):
+        fn = builder.module.declare_intrinsic(
+            "llvm.assume", fnty=ir.FunctionType(ir.VoidType(), [ir.IntType(1)])
+        )
+        builder.call(fn, [args[0]])
+        return context.get_dummy_value()
+
+    return types.none(cond), codegen
+
+
 @nb.njit(inline="always", **_LEAF)
 def _row(scr, r, m):
-    """Row ``r`` of a block's scratch, its first ``m`` lanes. The rows lie BLOCK apart in one
-    flat array, so each is the scratch's start plus a constant: LLVM then proves the rows of a
-    loop disjoint without run-time overlap checks, and addresses them all from one register
-    (with a 2-D scratch each row was a pointer of its own: more than the registers)."""
+    """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie BLOCK
+    apart in one flat array, and LLVM is told the scratch holds row ``r`` whole: the slice is
+    then the scratch's start plus a constant, not clamped at run time, so LLVM proves the rows
+    of a loop disjoint (no run-time overlap checks: a loop that reads and writes many rows had
+    too many to vectorise at all) and addresses them all from one register."""
+    _assume(scr.shape[0] >= (r + 1) * BLOCK)
+    _assume(m <= BLOCK)
+    _assume(m >= 0)
     return scr[r * BLOCK : r * BLOCK + m]
 
 
@@ -348,7 +383,7 @@ def _load_normals(N, nx, ny, nz, k):
         c = N[3 * i + 2] * one
         nn = a * a + b * b + c * c
         ok = nn > eps2
-        inv = one / np.sqrt(nn if ok else one)
+        inv = one / np.sqrt(nn if ok else unit(k))  # (>= 0: see nil)
         nx[i] = a * inv if ok else zero
         ny[i] = b * inv if ok else zero
         nz[i] = c * inv if ok else zero
@@ -449,7 +484,8 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
         B, WS, TRK = _row(scr, R_BASE, m), _row(scr, R_WS, m), _row(scr, R_TRK, m)
         GD, GS = _row(scr, gd, m), _row(scr, R_GS, m)
         zero, one, two = k[K_ZERO], unit(k), k[K_TWO]
-        h_eps2, p_eps2, floor = k[K_HALF_EPS2], k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
+        # (squares and abs: provably >= 0, which keeps the square roots vectorisable; see nil)
+        h_eps2, p_eps2, floor = abs(k[K_HALF_EPS2]), k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
         c_dot, c_len2, c_dist2 = k[K_MARGIN_DOT], k[K_MARGIN_LEN2], k[K_MARGIN_DIST2]
         kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
         dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
@@ -716,14 +752,14 @@ def _shadow(scr, m, vis):
 @nb.njit(**_LEAF)
 def _fresnel(scr, m, q, k):
     """w *= F = F0 + (1 - F0)(1 - V·H)^5 with V·H = sqrt((1 + V·L) / 2) (unit L, V)."""
-    zero, one = k[K_ZERO], k[K_ONE]
+    one = k[K_ONE]
     half = one / k[K_TWO]
     f0 = q[P_F0]
     Lx, Ly, Lz, W = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m)
     vx, vy, vz = _row(scr, R_VX, m), _row(scr, R_VY, m), _row(scr, R_VZ, m)
     for i in range(m):
         vl = Lx[i] * vx[i] + Ly[i] * vy[i] + Lz[i] * vz[i]
-        c = np.sqrt(max((one + vl) * half, zero))
+        c = np.sqrt(max((one + vl) * half, nil(k)))
         x = one - c
         x2 = x * x
         W[i] = W[i] * (f0 + (one - f0) * (x2 * x2 * x))
