@@ -24,7 +24,7 @@ import numpy as np
 
 import explorer
 from explorer import kernels as K
-from explorer.lights import PointLight
+from explorer.lights import PointLight, SpotLight
 from explorer.material import Material
 from explorer.reference import reference_shade
 from explorer.scene import Scene, Viewer
@@ -81,6 +81,23 @@ def scene_with(lights: int, rng) -> Scene:
     )
 
 
+def spot_lights(lights: int, rng) -> tuple:
+    """Spot lights around the mesh, each aimed at the centre (cone 40°, exponent 8)."""
+    out = []
+    for _ in range(lights):
+        p = rng.normal(size=3) * 3
+        out.append(
+            SpotLight(
+                position=tuple(p),
+                direction=tuple(-p / np.linalg.norm(p)),
+                cutoff=40.0,
+                exponent=8.0,
+                attenuation=(1.0, 0.1, 0.01),
+            )
+        )
+    return tuple(out)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--vertices", type=int, default=1_000_000)
@@ -119,6 +136,17 @@ def main(argv=None) -> int:
         )
         if precision == "float32":
             full32 = med
+
+    # the same with spot lights (cone and exponent: the engine's row path, not the inline one)
+    spots = [spot_lights(L, np.random.default_rng(s)) for s in (0, 1)]
+    sh = explorer.Shader(scene.replace(lights=spots[0]), P, N, precision="float32")
+
+    def respot(sh=sh, flip=spots):
+        flip.reverse()
+        sh.set_lights(flip[0])
+        return sh.colors
+
+    row(f"full shading, float32 ({L} spot lights, Blinn, local viewer)", *timed(respot, R), n * L)
 
     one_shot = timed(lambda: explorer.shade(scene, P, N, precision="float32"), R)
     row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
