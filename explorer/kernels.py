@@ -315,6 +315,16 @@ def _assume(typingctx, cond):
 
 
 @nb.njit(inline="always", **_LEAF)
+def _row_checked(scr, r, m):
+    """:func:`_row` without telling LLVM that the row lies whole in the scratch: the slice is
+    then clamped at run time, and LLVM checks a loop's rows for overlap before it enters the
+    vector loop. For the inline light loops: rows at a known constant distance make LLVM refuse to
+    interleave two vector iterations (it takes the distance as a limit), and interleaving is
+    worth more there (0.93x without it, full pass at 1M)."""
+    return scr[r * BLOCK : r * BLOCK + m]
+
+
+@nb.njit(inline="always", **_LEAF)
 def _row(scr, r, m):
     """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie BLOCK
     apart in one flat array, and LLVM is told the scratch holds row ``r`` whole: the slice is
@@ -324,17 +334,7 @@ def _row(scr, r, m):
     _assume(scr.shape[0] >= (r + 1) * BLOCK)
     _assume(m <= BLOCK)
     _assume(m >= 0)
-    return scr[r * BLOCK : r * BLOCK + m]
-
-
-@nb.njit(inline="always", **_LEAF)
-def _row_checked(scr, r, m):
-    """:func:`_row` without telling LLVM the row lies whole in the scratch: the slice is then
-    clamped at run time, and LLVM checks a loop's rows for overlap before it enters the vector
-    loop. For the inline light loops: rows at a known constant distance make LLVM refuse to
-    interleave two vector iterations (it takes the distance as a limit), and interleaving is
-    worth more there (0.93x without it, full pass at 1M)."""
-    return scr[r * BLOCK : r * BLOCK + m]
+    return _row_checked(scr, r, m)
 
 
 @nb.njit(**_LEAF)
@@ -1009,11 +1009,8 @@ def _block(
     store_lobe = opts[O_STORE_LOBE] != 0
     track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
     px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
-    nx, ny, nz = (
-        _row(scr, R_NX, m),
-        _row(scr, R_NY, m),
-        _row(scr, R_NZ, m),
-    )  # (two-sided flips these copies)
+    # (two-sided flips these copies)
+    nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
     _copy(px, gpx)
     _copy(py, gpy)
     _copy(pz, gpz)
