@@ -840,28 +840,24 @@ def _store_rows(dst, rx, ry, rz):
 
 
 @nb.njit(**_LEAF)
-def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k):
-    """colour = e_m + a_m·(ambient) + d_m·diffuse + s_m·specular, clamped to [0, 1]."""
+def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k, has_a):
+    """colour = e_m + a_m·(ambient) + d_m·diffuse + s_m·specular, clamped to [0, 1]; the
+    per-vertex ambient rows are read only when ``has_a`` (else the constant ambient alone)."""
     lo = k[K_ZERO]
     hi = k[K_ONE] if clamp else k[K_INF]
     e0 = mat[0] + mat[3] * aconst[0]
     e1 = mat[1] + mat[4] * aconst[1]
     e2 = mat[2] + mat[5] * aconst[2]
-    a0, a1, a2, d0, d1, d2, s0, s1, s2 = (
-        mat[3],
-        mat[4],
-        mat[5],
-        mat[6],
-        mat[7],
-        mat[8],
-        mat[9],
-        mat[10],
-        mat[11],
-    )
-    for i in range(Ax.shape[0]):
-        r = e0 + a0 * Ax[i] + d0 * Dx[i] + s0 * Sx[i]  # e + a_m·(a_const + A) + d_m·D + s_m·S
-        g = e1 + a1 * Ay[i] + d1 * Dy[i] + s1 * Sy[i]
-        b = e2 + a2 * Az[i] + d2 * Dz[i] + s2 * Sz[i]
+    a0, a1, a2, d0, d1, d2 = mat[3], mat[4], mat[5], mat[6], mat[7], mat[8]
+    s0, s1, s2 = mat[9], mat[10], mat[11]
+    for i in range(Dx.shape[0]):
+        r = e0 + d0 * Dx[i] + s0 * Sx[i]  # e + a_m·a_const + d_m·D + s_m·S
+        g = e1 + d1 * Dy[i] + s1 * Sy[i]
+        b = e2 + d2 * Dz[i] + s2 * Sz[i]
+        if has_a:  # + a_m·A (loop-invariant: LLVM unswitches it)
+            r += a0 * Ax[i]
+            g += a1 * Ay[i]
+            b += a2 * Az[i]
         out[3 * i] = min(max(r, lo), hi)
         out[3 * i + 1] = min(max(g, lo), hi)
         out[3 * i + 2] = min(max(b, lo), hi)
@@ -936,8 +932,7 @@ def _store_grey(dst, g, width):
 
 @nb.njit(**_LEAF)
 def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
-    """:func:`_compose_rows` when the diffuse and specular sums are grey rows alone (and
-    without per-vertex ambient rows unless ``has_a``)."""
+    """:func:`_compose_rows` when the diffuse and specular sums are grey rows alone."""
     lo = k[K_ZERO]
     hi = k[K_ONE] if clamp else k[K_INF]
     e0 = mat[0] + mat[3] * aconst[0]
@@ -945,21 +940,15 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
     e2 = mat[2] + mat[5] * aconst[2]
     a0, a1, a2, d0, d1, d2 = mat[3], mat[4], mat[5], mat[6], mat[7], mat[8]
     s0, s1, s2 = mat[9], mat[10], mat[11]
-    if not has_a:
-        for i in range(GD.shape[0]):
-            gd, gs = GD[i], GS[i]
-            r = e0 + d0 * gd + s0 * gs  # e + a_m·a_const + d_m·D + s_m·S
-            g = e1 + d1 * gd + s1 * gs
-            b = e2 + d2 * gd + s2 * gs
-            out[3 * i] = min(max(r, lo), hi)
-            out[3 * i + 1] = min(max(g, lo), hi)
-            out[3 * i + 2] = min(max(b, lo), hi)
-        return
-    for i in range(Ax.shape[0]):
+    for i in range(GD.shape[0]):
         gd, gs = GD[i], GS[i]
-        r = e0 + a0 * Ax[i] + d0 * gd + s0 * gs  # e + a_m·(a_const + A) + d_m·D + s_m·S
-        g = e1 + a1 * Ay[i] + d1 * gd + s1 * gs
-        b = e2 + a2 * Az[i] + d2 * gd + s2 * gs
+        r = e0 + d0 * gd + s0 * gs  # e + a_m·a_const + d_m·D + s_m·S
+        g = e1 + d1 * gd + s1 * gs
+        b = e2 + d2 * gd + s2 * gs
+        if has_a:  # + a_m·A (loop-invariant: LLVM unswitches it)
+            r += a0 * Ax[i]
+            g += a1 * Ay[i]
+            b += a2 * Az[i]
         out[3 * i] = min(max(r, lo), hi)
         out[3 * i + 1] = min(max(g, lo), hi)
         out[3 * i + 2] = min(max(b, lo), hi)
@@ -1142,9 +1131,8 @@ def _block(
         if do_spec and S.shape[0] > 0:
             _store_rows(S, Sx, Sy, Sz)
     if opts[O_COMPOSE]:
-        if not has_a:
-            _load_rows(A[:0], Ax, Ay, Az, zero)
-        _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, opts[O_CLAMP] != 0, k)
+        clamp = opts[O_CLAMP] != 0
+        _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k, has_a)
 
 
 @nb.njit(**_LEAF)
