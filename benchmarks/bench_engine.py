@@ -3,6 +3,11 @@
     python benchmarks/bench_engine.py                # 1M vertices, 8 point lights
     python benchmarks/bench_engine.py --vertices 200000 --lights 4 --repeat 15
 
+The full-shading rows run twice on random points (every vertex-light computed: the kernel's
+raw rate) and on a UV sphere mesh with as many vertices, in mesh order and shuffled: the
+engine skips a light for runs of vertices that all face away from it (light culling), which
+only a mesh whose vertex order keeps neighbours together allows.
+
 Prints the machine, then one row per case: median and best wall time over ``--repeat`` runs (the
 first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
 floor of a recolour (read positions and normals once, write colours once) is measured in the
@@ -21,6 +26,7 @@ import time
 
 import numba
 import numpy as np
+from common import uv_sphere  # benchmarks/common.py
 
 import explorer
 from explorer import kernels as K
@@ -137,6 +143,42 @@ def main(argv=None) -> int:
         if precision == "float32":
             full32 = med
 
+    # the same lights on a mesh: a UV sphere with as many vertices, in the order it was made
+    # (ring after ring), and the same vertices shuffled. In mesh order neighbours sit
+    # together, and a run of 32 that all face away from a light skips it (light culling);
+    # shuffled, no run has a narrow cone of normals, so nothing is culled and every
+    # vertex-light is computed
+    around = max(8, int(round(np.sqrt(n))))
+    mesh = uv_sphere(around, max(2, n // around - 1))
+    Pm = mesh.positions.astype(np.float32)
+    order = np.random.default_rng(2).permutation(len(Pm))
+    m = len(Pm)
+    culled = {}
+    for label, P_ in (("mesh order", Pm), ("shuffled", Pm[order])):
+        sh = explorer.Shader(scene, P_, P_, precision="float32")
+        flip = [scene.lights, other]
+
+        def relight(sh=sh, flip=flip):
+            flip.reverse()
+            sh.set_lights(flip[0])
+            return sh.colors
+
+        before = sh.stats["culled"], sh.stats["pass"]
+        med, best = timed(relight, R)
+        done = sh.stats["pass"] - before[1]
+        culled[label] = (sh.stats["culled"] - before[0]) / max(done, 1) / (m * L)
+        row(
+            f"full shading, float32, {m:,}-vertex UV sphere, {label} ({L} point lights)",
+            med,
+            best,
+            m * L,
+            f"light culling skips {culled[label]:.0%} of the vertex-lights",
+        )
+        if label == "mesh order":
+            mesh32 = med
+        else:
+            shuffled32 = med
+
     # the same with spot lights (cone and exponent: the engine's row path, not the inline one)
     spots = [spot_lights(L, np.random.default_rng(s)) for s in (0, 1)]
     sh = explorer.Shader(scene.replace(lights=spots[0]), P, N, precision="float32")
@@ -210,6 +252,10 @@ def main(argv=None) -> int:
         f"{recol[1] / floor[1]:.2f}x (best)"
     )
     print(f"full float32 shading vs plain numpy reference: {ref[0] * n / sub / full32:.1f}x faster")
+    print(
+        f"UV sphere, mesh order vs shuffled (light culling): {shuffled32 / mesh32:.2f}x faster "
+        f"({culled['mesh order']:.0%} of the vertex-lights skipped)"
+    )
     return 0
 
 

@@ -35,6 +35,8 @@ import numpy as np
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
+from common import uv_sphere  # noqa: E402  (benchmarks/common.py)
+
 import explorer  # noqa: E402
 from explorer import gui  # noqa: E402
 from explorer import meshes as M  # noqa: E402
@@ -99,20 +101,6 @@ def scene_for(mesh, count: int) -> Scene:
         lights=lights_around(mesh, count),
         viewer=Viewer(eye=tuple(eye)),
     )
-
-
-def uv_sphere(around: int, rings: int) -> M.Mesh:
-    """A UV sphere with ``around * (rings + 1)`` vertices (seam duplicated)."""
-    theta = np.linspace(0.0, np.pi, rings + 1)
-    phi = np.linspace(0.0, 2.0 * np.pi, around, endpoint=False)
-    t, p = np.meshgrid(theta, phi, indexing="ij")
-    pos = np.stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)], -1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(rings), np.arange(around), indexing="ij")
-    a = i * around + j
-    b = i * around + (j + 1) % around
-    c, d = a + around, b + around
-    faces = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)]).reshape(-1, 3)
-    return M.Mesh(pos, pos.copy(), faces, "uv_sphere")
 
 
 def finish(plotter) -> None:

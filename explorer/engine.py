@@ -147,6 +147,7 @@ class Shader:
         self._G = np.empty((6, n), self._T)  # frame positions and unit normals, SoA
         K.prepare(self._P, self._N, self._centre, 1.0 / self._scale, self._k, self._G)
         self.stats["geometry"] += 1
+        self._bounds = self._chunk_bounds()
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._colors = None
@@ -154,7 +155,19 @@ class Shader:
         self._spares: list[np.ndarray] = []  # memory of invalidated sums, reused likewise
         self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
         self._marks = np.zeros(-(-self._amb.size // K.BLOCK), np.int32)  # per block
+        self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
         self._lights_changed()
+
+    def _chunk_bounds(self) -> np.ndarray:
+        """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices, for
+        light culling (see :func:`explorer.kernels.bounds`), read-only; (N_BOUNDS, 0) when no
+        chunk has a normal cone narrower than 90° (shuffled vertices, say): nothing could be
+        culled, so the kernel does not test."""
+        b = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
+        K.bounds(self._G, b)
+        if not (b[K.B_COS] > 0).any():
+            b = b[:, :0]
+        return _readonly(b)
 
     def set_scene(self, scene) -> None:
         """Apply a new scene, invalidating only what its differences touch."""
@@ -537,8 +550,11 @@ class Shader:
             amb,
             self._marks,
             self._out,
+            self._bounds if self._plan.cull else self._bounds[:, :0],
+            self._culled,
         )
         self.stats["pass"] += 1
+        self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64

@@ -129,6 +129,17 @@ N_ROWS = 29
 # lobe modes
 LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
 
+#: vertices per culling chunk (two 16-lane vector iterations): a light is skipped for a chunk
+#: that provably gets nothing from it (see :func:`bounds` and :func:`_reach`)
+CHUNK = 32
+CHUNKS = BLOCK // CHUNK  # chunks per block
+
+# chunk bound rows (float64, see :func:`bounds`): the chunk's bounding sphere (centre, radius)
+# and its cone of normals (unit axis, cosine and sine of the half-angle; cosine -1 where the
+# cone is 90° or wider, or some normal is absent: such a chunk is never culled)
+B_CX, B_CY, B_CZ, B_R, B_AX, B_AY, B_AZ, B_COS, B_SIN = range(9)
+N_BOUNDS = 9
+
 
 # constants passed in the working precision (a float literal would promote float32 to float64)
 (
@@ -433,6 +444,116 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
         ny[i] = -ny[i] if s else ny[i]
         nz[i] = -nz[i] if s else nz[i]
         trk[i] = min(trk[i], abs(ndv) * c_dot)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def bounds(G, out):
+    """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
+
+    G : (6, n) T prepared geometry (see :func:`prepare`)
+    out : (N_BOUNDS, ceil(n / CHUNK)) float64: the bounding sphere of the chunk's positions
+    (centre of its box, radius to the farthest vertex) and the cone of its normals (axis: their
+    mean direction; half-angle: the widest normal from it), both widened by
+    :data:`explorer.tolerances.CULL_GUARD`. A cone of 90° or more, or a chunk with an absent
+    (zero) normal, gets cosine -1: never culled.
+    """
+    n = G.shape[1]
+    guard = tol.CULL_GUARD
+    for c in nb.prange(out.shape[1]):
+        s = c * CHUNK
+        e = min(n, s + CHUNK)
+        lo = np.full(3, np.inf)
+        hi = np.full(3, -np.inf)
+        ax = ay = az = 0.0
+        for i in range(s, e):
+            for d in range(3):
+                v = np.float64(G[d, i])
+                lo[d] = min(lo[d], v)
+                hi[d] = max(hi[d], v)
+            ax += np.float64(G[3, i])
+            ay += np.float64(G[4, i])
+            az += np.float64(G[5, i])
+        cx, cy, cz = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])
+        r2 = 0.0
+        for i in range(s, e):
+            x = np.float64(G[0, i]) - cx
+            y = np.float64(G[1, i]) - cy
+            z = np.float64(G[2, i]) - cz
+            r2 = max(r2, x * x + y * y + z * z)
+        r = np.sqrt(r2) * (1.0 + guard) + guard
+        la = np.sqrt(ax * ax + ay * ay + az * az)
+        ct = -1.0
+        if la > 0.0:
+            ax, ay, az = ax / la, ay / la, az / la
+            ct = 1.0
+            for i in range(s, e):
+                nn = ax * G[3, i] + ay * G[4, i] + az * G[5, i]
+                ct = min(ct, nn)  # an absent normal gives 0: never culled
+            ct -= guard
+        if ct <= 0.0:
+            ct = -1.0
+        out[B_CX, c], out[B_CY, c], out[B_CZ, c], out[B_R, c] = cx, cy, cz, r
+        out[B_AX, c], out[B_AY, c], out[B_AZ, c] = ax, ay, az
+        out[B_COS, c] = ct
+        out[B_SIN, c] = np.sqrt(max(1.0 - ct * ct, 0.0)) + guard
+
+
+@nb.njit(**_LEAF)
+def _reach(bd, c0, nc, q, fl, back, act):
+    """Which of chunks ``c0`` to ``c0 + nc - 1`` light ``q`` can reach: ``act[j]`` 1 if chunk
+    c0 + j may get something from it, 0 if provably nothing (returns how many may).
+
+    bd : (N_BOUNDS, nchunks) float64, every chunk's bounds (see :func:`bounds`; whole, not a
+    slice: a C-contiguous array's rows have a known unit stride, and the loop vectorises)
+    back : skip chunks whose every vertex faces away from the light (N·L <= -AMBIGUOUS_DOT):
+    their diffuse and specular are 0 in either precision (not when the light's ambient varies
+    per vertex: that does not depend on N·L). Chunks wholly outside a spot's cone (by
+    AMBIGUOUS_DOT in the cosine) are skipped always: the spot factor zeroes everything.
+    The light must be farther than AMBIGUOUS_DIST from every vertex (else "at the vertex"
+    lights it fully), so no margin the float32 pass keeps is lost by skipping.
+    """
+    eps, dist = tol.AMBIGUOUS_DOT, tol.AMBIGUOUS_DIST
+    positional, cone = (fl & POSITIONAL) != 0, (fl & SPOT) != 0
+    qx, qy, qz = np.float64(q[P_POS]), np.float64(q[P_POS + 1]), np.float64(q[P_POS + 2])
+    if not positional:  # toward a directional light, as a unit vector
+        ql = np.sqrt(qx * qx + qy * qy + qz * qz)
+        qx, qy, qz = qx / ql, qy / ql, qz / ql
+    sx, sy, sz = np.float64(q[P_AXIS]), np.float64(q[P_AXIS + 1]), np.float64(q[P_AXIS + 2])
+    cosc = np.float64(q[P_COS]) - eps
+    back_on = 1 if back else 0
+    count = 0
+    # branch-free (each test computed, combined as integers), so that it vectorises
+    for j in range(nc):
+        r, ct, st = bd[B_R, c0 + j], bd[B_COS, c0 + j], bd[B_SIN, c0 + j]
+        ax, ay, az = bd[B_AX, c0 + j], bd[B_AY, c0 + j], bd[B_AZ, c0 + j]
+        if positional:  # u = light - centre; N·(q - p) <= max over the cone of N·u, + r
+            ux, uy, uz = qx - bd[B_CX, c0 + j], qy - bd[B_CY, c0 + j], qz - bd[B_CZ, c0 + j]
+            uu = ux * ux + uy * uy + uz * uz
+            t = ax * ux + ay * uy + az * uz  # |u|·cos(angle from the axis)
+            # away: t·cos + sqrt(uu - t²)·sin + r + eps·(|u| + r) <= 0, without a square root:
+            # h = t·cos + r + eps·(|u| + r) <= 0 and h² >= (uu - t²)·sin² (|u| <= (uu + 1) / 2)
+            h = t * ct + r + eps * (0.5 * (uu + 1.0) + r)
+            far = 1 if uu > (r + dist) * (r + dist) else 0
+            tilt = max(uu - t * t, 0.0) * st * st
+            away = (
+                far & (1 if ct > 0.0 else 0) & (1 if h <= 0.0 else 0) & (1 if h * h >= tilt else 0)
+            )
+            outside = 0
+            if cone:  # every direction light -> vertex at least cutoff (+ eps) off the axis
+                sw = -(sx * ux + sy * uy + sz * uz)  # |u|·cos(axis, centre seen from the light)
+                rr = np.sqrt(max(uu - r * r, 0.0))  # |u|·cos(the sphere's angular radius)
+                rim = sw * rr + np.sqrt(max(uu - sw * sw, 0.0)) * r - cosc * uu
+                outside = far & (1 if sw <= rr else 0) & (1 if rim <= 0.0 else 0)
+        else:
+            t = ax * qx + ay * qy + az * qz  # (as above, with |u| = 1 and r = 0)
+            h = t * ct + eps
+            tilt = max(1.0 - t * t, 0.0) * st * st
+            away = (1 if ct > 0.0 else 0) & (1 if h <= 0.0 else 0) & (1 if h * h >= tilt else 0)
+            outside = 0
+        a = 1 - ((back_on & away) | outside)
+        act[j] = a
+        count += a
+    return count
 
 
 # --------------------------------------------------------------------------------------------
@@ -955,6 +1076,38 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
 
 
 @nb.njit(**_LEAF)
+def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
+    """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
+    ``scr`` starts at the run's first lane, see _block); ``vis`` : (m,) its visibility, or (0,)."""
+    if inline:  # a plain point light on the float32 path (see _is_inline)
+        atten, grey = (fl & ATTEN) != 0, (fl & GREY) != 0
+        if l_dif:
+            _light_inline(scr, m, R_DX, R_GD, q, shininess, k, atten, mode, l_spec, grey)
+        else:  # specular only: the diffuse goes to rows nobody reads (zeroed by _block)
+            _light_inline(scr, m, R_LX, R_D, q, shininess, k, atten, mode, True, grey)
+        return
+    fres = l_spec and (fl & FRESNEL) != 0
+    rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
+    if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
+        _to_light(scr, m, q, k, (fl & ATTEN) != 0)
+        if fl & SPOT:
+            _spot(scr, m, q, k, (fl & SPOT_EXP) != 0)
+        if l_amb:
+            _ambient(scr, m, q)
+    elif rows:  # a directional light on the row path
+        _dir_rows(scr, m, q, k[K_ONE])
+    if fl & SHADOW:  # after the ambient: ambient light is not shadowed
+        _shadow(scr, m, vis)
+    if fres:  # diffuse with w, then specular with w·F
+        if l_dif:
+            _light_any(scr, m, q, shininess, k, True, mode, True, False)
+        _fresnel(scr, m, q, k)
+        _light_any(scr, m, q, shininess, k, True, mode, False, True)
+    else:
+        _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
+
+
+@nb.njit(**_LEAF)
 def _block(
     gpx,
     gpy,
@@ -983,9 +1136,13 @@ def _block(
     grey_only,
     dw,
     sw,
+    act,
+    culled,
 ):
-    """One block; every array argument is already sliced to the block's vertices (``mark``:
-    this block's one-element slice of the marked-lane counts).
+    """One block; every array argument is already sliced to the block's vertices (``mark``,
+    ``culled``: this block's one-element slices of the marked-lane and skipped vertex-light
+    counts; ``act``: (L, chunks) int32, which of its chunks each light can reach (see
+    :func:`_reach`), or (L, 0): no culling).
 
     gpx, gpy, gpz, gx, gy, gz : (m,) T prepared positions and normals (read only), copied into
     the scratch rows, so that every light loop takes the scratch array alone (a call that passes
@@ -1046,6 +1203,9 @@ def _block(
         _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero, dw)
         _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero, sw)
 
+    nc = (m + CHUNK - 1) // CHUNK
+    cull = act.shape[1] > 0  # (see _reach: decided per task)
+    skipped = 0
     for li in range(params.shape[0]):
         fl = flags[li]
         q = params[li, :]
@@ -1055,48 +1215,47 @@ def _block(
         if not (l_amb or l_dif or l_spec):
             continue
         mode = _mode(fl, flat, phong)
-        fres = l_spec and (fl & FRESNEL) != 0
-        if _is_inline(fl, track, l_dif, l_spec, mode):  # L, attenuation inline
+        inline = _is_inline(fl, track, l_dif, l_spec, mode)  # L, attenuation inline
+        if inline:
             grey = (fl & GREY) != 0
             if grey and not used_grey:
                 _fill(_row(scr, R_GD, m), zero)
                 _fill(_row(scr, R_GS, m), zero)
             used_grey = used_grey or grey
-            if l_dif:
-                _light_inline(
-                    scr, m, R_DX, R_GD, q, shininess, k, (fl & ATTEN) != 0, mode, l_spec, grey
-                )
-            else:  # specular only (a viewer change): the diffuse goes to rows nobody reads
-                if not junk_zeroed:
-                    for row in (R_LX, R_LY, R_LZ, R_D):
-                        _fill(_row(scr, row, m), zero)
-                    junk_zeroed = True
-                _light_inline(
-                    scr, m, R_LX, R_D, q, shininess, k, (fl & ATTEN) != 0, mode, True, grey
-                )
-            if store_lobe and l_spec:
-                _keep_lobe(scr, m, base_out[li, :], ws_out[li, :], flat)
-            continue
-        rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
-        if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
-            _to_light(scr, m, q, k, (fl & ATTEN) != 0)
-            if fl & SPOT:
-                _spot(scr, m, q, k, (fl & SPOT_EXP) != 0)
-            if l_amb:
-                _ambient(scr, m, q)
-        elif rows:  # a directional light on the row path
-            _dir_rows(scr, m, q, k[K_ONE])
-        if fl & SHADOW:  # after the ambient: ambient light is not shadowed
-            _shadow(scr, m, vis[li, :])
-        if fres:  # diffuse with w, then specular with w·F
-            if l_dif:
-                _light_any(scr, m, q, shininess, k, True, mode, True, False)
-            _fresnel(scr, m, q, k)
-            _light_any(scr, m, q, shininess, k, True, mode, False, True)
-        else:
-            _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
+            # specular only (a viewer change): the diffuse goes to rows nobody reads
+            if not l_dif and not junk_zeroed:
+                for row in (R_LX, R_LY, R_LZ, R_D):
+                    _fill(_row(scr, row, m), zero)
+                junk_zeroed = True
+        reach = nc
+        if cull:
+            reach = 0
+            for j in range(nc):
+                reach += act[li, j]
+        if reach == nc:  # the whole block
+            _light_run(scr, m, fl, q, shininess, k, vis[li, :], l_amb, l_dif, l_spec, mode, inline)
+        else:  # runs of chunks it can reach; the others get nothing (a zero lobe weight)
+            c = 0
+            while c < nc:
+                e = c + 1
+                while e < nc and act[li, e] == act[li, c]:
+                    e += 1
+                s0, s1 = c * CHUNK, min(m, e * CHUNK)
+                if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
+                    sub = scr[s0 : s0 + N_ROWS * BLOCK]
+                    v = vis[li, s0:s1] if vis.shape[1] else vis[li, :]
+                    _light_run(
+                        sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
+                    )
+                else:
+                    skipped += s1 - s0
+                    if store_lobe and l_spec:
+                        _fill(_row(scr, R_WS, m)[s0:s1], zero)
+                        _fill(_row(scr, R_BASE, m)[s0:s1], zero)
+                c = e
         if store_lobe and l_spec:
             _keep_lobe(scr, m, base_out[li, :], ws_out[li, :], flat)
+    culled[0] = skipped
 
     if opts[O_TRACK]:  # mark the lanes inside some ambiguity band, if any
         lim = unit(k)
@@ -1156,15 +1315,29 @@ def _task(
     marks,
     out,
     scr,
+    act,
     b0,
     b1,
     grey_only,
     dw,
     sw,
+    bounds,
+    culled,
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
     arrays here costs no atomic operations on their counts, which both threads would contend)."""
     n = G.shape[1]
+    # light culling: which chunks of the task's blocks each light can reach, one vectorised
+    # _reach per light (per block, its 16 chunks are fewer than one vector iteration); not
+    # two-sided (N flips with V)
+    c0, c1 = b0 * CHUNKS, min(bounds.shape[1], b1 * CHUNKS)
+    cull = bounds.shape[1] > 0 and opts[O_TWO_SIDED] == 0
+    if cull:
+        do_amb = opts[O_DO_AMB] != 0
+        for li in range(params.shape[0]):
+            fl = flags[li]
+            back = not (do_amb and (fl & AMBIENT) != 0)
+            _reach(bounds, c0, c1 - c0, params[li, :], fl, back, act[li, :])
     for b in range(b0, b1):
         s = b * BLOCK
         e = min(n, s + BLOCK)
@@ -1196,6 +1369,8 @@ def _task(
             grey_only,
             dw,
             sw,
+            act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull else act[:, :0],
+            culled[b : b + 1],
         )
 
 
@@ -1298,6 +1473,32 @@ def _wide(kernel, dtype_arg: int):
 TASKS = 64
 
 
+@nb.njit(**_OPTS)
+def _scratch(dtype):
+    """A task's scratch: N_ROWS rows of BLOCK lanes, and one row more, so that the scratch seen
+    from any lane of a block on (``scr[s0 : s0 + N_ROWS * BLOCK]``, a run of chunks) still
+    holds N_ROWS whole rows."""
+    return np.empty((N_ROWS + 1) * BLOCK, dtype)
+
+
+@nb.njit(**_LEAF)
+def _spread(t, ntasks):
+    """The run of blocks parallel task ``t`` of ``ntasks`` shades: ``t`` with its bits reversed
+    when ``ntasks`` is a power of two (else ``t``). numba's threads take the tasks in contiguous
+    shares (static scheduling), and culling makes work uneven across a mesh (the half a light
+    faces costs, the other half is skipped): reversed bits deal every thread runs from all over
+    the mesh, so the threads finish together."""
+    if ntasks & (ntasks - 1):
+        return t
+    r = 0
+    w = ntasks
+    while w > 1:
+        r = (r << 1) | (t & 1)
+        t >>= 1
+        w >>= 1
+    return r
+
+
 @nb.njit(**_LEAF)
 def _tasks(nblocks):
     return max(1, min(nblocks, TASKS))
@@ -1330,6 +1531,8 @@ def shade(
     amb,
     marks,
     out,
+    bounds,
+    culled,
 ):
     """Shade every vertex (see the module docstring).
 
@@ -1346,6 +1549,9 @@ def shade(
     vertices (both (0,) when not tracking); a block that marks none leaves its part of ``amb``
     as it was: read the marks with :func:`marked`
     out : (n, 3) colours
+    bounds : (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds for light culling (see
+    :func:`bounds`), or (N_BOUNDS, 0): no culling
+    culled : (nblocks,) int32 out: vertex-lights each block skipped by culling
     """
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
@@ -1361,7 +1567,10 @@ def shade(
         ):
             raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
     for t in nb.prange(ntasks):
-        scr = np.empty(N_ROWS * BLOCK, params.dtype)  # once per task: no allocation per block
+        scr = _scratch(params.dtype)  # once per task: no allocation per block
+        r = _spread(np.int64(t), np.int64(ntasks))
+        b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
+        act = np.empty((params.shape[0], (b1 - b0) * CHUNKS), np.int32)
         _task(
             G,
             params,
@@ -1382,11 +1591,14 @@ def shade(
             marks,
             outf,
             scr,
-            t * nblocks // ntasks,
-            (t + 1) * nblocks // ntasks,
+            act,
+            b0,
+            b1,
             grey_only,
             dw,
             sw,
+            bounds,
+            culled,
         )
 
 
@@ -1495,12 +1707,15 @@ def fixup(
         np.zeros(0, np.bool_),
         np.zeros(0, np.int32),
         om.reshape(-1),
-        np.empty(N_ROWS * BLOCK),
+        _scratch(np.float64),
+        np.empty((L, 0), np.int32),
         0,
         nblocks,
         grey,
         Dm.shape[1],
         Sm.shape[1],
+        np.zeros((N_BOUNDS, 0)),  # (no culling: the lanes are not in chunks)
+        np.zeros(nblocks, np.int32),
     )
     for j in range(m):
         i = idx[j]
@@ -1734,6 +1949,7 @@ def _add(p, q, o):
 # the entry points, each compiled with wide float32 vectors where the CPU has them (see _wide);
 # the number is the argument whose dtype picks the precision
 prepare = _wide(prepare, 5)
+bounds = _wide(bounds, 0)
 shade = _wide(shade, 1)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)

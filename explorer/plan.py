@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from .kernels import CHUNK
 from .lights import NO_ATTENUATION, DirectionalLight, PointLight, SpotLight
 from .scene import Scene
 
@@ -71,6 +72,8 @@ class Plan:
     specular_scale : energy-conserving lobe normalisation folded into the specular colours
         (1 when off)
     hdr : colours are displayed unclamped with exposure and a tone map
+    cull : a run of vertices that provably gets nothing from a light (all facing away from
+        it, or outside its cone) skips that light; the mesh decides which (one-sided only)
     force_all : nothing is skipped (benchmark only; same colours)
     """
 
@@ -90,6 +93,7 @@ class Plan:
     specular_scale: float = 1.0
     hdr: bool = False
     force_all: bool = False
+    cull: bool = False
 
     @property
     def shadows(self) -> bool:
@@ -168,6 +172,7 @@ def _forced(plan: Plan, scene: Scene, mesh) -> Plan:
         lights=tuple(lights),
         reasons=plan.reasons + (("forced", "in", "force_all: nothing skipped (benchmark)"),),
         force_all=True,
+        cull=False,
     )
 
 
@@ -234,6 +239,19 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         scene.two_sided,
         "flip N where N·V < 0" if scene.two_sided else "two_sided is false",
     )
+    lit = diffuse or specular or any(_nonzero(lt.ambient) for lt in lights if lt.type == "spot")
+    cull = why(
+        "culling",
+        lit and not scene.two_sided,
+        "no diffuse, specular or spot ambient: nothing to skip"
+        if not lit
+        else (
+            "two-sided: N flips with V, so no vertex is known to face away from a light"
+            if scene.two_sided
+            else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
+            "spot's cone) skip it: how many, the mesh decides"
+        ),
+    )
 
     fresnel = m.fresnel if specular else None
     if m.fresnel is None:
@@ -295,6 +313,7 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         fresnel=fresnel,
         specular_scale=scale if specular else 1.0,
         hdr=scene.hdr is not None,
+        cull=cull,
     )
 
 

@@ -45,6 +45,12 @@ AMBIGUOUS_LEN2 = 1e-9
 #: float32 positions are accurate to ~1e-7 there, so "at the vertex" is decided in float64.
 AMBIGUOUS_DIST = 1e-5
 
+#: Light culling (explorer.kernels.bounds): a chunk's bounding sphere and normal cone are
+#: widened by this (relative, in float64) so that their own rounding can never leave a vertex
+#: outside them; a chunk is skipped for a light only when every vertex faces away from it (or
+#: lies outside its cone) by AMBIGUOUS_DOT or more, far beyond float32's rounding of N·L.
+CULL_GUARD = 1e-12
+
 #: The fast path must stay within this of the float64 path everywhere (one 8-bit level).
 FLOAT32_MAX_ABS_ERROR = 1.0 / 255.0
 

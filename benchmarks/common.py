@@ -1,0 +1,22 @@
+"""Meshes the benchmarks share (no GUI imports: bench_engine runs without VTK)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer import meshes as M
+
+
+def uv_sphere(around: int, rings: int) -> M.Mesh:
+    """A UV sphere with ``around * (rings + 1)`` vertices (seam duplicated), in the order a
+    mesh generator writes them: ring after ring, ``around`` vertices each."""
+    theta = np.linspace(0.0, np.pi, rings + 1)
+    phi = np.linspace(0.0, 2.0 * np.pi, around, endpoint=False)
+    t, p = np.meshgrid(theta, phi, indexing="ij")
+    pos = np.stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(rings), np.arange(around), indexing="ij")
+    a = i * around + j
+    b = i * around + (j + 1) % around
+    c, d = a + around, b + around
+    faces = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)]).reshape(-1, 3)
+    return M.Mesh(pos, pos.copy(), faces, "uv_sphere")
