@@ -45,6 +45,9 @@ from .shadows import is_convex, visibility
 PRECISIONS = ("float64", "float32")
 #: shadow rays are cast where N·L > -this (rounding of N·L must never skip a lit vertex)
 SHADOW_NDL_MARGIN = 1e-6
+#: light culling is kept for a mesh where one chunk of vertices in this many or more has a
+#: normal cone narrower than 90° (only such chunks can ever be skipped)
+CULL_MIN_SHARE = 8
 
 
 def shade(
@@ -88,6 +91,8 @@ class Shader:
     keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
     faces : (m, 3) int triangles for shadows (None: no shadows)
     force_all : the plan skips nothing (same colours; benchmark only)
+    cull : skip a light for runs of vertices that provably get nothing from it (the plan's
+        ``culling``); False computes every vertex-light (same colours; benchmark and tests)
     """
 
     def __init__(
@@ -102,6 +107,7 @@ class Shader:
         keep: bool = True,
         faces=None,
         force_all: bool = False,
+        cull: bool = True,
     ):
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
@@ -111,6 +117,7 @@ class Shader:
         self.keep = bool(keep)
         self.stats: Counter = Counter()
         self.force_all = bool(force_all)
+        self.cull = bool(cull)
         self._scene = load_scene(scene, materials_dirs=materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
@@ -160,12 +167,12 @@ class Shader:
 
     def _chunk_bounds(self) -> np.ndarray:
         """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices, for
-        light culling (see :func:`explorer.kernels.bounds`), read-only; (N_BOUNDS, 0) when no
-        chunk has a normal cone narrower than 90° (shuffled vertices, say): nothing could be
-        culled, so the kernel does not test."""
+        light culling (see :func:`explorer.kernels.bounds`), read-only; (N_BOUNDS, 0) when
+        fewer than one chunk in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled
+        vertices, say): too little could be culled to pay for the tests."""
         b = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
         K.bounds(self._G, b)
-        if not (b[K.B_COS] > 0).any():
+        if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
             b = b[:, :0]
         return _readonly(b)
 
@@ -550,7 +557,7 @@ class Shader:
             amb,
             self._marks,
             self._out,
-            self._bounds if self._plan.cull else self._bounds[:, :0],
+            self._bounds if self._plan.cull and self.cull else self._bounds[:, :0],
             self._culled,
         )
         self.stats["pass"] += 1
