@@ -1075,7 +1075,7 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
         out[3 * i + 2] = min(max(b, lo), hi)
 
 
-@nb.njit(**_LEAF)
+@nb.njit(inline="always", **_LEAF)
 def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
     """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
     ``scr`` starts at the run's first lane, see _block); ``vis`` : (m,) its visibility, or (0,)."""
