@@ -13,6 +13,11 @@ specular base and weight can be stored so a shininess change only re-runs the lo
 (:func:`lobe`). A pass whose lights are all grey (r = g = b) stores its diffuse and specular
 sums grey, (n, 1) (:func:`grey_pass`): at 1M vertices the (n, 3) stores were a fifth of the pass.
 
+Light culling: each run of :data:`CHUNK` consecutive vertices has a bounding sphere and a cone
+of normals (:func:`bounds`, once per geometry); a light is skipped for a run that provably gets
+nothing from it, every vertex facing away from it or outside its spot cone (:func:`_reach`, once
+per light and parallel task). A block then runs the light over the runs it reaches only.
+
 float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
 :data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
 in float64. Each lane keeps the smallest margin to such a decision (row R_TRK, a min per light,
@@ -1487,7 +1492,8 @@ def _spread(t, ntasks):
     when ``ntasks`` is a power of two (else ``t``). numba's threads take the tasks in contiguous
     shares (static scheduling), and culling makes work uneven across a mesh (the half a light
     faces costs, the other half is skipped): reversed bits deal every thread runs from all over
-    the mesh, so the threads finish together."""
+    the mesh, so the threads finish together. Used only when culling: without it the work is
+    even, and each thread streaming through one contiguous half is faster (1.04x, measured)."""
     if ntasks & (ntasks - 1):
         return t
     r = 0
@@ -1568,7 +1574,8 @@ def shade(
             raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
     for t in nb.prange(ntasks):
         scr = _scratch(params.dtype)  # once per task: no allocation per block
-        r = _spread(np.int64(t), np.int64(ntasks))
+        # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
+        r = _spread(np.int64(t), np.int64(ntasks)) if bounds.shape[1] else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
         act = np.empty((params.shape[0], (b1 - b0) * CHUNKS), np.int32)
         _task(
