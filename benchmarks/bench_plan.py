@@ -29,6 +29,7 @@ from explorer import meshes as M
 def cases(res: int):
     sphere = M.sphere(res)
     teapot = M.teapot()
+    big = M.sphere(4 * res)  # rings of 4 * res vertices: runs of 32 span a few degrees
     return [
         (
             "matte preset (opengl_default): specular skipped",
@@ -56,6 +57,13 @@ def cases(res: int):
              "lights": [{"type": "point", "position": [2, 2, 2]},
                         {"type": "point", "position": [-2, 1, 2], "attenuation": [2, 0, 0]}]},
             teapot,
+        ),
+        (
+            "4 point lights around a sphere: light culling",
+            {"material": "gold", "viewer": {"eye": [0, 1, 4]},
+             "lights": [{"type": "point", "position": p, "attenuation": [1, 0.1, 0.01]}
+                        for p in ([3, 1, 1], [-2, 2, -2], [0, -3, 1], [1, 0, -3])]},
+            big,
         ),
     ]  # fmt: skip
 
