@@ -178,6 +178,7 @@ def main(argv=None) -> int:
             mesh32 = med
         else:
             shuffled32 = med
+        del sh, relight  # (1M-vertex shaders left alive slowed the recolour row below 1.4x)
 
     # the same with spot lights (cone and exponent: the engine's row path, not the inline one)
     spots = [spot_lights(L, np.random.default_rng(s)) for s in (0, 1)]
