@@ -1577,7 +1577,7 @@ def shade(
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
         r = _spread(np.int64(t), np.int64(ntasks)) if bounds.shape[1] else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
-        act = np.empty((params.shape[0], (b1 - b0) * CHUNKS), np.int32)
+        act = np.empty((params.shape[0], (b1 - b0) * CHUNKS if bounds.shape[1] else 0), np.int32)
         _task(
             G,
             params,
