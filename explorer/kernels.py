@@ -1248,7 +1248,7 @@ def _block(
                 s0, s1 = c * CHUNK, min(m, e * CHUNK)
                 if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
                     sub = scr[s0 : s0 + N_ROWS * BLOCK]
-                    v = vis[li, s0:s1] if vis.shape[1] else vis[li, :]
+                    v = vis[li, s0:s1]  # (an empty row when no light casts shadows)
                     _light_run(
                         sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
                     )

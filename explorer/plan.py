@@ -239,18 +239,13 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         scene.two_sided,
         "flip N where N·V < 0" if scene.two_sided else "two_sided is false",
     )
-    lit = diffuse or specular or any(_nonzero(lt.ambient) for lt in lights if lt.type == "spot")
     cull = why(
         "culling",
-        lit and not scene.two_sided,
-        "no diffuse, specular or spot ambient: nothing to skip"
-        if not lit
-        else (
-            "two-sided: N flips with V, so no vertex is known to face away from a light"
-            if scene.two_sided
-            else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
-            "spot's cone) skip it: how many, the mesh decides"
-        ),
+        not scene.two_sided,
+        "two-sided: N flips with V, so no vertex is known to face away from a light"
+        if scene.two_sided
+        else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
+        "spot's cone) skip it: how many, the mesh decides",
     )
 
     fresnel = m.fresnel if specular else None

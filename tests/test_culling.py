@@ -7,6 +7,8 @@ scene allows it and never where it does not (two-sided, a light ambient that var
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -25,7 +27,9 @@ MATERIAL = {
 }
 
 
+@functools.cache
 def _mesh(name):
+    """A built-in mesh in its own vertex order (built once per test session)."""
     return {
         "sphere": lambda: M.sphere(256),  # (rings of 256: 32 vertices span 45°)
         "teapot": lambda: M.teapot(12),
@@ -186,17 +190,8 @@ def test_property_culling_never_changes_a_colour(kind, where, axis, cutoff, mesh
         if kind == "spot":
             light.update(direction=list(axis), cutoff=cutoff, exponent=2)
     scene = {"material": MATERIAL, "viewer": {"eye": [1, 2, 5]}, "lights": [light]}
-    on, off = pair(scene, _mesh_cached(mesh), "float64")
+    on, off = pair(scene, _mesh(mesh), "float64")
     same(on, off)
-
-
-_MESHES: dict = {}
-
-
-def _mesh_cached(name):
-    if name not in _MESHES:
-        _MESHES[name] = _mesh(name)
-    return _MESHES[name]
 
 
 @pytest.mark.parametrize("ntasks", [1, 2, 3, 16, 63, 64])
