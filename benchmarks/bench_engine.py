@@ -29,11 +29,11 @@ import numpy as np
 from common import uv_sphere  # benchmarks/common.py
 
 import explorer
-from explorer import kernels as K
-from explorer.lights import PointLight, SpotLight
-from explorer.material import Material
-from explorer.reference import reference_shade
-from explorer.scene import Scene, Viewer
+from explorer.core.lights import PointLight, SpotLight
+from explorer.core.material import Material
+from explorer.core.scene import Scene, Viewer
+from explorer.shading import kernels as K
+from explorer.shading.equation import reference_shade
 
 
 def machine() -> str:

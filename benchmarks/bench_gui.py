@@ -38,12 +38,13 @@ os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 from common import uv_sphere  # noqa: E402  (benchmarks/common.py)
 
 import explorer  # noqa: E402
-from explorer import gui  # noqa: E402
-from explorer import meshes as M  # noqa: E402
-from explorer.lights import PointLight  # noqa: E402
-from explorer.presets import find_preset  # noqa: E402
-from explorer.render import BACKGROUND, to_bytes  # noqa: E402
-from explorer.scene import Scene, Viewer  # noqa: E402
+from explorer.app import window as gui
+from explorer.core.lights import PointLight
+from explorer.core.presets import find_preset
+from explorer.core.scene import Scene, Viewer
+from explorer.geometry import meshes as M
+from explorer.render.offscreen import BACKGROUND
+from explorer.shading.display import to_bytes
 
 SIZE = (800, 600)
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "gui_bench.md"

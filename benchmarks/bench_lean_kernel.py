@@ -32,9 +32,9 @@ import numpy as np
 from bench_engine import machine, scene_with, sphere_points  # its machine line, scene, mesh
 
 import explorer
-from explorer import kernels as K
-from explorer import tolerances as tol
-from explorer.kernels import _LEAF, _OPTS, pow32
+from explorer.core import tolerances as tol
+from explorer.shading import kernels as K
+from explorer.shading.kernels import _LEAF, _OPTS, pow32
 
 BLOCK = 512
 F = np.float32

@@ -23,7 +23,7 @@ import numba
 import numpy as np
 
 import explorer
-from explorer import meshes as M
+from explorer.geometry import meshes as M
 
 
 def cases(res: int):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer import meshes as M
+from explorer.geometry import meshes as M
 
 
 def uv_sphere(around: int, rings: int) -> M.Mesh:

@@ -4,14 +4,13 @@
 import VTK when they are used.
 """
 
-__version__ = "0.1.0"
-
-from .engine import Shader, shade  # noqa: E402
-from .errors import ExplorerError, ValidationError  # noqa: E402
-from .lights import DirectionalLight, PointLight, SpotLight  # noqa: E402
-from .material import Material  # noqa: E402
-from .plan import make_plan  # noqa: E402
-from .scene import Scene, Viewer, load_scene  # noqa: E402
+from explorer.core.errors import ExplorerError, ValidationError
+from explorer.core.lights import DirectionalLight, PointLight, SpotLight
+from explorer.core.material import Material
+from explorer.core.scene import Scene, Viewer, load_scene
+from explorer.core.version import __version__
+from explorer.shading.plan import make_plan
+from explorer.shading.shader import Shader, shade
 
 __all__ = [
     "DirectionalLight",

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from explorer.presets import list_presets
+from explorer.core.presets import list_presets
 
 ROOT = Path(__file__).resolve().parents[1]
 

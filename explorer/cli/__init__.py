@@ -1,0 +1,72 @@
+"""The ``phong-explorer`` command: argument parsing and messages, one module per command.
+
+May import every other part of the package; nothing imports it. Each subcommand lives in its
+own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
+``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
+User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
+block on stderr, exit status 2, no traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from explorer.cli import bench, gui, plan, presets, render, sheet
+from explorer.core.errors import ExplorerError
+from explorer.core.presets import PresetNotice
+from explorer.core.version import __version__
+
+#: subcommand -> (module, one-line help); each module has ``add_arguments`` and ``run``
+COMMANDS = {
+    "plan": (plan, "print the work plan for a scene and why each term is in or out"),
+    "presets": (presets, "list, show and validate material presets"),
+    "render": (render, "render a scene off-screen to PNG, PLY or GLB"),
+    "sheet": (sheet, "render every preset in one labelled grid"),
+    "gui": (gui, "open the interactive explorer window"),
+    "bench": (bench, "measure what accuracy costs in time"),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="phong-explorer",
+        description="Explore materials under the Phong / Blinn-Phong illumination model.",
+    )
+    parser.add_argument("--version", action="version", version=f"phong-explorer {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, (mod, help_) in COMMANDS.items():
+        p = sub.add_parser(name, help=help_, description=help_)
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def _show_notices() -> None:
+    """Print preset notices as one ``notice: ...`` line on stderr, not as Python warnings."""
+    import warnings
+
+    original = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, PresetNotice):
+            print(f"notice: {message}", file=sys.stderr)
+        else:
+            original(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+
+
+def main(argv: list[str] | None = None) -> int:
+    _show_notices()
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:  # plain ``phong-explorer`` opens the window
+        args = parser.parse_args(["gui"])
+    try:
+        return int(args._run(args) or 0)
+    except ExplorerError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130

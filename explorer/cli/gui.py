@@ -1,0 +1,112 @@
+"""``phong-explorer gui`` (also plain ``phong-explorer``): the interactive explorer window.
+
+::
+
+    phong-explorer                                   # gold on the teapot under one point light
+    phong-explorer gui --preset jade --mesh torus
+    phong-explorer gui scene.yaml --mesh bunny.obj
+
+A SCENE file gives the start (material, lights, viewer, mesh); the options are the ``render``
+command's and override their part of it. The window needs a display: without one the command
+prints one line saying why and what to run instead, and exits with status 3.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import sys
+
+from explorer.app import window as gui
+from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
+from explorer.core.errors import ExplorerError
+from explorer.core.lights import PointLight
+from explorer.core.scene import Viewer
+from explorer.geometry.meshes import get_mesh
+from explorer.render.images import parse_size
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--preset", metavar="NAME",
+        help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
+    )  # fmt: skip
+    p.add_argument(
+        "--size", default="{}x{}".format(*gui.G.WINDOW_SIZE), metavar="WxH",
+        help="window size in pixels (default %(default)s)",
+    )  # fmt: skip
+    p.add_argument(
+        "--screenshot-dir", metavar="DIR", default=None,
+        help="where key i saves screenshots (default: the current directory)",
+    )  # fmt: skip
+    p.add_argument(
+        "--state-file", metavar="FILE.json", default=None,
+        help="write the explorer's state as JSON to this file after every frame (for scripts "
+        "and tests; written atomically)",
+    )  # fmt: skip
+    p.add_argument(
+        "--exit-after", type=float, metavar="SECONDS", default=None,
+        help="close the window after this many seconds (a safety net for scripts and tests)",
+    )  # fmt: skip
+    add_scene_arguments(p, force=False, mesh_default=gui.DEFAULT_MESH)
+
+
+def start(args):
+    """The start of the explorer from the command line: ``(scene, mesh, preset name)``.
+
+    Without a SCENE file the start is :data:`explorer.gui.DEFAULT_PRESET` on the teapot under
+    one point light placed at :data:`explorer.gui.DEFAULT_PLACEMENT`, seen from a local viewer
+    (a perspective camera); built-in meshes get the explorer's finer resolutions
+    (:data:`explorer.gui.MESH_CHOICES`) unless ``--resolution`` is given.
+    """
+    import numpy as np
+
+    if args.exit_after is not None and not args.exit_after > 0:
+        raise ExplorerError(f"--exit-after must be a number of seconds > 0, got {args.exit_after}")
+    if args.scene is None and args.preset is None:
+        args.preset = gui.DEFAULT_PRESET
+    args.mesh_default = gui.DEFAULT_MESH
+    placeholder = PointLight(position=(0.0, 0.0, 0.0), diffuse=(1.0, 1.0, 1.0))
+    scene, mesh = build_scene(args, default_light=placeholder)
+    spec = args.mesh if args.mesh is not None else (scene.mesh or gui.DEFAULT_MESH)
+    scene = scene.replace(mesh=spec)  # the state names the mesh shown
+    if args.resolution is None and spec in gui.MESH_CHOICES:
+        mesh = get_mesh(spec, gui.MESH_CHOICES[spec])
+    r = mesh.radius or 1.0
+    if scene.lights == (placeholder,):  # no scene lights and no --light-* option
+        az, el, d = gui.DEFAULT_PLACEMENT
+        scene = scene.replace(lights=(gui.place_light(PointLight(), az, el, d * r, mesh.centre),))
+    if args.scene is None and args.viewer_eye is None and args.viewer_direction is None:
+        e = np.asarray(gui.DEFAULT_EYE_DIRECTION, dtype=np.float64)
+        eye = mesh.centre + gui.DEFAULT_EYE_DISTANCE * r * e / np.linalg.norm(e)
+        scene = scene.replace(viewer=Viewer(eye=tuple(eye)))
+    preset = args.preset if isinstance(args.preset, str) else scene.material.name
+    return scene, mesh, preset
+
+
+def run(args) -> int:
+
+    reason = gui.no_display_reason()
+    if reason:
+        print(gui.no_display_message(reason), file=sys.stderr)
+        return gui.NO_DISPLAY_STATUS
+    if not logging.getLogger().handlers:
+        logging.basicConfig(
+            level=logging.WARNING, format="phong-explorer: %(levelname)s: %(message)s"
+        )
+    size = parse_size(args.size)
+    if args.screenshot_dir is not None and not os.path.isdir(args.screenshot_dir):
+        raise ExplorerError(f"--screenshot-dir: {args.screenshot_dir!r} is not a directory")
+    scene, mesh, preset = start(args)
+    try:
+        app = gui.Explorer(
+            scene, mesh, preset=preset, materials_dirs=tuple(args.materials),
+            window_size=size, state_file=args.state_file, output_dir=args.screenshot_dir,
+            background=background_from_options(args),
+        )  # fmt: skip
+    except gui.NoDisplayError as exc:
+        print(gui.no_display_message(str(exc)), file=sys.stderr)
+        return gui.NO_DISPLAY_STATUS
+    app.show(exit_after=args.exit_after)
+    return 0

@@ -1,0 +1,44 @@
+"""``phong-explorer plan SCENE``: the work the engine will do for a scene, and why."""
+
+from __future__ import annotations
+
+import argparse
+
+from explorer.core.scene import load_scene
+from explorer.geometry.meshes import DEFAULT_MESH, get_mesh
+from explorer.shading.plan import make_plan
+from explorer.shading.shadows import is_convex
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("scene", help="scene file (YAML)")
+    parser.add_argument(
+        "--materials",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="extra preset directory (repeatable), searched before the built-in presets",
+    )
+
+
+def run(args) -> int:
+
+    scene = load_scene(args.scene, materials_dirs=args.materials)
+    mesh_kind = None
+    if any(lt.shadows for lt in scene.lights):  # shadows depend on the mesh: look at it
+        mesh = get_mesh(scene.mesh or DEFAULT_MESH)
+        mesh_kind = "convex" if is_convex(mesh.positions, mesh.faces) else "concave"
+        print(f"mesh {mesh.name}: {mesh_kind} ({mesh.n_faces} triangles)")
+    plan = make_plan(scene, mesh=mesh_kind)
+    m = scene.material
+    viewer = (
+        f"eye {list(scene.viewer.eye)}"
+        if scene.viewer.local
+        else (f"direction {[round(c, 6) for c in scene.viewer.direction]}")
+    )
+    print(
+        f"scene {args.scene}: {len(scene.lights)} light(s), model {scene.model}, "
+        f"shininess {m.shininess:g}, viewer {viewer}"
+    )
+    print(plan.describe())
+    return 0

@@ -1,0 +1,191 @@
+"""``phong-explorer presets``: list, show and validate material presets.
+
+::
+
+    phong-explorer presets [list]            every preset: swatch, name, shininess, description
+    phong-explorer presets show NAME|FILE    its values (copy-pastable YAML) and where it is from
+    phong-explorer presets validate PATH...  check files (directories: every *.yaml in them);
+                                             one line per problem on stdout, exit status 1
+
+``--materials DIR`` (repeatable) adds preset directories searched before the user's and the
+built-in ones. The colour swatch is drawn with 24-bit ANSI colour only when stdout is a
+terminal, ``NO_COLOR`` is unset (or empty) and ``TERM`` is not ``dumb``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from explorer.core.errors import ExplorerError, Problem, ValidationError
+from explorer.core.material import Material
+from explorer.core.presets import (
+    SUFFIX,
+    is_valid_name,
+    list_presets,
+    load_material_file,
+    locate_preset,
+)
+from explorer.core.yamlio import dump_yaml
+
+#: Scene ambient used for the swatch (OpenGL's default light-model ambient).
+SWATCH_SCENE_AMBIENT = 0.2
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    materials_help = "extra preset directory, searched first (repeatable)"
+    parser.add_argument(
+        "--materials", action="append", default=[], metavar="DIR", help=materials_help
+    )
+    sub = parser.add_subparsers(dest="presets_command", metavar="ACTION")
+    p_list = sub.add_parser("list", help="list every preset (the default)")
+    p_show = sub.add_parser("show", help="print a preset's values and the file it came from")
+    p_show.add_argument("name", metavar="NAME", help="preset name, or a material file")
+    p_val = sub.add_parser("validate", help="check material files; exit 1 if any has a problem")
+    p_val.add_argument(
+        "paths", nargs="+", metavar="PATH", help="material file, or directory of *.yaml files"
+    )
+    for p in (p_list, p_show):
+        p.add_argument(
+            "--materials",
+            action="append",
+            default=[],
+            dest="materials_after",
+            metavar="DIR",
+            help=materials_help,
+        )
+
+
+def run(args) -> int:
+    dirs = list(getattr(args, "materials", None) or []) + list(
+        getattr(args, "materials_after", None) or []
+    )
+    command = getattr(args, "presets_command", None) or "list"
+    if command == "show":
+        return show(args.name, dirs)
+    if command == "validate":
+        return validate(args.paths)
+    return list_(dirs)
+
+
+# -- list ------------------------------------------------------------------------------------
+def list_(dirs, out=None, err=None) -> int:
+
+    out = out or sys.stdout
+    err = err or sys.stderr
+    notices: list[str] = []
+    presets = list_presets(dirs, notices=notices)
+    _print_notices(notices, err)
+    colour = use_colour(out)
+    width = max((len(p.name) for p in presets), default=4)
+    for p in presets:
+        swatch = _swatch(p.material) + " " if colour else ""
+        tag = "" if p.source == "builtin" else f" [{_source_label(p.source)}]"
+        out.write(
+            f"{swatch}{p.name:<{width}}  {p.material.shininess:>7g}  "
+            f"{p.material.description}{tag}\n"
+        )
+    return 0
+
+
+def use_colour(stream) -> bool:
+    """24-bit colour only on a terminal, without NO_COLOR (https://no-color.org), not dumb."""
+    if os.environ.get("NO_COLOR") or os.environ.get("TERM") == "dumb":
+        return False
+    isatty = getattr(stream, "isatty", None)
+    try:
+        return bool(isatty and isatty())
+    except (OSError, ValueError):
+        return False
+
+
+def swatch_rgb(material: Material) -> tuple[int, int, int]:
+    """8-bit colour of the material facing a white light head-on, without the highlight:
+    ``emission + 0.2 * ambient + diffuse`` clamped to [0, 1]."""
+    rgb = (
+        e + SWATCH_SCENE_AMBIENT * a + d
+        for e, a, d in zip(material.emission, material.ambient, material.diffuse, strict=True)
+    )
+    return tuple(int(round(min(1.0, max(0.0, c)) * 255)) for c in rgb)
+
+
+def _swatch(material: Material) -> str:
+    r, g, b = swatch_rgb(material)
+    return f"\x1b[48;2;{r};{g};{b}m    \x1b[0m"
+
+
+def _source_label(source: str) -> str:
+    return {"extra": "--materials", "user": "user", "builtin": "built-in"}.get(source, source)
+
+
+def _print_notices(notices, err) -> None:
+    for n in notices:
+        err.write(f"notice: {n}\n")
+
+
+# -- show ------------------------------------------------------------------------------------
+def show(name: str, dirs, out=None, err=None) -> int:
+
+    out = out or sys.stdout
+    err = err or sys.stderr
+    if name.endswith((SUFFIX, ".yml")) or os.sep in name or "/" in name:
+        path = Path(name)
+        material = load_material_file(path)
+        origin = f"# from the file {path}"
+    else:
+        path, source, shadowed = locate_preset(name, dirs)
+        material = load_material_file(path)
+        origin = f"# preset '{name}' ({_source_label(source)}): {path}"
+        if shadowed is not None:
+            _print_notices([f"preset '{name}': {path} hides {shadowed}"], err)
+    ka, kd, ks = material.scalars()
+    out.write(origin + "\n")
+    out.write(f"# scalars (largest channel of each term): ka {ka:g}, kd {kd:g}, ks {ks:g}\n")
+    if use_colour(out):
+        out.write(f"# swatch: {_swatch(material)}\n")
+    out.write(dump_yaml(material.to_mapping()))
+    return 0
+
+
+# -- validate --------------------------------------------------------------------------------
+def validate(paths, out=None, err=None) -> int:
+    """Check every file; one line per problem on ``out``; 1 if any problem, else 0."""
+
+    out = out or sys.stdout
+    err = err or sys.stderr
+    files: list[Path] = []
+    problems: list[Problem] = []
+    for p in paths:
+        path = Path(p)
+        if path.is_dir():
+            found = sorted(f for f in path.iterdir() if f.suffix == SUFFIX and f.is_file())
+            if not found:
+                problems.append(Problem(f"no *{SUFFIX} files in this directory", str(path)))
+            files.extend(found)
+        else:
+            files.append(path)
+    for path in files:
+        try:
+            load_material_file(path)
+        except ValidationError as exc:
+            problems.extend(exc.problems)
+        except ExplorerError as exc:  # pragma: no cover - the loader raises ValidationError
+            problems.append(Problem(str(exc), str(path)))
+        if path.suffix == SUFFIX and path.exists() and not is_valid_name(path.stem):
+            problems.append(
+                Problem(
+                    f"the file name {path.stem!r} is not a valid preset name (lowercase letters, "
+                    "digits and '_'); a preset directory ignores this file",
+                    str(path),
+                )
+            )
+    for problem in problems:
+        out.write(f"{problem}\n")
+    n = len(files)
+    err.write(
+        f"{n} file{'s' if n != 1 else ''} checked, "
+        f"{len(problems) or 'no'} problem{'s' if len(problems) != 1 else ''}\n"
+    )
+    return 1 if problems else 0

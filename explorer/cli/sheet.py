@@ -1,0 +1,61 @@
+"""``phong-explorer sheet``: every preset in one labelled grid.
+
+::
+
+    phong-explorer sheet --out presets.png --mesh teapot --columns 6 --tile 200x200
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from explorer.cli.options import (
+    add_scene_arguments,
+    background_from_options,
+    build_scene,
+    check_out,
+    size_from_option,
+)
+from explorer.core.atomic import write_atomic
+from explorer.core.errors import ExplorerError
+from explorer.core.lights import DirectionalLight
+from explorer.core.presets import find_preset, list_presets
+from explorer.render.images import encode_png
+from explorer.render.offscreen import SHEET_LIGHT_DIRECTION, sheet
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--out", required=True, metavar="FILE.png", help="output picture (.png)")
+    p.add_argument(
+        "--preset", action="append", default=None, metavar="NAME",
+        help="only these presets, in this order (repeatable); default: every preset",
+    )  # fmt: skip
+    p.add_argument("--columns", type=int, default=6, metavar="N", help="tiles per row (6)")
+    p.add_argument("--tile", default="200x150", metavar="WxH", help="tile size (200x150)")
+    add_scene_arguments(p, mesh_default="teapot")
+
+
+def run(args) -> int:
+
+    check_out(args.out, (".png",), args.force)
+    tile = size_from_option(args.tile, "--tile")
+    if args.columns < 1:
+        raise ExplorerError(f"--columns must be at least 1, got {args.columns}")
+    background = background_from_options(args)
+    args.mesh_default = "teapot"
+    chosen = args.preset
+    args.preset = None  # the sheet's --preset selects tiles; it does not set the material
+    scene, mesh = build_scene(args, default_light=DirectionalLight(direction=SHEET_LIGHT_DIRECTION))
+    dirs = tuple(args.materials)
+    if chosen:
+        items = [(name, find_preset(name, dirs)) for name in chosen]
+    else:
+        items = [(info.name, info.material) for info in list_presets(dirs)]
+    image = sheet(
+        items, scene, mesh, tile=tile, columns=args.columns, background=background,
+        model=args.model,
+    )  # fmt: skip
+    write_atomic(args.out, encode_png(image), overwrite=args.force)
+    h, w = image.shape[:2]
+    print(f"wrote {args.out}: {len(items)} presets on {mesh.name}, {w}x{h}")
+    return 0

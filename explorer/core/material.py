@@ -1,0 +1,279 @@
+"""Materials: the coefficients a surface has, and nothing else.
+
+A :class:`Material` holds linear RGB reflection coefficients in [0, 1] and the shininess
+exponent; the engine combines it with lights (see :mod:`explorer.engine`). Defaults are
+OpenGL's (``glMaterial``): ambient 0.2, diffuse 0.8, specular 0, emission 0, shininess 0.
+
+Two ways to write a material (in a preset file or a scene's ``material:`` mapping), both from
+the lecture notes; a material may use either form per term, but not both for the same term:
+
+* the nine-coefficient RGB form: ``ambient``, ``diffuse``, ``specular`` (and ``emission``),
+  each ``[r, g, b]`` in [0, 1];
+* the scalar form: ``ka``, ``kd``, ``ks`` in [0, 1] with a base ``color`` (default white) and an
+  optional ``specular_color`` (default white), meaning::
+
+      ambient  = ka * color          (ka defaults to 0.2 when color is given)
+      diffuse  = kd * color          (kd defaults to 0.8 when color is given)
+      specular = ks * specular_color
+
+  so ``{color: [1, 0, 0]}`` alone is OpenGL's default material in red.
+
+``shininess`` (exponent in [0, 1000]), ``opacity`` (in [0, 1], 1 = opaque), an optional default
+``model`` (``blinn`` / ``phong``) and a one-line ``description`` complete it. Only the resolved
+RGB coefficients are kept: a material read in the scalar form is saved in the RGB form, with
+identical colours.
+
+Scalars of an RGB material (:meth:`Material.scalars`, :meth:`Material.with_scalars`, used by
+the ka / kd / ks sliders): the scalar of a term is its largest channel, ``k = max(r, g, b)``,
+and its hue is the term divided by ``k`` (largest channel exactly 1). Setting a scalar keeps
+the hue: ``term' = hue * k'``, so ``with_scalars(kd=k).scalars()[1] == k`` exactly and setting
+the old value back restores the term to within rounding (a couple of ulps, unless a channel
+times the scalar underflows to a subnormal number). A black term has no
+hue of its own: ambient and diffuse then borrow the hue of the other one of the two (white if
+both are black), specular uses white.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields, replace
+from numbers import Real
+
+from explorer.core.errors import ExplorerError
+from explorer.core.validate import Checker
+
+RGB = tuple[float, float, float]
+
+#: Keys of the nine-coefficient (RGB) form, in the order they are written.
+RGB_KEYS = ("ambient", "diffuse", "specular", "emission")
+#: Keys of the scalar form (ka * color, kd * color, ks * specular_color).
+SCALAR_KEYS = ("ka", "kd", "ks", "color", "specular_color")
+#: Every key a material mapping may have.
+MATERIAL_KEYS = (
+    RGB_KEYS
+    + SCALAR_KEYS
+    + (
+        "shininess",
+        "opacity",
+        "model",
+        "description",
+        "fresnel",
+        "energy_conserving",
+    )
+)
+#: Allowed shininess in files and sliders (the engine itself accepts any finite value >= 0).
+SHININESS_RANGE = (0.0, 1000.0)
+#: Allowed range of every reflection coefficient (RGB channels, ka, kd, ks) in files.
+COEFFICIENT_RANGE = (0.0, 1.0)
+OPACITY_RANGE = (0.0, 1.0)
+#: Allowed Schlick reflectance at normal incidence ``F0`` (``fresnel``).
+FRESNEL_RANGE = (0.0, 1.0)
+MODELS = ("blinn", "phong")
+
+#: term -> its scalar key, and the scalar defaults applied to ``color`` (OpenGL's 0.2 / 0.8).
+TERM_SCALARS = {"ambient": "ka", "diffuse": "kd", "specular": "ks"}
+SCALAR_DEFAULTS = {"ka": 0.2, "kd": 0.8, "ks": 0.0}
+_WHITE = (1.0, 1.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Material:
+    """Surface coefficients.
+
+    ambient, diffuse, specular, emission : RGB triples in [0, 1] (``a_m, d_m, s_m, e_m``)
+    shininess : specular exponent ``n`` >= 0 (``0**0 == 1``: shininess 0 is a flat specular)
+    opacity : alpha in [0, 1]; 1 is opaque
+    model : default specular model for this material (``"blinn"`` / ``"phong"``) or None
+    name, description : for people; never affect colours (and never affect ``==``)
+    fresnel : Schlick's F0 in [0, 1], or None (off): the specular term of each light is
+        weighted by ``F = F0 + (1 - F0)·(1 - V·H)^5`` (see :mod:`explorer.effects`)
+    energy_conserving : normalise the specular lobe, ``(n + 2)/(2π)`` (Phong) or
+        ``(n + 8)/(8π)`` (Blinn), so a higher shininess narrows the highlight without dimming it
+    """
+
+    ambient: RGB = (0.2, 0.2, 0.2)
+    diffuse: RGB = (0.8, 0.8, 0.8)
+    specular: RGB = (0.0, 0.0, 0.0)
+    emission: RGB = (0.0, 0.0, 0.0)
+    shininess: float = 0.0
+    opacity: float = 1.0
+    model: str | None = None
+    name: str | None = field(default=None, compare=False)
+    description: str = field(default="", compare=False)
+    fresnel: float | None = None
+    energy_conserving: bool = False
+
+    def __post_init__(self):
+        for key in RGB_KEYS:
+            value = tuple(float(c) for c in getattr(self, key))
+            if len(value) != 3 or not all(math.isfinite(c) and c >= 0.0 for c in value):
+                raise ValueError(f"material {key} must be 3 finite numbers >= 0, got {value}")
+            object.__setattr__(self, key, value)
+        s = float(self.shininess)
+        if not (math.isfinite(s) and s >= 0.0):
+            raise ValueError(f"material shininess must be finite and >= 0, got {s}")
+        object.__setattr__(self, "shininess", s)
+        o = float(self.opacity)
+        if not (0.0 <= o <= 1.0):
+            raise ValueError(f"material opacity must be in [0, 1], got {o}")
+        object.__setattr__(self, "opacity", o)
+        if self.model is not None and self.model not in MODELS:
+            raise ValueError(f"material model must be one of {MODELS}, got {self.model!r}")
+        object.__setattr__(self, "description", str(self.description or ""))
+        if self.fresnel is not None:
+            f = float(self.fresnel)
+            if not (FRESNEL_RANGE[0] <= f <= FRESNEL_RANGE[1]):
+                raise ValueError(f"material fresnel (F0) must be in [0, 1], got {f}")
+            object.__setattr__(self, "fresnel", f)
+        object.__setattr__(self, "energy_conserving", bool(self.energy_conserving))
+
+    def replace(self, **changes) -> Material:
+        """A copy with some fields changed (``m.replace(shininess=64)``)."""
+        return replace(self, **changes)
+
+    def to_mapping(self) -> dict:
+        """The nine-coefficient form as plain Python values (YAML-ready).
+
+        ``parse_material(m.to_mapping(), ...) == m`` with identical floats (YAML writes floats
+        with ``repr``, which reads back exactly).
+        """
+        out: dict = {}
+        if self.description:
+            out["description"] = self.description
+        for key in RGB_KEYS:
+            out[key] = [float(c) for c in getattr(self, key)]
+        out["shininess"] = float(self.shininess)
+        if self.opacity != 1.0:
+            out["opacity"] = float(self.opacity)
+        if self.model is not None:
+            out["model"] = self.model
+        if self.fresnel is not None:
+            out["fresnel"] = float(self.fresnel)
+        if self.energy_conserving:
+            out["energy_conserving"] = True
+        return out
+
+    # -- scalar view (ka / kd / ks sliders) ---------------------------------------------------
+    def scalars(self) -> tuple[float, float, float]:
+        """``(ka, kd, ks)``: the largest channel of ambient, diffuse and specular."""
+        return (max(self.ambient), max(self.diffuse), max(self.specular))
+
+    def hue(self, term: str) -> RGB:
+        """The colour of ``term`` ("ambient" / "diffuse" / "specular") scaled so its largest
+        channel is 1; for a black term, the fallback described in the module docstring."""
+        if term not in TERM_SCALARS:
+            raise ValueError(f"term must be one of {tuple(TERM_SCALARS)}, got {term!r}")
+        own = _hue(getattr(self, term))
+        if own is not None:
+            return own
+        if term == "specular":
+            return _WHITE
+        other = "diffuse" if term == "ambient" else "ambient"
+        return _hue(getattr(self, other)) or _WHITE
+
+    def with_scalars(
+        self, ka: float | None = None, kd: float | None = None, ks: float | None = None
+    ) -> Material:
+        """A copy whose ambient / diffuse / specular have the given scalars, hues kept.
+
+        Each given value must be in [0, 1]; ``None`` leaves that term unchanged.
+        """
+        changes = {}
+        for term, key, k in (("ambient", "ka", ka), ("diffuse", "kd", kd), ("specular", "ks", ks)):
+            if k is None:
+                continue
+            if isinstance(k, bool) or not isinstance(k, Real) or not 0.0 <= k <= 1.0:
+                raise ExplorerError(f"material {key} must be a number in [0, 1], got {k!r}")
+            k = float(k)
+            if k == max(getattr(self, term)):
+                continue  # unchanged: keep the exact values
+            changes[term] = tuple(c * k for c in self.hue(term))
+        return self.replace(**changes) if changes else self
+
+
+def _hue(rgb: RGB) -> RGB | None:
+    m = max(rgb)
+    if m <= 0.0:
+        return None
+    # c / m is exactly 1.0 for the largest channel, so max(hue * k) == k exactly
+    return tuple(c / m for c in rgb)
+
+
+def parse_material(value, checker: Checker, path: tuple = ()) -> Material | None:
+    """Build a :class:`Material` from a mapping of :data:`MATERIAL_KEYS` (either form, see the
+    module docstring), reporting every problem to ``checker``; None when anything is wrong."""
+    m = checker.mapping(value, path, "a material mapping")
+    if m is None:
+        return None
+    before = len(checker.problems)
+    checker.keys(m, path, MATERIAL_KEYS)
+    lo, hi = COEFFICIENT_RANGE
+
+    def rgb(key):
+        return checker.rgb(m[key], path + (key,), lo, hi) if key in m else None
+
+    def scalar(key):
+        return checker.number(m[key], path + (key,), lo, hi) if key in m else None
+
+    kw: dict = {}
+    for key in RGB_KEYS:
+        if key in m:
+            kw[key] = rgb(key)
+
+    # the scalar form
+    color, specular_color = rgb("color"), rgb("specular_color")
+    ks_given = "ks" in m
+    for term, key in TERM_SCALARS.items():
+        if key in m and term in m:
+            checker.problem(
+                path + (key,),
+                f"'{key}' and '{term}' both set the {term} term; use either the scalar form "
+                f"({key} x {'specular_color' if key == 'ks' else 'color'}) or the RGB form "
+                f"({term}: [r, g, b]), not both",
+            )
+    if "color" in m and "ambient" in m and "diffuse" in m:
+        checker.problem(
+            path + ("color",),
+            "'color' is not used: ambient and diffuse are both given as [r, g, b] "
+            "(color is the base of ka and kd)",
+        )
+    if "specular_color" in m and not ks_given:
+        checker.problem(
+            path + ("specular_color",),
+            "'specular_color' needs 'ks' (specular = ks x specular_color)",
+        )
+    base = color if color is not None else _WHITE
+    for term, key in (("ambient", "ka"), ("diffuse", "kd")):
+        if term in m:
+            continue
+        if key in m or "color" in m:
+            k = scalar(key) if key in m else SCALAR_DEFAULTS[key]
+            if k is not None and ("color" not in m or color is not None):
+                kw[term] = tuple(k * c for c in base)
+    if ks_given and "specular" not in m:
+        ks = scalar("ks")
+        if ks is not None and ("specular_color" not in m or specular_color is not None):
+            base = specular_color if specular_color is not None else _WHITE
+            kw["specular"] = tuple(ks * c for c in base)
+
+    if "shininess" in m:
+        kw["shininess"] = checker.number(m["shininess"], path + ("shininess",), *SHININESS_RANGE)
+    if "opacity" in m:
+        kw["opacity"] = checker.number(m["opacity"], path + ("opacity",), *OPACITY_RANGE)
+    if "model" in m:
+        kw["model"] = checker.choice(m["model"], path + ("model",), MODELS)
+    if "description" in m:
+        kw["description"] = checker.string(m["description"], path + ("description",))
+    if "fresnel" in m:
+        kw["fresnel"] = checker.number(m["fresnel"], path + ("fresnel",), *FRESNEL_RANGE)
+    if "energy_conserving" in m:
+        kw["energy_conserving"] = checker.boolean(
+            m["energy_conserving"], path + ("energy_conserving",)
+        )
+    if len(checker.problems) > before or any(v is None for v in kw.values()):
+        return None
+    return Material(**kw)
+
+
+def material_fields() -> tuple[str, ...]:
+    return tuple(f.name for f in fields(Material))

@@ -1,0 +1,271 @@
+"""The material preset library: built-in presets, the user's own, listed, found and saved.
+
+A preset is one YAML file in a preset directory; its file stem is the preset's name
+(lowercase letters, digits and ``_``; files with other names are ignored with a notice). Three
+kinds of directories are searched, the first one holding a name wins:
+
+1. ``extra_dirs`` (the ``--materials DIR`` options), in the order given;
+2. the user's directory, :func:`user_dir` (``$PHONG_EXPLORER_MATERIALS`` if set, otherwise
+   ``<user config dir>/phong-explorer/materials``); it need not exist;
+3. the built-in presets shipped inside the package, :func:`builtin_dir`.
+
+A preset that hides another one of the same name gets a notice (once per process for
+warnings, so nothing is repeated per frame); ``notices=[...]`` collects them instead.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import warnings
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from explorer.core.atomic import write_atomic
+from explorer.core.errors import ExplorerError, ValidationError
+from explorer.core.material import Material, parse_material
+from explorer.core.validate import Checker, suggest
+from explorer.core.version import __version__
+from explorer.core.yamlio import dump_yaml, load_yaml
+
+#: Environment variable overriding the user's preset directory (used by the tests).
+ENV_VAR = "PHONG_EXPLORER_MATERIALS"
+#: A valid preset name (also its file stem).
+NAME_PATTERN = re.compile(r"[a-z0-9_]+")
+MAX_NAME_LENGTH = 64
+SUFFIX = ".yaml"
+SOURCES = ("extra", "user", "builtin")
+
+
+class PresetNotice(UserWarning):
+    """A preset hides another of the same name, or a file in a preset directory is skipped."""
+
+
+@dataclass(frozen=True)
+class PresetInfo:
+    """One preset as found in the library.
+
+    name : preset name (the file stem)
+    path : the file it was read from
+    material : the loaded :class:`~explorer.material.Material` (``material.name == name``)
+    source : "extra" (a ``--materials`` directory), "user" or "builtin"
+    shadows : the file of the same name it hides (next in precedence), or None
+    """
+
+    name: str
+    path: Path
+    material: Material
+    source: str
+    shadows: Path | None = None
+
+
+# -- directories -----------------------------------------------------------------------------
+def builtin_dir() -> Path:
+    """Directory of the built-in presets (inside the installed package)."""
+    from importlib import resources
+
+    return Path(os.fspath(resources.files("explorer.materials")))
+
+
+def user_dir() -> Path:
+    """The user's preset directory (may not exist yet)."""
+    env = os.environ.get(ENV_VAR)
+    if env:
+        return Path(env).expanduser()
+    from platformdirs import user_config_dir
+
+    return Path(user_config_dir("phong-explorer")) / "materials"
+
+
+def search_dirs(extra_dirs: Iterable = ()) -> list[tuple[Path, str]]:
+    """``[(directory, source), ...]`` in precedence order (first wins).
+
+    A ``--materials`` directory that does not exist is an error (it was asked for); a missing
+    user directory is simply skipped.
+    """
+    dirs: list[tuple[Path, str]] = []
+    for d in extra_dirs or ():
+        path = Path(os.fspath(d)).expanduser()
+        if not path.is_dir():
+            why = "is not a directory" if path.exists() else "does not exist"
+            raise ExplorerError(f"materials directory {path} {why}")
+        dirs.append((path, "extra"))
+    user = user_dir()
+    if user.is_dir():
+        dirs.append((user, "user"))
+    dirs.append((builtin_dir(), "builtin"))
+    # the same directory twice (e.g. --materials pointing at the user dir) counts once
+    seen: set = set()
+    unique = []
+    for path, source in dirs:
+        key = os.path.realpath(path)
+        if key not in seen:
+            seen.add(key)
+            unique.append((path, source))
+    return unique
+
+
+def is_valid_name(name) -> bool:
+    return (
+        isinstance(name, str)
+        and len(name) <= MAX_NAME_LENGTH
+        and NAME_PATTERN.fullmatch(name) is not None
+    )
+
+
+def check_name(name) -> str:
+    """``name`` if it is a valid preset name, else an :class:`ExplorerError` saying why."""
+    if is_valid_name(name):
+        return name
+    raise ExplorerError(
+        f"{name!r} is not a valid preset name: use 1 to {MAX_NAME_LENGTH} lowercase letters, "
+        "digits and '_' (it becomes the file name)"
+    )
+
+
+# -- reading ---------------------------------------------------------------------------------
+def load_material_file(path) -> Material:
+    """Load one material file (either form). Every problem in it, from YAML duplicate keys to
+    out-of-range values, is reported in one :class:`~explorer.errors.ValidationError`, in
+    line order. The material's name is the file stem."""
+    doc = load_yaml(path, what="material file", collect=True)
+    checker = doc.checker()
+    if checker.mapping(doc.data, (), "a mapping of material keys") is not None:
+        material = parse_material(doc.data, checker, ())
+    if checker.problems:
+        raise ValidationError(sorted(checker.problems, key=lambda p: p.line or 0))
+    return material.replace(name=Path(os.fspath(path)).stem)
+
+
+def _scan(dirs, notices) -> dict[str, list[tuple[Path, str]]]:
+    """name -> [(file, source), ...] in precedence order."""
+    found: dict[str, list[tuple[Path, str]]] = {}
+    for directory, source in dirs:
+        try:
+            entries = sorted(directory.iterdir())
+        except OSError as exc:
+            _notice(notices, f"cannot list preset directory {directory}: {exc.strerror or exc}")
+            continue
+        for path in entries:
+            if path.suffix != SUFFIX or path.name.startswith("."):
+                continue
+            if not is_valid_name(path.stem):
+                _notice(
+                    notices,
+                    f"{path}: ignored, {path.stem!r} is not a preset name (lowercase letters, "
+                    "digits and '_')",
+                )
+                continue
+            found.setdefault(path.stem, []).append((path, source))
+    return found
+
+
+def list_presets(extra_dirs: Iterable = (), *, notices: list | None = None) -> list[PresetInfo]:
+    """Every preset, sorted by name, each from the first directory that has it.
+
+    A preset file that does not load is left out of the list with a notice (its problems);
+    :func:`find_preset` on that name raises them. Notices go to ``notices`` when a list is
+    given, otherwise each is issued once per process as a :class:`PresetNotice` warning.
+    """
+    found = _scan(search_dirs(extra_dirs), notices)
+    out = []
+    for name in sorted(found):
+        (path, source), *rest = found[name]
+        try:
+            material = load_material_file(path)
+        except ValidationError as exc:
+            _notice(notices, f"preset '{name}' skipped, it has problems:\n{exc}")
+            continue
+        shadows = rest[0][0] if rest else None
+        if shadows is not None:
+            _notice(notices, _shadow_message(name, path, source, rest[0]))
+        out.append(PresetInfo(name, path, material, source, shadows))
+    return out
+
+
+def locate_preset(name: str, extra_dirs: Iterable = ()) -> tuple[Path, str, Path | None]:
+    """``(file, source, shadowed file or None)`` of preset ``name``, without loading it."""
+    _check_lookup_name(name)
+    dirs = search_dirs(extra_dirs)
+    hits = [(d / f"{name}{SUFFIX}", s) for d, s in dirs if (d / f"{name}{SUFFIX}").is_file()]
+    if not hits:
+        known = sorted(_scan(dirs, []))
+        hint = suggest(name.lower(), known) or suggest(name, known)
+        where = "; ".join(f"{d} ({s})" for d, s in dirs)
+        raise ExplorerError(
+            f"unknown material preset {name!r}{hint}. Looked in: {where}. "
+            "'phong-explorer presets' lists them all"
+        )
+    (path, source), *rest = hits
+    return path, source, (rest[0][0] if rest else None)
+
+
+def find_preset(name: str, extra_dirs: Iterable = (), *, notices: list | None = None) -> Material:
+    """The material of preset ``name`` (``material.name == name``).
+
+    Unknown name: :class:`ExplorerError` with a did-you-mean and the directories searched. A
+    preset file with problems: its :class:`ValidationError` (no silent fallback to a built-in
+    of the same name).
+    """
+    path, source, shadowed = locate_preset(name, extra_dirs)
+    material = load_material_file(path)
+    if shadowed is not None:
+        _notice(notices, _shadow_message(name, path, source, (shadowed, None)))
+    return material
+
+
+def _check_lookup_name(name) -> None:
+    if not isinstance(name, str):
+        raise ExplorerError(f"a preset name must be text, got {type(name).__name__}")
+    if not is_valid_name(name):
+        hint = ""
+        if is_valid_name(name.lower()):
+            hint = f" (preset names are lowercase: '{name.lower()}')"
+        elif name.endswith((".yaml", ".yml")) or "/" in name or os.sep in name:
+            hint = " (that looks like a file; preset names are file stems, e.g. 'gold')"
+        raise ExplorerError(
+            f"{name!r} is not a valid preset name: lowercase letters, digits and '_'{hint}"
+        )
+
+
+# -- writing ---------------------------------------------------------------------------------
+def save_preset(material: Material, name: str, directory=None, overwrite: bool = False) -> Path:
+    """Write ``material`` as preset ``name`` (``<directory>/<name>.yaml``, default
+    :func:`user_dir`) in the RGB form; returns the file written.
+
+    The file loads back to identical colours. It is written atomically and an existing file
+    is only replaced with ``overwrite=True``. A material a file could not hold (a coefficient
+    above 1, shininess above 1000) is refused before anything is written.
+    """
+
+    check_name(name)
+    if not isinstance(material, Material):
+        raise ExplorerError(f"save_preset needs a Material, got {type(material).__name__}")
+    data = material.to_mapping()
+    checker = Checker(f"preset '{name}'")
+    parse_material(data, checker, ())
+    checker.raise_if_any()
+    directory = user_dir() if directory is None else Path(os.fspath(directory)).expanduser()
+    header = f"phong-explorer material preset '{name}' (saved by phong-explorer {__version__})"
+    text = dump_yaml(data, header=header)  # before touching the disk: bad data fails first
+    return write_atomic(
+        directory / f"{name}{SUFFIX}", text.encode("utf-8"), overwrite=overwrite, make_dirs=True
+    )
+
+
+# -- notices ---------------------------------------------------------------------------------
+_NOTICED: set[str] = set()
+
+
+def _shadow_message(name, path, source, hidden) -> str:
+    label = {"extra": "--materials", "user": "user", "builtin": "built-in"}.get(source, source)
+    return f"preset '{name}': using {path} ({label}), which hides {hidden[0]}"
+
+
+def _notice(notices: list | None, message: str) -> None:
+    if notices is not None:
+        notices.append(message)
+    elif message not in _NOTICED:
+        _NOTICED.add(message)
+        warnings.warn(message, PresetNotice, stacklevel=3)

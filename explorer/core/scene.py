@@ -1,0 +1,231 @@
+"""Scenes: a material, lights, a viewer and options, loaded from YAML or a mapping.
+
+The scene-file schema (every key optional)::
+
+    material: bronze          # a preset name, or an inline mapping of the material keys
+    model: blinn              # or phong (default: the material's model, else blinn)
+    ambient: [0.2, 0.2, 0.2]  # scene ambient (OpenGL's default)
+    viewer: {eye: [0, 0, 5]}  # local viewer; or {direction: [0, 0, 1]} (infinite, the default)
+    two_sided: false
+    lights:                   # default: one directional light toward +z (OpenGL's GL_LIGHT0)
+      - {type: directional, direction: [1, 1, 1]}
+      - {type: point, position: [2, 3, 1], attenuation: [1, 0.1, 0.01]}
+      - {type: spot, position: [0, 4, 0], direction: [0, -1, 0], cutoff: 30, exponent: 8}
+    mesh: sphere              # built-in name or mesh file (relative to the scene file)
+    hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
+
+Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
+light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+from explorer.core.errors import ExplorerError
+from explorer.core.hdr import HDR, parse_hdr
+from explorer.core.lights import DirectionalLight, light_to_mapping, parse_light
+from explorer.core.material import MODELS, Material, parse_material
+from explorer.core.presets import find_preset
+from explorer.core.validate import Checker
+from explorer.core.yamlio import load_yaml
+
+Vec3 = tuple[float, float, float]
+
+SCENE_KEYS = ("material", "model", "ambient", "viewer", "two_sided", "lights", "mesh", "hdr")
+VIEWER_KEYS = ("eye", "direction")
+DEFAULT_AMBIENT = (0.2, 0.2, 0.2)
+
+
+@dataclass(frozen=True)
+class Viewer:
+    """Exactly one of ``eye`` (a local viewer at a point) or ``direction`` (an infinite viewer;
+    the direction points toward the viewer, stored unit length)."""
+
+    eye: Vec3 | None = None
+    direction: Vec3 | None = None
+
+    def __post_init__(self):
+        if (self.eye is None) == (self.direction is None):
+            raise ValueError("viewer needs exactly one of eye or direction")
+        if self.eye is not None:
+            e = tuple(float(c) for c in self.eye)
+            if len(e) != 3 or not all(math.isfinite(c) for c in e):
+                raise ValueError(f"viewer eye must be 3 finite numbers, got {self.eye!r}")
+            object.__setattr__(self, "eye", e)
+        else:
+            d = tuple(float(c) for c in self.direction)
+            n = math.sqrt(sum(c * c for c in d)) if len(d) == 3 else 0.0
+            if not (math.isfinite(n) and n > 0.0):
+                raise ValueError(f"viewer direction must be non-zero, got {self.direction!r}")
+            object.__setattr__(self, "direction", tuple(c / n for c in d))
+
+    @property
+    def local(self) -> bool:
+        return self.eye is not None
+
+    def to_mapping(self) -> dict:
+        if self.eye is not None:
+            return {"eye": list(self.eye)}
+        return {"direction": list(self.direction)}
+
+
+DEFAULT_VIEWER = Viewer(direction=(0.0, 0.0, 1.0))
+DEFAULT_LIGHTS: tuple = (DirectionalLight(direction=(0.0, 0.0, 1.0)),)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """Everything but the geometry.
+
+    material : the surface's coefficients
+    model : "blinn" ((N·H)^n) or "phong" ((R·V)^n)
+    ambient : scene ambient RGB (``a_scene``), never attenuated
+    viewer : local or infinite
+    two_sided : light back faces with -N
+    lights : tuple of lights
+    mesh : built-in mesh name or a file path, or None where arrays are given
+    hdr : display unclamped colours with this exposure and tone map (:mod:`explorer.tonemap`),
+        or None (OpenGL: clamp to [0, 1])
+    source : the file the scene came from (for messages), or None
+    """
+
+    material: Material = field(default_factory=Material)
+    model: str = "blinn"
+    ambient: Vec3 = DEFAULT_AMBIENT
+    viewer: Viewer = DEFAULT_VIEWER
+    two_sided: bool = False
+    lights: tuple = DEFAULT_LIGHTS
+    mesh: str | None = None
+    source: str | None = field(default=None, compare=False)
+    hdr: HDR | None = None
+
+    def __post_init__(self):
+        if self.model not in MODELS:
+            raise ValueError(f"model must be one of {MODELS}, got {self.model!r}")
+        a = tuple(float(c) for c in self.ambient)
+        if len(a) != 3 or not all(math.isfinite(c) and c >= 0 for c in a):
+            raise ValueError(f"scene ambient must be 3 finite numbers >= 0, got {self.ambient!r}")
+        object.__setattr__(self, "ambient", a)
+        object.__setattr__(self, "lights", tuple(self.lights))
+        object.__setattr__(self, "two_sided", bool(self.two_sided))
+
+    def replace(self, **changes) -> Scene:
+        """A copy with some fields changed (``scene.replace(material=m)``)."""
+        return replace(self, **changes)
+
+    def to_mapping(self) -> dict:
+        """The scene-file form (plain Python values, YAML-ready)."""
+        out = {
+            "material": self.material.to_mapping(),
+            "model": self.model,
+            "ambient": list(self.ambient),
+            "viewer": self.viewer.to_mapping(),
+            "two_sided": self.two_sided,
+            "lights": [light_to_mapping(light) for light in self.lights],
+        }
+        if self.mesh is not None:
+            out["mesh"] = self.mesh
+        if self.hdr is not None:
+            out["hdr"] = self.hdr.to_mapping()
+        return out
+
+
+def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
+    """A :class:`Scene` from a scene-file path, a mapping in the scene schema, or a Scene.
+
+    Every problem in the document is reported at once in one
+    :class:`~explorer.errors.ValidationError` naming the file, line and key.
+    ``materials_dirs`` are extra preset directories searched before the built-in ones.
+    """
+    if scene is None:
+        return Scene()
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, (str, os.PathLike)):
+        doc = load_yaml(scene, what="scene", collect=True)
+        checker = doc.checker()  # already holds duplicate keys etc.: one pass reports all
+        return _parse(doc.data, checker, materials_dirs, os.path.dirname(os.fspath(scene)))
+    if isinstance(scene, Mapping):
+        return _parse(scene, Checker(None), materials_dirs, None)
+    raise ExplorerError(
+        f"a scene must be a scene-file path, a mapping or a Scene, got {type(scene).__name__}"
+    )
+
+
+def _parse(data, checker: Checker, materials_dirs, base_dir) -> Scene:
+    m = checker.mapping(data, (), "a mapping of scene keys")
+    checker.raise_if_any()
+    checker.keys(m, (), SCENE_KEYS)
+    kw: dict = {}
+    material = None
+    if "material" in m:
+        value = m["material"]
+        if isinstance(value, Material):
+            material = value
+        elif isinstance(value, str):
+            material = _preset(value, checker, materials_dirs)
+        else:
+            material = parse_material(value, checker, ("material",))
+        if material is not None:
+            kw["material"] = material
+    if "model" in m:
+        kw["model"] = checker.choice(m["model"], ("model",), MODELS)
+    elif material is not None and material.model is not None:
+        kw["model"] = material.model
+    if "ambient" in m:
+        kw["ambient"] = checker.triple(m["ambient"], ("ambient",), 0.0)
+    if "viewer" in m:
+        kw["viewer"] = _viewer(m["viewer"], checker)
+    if "two_sided" in m:
+        kw["two_sided"] = checker.boolean(m["two_sided"], ("two_sided",))
+    if "lights" in m:
+        lights = m["lights"]
+        if isinstance(lights, (str, bytes, Mapping)) or not isinstance(lights, Sequence):
+            checker.problem(("lights",), "must be a list of lights (- {type: ..., ...})")
+        else:
+            kw["lights"] = tuple(
+                parse_light(light, checker, ("lights", i)) for i, light in enumerate(lights)
+            )
+    if "mesh" in m:
+        mesh = checker.string(m["mesh"], ("mesh",))
+        if mesh is not None and base_dir and _looks_like_path(mesh):
+            mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
+        kw["mesh"] = mesh
+    if "hdr" in m:
+        kw["hdr"] = parse_hdr(m["hdr"], checker, ("hdr",))
+    checker.raise_if_any()
+    return Scene(source=checker.file, **kw)
+
+
+def _looks_like_path(mesh: str) -> bool:
+    return os.sep in mesh or "/" in mesh or "." in os.path.basename(mesh)
+
+
+def _viewer(value, checker: Checker) -> Viewer | None:
+    if isinstance(value, Viewer):
+        return value
+    path = ("viewer",)
+    m = checker.mapping(value, path, "{eye: [x, y, z]} or {direction: [x, y, z]}")
+    if m is None:
+        return None
+    checker.keys(m, path, VIEWER_KEYS)
+    if ("eye" in m) == ("direction" in m):
+        checker.problem(path, "needs exactly one of eye (local viewer) or direction (infinite)")
+        return None
+    if "eye" in m:
+        eye = checker.triple(m["eye"], path + ("eye",))
+        return None if eye is None else Viewer(eye=eye)
+    d = checker.direction(m["direction"], path + ("direction",))
+    return None if d is None else Viewer(direction=d)
+
+
+def _preset(name: str, checker: Checker, materials_dirs) -> Material | None:
+    try:
+        return find_preset(name, materials_dirs)
+    except ExplorerError as exc:
+        checker.problem(("material",), str(exc))
+        return None

@@ -1,0 +1,228 @@
+"""Validation helpers shared by scene files, material presets and the Python API.
+
+A :class:`Checker` walks a parsed document, converts values and *collects* problems instead of
+stopping at the first one; ``raise_if_any()`` raises one :class:`ValidationError` listing all of
+them. Every helper takes the key path of the value (``path``) and says it in the message, along
+with the allowed range, the file and the line (when the document came from a file).
+
+Key paths are tuples such as ``("lights", 1, "attenuation")`` and print as
+``lights[1].attenuation``.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from numbers import Real
+
+from explorer.core.errors import Problem, ValidationError
+
+Path = tuple
+
+
+def line_of(lines: Mapping[Path, int], path: Path) -> int | None:
+    """Line of ``path`` in ``lines``, or of its nearest enclosing key (None if none)."""
+    path = tuple(path)
+    while True:
+        if path in lines:
+            return lines[path]
+        if not path:
+            return None
+        path = path[:-1]
+
+
+def format_path(path: Path) -> str:
+    """``("lights", 1, "position")`` -> ``"lights[1].position"``."""
+    out = ""
+    for part in path:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def suggest(word: str, options: Iterable[str]) -> str:
+    """A did-you-mean hint (``" (did you mean 'shininess'?)"``) or an empty string."""
+    close = difflib.get_close_matches(str(word), list(options), n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+def _fmt(x) -> str:
+    if isinstance(x, float):
+        return f"{x:g}"
+    return repr(x) if isinstance(x, str) else str(x)
+
+
+class Checker:
+    """Collects :class:`Problem` for one document.
+
+    file : shown in every message (a path, or None for an in-memory mapping)
+    lines : optional mapping ``path tuple -> 1-based line`` (from :mod:`explorer.yamlio`); a
+        problem is reported on the line of its key, or of the nearest enclosing key
+    """
+
+    def __init__(self, file: str | None = None, lines: Mapping[Path, int] | None = None):
+        self.file = None if file is None else str(file)
+        self.lines = dict(lines or {})
+        self.problems: list[Problem] = []
+
+    # -- bookkeeping -------------------------------------------------------------------------
+    def line(self, path: Path) -> int | None:
+        return line_of(self.lines, path)
+
+    def problem(self, path: Path, message: str) -> None:
+        self.problems.append(
+            Problem(message, self.file, self.line(path), format_path(path) or None)
+        )
+
+    def raise_if_any(self) -> None:
+        if self.problems:
+            raise ValidationError(self.problems)
+
+    # -- structure ---------------------------------------------------------------------------
+    def mapping(self, value, path: Path, what: str = "a mapping") -> dict | None:
+        if isinstance(value, Mapping):
+            return dict(value)
+        self.problem(path, f"must be {what} (key: value lines), got {_type(value)}")
+        return None
+
+    def keys(
+        self,
+        mapping: Mapping,
+        path: Path,
+        allowed: Sequence[str],
+        required: Sequence[str] = (),
+    ) -> bool:
+        """Report unknown keys (with a did-you-mean) and missing required keys."""
+        ok = True
+        for key in mapping:
+            if not isinstance(key, str) or key not in allowed:
+                hint = suggest(key, allowed) if isinstance(key, str) else ""
+                self.problem(
+                    path + (key,),
+                    f"unknown key{hint}; allowed keys: {', '.join(allowed)}",
+                )
+                ok = False
+        for key in required:
+            if key not in mapping:
+                self.problem(path, f"missing required key '{key}'")
+                ok = False
+        return ok
+
+    # -- scalars -----------------------------------------------------------------------------
+    def number(
+        self,
+        value,
+        path: Path,
+        lo: float = -math.inf,
+        hi: float = math.inf,
+        *,
+        lo_open: bool = False,
+    ) -> float | None:
+        """A finite real number in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``)."""
+        rng = _range(lo, hi, lo_open)
+        if isinstance(value, bool) or not isinstance(value, Real):
+            self.problem(path, f"must be a number{rng}, got {_type(value)} {_fmt(value)}")
+            return None
+        try:
+            x = float(value)
+        except OverflowError:  # an int beyond the float range
+            self.problem(path, f"must be a number{rng}, got an integer too large for a float")
+            return None
+        if not math.isfinite(x):
+            self.problem(path, f"must be a finite number{rng}, got {_fmt(x)}")
+            return None
+        if x < lo or x > hi or (lo_open and x == lo):
+            self.problem(path, f"must be{rng or ' a number'}, got {_fmt(x)}")
+            return None
+        return x
+
+    def boolean(self, value, path: Path) -> bool | None:
+        if isinstance(value, bool):
+            return value
+        self.problem(path, f"must be true or false, got {_type(value)} {_fmt(value)}")
+        return None
+
+    def choice(self, value, path: Path, options: Sequence[str]) -> str | None:
+        if isinstance(value, str) and value in options:
+            return value
+        hint = suggest(value, options) if isinstance(value, str) else ""
+        self.problem(path, f"must be one of {', '.join(options)}, got {_fmt(value)}{hint}")
+        return None
+
+    def string(self, value, path: Path) -> str | None:
+        if isinstance(value, str):
+            return value
+        self.problem(path, f"must be text, got {_type(value)} {_fmt(value)}")
+        return None
+
+    # -- vectors -----------------------------------------------------------------------------
+    def triple(
+        self, value, path: Path, lo: float = -math.inf, hi: float = math.inf
+    ) -> tuple[float, float, float] | None:
+        rng = _range(lo, hi, False)
+        if (
+            isinstance(value, (str, bytes, Mapping))
+            or not isinstance(value, (Sequence, _ndarray_type()))
+            or len(value) != 3
+        ):
+            self.problem(
+                path,
+                f"must be a list of 3 numbers{' each' + rng if rng else ''}, "
+                f"got {_type(value)} {_fmt(value)}",
+            )
+            return None
+        out = []
+        for i, v in enumerate(value):
+            x = self.number(v, path + (i,), lo, hi)
+            if x is None:
+                return None
+            out.append(x)
+        return (out[0], out[1], out[2])
+
+    def rgb(self, value, path: Path, lo: float = 0.0, hi: float = 1.0):
+        """An RGB triple with every channel in ``[lo, hi]``."""
+        return self.triple(value, path, lo, hi)
+
+    def direction(self, value, path: Path):
+        """A non-zero 3-vector (not normalised here)."""
+        v = self.triple(value, path)
+        if v is not None and not any(v):
+            self.problem(path, "must be a non-zero direction, got [0, 0, 0]")
+            return None
+        if v is not None and not math.isfinite(math.hypot(*v)):
+            self.problem(path, "is too long to normalise (length overflows)")
+            return None
+        return v
+
+
+def _range(lo: float, hi: float, lo_open: bool) -> str:
+    if lo == -math.inf and hi == math.inf:
+        return ""
+    if hi == math.inf:
+        return f" > {_fmt(lo)}" if lo_open else f" >= {_fmt(lo)}"
+    if lo == -math.inf:
+        return f" <= {_fmt(hi)}"
+    return f" in {'(' if lo_open else '['}{_fmt(lo)}, {_fmt(hi)}]"
+
+
+def _type(value) -> str:
+    if value is None:
+        return "nothing"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, str):
+        return "text"
+    if isinstance(value, Mapping):
+        return "a mapping"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)}"
+    return type(value).__name__
+
+
+def _ndarray_type():
+    import numpy as np
+
+    return np.ndarray

@@ -1,0 +1,86 @@
+"""Pictures as arrays and files: sizes, PNG encoding and decoding (VTK's codec)."""
+
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from explorer.core.errors import ExplorerError
+
+#: default image size (width, height)
+DEFAULT_SIZE = (400, 400)
+#: smallest and largest accepted image side in pixels
+SIZE_RANGE = (16, 8192)
+
+
+# -- sizes and files -----------------------------------------------------------------------
+
+
+def check_size(size) -> tuple[int, int]:
+    """(width, height) as ints in :data:`SIZE_RANGE`, or an :class:`ExplorerError`."""
+    lo, hi = SIZE_RANGE
+    try:
+        w, h = (int(v) for v in size)
+        ok = all(float(v) == int(v) for v in size)
+    except (TypeError, ValueError):
+        ok = False
+    if not ok or not (lo <= w <= hi and lo <= h <= hi):
+        raise ExplorerError(
+            f"image size must be two whole numbers of pixels, each in [{lo}, {hi}], got {size!r}"
+        )
+    return w, h
+
+
+_SIZE_RE = re.compile(r"^\s*(\d+)\s*[xX×]\s*(\d+)\s*$")
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``"400x300"`` -> (400, 300) (width x height), checked against :data:`SIZE_RANGE`."""
+    m = _SIZE_RE.match(str(text))
+    if not m:
+        raise ExplorerError(f"size must look like WIDTHxHEIGHT, e.g. 400x400, got {text!r}")
+    return check_size((int(m.group(1)), int(m.group(2))))
+
+
+def encode_png(image) -> bytes:
+    """PNG file contents of an (h, w, 3|4) uint8 image (VTK's PNG writer)."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+
+    img = np.asarray(image)
+    if img.dtype != np.uint8 or img.ndim != 3 or img.shape[2] not in (3, 4):
+        raise ValueError(f"image must be (h, w, 3|4) uint8, got {img.shape} {img.dtype}")
+    h, w, c = img.shape
+    data = vtkImageData()
+    data.SetDimensions(w, h, 1)
+    flat = np.ascontiguousarray(img[::-1].reshape(-1, c))  # VTK rows go bottom-up
+    arr = numpy_to_vtk(flat, deep=True)
+    arr.SetNumberOfComponents(c)
+    data.GetPointData().SetScalars(arr)
+    writer = vtkPNGWriter()
+    writer.SetWriteToMemory(True)
+    writer.SetInputData(data)
+    writer.Write()
+    result = writer.GetResult()
+    return bytes(memoryview(result))
+
+
+def read_png(path) -> np.ndarray:
+    """An (h, w, 3|4) uint8 image from a PNG file."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+
+    path = os.fspath(path)
+    reader = vtkPNGReader()
+    if not os.path.isfile(path) or not reader.CanReadFile(path):
+        raise ExplorerError(f"{path}: not a readable PNG file")
+    reader.SetFileName(path)
+    reader.Update()
+    img = reader.GetOutput()
+    w, h, _ = img.GetDimensions()
+    arr = vtk_to_numpy(img.GetPointData().GetScalars())
+    c = arr.shape[1] if arr.ndim == 2 else 1
+    return np.ascontiguousarray(arr.reshape(h, w, c)[::-1]).astype(np.uint8)

@@ -1,0 +1,311 @@
+"""Off-screen pictures of the engine's colours: PNG renders, the preset sheet, PLY/GLB export.
+
+The engine computes one colour per vertex (:func:`explorer.shade`); VTK only draws them. The
+colours go to VTK as RGB point scalars with VTK's lighting off, so VTK adds nothing: no light of
+its own, no specular, no ambient (``add_mesh(..., rgb=True, lighting=False)``, see the last
+section of the lighting-equation reference). Between vertices VTK interpolates the colours
+linearly across each triangle: Gouraud shading, as in OpenGL's fixed-function pipeline. No
+multisampling or anti-aliasing, a fixed background, ``render()`` before ``screenshot()``, and
+every plotter is closed afterwards: the same scene gives the same pixels every time.
+
+Camera and viewer agree (see :func:`camera_for`):
+
+- a **local viewer** (``viewer: {eye: ...}``) puts a perspective camera at the eye, looking at
+  the mesh's centre, with the narrowest field of view that shows the whole mesh;
+- an **infinite viewer** (``viewer: {direction: ...}``, the default) is a *parallel*
+  projection looking along ``-direction``: every pixel is seen along the same ``V``, exactly
+  what the engine assumes. The view is scaled so the mesh's bounding sphere fits.
+
+VTK is imported only inside the functions that draw or read/write PNG files.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+
+from explorer.core.errors import ExplorerError
+from explorer.geometry.meshes import Mesh
+from explorer.render.camera import Camera, Vec3, apply_camera, back_to_front, camera_for
+from explorer.render.images import DEFAULT_SIZE, check_size
+from explorer.shading.display import to_bytes, vertex_colors
+
+#: background colour of every render (linear RGB in [0, 1]): a neutral mid-dark grey on which
+#: both black rubber and white plastic read
+BACKGROUND: Vec3 = (0.32, 0.32, 0.32)
+#: the light of the preset sheet when no scene is given: OpenGL's directional light from the
+#: upper front, as in the classic chart of teapot materials (light position (0, 3, 3, 0))
+SHEET_LIGHT_DIRECTION: Vec3 = (0.0, 1.0, 1.0)
+#: default preset sheet layout
+SHEET_TILE = (200, 150)
+SHEET_COLUMNS = 6
+#: label text colour and height (fraction of the tile height) on the sheet
+LABEL_COLOR: Vec3 = (1.0, 1.0, 1.0)
+LABEL_HEIGHT = 0.085
+
+
+# -- the off-screen renderer ---------------------------------------------------------------
+
+
+_WINDOW_ENV = "VTK_DEFAULT_OPENGL_WINDOW"
+
+
+def _plotter(size: tuple[int, int], background):
+    import pyvista as pv
+
+    # No display: VTK would probe X, log "bad X server connection" and fall back to EGL; ask
+    # for EGL directly. Only while the window is created, so nothing else in the process
+    # (a GUI started later with a display) inherits the setting.
+    headless = not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
+    added = headless and _WINDOW_ENV not in os.environ
+    if added:
+        os.environ[_WINDOW_ENV] = "vtkEGLRenderWindow"
+    try:
+        pl = pv.Plotter(off_screen=True, window_size=list(size), lighting=None)
+    finally:
+        if added:
+            del os.environ[_WINDOW_ENV]
+    pl.render_window.SetMultiSamples(0)  # before the first render: no multisampling
+    pl.disable_anti_aliasing()
+    # translucency: plain "over" blending in the order the triangles are drawn (sorted back to
+    # front by the caller); VTK's weighted-average OIT and its depth peeling (wrong layer
+    # order on Mesa llvmpipe) are both off
+    pl.renderer.SetUseOIT(False)
+    pl.renderer.SetUseDepthPeeling(False)
+    pl.set_background(background)
+    return pl
+
+
+class OffscreenRenderer:
+    """One off-screen VTK window reused for many pictures of the same size (cheap: no new
+    OpenGL context per picture). Use as a context manager, or call :meth:`close`.
+
+    size : (width, height) in pixels
+    background : RGB in [0, 1]
+    """
+
+    def __init__(self, size: Sequence[int] = DEFAULT_SIZE, background=BACKGROUND):
+        self.size = check_size(size)
+        self.background = tuple(float(c) for c in background)
+        self._pl = None
+        self._actor = None
+        self._mesh = None
+        self._poly = None
+        self._text = None
+        self._sorted = False
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def close(self) -> None:
+        if self._pl is not None:
+            self._pl.close()
+            self._pl = None
+            self._actor = self._mesh = self._poly = self._text = None
+
+    @property
+    def plotter(self):
+        if self._pl is None:
+            self._pl = _plotter(self.size, self.background)
+        return self._pl
+
+    def render(
+        self,
+        scene,
+        mesh: Mesh,
+        colors=None,
+        *,
+        label: str | None = None,
+        label_size: int | None = None,
+        camera: Camera | None = None,
+        backdrop=None,
+    ) -> np.ndarray:
+        """Draw the mesh in the engine's colours and return the picture.
+
+        scene : a :class:`~explorer.scene.Scene` (its material's opacity is honoured)
+        colors : (n, 3) float in [0, 1] to draw instead of shading the scene
+        label : text drawn at the bottom centre (the preset sheet's names); the camera then
+            keeps the bottom of the picture free for it
+        label_size : its font size in pixels (default: the largest that fits)
+        camera : overrides :func:`camera_for`
+        backdrop : an opaque second object drawn with the mesh, ``(Mesh, colors (k, 3))``; a
+            translucent mesh in front of it blends over it (VTK draws opaque geometry first,
+            then the translucent triangles back to front with the depth test on)
+        Returns (height, width, 3) uint8.
+        """
+        pl = self.plotter
+        if colors is None:
+            colors = vertex_colors(scene, mesh)
+        rgb = to_bytes(colors)
+        if rgb.shape != (mesh.n_vertices, 3):
+            raise ExplorerError(
+                f"colors must have shape ({mesh.n_vertices}, 3), got {np.shape(colors)}"
+            )
+        if self._mesh is not mesh:
+            if self._actor is not None:
+                pl.remove_actor(self._actor)
+            self._poly = mesh.to_polydata(rgb)
+            self._sorted = False
+            self._actor = pl.add_mesh(
+                self._poly,
+                scalars="colors",
+                rgb=True,
+                lighting=False,
+                show_scalar_bar=False,
+                reset_camera=False,
+            )
+            self._mesh = mesh
+        else:
+            self._poly.point_data["colors"] = rgb
+        opacity = float(scene.material.opacity)
+        self._actor.GetProperty().SetOpacity(opacity)
+        self._set_label(label, label_size)
+        w, h = self.size
+        if camera is None:
+            band = 0.0
+            if label is not None:
+                band = 1.5 * self._text.GetTextProperty().GetFontSize() / h
+            camera = camera_for(scene, mesh, w / h, bottom=band)
+        self._set_camera(camera)
+        # translucent: draw the triangles back to front, so each blends over what is behind
+        # it; opaque: file order (the depth test decides)
+        order = back_to_front(mesh, camera) if opacity < 1.0 else None
+        if order is not None or self._sorted:
+            faces = mesh.faces if order is None else mesh.faces[order]
+            cells = np.hstack([np.full((len(faces), 1), 3, np.int64), faces]).ravel()
+            self._poly.faces = cells
+            self._sorted = order is not None
+        extra = None
+        if backdrop is not None:
+            bmesh, bcolors = backdrop
+            extra = pl.add_mesh(
+                bmesh.to_polydata(to_bytes(bcolors)),
+                scalars="colors",
+                rgb=True,
+                lighting=False,
+                show_scalar_bar=False,
+                reset_camera=False,
+            )
+        try:
+            pl.render()
+            img = pl.screenshot(return_img=True)
+        finally:
+            if extra is not None:
+                pl.remove_actor(extra)
+        return np.ascontiguousarray(img[:, :, :3])
+
+    def _text_actor(self):
+        if self._text is None:
+            import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
+            from vtkmodules.vtkRenderingCore import vtkTextActor
+
+            renderer = self.plotter.renderer
+            t = vtkTextActor()
+            prop = t.GetTextProperty()
+            prop.SetColor(*LABEL_COLOR)
+            prop.SetJustificationToCentered()
+            prop.SetVerticalJustificationToBottom()
+            prop.SetFontFamilyToArial()
+            prop.ShadowOff()
+            prop.BoldOff()
+            renderer.AddActor(t)
+            self._text = t
+        return self._text
+
+    def label_font_size(self, labels: Iterable[str]) -> int:
+        """The largest font size (pixels, at most ``LABEL_HEIGHT`` of the height) at which
+        every label fits the width."""
+        t = self._text_actor()
+        w, h = self.size
+        size = max(6, int(round(LABEL_HEIGHT * h)))
+        for label in labels:
+            while size > 6:
+                t.SetInput(str(label))
+                t.GetTextProperty().SetFontSize(size)
+                extent = [0.0, 0.0]
+                t.GetSize(self.plotter.renderer, extent)
+                if extent[0] <= w - 6:
+                    break
+                size -= 1
+        return size
+
+    def _set_label(self, label: str | None, font_size: int | None) -> None:
+        if label is None:
+            if self._text is not None:
+                self._text.SetVisibility(False)
+            return
+        if font_size is None:
+            font_size = self.label_font_size([label])
+        t = self._text_actor()
+        t.SetInput(str(label))
+        t.GetTextProperty().SetFontSize(int(font_size))
+        w, _ = self.size
+        t.SetPosition(w / 2.0, max(2.0, 0.25 * font_size))
+        t.SetVisibility(True)
+
+    def _set_camera(self, cam: Camera) -> None:
+        self.plotter.camera_set = True
+        apply_camera(self.plotter.camera, cam)
+
+
+def render_image(
+    scene,
+    mesh: Mesh,
+    size: Sequence[int] = DEFAULT_SIZE,
+    *,
+    background=BACKGROUND,
+    colors=None,
+    label: str | None = None,
+    camera: Camera | None = None,
+    backdrop=None,
+) -> np.ndarray:
+    """One off-screen picture of the mesh under the scene: (height, width, 3) uint8.
+
+    See :meth:`OffscreenRenderer.render`; the window is closed before returning.
+    """
+    with OffscreenRenderer(size, background) as r:
+        return r.render(scene, mesh, colors, label=label, camera=camera, backdrop=backdrop)
+
+
+def sheet(
+    materials: Iterable,
+    scene,
+    mesh: Mesh,
+    *,
+    tile: Sequence[int] = SHEET_TILE,
+    columns: int = SHEET_COLUMNS,
+    background=BACKGROUND,
+    gap: int = 2,
+    model: str | None = None,
+) -> np.ndarray:
+    """Every material on the same mesh, in a labelled grid: (H, W, 3) uint8.
+
+    materials : (label, Material) pairs, drawn left to right, top to bottom
+    scene : lights, viewer, model; each tile replaces its material
+    model : specular model of every tile; None: the material's own model when it has one,
+        else the scene's
+    tile : (width, height) of one cell; gap : pixels between cells (background colour)
+    """
+    items = list(materials)
+    if not items:
+        raise ExplorerError("no materials to put on the sheet")
+    tw, th = check_size(tile)
+    columns = max(1, min(int(columns), len(items)))
+    rows = -(-len(items) // columns)
+    bg = np.rint(np.asarray(background) * 255.0).astype(np.uint8)
+    out = np.empty((rows * th + (rows + 1) * gap, columns * tw + (columns + 1) * gap, 3), np.uint8)
+    out[:] = bg
+    with OffscreenRenderer((tw, th), background) as r:
+        font = r.label_font_size(str(label) for label, _ in items)
+        for i, (label, material) in enumerate(items):
+            s = scene.replace(material=material, model=model or material.model or scene.model)
+            img = r.render(s, mesh, label=str(label), label_size=font)
+            y0 = gap + (i // columns) * (th + gap)
+            x0 = gap + (i % columns) * (tw + gap)
+            out[y0 : y0 + th, x0 : x0 + tw] = img
+    return out

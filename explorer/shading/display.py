@@ -1,0 +1,112 @@
+"""The display pipeline: the engine's linear light sums to the colours and bytes people see.
+
+One path for every picture the project makes (renders, the per-pixel reference, the window,
+mesh exports)::
+
+    colours (n, 3) linear, >= 0          the engine (clamp=False under hdr)
+      -> exposure and tone map            scenes with ``hdr`` (below); else clamp to [0, 1]
+      -> sRGB encoding                    scenes with ``hdr``; OpenGL's clamp path is not encoded
+      -> 8-bit                            :func:`to_bytes`, rounded to nearest
+
+The engine's unclamped colours (``shade(..., clamp=False)``) are linear radiance-like values
+``>= 0`` that may exceed 1 (several lights, an energy-conserving lobe, bright lights). A scene
+with ``hdr: {exposure: E, tone_map: T}`` is displayed as::
+
+    x = c · 2**E                      exposure in stops (E = 0: unchanged, +1: twice as bright)
+    y = tone_map(x)                   into [0, 1]
+    out = srgb_encode(y)              the exact sRGB OETF (IEC 61966-2-1)
+
+Tone maps (:data:`TONE_MAPS`):
+
+- ``clamp``: ``min(x, 1)`` (what OpenGL does; HDR then only adds exposure and sRGB);
+- ``reinhard``: ``x / (1 + x)`` per channel (Reinhard et al. 2002, simple form): never clips,
+  compresses highlights smoothly, darkens mid-tones (0.5 -> 0.33);
+- ``aces``: Narkowicz's fit of the ACES filmic curve (2015),
+  ``x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14)`` clamped to [0, 1], with the input scaled by
+  0.6 as in the original fit: contrasty mid-tones, highlights roll off to white.
+
+The sRGB OETF: ``12.92·y`` for ``y <= 0.0031308``, else ``1.055·y^(1/2.4) - 0.055``.
+
+The lecture notes' rule for HDR (keep ``kd + ks`` at most 1 per channel) is checked by
+:func:`explorer.core.hdr.energy_warnings`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer.core.hdr import HDR, TONE_MAPS
+from explorer.geometry.meshes import Mesh
+from explorer.shading.shader import shade
+
+#: ACES (Narkowicz) input scale: the fit maps scene value 1/0.6 to about 0.8
+ACES_INPUT_SCALE = 0.6
+
+
+def expose(colors, exposure: float) -> np.ndarray:
+    """colors · 2**exposure; colors : (..., 3) float >= 0."""
+    return np.asarray(colors, np.float64) * (2.0 ** float(exposure))
+
+
+def tone_map(x, name: str) -> np.ndarray:
+    """One of :data:`TONE_MAPS` applied per channel: (..., 3) float >= 0 -> [0, 1]."""
+    x = np.maximum(np.asarray(x, np.float64), 0.0)
+    if name == "clamp":
+        return np.minimum(x, 1.0)
+    if name == "reinhard":
+        return x / (1.0 + x)
+    if name == "aces":
+        a = x * ACES_INPUT_SCALE
+        return np.clip(a * (2.51 * a + 0.03) / (a * (2.43 * a + 0.59) + 0.14), 0.0, 1.0)
+    raise ValueError(f"tone map must be one of {TONE_MAPS}, got {name!r}")
+
+
+def srgb_encode(y) -> np.ndarray:
+    """The exact sRGB OETF: linear [0, 1] -> encoded [0, 1] (monotone, continuous)."""
+    y = np.clip(np.asarray(y, np.float64), 0.0, 1.0)
+    return np.where(y <= 0.0031308, 12.92 * y, 1.055 * np.power(y, 1.0 / 2.4) - 0.055)
+
+
+def srgb_decode(v) -> np.ndarray:
+    """The inverse of :func:`srgb_encode`."""
+    v = np.clip(np.asarray(v, np.float64), 0.0, 1.0)
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+
+def display(colors, hdr: HDR) -> np.ndarray:
+    """Unclamped linear colours (n, 3) -> display values in [0, 1] (sRGB-encoded)."""
+    return srgb_encode(tone_map(expose(colors, hdr.exposure), hdr.tone_map))
+
+
+# -- colours -------------------------------------------------------------------------------
+
+
+def vertex_colors(scene, mesh: Mesh, *, precision: str = "float64") -> np.ndarray:
+    """Engine colours of the mesh's vertices under the scene: (n, 3) float64 in [0, 1].
+
+    The mesh's triangles go to the engine too (shadows). A scene with ``hdr`` is shaded
+    unclamped and shown through its exposure, tone map and the sRGB encoding
+    (:func:`explorer.tonemap.display`); the renderer then interpolates the encoded values."""
+    hdr = getattr(scene, "hdr", None)
+    c = shade(
+        scene,
+        mesh.positions,
+        mesh.normals,
+        precision=precision,
+        clamp=hdr is None,
+        faces=mesh.faces,
+    )
+    if hdr is not None:
+        c = display(c, hdr)
+    return c
+
+
+def to_bytes(colors, opacity: float | None = None) -> np.ndarray:
+    """Colours in [0, 1] as 8-bit values, rounded to nearest: (n, 3) uint8, or (n, 4) with an
+    alpha column of ``opacity`` when given."""
+    c = np.clip(np.asarray(colors, np.float64), 0.0, 1.0)
+    out = np.rint(c * 255.0).astype(np.uint8)
+    if opacity is not None:
+        alpha = np.full((len(out), 1), int(round(float(opacity) * 255.0)), np.uint8)
+        out = np.hstack([out, alpha])
+    return out

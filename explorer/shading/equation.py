@@ -1,0 +1,129 @@
+"""The full-generality float64 reference: every term for every light, no plan, plain numpy.
+
+This is the engine's specification in code. It computes each term whether or not it can be
+non-zero, so the planned fast path (:mod:`explorer.kernels`) is tested against it. It applies the
+same documented policies (:mod:`explorer.tolerances`) for the cases the equation leaves undefined.
+
+    c = e_m + a_m·a_scene
+      + Σ_i att_i · spot_i · ( a_m·a_i
+                               + vis_i · ( max(N·L_i, 0)·d_m·d_i
+                                           + f_i·F_i·E·max(N·H_i, 0)^n · s_m·s_i ) )
+
+with the effects of :mod:`explorer.effects` and :mod:`explorer.shadows`: ``vis_i`` the shadow
+visibility (1 without ``shadows: true`` or without faces; rays from every vertex, even on a
+convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and ``E`` the
+energy-conserving normalisation (1 without ``energy_conserving``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from explorer.core import tolerances as tol
+from explorer.core.lights import DirectionalLight, SpotLight
+from explorer.core.scene import Scene
+from explorer.geometry.frame import check_vertices, frame_of, to_frame
+from explorer.shading.effects import schlick, specular_scale
+from explorer.shading.shadows import visibility
+
+
+def _unit_or(v: np.ndarray, eps: float, fallback: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``v`` made unit length; rows shorter than ``eps`` replaced by ``fallback``.
+    Returns the unit rows (n, 3) and the lengths (n,)."""
+    length = np.sqrt(np.einsum("ij,ij->i", v, v))
+    ok = length > eps
+    unit = np.where(ok[:, None], v / np.where(ok, length, 1.0)[:, None], fallback)
+    return unit, length
+
+
+def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
+    """Per-vertex light sums, independent of the material.
+
+    Returns ``ambient``, ``diffuse``, ``specular`` : (n, 3) float64 such that the colour is
+    ``e_m + a_m·ambient + d_m·diffuse + s_m·specular`` (``ambient`` includes the scene ambient).
+    The specular sum uses the scene material's shininess and the scene's model.
+    faces : (m, 3) int triangles for shadows, or None
+    """
+
+    P, N = check_vertices(positions, normals)
+    world = P.astype(np.float64)
+    P = P.astype(np.float64)
+    N = N.astype(np.float64)
+    n = len(P)
+    centre, scale = frame_of(P)
+    P = (P - centre) / scale
+
+    # normals: unit, or zero where absent (tolerances.NORMAL_EPS)
+    N, _ = _unit_or(N, tol.NORMAL_EPS, np.zeros(3))
+
+    # viewer direction V per vertex (toward the viewer)
+    if scene.viewer.local:
+        eye = to_frame(scene.viewer.eye, centre, scale)
+        V, _ = _unit_or(eye - P, tol.POINT_EPS, N)  # eye at the vertex: look along N
+    else:
+        V = np.broadcast_to(np.asarray(scene.viewer.direction, dtype=np.float64), (n, 3))
+
+    if scene.two_sided:  # back-facing vertices are lit as the back face: N -> -N
+        N = np.where((np.einsum("ij,ij->i", N, V) < 0.0)[:, None], -N, N)
+
+    shininess = scene.material.shininess
+    f0 = scene.material.fresnel
+    escale = specular_scale(scene)
+    ambient = np.tile(np.asarray(scene.ambient, dtype=np.float64), (n, 1))
+    diffuse = np.zeros((n, 3))
+    specular = np.zeros((n, 3))
+    for light in scene.lights:
+        if isinstance(light, DirectionalLight):
+            L = np.broadcast_to(np.asarray(light.direction), (n, 3))
+            att = np.ones(n)
+        else:
+            lp = to_frame(light.position, centre, scale)
+            L, d = _unit_or(lp - P, tol.POINT_EPS, N)  # light at the vertex: L = N
+            d = d * scale  # attenuation uses world distances
+            kc, kl, kq = light.attenuation
+            att = 1.0 / np.maximum(kc + kl * d + kq * d * d, tol.ATTENUATION_FLOOR)
+        spot = np.ones(n)
+        if isinstance(light, SpotLight) and light.cutoff != 180.0:
+            x = -np.einsum("ij,j->i", L, np.asarray(light.direction))
+            inside = x >= math.cos(math.radians(light.cutoff))
+            spot = np.where(inside, np.maximum(x, 0.0) ** light.exponent, 0.0)
+        w = att * spot
+        vis = np.ones(n)
+        if light.shadows and faces is not None:
+            vis = visibility(world, faces, light)
+        fres = np.ones(n) if f0 is None else schlick(f0, np.einsum("ij,ij->i", V, L))
+
+        ndl = np.einsum("ij,ij->i", N, L)
+        lit = ndl > 0.0  # f_i: specular only where N·L > 0
+        if scene.model == "blinn":
+            H = L + V
+            h2 = np.einsum("ij,ij->i", H, H)
+            ok = h2 > tol.HALFWAY_EPS2  # H undefined for L = -V: N·H taken as 0
+            base = np.where(ok, np.einsum("ij,ij->i", N, H) / np.sqrt(np.where(ok, h2, 1.0)), 0.0)
+        else:
+            R = 2.0 * ndl[:, None] * N - L
+            base = np.einsum("ij,ij->i", R, V)
+        lobe = np.maximum(base, 0.0) ** shininess  # numpy: 0.0 ** 0.0 == 1.0
+
+        ambient += w[:, None] * np.asarray(light.ambient)  # a_i (attenuated)
+        diffuse += (w * vis * np.maximum(ndl, 0.0))[:, None] * np.asarray(light.diffuse)  # d_i
+        spec_w = w * vis * lit * fres * escale
+        specular += (spec_w * lobe)[:, None] * np.asarray(light.specular)  # s_i
+    return {"ambient": ambient, "diffuse": diffuse, "specular": specular}
+
+
+def reference_shade(
+    scene: Scene, positions, normals, *, clamp: bool = True, faces=None
+) -> np.ndarray:
+    """Colours (n, 3) float64 by the full-generality reference (see module docstring)."""
+    t = reference_terms(scene, positions, normals, faces)
+    m = scene.material
+    c = (
+        np.asarray(m.emission)  # e_m
+        + np.asarray(m.ambient) * t["ambient"]  # a_m·(a_scene + Σ w·a_i)
+        + np.asarray(m.diffuse) * t["diffuse"]  # d_m·Σ w·(N·L)·d_i
+        + np.asarray(m.specular) * t["specular"]  # s_m·Σ w·f·(N·H)^n·s_i
+    )
+    return np.clip(c, 0.0, 1.0) if clamp else c

@@ -1,0 +1,1963 @@
+"""Compiled shading kernels (numba): blocked, fused, one code for float32 and float64.
+
+Vertices are processed in blocks of :data:`BLOCK`. Each block is converted once to the
+normalised frame (:mod:`explorer.frame`) in float64 and then to the working precision ``T``
+(the dtype of ``params``: float32 for the fast path, float64 for the exact path), stored as
+structure-of-arrays scratch rows that stay in cache. Every light then runs a few short stage loops
+over the block (direction, weight, diffuse, lobe), each a branch-free loop the compiler turns into
+SIMD code; decisions the plan makes per light are taken once per block, outside those loops.
+
+The light sums (ambient, diffuse, specular; see :func:`explorer.reference.reference_terms`) are
+stored when asked, so a material change only recomposes (:func:`compose`), and each light's
+specular base and weight can be stored so a shininess change only re-runs the lobe
+(:func:`lobe`). A pass whose lights are all grey (r = g = b) stores its diffuse and specular
+sums grey, (n, 1) (:func:`grey_pass`): at 1M vertices the (n, 3) stores were a fifth of the pass.
+
+Light culling: each run of :data:`CHUNK` consecutive vertices has a bounding sphere and a cone
+of normals (:func:`bounds`, once per geometry); a light is skipped for a run that provably gets
+nothing from it, every vertex facing away from it or outside its spot cone (:func:`_reach`, once
+per light and parallel task). A block then runs the light over the runs it reaches only.
+
+float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
+:data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
+in float64. Each lane keeps the smallest margin to such a decision (row R_TRK, a min per light,
+no mask logic); the mark is "margin below 1".
+
+(n, 3) arrays (positions, normals, the cached sums, colours) are read and written through flat
+(3n,) views, indexed ``3 * i + c``: LLVM then knows the stride and vectorises the interleaved
+accesses; through numba's 2-D indexing (a run-time stride) those loops stayed scalar, at half
+the speed or less.
+
+Leaf kernels are compiled without numba's reference counting (``_nrt=False``): every slice of a
+shared array would otherwise be an atomic increment and decrement of its count, which the two
+threads of a pass contend for (about a fifth of a full pass at 1M vertices).
+
+On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many Intel cores still picks 256-bit
+ones; the float32 entry points are compiled with 16-lane vectors there, two vector iterations
+interleaved (see :func:`wide_vectors`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import os
+import sys
+import tempfile
+
+import llvmlite.binding as llvm
+import numba as nb
+import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.core.errors import TypingError
+from numba.extending import intrinsic, overload
+
+from explorer.core import tolerances as tol
+
+BLOCK = 512
+_FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
+_OPTS = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True)
+_LEAF = dict(_OPTS, _nrt=False)
+
+# per-light flag bits (int32)
+POSITIONAL = 1
+ATTEN = 2
+SPOT = 4
+SPOT_EXP = 8
+AMBIENT = 16  # per-vertex (attenuated) ambient
+DIFFUSE = 32
+SPECULAR = 64
+CONST_H = 128  # Blinn with a directional light and an infinite viewer
+SHADOW = 256  # w *= visibility row (explorer.shadows) for diffuse and specular
+FRESNEL = 512  # specular weight *= Schlick F = F0 + (1 - F0)(1 - V·H)^5
+GREY = 1024  # diffuse and specular colours have r = g = b (one sum per vertex, not three)
+
+# per-light parameter columns
+P_POS = 0  # position, or direction toward a directional light (3)
+P_AXIS = 3  # spot axis (3)
+P_ATT = 6  # kc, kl·scale, kq·scale² (3)
+P_COS = 9  # cos(cutoff)
+P_EXP = 10  # spot exponent
+P_AMB = 11  # ambient colour × constant factor (3)
+P_DIF = 14  # diffuse colour × constant factor (3)
+P_SPEC = 17  # specular colour × constant factor (3)
+P_H = 20  # constant halfway vector (3)
+P_F0 = 23  # Schlick F0 (Fresnel)
+N_PARAMS = 24
+
+# option slots (int64 array)
+O_LOCAL, O_TWO_SIDED, O_PHONG, O_FLAT = 0, 1, 2, 3
+O_DO_AMB, O_DO_DIF, O_DO_SPEC = 4, 5, 6  # recompute these sums in this pass
+O_STORE, O_STORE_LOBE, O_COMPOSE, O_CLAMP, O_TRACK = 7, 8, 9, 10, 11
+O_VIEW = 12  # V rows are needed even for a flat lobe (Fresnel)
+N_OPTS = 13
+
+# scratch rows
+(
+    R_PX,
+    R_PY,
+    R_PZ,
+    R_NX,
+    R_NY,
+    R_NZ,
+    R_VX,
+    R_VY,
+    R_VZ,
+    R_AX,
+    R_AY,
+    R_AZ,
+    R_DX,
+    R_DY,
+    R_DZ,
+    R_SX,
+    R_SY,
+    R_SZ,
+    R_LX,
+    R_LY,
+    R_LZ,
+    R_D,
+    R_W,
+    R_BASE,
+    R_WS,
+    R_TRK,
+    R_GD,
+    R_GS,
+    R_NV,
+) = range(29)
+N_ROWS = 29
+# R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
+# policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
+# (explorer.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
+# R_NV holds N·V (after a two-sided flip), for the inline lobes.
+
+# lobe modes
+LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
+
+#: vertices per culling chunk (two 16-lane vector iterations): a light is skipped for a chunk
+#: that provably gets nothing from it (see :func:`bounds` and :func:`_reach`)
+CHUNK = 32
+CHUNKS = BLOCK // CHUNK  # chunks per block
+
+# chunk bound rows (float64, see :func:`bounds`): the chunk's bounding sphere (centre, radius)
+# and its cone of normals (unit axis, cosine and sine of the half-angle; cosine -1 where the
+# cone is 90° or wider, or some normal is absent: such a chunk is never culled)
+B_CX, B_CY, B_CZ, B_R, B_AX, B_AY, B_AZ, B_COS, B_SIN = range(9)
+N_BOUNDS = 9
+
+
+# constants passed in the working precision (a float literal would promote float32 to float64)
+(
+    K_ZERO,
+    K_ONE,
+    K_TWO,
+    K_POINT_EPS,
+    K_HALF_EPS2,
+    K_ATT_FLOOR,
+    K_INF,
+    K_NORMAL_EPS2,
+    K_MARGIN_DOT,
+    K_MARGIN_LEN2,
+    K_MARGIN_DIST2,
+) = range(11)
+N_CONSTS = 11
+
+
+def constants(dtype) -> np.ndarray:
+    """The kernel's constants (see :mod:`explorer.tolerances`) in ``dtype``."""
+    return np.array(
+        [
+            0.0,
+            1.0,
+            2.0,
+            tol.POINT_EPS,
+            tol.HALFWAY_EPS2,
+            tol.ATTENUATION_FLOOR,
+            np.inf,
+            tol.NORMAL_EPS**2,
+            1.0 / tol.AMBIGUOUS_DOT,  # margins: a quantity over its band's width (< 1: inside)
+            1.0 / tol.AMBIGUOUS_LEN2,
+            1.0 / tol.AMBIGUOUS_DIST**2,
+        ],
+        dtype=dtype,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
+# log2 x from the exponent bits plus ln(1 + z) = z - z²/2 + z³·P(z), z in [-0.29, 0.41] (P of
+# degree 5, fitted like Cephes logf); 2**t = 2**k · 2**f with f in [-0.5, 0.5] (degree-5 fit)
+# and 2**k written as exponent bits. Relative error about 1e-6 (tests/test_kernels.py). Results
+# below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per element, which
+# does not vectorise (~15x slower here); this one inlines into the shading loop.
+
+
+@intrinsic
+def i2f(typingctx, x):
+    """An integer's low 32 bits read as a float32."""
+    if not isinstance(x, types.Integer):
+        return None
+
+    def codegen(context, builder, sig, args):
+        v = args[0]
+        if v.type.width > 32:
+            v = builder.trunc(v, ir.IntType(32))
+        return builder.bitcast(v, ir.FloatType())
+
+    return types.float32(x), codegen
+
+
+#: log2's split point: x = 2**k · m with m in [sqrt(1/2), sqrt(2)), so ln m = ln(1 + z) has
+#: |z| <= 0.41 (the range of the polynomial below)
+_SPLIT = 0x3F3504F3  # the bits of float32 sqrt(1/2)
+
+
+@intrinsic
+def split32(typingctx, x):
+    """x = 2**k · m for a positive float32 x, m in [sqrt(1/2), sqrt(2)): (k, m) as float32.
+
+    In 32-bit integer operations and without a branch or blend (numba's own integer arithmetic
+    widens to int64, which costs cross-lane conversions in SIMD code): subtracting the bits of
+    sqrt(1/2) moves the split point to an exponent boundary, so the shifted difference is k and
+    the bits of x minus k's exponent bits are m. x = 0 gives k = -127, m = 1.
+    """
+    if x != types.float32:
+        return None
+
+    def codegen(context, builder, sig, args):
+        i32 = ir.IntType(32)
+        ix = builder.bitcast(args[0], i32)
+        tmp = builder.sub(ix, ir.Constant(i32, _SPLIT))
+        k = builder.ashr(tmp, ir.Constant(i32, 23))
+        im = builder.sub(ix, builder.and_(tmp, ir.Constant(i32, -(1 << 23))))
+        kf = builder.sitofp(k, ir.FloatType())
+        m = builder.bitcast(im, ir.FloatType())
+        return context.make_tuple(builder, sig.return_type, (kf, m))
+
+    return types.UniTuple(types.float32, 2)(types.float32), codegen
+
+
+@nb.njit(inline="always", **_LEAF)
+def log2_32(x):
+    """log2 x for a positive, finite float32 x (-127 for x = 0)."""
+    e, f = split32(x)
+    z = f - np.float32(1.0)
+    p = np.float32(-0.10746953303517079)  # least-squares fit, |error| <= 3.5e-7 on the range
+    p = p * z + np.float32(0.15904727806564242)
+    p = p * z + np.float32(-0.16972990678158706)
+    p = p * z + np.float32(0.1993995441108155)
+    p = p * z + np.float32(-0.24992546983782263)
+    p = p * z + np.float32(0.33333703609427834)
+    ln = z + z * z * (z * p - np.float32(0.5))
+    return e + ln * np.float32(1.4426950408889634)
+
+
+@nb.njit(inline="always", **_LEAF)
+def exp2_32(t):
+    """2**t for float32 t; 0 for t <= -127."""
+    t = max(t, np.float32(-127.0))
+    k = np.rint(t)
+    fr = t - k
+    q = np.float32(0.0013390867352163702)  # 2**f = 1 + f·Q(f), least squares, rel. err 2e-7
+    q = q * fr + np.float32(0.00966637369320816)
+    q = q * fr + np.float32(0.05550357104250901)
+    q = q * fr + np.float32(0.24022348940946955)
+    q = q * fr + np.float32(0.6931471880293432)
+    q = q * fr + np.float32(1.0)  # exact at f = 0: 1**y == 1
+    return q * i2f((np.int32(k) + np.int32(127)) << 23)
+
+
+@nb.njit(inline="always", **_LEAF)
+def pow32(x, y):
+    """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
+    t = y * log2_32(x)
+    return exp2_32(t if x > np.float32(0.0) else np.float32(-200.0))
+
+
+def unit(k):
+    """1 in the precision of ``k`` (an array), as a compile-time constant: ``k[K_ONE]`` is a
+    run-time value, so ``k[K_ONE] / np.sqrt(x)`` costs a multiply the constant does not."""
+    return k.dtype.type(1)
+
+
+@overload(unit, jit_options=_LEAF)
+def _unit_overload(k):
+    if k.dtype == types.float32:
+        return lambda k: np.float32(1.0)
+    return lambda k: np.float64(1.0)
+
+
+def nil(k):
+    """0 in the precision of ``k``, as a compile-time constant (see :func:`unit`). A square
+    root's argument must be provably >= 0 (``max(x, nil(k))``, not ``max(x, k[K_ZERO])``):
+    LLVM then makes it an instruction; otherwise it stays a call to libm's sqrtf (which may set
+    errno), and a loop with a call does not vectorise."""
+    return k.dtype.type(0)
+
+
+@overload(nil, jit_options=_LEAF)
+def _nil_overload(k):
+    if k.dtype == types.float32:
+        return lambda k: np.float32(0.0)
+    return lambda k: np.float64(0.0)
+
+
+def fpow(x, y):
+    """x**y in the working precision: :func:`pow32` for float32, libm for float64."""
+    return x**y
+
+
+@overload(fpow, jit_options=_LEAF)
+def _fpow_overload(x, y):
+    if x == types.float32:
+        return lambda x, y: pow32(x, y)
+    return lambda x, y: x**y
+
+
+@intrinsic
+def _assume(typingctx, cond):
+    """Tell LLVM ``cond`` holds (``llvm.assume``): no code, only facts for the optimiser."""
+    if not isinstance(cond, types.Boolean):
+        return None
+
+    def codegen(context, builder, sig, args):
+        fn = builder.module.declare_intrinsic(
+            "llvm.assume", fnty=ir.FunctionType(ir.VoidType(), [ir.IntType(1)])
+        )
+        builder.call(fn, [args[0]])
+        return context.get_dummy_value()
+
+    return types.none(cond), codegen
+
+
+@nb.njit(inline="always", **_LEAF)
+def _row_checked(scr, r, m):
+    """:func:`_row` without telling LLVM that the row lies whole in the scratch: the slice is
+    then clamped at run time, and LLVM checks a loop's rows for overlap before it enters the
+    vector loop. For the inline light loops: rows at a known constant distance make LLVM refuse to
+    interleave two vector iterations (it takes the distance as a limit), and interleaving is
+    worth more there (0.93x without it, full pass at 1M)."""
+    return scr[r * BLOCK : r * BLOCK + m]
+
+
+@nb.njit(inline="always", **_LEAF)
+def _row(scr, r, m):
+    """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie BLOCK
+    apart in one flat array, and LLVM is told the scratch holds row ``r`` whole: the slice is
+    then the scratch's start plus a constant, not clamped at run time, so LLVM proves the rows
+    of a loop disjoint (no run-time overlap checks: a loop that reads and writes many rows had
+    too many to vectorise at all) and addresses them all from one register."""
+    _assume(scr.shape[0] >= (r + 1) * BLOCK)
+    _assume(m <= BLOCK)
+    _assume(m >= 0)
+    return _row_checked(scr, r, m)
+
+
+@nb.njit(**_LEAF)
+def _copy(dst, src):
+    for i in range(dst.shape[0]):
+        dst[i] = src[i]
+
+
+@nb.njit(**_LEAF)
+def _fill(a, v):
+    for i in range(a.shape[0]):
+        a[i] = v
+
+
+@nb.njit(**_LEAF)
+def _load_positions(P, centre, inv_scale, px, py, pz):
+    """Positions (flat x0 y0 z0 x1 ...) into the normalised frame: subtract in float64, then
+    round to T."""
+    for i in range(px.shape[0]):
+        px[i] = (np.float64(P[3 * i]) - centre[0]) * inv_scale
+        py[i] = (np.float64(P[3 * i + 1]) - centre[1]) * inv_scale
+        pz[i] = (np.float64(P[3 * i + 2]) - centre[2]) * inv_scale
+
+
+@nb.njit(parallel=True, **_OPTS)
+def prepare(P, N, centre, inv_scale, k, G):
+    """Geometry in the normalised frame, structure of arrays, working precision.
+
+    P, N : (n, 3) float32/float64 world positions and normals
+    G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
+    """
+    n = P.shape[0]
+    Pf, Nf = P.reshape(-1), N.reshape(-1)  # flat: x0 y0 z0 x1 ... (see the module docstring)
+    nblocks = (n + BLOCK - 1) // BLOCK
+    for b in nb.prange(nblocks):
+        _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
+
+
+@nb.njit(**_LEAF)
+def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
+    n = G.shape[1]
+    for b in range(b0, b1):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        _load_positions(Pf[3 * s : 3 * e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
+        _load_normals(Nf[3 * s : 3 * e], G[3, s:e], G[4, s:e], G[5, s:e], k)
+
+
+@nb.njit(**_LEAF)
+def _load_normals(N, nx, ny, nz, k):
+    """Unit normals in T; zero where |N|² <= NORMAL_EPS² (no diffuse, no specular there)."""
+    zero, one, eps2 = k[K_ZERO], k[K_ONE], k[K_NORMAL_EPS2]
+    for i in range(nx.shape[0]):
+        a = N[3 * i] * one
+        b = N[3 * i + 1] * one
+        c = N[3 * i + 2] * one
+        nn = a * a + b * b + c * c
+        ok = nn > eps2
+        inv = one / np.sqrt(nn if ok else unit(k))  # (>= 0: see nil)
+        nx[i] = a * inv if ok else zero
+        ny[i] = b * inv if ok else zero
+        nz[i] = c * inv if ok else zero
+
+
+@nb.njit(**_LEAF)
+def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
+    """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
+    one, eps2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS]
+    for i in range(px.shape[0]):
+        x = ex - px[i]
+        y = ey - py[i]
+        z = ez - pz[i]
+        d2 = x * x + y * y + z * z
+        at = d2 < eps2
+        inv = one / np.sqrt(max(d2, eps2))  # (a reciprocal square root: no divide)
+        a, b, c = nx[i], ny[i], nz[i]
+        vx[i] = a if at else x * inv
+        vy[i] = b if at else y * inv
+        vz[i] = c if at else z * inv
+
+
+@nb.njit(**_LEAF)
+def _dot(ax, ay, az, bx, by, bz, out):
+    for i in range(out.shape[0]):
+        out[i] = ax[i] * bx[i] + ay[i] * by[i] + az[i] * bz[i]
+
+
+@nb.njit(**_LEAF)
+def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
+    """N -> -N where N·V < 0 (the vertex shows its back face)."""
+    zero, c_dot = k[K_ZERO], k[K_MARGIN_DOT]
+    for i in range(nx.shape[0]):
+        ndv = nx[i] * vx[i] + ny[i] * vy[i] + nz[i] * vz[i]
+        s = ndv < zero
+        nx[i] = -nx[i] if s else nx[i]
+        ny[i] = -ny[i] if s else ny[i]
+        nz[i] = -nz[i] if s else nz[i]
+        trk[i] = min(trk[i], abs(ndv) * c_dot)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def bounds(G, out):
+    """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
+
+    G : (6, n) T prepared geometry (see :func:`prepare`)
+    out : (N_BOUNDS, ceil(n / CHUNK)) float64: the bounding sphere of the chunk's positions
+    (centre of its box, radius to the farthest vertex) and the cone of its normals (axis: their
+    mean direction; half-angle: the widest normal from it), both widened by
+    :data:`explorer.tolerances.CULL_GUARD`. A cone of 90° or more, or a chunk with an absent
+    (zero) normal, gets cosine -1: never culled.
+    """
+    n = G.shape[1]
+    guard = tol.CULL_GUARD
+    for c in nb.prange(out.shape[1]):
+        s = c * CHUNK
+        e = min(n, s + CHUNK)
+        lo = np.full(3, np.inf)
+        hi = np.full(3, -np.inf)
+        ax = ay = az = 0.0
+        for i in range(s, e):
+            for d in range(3):
+                v = np.float64(G[d, i])
+                lo[d] = min(lo[d], v)
+                hi[d] = max(hi[d], v)
+            ax += np.float64(G[3, i])
+            ay += np.float64(G[4, i])
+            az += np.float64(G[5, i])
+        cx, cy, cz = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])
+        r2 = 0.0
+        for i in range(s, e):
+            x = np.float64(G[0, i]) - cx
+            y = np.float64(G[1, i]) - cy
+            z = np.float64(G[2, i]) - cz
+            r2 = max(r2, x * x + y * y + z * z)
+        r = np.sqrt(r2) * (1.0 + guard) + guard
+        la = np.sqrt(ax * ax + ay * ay + az * az)
+        ct = -1.0
+        if la > 0.0:
+            ax, ay, az = ax / la, ay / la, az / la
+            ct = 1.0
+            for i in range(s, e):
+                nn = ax * G[3, i] + ay * G[4, i] + az * G[5, i]
+                ct = min(ct, nn)  # an absent normal gives 0: never culled
+            ct -= guard
+        if ct <= 0.0:
+            ct = -1.0
+        out[B_CX, c], out[B_CY, c], out[B_CZ, c], out[B_R, c] = cx, cy, cz, r
+        out[B_AX, c], out[B_AY, c], out[B_AZ, c] = ax, ay, az
+        out[B_COS, c] = ct
+        out[B_SIN, c] = np.sqrt(max(1.0 - ct * ct, 0.0)) + guard
+
+
+@nb.njit(**_LEAF)
+def _reach(bd, c0, nc, q, fl, back, act):
+    """Which of chunks ``c0`` to ``c0 + nc - 1`` light ``q`` can reach: ``act[j]`` 1 if chunk
+    c0 + j may get something from it, 0 if provably nothing (returns how many may).
+
+    bd : (N_BOUNDS, nchunks) float64, every chunk's bounds (see :func:`bounds`; whole, not a
+    slice: a C-contiguous array's rows have a known unit stride, and the loop vectorises)
+    back : skip chunks whose every vertex faces away from the light (N·L <= -AMBIGUOUS_DOT):
+    their diffuse and specular are 0 in either precision (not when the light's ambient varies
+    per vertex: that does not depend on N·L). Chunks wholly outside a spot's cone (by
+    AMBIGUOUS_DOT in the cosine) are skipped always: the spot factor zeroes everything.
+    The light must be farther than AMBIGUOUS_DIST from every vertex (else "at the vertex"
+    lights it fully), so no margin the float32 pass keeps is lost by skipping.
+    """
+    eps, dist = tol.AMBIGUOUS_DOT, tol.AMBIGUOUS_DIST
+    positional, cone = (fl & POSITIONAL) != 0, (fl & SPOT) != 0
+    qx, qy, qz = np.float64(q[P_POS]), np.float64(q[P_POS + 1]), np.float64(q[P_POS + 2])
+    if not positional:  # toward a directional light, as a unit vector
+        ql = np.sqrt(qx * qx + qy * qy + qz * qz)
+        qx, qy, qz = qx / ql, qy / ql, qz / ql
+    sx, sy, sz = np.float64(q[P_AXIS]), np.float64(q[P_AXIS + 1]), np.float64(q[P_AXIS + 2])
+    cosc = np.float64(q[P_COS]) - eps
+    back_on = 1 if back else 0
+    count = 0
+    # branch-free (each test computed, combined as integers), so that it vectorises
+    for j in range(nc):
+        r, ct, st = bd[B_R, c0 + j], bd[B_COS, c0 + j], bd[B_SIN, c0 + j]
+        ax, ay, az = bd[B_AX, c0 + j], bd[B_AY, c0 + j], bd[B_AZ, c0 + j]
+        if positional:  # u = light - centre; N·(q - p) <= max over the cone of N·u, + r
+            ux, uy, uz = qx - bd[B_CX, c0 + j], qy - bd[B_CY, c0 + j], qz - bd[B_CZ, c0 + j]
+            uu = ux * ux + uy * uy + uz * uz
+            t = ax * ux + ay * uy + az * uz  # |u|·cos(angle from the axis)
+            # away: t·cos + sqrt(uu - t²)·sin + r + eps·(|u| + r) <= 0, without a square root:
+            # h = t·cos + r + eps·(|u| + r) <= 0 and h² >= (uu - t²)·sin² (|u| <= (uu + 1) / 2)
+            h = t * ct + r + eps * (0.5 * (uu + 1.0) + r)
+            far = 1 if uu > (r + dist) * (r + dist) else 0
+            tilt = max(uu - t * t, 0.0) * st * st
+            away = (
+                far & (1 if ct > 0.0 else 0) & (1 if h <= 0.0 else 0) & (1 if h * h >= tilt else 0)
+            )
+            outside = 0
+            if cone:  # every direction light -> vertex at least cutoff (+ eps) off the axis
+                sw = -(sx * ux + sy * uy + sz * uz)  # |u|·cos(axis, centre seen from the light)
+                rr = np.sqrt(max(uu - r * r, 0.0))  # |u|·cos(the sphere's angular radius)
+                rim = sw * rr + np.sqrt(max(uu - sw * sw, 0.0)) * r - cosc * uu
+                outside = far & (1 if sw <= rr else 0) & (1 if rim <= 0.0 else 0)
+        else:
+            t = ax * qx + ay * qy + az * qz  # (as above, with |u| = 1 and r = 0)
+            h = t * ct + eps
+            tilt = max(1.0 - t * t, 0.0) * st * st
+            away = (1 if ct > 0.0 else 0) & (1 if h <= 0.0 else 0) & (1 if h * h >= tilt else 0)
+            outside = 0
+        a = 1 - ((back_on & away) | outside)
+        act[j] = a
+        count += a
+    return count
+
+
+# --------------------------------------------------------------------------------------------
+# One light over one block. The loop is specialised at compile time: `_light` is overloaded on a
+# literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular, bit 5
+# inline, bit 6 attenuated, bit 7 grey), so each combination gets a loop that holds exactly the
+# terms the plan asks for and no run-time test: where L comes from (constant, the rows a
+# positional pre-pass filled, or computed inline), how the lobe's base is found (flat, constant H,
+# Blinn, Phong), and whether the diffuse and specular sums are touched.
+#
+# Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
+# and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
+# or per-vertex ambient: no L or weight rows are written or read. They keep l = position - P
+# unnormalised (N·L = (N·l)/|l|, L + V = l/|l| + V in one fused step each) and take N·H's
+# numerator as N·L + N·V, with N·V computed once per block (row R_NV). Every light that
+# stores its lobe (the first pass of a shininess drag) writes base and weight rows from the same
+# arithmetic as a pass that does not, so a shininess change and a fresh pass agree bit for bit
+# in the base. A grey light (r = g = b for its diffuse and
+# its specular colour, as most lights are) adds one number per vertex to a grey row instead of
+# three to the RGB rows; the block adds the grey rows to every channel once. Inline variants also
+# drop the exact policies inside the ambiguity bands (a light at the vertex, L = -V): there they
+# only keep every value finite and mark the lane, which the engine redoes in float64, where the
+# policies hold.
+
+
+def _light(scr, m, dx, gd, q, y, k, variant):  # pragma: no cover - replaced by the overload below
+    raise NotImplementedError
+
+
+@overload(_light, prefer_literal=True, jit_options=_LEAF)
+def _light_overload(scr, m, dx, gd, q, y, k, variant):
+    if not isinstance(variant, types.IntegerLiteral):
+        raise TypingError("_light needs a literal variant")
+    v = variant.literal_value
+    positional = bool(v & 1)
+    mode = (v >> 1) & 3
+    dif = bool(v & 8)
+    spec = bool(v & 16)
+    inline = bool(v & 32)
+    atten = bool(v & 64)
+    grey = bool(v & 128)
+    lobe_on = spec and mode != LOBE_FLAT
+    track = scr.dtype == types.float32  # only the float32 path marks ambiguous lanes
+    if inline and not track:
+
+        def never(scr, m, dx, gd, q, y, k, variant):
+            raise AssertionError("inline light loops are float32 only")
+
+        return never
+
+    # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
+    # it interleaves them; the row-path loops read and write too many rows for such checks
+    row = _row_checked if inline else _row
+
+    def impl(scr, m, dx, gd, q, y, k, variant):
+        # rows as separate 1-D arrays: lets the compiler vectorise
+        px, py, pz = row(scr, R_PX, m), row(scr, R_PY, m), row(scr, R_PZ, m)
+        nx, ny, nz = row(scr, R_NX, m), row(scr, R_NY, m), row(scr, R_NZ, m)
+        vx, vy, vz, NV = row(scr, R_VX, m), row(scr, R_VY, m), row(scr, R_VZ, m), row(scr, R_NV, m)
+        Lx, Ly, Lz, W = row(scr, R_LX, m), row(scr, R_LY, m), row(scr, R_LZ, m), row(scr, R_W, m)
+        Dx, Dy, Dz = row(scr, dx, m), row(scr, dx + 1, m), row(scr, dx + 2, m)
+        Sx, Sy, Sz = row(scr, R_SX, m), row(scr, R_SY, m), row(scr, R_SZ, m)
+        B, WS, TRK = row(scr, R_BASE, m), row(scr, R_WS, m), row(scr, R_TRK, m)
+        GD, GS = row(scr, gd, m), row(scr, R_GS, m)
+        zero, one, two = k[K_ZERO], unit(k), k[K_TWO]
+        # (squares and abs: provably >= 0, which keeps the square roots vectorisable; see nil)
+        h_eps2, p_eps2, floor = abs(k[K_HALF_EPS2]), k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
+        c_dot, c_len2, c_dist2 = k[K_MARGIN_DOT], k[K_MARGIN_LEN2], k[K_MARGIN_DIST2]
+        kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
+        dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
+        sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
+        qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+        hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
+        for i in range(m):
+            a, b, c = nx[i], ny[i], nz[i]
+            # margin: how far this lane is from every decision that hangs on a nearly-zero
+            # quantity, in units of its ambiguity band (< 1: inside a band; see TRK)
+            margin = k[K_INF]
+            if inline:  # l = position - P, unnormalised; L = l / |l|
+                x = qx - px[i]
+                yy = qy - py[i]
+                z = qz - pz[i]
+                d2 = x * x + yy * yy + z * z
+                inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (then marked)
+                if atten:  # w = 1 / (kc + kl·d + kq·d²)
+                    d = d2 * inv
+                    w = one / max(kc + (kl + kq * d) * d, floor)
+                else:
+                    w = one
+                ndl = (a * x + b * yy + c * z) * inv  # N·L
+                margin = d2 * c_dist2
+            else:
+                if positional:  # L and w = att·spot from the pre-pass rows
+                    lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
+                else:  # directional: constant L, never attenuated
+                    lx, ly, lz, w = qx, qy, qz, one
+                ndl = a * lx + b * ly + c * lz  # N·L
+            if dif:  # w·max(N·L, 0)·d_i
+                t = w * max(ndl, zero)
+                if grey:
+                    GD[i] += t * dr
+                else:
+                    Dx[i] += t * dr
+                    Dy[i] += t * dg
+                    Dz[i] += t * db
+            if spec:
+                ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
+                margin = min(margin, abs(ndl) * c_dot)
+                lob = one  # flat lobe: 0**0 = 1
+                if lobe_on:
+                    if mode == LOBE_CONST_H:  # Blinn, constant H: N·H
+                        base = a * hx + b * hy + c * hz
+                    elif mode == LOBE_PHONG:  # Phong: R·V, R = 2(N·L)N - L
+                        ex, ey, ez = vx[i], vy[i], vz[i]
+                        if inline:  # N·V from the block's row, L·V from l
+                            ldv = (x * ex + yy * ey + z * ez) * inv
+                            base = two * ndl * NV[i] - ldv
+                        else:
+                            ndv = a * ex + b * ey + c * ez
+                            base = two * ndl * ndv - (lx * ex + ly * ey + lz * ez)
+                    else:  # Blinn: N·normalize(L + V); 0 where L = -V
+                        if inline:  # u = L + V; N·u = N·L + N·V (the block's row)
+                            ux = x * inv + vx[i]
+                            uy = yy * inv + vy[i]
+                            uz = z * inv + vz[i]
+                            ndu = ndl + NV[i]
+                        else:
+                            ux = lx + vx[i]
+                            uy = ly + vy[i]
+                            uz = lz + vz[i]
+                            ndu = a * ux + b * uy + c * uz
+                        h2 = ux * ux + uy * uy + uz * uz
+                        if track:  # lanes near L = -V are marked and redone in float64
+                            base = ndu * (one / np.sqrt(max(h2, h_eps2)))
+                        else:
+                            ok = h2 > h_eps2
+                            hn = one / np.sqrt(h2 if ok else one)
+                            base = ndu * hn if ok else zero
+                        margin = min(margin, h2 * c_len2)
+                    margin = min(margin, abs(base) * c_dot)
+                    base = max(base, zero)
+                    lob = fpow(base, y)  # base^n
+                    B[i] = base  # kept for a lobe store
+                t = ws * lob  # w·f·base^n·s_i
+                if grey:
+                    GS[i] += t * sr
+                else:
+                    Sx[i] += t * sr
+                    Sy[i] += t * sg
+                    Sz[i] += t * sb
+                WS[i] = ws
+            if track and (spec or inline):
+                TRK[i] = min(TRK[i], margin)
+
+    return impl
+
+
+@nb.njit(**_LEAF)
+def _light_inline(scr, m, dx, gd, q, y, k, atten, mode, l_spec, grey):
+    """Call the inline point-light loop compiled for this combination (diffuse always on)."""
+    if grey and atten:
+        if not l_spec:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128)
+        elif mode == LOBE_FLAT:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16)
+        elif mode == LOBE_PHONG:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 6)
+        else:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 4)
+    elif grey and not atten:
+        if not l_spec:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128)
+        elif mode == LOBE_FLAT:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16)
+        elif mode == LOBE_PHONG:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 6)
+        else:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 4)
+    elif not grey and atten:
+        if not l_spec:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64)
+        elif mode == LOBE_FLAT:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16)
+        elif mode == LOBE_PHONG:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 6)
+        else:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 4)
+    elif not grey and not atten:
+        if not l_spec:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32)
+        elif mode == LOBE_FLAT:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16)
+        elif mode == LOBE_PHONG:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 6)
+        else:
+            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 4)
+
+
+@nb.njit(**_LEAF)
+def _light_any(scr, m, q, y, k, positional, mode, l_dif, l_spec):
+    """Call the light loop compiled for this combination (each call site passes a literal)."""
+    if not positional:
+        if not l_spec:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 8)
+        elif mode == LOBE_FLAT:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 24)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 16)
+        elif mode == LOBE_CONST_H:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 26)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 18)
+        elif mode == LOBE_BLINN:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 28)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 20)
+        elif mode == LOBE_PHONG:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 30)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 22)
+    else:
+        if not l_spec:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 9)
+        elif mode == LOBE_FLAT:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 25)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 17)
+        elif mode == LOBE_CONST_H:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 27)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 19)
+        elif mode == LOBE_BLINN:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 29)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 21)
+        elif mode == LOBE_PHONG:
+            if l_dif:
+                _light(scr, m, R_DX, R_GD, q, y, k, 31)
+            else:
+                _light(scr, m, R_DX, R_GD, q, y, k, 23)
+
+
+@nb.njit(**_LEAF)
+def _to_light(scr, m, q, k, atten):
+    """Positional pre-pass: rows L = normalize(q - P) (L = N at the vertex) and the weight
+    w = 1 / max(kc + kl·d + kq·d², floor) when ``atten`` (kl, kq scaled to the frame), else 1."""
+    one, eps2, c_dist2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS], k[K_MARGIN_DIST2]
+    floor = k[K_ATT_FLOOR]
+    kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
+    qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+    px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
+    nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
+    Lx, Ly, Lz, W, TRK = (
+        _row(scr, R_LX, m),
+        _row(scr, R_LY, m),
+        _row(scr, R_LZ, m),
+        _row(scr, R_W, m),
+        _row(scr, R_TRK, m),
+    )
+    if atten:
+        for i in range(m):
+            x = qx - px[i]
+            y = qy - py[i]
+            z = qz - pz[i]
+            d2 = x * x + y * y + z * z
+            at = d2 < eps2
+            inv = one / np.sqrt(one if at else d2)
+            d = np.sqrt(d2) if at else d2 * inv
+            a, b, c = nx[i], ny[i], nz[i]
+            Lx[i] = a if at else x * inv
+            Ly[i] = b if at else y * inv
+            Lz[i] = c if at else z * inv
+            W[i] = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
+            TRK[i] = min(TRK[i], d2 * c_dist2)
+    else:
+        for i in range(m):
+            x = qx - px[i]
+            y = qy - py[i]
+            z = qz - pz[i]
+            d2 = x * x + y * y + z * z
+            at = d2 < eps2
+            inv = one / np.sqrt(one if at else d2)
+            a, b, c = nx[i], ny[i], nz[i]
+            Lx[i] = a if at else x * inv
+            Ly[i] = b if at else y * inv
+            Lz[i] = c if at else z * inv
+            W[i] = one
+            TRK[i] = min(TRK[i], d2 * c_dist2)
+
+
+@nb.njit(**_LEAF)
+def _spot(scr, m, q, k, exponent):
+    """w *= x**exponent inside the cone (x = (-L)·axis >= cos cutoff), else 0."""
+    zero, c_dot = k[K_ZERO], k[K_MARGIN_DOT]
+    ax, ay, az = q[P_AXIS], q[P_AXIS + 1], q[P_AXIS + 2]
+    cosc, e = q[P_COS], q[P_EXP]
+    Lx, Ly, Lz, W, TRK = (
+        _row(scr, R_LX, m),
+        _row(scr, R_LY, m),
+        _row(scr, R_LZ, m),
+        _row(scr, R_W, m),
+        _row(scr, R_TRK, m),
+    )
+    for i in range(m):
+        x = -(Lx[i] * ax + Ly[i] * ay + Lz[i] * az)
+        if exponent:
+            f = fpow(max(x, zero), e)
+            W[i] = W[i] * f if x >= cosc else zero
+        else:
+            W[i] = W[i] if x >= cosc else zero
+        TRK[i] = min(TRK[i], abs(x - cosc) * c_dot)
+
+
+@nb.njit(**_LEAF)
+def _dir_rows(scr, m, q, one):
+    """Directional light on the row path (shadows, Fresnel): rows L = constant, w = 1."""
+    Lx, Ly, Lz, W = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m)
+    qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
+    for i in range(m):
+        Lx[i] = qx
+        Ly[i] = qy
+        Lz[i] = qz
+        W[i] = one
+
+
+@nb.njit(**_LEAF)
+def _shadow(scr, m, vis):
+    """w *= visibility (0 or 1 per vertex, from explorer.shadows)."""
+    W = _row(scr, R_W, m)
+    for i in range(m):
+        W[i] = W[i] * vis[i]
+
+
+@nb.njit(**_LEAF)
+def _fresnel(scr, m, q, k):
+    """w *= F = F0 + (1 - F0)(1 - V·H)^5 with V·H = sqrt((1 + V·L) / 2) (unit L, V)."""
+    one = k[K_ONE]
+    half = one / k[K_TWO]
+    f0 = q[P_F0]
+    Lx, Ly, Lz, W = _row(scr, R_LX, m), _row(scr, R_LY, m), _row(scr, R_LZ, m), _row(scr, R_W, m)
+    vx, vy, vz = _row(scr, R_VX, m), _row(scr, R_VY, m), _row(scr, R_VZ, m)
+    for i in range(m):
+        vl = Lx[i] * vx[i] + Ly[i] * vy[i] + Lz[i] * vz[i]
+        c = np.sqrt(max((one + vl) * half, nil(k)))
+        x = one - c
+        x2 = x * x
+        W[i] = W[i] * (f0 + (one - f0) * (x2 * x2 * x))
+
+
+@nb.njit(**_LEAF)
+def _ambient(scr, m, q):
+    """A += w·a_i (an attenuated or cone-cut light ambient)."""
+    ar, ag, ab = q[P_AMB], q[P_AMB + 1], q[P_AMB + 2]
+    W, Ax, Ay, Az = _row(scr, R_W, m), _row(scr, R_AX, m), _row(scr, R_AY, m), _row(scr, R_AZ, m)
+    for i in range(m):
+        w = W[i]
+        Ax[i] += w * ar
+        Ay[i] += w * ag
+        Az[i] += w * ab
+
+
+@nb.njit(**_LEAF)
+def _load_rows(src, rx, ry, rz, zero, width=3):
+    """Rows from a cached block (flat (3m,), or (m,) for a grey sum: ``width`` 1), or zeros
+    when the cache is empty."""
+    if src.shape[0] == 0:
+        _fill(rx, zero)
+        _fill(ry, zero)
+        _fill(rz, zero)
+    elif width == 1:
+        _copy(rx, src)
+        _copy(ry, src)
+        _copy(rz, src)
+    else:
+        for i in range(rx.shape[0]):
+            rx[i] = src[3 * i]
+            ry[i] = src[3 * i + 1]
+            rz[i] = src[3 * i + 2]
+
+
+@nb.njit(**_LEAF)
+def _add_grey(rx, ry, rz, g):
+    for i in range(g.shape[0]):
+        rx[i] += g[i]
+        ry[i] += g[i]
+        rz[i] += g[i]
+
+
+@nb.njit(**_LEAF)
+def _store_rows(dst, rx, ry, rz):
+    """Rows into a flat (3m,) block of an (n, 3) array."""
+    for i in range(rx.shape[0]):
+        dst[3 * i] = rx[i]
+        dst[3 * i + 1] = ry[i]
+        dst[3 * i + 2] = rz[i]
+
+
+@nb.njit(**_LEAF)
+def _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k, has_a):
+    """colour = e_m + a_m·(ambient) + d_m·diffuse + s_m·specular, clamped to [0, 1]; the
+    per-vertex ambient rows are read only when ``has_a`` (else the constant ambient alone)."""
+    lo = k[K_ZERO]
+    hi = k[K_ONE] if clamp else k[K_INF]
+    e0 = mat[0] + mat[3] * aconst[0]
+    e1 = mat[1] + mat[4] * aconst[1]
+    e2 = mat[2] + mat[5] * aconst[2]
+    a0, a1, a2, d0, d1, d2 = mat[3], mat[4], mat[5], mat[6], mat[7], mat[8]
+    s0, s1, s2 = mat[9], mat[10], mat[11]
+    for i in range(Dx.shape[0]):
+        r = e0 + d0 * Dx[i] + s0 * Sx[i]  # e + a_m·a_const + d_m·D + s_m·S
+        g = e1 + d1 * Dy[i] + s1 * Sy[i]
+        b = e2 + d2 * Dz[i] + s2 * Sz[i]
+        if has_a:  # + a_m·A (loop-invariant: LLVM unswitches it)
+            r += a0 * Ax[i]
+            g += a1 * Ay[i]
+            b += a2 * Az[i]
+        out[3 * i] = min(max(r, lo), hi)
+        out[3 * i + 1] = min(max(g, lo), hi)
+        out[3 * i + 2] = min(max(b, lo), hi)
+
+
+@nb.njit(**_LEAF)
+def _keep_lobe(scr, m, base, ws, flat):
+    """A light's lobe base (unless the lobe is flat) and weight rows into the lobe store."""
+    if not flat:
+        _copy(base, _row(scr, R_BASE, m))
+    _copy(ws, _row(scr, R_WS, m))
+
+
+@nb.njit(**_LEAF)
+def _mode(fl, flat, phong):
+    """How a light's lobe base is found (LOBE_*)."""
+    if flat:
+        return LOBE_FLAT
+    if fl & CONST_H:
+        return LOBE_CONST_H
+    return LOBE_PHONG if phong else LOBE_BLINN
+
+
+@nb.njit(**_LEAF)
+def _is_inline(fl, track, l_dif, l_spec, mode):
+    """A plain point light on the float32 path: L and attenuation computed in the light loop."""
+    return (
+        track
+        and (l_dif or l_spec)
+        and (fl & AMBIENT) == 0  # the path depends on the light only, not on the pass
+        and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
+        and not (l_spec and (fl & FRESNEL) != 0)
+        and mode != LOBE_CONST_H
+    )
+
+
+@nb.njit(**_LEAF)
+def grey_pass(flags, opts, diffuse_grey):
+    """Whether a pass keeps its diffuse and specular sums in the grey rows alone: the specular
+    sum is recomputed, every diffuse or specular light is an inline grey one, and the diffuse
+    sum is recomputed too or grey already (``diffuse_grey``: cached (n, 1), or absent). Decided
+    once per pass; the engine asks too, and gives such a pass grey (n, 1) sums to store: a
+    third of the memory traffic of (n, 3) ones."""
+    if opts[O_DO_SPEC] == 0 or not (opts[O_DO_DIF] != 0 or diffuse_grey):
+        return False
+    track = opts[O_TRACK] != 0
+    flat, phong = opts[O_FLAT] != 0, opts[O_PHONG] != 0
+    for li in range(flags.shape[0]):
+        fl = flags[li]
+        l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
+        if (l_dif or l_spec) and not (
+            (fl & GREY) != 0 and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong))
+        ):
+            return False
+    return True
+
+
+@nb.njit(**_LEAF)
+def _store_grey(dst, g, width):
+    """A grey row into a block of a cached sum: as it is into a grey (n, 1) sum (``width`` 1),
+    into every channel of an (n, 3) one (flat (3m,)); nothing into an empty one."""
+    if dst.shape[0] == 0:
+        return
+    if width == 1:
+        _copy(dst, g)
+        return
+    for i in range(g.shape[0]):
+        dst[3 * i] = g[i]
+        dst[3 * i + 1] = g[i]
+        dst[3 * i + 2] = g[i]
+
+
+@nb.njit(**_LEAF)
+def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
+    """:func:`_compose_rows` when the diffuse and specular sums are grey rows alone."""
+    lo = k[K_ZERO]
+    hi = k[K_ONE] if clamp else k[K_INF]
+    e0 = mat[0] + mat[3] * aconst[0]
+    e1 = mat[1] + mat[4] * aconst[1]
+    e2 = mat[2] + mat[5] * aconst[2]
+    a0, a1, a2, d0, d1, d2 = mat[3], mat[4], mat[5], mat[6], mat[7], mat[8]
+    s0, s1, s2 = mat[9], mat[10], mat[11]
+    for i in range(GD.shape[0]):
+        gd, gs = GD[i], GS[i]
+        r = e0 + d0 * gd + s0 * gs  # e + a_m·a_const + d_m·D + s_m·S
+        g = e1 + d1 * gd + s1 * gs
+        b = e2 + d2 * gd + s2 * gs
+        if has_a:  # + a_m·A (loop-invariant: LLVM unswitches it)
+            r += a0 * Ax[i]
+            g += a1 * Ay[i]
+            b += a2 * Az[i]
+        out[3 * i] = min(max(r, lo), hi)
+        out[3 * i + 1] = min(max(g, lo), hi)
+        out[3 * i + 2] = min(max(b, lo), hi)
+
+
+@nb.njit(inline="always", **_LEAF)
+def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
+    """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
+    ``scr`` starts at the run's first lane, see _block); ``vis`` : (m,) its visibility, or (0,)."""
+    if inline:  # a plain point light on the float32 path (see _is_inline)
+        atten, grey = (fl & ATTEN) != 0, (fl & GREY) != 0
+        if l_dif:
+            _light_inline(scr, m, R_DX, R_GD, q, shininess, k, atten, mode, l_spec, grey)
+        else:  # specular only: the diffuse goes to rows nobody reads (zeroed by _block)
+            _light_inline(scr, m, R_LX, R_D, q, shininess, k, atten, mode, True, grey)
+        return
+    fres = l_spec and (fl & FRESNEL) != 0
+    rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
+    if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
+        _to_light(scr, m, q, k, (fl & ATTEN) != 0)
+        if fl & SPOT:
+            _spot(scr, m, q, k, (fl & SPOT_EXP) != 0)
+        if l_amb:
+            _ambient(scr, m, q)
+    elif rows:  # a directional light on the row path
+        _dir_rows(scr, m, q, k[K_ONE])
+    if fl & SHADOW:  # after the ambient: ambient light is not shadowed
+        _shadow(scr, m, vis)
+    if fres:  # diffuse with w, then specular with w·F
+        if l_dif:
+            _light_any(scr, m, q, shininess, k, True, mode, True, False)
+        _fresnel(scr, m, q, k)
+        _light_any(scr, m, q, shininess, k, True, mode, False, True)
+    else:
+        _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
+
+
+@nb.njit(**_LEAF)
+def _block(
+    gpx,
+    gpy,
+    gpz,
+    gx,
+    gy,
+    gz,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    vis,
+    amb,
+    mark,
+    out,
+    scr,
+    grey_only,
+    dw,
+    sw,
+    act,
+    culled,
+):
+    """One block; every array argument is already sliced to the block's vertices (``mark``,
+    ``culled``: this block's one-element slices of the marked-lane and skipped vertex-light
+    counts; ``act``: (L, chunks) int32, which of its chunks each light can reach (see
+    :func:`_reach`), or (L, 0): no culling).
+
+    gpx, gpy, gpz, gx, gy, gz : (m,) T prepared positions and normals (read only), copied into
+    the scratch rows, so that every light loop takes the scratch array alone (a call that passes
+    a tuple of rows copies each row's array structure: ~1 µs per light and block)
+    """
+    m = gpx.shape[0]
+    zero = k[K_ZERO]
+    two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
+    do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
+    store_lobe = opts[O_STORE_LOBE] != 0
+    track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
+    px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
+    # (two-sided flips these copies)
+    nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
+    _copy(px, gpx)
+    _copy(py, gpy)
+    _copy(pz, gpz)
+    _copy(nx, gx)
+    _copy(ny, gy)
+    _copy(nz, gz)
+    vx, vy, vz = _row(scr, R_VX, m), _row(scr, R_VY, m), _row(scr, R_VZ, m)
+    Ax, Ay, Az = _row(scr, R_AX, m), _row(scr, R_AY, m), _row(scr, R_AZ, m)
+    Dx, Dy, Dz = _row(scr, R_DX, m), _row(scr, R_DY, m), _row(scr, R_DZ, m)
+    Sx, Sy, Sz = _row(scr, R_SX, m), _row(scr, R_SY, m), _row(scr, R_SZ, m)
+    trk = _row(scr, R_TRK, m)
+    # the inline loops always add a diffuse term: for a specular-only pass it goes to the rows
+    # R_LX, R_LY, R_LZ (RGB) and R_D (grey), which the inline loops never read
+    junk_zeroed = False
+
+    _fill(trk, k[K_INF])  # no lane is near a decision until a light says so
+    used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
+    # grey_only (see grey_pass): the diffuse and specular sums live in the grey rows alone, so
+    # there are no RGB rows to zero, add to, store or compose from
+    if grey_only:
+        if do_dif or D.shape[0] == 0:
+            _fill(_row(scr, R_GD, m), zero)
+        else:  # the cached diffuse sum (grey: see grey_pass)
+            _copy(_row(scr, R_GD, m), D)
+        _fill(_row(scr, R_GS, m), zero)
+        used_grey = True
+    if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
+        if opts[O_LOCAL]:
+            _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
+        else:
+            _fill(vx, view[0])
+            _fill(vy, view[1])
+            _fill(vz, view[2])
+    if two_sided:
+        _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
+    if track and do_spec and not flat:  # N·V, for the inline lobes
+        _dot(nx, ny, nz, vx, vy, vz, _row(scr, R_NV, m))
+
+    # the sums: recomputed ones start at 0, the others come from the caches
+    has_a = do_amb or A.shape[0] > 0  # else no per-vertex ambient: its rows stay unused
+    if has_a:
+        _load_rows(A[:0] if do_amb else A, Ax, Ay, Az, zero)
+    if not grey_only:
+        _load_rows(D[:0] if do_dif else D, Dx, Dy, Dz, zero, dw)
+        _load_rows(S[:0] if do_spec else S, Sx, Sy, Sz, zero, sw)
+
+    nc = (m + CHUNK - 1) // CHUNK
+    cull = act.shape[1] > 0  # (see _reach: decided per task)
+    skipped = 0
+    for li in range(params.shape[0]):
+        fl = flags[li]
+        q = params[li, :]
+        l_amb = do_amb and (fl & AMBIENT) != 0
+        l_dif = do_dif and (fl & DIFFUSE) != 0
+        l_spec = do_spec and (fl & SPECULAR) != 0
+        if not (l_amb or l_dif or l_spec):
+            continue
+        mode = _mode(fl, flat, phong)
+        inline = _is_inline(fl, track, l_dif, l_spec, mode)  # L, attenuation inline
+        if inline:
+            grey = (fl & GREY) != 0
+            if grey and not used_grey:
+                _fill(_row(scr, R_GD, m), zero)
+                _fill(_row(scr, R_GS, m), zero)
+            used_grey = used_grey or grey
+            # specular only (a viewer change): the diffuse goes to rows nobody reads
+            if not l_dif and not junk_zeroed:
+                for row in (R_LX, R_LY, R_LZ, R_D):
+                    _fill(_row(scr, row, m), zero)
+                junk_zeroed = True
+        reach = nc
+        if cull:
+            reach = 0
+            for j in range(nc):
+                reach += act[li, j]
+        if reach == nc:  # the whole block
+            _light_run(scr, m, fl, q, shininess, k, vis[li, :], l_amb, l_dif, l_spec, mode, inline)
+        else:  # runs of chunks it can reach; the others get nothing (a zero lobe weight)
+            c = 0
+            while c < nc:
+                e = c + 1
+                while e < nc and act[li, e] == act[li, c]:
+                    e += 1
+                s0, s1 = c * CHUNK, min(m, e * CHUNK)
+                if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
+                    sub = scr[s0 : s0 + N_ROWS * BLOCK]
+                    v = vis[li, s0:s1]  # (an empty row when no light casts shadows)
+                    _light_run(
+                        sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
+                    )
+                else:
+                    skipped += s1 - s0
+                    if store_lobe and l_spec:
+                        _fill(_row(scr, R_WS, m)[s0:s1], zero)
+                        _fill(_row(scr, R_BASE, m)[s0:s1], zero)
+                c = e
+        if store_lobe and l_spec:
+            _keep_lobe(scr, m, base_out[li, :], ws_out[li, :], flat)
+    culled[0] = skipped
+
+    if opts[O_TRACK]:  # mark the lanes inside some ambiguity band, if any
+        lim = unit(k)
+        hit = np.int32(0)
+        for i in range(m):  # (an OR: vectorises; a count does not)
+            hit |= np.int32(1) if trk[i] < lim else np.int32(0)
+        count = 0
+        if hit:  # (the marks of a block that counts none are never read)
+            for i in range(m):
+                amb[i] = trk[i] < lim
+                count += 1 if trk[i] < lim else 0
+        mark[0] = count
+    if grey_only:
+        GD, GS = _row(scr, R_GD, m), _row(scr, R_GS, m)
+        if opts[O_STORE]:
+            if do_amb and A.shape[0] > 0:
+                _store_rows(A, Ax, Ay, Az)
+            if do_dif:
+                _store_grey(D, GD, dw)
+            _store_grey(S, GS, sw)
+        if opts[O_COMPOSE]:
+            _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, opts[O_CLAMP] != 0, k, has_a)
+        return
+    if used_grey:  # the grey sums count in every channel
+        _add_grey(Dx, Dy, Dz, _row(scr, R_GD, m))
+        _add_grey(Sx, Sy, Sz, _row(scr, R_GS, m))
+    if opts[O_STORE]:
+        if do_amb and A.shape[0] > 0:
+            _store_rows(A, Ax, Ay, Az)
+        if do_dif and D.shape[0] > 0:
+            _store_rows(D, Dx, Dy, Dz)
+        if do_spec and S.shape[0] > 0:
+            _store_rows(S, Sx, Sy, Sz)
+    if opts[O_COMPOSE]:
+        clamp = opts[O_CLAMP] != 0
+        _compose_rows(out, mat, aconst, Ax, Ay, Az, Dx, Dy, Dz, Sx, Sy, Sz, clamp, k, has_a)
+
+
+@nb.njit(**_LEAF)
+def _task(
+    G,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    vis,
+    amb,
+    marks,
+    out,
+    scr,
+    act,
+    b0,
+    b1,
+    grey_only,
+    dw,
+    sw,
+    bounds,
+    culled,
+):
+    """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
+    arrays here costs no atomic operations on their counts, which both threads would contend)."""
+    n = G.shape[1]
+    # light culling: which chunks of the task's blocks each light can reach, one vectorised
+    # _reach per light (per block, its 16 chunks are fewer than one vector iteration); not
+    # two-sided (N flips with V)
+    c0, c1 = b0 * CHUNKS, min(bounds.shape[1], b1 * CHUNKS)
+    cull = bounds.shape[1] > 0 and opts[O_TWO_SIDED] == 0
+    if cull:
+        do_amb = opts[O_DO_AMB] != 0
+        for li in range(params.shape[0]):
+            fl = flags[li]
+            back = not (do_amb and (fl & AMBIENT) != 0)
+            _reach(bounds, c0, c1 - c0, params[li, :], fl, back, act[li, :])
+    for b in range(b0, b1):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        _block(
+            G[0, s:e],
+            G[1, s:e],
+            G[2, s:e],
+            G[3, s:e],
+            G[4, s:e],
+            G[5, s:e],
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shininess,
+            k,
+            A[3 * s : 3 * e],
+            D[dw * s : dw * e],
+            S[sw * s : sw * e],
+            base_out[:, s:e],
+            ws_out[:, s:e],
+            vis[:, s:e],
+            amb[s:e],
+            marks[b : b + 1],
+            out[3 * s : 3 * e],
+            scr,
+            grey_only,
+            dw,
+            sw,
+            act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull else act[:, :0],
+            culled[b : b + 1],
+        )
+
+
+def _host_has_avx512() -> bool:
+    try:
+        return bool(llvm.get_host_cpu_features().get("avx512f", False))
+    except RuntimeError:  # llvmlite cannot read this host's features: keep LLVM's choice
+        return False
+
+
+#: float32 loops are vectorised 16 lanes wide where the CPU has AVX-512 (LLVM's Intel tunings
+#: prefer 256-bit vectors; 512-bit ones shade about 12% faster here). Set the environment
+#: variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's choice (numba's on-disk cache keeps
+#: whichever was compiled first: clear it, or use another NUMBA_CACHE_DIR, to compare).
+WIDE_FLOAT32 = (
+    os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
+    and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
+    and _host_has_avx512()
+)
+
+
+@contextlib.contextmanager
+def _quiet_llvm_remarks():
+    """Drop the "remark: ... loop not vectorized" lines LLVM writes to the process's stderr
+    (file descriptor 2) for loops it leaves scalar once a vector width is forced; any other
+    output is passed on."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no usable stderr: nothing to filter
+        yield
+        return
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            rest = [ln for ln in tmp.read().splitlines(True) if not ln.startswith(b"remark: ")]
+            if rest:
+                os.write(2, b"".join(rest))
+
+
+#: and their loops run two vector iterations interleaved (LLVM's -force-vector-interleave): a
+#: light loop is one long dependency chain per iteration (two square roots, pow), which the
+#: out-of-order core overlaps too little on its own; two independent chains side by side make
+#: the light loop about 15% faster here (LLVM picks 1 for a loop that large)
+INTERLEAVE = 2
+
+
+@contextlib.contextmanager
+def wide_vectors():
+    """Compile numba code inside this block with 16-lane vectors where :data:`WIDE_FLOAT32`
+    (else a no-op). LLVM's ``-force-vector-width`` is a process-wide option: it is set for the
+    block only and reset to 0 (LLVM's own choice) after, so other numba code is not affected."""
+    if not WIDE_FLOAT32:
+        yield
+        return
+    with _quiet_llvm_remarks():
+        llvm.set_option("", "-force-vector-width=16")
+        llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
+        try:
+            yield
+        finally:
+            llvm.set_option("", "-force-vector-width=0")
+            llvm.set_option("", "-force-vector-interleave=0")
+
+
+def _wide(kernel, dtype_arg: int):
+    """Call ``kernel`` so that a signature it meets for the first time with float32 data (the
+    dtype of positional argument ``dtype_arg``) is compiled with 16-lane vectors
+    (:func:`wide_vectors` around such first calls, which compile or load from numba's cache);
+    later calls go straight to the kernel."""
+    if not WIDE_FLOAT32:
+        return kernel
+    seen: set = set()
+
+    @functools.wraps(kernel.py_func)
+    def call(*args):
+        dt = args[dtype_arg].dtype
+        if dt in seen:
+            return kernel(*args)
+        if dt != np.float32:
+            seen.add(dt)
+            return kernel(*args)
+        with wide_vectors():
+            try:
+                return kernel(*args)
+            finally:
+                seen.add(dt)
+
+    call.dispatcher = kernel  # the numba dispatcher itself (signatures, inspection)
+    return call
+
+
+#: parallel tasks of a pass: blocks are dealt out in this many contiguous runs (enough to keep
+#: every thread busy to the end); a task allocates its scratch rows once, not once per block
+TASKS = 64
+
+
+@nb.njit(**_OPTS)
+def _scratch(dtype):
+    """A task's scratch: N_ROWS rows of BLOCK lanes, and one row more, so that the scratch seen
+    from any lane of a block on (``scr[s0 : s0 + N_ROWS * BLOCK]``, a run of chunks) still
+    holds N_ROWS whole rows."""
+    return np.empty((N_ROWS + 1) * BLOCK, dtype)
+
+
+@nb.njit(**_LEAF)
+def _spread(t, ntasks):
+    """The run of blocks parallel task ``t`` of ``ntasks`` shades: ``t`` with its bits reversed
+    when ``ntasks`` is a power of two (else ``t``). numba's threads take the tasks in contiguous
+    shares (static scheduling), and culling makes work uneven across a mesh (the half a light
+    faces costs, the other half is skipped): reversed bits deal every thread runs from all over
+    the mesh, so the threads finish together. Used only when culling: without it the work is
+    even, and each thread streaming through one contiguous half is faster (1.04x, measured)."""
+    if ntasks & (ntasks - 1):
+        return t
+    r = 0
+    w = ntasks
+    while w > 1:
+        r = (r << 1) | (t & 1)
+        t >>= 1
+        w >>= 1
+    return r
+
+
+@nb.njit(**_LEAF)
+def _tasks(nblocks):
+    return max(1, min(nblocks, TASKS))
+
+
+@nb.njit(**_OPTS)
+def _flat(A, D, S, out):
+    """Flat (3n,) views of the (n, 3) sums and colours (see the module docstring); a grey
+    (n, 1) sum gives (n,)."""
+    return A.reshape(-1), D.reshape(-1), S.reshape(-1), out.reshape(-1)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def shade(
+    G,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    vis,
+    amb,
+    marks,
+    out,
+    bounds,
+    culled,
+):
+    """Shade every vertex (see the module docstring).
+
+    G : (6, n) T prepared geometry (see :func:`prepare`)
+    params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
+    opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
+    shininess : T; k : constants(T)
+    A, D, S : (n, 3) T caches (or (0, 3)); D and S may be grey, (n, 1): read as one value
+    for every channel, and written only by a pass that keeps its sums in the grey rows alone
+    (:func:`grey_pass`, which the caller asks before it allocates them)
+    base_out, ws_out : (L, n) T (or (L, 0))
+    vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
+    amb : (n,) bool ambiguity marks, marks : (nblocks,) int32 marked lanes per block of BLOCK
+    vertices (both (0,) when not tracking); a block that marks none leaves its part of ``amb``
+    as it was: read the marks with :func:`marked`
+    out : (n, 3) colours
+    bounds : (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds for light culling (see
+    :func:`bounds`), or (N_BOUNDS, 0): no culling
+    culled : (nblocks,) int32 out: vertex-lights each block skipped by culling
+    """
+    n = G.shape[1]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    ntasks = _tasks(nblocks)
+    Af, Df, Sf, outf = _flat(A, D, S, out)
+    # once per pass: a diffuse sum not recomputed here must be grey already, or absent
+    grey_only = grey_pass(flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
+    dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
+    # a pass that is not grey writes three values per vertex: a grey sum would overflow
+    if not grey_only and opts[O_STORE] != 0:
+        if (opts[O_DO_DIF] != 0 and dw == 1 and D.shape[0]) or (
+            opts[O_DO_SPEC] != 0 and sw == 1 and S.shape[0]
+        ):
+            raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
+    for t in nb.prange(ntasks):
+        scr = _scratch(params.dtype)  # once per task: no allocation per block
+        # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
+        r = _spread(np.int64(t), np.int64(ntasks)) if bounds.shape[1] else np.int64(t)
+        b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
+        act = np.empty((params.shape[0], (b1 - b0) * CHUNKS if bounds.shape[1] else 0), np.int32)
+        _task(
+            G,
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shininess,
+            k,
+            Af,
+            Df,
+            Sf,
+            base_out,
+            ws_out,
+            vis,
+            amb,
+            marks,
+            outf,
+            scr,
+            act,
+            b0,
+            b1,
+            grey_only,
+            dw,
+            sw,
+            bounds,
+            culled,
+        )
+
+
+@nb.njit(**_OPTS)
+def marked(amb, marks):
+    """Indices of the marked lanes, (k,) int64, from a pass's marks and per-block counts:
+    only the blocks that counted some are read."""
+    idx = np.empty(marks.sum(), np.int64)
+    j = 0
+    for b in range(marks.shape[0]):
+        if marks[b]:
+            for i in range(b * BLOCK, min(amb.shape[0], b * BLOCK + BLOCK)):
+                if amb[i]:
+                    idx[j] = i
+                    j += 1
+    return idx
+
+
+@nb.njit(**_OPTS)
+def _gather_sum(X, idx):
+    """Rows ``idx`` of a cached sum as (m, 3) float64 (a grey (n, 1) sum in every channel), or
+    (0, 3) for an empty one."""
+    m = idx.shape[0] if X.shape[0] else 0
+    out = np.empty((m, 3))
+    for j in range(m):
+        for c in range(3):
+            out[j, c] = X[idx[j], c if X.shape[1] == 3 else 0]
+    return out
+
+
+@nb.njit(**_OPTS)
+def fixup(
+    amb,
+    marks,
+    P,
+    N,
+    centre,
+    inv_scale,
+    params,
+    flags,
+    view,
+    opts,
+    mat,
+    aconst,
+    shininess,
+    k,
+    A,
+    D,
+    S,
+    base_out,
+    ws_out,
+    vis,
+    out,
+):
+    """Redo the lanes a float32 pass marked in float64, where the policies hold exactly, and
+    write the results over the float32 ones; returns how many lanes.
+
+    amb, marks : the pass's marks (see :func:`marked`)
+    P, N : (n, 3) world positions and normals; centre, inv_scale : the frame (:func:`prepare`)
+    params, view, mat, aconst, shininess, k : the pass's inputs in float64; flags, opts : the
+    pass's (ambiguity tracking is switched off here)
+    A, D, S, base_out, ws_out, vis, out : the pass's float32 arrays, written at the marked lanes
+    (one compiled call: gathering, shading and scattering ~150 lanes from Python cost about as
+    much as a light at 1M vertices)
+    """
+    idx = marked(amb, marks)
+    m = idx.shape[0]
+    if m == 0:
+        return 0
+    L = params.shape[0]
+    Pm, Nm = np.empty((m, 3)), np.empty((m, 3))
+    for j in range(m):
+        for c in range(3):
+            Pm[j, c] = P[idx[j], c]
+            Nm[j, c] = N[idx[j], c]
+    nblocks = (m + BLOCK - 1) // BLOCK
+    G = np.empty((6, m))
+    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks)
+    o = opts.copy()
+    o[O_TRACK] = 0
+    Am, Dm, Sm = _gather_sum(A, idx), _gather_sum(D, idx), _gather_sum(S, idx)
+    lobes = m if base_out.shape[1] else 0
+    bm, wm = np.zeros((L, lobes)), np.zeros((L, lobes))
+    vm = np.empty((L, m if vis.shape[1] else 0))
+    for li in range(vm.shape[0]):
+        for j in range(vm.shape[1]):
+            vm[li, j] = vis[li, idx[j]]
+    om = np.empty((m, 3))
+    grey = o[O_TRACK] != 0  # (False: the float64 pass keeps RGB sums)
+    _task(
+        G,
+        params,
+        flags,
+        view,
+        o,
+        mat,
+        aconst,
+        shininess,
+        k,
+        Am.reshape(-1),
+        Dm.reshape(-1),
+        Sm.reshape(-1),
+        bm,
+        wm,
+        vm,
+        np.zeros(0, np.bool_),
+        np.zeros(0, np.int32),
+        om.reshape(-1),
+        _scratch(np.float64),
+        np.empty((L, 0), np.int32),
+        0,
+        nblocks,
+        grey,
+        Dm.shape[1],
+        Sm.shape[1],
+        np.zeros((N_BOUNDS, 0)),  # (no culling: the lanes are not in chunks)
+        np.zeros(nblocks, np.int32),
+    )
+    for j in range(m):
+        i = idx[j]
+        for c in range(3):
+            out[i, c] = om[j, c]
+        for c in range(A.shape[1] if A.shape[0] else 0):
+            A[i, c] = Am[j, c]
+        for c in range(D.shape[1] if D.shape[0] else 0):  # (a grey sum: its lights are grey)
+            D[i, c] = Dm[j, c]
+        for c in range(S.shape[1] if S.shape[0] else 0):
+            S[i, c] = Sm[j, c]
+        for li in range(L if lobes else 0):
+            base_out[li, i] = bm[li, j]
+            ws_out[li, i] = wm[li, j]
+    return m
+
+
+@nb.njit(**_LEAF)
+def _lobe_rows(base, ws, y, flat, cr, cg, cb, Sx, Sy, Sz):
+    for i in range(ws.shape[0]):
+        t = ws[i] if flat else ws[i] * fpow(base[i], y)
+        Sx[i] += t * cr
+        Sy[i] += t * cg
+        Sz[i] += t * cb
+
+
+@nb.njit(parallel=True, **_OPTS)
+def lobe(base, ws, params, flags, shininess, k, S):
+    """S = Σ_l ws_l·base_l^n·s_l from stored per-light bases (a shininess change).
+
+    base, ws : (L, n) T (base unused when shininess is 0); params : (L, N_PARAMS) T;
+    flags : (L,) int32; S : (n, 3) T out
+    """
+    n = S.shape[0]
+    nblocks = (n + BLOCK - 1) // BLOCK
+    ntasks = _tasks(nblocks)
+    Sf = S.reshape(-1)
+    for t in nb.prange(ntasks):
+        scr = np.empty(3 * BLOCK, params.dtype)
+        _lobe_task(
+            base,
+            ws,
+            params,
+            flags,
+            shininess,
+            k,
+            Sf,
+            scr,
+            t * nblocks // ntasks,
+            (t + 1) * nblocks // ntasks,
+        )
+
+
+@nb.njit(**_LEAF)
+def _lobe_task(base, ws, params, flags, shininess, k, Sf, scr, b0, b1):
+    """Blocks b0 to b1 - 1 of :func:`lobe` (a leaf: no reference counting, see _task)."""
+    n = Sf.shape[0] // 3
+    flat = shininess == k[K_ZERO]
+    for b in range(b0, b1):
+        s = b * BLOCK
+        e = min(n, s + BLOCK)
+        m = e - s
+        Sx, Sy, Sz = _row(scr, 0, m), _row(scr, 1, m), _row(scr, 2, m)
+        _fill(Sx, k[K_ZERO])
+        _fill(Sy, k[K_ZERO])
+        _fill(Sz, k[K_ZERO])
+        for li in range(params.shape[0]):
+            if flags[li] & SPECULAR:
+                _lobe_rows(
+                    base[li, s:e],
+                    ws[li, s:e],
+                    shininess,
+                    flat,
+                    params[li, P_SPEC],
+                    params[li, P_SPEC + 1],
+                    params[li, P_SPEC + 2],
+                    Sx,
+                    Sy,
+                    Sz,
+                )
+        _store_rows(Sf[3 * s : 3 * e], Sx, Sy, Sz)
+
+
+@nb.njit(**_LEAF)
+def _channels(X, i, grey):
+    """Vertex i's three values in a flat block of a sum: (n, 3), or grey (n, 1) (one value for
+    every channel)."""
+    if grey:
+        return X[i], X[i], X[i]
+    return X[3 * i], X[3 * i + 1], X[3 * i + 2]
+
+
+def _compose_block(o, A, D, S, c, lo, hi, variant):  # pragma: no cover - overloaded below
+    raise NotImplementedError
+
+
+@overload(_compose_block, prefer_literal=True, jit_options=_LEAF)
+def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
+    """One fused pass: o = c0 + cA·A + cD·D + cS·S, clamped; the sums a material does not use
+    are not read at all (``variant`` bits 0, 1, 2: A, D, S present; bits 3, 4: D, S grey, one
+    value per vertex for every channel)."""
+    if not isinstance(variant, types.IntegerLiteral):
+        raise TypingError("_compose_block needs a literal variant")
+    v = variant.literal_value
+    has_a, has_d, has_s = bool(v & 1), bool(v & 2), bool(v & 4)
+    grey_d, grey_s = bool(v & 8), bool(v & 16)
+
+    def impl(o, A, D, S, c, lo, hi, variant):
+        c0, c1, c2 = c[0], c[1], c[2]
+        a0, a1, a2, d0, d1, d2, s0, s1, s2 = c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11]
+        for i in range(o.shape[0] // 3):  # flat (3m,) blocks of (n, 3) arrays
+            r, g, b = c0, c1, c2  # e_m + a_m·(scene and constant light ambient)
+            if has_a:  # a_m·A (attenuated light ambient)
+                x, y, z = _channels(A, i, False)
+                r, g, b = r + a0 * x, g + a1 * y, b + a2 * z
+            if has_d:  # d_m·D
+                x, y, z = _channels(D, i, grey_d)
+                r, g, b = r + d0 * x, g + d1 * y, b + d2 * z
+            if has_s:  # s_m·S
+                x, y, z = _channels(S, i, grey_s)
+                r, g, b = r + s0 * x, g + s1 * y, b + s2 * z
+            o[3 * i] = min(max(r, lo), hi)
+            o[3 * i + 1] = min(max(g, lo), hi)
+            o[3 * i + 2] = min(max(b, lo), hi)
+
+    return impl
+
+
+def _compose_a(o, A, D, S, c, lo, hi, base, has_a):  # pragma: no cover - overloaded below
+    raise NotImplementedError
+
+
+@overload(_compose_a, prefer_literal=True, jit_options=_LEAF)
+def _compose_a_overload(o, A, D, S, c, lo, hi, base, has_a):
+    """The compose loop for the D and S layout ``base`` (a literal), with or without A."""
+    if not isinstance(base, types.IntegerLiteral):
+        raise TypingError("_compose_a needs a literal base variant")
+    without, with_a = base.literal_value, base.literal_value | 1
+
+    def impl(o, A, D, S, c, lo, hi, base, has_a):
+        if has_a:
+            _compose_block(o, A, D, S, c, lo, hi, with_a)
+        else:
+            _compose_block(o, A, D, S, c, lo, hi, without)
+
+    return impl
+
+
+@nb.njit(**_LEAF)
+def _compose_any(o, A, D, S, c, lo, hi, v):
+    """Call the compose loop compiled for variant ``v`` (see :func:`_compose_block`): D and S
+    each absent, RGB or grey, A present or not."""
+    a, ds = v & 1, v & ~1
+    if ds == 0:
+        _compose_a(o, A, D, S, c, lo, hi, 0, a)
+    elif ds == 2:  # D
+        _compose_a(o, A, D, S, c, lo, hi, 2, a)
+    elif ds == 4:  # S
+        _compose_a(o, A, D, S, c, lo, hi, 4, a)
+    elif ds == 6:  # D, S
+        _compose_a(o, A, D, S, c, lo, hi, 6, a)
+    elif ds == 2 | 8:  # D grey
+        _compose_a(o, A, D, S, c, lo, hi, 2 | 8, a)
+    elif ds == 6 | 8:  # D grey, S
+        _compose_a(o, A, D, S, c, lo, hi, 6 | 8, a)
+    elif ds == 4 | 16:  # S grey
+        _compose_a(o, A, D, S, c, lo, hi, 4 | 16, a)
+    elif ds == 6 | 16:  # D, S grey
+        _compose_a(o, A, D, S, c, lo, hi, 6 | 16, a)
+    else:  # D grey, S grey
+        _compose_a(o, A, D, S, c, lo, hi, 6 | 8 | 16, a)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def compose(mat, aconst, A, D, S, clamp, k, out):
+    """Colours from cached sums: out = e + a_m·(aconst + A) + d_m·D + s_m·S, clamped.
+
+    A, D, S : (n, 3) T or (0, 3) for "all zero"; D and S may be grey, (n, 1); out : (n, 3)
+    """
+    n = out.shape[0]
+    v = (1 if A.shape[0] > 0 else 0) | (2 if D.shape[0] > 0 else 0) | (4 if S.shape[0] > 0 else 0)
+    dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
+    v |= (8 if v & 2 and dw == 1 else 0) | (16 if v & 4 and sw == 1 else 0)
+    lo = k[K_ZERO]
+    hi = k[K_ONE] if clamp else k[K_INF]
+    c = mat.copy()
+    for ch in range(3):
+        c[ch] = mat[ch] + mat[3 + ch] * aconst[ch]
+    chunk = COMPOSE_BLOCK
+    nblocks = (n + chunk - 1) // chunk
+    Af, Df, Sf, outf = _flat(A, D, S, out)
+    for b in nb.prange(nblocks):
+        s = b * chunk
+        e = min(n, s + chunk)
+        _compose_any(
+            outf[3 * s : 3 * e],
+            Af[3 * s : 3 * e] if v & 1 else Af,
+            Df[dw * s : dw * e] if v & 2 else Df,
+            Sf[sw * s : sw * e] if v & 4 else Sf,
+            c,
+            lo,
+            hi,
+            v,
+        )
+
+
+#: vertices per parallel task of a recompose (a streaming pass: large chunks, few tasks)
+COMPOSE_BLOCK = 16384
+
+
+@nb.njit(parallel=True, **_OPTS)
+def stream(P, N, out):
+    """The memory-bandwidth floor of a recolour: read positions and normals once, write
+    colours once (out = P + N). Used only by the benchmark, as the yardstick."""
+    Pf, Nf, outf = P.reshape(-1), N.reshape(-1), out.reshape(-1)  # flat views (module docstring)
+    n = outf.shape[0]
+    chunk = 3 * COMPOSE_BLOCK
+    nblocks = (n + chunk - 1) // chunk
+    for b in nb.prange(nblocks):
+        s = b * chunk
+        e = min(n, s + chunk)
+        _add(Pf[s:e], Nf[s:e], outf[s:e])
+
+
+@nb.njit(**_LEAF)
+def _add(p, q, o):
+    for i in range(o.shape[0]):
+        o[i] = p[i] + q[i]
+
+
+# the entry points, each compiled with wide float32 vectors where the CPU has them (see _wide);
+# the number is the argument whose dtype picks the precision
+prepare = _wide(prepare, 5)
+bounds = _wide(bounds, 0)
+shade = _wide(shade, 1)
+lobe = _wide(lobe, 2)
+compose = _wide(compose, 7)
+stream = _wide(stream, 2)

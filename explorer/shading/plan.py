@@ -1,0 +1,398 @@
+"""Plans: which terms a scene can make non-zero, and so which work the engine does.
+
+:func:`make_plan` looks at the scene alone (never at the mesh) and decides, per light and for
+the whole scene, what must be computed per vertex, what is constant, and what is skipped, with
+the reason for each decision. The kernels (:mod:`explorer.kernels`) follow the plan; the test
+suite checks that the planned result equals the full-generality reference on random scenes.
+
+Light-level decisions depend on the light only (its colours, type, attenuation, cone); the
+term-level decisions (is there any ambient, diffuse, specular at all?) depend on the material
+too. The interactive :class:`~explorer.engine.Shader` keeps per-light work cached across material
+changes and asks for a term only when the current material needs it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from explorer.core.hdr import energy_warnings
+from explorer.core.lights import NO_ATTENUATION, DirectionalLight, PointLight, SpotLight
+from explorer.core.scene import Scene
+from explorer.shading.effects import specular_scale
+from explorer.shading.kernels import CHUNK
+
+
+def _nonzero(rgb) -> bool:
+    return any(c != 0.0 for c in rgb)
+
+
+@dataclass(frozen=True)
+class LightPlan:
+    """The work for one light.
+
+    ambient, diffuse, specular : the light has that colour (non-zero)
+    positional : L is computed per vertex (point and spot); else constant
+    attenuation : "none" | "constant" (folded into the colours) | "per-vertex"
+    spot : "none" | "cone" | "cone+exponent"
+    factor : constant attenuation 1/kc folded into the light's colours
+    shadows : shadow rays are cast for this light (``shadows: true``, faces given, the mesh
+        can shadow itself, the light has diffuse or specular)
+    reasons : (item, "in"|"out", why) rows for people
+    """
+
+    index: int
+    kind: str
+    ambient: bool
+    diffuse: bool
+    specular: bool
+    positional: bool
+    attenuation: str
+    spot: str
+    factor: float
+    reasons: tuple = ()
+    shadows: bool = False
+
+    @property
+    def varying_weight(self) -> bool:
+        """att·spot differs between vertices."""
+        return self.attenuation == "per-vertex" or self.spot != "none"
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The work for a scene.
+
+    emission, ambient, diffuse, specular : the term can be non-zero (material and lights)
+    ambient_per_vertex : some light's ambient is attenuated or cut by a cone per vertex
+    flat_specular : shininess 0, so the lobe is 1 wherever N·L > 0 (no H, no R, no pow)
+    view : "none" | "constant" | "per-vertex" (the V vector)
+    halfway : "none" | "constant" | "per-vertex" | "reflection" (how the lobe's base is found)
+    two_sided : flip N where N·V < 0
+    lights : one LightPlan per scene light, in scene order
+    reasons : (item, "in"|"out", why) rows for the scene-level decisions
+    fresnel : Schlick's F0 weighting the specular term, or None
+    specular_scale : energy-conserving lobe normalisation folded into the specular colours
+        (1 when off)
+    hdr : colours are displayed unclamped with exposure and a tone map
+    cull : a run of vertices that provably gets nothing from a light (all facing away from
+        it, or outside its cone) skips that light; the mesh decides which (one-sided only)
+    force_all : nothing is skipped (benchmark only; same colours)
+    """
+
+    emission: bool
+    ambient: bool
+    ambient_per_vertex: bool
+    diffuse: bool
+    specular: bool
+    flat_specular: bool
+    view: str
+    halfway: str
+    two_sided: bool
+    model: str
+    lights: tuple[LightPlan, ...] = ()
+    reasons: tuple = field(default=())
+    fresnel: float | None = None
+    specular_scale: float = 1.0
+    hdr: bool = False
+    force_all: bool = False
+    cull: bool = False
+
+    @property
+    def shadows(self) -> bool:
+        """Some light casts shadow rays."""
+        return any(lp.shadows for lp in self.lights)
+
+    def light_does(self, lp: LightPlan) -> dict[str, bool]:
+        """Which terms light ``lp`` computes under this plan."""
+        return {
+            "ambient": self.ambient and lp.ambient and lp.varying_weight,
+            "diffuse": self.diffuse and lp.diffuse,
+            "specular": self.specular and lp.specular,
+        }
+
+    def describe(self) -> str:
+        """The plan as text: one line per decision with its reason."""
+        rows = [("scene", *r) for r in self.reasons]
+        for lp in self.lights:
+            rows += [(f"light {lp.index} ({lp.kind})", *r) for r in lp.reasons]
+        w0 = max(len(r[0]) for r in rows) if rows else 0
+        w1 = max(len(r[1]) for r in rows) if rows else 0
+        out = []
+        for who, item, state, why in rows:
+            out.append(f"{who:<{w0}}  {item:<{w1}}  {state:<3}  {why}")
+        return "\n".join(out)
+
+
+#: what :func:`make_plan` knows of the mesh for shadows
+MESH_KINDS = (None, "convex", "concave")
+
+
+def make_plan(scene: Scene, *, mesh: str | None = None, force_all: bool = False) -> Plan:
+    """Decide the work for ``scene`` (see the module docstring).
+
+    mesh : what the shader knows of the mesh, for shadows: None (no faces given: nothing can
+        cast a shadow), "convex" (cannot shadow itself) or "concave"
+    force_all : skip nothing (every term of every light per vertex, shadow rays from every
+        vertex even on a convex mesh); the colours are the same. For the benchmark only.
+    """
+    if mesh not in MESH_KINDS:
+        raise ValueError(f"mesh must be one of {MESH_KINDS}, got {mesh!r}")
+    plan = _make_plan(scene, mesh)
+    if force_all:
+        plan = _forced(plan, scene, mesh)
+    return plan
+
+
+def _forced(plan: Plan, scene: Scene, mesh) -> Plan:
+    from dataclasses import replace
+
+    lights = []
+    for lp, lt in zip(plan.lights, scene.lights, strict=True):
+        att = "per-vertex" if lp.positional else "none"
+        lights.append(
+            replace(
+                lp,
+                ambient=True,
+                diffuse=True,
+                specular=True,
+                attenuation=att,
+                factor=1.0,
+                shadows=lt.shadows and mesh is not None,
+                reasons=lp.reasons + (("forced", "in", "force_all: nothing skipped"),),
+            )
+        )
+    flat = scene.material.shininess == 0.0
+    return replace(
+        plan,
+        ambient=True,
+        ambient_per_vertex=any(lp.varying_weight for lp in lights),
+        diffuse=True,
+        specular=True,
+        flat_specular=flat,
+        view="per-vertex" if scene.viewer.local else "constant",
+        halfway="none" if flat else ("reflection" if scene.model == "phong" else "per-vertex"),
+        lights=tuple(lights),
+        reasons=plan.reasons + (("forced", "in", "force_all: nothing skipped (benchmark)"),),
+        force_all=True,
+        cull=False,
+    )
+
+
+def _make_plan(scene: Scene, mesh) -> Plan:
+    m = scene.material
+    lights = scene.lights
+    reasons = []
+
+    def why(item, on, reason):
+        reasons.append((item, "in" if on else "out", reason))
+        return on
+
+    emission = why(
+        "emission",
+        _nonzero(m.emission),
+        "material emission is non-zero" if _nonzero(m.emission) else "material emission is 0",
+    )
+    any_amb = _nonzero(scene.ambient) or any(_nonzero(lt.ambient) for lt in lights)
+    ambient = why(
+        "ambient",
+        _nonzero(m.ambient) and any_amb,
+        "material ambient 0"
+        if not _nonzero(m.ambient)
+        else ("scene and light ambient are 0" if not any_amb else "a_m and an ambient light"),
+    )
+    any_dif = any(_nonzero(lt.diffuse) for lt in lights)
+    diffuse = why(
+        "diffuse",
+        _nonzero(m.diffuse) and any_dif,
+        "material diffuse 0"
+        if not _nonzero(m.diffuse)
+        else ("no light has diffuse colour" if not any_dif else "d_m and a light's diffuse"),
+    )
+    any_spec = any(_nonzero(lt.specular) for lt in lights)
+    specular = why(
+        "specular",
+        _nonzero(m.specular) and any_spec,
+        "material specular 0"
+        if not _nonzero(m.specular)
+        else ("no light has specular colour" if not any_spec else "s_m and a light's specular"),
+    )
+    flat = specular and m.shininess == 0.0
+    if specular:
+        why(
+            "lobe",
+            not flat,
+            "shininess 0: 0^0 = 1, the lobe is 1 wherever N·L > 0 (no H, no R, no pow)"
+            if flat
+            else f"pow(base, {m.shininess:g}) per vertex",
+        )
+
+    needs_view = (specular and (not flat or m.fresnel is not None)) or scene.two_sided
+    if not needs_view:
+        view = "none"
+        why("view vector", False, "no lobe, no Fresnel and one-sided: V is never used")
+    elif scene.viewer.local:
+        view = "per-vertex"
+        why("view vector", True, "local viewer: V = normalize(eye - P) per vertex")
+    else:
+        view = "constant"
+        why("view vector", True, "infinite viewer: V is constant")
+    why(
+        "two-sided",
+        scene.two_sided,
+        "flip N where N·V < 0" if scene.two_sided else "two_sided is false",
+    )
+    cull = why(
+        "culling",
+        not scene.two_sided,
+        "two-sided: N flips with V, so no vertex is known to face away from a light"
+        if scene.two_sided
+        else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
+        "spot's cone) skip it: how many, the mesh decides",
+    )
+
+    fresnel = m.fresnel if specular else None
+    if m.fresnel is None:
+        why("fresnel", False, "material fresnel not set")
+    elif not specular:
+        why("fresnel", False, f"F0 = {m.fresnel:g} but there is no specular term to weight")
+    else:
+        why("fresnel", True, f"Schlick F0 = {m.fresnel:g}: specular × F0 + (1-F0)(1-V·H)^5")
+
+    scale = specular_scale(scene)
+    if not m.energy_conserving:
+        why("energy", False, "material energy_conserving is false")
+    elif not specular:
+        why("energy", False, "energy_conserving, but there is no specular term to normalise")
+    else:
+        form = "(n+2)/(2π)" if scene.model == "phong" else "(n+8)/(8π)"
+        why("energy", True, f"energy_conserving: {form} = {scale:.4g} folded into s_i")
+    if scene.hdr is None:
+        why("hdr", False, "no hdr: colours clamped to [0, 1] (OpenGL)")
+    else:
+        why(
+            "hdr",
+            True,
+            f"unclamped, exposure {scene.hdr.exposure:g} stops, {scene.hdr.tone_map} tone "
+            "map, sRGB",
+        )
+
+        for w in energy_warnings(m):
+            why("kd + ks", False, "warning: " + w)
+
+    lplans = []
+    for i, lt in enumerate(lights):
+        lplans.append(_light_plan(i, lt, scene, m, mesh, diffuse, specular))
+    per_vertex_amb = ambient and any(lp.ambient and lp.varying_weight for lp in lplans)
+
+    halfway = "none"
+    if specular and not flat:
+        if scene.model == "phong":
+            halfway = "reflection"
+        elif scene.viewer.local or any(lp.positional for lp in lplans if lp.specular):
+            halfway = "per-vertex"
+        else:
+            halfway = "constant"
+    return Plan(
+        emission=emission,
+        ambient=ambient,
+        ambient_per_vertex=per_vertex_amb,
+        diffuse=diffuse,
+        specular=specular,
+        flat_specular=flat,
+        view=view,
+        halfway=halfway,
+        two_sided=scene.two_sided,
+        model=scene.model,
+        lights=tuple(lplans),
+        reasons=tuple(reasons),
+        fresnel=fresnel,
+        specular_scale=scale if specular else 1.0,
+        hdr=scene.hdr is not None,
+        cull=cull,
+    )
+
+
+def _light_plan(i: int, lt, scene: Scene, m, mesh, diffuse: bool, specular: bool) -> LightPlan:
+    reasons = []
+
+    def why(item, on, reason):
+        reasons.append((item, "in" if on else "out", reason))
+        return on
+
+    amb = _nonzero(lt.ambient)
+    dif = _nonzero(lt.diffuse)
+    spec = _nonzero(lt.specular)
+    positional = isinstance(lt, PointLight)
+    attenuation, factor = "none", 1.0
+    spot = "none"
+    if isinstance(lt, DirectionalLight):
+        why("distance", False, "directional: L is constant and never attenuated")
+    else:
+        why("distance", True, "positional: L = normalize(position - P) per vertex")
+        kc, kl, kq = lt.attenuation
+        if lt.attenuation == NO_ATTENUATION:
+            why("attenuation", False, "attenuation [1, 0, 0] is 1 everywhere")
+        elif kl == 0.0 and kq == 0.0:
+            attenuation, factor = "constant", 1.0 / kc
+            why("attenuation", False, f"constant 1/kc = {factor:g} folded into the colours")
+        else:
+            attenuation = "per-vertex"
+            why("attenuation", True, "1/(kc + kl·d + kq·d²) per vertex")
+    if isinstance(lt, SpotLight):
+        if lt.cutoff == 180.0:
+            why("spot", False, "cutoff 180: no cone")
+        elif lt.exponent == 0.0:
+            spot = "cone"
+            why("spot", True, f"cone test at {lt.cutoff:g}°, exponent 0 (no pow)")
+        else:
+            spot = "cone+exponent"
+            why("spot", True, f"cone test at {lt.cutoff:g}° and x^{lt.exponent:g}")
+    lp = LightPlan(i, lt.type, amb, dif, spec, positional, attenuation, spot, factor)
+    varying = lp.varying_weight
+
+    if not _nonzero(m.ambient):
+        why("ambient", False, "material ambient 0")
+    elif not amb:
+        why("ambient", False, "light ambient 0")
+    else:
+        why(
+            "ambient",
+            True,
+            "attenuated per vertex" if varying else "constant: added once to the scene ambient",
+        )
+    why(
+        "diffuse",
+        dif and _nonzero(m.diffuse),
+        "light diffuse 0"
+        if not dif
+        else ("material diffuse 0" if not _nonzero(m.diffuse) else "max(N·L, 0)·d_i"),
+    )
+    if not spec:
+        why("specular", False, "light specular 0")
+    elif not _nonzero(m.specular):
+        why("specular", False, "material specular 0")
+    elif m.shininess == 0.0:
+        why("specular", True, "flat lobe (shininess 0): s_i where N·L > 0")
+    elif scene.model == "phong":
+        why("specular", True, "Phong: (R·V)^n with R = 2(N·L)N - L per vertex")
+    elif not positional and not scene.viewer.local:
+        why("specular", True, "Blinn: constant H (directional light, infinite viewer), N·H")
+    else:
+        why("specular", True, "Blinn: H = normalize(L + V) per vertex")
+    shadows = False
+    if not lt.shadows:
+        why("shadows", False, "shadows is false")
+    elif mesh is None:
+        why("shadows", False, "no mesh faces given: nothing can cast a shadow")
+    elif mesh == "convex":
+        why("shadows", False, "convex mesh: it cannot shadow itself")
+    elif not ((dif and diffuse) or (spec and specular)):
+        why("shadows", False, "no diffuse or specular from this light to shadow")
+    else:
+        shadows = True
+        why("shadows", True, "rays toward the light from vertices with N·L > 0 (others: none)")
+    if not (amb or dif or spec):
+        why("light", False, "all colours 0: skipped entirely")
+    return LightPlan(
+        i, lt.type, amb, dif, spec, positional, attenuation, spot, factor, tuple(reasons), shadows
+    )

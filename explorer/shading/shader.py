@@ -1,0 +1,610 @@
+"""The engine's front: :func:`shade` for one-shot colours, :class:`Shader` for interaction.
+
+A :class:`Shader` keeps the per-vertex light sums of
+:func:`explorer.reference.reference_terms` cached by what they depend on:
+
+=====================  =======================================================================
+change                 work done on the next ``colors``
+=====================  =======================================================================
+material colours       compose only: ``e + a_m·A + d_m·D + s_m·S`` (no dot product)
+shininess              the lobe only: ``Σ ws·base^n·s`` from stored per-light bases (no
+                       distances, no normalisations), then compose
+viewer                 the specular sum (and, when two-sided, everything: N·V flips normals)
+model (phong/blinn)    the specular sum
+fresnel (F0)           the specular sum (F is stored in each light's lobe weight)
+energy_conserving      the lobe only, as for a shininess change (a constant per scene)
+lights                 every sum the material needs (shadow visibility is kept per light
+                       position and direction: only a moved light casts new rays)
+geometry               every sum the material needs, and new shadow rays
+=====================  =======================================================================
+
+Shadows need the mesh's triangles: pass ``faces`` (default None: no shadows, and the plan says
+so). ``force_all=True`` makes the plan skip nothing (same colours; for the benchmark only).
+
+A term the material does not need (``s_m = 0``, say) is not computed until it is needed.
+``stats`` counts each kind of pass, so tests can check that a change costs what it should.
+Cached arrays are read-only.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from collections import Counter
+
+import numpy as np
+
+from explorer.core.errors import ExplorerError
+from explorer.core.lights import DirectionalLight, SpotLight
+from explorer.core.scene import Scene, Viewer, load_scene
+from explorer.geometry.frame import check_vertices, frame_of, to_frame
+from explorer.shading import kernels as K
+from explorer.shading.plan import Plan, make_plan
+from explorer.shading.shadows import is_convex, visibility
+
+PRECISIONS = ("float64", "float32")
+#: shadow rays are cast where N·L > -this (rounding of N·L must never skip a lit vertex)
+SHADOW_NDL_MARGIN = 1e-6
+#: light culling is kept for a mesh where one chunk of vertices in this many or more has a
+#: normal cone narrower than 90° (only such chunks can ever be skipped)
+CULL_MIN_SHARE = 8
+
+
+def shade(
+    scene,
+    positions,
+    normals,
+    *,
+    precision: str = "float64",
+    clamp: bool = True,
+    materials_dirs=(),
+    faces=None,
+) -> np.ndarray:
+    """Per-vertex colours of a mesh under a scene.
+
+    scene : a scene-file path, a mapping in the scene schema, or a :class:`~explorer.scene.Scene`
+    positions : (n, 3) float vertex positions
+    normals : (n, 3) float vertex normals (any length; zero means "no normal")
+    precision : "float64" (exact path) or "float32" (fast path, within 1/255 of float64)
+    clamp : clamp to [0, 1] (OpenGL); False keeps the unclamped sums (>= 0) for HDR
+    faces : (m, 3) int triangles, needed for shadows (None: no shadows)
+    Returns colours : (n, 3) float64.
+    """
+    s = Shader(
+        scene,
+        positions,
+        normals,
+        precision=precision,
+        clamp=clamp,
+        materials_dirs=materials_dirs,
+        keep=False,
+        faces=faces,
+    )
+    return np.asarray(s.colors, dtype=np.float64)
+
+
+class Shader:
+    """Cached, stateful shading of one mesh (see the module docstring).
+
+    positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation)
+    precision : "float32" (default here: the interactive path) or "float64"
+    keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
+    faces : (m, 3) int triangles for shadows (None: no shadows)
+    force_all : the plan skips nothing (same colours; benchmark only)
+    cull : skip a light for runs of vertices that provably get nothing from it (the plan's
+        ``culling``); False computes every vertex-light (same colours; benchmark and tests)
+    """
+
+    def __init__(
+        self,
+        scene,
+        positions,
+        normals,
+        *,
+        precision: str = "float32",
+        clamp: bool = True,
+        materials_dirs=(),
+        keep: bool = True,
+        faces=None,
+        force_all: bool = False,
+        cull: bool = True,
+    ):
+        if precision not in PRECISIONS:
+            raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+        self._T = np.float32 if precision == "float32" else np.float64
+        self.precision = precision
+        self.clamp = bool(clamp)
+        self.keep = bool(keep)
+        self.stats: Counter = Counter()
+        self.force_all = bool(force_all)
+        self.cull = bool(cull)
+        self._scene = load_scene(scene, materials_dirs=materials_dirs)
+        self._k = K.constants(self._T)
+        self._keep_lobe = False
+        self._lobe_memory = None  # (base, ws) arrays kept for reuse
+        self._k64 = K.constants(np.float64)
+        self.set_geometry(positions, normals, faces)
+
+    # -- inputs ------------------------------------------------------------------------------
+    @property
+    def scene(self) -> Scene:
+        return self._scene
+
+    @property
+    def plan(self) -> Plan:
+        return self._plan
+
+    @property
+    def n(self) -> int:
+        return len(self._P)
+
+    def set_geometry(self, positions, normals, faces=None) -> None:
+        """New vertices (and triangles, for shadows): every cached sum is invalid."""
+        self._P, self._N = check_vertices(positions, normals)
+        if faces is not None:
+            faces = np.asarray(faces, np.int64).reshape(-1, 3)
+            if len(faces) and (faces.min() < 0 or faces.max() >= len(self._P)):
+                raise ExplorerError("faces index vertices that do not exist")
+        self._faces = faces
+        self._convex = None  # decided when a light first asks for shadows
+        self._vis_cache: dict = {}
+        self._plan = self._make_plan(self._scene)
+        self._centre, self._scale = frame_of(self._P)
+        n = len(self._P)
+        self._G = np.empty((6, n), self._T)  # frame positions and unit normals, SoA
+        K.prepare(self._P, self._N, self._centre, 1.0 / self._scale, self._k, self._G)
+        self.stats["geometry"] += 1
+        self._bounds = self._chunk_bounds()
+        self._A = self._D = self._S = None
+        self._base = self._ws = None
+        self._colors = None
+        self._pool: list[np.ndarray] = []  # colour buffers, reused once nothing views them
+        self._spares: list[np.ndarray] = []  # memory of invalidated sums, reused likewise
+        self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
+        self._marks = np.zeros(-(-self._amb.size // K.BLOCK), np.int32)  # per block
+        self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
+        self._lights_changed()
+
+    def _chunk_bounds(self) -> np.ndarray:
+        """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices, for
+        light culling (see :func:`explorer.kernels.bounds`), read-only; (N_BOUNDS, 0) when
+        fewer than one chunk in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled
+        vertices, say): too little could be culled to pay for the tests."""
+        b = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
+        K.bounds(self._G, b)
+        if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
+            b = b[:, :0]
+        return _readonly(b)
+
+    def set_scene(self, scene) -> None:
+        """Apply a new scene, invalidating only what its differences touch."""
+        new = load_scene(scene)
+        old = self._scene
+        if new == old:
+            return
+        self._scene = new
+        self._plan = self._make_plan(new)
+        if new.lights != old.lights or new.two_sided != old.two_sided:
+            self._lights_changed()
+            return
+        nm, om = new.material, old.material
+        if new.viewer != old.viewer or new.model != old.model or nm.fresnel != om.fresnel:
+            self._viewer_changed()
+        if nm.shininess != om.shininess or nm.energy_conserving != om.energy_conserving:
+            self._shininess_changed()
+        self._colors = None  # material colours and scene ambient: compose only
+        self._aconst = self._ambient_constant()
+
+    def set_material(self, material) -> None:
+        self.set_scene(self._scene.replace(material=material))
+
+    def set_model(self, model: str) -> None:
+        self.set_scene(self._scene.replace(model=model))
+
+    def set_viewer(self, viewer: Viewer) -> None:
+        self.set_scene(self._scene.replace(viewer=viewer))
+
+    def set_lights(self, lights) -> None:
+        self.set_scene(self._scene.replace(lights=tuple(lights)))
+
+    # -- outputs -----------------------------------------------------------------------------
+    @property
+    def colors(self) -> np.ndarray:
+        """(n, 3) colours in the working precision, read-only."""
+        if self._colors is None:
+            self._update()
+        return self._colors
+
+    @property
+    def terms(self) -> dict[str, np.ndarray]:
+        """Per-vertex sums (n, 3), read-only: ``ambient`` (scene ambient included),
+        ``diffuse``, ``specular``, so that colour = e + a_m·ambient + d_m·diffuse +
+        s_m·specular. Terms the plan skips are zeros."""
+        if not self.keep:
+            raise ExplorerError("terms need a Shader with keep=True")
+        # every sum the lights can produce, whatever the current material needs
+        self._update(force=(True, True, True))
+        n = self.n
+        A = np.broadcast_to(self._aconst.astype(self._T), (n, 3)).copy()
+        if self._A is not None:
+            A += self._A
+        out = {
+            "ambient": A,
+            "diffuse": self._D if self._D is not None else np.zeros((n, 1), self._T),
+            "specular": self._S if self._S is not None else np.zeros((n, 1), self._T),
+        }
+        # grey sums (n, 1) are shown as (n, 3), every channel the same (a read-only view)
+        out = {k: np.broadcast_to(v, (n, 3)) for k, v in out.items()}
+        return {k: _readonly(v) for k, v in out.items()}
+
+    # -- invalidation --------------------------------------------------------------------------
+    def _retire(self, *sums) -> None:
+        """Keep the memory of invalidated sums for the next pass (see :meth:`_fresh_sum`)."""
+        for a in sums:
+            if a is not None and len(self._spares) < 5:
+                self._spares.append(a)
+
+    def _fresh_sum(self, grey: bool = False) -> np.ndarray:
+        """An (n, 3) array for a sum being recomputed, or (n, 1) for a grey one (every
+        channel the same, see :func:`explorer.kernels.grey_pass`): the memory of an invalidated
+        sum of that shape that no array handed out (``terms``) still views, else a new one.
+        Reuse saves the page faults of fresh memory (three 12 MB sums per light change at 1M
+        vertices)."""
+        shape = (self.n, 1 if grey else 3)
+        for i in range(len(self._spares)):
+            buf = self._spares[i]  # (not enumerate: its tuple would hold one more reference)
+            # references: the list, ``buf``, getrefcount's argument
+            if buf.shape == shape and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
+                return self._spares.pop(i)
+        return np.empty(shape, self._T)
+
+    def _lights_changed(self):
+        self._retire(self._A, self._D, self._S)
+        self._A = self._D = self._S = None
+        self._base = self._ws = None
+        self._spec_shininess = None
+        self._colors = None
+        self._params = None
+        self._aconst = self._ambient_constant()
+
+    def _viewer_changed(self):
+        if self._scene.two_sided:  # N·V decides which normals flip: every sum depends on V
+            self._lights_changed()
+            return
+        self._retire(self._S)
+        self._S = None
+        self._base = self._ws = None
+        self._spec_shininess = None
+        self._params = None  # constant halfway vectors depend on V
+        # a moving camera changes V every frame: stop storing lobes (8 bytes per vertex and
+        # light per frame) until shininess moves again
+        self._keep_lobe = False
+
+    def _shininess_changed(self):
+        self._retire(self._S)
+        self._S = None  # the stored bases and weights stay valid
+        self._params = None  # an energy-conserving factor changes with n (cheap to redo)
+        # from now on keep each light's base and weight, so the next shininess change only
+        # re-runs the lobe (kept on demand: storing them costs 8 bytes per vertex and light)
+        self._keep_lobe = True
+
+    # -- shadows -------------------------------------------------------------------------------
+    def _mesh_kind(self, scene) -> str | None:
+        """What the plan knows of the mesh: None (no faces), "convex" or "concave"."""
+        if self._faces is None:
+            return None
+        if not any(lt.shadows for lt in scene.lights):
+            return "concave"  # not asked: no need to decide
+        if self._convex is None:
+            self._convex = is_convex(self._P, self._faces)
+        return "convex" if self._convex else "concave"
+
+    def _make_plan(self, scene) -> Plan:
+        return make_plan(scene, mesh=self._mesh_kind(scene), force_all=self.force_all)
+
+    def _visibility(self, dtype) -> np.ndarray:
+        """(L, n) visibility rows of the lights the plan shadows, or (L, 0) when none."""
+        scene, plan = self._scene, self._plan
+        L, n = len(scene.lights), self.n
+        if not plan.shadows:
+            return np.zeros((L, 0), dtype)
+        vis = np.ones((L, n), dtype)
+        N = np.asarray(self._N, np.float64)
+        length = np.sqrt(np.einsum("ij,ij->i", N, N))
+        unit = (N / np.where(length > 0, length, 1.0)[:, None]).T  # (3, n)
+        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights, strict=True)):
+            if not lp.shadows:
+                continue
+            if isinstance(light, DirectionalLight):
+                where = ("d", light.direction)
+            else:
+                where = ("p", light.position)
+            key = (where, scene.two_sided, self.force_all)
+            v = self._vis_cache.get(key)
+            if v is None:
+                only = None
+                if not self.force_all:  # rays only where N·L can be > 0 (either side if 2-sided)
+                    if isinstance(light, DirectionalLight):
+                        ndl = np.asarray(light.direction) @ unit
+                    else:
+                        ndl = np.einsum("ij,ji->i", np.asarray(light.position) - self._P, unit)
+                    # a margin: a ray more than needed is harmless, one fewer is not
+                    only = length > 0 if scene.two_sided else ndl > -SHADOW_NDL_MARGIN
+                v = visibility(self._P, self._faces, light, only=only)
+                self._vis_cache[key] = v
+                self.stats["shadow_rays"] += int(n if only is None else only.sum())
+            vis[i] = v
+        return vis
+
+    # -- the work ------------------------------------------------------------------------------
+    def _ambient_constant(self) -> np.ndarray:
+        """Scene ambient plus the ambient of lights whose weight is constant, (3,) float64."""
+        a = np.asarray(self._scene.ambient, dtype=np.float64).copy()
+        for lp, light in zip(self._plan.lights, self._scene.lights, strict=True):
+            if lp.ambient and not lp.varying_weight:
+                a += lp.factor * np.asarray(light.ambient)
+        return a
+
+    def _light_params(self, dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Kernel inputs for the lights and viewer in the normalised frame.
+
+        Built in Python floats, one row per light, and made an array once (a light drag
+        rebuilds them every frame: small numpy operations per light cost more than the row)."""
+        scene, plan = self._scene, self._plan
+        c, s = self._centre, self._scale
+        cx, cy, cz = (float(v) for v in c)
+        if scene.viewer.local:
+            view = to_frame(scene.viewer.eye, c, s)
+        else:
+            view = np.asarray(scene.viewer.direction, dtype=np.float64)
+        vx, vy, vz = (float(v) for v in view)
+        rows, flags = [], []
+        for lp, light in zip(plan.lights, scene.lights, strict=True):
+            f = 0
+            q = [0.0] * K.N_PARAMS
+            if isinstance(light, DirectionalLight):
+                q[K.P_POS : K.P_POS + 3] = light.direction
+                if scene.model == "blinn" and not scene.viewer.local and not plan.force_all:
+                    dx, dy, dz = light.direction
+                    hx, hy, hz = dx + vx, dy + vy, dz + vz
+                    hn = math.sqrt(hx * hx + hy * hy + hz * hz)
+                    if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
+                        q[K.P_H : K.P_H + 3] = (hx / hn, hy / hn, hz / hn)
+                    f |= K.CONST_H
+            else:
+                f |= K.POSITIONAL
+                px, py, pz = light.position
+                q[K.P_POS : K.P_POS + 3] = ((px - cx) / s, (py - cy) / s, (pz - cz) / s)
+                kc, kl, kq = light.attenuation
+                q[K.P_ATT : K.P_ATT + 3] = (kc, kl * s, kq * s * s)
+                if lp.attenuation == "per-vertex":
+                    f |= K.ATTEN
+            if isinstance(light, SpotLight) and lp.spot != "none":
+                f |= K.SPOT
+                q[K.P_AXIS : K.P_AXIS + 3] = light.direction
+                q[K.P_COS] = math.cos(math.radians(light.cutoff))
+                q[K.P_EXP] = light.exponent
+                if lp.spot == "cone+exponent":
+                    f |= K.SPOT_EXP
+            fa, fs = lp.factor, lp.factor * plan.specular_scale
+            dif = [fa * v for v in light.diffuse]
+            spec = [fs * v for v in light.specular]
+            q[K.P_AMB : K.P_AMB + 3] = [fa * v for v in light.ambient]
+            q[K.P_DIF : K.P_DIF + 3] = dif
+            q[K.P_SPEC : K.P_SPEC + 3] = spec
+            if lp.shadows:
+                f |= K.SHADOW
+            if plan.fresnel is not None and lp.specular:
+                f |= K.FRESNEL
+                q[K.P_F0] = plan.fresnel
+            if lp.ambient and lp.varying_weight:
+                f |= K.AMBIENT
+            if lp.diffuse:
+                f |= K.DIFFUSE
+            if lp.specular:
+                f |= K.SPECULAR
+            if min(dif) == max(dif) and min(spec) == max(spec):
+                f |= K.GREY  # one sum per vertex instead of three (the kernel may use it)
+            rows.append(q)
+            flags.append(f)
+        params = np.array(rows, dtype=np.float64).reshape(len(rows), K.N_PARAMS)
+        return params.astype(dtype), np.array(flags, np.int32), view.astype(dtype)
+
+    def _material_vector(self, dtype) -> np.ndarray:
+        m = self._scene.material
+        return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
+
+    def _take_buffer(self) -> np.ndarray:
+        """An (n, 3) colour buffer that no array handed out still views.
+
+        Colours already returned are never overwritten; a buffer whose views are all gone is
+        reused instead of allocating (a fresh 12 MB array costs its page faults on every update).
+        """
+        for buf in self._pool:
+            # references: the pool's list, the loop variable, getrefcount's argument
+            if sys.getrefcount(buf) <= 3:
+                return buf
+        buf = np.empty((self.n, 3), self._T)
+        if len(self._pool) < 2:
+            self._pool.append(buf)
+        return buf
+
+    def _update(self, force=(False, False, False)):
+        plan, scene, T = self._plan, self._scene, self._T
+        self._colors = None
+        self._out = self._take_buffer()
+        need_amb = plan.ambient_per_vertex or force[0]
+        need_dif = plan.diffuse or force[1]
+        need_spec = plan.specular or force[2]
+        shininess = scene.material.shininess
+        do_amb = need_amb and self._A is None
+        do_dif = need_dif and self._D is None
+        do_spec = need_spec and self._S is None
+        flat = shininess == 0.0
+        if do_spec and self._ws is not None and (flat or self._base is not None):
+            # the lobe alone: bases and weights are stored, only n changed
+            params, flags, _ = self._params_for(T)
+            S = self._fresh_sum()
+            K.lobe(
+                self._base if self._base is not None else self._ws,
+                self._ws,
+                params,
+                flags,
+                T(shininess),
+                self._k,
+                S,
+            )
+            self._S = S
+            self._spec_shininess = shininess
+            self.stats["lobe"] += 1
+            do_spec = False
+        mat = self._material_vector(T)
+        aconst = self._aconst.astype(T)
+        if do_amb or do_dif or do_spec:
+            self._run(do_amb, do_dif, do_spec, flat, mat, aconst)
+        else:
+            empty = np.zeros((0, 3), T)
+            K.compose(
+                mat,
+                aconst,
+                self._A if self._A is not None and need_amb else empty,
+                self._D if self._D is not None and need_dif else empty,
+                self._S if self._S is not None and need_spec else empty,
+                self.clamp,
+                self._k,
+                self._out,
+            )
+            self.stats["compose"] += 1
+        self._colors = _readonly(self._out)
+        self._out = None
+
+    def _params_for(self, dtype):
+        if self._params is None:
+            self._params = {}
+        if dtype not in self._params:
+            # built once in float64 (the float64 redo of ambiguous lanes needs those too)
+            if np.float64 not in self._params:
+                self._params[np.float64] = self._light_params(np.float64)
+            params, flags, view = self._params[np.float64]
+            self._params[dtype] = (params.astype(dtype), flags, view.astype(dtype))
+        return self._params[dtype]
+
+    def _run(self, do_amb, do_dif, do_spec, flat, mat, aconst):
+        """One fused pass of the shading kernel over every vertex (+ float64 fix-ups)."""
+        scene, T, n = self._scene, self._T, self.n
+        params, flags, view = self._params_for(T)
+        L = len(params)
+        keep = self.keep
+        opts = np.zeros(K.N_OPTS, np.int64)
+        opts[K.O_LOCAL] = scene.viewer.local
+        opts[K.O_TWO_SIDED] = scene.two_sided
+        opts[K.O_PHONG] = scene.model == "phong"
+        opts[K.O_FLAT] = flat
+        opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do_amb, do_dif, do_spec
+        opts[K.O_STORE] = keep
+        opts[K.O_STORE_LOBE] = keep and do_spec and self._keep_lobe
+        opts[K.O_COMPOSE] = 1
+        opts[K.O_CLAMP] = self.clamp
+        opts[K.O_TRACK] = T is np.float32
+        opts[K.O_VIEW] = self._plan.fresnel is not None
+        empty3 = np.zeros((0, 3), T)
+
+        def cache(current, do, grey=False):
+            if not keep:
+                return empty3
+            if do:
+                return self._fresh_sum(grey)
+            return current if current is not None else empty3
+
+        # a pass whose diffuse and specular sums are grey stores them as (n, 1) (the kernel
+        # decides alike, from the diffuse sum it is given when that is not recomputed)
+        D = None if do_dif else cache(self._D, False)
+        diffuse_grey = D is None or D.shape[0] == 0 or D.shape[1] == 1
+        grey = keep and K.grey_pass(flags, opts, diffuse_grey)
+        A = cache(self._A, do_amb)
+        D = cache(self._D, True, grey) if do_dif else D
+        S = cache(self._S, do_spec, grey)
+        if opts[K.O_STORE_LOBE]:
+            # every row the lobe kernel reads (lights with specular) is written by this pass;
+            # the memory of the previous, now invalid, lobes is reused (no page faults)
+            old = self._lobe_memory
+            if old is not None and old[0].shape == (L, n):
+                base, ws = old
+            else:
+                base, ws = np.empty((L, n), T), np.empty((L, n), T)
+            self._lobe_memory = (base, ws)
+        else:
+            base = ws = np.zeros((L, 0), T)
+        amb = self._amb  # every block writes its count, and its marks if it counts any
+        vis = self._visibility(T)
+        shin = T(scene.material.shininess)
+        K.shade(
+            self._G,
+            params,
+            flags,
+            view,
+            opts,
+            mat,
+            aconst,
+            shin,
+            self._k,
+            A,
+            D,
+            S,
+            base,
+            ws,
+            vis,
+            amb,
+            self._marks,
+            self._out,
+            self._bounds if self._plan.cull and self.cull else self._bounds[:, :0],
+            self._culled,
+        )
+        self.stats["pass"] += 1
+        self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
+        for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
+            self.stats[name] += int(bool(do))
+        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
+            params64, _, view64 = self._params_for(np.float64)
+            self.stats["fixup_vertices"] += K.fixup(
+                amb,
+                self._marks,
+                self._P,
+                self._N,
+                self._centre,
+                1.0 / self._scale,
+                params64,
+                flags,
+                view64,
+                opts,
+                self._material_vector(np.float64),
+                self._aconst,
+                np.float64(scene.material.shininess),
+                self._k64,
+                A,
+                D,
+                S,
+                base,
+                ws,
+                vis,
+                self._out,
+            )
+        if keep:
+            if do_amb:
+                self._A = A
+            if do_dif:
+                self._D = D
+            if do_spec:
+                self._S = S
+                if opts[K.O_STORE_LOBE]:
+                    self._base = base if not flat else None
+                    self._ws = ws
+                self._spec_shininess = scene.material.shininess
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """A read-only view (the engine keeps the writable base private, so kernels get one
+    array type and compile once)."""
+    v = a.view()
+    v.flags.writeable = False
+    return v

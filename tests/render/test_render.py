@@ -1,0 +1,779 @@
+"""Off-screen renders (explorer.render, explorer.cli_render) and golden pictures.
+
+Goldens live in tests/golden/; see tests/helpers/imagecompare.py for the tolerance and for
+``PHONG_EXPLORER_REGENERATE_GOLDENS=1`` (regenerate).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+import pytest
+import trimesh
+from helpers.imagecompare import (
+    GOLDEN_DIR,
+    MAX_DIFFERENT_FRACTION,
+    PIXEL_TOL,
+    check_golden,
+    compare,
+    diff_image,
+    regenerating,
+)
+
+import explorer
+from explorer.cli import main
+from explorer.core import presets
+from explorer.core.atomic import write_atomic
+from explorer.core.errors import ExplorerError
+from explorer.core.lights import DirectionalLight
+from explorer.core.material import Material
+from explorer.core.scene import Viewer
+from explorer.geometry import meshes as M
+from explorer.render.camera import FRAME_MARGIN, Camera, back_to_front, camera_for
+from explorer.render.exports import mesh_file_bytes
+from explorer.render.images import check_size, encode_png, parse_size, read_png
+from explorer.render.offscreen import (
+    BACKGROUND,
+    LABEL_HEIGHT,
+    SHEET_LIGHT_DIRECTION,
+    OffscreenRenderer,
+    render_image,
+)
+from explorer.shading.display import to_bytes, vertex_colors
+
+SIZE = (400, 400)
+BG = np.rint(np.asarray(BACKGROUND) * 255).astype(np.uint8)
+
+
+@pytest.fixture(scope="module")
+def renderer():
+    with OffscreenRenderer(SIZE) as r:
+        yield r
+
+
+def _mesh_mask(img) -> np.ndarray:
+    return (img != BG).any(axis=2)
+
+
+# -- camera --------------------------------------------------------------------------------
+
+
+def _project(cam: Camera, points, aspect):
+    """Normalised image coordinates ([-1, 1] inside the picture) of world points."""
+    fwd = cam.direction
+    up = np.asarray(cam.view_up)
+    right = np.cross(fwd, up)
+    rel = np.asarray(points) - np.asarray(cam.position)
+    x, y, z = rel @ right, rel @ up, rel @ fwd
+    if cam.parallel:
+        half_h = cam.parallel_scale
+        return x / (half_h * aspect), y / half_h - cam.window_center[1], z
+    t = math.tan(math.radians(cam.view_angle) / 2)
+    return x / (z * t * aspect), y / (z * t) - cam.window_center[1], z
+
+
+@pytest.mark.parametrize("name", ["sphere", "teapot", "torus", "plane"])
+@pytest.mark.parametrize("aspect", [1.0, 2.0, 0.5])
+def test_infinite_viewer_camera_frames_mesh(name, aspect):
+    mesh = M.get_mesh(name, 8 if name != "teapot" else 4)
+    for d in [(0, 0, 1), (1, 2, 3), (0, 1, 0), (0, -1, 0), (0, 0, -1)]:
+        scene = explorer.Scene(viewer=Viewer(direction=d))
+        cam = camera_for(scene, mesh, aspect)
+        assert cam.parallel
+        # looks along -direction: the engine's constant V points back at the camera
+        assert np.allclose(cam.direction, -np.asarray(d) / np.linalg.norm(d))
+        assert abs(np.dot(cam.view_up, cam.direction)) < 1e-12
+        x, y, z = _project(cam, mesh.positions, aspect)
+        assert np.abs(x).max() <= 1.0 and np.abs(y).max() <= 1.0
+        # fitted: the mesh spans most of one image direction
+        assert max(np.ptp(x), np.ptp(y)) > 2.0 / FRAME_MARGIN - 1e-9
+        near, far = cam.clipping_range
+        assert near < z.min() and z.max() < far
+
+
+@pytest.mark.parametrize("aspect", [1.0, 1.6, 0.6])
+def test_local_viewer_camera_sits_at_the_eye(aspect):
+    mesh = M.teapot(4)
+    for eye in [(0, 0, 5), (3, 2, 1), (0, 10, 0), (0.1, -4, 0.2)]:
+        scene = explorer.Scene(viewer=Viewer(eye=eye))
+        cam = camera_for(scene, mesh, aspect)
+        assert not cam.parallel
+        assert np.allclose(cam.position, eye)
+        assert np.allclose(cam.focal_point, mesh.centre)
+        x, y, z = _project(cam, mesh.positions, aspect)
+        assert (z > 0).all()
+        assert np.abs(x).max() <= 1.0 and np.abs(y).max() <= 1.0
+        near, far = cam.clipping_range
+        assert near < z.min() and z.max() < far
+
+
+def test_label_band_is_left_free():
+    mesh = M.sphere(16)
+    for viewer in (Viewer(direction=(0, 0, 1)), Viewer(eye=(0, 0, 4))):
+        cam = camera_for(explorer.Scene(viewer=viewer), mesh, 1.0, bottom=0.25)
+        _, y, _ = _project(cam, mesh.positions, 1.0)
+        assert y.min() >= -1.0 + 2 * 0.25 - 1e-9 and y.max() <= 1.0
+
+
+# -- colours and pixels --------------------------------------------------------------------
+
+
+def test_to_bytes_rounds_and_clamps():
+    c = np.array([[0.0, 0.5, 1.0], [1.2, -0.1, 127.4 / 255]])
+    assert to_bytes(c).tolist() == [[0, 128, 255], [255, 0, 127]]
+    assert to_bytes(c, 0.5)[:, 3].tolist() == [128, 128]
+
+
+def test_vtk_adds_nothing(renderer):
+    """A plane facing a head-on directional light: every vertex has the same engine colour,
+    and every pixel of the plane is exactly that colour (no VTK light, no VTK specular)."""
+    mesh = M.plane(4)
+    mat = Material(
+        ambient=(0.3, 0.2, 0.1), diffuse=(0.5, 0.3, 0.7), specular=(0.2, 0.2, 0.2), shininess=8
+    )
+    scene = explorer.Scene(material=mat)
+    colors = vertex_colors(scene, mesh)
+    assert np.ptp(colors, axis=0).max() < 1e-12
+    img = renderer.render(scene, mesh)
+    mask = _mesh_mask(img)
+    assert mask.mean() > 0.5
+    expect = to_bytes(colors[:1])[0]
+    assert (img[mask] == expect).all()
+    assert (img[~mask] == BG).all()
+
+
+def test_gouraud_interpolation(renderer):
+    """Colours vary linearly between vertices (OpenGL's smooth shading): a plane whose
+    colour ramps with x shows the same ramp across the picture."""
+    mesh = M.plane(1)
+    colors = np.zeros((4, 3))
+    colors[:, 0] = (mesh.positions[:, 0] + 1) / 2  # red 0 at x = -1 .. 1 at x = 1
+    img = renderer.render(explorer.Scene(), mesh, colors)
+    row = img[200, :, 0].astype(float)
+    inside = np.nonzero(_mesh_mask(img)[200])[0]
+    xs = inside[5:-5]
+    slope = np.polyfit(xs, row[xs], 1)
+    assert np.abs(np.polyval(slope, xs) - row[xs]).max() <= 1.0
+    assert row[inside[0]] < 10 and row[inside[-1]] > 245
+
+
+@pytest.mark.parametrize("opacity", [1.0, 0.75, 0.3])
+def test_opacity_blends_over_background(renderer, opacity):
+    mesh = M.plane(2)
+    c = np.full((mesh.n_vertices, 3), 0.8)
+    img = renderer.render(explorer.Scene(material=Material(opacity=opacity)), mesh, c)
+    expect = opacity * 204 + (1 - opacity) * BG.astype(float)
+    assert np.abs(img[200, 200].astype(float) - expect).max() <= 1.0
+
+
+@pytest.mark.parametrize(
+    "viewer", [Viewer(direction=(0, 0, 1)), Viewer(eye=(0, 0, 4)), Viewer(direction=(1, 0, 0))]
+)
+def test_translucent_front_over_back(renderer, viewer):
+    """The near half of a translucent sphere is white, the far half black: the nearer layer
+    must end on top, whatever the triangle order in the file."""
+    mesh = M.sphere(32)
+    toward = np.asarray(viewer.eye if viewer.eye else viewer.direction, float)
+    colors = np.where((mesh.positions @ toward)[:, None] > 0, 1.0, 0.0) * np.ones(3)
+    scene = explorer.Scene(material=Material(opacity=0.9), viewer=viewer)
+    img = renderer.render(scene, mesh, colors)
+    back_then_front = 0.9 * 255 + 0.1 * (0.9 * 0 + 0.1 * BG[0])
+    assert abs(int(img[200, 200, 0]) - back_then_front) <= 1.5
+    # the same file order rendered opaque shows the front only
+    img = renderer.render(scene.replace(material=Material()), mesh, colors)
+    assert img[200, 200].tolist() == [255, 255, 255]
+
+
+def test_back_to_front_order():
+    mesh = M.sphere(8)
+    cam = camera_for(explorer.Scene(), mesh)
+    order = back_to_front(mesh, cam)
+    z = mesh.positions[mesh.faces[order]].mean(axis=1)[:, 2]
+    assert (np.diff(z) >= -1e-12).all()  # camera on +z: far (low z) first
+
+
+def test_render_twice_identical(renderer):
+    scene = explorer.load_scene(
+        {"material": "gold", "lights": [{"type": "point", "position": [1, 2, 3]}]}
+    )
+    mesh = M.teapot(6)
+    a = renderer.render(scene, mesh)
+    b = renderer.render(scene, mesh)
+    c = render_image(scene, mesh, SIZE)  # a fresh window
+    assert np.array_equal(a, b) and np.array_equal(a, c)
+
+
+def test_reused_window_matches_fresh_one(renderer):
+    """One window drawing one mesh under changing materials (new colours, opacity, sorted
+    faces) gives what a fresh window gives each time."""
+    mesh = M.teapot(6)
+    for mapping in (
+        {"material": "gold"},
+        {"material": "emerald"},  # translucent: faces sorted
+        {"material": "chalk", "viewer": {"eye": [2, 1, 3]}},
+        {"material": "ruby", "model": "phong"},
+    ):
+        scene = explorer.load_scene(mapping)
+        assert np.array_equal(renderer.render(scene, mesh), render_image(scene, mesh, SIZE))
+
+
+def test_size_and_label():
+    mesh = M.cube()
+    black = np.zeros((mesh.n_vertices, 3))
+    img = render_image(explorer.Scene(), mesh, (200, 150), colors=black, label="cube")
+    assert img.shape == (150, 200, 3) and img.dtype == np.uint8
+    # white text, centred, in a band at the bottom that the mesh leaves free
+    text = img.max(axis=2) > 200
+    rows, cols = np.nonzero(text)
+    assert len(rows) > 20
+    assert rows.min() > 150 - 1.5 * round(LABEL_HEIGHT * 150) - 2
+    assert abs(0.5 * (cols.min() + cols.max()) - 100) < 4
+    mesh_rows = np.nonzero((img == 0).all(axis=2).any(axis=1))[0]
+    assert mesh_rows.max() < rows.min()
+    plain = render_image(explorer.Scene(), mesh, (120, 48), colors=black)
+    assert plain.shape == (48, 120, 3) and not (plain.max(axis=2) > 200).any()
+
+
+def test_wrong_colour_count(renderer):
+    with pytest.raises(ExplorerError, match="shape"):
+        renderer.render(explorer.Scene(), M.cube(), np.zeros((3, 3)))
+
+
+# -- sizes and files -----------------------------------------------------------------------
+
+
+def test_parse_size():
+    assert parse_size("400x300") == (400, 300)
+    assert parse_size(" 64 X 32 ") == (64, 32)
+    for bad in ["400", "x300", "400x", "4.5x300", "-4x300", "400x300x2", "abc"]:
+        with pytest.raises(ExplorerError, match="WIDTHxHEIGHT"):
+            parse_size(bad)
+    for bad in ["8x400", "400x9000"]:
+        with pytest.raises(ExplorerError, match=r"\[16, 8192\]"):
+            parse_size(bad)
+    with pytest.raises(ExplorerError):
+        check_size((400.5, 300))
+
+
+def test_png_round_trip(tmp_path):
+    rng = np.random.default_rng(1)
+    for c in (3, 4):
+        img = rng.integers(0, 256, (7, 11, c), dtype=np.uint8)
+        path = tmp_path / f"x{c}.png"
+        path.write_bytes(encode_png(img))
+        assert np.array_equal(read_png(path), img)
+    with pytest.raises(ExplorerError, match="PNG"):
+        read_png(tmp_path / "missing.png")
+
+
+def test_write_atomic(tmp_path):
+    target = tmp_path / "out.bin"
+    write_atomic(target, b"one")
+    with pytest.raises(ExplorerError, match="already exists"):
+        write_atomic(target, b"two")
+    assert target.read_bytes() == b"one"
+    write_atomic(target, b"two", overwrite=True)
+    assert target.read_bytes() == b"two"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.bin"]  # no temporary left over
+    with pytest.raises(ExplorerError, match="does not exist"):
+        write_atomic(tmp_path / "nodir" / "x.png", b"")
+    with pytest.raises(ExplorerError, match="directory"):
+        write_atomic(tmp_path, b"")
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".glb"])
+def test_mesh_export_keeps_colours(tmp_path, suffix):
+    mesh = M.icosphere(2)
+    scene = explorer.load_scene({"material": "ruby"})
+    colors = vertex_colors(scene, mesh)
+    path = tmp_path / f"m{suffix}"
+    path.write_bytes(mesh_file_bytes(mesh, colors, suffix, scene.material.opacity))
+    back = trimesh.load(path, process=False)
+    if isinstance(back, trimesh.Scene):
+        back = back.to_geometry()
+    assert len(back.vertices) == mesh.n_vertices
+    assert np.allclose(back.vertices, mesh.positions, atol=1e-6)
+    rgba = np.asarray(back.visual.vertex_colors)
+    assert np.array_equal(rgba[:, :3], to_bytes(colors))
+    assert (rgba[:, 3] == round(scene.material.opacity * 255)).all()
+
+
+# -- image comparison ----------------------------------------------------------------------
+
+
+def _highlight_scene(angle_deg: float):
+    """A red sphere lit by two lights: one for diffuse only (fixed) and one for the specular
+    only, turned by ``angle_deg`` about the y axis. Only the highlight moves."""
+    a = math.radians(angle_deg)
+    mat = Material(
+        ambient=(0.1, 0.1, 0.1), diffuse=(0.6, 0.1, 0.1), specular=(1, 1, 1), shininess=60
+    )
+    return explorer.Scene(
+        material=mat,
+        lights=(
+            DirectionalLight(direction=(0.5, 0.5, 1), specular=(0, 0, 0)),
+            DirectionalLight(
+                direction=(0.5 * math.cos(a) + math.sin(a), 0.5, math.cos(a) - 0.5 * math.sin(a)),
+                diffuse=(0, 0, 0),
+            ),
+        ),
+    )
+
+
+def test_comparison_catches_uniform_shift(renderer):
+    img = renderer.render(_highlight_scene(0), M.sphere())
+    assert compare(img, img).ok
+    for shift in (3, -3):
+        other = np.clip(img.astype(int) + shift, 0, 255).astype(np.uint8)
+        assert not compare(other, img).ok
+    # ... but not one level of rounding noise, nor a few pixels of a silhouette
+    rng = np.random.default_rng(0)
+    noisy = np.clip(img.astype(int) + rng.integers(-1, 2, img.shape), 0, 255).astype(np.uint8)
+    assert compare(noisy, img).ok
+    edge = img.copy()
+    idx = rng.choice(img.shape[0] * img.shape[1], int(0.5 * MAX_DIFFERENT_FRACTION * img.size / 3))
+    edge.reshape(-1, 3)[idx] = 255 - edge.reshape(-1, 3)[idx]
+    assert compare(edge, img).ok
+
+
+def test_comparison_catches_moved_highlight(renderer):
+    mesh = M.sphere()
+    base = renderer.render(_highlight_scene(0), mesh)
+    moved = renderer.render(_highlight_scene(2.0), mesh)
+    # only the highlight moved: without the specular term the pictures are the same
+    matte = Material(ambient=(0.1, 0.1, 0.1), diffuse=(0.6, 0.1, 0.1))
+    assert np.array_equal(
+        renderer.render(_highlight_scene(0).replace(material=matte), mesh),
+        renderer.render(_highlight_scene(2.0).replace(material=matte), mesh),
+    )
+    changed = (np.abs(moved.astype(int) - base.astype(int)) > PIXEL_TOL).any(axis=2)
+    assert 0 < changed.mean() < 0.2
+    assert not compare(moved, base).ok
+    d = diff_image(moved, base)
+    assert (d[changed] == (255, 0, 255)).all()
+
+
+# -- goldens -------------------------------------------------------------------------------
+
+
+def _builtin_presets():
+
+    old = os.environ.get(presets.ENV_VAR)
+    os.environ[presets.ENV_VAR] = os.path.join(tempfile.gettempdir(), "no-such-dir-phong")
+    try:
+        infos = presets.list_presets()
+    finally:
+        if old is None:
+            del os.environ[presets.ENV_VAR]
+        else:
+            os.environ[presets.ENV_VAR] = old
+    return {i.name: i.material for i in infos if i.source == "builtin"}
+
+
+PRESETS = _builtin_presets()
+
+#: the fixed scene of the preset goldens: the teapot under the preset sheet's light
+PRESET_SCENE = {
+    "viewer": {"direction": [0, 0, 1]},
+    "lights": [{"type": "directional", "direction": list(SHEET_LIGHT_DIRECTION)}],
+}
+
+_SPHERE_MAT = {
+    "ambient": [0.1, 0.1, 0.12],
+    "diffuse": [0.2, 0.35, 0.7],
+    "specular": [0.9, 0.9, 0.9],
+    "shininess": 40,
+}
+_WHITE = {
+    "ambient": [0.2, 0.2, 0.2],
+    "diffuse": [0.8, 0.8, 0.8],
+    "specular": [0.5, 0.5, 0.5],
+    "shininess": 20,
+}
+
+#: feature goldens: name -> (scene mapping, mesh, resolution)
+FEATURES = {
+    "directional": (
+        {"material": _SPHERE_MAT, "lights": [{"type": "directional", "direction": [1, 1, 1]}]},
+        "sphere",
+        None,
+    ),
+    "point_attenuation": (
+        {
+            "material": _WHITE,
+            "lights": [
+                {"type": "point", "position": [-0.3, 0.3, 0.5], "attenuation": [0.2, 1.0, 4.0]}
+            ],
+        },
+        "plane",
+        64,
+    ),
+    "spot": (
+        {
+            "material": _WHITE,
+            "lights": [
+                {
+                    "type": "spot",
+                    "position": [0.2, 0.1, 2],
+                    "direction": [-0.1, -0.05, -1],
+                    "cutoff": 25,
+                    "exponent": 30,
+                    "intensity": 0.8,
+                }
+            ],
+        },
+        "plane",
+        96,
+    ),
+    "model_blinn": (
+        {
+            "material": _SPHERE_MAT,
+            "model": "blinn",
+            "lights": [{"type": "directional", "direction": [1.5, 0.4, 0.3]}],
+        },
+        "sphere",
+        None,
+    ),
+    "model_phong": (
+        {
+            "material": _SPHERE_MAT,
+            "model": "phong",
+            "lights": [{"type": "directional", "direction": [1.5, 0.4, 0.3]}],
+        },
+        "sphere",
+        None,
+    ),
+    "two_sided": (
+        {
+            "material": _WHITE,
+            "two_sided": True,
+            "viewer": {"direction": [0.3, 0.2, -1]},
+            "lights": [{"type": "point", "position": [0.4, 0.3, -1.5], "intensity": 0.6}],
+        },
+        "plane",
+        32,
+    ),
+    "translucent": (
+        {
+            "material": {
+                "ambient": [0.17, 0.01, 0.01],
+                "diffuse": [0.61, 0.04, 0.04],
+                "specular": [0.73, 0.63, 0.63],
+                "shininess": 76.8,
+                "opacity": 0.4,
+            },
+            "viewer": {"eye": [3.2, 1.6, 1.8]},
+            "lights": [{"type": "directional", "direction": [0, 1, 1]}],
+        },
+        "teapot",
+        None,
+    ),
+    "emissive": (
+        {
+            "material": {
+                "ambient": [0.1, 0.1, 0.1],
+                "diffuse": [0.3, 0.3, 0.3],
+                "emission": [0.6, 0.25, 0.0],
+                "specular": [0.3, 0.3, 0.3],
+                "shininess": 10,
+            },
+            "lights": [{"type": "directional", "direction": [-1, 1, 1], "intensity": 0.5}],
+        },
+        "icosphere",
+        3,
+    ),
+}
+
+
+def _feature_image(renderer, name):
+    mapping, mesh_name, res = FEATURES[name]
+    return renderer.render(explorer.load_scene(mapping), M.get_mesh(mesh_name, res))
+
+
+@pytest.mark.parametrize("name", sorted(PRESETS))
+def test_golden_preset(renderer, name):
+    material = PRESETS[name]
+    scene = explorer.load_scene(PRESET_SCENE).replace(
+        material=material, model=material.model or "blinn"
+    )
+    check_golden(f"preset_{name}", renderer.render(scene, M.teapot()))
+
+
+@pytest.mark.parametrize("name", sorted(FEATURES))
+def test_golden_feature(renderer, name):
+    check_golden(f"feature_{name}", _feature_image(renderer, name))
+
+
+def test_golden_features_show_their_feature(renderer):
+    """The feature scenes really differ where they should (so each golden guards something)."""
+    blinn = _feature_image(renderer, "model_blinn")
+    phong = _feature_image(renderer, "model_phong")
+    assert not compare(blinn, phong).ok
+    mapping, _, _ = FEATURES["two_sided"]
+    one_sided = renderer.render(explorer.load_scene({**mapping, "two_sided": False}), M.plane(32))
+    two_sided = _feature_image(renderer, "two_sided")
+    assert two_sided.mean() > one_sided.mean() + 5  # the back is lit only when two-sided
+    mapping, _, _ = FEATURES["emissive"]
+    dark = explorer.load_scene({**mapping, "lights": []})
+    img = renderer.render(dark, M.icosphere(3))
+    em = np.rint(np.add(mapping["material"]["emission"], 0.02) * 255)  # + ambient 0.1·0.2
+    assert np.abs(img[200, 200].astype(float) - em).max() <= 1  # emission needs no light
+
+
+def test_golden_files_all_used():
+    """Every golden belongs to a test (regenerating removes the rest)."""
+    wanted = {f"preset_{n}.png" for n in PRESETS} | {f"feature_{n}.png" for n in FEATURES}
+    have = {p.name for p in GOLDEN_DIR.glob("*.png")} if GOLDEN_DIR.exists() else set()
+    if regenerating():
+        for name in have - wanted:
+            (GOLDEN_DIR / name).unlink()
+        return
+    assert have - wanted == set(), "stale goldens; regenerate to remove them"
+    assert wanted - have == set(), "missing goldens; regenerate to create them"
+
+
+# -- command line --------------------------------------------------------------------------
+
+
+def test_cli_render_png(tmp_path, capsys):
+    out = tmp_path / "gold.png"
+    rc = main(
+        [
+            "render",
+            "--preset",
+            "gold",
+            "--mesh",
+            "sphere",
+            "--resolution",
+            "24",
+            "--out",
+            str(out),
+            "--size",
+            "96x64",
+            "--light-direction",
+            "1",
+            "1",
+            "1",
+        ]
+    )
+    assert rc == 0 and "wrote" in capsys.readouterr().out
+    img = read_png(out)
+    assert img.shape == (64, 96, 3)
+    scene = explorer.load_scene(
+        {"material": "gold", "lights": [{"type": "directional", "direction": [1, 1, 1]}]}
+    )
+    assert np.array_equal(img, render_image(scene, M.sphere(24), (96, 64)))
+    # never overwritten silently
+    assert main(["render", "--out", str(out), "--size", "96x64"]) == 2
+    assert "already exists" in capsys.readouterr().err
+    assert np.array_equal(read_png(out), img)
+    assert main(["render", "--out", str(out), "--size", "96x64", "--force"]) == 0
+    assert not np.array_equal(read_png(out), img)
+
+
+def test_cli_scene_file_and_overrides(tmp_path, capsys):
+    scene_file = tmp_path / "s.yaml"
+    scene_file.write_text(
+        "material: jade\nmesh: cube\nviewer: {eye: [2, 2, 3]}\n"
+        "lights:\n  - {type: point, position: [2, 3, 1], attenuation: [1, 0.1, 0.01]}\n"
+    )
+    out = tmp_path / "a.png"
+    assert main(["render", str(scene_file), "--out", str(out), "--size", "80x80"]) == 0
+    scene = explorer.load_scene(scene_file)
+    assert np.array_equal(read_png(out), render_image(scene, M.cube(), (80, 80)))
+    # options override parts of the scene
+    out2 = tmp_path / "b.png"
+    assert (
+        main(
+            [
+                "render",
+                str(scene_file),
+                "--out",
+                str(out2),
+                "--size",
+                "80x80",
+                "--preset",
+                "ruby",
+                "--model",
+                "phong",
+                "--light-type",
+                "spot",
+                "--light-position",
+                "0",
+                "0",
+                "3",
+                "--light-direction",
+                "0",
+                "0",
+                "-1",
+                "--light-cutoff",
+                "30",
+                "--viewer-direction",
+                "0",
+                "0",
+                "1",
+            ]
+        )
+        == 0
+    )
+    want = scene.replace(
+        material=explorer.load_scene({"material": "ruby"}).material,
+        model="phong",
+        viewer=Viewer(direction=(0, 0, 1)),
+        lights=(explorer.SpotLight(position=(0, 0, 3), direction=(0, 0, -1), cutoff=30),),
+    )
+    assert np.array_equal(read_png(out2), render_image(want, M.cube(), (80, 80)))
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("suffix", [".ply", ".glb"])
+def test_cli_render_mesh_file(tmp_path, suffix):
+    out = tmp_path / f"m{suffix}"
+    assert (
+        main(
+            [
+                "render",
+                "--preset",
+                "copper",
+                "--mesh",
+                "icosphere",
+                "--resolution",
+                "2",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    back = trimesh.load(out, process=False)
+    if isinstance(back, trimesh.Scene):
+        back = back.to_geometry()
+    scene = explorer.load_scene({"material": "copper"})
+    want = to_bytes(vertex_colors(scene, M.icosphere(2)))
+    assert np.array_equal(np.asarray(back.visual.vertex_colors)[:, :3], want)
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--out", "x.jpg"], "must end in .png or .ply or .glb"),
+        (["--out", "OUT", "--size", "100"], "--size 100: size must look like"),
+        (["--out", "OUT", "--size", "10x10"], "[16, 8192]"),
+        (["--out", "nodir/x.png"], "does not exist"),
+        (["--out", "OUT", "--preset", "gld"], "did you mean 'gold'"),
+        (["--out", "OUT", "--mesh", "spere"], "did you mean 'sphere'"),
+        (["--out", "OUT", "--mesh", "missing.obj"], "does not exist"),
+        (["--out", "OUT", "--mesh", "cube", "--resolution", "4"], "--resolution applies"),
+        (["--out", "OUT", "--resolution", "2"], "[3, 1024]"),
+        (["--out", "OUT", "--light-cutoff", "120"], "--light-cutoff: must be in [0, 90]"),
+        (
+            ["--out", "OUT", "--light-type", "directional", "--light-position", "1", "1", "1"],
+            "--light-position does not apply to a directional light",
+        ),
+        (["--out", "OUT", "--light-attenuation", "0", "0", "0"], "--light-attenuation"),
+        (["--out", "OUT", "--viewer-direction", "0", "0", "0"], "--viewer-direction"),
+        (["--out", "OUT", "--background", "2", "0", "0"], "--background"),
+        (["--out", "OUT", "--materials", "no_such_dir"], "--materials"),
+        (["missing_scene.yaml", "--out", "OUT"], "missing_scene.yaml"),
+    ],
+)
+def test_cli_render_errors(tmp_path, capsys, argv, message):
+    argv = [a.replace("OUT", str(tmp_path / "o.png")) for a in argv]
+    argv = [str(tmp_path / a) if a.startswith("nodir/") else a for a in argv]
+    assert main(["render", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and message in err and "Traceback" not in err
+    assert not (tmp_path / "o.png").exists()
+
+
+def test_cli_sheet(tmp_path, capsys):
+    out = tmp_path / "sheet.png"
+    rc = main(
+        [
+            "sheet",
+            "--out",
+            str(out),
+            "--tile",
+            "64x48",
+            "--columns",
+            "2",
+            "--preset",
+            "gold",
+            "--preset",
+            "jade",
+            "--preset",
+            "ruby",
+            "--mesh",
+            "sphere",
+            "--resolution",
+            "12",
+        ]
+    )
+    assert rc == 0 and "3 presets" in capsys.readouterr().out
+    img = read_png(out)
+    gap = 2
+    assert img.shape == (2 * 48 + 3 * gap, 2 * 64 + 3 * gap, 3)
+    tile = img[gap : gap + 48, gap : gap + 64]
+    scene = explorer.Scene(lights=(DirectionalLight(direction=SHEET_LIGHT_DIRECTION),))
+    gold = explorer.load_scene({"material": "gold"}).material
+    with OffscreenRenderer((64, 48)) as r:
+        size = r.label_font_size(["gold", "jade", "ruby"])
+        want = r.render(scene.replace(material=gold), M.sphere(12), label="gold", label_size=size)
+    assert np.array_equal(tile, want)
+    # the empty fourth cell is background
+    assert (img[gap + 48 + gap :, gap + 64 + gap :] == BG).all()
+    assert main(["sheet", "--out", str(out), "--preset", "gold"]) == 2
+    assert main(["sheet", "--out", str(tmp_path / "s.ply")]) == 2
+    assert main(["sheet", "--out", str(tmp_path / "t.png"), "--columns", "0"]) == 2
+    assert main(["sheet", "--out", str(tmp_path / "t.png"), "--preset", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert "already exists" in err and "must end in .png" in err and "--columns" in err
+    assert "nope" in err
+
+
+def test_renders_without_display(tmp_path):
+    """No DISPLAY and no X server: VTK renders through EGL, with no X warning."""
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("DISPLAY", "WAYLAND_DISPLAY", "VTK_DEFAULT_OPENGL_WINDOW")
+    }
+    out = tmp_path / "x.png"
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "explorer.cli",
+            "render",
+            "--mesh",
+            "cube",
+            "--out",
+            str(out),
+            "--size",
+            "64x64",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "X server" not in proc.stderr and "Traceback" not in proc.stderr
+    assert read_png(out).shape == (64, 64, 3)
+
+
+def test_window_setting_not_left_behind(monkeypatch):
+    """The EGL choice is made for the renderer's own window only: the process environment
+    is unchanged afterwards (a GUI opened later with a display must get an X window)."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.delenv("VTK_DEFAULT_OPENGL_WINDOW", raising=False)
+    with OffscreenRenderer((32, 32)) as r:
+        r.render(explorer.Scene(), M.cube())
+        assert type(r.plotter.render_window).__name__ == "vtkEGLRenderWindow"
+    assert "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ

@@ -1,0 +1,149 @@
+"""The compiled kernels' own arithmetic."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from explorer.shading import kernels as K
+from explorer.shading.equation import reference_shade
+
+
+@pytest.mark.parametrize("y", [1e-6, 0.5, 1.0, 12.8, 76.8, 128.0, 1000.0, 1e4])
+def test_pow32_matches_float64_pow(y):
+    x = np.concatenate([np.linspace(0, 1, 100001), [1e-30, 1e-38, 0.5, 1.0]]).astype(np.float32)
+    got = np.array(
+        [K.pow32(v, np.float32(y)) for v in x[::97]] + [K.pow32(v, np.float32(y)) for v in x[-4:]]
+    )
+    xs = np.concatenate([x[::97], x[-4:]]).astype(np.float64)
+    want = xs**y
+    assert np.all(np.isfinite(got))
+    assert np.abs(got - want).max() <= 1e-6
+    # relative accuracy where the lobe is visible (tiny results: the absolute bound above)
+    normal = (xs >= 2.0**-126) & (want > 1e-4)
+    rel = np.abs(got - want)[normal] / want[normal]
+    assert rel.max() <= 1e-5
+
+
+def test_pow32_edge_values():
+    assert K.pow32(np.float32(0.0), np.float32(3.0)) == 0.0
+    assert K.pow32(np.float32(1.0), np.float32(1e4)) == 1.0
+    assert K.pow32(np.float32(1e-30), np.float32(1e-6)) == pytest.approx(1e-30**1e-6, rel=1e-6)
+
+
+def test_stream_is_the_bandwidth_yardstick():
+    P = np.arange(30, dtype=np.float32).reshape(10, 3)
+    out = np.empty_like(P)
+    K.stream(P, P, out)
+    assert np.array_equal(out, 2 * P)
+
+
+def test_every_block_of_every_task_is_shaded():
+    # more blocks than parallel tasks, and a last block that is not full: each vertex is shaded
+    # once, whichever task it falls to (compared with the independent numpy reference)
+    import explorer
+
+    n = K.TASKS * K.BLOCK + K.BLOCK // 2 + 3
+    rng = np.random.default_rng(5)
+    P, N = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    scene = {
+        "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20},
+        "viewer": {"eye": [0, 0, 6]},
+        "lights": [{"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]}],
+    }
+    ref = reference_shade(explorer.load_scene(scene), P, N)
+    for precision in ("float32", "float64"):
+        got = explorer.shade(scene, P, N, precision=precision)
+        assert np.abs(got - ref).max() <= 1 / 255
+
+
+def test_llvm_remarks_are_dropped_and_other_stderr_kept(capfd):
+    # forcing a vector width makes LLVM print "remark: ... loop not vectorized" to fd 2 on a
+    # first compile; those lines are dropped, anything else written there is passed on
+    import os
+
+    with K._quiet_llvm_remarks():
+        os.write(2, b"remark: <unknown>:0:0: loop not vectorized: call instruction\n")
+        os.write(2, b"a real warning\n")
+    assert capfd.readouterr().err == "a real warning\n"
+
+
+def test_wide_vectors_can_be_switched_off():
+    # PHONG_EXPLORER_WIDE_VECTORS=0 keeps LLVM's own vector width: the entry points are the numba
+    # dispatchers themselves, with no first-call wrapper
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "from explorer.shading import kernels as K; import numba; "
+        "assert not K.WIDE_FLOAT32; "
+        "assert isinstance(K.shade, numba.core.registry.CPUDispatcher); print('ok')"
+    )
+    env = dict(os.environ, PHONG_EXPLORER_WIDE_VECTORS="0")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip() == "ok", out.stderr
+
+
+def test_marked_reads_only_the_blocks_that_count_marks():
+    # a block that counts no marks does not write them: what its part of the array holds is
+    # stale and must not be read
+    n = 2 * K.BLOCK + 7
+    amb = np.ones(n, np.bool_)  # stale everywhere
+    amb[K.BLOCK :] = False  # blocks 1 and 2 write their marks: three in all
+    amb[[K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]] = True
+    marks = np.array([0, 2, 1], np.int32)
+    idx = K.marked(amb, marks)
+    assert idx.tolist() == [K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]
+    assert K.marked(amb, np.zeros(3, np.int32)).size == 0
+
+
+@pytest.mark.parametrize("precision", [np.float32, np.float64])
+def test_compose_reads_every_layout_of_the_sums(precision):
+    # A absent or (n, 3); D and S each absent, (n, 3) or grey (n, 1): every combination gives
+    # e + a_m·(aconst + A) + d_m·D + s_m·S, clamped, with a grey sum counted in every channel
+    import itertools
+
+    rng = np.random.default_rng(7)
+    n = K.COMPOSE_BLOCK + 5  # two parallel chunks, the second short
+    mat = rng.uniform(0, 0.5, 12).astype(precision)
+    aconst = rng.uniform(0, 0.3, 3).astype(precision)
+    k = K.constants(precision)
+    layouts = {"absent": (0, 3), "rgb": (n, 3), "grey": (n, 1)}
+    for a, d, s in itertools.product(("absent", "rgb"), layouts, layouts):
+        A, D, S = (rng.uniform(0, 1, layouts[x]).astype(precision) for x in (a, d, s))
+        out = np.empty((n, 3), precision)
+        K.compose(mat, aconst, A, D, S, True, k, out)
+        want = mat[0:3] + mat[3:6] * aconst
+        for X, m in ((A, mat[3:6]), (D, mat[6:9]), (S, mat[9:12])):
+            if X.shape[0]:
+                want = want + m * X  # (n, 1) broadcasts over the channels
+        want = np.clip(np.broadcast_to(want, (n, 3)), 0, 1)
+        tol_ = 1e-6 if precision == np.float32 else 1e-12
+        assert np.abs(out - want).max() <= tol_, (a, d, s)
+
+
+def test_shade_refuses_grey_sums_for_a_pass_that_is_not_grey(monkeypatch):
+    # the caller asks grey_pass before allocating grey (n, 1) sums; a pass whose options make
+    # it RGB would write three values per vertex into them: the kernel refuses, not overflows
+    import explorer
+
+    P = np.random.default_rng(2).normal(size=(700, 3))
+    scene = {
+        "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20},
+        "viewer": {"eye": [0, 0, 6]},
+        "lights": [{"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]}],
+    }
+    sh = explorer.Shader(scene, P, P, precision="float32")
+    seen = []
+    shade = K.shade
+    monkeypatch.setattr(K, "shade", lambda *a: (seen.append(a), shade(*a))[1])
+    _ = sh.colors
+    args = list(seen[0])
+    D, S = args[10], args[11]
+    assert D.shape == S.shape == (700, 1)  # a grey pass (white light)
+    opts = args[4].copy()
+    opts[K.O_TRACK] = 0  # no inline loops: not a grey pass
+    args[4] = opts
+    with pytest.raises(ValueError, match="grey pass"):
+        shade(*args)
