@@ -5,14 +5,14 @@ engine's guarantees costs on top of it.
     python benchmarks/bench_lean_kernel.py --rounds 10
 
 The lean kernel is the hot loop alone: blocks of 512 vertices, view vector, then per point light
-L, attenuation, N·L, Blinn's N·H and pow (the engine's own :func:`explorer.kernels.pow32`),
+L, attenuation, N·L, Blinn's N·H and pow (the engine's own :func:`explorer.shading.kernels.pow32`),
 grey sums, and the compose into (n, 3) colours. It has none of the engine's guarantees, so it is
 not a usable shader; it shows how far the engine's full pass (``bench_engine.py``, "full shading,
 float32") is from the bare arithmetic, and which guarantee costs what:
 
 - ``floors``: the clamps that keep a light at the vertex and L = -V finite;
 - ``tracking``: marking lanes whose result hangs on a nearly-zero sign (the engine redoes those
-  in float64; see explorer.tolerances.AMBIGUOUS_DOT);
+  in float64; see explorer.core.tolerances.AMBIGUOUS_DOT);
 - ``store (n,3)`` / ``store grey (n,1)``: writing the diffuse and specular sums a material
   change recomposes from, per channel or once (the engine stores grey sums when every light is
   grey, as here).
@@ -39,7 +39,7 @@ from explorer.shading.kernels import _LEAF, _OPTS, pow32
 BLOCK = 512
 F = np.float32
 # compiled as the engine's kernels are: the light loop without reference counting, both with
-# 16-lane vectors where the engine gets them (explorer.kernels.wide_vectors)
+# 16-lane vectors where the engine gets them (explorer.shading.kernels.wide_vectors)
 _JIT = {k: v for k, v in _OPTS.items() if k != "cache"}
 _JIT_LEAF = {k: v for k, v in _LEAF.items() if k != "cache"}
 # the engine's tolerances, in float32 (frozen into the kernels as constants)
@@ -149,7 +149,7 @@ def main(argv=None) -> int:
     )
     eye = np.array([0, 0, 5], F)
     mat = np.array([0.1, 0.1, 0.1, 0.5, 0.4, 0.3, 0.8, 0.8, 0.8], F)
-    out = np.empty(3 * n, F)  # (n, 3) arrays as flat views (see explorer.kernels)
+    out = np.empty(3 * n, F)  # (n, 3) arrays as flat views (see explorer.shading.kernels)
     sums = {1: (np.empty(3 * n, F), np.empty(3 * n, F)), 2: (np.empty(n, F), np.empty(n, F))}
     variants = {
         "lean": (False, False, 0),

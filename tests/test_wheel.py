@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SNIPPET = r"""
 import json, sys
 import explorer
-from explorer.presets import builtin_dir, find_preset, list_presets
+from explorer.core.presets import builtin_dir, find_preset, list_presets
 infos = list_presets(notices=[])
 print(json.dumps({
     "explorer": explorer.__file__,

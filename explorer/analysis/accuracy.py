@@ -2,8 +2,9 @@
 
 A per-vertex picture (:mod:`explorer.render`: the engine lights the vertices, VTK interpolates
 the colours across each triangle) is compared with the per-pixel reference of the same view
-(:mod:`explorer.perpixel`: the engine lights the exact surface point under each pixel centre).
-Both are 8-bit pictures from the same camera; the error of a pixel is the largest difference of
+(:mod:`explorer.render.perpixel`: the engine lights the exact surface point under each pixel
+centre). Both are 8-bit pictures from the same camera; the error of a pixel is the largest
+difference of
 its three channels in 1/255 levels. Only pixels the object covers in *both* pictures count (a
 coarse polygon covers fewer pixels than the sphere it approximates; the background is never
 compared). Per picture:
@@ -180,7 +181,7 @@ def compare(vertex_image, reference, coverage) -> Comparison:
 
 def coverage(renderer, scene, mesh, camera) -> np.ndarray:
     """(h, w) bool: the pixels ``mesh`` covers in a render by ``renderer`` (an
-    :class:`~explorer.render.OffscreenRenderer` with a black background), drawn white."""
+    :class:`~explorer.render.offscreen.OffscreenRenderer` with a black background), drawn white."""
     white = np.ones((mesh.n_vertices, 3))
     img = renderer.render(scene.replace(material=scene.material.replace(opacity=1.0)), mesh,
                           white, camera=camera)  # fmt: skip
@@ -231,8 +232,8 @@ def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
 
     scene, mesh : what is shown; colors : (n, 3) the vertex colours shown (default: shaded
     as the renderer shades them)
-    size : (width, height) of the picture to compare
-    camera : an :class:`explorer.render.Camera` (default :func:`explorer.render.camera_for`);
+    size : (width, height) of the picture to compare camera : an
+    :class:`explorer.render.camera.Camera` (default :func:`explorer.render.camera.camera_for`);
         for a live VTK camera use :func:`explorer.camera_from_vtk`
     method : the per-pixel reference's (:func:`explorer.hits`)
     Renders the per-vertex picture and the coverage off-screen, so the GUI's own overlays
@@ -955,7 +956,7 @@ def refine_highlights(scene, mesh, max_error: float = 1.0, *, min_edge: float = 
     the silhouette, where the flat triangles lag behind the sphere, is refined too; give
     ``min_edge`` (world units, about a pixel) so edges smaller than a pixel stay whole.
 
-    Returns a new :class:`~explorer.meshes.Mesh` (same name) whose first vertices are the
+    Returns a new :class:`~explorer.geometry.meshes.Mesh` (same name) whose first vertices are the
     original ones. The result depends on the scene (lights, viewer, material): refine again
     when they change.
     """
@@ -1104,7 +1105,8 @@ def markdown(table: dict, *, plot: str | None, command: str) -> str:
         f"Scene: one white directional light toward {sc['light']['direction']}, scene ambient "
         f"{sc['ambient']}, infinite viewer on +z (parallel projection), pictures {main}x{main} "
         "unless stated. **Shade** is `explorer.shade` (one call: plan, kernel, colours) or, for "
-        "*plan off*, the full-generality numpy reference `explorer.reference.reference_shade`; "
+        "*plan off*, the full-generality numpy reference "
+        "`explorer.shading.equation.reference_shade`; "
         "**render** is one off-screen VTK frame with new vertex colours (upload, draw, read back)."
     )
     add("")
@@ -1171,7 +1173,7 @@ def markdown(table: dict, *, plot: str | None, command: str) -> str:
         add(f"## Adaptive refinement ({main}x{main}, Blinn, float64)")
         add("")
         add(
-            f"`explorer.accuracy.refine_highlights(scene, mesh, max_error)` starting from "
+            f"`explorer.analysis.accuracy.refine_highlights(scene, mesh, max_error)` starting from "
             f"{adaptive[0]['base']}: each round shades every edge's midpoint exactly and splits "
             "the edges where the interpolated colour is off by more than the threshold "
             "(levels), by longest-edge bisection (no cracks, no slivers), new vertices on the "
@@ -1246,7 +1248,8 @@ def markdown(table: dict, *, plot: str | None, command: str) -> str:
     add("## How fine must the mesh be?")
     add("")
     add(
-        "`explorer.accuracy.mesh_for_error(shininess, size=(w, h), max_error=1.0, metric=..., "
+        "`explorer.analysis.accuracy.mesh_for_error(shininess, size=(w, h), max_error=1.0, "
+        "metric=..., "
         "model=..., mesh=...)` answers from this table (interpolating between the measured "
         "shininess values and sizes). For the measured materials at "
         f"{main}x{main}, per-vertex Blinn:"

@@ -1,7 +1,7 @@
 """Where everything sits in the explorer window, and which key does what.
 
-One module for the layout so that the app (:mod:`explorer.gui`), its tests and its docs agree.
-Coordinates of sliders and text are *normalised display* coordinates: ``(0, 0)`` is the
+One module for the layout so that the app (:mod:`explorer.app.window`), its tests and its docs
+agree. Coordinates of sliders and text are *normalised display* coordinates: ``(0, 0)`` is the
 window's bottom-left corner, ``(1, 1)`` its top-right, so they follow the window when it is
 resized. Buttons are placed in pixels from those same normalised anchors (and placed again when
 the window is resized). The lobe inset is in pixels from the bottom-left corner, so it stays

@@ -207,10 +207,10 @@ def viewer_of_camera(position, focal_point, parallel: bool) -> Viewer:
 
 
 def widen_to_show(camera, points, aspect: float, *, pad: float = 0.0, margin: float = 1.1):
-    """``camera`` (a :class:`explorer.render.Camera`) with its view widened just enough to show
-    ``points`` (each a sphere of radius ``pad``) too, in a picture of ``aspect`` (width /
-    height); points behind a perspective camera are left out. Position, direction and
-    up are kept (the viewer does not move)."""
+    """``camera`` (a :class:`explorer.render.camera.Camera`) with its view widened just enough to
+    show ``points`` (each a sphere of radius ``pad``) too, in a picture of ``aspect`` (width /
+    height); points behind a perspective camera are left out. Position, direction and up are kept
+    (the viewer does not move)."""
     from dataclasses import replace
 
     fwd = camera.direction
@@ -385,7 +385,8 @@ class _View:
 
     def colors(self) -> np.ndarray:
         """(n, 3) display colours in [0, 1]: the shader's, through the scene's HDR display
-        (exposure, tone map, sRGB) when it has one, as :func:`explorer.render.vertex_colors`."""
+        (exposure, tone map, sRGB) when it has one, as
+        :func:`explorer.shading.display.vertex_colors`."""
         if self.hdr is None:
             return self.shader.colors
 
@@ -393,7 +394,7 @@ class _View:
 
     def upload(self) -> None:
         """Write the display colours into VTK's array (rounded to nearest, like
-        :func:`explorer.render.to_bytes`) and mark it modified."""
+        :func:`explorer.shading.display.to_bytes`) and mark it modified."""
         np.multiply(self.colors(), 255.0, out=self._buf)
         np.rint(self._buf, out=self._buf)
         self.rgb[...] = self._buf
@@ -1098,7 +1099,7 @@ class Explorer:
     def toggle_term(self, term: str) -> None:
         self.set_term(term, not self.terms[term])
 
-    # -- the difference view (see explorer.gui_difference) ---------------------------------
+    # -- the difference view (see explorer.app.difference) ---------------------------------
     def set_difference(self, on: bool) -> None:
         """Show the per-pixel difference of the view as a heat map, and the mesh advice."""
         self._set_difference_on(on)

@@ -7,11 +7,11 @@
     phong-explorer bench accuracy --quick --out-dir /tmp/q
 
 Per-vertex shading of sphere tessellations against the per-pixel reference (see
-:mod:`explorer.accuracy`). Outputs:
+:mod:`explorer.analysis.accuracy`). Outputs:
 
 - by default, in the source checkout the package runs from: ``docs/accuracy.md``,
   ``docs/accuracy.png`` and ``explorer/data/accuracy.json`` (the table
-  :func:`explorer.accuracy.mesh_for_error` reads). These files belong to the command: it
+  :func:`explorer.analysis.accuracy.mesh_for_error` reads). These files belong to the command: it
   replaces them without ``--force``.
 - with ``--out-dir DIR``: ``DIR/accuracy.md``, ``DIR/accuracy.png``, ``DIR/accuracy.json``;
   existing files there are user files and are replaced only with ``--force``.

@@ -55,10 +55,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def start(args):
     """The start of the explorer from the command line: ``(scene, mesh, preset name)``.
 
-    Without a SCENE file the start is :data:`explorer.gui.DEFAULT_PRESET` on the teapot under
-    one point light placed at :data:`explorer.gui.DEFAULT_PLACEMENT`, seen from a local viewer
-    (a perspective camera); built-in meshes get the explorer's finer resolutions
-    (:data:`explorer.gui.MESH_CHOICES`) unless ``--resolution`` is given.
+    Without a SCENE file the start is :data:`explorer.app.window.DEFAULT_PRESET` on the teapot under
+    one point light placed at :data:`explorer.app.window.DEFAULT_PLACEMENT`, seen from a local
+    viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
+    (:data:`explorer.app.window.MESH_CHOICES`) unless ``--resolution`` is given.
     """
     import numpy as np
 

@@ -55,7 +55,7 @@ class _Light:
     ambient: RGB = (0.0, 0.0, 0.0)
     diffuse: RGB = (1.0, 1.0, 1.0)
     specular: RGB = (1.0, 1.0, 1.0)
-    #: cast hard shadows on the mesh (see :mod:`explorer.shadows`); keyword only
+    #: cast hard shadows on the mesh (see :mod:`explorer.shading.shadows`); keyword only
     shadows: bool = field(default=False, kw_only=True)
 
     type: ClassVar[str] = ""

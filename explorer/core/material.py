@@ -1,7 +1,7 @@
 """Materials: the coefficients a surface has, and nothing else.
 
 A :class:`Material` holds linear RGB reflection coefficients in [0, 1] and the shininess
-exponent; the engine combines it with lights (see :mod:`explorer.engine`). Defaults are
+exponent; the engine combines it with lights (see :mod:`explorer.shading.shader`). Defaults are
 OpenGL's (``glMaterial``): ambient 0.2, diffuse 0.8, specular 0, emission 0, shininess 0.
 
 Two ways to write a material (in a preset file or a scene's ``material:`` mapping), both from
@@ -86,7 +86,7 @@ class Material:
     model : default specular model for this material (``"blinn"`` / ``"phong"``) or None
     name, description : for people; never affect colours (and never affect ``==``)
     fresnel : Schlick's F0 in [0, 1], or None (off): the specular term of each light is
-        weighted by ``F = F0 + (1 - F0)·(1 - V·H)^5`` (see :mod:`explorer.effects`)
+        weighted by ``F = F0 + (1 - F0)·(1 - V·H)^5`` (see :mod:`explorer.shading.effects`)
     energy_conserving : normalise the specular lobe, ``(n + 2)/(2π)`` (Phong) or
         ``(n + 8)/(8π)`` (Blinn), so a higher shininess narrows the highlight without dimming it
     """

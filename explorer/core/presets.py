@@ -48,7 +48,7 @@ class PresetInfo:
 
     name : preset name (the file stem)
     path : the file it was read from
-    material : the loaded :class:`~explorer.material.Material` (``material.name == name``)
+    material : the loaded :class:`~explorer.core.material.Material` (``material.name == name``)
     source : "extra" (a ``--materials`` directory), "user" or "builtin"
     shadows : the file of the same name it hides (next in precedence), or None
     """
@@ -127,7 +127,7 @@ def check_name(name) -> str:
 # -- reading ---------------------------------------------------------------------------------
 def load_material_file(path) -> Material:
     """Load one material file (either form). Every problem in it, from YAML duplicate keys to
-    out-of-range values, is reported in one :class:`~explorer.errors.ValidationError`, in
+    out-of-range values, is reported in one :class:`~explorer.core.errors.ValidationError`, in
     line order. The material's name is the file stem."""
     doc = load_yaml(path, what="material file", collect=True)
     checker = doc.checker()

@@ -87,8 +87,8 @@ class Scene:
     viewer : local or infinite
     two_sided : light back faces with -N
     lights : tuple of lights
-    mesh : built-in mesh name or a file path, or None where arrays are given
-    hdr : display unclamped colours with this exposure and tone map (:mod:`explorer.tonemap`),
+    mesh : built-in mesh name or a file path, or None where arrays are given hdr : display unclamped
+    colours with this exposure and tone map (:mod:`explorer.shading.display`),
         or None (OpenGL: clamp to [0, 1])
     source : the file the scene came from (for messages), or None
     """
@@ -138,7 +138,7 @@ def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
     """A :class:`Scene` from a scene-file path, a mapping in the scene schema, or a Scene.
 
     Every problem in the document is reported at once in one
-    :class:`~explorer.errors.ValidationError` naming the file, line and key.
+    :class:`~explorer.core.errors.ValidationError` naming the file, line and key.
     ``materials_dirs`` are extra preset directories searched before the built-in ones.
     """
     if scene is None:

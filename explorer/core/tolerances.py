@@ -2,7 +2,7 @@
 
 Engine epsilons are applied to *normalised* coordinates: before shading, the engine moves the
 scene so the mesh's bounding-box centre is the origin and divides by its largest half-extent
-(see :func:`explorer.frame.frame_of`), so "small" below means small relative to the mesh.
+(see :func:`explorer.geometry.frame.frame_of`), so "small" below means small relative to the mesh.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ AMBIGUOUS_LEN2 = 1e-9
 #: float32 positions are accurate to ~1e-7 there, so "at the vertex" is decided in float64.
 AMBIGUOUS_DIST = 1e-5
 
-#: Light culling (explorer.kernels.bounds): a chunk's bounding sphere and normal cone are
+#: Light culling (explorer.shading.kernels.bounds): a chunk's bounding sphere and normal cone are
 #: widened by this (relative, in float64) so that their own rounding can never leave a vertex
 #: outside them; a chunk is skipped for a light only when every vertex faces away from it (or
 #: lies outside its cone) by AMBIGUOUS_DOT or more, far beyond float32's rounding of N·L.

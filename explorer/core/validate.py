@@ -59,7 +59,7 @@ class Checker:
     """Collects :class:`Problem` for one document.
 
     file : shown in every message (a path, or None for an in-memory mapping)
-    lines : optional mapping ``path tuple -> 1-based line`` (from :mod:`explorer.yamlio`); a
+    lines : optional mapping ``path tuple -> 1-based line`` (from :mod:`explorer.core.yamlio`); a
         problem is reported on the line of its key, or of the nearest enclosing key
     """
 

@@ -7,9 +7,9 @@ Every document a user gives the explorer (scene files, material presets) is read
   ``bool`` and ``None``;
 * ``lines`` maps each key path to the 1-based line it is written on
   (``("lights", 1, "position") -> 12``; list items map to the line of the item; ``()`` maps to
-  the line the document starts on), ready for :class:`~explorer.validate.Checker`.
+  the line the document starts on), ready for :class:`~explorer.core.validate.Checker`.
 
-What is refused (each as a :class:`~explorer.errors.ValidationError` naming file, line and key,
+What is refused (each as a :class:`~explorer.core.errors.ValidationError` naming file, line and key,
 all problems of one document in one pass; YAML syntax errors stop at the first one):
 
 * a missing or unreadable file, a directory, more than :data:`MAX_BYTES` bytes;
@@ -80,7 +80,7 @@ class YamlDocument:
         return line_of(self.lines, path)
 
     def checker(self):
-        """A :class:`~explorer.validate.Checker` reporting against this document's lines,
+        """A :class:`~explorer.core.validate.Checker` reporting against this document's lines,
         already holding :attr:`problems` (so one ``raise_if_any()`` reports everything)."""
 
         checker = Checker(self.file, self.lines)

@@ -3,7 +3,7 @@
 Shading depends only on directions and distances, so the engine moves the scene to put the
 mesh's bounding-box centre at the origin and divides every coordinate by the largest half-extent.
 Coordinates near 1e8 or 1e-8 then become numbers near 1, where float32 keeps 7 digits, and the
-epsilons in :mod:`explorer.tolerances` mean the same thing for every mesh. Distances used for
+epsilons in :mod:`explorer.core.tolerances` mean the same thing for every mesh. Distances used for
 attenuation are scaled back (``kl·s`` and ``kq·s²``), so colours do not change.
 """
 
@@ -43,7 +43,7 @@ def check_vertices(positions, normals) -> tuple[np.ndarray, np.ndarray]:
     kept, anything else converted to float64).
 
     positions, normals : (n, 3) array-like of finite numbers. NaN or inf raise an
-    :class:`~explorer.errors.ExplorerError` naming the first bad vertex (the engine never
+    :class:`~explorer.core.errors.ExplorerError` naming the first bad vertex (the engine never
     guesses a value for it).
     """
 

@@ -1,10 +1,10 @@
 """Martin Newell's Utah teapot (1975): 32 bicubic Bézier patches over 306 control points.
 
-The data is in the public domain. Coordinates are Newell's (z up, spout toward +x, the bottom
-at z = 0, the lid knob at z = 3.15); :func:`explorer.meshes.teapot` turns it y-up and fits it to
-the unit cube. Patch rows hold 16 zero-based control-point indices, row-major (4 rows of 4), in
-this order: rim (4), upper body (4), lower body (4), handle (4), spout (4), lid knob (4),
-lid (4), bottom (4). Some control points are unused (Newell's file had them).
+The data is in the public domain. Coordinates are Newell's (z up, spout toward +x, the bottom at z =
+0, the lid knob at z = 3.15); :func:`explorer.geometry.meshes.teapot` turns it y-up and fits it to
+the unit cube. Patch rows hold 16 zero-based control-point indices, row-major (4 rows of 4), in this
+order: rim (4), upper body (4), lower body (4), handle (4), spout (4), lid knob (4), lid (4), bottom
+(4). Some control points are unused (Newell's file had them).
 """
 
 from __future__ import annotations

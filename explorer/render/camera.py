@@ -68,7 +68,7 @@ def _view_up(forward: np.ndarray) -> np.ndarray:
 def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -> Camera:
     """The camera that sees what the scene's viewer sees, framing the mesh.
 
-    scene : a :class:`~explorer.scene.Scene` (only ``scene.viewer`` is used)
+    scene : a :class:`~explorer.core.scene.Scene` (only ``scene.viewer`` is used)
     mesh : the mesh to frame
     aspect : image width / height
     bottom : fraction of the image height kept free at the bottom (for a label), in [0, 0.9]
@@ -195,7 +195,7 @@ def pixel_ndc(size: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
 def pixel_rays(camera, size: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
     """The ray through the centre of every pixel.
 
-    camera : an :class:`explorer.render.Camera`
+    camera : an :class:`explorer.render.camera.Camera`
     size : (width, height) of the picture
     Returns origins and unit directions, each (h, w, 3) float64, in image row order (row 0 at
     the top). A parallel camera's rays start on the plane through the camera position; a
@@ -248,7 +248,7 @@ def project(camera, points, size: Sequence[int]) -> tuple[np.ndarray, np.ndarray
 
 
 def camera_from_vtk(vtk_camera, window_center=None):
-    """The :class:`explorer.render.Camera` of a live ``vtkCamera`` (a GUI's current view), so
+    """The :class:`explorer.render.camera.Camera` of a live ``vtkCamera`` (a GUI's current view), so
     the per-pixel reference sees exactly what that camera sees."""
 
     wc = tuple(vtk_camera.GetWindowCenter()) if window_center is None else window_center
@@ -265,7 +265,7 @@ def camera_from_vtk(vtk_camera, window_center=None):
 
 
 def sphere_camera(scene, aspect: float = 1.0):
-    """:func:`explorer.render.camera_for` framing the exact unit sphere at the origin (the
+    """:func:`explorer.render.camera.camera_for` framing the exact unit sphere at the origin (the
     surface every built-in sphere tessellation approximates): one camera for all of them."""
 
     if scene.viewer.local:

@@ -127,7 +127,7 @@ class OffscreenRenderer:
     ) -> np.ndarray:
         """Draw the mesh in the engine's colours and return the picture.
 
-        scene : a :class:`~explorer.scene.Scene` (its material's opacity is honoured)
+        scene : a :class:`~explorer.core.scene.Scene` (its material's opacity is honoured)
         colors : (n, 3) float in [0, 1] to draw instead of shading the scene
         label : text drawn at the bottom centre (the preset sheet's names); the camera then
             keeps the bottom of the picture free for it

@@ -3,8 +3,8 @@
 A per-vertex render (:mod:`explorer.render`) lights the vertices and lets VTK interpolate the
 colours across each triangle (Gouraud). The per-pixel reference lights instead the surface
 point each pixel sees, with the surface's own normal there, through the *same* camera
-(:func:`explorer.render.camera_for`) and the *same* lighting code (:func:`explorer.shade`), so
-the only difference between the two pictures is where the lighting is evaluated.
+(:func:`explorer.render.camera.camera_for`) and the *same* lighting code (:func:`explorer.shade`),
+so the only difference between the two pictures is where the lighting is evaluated.
 
 - **Spheres** (the built-in ``sphere`` and ``icosphere``): the ray through each pixel centre
   meets the exact sphere (closed-form ray-sphere intersection); the normal is the radius
@@ -169,7 +169,7 @@ def _pixel_boxes(camera, size, tri: np.ndarray) -> np.ndarray:
 def mesh_hits(camera, size: Sequence[int], mesh) -> Hits:
     """Ray-cast hits of the pixel rays on a mesh's triangles, with interpolated normals.
 
-    mesh : an :class:`explorer.meshes.Mesh`
+    mesh : an :class:`explorer.geometry.meshes.Mesh`
     The nearest hit of each ray over all triangles (front or back, as VTK draws both); the
     hit's normal is ``(1-u-v)·n0 + u·n1 + v·n2`` normalised (zero stays zero).
     """
@@ -225,7 +225,7 @@ def hits(scene, mesh, size: Sequence[int], *, camera=None, method: str = "auto")
     """What each pixel sees: :func:`sphere_hits` for a built-in sphere (``method="auto"`` or
     ``"sphere"``), :func:`mesh_hits` otherwise (or with ``method="raycast"``).
 
-    camera : default :func:`explorer.render.camera_for` (scene, mesh, w / h), the camera of a
+    camera : default :func:`explorer.render.camera.camera_for` (scene, mesh, w / h), the camera of a
         per-vertex render of the same scene
     """
 
@@ -287,8 +287,8 @@ class Reference:
 
 def point_colors(scene, positions, normals, *, mesh=None, precision: str = "float64"):
     """Engine colours of surface points, as the per-vertex renderer computes its vertices'
-    (:func:`explorer.render.vertex_colors`): clamped, or through the scene's HDR display when
-    it has one. With a light that casts shadows the points are shaded together with ``mesh``'s
+    (:func:`explorer.shading.display.vertex_colors`): clamped, or through the scene's HDR display
+    when it has one. With a light that casts shadows the points are shaded together with ``mesh``'s
     vertices and triangles, so the engine's own shadow rays decide what each point sees.
 
     positions, normals : (k, 3) float

@@ -84,9 +84,10 @@ def display(colors, hdr: HDR) -> np.ndarray:
 def vertex_colors(scene, mesh: Mesh, *, precision: str = "float64") -> np.ndarray:
     """Engine colours of the mesh's vertices under the scene: (n, 3) float64 in [0, 1].
 
-    The mesh's triangles go to the engine too (shadows). A scene with ``hdr`` is shaded
-    unclamped and shown through its exposure, tone map and the sRGB encoding
-    (:func:`explorer.tonemap.display`); the renderer then interpolates the encoded values."""
+    The mesh's triangles go to the engine too (shadows). A scene with ``hdr`` is shaded unclamped
+    and shown through its exposure, tone map and the sRGB encoding
+    (:func:`explorer.shading.display.display`); the renderer then interpolates the encoded
+    values."""
     hdr = getattr(scene, "hdr", None)
     c = shade(
         scene,

@@ -1,6 +1,6 @@
 """Effects beyond the local model that are cheap closed forms: the energy-conserving lobe
-normalisation and Schlick's Fresnel weight. Shadows are in :mod:`explorer.shadows`, the HDR
-display in :mod:`explorer.tonemap`. Every effect is off by default (see docs/effects.md).
+normalisation and Schlick's Fresnel weight. Shadows are in :mod:`explorer.shading.shadows`, the HDR
+display in :mod:`explorer.shading.display`. Every effect is off by default (see docs/effects.md).
 
 Energy-conserving specular (``energy_conserving: true`` on the material) multiplies the lobe by
 the constant that makes its cosine-weighted integral over the hemisphere independent of ``n``::
@@ -25,7 +25,7 @@ import numpy as np
 
 
 def energy_factor(model: str, shininess: float) -> float:
-    """The lobe normalisation of :mod:`explorer.effects` for ``model`` at exponent n."""
+    """The lobe normalisation of :mod:`explorer.shading.effects` for ``model`` at exponent n."""
     n = float(shininess)
     if model == "phong":
         return (n + 2.0) / (2.0 * math.pi)

@@ -1,17 +1,18 @@
 """The full-generality float64 reference: every term for every light, no plan, plain numpy.
 
 This is the engine's specification in code. It computes each term whether or not it can be
-non-zero, so the planned fast path (:mod:`explorer.kernels`) is tested against it. It applies the
-same documented policies (:mod:`explorer.tolerances`) for the cases the equation leaves undefined.
+non-zero, so the planned fast path (:mod:`explorer.shading.kernels`) is tested against it. It
+applies the same documented policies (:mod:`explorer.core.tolerances`) for the cases the equation
+leaves undefined.
 
     c = e_m + a_m·a_scene
       + Σ_i att_i · spot_i · ( a_m·a_i
                                + vis_i · ( max(N·L_i, 0)·d_m·d_i
                                            + f_i·F_i·E·max(N·H_i, 0)^n · s_m·s_i ) )
 
-with the effects of :mod:`explorer.effects` and :mod:`explorer.shadows`: ``vis_i`` the shadow
-visibility (1 without ``shadows: true`` or without faces; rays from every vertex, even on a
-convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and ``E`` the
+with the effects of :mod:`explorer.shading.effects` and :mod:`explorer.shading.shadows`: ``vis_i``
+the shadow visibility (1 without ``shadows: true`` or without faces; rays from every vertex, even on
+a convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and ``E`` the
 energy-conserving normalisation (1 without ``energy_conserving``).
 """
 

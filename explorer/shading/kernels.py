@@ -1,14 +1,14 @@
 """Compiled shading kernels (numba): blocked, fused, one code for float32 and float64.
 
 Vertices are processed in blocks of :data:`BLOCK`. Each block is converted once to the
-normalised frame (:mod:`explorer.frame`) in float64 and then to the working precision ``T``
+normalised frame (:mod:`explorer.geometry.frame`) in float64 and then to the working precision ``T``
 (the dtype of ``params``: float32 for the fast path, float64 for the exact path), stored as
 structure-of-arrays scratch rows that stay in cache. Every light then runs a few short stage loops
 over the block (direction, weight, diffuse, lobe), each a branch-free loop the compiler turns into
 SIMD code; decisions the plan makes per light are taken once per block, outside those loops.
 
-The light sums (ambient, diffuse, specular; see :func:`explorer.reference.reference_terms`) are
-stored when asked, so a material change only recomposes (:func:`compose`), and each light's
+The light sums (ambient, diffuse, specular; see :func:`explorer.shading.equation.reference_terms`)
+are stored when asked, so a material change only recomposes (:func:`compose`), and each light's
 specular base and weight can be stored so a shininess change only re-runs the lobe
 (:func:`lobe`). A pass whose lights are all grey (r = g = b) stores its diffuse and specular
 sums grey, (n, 1) (:func:`grey_pass`): at 1M vertices the (n, 3) stores were a fifth of the pass.
@@ -19,8 +19,8 @@ nothing from it, every vertex facing away from it or outside its spot cone (:fun
 per light and parallel task). A block then runs the light over the runs it reaches only.
 
 float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
-:data:`explorer.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo them
-in float64. Each lane keeps the smallest margin to such a decision (row R_TRK, a min per light,
+:data:`explorer.core.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo
+them in float64. Each lane keeps the smallest margin to such a decision (row R_TRK, a min per light,
 no mask logic); the mark is "margin below 1".
 
 (n, 3) arrays (positions, normals, the cached sums, colours) are read and written through flat
@@ -69,7 +69,7 @@ AMBIENT = 16  # per-vertex (attenuated) ambient
 DIFFUSE = 32
 SPECULAR = 64
 CONST_H = 128  # Blinn with a directional light and an infinite viewer
-SHADOW = 256  # w *= visibility row (explorer.shadows) for diffuse and specular
+SHADOW = 256  # w *= visibility row (explorer.shading.shadows) for diffuse and specular
 FRESNEL = 512  # specular weight *= Schlick F = F0 + (1 - F0)(1 - V·H)^5
 GREY = 1024  # diffuse and specular colours have r = g = b (one sum per vertex, not three)
 
@@ -128,7 +128,7 @@ N_OPTS = 13
 N_ROWS = 29
 # R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
 # policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
-# (explorer.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
+# (explorer.core.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
 # R_NV holds N·V (after a two-sided flip), for the inline lobes.
 
 # lobe modes
@@ -164,7 +164,7 @@ N_CONSTS = 11
 
 
 def constants(dtype) -> np.ndarray:
-    """The kernel's constants (see :mod:`explorer.tolerances`) in ``dtype``."""
+    """The kernel's constants (see :mod:`explorer.core.tolerances`) in ``dtype``."""
     return np.array(
         [
             0.0,
@@ -459,7 +459,7 @@ def bounds(G, out):
     out : (N_BOUNDS, ceil(n / CHUNK)) float64: the bounding sphere of the chunk's positions
     (centre of its box, radius to the farthest vertex) and the cone of its normals (axis: their
     mean direction; half-angle: the widest normal from it), both widened by
-    :data:`explorer.tolerances.CULL_GUARD`. A cone of 90° or more, or a chunk with an absent
+    :data:`explorer.core.tolerances.CULL_GUARD`. A cone of 90° or more, or a chunk with an absent
     (zero) normal, gets cosine -1: never culled.
     """
     n = G.shape[1]
@@ -895,7 +895,7 @@ def _dir_rows(scr, m, q, one):
 
 @nb.njit(**_LEAF)
 def _shadow(scr, m, vis):
-    """w *= visibility (0 or 1 per vertex, from explorer.shadows)."""
+    """w *= visibility (0 or 1 per vertex, from explorer.shading.shadows)."""
     W = _row(scr, R_W, m)
     for i in range(m):
         W[i] = W[i] * vis[i]

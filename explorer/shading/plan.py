@@ -2,13 +2,13 @@
 
 :func:`make_plan` looks at the scene alone (never at the mesh) and decides, per light and for
 the whole scene, what must be computed per vertex, what is constant, and what is skipped, with
-the reason for each decision. The kernels (:mod:`explorer.kernels`) follow the plan; the test
-suite checks that the planned result equals the full-generality reference on random scenes.
+the reason for each decision. The kernels (:mod:`explorer.shading.kernels`) follow the plan; the
+test suite checks that the planned result equals the full-generality reference on random scenes.
 
 Light-level decisions depend on the light only (its colours, type, attenuation, cone); the
 term-level decisions (is there any ambient, diffuse, specular at all?) depend on the material
-too. The interactive :class:`~explorer.engine.Shader` keeps per-light work cached across material
-changes and asks for a term only when the current material needs it.
+too. The interactive :class:`~explorer.shading.shader.Shader` keeps per-light work cached across
+material changes and asks for a term only when the current material needs it.
 """
 
 from __future__ import annotations

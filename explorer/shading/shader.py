@@ -1,7 +1,7 @@
 """The engine's front: :func:`shade` for one-shot colours, :class:`Shader` for interaction.
 
 A :class:`Shader` keeps the per-vertex light sums of
-:func:`explorer.reference.reference_terms` cached by what they depend on:
+:func:`explorer.shading.equation.reference_terms` cached by what they depend on:
 
 =====================  =======================================================================
 change                 work done on the next ``colors``
@@ -62,7 +62,8 @@ def shade(
 ) -> np.ndarray:
     """Per-vertex colours of a mesh under a scene.
 
-    scene : a scene-file path, a mapping in the scene schema, or a :class:`~explorer.scene.Scene`
+    scene : a scene-file path, a mapping in the scene schema, or a
+    :class:`~explorer.core.scene.Scene`
     positions : (n, 3) float vertex positions
     normals : (n, 3) float vertex normals (any length; zero means "no normal")
     precision : "float64" (exact path) or "float32" (fast path, within 1/255 of float64)
@@ -167,7 +168,7 @@ class Shader:
 
     def _chunk_bounds(self) -> np.ndarray:
         """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices, for
-        light culling (see :func:`explorer.kernels.bounds`), read-only; (N_BOUNDS, 0) when
+        light culling (see :func:`explorer.shading.kernels.bounds`), read-only; (N_BOUNDS, 0) when
         fewer than one chunk in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled
         vertices, say): too little could be culled to pay for the tests."""
         b = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
@@ -245,11 +246,10 @@ class Shader:
                 self._spares.append(a)
 
     def _fresh_sum(self, grey: bool = False) -> np.ndarray:
-        """An (n, 3) array for a sum being recomputed, or (n, 1) for a grey one (every
-        channel the same, see :func:`explorer.kernels.grey_pass`): the memory of an invalidated
-        sum of that shape that no array handed out (``terms``) still views, else a new one.
-        Reuse saves the page faults of fresh memory (three 12 MB sums per light change at 1M
-        vertices)."""
+        """An (n, 3) array for a sum being recomputed, or (n, 1) for a grey one (every channel the
+        same, see :func:`explorer.shading.kernels.grey_pass`): the memory of an invalidated sum of
+        that shape that no array handed out (``terms``) still views, else a new one. Reuse saves the
+        page faults of fresh memory (three 12 MB sums per light change at 1M vertices)."""
         shape = (self.n, 1 if grey else 3)
         for i in range(len(self._spares)):
             buf = self._spares[i]  # (not enumerate: its tuple would hold one more reference)

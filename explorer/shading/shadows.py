@@ -58,7 +58,7 @@ def visibility(positions, faces, light, *, only=None):
     """Visibility of ``light`` at each vertex: (n,) float64, 1 lit, 0 shadowed.
 
     positions : (n, 3) float; faces : (m, 3) int (counter-clockwise seen from the front)
-    light : a light of :mod:`explorer.lights`
+    light : a light of :mod:`explorer.core.lights`
     only : (n,) bool, the vertices to cast rays from (the others get 1); default all
     """
     P = np.asarray(positions, np.float64)

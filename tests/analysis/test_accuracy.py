@@ -1,5 +1,5 @@
-"""The accuracy measurement (explorer.accuracy), mesh_for_error against the measured table, and
-``phong-explorer bench accuracy``."""
+"""The accuracy measurement (explorer.analysis.accuracy), mesh_for_error against the measured table,
+and ``phong-explorer bench accuracy``."""
 
 from __future__ import annotations
 
@@ -164,7 +164,7 @@ def test_shipped_table_is_complete():
         assert r["rmse"] >= 0 and r["max"] >= 0 and r["shade_ms"] > 0 and r["render_ms"] > 0
         assert r["max"] >= r["rmse"] - 1e-9 or r["max"] == 0
         if r["path"] == "float32":
-            assert r["vs_float64"] <= 255 * explorer.tolerances.FLOAT32_MAX_ABS_ERROR
+            assert r["vs_float64"] <= 255 * explorer.core.tolerances.FLOAT32_MAX_ABS_ERROR
         if r["path"] == "plan off":
             assert r["vs_float64"] <= 255 * 1e-6
 
@@ -409,7 +409,7 @@ def test_plot_is_skipped_without_matplotlib(quick, tmp_path, monkeypatch, capsys
 
 def test_import_stays_light():
     code = (
-        "import sys, explorer.accuracy, explorer.perpixel, explorer.cli_bench; "
+        "import sys, explorer.analysis.accuracy, explorer.render.perpixel, explorer.cli.bench; "
         "bad = [m for m in ('vtk', 'vtkmodules', 'pyvista', 'matplotlib') if m in sys.modules]; "
         "print(bad); sys.exit(1 if bad else 0)"
     )

@@ -1,4 +1,4 @@
-"""The desktop explorer (explorer.gui, explorer.cli_gui) driven in-process, off-screen.
+"""The desktop explorer (explorer.app.window, explorer.cli.gui) driven in-process, off-screen.
 
 Widgets are driven the way VTK drives them: set a representation's value and fire the event the
 callback is bound to (see /work/shared/notes/gui-testing.md), or send key events through the
@@ -711,7 +711,7 @@ def test_error_in_a_callback_is_shown_and_logged(app, user_presets, caplog, monk
     not_a_dir = user_presets / "a-file"
     not_a_dir.write_text("")
     monkeypatch.setattr(app, "preset_dir", str(not_a_dir))
-    with caplog.at_level(logging.ERROR, logger="explorer.gui"):
+    with caplog.at_level(logging.ERROR, logger="explorer.app.window"):
         press(app, "s")
     assert app.errors and "key s" in app.errors[0]
     assert app.message.startswith("error (key s):")
@@ -723,7 +723,7 @@ def test_error_in_a_callback_is_shown_and_logged(app, user_presets, caplog, monk
         raise RuntimeError("broken on purpose")
 
     monkeypatch.setattr(app, "set_model", broken)
-    with caplog.at_level(logging.ERROR, logger="explorer.gui"):
+    with caplog.at_level(logging.ERROR, logger="explorer.app.window"):
         click(app, "phong")  # a widget callback this time
     assert "RuntimeError: broken on purpose" in app.message
     assert any(r.exc_info for r in caplog.records)  # the traceback is in the log

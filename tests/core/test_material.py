@@ -1,4 +1,5 @@
-"""Material: the two written forms, validation messages, ka/kd/ks scalars (explorer.material)."""
+"""Material: the two written forms, validation messages, ka/kd/ks scalars
+(explorer.core.material)."""
 
 from __future__ import annotations
 

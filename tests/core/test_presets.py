@@ -1,4 +1,5 @@
-"""The preset library (explorer.presets) and ``phong-explorer presets`` (explorer.cli_presets)."""
+"""The preset library (explorer.core.presets) and ``phong-explorer presets``
+(explorer.cli.presets)."""
 
 from __future__ import annotations
 
@@ -10,10 +11,15 @@ from pathlib import Path
 
 import pytest
 import yaml
-from explorer.cli_presets import swatch_rgb, use_colour
-from explorer.errors import ExplorerError, ValidationError
-from explorer.material import MATERIAL_KEYS, Material
-from explorer.presets import (
+from hypothesis import given
+from hypothesis import strategies as st
+
+from explorer.cli import main
+from explorer.cli.presets import swatch_rgb, use_colour
+from explorer.core import presets
+from explorer.core.errors import ExplorerError, ValidationError
+from explorer.core.material import MATERIAL_KEYS, Material
+from explorer.core.presets import (
     PresetNotice,
     builtin_dir,
     find_preset,
@@ -22,12 +28,7 @@ from explorer.presets import (
     save_preset,
     user_dir,
 )
-from explorer.yamlio import MAX_BYTES
-from hypothesis import given
-from hypothesis import strategies as st
-
-from explorer.cli import main
-from explorer.core import presets
+from explorer.core.yamlio import MAX_BYTES
 
 SHARED_TABLE = Path("/work/shared/reference/classic-materials.yaml")
 
@@ -484,7 +485,7 @@ def test_colour_only_on_a_tty_without_no_color(monkeypatch):
 
 
 def test_swatch_is_drawn_with_24_bit_colour_on_a_tty(monkeypatch):
-    from explorer.cli_presets import list_
+    from explorer.cli.presets import list_
 
     monkeypatch.delenv("NO_COLOR", raising=False)
     monkeypatch.setenv("TERM", "xterm")
@@ -511,8 +512,8 @@ def test_cli_show_prints_the_file_and_values_that_load_back(capsys):
     assert main(["presets", "show", "emerald"]) == 0
     out = capsys.readouterr().out
     assert str(builtin_dir() / "emerald.yaml") in out
-    from explorer.material import parse_material
-    from explorer.validate import Checker
+    from explorer.core.material import parse_material
+    from explorer.core.validate import Checker
 
     shown = parse_material(yaml.safe_load(out), Checker(), ())
     assert shown == find_preset("emerald")

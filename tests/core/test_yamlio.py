@@ -1,4 +1,4 @@
-"""The safe YAML loader and the atomic writer (explorer.yamlio)."""
+"""The safe YAML loader and the atomic writer (explorer.core.yamlio)."""
 
 from __future__ import annotations
 

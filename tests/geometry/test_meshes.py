@@ -1,4 +1,4 @@
-"""Built-in meshes and mesh files (explorer.meshes)."""
+"""Built-in meshes and mesh files (explorer.geometry.meshes)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pytest
 import trimesh
 
 from explorer.core.errors import ExplorerError
-from explorer.data import teapot as data
 from explorer.geometry import meshes as M
+from explorer.geometry import teapot_patches as data
 
 
 def _unit(m: M.Mesh) -> bool:

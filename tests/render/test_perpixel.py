@@ -1,4 +1,4 @@
-"""The per-pixel reference (explorer.perpixel): VTK's camera model, exact sphere hits, ray
+"""The per-pixel reference (explorer.render.perpixel): VTK's camera model, exact sphere hits, ray
 casting with interpolated normals, agreement with a fine per-vertex render, render --per-pixel."""
 
 from __future__ import annotations

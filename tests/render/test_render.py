@@ -1,4 +1,4 @@
-"""Off-screen renders (explorer.render, explorer.cli_render) and golden pictures.
+"""Off-screen renders (explorer.render, explorer.cli.render) and golden pictures.
 
 Goldens live in tests/golden/; see tests/helpers/imagecompare.py for the tolerance and for
 ``PHONG_EXPLORER_REGENERATE_GOLDENS=1`` (regenerate).

@@ -118,7 +118,7 @@ def test_every_update_after_a_culled_pass_is_right(precision):
     for change in (
         lambda s: s.set_material(s.scene.material.replace(shininess=80)),
         lambda s: s.set_material(s.scene.material.replace(shininess=12)),  # from stored lobes
-        lambda s: s.set_viewer(explorer.scene.Viewer(eye=(3.0, 1.0, 2.0))),
+        lambda s: s.set_viewer(explorer.core.scene.Viewer(eye=(3.0, 1.0, 2.0))),
         lambda s: s.set_material(s.scene.material.replace(diffuse=(0.1, 0.8, 0.3))),
         lambda s: s.set_lights(s.scene.lights[::-1]),
     ):
