@@ -135,11 +135,11 @@ def show(name: str, dirs, out=None, err=None) -> int:
         material = load_material_file(path)
         origin = f"# from the file {path}"
     else:
-        path, source, shadowed = locate_preset(name, dirs)
+        path, source, hidden = locate_preset(name, dirs)
         material = load_material_file(path)
         origin = f"# preset '{name}' ({_source_label(source)}): {path}"
-        if shadowed is not None:
-            _print_notices([f"preset '{name}': {path} hides {shadowed}"], err)
+        if hidden is not None:
+            _print_notices([f"preset '{name}': {path} hides {hidden}"], err)
     ka, kd, ks = material.scalars()
     out.write(origin + "\n")
     out.write(f"# scalars (largest channel of each term): ka {ka:g}, kd {kd:g}, ks {ks:g}\n")

@@ -36,7 +36,7 @@ both are black), specular uses white.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from numbers import Real
 
 from explorer.core.errors import ExplorerError
@@ -273,7 +273,3 @@ def parse_material(value, checker: Checker, path: tuple = ()) -> Material | None
     if len(checker.problems) > before or any(v is None for v in kw.values()):
         return None
     return Material(**kw)
-
-
-def material_fields() -> tuple[str, ...]:
-    return tuple(f.name for f in fields(Material))

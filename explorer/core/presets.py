@@ -4,7 +4,7 @@ A preset is one YAML file in a preset directory; its file stem is the preset's n
 (lowercase letters, digits and ``_``; files with other names are ignored with a notice). Three
 kinds of directories are searched, the first one holding a name wins:
 
-1. ``extra_dirs`` (the ``--materials DIR`` options), in the order given;
+1. ``materials_dirs`` (the ``--materials DIR`` options), in the order given;
 2. the user's directory, :func:`user_dir` (``$PHONG_EXPLORER_MATERIALS`` if set, otherwise
    ``<user config dir>/phong-explorer/materials``); it need not exist;
 3. the built-in presets shipped inside the package, :func:`builtin_dir`.
@@ -35,7 +35,6 @@ ENV_VAR = "PHONG_EXPLORER_MATERIALS"
 NAME_PATTERN = re.compile(r"[a-z0-9_]+")
 MAX_NAME_LENGTH = 64
 SUFFIX = ".yaml"
-SOURCES = ("extra", "user", "builtin")
 
 
 class PresetNotice(UserWarning):
@@ -50,14 +49,14 @@ class PresetInfo:
     path : the file it was read from
     material : the loaded :class:`~explorer.core.material.Material` (``material.name == name``)
     source : "extra" (a ``--materials`` directory), "user" or "builtin"
-    shadows : the file of the same name it hides (next in precedence), or None
+    hides : the file of the same name it hides (next in precedence), or None
     """
 
     name: str
     path: Path
     material: Material
     source: str
-    shadows: Path | None = None
+    hides: Path | None = None
 
 
 # -- directories -----------------------------------------------------------------------------
@@ -78,14 +77,14 @@ def user_dir() -> Path:
     return Path(user_config_dir("phong-explorer")) / "materials"
 
 
-def search_dirs(extra_dirs: Iterable = ()) -> list[tuple[Path, str]]:
+def search_dirs(materials_dirs: Iterable = ()) -> list[tuple[Path, str]]:
     """``[(directory, source), ...]`` in precedence order (first wins).
 
     A ``--materials`` directory that does not exist is an error (it was asked for); a missing
     user directory is simply skipped.
     """
     dirs: list[tuple[Path, str]] = []
-    for d in extra_dirs or ():
+    for d in materials_dirs or ():
         path = Path(os.fspath(d)).expanduser()
         if not path.is_dir():
             why = "is not a directory" if path.exists() else "does not exist"
@@ -161,14 +160,14 @@ def _scan(dirs, notices) -> dict[str, list[tuple[Path, str]]]:
     return found
 
 
-def list_presets(extra_dirs: Iterable = (), *, notices: list | None = None) -> list[PresetInfo]:
+def list_presets(materials_dirs: Iterable = (), *, notices: list | None = None) -> list[PresetInfo]:
     """Every preset, sorted by name, each from the first directory that has it.
 
     A preset file that does not load is left out of the list with a notice (its problems);
     :func:`find_preset` on that name raises them. Notices go to ``notices`` when a list is
     given, otherwise each is issued once per process as a :class:`PresetNotice` warning.
     """
-    found = _scan(search_dirs(extra_dirs), notices)
+    found = _scan(search_dirs(materials_dirs), notices)
     out = []
     for name in sorted(found):
         (path, source), *rest = found[name]
@@ -177,17 +176,17 @@ def list_presets(extra_dirs: Iterable = (), *, notices: list | None = None) -> l
         except ValidationError as exc:
             _notice(notices, f"preset '{name}' skipped, it has problems:\n{exc}")
             continue
-        shadows = rest[0][0] if rest else None
-        if shadows is not None:
-            _notice(notices, _shadow_message(name, path, source, rest[0]))
-        out.append(PresetInfo(name, path, material, source, shadows))
+        hides = rest[0][0] if rest else None
+        if hides is not None:
+            _notice(notices, _hidden_message(name, path, source, rest[0]))
+        out.append(PresetInfo(name, path, material, source, hides))
     return out
 
 
-def locate_preset(name: str, extra_dirs: Iterable = ()) -> tuple[Path, str, Path | None]:
-    """``(file, source, shadowed file or None)`` of preset ``name``, without loading it."""
+def locate_preset(name: str, materials_dirs: Iterable = ()) -> tuple[Path, str, Path | None]:
+    """``(file, source, hidden file or None)`` of preset ``name``, without loading it."""
     _check_lookup_name(name)
-    dirs = search_dirs(extra_dirs)
+    dirs = search_dirs(materials_dirs)
     hits = [(d / f"{name}{SUFFIX}", s) for d, s in dirs if (d / f"{name}{SUFFIX}").is_file()]
     if not hits:
         known = sorted(_scan(dirs, []))
@@ -201,17 +200,19 @@ def locate_preset(name: str, extra_dirs: Iterable = ()) -> tuple[Path, str, Path
     return path, source, (rest[0][0] if rest else None)
 
 
-def find_preset(name: str, extra_dirs: Iterable = (), *, notices: list | None = None) -> Material:
+def find_preset(
+    name: str, materials_dirs: Iterable = (), *, notices: list | None = None
+) -> Material:
     """The material of preset ``name`` (``material.name == name``).
 
     Unknown name: :class:`ExplorerError` with a did-you-mean and the directories searched. A
     preset file with problems: its :class:`ValidationError` (no silent fallback to a built-in
     of the same name).
     """
-    path, source, shadowed = locate_preset(name, extra_dirs)
+    path, source, hidden = locate_preset(name, materials_dirs)
     material = load_material_file(path)
-    if shadowed is not None:
-        _notice(notices, _shadow_message(name, path, source, (shadowed, None)))
+    if hidden is not None:
+        _notice(notices, _hidden_message(name, path, source, (hidden, None)))
     return material
 
 
@@ -258,7 +259,7 @@ def save_preset(material: Material, name: str, directory=None, overwrite: bool =
 _NOTICED: set[str] = set()
 
 
-def _shadow_message(name, path, source, hidden) -> str:
+def _hidden_message(name, path, source, hidden) -> str:
     label = {"extra": "--materials", "user": "user", "builtin": "built-in"}.get(source, source)
     return f"preset '{name}': using {path} ({label}), which hides {hidden[0]}"
 

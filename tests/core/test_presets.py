@@ -173,7 +173,7 @@ def test_user_dir_env_override_and_default(isolated_user_dir, monkeypatch):
 def test_user_preset_is_listed_and_found(isolated_user_dir):
     write(isolated_user_dir / "my_clay.yaml", "kd: 0.7\ncolor: [0.8, 0.5, 0.3]\n")
     infos = {p.name: p for p in list_presets()}
-    assert infos["my_clay"].source == "user" and infos["my_clay"].shadows is None
+    assert infos["my_clay"].source == "user" and infos["my_clay"].hides is None
     assert infos["gold"].source == "builtin"
     assert find_preset("my_clay").diffuse == tuple(0.7 * c for c in (0.8, 0.5, 0.3))
 
@@ -183,7 +183,7 @@ def test_user_preset_shadows_builtin_with_a_notice(isolated_user_dir):
     notices: list = []
     infos = {p.name: p for p in list_presets(notices=notices)}
     assert infos["gold"].path == mine and infos["gold"].source == "user"
-    assert infos["gold"].shadows == builtin_dir() / "gold.yaml"
+    assert infos["gold"].hides == builtin_dir() / "gold.yaml"
     assert infos["gold"].material.diffuse == (0.9, 0.7, 0.1)
     assert len(notices) == 1 and "gold" in notices[0] and str(mine) in notices[0]
     notices = []
@@ -213,7 +213,7 @@ def test_precedence_extra_then_user_then_builtin(tmp_path, isolated_user_dir):
     assert find_preset("gold", notices=[]).description == "user"
     infos = {p.name: p for p in list_presets(dirs, notices=[])}
     assert infos["gold"].path == a and infos["gold"].source == "extra"
-    assert infos["gold"].shadows == tmp_path / "b" / "gold.yaml"
+    assert infos["gold"].hides == tmp_path / "b" / "gold.yaml"
     assert infos["only_b"].source == "extra"
 
 
