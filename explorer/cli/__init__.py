@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 
 from explorer.cli import bench, gui, plan, presets, render, sheet
 from explorer.core.errors import ExplorerError
@@ -44,8 +45,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _show_notices() -> None:
     """Print preset notices as one ``notice: ...`` line on stderr, not as Python warnings."""
-    import warnings
-
     original = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):

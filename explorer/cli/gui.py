@@ -18,6 +18,8 @@ import logging
 import os
 import sys
 
+import numpy as np
+
 from explorer.app import window as gui
 from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
 from explorer.core.errors import ExplorerError
@@ -60,8 +62,6 @@ def start(args):
     viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
     (:data:`explorer.app.window.MESH_CHOICES`) unless ``--resolution`` is given.
     """
-    import numpy as np
-
     if args.exit_after is not None and not args.exit_after > 0:
         raise ExplorerError(f"--exit-after must be a number of seconds > 0, got {args.exit_after}")
     if args.scene is None and args.preset is None:

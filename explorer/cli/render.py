@@ -12,6 +12,7 @@ The scene options are :mod:`explorer.cli.options`'.
 from __future__ import annotations
 
 import argparse
+import sys
 
 from explorer.cli.options import (
     add_scene_arguments,
@@ -58,8 +59,6 @@ def run(args) -> int:
     args.mesh_default = "sphere"
     scene, mesh = build_scene(args)
     if scene.hdr is not None:
-        import sys
-
         for w in energy_warnings(scene.material):
             print(f"warning: {w}", file=sys.stderr)
     if args.per_pixel:
@@ -80,8 +79,6 @@ def run(args) -> int:
 
 def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
     """``phong-explorer render --per-pixel``: write the per-pixel picture to ``args.out``."""
-    import sys
-
     if suffix != ".png":
         raise ExplorerError(f"--per-pixel draws a picture: give --out FILE.png, not {suffix}")
     if scene.material.opacity < 1.0:

@@ -20,7 +20,10 @@ import re
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
+
+from platformdirs import user_config_dir
 
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, ValidationError
@@ -62,8 +65,6 @@ class PresetInfo:
 # -- directories -----------------------------------------------------------------------------
 def builtin_dir() -> Path:
     """Directory of the built-in presets (inside the installed package)."""
-    from importlib import resources
-
     return Path(os.fspath(resources.files("explorer.materials")))
 
 
@@ -72,8 +73,6 @@ def user_dir() -> Path:
     env = os.environ.get(ENV_VAR)
     if env:
         return Path(env).expanduser()
-    from platformdirs import user_config_dir
-
     return Path(user_config_dir("phong-explorer")) / "materials"
 
 

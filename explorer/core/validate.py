@@ -16,6 +16,8 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from numbers import Real
 
+import numpy as np
+
 from explorer.core.errors import Problem, ValidationError
 
 Path = tuple
@@ -165,7 +167,7 @@ class Checker:
         rng = _range(lo, hi, False)
         if (
             isinstance(value, (str, bytes, Mapping))
-            or not isinstance(value, (Sequence, _ndarray_type()))
+            or not isinstance(value, (Sequence, np.ndarray))
             or len(value) != 3
         ):
             self.problem(
@@ -220,9 +222,3 @@ def _type(value) -> str:
     if isinstance(value, (list, tuple)):
         return f"a list of {len(value)}"
     return type(value).__name__
-
-
-def _ndarray_type():
-    import numpy as np
-
-    return np.ndarray
