@@ -1,4 +1,4 @@
-"""The layout keeps its shape: import contracts, sizes, and where imports sit (docs/architecture.md)."""
+"""The layout keeps its shape: import contracts, sizes, where imports sit (docs/architecture.md)."""
 
 from __future__ import annotations
 
