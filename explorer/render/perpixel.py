@@ -38,9 +38,8 @@ from explorer.geometry.rays import nearest_hits, triangle_edges
 from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
-from explorer.shading.display import display, to_bytes
+from explorer.shading.display import display_colors, to_bytes
 from explorer.shading.equation import reference_terms
-from explorer.shading.shader import shade
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -244,27 +243,24 @@ class Reference:
 
 
 def point_colors(scene, positions, normals, *, mesh=None, precision: str = "float64"):
-    """Engine colours of surface points, as the per-vertex renderer computes its vertices'
-    (:func:`explorer.shading.display.vertex_colors`): clamped, or through the scene's HDR display
-    when it has one. With a light that casts shadows the points are shaded together with ``mesh``'s
-    vertices and triangles, so the engine's own shadow rays decide what each point sees.
+    """Display colours of surface points, computed as the per-vertex renderer computes its
+    vertices' (:func:`explorer.shading.display.display_colors`). With a light that casts
+    shadows the points are shaded together with ``mesh``'s vertices and triangles, so the
+    engine's own shadow rays decide what each point sees.
 
     positions, normals : (k, 3) float
     Returns (k, 3) float64 display colours in [0, 1].
     """
-    hdr = getattr(scene, "hdr", None)
-    shadows = mesh is not None and any(getattr(lt, "shadows", False) for lt in scene.lights)
-    kw = {}
-    skip = 0
-    if shadows:
-        skip = mesh.n_vertices
-        positions = np.vstack([mesh.positions, positions])
-        normals = np.vstack([mesh.normals, normals])
-        kw["faces"] = mesh.faces
-    c = shade(scene, positions, normals, precision=precision, clamp=hdr is None, **kw)[skip:]
-    if hdr is not None:
-        c = display(c, hdr)
-    return c
+    if mesh is None or not any(getattr(lt, "shadows", False) for lt in scene.lights):
+        return display_colors(scene, positions, normals, precision=precision)
+    both = display_colors(
+        scene,
+        np.vstack([mesh.positions, positions]),
+        np.vstack([mesh.normals, normals]),
+        faces=mesh.faces,
+        precision=precision,
+    )
+    return both[mesh.n_vertices :]
 
 
 def reference(

@@ -73,41 +73,74 @@ def srgb_decode(v) -> np.ndarray:
     return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
-def display(colors, hdr: HDR) -> np.ndarray:
-    """Unclamped linear colours (n, 3) -> display values in [0, 1] (sRGB-encoded)."""
+def display(colors, hdr: HDR | None) -> np.ndarray:
+    """The engine's colours (n, 3) -> display values in [0, 1].
+
+    hdr : the scene's ``hdr`` (None: the engine clamped the colours, as OpenGL does, and they
+        are shown as they are, the same array; else the unclamped sums go through exposure,
+        tone map and sRGB encoding)
+    """
+    if hdr is None:
+        return colors
     return srgb_encode(tone_map(expose(colors, hdr.exposure), hdr.tone_map))
 
 
-# -- colours -------------------------------------------------------------------------------
+def engine_clamps(scene) -> bool:
+    """Whether the engine clamps the scene's colours (OpenGL's path): a scene without ``hdr``.
+    A scene with ``hdr`` is shaded unclamped and shown through :func:`display`."""
+    return scene.hdr is None
+
+
+def display_colors(
+    scene, positions, normals, *, faces=None, precision: str = "float64"
+) -> np.ndarray:
+    """Display colours of surface points under the scene: the engine's colours
+    (:func:`explorer.shading.shader.shade`, clamped or not by :func:`engine_clamps`) through
+    :func:`display`.
+
+    positions, normals : (n, 3) float
+    faces : (m, 3) int triangles over ``positions`` (shadow rays need them), or None
+    Returns (n, 3) float64 in [0, 1].
+    """
+    c = shade(
+        scene,
+        positions,
+        normals,
+        precision=precision,
+        clamp=engine_clamps(scene),
+        faces=faces,
+    )
+    return display(c, scene.hdr)
 
 
 def vertex_colors(scene, mesh: Mesh, *, precision: str = "float64") -> np.ndarray:
-    """Engine colours of the mesh's vertices under the scene: (n, 3) float64 in [0, 1].
-
-    The mesh's triangles go to the engine too (shadows). A scene with ``hdr`` is shaded unclamped
-    and shown through its exposure, tone map and the sRGB encoding
-    (:func:`explorer.shading.display.display`); the renderer then interpolates the encoded
-    values."""
-    hdr = getattr(scene, "hdr", None)
-    c = shade(
-        scene,
-        mesh.positions,
-        mesh.normals,
-        precision=precision,
-        clamp=hdr is None,
-        faces=mesh.faces,
+    """Display colours of the mesh's vertices under the scene (:func:`display_colors`, the
+    mesh's triangles included for shadows): (n, 3) float64 in [0, 1]. The renderer interpolates
+    these (sRGB-encoded under ``hdr``) values across each triangle."""
+    return display_colors(
+        scene, mesh.positions, mesh.normals, faces=mesh.faces, precision=precision
     )
-    if hdr is not None:
-        c = display(c, hdr)
-    return c
 
 
-def to_bytes(colors, opacity: float | None = None) -> np.ndarray:
-    """Colours in [0, 1] as 8-bit values, rounded to nearest: (n, 3) uint8, or (n, 4) with an
-    alpha column of ``opacity`` when given."""
-    c = np.clip(np.asarray(colors, np.float64), 0.0, 1.0)
-    out = np.rint(c * 255.0).astype(np.uint8)
-    if opacity is not None:
-        alpha = np.full((len(out), 1), int(round(float(opacity) * 255.0)), np.uint8)
-        out = np.hstack([out, alpha])
-    return out
+def to_bytes(colors, opacity: float | None = None, *, out=None) -> np.ndarray:
+    """Display colours in [0, 1] as 8-bit values, rounded to nearest (computed in float64, so
+    float32 colours round exactly as their float64 values).
+
+    colors : (n, 3) float
+    opacity : adds an alpha column of ``opacity`` (then (n, 4))
+    out : (n, 3) uint8 array to write into (VTK's colour array, in place), without ``opacity``
+    Returns (n, 3) or (n, 4) uint8 (``out`` when given).
+    """
+    x = np.multiply(colors, 255.0, dtype=np.float64)
+    np.clip(x, 0.0, 255.0, out=x)
+    np.rint(x, out=x)
+    if out is not None:
+        if opacity is not None:
+            raise ValueError("to_bytes: out= takes no opacity")
+        out[...] = x
+        return out
+    rgb = x.astype(np.uint8)
+    if opacity is None:
+        return rgb
+    alpha = np.full((len(rgb), 1), int(round(float(opacity) * 255.0)), np.uint8)
+    return np.hstack([rgb, alpha])
