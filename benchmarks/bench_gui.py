@@ -41,7 +41,7 @@ from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer
 from explorer.geometry import meshes as M
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import plotter, polydata
+from explorer.render.vtk import add_unlit, plotter, polydata
 from explorer.shading.display import to_bytes
 
 SIZE = (800, 600)
@@ -150,7 +150,7 @@ def bare_engine_frames(mesh, count: int, repeat: int) -> dict:
     shader = explorer.Shader(scene, mesh.positions, mesh.normals, precision="float32")
     pl = plotter(SIZE, BACKGROUND)
     poly = polydata(mesh, to_bytes(shader.colors), float32=True, normals=False)
-    pl.add_mesh(poly, scalars="colors", rgb=True, lighting=False, show_scalar_bar=False)
+    add_unlit(pl, poly)
     pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
     arr = poly.GetPointData().GetArray("colors")
     rgb = vtk_to_numpy(arr)

@@ -45,7 +45,7 @@ from explorer.geometry.meshes import Mesh, area_weighted_normals, get_mesh
 from explorer.render.camera import Camera, apply_camera, back_to_front, camera_for, camera_from_vtk
 from explorer.render.images import encode_png
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import cells, plotter, polydata
+from explorer.render.vtk import add_unlit, cells, plotter, polydata
 from explorer.shading.display import display, engine_clamps, to_bytes
 from explorer.shading.shader import Shader
 
@@ -343,7 +343,7 @@ class _View:
     """One drawn version of the mesh (the full mesh or its level of detail): its Shader, its
     PolyData and actor, and the uint8 colour array VTK draws, written in place."""
 
-    def __init__(self, plotter, mesh: Mesh, scene: Scene):
+    def __init__(self, pl, mesh: Mesh, scene: Scene):
         from vtkmodules.util.numpy_support import vtk_to_numpy
 
         self.mesh = mesh
@@ -362,14 +362,7 @@ class _View:
         self.poly = polydata(
             mesh, np.zeros((mesh.n_vertices, 3), np.uint8), float32=True, normals=False
         )
-        self.actor = plotter.add_mesh(
-            self.poly,
-            scalars="colors",
-            rgb=True,
-            lighting=False,
-            show_scalar_bar=False,
-            reset_camera=False,
-        )
+        self.actor = add_unlit(pl, self.poly)
         self.vtk_colors = self.poly.GetPointData().GetArray("colors")
         self.rgb = vtk_to_numpy(self.vtk_colors)  # a view of VTK's memory
         self.sorted_for = None  # camera the triangles were last sorted for (translucency)

@@ -2,11 +2,12 @@
 
 The engine computes one colour per vertex (:func:`explorer.shade`); VTK only draws them. The
 colours go to VTK as RGB point scalars with VTK's lighting off, so VTK adds nothing: no light of
-its own, no specular, no ambient (``add_mesh(..., rgb=True, lighting=False)``, see the last
-section of the lighting-equation reference). Between vertices VTK interpolates the colours
-linearly across each triangle: Gouraud shading, as in OpenGL's fixed-function pipeline. No
-multisampling or anti-aliasing, a fixed background, ``render()`` before ``screenshot()``, and
-every plotter is closed afterwards: the same scene gives the same pixels every time.
+its own, no specular, no ambient (:func:`explorer.render.vtk.add_unlit`, see the last section of
+the lighting-equation reference). Between vertices VTK interpolates the colours linearly across
+each triangle: Gouraud shading, as in OpenGL's fixed-function pipeline. No multisampling or
+anti-aliasing (:func:`explorer.render.vtk.plotter`), a fixed background, ``render()`` before
+``screenshot()``, and every plotter is closed afterwards: the same scene gives the same pixels
+every time.
 
 Camera and viewer agree (see :func:`camera_for`):
 
@@ -29,7 +30,7 @@ from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera, Vec3, apply_camera, back_to_front, camera_for
 from explorer.render.images import DEFAULT_SIZE, check_size
-from explorer.render.vtk import cells, plotter, polydata
+from explorer.render.vtk import add_unlit, cells, plotter, polydata
 from explorer.shading.display import to_bytes, vertex_colors
 
 #: background colour of every render (linear RGB in [0, 1]): a neutral mid-dark grey on which
@@ -122,14 +123,7 @@ class OffscreenRenderer:
                 pl.remove_actor(self._actor)
             self._poly = polydata(mesh, rgb)
             self._sorted = False
-            self._actor = pl.add_mesh(
-                self._poly,
-                scalars="colors",
-                rgb=True,
-                lighting=False,
-                show_scalar_bar=False,
-                reset_camera=False,
-            )
+            self._actor = add_unlit(pl, self._poly)
             self._mesh = mesh
         else:
             self._poly.point_data["colors"] = rgb
@@ -152,14 +146,7 @@ class OffscreenRenderer:
         extra = None
         if backdrop is not None:
             bmesh, bcolors = backdrop
-            extra = pl.add_mesh(
-                polydata(bmesh, to_bytes(bcolors)),
-                scalars="colors",
-                rgb=True,
-                lighting=False,
-                show_scalar_bar=False,
-                reset_camera=False,
-            )
+            extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors)))
         try:
             pl.render()
             img = pl.screenshot(return_img=True)

@@ -66,11 +66,6 @@ class Hits:
     normals: np.ndarray
     method: str
 
-    @property
-    def size(self) -> tuple[int, int]:
-        h, w = self.mask.shape
-        return w, h
-
 
 def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0) -> Hits:
     """Closed-form hits of the pixel rays on the sphere ``|P - centre| = radius``.
@@ -287,17 +282,3 @@ def reference(
         colors = np.zeros((0, 3))
         spec = np.zeros(0)
     return Reference(h, colors, spec)
-
-
-def render_per_pixel(
-    scene,
-    mesh,
-    size: Sequence[int],
-    *,
-    background=None,
-    camera=None,
-    method: str = "auto",
-) -> np.ndarray:
-    """The per-pixel picture of a scene on a mesh: (h, w, 3) uint8 (what ``phong-explorer
-    render --per-pixel`` writes). Translucency is not drawn: every seen point is opaque."""
-    return reference(scene, mesh, size, camera=camera, method=method).image(background)

@@ -5,7 +5,9 @@ renders, the explorer window, the GUI benchmark) comes from :func:`plotter`, so 
 same way: no multisampling or anti-aliasing, no lights of VTK's own, plain "over" blending of
 translucent triangles in the order they are drawn (VTK's weighted-average order-independent
 transparency and its depth peeling, which orders layers wrongly on Mesa llvmpipe, are both off).
-Every mesh goes to VTK through :func:`polydata`.
+Every mesh goes to VTK through :func:`polydata`, and is drawn in the engine's colours by
+:func:`add_unlit`: RGB point scalars with VTK's lighting off, so VTK adds nothing (no light of
+its own, no specular, no ambient) and interpolates the colours linearly across each triangle.
 
 With no display, an off-screen window asks VTK for EGL directly (:func:`headless_egl`): VTK
 would otherwise probe X, log "bad X server connection" and then fall back to EGL.
@@ -97,3 +99,16 @@ def polydata(mesh: Mesh, colors=None, *, faces=None, float32: bool = False, norm
     if colors is not None:
         poly.point_data["colors"] = np.asarray(colors)
     return poly
+
+
+def add_unlit(plotter, poly):
+    """Draw ``poly`` in its ``"colors"`` point data as they are (VTK's lighting off), without
+    moving the camera. Returns the actor."""
+    return plotter.add_mesh(
+        poly,
+        scalars="colors",
+        rgb=True,
+        lighting=False,
+        show_scalar_bar=False,
+        reset_camera=False,
+    )
