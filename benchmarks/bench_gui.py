@@ -40,8 +40,9 @@ from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer
 from explorer.geometry import meshes as M
+from explorer.render.camera import camera_for
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import add_unlit, plotter, polydata
+from explorer.render.vtk import add_unlit, plotter, polydata, set_camera
 from explorer.shading.display import to_bytes
 
 SIZE = (800, 600)
@@ -151,7 +152,7 @@ def bare_engine_frames(mesh, count: int, repeat: int) -> dict:
     pl = plotter(SIZE, BACKGROUND)
     poly = polydata(mesh, to_bytes(shader.colors), float32=True, normals=False)
     add_unlit(pl, poly)
-    pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
+    set_camera(pl, camera_for(scene, mesh, SIZE[0] / SIZE[1]))
     arr = poly.GetPointData().GetArray("colors")
     rgb = vtk_to_numpy(arr)
     m = scene.material
@@ -191,7 +192,7 @@ def vtk_lighting_frames(mesh, count: int, repeat: int) -> dict:
             pv.Light(position=light.position, focal_point=tuple(mesh.centre), positional=True,
                      cone_angle=180.0, light_type="scene light")
         )  # fmt: skip
-    pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
+    set_camera(pl, camera_for(scene, mesh, SIZE[0] / SIZE[1]))
     prop = actor.GetProperty()
 
     def step(i):

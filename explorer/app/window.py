@@ -45,7 +45,7 @@ from explorer.geometry.meshes import Mesh, area_weighted_normals, get_mesh
 from explorer.render.camera import Camera, apply_camera, back_to_front, camera_for, camera_from_vtk
 from explorer.render.images import encode_png
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import add_unlit, cells, plotter, polydata
+from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import display, engine_clamps, to_bytes
 from explorer.shading.shader import Shader
 
@@ -726,9 +726,8 @@ class Explorer:
                 handle = self.centre + d * light_direction(az, el)
                 r = G.HANDLE_RADIUS * self.radius
                 cam = widen_to_show(cam, [handle], aspect, pad=r)
-        self.plotter.camera_set = True
         # the picture moved left by half the panel's width, without turning the camera
-        apply_camera(self.plotter.camera, replace(cam, window_center=(1.0 - G.PANEL_X, 0.0)))
+        set_camera(self.plotter, replace(cam, window_center=(1.0 - G.PANEL_X, 0.0)))
         self.plotter.renderer.ResetCameraClippingRange()
 
     def _observe(self) -> None:

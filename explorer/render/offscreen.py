@@ -28,9 +28,9 @@ import numpy as np
 
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import Camera, Vec3, apply_camera, back_to_front, camera_for
+from explorer.render.camera import Camera, Vec3, back_to_front, camera_for
 from explorer.render.images import DEFAULT_SIZE, check_size
-from explorer.render.vtk import add_unlit, cells, plotter, polydata
+from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import to_bytes, vertex_colors
 
 #: background colour of every render (linear RGB in [0, 1]): a neutral mid-dark grey on which
@@ -136,7 +136,7 @@ class OffscreenRenderer:
             if label is not None:
                 band = 1.5 * self._text.GetTextProperty().GetFontSize() / h
             camera = camera_for(scene, mesh, w / h, bottom=band)
-        self._set_camera(camera)
+        set_camera(pl, camera)
         # translucent: draw the triangles back to front, so each blends over what is behind
         # it; opaque: file order (the depth test decides)
         order = back_to_front(mesh, camera) if opacity < 1.0 else None
@@ -203,10 +203,6 @@ class OffscreenRenderer:
         w, _ = self.size
         t.SetPosition(w / 2.0, max(2.0, 0.25 * font_size))
         t.SetVisibility(True)
-
-    def _set_camera(self, cam: Camera) -> None:
-        self.plotter.camera_set = True
-        apply_camera(self.plotter.camera, cam)
 
 
 def render_image(

@@ -24,6 +24,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from explorer.geometry.meshes import Mesh
+from explorer.render.camera import Camera, apply_camera
 
 #: the environment variable that picks VTK's OpenGL window class
 WINDOW_ENV = "VTK_DEFAULT_OPENGL_WINDOW"
@@ -112,3 +113,10 @@ def add_unlit(plotter, poly):
         show_scalar_bar=False,
         reset_camera=False,
     )
+
+
+def set_camera(plotter, camera: Camera) -> None:
+    """Point the plotter's camera as ``camera`` (:func:`explorer.render.camera.apply_camera`)
+    and keep PyVista from resetting it at the first frame."""
+    plotter.camera_set = True
+    apply_camera(plotter.camera, camera)
