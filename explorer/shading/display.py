@@ -3,10 +3,13 @@
 One path for every picture the project makes (renders, the per-pixel reference, the window,
 mesh exports)::
 
-    colours (n, 3) linear, >= 0          the engine (clamp=False under hdr)
+    colours (n, 3) linear, >= 0          the engine (clamp=False under hdr: engine_clamps)
       -> exposure and tone map            scenes with ``hdr`` (below); else clamp to [0, 1]
       -> sRGB encoding                    scenes with ``hdr``; OpenGL's clamp path is not encoded
       -> 8-bit                            :func:`to_bytes`, rounded to nearest
+
+:func:`display` is the middle two steps, :func:`display_colors` (and :func:`vertex_colors` for a
+mesh's vertices) the engine and :func:`display` together.
 
 The engine's unclamped colours (``shade(..., clamp=False)``) are linear radiance-like values
 ``>= 0`` that may exceed 1 (several lights, an energy-conserving lobe, bright lights). A scene
@@ -33,8 +36,10 @@ The lecture notes' rule for HDR (keep ``kd + ks`` at most 1 per channel) is chec
 
 from __future__ import annotations
 
+import numba as nb
 import numpy as np
 
+from explorer.core.errors import ExplorerError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.geometry.meshes import Mesh
 from explorer.shading.shader import shade
@@ -123,24 +128,47 @@ def vertex_colors(scene, mesh: Mesh, *, precision: str = "float64") -> np.ndarra
 
 
 def to_bytes(colors, opacity: float | None = None, *, out=None) -> np.ndarray:
-    """Display colours in [0, 1] as 8-bit values, rounded to nearest (computed in float64, so
-    float32 colours round exactly as their float64 values).
+    """Display colours in [0, 1] as 8-bit values, rounded to nearest (half to even) in float64,
+    so float32 colours round exactly as their float64 values.
 
     colors : (n, 3) float
     opacity : adds an alpha column of ``opacity`` (then (n, 4))
     out : (n, 3) uint8 array to write into (VTK's colour array, in place), without ``opacity``
     Returns (n, 3) or (n, 4) uint8 (``out`` when given).
     """
-    x = np.multiply(colors, 255.0, dtype=np.float64)
-    np.clip(x, 0.0, 255.0, out=x)
-    np.rint(x, out=x)
+    c = np.asarray(colors)
+    if c.dtype != np.float32:
+        c = c.astype(np.float64, copy=False)
+    c = np.ascontiguousarray(c)
+    if out is not None and opacity is not None:
+        raise ExplorerError("to_bytes: out= takes no opacity")
+    direct = (
+        out is not None
+        and out.dtype == np.uint8
+        and out.shape == c.shape
+        and out.flags.c_contiguous
+        and out.flags.writeable
+    )
+    rgb = out if direct else np.empty(c.shape, np.uint8)
+    _round_bytes(c.reshape(-1), rgb.reshape(-1))
     if out is not None:
-        if opacity is not None:
-            raise ValueError("to_bytes: out= takes no opacity")
-        out[...] = x
+        if not direct:
+            out[...] = rgb
         return out
-    rgb = x.astype(np.uint8)
     if opacity is None:
         return rgb
     alpha = np.full((len(rgb), 1), int(round(float(opacity) * 255.0)), np.uint8)
     return np.hstack([rgb, alpha])
+
+
+@nb.njit(cache=True, nogil=True)
+def _round_bytes(x, out):
+    """out[i] = x[i]·255 clamped to [0, 255] and rounded to nearest, in float64.
+    x : (k,) float32 or float64; out : (k,) uint8."""
+    for i in range(x.size):
+        v = np.float64(x[i]) * 255.0
+        if v < 0.0:
+            v = 0.0
+        elif v > 255.0:
+            v = 255.0
+        out[i] = np.uint8(np.rint(v))

@@ -138,7 +138,10 @@ def test_to_bytes_writes_in_place_and_rounds_float32_exactly():
     x = np.float32(0.5078431367874146)
     assert float(x) * 255 < 129.5 and x * np.float32(255) == np.float32(129.5)
     assert to_bytes(np.full((1, 3), x, np.float32)).tolist() == [[129, 129, 129]]
-    with pytest.raises(ValueError):
+    strided = np.zeros((2, 6), np.uint8)  # an array that is not contiguous is written too
+    assert to_bytes(c, out=strided[:, ::2]).tolist() == to_bytes(c).tolist()
+    assert strided[:, ::2].tolist() == to_bytes(c).tolist() and not strided[:, 1::2].any()
+    with pytest.raises(ExplorerError, match="opacity"):
         to_bytes(c, 0.5, out=out)
 
 
