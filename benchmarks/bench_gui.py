@@ -32,18 +32,17 @@ import time
 from pathlib import Path
 
 import numpy as np
+from common import uv_sphere  # benchmarks/common.py
 
-os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-
-from common import uv_sphere  # noqa: E402  (benchmarks/common.py)
-
-import explorer  # noqa: E402
+import explorer
 from explorer.app import window as gui
 from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer
 from explorer.geometry import meshes as M
+from explorer.render.camera import camera_for
 from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import add_unlit, plotter, polydata, set_camera
 from explorer.shading.display import to_bytes
 
 SIZE = (800, 600)
@@ -146,28 +145,21 @@ def explorer_frames(mesh, count: int, repeat: int, **kw) -> dict:
 
 def bare_engine_frames(mesh, count: int, repeat: int) -> dict:
     """The engine's update and upload on a bare window: the cost without the widgets."""
-    import pyvista as pv
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     scene = scene_for(mesh, count)
     shader = explorer.Shader(scene, mesh.positions, mesh.normals, precision="float32")
-    pl = pv.Plotter(off_screen=True, window_size=list(SIZE), lighting=None)
-    pl.render_window.SetMultiSamples(0)
-    pl.disable_anti_aliasing()
-    pl.set_background(BACKGROUND)
-    poly = gui._polydata(mesh, to_bytes(shader.colors))
-    pl.add_mesh(poly, scalars="colors", rgb=True, lighting=False, show_scalar_bar=False)
-    pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
+    pl = plotter(SIZE, BACKGROUND)
+    poly = polydata(mesh, to_bytes(shader.colors), float32=True, normals=False)
+    add_unlit(pl, poly)
+    set_camera(pl, camera_for(scene, mesh, SIZE[0] / SIZE[1]))
     arr = poly.GetPointData().GetArray("colors")
     rgb = vtk_to_numpy(arr)
-    buf = np.empty((mesh.n_vertices, 3), np.float32)
     m = scene.material
 
     def step(i):
         shader.set_material(m.with_scalars(kd=0.3 + 0.4 * (i % 2)))
-        np.multiply(shader.colors, 255.0, out=buf)
-        np.rint(buf, out=buf)
-        rgb[...] = buf
+        to_bytes(shader.colors, out=rgb)
         arr.Modified()
         pl.render_window.Render()
         finish(pl)
@@ -183,11 +175,8 @@ def vtk_lighting_frames(mesh, count: int, repeat: int) -> dict:
 
     scene = scene_for(mesh, count)
     m = scene.material
-    pl = pv.Plotter(off_screen=True, window_size=list(SIZE), lighting=None)
-    pl.render_window.SetMultiSamples(0)
-    pl.disable_anti_aliasing()
-    pl.set_background(BACKGROUND)
-    poly = mesh.to_polydata()
+    pl = plotter(SIZE, BACKGROUND)
+    poly = polydata(mesh)
     actor = pl.add_mesh(
         poly,
         color=m.diffuse,
@@ -203,7 +192,7 @@ def vtk_lighting_frames(mesh, count: int, repeat: int) -> dict:
             pv.Light(position=light.position, focal_point=tuple(mesh.centre), positional=True,
                      cone_angle=180.0, light_type="scene light")
         )  # fmt: skip
-    pl.camera_position = [scene.viewer.eye, tuple(mesh.centre), (0.0, 1.0, 0.0)]
+    set_camera(pl, camera_for(scene, mesh, SIZE[0] / SIZE[1]))
     prop = actor.GetProperty()
 
     def step(i):

@@ -55,6 +55,7 @@ from explorer.render.perpixel import (
     reference,
     sphere_hits,
 )
+from explorer.render.vtk import headless_egl
 from explorer.shading.display import vertex_colors
 from explorer.shading.equation import reference_shade
 from explorer.shading.shader import shade
@@ -365,16 +366,8 @@ def _opengl() -> dict[str, str]:
     try:
         import pyvista as pv
 
-        headless = not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
-        key = "VTK_DEFAULT_OPENGL_WINDOW"
-        added = headless and key not in os.environ
-        if added:
-            os.environ[key] = "vtkEGLRenderWindow"
-        try:
+        with headless_egl():
             info = pv.GPUInfo()
-        finally:
-            if added:
-                del os.environ[key]
         return {"vendor": info.vendor, "renderer": info.renderer, "version": info.version}
     except Exception:  # noqa: BLE001 - only informative
         return {}

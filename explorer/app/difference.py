@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.analysis import accuracy as A
+from explorer.shading.display import to_bytes
 
 #: the error (1/255 levels) drawn white; the ramp below it is logarithmic (see heat_map)
 VMAX = 16.0
@@ -63,7 +64,7 @@ class DifferenceView:
             self.close()
             self._comparer = A.ViewComparer(size)
         c = self._comparer.compare(scene, mesh, camera=camera, colors=colors)
-        bg = tuple(int(round(255 * float(v))) for v in background)
+        bg = tuple(int(v) for v in to_bytes([background])[0])
         self._set_image(A.heat_map(c.levels, c.mask, vmax=VMAX, background=bg))
         self.comparison = c
         self.key = key

@@ -44,8 +44,9 @@ from explorer.core.scene import Scene, Viewer
 from explorer.geometry.meshes import Mesh, area_weighted_normals, get_mesh
 from explorer.render.camera import Camera, apply_camera, back_to_front, camera_for, camera_from_vtk
 from explorer.render.images import encode_png
-from explorer.render.offscreen import BACKGROUND, _plotter
-from explorer.shading.display import display
+from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
+from explorer.shading.display import display, engine_clamps, to_bytes
 from explorer.shading.shader import Shader
 
 log = logging.getLogger(__name__)
@@ -309,7 +310,7 @@ def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkFiltersCore import vtkQuadricClustering
 
-    poly = _polydata(mesh)
+    poly = polydata(mesh, float32=True, normals=False)
 
     def cluster(divisions: int):
         q = vtkQuadricClustering()
@@ -338,66 +339,43 @@ def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
     return Mesh(pos, area_weighted_normals(pos, faces), faces, f"{mesh.name} (LOD)")
 
 
-def _polydata(mesh: Mesh, colors=None):
-    """A PolyData of the mesh's triangles with float32 points and no normals (the colours are
-    drawn unlit, so VTK has no use for normals), and ``colors`` as uint8 point data."""
-    import pyvista as pv
-
-    cells = np.hstack([np.full((mesh.n_faces, 1), 3, np.int64), mesh.faces]).ravel()
-    poly = pv.PolyData(np.asarray(mesh.positions, dtype=np.float32), cells)
-    if colors is not None:
-        poly.point_data["colors"] = colors
-    return poly
-
-
 class _View:
     """One drawn version of the mesh (the full mesh or its level of detail): its Shader, its
     PolyData and actor, and the uint8 colour array VTK draws, written in place."""
 
-    def __init__(self, plotter, mesh: Mesh, scene: Scene):
+    def __init__(self, pl, mesh: Mesh, scene: Scene):
         from vtkmodules.util.numpy_support import vtk_to_numpy
 
         self.mesh = mesh
         self.centre = mesh.centre  # (3,): Mesh computes these on every call
         self.radius = mesh.radius or 1.0
-        self.hdr = getattr(scene, "hdr", None)
+        self.hdr = scene.hdr
         self.shader = Shader(
             scene,
             mesh.positions,
             mesh.normals,
             precision="float32",
-            clamp=self.hdr is None,
+            clamp=engine_clamps(scene),
             faces=mesh.faces,
         )
-        self.poly = _polydata(mesh, np.zeros((mesh.n_vertices, 3), np.uint8))
-        self.actor = plotter.add_mesh(
-            self.poly,
-            scalars="colors",
-            rgb=True,
-            lighting=False,
-            show_scalar_bar=False,
-            reset_camera=False,
+        # float32 points, no normals: the colours are drawn unlit
+        self.poly = polydata(
+            mesh, np.zeros((mesh.n_vertices, 3), np.uint8), float32=True, normals=False
         )
+        self.actor = add_unlit(pl, self.poly)
         self.vtk_colors = self.poly.GetPointData().GetArray("colors")
         self.rgb = vtk_to_numpy(self.vtk_colors)  # a view of VTK's memory
-        self._buf = np.empty((mesh.n_vertices, 3), np.float32)
         self.sorted_for = None  # camera the triangles were last sorted for (translucency)
 
     def colors(self) -> np.ndarray:
-        """(n, 3) display colours in [0, 1]: the shader's, through the scene's HDR display
-        (exposure, tone map, sRGB) when it has one, as
-        :func:`explorer.shading.display.vertex_colors`."""
-        if self.hdr is None:
-            return self.shader.colors
-
+        """(n, 3) display colours in [0, 1]: the shader's through
+        :func:`explorer.shading.display.display`."""
         return display(self.shader.colors, self.hdr)
 
     def upload(self) -> None:
-        """Write the display colours into VTK's array (rounded to nearest, like
-        :func:`explorer.shading.display.to_bytes`) and mark it modified."""
-        np.multiply(self.colors(), 255.0, out=self._buf)
-        np.rint(self._buf, out=self._buf)
-        self.rgb[...] = self._buf
+        """Write the display colours into VTK's array as 8-bit values
+        (:func:`explorer.shading.display.to_bytes`) and mark it modified."""
+        to_bytes(self.colors(), out=self.rgb)
         self.vtk_colors.Modified()
 
     def show(self, visible: bool) -> None:
@@ -439,8 +417,6 @@ class Explorer:
         lod_target: int = LOD_TARGET,
         background=None,
     ):
-        import pyvista as pv
-
         self.materials_dirs = tuple(materials_dirs)
         self.state_file = Path(state_file) if state_file else None
         self.output_dir = Path(output_dir) if output_dir else Path.cwd()
@@ -473,15 +449,8 @@ class Explorer:
 
         w, h = (int(v) for v in window_size)
         background = BACKGROUND if background is None else background
-        if off_screen:  # the renderer's off-screen window (EGL when there is no display)
-            self.plotter = pl = _plotter((w, h), background)
-        else:  # the same settings in a window on the screen
-            self.plotter = pl = pv.Plotter(window_size=[w, h], lighting=None, title=G.TITLE)
-            pl.render_window.SetMultiSamples(0)
-            pl.disable_anti_aliasing()
-            pl.renderer.SetUseOIT(False)
-            pl.renderer.SetUseDepthPeeling(False)
-            pl.set_background(background)
+        self.plotter = pl = plotter((w, h), background, off_screen=off_screen, title=G.TITLE)
+        if not off_screen:
             reason = _window_problem(pl.render_window)
             if reason:
                 pl.close()
@@ -502,7 +471,12 @@ class Explorer:
         self._on_screen = not off_screen
         self._frame_camera()
         self._observe()
-        self._start = (self.scene, mesh.name, self.preset_name, self._camera_tuple())
+        self._start = (
+            self.scene,
+            mesh.name,
+            self.preset_name,
+            camera_from_vtk(self.plotter.camera),
+        )
         self._building = False
         self._push_scene(render=False)
         self._sync_controls()
@@ -752,9 +726,8 @@ class Explorer:
                 handle = self.centre + d * light_direction(az, el)
                 r = G.HANDLE_RADIUS * self.radius
                 cam = widen_to_show(cam, [handle], aspect, pad=r)
-        self.plotter.camera_set = True
         # the picture moved left by half the panel's width, without turning the camera
-        apply_camera(self.plotter.camera, replace(cam, window_center=(1.0 - G.PANEL_X, 0.0)))
+        set_camera(self.plotter, replace(cam, window_center=(1.0 - G.PANEL_X, 0.0)))
         self.plotter.renderer.ResetCameraClippingRange()
 
     def _observe(self) -> None:
@@ -961,18 +934,13 @@ class Explorer:
             self.active_view.upload()
 
     def _sort(self, view: _View) -> None:
-
-        cam = self._camera_tuple()
-        if view.sorted_for == cam:
+        """Draw the view's triangles back to front for the camera (translucency)."""
+        camera = camera_from_vtk(self.plotter.camera)
+        key = (camera.position, camera.focal_point, camera.parallel)  # what the order depends on
+        if view.sorted_for == key:
             return
-        c = self.plotter.camera
-        camera = Camera(
-            c.GetPosition(), c.GetFocalPoint(), c.GetViewUp(), bool(c.GetParallelProjection()),
-            c.GetParallelScale(), c.GetViewAngle(), c.GetClippingRange(),
-        )  # fmt: skip
-        faces = view.mesh.faces[back_to_front(view.mesh, camera)]
-        view.poly.faces = np.hstack([np.full((len(faces), 1), 3, np.int64), faces]).ravel()
-        view.sorted_for = cam
+        view.poly.faces = cells(view.mesh.faces[back_to_front(view.mesh, camera)])
+        view.sorted_for = key
 
     def _after_frame(self, *_) -> None:
         """Render window EndEvent: count the frame, time it, and write the state file (after
@@ -986,17 +954,6 @@ class Explorer:
             self._diff_timer = self.plotter.iren.interactor.CreateOneShotTimer(20)
         if self.state_file is not None:
             self.write_state()
-
-    def _camera_tuple(self):
-        c = self.plotter.camera
-        return (
-            tuple(c.GetPosition()),
-            tuple(c.GetFocalPoint()),
-            tuple(c.GetViewUp()),
-            bool(c.GetParallelProjection()),
-            c.GetParallelScale(),
-            c.GetViewAngle(),
-        )
 
     # -- level of detail -------------------------------------------------------------------
     @property
@@ -1124,7 +1081,7 @@ class Explorer:
             repr(self.shown_scene()),
             self.mesh.name,
             self.mesh.n_vertices,
-            self._camera_tuple(),
+            self._view_camera(),
             tuple(self.plotter.window_size),
         )
 
@@ -1146,7 +1103,7 @@ class Explorer:
                 scene,
                 self.mesh,
                 self._views[0].colors(),
-                self._mesh_camera(camera_from_vtk(self.plotter.camera)),
+                self._view_camera(),
                 self.plotter.window_size,
                 key,
                 self.plotter.renderer.GetBackground(),
@@ -1161,11 +1118,13 @@ class Explorer:
         self.texts["advice"].SetInput(advice_lines(self.advice))
         self._diff_pending = False
 
-    def _mesh_camera(self, cam):
-        """``cam`` with a clipping range around the mesh (the window's own range follows what
-        is visible, and the mesh is hidden while the heat map shows)."""
+    def _view_camera(self) -> Camera:
+        """The window's camera, with a clipping range around the mesh (the window's own range
+        follows what is visible, and the mesh is hidden while the heat map shows): what the
+        difference view compares."""
         import dataclasses
 
+        cam = camera_from_vtk(self.plotter.camera)
         pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
         ahead = (focal - pos) / max(float(np.linalg.norm(focal - pos)), 1e-300)
         d = float((self.centre - pos) @ ahead)
@@ -1292,14 +1251,7 @@ class Explorer:
             self._set_mesh(self._meshes[mesh_name])
             self.handle.SetRadius(G.HANDLE_RADIUS * self.radius)
         self.scene = scene
-        c = self.plotter.camera
-        pos, focal, up, parallel, scale, angle = camera
-        c.SetPosition(*pos)
-        c.SetFocalPoint(*focal)
-        c.SetViewUp(*up)
-        c.SetParallelProjection(parallel)
-        c.SetParallelScale(scale)
-        c.SetViewAngle(angle)
+        apply_camera(self.plotter.camera, camera)
         self._reset_distance_range()
         self._say("reset to the start")
         self._refresh()

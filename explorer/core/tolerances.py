@@ -27,6 +27,23 @@ HALFWAY_EPS2 = 1e-24
 #: attenuation factor is capped at 1 / ATTENUATION_FLOOR (and colours stay finite).
 ATTENUATION_FLOOR = 1e-6
 
+# --- rays (explorer.geometry.rays) ----------------------------------------------------------
+
+#: Shadow rays: a hit nearer than this (normalised units) is the ray's own surface, not an
+#: occluder; a hit within this of the light is the light's own position. Only front sides
+#: occlude, so no larger bias is needed against "shadow acne".
+RAY_T_EPS = 1e-9
+
+#: Shadow rays: a ray-triangle determinant below this (it is -D·(e1 × e2)) is a back side or a
+#: ray parallel to the triangle: no hit.
+DET_EPS = 1e-15
+
+#: Per-pixel reference: a pixel's ray meeting a triangle at a parameter at most this times the
+#: scene's size (max(largest absolute coordinate, 1)) is ignored; the rays start at the camera,
+#: so this only drops hits at the camera itself. Any determinant other than 0 counts (both
+#: sides are seen, as VTK draws them).
+PIXEL_RAY_T_MIN = 1e-9
+
 # --- float32 fast path ----------------------------------------------------------------------
 
 #: A float32 dot product of unit vectors is within about 1e-6 of the float64 one after the

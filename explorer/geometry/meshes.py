@@ -108,19 +108,6 @@ class Mesh:
         """(m, 3) float64 unit normals of the triangles (zero for degenerate ones)."""
         return _unit_rows(_face_cross(self.positions, self.faces))
 
-    def to_polydata(self, colors=None):
-        """A ``pyvista.PolyData`` with point normals (and ``colors`` as (n, 3|4) uint8 point
-        data named ``"colors"`` when given). Imports pyvista."""
-        import pyvista as pv
-
-        tri = np.hstack([np.full((self.n_faces, 1), 3, np.int64), self.faces]).ravel()
-        poly = pv.PolyData(np.array(self.positions), tri)
-        poly.point_data["Normals"] = np.array(self.normals)
-        poly.point_data.active_normals_name = "Normals"
-        if colors is not None:
-            poly.point_data["colors"] = np.asarray(colors)
-        return poly
-
 
 def _frozen(a, dtype, name) -> np.ndarray:
     arr = np.array(a, dtype=dtype, copy=True, order="C")

@@ -2,11 +2,12 @@
 
 The engine computes one colour per vertex (:func:`explorer.shade`); VTK only draws them. The
 colours go to VTK as RGB point scalars with VTK's lighting off, so VTK adds nothing: no light of
-its own, no specular, no ambient (``add_mesh(..., rgb=True, lighting=False)``, see the last
-section of the lighting-equation reference). Between vertices VTK interpolates the colours
-linearly across each triangle: Gouraud shading, as in OpenGL's fixed-function pipeline. No
-multisampling or anti-aliasing, a fixed background, ``render()`` before ``screenshot()``, and
-every plotter is closed afterwards: the same scene gives the same pixels every time.
+its own, no specular, no ambient (:func:`explorer.render.vtk.add_unlit`, see the last section of
+the lighting-equation reference). Between vertices VTK interpolates the colours linearly across
+each triangle: Gouraud shading, as in OpenGL's fixed-function pipeline. No multisampling or
+anti-aliasing (:func:`explorer.render.vtk.plotter`), a fixed background, ``render()`` before
+``screenshot()``, and every plotter is closed afterwards: the same scene gives the same pixels
+every time.
 
 Camera and viewer agree (see :func:`camera_for`):
 
@@ -21,15 +22,15 @@ VTK is imported only inside the functions that draw or read/write PNG files.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Iterable, Sequence
 
 import numpy as np
 
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import Camera, Vec3, apply_camera, back_to_front, camera_for
+from explorer.render.camera import Camera, Vec3, back_to_front, camera_for
 from explorer.render.images import DEFAULT_SIZE, check_size
+from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import to_bytes, vertex_colors
 
 #: background colour of every render (linear RGB in [0, 1]): a neutral mid-dark grey on which
@@ -47,35 +48,6 @@ LABEL_HEIGHT = 0.085
 
 
 # -- the off-screen renderer ---------------------------------------------------------------
-
-
-_WINDOW_ENV = "VTK_DEFAULT_OPENGL_WINDOW"
-
-
-def _plotter(size: tuple[int, int], background):
-    import pyvista as pv
-
-    # No display: VTK would probe X, log "bad X server connection" and fall back to EGL; ask
-    # for EGL directly. Only while the window is created, so nothing else in the process
-    # (a GUI started later with a display) inherits the setting.
-    headless = not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
-    added = headless and _WINDOW_ENV not in os.environ
-    if added:
-        os.environ[_WINDOW_ENV] = "vtkEGLRenderWindow"
-    try:
-        pl = pv.Plotter(off_screen=True, window_size=list(size), lighting=None)
-    finally:
-        if added:
-            del os.environ[_WINDOW_ENV]
-    pl.render_window.SetMultiSamples(0)  # before the first render: no multisampling
-    pl.disable_anti_aliasing()
-    # translucency: plain "over" blending in the order the triangles are drawn (sorted back to
-    # front by the caller); VTK's weighted-average OIT and its depth peeling (wrong layer
-    # order on Mesa llvmpipe) are both off
-    pl.renderer.SetUseOIT(False)
-    pl.renderer.SetUseDepthPeeling(False)
-    pl.set_background(background)
-    return pl
 
 
 class OffscreenRenderer:
@@ -111,7 +83,7 @@ class OffscreenRenderer:
     @property
     def plotter(self):
         if self._pl is None:
-            self._pl = _plotter(self.size, self.background)
+            self._pl = plotter(self.size, self.background)
         return self._pl
 
     def render(
@@ -149,16 +121,9 @@ class OffscreenRenderer:
         if self._mesh is not mesh:
             if self._actor is not None:
                 pl.remove_actor(self._actor)
-            self._poly = mesh.to_polydata(rgb)
+            self._poly = polydata(mesh, rgb)
             self._sorted = False
-            self._actor = pl.add_mesh(
-                self._poly,
-                scalars="colors",
-                rgb=True,
-                lighting=False,
-                show_scalar_bar=False,
-                reset_camera=False,
-            )
+            self._actor = add_unlit(pl, self._poly)
             self._mesh = mesh
         else:
             self._poly.point_data["colors"] = rgb
@@ -171,26 +136,17 @@ class OffscreenRenderer:
             if label is not None:
                 band = 1.5 * self._text.GetTextProperty().GetFontSize() / h
             camera = camera_for(scene, mesh, w / h, bottom=band)
-        self._set_camera(camera)
+        set_camera(pl, camera)
         # translucent: draw the triangles back to front, so each blends over what is behind
         # it; opaque: file order (the depth test decides)
         order = back_to_front(mesh, camera) if opacity < 1.0 else None
         if order is not None or self._sorted:
-            faces = mesh.faces if order is None else mesh.faces[order]
-            cells = np.hstack([np.full((len(faces), 1), 3, np.int64), faces]).ravel()
-            self._poly.faces = cells
+            self._poly.faces = cells(mesh.faces if order is None else mesh.faces[order])
             self._sorted = order is not None
         extra = None
         if backdrop is not None:
             bmesh, bcolors = backdrop
-            extra = pl.add_mesh(
-                bmesh.to_polydata(to_bytes(bcolors)),
-                scalars="colors",
-                rgb=True,
-                lighting=False,
-                show_scalar_bar=False,
-                reset_camera=False,
-            )
+            extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors)))
         try:
             pl.render()
             img = pl.screenshot(return_img=True)
@@ -248,10 +204,6 @@ class OffscreenRenderer:
         t.SetPosition(w / 2.0, max(2.0, 0.25 * font_size))
         t.SetVisibility(True)
 
-    def _set_camera(self, cam: Camera) -> None:
-        self.plotter.camera_set = True
-        apply_camera(self.plotter.camera, cam)
-
 
 def render_image(
     scene,
@@ -297,7 +249,7 @@ def sheet(
     tw, th = check_size(tile)
     columns = max(1, min(int(columns), len(items)))
     rows = -(-len(items) // columns)
-    bg = np.rint(np.asarray(background) * 255.0).astype(np.uint8)
+    bg = to_bytes([background])[0]
     out = np.empty((rows * th + (rows + 1) * gap, columns * tw + (columns + 1) * gap, 3), np.uint8)
     out[:] = bg
     with OffscreenRenderer((tw, th), background) as r:

@@ -17,12 +17,12 @@ The camera model is VTK's (``vtkCamera``): a pixel (row ``r`` from the top, colu
 sampled at its centre, normalised device coordinates ``x = 2(c + ½)/w - 1``, ``y = 1 - 2(r +
 ½)/h``, shifted by the window centre; a parallel camera spans ``±parallel_scale`` vertically
 (times the aspect ratio horizontally), a perspective camera ``±tan(view_angle / 2)`` at unit
-distance. ``tests/test_perpixel.py`` checks this against VTK's own projection matrix and a
+distance. ``tests/render/test_perpixel.py`` checks this against VTK's own projection matrix and a
 per-pixel render of a fine sphere against VTK's render of it.
 
-The ray caster is a small numba kernel (no R-tree or Embree needed): each triangle's projected
-bounding box selects the pixels whose rays are tested against it exactly (Möller-Trumbore), and
-the nearest hit wins. VTK is imported only to read a live camera (:func:`camera_from_vtk`).
+The ray caster is :func:`explorer.geometry.rays.nearest_hits` (no R-tree or Embree needed): each
+triangle's projected bounding box selects the pixels whose rays are tested against it exactly
+(Möller-Trumbore), and the nearest hit wins. Nothing here imports VTK.
 """
 
 from __future__ import annotations
@@ -31,22 +31,20 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from explorer.core.errors import ExplorerError
+from explorer.core.tolerances import PIXEL_RAY_T_MIN
+from explorer.geometry.rays import nearest_hits, triangle_edges
 from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
-from explorer.shading.display import display, to_bytes
+from explorer.shading.display import display_colors, to_bytes
 from explorer.shading.equation import reference_terms
-from explorer.shading.shader import shade
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
 #: methods of :func:`reference`
 METHODS = ("auto", "sphere", "raycast")
-#: rays meeting a triangle at a parameter below this (relative to the scene size) are ignored
-_T_MIN = 1e-9
 
 
 # -- hits ----------------------------------------------------------------------------------
@@ -67,11 +65,6 @@ class Hits:
     positions: np.ndarray
     normals: np.ndarray
     method: str
-
-    @property
-    def size(self) -> tuple[int, int]:
-        h, w = self.mask.shape
-        return w, h
 
 
 def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0) -> Hits:
@@ -95,45 +88,6 @@ def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0)
     N = (P - c) / radius
     N /= np.linalg.norm(N, axis=1, keepdims=True)
     return Hits(mask, P, N, "sphere")
-
-
-@njit(cache=True, nogil=True)
-def _cast(v0, e1, e2, box, orig, dirs, t_min, best_t, best_tri, best_u, best_v):
-    m = v0.shape[0]
-    for f in range(m):
-        c0, c1, r0, r1 = box[f, 0], box[f, 1], box[f, 2], box[f, 3]
-        a0, a1, a2 = v0[f, 0], v0[f, 1], v0[f, 2]
-        p0, p1, p2 = e1[f, 0], e1[f, 1], e1[f, 2]
-        q0, q1, q2 = e2[f, 0], e2[f, 1], e2[f, 2]
-        for r in range(r0, r1 + 1):
-            for c in range(c0, c1 + 1):
-                d0, d1, d2 = dirs[r, c, 0], dirs[r, c, 1], dirs[r, c, 2]
-                # Möller-Trumbore: pv = d × e2, det = e1 · pv
-                pv0 = d1 * q2 - d2 * q1
-                pv1 = d2 * q0 - d0 * q2
-                pv2 = d0 * q1 - d1 * q0
-                det = p0 * pv0 + p1 * pv1 + p2 * pv2
-                if det == 0.0:
-                    continue
-                inv = 1.0 / det
-                s0 = orig[r, c, 0] - a0
-                s1 = orig[r, c, 1] - a1
-                s2 = orig[r, c, 2] - a2
-                u = (s0 * pv0 + s1 * pv1 + s2 * pv2) * inv
-                if u < 0.0 or u > 1.0:
-                    continue
-                w0 = s1 * p2 - s2 * p1
-                w1 = s2 * p0 - s0 * p2
-                w2 = s0 * p1 - s1 * p0
-                v = (d0 * w0 + d1 * w1 + d2 * w2) * inv
-                if v < 0.0 or u + v > 1.0:
-                    continue
-                t = (q0 * w0 + q1 * w1 + q2 * w2) * inv
-                if t > t_min and t < best_t[r, c]:
-                    best_t[r, c] = t
-                    best_tri[r, c] = f
-                    best_u[r, c] = u
-                    best_v[r, c] = v
 
 
 def _pixel_boxes(camera, size, tri: np.ndarray) -> np.ndarray:
@@ -178,9 +132,7 @@ def mesh_hits(camera, size: Sequence[int], mesh) -> Hits:
     P = np.asarray(mesh.positions, np.float64)
     F = np.asarray(mesh.faces, np.int64)
     tri = P[F]  # (m, 3, 3)
-    v0 = np.ascontiguousarray(tri[:, 0])
-    e1 = np.ascontiguousarray(tri[:, 1] - tri[:, 0])
-    e2 = np.ascontiguousarray(tri[:, 2] - tri[:, 0])
+    v0, e1, e2 = triangle_edges(tri)
     box = np.ascontiguousarray(_pixel_boxes(camera, (w, h), tri))
     best_t = np.full((h, w), np.inf)
     best_tri = np.full((h, w), -1, np.int64)
@@ -188,14 +140,14 @@ def mesh_hits(camera, size: Sequence[int], mesh) -> Hits:
     best_v = np.zeros((h, w))
     scale = max(float(np.abs(P).max(initial=0.0)), 1.0)
     if len(F):
-        _cast(
+        nearest_hits(
             v0,
             e1,
             e2,
             box,
             np.ascontiguousarray(origins),
             np.ascontiguousarray(dirs),
-            _T_MIN * scale,
+            PIXEL_RAY_T_MIN * scale,
             best_t,
             best_tri,
             best_u,
@@ -286,27 +238,24 @@ class Reference:
 
 
 def point_colors(scene, positions, normals, *, mesh=None, precision: str = "float64"):
-    """Engine colours of surface points, as the per-vertex renderer computes its vertices'
-    (:func:`explorer.shading.display.vertex_colors`): clamped, or through the scene's HDR display
-    when it has one. With a light that casts shadows the points are shaded together with ``mesh``'s
-    vertices and triangles, so the engine's own shadow rays decide what each point sees.
+    """Display colours of surface points, computed as the per-vertex renderer computes its
+    vertices' (:func:`explorer.shading.display.display_colors`). With a light that casts
+    shadows the points are shaded together with ``mesh``'s vertices and triangles, so the
+    engine's own shadow rays decide what each point sees.
 
     positions, normals : (k, 3) float
     Returns (k, 3) float64 display colours in [0, 1].
     """
-    hdr = getattr(scene, "hdr", None)
-    shadows = mesh is not None and any(getattr(lt, "shadows", False) for lt in scene.lights)
-    kw = {}
-    skip = 0
-    if shadows:
-        skip = mesh.n_vertices
-        positions = np.vstack([mesh.positions, positions])
-        normals = np.vstack([mesh.normals, normals])
-        kw["faces"] = mesh.faces
-    c = shade(scene, positions, normals, precision=precision, clamp=hdr is None, **kw)[skip:]
-    if hdr is not None:
-        c = display(c, hdr)
-    return c
+    if mesh is None or not any(getattr(lt, "shadows", False) for lt in scene.lights):
+        return display_colors(scene, positions, normals, precision=precision)
+    both = display_colors(
+        scene,
+        np.vstack([mesh.positions, positions]),
+        np.vstack([mesh.normals, normals]),
+        faces=mesh.faces,
+        precision=precision,
+    )
+    return both[mesh.n_vertices :]
 
 
 def reference(
@@ -333,17 +282,3 @@ def reference(
         colors = np.zeros((0, 3))
         spec = np.zeros(0)
     return Reference(h, colors, spec)
-
-
-def render_per_pixel(
-    scene,
-    mesh,
-    size: Sequence[int],
-    *,
-    background=None,
-    camera=None,
-    method: str = "auto",
-) -> np.ndarray:
-    """The per-pixel picture of a scene on a mesh: (h, w, 3) uint8 (what ``phong-explorer
-    render --per-pixel`` writes). Translucency is not drawn: every seen point is opaque."""
-    return reference(scene, mesh, size, camera=camera, method=method).image(background)

@@ -2,7 +2,8 @@
 
 A vertex is in the shadow of a light when the ray from the vertex toward the light (to infinity
 for a directional light, up to the light's position for a point or spot light) enters the mesh
-through the front (outward) side of a triangle at a distance beyond :data:`RAY_T_EPS`. Only
+through the front (outward) side of a triangle at a distance beyond
+:data:`explorer.core.tolerances.RAY_T_EPS`. Only
 front sides occlude, as with back-face-culled shadow rays: a closed mesh shadows exactly like
 the solid it bounds, and a ray leaving the surface it starts on (through the triangles around
 its vertex, or out through the far side of the body) never counts, so no bias or "shadow acne"
@@ -12,9 +13,9 @@ Visibility is 1 (lit) or 0 (shadowed); the engine multiplies it into the light's
 specular weight (ambient light is not shadowed, as in OpenGL practice). Between vertices the
 renderer interpolates colours, so a shadow edge is as sharp as the mesh is fine.
 
-Ray engine: a compiled Möller-Trumbore test of every ray against every triangle on both cores
-(about 20 M ray-triangle tests per second per core: instant for the built-in meshes, seconds for
-meshes of 100k triangles). trimesh's embree- or rtree-backed intersectors report the nearest hit
+Ray engine: :func:`explorer.geometry.rays.any_hit`, a compiled Möller-Trumbore test of every
+ray against every triangle on both cores (instant for the built-in meshes, seconds for meshes of
+100k triangles). trimesh's embree- or rtree-backed intersectors report the nearest hit
 only, which cannot skip back faces and the triangles at the ray's own vertex, so they are not
 used.
 
@@ -28,17 +29,11 @@ meshes (:func:`is_convex`: a convex surface cannot shadow itself).
 
 from __future__ import annotations
 
-import numba as nb
 import numpy as np
 
 from explorer.core.lights import DirectionalLight
 from explorer.geometry.frame import frame_of, to_frame
-
-#: hits nearer than this (normalised units) are the ray's own surface, not an occluder
-RAY_T_EPS = 1e-9
-#: ray-triangle determinants below this are parallel or back-facing: no hit
-DET_EPS = 1e-15
-ENGINE = "numba"
+from explorer.geometry.rays import any_hit
 
 
 def is_convex(positions, faces) -> bool:
@@ -78,45 +73,6 @@ def visibility(positions, faces, light, *, only=None):
         tmax = np.linalg.norm(D, axis=1)
         D = D / np.where(tmax > 0, tmax, 1.0)[:, None]
     tri = Q[faces]
-    v0 = np.ascontiguousarray(tri[:, 0])
-    e1 = np.ascontiguousarray(tri[:, 1] - tri[:, 0])
-    e2 = np.ascontiguousarray(tri[:, 2] - tri[:, 0])
-    hit = np.zeros(len(idx), np.bool_)
-    _any_hit(np.ascontiguousarray(Q[idx]), D, tmax, v0, e1, e2, RAY_T_EPS, DET_EPS, hit)
+    hit = any_hit(Q[idx], D, tmax, tri)
     vis[idx[hit]] = 0.0
     return vis
-
-
-@nb.njit(parallel=True, cache=True, boundscheck=False)
-def _any_hit(O, D, tmax, v0, e1, e2, t_eps, det_eps, out):
-    """Möller-Trumbore, front faces only (det > det_eps), t in (t_eps, tmax - t_eps); every ray
-    against every triangle, stopping at the first hit."""
-    m = v0.shape[0]
-    for r in nb.prange(O.shape[0]):
-        ox, oy, oz = O[r, 0], O[r, 1], O[r, 2]
-        dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
-        tm = tmax[r] - t_eps
-        for j in range(m):
-            ax, ay, az = e1[j, 0], e1[j, 1], e1[j, 2]
-            bx, by, bz = e2[j, 0], e2[j, 1], e2[j, 2]
-            px = dy * bz - dz * by
-            py = dz * bx - dx * bz
-            pz = dx * by - dy * bx
-            det = ax * px + ay * py + az * pz  # = -D·(e1 × e2): > 0 when D meets the front
-            if det < det_eps:
-                continue
-            inv = 1.0 / det
-            tx, ty, tz = ox - v0[j, 0], oy - v0[j, 1], oz - v0[j, 2]
-            u = (tx * px + ty * py + tz * pz) * inv
-            if u < 0.0 or u > 1.0:
-                continue
-            qx = ty * az - tz * ay
-            qy = tz * ax - tx * az
-            qz = tx * ay - ty * ax
-            v = (dx * qx + dy * qy + dz * qz) * inv
-            if v < 0.0 or u + v > 1.0:
-                continue
-            t = (bx * qx + by * qy + bz * qz) * inv
-            if t > t_eps and t < tm:
-                out[r] = True
-                break

@@ -31,7 +31,7 @@ from explorer.core.material import Material
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer
 from explorer.geometry import meshes as M
-from explorer.render.camera import Camera, back_to_front, camera_for, camera_from_vtk
+from explorer.render.camera import back_to_front, camera_for, camera_from_vtk
 from explorer.render.images import read_png
 from explorer.shading.display import to_bytes
 
@@ -467,11 +467,7 @@ def test_translucent_preset_is_drawn_back_to_front(app):
     assert app._views[0].actor.GetProperty().GetOpacity() == pytest.approx(m.opacity)
     app.plotter.camera.Azimuth(50.0)
     app.render()
-    c = app.plotter.camera
-    cam = Camera(
-        c.GetPosition(), c.GetFocalPoint(), c.GetViewUp(), False, 1.0, c.GetViewAngle(), (1, 2)
-    )
-    faces = app.mesh.faces[back_to_front(app.mesh, cam)]
+    faces = app.mesh.faces[back_to_front(app.mesh, camera_from_vtk(app.plotter.camera))]
     drawn = np.asarray(app._views[0].poly.faces).reshape(-1, 4)[:, 1:]
     assert (drawn == faces).all()
 
@@ -661,7 +657,7 @@ def test_difference_view_shows_the_heat_map_of_this_view(app):
     st = app.state()["difference"]
     assert st["on"] and st["shown"] and not app.errors
     # the same comparison, made independently for the same scene, camera and size
-    cam = app._mesh_camera(camera_from_vtk(app.plotter.camera))
+    cam = app._view_camera()
     want = A.compare_view(app.shown_scene(), app.mesh, (w, h), camera=cam)
     assert st["max"] == want.max and st["rmse"] == pytest.approx(want.rmse, abs=0.05)
     assert st["pixels"] == int(want.mask.sum()) > 10_000

@@ -464,13 +464,3 @@ def test_get_mesh_names():
     assert M.get_mesh(None).name == M.DEFAULT_MESH
     m = M.cube()
     assert M.get_mesh(m) is m
-
-
-def test_to_polydata():
-    pytest.importorskip("pyvista")
-    m = M.cube()
-    colors = np.zeros((m.n_vertices, 3), np.uint8)
-    poly = m.to_polydata(colors)
-    assert poly.n_points == 24 and poly.n_cells == 12
-    assert np.array_equal(poly.faces.reshape(-1, 4)[:, 1:], m.faces)
-    assert np.allclose(poly.point_data["Normals"], m.normals)

@@ -34,7 +34,6 @@ from explorer.render.perpixel import (
     mesh_hits,
     point_colors,
     reference,
-    render_per_pixel,
     sphere_hits,
 )
 from explorer.shading.display import vertex_colors
@@ -337,7 +336,7 @@ def test_render_per_pixel_command(tmp_path, capsys):
     assert "per-pixel picture (sphere, exact sphere, chrome, blinn)" in capsys.readouterr().out
     img = read_png(out)
     scene = _scene().replace(lights=explorer.Scene().lights)
-    want = render_per_pixel(scene, M.sphere(), (64, 48))
+    want = reference(scene, M.sphere(), (64, 48)).image()
     assert np.array_equal(img, want)
     # an existing file is kept without --force
     assert main(["render", "--per-pixel", "--out", str(out)]) == 2

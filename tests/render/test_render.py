@@ -129,6 +129,22 @@ def test_to_bytes_rounds_and_clamps():
     assert to_bytes(c, 0.5)[:, 3].tolist() == [128, 128]
 
 
+def test_to_bytes_writes_in_place_and_rounds_float32_exactly():
+    c = np.array([[0.0, 0.5, 1.0], [1.2, -0.1, 127.4 / 255]])
+    out = np.full((2, 3), 7, np.uint8)
+    assert to_bytes(c, out=out) is out and out.tolist() == to_bytes(c).tolist()
+    # float32 colours round as their exact (float64) values: x·255 is just below 129.5, and
+    # the float32 product would round it to 129.5 and then to 130
+    x = np.float32(0.5078431367874146)
+    assert float(x) * 255 < 129.5 and x * np.float32(255) == np.float32(129.5)
+    assert to_bytes(np.full((1, 3), x, np.float32)).tolist() == [[129, 129, 129]]
+    strided = np.zeros((2, 6), np.uint8)  # an array that is not contiguous is written too
+    assert to_bytes(c, out=strided[:, ::2]).tolist() == to_bytes(c).tolist()
+    assert strided[:, ::2].tolist() == to_bytes(c).tolist() and not strided[:, 1::2].any()
+    with pytest.raises(ExplorerError, match="opacity"):
+        to_bytes(c, 0.5, out=out)
+
+
 def test_vtk_adds_nothing(renderer):
     """A plane facing a head-on directional light: every vertex has the same engine colour,
     and every pixel of the plane is exactly that colour (no VTK light, no VTK specular)."""

@@ -27,6 +27,8 @@ from explorer.render.images import read_png
 from explorer.render.offscreen import OffscreenRenderer
 from explorer.shading.display import (
     display,
+    display_colors,
+    engine_clamps,
     expose,
     srgb_decode,
     srgb_encode,
@@ -536,3 +538,16 @@ def test_render_cli_hdr_flags(tmp_path, capsys):
     assert main(["render", str(f), "--out", str(tmp_path / "w.png")]) == 0
     err = capsys.readouterr().err
     assert "warning:" in err and "R channel" in err and "G channel" not in err
+
+
+def test_display_without_hdr_is_the_engines_clamped_colours():
+    scene = explorer.Scene()
+    mesh = M.icosphere(1)
+    c = explorer.shade(scene, mesh.positions, mesh.normals, faces=mesh.faces)
+    assert display(c, None) is c and engine_clamps(scene)
+    assert np.array_equal(vertex_colors(scene, mesh), c)
+    assert np.array_equal(display_colors(scene, mesh.positions, mesh.normals), c)
+    hdr = load_scene({"hdr": {"exposure": 1, "tone_map": "reinhard"}})
+    assert not engine_clamps(hdr)
+    raw = explorer.shade(hdr, mesh.positions, mesh.normals, clamp=False)
+    assert np.array_equal(display_colors(hdr, mesh.positions, mesh.normals), display(raw, hdr.hdr))
