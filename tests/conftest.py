@@ -2,9 +2,10 @@
 
 Hypothesis profiles: ``default`` (100 examples) and ``thorough`` (2,000; run with
 ``HYPOTHESIS_PROFILE=thorough``). Both keep every health check on. Deadlines are off
-(``deadline=None``): the first example of a property test compiles its numba kernels, which takes
-seconds, so a per-example deadline would measure the compiler rather than the test. A test whose
-examples are legitimately slow says so with its own ``@settings``.
+(``deadline=None``): the first example of a property test compiles its numba kernels or loads
+them from numba's cache, which takes seconds, so a per-example deadline would measure the
+compiler rather than the test. A test whose examples are legitimately slow to generate says so
+with its own ``@settings(suppress_health_check=[HealthCheck.too_slow])`` and a reason.
 
 Slow tests (more than a few seconds each, warm) carry ``@pytest.mark.slow``. The full run
 (README's test command, ``.ci/run``) runs them; skip them locally with::
