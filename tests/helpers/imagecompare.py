@@ -190,34 +190,55 @@ def _artifact(name: str, suffix: str) -> Path:
     return artifacts_dir() / f"{name.replace('/', '_')}{suffix}"
 
 
+def _check(name: str, suffix: str, value, *, read, write, same, differences) -> None:
+    """The golden mechanism of one file ``<name><suffix>``: write it when regenerating (unless
+    it holds exactly ``value`` already), fail when it is missing, else fail with
+    ``differences(value, golden)`` when that is not empty; each failure writes ``value`` to
+    the artifacts folder as ``<name>.new<suffix>``.
+
+    read(path) / write(path, value) / same(a, b) -> bool (exactly equal) /
+    differences(value, golden) -> str ("" when they match)."""
+    golden = _use(f"{name}{suffix}")
+    if regenerating():
+        if not (golden.exists() and same(read(golden), value)):
+            write(golden, value)
+        return
+    new = _artifact(name, f".new{suffix}")
+    if not golden.exists():
+        write(new, value)
+        pytest.fail(f"no golden {golden}; the new one is {new}. To create it: {REGENERATE_COMMAND}")
+    problems = differences(value, read(golden))
+    if problems:
+        write(new, value)
+        pytest.fail(
+            f"{name}: differs from {golden}: {problems}\nnew: {new}\n"
+            f"if the change is intended: {REGENERATE_COMMAND}"
+        )
+
+
 def check_golden(name: str, image) -> None:
     """Compare ``image`` (h, w, 3|4) uint8 with ``tests/golden/<name>.png`` (or write it when
     regenerating).
 
     Fails the test with the comparison and where the new and difference pictures went."""
-    golden = _use(f"{name}.png")
-    if regenerating():
-        if not (golden.exists() and np.array_equal(read_picture(golden), image)):
-            write_picture(golden, image)
-        return
-    if not golden.exists():
-        new = _artifact(name, ".new.png")
-        write_picture(new, image)
-        pytest.fail(
-            f"no golden picture {golden}; the new picture is {new}. To create the goldens run "
-            f"{REGENERATE_COMMAND}"
-        )
-    expected = read_picture(golden)
-    result = compare(image, expected)
-    if not result.ok:
-        new, diff = _artifact(name, ".new.png"), _artifact(name, ".diff.png")
-        write_picture(new, image)
-        write_picture(diff, diff_image(image, expected))
-        pytest.fail(
-            f"{name}: picture differs from {golden}: {result}.\n"
-            f"new picture: {new}\ndifference (x{DIFF_GAIN}, magenta beyond tolerance): {diff}\n"
-            f"if the change is intended: {REGENERATE_COMMAND}"
-        )
+
+    def differences(actual, expected) -> str:
+        result = compare(actual, expected)
+        if result.ok:
+            return ""
+        diff = _artifact(name, ".diff.png")
+        write_picture(diff, diff_image(actual, expected))
+        return f"{result}.\ndifference (x{DIFF_GAIN}, magenta beyond tolerance): {diff}"
+
+    _check(
+        name,
+        ".png",
+        image,
+        read=read_picture,
+        write=write_picture,
+        same=np.array_equal,
+        differences=differences,
+    )
 
 
 def array_differences(actual: Mapping, expected: Mapping, atol: float) -> list[str]:
@@ -254,23 +275,16 @@ def check_golden_arrays(name: str, arrays: Mapping[str, np.ndarray], atol: float
     regenerating); every element must be within ``atol`` of the golden's.
 
     Fails the test naming each array that differs, and where the new arrays went."""
-    golden = _use(f"{name}.npz")
-    if regenerating():
-        if not (golden.exists() and _identical(read_arrays(golden), arrays)):
-            write_arrays(golden, arrays)
-        return
-    if not golden.exists():
-        new = _artifact(name, ".new.npz")
-        write_arrays(new, arrays)
-        pytest.fail(
-            f"no golden arrays {golden}; the new ones are {new}. To create the goldens run "
-            f"{REGENERATE_COMMAND}"
-        )
-    problems = array_differences(arrays, read_arrays(golden), atol)
-    if problems:
-        new = _artifact(name, ".new.npz")
-        write_arrays(new, arrays)
-        pytest.fail(
-            f"{name}: arrays differ from {golden}:\n  " + "\n  ".join(problems) + f"\n"
-            f"new arrays: {new}\nif the change is intended: {REGENERATE_COMMAND}"
-        )
+
+    def differences(actual, expected) -> str:
+        return "".join(f"\n  {p}" for p in array_differences(actual, expected, atol))
+
+    _check(
+        name,
+        ".npz",
+        arrays,
+        read=read_arrays,
+        write=write_arrays,
+        same=_identical,
+        differences=differences,
+    )
