@@ -530,8 +530,8 @@ def test_golden_preset_colors_catch_a_small_change():
 
 
 def test_golden_preset_sheet():
-    """What people see: every built-in preset on the teapot, as ``phong-explorer sheet``
-    draws it."""
+    """What people see: every built-in preset on the teapot, as
+    ``phong-explorer sheet --tile 160x120 --columns 7`` draws it."""
     items = sorted(PRESETS.items())
     image = sheet(items, explorer.load_scene(PRESET_SCENE), M.teapot(), tile=(160, 120), columns=7)
     check_golden("preset_sheet", image)
