@@ -1,25 +1,88 @@
-"""Shared pytest settings: hypothesis profiles (``HYPOTHESIS_PROFILE=thorough`` for more)."""
+"""Shared pytest settings, options and fixtures of the whole test suite.
+
+Hypothesis profiles: ``default`` (100 examples) and ``thorough`` (2,000; run with
+``HYPOTHESIS_PROFILE=thorough``). Both keep every health check on. Deadlines are off
+(``deadline=None``): the first example of a property test compiles its numba kernels or loads
+them from numba's cache, which takes seconds, so a per-example deadline would measure the
+compiler rather than the test. A test whose examples are legitimately slow to generate says so
+with its own ``@settings(suppress_health_check=[HealthCheck.too_slow])`` and a reason.
+
+Slow tests (more than a few seconds each, warm) carry ``@pytest.mark.slow``. The full run
+(README's test command, ``.ci/run``) runs them; skip them locally with::
+
+    python -m pytest -m "not slow"
+
+Golden files (tests/golden/, see tests/helpers/imagecompare.py): ``--regenerate-goldens`` (or
+``PHONG_EXPLORER_REGENERATE_GOLDENS=1``) rewrites them from the current results; the hooks
+below tell tests/test_goldens.py whether this session ran every golden test, which it needs to
+find the golden files no test uses.
+
+Fixtures: ``renderer``, one 400×400 off-screen window per test module.
+"""
 
 import os
 
-from hypothesis import HealthCheck, settings
+import pytest
+from helpers import imagecompare
+from hypothesis import settings
 
-settings.register_profile(
-    "default", max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow]
-)
+settings.register_profile("default", max_examples=100, deadline=None)
 settings.register_profile("thorough", max_examples=2000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
+
+#: size of the shared ``renderer`` fixture's pictures (width, height)
+RENDER_SIZE = (400, 400)
 
 
 def pytest_addoption(parser):
     parser.addoption(
         "--regenerate-goldens",
         action="store_true",
-        help="rewrite the golden images from the current renders (same as "
-        "PHONG_EXPLORER_REGENERATE_GOLDENS=1); review the diff before committing",
+        help="rewrite the golden files from the current results (same as "
+        f"{imagecompare.REGENERATE_ENV}=1) and remove the ones no test uses; review the diff "
+        "before committing",
     )
 
 
 def pytest_configure(config):
     if config.getoption("--regenerate-goldens"):
-        os.environ["PHONG_EXPLORER_REGENERATE_GOLDENS"] = "1"
+        os.environ[imagecompare.REGENERATE_ENV] = "1"
+
+
+def _is_golden_test(item) -> bool:
+    return "golden" in getattr(item, "name", "")
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The check for unused goldens runs last, after every test that uses one."""
+    last = [i for i in items if getattr(i, "originalname", None) == "test_golden_files_all_used"]
+    items[:] = [i for i in items if i not in last] + last
+    tests_dir = imagecompare.GOLDEN_DIR.parent
+    base = config.invocation_params.dir
+    whole = False
+    for arg in config.args:
+        path = (base / arg.split("::")[0]).resolve()
+        whole |= "::" not in arg and (path == tests_dir or path in tests_dir.parents)
+    if not whole:
+        imagecompare.INCOMPLETE.append(f"collected {config.args}, not the whole of {tests_dir}")
+
+
+def pytest_deselected(items):
+    names = [i.nodeid for i in items if _is_golden_test(i)]
+    if names:
+        imagecompare.INCOMPLETE.append(f"deselected golden tests: {names[:3]}...")
+
+
+def pytest_runtest_logreport(report):
+    if report.skipped and "golden" in report.nodeid.rsplit("::", 1)[-1]:
+        imagecompare.INCOMPLETE.append(f"skipped golden test: {report.nodeid}")
+
+
+@pytest.fixture(scope="module")
+def renderer():
+    """An off-screen window of RENDER_SIZE, shared by the tests of one module."""
+    # VTK is imported only by the tests that draw
+    from explorer.render.offscreen import OffscreenRenderer
+
+    with OffscreenRenderer(RENDER_SIZE) as r:
+        yield r

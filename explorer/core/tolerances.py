@@ -84,3 +84,10 @@ INVARIANCE_ABS_TOL = 1e-6
 #: compiled loops, and a last-bit difference in a lobe's base (2**-24 relative) grows n-fold
 #: through base**n. A stale cache entry is orders of magnitude larger.
 FLOAT32_ROUTE_ABS_TOL = 1e-6
+#: Stored float64 colours of every preset (tests/golden/preset_colors.npz) against the engine's
+#: colours now. The kernels compile with fast-math flags (reassociation, contraction, approximate
+#: functions), so another CPU (vector width), numba or LLVM version may round differently: a few
+#: ulps of 1, grown at most n-fold through base**n (shininess n <= 1000), orders of magnitude
+#: below this. A change of 0.001 in one coefficient of a preset moves its colours by about 1e-3,
+#: far above it; one 8-bit level is 4e-3.
+GOLDEN_COLOR_ABS_TOL = 1e-9

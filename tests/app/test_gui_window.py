@@ -202,6 +202,7 @@ def check_probe(win: Window, mesh: M.Mesh) -> dict:
         time.sleep(0.05)
 
 
+@pytest.mark.slow  # a real X window driven with xdotool, waiting for each frame
 def test_real_window(display, tmp_path):
     mesh = M.get_mesh(MESH, gui.MESH_CHOICES[MESH])
     win = Window(display, tmp_path)

@@ -1,4 +1,9 @@
-"""Golden-image comparison for the render tests. Every image tolerance is here.
+"""Golden files of the tests: pictures and colour arrays. Every image tolerance is here.
+
+Goldens live in ``tests/golden/`` and its subfolders: ``<name>.png`` pictures
+(:func:`check_golden`) and ``<name>.npz`` arrays (:func:`check_golden_arrays`). They are read and
+written with Pillow and numpy, never with the PNG codec under test
+(:mod:`explorer.render.images`, which tests/render tests on its own).
 
 A picture matches its golden when
 
@@ -13,31 +18,42 @@ few dozen pixels of a 400×400 picture). A uniform shift of 3/255 (every pixel b
 ``PIXEL_TOL``, mean 3), or a highlight moved by a 2-degree turn of its light (a few percent of
 the pixels), is far beyond that; the tests check both, and that rounding noise passes.
 
-Regenerating goldens (after an intended change in the pictures)::
+Arrays match when every element is within the tolerance the test gives (see
+:mod:`explorer.core.tolerances`), with the same names and shapes.
 
-    PHONG_EXPLORER_REGENERATE_GOLDENS=1 python -m pytest tests/render/test_render.py -k golden
+A test that uses a golden has ``golden`` in its name (:func:`check_golden` insists), so
+``-k golden`` selects every one of them. Regenerating goldens (after an intended change)::
 
-writes every golden again under ``tests/golden/`` (and removes goldens no test uses). Check the
-new pictures before committing them. When a comparison fails, the new picture
-(``<name>.new.png``) and a difference picture (``<name>.diff.png``: differences amplified 8×,
-pixels beyond the tolerance in magenta) are written to ``$PHONG_EXPLORER_ARTIFACTS`` (default:
+    python -m pytest tests -k golden --regenerate-goldens
+
+(or ``PHONG_EXPLORER_REGENERATE_GOLDENS=1``) writes every golden whose content changed (a file
+that still holds exactly the current result is left as it is) and removes the files in
+``tests/golden/`` no test used (tests/test_goldens.py). Check the new files before committing
+them. When a comparison fails, the new picture (``<name>.new.png``) and a difference picture
+(``<name>.diff.png``: differences amplified 8×, pixels beyond the tolerance in magenta), or the
+new arrays (``<name>.new.npz``), are written to ``$PHONG_EXPLORER_ARTIFACTS`` (default:
 ``<temp dir>/phong-explorer-golden``) and the failure message says where.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import tempfile
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pytest
+from PIL import Image
 
-from explorer.render.images import encode_png, read_png
+from explorer.core.atomic import write_atomic
 
 GOLDEN_DIR = Path(__file__).resolve().parent.parent / "golden"
 REGENERATE_ENV = "PHONG_EXPLORER_REGENERATE_GOLDENS"
 ARTIFACTS_ENV = "PHONG_EXPLORER_ARTIFACTS"
+REGENERATE_COMMAND = "python -m pytest tests -k golden --regenerate-goldens"
 
 #: a pixel differs when some channel is off by more than this many levels (of 255)
 PIXEL_TOL = 2
@@ -48,6 +64,11 @@ MAX_DIFFERENT_FRACTION = 0.001
 MEAN_TOL = 1.0
 #: amplification of the difference picture
 DIFF_GAIN = 8
+
+#: golden files (paths relative to GOLDEN_DIR) that the tests of this session checked
+USED: set[str] = set()
+#: why this session cannot tell which goldens are unused (filled by tests/conftest.py's hooks)
+INCOMPLETE: list[str] = []
 
 
 @dataclass(frozen=True)
@@ -101,6 +122,38 @@ def diff_image(actual, expected) -> np.ndarray:
     return out
 
 
+# -- files ---------------------------------------------------------------------------------
+
+
+def read_picture(path) -> np.ndarray:
+    """A PNG read with Pillow: (h, w, 3) or (h, w, 4) uint8."""
+    with Image.open(path) as im:
+        if im.mode not in ("RGB", "RGBA"):
+            im = im.convert("RGBA" if "A" in im.getbands() else "RGB")
+        return np.array(im)
+
+
+def write_picture(path, image) -> None:
+    """Write an (h, w, 3|4) uint8 picture as PNG with Pillow (atomically, folders made)."""
+    a = np.ascontiguousarray(image)
+    _rgb(a)  # shape and type check
+    buf = io.BytesIO()
+    Image.fromarray(a).save(buf, format="PNG")
+    write_atomic(path, buf.getvalue(), overwrite=True, make_dirs=True)
+
+
+def write_arrays(path, arrays: Mapping[str, np.ndarray]) -> None:
+    """Write named arrays as one compressed .npz (atomically, folders made)."""
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **{k: np.asarray(v) for k, v in arrays.items()})
+    write_atomic(path, buf.getvalue(), overwrite=True, make_dirs=True)
+
+
+def read_arrays(path) -> dict[str, np.ndarray]:
+    with np.load(path, allow_pickle=False) as data:
+        return {k: data[k] for k in data.files}
+
+
 def artifacts_dir() -> Path:
     d = os.environ.get(ARTIFACTS_ENV) or os.path.join(
         tempfile.gettempdir(), "phong-explorer-golden"
@@ -114,41 +167,124 @@ def regenerating() -> bool:
     return os.environ.get(REGENERATE_ENV, "") not in ("", "0", "false", "no")
 
 
-def _write(path: Path, image) -> None:
+def golden_files() -> set[str]:
+    """Every file under GOLDEN_DIR, subfolders included, as paths relative to it ('/'-separated)."""
+    if not GOLDEN_DIR.exists():
+        return set()
+    return {p.relative_to(GOLDEN_DIR).as_posix() for p in GOLDEN_DIR.rglob("*") if p.is_file()}
 
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_bytes(encode_png(np.asarray(image)))
-    os.replace(tmp, path)
+
+def _use(relative: str) -> Path:
+    """Record that the running test checks golden ``relative``; its path."""
+    test = os.environ.get("PYTEST_CURRENT_TEST", "").rsplit(" ", 1)[0]  # drop " (call)"
+    if "golden" not in test.rsplit("::", 1)[-1]:
+        raise AssertionError(
+            f"{test or 'this code'} checks golden {relative!r}: a test that uses a golden needs "
+            f"'golden' in its name, so that `{REGENERATE_COMMAND}` selects it"
+        )
+    USED.add(relative)
+    return GOLDEN_DIR / relative
+
+
+def _artifact(name: str, suffix: str) -> Path:
+    return artifacts_dir() / f"{name.replace('/', '_')}{suffix}"
+
+
+def _check(name: str, suffix: str, value, *, read, write, same, differences) -> None:
+    """The golden mechanism of one file ``<name><suffix>``: write it when regenerating (unless
+    it holds exactly ``value`` already), fail when it is missing, else fail with
+    ``differences(value, golden)`` when that is not empty; each failure writes ``value`` to
+    the artifacts folder as ``<name>.new<suffix>``.
+
+    read(path) / write(path, value) / same(a, b) -> bool (exactly equal) /
+    differences(value, golden) -> str ("" when they match)."""
+    golden = _use(f"{name}{suffix}")
+    if regenerating():
+        if not (golden.exists() and same(read(golden), value)):
+            write(golden, value)
+        return
+    new = _artifact(name, f".new{suffix}")
+    if not golden.exists():
+        write(new, value)
+        pytest.fail(f"no golden {golden}; the new one is {new}. To create it: {REGENERATE_COMMAND}")
+    problems = differences(value, read(golden))
+    if problems:
+        write(new, value)
+        pytest.fail(
+            f"{name}: differs from {golden}: {problems}\nnew: {new}\n"
+            f"if the change is intended: {REGENERATE_COMMAND}"
+        )
 
 
 def check_golden(name: str, image) -> None:
-    """Compare ``image`` with ``tests/golden/<name>.png`` (or write it when regenerating).
+    """Compare ``image`` (h, w, 3|4) uint8 with ``tests/golden/<name>.png`` (or write it when
+    regenerating).
 
     Fails the test with the comparison and where the new and difference pictures went."""
-    import pytest
 
-    GOLDEN_DIR.mkdir(exist_ok=True)
-    golden = GOLDEN_DIR / f"{name}.png"
-    if regenerating():
-        _write(golden, image)
-        return
-    if not golden.exists():
-        new = artifacts_dir() / f"{name}.new.png"
-        _write(new, image)
-        pytest.fail(
-            f"no golden picture {golden}; the new picture is {new}. To create the goldens run "
-            f"{REGENERATE_ENV}=1 python -m pytest tests/render/test_render.py -k golden"
-        )
-    expected = read_png(golden)
-    result = compare(image, expected)
-    if not result.ok:
-        out = artifacts_dir()
-        new, diff = out / f"{name}.new.png", out / f"{name}.diff.png"
-        _write(new, image)
-        _write(diff, diff_image(image, expected))
-        pytest.fail(
-            f"{name}: picture differs from {golden}: {result}.\n"
-            f"new picture: {new}\ndifference (x{DIFF_GAIN}, magenta beyond tolerance): {diff}\n"
-            f"if the change is intended: {REGENERATE_ENV}=1 python -m pytest "
-            "tests/render/test_render.py -k golden"
-        )
+    def differences(actual, expected) -> str:
+        result = compare(actual, expected)
+        if result.ok:
+            return ""
+        diff = _artifact(name, ".diff.png")
+        write_picture(diff, diff_image(actual, expected))
+        return f"{result}.\ndifference (x{DIFF_GAIN}, magenta beyond tolerance): {diff}"
+
+    _check(
+        name,
+        ".png",
+        image,
+        read=read_picture,
+        write=write_picture,
+        same=np.array_equal,
+        differences=differences,
+    )
+
+
+def array_differences(actual: Mapping, expected: Mapping, atol: float) -> list[str]:
+    """What differs between two sets of named arrays, one line per problem (empty: they match).
+
+    Arrays match when names and shapes are equal and every element is within ``atol``."""
+    problems = []
+    for key in sorted(set(expected) - set(actual)):
+        problems.append(f"{key}: in the golden, not computed")
+    for key in sorted(set(actual) - set(expected)):
+        problems.append(f"{key}: computed, not in the golden")
+    for key in sorted(set(actual) & set(expected)):
+        a, b = np.asarray(actual[key], np.float64), np.asarray(expected[key], np.float64)
+        if a.shape != b.shape:
+            problems.append(f"{key}: shape {a.shape}, golden {b.shape}")
+            continue
+        d = np.abs(a - b)
+        bad = ~(d <= atol)  # NaN counts as a difference
+        if bad.any():
+            rows = np.unique(np.nonzero(bad)[0])
+            problems.append(
+                f"{key}: {len(rows)} of {len(a)} rows differ by more than {atol:g} "
+                f"(largest {np.nanmax(np.where(np.isnan(d), np.inf, d)):.3g}, first row {rows[0]})"
+            )
+    return problems
+
+
+def _identical(a: Mapping, b: Mapping) -> bool:
+    return a.keys() == b.keys() and all(np.array_equal(a[k], b[k]) for k in a)
+
+
+def check_golden_arrays(name: str, arrays: Mapping[str, np.ndarray], atol: float) -> None:
+    """Compare named float arrays with ``tests/golden/<name>.npz`` (or write it when
+    regenerating); every element must be within ``atol`` of the golden's.
+
+    Fails the test naming each array that differs, and where the new arrays went."""
+
+    def differences(actual, expected) -> str:
+        return "".join(f"\n  {p}" for p in array_differences(actual, expected, atol))
+
+    _check(
+        name,
+        ".npz",
+        arrays,
+        read=read_arrays,
+        write=write_arrays,
+        same=_identical,
+        differences=differences,
+    )

@@ -1,7 +1,7 @@
 """Off-screen renders (explorer.render, explorer.cli.render) and golden pictures.
 
-Goldens live in tests/golden/; see tests/helpers/imagecompare.py for the tolerance and for
-``PHONG_EXPLORER_REGENERATE_GOLDENS=1`` (regenerate).
+Goldens live in tests/golden/: feature pictures, the preset sheet and the presets' stored colours;
+see tests/helpers/imagecompare.py for the tolerances and for ``--regenerate-goldens``.
 """
 
 from __future__ import annotations
@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 import trimesh
 from helpers.imagecompare import (
-    GOLDEN_DIR,
     MAX_DIFFERENT_FRACTION,
     PIXEL_TOL,
+    array_differences,
     check_golden,
+    check_golden_arrays,
     compare,
     diff_image,
-    regenerating,
 )
 
 import explorer
@@ -33,6 +33,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import DirectionalLight
 from explorer.core.material import Material
 from explorer.core.scene import Viewer
+from explorer.core.tolerances import GOLDEN_COLOR_ABS_TOL
 from explorer.geometry import meshes as M
 from explorer.render.camera import FRAME_MARGIN, Camera, back_to_front, camera_for
 from explorer.render.exports import mesh_file_bytes
@@ -43,17 +44,12 @@ from explorer.render.offscreen import (
     SHEET_LIGHT_DIRECTION,
     OffscreenRenderer,
     render_image,
+    sheet,
 )
 from explorer.shading.display import to_bytes, vertex_colors
 
-SIZE = (400, 400)
+SIZE = (400, 400)  # the shared ``renderer`` fixture's size (tests/conftest.py)
 BG = np.rint(np.asarray(BACKGROUND) * 255).astype(np.uint8)
-
-
-@pytest.fixture(scope="module")
-def renderer():
-    with OffscreenRenderer(SIZE) as r:
-        yield r
 
 
 def _mesh_mask(img) -> np.ndarray:
@@ -393,8 +389,10 @@ def _builtin_presets():
 
 PRESETS = _builtin_presets()
 
-#: the fixed scene of the preset goldens: the teapot under the preset sheet's light
+#: the fixed scene of the preset goldens: the teapot under the preset sheet's light; a preset
+#: with a model of its own keeps it
 PRESET_SCENE = {
+    "model": "blinn",
     "viewer": {"direction": [0, 0, 1]},
     "lights": [{"type": "directional", "direction": list(SHEET_LIGHT_DIRECTION)}],
 }
@@ -511,13 +509,48 @@ def _feature_image(renderer, name):
     return renderer.render(explorer.load_scene(mapping), M.get_mesh(mesh_name, res))
 
 
-@pytest.mark.parametrize("name", sorted(PRESETS))
-def test_golden_preset(renderer, name):
-    material = PRESETS[name]
-    scene = explorer.load_scene(PRESET_SCENE).replace(
-        material=material, model=material.model or "blinn"
+def _preset_scene(material):
+    return explorer.load_scene(PRESET_SCENE).replace(
+        material=material, model=material.model or PRESET_SCENE["model"]
     )
-    check_golden(f"preset_{name}", renderer.render(scene, M.teapot()))
+
+
+def _preset_colors() -> dict[str, np.ndarray]:
+    """The engine's colours of every built-in preset on the teapot: name -> (n, 3) float64."""
+    mesh = M.teapot()
+    return {name: vertex_colors(_preset_scene(m), mesh) for name, m in sorted(PRESETS.items())}
+
+
+def test_golden_preset_colors():
+    """Every preset's numbers, through the engine: the stored float64 colours of each preset
+    on the teapot under the sheet's light."""
+    check_golden_arrays("preset_colors", _preset_colors(), GOLDEN_COLOR_ABS_TOL)
+
+
+def test_golden_preset_colors_catch_a_small_change():
+    """The stored colours' tolerance passes rounding and catches a change of 0.001 in one
+    coefficient of one preset."""
+    mesh = M.teapot()
+    gold = PRESETS["gold"]
+    colors = vertex_colors(_preset_scene(gold), mesh)
+    ulps = colors * (1 + 8 * np.finfo(float).eps)
+    assert array_differences({"gold": ulps}, {"gold": colors}, GOLDEN_COLOR_ABS_TOL) == []
+    dim = gold.replace(diffuse=tuple(np.subtract(gold.diffuse, 0.001)))
+    changed = vertex_colors(_preset_scene(dim), mesh)
+    problems = array_differences({"gold": changed}, {"gold": colors}, GOLDEN_COLOR_ABS_TOL)
+    assert len(problems) == 1 and problems[0].startswith("gold: ")
+    assert array_differences({"gold": colors}, {"jade": colors}, 1.0) == [
+        "jade: in the golden, not computed",
+        "gold: computed, not in the golden",
+    ]
+
+
+def test_golden_preset_sheet():
+    """What people see: every built-in preset on the teapot, as
+    ``phong-explorer sheet --tile 160x120 --columns 7`` draws it."""
+    items = sorted(PRESETS.items())
+    image = sheet(items, explorer.load_scene(PRESET_SCENE), M.teapot(), tile=(160, 120), columns=7)
+    check_golden("preset_sheet", image)
 
 
 @pytest.mark.parametrize("name", sorted(FEATURES))
@@ -539,18 +572,6 @@ def test_golden_features_show_their_feature(renderer):
     img = renderer.render(dark, M.icosphere(3))
     em = np.rint(np.add(mapping["material"]["emission"], 0.02) * 255)  # + ambient 0.1·0.2
     assert np.abs(img[200, 200].astype(float) - em).max() <= 1  # emission needs no light
-
-
-def test_golden_files_all_used():
-    """Every golden belongs to a test (regenerating removes the rest)."""
-    wanted = {f"preset_{n}.png" for n in PRESETS} | {f"feature_{n}.png" for n in FEATURES}
-    have = {p.name for p in GOLDEN_DIR.glob("*.png")} if GOLDEN_DIR.exists() else set()
-    if regenerating():
-        for name in have - wanted:
-            (GOLDEN_DIR / name).unlink()
-        return
-    assert have - wanted == set(), "stale goldens; regenerate to remove them"
-    assert wanted - have == set(), "missing goldens; regenerate to create them"
 
 
 # -- command line --------------------------------------------------------------------------

@@ -11,7 +11,7 @@ import functools
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import explorer
@@ -172,7 +172,7 @@ def test_a_light_at_a_vertex_or_inside_the_mesh_is_not_culled_wrongly():
     assert centre.stats["culled"] == centre.n - 2
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25)
 @given(
     kind=st.sampled_from(["directional", "point", "spot"]),
     where=st.tuples(*[st.floats(-4, 4)] * 3),

@@ -1,7 +1,7 @@
 """Effects beyond the local model (issue 6): shadows, Fresnel, energy-conserving specular, HDR,
 translucency in front of an opaque object; their plan decisions and golden pictures.
 
-Goldens live in tests/golden/effects/ (same tolerance and regenerate flag as test_render.py).
+Goldens live in tests/golden/effects/ (tolerance and regenerating: tests/helpers/imagecompare.py).
 """
 
 from __future__ import annotations
@@ -24,7 +24,6 @@ from explorer.core.scene import load_scene
 from explorer.geometry import meshes as M
 from explorer.geometry.meshes import Mesh
 from explorer.render.images import read_png
-from explorer.render.offscreen import OffscreenRenderer
 from explorer.shading.display import (
     display,
     display_colors,
@@ -376,13 +375,6 @@ def test_plan_command_shows_each_effect(tmp_path, capsys):
 
 
 # -- golden pictures -------------------------------------------------------------------------
-
-
-@pytest.fixture(scope="module")
-def renderer():
-
-    with OffscreenRenderer((400, 400)) as r:
-        yield r
 
 
 _GLOSSY = {
