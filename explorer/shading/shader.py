@@ -34,6 +34,7 @@ from collections import Counter
 
 import numpy as np
 
+from explorer.core import lightrow as R
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import DirectionalLight, SpotLight
 from explorer.core.scene import Scene, Viewer, load_scene
@@ -161,8 +162,8 @@ class Shader:
         self._colors = None
         self._pool: list[np.ndarray] = []  # colour buffers, reused once nothing views them
         self._spares: list[np.ndarray] = []  # memory of invalidated sums, reused likewise
-        self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
-        self._marks = np.zeros(-(-self._amb.size // K.BLOCK), np.int32)  # per block
+        self._redo = np.zeros(n if self._T is np.float32 else 0, np.bool_)
+        self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
         self._lights_changed()
 
@@ -361,7 +362,7 @@ class Shader:
         rows, flags = [], []
         for lp, light in zip(plan.lights, scene.lights, strict=True):
             f = 0
-            q = [0.0] * K.N_PARAMS
+            q = [0.0] * R.N_PARAMS
             if isinstance(light, DirectionalLight):
                 q[K.P_POS : K.P_POS + 3] = light.direction
                 if scene.model == "blinn" and not scene.viewer.local and not plan.force_all:
@@ -407,7 +408,7 @@ class Shader:
                 f |= K.GREY  # one sum per vertex instead of three (the kernel may use it)
             rows.append(q)
             flags.append(f)
-        params = np.array(rows, dtype=np.float64).reshape(len(rows), K.N_PARAMS)
+        params = np.array(rows, dtype=np.float64).reshape(len(rows), R.N_PARAMS)
         return params.astype(dtype), np.array(flags, np.int32), view.astype(dtype)
 
     def _material_vector(self, dtype) -> np.ndarray:
@@ -535,7 +536,7 @@ class Shader:
             self._lobe_memory = (base, ws)
         else:
             base = ws = np.zeros((L, 0), T)
-        amb = self._amb  # every block writes its count, and its marks if it counts any
+        redo = self._redo  # every block writes its count, and its marks if it counts any
         vis = self._visibility(T)
         shin = T(scene.material.shininess)
         K.shade(
@@ -554,8 +555,8 @@ class Shader:
             base,
             ws,
             vis,
-            amb,
-            self._marks,
+            redo,
+            self._redo_count,
             self._out,
             self._bounds if self._plan.cull and self.cull else self._bounds[:, :0],
             self._culled,
@@ -567,8 +568,8 @@ class Shader:
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
             params64, _, view64 = self._params_for(np.float64)
             self.stats["fixup_vertices"] += K.fixup(
-                amb,
-                self._marks,
+                redo,
+                self._redo_count,
                 self._P,
                 self._N,
                 self._centre,
