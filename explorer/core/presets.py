@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from explorer.core.atomic import write_atomic
-from explorer.core.errors import ExplorerError, ValidationError
+from explorer.core.errors import ExplorerError, Notice, ValidationError
 from explorer.core.material import Material, parse_material
 from explorer.core.validate import Checker, suggest
 from explorer.core.version import __version__
@@ -38,7 +38,7 @@ SUFFIX = ".yaml"
 SOURCES = ("extra", "user", "builtin")
 
 
-class PresetNotice(UserWarning):
+class PresetNotice(Notice):
     """A preset hides another of the same name, or a file in a preset directory is skipped."""
 
 

@@ -28,7 +28,6 @@ Cached arrays are read-only.
 
 from __future__ import annotations
 
-import math
 import sys
 from collections import Counter
 
@@ -36,16 +35,13 @@ import numpy as np
 
 from explorer.core import lightrow as R
 from explorer.core.errors import ExplorerError
-from explorer.core.lights import DirectionalLight, SpotLight
 from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.geometry.frame import check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.shadows import is_convex, visibility
+from explorer.shading.shadows import is_convex, visibility_rows
 
 PRECISIONS = ("float64", "float32")
-#: shadow rays are cast where N·L > -this (rounding of N·L must never skip a lit vertex)
-SHADOW_NDL_MARGIN = 1e-6
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
@@ -306,35 +302,20 @@ class Shader:
     def _visibility(self, dtype) -> np.ndarray:
         """(L, n) visibility rows of the lights the plan shadows, or (L, 0) when none."""
         scene, plan = self._scene, self._plan
-        L, n = len(scene.lights), self.n
         if not plan.shadows:
-            return np.zeros((L, 0), dtype)
-        vis = np.ones((L, n), dtype)
-        N = np.asarray(self._N, np.float64)
-        length = np.sqrt(np.einsum("ij,ij->i", N, N))
-        unit = (N / np.where(length > 0, length, 1.0)[:, None]).T  # (3, n)
-        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights, strict=True)):
-            if not lp.shadows:
-                continue
-            if isinstance(light, DirectionalLight):
-                where = ("d", light.direction)
-            else:
-                where = ("p", light.position)
-            key = (where, scene.two_sided, self.force_all)
-            v = self._vis_cache.get(key)
-            if v is None:
-                only = None
-                if not self.force_all:  # rays only where N·L can be > 0 (either side if 2-sided)
-                    if isinstance(light, DirectionalLight):
-                        ndl = np.asarray(light.direction) @ unit
-                    else:
-                        ndl = np.einsum("ij,ji->i", np.asarray(light.position) - self._P, unit)
-                    # a margin: a ray more than needed is harmless, one fewer is not
-                    only = length > 0 if scene.two_sided else ndl > -SHADOW_NDL_MARGIN
-                v = visibility(self._P, self._faces, light, only=only)
-                self._vis_cache[key] = v
-                self.stats["shadow_rays"] += int(n if only is None else only.sum())
-            vis[i] = v
+            return np.zeros((len(scene.lights), 0), dtype)
+        vis, rays = visibility_rows(
+            self._P,
+            self._N,
+            self._faces,
+            scene.lights,
+            [lp.shadows for lp in plan.lights],
+            two_sided=scene.two_sided,
+            force_all=self.force_all,
+            cache=self._vis_cache,
+            dtype=dtype,
+        )
+        self.stats["shadow_rays"] += rays
         return vis
 
     # -- the work ------------------------------------------------------------------------------
@@ -347,66 +328,28 @@ class Shader:
         return a
 
     def _light_params(self, dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Kernel inputs for the lights and viewer in the normalised frame.
-
-        Built in Python floats, one row per light, and made an array once (a light drag
-        rebuilds them every frame: small numpy operations per light cost more than the row)."""
+        """Kernel inputs for the lights and viewer in the normalised frame: params (L,
+        N_PARAMS), flags (L,) int32 (each light packs its row: :meth:`Light.kernel_row`) and
+        the view (3,): the eye, or V for an infinite viewer."""
         scene, plan = self._scene, self._plan
         c, s = self._centre, self._scale
-        cx, cy, cz = (float(v) for v in c)
         if scene.viewer.local:
             view = to_frame(scene.viewer.eye, c, s)
         else:
-            view = np.asarray(scene.viewer.direction, dtype=np.float64)
-        vx, vy, vz = (float(v) for v in view)
+            view = np.asarray(scene.viewer.to_viewer, dtype=np.float64)
+        constant_h = scene.model == "blinn" and not scene.viewer.local and not plan.force_all
+        halfway_view = tuple(float(v) for v in view) if constant_h else None
         rows, flags = [], []
         for lp, light in zip(plan.lights, scene.lights, strict=True):
-            f = 0
-            q = [0.0] * R.N_PARAMS
-            if isinstance(light, DirectionalLight):
-                q[K.P_POS : K.P_POS + 3] = light.direction
-                if scene.model == "blinn" and not scene.viewer.local and not plan.force_all:
-                    dx, dy, dz = light.direction
-                    hx, hy, hz = dx + vx, dy + vy, dz + vz
-                    hn = math.sqrt(hx * hx + hy * hy + hz * hz)
-                    if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
-                        q[K.P_H : K.P_H + 3] = (hx / hn, hy / hn, hz / hn)
-                    f |= K.CONST_H
-            else:
-                f |= K.POSITIONAL
-                px, py, pz = light.position
-                q[K.P_POS : K.P_POS + 3] = ((px - cx) / s, (py - cy) / s, (pz - cz) / s)
-                kc, kl, kq = light.attenuation
-                q[K.P_ATT : K.P_ATT + 3] = (kc, kl * s, kq * s * s)
-                if lp.attenuation == "per-vertex":
-                    f |= K.ATTEN
-            if isinstance(light, SpotLight) and lp.spot != "none":
-                f |= K.SPOT
-                q[K.P_AXIS : K.P_AXIS + 3] = light.direction
-                q[K.P_COS] = math.cos(math.radians(light.cutoff))
-                q[K.P_EXP] = light.exponent
-                if lp.spot == "cone+exponent":
-                    f |= K.SPOT_EXP
-            fa, fs = lp.factor, lp.factor * plan.specular_scale
-            dif = [fa * v for v in light.diffuse]
-            spec = [fs * v for v in light.specular]
-            q[K.P_AMB : K.P_AMB + 3] = [fa * v for v in light.ambient]
-            q[K.P_DIF : K.P_DIF + 3] = dif
-            q[K.P_SPEC : K.P_SPEC + 3] = spec
-            if lp.shadows:
-                f |= K.SHADOW
-            if plan.fresnel is not None and lp.specular:
-                f |= K.FRESNEL
-                q[K.P_F0] = plan.fresnel
-            if lp.ambient and lp.varying_weight:
-                f |= K.AMBIENT
-            if lp.diffuse:
-                f |= K.DIFFUSE
-            if lp.specular:
-                f |= K.SPECULAR
-            if min(dif) == max(dif) and min(spec) == max(spec):
-                f |= K.GREY  # one sum per vertex instead of three (the kernel may use it)
-            rows.append(q)
+            row, f = light.kernel_row(
+                lp,
+                c,
+                s,
+                halfway_view=halfway_view,
+                specular_scale=plan.specular_scale,
+                fresnel=plan.fresnel,
+            )
+            rows.append(row)
             flags.append(f)
         params = np.array(rows, dtype=np.float64).reshape(len(rows), R.N_PARAMS)
         return params.astype(dtype), np.array(flags, np.int32), view.astype(dtype)
