@@ -85,7 +85,7 @@ def test_infinite_viewer_camera_frames_mesh(name, aspect):
         scene = explorer.Scene(viewer=Viewer(to_viewer=d))
         cam = camera_for(scene, mesh, aspect)
         assert cam.parallel
-        # looks along -direction: the engine's constant V points back at the camera
+        # looks along -to_viewer: the engine's constant V points back at the camera
         assert np.allclose(cam.direction, -np.asarray(d) / np.linalg.norm(d))
         assert abs(np.dot(cam.view_up, cam.direction)) < 1e-12
         x, y, z = _project(cam, mesh.positions, aspect)
@@ -629,6 +629,30 @@ def test_cli_scene_file_and_overrides(tmp_path, capsys):
     )
     assert np.array_equal(read_png(out2), render_image(want, M.cube(), (80, 80)))
     capsys.readouterr()
+
+
+@pytest.mark.parametrize(
+    "old, new",
+    [
+        (["--light-direction", "1", "1", "1"], ["--light-to-light", "1", "1", "1"]),
+        (
+            ["--light-cutoff", "30", "--light-position", "0", "0", "3"]
+            + ["--light-direction", "0", "0", "-1"],
+            ["--light-cutoff", "30", "--light-position", "0", "0", "3"]
+            + ["--light-aim", "0", "0", "-1"],
+        ),
+        (["--viewer-direction", "0", "1", "1"], ["--viewer-to-viewer", "0", "1", "1"]),
+    ],
+)
+def test_cli_old_direction_flags_still_work_with_a_notice(tmp_path, capsys, old, new):
+    base = ["render", "--mesh", "sphere", "--resolution", "16", "--size", "64x64", "--out"]
+    assert main([*base, str(tmp_path / "new.png"), *new]) == 0
+    assert "notice:" not in capsys.readouterr().err
+    assert main([*base, str(tmp_path / "old.png"), *old]) == 0
+    err = capsys.readouterr().err
+    flag = new[-4]
+    assert f"notice: {old[-4]} is now {flag} (" in err and "the old name still works" in err
+    assert np.array_equal(read_png(tmp_path / "old.png"), read_png(tmp_path / "new.png"))
 
 
 @pytest.mark.parametrize("suffix", [".ply", ".glb"])
