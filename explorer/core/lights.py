@@ -263,13 +263,8 @@ class Light:
 
     @property
     def anchor(self) -> tuple[str, Vec3]:
-        """How the window names where the light is: ``("from", to_light)`` or ``("at",
-        position)``."""
-        raise NotImplementedError
-
-    @property
-    def ray_source(self) -> tuple:
-        """What this light's shadow rays depend on (hashable): its position or direction."""
+        """Where the light is: ``("from", to_light)`` or ``("at", position)``; the window
+        shows it, and shadow rays depend on nothing else (a hashable key)."""
         raise NotImplementedError
 
     # -- shared --------------------------------------------------------------------------------
@@ -377,10 +372,6 @@ class DirectionalLight(Light):
     def anchor(self):
         return "from", self.to_light
 
-    @property
-    def ray_source(self):
-        return ("to_light", self.to_light)
-
 
 @dataclass(frozen=True)
 class PositionalLight(Light):
@@ -458,10 +449,6 @@ class PositionalLight(Light):
     @property
     def anchor(self):
         return "at", self.position
-
-    @property
-    def ray_source(self):
-        return ("position", self.position)
 
 
 @dataclass(frozen=True)

@@ -105,7 +105,7 @@ def visibility_rows(
     for i, (light, on) in enumerate(zip(lights, shadowed, strict=True)):
         if not on:
             continue
-        key = (light.ray_source, two_sided, force_all)
+        key = (light.anchor, two_sided, force_all)
         v = cache.get(key)
         if v is None:
             only = None
