@@ -95,7 +95,7 @@ def spot_lights(lights: int, rng) -> tuple:
         out.append(
             SpotLight(
                 position=tuple(p),
-                direction=tuple(-p / np.linalg.norm(p)),
+                aim=tuple(-p / np.linalg.norm(p)),
                 cutoff=40.0,
                 exponent=8.0,
                 attenuation=(1.0, 0.1, 0.01),

@@ -90,7 +90,7 @@ def lights_around(mesh, count: int) -> tuple:
     for i in range(count):
         az = -60.0 + 120.0 * (i + 0.5) / count
         el = 20.0 + 25.0 * (i % 2)
-        out.append(gui.place_light(PointLight(), az, el, 3.0 * mesh.radius, mesh.centre))
+        out.append(PointLight().placed(az, el, 3.0 * mesh.radius, mesh.centre))
     return tuple(out)
 
 

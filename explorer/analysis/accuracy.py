@@ -117,7 +117,7 @@ def bench_scene(material, model: str = "blinn"):
     """The bench's scene: ``material``, one white directional light (:data:`BENCH_LIGHT`),
     OpenGL's scene ambient, the default infinite viewer on +z (parallel projection)."""
 
-    return Scene(material=material, model=model, lights=(DirectionalLight(direction=BENCH_LIGHT),))
+    return Scene(material=material, model=model, lights=(DirectionalLight(to_light=BENCH_LIGHT),))
 
 
 def bench_material(preset: str, shininess: float | None = None):
@@ -924,7 +924,7 @@ def _seen_on_sphere(viewer, points: np.ndarray, normals: np.ndarray):
         v = np.asarray(viewer.eye, np.float64) - points
         v /= np.maximum(np.linalg.norm(v, axis=1, keepdims=True), 1e-300)
     else:
-        v = np.broadcast_to(np.asarray(viewer.direction, np.float64), points.shape)
+        v = np.broadcast_to(np.asarray(viewer.to_viewer, np.float64), points.shape)
     b = np.einsum("ij,ij->i", points, v)
     c = np.einsum("ij,ij->i", points, points) - 1.0
     t = -b + np.sqrt(np.maximum(b * b - c, 0.0))

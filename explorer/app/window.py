@@ -37,7 +37,7 @@ from explorer.app import layout as G
 from explorer.app.difference import PENDING, DifferenceView, advice_lines
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
-from explorer.core.lights import DirectionalLight, PointLight, SpotLight
+from explorer.core.lights import angles_of, direction_of
 from explorer.core.material import Material
 from explorer.core.presets import MAX_NAME_LENGTH, list_presets, save_preset, user_dir
 from explorer.core.scene import Scene, Viewer
@@ -77,9 +77,6 @@ DEFAULT_EYE_DISTANCE = 6.5
 HANDLE_FRAMING = 4.0
 #: widest view angle (degrees) the framing may use to show the handle
 MAX_VIEW_ANGLE = 60.0
-#: cone of a spot light made by switching the light type
-SPOT_CUTOFF = 25.0
-SPOT_EXPONENT = 10.0
 #: exit status when no window can be opened
 NO_DISPLAY_STATUS = 3
 TERMS = G.TERM_BUTTONS
@@ -117,69 +114,6 @@ def slider_to_coefficient(value: float) -> float:
     return min(max(round(float(value), 3), 0.0), 1.0)
 
 
-def light_direction(azimuth: float, elevation: float) -> np.ndarray:
-    """(3,) unit vector of a placement: y up, azimuth in degrees from +z (the front) toward
-    +x, elevation in degrees above the xz plane."""
-    a, e = math.radians(azimuth), math.radians(elevation)
-    return np.array([math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a)])
-
-
-def placement_of_vector(v) -> tuple[float, float, float]:
-    """``(azimuth, elevation, length)`` of a vector (degrees, degrees, its length); the zero
-    vector gives (0, 0, 0)."""
-    v = np.asarray(v, dtype=np.float64)
-    length = float(np.linalg.norm(v))
-    if length == 0.0:
-        return 0.0, 0.0, 0.0
-    x, y, z = v / length
-    azimuth = math.degrees(math.atan2(x, z)) if abs(y) < 1.0 else 0.0
-    elevation = math.degrees(math.asin(min(max(y, -1.0), 1.0)))
-    return azimuth, elevation, length
-
-
-def placement_of(light, centre) -> tuple[float, float, float | None]:
-    """``(azimuth, elevation, distance)`` of a light around ``centre`` (degrees, degrees,
-    world units); a directional light has no distance (None)."""
-    if isinstance(light, DirectionalLight):
-        az, el, _ = placement_of_vector(light.direction)
-        return az, el, None
-    return placement_of_vector(np.subtract(light.position, centre))
-
-
-def place_light(light, azimuth: float, elevation: float, distance: float, centre):
-    """``light`` moved to a placement around ``centre``: a directional light shines from the
-    placement's direction; a point light sits at ``centre + distance·direction``; a spot light
-    sits there too and aims at the centre. Colours, attenuation and cone are kept."""
-    d = light_direction(azimuth, elevation)
-    if isinstance(light, DirectionalLight):
-        return light.replace(direction=tuple(d))
-    position = tuple(np.asarray(centre, dtype=np.float64) + float(distance) * d)
-    if isinstance(light, SpotLight):
-        return light.replace(position=position, direction=tuple(-d))
-    return light.replace(position=position)
-
-
-def convert_light(light, kind: str, azimuth: float, elevation: float, distance: float, centre):
-    """``light`` as another type (``directional``, ``point`` or ``spot``) at a placement,
-    keeping its colours (and its attenuation between point and spot). A new spot gets a
-    :data:`SPOT_CUTOFF` cone."""
-    if light.type == kind:
-        return place_light(light, azimuth, elevation, distance, centre)
-    colours = dict(ambient=light.ambient, diffuse=light.diffuse, specular=light.specular)
-    attenuation = getattr(light, "attenuation", (1.0, 0.0, 0.0))
-    if kind == "directional":
-        new = DirectionalLight(**colours)
-    elif kind == "point":
-        new = PointLight(attenuation=attenuation, **colours)
-    elif kind == "spot":
-        new = SpotLight(
-            attenuation=attenuation, cutoff=SPOT_CUTOFF, exponent=SPOT_EXPONENT, **colours
-        )
-    else:
-        raise ExplorerError(f"light type must be directional, point or spot, got {kind!r}")
-    return place_light(new, azimuth, elevation, distance, centre)
-
-
 def display_material(material: Material, terms: dict) -> Material:
     """The material drawn when some terms are hidden: each hidden term's coefficient is 0
     (``ambient`` also hides the emission, the other constant term)."""
@@ -203,7 +137,7 @@ def viewer_of_camera(position, focal_point, parallel: bool) -> Viewer:
     """The engine's viewer seen by a camera: a local viewer at the position (perspective), or
     an infinite viewer looking along the camera (parallel projection)."""
     if parallel:
-        return Viewer(direction=tuple(np.subtract(position, focal_point)))
+        return Viewer(to_viewer=tuple(np.subtract(position, focal_point)))
     return Viewer(eye=tuple(position))
 
 
@@ -560,9 +494,8 @@ class Explorer:
             return G.ELEVATION_RANGE
         r = self.radius
         lo, hi = G.DISTANCE_RANGE[0] * r, G.DISTANCE_RANGE[1] * r
-        light = self.light
-        if light is not None and not isinstance(light, DirectionalLight):
-            d = placement_of(light, self.centre)[2]
+        d = None if self.light is None else self.light.placement(self.centre)[2]
+        if d is not None:  # a light at a distance (not at infinity)
             lo, hi = min(lo, d), max(hi, d)
         return (lo, hi)
 
@@ -723,7 +656,7 @@ class Explorer:
         if self.light is not None:  # widen the view to show the light's handle, if near
             az, el, d = self._placement()
             if d <= HANDLE_FRAMING * self.radius:
-                handle = self.centre + d * light_direction(az, el)
+                handle = self.centre + d * direction_of(az, el)
                 r = G.HANDLE_RADIUS * self.radius
                 cam = widen_to_show(cam, [handle], aspect, pad=r)
         # the picture moved left by half the panel's width, without turning the camera
@@ -1001,9 +934,9 @@ class Explorer:
         # keep each light where it is relative to the mesh, scaled to the new mesh's size
         lights = []
         for light in self.scene.lights:
-            az, el, d = placement_of(light, old_centre)
+            az, el, d = light.placement(old_centre)
             d = (d or 0.0) * self.radius / old_radius
-            lights.append(place_light(light, az, el, d, self.centre))
+            lights.append(light.placed(az, el, d, self.centre))
         spec = self._mesh_specs.get(name, name)
         self.scene = self.scene.replace(lights=tuple(lights), mesh=spec)
         self.handle.SetRadius(G.HANDLE_RADIUS * self.radius)
@@ -1152,7 +1085,7 @@ class Explorer:
     def _placement(self) -> tuple[float, float, float]:
         """The controlled light's placement; a directional light's distance is the distance
         slider's (it only places the handle)."""
-        az, el, d = placement_of(self.light, self.centre)
+        az, el, d = self.light.placement(self.centre)
         if d is None:
             d = self.sliders["distance"].GetRepresentation().GetValue()
         return az, el, d
@@ -1171,7 +1104,7 @@ class Explorer:
         az = az if azimuth is None else float(azimuth)
         el = el if elevation is None else float(elevation)
         d = d if distance is None else float(distance)
-        self._set_light(place_light(self.light, az, el, d, self.centre))
+        self._set_light(self.light.placed(az, el, d, self.centre))
         self._sync_controls(placement=(az, el, d))
         self.render()
 
@@ -1179,7 +1112,7 @@ class Explorer:
         if self.light is None:
             raise ExplorerError("the scene has no lights to change")
         az, el, d = self._placement()
-        self._set_light(convert_light(self.light, kind, az, el, d, self.centre))
+        self._set_light(self.light.as_type(kind).placed(az, el, d, self.centre))
         self._sync_controls(placement=(az, el, d))
         self.render()
 
@@ -1304,7 +1237,7 @@ class Explorer:
             return
         if self._t0 is None:
             self._t0 = time.perf_counter()
-        az, el, d = placement_of_vector(np.subtract(center, self.centre))
+        az, el, d = angles_of(np.subtract(center, self.centre))
         if d == 0.0:
             return
         lo, hi = self._slider_range("distance")
@@ -1327,13 +1260,11 @@ class Explorer:
         if light is not None:
             az, el, d = placement if placement is not None else self._placement()
             values.update(azimuth=az, elevation=el, distance=d)
-            self.handle.SetCenter(*(self.centre + d * light_direction(az, el)))
+            self.handle.SetCenter(*(self.centre + d * direction_of(az, el)))
             self.handle.On()
             kind = light.type
-            if kind == "directional":
-                where = "from " + _fmt_vec(light.direction)
-            else:
-                where = "at " + _fmt_vec(light.position)
+            word, where = light.anchor
+            where = f"{word} {_fmt_vec(where)}"
             n = len(self.scene.lights)
             which = f"{self.light_index + 1} of {n}: " if n > 1 else ""
             self.texts["light"].SetInput(f"{which}{kind} {where}")

@@ -14,8 +14,7 @@ import sys
 import warnings
 
 from explorer.cli import bench, gui, plan, presets, render, sheet
-from explorer.core.errors import ExplorerError
-from explorer.core.presets import PresetNotice
+from explorer.core.errors import ExplorerError, Notice
 from explorer.core.version import __version__
 
 #: subcommand -> (module, one-line help); each module has ``add_arguments`` and ``run``
@@ -44,11 +43,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _show_notices() -> None:
-    """Print preset notices as one ``notice: ...`` line on stderr, not as Python warnings."""
+    """Print every :class:`~explorer.core.errors.Notice` (a preset hiding another, an old key
+    name) as one ``notice: ...`` line on stderr, not as a Python warning."""
     original = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, PresetNotice):
+        if issubclass(category, Notice):
             print(f"notice: {message}", file=sys.stderr)
         else:
             original(message, category, filename, lineno, file, line)

@@ -76,8 +76,8 @@ def start(args):
     r = mesh.radius or 1.0
     if scene.lights == (placeholder,):  # no scene lights and no --light-* option
         az, el, d = gui.DEFAULT_PLACEMENT
-        scene = scene.replace(lights=(gui.place_light(PointLight(), az, el, d * r, mesh.centre),))
-    if args.scene is None and args.viewer_eye is None and args.viewer_direction is None:
+        scene = scene.replace(lights=(PointLight().placed(az, el, d * r, mesh.centre),))
+    if args.scene is None and args.viewer_eye is None and args.viewer_to_viewer is None:
         e = np.asarray(gui.DEFAULT_EYE_DIRECTION, dtype=np.float64)
         eye = mesh.centre + gui.DEFAULT_EYE_DISTANCE * r * e / np.linalg.norm(e)
         scene = scene.replace(viewer=Viewer(eye=tuple(eye)))

@@ -2,8 +2,10 @@
 
 A SCENE file gives the material, lights, viewer and mesh; every option overrides its part of
 it. Options are named after the scene-file keys: ``--light-position`` is ``lights[].position``,
-``--viewer-eye`` is ``viewer.eye``, ``--model`` is ``model``. Any ``--light-*`` option replaces
-the scene's lights with that one light.
+``--light-to-light`` is ``lights[].to_light``, ``--viewer-eye`` is ``viewer.eye``, ``--model`` is
+``model``. Any ``--light-*`` option replaces the scene's lights with that one light. The old
+``--light-direction`` (``--light-to-light`` or ``--light-aim`` by the light's type) and
+``--viewer-direction`` still work, with a notice.
 """
 
 from __future__ import annotations
@@ -13,37 +15,53 @@ import os
 
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
-from explorer.core.lights import parse_light
+from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
 from explorer.core.presets import find_preset
 from explorer.core.scene import Viewer
-from explorer.core.validate import Checker
+from explorer.core.validate import Checker, notice
 from explorer.geometry.meshes import BUILTIN_MESHES, RESOLUTION, get_mesh
 from explorer.render.images import parse_size
 from explorer.render.offscreen import BACKGROUND
 
+_XYZ = dict(nargs=3, type=float, metavar=("X", "Y", "Z"))
 #: --light-<key> options, in the scene file's light keys
 LIGHT_OPTIONS = {
-    "type": dict(choices=("directional", "point", "spot"), help="kind of light"),
-    "direction": dict(
-        nargs=3, type=float, metavar=("X", "Y", "Z"),
-        help="directional: toward the light; spot: the axis it points along",
-    ),
-    "position": dict(nargs=3, type=float, metavar=("X", "Y", "Z"), help="point/spot position"),
+    "type": dict(choices=LIGHT_TYPES, help="kind of light"),
+    "to_light": dict(_XYZ, help="directional: the direction toward the light"),
+    "position": dict(_XYZ, help="point/spot position"),
     "attenuation": dict(
         nargs=3, type=float, metavar=("KC", "KL", "KQ"),
         help="point/spot: 1 / (kc + kl·d + kq·d²), default 1 0 0",
     ),
+    "aim": dict(_XYZ, help="spot: the axis it shines along, from the light outward"),
     "cutoff": dict(type=float, metavar="DEG", help="spot cone half-angle, 0-90 or 180"),
     "exponent": dict(type=float, metavar="E", help="spot exponent, 0-128"),
     "color": dict(nargs=3, type=float, metavar=("R", "G", "B"), help="light colour"),
     "intensity": dict(type=float, metavar="K", help="multiplies the colour (default 1)"),
 }  # fmt: skip
+#: the --light-* keys each light type takes
 _KEYS_OF = {
-    "directional": {"type", "direction", "color", "intensity"},
-    "point": {"type", "position", "attenuation", "color", "intensity"},
-    "spot": {"type", "position", "attenuation", "direction", "cutoff", "exponent", "color",
-             "intensity"},
-}  # fmt: skip
+    kind: {k for k in cls.FILE_KEYS if k in LIGHT_OPTIONS} for kind, cls in LIGHT_CLASSES.items()
+}
+#: keys that only a spot takes, or only a positional light: they decide the type when
+#: --light-type is not given
+_SPOT_ONLY = _KEYS_OF["spot"] - _KEYS_OF["point"] - _KEYS_OF["directional"]
+_POSITIONAL = (_KEYS_OF["point"] & _KEYS_OF["spot"]) - _KEYS_OF["directional"]
+
+
+def _flag(key: str) -> str:
+    return "--light-" + key.replace("_", "-")
+
+
+class _OldName(argparse.Action):
+    """An option's old name: stores like the new one, with one notice."""
+
+    NEW = {"--viewer-direction": ("--viewer-to-viewer", "the direction toward the viewer")}
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        new, meaning = self.NEW[option_string]
+        notice(f"{option_string} is now {new} ({meaning}); the old name still works")
+        setattr(namespace, self.dest, values)
 
 
 # -- arguments -----------------------------------------------------------------------------
@@ -77,16 +95,24 @@ def add_scene_arguments(
     )  # fmt: skip
     g = p.add_argument_group("light (replaces the scene's lights with one light)")
     for key, kw in LIGHT_OPTIONS.items():
-        g.add_argument(f"--light-{key}", dest=f"light_{key}", default=None, **kw)
+        g.add_argument(_flag(key), dest=f"light_{key}", default=None, **kw)
+    g.add_argument(
+        "--light-direction", dest="light_direction", default=None, **_XYZ,
+        help="old name of --light-to-light (directional) and --light-aim (spot)",
+    )  # fmt: skip
     v = p.add_argument_group("viewer").add_mutually_exclusive_group()
     v.add_argument(
         "--viewer-eye", "--eye", dest="viewer_eye", nargs=3, type=float, metavar=("X", "Y", "Z"),
         help="local viewer at this point (perspective camera there, looking at the mesh)",
     )  # fmt: skip
     v.add_argument(
-        "--viewer-direction", dest="viewer_direction", nargs=3, type=float,
-        metavar=("X", "Y", "Z"),
-        help="infinite viewer in this direction (parallel projection); default 0 0 1",
+        "--viewer-to-viewer", dest="viewer_to_viewer", **_XYZ,
+        help="infinite viewer: the direction from the scene toward it (parallel projection); "
+        "default 0 0 1",
+    )  # fmt: skip
+    v.add_argument(
+        "--viewer-direction", dest="viewer_to_viewer", action=_OldName, **_XYZ,
+        help="old name of --viewer-to-viewer",
     )  # fmt: skip
     p.add_argument(
         "--background", nargs=3, type=float, metavar=("R", "G", "B"),
@@ -114,20 +140,32 @@ def light_from_options(args):
 
     given = {k: getattr(args, f"light_{k}") for k in LIGHT_OPTIONS}
     given = {k: v for k, v in given.items() if v is not None}
-    if not given:
+    old = getattr(args, "light_direction", None)
+    if not given and old is None:
         return None
     kind = given.get("type")
     if kind is None:
-        if "cutoff" in given or "exponent" in given:
+        if set(given) & _SPOT_ONLY:
             kind = "spot"
-        elif "position" in given or "attenuation" in given:
+        elif set(given) & _POSITIONAL:
             kind = "point"
         else:
             kind = "directional"
+    if old is not None:
+        new = LIGHT_CLASSES[kind].RENAMED.get("direction")
+        if new is None:
+            given["direction"] = old  # reported below: it does not apply to this type
+        elif new[0] in given:
+            raise ExplorerError(f"--light-direction is the old name of {_flag(new[0])}: give one")
+        else:
+            notice(f"--light-direction is now {_flag(new[0])} ({new[1]}); the old name still works")
+            given[new[0]] = old
     wrong = sorted(set(given) - _KEYS_OF[kind])
     if wrong:
-        flags = ", ".join(f"--light-{k}" for k in wrong)
-        fits = ", ".join(t for t, keys in _KEYS_OF.items() if set(wrong) <= keys)
+        flags = ", ".join(_flag(k) for k in wrong)
+        fits = ", ".join(
+            t for t, cls in LIGHT_CLASSES.items() if set(wrong) <= _KEYS_OF[t] | set(cls.RENAMED)
+        )
         raise ExplorerError(
             f"{flags} does not apply to a {kind} light" + (f" (only to: {fits})" if fits else "")
         )
@@ -142,20 +180,20 @@ def light_from_options(args):
 
 def as_flag(problem: Problem, prefix: str) -> Problem:
     key = problem.key or ""
-    head = key.split("[")[0].split(".")[0]
+    head = key.split("[")[0].split(".")[0].replace("_", "-")
     where = f"{prefix}{head}" if head else prefix.rstrip("-")
     return Problem(problem.message, key=where)
 
 
 def viewer_from_options(args):
-
+    """The --viewer-* options as a viewer, or None when none is given."""
     try:
         if args.viewer_eye is not None:
             return Viewer(eye=tuple(args.viewer_eye))
-        if args.viewer_direction is not None:
-            return Viewer(direction=tuple(args.viewer_direction))
+        if args.viewer_to_viewer is not None:
+            return Viewer(to_viewer=tuple(args.viewer_to_viewer))
     except ValueError as exc:
-        flag = "--viewer-eye" if args.viewer_eye is not None else "--viewer-direction"
+        flag = "--viewer-eye" if args.viewer_eye is not None else "--viewer-to-viewer"
         raise ExplorerError(f"{flag}: {exc}") from None
     return None
 

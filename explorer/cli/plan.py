@@ -34,7 +34,7 @@ def run(args) -> int:
     viewer = (
         f"eye {list(scene.viewer.eye)}"
         if scene.viewer.local
-        else (f"direction {[round(c, 6) for c in scene.viewer.direction]}")
+        else (f"to_viewer {[round(c, 6) for c in scene.viewer.to_viewer]}")
     )
     print(
         f"scene {args.scene}: {len(scene.lights)} light(s), model {scene.model}, "

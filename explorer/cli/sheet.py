@@ -45,7 +45,7 @@ def run(args) -> int:
     args.mesh_default = "teapot"
     chosen = args.preset
     args.preset = None  # the sheet's --preset selects tiles; it does not set the material
-    scene, mesh = build_scene(args, default_light=DirectionalLight(direction=SHEET_LIGHT_DIRECTION))
+    scene, mesh = build_scene(args, default_light=DirectionalLight(to_light=SHEET_LIGHT_DIRECTION))
     dirs = tuple(args.materials)
     if chosen:
         items = [(name, find_preset(name, dirs)) for name in chosen]

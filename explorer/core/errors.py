@@ -4,6 +4,9 @@ Every mistake a user can make (a bad scene file, an unknown preset, a missing me
 :class:`ExplorerError`. The CLI prints its message and exits non-zero without a traceback. A
 validation pass collects every :class:`Problem` in a document before raising one
 :class:`ValidationError`, so the user sees all of them at once.
+
+Things the user should know that are not errors (a preset hiding another, a key's old name)
+are :class:`Notice` warnings; the CLI prints each as one ``notice: ...`` line.
 """
 
 from __future__ import annotations
@@ -31,13 +34,17 @@ class Problem:
     key: str | None = None
 
     def __str__(self) -> str:
-        where = ""
-        if self.file:
-            where = f"{self.file}:{self.line}: " if self.line else f"{self.file}: "
-        elif self.line:
-            where = f"line {self.line}: "
         key = f"{self.key}: " if self.key else ""
-        return f"{where}{key}{self.message}"
+        return f"{self.where}{key}{self.message}"
+
+    @property
+    def where(self) -> str:
+        """``"file:line: "``, ``"file: "``, ``"line N: "`` or ``""``."""
+        if self.file:
+            return f"{self.file}:{self.line}: " if self.line else f"{self.file}: "
+        if self.line:
+            return f"line {self.line}: "
+        return ""
 
 
 class ValidationError(ExplorerError, ValueError):
@@ -46,3 +53,11 @@ class ValidationError(ExplorerError, ValueError):
     def __init__(self, problems: list[Problem]):
         self.problems = list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class Notice(UserWarning):
+    """Something the user should know that is not an error (printed as ``notice: ...``)."""
+
+
+class DeprecatedName(Notice):
+    """A key, keyword or flag was given by its old name; it still works."""

@@ -4,11 +4,32 @@ Three kinds, as in OpenGL's fixed-function pipeline. Every light has ``ambient``
 and ``specular`` RGB colours (defaults 0, 1, 1: OpenGL's ``GL_LIGHT0``); the ``color`` +
 ``intensity`` shorthand in files sets diffuse = specular = intensity·color.
 
-- :class:`DirectionalLight`: ``direction`` points *toward* the light; never attenuated.
+- :class:`DirectionalLight`: ``to_light``, the unit vector from the surface toward the light;
+  never attenuated.
 - :class:`PointLight`: ``position``; ``attenuation = (kc, kl, kq)`` gives
   ``1 / (kc + kl·d + kq·d²)`` at distance ``d``.
-- :class:`SpotLight`: a point light with an ``axis`` it points along (``direction``), a
-  ``cutoff`` half-angle in degrees (0–90, or 180 for no cone) and an ``exponent`` (0–128).
+- :class:`SpotLight`: a positional light with an ``aim`` (the axis it shines along, from the
+  light outward), a ``cutoff`` half-angle in degrees (0–90, or 180 for no cone) and an
+  ``exponent`` (0–128).
+
+A light type is one class that owns its behaviour; the code that combines lights (the plan, the
+shader, the reference equation, shadows, the window) asks the light and never its type:
+
+- ``KEYS``: one check per key (:mod:`explorer.core.validate`), run by :func:`parse_light` on a
+  scene file (every problem at once, with file and line) and by the constructor (one
+  :class:`~explorer.core.errors.ValidationError`, same messages);
+- :meth:`Light.work`: what the light needs per vertex (distance, attenuation, cone) and why;
+- :meth:`Light.kernel_row`: its row of the compiled kernel's parameters. The light writes the
+  slots of :mod:`explorer.core.lightrow` itself: the layout is plain constants that the kernels
+  read too, so a new light type adds its slots and its class, and no table in the shader has to
+  follow;
+- :meth:`Light.incident`: the reference's "what arrives and from where" (L, distance, weight);
+- :meth:`Light.shadow_ray`: the ray from a vertex toward the light;
+- :meth:`Light.placement`, :meth:`Light.placed`, :meth:`Light.as_type`: its handle in the
+  window.
+
+The old key ``direction`` (``to_light`` or ``aim``) still loads, with a
+:class:`~explorer.core.errors.DeprecatedName` notice.
 """
 
 from __future__ import annotations
@@ -17,7 +38,12 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import ClassVar
 
-from explorer.core.validate import Checker
+import numpy as np
+
+from explorer.core import lightrow as R
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
+from explorer.core.validate import Check, Checker, check_fields, checked, new_keywords, old_keywords
 
 Vec3 = tuple[float, float, float]
 RGB = tuple[float, float, float]
@@ -29,29 +55,111 @@ MAX_LIGHT_VALUE = 1e6
 SPOT_EXPONENT_RANGE = (0.0, 128.0)
 
 
-def _vec(value, name: str, *, nonzero: bool = False) -> Vec3:
-    v = tuple(float(c) for c in value)
-    if len(v) != 3 or not all(math.isfinite(c) for c in v):
-        raise ValueError(f"{name} must be 3 finite numbers, got {value!r}")
-    if nonzero and not any(v):
-        raise ValueError(f"{name} must be a non-zero direction")
-    return v  # type: ignore[return-value]
+# -- the checks of each key ------------------------------------------------------------------
+def _colour(checker: Checker, value, path):
+    return checker.rgb(value, path, 0.0, MAX_LIGHT_VALUE)
 
 
-def _colour(value, name: str) -> RGB:
-    v = _vec(value, name)
-    if not all(0.0 <= c <= MAX_LIGHT_VALUE for c in v):
-        raise ValueError(f"{name} channels must be in [0, {MAX_LIGHT_VALUE:g}], got {v}")
-    return v
+def _flag(checker: Checker, value, path):
+    return checker.boolean(value, path)
 
 
+def _point(checker: Checker, value, path):
+    return checker.triple(value, path)
+
+
+def _direction(checker: Checker, value, path):
+    return checker.direction(value, path)
+
+
+def _attenuation(checker: Checker, value, path):
+    att = checker.triple(value, path, 0.0)
+    if att is not None and not any(att):
+        checker.problem(
+            path,
+            "must not be all zero (1 / (kc + kl·d + kq·d²) would divide by zero); "
+            "use [1, 0, 0] for no attenuation",
+        )
+        return None
+    return att
+
+
+def _cutoff(checker: Checker, value, path):
+    c = checker.number(value, path, 0.0, 180.0)
+    if c is not None and 90.0 < c < 180.0:
+        checker.problem(path, f"must be in [0, 90] or exactly 180, got {c:g}")
+        return None
+    return c
+
+
+def _exponent(checker: Checker, value, path):
+    return checker.number(value, path, *SPOT_EXPONENT_RANGE)
+
+
+# -- small vector helpers --------------------------------------------------------------------
 def _unit(v: Vec3) -> Vec3:
     n = math.sqrt(sum(c * c for c in v))
     return (v[0] / n, v[1] / n, v[2] / n)
 
 
+def unit_rows(v: np.ndarray, eps: float, fallback) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``v`` (n, 3) made unit length; rows shorter than ``eps`` replaced by
+    ``fallback`` ((3,) or (n, 3)). Returns the unit rows (n, 3) and the lengths (n,)."""
+    length = np.sqrt(np.einsum("ij,ij->i", v, v))
+    ok = length > eps
+    unit = np.where(ok[:, None], v / np.where(ok, length, 1.0)[:, None], fallback)
+    return unit, length
+
+
+def in_frame(point, centre=None, scale=1.0) -> np.ndarray:
+    """A world point (3,) in the normalised frame ``(point - centre) / scale``, float64 (the
+    point itself when ``centre`` is None)."""
+    p = np.asarray(point, dtype=np.float64)
+    return p if centre is None else (p - centre) / scale
+
+
+def direction_of(azimuth: float, elevation: float) -> np.ndarray:
+    """(3,) unit vector of a placement: y up, azimuth in degrees from +z (the front) toward
+    +x, elevation in degrees above the xz plane."""
+    a, e = math.radians(azimuth), math.radians(elevation)
+    return np.array([math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a)])
+
+
+def angles_of(v) -> tuple[float, float, float]:
+    """``(azimuth, elevation, length)`` of a vector (degrees, degrees, its length); the zero
+    vector gives (0, 0, 0)."""
+    v = np.asarray(v, dtype=np.float64)
+    length = float(np.linalg.norm(v))
+    if length == 0.0:
+        return 0.0, 0.0, 0.0
+    x, y, z = v / length
+    azimuth = math.degrees(math.atan2(x, z)) if abs(y) < 1.0 else 0.0
+    elevation = math.degrees(math.asin(min(max(y, -1.0), 1.0)))
+    return azimuth, elevation, length
+
+
 @dataclass(frozen=True)
-class _Light:
+class LightWork:
+    """What a light needs computed per vertex, decided from the light alone.
+
+    positional : L = normalize(position - P) per vertex (else constant)
+    attenuation : "none" | "constant" (``factor`` folded into the colours) | "per-vertex"
+    spot : "none" | "cone" | "cone+exponent"
+    factor : the constant attenuation 1/kc folded into the colours (1 otherwise)
+    reasons : (item, "in"|"out", why) rows for people: distance, attenuation, spot
+    """
+
+    positional: bool
+    attenuation: str = "none"
+    spot: str = "none"
+    factor: float = 1.0
+    reasons: tuple = ()
+
+
+@dataclass(frozen=True)
+class Light:
+    """What every light has: colours and whether it casts shadows (see the module docstring)."""
+
     ambient: RGB = (0.0, 0.0, 0.0)
     diffuse: RGB = (1.0, 1.0, 1.0)
     specular: RGB = (1.0, 1.0, 1.0)
@@ -59,93 +167,399 @@ class _Light:
     shadows: bool = field(default=False, kw_only=True)
 
     type: ClassVar[str] = ""
-
-    def _check_colours(self):
-        for key in ("ambient", "diffuse", "specular"):
-            object.__setattr__(self, key, _colour(getattr(self, key), f"light {key}"))
-        object.__setattr__(self, "shadows", bool(self.shadows))
-
-    def replace(self, **changes):
-        """A copy with some fields changed."""
-        return replace(self, **changes)
-
-
-@dataclass(frozen=True)
-class DirectionalLight(_Light):
-    """A light at infinity. direction : (3,) toward the light (stored unit length)."""
-
-    direction: Vec3 = (0.0, 0.0, 1.0)
-    type: ClassVar[str] = "directional"
+    #: key -> its check (the scene-file keys that are fields, in the order they are checked)
+    KEYS: ClassVar[dict[str, Check]] = {
+        "ambient": _colour,
+        "diffuse": _colour,
+        "specular": _colour,
+        "shadows": _flag,
+    }
+    #: old key -> (new key, what the new name means); both still load
+    RENAMED: ClassVar[dict[str, tuple[str, str]]] = {}
+    #: the keys a scene file may give this type, in the order messages list them
+    FILE_KEYS: ClassVar[tuple[str, ...]] = ()
+    #: fields a light made by :meth:`like` gets (a new spot's cone, say)
+    LIKE_DEFAULTS: ClassVar[dict] = {}
 
     def __post_init__(self):
-        self._check_colours()
-        object.__setattr__(
-            self, "direction", _unit(_vec(self.direction, "light direction", nonzero=True))
-        )
+        checked(self, type(self).KEYS)
+        self._normalise()
+
+    def _normalise(self) -> None:
+        """Store direction fields unit length (after the checks)."""
+
+    def replace(self, **changes):
+        """A copy with some fields changed (old key names are accepted, with a notice)."""
+        return replace(self, **new_keywords(type(self), changes))
+
+    def to_mapping(self) -> dict:
+        """The scene-file form of the light (plain Python values, new key names)."""
+        out: dict = {"type": self.type, **self._own_mapping()}
+        for key in ("ambient", "diffuse", "specular"):
+            out[key] = list(getattr(self, key))
+        if self.shadows:
+            out["shadows"] = True
+        return out
+
+    def as_type(self, kind: str) -> Light:
+        """This light as another type (``directional``, ``point`` or ``spot``; see
+        :meth:`like`), or itself when it is that type already."""
+        if kind not in LIGHT_CLASSES:
+            raise ExplorerError(f"light type must be directional, point or spot, got {kind!r}")
+        return self if self.type == kind else LIGHT_CLASSES[kind].like(self)
+
+    @classmethod
+    def like(cls, light: Light) -> Light:
+        """A light of this type with the colours of ``light`` (and its attenuation between
+        positional types; a new spot gets the cone of ``LIKE_DEFAULTS``), at this type's default
+        place: move it with :meth:`placed`."""
+        colours = dict(ambient=light.ambient, diffuse=light.diffuse, specular=light.specular)
+        return cls(**colours, **cls._kept_from(light), **cls.LIKE_DEFAULTS)
+
+    @classmethod
+    def _kept_from(cls, light: Light) -> dict:
+        return {}
+
+    # -- per type ------------------------------------------------------------------------------
+    def _own_mapping(self) -> dict:
+        raise NotImplementedError
+
+    def work(self) -> LightWork:
+        """Which per-vertex work the light needs, with the reasons (see :class:`LightWork`)."""
+        raise NotImplementedError
+
+    def _pack(self, row: list, plan, centre, scale, halfway_view) -> int:
+        """Write the light's own slots of ``row``; returns its flag bits."""
+        raise NotImplementedError
+
+    def toward(self, points, centre=None, scale=1.0) -> np.ndarray:
+        """(n, 3) float64 vectors from ``points`` (n, 3), in the frame ``centre``/``scale``
+        (world when None), toward the light: not unit length."""
+        raise NotImplementedError
+
+    def shadow_ray(self, points, centre=None, scale=1.0) -> tuple[np.ndarray, np.ndarray]:
+        """Rays from ``points`` (n, 3) toward the light: unit directions (n, 3) and the
+        distance (n,) to the light (inf for a light at infinity), in the same frame."""
+        raise NotImplementedError
+
+    def incident(self, P, N, centre, scale) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """What arrives at each vertex and from where (the reference equation's terms).
+
+        P : (n, 3) float64 positions in the normalised frame ``(world - centre) / scale``
+        N : (n, 3) float64 unit normals (zero where absent): L where the light sits on the vertex
+        Returns L : (n, 3) unit vectors toward the light, distance : (n,) world distances (inf
+        at infinity), weight : (n,) attenuation × spot factor."""
+        raise NotImplementedError
+
+    def placement(self, centre) -> tuple[float, float, float | None]:
+        """``(azimuth, elevation, distance)`` of the light around ``centre`` (degrees, degrees,
+        world units); a light at infinity has no distance (None)."""
+        raise NotImplementedError
+
+    def placed(self, azimuth: float, elevation: float, distance: float, centre) -> Light:
+        """The light moved to a placement around ``centre`` (see :func:`direction_of`);
+        colours, attenuation and cone are kept."""
+        raise NotImplementedError
+
+    @property
+    def anchor(self) -> tuple[str, Vec3]:
+        """Where the light is: ``("from", to_light)`` or ``("at", position)``; the window
+        shows it, and shadow rays depend on nothing else (a hashable key)."""
+        raise NotImplementedError
+
+    # -- shared --------------------------------------------------------------------------------
+    def kernel_row(
+        self,
+        plan,
+        centre,
+        scale: float,
+        *,
+        halfway_view=None,
+        specular_scale: float = 1.0,
+        fresnel: float | None = None,
+    ) -> tuple[list[float], int]:
+        """The light's row of :data:`~explorer.core.lightrow.N_PARAMS` floats and its flag
+        bits for the compiled kernel, in the normalised frame ``centre`` (3,), ``scale``.
+
+        plan : this light's row of the plan (:class:`explorer.shading.plan.LightPlan`: which
+            terms, attenuation, spot, factor, shadows)
+        halfway_view : the constant unit V when a constant Blinn halfway vector may be used
+            (infinite viewer), else None
+        specular_scale, fresnel : the scene's energy-conserving factor and Schlick F0 (or None)
+        Built in Python floats (a light drag rebuilds rows every frame: small numpy operations
+        per light cost more than the row)."""
+        row = [0.0] * R.N_PARAMS
+        f = self._pack(row, plan, centre, scale, halfway_view)
+        fa, fs = plan.factor, plan.factor * specular_scale
+        dif = [fa * v for v in self.diffuse]
+        spec = [fs * v for v in self.specular]
+        row[R.P_AMB : R.P_AMB + 3] = [fa * v for v in self.ambient]
+        row[R.P_DIF : R.P_DIF + 3] = dif
+        row[R.P_SPEC : R.P_SPEC + 3] = spec
+        if plan.shadows:
+            f |= R.SHADOW
+        if fresnel is not None and plan.specular:
+            f |= R.FRESNEL
+            row[R.P_F0] = fresnel
+        if plan.ambient and plan.varying_weight:
+            f |= R.AMBIENT
+        if plan.diffuse:
+            f |= R.DIFFUSE
+        if plan.specular:
+            f |= R.SPECULAR
+        if min(dif) == max(dif) and min(spec) == max(spec):
+            f |= R.GREY  # one sum per vertex instead of three (the kernel may use it)
+        return row, f
+
+
+_COMMON = ("type", "ambient", "diffuse", "specular", "color", "intensity", "shadows")
+
+
+@old_keywords
+@dataclass(frozen=True)
+class DirectionalLight(Light):
+    """A light at infinity. to_light : (3,) unit vector from the surface toward the light."""
+
+    to_light: Vec3 = (0.0, 0.0, 1.0)
+
+    type: ClassVar[str] = "directional"
+    KEYS: ClassVar[dict[str, Check]] = {**Light.KEYS, "to_light": _direction}
+    RENAMED: ClassVar[dict] = {"direction": ("to_light", "the direction toward the light")}
+    FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + ("to_light",)
+
+    def _normalise(self) -> None:
+        object.__setattr__(self, "to_light", _unit(self.to_light))
+
+    def _own_mapping(self) -> dict:
+        return {"to_light": list(self.to_light)}
+
+    def work(self) -> LightWork:
+        out = ("distance", "out", "directional: L is constant and never attenuated")
+        return LightWork(positional=False, reasons=(out,))
+
+    def _pack(self, row, plan, centre, scale, halfway_view) -> int:
+        row[R.P_POS : R.P_POS + 3] = self.to_light
+        if halfway_view is None:
+            return 0
+        dx, dy, dz = self.to_light
+        vx, vy, vz = halfway_view
+        hx, hy, hz = dx + vx, dy + vy, dz + vz
+        hn = math.sqrt(hx * hx + hy * hy + hz * hz)
+        if hn * hn > tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
+            row[R.P_H : R.P_H + 3] = (hx / hn, hy / hn, hz / hn)
+        return R.CONST_H
+
+    def toward(self, points, centre=None, scale=1.0) -> np.ndarray:
+        return np.broadcast_to(np.asarray(self.to_light, np.float64), (len(points), 3))
+
+    def shadow_ray(self, points, centre=None, scale=1.0):
+        D = self.toward(points).copy()
+        return D, np.full(len(points), np.inf)
+
+    def incident(self, P, N, centre, scale):
+        n = len(P)
+        L = np.broadcast_to(np.asarray(self.to_light), (n, 3))
+        return L, np.full(n, np.inf), np.ones(n)
+
+    def placement(self, centre):
+        az, el, _ = angles_of(self.to_light)
+        return az, el, None
+
+    def placed(self, azimuth, elevation, distance, centre):
+        return self.replace(to_light=tuple(direction_of(azimuth, elevation)))
+
+    @property
+    def anchor(self):
+        return "from", self.to_light
 
 
 @dataclass(frozen=True)
-class PointLight(_Light):
-    """A positional light. attenuation : (kc, kl, kq) >= 0, not all zero."""
+class PositionalLight(Light):
+    """A light at a point. attenuation : (kc, kl, kq) >= 0, not all zero."""
 
     position: Vec3 = (0.0, 0.0, 1.0)
     attenuation: Vec3 = NO_ATTENUATION
-    type: ClassVar[str] = "point"
 
-    def __post_init__(self):
-        self._check_colours()
-        object.__setattr__(self, "position", _vec(self.position, "light position"))
-        att = _vec(self.attenuation, "light attenuation")
-        if min(att) < 0.0 or not any(att):
-            raise ValueError(
-                f"light attenuation [kc, kl, kq] must be >= 0 and not all zero, got {list(att)}"
+    KEYS: ClassVar[dict[str, Check]] = {
+        **Light.KEYS,
+        "position": _point,
+        "attenuation": _attenuation,
+    }
+
+    def _own_mapping(self) -> dict:
+        out: dict = {"position": list(self.position)}
+        if self.attenuation != NO_ATTENUATION:
+            out["attenuation"] = list(self.attenuation)
+        return out
+
+    @classmethod
+    def _kept_from(cls, light: Light) -> dict:
+        return {"attenuation": getattr(light, "attenuation", NO_ATTENUATION)}
+
+    def work(self) -> LightWork:
+        reasons = [("distance", "in", "positional: L = normalize(position - P) per vertex")]
+        attenuation, factor = "none", 1.0
+        kc, kl, kq = self.attenuation
+        if self.attenuation == NO_ATTENUATION:
+            reasons.append(("attenuation", "out", "attenuation [1, 0, 0] is 1 everywhere"))
+        elif kl == 0.0 and kq == 0.0:
+            attenuation, factor = "constant", 1.0 / kc
+            reasons.append(
+                ("attenuation", "out", f"constant 1/kc = {factor:g} folded into the colours")
             )
-        object.__setattr__(self, "attenuation", att)
+        else:
+            attenuation = "per-vertex"
+            reasons.append(("attenuation", "in", "1/(kc + kl·d + kq·d²) per vertex"))
+        return LightWork(True, attenuation, "none", factor, tuple(reasons))
+
+    def _pack(self, row, plan, centre, scale, halfway_view) -> int:
+        f = R.POSITIONAL
+        cx, cy, cz = (float(v) for v in centre)
+        px, py, pz = self.position
+        s = scale
+        row[R.P_POS : R.P_POS + 3] = ((px - cx) / s, (py - cy) / s, (pz - cz) / s)
+        kc, kl, kq = self.attenuation
+        row[R.P_ATT : R.P_ATT + 3] = (kc, kl * s, kq * s * s)
+        if plan.attenuation == "per-vertex":
+            f |= R.ATTEN
+        return f
+
+    def toward(self, points, centre=None, scale=1.0) -> np.ndarray:
+        return in_frame(self.position, centre, scale) - points
+
+    def shadow_ray(self, points, centre=None, scale=1.0):
+        D = self.toward(points, centre, scale)
+        tmax = np.linalg.norm(D, axis=1)
+        return D / np.where(tmax > 0, tmax, 1.0)[:, None], tmax
+
+    def _attenuated(self, P, N, centre, scale):
+        L, d = unit_rows(in_frame(self.position, centre, scale) - P, tol.POINT_EPS, N)
+        d = d * scale  # attenuation uses world distances
+        kc, kl, kq = self.attenuation
+        att = 1.0 / np.maximum(kc + kl * d + kq * d * d, tol.ATTENUATION_FLOOR)
+        return L, d, att
+
+    def placement(self, centre):
+        return angles_of(np.subtract(self.position, centre))
+
+    def _position_at(self, azimuth, elevation, distance, centre) -> tuple[np.ndarray, tuple]:
+        d = direction_of(azimuth, elevation)
+        return d, tuple(np.asarray(centre, dtype=np.float64) + float(distance) * d)
+
+    @property
+    def anchor(self):
+        return "at", self.position
 
 
 @dataclass(frozen=True)
-class SpotLight(PointLight):
-    """A point light restricted to a cone.
+class PointLight(PositionalLight):
+    """A light at ``position`` shining every way; attenuation : (kc, kl, kq)."""
 
-    direction : (3,) the axis the spot points along (stored unit length)
+    type: ClassVar[str] = "point"
+    FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + ("position", "attenuation")
+
+    def incident(self, P, N, centre, scale):
+        return self._attenuated(P, N, centre, scale)
+
+    def placed(self, azimuth, elevation, distance, centre):
+        _, position = self._position_at(azimuth, elevation, distance, centre)
+        return self.replace(position=position)
+
+
+@old_keywords
+@dataclass(frozen=True)
+class SpotLight(PositionalLight):
+    """A positional light restricted to a cone.
+
+    aim : (3,) unit vector of the axis the spot shines along, from the light outward
     cutoff : cone half-angle in degrees, in [0, 90], or 180 for no cone (OpenGL's rule)
     exponent : spot exponent in [0, 128]; the factor is (cos angle to the axis)**exponent
     """
 
-    direction: Vec3 = (0.0, 0.0, -1.0)
+    aim: Vec3 = (0.0, 0.0, -1.0)
     cutoff: float = 180.0
     exponent: float = 0.0
+
     type: ClassVar[str] = "spot"
+    KEYS: ClassVar[dict[str, Check]] = {
+        **PositionalLight.KEYS,
+        "aim": _direction,
+        "cutoff": _cutoff,
+        "exponent": _exponent,
+    }
+    RENAMED: ClassVar[dict] = {"direction": ("aim", "the axis the spot shines along")}
+    FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + (
+        "position",
+        "attenuation",
+        "aim",
+        "cutoff",
+        "exponent",
+    )
+    #: the cone of a spot made from another light (:meth:`like`)
+    LIKE_DEFAULTS: ClassVar[dict] = {"cutoff": 25.0, "exponent": 10.0}
 
-    def __post_init__(self):
-        super().__post_init__()
-        object.__setattr__(
-            self, "direction", _unit(_vec(self.direction, "spot direction", nonzero=True))
-        )
-        c = float(self.cutoff)
-        if not (0.0 <= c <= 90.0 or c == 180.0):
-            raise ValueError(f"spot cutoff must be in [0, 90] or exactly 180, got {c:g}")
-        e = float(self.exponent)
-        if not (SPOT_EXPONENT_RANGE[0] <= e <= SPOT_EXPONENT_RANGE[1]):
-            raise ValueError(f"spot exponent must be in [0, 128], got {e:g}")
-        object.__setattr__(self, "cutoff", c)
-        object.__setattr__(self, "exponent", e)
+    def _normalise(self) -> None:
+        object.__setattr__(self, "aim", _unit(self.aim))
+
+    def _own_mapping(self) -> dict:
+        return {
+            **super()._own_mapping(),
+            "aim": list(self.aim),
+            "cutoff": self.cutoff,
+            "exponent": self.exponent,
+        }
+
+    def work(self) -> LightWork:
+        w = super().work()
+        if self.cutoff == 180.0:
+            spot, row = "none", ("spot", "out", "cutoff 180: no cone")
+        elif self.exponent == 0.0:
+            spot = "cone"
+            row = ("spot", "in", f"cone test at {self.cutoff:g}°, exponent 0 (no pow)")
+        else:
+            spot = "cone+exponent"
+            row = ("spot", "in", f"cone test at {self.cutoff:g}° and x^{self.exponent:g}")
+        return replace(w, spot=spot, reasons=w.reasons + (row,))
+
+    def _pack(self, row, plan, centre, scale, halfway_view) -> int:
+        f = super()._pack(row, plan, centre, scale, halfway_view)
+        if plan.spot == "none":
+            return f
+        f |= R.SPOT
+        row[R.P_AXIS : R.P_AXIS + 3] = self.aim
+        row[R.P_COS] = math.cos(math.radians(self.cutoff))
+        row[R.P_EXP] = self.exponent
+        if plan.spot == "cone+exponent":
+            f |= R.SPOT_EXP
+        return f
+
+    def incident(self, P, N, centre, scale):
+        L, d, att = self._attenuated(P, N, centre, scale)
+        if self.cutoff == 180.0:
+            return L, d, att * np.ones(len(P))
+        x = -np.einsum("ij,j->i", L, np.asarray(self.aim))
+        inside = x >= math.cos(math.radians(self.cutoff))
+        return L, d, att * np.where(inside, np.maximum(x, 0.0) ** self.exponent, 0.0)
+
+    def placed(self, azimuth, elevation, distance, centre):
+        """Placed like a point light, aiming at ``centre``."""
+        d, position = self._position_at(azimuth, elevation, distance, centre)
+        return self.replace(position=position, aim=tuple(-d))
 
 
-Light = DirectionalLight | PointLight | SpotLight
-
-_COMMON = ("type", "ambient", "diffuse", "specular", "color", "intensity", "shadows")
-LIGHT_KEYS = {
-    "directional": _COMMON + ("direction",),
-    "point": _COMMON + ("position", "attenuation"),
-    "spot": _COMMON + ("position", "attenuation", "direction", "cutoff", "exponent"),
+#: light type name -> class
+LIGHT_CLASSES: dict[str, type[Light]] = {
+    cls.type: cls for cls in (DirectionalLight, PointLight, SpotLight)
 }
-ALL_LIGHT_KEYS = tuple(dict.fromkeys(k for keys in LIGHT_KEYS.values() for k in keys))
+#: every key any light type accepts in a file (old names included)
+ALL_LIGHT_KEYS = tuple(
+    dict.fromkeys(k for cls in LIGHT_CLASSES.values() for k in cls.FILE_KEYS + tuple(cls.RENAMED))
+)
 
 
 def parse_light(value, checker: Checker, path: tuple) -> Light | None:
     """Build a light from a scene-file mapping, reporting every problem to ``checker``."""
-    if isinstance(value, _Light):
+    if isinstance(value, Light):
         return value
     m = checker.mapping(value, path)
     if m is None:
@@ -155,79 +569,39 @@ def parse_light(value, checker: Checker, path: tuple) -> Light | None:
     if kind is None:
         checker.keys(m, path, ALL_LIGHT_KEYS)
         return None
-    checker.keys(m, path, LIGHT_KEYS[kind])
+    cls = LIGHT_CLASSES[kind]
+    m = checker.renamed(m, path, cls.RENAMED)
+    checker.keys(m, path, cls.FILE_KEYS)
     before = len(checker.problems)
-    kw: dict = {}
-    for key in ("ambient", "diffuse", "specular"):
-        if key in m:
-            kw[key] = checker.rgb(m[key], path + (key,), 0.0, MAX_LIGHT_VALUE)
+    kw = check_fields(cls.KEYS, m, checker, path)
     if "color" in m or "intensity" in m:
-        for key in ("diffuse", "specular"):
-            if key in m:
-                checker.problem(
-                    path + (key,),
-                    "cannot be combined with color/intensity (they set diffuse and specular)",
-                )
-        color = (1.0, 1.0, 1.0)
-        if "color" in m:
-            color = checker.rgb(m["color"], path + ("color",), 0.0, MAX_LIGHT_VALUE)
-        k = 1.0
-        if "intensity" in m:
-            k = checker.number(m["intensity"], path + ("intensity",), 0.0, MAX_LIGHT_VALUE)
-        if color is not None and k is not None:
-            kw["diffuse"] = kw["specular"] = tuple(k * c for c in color)
-    if "shadows" in m:
-        kw["shadows"] = checker.boolean(m["shadows"], path + ("shadows",))
-    if kind == "directional":
-        if "direction" in m:
-            kw["direction"] = checker.direction(m["direction"], path + ("direction",))
-    else:
-        if "position" in m:
-            kw["position"] = checker.triple(m["position"], path + ("position",))
-        if "attenuation" in m:
-            att = checker.triple(m["attenuation"], path + ("attenuation",), 0.0)
-            if att is not None and not any(att):
-                checker.problem(
-                    path + ("attenuation",),
-                    "must not be all zero (1 / (kc + kl·d + kq·d²) would divide by zero); "
-                    "use [1, 0, 0] for no attenuation",
-                )
-            kw["attenuation"] = att
-    if kind == "spot":
-        if "direction" in m:
-            kw["direction"] = checker.direction(m["direction"], path + ("direction",))
-        if "cutoff" in m:
-            c = checker.number(m["cutoff"], path + ("cutoff",), 0.0, 180.0)
-            if c is not None and 90.0 < c < 180.0:
-                checker.problem(path + ("cutoff",), f"must be in [0, 90] or exactly 180, got {c:g}")
-            kw["cutoff"] = c
-        if "exponent" in m:
-            kw["exponent"] = checker.number(m["exponent"], path + ("exponent",), 0.0, 128.0)
+        shorthand = _color_intensity(m, checker, path)
+        if shorthand is not None:
+            kw["diffuse"] = kw["specular"] = shorthand
     if len(checker.problems) > before or any(v is None for v in kw.values()):
         return None
-    cls = {"directional": DirectionalLight, "point": PointLight, "spot": SpotLight}[kind]
     try:
         return cls(**kw)
-    except ValueError as exc:  # pragma: no cover - the checks above mirror __post_init__
-        checker.problem(path, str(exc))
+    except ValueError as exc:  # a colour·intensity product beyond MAX_LIGHT_VALUE
+        for p in getattr(exc, "problems", ()):
+            checker.problem(path + (p.key,) if p.key else path, p.message)
         return None
 
 
-def light_to_mapping(light: Light) -> dict:
-    """The scene-file form of a light (plain Python values)."""
-    out: dict = {"type": light.type}
-    if isinstance(light, DirectionalLight):
-        out["direction"] = list(light.direction)
-    else:
-        out["position"] = list(light.position)
-        if light.attenuation != NO_ATTENUATION:
-            out["attenuation"] = list(light.attenuation)
-    if isinstance(light, SpotLight):
-        out["direction"] = list(light.direction)
-        out["cutoff"] = light.cutoff
-        out["exponent"] = light.exponent
-    for key in ("ambient", "diffuse", "specular"):
-        out[key] = list(getattr(light, key))
-    if light.shadows:
-        out["shadows"] = True
-    return out
+def _color_intensity(m: dict, checker: Checker, path: tuple):
+    """diffuse = specular = intensity·color (both optional), or None after a problem."""
+    for key in ("diffuse", "specular"):
+        if key in m:
+            checker.problem(
+                path + (key,),
+                "cannot be combined with color/intensity (they set diffuse and specular)",
+            )
+    color = (1.0, 1.0, 1.0)
+    if "color" in m:
+        color = checker.rgb(m["color"], path + ("color",), 0.0, MAX_LIGHT_VALUE)
+    k = 1.0
+    if "intensity" in m:
+        k = checker.number(m["intensity"], path + ("intensity",), 0.0, MAX_LIGHT_VALUE)
+    if color is None or k is None:
+        return None
+    return tuple(k * c for c in color)

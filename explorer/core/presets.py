@@ -26,7 +26,7 @@ from pathlib import Path
 from platformdirs import user_config_dir
 
 from explorer.core.atomic import write_atomic
-from explorer.core.errors import ExplorerError, ValidationError
+from explorer.core.errors import ExplorerError, Notice, ValidationError
 from explorer.core.material import Material, parse_material
 from explorer.core.validate import Checker, suggest
 from explorer.core.version import __version__
@@ -40,7 +40,7 @@ MAX_NAME_LENGTH = 64
 SUFFIX = ".yaml"
 
 
-class PresetNotice(UserWarning):
+class PresetNotice(Notice):
     """A preset hides another of the same name, or a file in a preset directory is skipped."""
 
 

@@ -5,12 +5,12 @@ The scene-file schema (every key optional)::
     material: bronze          # a preset name, or an inline mapping of the material keys
     model: blinn              # or phong (default: the material's model, else blinn)
     ambient: [0.2, 0.2, 0.2]  # scene ambient (OpenGL's default)
-    viewer: {eye: [0, 0, 5]}  # local viewer; or {direction: [0, 0, 1]} (infinite, the default)
+    viewer: {eye: [0, 0, 5]}  # local viewer; or {to_viewer: [0, 0, 1]} (infinite, the default)
     two_sided: false
     lights:                   # default: one directional light toward +z (OpenGL's GL_LIGHT0)
-      - {type: directional, direction: [1, 1, 1]}
+      - {type: directional, to_light: [1, 1, 1]}     # toward the light
       - {type: point, position: [2, 3, 1], attenuation: [1, 0.1, 0.01]}
-      - {type: spot, position: [0, 4, 0], direction: [0, -1, 0], cutoff: 30, exponent: 8}
+      - {type: spot, position: [0, 4, 0], aim: [0, -1, 0], cutoff: 30, exponent: 8}
     mesh: sphere              # built-in name or mesh file (relative to the scene file)
     hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
 
@@ -24,44 +24,53 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, parse_hdr
-from explorer.core.lights import DirectionalLight, light_to_mapping, parse_light
+from explorer.core.lights import DirectionalLight, parse_light
 from explorer.core.material import MODELS, Material, parse_material
 from explorer.core.presets import find_preset
-from explorer.core.validate import Checker
+from explorer.core.validate import Check, Checker, check_fields, checked, old_keywords
 from explorer.core.yamlio import load_yaml
 
 Vec3 = tuple[float, float, float]
 
 SCENE_KEYS = ("material", "model", "ambient", "viewer", "two_sided", "lights", "mesh", "hdr")
-VIEWER_KEYS = ("eye", "direction")
+VIEWER_KEYS = ("eye", "to_viewer")
 DEFAULT_AMBIENT = (0.2, 0.2, 0.2)
 
 
+def _eye(checker: Checker, value, path):
+    return checker.triple(value, path)
+
+
+def _to_viewer(checker: Checker, value, path):
+    return checker.direction(value, path)
+
+
+@old_keywords
 @dataclass(frozen=True)
 class Viewer:
-    """Exactly one of ``eye`` (a local viewer at a point) or ``direction`` (an infinite viewer;
-    the direction points toward the viewer, stored unit length)."""
+    """Exactly one of ``eye`` (a local viewer at a point) or ``to_viewer`` (an infinite viewer:
+    the unit vector from the scene toward the viewer)."""
 
     eye: Vec3 | None = None
-    direction: Vec3 | None = None
+    to_viewer: Vec3 | None = None
+
+    #: key -> its check, run by the scene-file parser and by the constructor
+    KEYS: ClassVar[dict[str, Check]] = {"eye": _eye, "to_viewer": _to_viewer}
+    RENAMED: ClassVar[dict] = {"direction": ("to_viewer", "the direction toward the viewer")}
+    ONE_OF: ClassVar[str] = "needs exactly one of eye (local viewer) or to_viewer (infinite)"
 
     def __post_init__(self):
-        if (self.eye is None) == (self.direction is None):
-            raise ValueError("viewer needs exactly one of eye or direction")
-        if self.eye is not None:
-            e = tuple(float(c) for c in self.eye)
-            if len(e) != 3 or not all(math.isfinite(c) for c in e):
-                raise ValueError(f"viewer eye must be 3 finite numbers, got {self.eye!r}")
-            object.__setattr__(self, "eye", e)
-        else:
-            d = tuple(float(c) for c in self.direction)
-            n = math.sqrt(sum(c * c for c in d)) if len(d) == 3 else 0.0
-            if not (math.isfinite(n) and n > 0.0):
-                raise ValueError(f"viewer direction must be non-zero, got {self.direction!r}")
-            object.__setattr__(self, "direction", tuple(c / n for c in d))
+        if (self.eye is None) == (self.to_viewer is None):
+            raise ValidationError([Problem(self.ONE_OF)])
+        checked(self, {k: c for k, c in self.KEYS.items() if getattr(self, k) is not None})
+        if self.to_viewer is not None:
+            d = self.to_viewer
+            n = math.sqrt(sum(c * c for c in d))
+            object.__setattr__(self, "to_viewer", tuple(c / n for c in d))
 
     @property
     def local(self) -> bool:
@@ -70,11 +79,11 @@ class Viewer:
     def to_mapping(self) -> dict:
         if self.eye is not None:
             return {"eye": list(self.eye)}
-        return {"direction": list(self.direction)}
+        return {"to_viewer": list(self.to_viewer)}
 
 
-DEFAULT_VIEWER = Viewer(direction=(0.0, 0.0, 1.0))
-DEFAULT_LIGHTS: tuple = (DirectionalLight(direction=(0.0, 0.0, 1.0)),)
+DEFAULT_VIEWER = Viewer(to_viewer=(0.0, 0.0, 1.0))
+DEFAULT_LIGHTS: tuple = (DirectionalLight(to_light=(0.0, 0.0, 1.0)),)
 
 
 @dataclass(frozen=True)
@@ -125,7 +134,7 @@ class Scene:
             "ambient": list(self.ambient),
             "viewer": self.viewer.to_mapping(),
             "two_sided": self.two_sided,
-            "lights": [light_to_mapping(light) for light in self.lights],
+            "lights": [light.to_mapping() for light in self.lights],
         }
         if self.mesh is not None:
             out["mesh"] = self.mesh
@@ -209,18 +218,16 @@ def _viewer(value, checker: Checker) -> Viewer | None:
     if isinstance(value, Viewer):
         return value
     path = ("viewer",)
-    m = checker.mapping(value, path, "{eye: [x, y, z]} or {direction: [x, y, z]}")
+    m = checker.mapping(value, path, "{eye: [x, y, z]} or {to_viewer: [x, y, z]}")
     if m is None:
         return None
+    m = checker.renamed(m, path, Viewer.RENAMED)
     checker.keys(m, path, VIEWER_KEYS)
-    if ("eye" in m) == ("direction" in m):
-        checker.problem(path, "needs exactly one of eye (local viewer) or direction (infinite)")
+    if ("eye" in m) == ("to_viewer" in m):
+        checker.problem(path, Viewer.ONE_OF)
         return None
-    if "eye" in m:
-        eye = checker.triple(m["eye"], path + ("eye",))
-        return None if eye is None else Viewer(eye=eye)
-    d = checker.direction(m["direction"], path + ("direction",))
-    return None if d is None else Viewer(direction=d)
+    kw = check_fields(Viewer.KEYS, m, checker, path)
+    return None if None in kw.values() else Viewer(**kw)
 
 
 def _preset(name: str, checker: Checker, materials_dirs) -> Material | None:

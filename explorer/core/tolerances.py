@@ -38,6 +38,10 @@ RAY_T_EPS = 1e-9
 #: ray parallel to the triangle: no hit.
 DET_EPS = 1e-15
 
+#: Shadow rays are cast from the vertices where N·L > -SHADOW_NDL_MARGIN: N·L is rounded, and a
+#: ray more than needed is harmless where one fewer would leave a lit vertex unshadowed.
+SHADOW_NDL_MARGIN = 1e-6
+
 #: Per-pixel reference: a pixel's ray meeting a triangle at a parameter at most this times the
 #: scene's size (max(largest absolute coordinate, 1)) is ignored; the rays start at the camera,
 #: so this only drops hits at the camera itself. Any determinant other than 0 counts (both

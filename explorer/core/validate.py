@@ -7,18 +7,27 @@ with the allowed range, the file and the line (when the document came from a fil
 
 Key paths are tuples such as ``("lights", 1, "attenuation")`` and print as
 ``lights[1].attenuation``.
+
+Each key of a model class (a light, the viewer) is checked by one function ``check(checker,
+value, path) -> value or None`` in the class's ``KEYS`` table: the scene-file parser runs it with
+the document's checker (every problem of the file at once, with file and line), the class's
+constructor runs it through :func:`check_fields` (a :class:`ValidationError` with the same
+message). A key renamed for clarity keeps its old name readable: :meth:`Checker.renamed` in
+documents, :func:`old_keywords` for constructors, both with one :class:`DeprecatedName` notice.
 """
 
 from __future__ import annotations
 
 import difflib
+import functools
 import math
-from collections.abc import Iterable, Mapping, Sequence
+import warnings
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from numbers import Real
 
 import numpy as np
 
-from explorer.core.errors import Problem, ValidationError
+from explorer.core.errors import DeprecatedName, Problem, ValidationError
 
 Path = tuple
 
@@ -113,6 +122,31 @@ class Checker:
                 ok = False
         return ok
 
+    def renamed(self, mapping: Mapping, path: Path, renames: Mapping[str, tuple[str, str]]) -> dict:
+        """``mapping`` with keys given by an old name moved to the new one.
+
+        renames : old key -> (new key, what the new name means), e.g. ``{"direction":
+            ("to_light", "the direction toward the light")}``
+        Each old name in use issues one :class:`DeprecatedName` notice naming the file, line and
+        key path; giving both names is a problem."""
+        out = dict(mapping)
+        for old, (new, meaning) in renames.items():
+            if old not in out:
+                continue
+            if new in out:
+                self.problem(path + (old,), f"is the old name of {new}: give only one of them")
+                del out[old]
+                continue
+            where = Problem("", self.file, self.line(path + (old,))).where
+            notice(f"{where}{format_path(path + (old,))} is now {new} ({meaning}); "
+                   "the old name still works")  # fmt: skip
+            out = {new if k == old else k: v for k, v in out.items()}
+            n = len(path) + 1
+            for p, line in list(self.lines.items()):  # problems in the value keep their line
+                if p[:n] == path + (old,):
+                    self.lines[path + (new,) + p[n:]] = line
+        return out
+
     # -- scalars -----------------------------------------------------------------------------
     def number(
         self,
@@ -198,6 +232,63 @@ class Checker:
             self.problem(path, "is too long to normalise (length overflows)")
             return None
         return v
+
+
+#: checks one key's value: (checker, value, path) -> the converted value, or None (a problem)
+Check = Callable[[Checker, object, Path], object]
+
+
+def check_fields(
+    checks: Mapping[str, Check], values: Mapping, checker: Checker, path: Path
+) -> dict:
+    """Run the check of each key present in ``values``; returns key -> converted value (None
+    where the check reported a problem)."""
+    return {k: check(checker, values[k], path + (k,)) for k, check in checks.items() if k in values}
+
+
+def checked(obj, checks: Mapping[str, Check]) -> None:
+    """Check and convert the fields ``checks`` names on a frozen dataclass instance, in place
+    (from its ``__post_init__``); raises one :class:`ValidationError` listing every problem, with
+    the key paths and messages the scene-file parser gives."""
+    checker = Checker(None)
+    values = check_fields(checks, {k: getattr(obj, k) for k in checks}, checker, ())
+    checker.raise_if_any()
+    for k, v in values.items():
+        object.__setattr__(obj, k, v)
+
+
+def notice(message: str) -> None:
+    """Issue one :class:`DeprecatedName` notice (the CLI prints it as ``notice: ...``)."""
+    warnings.warn(message, DeprecatedName, stacklevel=4)
+
+
+def old_keywords(cls):
+    """Class decorator: the constructor also takes the old names in ``cls.RENAMED`` (old ->
+    (new, meaning)) as keywords, with one :class:`DeprecatedName` notice each."""
+    init = cls.__init__
+
+    @functools.wraps(init)
+    def __init__(self, *args, **kwargs):
+        init(self, *args, **new_keywords(cls, kwargs))
+
+    cls.__init__ = __init__
+    return cls
+
+
+def new_keywords(cls, kwargs: Mapping) -> dict:
+    """``kwargs`` with the old names of ``cls.RENAMED`` replaced by the new ones (one notice
+    each; both names at once raise a :class:`ValidationError`)."""
+    out = dict(kwargs)
+    for old, (new, meaning) in cls.RENAMED.items():
+        if old not in out:
+            continue
+        if new in out:
+            raise ValidationError(
+                [Problem(f"is the old name of {new}: give only one of them", key=old)]
+            )
+        notice(f"{cls.__name__}({old}=...) is now {new} ({meaning}); the old name still works")
+        out[new] = out.pop(old)
+    return out
 
 
 def _range(lo: float, hi: float, lo_open: bool) -> str:

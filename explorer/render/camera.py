@@ -73,7 +73,7 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
     aspect : image width / height
     bottom : fraction of the image height kept free at the bottom (for a label), in [0, 0.9]
 
-    Infinite viewer (``viewer.direction``): parallel projection along ``-direction``, so every
+    Infinite viewer (``viewer.to_viewer``): parallel projection along ``-to_viewer``, so every
     pixel is seen along the engine's constant ``V``; the view is fitted to the mesh's
     projected bounding box (times :data:`FRAME_MARGIN`) and centred on it.
 
@@ -115,7 +115,7 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
             (near, far),
             (0.0, -shift),
         )
-    toward = np.asarray(viewer.direction, np.float64)
+    toward = np.asarray(viewer.to_viewer, np.float64)
     toward = toward / np.linalg.norm(toward)
     forward = -toward
     up = _view_up(forward)
@@ -271,7 +271,7 @@ def sphere_camera(scene, aspect: float = 1.0):
     if scene.viewer.local:
         pts = np.vstack([np.eye(3), -np.eye(3)])
     else:
-        forward = -np.asarray(scene.viewer.direction, np.float64)
+        forward = -np.asarray(scene.viewer.to_viewer, np.float64)
         up = _view_up(forward)
         right = np.cross(forward, up)
         pts = np.array([right, -right, up, -up, forward, -forward])

@@ -13,8 +13,8 @@ Camera and viewer agree (see :func:`camera_for`):
 
 - a **local viewer** (``viewer: {eye: ...}``) puts a perspective camera at the eye, looking at
   the mesh's centre, with the narrowest field of view that shows the whole mesh;
-- an **infinite viewer** (``viewer: {direction: ...}``, the default) is a *parallel*
-  projection looking along ``-direction``: every pixel is seen along the same ``V``, exactly
+- an **infinite viewer** (``viewer: {to_viewer: ...}``, the default) is a *parallel*
+  projection looking along ``-to_viewer``: every pixel is seen along the same ``V``, exactly
   what the engine assumes. The view is scaled so the mesh's bounding sphere fits.
 
 VTK is imported only inside the functions that draw or read/write PNG files.

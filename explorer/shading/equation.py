@@ -18,25 +18,14 @@ energy-conserving normalisation (1 without ``energy_conserving``).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from explorer.core import tolerances as tol
-from explorer.core.lights import DirectionalLight, SpotLight
+from explorer.core.lights import unit_rows
 from explorer.core.scene import Scene
 from explorer.geometry.frame import check_vertices, frame_of, to_frame
 from explorer.shading.effects import schlick, specular_scale
 from explorer.shading.shadows import visibility
-
-
-def _unit_or(v: np.ndarray, eps: float, fallback: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rows of ``v`` made unit length; rows shorter than ``eps`` replaced by ``fallback``.
-    Returns the unit rows (n, 3) and the lengths (n,)."""
-    length = np.sqrt(np.einsum("ij,ij->i", v, v))
-    ok = length > eps
-    unit = np.where(ok[:, None], v / np.where(ok, length, 1.0)[:, None], fallback)
-    return unit, length
 
 
 def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
@@ -57,14 +46,14 @@ def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, n
     P = (P - centre) / scale
 
     # normals: unit, or zero where absent (tolerances.NORMAL_EPS)
-    N, _ = _unit_or(N, tol.NORMAL_EPS, np.zeros(3))
+    N, _ = unit_rows(N, tol.NORMAL_EPS, np.zeros(3))
 
     # viewer direction V per vertex (toward the viewer)
     if scene.viewer.local:
         eye = to_frame(scene.viewer.eye, centre, scale)
-        V, _ = _unit_or(eye - P, tol.POINT_EPS, N)  # eye at the vertex: look along N
+        V, _ = unit_rows(eye - P, tol.POINT_EPS, N)  # eye at the vertex: look along N
     else:
-        V = np.broadcast_to(np.asarray(scene.viewer.direction, dtype=np.float64), (n, 3))
+        V = np.broadcast_to(np.asarray(scene.viewer.to_viewer, dtype=np.float64), (n, 3))
 
     if scene.two_sided:  # back-facing vertices are lit as the back face: N -> -N
         N = np.where((np.einsum("ij,ij->i", N, V) < 0.0)[:, None], -N, N)
@@ -76,21 +65,7 @@ def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, n
     diffuse = np.zeros((n, 3))
     specular = np.zeros((n, 3))
     for light in scene.lights:
-        if isinstance(light, DirectionalLight):
-            L = np.broadcast_to(np.asarray(light.direction), (n, 3))
-            att = np.ones(n)
-        else:
-            lp = to_frame(light.position, centre, scale)
-            L, d = _unit_or(lp - P, tol.POINT_EPS, N)  # light at the vertex: L = N
-            d = d * scale  # attenuation uses world distances
-            kc, kl, kq = light.attenuation
-            att = 1.0 / np.maximum(kc + kl * d + kq * d * d, tol.ATTENUATION_FLOOR)
-        spot = np.ones(n)
-        if isinstance(light, SpotLight) and light.cutoff != 180.0:
-            x = -np.einsum("ij,j->i", L, np.asarray(light.direction))
-            inside = x >= math.cos(math.radians(light.cutoff))
-            spot = np.where(inside, np.maximum(x, 0.0) ** light.exponent, 0.0)
-        w = att * spot
+        L, _, w = light.incident(P, N, centre, scale)  # what arrives and from where
         vis = np.ones(n)
         if light.shadows and faces is not None:
             vis = visibility(world, faces, light)

@@ -19,7 +19,7 @@ nothing from it, every vertex facing away from it or outside its spot cone (:fun
 per light and parallel task). A block then runs the light over the runs it reaches only.
 
 float32 lanes whose result hangs on the sign of a nearly-zero quantity (see
-:data:`explorer.core.tolerances.AMBIGUOUS_DOT`) are marked in ``ambiguous`` so the engine can redo
+:data:`explorer.core.tolerances.AMBIGUOUS_DOT`) are marked in ``redo`` so the engine can redo
 them in float64. Each lane keeps the smallest margin to such a decision (row R_TRK, a min per light,
 no mask logic); the mark is "margin below 1".
 
@@ -54,37 +54,34 @@ from numba.core.errors import TypingError
 from numba.extending import intrinsic, overload
 
 from explorer.core import tolerances as tol
+from explorer.core.lightrow import (  # the row layout, shared with the lights that pack it
+    AMBIENT,
+    ATTEN,
+    CONST_H,
+    DIFFUSE,
+    FRESNEL,
+    GREY,
+    P_AMB,
+    P_ATT,
+    P_AXIS,
+    P_COS,
+    P_DIF,
+    P_EXP,
+    P_F0,
+    P_H,
+    P_POS,
+    P_SPEC,
+    POSITIONAL,
+    SHADOW,
+    SPECULAR,
+    SPOT,
+    SPOT_EXP,
+)
 
 BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
 _OPTS = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True)
 _LEAF = dict(_OPTS, _nrt=False)
-
-# per-light flag bits (int32)
-POSITIONAL = 1
-ATTEN = 2
-SPOT = 4
-SPOT_EXP = 8
-AMBIENT = 16  # per-vertex (attenuated) ambient
-DIFFUSE = 32
-SPECULAR = 64
-CONST_H = 128  # Blinn with a directional light and an infinite viewer
-SHADOW = 256  # w *= visibility row (explorer.shading.shadows) for diffuse and specular
-FRESNEL = 512  # specular weight *= Schlick F = F0 + (1 - F0)(1 - V·H)^5
-GREY = 1024  # diffuse and specular colours have r = g = b (one sum per vertex, not three)
-
-# per-light parameter columns
-P_POS = 0  # position, or direction toward a directional light (3)
-P_AXIS = 3  # spot axis (3)
-P_ATT = 6  # kc, kl·scale, kq·scale² (3)
-P_COS = 9  # cos(cutoff)
-P_EXP = 10  # spot exponent
-P_AMB = 11  # ambient colour × constant factor (3)
-P_DIF = 14  # diffuse colour × constant factor (3)
-P_SPEC = 17  # specular colour × constant factor (3)
-P_H = 20  # constant halfway vector (3)
-P_F0 = 23  # Schlick F0 (Fresnel)
-N_PARAMS = 24
 
 # option slots (int64 array)
 O_LOCAL, O_TWO_SIDED, O_PHONG, O_FLAT = 0, 1, 2, 3
@@ -1134,8 +1131,8 @@ def _block(
     base_out,
     ws_out,
     vis,
-    amb,
-    mark,
+    redo,
+    redo_count,
     out,
     scr,
     grey_only,
@@ -1270,9 +1267,9 @@ def _block(
         count = 0
         if hit:  # (the marks of a block that counts none are never read)
             for i in range(m):
-                amb[i] = trk[i] < lim
+                redo[i] = trk[i] < lim
                 count += 1 if trk[i] < lim else 0
-        mark[0] = count
+        redo_count[0] = count
     if grey_only:
         GD, GS = _row(scr, R_GD, m), _row(scr, R_GS, m)
         if opts[O_STORE]:
@@ -1316,8 +1313,8 @@ def _task(
     base_out,
     ws_out,
     vis,
-    amb,
-    marks,
+    redo,
+    redo_count,
     out,
     scr,
     act,
@@ -1367,8 +1364,8 @@ def _task(
             base_out[:, s:e],
             ws_out[:, s:e],
             vis[:, s:e],
-            amb[s:e],
-            marks[b : b + 1],
+            redo[s:e],
+            redo_count[b : b + 1],
             out[3 * s : 3 * e],
             scr,
             grey_only,
@@ -1534,8 +1531,8 @@ def shade(
     base_out,
     ws_out,
     vis,
-    amb,
-    marks,
+    redo,
+    redo_count,
     out,
     bounds,
     culled,
@@ -1551,9 +1548,9 @@ def shade(
     (:func:`grey_pass`, which the caller asks before it allocates them)
     base_out, ws_out : (L, n) T (or (L, 0))
     vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
-    amb : (n,) bool ambiguity marks, marks : (nblocks,) int32 marked lanes per block of BLOCK
-    vertices (both (0,) when not tracking); a block that marks none leaves its part of ``amb``
-    as it was: read the marks with :func:`marked`
+    redo : (n,) bool lanes marked ambiguous in float32 (redone in float64), redo_count :
+    (nblocks,) int32 marked lanes per block of BLOCK vertices (both (0,) when not tracking); a
+    block that marks none leaves its part of ``redo`` as it was: read them with :func:`marked`
     out : (n, 3) colours
     bounds : (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds for light culling (see
     :func:`bounds`), or (N_BOUNDS, 0): no culling
@@ -1594,8 +1591,8 @@ def shade(
             base_out,
             ws_out,
             vis,
-            amb,
-            marks,
+            redo,
+            redo_count,
             outf,
             scr,
             act,
@@ -1610,15 +1607,15 @@ def shade(
 
 
 @nb.njit(**_OPTS)
-def marked(amb, marks):
-    """Indices of the marked lanes, (k,) int64, from a pass's marks and per-block counts:
-    only the blocks that counted some are read."""
-    idx = np.empty(marks.sum(), np.int64)
+def marked(redo, redo_count):
+    """Indices of the lanes to redo in float64, (k,) int64, from a pass's ``redo`` marks and
+    per-block ``redo_count``: only the blocks that counted some are read."""
+    idx = np.empty(redo_count.sum(), np.int64)
     j = 0
-    for b in range(marks.shape[0]):
-        if marks[b]:
-            for i in range(b * BLOCK, min(amb.shape[0], b * BLOCK + BLOCK)):
-                if amb[i]:
+    for b in range(redo_count.shape[0]):
+        if redo_count[b]:
+            for i in range(b * BLOCK, min(redo.shape[0], b * BLOCK + BLOCK)):
+                if redo[i]:
                     idx[j] = i
                     j += 1
     return idx
@@ -1638,8 +1635,8 @@ def _gather_sum(X, idx):
 
 @nb.njit(**_OPTS)
 def fixup(
-    amb,
-    marks,
+    redo,
+    redo_count,
     P,
     N,
     centre,
@@ -1663,7 +1660,7 @@ def fixup(
     """Redo the lanes a float32 pass marked in float64, where the policies hold exactly, and
     write the results over the float32 ones; returns how many lanes.
 
-    amb, marks : the pass's marks (see :func:`marked`)
+    redo, redo_count : the pass's marks (see :func:`marked`)
     P, N : (n, 3) world positions and normals; centre, inv_scale : the frame (:func:`prepare`)
     params, view, mat, aconst, shininess, k : the pass's inputs in float64; flags, opts : the
     pass's (ambiguity tracking is switched off here)
@@ -1671,7 +1668,7 @@ def fixup(
     (one compiled call: gathering, shading and scattering ~150 lanes from Python cost about as
     much as a light at 1M vertices)
     """
-    idx = marked(amb, marks)
+    idx = marked(redo, redo_count)
     m = idx.shape[0]
     if m == 0:
         return 0

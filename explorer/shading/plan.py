@@ -5,7 +5,8 @@ the whole scene, what must be computed per vertex, what is constant, and what is
 the reason for each decision. The kernels (:mod:`explorer.shading.kernels`) follow the plan; the
 test suite checks that the planned result equals the full-generality reference on random scenes.
 
-Light-level decisions depend on the light only (its colours, type, attenuation, cone); the
+Light-level decisions depend on the light only (its colours, and what its class says it needs:
+:meth:`explorer.core.lights.Light.work`: distance, attenuation, cone); the
 term-level decisions (is there any ambient, diffuse, specular at all?) depend on the material
 too. The interactive :class:`~explorer.shading.shader.Shader` keeps per-light work cached across
 material changes and asks for a term only when the current material needs it.
@@ -13,10 +14,9 @@ material changes and asks for a term only when the current material needs it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from explorer.core.hdr import energy_warnings
-from explorer.core.lights import NO_ATTENUATION, DirectionalLight, PointLight, SpotLight
 from explorer.core.scene import Scene
 from explorer.shading.effects import specular_scale
 from explorer.shading.kernels import CHUNK
@@ -102,14 +102,6 @@ class Plan:
         """Some light casts shadow rays."""
         return any(lp.shadows for lp in self.lights)
 
-    def light_does(self, lp: LightPlan) -> dict[str, bool]:
-        """Which terms light ``lp`` computes under this plan."""
-        return {
-            "ambient": self.ambient and lp.ambient and lp.varying_weight,
-            "diffuse": self.diffuse and lp.diffuse,
-            "specular": self.specular and lp.specular,
-        }
-
     def describe(self) -> str:
         """The plan as text: one line per decision with its reason."""
         rows = [("scene", *r) for r in self.reasons]
@@ -144,8 +136,6 @@ def make_plan(scene: Scene, *, mesh: str | None = None, force_all: bool = False)
 
 
 def _forced(plan: Plan, scene: Scene, mesh) -> Plan:
-    from dataclasses import replace
-
     lights = []
     for lp, lt in zip(plan.lights, scene.lights, strict=True):
         att = "per-vertex" if lp.positional else "none"
@@ -178,70 +168,34 @@ def _forced(plan: Plan, scene: Scene, mesh) -> Plan:
     )
 
 
-def _make_plan(scene: Scene, mesh) -> Plan:
-    m = scene.material
-    lights = scene.lights
-    reasons = []
+class _Reasons(list):
+    """(item, "in"|"out", why) rows; :meth:`why` adds one and returns the decision."""
 
-    def why(item, on, reason):
-        reasons.append((item, "in" if on else "out", reason))
+    def why(self, item: str, on: bool, reason: str) -> bool:
+        self.append((item, "in" if on else "out", reason))
         return on
 
-    emission = why(
-        "emission",
-        _nonzero(m.emission),
-        "material emission is non-zero" if _nonzero(m.emission) else "material emission is 0",
-    )
-    any_amb = _nonzero(scene.ambient) or any(_nonzero(lt.ambient) for lt in lights)
-    ambient = why(
-        "ambient",
-        _nonzero(m.ambient) and any_amb,
-        "material ambient 0"
-        if not _nonzero(m.ambient)
-        else ("scene and light ambient are 0" if not any_amb else "a_m and an ambient light"),
-    )
-    any_dif = any(_nonzero(lt.diffuse) for lt in lights)
-    diffuse = why(
-        "diffuse",
-        _nonzero(m.diffuse) and any_dif,
-        "material diffuse 0"
-        if not _nonzero(m.diffuse)
-        else ("no light has diffuse colour" if not any_dif else "d_m and a light's diffuse"),
-    )
-    any_spec = any(_nonzero(lt.specular) for lt in lights)
-    specular = why(
-        "specular",
-        _nonzero(m.specular) and any_spec,
-        "material specular 0"
-        if not _nonzero(m.specular)
-        else ("no light has specular colour" if not any_spec else "s_m and a light's specular"),
-    )
+
+def _make_plan(scene: Scene, mesh) -> Plan:
+    m = scene.material
+    r = _Reasons()
+    emission, ambient, diffuse, specular = _terms(scene, r)
     flat = specular and m.shininess == 0.0
     if specular:
-        why(
+        r.why(
             "lobe",
             not flat,
             "shininess 0: 0^0 = 1, the lobe is 1 wherever N·L > 0 (no H, no R, no pow)"
             if flat
             else f"pow(base, {m.shininess:g}) per vertex",
         )
-
-    needs_view = (specular and (not flat or m.fresnel is not None)) or scene.two_sided
-    if not needs_view:
-        view = "none"
-        why("view vector", False, "no lobe, no Fresnel and one-sided: V is never used")
-    elif scene.viewer.local:
-        view = "per-vertex"
-        why("view vector", True, "local viewer: V = normalize(eye - P) per vertex")
-    else:
-        view = "constant"
-        why("view vector", True, "infinite viewer: V is constant")
-    why(
+    view = _view(scene, specular, flat, r)
+    r.why(
         "two-sided",
         scene.two_sided,
         "flip N where N·V < 0" if scene.two_sided else "two_sided is false",
     )
-    cull = why(
+    cull = r.why(
         "culling",
         not scene.two_sided,
         "two-sided: N flips with V, so no vertex is known to face away from a light"
@@ -249,41 +203,11 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
         "spot's cone) skip it: how many, the mesh decides",
     )
+    fresnel, scale = _effects(scene, specular, r)
 
-    fresnel = m.fresnel if specular else None
-    if m.fresnel is None:
-        why("fresnel", False, "material fresnel not set")
-    elif not specular:
-        why("fresnel", False, f"F0 = {m.fresnel:g} but there is no specular term to weight")
-    else:
-        why("fresnel", True, f"Schlick F0 = {m.fresnel:g}: specular × F0 + (1-F0)(1-V·H)^5")
-
-    scale = specular_scale(scene)
-    if not m.energy_conserving:
-        why("energy", False, "material energy_conserving is false")
-    elif not specular:
-        why("energy", False, "energy_conserving, but there is no specular term to normalise")
-    else:
-        form = "(n+2)/(2π)" if scene.model == "phong" else "(n+8)/(8π)"
-        why("energy", True, f"energy_conserving: {form} = {scale:.4g} folded into s_i")
-    if scene.hdr is None:
-        why("hdr", False, "no hdr: colours clamped to [0, 1] (OpenGL)")
-    else:
-        why(
-            "hdr",
-            True,
-            f"unclamped, exposure {scene.hdr.exposure:g} stops, {scene.hdr.tone_map} tone "
-            "map, sRGB",
-        )
-
-        for w in energy_warnings(m):
-            why("kd + ks", False, "warning: " + w)
-
-    lplans = []
-    for i, lt in enumerate(lights):
-        lplans.append(_light_plan(i, lt, scene, m, mesh, diffuse, specular))
-    per_vertex_amb = ambient and any(lp.ambient and lp.varying_weight for lp in lplans)
-
+    lplans = tuple(
+        _light_plan(i, lt, scene, mesh, diffuse, specular) for i, lt in enumerate(scene.lights)
+    )
     halfway = "none"
     if specular and not flat:
         if scene.model == "phong":
@@ -295,7 +219,7 @@ def _make_plan(scene: Scene, mesh) -> Plan:
     return Plan(
         emission=emission,
         ambient=ambient,
-        ambient_per_vertex=per_vertex_amb,
+        ambient_per_vertex=ambient and any(lp.ambient and lp.varying_weight for lp in lplans),
         diffuse=diffuse,
         specular=specular,
         flat_specular=flat,
@@ -303,8 +227,8 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         halfway=halfway,
         two_sided=scene.two_sided,
         model=scene.model,
-        lights=tuple(lplans),
-        reasons=tuple(reasons),
+        lights=lplans,
+        reasons=tuple(r),
         fresnel=fresnel,
         specular_scale=scale if specular else 1.0,
         hdr=scene.hdr is not None,
@@ -312,55 +236,111 @@ def _make_plan(scene: Scene, mesh) -> Plan:
     )
 
 
-def _light_plan(i: int, lt, scene: Scene, m, mesh, diffuse: bool, specular: bool) -> LightPlan:
-    reasons = []
+def _terms(scene: Scene, r: _Reasons) -> tuple[bool, bool, bool, bool]:
+    """Which of emission, ambient, diffuse, specular the material and lights can make
+    non-zero."""
+    m, lights = scene.material, scene.lights
+    emission = r.why(
+        "emission",
+        _nonzero(m.emission),
+        "material emission is non-zero" if _nonzero(m.emission) else "material emission is 0",
+    )
+    any_amb = _nonzero(scene.ambient) or any(_nonzero(lt.ambient) for lt in lights)
+    ambient = r.why(
+        "ambient",
+        _nonzero(m.ambient) and any_amb,
+        "material ambient 0"
+        if not _nonzero(m.ambient)
+        else ("scene and light ambient are 0" if not any_amb else "a_m and an ambient light"),
+    )
+    any_dif = any(_nonzero(lt.diffuse) for lt in lights)
+    diffuse = r.why(
+        "diffuse",
+        _nonzero(m.diffuse) and any_dif,
+        "material diffuse 0"
+        if not _nonzero(m.diffuse)
+        else ("no light has diffuse colour" if not any_dif else "d_m and a light's diffuse"),
+    )
+    any_spec = any(_nonzero(lt.specular) for lt in lights)
+    specular = r.why(
+        "specular",
+        _nonzero(m.specular) and any_spec,
+        "material specular 0"
+        if not _nonzero(m.specular)
+        else ("no light has specular colour" if not any_spec else "s_m and a light's specular"),
+    )
+    return emission, ambient, diffuse, specular
 
-    def why(item, on, reason):
-        reasons.append((item, "in" if on else "out", reason))
-        return on
 
+def _view(scene: Scene, specular: bool, flat: bool, r: _Reasons) -> str:
+    """How the view vector V is found: "none", "constant" or "per-vertex"."""
+    m = scene.material
+    if not ((specular and (not flat or m.fresnel is not None)) or scene.two_sided):
+        r.why("view vector", False, "no lobe, no Fresnel and one-sided: V is never used")
+        return "none"
+    if scene.viewer.local:
+        r.why("view vector", True, "local viewer: V = normalize(eye - P) per vertex")
+        return "per-vertex"
+    r.why("view vector", True, "infinite viewer: V is constant")
+    return "constant"
+
+
+def _effects(scene: Scene, specular: bool, r: _Reasons) -> tuple[float | None, float]:
+    """Fresnel, energy conservation and HDR: returns (F0 or None, the specular scale)."""
+    m = scene.material
+    fresnel = m.fresnel if specular else None
+    if m.fresnel is None:
+        r.why("fresnel", False, "material fresnel not set")
+    elif not specular:
+        r.why("fresnel", False, f"F0 = {m.fresnel:g} but there is no specular term to weight")
+    else:
+        r.why("fresnel", True, f"Schlick F0 = {m.fresnel:g}: specular × F0 + (1-F0)(1-V·H)^5")
+
+    scale = specular_scale(scene)
+    if not m.energy_conserving:
+        r.why("energy", False, "material energy_conserving is false")
+    elif not specular:
+        r.why("energy", False, "energy_conserving, but there is no specular term to normalise")
+    else:
+        form = "(n+2)/(2π)" if scene.model == "phong" else "(n+8)/(8π)"
+        r.why("energy", True, f"energy_conserving: {form} = {scale:.4g} folded into s_i")
+    if scene.hdr is None:
+        r.why("hdr", False, "no hdr: colours clamped to [0, 1] (OpenGL)")
+    else:
+        r.why(
+            "hdr",
+            True,
+            f"unclamped, exposure {scene.hdr.exposure:g} stops, {scene.hdr.tone_map} tone "
+            "map, sRGB",
+        )
+        for w in energy_warnings(m):
+            r.why("kd + ks", False, "warning: " + w)
+    return fresnel, scale
+
+
+def _light_plan(i: int, lt, scene: Scene, mesh, diffuse: bool, specular: bool) -> LightPlan:
+    """The light's own decisions (:meth:`explorer.core.lights.Light.work`) and what the
+    material, model, viewer and mesh make of its terms."""
+    m = scene.material
+    work = lt.work()
+    r = _Reasons(work.reasons)
     amb = _nonzero(lt.ambient)
     dif = _nonzero(lt.diffuse)
     spec = _nonzero(lt.specular)
-    positional = isinstance(lt, PointLight)
-    attenuation, factor = "none", 1.0
-    spot = "none"
-    if isinstance(lt, DirectionalLight):
-        why("distance", False, "directional: L is constant and never attenuated")
-    else:
-        why("distance", True, "positional: L = normalize(position - P) per vertex")
-        kc, kl, kq = lt.attenuation
-        if lt.attenuation == NO_ATTENUATION:
-            why("attenuation", False, "attenuation [1, 0, 0] is 1 everywhere")
-        elif kl == 0.0 and kq == 0.0:
-            attenuation, factor = "constant", 1.0 / kc
-            why("attenuation", False, f"constant 1/kc = {factor:g} folded into the colours")
-        else:
-            attenuation = "per-vertex"
-            why("attenuation", True, "1/(kc + kl·d + kq·d²) per vertex")
-    if isinstance(lt, SpotLight):
-        if lt.cutoff == 180.0:
-            why("spot", False, "cutoff 180: no cone")
-        elif lt.exponent == 0.0:
-            spot = "cone"
-            why("spot", True, f"cone test at {lt.cutoff:g}°, exponent 0 (no pow)")
-        else:
-            spot = "cone+exponent"
-            why("spot", True, f"cone test at {lt.cutoff:g}° and x^{lt.exponent:g}")
-    lp = LightPlan(i, lt.type, amb, dif, spec, positional, attenuation, spot, factor)
-    varying = lp.varying_weight
+    positional = work.positional
+    varying = work.attenuation == "per-vertex" or work.spot != "none"
 
     if not _nonzero(m.ambient):
-        why("ambient", False, "material ambient 0")
+        r.why("ambient", False, "material ambient 0")
     elif not amb:
-        why("ambient", False, "light ambient 0")
+        r.why("ambient", False, "light ambient 0")
     else:
-        why(
+        r.why(
             "ambient",
             True,
             "attenuated per vertex" if varying else "constant: added once to the scene ambient",
         )
-    why(
+    r.why(
         "diffuse",
         dif and _nonzero(m.diffuse),
         "light diffuse 0"
@@ -368,31 +348,42 @@ def _light_plan(i: int, lt, scene: Scene, m, mesh, diffuse: bool, specular: bool
         else ("material diffuse 0" if not _nonzero(m.diffuse) else "max(N·L, 0)·d_i"),
     )
     if not spec:
-        why("specular", False, "light specular 0")
+        r.why("specular", False, "light specular 0")
     elif not _nonzero(m.specular):
-        why("specular", False, "material specular 0")
+        r.why("specular", False, "material specular 0")
     elif m.shininess == 0.0:
-        why("specular", True, "flat lobe (shininess 0): s_i where N·L > 0")
+        r.why("specular", True, "flat lobe (shininess 0): s_i where N·L > 0")
     elif scene.model == "phong":
-        why("specular", True, "Phong: (R·V)^n with R = 2(N·L)N - L per vertex")
+        r.why("specular", True, "Phong: (R·V)^n with R = 2(N·L)N - L per vertex")
     elif not positional and not scene.viewer.local:
-        why("specular", True, "Blinn: constant H (directional light, infinite viewer), N·H")
+        r.why("specular", True, "Blinn: constant H (directional light, infinite viewer), N·H")
     else:
-        why("specular", True, "Blinn: H = normalize(L + V) per vertex")
+        r.why("specular", True, "Blinn: H = normalize(L + V) per vertex")
     shadows = False
     if not lt.shadows:
-        why("shadows", False, "shadows is false")
+        r.why("shadows", False, "shadows is false")
     elif mesh is None:
-        why("shadows", False, "no mesh faces given: nothing can cast a shadow")
+        r.why("shadows", False, "no mesh faces given: nothing can cast a shadow")
     elif mesh == "convex":
-        why("shadows", False, "convex mesh: it cannot shadow itself")
+        r.why("shadows", False, "convex mesh: it cannot shadow itself")
     elif not ((dif and diffuse) or (spec and specular)):
-        why("shadows", False, "no diffuse or specular from this light to shadow")
+        r.why("shadows", False, "no diffuse or specular from this light to shadow")
     else:
-        shadows = True
-        why("shadows", True, "rays toward the light from vertices with N·L > 0 (others: none)")
+        shadows = r.why(
+            "shadows", True, "rays toward the light from vertices with N·L > 0 (others: none)"
+        )
     if not (amb or dif or spec):
-        why("light", False, "all colours 0: skipped entirely")
+        r.why("light", False, "all colours 0: skipped entirely")
     return LightPlan(
-        i, lt.type, amb, dif, spec, positional, attenuation, spot, factor, tuple(reasons), shadows
+        i,
+        lt.type,
+        amb,
+        dif,
+        spec,
+        positional,
+        work.attenuation,
+        work.spot,
+        work.factor,
+        tuple(r),
+        shadows,
     )

@@ -28,23 +28,20 @@ Cached arrays are read-only.
 
 from __future__ import annotations
 
-import math
 import sys
 from collections import Counter
 
 import numpy as np
 
+from explorer.core import lightrow as R
 from explorer.core.errors import ExplorerError
-from explorer.core.lights import DirectionalLight, SpotLight
 from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.geometry.frame import check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.shadows import is_convex, visibility
+from explorer.shading.shadows import is_convex, visibility_rows
 
 PRECISIONS = ("float64", "float32")
-#: shadow rays are cast where N·L > -this (rounding of N·L must never skip a lit vertex)
-SHADOW_NDL_MARGIN = 1e-6
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
@@ -159,10 +156,9 @@ class Shader:
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._colors = None
-        self._pool: list[np.ndarray] = []  # colour buffers, reused once nothing views them
-        self._spares: list[np.ndarray] = []  # memory of invalidated sums, reused likewise
-        self._amb = np.zeros(n if self._T is np.float32 else 0, np.bool_)
-        self._marks = np.zeros(-(-self._amb.size // K.BLOCK), np.int32)  # per block
+        self._memory = _Memory()
+        self._redo = np.zeros(n if self._T is np.float32 else 0, np.bool_)
+        self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
         self._lights_changed()
 
@@ -194,7 +190,7 @@ class Shader:
         if nm.shininess != om.shininess or nm.energy_conserving != om.energy_conserving:
             self._shininess_changed()
         self._colors = None  # material colours and scene ambient: compose only
-        self._aconst = self._ambient_constant()
+        self._aconst = ambient_constant(self._scene, self._plan)
 
     def set_material(self, material) -> None:
         self.set_scene(self._scene.replace(material=material))
@@ -239,39 +235,20 @@ class Shader:
         return {k: _readonly(v) for k, v in out.items()}
 
     # -- invalidation --------------------------------------------------------------------------
-    def _retire(self, *sums) -> None:
-        """Keep the memory of invalidated sums for the next pass (see :meth:`_fresh_sum`)."""
-        for a in sums:
-            if a is not None and len(self._spares) < 5:
-                self._spares.append(a)
-
-    def _fresh_sum(self, grey: bool = False) -> np.ndarray:
-        """An (n, 3) array for a sum being recomputed, or (n, 1) for a grey one (every channel the
-        same, see :func:`explorer.shading.kernels.grey_pass`): the memory of an invalidated sum of
-        that shape that no array handed out (``terms``) still views, else a new one. Reuse saves the
-        page faults of fresh memory (three 12 MB sums per light change at 1M vertices)."""
-        shape = (self.n, 1 if grey else 3)
-        for i in range(len(self._spares)):
-            buf = self._spares[i]  # (not enumerate: its tuple would hold one more reference)
-            # references: the list, ``buf``, getrefcount's argument
-            if buf.shape == shape and buf.dtype == self._T and sys.getrefcount(buf) <= 3:
-                return self._spares.pop(i)
-        return np.empty(shape, self._T)
-
     def _lights_changed(self):
-        self._retire(self._A, self._D, self._S)
+        self._memory.retire(self._A, self._D, self._S)
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._spec_shininess = None
         self._colors = None
         self._params = None
-        self._aconst = self._ambient_constant()
+        self._aconst = ambient_constant(self._scene, self._plan)
 
     def _viewer_changed(self):
         if self._scene.two_sided:  # N·V decides which normals flip: every sum depends on V
             self._lights_changed()
             return
-        self._retire(self._S)
+        self._memory.retire(self._S)
         self._S = None
         self._base = self._ws = None
         self._spec_shininess = None
@@ -281,7 +258,7 @@ class Shader:
         self._keep_lobe = False
 
     def _shininess_changed(self):
-        self._retire(self._S)
+        self._memory.retire(self._S)
         self._S = None  # the stored bases and weights stay valid
         self._params = None  # an energy-conserving factor changes with n (cheap to redo)
         # from now on keep each light's base and weight, so the next shininess change only
@@ -305,134 +282,31 @@ class Shader:
     def _visibility(self, dtype) -> np.ndarray:
         """(L, n) visibility rows of the lights the plan shadows, or (L, 0) when none."""
         scene, plan = self._scene, self._plan
-        L, n = len(scene.lights), self.n
         if not plan.shadows:
-            return np.zeros((L, 0), dtype)
-        vis = np.ones((L, n), dtype)
-        N = np.asarray(self._N, np.float64)
-        length = np.sqrt(np.einsum("ij,ij->i", N, N))
-        unit = (N / np.where(length > 0, length, 1.0)[:, None]).T  # (3, n)
-        for i, (lp, light) in enumerate(zip(plan.lights, scene.lights, strict=True)):
-            if not lp.shadows:
-                continue
-            if isinstance(light, DirectionalLight):
-                where = ("d", light.direction)
-            else:
-                where = ("p", light.position)
-            key = (where, scene.two_sided, self.force_all)
-            v = self._vis_cache.get(key)
-            if v is None:
-                only = None
-                if not self.force_all:  # rays only where N·L can be > 0 (either side if 2-sided)
-                    if isinstance(light, DirectionalLight):
-                        ndl = np.asarray(light.direction) @ unit
-                    else:
-                        ndl = np.einsum("ij,ji->i", np.asarray(light.position) - self._P, unit)
-                    # a margin: a ray more than needed is harmless, one fewer is not
-                    only = length > 0 if scene.two_sided else ndl > -SHADOW_NDL_MARGIN
-                v = visibility(self._P, self._faces, light, only=only)
-                self._vis_cache[key] = v
-                self.stats["shadow_rays"] += int(n if only is None else only.sum())
-            vis[i] = v
+            return np.zeros((len(scene.lights), 0), dtype)
+        vis, rays = visibility_rows(
+            self._P,
+            self._N,
+            self._faces,
+            scene.lights,
+            [lp.shadows for lp in plan.lights],
+            two_sided=scene.two_sided,
+            force_all=self.force_all,
+            cache=self._vis_cache,
+            dtype=dtype,
+        )
+        self.stats["shadow_rays"] += rays
         return vis
 
     # -- the work ------------------------------------------------------------------------------
-    def _ambient_constant(self) -> np.ndarray:
-        """Scene ambient plus the ambient of lights whose weight is constant, (3,) float64."""
-        a = np.asarray(self._scene.ambient, dtype=np.float64).copy()
-        for lp, light in zip(self._plan.lights, self._scene.lights, strict=True):
-            if lp.ambient and not lp.varying_weight:
-                a += lp.factor * np.asarray(light.ambient)
-        return a
-
-    def _light_params(self, dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Kernel inputs for the lights and viewer in the normalised frame.
-
-        Built in Python floats, one row per light, and made an array once (a light drag
-        rebuilds them every frame: small numpy operations per light cost more than the row)."""
-        scene, plan = self._scene, self._plan
-        c, s = self._centre, self._scale
-        cx, cy, cz = (float(v) for v in c)
-        if scene.viewer.local:
-            view = to_frame(scene.viewer.eye, c, s)
-        else:
-            view = np.asarray(scene.viewer.direction, dtype=np.float64)
-        vx, vy, vz = (float(v) for v in view)
-        rows, flags = [], []
-        for lp, light in zip(plan.lights, scene.lights, strict=True):
-            f = 0
-            q = [0.0] * K.N_PARAMS
-            if isinstance(light, DirectionalLight):
-                q[K.P_POS : K.P_POS + 3] = light.direction
-                if scene.model == "blinn" and not scene.viewer.local and not plan.force_all:
-                    dx, dy, dz = light.direction
-                    hx, hy, hz = dx + vx, dy + vy, dz + vz
-                    hn = math.sqrt(hx * hx + hy * hy + hz * hz)
-                    if hn * hn > K.tol.HALFWAY_EPS2:  # else H undefined: N·H = 0
-                        q[K.P_H : K.P_H + 3] = (hx / hn, hy / hn, hz / hn)
-                    f |= K.CONST_H
-            else:
-                f |= K.POSITIONAL
-                px, py, pz = light.position
-                q[K.P_POS : K.P_POS + 3] = ((px - cx) / s, (py - cy) / s, (pz - cz) / s)
-                kc, kl, kq = light.attenuation
-                q[K.P_ATT : K.P_ATT + 3] = (kc, kl * s, kq * s * s)
-                if lp.attenuation == "per-vertex":
-                    f |= K.ATTEN
-            if isinstance(light, SpotLight) and lp.spot != "none":
-                f |= K.SPOT
-                q[K.P_AXIS : K.P_AXIS + 3] = light.direction
-                q[K.P_COS] = math.cos(math.radians(light.cutoff))
-                q[K.P_EXP] = light.exponent
-                if lp.spot == "cone+exponent":
-                    f |= K.SPOT_EXP
-            fa, fs = lp.factor, lp.factor * plan.specular_scale
-            dif = [fa * v for v in light.diffuse]
-            spec = [fs * v for v in light.specular]
-            q[K.P_AMB : K.P_AMB + 3] = [fa * v for v in light.ambient]
-            q[K.P_DIF : K.P_DIF + 3] = dif
-            q[K.P_SPEC : K.P_SPEC + 3] = spec
-            if lp.shadows:
-                f |= K.SHADOW
-            if plan.fresnel is not None and lp.specular:
-                f |= K.FRESNEL
-                q[K.P_F0] = plan.fresnel
-            if lp.ambient and lp.varying_weight:
-                f |= K.AMBIENT
-            if lp.diffuse:
-                f |= K.DIFFUSE
-            if lp.specular:
-                f |= K.SPECULAR
-            if min(dif) == max(dif) and min(spec) == max(spec):
-                f |= K.GREY  # one sum per vertex instead of three (the kernel may use it)
-            rows.append(q)
-            flags.append(f)
-        params = np.array(rows, dtype=np.float64).reshape(len(rows), K.N_PARAMS)
-        return params.astype(dtype), np.array(flags, np.int32), view.astype(dtype)
-
     def _material_vector(self, dtype) -> np.ndarray:
         m = self._scene.material
         return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
 
-    def _take_buffer(self) -> np.ndarray:
-        """An (n, 3) colour buffer that no array handed out still views.
-
-        Colours already returned are never overwritten; a buffer whose views are all gone is
-        reused instead of allocating (a fresh 12 MB array costs its page faults on every update).
-        """
-        for buf in self._pool:
-            # references: the pool's list, the loop variable, getrefcount's argument
-            if sys.getrefcount(buf) <= 3:
-                return buf
-        buf = np.empty((self.n, 3), self._T)
-        if len(self._pool) < 2:
-            self._pool.append(buf)
-        return buf
-
     def _update(self, force=(False, False, False)):
         plan, scene, T = self._plan, self._scene, self._T
         self._colors = None
-        self._out = self._take_buffer()
+        self._out = self._memory.colour_buffer(self.n, self._T)
         need_amb = plan.ambient_per_vertex or force[0]
         need_dif = plan.diffuse or force[1]
         need_spec = plan.specular or force[2]
@@ -444,7 +318,7 @@ class Shader:
         if do_spec and self._ws is not None and (flat or self._base is not None):
             # the lobe alone: bases and weights are stored, only n changed
             params, flags, _ = self._params_for(T)
-            S = self._fresh_sum()
+            S = self._memory.fresh((self.n, 3), self._T)
             K.lobe(
                 self._base if self._base is not None else self._ws,
                 self._ws,
@@ -484,7 +358,9 @@ class Shader:
         if dtype not in self._params:
             # built once in float64 (the float64 redo of ambiguous lanes needs those too)
             if np.float64 not in self._params:
-                self._params[np.float64] = self._light_params(np.float64)
+                self._params[np.float64] = light_params(
+                    self._scene, self._plan, self._centre, self._scale
+                )
             params, flags, view = self._params[np.float64]
             self._params[dtype] = (params.astype(dtype), flags, view.astype(dtype))
         return self._params[dtype]
@@ -495,25 +371,17 @@ class Shader:
         params, flags, view = self._params_for(T)
         L = len(params)
         keep = self.keep
-        opts = np.zeros(K.N_OPTS, np.int64)
-        opts[K.O_LOCAL] = scene.viewer.local
-        opts[K.O_TWO_SIDED] = scene.two_sided
-        opts[K.O_PHONG] = scene.model == "phong"
-        opts[K.O_FLAT] = flat
-        opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do_amb, do_dif, do_spec
+        opts = pass_options(scene, self._plan, flat, (do_amb, do_dif, do_spec), T)
         opts[K.O_STORE] = keep
         opts[K.O_STORE_LOBE] = keep and do_spec and self._keep_lobe
-        opts[K.O_COMPOSE] = 1
         opts[K.O_CLAMP] = self.clamp
-        opts[K.O_TRACK] = T is np.float32
-        opts[K.O_VIEW] = self._plan.fresnel is not None
         empty3 = np.zeros((0, 3), T)
 
         def cache(current, do, grey=False):
             if not keep:
                 return empty3
             if do:
-                return self._fresh_sum(grey)
+                return self._memory.fresh((n, 1 if grey else 3), T)
             return current if current is not None else empty3
 
         # a pass whose diffuse and specular sums are grey stores them as (n, 1) (the kernel
@@ -535,7 +403,7 @@ class Shader:
             self._lobe_memory = (base, ws)
         else:
             base = ws = np.zeros((L, 0), T)
-        amb = self._amb  # every block writes its count, and its marks if it counts any
+        redo = self._redo  # every block writes its count, and its marks if it counts any
         vis = self._visibility(T)
         shin = T(scene.material.shininess)
         K.shade(
@@ -554,8 +422,8 @@ class Shader:
             base,
             ws,
             vis,
-            amb,
-            self._marks,
+            redo,
+            self._redo_count,
             self._out,
             self._bounds if self._plan.cull and self.cull else self._bounds[:, :0],
             self._culled,
@@ -567,8 +435,8 @@ class Shader:
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
             params64, _, view64 = self._params_for(np.float64)
             self.stats["fixup_vertices"] += K.fixup(
-                amb,
-                self._marks,
+                redo,
+                self._redo_count,
                 self._P,
                 self._N,
                 self._centre,
@@ -600,6 +468,98 @@ class Shader:
                     self._base = base if not flat else None
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
+
+
+def ambient_constant(scene: Scene, plan: Plan) -> np.ndarray:
+    """Scene ambient plus the ambient of lights whose weight is constant, (3,) float64."""
+    a = np.asarray(scene.ambient, dtype=np.float64).copy()
+    for lp, light in zip(plan.lights, scene.lights, strict=True):
+        if lp.ambient and not lp.varying_weight:
+            a += lp.factor * np.asarray(light.ambient)
+    return a
+
+
+def light_params(scene: Scene, plan: Plan, centre, scale) -> tuple:
+    """Kernel inputs for the lights and viewer in the normalised frame ``centre`` (3,),
+    ``scale``, float64: params (L, N_PARAMS) and flags (L,) int32, one row per light (each light
+    packs its own: :meth:`explorer.core.lights.Light.kernel_row`), and the view (3,): the eye,
+    or V for an infinite viewer."""
+    if scene.viewer.local:
+        view = to_frame(scene.viewer.eye, centre, scale)
+    else:
+        view = np.asarray(scene.viewer.to_viewer, dtype=np.float64)
+    constant_h = scene.model == "blinn" and not scene.viewer.local and not plan.force_all
+    halfway_view = tuple(float(v) for v in view) if constant_h else None
+    rows, flags = [], []
+    for lp, light in zip(plan.lights, scene.lights, strict=True):
+        row, f = light.kernel_row(
+            lp,
+            centre,
+            scale,
+            halfway_view=halfway_view,
+            specular_scale=plan.specular_scale,
+            fresnel=plan.fresnel,
+        )
+        rows.append(row)
+        flags.append(f)
+    params = np.array(rows, dtype=np.float64).reshape(len(rows), R.N_PARAMS)
+    return params, np.array(flags, np.int32), view
+
+
+def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.ndarray:
+    """(N_OPTS,) int64 options of a shading pass that follow from the scene and plan: viewer,
+    sidedness, model, flat lobe, the sums ``do`` = (ambient, diffuse, specular) recomputed,
+    ambiguity tracking (float32) and V rows for Fresnel; storing and clamping are the caller's."""
+    opts = np.zeros(K.N_OPTS, np.int64)
+    opts[K.O_LOCAL] = scene.viewer.local
+    opts[K.O_TWO_SIDED] = scene.two_sided
+    opts[K.O_PHONG] = scene.model == "phong"
+    opts[K.O_FLAT] = flat
+    opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do
+    opts[K.O_COMPOSE] = 1
+    opts[K.O_TRACK] = dtype is np.float32
+    opts[K.O_VIEW] = plan.fresnel is not None
+    return opts
+
+
+class _Memory:
+    """Arrays reused instead of allocated: colour buffers, and the memory of invalidated sums.
+
+    Reuse saves the page faults of fresh memory (three 12 MB sums per light change at 1M
+    vertices). An array is reused only once no array handed out (``colors``, ``terms``) still
+    views it: colours already returned are never overwritten."""
+
+    def __init__(self):
+        self.colours: list[np.ndarray] = []
+        self.spares: list[np.ndarray] = []
+
+    def retire(self, *sums) -> None:
+        """Keep the memory of invalidated sums for the next pass (see :meth:`fresh`)."""
+        for a in sums:
+            if a is not None and len(self.spares) < 5:
+                self.spares.append(a)
+
+    def fresh(self, shape: tuple, dtype) -> np.ndarray:
+        """An array for a sum being recomputed, (n, 3), or (n, 1) for a grey one (every channel
+        the same, see :func:`explorer.shading.kernels.grey_pass`): retired memory of that shape
+        that nothing views any more, else a new one."""
+        for i in range(len(self.spares)):
+            buf = self.spares[i]  # (not enumerate: its tuple would hold one more reference)
+            # references: the list, ``buf``, getrefcount's argument
+            if buf.shape == shape and buf.dtype == dtype and sys.getrefcount(buf) <= 3:
+                return self.spares.pop(i)
+        return np.empty(shape, dtype)
+
+    def colour_buffer(self, n: int, dtype) -> np.ndarray:
+        """An (n, 3) colour buffer that no array handed out still views."""
+        for buf in self.colours:
+            # references: the list, the loop variable, getrefcount's argument
+            if sys.getrefcount(buf) <= 3:
+                return buf
+        buf = np.empty((n, 3), dtype)
+        if len(self.colours) < 2:
+            self.colours.append(buf)
+        return buf
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:

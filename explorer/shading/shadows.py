@@ -31,8 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer.core.lights import DirectionalLight
-from explorer.geometry.frame import frame_of, to_frame
+from explorer.core import tolerances as tol
+from explorer.geometry.frame import frame_of
 from explorer.geometry.rays import any_hit
 
 
@@ -53,7 +53,7 @@ def visibility(positions, faces, light, *, only=None):
     """Visibility of ``light`` at each vertex: (n,) float64, 1 lit, 0 shadowed.
 
     positions : (n, 3) float; faces : (m, 3) int (counter-clockwise seen from the front)
-    light : a light of :mod:`explorer.core.lights`
+    light : a light of :mod:`explorer.core.lights` (it gives the rays: :meth:`shadow_ray`)
     only : (n,) bool, the vertices to cast rays from (the others get 1); default all
     """
     P = np.asarray(positions, np.float64)
@@ -65,14 +65,47 @@ def visibility(positions, faces, light, *, only=None):
         return vis
     centre, scale = frame_of(P)
     Q = (P - centre) / scale  # the normalised frame: RAY_T_EPS is relative to the mesh
-    if isinstance(light, DirectionalLight):
-        D = np.broadcast_to(np.asarray(light.direction, np.float64), (len(idx), 3)).copy()
-        tmax = np.full(len(idx), np.inf)
-    else:
-        D = to_frame(light.position, centre, scale) - Q[idx]
-        tmax = np.linalg.norm(D, axis=1)
-        D = D / np.where(tmax > 0, tmax, 1.0)[:, None]
+    D, tmax = light.shadow_ray(Q[idx], centre, scale)
+    D = np.ascontiguousarray(D)
     tri = Q[faces]
     hit = any_hit(Q[idx], D, tmax, tri)
     vis[idx[hit]] = 0.0
     return vis
+
+
+def visibility_rows(
+    positions, normals, faces, lights, shadowed, *, two_sided, force_all, cache, dtype=np.float64
+):
+    """(L, n) ``dtype`` visibility rows, one per light (rows of lights not ``shadowed`` are 1).
+
+    positions, normals : (n, 3) float; faces : (m, 3) int
+    lights : the scene's lights; shadowed : (L,) bool, the lights the plan casts rays for
+    two_sided : N flips with V: rays from every vertex with a normal (either side may be lit)
+    force_all : rays from every vertex (benchmark); else only where N·L > -SHADOW_NDL_MARGIN
+        (:mod:`explorer.core.tolerances`)
+    cache : dict kept by the caller for this geometry: a light whose rays are unchanged (same
+        position or direction) reuses its row
+    Returns the rows and the number of rays cast."""
+    P = positions
+    n = len(P)
+    vis = np.ones((len(lights), n), dtype)
+    N = np.asarray(normals, np.float64)
+    length = np.sqrt(np.einsum("ij,ij->i", N, N))
+    unit = N / np.where(length > 0, length, 1.0)[:, None]
+    rays = 0
+    for i, (light, on) in enumerate(zip(lights, shadowed, strict=True)):
+        if not on:
+            continue
+        key = (light.anchor, two_sided, force_all)
+        v = cache.get(key)
+        if v is None:
+            only = None
+            if not force_all:  # rays only where N·L can be > 0 (either side if two-sided)
+                ndl = np.einsum("ij,ij->i", light.toward(P), unit)
+                # a margin: a ray more than needed is harmless, one fewer is not
+                only = length > 0 if two_sided else ndl > -tol.SHADOW_NDL_MARGIN
+            v = visibility(P, faces, light, only=only)
+            cache[key] = v
+            rays += int(n if only is None else only.sum())
+        vis[i] = v
+    return vis, rays

@@ -461,7 +461,7 @@ def test_refine_highlights_on_a_sphere():
         base.n_vertices
     )
     # the new vertices sit where the light is: near the highlight's direction H
-    h = np.add(scene.lights[0].direction, (0, 0, 1))
+    h = np.add(scene.lights[0].to_light, (0, 0, 1))
     h /= np.linalg.norm(h)
     new = fine.positions[base.n_vertices :]
     assert np.median(new @ h) > 0.9

@@ -26,7 +26,7 @@ from explorer.app import layout as G
 from explorer.app import window as gui
 from explorer.cli import build_parser
 from explorer.cli.gui import start
-from explorer.core.lights import DirectionalLight, PointLight, SpotLight
+from explorer.core.lights import DirectionalLight, PointLight, direction_of
 from explorer.core.material import Material
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer
@@ -46,7 +46,7 @@ SIZE = (900, 600)
 
 def start_scene(mesh, preset="gold") -> Scene:
     az, el, d = gui.DEFAULT_PLACEMENT
-    light = gui.place_light(PointLight(), az, el, d * mesh.radius, mesh.centre)
+    light = PointLight().placed(az, el, d * mesh.radius, mesh.centre)
     eye = mesh.centre + 6.0 * mesh.radius * np.array([0.0, 0.3, 1.0]) / math.hypot(0.3, 1.0)
     return Scene(material=find_preset(preset), lights=(light,), viewer=Viewer(eye=tuple(eye)))
 
@@ -154,45 +154,6 @@ def test_shininess_slider_ends_and_values_below_one():
     assert gui.slider_to_shininess(1.0) == 10.0 and gui.slider_to_shininess(2.0) == 100.0
 
 
-@pytest.mark.parametrize("az", [-170.0, -90.0, -30.0, 0.0, 45.0, 135.0, 180.0])
-@pytest.mark.parametrize("el", [-80.0, -10.0, 0.0, 35.0, 89.0])
-def test_placement_round_trips_for_every_light_type(az, el):
-    centre = np.array([0.5, -1.0, 2.0])
-    for light in (DirectionalLight(), PointLight(), SpotLight(cutoff=30.0)):
-        placed = gui.place_light(light, az, el, 3.0, centre)
-        a, e, d = gui.placement_of(placed, centre)
-        assert (a - az + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=1e-9)
-        assert e == pytest.approx(el, abs=1e-9)
-        if isinstance(placed, DirectionalLight):
-            assert d is None
-        else:
-            assert d == pytest.approx(3.0)
-        if isinstance(placed, SpotLight):  # a spot aims at the centre
-            to_centre = centre - np.asarray(placed.position)
-            assert np.allclose(placed.direction, to_centre / np.linalg.norm(to_centre))
-            assert placed.cutoff == 30.0
-
-
-def test_light_direction_convention():
-    assert np.allclose(gui.light_direction(0, 0), [0, 0, 1])  # the front (default viewer)
-    assert np.allclose(gui.light_direction(90, 0), [1, 0, 0])
-    assert np.allclose(gui.light_direction(0, 90), [0, 1, 0])
-
-
-def test_convert_light_keeps_colours_and_attenuation():
-    p = PointLight(diffuse=(1, 0.5, 0.2), specular=(0.3, 0.3, 0.3), attenuation=(1, 0.1, 0.01))
-    s = gui.convert_light(p, "spot", 20, 10, 4.0, (0, 0, 0))
-    assert isinstance(s, SpotLight) and s.cutoff == gui.SPOT_CUTOFF
-    assert s.diffuse == p.diffuse and s.specular == p.specular and s.attenuation == p.attenuation
-    d = gui.convert_light(s, "directional", 20, 10, 4.0, (0, 0, 0))
-    assert isinstance(d, DirectionalLight) and d.diffuse == p.diffuse
-    assert np.allclose(d.direction, gui.light_direction(20, 10))
-    back = gui.convert_light(d, "point", 20, 10, 4.0, (0, 0, 0))
-    assert np.allclose(back.position, 4.0 * gui.light_direction(20, 10))
-    with pytest.raises(explorer.ExplorerError):
-        gui.convert_light(p, "area", 0, 0, 1, (0, 0, 0))
-
-
 def test_display_material_hides_terms():
     m = Material(
         ambient=(0.1, 0.2, 0.3), diffuse=(0.4, 0.5, 0.6), specular=(0.7, 0.8, 0.9),
@@ -243,13 +204,13 @@ def test_no_display_reason():
 def test_viewer_of_camera():
     assert gui.viewer_of_camera((1, 2, 3), (0, 0, 0), False) == Viewer(eye=(1, 2, 3))
     v = gui.viewer_of_camera((0, 0, 5), (0, 0, 1), True)
-    assert v == Viewer(direction=(0, 0, 1))
+    assert v == Viewer(to_viewer=(0, 0, 1))
 
 
 def test_widen_to_show_keeps_the_viewer_and_shows_the_points():
 
     mesh = M.get_mesh("sphere", 16)
-    for viewer in (Viewer(eye=(0, 1, 6)), Viewer(direction=(0, 0.3, 1))):
+    for viewer in (Viewer(eye=(0, 1, 6)), Viewer(to_viewer=(0, 0.3, 1))):
         cam = camera_for(Scene(viewer=viewer), mesh, 1.2)
         far = np.array([2.5, 2.0, 1.0])
         wide = gui.widen_to_show(cam, [far], 1.2, pad=0.1)
@@ -345,7 +306,7 @@ def test_camera_is_the_viewer_and_moves_the_highlights_only(app):
     cam.ParallelProjectionOn()
     app.render()
     d = np.subtract(cam.GetPosition(), cam.GetFocalPoint())
-    assert app.scene.viewer == Viewer(direction=tuple(d))
+    assert app.scene.viewer == Viewer(to_viewer=tuple(d))
     assert_shows_engine_colours(app)
     cam.ParallelProjectionOff()
 
@@ -518,14 +479,14 @@ def test_light_sliders_move_the_light_and_the_handle(app):
     fire_slider(app, "elevation", 20.0)
     fire_slider(app, "distance", 3.0)
     light = app.light
-    want = app.mesh.centre + 3.0 * gui.light_direction(-60.0, 20.0)
+    want = app.mesh.centre + 3.0 * direction_of(-60.0, 20.0)
     assert np.allclose(light.position, want)
     assert np.allclose(app.handle.GetCenter(), want)
     assert_shows_engine_colours(app)
 
 
 def test_dragging_the_handle_moves_the_light_and_the_sliders(app):
-    target = app.mesh.centre + 2.5 * gui.light_direction(100.0, -15.0)
+    target = app.mesh.centre + 2.5 * direction_of(100.0, -15.0)
     app.handle.SetCenter(*target)
     app.handle.InvokeEvent(InteractionEvent)
     app.render()
@@ -535,7 +496,7 @@ def test_dragging_the_handle_moves_the_light_and_the_sliders(app):
     assert_shows_engine_colours(app)
     # beyond the distance slider's range the light stops at its end
     lo, hi = app._slider_range("distance")
-    app.handle.SetCenter(*(app.mesh.centre + 10 * hi * gui.light_direction(0, 0)))
+    app.handle.SetCenter(*(app.mesh.centre + 10 * hi * direction_of(0, 0)))
     app.handle.InvokeEvent(InteractionEvent)
     assert np.linalg.norm(np.subtract(app.light.position, app.mesh.centre)) == pytest.approx(hi)
     assert np.allclose(app.handle.GetCenter(), app.light.position)
@@ -558,7 +519,7 @@ def test_light_type_switch(app, kind):
 
 def test_next_light_in_a_scene_with_two(mesh, user_presets):
     scene = start_scene(mesh).replace(
-        lights=(PointLight(position=(2, 2, 2)), DirectionalLight(direction=(-1, 0.5, 1)))
+        lights=(PointLight(position=(2, 2, 2)), DirectionalLight(to_light=(-1, 0.5, 1)))
     )
     a = gui.Explorer(scene, mesh, off_screen=True, window_size=SIZE)
     try:
@@ -568,7 +529,7 @@ def test_next_light_in_a_scene_with_two(mesh, user_presets):
         fire_slider(a, "azimuth", 10.0)
         assert a.scene.lights[0] == PointLight(position=(2, 2, 2))
         el = a._placement()[1]
-        assert np.allclose(a.scene.lights[1].direction, gui.light_direction(10.0, el))
+        assert np.allclose(a.scene.lights[1].to_light, direction_of(10.0, el))
         assert a.texts["light"].GetInput().startswith("2 of 2: directional")
         assert_shows_engine_colours(a)
     finally:
@@ -791,7 +752,7 @@ def test_default_start_is_a_preset_on_the_teapot_under_one_light():
     assert preset == gui.DEFAULT_PRESET and scene.material == find_preset(gui.DEFAULT_PRESET)
     assert mesh.name == "teapot" and len(scene.lights) == 1
     assert mesh.n_vertices == M.get_mesh("teapot", gui.MESH_CHOICES["teapot"]).n_vertices
-    az, el, d = gui.placement_of(scene.lights[0], mesh.centre)
+    az, el, d = scene.lights[0].placement(mesh.centre)
     assert (az, el, d) == pytest.approx(
         (gui.DEFAULT_PLACEMENT[0], gui.DEFAULT_PLACEMENT[1], gui.DEFAULT_PLACEMENT[2] * mesh.radius)
     )
@@ -803,11 +764,11 @@ def test_start_from_options_and_scene_file(tmp_path):
     scene, mesh, preset = start(_gui_args("--preset", "jade", "--mesh", "torus"))
     assert preset == "jade" and mesh.name == "torus" and scene.model == "blinn"
     f = tmp_path / "s.yaml"
-    f.write_text("material: ruby\nlights: [{type: directional, direction: [1, 1, 1]}]\n")
+    f.write_text("material: ruby\nlights: [{type: directional, to_light: [1, 1, 1]}]\n")
     scene, mesh, preset = start(_gui_args(str(f), "--resolution", "5"))
     assert preset == "ruby" and mesh.name == "teapot"
     assert mesh.n_vertices == M.get_mesh("teapot", 5).n_vertices
-    assert scene.lights == (DirectionalLight(direction=(1, 1, 1)),)
+    assert scene.lights == (DirectionalLight(to_light=(1, 1, 1)),)
     with pytest.raises(explorer.ExplorerError, match="--exit-after"):
         start(_gui_args("--exit-after", "0"))
 

@@ -25,7 +25,7 @@ SCENE = """\
 material: gold
 lights:
   - type: directional
-    direction: [0, 0, 1]
+    to_light: [0, 0, 1]
   - type: point
     position: [1, 2, 3]
     attenuation: [1, 0.1, 0]

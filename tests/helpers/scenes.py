@@ -22,7 +22,7 @@ def lights(draw):
         "specular": draw(maybe_zero_rgb),
     }
     if kind == "directional":
-        light["direction"] = draw(vec)
+        light["to_light"] = draw(vec)
     else:
         light["position"] = [c * 2 for c in draw(vec)]
         light["attenuation"] = draw(
@@ -31,7 +31,7 @@ def lights(draw):
             )
         )
     if kind == "spot":
-        light["direction"] = draw(vec)
+        light["aim"] = draw(vec)
         light["cutoff"] = draw(st.sampled_from([180.0, 90.0, 60.0, 25.0]))
         light["exponent"] = draw(st.sampled_from([0.0, 1.0, 7.5, 128.0]))
     return light
@@ -49,7 +49,7 @@ def scenes(draw, max_lights=4):
     viewer = draw(
         st.one_of(
             st.builds(lambda v: {"eye": [c * 3 for c in v]}, vec),
-            st.builds(lambda v: {"direction": v}, vec),
+            st.builds(lambda v: {"to_viewer": v}, vec),
         )
     )
     return {

@@ -39,12 +39,12 @@ from explorer.render.perpixel import (
 from explorer.shading.display import vertex_colors
 
 CHROME = load_material_file(builtin_dir() / "chrome.yaml")
-LIGHT = DirectionalLight(direction=(-0.4, 0.6, 1.0))
+LIGHT = DirectionalLight(to_light=(-0.4, 0.6, 1.0))
 
 
 def _scene(viewer=None, material=CHROME, lights=(LIGHT,), **kw):
     return explorer.Scene(
-        material=material, lights=lights, viewer=viewer or Viewer(direction=(0, 0, 1)), **kw
+        material=material, lights=lights, viewer=viewer or Viewer(to_viewer=(0, 0, 1)), **kw
     )
 
 
@@ -52,7 +52,7 @@ def _cameras():
     """Parallel and perspective cameras, square and not, with and without a window shift."""
     mesh = M.teapot(4)
     out = []
-    for viewer in (Viewer(direction=(1, 2, 3)), Viewer(eye=(0.5, 1.5, 4.0))):
+    for viewer in (Viewer(to_viewer=(1, 2, 3)), Viewer(eye=(0.5, 1.5, 4.0))):
         for aspect, bottom in ((1.0, 0.0), (1.6, 0.2), (0.7, 0.0)):
             out.append((camera_for(_scene(viewer), mesh, aspect, bottom=bottom), aspect))
     return out
@@ -242,7 +242,7 @@ def test_point_colors_at_the_vertices_are_the_vertex_colors():
         np.vstack([s.faces, p.faces + s.n_vertices]),
         "sphere over plane",
     )
-    shadow = DirectionalLight(direction=(0.3, 0.2, 1.0), shadows=True)
+    shadow = DirectionalLight(to_light=(0.3, 0.2, 1.0), shadows=True)
     for scene in (
         _scene(),
         _scene(hdr=HDR(exposure=1.0)),
@@ -269,7 +269,7 @@ def test_per_pixel_shadows_follow_geometry():
     scene = explorer.Scene(
         material=material,
         ambient=(0, 0, 0),
-        lights=(DirectionalLight(direction=(0, 0, 1), shadows=True),),
+        lights=(DirectionalLight(to_light=(0, 0, 1), shadows=True),),
     )
     ref = reference(scene, mesh, (64, 64))
     on_plane = np.abs(ref.hits.positions[:, 2]) < 1e-9
@@ -281,7 +281,7 @@ def test_per_pixel_shadows_follow_geometry():
     side = explorer.Scene(
         material=material,
         ambient=(0, 0, 0),
-        viewer=Viewer(direction=(1, 0, 1)),
+        viewer=Viewer(to_viewer=(1, 0, 1)),
         lights=scene.lights,
     )
     ref = reference(side, mesh, (96, 96))  # ... so look from the side
@@ -299,7 +299,7 @@ def test_per_pixel_shadows_follow_geometry():
 
 @pytest.mark.parametrize(
     "viewer, bottom",
-    [(Viewer(direction=(0, 0, 1)), 0.0), (Viewer(eye=(0.6, 0.4, 4.0)), 0.15)],
+    [(Viewer(to_viewer=(0, 0, 1)), 0.0), (Viewer(eye=(0.6, 0.4, 4.0)), 0.15)],
     ids=["parallel", "perspective-shifted"],
 )
 def test_per_pixel_agrees_with_a_very_fine_per_vertex_render(viewer, bottom):

@@ -78,10 +78,10 @@ def _project(cam: Camera, points, aspect):
 def test_infinite_viewer_camera_frames_mesh(name, aspect):
     mesh = M.get_mesh(name, 8 if name != "teapot" else 4)
     for d in [(0, 0, 1), (1, 2, 3), (0, 1, 0), (0, -1, 0), (0, 0, -1)]:
-        scene = explorer.Scene(viewer=Viewer(direction=d))
+        scene = explorer.Scene(viewer=Viewer(to_viewer=d))
         cam = camera_for(scene, mesh, aspect)
         assert cam.parallel
-        # looks along -direction: the engine's constant V points back at the camera
+        # looks along -to_viewer: the engine's constant V points back at the camera
         assert np.allclose(cam.direction, -np.asarray(d) / np.linalg.norm(d))
         assert abs(np.dot(cam.view_up, cam.direction)) < 1e-12
         x, y, z = _project(cam, mesh.positions, aspect)
@@ -110,7 +110,7 @@ def test_local_viewer_camera_sits_at_the_eye(aspect):
 
 def test_label_band_is_left_free():
     mesh = M.sphere(16)
-    for viewer in (Viewer(direction=(0, 0, 1)), Viewer(eye=(0, 0, 4))):
+    for viewer in (Viewer(to_viewer=(0, 0, 1)), Viewer(eye=(0, 0, 4))):
         cam = camera_for(explorer.Scene(viewer=viewer), mesh, 1.0, bottom=0.25)
         _, y, _ = _project(cam, mesh.positions, 1.0)
         assert y.min() >= -1.0 + 2 * 0.25 - 1e-9 and y.max() <= 1.0
@@ -184,13 +184,13 @@ def test_opacity_blends_over_background(renderer, opacity):
 
 
 @pytest.mark.parametrize(
-    "viewer", [Viewer(direction=(0, 0, 1)), Viewer(eye=(0, 0, 4)), Viewer(direction=(1, 0, 0))]
+    "viewer", [Viewer(to_viewer=(0, 0, 1)), Viewer(eye=(0, 0, 4)), Viewer(to_viewer=(1, 0, 0))]
 )
 def test_translucent_front_over_back(renderer, viewer):
     """The near half of a translucent sphere is white, the far half black: the nearer layer
     must end on top, whatever the triangle order in the file."""
     mesh = M.sphere(32)
-    toward = np.asarray(viewer.eye if viewer.eye else viewer.direction, float)
+    toward = np.asarray(viewer.eye if viewer.eye else viewer.to_viewer, float)
     colors = np.where((mesh.positions @ toward)[:, None] > 0, 1.0, 0.0) * np.ones(3)
     scene = explorer.Scene(material=Material(opacity=0.9), viewer=viewer)
     img = renderer.render(scene, mesh, colors)
@@ -328,9 +328,9 @@ def _highlight_scene(angle_deg: float):
     return explorer.Scene(
         material=mat,
         lights=(
-            DirectionalLight(direction=(0.5, 0.5, 1), specular=(0, 0, 0)),
+            DirectionalLight(to_light=(0.5, 0.5, 1), specular=(0, 0, 0)),
             DirectionalLight(
-                direction=(0.5 * math.cos(a) + math.sin(a), 0.5, math.cos(a) - 0.5 * math.sin(a)),
+                to_light=(0.5 * math.cos(a) + math.sin(a), 0.5, math.cos(a) - 0.5 * math.sin(a)),
                 diffuse=(0, 0, 0),
             ),
         ),
@@ -393,8 +393,8 @@ PRESETS = _builtin_presets()
 #: with a model of its own keeps it
 PRESET_SCENE = {
     "model": "blinn",
-    "viewer": {"direction": [0, 0, 1]},
-    "lights": [{"type": "directional", "direction": list(SHEET_LIGHT_DIRECTION)}],
+    "viewer": {"to_viewer": [0, 0, 1]},
+    "lights": [{"type": "directional", "to_light": list(SHEET_LIGHT_DIRECTION)}],
 }
 
 _SPHERE_MAT = {
@@ -413,7 +413,7 @@ _WHITE = {
 #: feature goldens: name -> (scene mapping, mesh, resolution)
 FEATURES = {
     "directional": (
-        {"material": _SPHERE_MAT, "lights": [{"type": "directional", "direction": [1, 1, 1]}]},
+        {"material": _SPHERE_MAT, "lights": [{"type": "directional", "to_light": [1, 1, 1]}]},
         "sphere",
         None,
     ),
@@ -434,7 +434,7 @@ FEATURES = {
                 {
                     "type": "spot",
                     "position": [0.2, 0.1, 2],
-                    "direction": [-0.1, -0.05, -1],
+                    "aim": [-0.1, -0.05, -1],
                     "cutoff": 25,
                     "exponent": 30,
                     "intensity": 0.8,
@@ -448,7 +448,7 @@ FEATURES = {
         {
             "material": _SPHERE_MAT,
             "model": "blinn",
-            "lights": [{"type": "directional", "direction": [1.5, 0.4, 0.3]}],
+            "lights": [{"type": "directional", "to_light": [1.5, 0.4, 0.3]}],
         },
         "sphere",
         None,
@@ -457,7 +457,7 @@ FEATURES = {
         {
             "material": _SPHERE_MAT,
             "model": "phong",
-            "lights": [{"type": "directional", "direction": [1.5, 0.4, 0.3]}],
+            "lights": [{"type": "directional", "to_light": [1.5, 0.4, 0.3]}],
         },
         "sphere",
         None,
@@ -466,7 +466,7 @@ FEATURES = {
         {
             "material": _WHITE,
             "two_sided": True,
-            "viewer": {"direction": [0.3, 0.2, -1]},
+            "viewer": {"to_viewer": [0.3, 0.2, -1]},
             "lights": [{"type": "point", "position": [0.4, 0.3, -1.5], "intensity": 0.6}],
         },
         "plane",
@@ -482,7 +482,7 @@ FEATURES = {
                 "opacity": 0.4,
             },
             "viewer": {"eye": [3.2, 1.6, 1.8]},
-            "lights": [{"type": "directional", "direction": [0, 1, 1]}],
+            "lights": [{"type": "directional", "to_light": [0, 1, 1]}],
         },
         "teapot",
         None,
@@ -496,7 +496,7 @@ FEATURES = {
                 "specular": [0.3, 0.3, 0.3],
                 "shininess": 10,
             },
-            "lights": [{"type": "directional", "direction": [-1, 1, 1], "intensity": 0.5}],
+            "lights": [{"type": "directional", "to_light": [-1, 1, 1], "intensity": 0.5}],
         },
         "icosphere",
         3,
@@ -592,7 +592,7 @@ def test_cli_render_png(tmp_path, capsys):
             str(out),
             "--size",
             "96x64",
-            "--light-direction",
+            "--light-to-light",
             "1",
             "1",
             "1",
@@ -602,7 +602,7 @@ def test_cli_render_png(tmp_path, capsys):
     img = read_png(out)
     assert img.shape == (64, 96, 3)
     scene = explorer.load_scene(
-        {"material": "gold", "lights": [{"type": "directional", "direction": [1, 1, 1]}]}
+        {"material": "gold", "lights": [{"type": "directional", "to_light": [1, 1, 1]}]}
     )
     assert np.array_equal(img, render_image(scene, M.sphere(24), (96, 64)))
     # never overwritten silently
@@ -644,13 +644,13 @@ def test_cli_scene_file_and_overrides(tmp_path, capsys):
                 "0",
                 "0",
                 "3",
-                "--light-direction",
+                "--light-aim",
                 "0",
                 "0",
                 "-1",
                 "--light-cutoff",
                 "30",
-                "--viewer-direction",
+                "--viewer-to-viewer",
                 "0",
                 "0",
                 "1",
@@ -661,11 +661,35 @@ def test_cli_scene_file_and_overrides(tmp_path, capsys):
     want = scene.replace(
         material=explorer.load_scene({"material": "ruby"}).material,
         model="phong",
-        viewer=Viewer(direction=(0, 0, 1)),
-        lights=(explorer.SpotLight(position=(0, 0, 3), direction=(0, 0, -1), cutoff=30),),
+        viewer=Viewer(to_viewer=(0, 0, 1)),
+        lights=(explorer.SpotLight(position=(0, 0, 3), aim=(0, 0, -1), cutoff=30),),
     )
     assert np.array_equal(read_png(out2), render_image(want, M.cube(), (80, 80)))
     capsys.readouterr()
+
+
+@pytest.mark.parametrize(
+    "old, new",
+    [
+        (["--light-direction", "1", "1", "1"], ["--light-to-light", "1", "1", "1"]),
+        (
+            ["--light-cutoff", "30", "--light-position", "0", "0", "3"]
+            + ["--light-direction", "0", "0", "-1"],
+            ["--light-cutoff", "30", "--light-position", "0", "0", "3"]
+            + ["--light-aim", "0", "0", "-1"],
+        ),
+        (["--viewer-direction", "0", "1", "1"], ["--viewer-to-viewer", "0", "1", "1"]),
+    ],
+)
+def test_cli_old_direction_flags_still_work_with_a_notice(tmp_path, capsys, old, new):
+    base = ["render", "--mesh", "sphere", "--resolution", "16", "--size", "64x64", "--out"]
+    assert main([*base, str(tmp_path / "new.png"), *new]) == 0
+    assert "notice:" not in capsys.readouterr().err
+    assert main([*base, str(tmp_path / "old.png"), *old]) == 0
+    err = capsys.readouterr().err
+    flag = new[-4]
+    assert f"notice: {old[-4]} is now {flag} (" in err and "the old name still works" in err
+    assert np.array_equal(read_png(tmp_path / "old.png"), read_png(tmp_path / "new.png"))
 
 
 @pytest.mark.parametrize("suffix", [".ply", ".glb"])
@@ -713,7 +737,16 @@ def test_cli_render_mesh_file(tmp_path, suffix):
             "--light-position does not apply to a directional light",
         ),
         (["--out", "OUT", "--light-attenuation", "0", "0", "0"], "--light-attenuation"),
-        (["--out", "OUT", "--viewer-direction", "0", "0", "0"], "--viewer-direction"),
+        (["--out", "OUT", "--viewer-to-viewer", "0", "0", "0"], "--viewer-to-viewer"),
+        (["--out", "OUT", "--light-aim", "0", "0", "0"], "--light-aim: must be a non-zero"),
+        (
+            ["--out", "OUT", "--light-position", "1", "1", "1", "--light-to-light", "1", "0", "0"],
+            "--light-to-light does not apply to a point light (only to: directional)",
+        ),
+        (
+            ["--out", "OUT", "--light-type", "point", "--light-direction", "1", "0", "0"],
+            "--light-direction does not apply to a point light (only to: directional, spot)",
+        ),
         (["--out", "OUT", "--background", "2", "0", "0"], "--background"),
         (["--out", "OUT", "--materials", "no_such_dir"], "--materials"),
         (["missing_scene.yaml", "--out", "OUT"], "missing_scene.yaml"),
@@ -756,7 +789,7 @@ def test_cli_sheet(tmp_path, capsys):
     gap = 2
     assert img.shape == (2 * 48 + 3 * gap, 2 * 64 + 3 * gap, 3)
     tile = img[gap : gap + 48, gap : gap + 64]
-    scene = explorer.Scene(lights=(DirectionalLight(direction=SHEET_LIGHT_DIRECTION),))
+    scene = explorer.Scene(lights=(DirectionalLight(to_light=SHEET_LIGHT_DIRECTION),))
     gold = explorer.load_scene({"material": "gold"}).material
     with OffscreenRenderer((64, 48)) as r:
         size = r.label_font_size(["gold", "jade", "ruby"])

@@ -25,7 +25,7 @@ SCENE = {
             "attenuation": [1, 0.1, 0.01],
             "ambient": [0.1, 0.1, 0.1],
         },
-        {"type": "directional", "direction": [-1, 1, 1]},
+        {"type": "directional", "to_light": [-1, 1, 1]},
     ],
 }
 
@@ -136,7 +136,7 @@ def test_two_sided_viewer_change_recomputes_everything(shader):
     shader.set_scene(shader.scene.replace(two_sided=True))
     _ = shader.colors
     before = counts(shader)
-    shader.set_viewer(Viewer(direction=(0, 1, 0)))
+    shader.set_viewer(Viewer(to_viewer=(0, 1, 0)))
     _ = shader.colors
     assert delta(before, counts(shader)) == {"pass": 1, "ambient": 1, "diffuse": 1, "specular": 1}
     check(shader)
@@ -145,7 +145,7 @@ def test_two_sided_viewer_change_recomputes_everything(shader):
 def test_light_change_invalidates(shader):
     _ = shader.colors
     before = counts(shader)
-    shader.set_lights([PointLight(position=(0, 0, 3)), DirectionalLight(direction=(1, 0, 0))])
+    shader.set_lights([PointLight(position=(0, 0, 3)), DirectionalLight(to_light=(1, 0, 0))])
     _ = shader.colors
     assert delta(before, counts(shader))["pass"] == 1
     check(shader)
@@ -187,7 +187,7 @@ def test_cached_arrays_are_read_only_and_never_rewritten(shader):
 def test_sums_reuse_memory_only_when_nothing_views_it(shader):
     # a light change recomputes the sums into the memory of the invalidated ones (no page
     # faults at 1M vertices) unless an array handed out (terms) still views that memory
-    lights = [PointLight(position=(0, 0, 3)), DirectionalLight(direction=(1, 0, 0))]
+    lights = [PointLight(position=(0, 0, 3)), DirectionalLight(to_light=(1, 0, 0))]
     _ = shader.colors
 
     def addresses():  # not references: holding the arrays would keep them from reuse

@@ -88,10 +88,10 @@ def test_shuffled_vertices_are_not_tested_at_all():
 
 
 LIGHTS = [
-    {"type": "directional", "direction": [1, 0.3, 0.2]},
+    {"type": "directional", "to_light": [1, 0.3, 0.2]},
     {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
     {"type": "point", "position": [0, 0, 1.05]},  # close: a small lit cap
-    {"type": "spot", "position": [0, 4, 0], "direction": [0, -1, 0], "cutoff": 6, "exponent": 5},
+    {"type": "spot", "position": [0, 4, 0], "aim": [0, -1, 0], "cutoff": 6, "exponent": 5},
 ]
 
 
@@ -184,11 +184,11 @@ def test_property_culling_never_changes_a_colour(kind, where, axis, cutoff, mesh
     if kind == "directional":
         if sum(c * c for c in where) < 1e-6:
             where = (0.0, 0.0, 1.0)
-        light = {"type": "directional", "direction": list(where)}
+        light = {"type": "directional", "to_light": list(where)}
     else:
         light = {"type": kind, "position": list(where), "attenuation": [1, 0.2, 0.05]}
         if kind == "spot":
-            light.update(direction=list(axis), cutoff=cutoff, exponent=2)
+            light.update(aim=list(axis), cutoff=cutoff, exponent=2)
     scene = {"material": MATERIAL, "viewer": {"eye": [1, 2, 5]}, "lights": [light]}
     on, off = pair(scene, _mesh(mesh), "float64")
     same(on, off)

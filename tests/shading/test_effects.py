@@ -118,8 +118,8 @@ def _in_shadow(points, direction=None, position=None):
 @pytest.mark.parametrize(
     "light",
     [
-        {"type": "directional", "direction": [0.0, 0.0, 1.0]},
-        {"type": "directional", "direction": [0.5, -0.3, 1.0]},
+        {"type": "directional", "to_light": [0.0, 0.0, 1.0]},
+        {"type": "directional", "to_light": [0.5, -0.3, 1.0]},
         {"type": "point", "position": [-0.2, 0.1, 1.6]},
     ],
 )
@@ -134,7 +134,7 @@ def test_plane_under_sphere_is_shadowed_where_geometry_says(light):
     plane = slice(len(mesh.positions) - 49 * 49, None)
     pts = mesh.positions[plane]
     gap = _in_shadow(
-        pts, light.get("direction"), light.get("position")
+        pts, light.get("to_light"), light.get("position")
     )  # signed distance to the shadow edge
     lit = c[plane, 0]
     margin = 0.03  # the tessellated sphere is within 0.01 of the true one
@@ -146,12 +146,12 @@ def test_plane_under_sphere_is_shadowed_where_geometry_says(light):
 
 
 def test_plan_skips_shadow_rays_where_they_cannot_matter():
-    light = {"type": "directional", "direction": [0.3, 0.2, 1.0], "shadows": True}
-    scene = {"lights": [light, {"type": "directional", "direction": [0, 1, 0]}]}
+    light = {"type": "directional", "to_light": [0.3, 0.2, 1.0], "shadows": True}
+    scene = {"lights": [light, {"type": "directional", "to_light": [0, 1, 0]}]}
     mesh = sphere_over_plane(12, 16)
     sh = explorer.Shader(scene, mesh.positions, mesh.normals, faces=mesh.faces)
     _ = sh.colors
-    facing = mesh.normals @ np.array(light["direction"]) / np.linalg.norm(light["direction"])
+    facing = mesh.normals @ np.array(light["to_light"]) / np.linalg.norm(light["to_light"])
     assert sh.stats["shadow_rays"] == int((facing > -1e-6).sum()) < len(facing)
     assert sh.plan.lights[0].shadows and not sh.plan.lights[1].shadows
     convex = explorer.Shader(scene, CONVEX.positions, CONVEX.normals, faces=CONVEX.faces)
@@ -205,7 +205,7 @@ def test_fresnel_weights_the_specular_by_schlick():
                 {
                     "material": {**mat, "fresnel": f0},
                     "ambient": [0, 0, 0],
-                    "lights": [{"type": "directional", "direction": L[i].tolist()}],
+                    "lights": [{"type": "directional", "to_light": L[i].tolist()}],
                 },
                 np.zeros((1, 3)),
                 H[i : i + 1],
@@ -261,7 +261,7 @@ def test_energy_conserving_lobe_narrows_without_dimming(model):
             "material": {**base, "shininess": n, "energy_conserving": on},
             "model": model,
             "ambient": [0, 0, 0],
-            "lights": [{"type": "directional", "direction": [0, 0, 1]}],
+            "lights": [{"type": "directional", "to_light": [0, 0, 1]}],
         }
         c = explorer.shade(scene, np.zeros_like(N), N, clamp=False)[:, 0]
         return c.max(), (c * N[:, 2]).mean()  # peak, and the picture's total (projected area)
@@ -362,7 +362,7 @@ def test_plan_command_shows_each_effect(tmp_path, capsys):
         "material: {specular: [0.5, 0.5, 0.5], shininess: 30, fresnel: 0.04,"
         " energy_conserving: true}\n"
         "hdr: {exposure: 1, tone_map: aces}\nmesh: sphere\n"
-        "lights:\n  - {type: directional, direction: [1, 1, 1], shadows: true}\n"
+        "lights:\n  - {type: directional, to_light: [1, 1, 1], shadows: true}\n"
         "  - {type: point, position: [2, 2, 2]}\n"
     )
     assert main(["plan", str(f)]) == 0
@@ -389,22 +389,22 @@ EFFECT_SCENES = {
         {
             "material": {"ambient": [0.15, 0.15, 0.15], "diffuse": [0.8, 0.7, 0.5]},
             "viewer": {"eye": [0.0, -2.6, 2.4]},
-            "lights": [{"type": "directional", "direction": [0.6, 0.3, 1.0], "shadows": True}],
+            "lights": [{"type": "directional", "to_light": [0.6, 0.3, 1.0], "shadows": True}],
         },
         "sphere_over_plane",
     ),
     "fresnel": (
         {
             "material": {**_GLOSSY, "specular": [1, 1, 1], "fresnel": 0.04},
-            "viewer": {"direction": [0, 0, 1]},
-            "lights": [{"type": "directional", "direction": [0.643, 0.2, -0.766]}],
+            "viewer": {"to_viewer": [0, 0, 1]},
+            "lights": [{"type": "directional", "to_light": [0.643, 0.2, -0.766]}],
         },
         "sphere",
     ),
     "energy_n10": (
         {
             "material": {**_GLOSSY, "shininess": 10, "energy_conserving": True},
-            "lights": [{"type": "directional", "direction": [1, 1, 1], "intensity": 0.5}],
+            "lights": [{"type": "directional", "to_light": [1, 1, 1], "intensity": 0.5}],
             "hdr": {"exposure": 0, "tone_map": "reinhard"},
         },
         "sphere",
@@ -412,7 +412,7 @@ EFFECT_SCENES = {
     "energy_n200": (
         {
             "material": {**_GLOSSY, "shininess": 200, "energy_conserving": True},
-            "lights": [{"type": "directional", "direction": [1, 1, 1], "intensity": 0.5}],
+            "lights": [{"type": "directional", "to_light": [1, 1, 1], "intensity": 0.5}],
             "hdr": {"exposure": 0, "tone_map": "reinhard"},
         },
         "sphere",
@@ -422,7 +422,7 @@ EFFECT_SCENES = {
             "material": _GLOSSY,
             "lights": [
                 {"type": "point", "position": [1.5, 1.5, 2.0], "intensity": 4},
-                {"type": "directional", "direction": [-1, 0, 0.3], "intensity": 1.5},
+                {"type": "directional", "to_light": [-1, 0, 0.3], "intensity": 1.5},
             ],
             "hdr": {"exposure": -0.5, "tone_map": "aces"},
         },
@@ -475,7 +475,7 @@ def _translucent_over_opaque(renderer):
                 "opacity": 0.45,
             },
             "viewer": {"eye": [0.0, 0.0, 3.2]},
-            "lights": [{"type": "directional", "direction": [0.3, 0.5, 1]}],
+            "lights": [{"type": "directional", "to_light": [0.3, 0.5, 1]}],
         }
     )
     sphere = M.sphere(48)
@@ -503,7 +503,7 @@ def test_translucent_is_drawn_the_same_from_both_sides(renderer):
                          "shininess": 20, "opacity": 0.5},
             "two_sided": True,
             "viewer": {"eye": [0.0, 0.0, 3.0]},
-            "lights": [{"type": "directional", "direction": [0, 1, 0]}],
+            "lights": [{"type": "directional", "to_light": [0, 1, 0]}],
         }
     )  # fmt: skip
     a = renderer.render(scene, sphere)

@@ -40,7 +40,7 @@ def random_gl_scene(rng: np.random.Generator) -> dict:
         kind = rng.choice(["directional", "point", "spot"])
         light = {"type": str(kind), "ambient": rgb(), "diffuse": rgb(), "specular": rgb()}
         if kind == "directional":
-            light["direction"] = rng.normal(size=3).tolist()
+            light["to_light"] = rng.normal(size=3).tolist()
         else:
             light["position"] = (rng.normal(size=3) * 3).tolist()
             light["attenuation"] = [
@@ -49,14 +49,14 @@ def random_gl_scene(rng: np.random.Generator) -> dict:
                 float(rng.uniform(0, 0.2)),
             ]
         if kind == "spot":
-            light["direction"] = rng.normal(size=3).tolist()
+            light["aim"] = rng.normal(size=3).tolist()
             light["cutoff"] = float(rng.choice([rng.uniform(5, 90), 180.0]))
             light["exponent"] = float(rng.uniform(0, 128))
         lights.append(light)
     viewer = (
         {"eye": (rng.normal(size=3) * 4).tolist()}
         if rng.random() < 0.5
-        else {"direction": rng.normal(size=3).tolist()}
+        else {"to_viewer": rng.normal(size=3).tolist()}
     )
     return {
         "material": {
@@ -78,7 +78,7 @@ def to_gl(scene: dict) -> dict:
     gl_lights = []
     for lt in scene["lights"]:
         if lt["type"] == "directional":
-            pos = [*lt["direction"], 0.0]
+            pos = [*lt["to_light"], 0.0]
         else:
             pos = [*lt["position"], 1.0]
         gl_lights.append(
@@ -88,7 +88,7 @@ def to_gl(scene: dict) -> dict:
                 "diffuse": lt["diffuse"],
                 "specular": lt["specular"],
                 "attenuation": lt.get("attenuation", [1, 0, 0]),
-                "spot_direction": lt.get("direction", [0, 0, -1]) if lt["type"] == "spot" else None,
+                "spot_direction": lt.get("aim", [0, 0, -1]) if lt["type"] == "spot" else None,
                 "spot_cutoff": lt.get("cutoff", 180.0) if lt["type"] == "spot" else 180.0,
                 "spot_exponent": lt.get("exponent", 0.0) if lt["type"] == "spot" else 0.0,
             }
@@ -99,7 +99,7 @@ def to_gl(scene: dict) -> dict:
         "ambient": scene["ambient"],
         "local_viewer": "eye" in v,
         "eye": v.get("eye"),
-        "view_dir": v.get("direction"),
+        "view_dir": v.get("to_viewer"),
         "lights": gl_lights,
     }
 
@@ -141,14 +141,14 @@ LIGHT_COLOURS = {
 
 @pytest.mark.parametrize("precision", PRECISIONS)
 @pytest.mark.parametrize("model", ["blinn", "phong"])
-@pytest.mark.parametrize("viewer", [{"direction": [0, 0, 1]}, {"eye": [0, 0, 7]}])
+@pytest.mark.parametrize("viewer", [{"to_viewer": [0, 0, 1]}, {"eye": [0, 0, 7]}])
 def test_light_and_viewer_along_the_normal(precision, model, viewer):
     scene = {
         "material": MAT,
         "model": model,
         "ambient": [0.3, 0.3, 0.3],
         "viewer": viewer,
-        "lights": [{"type": "directional", "direction": [0, 0, 1], **LIGHT_COLOURS}],
+        "lights": [{"type": "directional", "to_light": [0, 0, 1], **LIGHT_COLOURS}],
     }
     m = {k: np.array(v) for k, v in MAT.items()}
     want = (
@@ -191,7 +191,7 @@ def test_spot_cone_edge(precision):
             {
                 "type": "spot",
                 "position": [0, 0, 0],
-                "direction": [0, 0, -1],
+                "aim": [0, 0, -1],
                 "cutoff": cutoff,
                 "exponent": 0,
             }
@@ -221,8 +221,8 @@ def test_highlight_peak_on_the_mirror_direction(model):
         },
         "model": model,
         "ambient": [0, 0, 0],
-        "viewer": {"direction": V.tolist()},
-        "lights": [{"type": "directional", "direction": L.tolist()}],
+        "viewer": {"to_viewer": V.tolist()},
+        "lights": [{"type": "directional", "to_light": L.tolist()}],
     }
     c = explorer.shade(scene, np.zeros_like(N), N)[:, 0]
     peak = N[np.argmax(c)]
@@ -235,8 +235,8 @@ def test_phong_and_blinn_agree_where_R_equals_V():
     R = 2 * (N @ L) * N - L  # V = R: the viewer sits on the mirror direction
     base = {
         "material": {**MAT, "shininess": 77},
-        "viewer": {"direction": R.tolist()},
-        "lights": [{"type": "directional", "direction": L.tolist(), **LIGHT_COLOURS}],
+        "viewer": {"to_viewer": R.tolist()},
+        "lights": [{"type": "directional", "to_light": L.tolist(), **LIGHT_COLOURS}],
     }
     blinn = one_vertex({**base, "model": "blinn"}, n=N)
     phong = one_vertex({**base, "model": "phong"}, n=N)
@@ -257,8 +257,8 @@ def test_phong_uses_the_reflection_vector():
         },
         "model": "phong",
         "ambient": [0, 0, 0],
-        "viewer": {"direction": V.tolist()},
-        "lights": [{"type": "directional", "direction": L.tolist()}],
+        "viewer": {"to_viewer": V.tolist()},
+        "lights": [{"type": "directional", "to_light": L.tolist()}],
     }
     assert one_vertex(scene)[0] == pytest.approx(max(R @ V, 0) ** n, abs=1e-12)
 
@@ -270,7 +270,7 @@ def test_scene_defaults_follow_opengl():
     s = load_scene({})
     assert s.ambient == (0.2, 0.2, 0.2)
     assert s.material == Material()
-    assert s.viewer == Viewer(direction=(0, 0, 1))
+    assert s.viewer == Viewer(to_viewer=(0, 0, 1))
     assert s.model == "blinn" and s.two_sided is False
     p = load_scene({"lights": [{"type": "point"}]}).lights[0]
     assert p.attenuation == (1.0, 0.0, 0.0)
@@ -289,7 +289,7 @@ def test_color_intensity_shorthand():
 def test_every_problem_in_a_scene_is_reported_at_once():
     bad = {
         "material": {"diffuse": [2, 0, 0], "shinyness": 3},
-        "viewer": {"eye": [0, 0, 1], "direction": [0, 0, 1]},
+        "viewer": {"eye": [0, 0, 1], "to_viewer": [0, 0, 1]},
         "lights": [
             {"type": "point", "attenuation": [0, 0, 0]},
             {"type": "spot", "cutoff": 120},
@@ -327,7 +327,7 @@ def test_scene_file(tmp_path):
     f = tmp_path / "s.yaml"
     f.write_text(
         "material: {diffuse: [1, 0, 0], ambient: [0, 0, 0]}\nambient: [0, 0, 0]\n"
-        "lights:\n  - {type: directional, direction: [0, 0, 1]}\n"
+        "lights:\n  - {type: directional, to_light: [0, 0, 1]}\n"
     )
     assert one_vertex(str(f)) == pytest.approx([1, 0, 0])
     f.write_text("lights:\n  - {type: point, attenuation: [0, 0, 0]}\n")
@@ -351,11 +351,11 @@ HARD = {
         {
             "type": "spot",
             "position": [0, 2, 0],
-            "direction": [0, -1, 0],
+            "aim": [0, -1, 0],
             "cutoff": 40,
             "exponent": 10,
         },
-        {"type": "directional", "direction": [1, 1, 1]},
+        {"type": "directional", "to_light": [1, 1, 1]},
     ],
 }
 
@@ -423,8 +423,8 @@ def test_grazing_light_never_flips_a_highlight_in_float32(shininess, sign):
             "shininess": shininess,
         },
         "ambient": [0, 0, 0],
-        "viewer": {"direction": L.tolist()},
-        "lights": [{"type": "directional", "direction": L.tolist()}],
+        "viewer": {"to_viewer": L.tolist()},
+        "lights": [{"type": "directional", "to_light": L.tolist()}],
     }
     rng = np.random.default_rng(1)
     P = rng.normal(size=(64, 3)) * 1e3 + 1e4
@@ -454,8 +454,8 @@ def test_blinn_with_light_opposite_the_viewer(precision):
     # L = -V: H is undefined; the policy takes N·H = 0
     scene = {
         "material": {**MAT, "shininess": 10},
-        "viewer": {"direction": [0, 0, -1]},
-        "lights": [{"type": "directional", "direction": [0, 0, 1]}],
+        "viewer": {"to_viewer": [0, 0, -1]},
+        "lights": [{"type": "directional", "to_light": [0, 0, 1]}],
     }
     c = one_vertex(scene, precision=precision, clamp=False)
     m = {k: np.array(v) for k, v in MAT.items()}
@@ -531,13 +531,13 @@ def test_float32_matches_float64_on_hard_scenes():
     scene = {
         "material": {**MAT, "shininess": 1e-6},
         "two_sided": True,
-        "viewer": {"direction": L.tolist()},
+        "viewer": {"to_viewer": L.tolist()},
         "lights": [
-            {"type": "directional", "direction": L.tolist()},
+            {"type": "directional", "to_light": L.tolist()},
             {
                 "type": "spot",
                 "position": [0, 0, 3],
-                "direction": [0, 0, -1],
+                "aim": [0, 0, -1],
                 "cutoff": 20,
                 "exponent": 0,
             },
@@ -554,7 +554,7 @@ def test_unclamped_output_keeps_hdr_sums():
     scene = {
         "material": {"diffuse": [1, 1, 1], "ambient": [0, 0, 0]},
         "ambient": [0, 0, 0],
-        "lights": [{"type": "directional", "direction": [0, 0, 1], "intensity": 3}],
+        "lights": [{"type": "directional", "to_light": [0, 0, 1], "intensity": 3}],
     }
     assert one_vertex(scene, clamp=False) == pytest.approx([3, 3, 3])
     assert one_vertex(scene) == pytest.approx([1, 1, 1])
@@ -565,8 +565,8 @@ def test_python_objects_work_as_scenes():
         material=Material(diffuse=(1, 0, 0), ambient=(0, 0, 0)),
         ambient=(0, 0, 0),
         lights=(
-            SpotLight(position=(0, 0, 2), direction=(0, 0, -1), cutoff=45),
-            DirectionalLight(direction=(0, 0, 1), diffuse=(0, 0, 0)),
+            SpotLight(position=(0, 0, 2), aim=(0, 0, -1), cutoff=45),
+            DirectionalLight(to_light=(0, 0, 1), diffuse=(0, 0, 0)),
         ),
     )
     assert one_vertex(scene) == pytest.approx([1 / 1, 0, 0])
@@ -589,8 +589,8 @@ def test_grey_and_coloured_point_lights_together(model):
             {"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]},
             {"type": "point", "position": [-2, 1, 2], "diffuse": [1, 0.5, 0.2]},
             {"type": "point", "position": [0, -3, 1], "color": [0.4, 0.4, 0.4], "intensity": 2},
-            {"type": "spot", "position": [0, 4, 0], "direction": [0, -1, 0], "cutoff": 40},
-            {"type": "directional", "direction": [1, 1, 1], "specular": [0.2, 0.9, 0.3]},
+            {"type": "spot", "position": [0, 4, 0], "aim": [0, -1, 0], "cutoff": 40},
+            {"type": "directional", "to_light": [1, 1, 1], "specular": [0.2, 0.9, 0.3]},
         ],
     }
     ref = reference_shade(load_scene(scene), P, N)

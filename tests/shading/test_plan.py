@@ -53,7 +53,7 @@ def test_lights_without_specular_colour_plan_no_specular():
 
 
 def test_directional_lights_need_no_distance():
-    scene = {"lights": [{"type": "directional", "direction": [1, 1, 1]}]}
+    scene = {"lights": [{"type": "directional", "to_light": [1, 1, 1]}]}
     lp = plan_of(**scene).lights[0]
     assert not lp.positional and lp.attenuation == "none"
     assert not light_flags(scene)[0] & (K.POSITIONAL | K.ATTEN | K.SPOT)
@@ -85,10 +85,10 @@ def test_spot_factor_only_for_a_cone(cutoff, exponent, want):
 def test_constant_halfway_for_directional_light_and_infinite_viewer():
     base = {
         "material": {"specular": [1, 1, 1], "shininess": 10},
-        "lights": [{"type": "directional", "direction": [0, 1, 1]}],
+        "lights": [{"type": "directional", "to_light": [0, 1, 1]}],
     }
-    assert plan_of(**base, viewer={"direction": [0, 0, 1]}).halfway == "constant"
-    assert light_flags({**base, "viewer": {"direction": [0, 0, 1]}})[0] & K.CONST_H
+    assert plan_of(**base, viewer={"to_viewer": [0, 0, 1]}).halfway == "constant"
+    assert light_flags({**base, "viewer": {"to_viewer": [0, 0, 1]}})[0] & K.CONST_H
     assert plan_of(**base, viewer={"eye": [0, 0, 5]}).halfway == "per-vertex"
     assert plan_of(**base, model="phong").halfway == "reflection"
     assert not light_flags({**base, "model": "phong"})[0] & K.CONST_H
@@ -118,10 +118,10 @@ def test_constant_light_ambient_folds_into_scene_ambient():
 def test_plan_command_prints_every_decision(tmp_path, capsys):
     f = tmp_path / "scene.yaml"
     f.write_text(
-        "material: {specular: [1, 1, 1], shininess: 20}\nviewer: {direction: [0, 0, 1]}\n"
-        "lights:\n  - {type: directional, direction: [1, 1, 1]}\n"
+        "material: {specular: [1, 1, 1], shininess: 20}\nviewer: {to_viewer: [0, 0, 1]}\n"
+        "lights:\n  - {type: directional, to_light: [1, 1, 1]}\n"
         "  - {type: point, position: [2, 3, 1], attenuation: [1, 0, 0]}\n"
-        "  - {type: spot, position: [0, 4, 0], direction: [0, -1, 0], cutoff: 30}\n"
+        "  - {type: spot, position: [0, 4, 0], aim: [0, -1, 0], cutoff: 30}\n"
     )
     assert main(["plan", str(f)]) == 0
     out = capsys.readouterr().out

@@ -34,11 +34,12 @@ def moved(scene: dict, R: np.ndarray, t: np.ndarray) -> dict:
     for light in s["lights"]:
         if "position" in light:
             light["position"] = point(light["position"])
-        if "direction" in light:
-            light["direction"] = direction(light["direction"])
+        for key in ("to_light", "aim"):
+            if key in light:
+                light[key] = direction(light[key])
     v = s["viewer"]
     s["viewer"] = (
-        {"eye": point(v["eye"])} if "eye" in v else {"direction": direction(v["direction"])}
+        {"eye": point(v["eye"])} if "eye" in v else {"to_viewer": direction(v["to_viewer"])}
     )
     return s
 
