@@ -325,7 +325,7 @@ class Explorer:
     scene : the start scene (material, model, lights, viewer); the camera starts at its viewer
     mesh : the start mesh
     preset : name of the start preset in the chooser (None: the scene's material, unnamed)
-    materials_dirs : extra preset directories (``--materials``)
+    materials_dirs : extra preset directories (``--materials-dir``)
     off_screen : draw into an off-screen buffer (tests, benchmarks); no event loop
     state_file : write the app's state as JSON here (atomically) after every frame
     output_dir : where screenshots go (default: the current directory)

@@ -101,7 +101,7 @@ def run(args) -> int:
     scene, mesh, preset = start(args)
     try:
         app = gui.Explorer(
-            scene, mesh, preset=preset, materials_dirs=tuple(args.materials),
+            scene, mesh, preset=preset, materials_dirs=tuple(args.materials_dirs),
             window_size=size, state_file=args.state_file, output_dir=args.screenshot_dir,
             background=background_from_options(args),
         )  # fmt: skip

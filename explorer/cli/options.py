@@ -17,7 +17,7 @@ from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
 from explorer.core.presets import find_preset
-from explorer.core.scene import Viewer
+from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.core.validate import Checker, notice
 from explorer.geometry.meshes import BUILTIN_MESHES, RESOLUTION, get_mesh
 from explorer.render.images import parse_size
@@ -67,16 +67,23 @@ class _OldName(argparse.Action):
 # -- arguments -----------------------------------------------------------------------------
 
 
+def add_materials_dir_option(p: argparse.ArgumentParser, dest: str = "materials_dirs") -> None:
+    """``--materials-dir DIR`` (repeatable; ``--materials`` is the same option): extra preset
+    directories, searched before the user's and the built-in ones (``materials_dirs`` in the
+    Python API)."""
+    p.add_argument(
+        "--materials-dir", "--materials", dest=dest, action="append", default=[], metavar="DIR",
+        help="extra preset directory, searched first (repeatable)",
+    )  # fmt: skip
+
+
 def add_scene_arguments(
     p: argparse.ArgumentParser, *, mesh_default: str | None, force: bool = True
 ) -> None:
     """The SCENE argument and the options that override its parts; ``force``: also
     ``--force`` (commands that write a file)."""
     p.add_argument("scene", nargs="?", metavar="SCENE", help="scene file (YAML); optional")
-    p.add_argument(
-        "--materials", action="append", default=[], metavar="DIR",
-        help="extra preset directory, searched first (repeatable)",
-    )  # fmt: skip
+    add_materials_dir_option(p)
 
     p.add_argument(
         "--mesh", metavar="NAME|FILE", default=None,
@@ -210,21 +217,19 @@ def background_from_options(args):
 def build_scene(args, *, default_light=None):
     """The scene of a render/sheet command: the SCENE file (or the defaults) with the
     command-line options applied. Returns (scene, mesh)."""
-    import explorer
-
-    dirs = tuple(args.materials)
-    for d in dirs:
+    materials_dirs = tuple(args.materials_dirs)
+    for d in materials_dirs:
         if not os.path.isdir(d):
-            raise ExplorerError(f"--materials: {d!r} is not a directory")
-    scene = explorer.load_scene(args.scene, materials_dirs=dirs) if args.scene else None
+            raise ExplorerError(f"--materials-dir: {d!r} is not a directory")
+    scene = load_scene(args.scene, materials_dirs=materials_dirs) if args.scene else None
     if scene is None:
-        scene = explorer.Scene()
+        scene = Scene()
         if default_light is not None:
             scene = scene.replace(lights=(default_light,))
     changes: dict = {}
     preset = getattr(args, "preset", None)
     if isinstance(preset, str):
-        material = find_preset(preset, dirs)
+        material = find_preset(preset, materials_dirs)
         changes["material"] = material
         if material.model is not None:
             changes["model"] = material.model

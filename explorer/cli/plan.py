@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from explorer.cli.options import add_materials_dir_option
 from explorer.core.scene import load_scene
 from explorer.geometry.meshes import DEFAULT_MESH, get_mesh
 from explorer.shading.plan import make_plan
@@ -12,18 +13,12 @@ from explorer.shading.shadows import is_convex
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("scene", help="scene file (YAML)")
-    parser.add_argument(
-        "--materials",
-        action="append",
-        default=[],
-        metavar="DIR",
-        help="extra preset directory (repeatable), searched before the built-in presets",
-    )
+    add_materials_dir_option(parser)
 
 
 def run(args) -> int:
 
-    scene = load_scene(args.scene, materials_dirs=args.materials)
+    scene = load_scene(args.scene, materials_dirs=args.materials_dirs)
     mesh_kind = None
     if any(lt.shadows for lt in scene.lights):  # shadows depend on the mesh: look at it
         mesh = get_mesh(scene.mesh or DEFAULT_MESH)

@@ -7,7 +7,7 @@
     phong-explorer presets validate PATH...  check files (directories: every *.yaml in them);
                                              one line per problem on stdout, exit status 1
 
-``--materials DIR`` (repeatable) adds preset directories searched before the user's and the
+``--materials-dir DIR`` (repeatable) adds preset directories searched before the user's and the
 built-in ones. The colour swatch is drawn with 24-bit ANSI colour only when stdout is a
 terminal, ``NO_COLOR`` is unset (or empty) and ``TERM`` is not ``dumb``.
 """
@@ -19,6 +19,7 @@ import os
 import sys
 from pathlib import Path
 
+from explorer.cli.options import add_materials_dir_option
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.material import Material
 from explorer.core.presets import (
@@ -35,10 +36,7 @@ SWATCH_SCENE_AMBIENT = 0.2
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    materials_help = "extra preset directory, searched first (repeatable)"
-    parser.add_argument(
-        "--materials", action="append", default=[], metavar="DIR", help=materials_help
-    )
+    add_materials_dir_option(parser)
     sub = parser.add_subparsers(dest="presets_command", metavar="ACTION")
     p_list = sub.add_parser("list", help="list every preset (the default)")
     p_show = sub.add_parser("show", help="print a preset's values and the file it came from")
@@ -48,35 +46,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "paths", nargs="+", metavar="PATH", help="material file, or directory of *.yaml files"
     )
     for p in (p_list, p_show):
-        p.add_argument(
-            "--materials",
-            action="append",
-            default=[],
-            dest="materials_after",
-            metavar="DIR",
-            help=materials_help,
-        )
+        add_materials_dir_option(p, dest="materials_dirs_after")
 
 
 def run(args) -> int:
-    dirs = list(getattr(args, "materials", None) or []) + list(
-        getattr(args, "materials_after", None) or []
+    materials_dirs = list(args.materials_dirs) + list(
+        getattr(args, "materials_dirs_after", None) or []
     )
     command = getattr(args, "presets_command", None) or "list"
     if command == "show":
-        return show(args.name, dirs)
+        return show(args.name, materials_dirs)
     if command == "validate":
         return validate(args.paths)
-    return list_(dirs)
+    return list_(materials_dirs)
 
 
 # -- list ------------------------------------------------------------------------------------
-def list_(dirs, out=None, err=None) -> int:
+def list_(materials_dirs, out=None, err=None) -> int:
 
     out = out or sys.stdout
     err = err or sys.stderr
     notices: list[str] = []
-    presets = list_presets(dirs, notices=notices)
+    presets = list_presets(materials_dirs, notices=notices)
     _print_notices(notices, err)
     colour = use_colour(out)
     width = max((len(p.name) for p in presets), default=4)
@@ -117,7 +108,7 @@ def _swatch(material: Material) -> str:
 
 
 def _source_label(source: str) -> str:
-    return {"extra": "--materials", "user": "user", "builtin": "built-in"}.get(source, source)
+    return {"extra": "--materials-dir", "user": "user", "builtin": "built-in"}.get(source, source)
 
 
 def _print_notices(notices, err) -> None:
@@ -126,7 +117,7 @@ def _print_notices(notices, err) -> None:
 
 
 # -- show ------------------------------------------------------------------------------------
-def show(name: str, dirs, out=None, err=None) -> int:
+def show(name: str, materials_dirs, out=None, err=None) -> int:
 
     out = out or sys.stdout
     err = err or sys.stderr
@@ -135,7 +126,7 @@ def show(name: str, dirs, out=None, err=None) -> int:
         material = load_material_file(path)
         origin = f"# from the file {path}"
     else:
-        path, source, hidden = locate_preset(name, dirs)
+        path, source, hidden = locate_preset(name, materials_dirs)
         material = load_material_file(path)
         origin = f"# preset '{name}' ({_source_label(source)}): {path}"
         if hidden is not None:

@@ -46,11 +46,11 @@ def run(args) -> int:
     chosen = args.preset
     args.preset = None  # the sheet's --preset selects tiles; it does not set the material
     scene, mesh = build_scene(args, default_light=DirectionalLight(to_light=SHEET_LIGHT_DIRECTION))
-    dirs = tuple(args.materials)
+    materials_dirs = tuple(args.materials_dirs)
     if chosen:
-        items = [(name, find_preset(name, dirs)) for name in chosen]
+        items = [(name, find_preset(name, materials_dirs)) for name in chosen]
     else:
-        items = [(info.name, info.material) for info in list_presets(dirs)]
+        items = [(info.name, info.material) for info in list_presets(materials_dirs)]
     image = sheet(
         items, scene, mesh, tile=tile, columns=args.columns, background=background,
         model=args.model,

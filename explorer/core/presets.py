@@ -4,7 +4,7 @@ A preset is one YAML file in a preset directory; its file stem is the preset's n
 (lowercase letters, digits and ``_``; files with other names are ignored with a notice). Three
 kinds of directories are searched, the first one holding a name wins:
 
-1. ``materials_dirs`` (the ``--materials DIR`` options), in the order given;
+1. ``materials_dirs`` (the ``--materials-dir DIR`` options), in the order given;
 2. the user's directory, :func:`user_dir` (``$PHONG_EXPLORER_MATERIALS`` if set, otherwise
    ``<user config dir>/phong-explorer/materials``); it need not exist;
 3. the built-in presets shipped inside the package, :func:`builtin_dir`.
@@ -51,7 +51,7 @@ class PresetInfo:
     name : preset name (the file stem)
     path : the file it was read from
     material : the loaded :class:`~explorer.core.material.Material` (``material.name == name``)
-    source : "extra" (a ``--materials`` directory), "user" or "builtin"
+    source : "extra" (a ``--materials-dir`` directory), "user" or "builtin"
     hides : the file of the same name it hides (next in precedence), or None
     """
 
@@ -79,7 +79,7 @@ def user_dir() -> Path:
 def search_dirs(materials_dirs: Iterable = ()) -> list[tuple[Path, str]]:
     """``[(directory, source), ...]`` in precedence order (first wins).
 
-    A ``--materials`` directory that does not exist is an error (it was asked for); a missing
+    A ``--materials-dir`` directory that does not exist is an error (it was asked for); a missing
     user directory is simply skipped.
     """
     dirs: list[tuple[Path, str]] = []
@@ -93,7 +93,7 @@ def search_dirs(materials_dirs: Iterable = ()) -> list[tuple[Path, str]]:
     if user.is_dir():
         dirs.append((user, "user"))
     dirs.append((builtin_dir(), "builtin"))
-    # the same directory twice (e.g. --materials pointing at the user dir) counts once
+    # the same directory twice (e.g. --materials-dir pointing at the user dir) counts once
     seen: set = set()
     unique = []
     for path, source in dirs:
@@ -259,7 +259,7 @@ _NOTICED: set[str] = set()
 
 
 def _hidden_message(name, path, source, hidden) -> str:
-    label = {"extra": "--materials", "user": "user", "builtin": "built-in"}.get(source, source)
+    label = {"extra": "--materials-dir", "user": "user", "builtin": "built-in"}.get(source, source)
     return f"preset '{name}': using {path} ({label}), which hides {hidden[0]}"
 
 

@@ -504,7 +504,7 @@ def test_cli_list_shows_user_presets_and_prints_shadow_notices(capsys, tmp_path)
     captured = capsys.readouterr()
     assert "notice:" in captured.err and "gold" in captured.err
     assert any(
-        ln.startswith("my_own") and "[--materials]" in ln for ln in captured.out.splitlines()
+        ln.startswith("my_own") and "[--materials-dir]" in ln for ln in captured.out.splitlines()
     )
 
 
