@@ -184,9 +184,10 @@ def constants(dtype) -> np.ndarray:
 # pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
 # log2 x from the exponent bits plus ln(1 + z) = z - z²/2 + z³·P(z), z in [-0.29, 0.41] (P of
 # degree 5, fitted like Cephes logf); 2**t = 2**k · 2**f with f in [-0.5, 0.5] (degree-5 fit)
-# and 2**k written as exponent bits. Relative error about 1e-6 (tests/test_kernels.py). Results
+# and 2**k written as exponent bits. Relative error about 1e-6 (tests/shading/test_kernels.py). Results
 # below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per element, which
-# does not vectorise (~15x slower here); this one inlines into the shading loop.
+# does not vectorise; this one inlines into the shading loop (benchmarks/bench_lean_kernel.py
+# times the loop with it).
 
 
 @intrinsic
@@ -1490,7 +1491,8 @@ def _spread(t, ntasks):
     shares (static scheduling), and culling makes work uneven across a mesh (the half a light
     faces costs, the other half is skipped): reversed bits deal every thread runs from all over
     the mesh, so the threads finish together. Used only when culling: without it the work is
-    even, and each thread streaming through one contiguous half is faster (1.04x, measured)."""
+    even, and each thread streaming through one contiguous half is faster
+    (``benchmarks/bench_revisions.py`` compares the two)."""
     if ntasks & (ntasks - 1):
         return t
     r = 0
