@@ -142,8 +142,7 @@ def report_values(table: dict, *, plot: str | None, command: str) -> dict[str, s
         "findings": "\n".join(f"- {line}" for line in findings(table)),
         "tessellation": _per_material(table, _tessellation_table),
         "per_pixel": "\n".join(
-            f"| {x['material']} | {x['pixels']:,} | {fmt(x['shade_ms'])} |"
-            for x in table["per_pixel"]
+            _row(x["material"], f"{x['pixels']:,}", fmt(x["shade_ms"])) for x in table["per_pixel"]
         ),
         "adaptive": _per_material(table, _adaptive_table) if adaptive else "",
         "adaptive_base": adaptive[0]["base"] if adaptive else "",
@@ -181,6 +180,21 @@ def _per_material(table: dict, make: Callable[[dict, str], list[str]]) -> str:
     )
 
 
+def _row(*cells) -> str:
+    """A Markdown table row."""
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+def _errors(r: dict) -> tuple[str, str, str]:
+    """A row's RMSE, max and peak cells (``–`` where the row is missing)."""
+    return fmt(r.get("rmse")), fmt(r.get("max")), fmt(r.get("peak"))
+
+
+def _mesh(r: dict) -> tuple[str, str]:
+    """A row's tessellation and vertex count cells."""
+    return f"{r['mesh']} {r['resolution']}", f"{r['vertices']:,}"
+
+
 def _tessellation_table(table: dict, label: str) -> list[str]:
     """Per-vertex Blinn against per-pixel Blinn, one row per tessellation: times of the three
     paths, errors of float64 and float32."""
@@ -194,13 +208,10 @@ def _tessellation_table(table: dict, label: str) -> list[str]:
         key = dict(material=label, side=main, mesh=r["mesh"], resolution=r["resolution"])
         f32 = _first(table, variant="blinn float32", **key)
         off = _first(table, variant="blinn plan off", **key)
-        out.append(
-            f"| {r['mesh']} {r['resolution']} | {r['vertices']:,} | {fmt(r['shade_ms'])} "
-            f"| {fmt(f32.get('shade_ms'))} | {fmt(off.get('shade_ms'))} "
-            f"| {fmt(r['render_ms'])} | {fmt(r['rmse'])} | {r['max']} | {fmt(r['peak'])} "
-            f"| {fmt(f32.get('max'))} | {fmt(f32.get('vs_float64'))} "
-            f"| {fmt(off.get('vs_float64'))} |"
-        )
+        out.append(_row(*_mesh(r), fmt(r["shade_ms"]), fmt(f32.get("shade_ms")),
+                        fmt(off.get("shade_ms")), fmt(r["render_ms"]), *_errors(r),
+                        fmt(f32.get("max")), fmt(f32.get("vs_float64")),
+                        fmt(off.get("vs_float64"))))  # fmt: skip
     return out
 
 
@@ -211,10 +222,8 @@ def _adaptive_table(table: dict, label: str) -> list[str]:
         "|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows_where(table, adaptive=True, side=table["main_side"], material=label):
-        out.append(
-            f"| {r['resolution']:g} | {r['vertices']:,} | {fmt(r['shade_ms'])} "
-            f"| {fmt(r['render_ms'])} | {fmt(r['rmse'])} | {r['max']} | {fmt(r['peak'])} |"
-        )
+        out.append(_row(f"{r['resolution']:g}", f"{r['vertices']:,}", fmt(r["shade_ms"]),
+                        fmt(r["render_ms"]), *_errors(r)))  # fmt: skip
     return out
 
 
@@ -228,19 +237,12 @@ def _model_match_table(table: dict, label: str) -> list[str]:
     ]
     for x in table["model_match"]:
         if x["material"] == label:
-            out.append(
-                f"| per pixel | – | – | – | 0 | 0 | 0 | – | {fmt(x['rmse'])} | {x['max']} "
-                f"| {fmt(x['peak'])} |"
-            )
+            out.append(_row("per pixel", "–", "–", "–", 0, 0, 0, "–", *_errors(x)))
     for r in rows_where(table, material=label, variant="phong", side=main):
         b = _first(table, material=label, variant="blinn 4n", side=main, mesh=r["mesh"],
                    resolution=r["resolution"])  # fmt: skip
-        out.append(
-            f"| {r['mesh']} {r['resolution']} | {r['vertices']:,} | {fmt(r['shade_ms'])} "
-            f"| {fmt(r['render_ms'])} | {fmt(r['rmse'])} | {r['max']} | {fmt(r['peak'])} "
-            f"| {fmt(b.get('shade_ms'))} | {fmt(b.get('rmse'))} | {fmt(b.get('max'))} "
-            f"| {fmt(b.get('peak'))} |"
-        )
+        out.append(_row(*_mesh(r), fmt(r["shade_ms"]), fmt(r["render_ms"]), *_errors(r),
+                        fmt(b.get("shade_ms")), *_errors(b)))  # fmt: skip
     return out
 
 
@@ -248,7 +250,7 @@ def _size_table(table: dict, label: str) -> list[str]:
     """``RMSE / max`` of each tessellation at every picture size."""
     sides = table["sides"]
     out = [
-        "| mesh | vertices | " + " | ".join(f"{s}x{s}" for s in sides) + " |",
+        _row("mesh", "vertices", *(f"{s}x{s}" for s in sides)),
         "|---|---:|" + "---:|" * len(sides),
     ]
     for r in rows_where(table, material=label, variant="blinn", side=table["main_side"]):
@@ -257,8 +259,7 @@ def _size_table(table: dict, label: str) -> list[str]:
             x = _first(table, material=label, variant="blinn", side=s, mesh=r["mesh"],
                        resolution=r["resolution"])  # fmt: skip
             cells.append(f"{fmt(x['rmse'])} / {x['max']}" if x else "–")
-        out.append(f"| {r['mesh']} {r['resolution']} | {r['vertices']:,} | " + " | ".join(cells)
-                   + " |")  # fmt: skip
+        out.append(_row(*_mesh(r), *cells))
     return out
 
 
@@ -281,7 +282,7 @@ def _how_fine_row(table: dict, shininess: float) -> str:
                 else f"> {mesh} {rec.finest[0]}"
             )
         cells.append("<br>".join(parts) or "–")
-    return f"| {shininess:g} | " + " | ".join(cells) + " |"
+    return _row(f"{shininess:g}", *cells)
 
 
 # -- the findings -------------------------------------------------------------------------------
