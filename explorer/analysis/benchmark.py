@@ -38,7 +38,7 @@ from explorer.shading.display import vertex_colors
 from explorer.shading.equation import reference_shade
 from explorer.shading.shader import shade
 
-# -- what the bench measures -----------------------------------------------------------------
+# -- what the bench measures -----------------------------------------------------------------------
 
 #: the bench's one light: directional, white, from the upper left front. A generic direction
 #: (not along the view or a mesh axis) so the highlight does not sit on a vertex of every
@@ -226,7 +226,7 @@ def machine_info(opengl: bool = False) -> dict:
     return info
 
 
-# -- the bench --------------------------------------------------------------------------------
+# -- the bench -------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)

@@ -59,7 +59,7 @@ def template_text() -> str:
     return resources.files(__package__).joinpath(TEMPLATE).read_text(encoding="utf-8")
 
 
-# -- reading the table ------------------------------------------------------------------------
+# -- reading the table -----------------------------------------------------------------------------
 
 
 def rows_where(table: dict, *, adaptive: bool = False, **match) -> list[dict]:
@@ -109,7 +109,7 @@ def _labels(table: dict) -> list[str]:
     return [x["label"] for x in table["scene"]["materials"]]
 
 
-# -- the Markdown -------------------------------------------------------------------------------
+# -- the Markdown ----------------------------------------------------------------------------------
 
 
 def markdown(table: dict, *, plot: str | None, command: str) -> str:
@@ -285,7 +285,7 @@ def _how_fine_row(table: dict, shininess: float) -> str:
     return _row(f"{shininess:g}", *cells)
 
 
-# -- the findings -------------------------------------------------------------------------------
+# -- the findings ----------------------------------------------------------------------------------
 
 
 def findings(table: dict) -> list[str]:

@@ -38,7 +38,7 @@ def test_pareto_front_by_brute_force(points):
     assert [t[i] for i in front] == sorted(t[i] for i in front)
 
 
-# -- the Markdown ---------------------------------------------------------------------------------
+# -- the Markdown ----------------------------------------------------------------------------------
 
 
 def test_report_of_the_shipped_table_is_docs_accuracy_md():
