@@ -6,7 +6,7 @@ per vertex, renders it off-screen and compares it with the per-pixel reference
 float64 and float32, the plan off) and picture sizes, and times the shading and the render;
 adaptive refinement (:mod:`explorer.analysis.refine`) is measured alongside. The result is the
 table :mod:`explorer.analysis.advice` answers from (shipped as ``explorer/data/accuracy.json``)
-and :mod:`explorer.analysis.report` turns into ``docs/accuracy.md``. The machine it ran on is
+and :mod:`explorer.analysis.report` turns into ``accuracy.md``. The machine it ran on is
 recorded with it (:func:`machine_info`).
 """
 
@@ -56,7 +56,8 @@ BENCH_MESHES: tuple[tuple[str, tuple[int, ...]], ...] = (
     ("sphere", (8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256, 384, 512, 768, 1024)),
     ("icosphere", (0, 1, 2, 3, 4, 5, 6, 7)),
 )
-#: picture sides of the size sweep (square pictures); :data:`MAIN_SIDE` gets every variant
+#: picture sides of the size sweep (square pictures); :data:`~explorer.analysis.advice.MAIN_SIDE`
+#: gets every variant
 SIZE_SWEEP = (100, 200, 400, 800)
 #: the quick run (tests): small pictures, few meshes, two materials, one repeat
 QUICK_MATERIALS = BENCH_MATERIALS[:2]
@@ -78,8 +79,8 @@ VARIANTS: dict[str, tuple[str, float, str, str]] = {
 }
 #: variants measured at every size of the sweep (the others only at the main size)
 SWEEP_VARIANTS = ("blinn", "phong")
-#: adaptive refinement (:func:`refine_highlights`, Blinn float64, main size only): the base
-#: mesh and the edge-midpoint thresholds (levels)
+#: adaptive refinement (:func:`~explorer.analysis.refine.refine_highlights`, Blinn float64,
+#: main size only): the base mesh and the edge-midpoint thresholds (levels)
 ADAPTIVE_BASE = ("icosphere", 3)
 ADAPTIVE_THRESHOLDS = (8.0, 4.0, 2.0, 1.0)
 QUICK_ADAPTIVE_THRESHOLDS = (4.0,)

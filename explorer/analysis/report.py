@@ -1,4 +1,5 @@
-"""The accuracy report: ``docs/accuracy.md`` and its plot from a measured table.
+"""The accuracy report: ``accuracy.md`` (published as ``docs/accuracy.md``) and its plot from a
+measured table.
 
 :func:`markdown` fills the template ``templates/accuracy.md`` (shipped with the package) with
 the table's numbers: the prose lives in the template, and each small function here makes one
@@ -458,7 +459,7 @@ def _per_pixel_finding(table: dict) -> str | None:
 
 
 def plot(table: dict, path, *, overwrite: bool = False) -> bool:
-    """Draw docs/accuracy.png: error against time per frame for each material, the Pareto
+    """Draw accuracy.png: error against time per frame for each material, the Pareto
     front marked; written atomically to ``path`` (an existing file only with ``overwrite``).
     Returns False (and writes nothing) when matplotlib is not installed (it is the optional
     ``bench`` extra)."""
