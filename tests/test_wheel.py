@@ -1,5 +1,6 @@
-"""The presets ship inside the wheel: build it, install it into a fresh environment outside the
-source tree, and load every preset from there."""
+"""The package data ships inside the wheel: build it, install it into a fresh environment outside
+the source tree, load every preset from there and write the accuracy report from the shipped table
+and template."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import shutil
 import subprocess
 import sys
 import venv
+import zipfile
 from pathlib import Path
 
 import pytest
@@ -32,6 +34,14 @@ print(json.dumps({
         for p in infos
     },
 }))
+"""
+
+REPORT = r"""
+import sys
+from explorer.analysis.advice import load_table
+from explorer.analysis.report import markdown
+table = load_table()
+sys.stdout.buffer.write(markdown(table, plot="accuracy.png", command=table["command"]).encode())
 """
 
 
@@ -69,6 +79,9 @@ def test_presets_load_from_an_installed_wheel(tmp_path):
         cwd=tmp_path,
     )  # fmt: skip
     (wheel,) = dist.glob("phong_explorer-*.whl")
+    names = zipfile.ZipFile(wheel).namelist()
+    assert "explorer/analysis/templates/accuracy.md" in names
+    assert "explorer/data/accuracy.json" in names
 
     # 2. a fresh environment (numpy & co. come from the system site-packages, no network)
     env_dir = tmp_path / "venv"
@@ -103,3 +116,8 @@ def test_presets_load_from_an_installed_wheel(tmp_path):
         [str(env_dir / "bin" / "phong-explorer"), "presets", "show", "gold"], cwd=work, env=env
     )
     assert str(Path(out["builtin_dir"]) / "gold.yaml") in proc.stdout
+
+    # 5. the accuracy report from the installed table and template is docs/accuracy.md
+    report = subprocess.run([str(py), "-c", REPORT], cwd=work, env=env, capture_output=True)
+    assert report.returncode == 0, report.stderr.decode()
+    assert report.stdout == (ROOT / "docs" / "accuracy.md").read_bytes()

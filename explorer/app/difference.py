@@ -2,13 +2,13 @@
 
 The toggle ``difference`` (a check box in the mesh section of the panel, key ``d``) compares
 what the window shows, per-vertex colours interpolated across each triangle, with the same
-lighting evaluated at every pixel (:func:`explorer.analysis.accuracy.compare_view`: the exact sphere
-for the built-in spheres, ray casting with interpolated normals for any other mesh), for the current
-camera, window size, mesh, material and lights. The error of each pixel, in 1/255 levels, is
-drawn with :func:`explorer.analysis.accuracy.heat_map` as the renderer's background while the mesh
-is hidden, so the map sits exactly where the mesh is drawn. A legend gives the RMSE and the worst
-pixel, and a second text gives :func:`explorer.analysis.accuracy.advice`: which tessellation keeps
-the error within one level for the current shininess at this window's size.
+lighting evaluated at every pixel (:func:`explorer.analysis.comparison.compare_view`: the exact
+sphere for the built-in spheres, ray casting with interpolated normals for any other mesh), for
+the current camera, window size, mesh, material and lights. The error of each pixel, in 1/255
+levels, is drawn with :func:`explorer.analysis.comparison.heat_map` as the renderer's background
+while the mesh is hidden, so the map sits exactly where the mesh is drawn. A legend gives the
+RMSE and the worst pixel, and a second text gives :func:`explorer.analysis.advice.advice`: which
+tessellation keeps the error within one level for the current shininess at this window's size.
 
 One comparison costs two off-screen renders and the per-pixel reference at the window's size
 (a few hundred ms), so the explorer computes it once a change is complete: at once after a key
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from explorer.analysis import accuracy as A
+from explorer.analysis import comparison as A
 from explorer.shading.display import to_bytes
 
 #: the error (1/255 levels) drawn white; the ramp below it is logarithmic (see heat_map)
@@ -34,7 +34,8 @@ class DifferenceView:
     """The heat map, shown in a renderer's background, and what it was computed for.
 
     renderer : the explorer's vtkRenderer
-    on : the toggle; comparison : the last :class:`explorer.analysis.accuracy.Comparison` (or None)
+    on : the toggle
+    comparison : the last :class:`explorer.analysis.comparison.Comparison` (or None)
     key : what the shown map was computed for (the explorer decides what goes in it)
     """
 
@@ -122,5 +123,5 @@ class DifferenceView:
 
 
 def advice_lines(text: str) -> str:
-    """:func:`explorer.analysis.accuracy.advice`'s one line split after its ``;`` (it is wide)."""
+    """:func:`explorer.analysis.advice.advice`'s one line split after its ``;`` (it is wide)."""
     return text.replace("; ", ";\n")

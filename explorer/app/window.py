@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.analysis import accuracy as A
+from explorer.analysis import advice as A
 from explorer.app import layout as G
 from explorer.app.difference import PENDING, DifferenceView, advice_lines
 from explorer.core.atomic import write_atomic

@@ -2,37 +2,45 @@
 
 ::
 
-    phong-explorer bench accuracy                      # full run, in a source checkout
-    phong-explorer bench accuracy --out-dir results/   # anywhere: results/accuracy.{md,png,json}
+    phong-explorer bench accuracy                      # ./accuracy.md, .png, .json
+    phong-explorer bench accuracy --out-dir results/   # results/accuracy.{md,png,json}
     phong-explorer bench accuracy --quick --out-dir /tmp/q
 
-Per-vertex shading of sphere tessellations against the per-pixel reference (see
-:mod:`explorer.analysis.accuracy`). Outputs:
+Per-vertex shading of sphere tessellations against the per-pixel reference
+(:mod:`explorer.analysis.benchmark`). It writes three files into the current directory, or into
+``--out-dir DIR`` (which must exist): ``accuracy.json`` (the measured table),
+``accuracy.png`` (the plot) and ``accuracy.md`` (the report, linking the plot). It checks
+before measuring that none of them exists, and replaces existing ones only with ``--force``;
+every file is written atomically. It never writes anywhere else: not into the installed
+package, not into a source checkout it runs from.
 
-- by default, in the source checkout the package runs from: ``docs/accuracy.md``,
-  ``docs/accuracy.png`` and ``explorer/data/accuracy.json`` (the table
-  :func:`explorer.analysis.accuracy.mesh_for_error` reads). These files belong to the command: it
-  replaces them without ``--force``.
-- with ``--out-dir DIR``: ``DIR/accuracy.md``, ``DIR/accuracy.png``, ``DIR/accuracy.json``;
-  existing files there are user files and are replaced only with ``--force``.
+The copies published with the project are made by the maintainer in a source checkout::
 
-Every file is written atomically. The plot needs matplotlib (``pip install
-'phong-explorer[bench]'``); without it the plot is skipped with a message.
+    phong-explorer bench accuracy --out-dir docs --force
+    mv docs/accuracy.json explorer/data/accuracy.json
+
+(``docs/accuracy.md`` and ``docs/accuracy.png``, and the table the package ships, which
+:func:`explorer.analysis.advice.mesh_for_error` reads). The plot needs matplotlib
+(``pip install 'phong-explorer[bench]'``); without it the plot is skipped with a message.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import os
 import sys
 from pathlib import Path
 
-from explorer.analysis import accuracy as A
-from explorer.analysis.accuracy import data_path
+from explorer.analysis.benchmark import BenchConfig, Progress, run_bench
+from explorer.analysis.report import markdown, plot, table_bytes
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 
 #: bench -> one-line help
 BENCHES = {"accuracy": "per-vertex shading against the per-pixel reference: error and time"}
+#: the files a run writes, by kind
+OUTPUTS = ("json", "png", "md")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -41,67 +49,42 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "accuracy",
         help=BENCHES["accuracy"],
         description=BENCHES["accuracy"],
-        epilog="Without --out-dir (in a source checkout) it replaces docs/accuracy.md, "
-        "docs/accuracy.png and explorer/data/accuracy.json: those files belong to this command. "
-        "In --out-dir it never replaces an existing file without --force. A progress bar is "
-        "shown on a terminal. The plot needs matplotlib (pip install 'phong-explorer[bench]').",
+        epilog="Writes accuracy.md, accuracy.png and accuracy.json into the current directory "
+        "(or --out-dir DIR) and never replaces an existing file without --force. A progress "
+        "bar is shown on a terminal. The plot needs matplotlib (pip install "
+        "'phong-explorer[bench]'). To update the project's published copies, in a source "
+        "checkout: --out-dir docs --force, then move docs/accuracy.json to "
+        "explorer/data/accuracy.json.",
     )
     p.add_argument(
         "--quick",
         action="store_true",
-        help="a small run (2 materials, 7 meshes, 96x96, one repeat) for tests; needs --out-dir",
+        help="a small run (2 materials, 7 meshes, 96x96, one repeat) for tests",
     )
     p.add_argument(
         "--out-dir",
         metavar="DIR",
-        help="write DIR/accuracy.md, .png and .json (default: the checkout's docs/ and "
-        "explorer/data/)",
+        default=".",
+        help="write DIR/accuracy.md, .png and .json (default: the current directory)",
     )
     p.add_argument(
         "--repeats", type=int, metavar="N", help="timed runs per median (default 5; quick 1)"
     )
-    p.add_argument("--force", action="store_true", help="replace existing files in --out-dir")
+    p.add_argument("--force", action="store_true", help="replace existing files")
 
 
-def checkout_root() -> Path | None:
-    """The source checkout the package runs from (it has pyproject.toml and docs/), or None
-    for an installed package."""
-    import explorer
-
-    root = Path(explorer.__file__).resolve().parent.parent
-    if (root / "pyproject.toml").is_file() and (root / "docs").is_dir():
-        return root
-    return None
-
-
-def outputs(args) -> tuple[dict[str, Path], bool]:
-    """Where the three files go, and whether existing ones may be replaced."""
-    if args.out_dir is not None:
-        d = Path(args.out_dir)
-        if not d.is_dir():
-            raise ExplorerError(f"--out-dir {args.out_dir!r}: not a directory")
-        paths = {k: d / f"accuracy.{k}" for k in ("md", "png", "json")}
-        if not args.force:
-            for p in paths.values():
-                if p.exists():
-                    raise ExplorerError(f"{p}: already exists; use --force to replace it")
-        return paths, bool(args.force)
-    if args.quick:
-        raise ExplorerError(
-            "--quick measures a small table for tests; give --out-dir so it does not replace "
-            "the project's measured table"
-        )
-    root = checkout_root()
-    if root is None:
-        raise ExplorerError(
-            "not running from a source checkout: give --out-dir DIR for the results"
-        )
-
-    return {
-        "md": root / "docs" / "accuracy.md",
-        "png": root / "docs" / "accuracy.png",
-        "json": data_path(),
-    }, True
+def outputs(out_dir, force: bool) -> dict[str, Path]:
+    """Where the files go (``json``, ``png``, ``md`` -> path in ``out_dir``); an ExplorerError
+    when ``out_dir`` is not a directory or, without ``force``, when one of them exists."""
+    d = Path(out_dir)
+    if not d.is_dir():
+        raise ExplorerError(f"--out-dir {str(out_dir)!r}: not a directory")
+    paths = {k: d / f"accuracy.{k}" for k in OUTPUTS}
+    if not force:
+        for p in paths.values():
+            if p.exists():
+                raise ExplorerError(f"{p}: already exists; use --force to replace it")
+    return paths
 
 
 def run(args) -> int:
@@ -111,20 +94,18 @@ def run(args) -> int:
 
 
 def run_accuracy(args) -> int:
-    import os
-
-    paths, overwrite = outputs(args)
-    config = A.BenchConfig.quick_run() if args.quick else A.BenchConfig()
+    paths = outputs(args.out_dir, args.force)
+    config = BenchConfig.quick_run() if args.quick else BenchConfig()
     if args.repeats is not None:
         if args.repeats < 1:
             raise ExplorerError(f"--repeats must be at least 1, got {args.repeats}")
-        config = A.BenchConfig(**{**config.__dict__, "repeats": args.repeats})
+        config = dataclasses.replace(config, repeats=args.repeats)
     command = "phong-explorer bench accuracy" + (" --quick" if args.quick else "")
-    table = A.run_bench(config, progress=A.Progress())
+    table = run_bench(config, progress=Progress())
     table["command"] = command
-    write_atomic(paths["json"], A.table_bytes(table), overwrite=overwrite)
+    write_atomic(paths["json"], table_bytes(table), overwrite=args.force)
     print(f"wrote {paths['json']}: {len(table['rows'])} rows")
-    drawn = A.plot(table, paths["png"], overwrite=overwrite)
+    drawn = plot(table, paths["png"], overwrite=args.force)
     if drawn:
         print(f"wrote {paths['png']}")
     else:
@@ -133,7 +114,7 @@ def run_accuracy(args) -> int:
             file=sys.stderr,
         )
     rel = os.path.relpath(paths["png"], paths["md"].parent) if drawn else None
-    text = A.markdown(table, plot=rel, command=command)
-    write_atomic(paths["md"], text.encode("utf-8"), overwrite=overwrite)
+    text = markdown(table, plot=rel, command=command)
+    write_atomic(paths["md"], text.encode("utf-8"), overwrite=args.force)
     print(f"wrote {paths['md']}")
     return 0

@@ -184,10 +184,10 @@ def constants(dtype) -> np.ndarray:
 # pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
 # log2 x from the exponent bits plus ln(1 + z) = z - z²/2 + z³·P(z), z in [-0.29, 0.41] (P of
 # degree 5, fitted like Cephes logf); 2**t = 2**k · 2**f with f in [-0.5, 0.5] (degree-5 fit)
-# and 2**k written as exponent bits. Relative error about 1e-6 (tests/shading/test_kernels.py). Results
-# below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per element, which
-# does not vectorise; this one inlines into the shading loop (benchmarks/bench_lean_kernel.py
-# times the loop with it).
+# and 2**k written as exponent bits. Relative error about 1e-6 (tests/shading/test_kernels.py).
+# Results below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per
+# element, which does not vectorise; this one inlines into the shading loop
+# (benchmarks/bench_lean_kernel.py times the loop with it).
 
 
 @intrinsic

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import explorer
-from explorer.analysis import accuracy as A
+from explorer.analysis import comparison as A
 from explorer.app import layout as G
 from explorer.app import window as gui
 from explorer.cli import build_parser

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import explorer
-from explorer.analysis.accuracy import compare, coverage
+from explorer.analysis.comparison import compare, coverage
 from explorer.cli import main
 from explorer.core.hdr import HDR
 from explorer.core.lights import DirectionalLight
