@@ -33,7 +33,7 @@ from explorer.core.lights import PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
-from explorer.shading.equation import reference_shade
+from explorer.shading.equation import equation_shade
 
 
 def machine() -> str:
@@ -233,7 +233,7 @@ def main(argv=None) -> int:
     )
 
     sub = max(n // 20, 1)
-    ref = timed(lambda: reference_shade(scene, P[:sub], N[:sub]), max(3, R // 3))
+    ref = timed(lambda: equation_shade(scene, P[:sub], N[:sub]), max(3, R // 3))
     row(
         f"plain numpy float64 reference (full generality; on {sub} vertices, scaled)",
         ref[0] * n / sub,

@@ -36,7 +36,7 @@ from explorer.render.offscreen import OffscreenRenderer
 from explorer.render.perpixel import point_colors, reference, sphere_hits
 from explorer.render.vtk import headless_egl
 from explorer.shading.display import vertex_colors
-from explorer.shading.equation import reference_shade
+from explorer.shading.equation import equation_shade
 from explorer.shading.shader import shade
 
 # -- what the bench measures -----------------------------------------------------------------------
@@ -272,7 +272,7 @@ class _References:
 def _shade_fn(scene, path: str, P, N) -> Callable[[], np.ndarray]:
     """The timed shading call of a variant's path."""
     if path == "plan off":
-        return lambda: reference_shade(scene, P, N)
+        return lambda: equation_shade(scene, P, N)
     return lambda: shade(scene, P, N, precision=path)
 
 

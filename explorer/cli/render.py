@@ -6,7 +6,7 @@
     phong-explorer render --preset jade --light-type point --light-position 2 2 2 --out j.ply
     phong-explorer render --preset jade --per-pixel --out reference.png
 
-The scene options are :mod:`explorer.cli.options`'.
+The scene options are in :mod:`explorer.cli.options`.
 """
 
 from __future__ import annotations

@@ -79,7 +79,7 @@ FLOAT32_MAX_ABS_ERROR = 1.0 / 255.0
 
 #: Engine (float64) against the independent OpenGL 2.1 oracle in the tests.
 ORACLE_ABS_TOL = 1e-5
-#: Planned result against the full-generality reference (both float64).
+#: Planned result against the full equation (explorer.shading.equation; both float64).
 PLAN_ABS_TOL = 1e-9
 #: Colours after rotating/translating the whole scene (float64; the rotation itself rounds).
 INVARIANCE_ABS_TOL = 1e-6

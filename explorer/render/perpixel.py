@@ -39,7 +39,7 @@ from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
-from explorer.shading.equation import reference_terms
+from explorer.shading.equation import equation_terms
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -277,7 +277,7 @@ def reference(
     h = hits(scene, mesh, size, camera=camera, method=method)
     if len(h.positions):
         colors = point_colors(scene, h.positions, h.normals, mesh=mesh, precision=precision)
-        spec = reference_terms(scene, h.positions, h.normals)["specular"].sum(axis=1)
+        spec = equation_terms(scene, h.positions, h.normals)["specular"].sum(axis=1)
     else:
         colors = np.zeros((0, 3))
         spec = np.zeros(0)

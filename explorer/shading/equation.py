@@ -1,4 +1,4 @@
-"""The full-generality float64 reference: every term for every light, no plan, plain numpy.
+"""The lighting equation in plain numpy, float64: every term for every light, no plan.
 
 This is the engine's specification in code. It computes each term whether or not it can be
 non-zero, so the planned fast path (:mod:`explorer.shading.kernels`) is tested against it. It
@@ -28,7 +28,7 @@ from explorer.shading.effects import schlick, specular_scale
 from explorer.shading.shadows import visibility
 
 
-def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
+def equation_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
     """Per-vertex light sums, independent of the material.
 
     Returns ``ambient``, ``diffuse``, ``specular`` : (n, 3) float64 such that the colour is
@@ -90,11 +90,11 @@ def reference_terms(scene: Scene, positions, normals, faces=None) -> dict[str, n
     return {"ambient": ambient, "diffuse": diffuse, "specular": specular}
 
 
-def reference_shade(
+def equation_shade(
     scene: Scene, positions, normals, *, clamp: bool = True, faces=None
 ) -> np.ndarray:
-    """Colours (n, 3) float64 by the full-generality reference (see module docstring)."""
-    t = reference_terms(scene, positions, normals, faces)
+    """Colours (n, 3) float64 by the full equation (see module docstring)."""
+    t = equation_terms(scene, positions, normals, faces)
     m = scene.material
     c = (
         np.asarray(m.emission)  # e_m

@@ -7,7 +7,7 @@ structure-of-arrays scratch rows that stay in cache. Every light then runs a few
 over the block (direction, weight, diffuse, lobe), each a branch-free loop the compiler turns into
 SIMD code; decisions the plan makes per light are taken once per block, outside those loops.
 
-The light sums (ambient, diffuse, specular; see :func:`explorer.shading.equation.reference_terms`)
+The light sums (ambient, diffuse, specular; see :func:`explorer.shading.equation.equation_terms`)
 are stored when asked, so a material change only recomposes (:func:`compose`), and each light's
 specular base and weight can be stored so a shininess change only re-runs the lobe
 (:func:`lobe`). A pass whose lights are all grey (r = g = b) stores its diffuse and specular

@@ -3,7 +3,8 @@
 :func:`make_plan` looks at the scene alone (never at the mesh) and decides, per light and for
 the whole scene, what must be computed per vertex, what is constant, and what is skipped, with
 the reason for each decision. The kernels (:mod:`explorer.shading.kernels`) follow the plan; the
-test suite checks that the planned result equals the full-generality reference on random scenes.
+test suite checks that the planned result equals the full equation (:mod:`.equation`) on random
+scenes.
 
 Light-level decisions depend on the light only (its colours, and what its class says it needs:
 :meth:`explorer.core.lights.Light.work`: distance, attenuation, cone); the

@@ -1,7 +1,7 @@
 """The engine's front: :func:`shade` for one-shot colours, :class:`Shader` for interaction.
 
 A :class:`Shader` keeps the per-vertex light sums of
-:func:`explorer.shading.equation.reference_terms` cached by what they depend on:
+:func:`explorer.shading.equation.equation_terms` cached by what they depend on:
 
 =====================  =======================================================================
 change                 work done on the next ``colors``

@@ -35,7 +35,7 @@ from explorer.shading.display import (
     vertex_colors,
 )
 from explorer.shading.effects import energy_factor, schlick
-from explorer.shading.equation import reference_shade
+from explorer.shading.equation import equation_shade
 from explorer.shading.plan import make_plan
 
 SPHERE_Z, SPHERE_R = 0.6, 0.4
@@ -85,7 +85,7 @@ def test_planned_effects_equal_full_generality(scene, which):
     faces = None if which == "none" else mesh.faces
     loaded = load_scene(scene)
     P, N = mesh.positions, mesh.normals
-    full = reference_shade(loaded, P, N, clamp=False, faces=faces)
+    full = equation_shade(loaded, P, N, clamp=False, faces=faces)
     planned = explorer.shade(loaded, P, N, clamp=False, faces=faces)
     scale = max(1.0, float(np.abs(full).max(initial=0)))
     assert np.abs(planned - full).max(initial=0) <= tol.PLAN_ABS_TOL * scale

@@ -15,7 +15,7 @@ from explorer.core.errors import ExplorerError, ValidationError
 from explorer.core.lights import DirectionalLight, PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer, load_scene
-from explorer.shading.equation import reference_shade
+from explorer.shading.equation import equation_shade
 
 PRECISIONS = ("float64", "float32")
 
@@ -445,7 +445,7 @@ def test_extreme_shininess(shininess, precision):
     scene = load_scene(HARD).replace(material=Material(**{**MAT, "shininess": shininess}))
     c = explorer.shade(scene, P, N, precision=precision)
     check_finite_in_range(c)
-    ref = reference_shade(scene, P, N)
+    ref = equation_shade(scene, P, N)
     assert np.abs(c - ref).max() <= (1e-9 if precision == "float64" else tol.FLOAT32_MAX_ABS_ERROR)
 
 
@@ -593,7 +593,7 @@ def test_grey_and_coloured_point_lights_together(model):
             {"type": "directional", "to_light": [1, 1, 1], "specular": [0.2, 0.9, 0.3]},
         ],
     }
-    ref = reference_shade(load_scene(scene), P, N)
+    ref = equation_shade(load_scene(scene), P, N)
     c64 = explorer.shade(scene, P, N)
     c32 = explorer.shade(scene, P, N, precision="float32")
     assert np.abs(c64 - ref).max() <= 1e-9

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from explorer.shading import kernels as K
-from explorer.shading.equation import reference_shade
+from explorer.shading.equation import equation_shade
 
 
 @pytest.mark.parametrize("y", [1e-6, 0.5, 1.0, 12.8, 76.8, 128.0, 1000.0, 1e4])
@@ -51,7 +51,7 @@ def test_every_block_of_every_task_is_shaded():
         "viewer": {"eye": [0, 0, 6]},
         "lights": [{"type": "point", "position": [2, 3, 1], "attenuation": [1, 0.1, 0.01]}],
     }
-    ref = reference_shade(explorer.load_scene(scene), P, N)
+    ref = equation_shade(explorer.load_scene(scene), P, N)
     for precision in ("float32", "float64"):
         got = explorer.shade(scene, P, N, precision=precision)
         assert np.abs(got - ref).max() <= 1 / 255

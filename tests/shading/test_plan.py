@@ -13,7 +13,7 @@ from explorer.cli import main
 from explorer.core import tolerances as tol
 from explorer.core.scene import load_scene
 from explorer.shading import kernels as K
-from explorer.shading.equation import reference_shade
+from explorer.shading.equation import equation_shade
 from explorer.shading.plan import make_plan
 
 
@@ -21,7 +21,7 @@ from explorer.shading.plan import make_plan
 def test_planned_result_equals_full_generality_result(scene, seed):
     P, N = vertices(seed)
     loaded = load_scene(scene)
-    full = reference_shade(loaded, P, N, clamp=False)
+    full = equation_shade(loaded, P, N, clamp=False)
     planned = explorer.shade(loaded, P, N, clamp=False)
     assert np.abs(planned - full).max(initial=0) <= tol.PLAN_ABS_TOL
     fast = explorer.shade(loaded, P, N, precision="float32")
