@@ -49,13 +49,13 @@ PRECISIONS = ("float64", "float32")
 CULL_MIN_SHARE = 8
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
+#: (:func:`invalidated`)
 UPDATES = (
     (lambda s: s.lights, "lights"),
     (lambda s: s.two_sided, "lights"),
     (lambda s: s.viewer, "specular"),
     (lambda s: s.model, "specular"),
     (lambda s: s.material.shininess, "lobe"),
-    *((e.setting, e.invalidates) for e in EFFECTS),
 )
 
 
@@ -193,7 +193,7 @@ class Shader:
             return
         self._scene = new
         self._plan = self._make_plan(new)
-        changed = {level for setting, level in UPDATES if setting(new) != setting(old)}
+        changed = invalidated(new, old)
         if "lights" in changed:
             self._lights_changed()
             return
@@ -480,6 +480,13 @@ class Shader:
                     self._base = base if not flat else None
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
+
+
+def invalidated(new: Scene, old: Scene) -> set[str]:
+    """The cached work (:data:`explorer.shading.effects.LEVELS`) that the differences between
+    two scenes invalidate: :data:`UPDATES` and each effect's setting."""
+    updates = UPDATES + tuple((e.setting, e.invalidates) for e in EFFECTS)
+    return {level for setting, level in updates if setting(new) != setting(old)}
 
 
 def ambient_constant(scene: Scene, plan: Plan) -> np.ndarray:
