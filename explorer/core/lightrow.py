@@ -1,8 +1,9 @@
 """The kernel's row of light parameters: one row of :data:`N_PARAMS` floats and one int32 of
 flag bits per light, in the normalised frame (:mod:`explorer.geometry.frame`).
 
-Plain constants, so that a light (:mod:`explorer.core.lights`) packs its own slots without
-importing the compiled kernels (:mod:`explorer.shading.kernels`), which read the same slots.
+Plain constants, so that a light (:mod:`explorer.core.lights`) and an effect
+(:mod:`explorer.shading.effects`) pack their own slots without importing the compiled kernels
+(:mod:`explorer.shading.kernels`), which read the same slots.
 """
 
 # per-light flag bits (int32)

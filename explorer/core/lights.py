@@ -276,16 +276,17 @@ class Light:
         *,
         halfway_view=None,
         specular_scale: float = 1.0,
-        fresnel: float | None = None,
     ) -> tuple[list[float], int]:
         """The light's row of :data:`~explorer.core.lightrow.N_PARAMS` floats and its flag
         bits for the compiled kernel, in the normalised frame ``centre`` (3,), ``scale``.
 
         plan : this light's row of the plan (:class:`explorer.shading.plan.LightPlan`: which
-            terms, attenuation, spot, factor, shadows)
+            terms, attenuation, spot, factor)
         halfway_view : the constant unit V when a constant Blinn halfway vector may be used
             (infinite viewer), else None
-        specular_scale, fresnel : the scene's energy-conserving factor and Schlick F0 (or None)
+        specular_scale : a constant the effects fold into the specular colour (energy
+            conservation); the effects' own slots and flags are theirs to add
+            (:meth:`explorer.shading.effects.base.Effect.pack`)
         Built in Python floats (a light drag rebuilds rows every frame: small numpy operations
         per light cost more than the row)."""
         row = [0.0] * R.N_PARAMS
@@ -296,11 +297,6 @@ class Light:
         row[R.P_AMB : R.P_AMB + 3] = [fa * v for v in self.ambient]
         row[R.P_DIF : R.P_DIF + 3] = dif
         row[R.P_SPEC : R.P_SPEC + 3] = spec
-        if plan.shadows:
-            f |= R.SHADOW
-        if fresnel is not None and plan.specular:
-            f |= R.FRESNEL
-            row[R.P_F0] = fresnel
         if plan.ambient and plan.varying_weight:
             f |= R.AMBIENT
         if plan.diffuse:

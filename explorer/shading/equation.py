@@ -10,10 +10,11 @@ leaves undefined.
                                + vis_i · ( max(N·L_i, 0)·d_m·d_i
                                            + f_i·F_i·E·max(N·H_i, 0)^n · s_m·s_i ) )
 
-with the effects of :mod:`explorer.shading.effects` and :mod:`explorer.shading.shadows`: ``vis_i``
-the shadow visibility (1 without ``shadows: true`` or without faces; rays from every vertex, even on
-a convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and ``E`` the
-energy-conserving normalisation (1 without ``energy_conserving``).
+with the per-vertex weights of the effects (:mod:`explorer.shading.effects`, each
+:meth:`~explorer.shading.effects.base.Effect.weights`, multiplied in the order of ``EFFECTS``):
+``vis_i`` the shadow visibility (1 without ``shadows: true`` or without faces; rays from every
+vertex, even on a convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and
+``E`` the energy-conserving normalisation (1 without ``energy_conserving``).
 """
 
 from __future__ import annotations
@@ -24,8 +25,7 @@ from explorer.core import tolerances as tol
 from explorer.core.lights import unit_rows
 from explorer.core.scene import Scene
 from explorer.geometry.frame import check_vertices, frame_of, to_frame
-from explorer.shading.effects import schlick, specular_scale
-from explorer.shading.shadows import visibility
+from explorer.shading.effects import EFFECTS, Incident
 
 
 def equation_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
@@ -59,17 +59,12 @@ def equation_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np
         N = np.where((np.einsum("ij,ij->i", N, V) < 0.0)[:, None], -N, N)
 
     shininess = scene.material.shininess
-    f0 = scene.material.fresnel
-    escale = specular_scale(scene)
     ambient = np.tile(np.asarray(scene.ambient, dtype=np.float64), (n, 1))
     diffuse = np.zeros((n, 3))
     specular = np.zeros((n, 3))
     for light in scene.lights:
         L, _, w = light.incident(P, N, centre, scale)  # what arrives and from where
-        vis = np.ones(n)
-        if light.shadows and faces is not None:
-            vis = visibility(world, faces, light)
-        fres = np.ones(n) if f0 is None else schlick(f0, np.einsum("ij,ij->i", V, L))
+        dif_w, spec_w = _effect_weights(scene, light, Incident(world, faces, L, V), w)
 
         ndl = np.einsum("ij,ij->i", N, L)
         lit = ndl > 0.0  # f_i: specular only where N·L > 0
@@ -84,10 +79,22 @@ def equation_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np
         lobe = np.maximum(base, 0.0) ** shininess  # numpy: 0.0 ** 0.0 == 1.0
 
         ambient += w[:, None] * np.asarray(light.ambient)  # a_i (attenuated)
-        diffuse += (w * vis * np.maximum(ndl, 0.0))[:, None] * np.asarray(light.diffuse)  # d_i
-        spec_w = w * vis * lit * fres * escale
-        specular += (spec_w * lobe)[:, None] * np.asarray(light.specular)  # s_i
+        diffuse += (dif_w * np.maximum(ndl, 0.0))[:, None] * np.asarray(light.diffuse)  # d_i
+        specular += (spec_w * lit * lobe)[:, None] * np.asarray(light.specular)  # s_i
     return {"ambient": ambient, "diffuse": diffuse, "specular": specular}
+
+
+def _effect_weights(scene: Scene, light, at: Incident, w: np.ndarray):
+    """The light's weights on its diffuse and specular terms: ``w`` (n,) times each effect's
+    weight, in the order of ``EFFECTS``. Returns two (n,) float64."""
+    dif_w, spec_w = w, w
+    for e in EFFECTS:
+        d, s = e.weights(scene, light, at)
+        if d is not None:
+            dif_w = dif_w * d
+        if s is not None:
+            spec_w = spec_w * s
+    return dif_w, spec_w
 
 
 def equation_shade(

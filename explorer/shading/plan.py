@@ -6,6 +6,9 @@ the reason for each decision. The kernels (:mod:`explorer.shading.kernels`) foll
 test suite checks that the planned result equals the full equation (:mod:`.equation`) on random
 scenes.
 
+The effects (:mod:`explorer.shading.effects`) plan themselves: each adds its rows and a value
+the kernels and the shader read back (:meth:`Plan.effect`, :meth:`LightPlan.effect`).
+
 Light-level decisions depend on the light only (its colours, and what its class says it needs:
 :meth:`explorer.core.lights.Light.work`: distance, attenuation, cone); the
 term-level decisions (is there any ambient, diffuse, specular at all?) depend on the material
@@ -17,9 +20,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-from explorer.core.hdr import energy_warnings
 from explorer.core.scene import Scene
-from explorer.shading.effects import specular_scale
+from explorer.shading.effects import EFFECTS, LightTerms, Terms
 from explorer.shading.kernels import CHUNK
 
 
@@ -36,9 +38,9 @@ class LightPlan:
     attenuation : "none" | "constant" (folded into the colours) | "per-vertex"
     spot : "none" | "cone" | "cone+exponent"
     factor : constant attenuation 1/kc folded into the light's colours
-    shadows : shadow rays are cast for this light (``shadows: true``, faces given, the mesh
-        can shadow itself, the light has diffuse or specular)
     reasons : (item, "in"|"out", why) rows for people
+    effects : (name, value) of each effect planned per light
+        (:meth:`explorer.shading.effects.base.Effect.plan_light`)
     """
 
     index: int
@@ -51,12 +53,21 @@ class LightPlan:
     spot: str
     factor: float
     reasons: tuple = ()
-    shadows: bool = False
+    effects: tuple = ()
 
     @property
     def varying_weight(self) -> bool:
         """att·spot differs between vertices."""
         return self.attenuation == "per-vertex" or self.spot != "none"
+
+    def effect(self, name: str):
+        """The value the effect ``name`` planned for this light (None when it plans none)."""
+        return dict(self.effects).get(name)
+
+    @property
+    def shadows(self) -> bool:
+        """Shadow rays are cast for this light (the shadow effect's value)."""
+        return bool(self.effect("shadows"))
 
 
 @dataclass(frozen=True)
@@ -71,10 +82,9 @@ class Plan:
     two_sided : flip N where N·V < 0
     lights : one LightPlan per scene light, in scene order
     reasons : (item, "in"|"out", why) rows for the scene-level decisions
-    fresnel : Schlick's F0 weighting the specular term, or None
-    specular_scale : energy-conserving lobe normalisation folded into the specular colours
-        (1 when off)
-    hdr : colours are displayed unclamped with exposure and a tone map
+    effects : (name, value) of each effect (:meth:`explorer.shading.effects.base.Effect.plan`):
+        Schlick's F0 or None, the energy-conserving factor folded into the specular colours (1
+        when off), whether colours are displayed unclamped (HDR)
     cull : a run of vertices that provably gets nothing from a light (all facing away from
         it, or outside its cone) skips that light; the mesh decides which (one-sided only)
     force_all : nothing is skipped (benchmark only; same colours)
@@ -92,11 +102,13 @@ class Plan:
     model: str
     lights: tuple[LightPlan, ...] = ()
     reasons: tuple = field(default=())
-    fresnel: float | None = None
-    specular_scale: float = 1.0
-    hdr: bool = False
+    effects: tuple = ()
     force_all: bool = False
     cull: bool = False
+
+    def effect(self, name: str):
+        """The value the effect ``name`` planned for the scene (None when it plans none)."""
+        return dict(self.effects).get(name)
 
     @property
     def shadows(self) -> bool:
@@ -148,7 +160,7 @@ def _forced(plan: Plan, scene: Scene, mesh) -> Plan:
                 specular=True,
                 attenuation=att,
                 factor=1.0,
-                shadows=lt.shadows and mesh is not None,
+                effects=tuple((e.name, e.forced_light(lt, mesh)) for e in EFFECTS),
                 reasons=lp.reasons + (("forced", "in", "force_all: nothing skipped"),),
             )
         )
@@ -180,7 +192,9 @@ class _Reasons(list):
 def _make_plan(scene: Scene, mesh) -> Plan:
     m = scene.material
     r = _Reasons()
-    emission, ambient, diffuse, specular = _terms(scene, r)
+    terms = Terms(*_terms(scene, r))
+    emission, ambient, diffuse, specular = terms
+    effects = [(e, *e.plan(scene, terms)) for e in EFFECTS]  # (effect, value, rows)
     flat = specular and m.shininess == 0.0
     if specular:
         r.why(
@@ -190,7 +204,7 @@ def _make_plan(scene: Scene, mesh) -> Plan:
             if flat
             else f"pow(base, {m.shininess:g}) per vertex",
         )
-    view = _view(scene, specular, flat, r)
+    view = _view(scene, specular, flat, any(e.needs_view(v) for e, v, _ in effects), r)
     r.why(
         "two-sided",
         scene.two_sided,
@@ -204,11 +218,10 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
         "spot's cone) skip it: how many, the mesh decides",
     )
-    fresnel, scale = _effects(scene, specular, r)
+    for _, _, rows in effects:
+        r.extend(rows)
 
-    lplans = tuple(
-        _light_plan(i, lt, scene, mesh, diffuse, specular) for i, lt in enumerate(scene.lights)
-    )
+    lplans = tuple(_light_plan(i, lt, scene, mesh, terms) for i, lt in enumerate(scene.lights))
     halfway = "none"
     if specular and not flat:
         if scene.model == "phong":
@@ -230,9 +243,7 @@ def _make_plan(scene: Scene, mesh) -> Plan:
         model=scene.model,
         lights=lplans,
         reasons=tuple(r),
-        fresnel=fresnel,
-        specular_scale=scale if specular else 1.0,
-        hdr=scene.hdr is not None,
+        effects=tuple((e.name, v) for e, v, _ in effects),
         cull=cull,
     )
 
@@ -273,10 +284,10 @@ def _terms(scene: Scene, r: _Reasons) -> tuple[bool, bool, bool, bool]:
     return emission, ambient, diffuse, specular
 
 
-def _view(scene: Scene, specular: bool, flat: bool, r: _Reasons) -> str:
-    """How the view vector V is found: "none", "constant" or "per-vertex"."""
-    m = scene.material
-    if not ((specular and (not flat or m.fresnel is not None)) or scene.two_sided):
+def _view(scene: Scene, specular: bool, flat: bool, effect_view: bool, r: _Reasons) -> str:
+    """How the view vector V is found: "none", "constant" or "per-vertex".
+    effect_view : an effect reads V even for a flat lobe (Fresnel)"""
+    if not ((specular and not flat) or effect_view or scene.two_sided):
         r.why("view vector", False, "no lobe, no Fresnel and one-sided: V is never used")
         return "none"
     if scene.viewer.local:
@@ -286,42 +297,10 @@ def _view(scene: Scene, specular: bool, flat: bool, r: _Reasons) -> str:
     return "constant"
 
 
-def _effects(scene: Scene, specular: bool, r: _Reasons) -> tuple[float | None, float]:
-    """Fresnel, energy conservation and HDR: returns (F0 or None, the specular scale)."""
-    m = scene.material
-    fresnel = m.fresnel if specular else None
-    if m.fresnel is None:
-        r.why("fresnel", False, "material fresnel not set")
-    elif not specular:
-        r.why("fresnel", False, f"F0 = {m.fresnel:g} but there is no specular term to weight")
-    else:
-        r.why("fresnel", True, f"Schlick F0 = {m.fresnel:g}: specular × F0 + (1-F0)(1-V·H)^5")
-
-    scale = specular_scale(scene)
-    if not m.energy_conserving:
-        r.why("energy", False, "material energy_conserving is false")
-    elif not specular:
-        r.why("energy", False, "energy_conserving, but there is no specular term to normalise")
-    else:
-        form = "(n+2)/(2π)" if scene.model == "phong" else "(n+8)/(8π)"
-        r.why("energy", True, f"energy_conserving: {form} = {scale:.4g} folded into s_i")
-    if scene.hdr is None:
-        r.why("hdr", False, "no hdr: colours clamped to [0, 1] (OpenGL)")
-    else:
-        r.why(
-            "hdr",
-            True,
-            f"unclamped, exposure {scene.hdr.exposure:g} stops, {scene.hdr.tone_map} tone "
-            "map, sRGB",
-        )
-        for w in energy_warnings(m):
-            r.why("kd + ks", False, "warning: " + w)
-    return fresnel, scale
-
-
-def _light_plan(i: int, lt, scene: Scene, mesh, diffuse: bool, specular: bool) -> LightPlan:
-    """The light's own decisions (:meth:`explorer.core.lights.Light.work`) and what the
-    material, model, viewer and mesh make of its terms."""
+def _light_plan(i: int, lt, scene: Scene, mesh, terms: Terms) -> LightPlan:
+    """The light's own decisions (:meth:`explorer.core.lights.Light.work`), what the
+    material, model, viewer make of its terms, and what the effects plan for it (the mesh:
+    None, "convex" or "concave")."""
     m = scene.material
     work = lt.work()
     r = _Reasons(work.reasons)
@@ -360,19 +339,12 @@ def _light_plan(i: int, lt, scene: Scene, mesh, diffuse: bool, specular: bool) -
         r.why("specular", True, "Blinn: constant H (directional light, infinite viewer), N·H")
     else:
         r.why("specular", True, "Blinn: H = normalize(L + V) per vertex")
-    shadows = False
-    if not lt.shadows:
-        r.why("shadows", False, "shadows is false")
-    elif mesh is None:
-        r.why("shadows", False, "no mesh faces given: nothing can cast a shadow")
-    elif mesh == "convex":
-        r.why("shadows", False, "convex mesh: it cannot shadow itself")
-    elif not ((dif and diffuse) or (spec and specular)):
-        r.why("shadows", False, "no diffuse or specular from this light to shadow")
-    else:
-        shadows = r.why(
-            "shadows", True, "rays toward the light from vertices with N·L > 0 (others: none)"
-        )
+    own = LightTerms(amb, dif, spec)
+    effects = []
+    for e in EFFECTS:
+        value, rows = e.plan_light(lt, mesh, terms, own)
+        effects.append((e.name, value))
+        r.extend(rows)
     if not (amb or dif or spec):
         r.why("light", False, "all colours 0: skipped entirely")
     return LightPlan(
@@ -386,5 +358,5 @@ def _light_plan(i: int, lt, scene: Scene, mesh, diffuse: bool, specular: bool) -
         work.spot,
         work.factor,
         tuple(r),
-        shadows,
+        tuple(effects),
     )

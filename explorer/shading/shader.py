@@ -11,8 +11,9 @@ shininess              the lobe only: ``Σ ws·base^n·s`` from stored per-light
                        distances, no normalisations), then compose
 viewer                 the specular sum (and, when two-sided, everything: N·V flips normals)
 model (phong/blinn)    the specular sum
-fresnel (F0)           the specular sum (F is stored in each light's lobe weight)
-energy_conserving      the lobe only, as for a shininess change (a constant per scene)
+an effect's setting    what the effect declares (``Effect.invalidates``): the specular sum for
+                       Fresnel's F0 (F is stored in each light's lobe weight), the lobe only
+                       for energy_conserving (a constant per scene)
 lights                 every sum the material needs (shadow visibility is kept per light
                        position and direction: only a moved light casts new rays)
 geometry               every sum the material needs, and new shadow rays
@@ -38,6 +39,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.geometry.frame import check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
+from explorer.shading.effects import EFFECTS
 from explorer.shading.plan import Plan, make_plan
 from explorer.shading.shadows import is_convex, visibility_rows
 
@@ -45,6 +47,16 @@ PRECISIONS = ("float64", "float32")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
+#: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
+#: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
+#: (:func:`invalidated`)
+UPDATES = (
+    (lambda s: s.lights, "lights"),
+    (lambda s: s.two_sided, "lights"),
+    (lambda s: s.viewer, "specular"),
+    (lambda s: s.model, "specular"),
+    (lambda s: s.material.shininess, "lobe"),
+)
 
 
 def shade(
@@ -181,13 +193,13 @@ class Shader:
             return
         self._scene = new
         self._plan = self._make_plan(new)
-        if new.lights != old.lights or new.two_sided != old.two_sided:
+        changed = invalidated(new, old)
+        if "lights" in changed:
             self._lights_changed()
             return
-        nm, om = new.material, old.material
-        if new.viewer != old.viewer or new.model != old.model or nm.fresnel != om.fresnel:
+        if "specular" in changed:
             self._viewer_changed()
-        if nm.shininess != om.shininess or nm.energy_conserving != om.energy_conserving:
+        if "lobe" in changed:
             self._shininess_changed()
         self._colors = None  # material colours and scene ambient: compose only
         self._aconst = ambient_constant(self._scene, self._plan)
@@ -270,7 +282,7 @@ class Shader:
         """What the plan knows of the mesh: None (no faces), "convex" or "concave"."""
         if self._faces is None:
             return None
-        if not any(lt.shadows for lt in scene.lights):
+        if not any(e.needs_mesh(scene) for e in EFFECTS):
             return "concave"  # not asked: no need to decide
         if self._convex is None:
             self._convex = is_convex(self._P, self._faces)
@@ -470,6 +482,13 @@ class Shader:
                 self._spec_shininess = scene.material.shininess
 
 
+def invalidated(new: Scene, old: Scene) -> set[str]:
+    """The cached work (:data:`explorer.shading.effects.LEVELS`) that the differences between
+    two scenes invalidate: :data:`UPDATES` and each effect's setting."""
+    updates = UPDATES + tuple((e.setting, e.invalidates) for e in EFFECTS)
+    return {level for setting, level in updates if setting(new) != setting(old)}
+
+
 def ambient_constant(scene: Scene, plan: Plan) -> np.ndarray:
     """Scene ambient plus the ambient of lights whose weight is constant, (3,) float64."""
     a = np.asarray(scene.ambient, dtype=np.float64).copy()
@@ -482,24 +501,25 @@ def ambient_constant(scene: Scene, plan: Plan) -> np.ndarray:
 def light_params(scene: Scene, plan: Plan, centre, scale) -> tuple:
     """Kernel inputs for the lights and viewer in the normalised frame ``centre`` (3,),
     ``scale``, float64: params (L, N_PARAMS) and flags (L,) int32, one row per light (each light
-    packs its own: :meth:`explorer.core.lights.Light.kernel_row`), and the view (3,): the eye,
-    or V for an infinite viewer."""
+    packs its own: :meth:`explorer.core.lights.Light.kernel_row`, then each effect adds its
+    slots and flags), and the view (3,): the eye, or V for an infinite viewer."""
     if scene.viewer.local:
         view = to_frame(scene.viewer.eye, centre, scale)
     else:
         view = np.asarray(scene.viewer.to_viewer, dtype=np.float64)
     constant_h = scene.model == "blinn" and not scene.viewer.local and not plan.force_all
     halfway_view = tuple(float(v) for v in view) if constant_h else None
+    values = [plan.effect(e.name) for e in EFFECTS]
+    specular_scale = 1.0
+    for e, v in zip(EFFECTS, values, strict=True):
+        specular_scale *= e.specular_factor(v)
     rows, flags = [], []
     for lp, light in zip(plan.lights, scene.lights, strict=True):
         row, f = light.kernel_row(
-            lp,
-            centre,
-            scale,
-            halfway_view=halfway_view,
-            specular_scale=plan.specular_scale,
-            fresnel=plan.fresnel,
+            lp, centre, scale, halfway_view=halfway_view, specular_scale=specular_scale
         )
+        for e, v in zip(EFFECTS, values, strict=True):
+            f = e.pack(v, lp.effect(e.name), lp, row, f)
         rows.append(row)
         flags.append(f)
     params = np.array(rows, dtype=np.float64).reshape(len(rows), R.N_PARAMS)
@@ -509,7 +529,8 @@ def light_params(scene: Scene, plan: Plan, centre, scale) -> tuple:
 def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.ndarray:
     """(N_OPTS,) int64 options of a shading pass that follow from the scene and plan: viewer,
     sidedness, model, flat lobe, the sums ``do`` = (ambient, diffuse, specular) recomputed,
-    ambiguity tracking (float32) and V rows for Fresnel; storing and clamping are the caller's."""
+    ambiguity tracking (float32) and V rows for an effect that reads V (Fresnel); storing and
+    clamping are the caller's."""
     opts = np.zeros(K.N_OPTS, np.int64)
     opts[K.O_LOCAL] = scene.viewer.local
     opts[K.O_TWO_SIDED] = scene.two_sided
@@ -518,7 +539,7 @@ def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.n
     opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do
     opts[K.O_COMPOSE] = 1
     opts[K.O_TRACK] = dtype is np.float32
-    opts[K.O_VIEW] = plan.fresnel is not None
+    opts[K.O_VIEW] = any(e.needs_view(plan.effect(e.name)) for e in EFFECTS)
     return opts
 
 

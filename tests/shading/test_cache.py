@@ -7,6 +7,7 @@ import pytest
 
 import explorer
 from explorer.core import tolerances as tol
+from explorer.core.hdr import HDR
 from explorer.core.lights import DirectionalLight, PointLight
 from explorer.core.scene import Viewer, load_scene
 
@@ -130,6 +131,30 @@ def test_viewer_change_recomputes_specular_not_diffuse(shader):
     _ = shader.colors
     assert delta(before, counts(shader)) == {"pass": 2, "specular": 2}
     check(shader)
+
+
+def test_effect_settings_cost_what_their_effect_declares(shader):
+    # Fresnel's F is stored in each light's lobe weight: a new F0 recomputes the specular sum;
+    # the energy-conserving factor is a constant: it only re-runs the lobe, as shininess does
+    _ = shader.colors
+    shader.set_material(shader.scene.material.replace(shininess=5.0))  # lobes stored from now
+    _ = shader.colors
+    before = counts(shader)
+    shader.set_material(shader.scene.material.replace(energy_conserving=True))
+    _ = shader.colors
+    check(shader)
+    assert delta(before, counts(shader)) == {"lobe": 1, "compose": 1}
+    before = counts(shader)
+    for f0 in (0.04, 0.5, None):
+        shader.set_material(shader.scene.material.replace(fresnel=f0))
+        _ = shader.colors
+        check(shader)
+    assert delta(before, counts(shader)) == {"pass": 3, "specular": 3}
+    before = counts(shader)
+    shader.set_scene(shader.scene.replace(hdr=HDR()))  # a display effect: compose only
+    _ = shader.colors
+    check(shader)
+    assert delta(before, counts(shader)) == {"compose": 1}
 
 
 def test_two_sided_viewer_change_recomputes_everything(shader):

@@ -24,17 +24,9 @@ from explorer.core.scene import load_scene
 from explorer.geometry import meshes as M
 from explorer.geometry.meshes import Mesh
 from explorer.render.images import read_png
-from explorer.shading.display import (
-    display,
-    display_colors,
-    engine_clamps,
-    expose,
-    srgb_decode,
-    srgb_encode,
-    tone_map,
-    vertex_colors,
-)
-from explorer.shading.effects import energy_factor, schlick
+from explorer.shading.display import display, display_colors, engine_clamps, vertex_colors
+from explorer.shading.effects import EFFECTS, LEVELS, Effect, energy_factor, schlick
+from explorer.shading.effects.hdr import expose, srgb_decode, srgb_encode, tone_map
 from explorer.shading.equation import equation_shade
 from explorer.shading.plan import make_plan
 
@@ -543,3 +535,56 @@ def test_display_without_hdr_is_the_engines_clamped_colours():
     assert not engine_clamps(hdr)
     raw = explorer.shade(hdr, mesh.positions, mesh.normals, clamp=False)
     assert np.array_equal(display_colors(hdr, mesh.positions, mesh.normals), display(raw, hdr.hdr))
+
+
+# -- the effect interface --------------------------------------------------------------------
+
+
+def test_effects_have_one_name_each_and_declare_a_known_cost():
+    names = [e.name for e in EFFECTS]
+    assert len(set(names)) == len(names)
+    assert all(e.invalidates in LEVELS for e in EFFECTS)
+    plan = make_plan(load_scene({}))
+    assert [n for n, _ in plan.effects] == names  # every effect planned, in registry order
+
+
+class _Doubled(Effect):
+    """A toy effect: twice the specular, folded into the kernel rows, its own plan row."""
+
+    name = "doubled"
+    invalidates = "specular"
+
+    def plan(self, scene, terms):
+        return (2.0 if terms.specular else 1.0), [(self.name, "in", "toy: specular × 2")]
+
+    def specular_factor(self, value):
+        return value
+
+    def weights(self, scene, light, at):
+        return None, 2.0
+
+
+def test_a_new_effect_needs_no_change_in_plan_shader_or_equation(monkeypatch):
+    from explorer.shading import display, equation, plan, shader
+
+    scene = load_scene(
+        {
+            "material": {"diffuse": [0.3, 0.3, 0.3], "specular": [0.4, 0.5, 0.6],
+                         "shininess": 12, "fresnel": 0.2},
+            "lights": [{"type": "point", "position": [1, 2, 3]}],
+        }
+    )  # fmt: skip
+    mesh = M.sphere(12)
+    P, N = mesh.positions, mesh.normals
+    without = explorer.shade(scene, P, N, clamp=False)
+    for module in (plan, shader, equation, display):
+        monkeypatch.setattr(module, "EFFECTS", (*EFFECTS, _Doubled()))
+    assert "doubled" in make_plan(scene).describe()
+    got = explorer.shade(scene, P, N, clamp=False)
+    full = equation_shade(scene, P, N, clamp=False)
+    assert np.abs(got - full).max() <= tol.PLAN_ABS_TOL * max(1.0, float(full.max()))
+    spec = explorer.Shader(scene, P, N, precision="float64", clamp=False).terms["specular"]
+    diffuse_only = scene.replace(material=scene.material.replace(specular=(0.0, 0.0, 0.0)))
+    base = explorer.shade(diffuse_only, P, N, clamp=False)
+    s_m = np.asarray(scene.material.specular)
+    assert np.allclose(got - base, 2 * (without - base)) and np.allclose(got - base, s_m * spec)
