@@ -89,12 +89,8 @@ def _coefficients(checker: Checker, value, path, hi: float = math.inf):
     return checker.rgb(value, path, 0.0, hi)
 
 
-def _coefficient(checker: Checker, value, path, hi: float = math.inf):
-    """One reflection coefficient (ka, kd, ks) in [0, hi]."""
-    return checker.number(value, path, 0.0, hi)
-
-
-def _shininess(checker: Checker, value, path, hi: float = math.inf):
+def _scalar(checker: Checker, value, path, hi: float = math.inf):
+    """One number in [0, hi]: a reflection coefficient (ka, kd, ks) or the shininess."""
     return checker.number(value, path, 0.0, hi)
 
 
@@ -149,7 +145,7 @@ class Material:
     #: file's problems are listed
     KEYS: ClassVar[dict[str, Check]] = {
         **dict.fromkeys(RGB_KEYS, _coefficients),
-        "shininess": _shininess,
+        "shininess": _scalar,
         "opacity": _opacity,
         "model": _model,
         "description": _text,
@@ -226,8 +222,8 @@ class Material:
 FILE_CHECKS: dict[str, Check] = {
     **Material.KEYS,
     **{key: partial(_coefficients, hi=COEFFICIENT_RANGE[1]) for key in RGB_KEYS},
-    "shininess": partial(_shininess, hi=SHININESS_RANGE[1]),
-    **{key: partial(_coefficient, hi=COEFFICIENT_RANGE[1]) for key in TERM_SCALARS.values()},
+    "shininess": partial(_scalar, hi=SHININESS_RANGE[1]),
+    **{key: partial(_scalar, hi=COEFFICIENT_RANGE[1]) for key in TERM_SCALARS.values()},
     "color": partial(_coefficients, hi=COEFFICIENT_RANGE[1]),
     "specular_color": partial(_coefficients, hi=COEFFICIENT_RANGE[1]),
 }

@@ -16,6 +16,12 @@ The scene-file schema (every key optional)::
 
 Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
 light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
+
+Each key is checked by one function (:attr:`Scene.KEYS`, :attr:`Viewer.KEYS`; see
+:mod:`explorer.core.validate`), run by :func:`load_scene` on a file and by the constructor, with
+the same messages. The file's own forms stay in :func:`load_scene`: a material given by preset
+name, the model taken from the material when the file gives none, a mesh path relative to the
+file.
 """
 
 from __future__ import annotations
