@@ -79,10 +79,9 @@ class Viewer:
     ONE_OF: ClassVar[str] = "needs exactly one of eye (local viewer) or to_viewer (infinite)"
 
     def __post_init__(self):
+        given = {k: getattr(self, k) for k in self.KEYS if getattr(self, k) is not None}
         checker = Checker(None)
-        _one_viewer(
-            checker, {k: getattr(self, k) for k in self.KEYS if getattr(self, k) is not None}, ()
-        )
+        _one_viewer(checker, given, ())
         checker.raise_if_any()
         checked(self, self.KEYS)
         if self.to_viewer is not None:
