@@ -250,8 +250,8 @@ def build_scene(args, *, default_light=None):
                 exposure=old.exposure if args.exposure is None else args.exposure,
                 tone_map=old.tone_map if args.tone_map is None else args.tone_map,
             )
-        except ValueError as exc:
-            raise ExplorerError(f"--exposure: {exc}") from None
+        except ValidationError as exc:
+            raise ValidationError([as_flag(p, "--") for p in exc.problems]) from None
     scene = scene.replace(**changes)
     spec = args.mesh if args.mesh is not None else scene.mesh
     if spec is None:

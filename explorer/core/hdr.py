@@ -8,13 +8,22 @@ exceeds 1.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+from typing import ClassVar
+
+from explorer.core.validate import Check, Checker, check_fields, checked
 
 TONE_MAPS = ("clamp", "reinhard", "aces")
 #: accepted exposure, in stops
 EXPOSURE_RANGE = (-16.0, 16.0)
-HDR_KEYS = ("exposure", "tone_map")
+
+
+def _exposure(checker: Checker, value, path):
+    return checker.number(value, path, *EXPOSURE_RANGE)
+
+
+def _tone_map(checker: Checker, value, path):
+    return checker.choice(value, path, TONE_MAPS)
 
 
 @dataclass(frozen=True)
@@ -24,19 +33,20 @@ class HDR:
     exposure: float = 0.0
     tone_map: str = "reinhard"
 
+    #: key -> its check, run by :func:`parse_hdr` and by the constructor
+    KEYS: ClassVar[dict[str, Check]] = {"exposure": _exposure, "tone_map": _tone_map}
+
     def __post_init__(self):
-        e = float(self.exposure)
-        if not (math.isfinite(e) and EXPOSURE_RANGE[0] <= e <= EXPOSURE_RANGE[1]):
-            raise ValueError(f"hdr exposure must be in {list(EXPOSURE_RANGE)} stops, got {e}")
-        if self.tone_map not in TONE_MAPS:
-            raise ValueError(f"hdr tone_map must be one of {TONE_MAPS}, got {self.tone_map!r}")
-        object.__setattr__(self, "exposure", e)
+        checked(self, self.KEYS)
 
     def to_mapping(self) -> dict:
         return {"exposure": self.exposure, "tone_map": self.tone_map}
 
 
-def parse_hdr(value, checker, path=("hdr",)) -> HDR | None:
+HDR_KEYS = tuple(HDR.KEYS)
+
+
+def parse_hdr(value, checker: Checker, path=("hdr",)) -> HDR | None:
     """An :class:`HDR` from a scene's ``hdr`` mapping (``true`` means the defaults)."""
     if isinstance(value, HDR):
         return value
@@ -46,11 +56,7 @@ def parse_hdr(value, checker, path=("hdr",)) -> HDR | None:
     if m is None:
         return None
     checker.keys(m, path, HDR_KEYS)
-    kw = {}
-    if "exposure" in m:
-        kw["exposure"] = checker.number(m["exposure"], path + ("exposure",), *EXPOSURE_RANGE)
-    if "tone_map" in m:
-        kw["tone_map"] = checker.choice(m["tone_map"], path + ("tone_map",), TONE_MAPS)
+    kw = check_fields(HDR.KEYS, m, checker, path)
     if any(v is None for v in kw.values()):
         return None
     return HDR(**kw)

@@ -23,6 +23,11 @@ the lecture notes; a material may use either form per term, but not both for the
 RGB coefficients are kept: a material read in the scalar form is saved in the RGB form, with
 identical colours.
 
+Each key is checked by one function (:attr:`Material.KEYS`, see :mod:`explorer.core.validate`),
+run by :func:`parse_material` on a file and by the constructor, with the same messages. The
+ranges above are a file's; the engine (the constructor) takes any coefficient and shininess
+>= 0, and :data:`FILE_CHECKS` are the same checks with the file's bounds.
+
 Scalars of an RGB material (:meth:`Material.scalars`, :meth:`Material.with_scalars`, used by
 the ka / kd / ks sliders): the scalar of a term is its largest channel, ``k = max(r, g, b)``,
 and its hue is the term divided by ``k`` (largest channel exactly 1). Setting a scalar keeps
@@ -37,10 +42,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from numbers import Real
+from functools import partial
+from typing import ClassVar
 
-from explorer.core.errors import ExplorerError
-from explorer.core.validate import Checker
+from explorer.core.validate import Check, Checker, check_fields, check_values, checked
 
 RGB = tuple[float, float, float]
 
@@ -76,6 +81,39 @@ SCALAR_DEFAULTS = {"ka": 0.2, "kd": 0.8, "ks": 0.0}
 _WHITE = (1.0, 1.0, 1.0)
 
 
+# -- the checks of each key ------------------------------------------------------------------
+# A coefficient or shininess check takes its upper bound ``hi``: the engine takes any value
+# >= 0 (the constructor's default), a file holds COEFFICIENT_RANGE / SHININESS_RANGE.
+def _coefficients(checker: Checker, value, path, hi: float = math.inf):
+    """An RGB triple of reflection coefficients (ambient, color, ...), each in [0, hi]."""
+    return checker.rgb(value, path, 0.0, hi)
+
+
+def _scalar(checker: Checker, value, path, hi: float = math.inf):
+    """One number in [0, hi]: a reflection coefficient (ka, kd, ks) or the shininess."""
+    return checker.number(value, path, 0.0, hi)
+
+
+def _opacity(checker: Checker, value, path):
+    return checker.number(value, path, *OPACITY_RANGE)
+
+
+def _model(checker: Checker, value, path):
+    return checker.choice(value, path, MODELS)
+
+
+def _text(checker: Checker, value, path):
+    return checker.string(value, path)
+
+
+def _fresnel(checker: Checker, value, path):
+    return checker.number(value, path, *FRESNEL_RANGE)
+
+
+def _flag(checker: Checker, value, path):
+    return checker.boolean(value, path)
+
+
 @dataclass(frozen=True)
 class Material:
     """Surface coefficients.
@@ -103,29 +141,20 @@ class Material:
     fresnel: float | None = None
     energy_conserving: bool = False
 
+    #: key -> its check (the engine's range: coefficients and shininess >= 0), in the order a
+    #: file's problems are listed
+    KEYS: ClassVar[dict[str, Check]] = {
+        **dict.fromkeys(RGB_KEYS, _coefficients),
+        "shininess": _scalar,
+        "opacity": _opacity,
+        "model": _model,
+        "description": _text,
+        "fresnel": _fresnel,
+        "energy_conserving": _flag,
+    }
+
     def __post_init__(self):
-        for key in RGB_KEYS:
-            value = tuple(float(c) for c in getattr(self, key))
-            if len(value) != 3 or not all(math.isfinite(c) and c >= 0.0 for c in value):
-                raise ValueError(f"material {key} must be 3 finite numbers >= 0, got {value}")
-            object.__setattr__(self, key, value)
-        s = float(self.shininess)
-        if not (math.isfinite(s) and s >= 0.0):
-            raise ValueError(f"material shininess must be finite and >= 0, got {s}")
-        object.__setattr__(self, "shininess", s)
-        o = float(self.opacity)
-        if not (0.0 <= o <= 1.0):
-            raise ValueError(f"material opacity must be in [0, 1], got {o}")
-        object.__setattr__(self, "opacity", o)
-        if self.model is not None and self.model not in MODELS:
-            raise ValueError(f"material model must be one of {MODELS}, got {self.model!r}")
-        object.__setattr__(self, "description", str(self.description or ""))
-        if self.fresnel is not None:
-            f = float(self.fresnel)
-            if not (FRESNEL_RANGE[0] <= f <= FRESNEL_RANGE[1]):
-                raise ValueError(f"material fresnel (F0) must be in [0, 1], got {f}")
-            object.__setattr__(self, "fresnel", f)
-        object.__setattr__(self, "energy_conserving", bool(self.energy_conserving))
+        checked(self, self.KEYS)
 
     def replace(self, **changes) -> Material:
         """A copy with some fields changed (``m.replace(shininess=64)``)."""
@@ -178,17 +207,26 @@ class Material:
 
         Each given value must be in [0, 1]; ``None`` leaves that term unchanged.
         """
+        given = {key: k for key, k in (("ka", ka), ("kd", kd), ("ks", ks)) if k is not None}
+        values = check_values({key: FILE_CHECKS[key] for key in given}, given)
         changes = {}
-        for term, key, k in (("ambient", "ka", ka), ("diffuse", "kd", kd), ("specular", "ks", ks)):
-            if k is None:
-                continue
-            if isinstance(k, bool) or not isinstance(k, Real) or not 0.0 <= k <= 1.0:
-                raise ExplorerError(f"material {key} must be a number in [0, 1], got {k!r}")
-            k = float(k)
-            if k == max(getattr(self, term)):
-                continue  # unchanged: keep the exact values
-            changes[term] = tuple(c * k for c in self.hue(term))
+        for term, key in TERM_SCALARS.items():
+            if key not in values or values[key] == max(getattr(self, term)):
+                continue  # not given or unchanged: keep the exact values
+            changes[term] = tuple(c * values[key] for c in self.hue(term))
         return self.replace(**changes) if changes else self
+
+
+#: key -> its check in a file (every key of :data:`MATERIAL_KEYS`): the checks of
+#: :attr:`Material.KEYS` with the file's ranges, and the scalar form's keys
+FILE_CHECKS: dict[str, Check] = {
+    **Material.KEYS,
+    **{key: partial(_coefficients, hi=COEFFICIENT_RANGE[1]) for key in RGB_KEYS},
+    "shininess": partial(_scalar, hi=SHININESS_RANGE[1]),
+    **{key: partial(_scalar, hi=COEFFICIENT_RANGE[1]) for key in TERM_SCALARS.values()},
+    "color": partial(_coefficients, hi=COEFFICIENT_RANGE[1]),
+    "specular_color": partial(_coefficients, hi=COEFFICIENT_RANGE[1]),
+}
 
 
 def _hue(rgb: RGB) -> RGB | None:
@@ -207,21 +245,15 @@ def parse_material(value, checker: Checker, path: tuple = ()) -> Material | None
         return None
     before = len(checker.problems)
     checker.keys(m, path, MATERIAL_KEYS)
-    lo, hi = COEFFICIENT_RANGE
 
-    def rgb(key):
-        return checker.rgb(m[key], path + (key,), lo, hi) if key in m else None
+    def check(key):
+        return FILE_CHECKS[key](checker, m[key], path + (key,))
 
-    def scalar(key):
-        return checker.number(m[key], path + (key,), lo, hi) if key in m else None
-
-    kw: dict = {}
-    for key in RGB_KEYS:
-        if key in m:
-            kw[key] = rgb(key)
+    kw = check_fields({key: FILE_CHECKS[key] for key in RGB_KEYS}, m, checker, path)
 
     # the scalar form
-    color, specular_color = rgb("color"), rgb("specular_color")
+    color = check("color") if "color" in m else None
+    specular_color = check("specular_color") if "specular_color" in m else None
     ks_given = "ks" in m
     for term, key in TERM_SCALARS.items():
         if key in m and term in m:
@@ -247,29 +279,17 @@ def parse_material(value, checker: Checker, path: tuple = ()) -> Material | None
         if term in m:
             continue
         if key in m or "color" in m:
-            k = scalar(key) if key in m else SCALAR_DEFAULTS[key]
+            k = check(key) if key in m else SCALAR_DEFAULTS[key]
             if k is not None and ("color" not in m or color is not None):
                 kw[term] = tuple(k * c for c in base)
     if ks_given and "specular" not in m:
-        ks = scalar("ks")
+        ks = check("ks")
         if ks is not None and ("specular_color" not in m or specular_color is not None):
             base = specular_color if specular_color is not None else _WHITE
             kw["specular"] = tuple(ks * c for c in base)
 
-    if "shininess" in m:
-        kw["shininess"] = checker.number(m["shininess"], path + ("shininess",), *SHININESS_RANGE)
-    if "opacity" in m:
-        kw["opacity"] = checker.number(m["opacity"], path + ("opacity",), *OPACITY_RANGE)
-    if "model" in m:
-        kw["model"] = checker.choice(m["model"], path + ("model",), MODELS)
-    if "description" in m:
-        kw["description"] = checker.string(m["description"], path + ("description",))
-    if "fresnel" in m:
-        kw["fresnel"] = checker.number(m["fresnel"], path + ("fresnel",), *FRESNEL_RANGE)
-    if "energy_conserving" in m:
-        kw["energy_conserving"] = checker.boolean(
-            m["energy_conserving"], path + ("energy_conserving",)
-        )
+    rest = [key for key in Material.KEYS if key not in RGB_KEYS]
+    kw.update(check_fields({key: FILE_CHECKS[key] for key in rest}, m, checker, path))
     if len(checker.problems) > before or any(v is None for v in kw.values()):
         return None
     return Material(**kw)

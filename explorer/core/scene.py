@@ -16,6 +16,12 @@ The scene-file schema (every key optional)::
 
 Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
 light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
+
+Each key is checked by one function (:attr:`Scene.KEYS`, :attr:`Viewer.KEYS`; see
+:mod:`explorer.core.validate`), run by :func:`load_scene` on a file and by the constructor, with
+the same messages. The file's own forms stay in :func:`load_scene`: a material given by preset
+name, the model taken from the material when the file gives none, a mesh path relative to the
+file.
 """
 
 from __future__ import annotations
@@ -24,9 +30,10 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import partial
 from typing import ClassVar
 
-from explorer.core.errors import ExplorerError, Problem, ValidationError
+from explorer.core.errors import ExplorerError
 from explorer.core.hdr import HDR, parse_hdr
 from explorer.core.lights import DirectionalLight, parse_light
 from explorer.core.material import MODELS, Material, parse_material
@@ -36,17 +43,25 @@ from explorer.core.yamlio import load_yaml
 
 Vec3 = tuple[float, float, float]
 
-SCENE_KEYS = ("material", "model", "ambient", "viewer", "two_sided", "lights", "mesh", "hdr")
 VIEWER_KEYS = ("eye", "to_viewer")
 DEFAULT_AMBIENT = (0.2, 0.2, 0.2)
 
 
+# -- the checks of each key ------------------------------------------------------------------
 def _eye(checker: Checker, value, path):
     return checker.triple(value, path)
 
 
 def _to_viewer(checker: Checker, value, path):
     return checker.direction(value, path)
+
+
+def _one_viewer(checker: Checker, given: Mapping, path) -> bool:
+    """Exactly one of eye / to_viewer is given (else a problem)."""
+    if ("eye" in given) == ("to_viewer" in given):
+        checker.problem(path, Viewer.ONE_OF)
+        return False
+    return True
 
 
 @old_keywords
@@ -64,9 +79,11 @@ class Viewer:
     ONE_OF: ClassVar[str] = "needs exactly one of eye (local viewer) or to_viewer (infinite)"
 
     def __post_init__(self):
-        if (self.eye is None) == (self.to_viewer is None):
-            raise ValidationError([Problem(self.ONE_OF)])
-        checked(self, {k: c for k, c in self.KEYS.items() if getattr(self, k) is not None})
+        given = {k: getattr(self, k) for k in self.KEYS if getattr(self, k) is not None}
+        checker = Checker(None)
+        _one_viewer(checker, given, ())
+        checker.raise_if_any()
+        checked(self, self.KEYS)
         if self.to_viewer is not None:
             d = self.to_viewer
             n = math.sqrt(sum(c * c for c in d))
@@ -80,6 +97,60 @@ class Viewer:
         if self.eye is not None:
             return {"eye": list(self.eye)}
         return {"to_viewer": list(self.to_viewer)}
+
+
+def parse_viewer(checker: Checker, value, path=("viewer",)) -> Viewer | None:
+    """A :class:`Viewer` from a scene's ``viewer`` mapping (or a Viewer), reporting every
+    problem to ``checker``."""
+    if isinstance(value, Viewer):
+        return value
+    m = checker.mapping(value, path, "{eye: [x, y, z]} or {to_viewer: [x, y, z]}")
+    if m is None:
+        return None
+    m = checker.renamed(m, path, Viewer.RENAMED)
+    checker.keys(m, path, VIEWER_KEYS)
+    if not _one_viewer(checker, m, path):
+        return None
+    kw = check_fields(Viewer.KEYS, m, checker, path)
+    return None if None in kw.values() else Viewer(**kw)
+
+
+def _material(checker: Checker, value, path):
+    """A Material, or a mapping of material keys (a preset name is a file's form: see
+    :func:`load_scene`)."""
+    return value if isinstance(value, Material) else parse_material(value, checker, path)
+
+
+def _model(checker: Checker, value, path):
+    return checker.choice(value, path, MODELS)
+
+
+def _ambient(checker: Checker, value, path):
+    return checker.triple(value, path, 0.0)
+
+
+def _flag(checker: Checker, value, path):
+    return checker.boolean(value, path)
+
+
+def _lights(checker: Checker, value, path):
+    """A list of lights: each a Light or a mapping of light keys."""
+    if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence):
+        checker.problem(path, "must be a list of lights (- {type: ..., ...})")
+        return None
+    lights = tuple(parse_light(light, checker, path + (i,)) for i, light in enumerate(value))
+    return None if any(light is None for light in lights) else lights
+
+
+def _mesh(checker: Checker, value, path):
+    """A built-in mesh name or a mesh file path (text, or an os.PathLike)."""
+    if isinstance(value, os.PathLike):
+        value = os.fspath(value)
+    return checker.string(value, path)
+
+
+def _hdr(checker: Checker, value, path):
+    return parse_hdr(value, checker, path)
 
 
 DEFAULT_VIEWER = Viewer(to_viewer=(0.0, 0.0, 1.0))
@@ -96,9 +167,9 @@ class Scene:
     viewer : local or infinite
     two_sided : light back faces with -N
     lights : tuple of lights
-    mesh : built-in mesh name or a file path, or None where arrays are given hdr : display unclamped
-    colours with this exposure and tone map (:mod:`explorer.shading.display`),
-        or None (OpenGL: clamp to [0, 1])
+    mesh : built-in mesh name or a file path, or None where arrays are given
+    hdr : display unclamped colours with this exposure and tone map
+        (:mod:`explorer.shading.display`), or None (OpenGL: clamp to [0, 1])
     source : the file the scene came from (for messages), or None
     """
 
@@ -112,15 +183,21 @@ class Scene:
     source: str | None = field(default=None, compare=False)
     hdr: HDR | None = None
 
+    #: key -> its check, run by the scene-file parser and by the constructor, in the order a
+    #: file's problems are listed (a constructor also takes a mapping where a file does)
+    KEYS: ClassVar[dict[str, Check]] = {
+        "material": _material,
+        "model": _model,
+        "ambient": _ambient,
+        "viewer": parse_viewer,
+        "two_sided": _flag,
+        "lights": _lights,
+        "mesh": _mesh,
+        "hdr": _hdr,
+    }
+
     def __post_init__(self):
-        if self.model not in MODELS:
-            raise ValueError(f"model must be one of {MODELS}, got {self.model!r}")
-        a = tuple(float(c) for c in self.ambient)
-        if len(a) != 3 or not all(math.isfinite(c) and c >= 0 for c in a):
-            raise ValueError(f"scene ambient must be 3 finite numbers >= 0, got {self.ambient!r}")
-        object.__setattr__(self, "ambient", a)
-        object.__setattr__(self, "lights", tuple(self.lights))
-        object.__setattr__(self, "two_sided", bool(self.two_sided))
+        checked(self, self.KEYS)
 
     def replace(self, **changes) -> Scene:
         """A copy with some fields changed (``scene.replace(material=m)``)."""
@@ -141,6 +218,9 @@ class Scene:
         if self.hdr is not None:
             out["hdr"] = self.hdr.to_mapping()
         return out
+
+
+SCENE_KEYS = tuple(Scene.KEYS)
 
 
 def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
@@ -166,46 +246,21 @@ def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
 
 
 def _parse(data, checker: Checker, materials_dirs, base_dir) -> Scene:
+    """The file's form on top of :attr:`Scene.KEYS`: a material may be a preset name, the
+    model defaults to the material's, a mesh path is relative to the file."""
     m = checker.mapping(data, (), "a mapping of scene keys")
     checker.raise_if_any()
     checker.keys(m, (), SCENE_KEYS)
-    kw: dict = {}
-    material = None
-    if "material" in m:
-        value = m["material"]
-        if isinstance(value, Material):
-            material = value
-        elif isinstance(value, str):
-            material = _preset(value, checker, materials_dirs)
-        else:
-            material = parse_material(value, checker, ("material",))
-        if material is not None:
-            kw["material"] = material
-    if "model" in m:
-        kw["model"] = checker.choice(m["model"], ("model",), MODELS)
-    elif material is not None and material.model is not None:
+    checks = dict(Scene.KEYS)
+    if isinstance(m.get("material"), str):
+        checks["material"] = partial(_preset, materials_dirs=materials_dirs)
+    kw = check_fields(checks, m, checker, ())
+    material = kw.get("material")
+    if "model" not in m and material is not None and material.model is not None:
         kw["model"] = material.model
-    if "ambient" in m:
-        kw["ambient"] = checker.triple(m["ambient"], ("ambient",), 0.0)
-    if "viewer" in m:
-        kw["viewer"] = _viewer(m["viewer"], checker)
-    if "two_sided" in m:
-        kw["two_sided"] = checker.boolean(m["two_sided"], ("two_sided",))
-    if "lights" in m:
-        lights = m["lights"]
-        if isinstance(lights, (str, bytes, Mapping)) or not isinstance(lights, Sequence):
-            checker.problem(("lights",), "must be a list of lights (- {type: ..., ...})")
-        else:
-            kw["lights"] = tuple(
-                parse_light(light, checker, ("lights", i)) for i, light in enumerate(lights)
-            )
-    if "mesh" in m:
-        mesh = checker.string(m["mesh"], ("mesh",))
-        if mesh is not None and base_dir and _looks_like_path(mesh):
-            mesh = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
-        kw["mesh"] = mesh
-    if "hdr" in m:
-        kw["hdr"] = parse_hdr(m["hdr"], checker, ("hdr",))
+    mesh = kw.get("mesh")
+    if mesh is not None and base_dir and _looks_like_path(mesh):
+        kw["mesh"] = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
     checker.raise_if_any()
     return Scene(source=checker.file, **kw)
 
@@ -214,25 +269,10 @@ def _looks_like_path(mesh: str) -> bool:
     return os.sep in mesh or "/" in mesh or "." in os.path.basename(mesh)
 
 
-def _viewer(value, checker: Checker) -> Viewer | None:
-    if isinstance(value, Viewer):
-        return value
-    path = ("viewer",)
-    m = checker.mapping(value, path, "{eye: [x, y, z]} or {to_viewer: [x, y, z]}")
-    if m is None:
-        return None
-    m = checker.renamed(m, path, Viewer.RENAMED)
-    checker.keys(m, path, VIEWER_KEYS)
-    if ("eye" in m) == ("to_viewer" in m):
-        checker.problem(path, Viewer.ONE_OF)
-        return None
-    kw = check_fields(Viewer.KEYS, m, checker, path)
-    return None if None in kw.values() else Viewer(**kw)
-
-
-def _preset(name: str, checker: Checker, materials_dirs) -> Material | None:
+def _preset(checker: Checker, name: str, path, materials_dirs: Sequence = ()) -> Material | None:
+    """The material of preset ``name`` (searched in ``materials_dirs``, then the built-ins)."""
     try:
         return find_preset(name, materials_dirs)
     except ExplorerError as exc:
-        checker.problem(("material",), str(exc))
+        checker.problem(path, str(exc))
         return None

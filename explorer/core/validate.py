@@ -8,16 +8,18 @@ with the allowed range, the file and the line (when the document came from a fil
 Key paths are tuples such as ``("lights", 1, "attenuation")`` and print as
 ``lights[1].attenuation``.
 
-Each key of a model class (a light, the viewer) is checked by one function ``check(checker,
-value, path) -> value or None`` in the class's ``KEYS`` table: the scene-file parser runs it with
-the document's checker (every problem of the file at once, with file and line), the class's
-constructor runs it through :func:`check_fields` (a :class:`ValidationError` with the same
-message). A key renamed for clarity keeps its old name readable: :meth:`Checker.renamed` in
-documents, :func:`old_keywords` for constructors, both with one :class:`DeprecatedName` notice.
+Each key of a model class (a material, a light, the viewer, the HDR settings, the scene) is
+checked by one function ``check(checker, value, path) -> value or None`` in the class's ``KEYS``
+table: the file parser runs it with the document's checker (every problem of the file at once,
+with file and line), the class's constructor runs it through :func:`checked` (a
+:class:`ValidationError` with the same message). A key renamed for clarity keeps its old name
+readable: :meth:`Checker.renamed` in documents, :func:`old_keywords` for constructors, both with
+one :class:`DeprecatedName` notice.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import functools
 import math
@@ -246,14 +248,23 @@ def check_fields(
     return {k: check(checker, values[k], path + (k,)) for k, check in checks.items() if k in values}
 
 
+def check_values(checks: Mapping[str, Check], values: Mapping, path: Path = ()) -> dict:
+    """:func:`check_fields` for values given in code: raises one :class:`ValidationError`
+    listing every problem (key paths and messages as in a file, without file and line)."""
+    checker = Checker(None)
+    out = check_fields(checks, values, checker, path)
+    checker.raise_if_any()
+    return out
+
+
 def checked(obj, checks: Mapping[str, Check]) -> None:
     """Check and convert the fields ``checks`` names on a frozen dataclass instance, in place
     (from its ``__post_init__``); raises one :class:`ValidationError` listing every problem, with
-    the key paths and messages the scene-file parser gives."""
-    checker = Checker(None)
-    values = check_fields(checks, {k: getattr(obj, k) for k in checks}, checker, ())
-    checker.raise_if_any()
-    for k, v in values.items():
+    the key paths and messages the scene-file parser gives. A field whose default is None
+    (an optional part: a material's ``fresnel``, a scene's ``hdr``) takes None as "not given"."""
+    optional = {f.name for f in dataclasses.fields(obj) if f.default is None}
+    given = {k: getattr(obj, k) for k in checks if not (k in optional and getattr(obj, k) is None)}
+    for k, v in check_values(checks, given).items():
         object.__setattr__(obj, k, v)
 
 

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import ValidationError
 from explorer.core.material import MATERIAL_KEYS, SHININESS_RANGE, Material, parse_material
 from explorer.core.validate import Checker
 
@@ -185,13 +185,50 @@ def test_line_numbers_come_from_the_checker():
     assert str(checker.problems[0]).startswith("m.yaml:4: diffuse[2]: ")
 
 
-def test_material_constructor_rejects_impossible_values():
-    with pytest.raises(ValueError):
-        Material(diffuse=(0.1, -0.1, 0.1))
-    with pytest.raises(ValueError):
-        Material(opacity=2)
-    with pytest.raises(ValueError):
-        Material(model="flat")
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"diffuse": (0.1, -0.1, 0.1)}, "diffuse[1]: must be >= 0, got -0.1"),
+        ({"emission": (0, 0)}, "emission: must be a list of 3 numbers each >= 0"),
+        ({"shininess": -1}, "shininess: must be >= 0, got -1"),
+        ({"shininess": float("inf")}, "shininess: must be a finite number >= 0, got inf"),
+        ({"opacity": 2}, "opacity: must be in [0, 1], got 2"),
+        ({"model": "flat"}, "model: must be one of blinn, phong, got 'flat'"),
+        ({"fresnel": 1.5}, "fresnel: must be in [0, 1], got 1.5"),
+        ({"energy_conserving": "yes"}, "energy_conserving: must be true or false"),
+        ({"description": 3}, "description: must be text"),
+    ],
+)
+def test_material_constructor_rejects_impossible_values(kwargs, message):
+    with pytest.raises(ValidationError) as info:
+        Material(**kwargs)
+    assert isinstance(info.value, ValueError) and str(info.value).startswith(message)
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("opacity", 2),
+        ("model", "flat"),
+        ("fresnel", -0.5),
+        ("energy_conserving", "yes"),
+        ("description", ["a"]),
+    ],
+)
+def test_constructor_and_file_say_the_same(key, value):
+    (from_file,) = messages({key: value})
+    with pytest.raises(ValidationError) as info:
+        Material(**{key: value})
+    assert from_file == f"m.yaml: {info.value}"
+
+
+def test_constructor_takes_what_the_engine_can_shade():
+    # files hold coefficients in [0, 1] and shininess in [0, 1000]; the engine any value >= 0
+    m = Material(diffuse=(1.5, 0, 0), shininess=4000)
+    assert m.diffuse == (1.5, 0.0, 0.0) and m.shininess == 4000.0
+    (msg,) = messages({"shininess": 4000})
+    assert "[0, 1000]" in msg
+    assert Material(model=None, fresnel=None) == Material()  # None: not given
 
 
 # -- scalars (ka / kd / ks sliders) ----------------------------------------------------------
@@ -250,5 +287,5 @@ def test_black_terms_borrow_a_hue():
 
 @pytest.mark.parametrize("bad", [-0.1, 1.5, float("nan"), "0.5", True])
 def test_with_scalars_rejects_out_of_range(bad):
-    with pytest.raises(ExplorerError, match=r"kd must be a number in \[0, 1\]"):
+    with pytest.raises(ValidationError, match=r"^kd: must be (a (finite )?number )?in \[0, 1\]"):
         Material().with_scalars(kd=bad)
