@@ -1,6 +1,6 @@
 """HDR display settings of a scene: exposure in stops and a tone map (the ``hdr`` key).
 
-What the settings do to colours is :mod:`explorer.shading.display`. The lecture notes' rule for
+What the settings do to colours is :mod:`explorer.shading.effects.hdr`. The lecture notes' rule for
 HDR, keep ``kd + ks`` at most 1 per channel so a surface never reflects more than it receives,
 is :func:`energy_warnings`: one warning per channel where the material's diffuse + specular
 exceeds 1.
