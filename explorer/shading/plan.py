@@ -265,23 +265,21 @@ def _terms(scene: Scene, r: _Reasons) -> tuple[bool, bool, bool, bool]:
         if not _nonzero(m.ambient)
         else ("scene and light ambient are 0" if not any_amb else "a_m and an ambient light"),
     )
-    any_dif = any(_nonzero(lt.diffuse) for lt in lights)
-    diffuse = r.why(
-        "diffuse",
-        _nonzero(m.diffuse) and any_dif,
-        "material diffuse 0"
-        if not _nonzero(m.diffuse)
-        else ("no light has diffuse colour" if not any_dif else "d_m and a light's diffuse"),
-    )
-    any_spec = any(_nonzero(lt.specular) for lt in lights)
-    specular = r.why(
-        "specular",
-        _nonzero(m.specular) and any_spec,
-        "material specular 0"
-        if not _nonzero(m.specular)
-        else ("no light has specular colour" if not any_spec else "s_m and a light's specular"),
-    )
+    diffuse = _lit_term(r, "diffuse", "d", m.diffuse, lights)
+    specular = _lit_term(r, "specular", "s", m.specular, lights)
     return emission, ambient, diffuse, specular
+
+
+def _lit_term(r, term: str, symbol: str, material_rgb, lights) -> bool:
+    """The diffuse or specular term: in when the material and some light both have it."""
+    lit = any(_nonzero(getattr(lt, term)) for lt in lights)
+    if not _nonzero(material_rgb):
+        reason = f"material {term} 0"
+    elif not lit:
+        reason = f"no light has {term} colour"
+    else:
+        reason = f"{symbol}_m and a light's {term}"
+    return r.why(term, _nonzero(material_rgb) and lit, reason)
 
 
 def _view(scene: Scene, specular: bool, flat: bool, effect_view: bool, r: _Reasons) -> str:

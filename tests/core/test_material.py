@@ -6,11 +6,11 @@ from __future__ import annotations
 import sys
 
 import pytest
+from helpers.scenes import materials, unit
 from hypothesis import given
-from hypothesis import strategies as st
 
 from explorer.core.errors import ValidationError
-from explorer.core.material import MATERIAL_KEYS, SHININESS_RANGE, Material, parse_material
+from explorer.core.material import MATERIAL_KEYS, Material, parse_material
 from explorer.core.validate import Checker
 
 
@@ -30,21 +30,6 @@ def messages(mapping) -> list[str]:
     material, problems = parse(mapping)
     assert material is None and problems
     return [str(p) for p in problems]
-
-
-unit = st.floats(0.0, 1.0, allow_nan=False)
-rgb = st.tuples(unit, unit, unit)
-materials = st.builds(
-    Material,
-    ambient=rgb,
-    diffuse=rgb,
-    specular=rgb,
-    emission=rgb,
-    shininess=st.floats(*SHININESS_RANGE),
-    opacity=unit,
-    model=st.sampled_from([None, "blinn", "phong"]),
-    description=st.text(max_size=40),
-)
 
 
 # -- defaults and the RGB form ---------------------------------------------------------------

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from helpers.scenes import materials
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -260,19 +261,6 @@ def test_invalid_lookup_names(name, hint):
 
 
 # -- saving ----------------------------------------------------------------------------------
-unit = st.floats(0.0, 1.0, allow_nan=False)
-rgb = st.tuples(unit, unit, unit)
-materials = st.builds(
-    Material,
-    ambient=rgb,
-    diffuse=rgb,
-    specular=rgb,
-    emission=rgb,
-    shininess=st.floats(0.0, 1000.0),
-    opacity=unit,
-    model=st.sampled_from([None, "blinn", "phong"]),
-    description=st.text(max_size=40),
-)
 
 
 @given(materials)

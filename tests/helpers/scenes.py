@@ -5,10 +5,26 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import strategies as st
 
+from explorer.core.material import SHININESS_RANGE, Material
+
 unit_float = st.floats(0, 1, allow_nan=False, allow_infinity=False)
 maybe_zero_rgb = st.one_of(st.just([0.0, 0.0, 0.0]), st.lists(unit_float, min_size=3, max_size=3))
 vec = st.lists(st.floats(-3, 3, allow_nan=False), min_size=3, max_size=3).filter(
     lambda v: sum(c * c for c in v) > 1e-2
+)
+#: materials a preset file can hold (every coefficient in [0, 1], shininess in its file range)
+unit = st.floats(0.0, 1.0, allow_nan=False)
+rgb = st.tuples(unit, unit, unit)
+materials = st.builds(
+    Material,
+    ambient=rgb,
+    diffuse=rgb,
+    specular=rgb,
+    emission=rgb,
+    shininess=st.floats(*SHININESS_RANGE),
+    opacity=unit,
+    model=st.sampled_from([None, "blinn", "phong"]),
+    description=st.text(max_size=40),
 )
 
 
