@@ -111,6 +111,17 @@ def test_import_explorer_loads_no_drawing_or_gui_toolkit():
     assert out.stdout.strip() == "[]"
 
 
+def test_every_package_is_in_the_wheel():
+    """pyproject.toml lists the packages explicitly (``explorer.materials`` lives outside the
+    source folder): a new subpackage must be listed, or the installed wheel lacks it."""
+    tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+    listed = set(
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    )
+    found = {".".join(init.parent.relative_to(ROOT).parts) for init in PACKAGE.rglob("__init__.py")}
+    assert found <= listed, f"not listed in pyproject.toml: {sorted(found - listed)}"
+
+
 def test_every_subpackage_says_what_it_owns_and_may_import():
     for init in sorted(PACKAGE.glob("*/__init__.py")):
         if init.parent.name in ("data",):
