@@ -111,6 +111,27 @@ def unit_rows(v: np.ndarray, eps: float, fallback) -> tuple[np.ndarray, np.ndarr
     return unit, length
 
 
+def _span(point, centre, scale: float) -> tuple[Vec3, Vec3, float]:
+    """``v = (point - centre) / scale`` (3,) (components inf where they overflow), its
+    direction as a unit vector (3,) and its length (inf when that overflows), with no overflow
+    or underflow on the way to the direction: halves first (``point - centre`` could overflow
+    near 1e308; halving is exact, so ``v`` is bit for bit ``(point - centre) / scale``), then
+    divided by the largest component. Python floats."""
+    h = [0.5 * p - 0.5 * float(c) for p, c in zip(point, centre, strict=True)]
+    v = tuple(c / scale * 2.0 for c in h)
+    m = max(abs(c) for c in h)
+    if m == 0.0:
+        return v, (0.0, 0.0, 0.0), 0.0
+    x, y, z = (c / m for c in h)  # the largest is ±1
+    n = math.sqrt(x * x + y * y + z * z)  # in [1, √3]
+    return v, (x / n, y / n, z / n), m / scale * 2.0 * n
+
+
+def _times(k: float, d: float) -> float:
+    """k·d, with 0·inf = 0 (a zero coefficient contributes nothing at any distance)."""
+    return k * d if k != 0.0 else 0.0
+
+
 def in_frame(point, centre=None, scale=1.0) -> np.ndarray:
     """A world point (3,) in the normalised frame ``(point - centre) / scale``, float64 (the
     point itself when ``centre`` is None)."""
@@ -399,7 +420,7 @@ class PositionalLight(Light):
         if self.attenuation == NO_ATTENUATION:
             reasons.append(("attenuation", "out", "attenuation [1, 0, 0] is 1 everywhere"))
         elif kl == 0.0 and kq == 0.0:
-            attenuation, factor = "constant", 1.0 / kc
+            attenuation, factor = "constant", 1.0 / max(kc, tol.ATTENUATION_FLOOR)
             reasons.append(
                 ("attenuation", "out", f"constant 1/kc = {factor:g} folded into the colours")
             )
@@ -410,18 +431,30 @@ class PositionalLight(Light):
 
     def _pack(self, row, plan, centre, scale, halfway_view) -> int:
         f = R.POSITIONAL
-        cx, cy, cz = (float(v) for v in centre)
-        px, py, pz = self.position
-        s = scale
-        row[R.P_POS : R.P_POS + 3] = ((px - cx) / s, (py - cy) / s, (pz - cz) / s)
-        kc, kl, kq = self.attenuation
-        row[R.P_ATT : R.P_ATT + 3] = (kc, kl * s, kq * s * s)
+        row[R.P_POS : R.P_POS + 3], row[R.P_ATT : R.P_ATT + 3] = self.framed(centre, scale)
         if plan.attenuation == "per-vertex":
             f |= R.ATTEN
         return f
 
+    def framed(self, centre, scale: float) -> tuple[Vec3, Vec3]:
+        """Where the engine puts the light in the normalised frame ``centre`` (3,) (None: the
+        world), ``scale``, and its attenuation there: ``position`` (3,) and ``(kc, kl·s, kq·s²)``
+        (so that ``1 / (kc + kl·d + kq·d²)`` takes frame distances ``d``), each coefficient at
+        most ATTENUATION_CAP. The far-light policy (:data:`~explorer.core.tolerances.FAR_LIGHT`):
+        a light farther than FAR_LIGHT from the frame's origin is put at FAR_LIGHT along its
+        direction, with ``(A, 0, 0)``: A the attenuation's denominator at its true distance.
+        Python floats (a light drag rebuilds the rows every frame)."""
+        cap = tol.ATTENUATION_CAP
+        kc, kl, kq = self.attenuation
+        kl, kq = min(kl * scale, cap), min(kq * scale * scale, cap)
+        v, u, distance = _span(self.position, (0.0,) * 3 if centre is None else centre, scale)
+        if distance <= tol.FAR_LIGHT:
+            return v, (min(kc, cap), kl, kq)
+        denominator = kc + _times(kl, distance) + _times(_times(kq, distance), distance)
+        return tuple(tol.FAR_LIGHT * c for c in u), (min(denominator, cap), 0.0, 0.0)
+
     def toward(self, points, centre=None, scale=1.0) -> np.ndarray:
-        return in_frame(self.position, centre, scale) - points
+        return np.asarray(self.framed(centre, scale)[0]) - points
 
     def shadow_ray(self, points, centre=None, scale=1.0):
         D = self.toward(points, centre, scale)
@@ -429,11 +462,10 @@ class PositionalLight(Light):
         return D / np.where(tmax > 0, tmax, 1.0)[:, None], tmax
 
     def _attenuated(self, P, N, centre, scale):
-        L, d = unit_rows(in_frame(self.position, centre, scale) - P, tol.POINT_EPS, N)
-        d = d * scale  # attenuation uses world distances
-        kc, kl, kq = self.attenuation
-        att = 1.0 / np.maximum(kc + kl * d + kq * d * d, tol.ATTENUATION_FLOOR)
-        return L, d, att
+        position, (kc, kl, kq) = self.framed(centre, scale)
+        L, d = unit_rows(np.asarray(position) - P, tol.POINT_EPS, N)
+        att = 1.0 / np.maximum(kc + (kl + kq * d) * d, tol.ATTENUATION_FLOOR)
+        return L, d * scale, att  # world distances (up to FAR_LIGHT·scale)
 
     def placement(self, centre):
         return angles_of(np.subtract(self.position, centre))

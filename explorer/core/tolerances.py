@@ -26,6 +26,27 @@ HALFWAY_EPS2 = 1e-24
 #: a scene is loaded; with kc = 0 a light exactly at a vertex would divide by zero, so the
 #: attenuation factor is capped at 1 / ATTENUATION_FLOOR (and colours stay finite).
 ATTENUATION_FLOOR = 1e-6
+#: The same floor applies to a constant attenuation folded into the colours: 1/max(kc, floor).
+#: So the factor never exceeds 1e6, never becomes inf (1/1e-320 would) or NaN (inf·0 with a
+#: zero colour channel), and stays finite in float32 (1/1e-39 would not).
+
+#: The attenuation coefficients the kernels receive, kc, kl·s and kq·s² (s the frame's scale),
+#: are each capped at this: kq·s² overflows for a huge mesh (and so would inf·0 for a light on
+#: a vertex), and float32 holds only up to 3.4e38. A capped coefficient still gives a weight of
+#: at most 1/ATTENUATION_CAP wherever it matters (1e-30; colours are at most 1e6 per light), and
+#: the weight stays monotone in the distance and in each coefficient.
+ATTENUATION_CAP = 1e30
+
+#: Far-light policy. A positional light farther than this from the mesh's centre (in normalised
+#: units, i.e. mesh half-extents) is shaded as a directional light toward it: the engine and the
+#: reference put it at exactly this distance along its direction, with the constant attenuation
+#: 1 / max(kc + kl·D + kq·D², floor) at its true distance D (the denominator evaluated from the
+#: frame-unit coefficients with 0·inf taken as 0, capped at ATTENUATION_CAP; D may be inf).
+#: Beyond 1e12 the direction varies across the mesh by less than 2e-12 (below every colour
+#: tolerance), while d² stays far from overflow in float32 (1e24) and float64: without it, a
+#: light at 4e154 (float64) or 1e19 (float32) gave d² = inf and NaN colours, and one at 1e200
+#: lit nothing.
+FAR_LIGHT = 1e12
 
 # --- rays (explorer.geometry.rays) ----------------------------------------------------------
 

@@ -31,6 +31,10 @@ from explorer.shading.effects.base import Effect
 
 #: ACES (Narkowicz) input scale: the fit maps scene value 1/0.6 to about 0.8
 ACES_INPUT_SCALE = 0.6
+#: tone maps take min(x, this): reinhard's x/(1 + x) rounds to exactly 1 from x = 2**53, the
+#: ACES fit clips to 1 from 0.6·x = 7.25; so capping changes no value and keeps inf and huge
+#: inputs (an HDR scene with exposure 16 and a blinding light) from giving inf/inf = NaN
+TONE_MAP_CAP = 1e20
 
 
 def expose(colors, exposure: float) -> np.ndarray:
@@ -41,13 +45,16 @@ def expose(colors, exposure: float) -> np.ndarray:
 def tone_map(x, name: str) -> np.ndarray:
     """One of :data:`~explorer.core.hdr.TONE_MAPS` applied per channel: (..., 3) float >= 0 ->
     [0, 1]."""
+    # huge and inf map to 1 (x/(1 + x) -> 1): the input is capped where each map is already
+    # exactly 1 (inf/inf would be NaN, and a² overflows beyond 1e154); NaN is kept (no guess)
     x = np.maximum(np.asarray(x, np.float64), 0.0)
     if name == "clamp":
         return np.minimum(x, 1.0)
     if name == "reinhard":
+        x = np.minimum(x, TONE_MAP_CAP)
         return x / (1.0 + x)
     if name == "aces":
-        a = x * ACES_INPUT_SCALE
+        a = np.minimum(x, TONE_MAP_CAP) * ACES_INPUT_SCALE
         return np.clip(a * (2.51 * a + 0.03) / (a * (2.43 * a + 0.59) + 0.14), 0.0, 1.0)
     raise ValueError(f"tone map must be one of {TONE_MAPS}, got {name!r}")
 
