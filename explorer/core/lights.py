@@ -454,7 +454,9 @@ class PositionalLight(Light):
         return tuple(tol.FAR_LIGHT * c for c in u), (min(denominator, cap), 0.0, 0.0)
 
     def toward(self, points, centre=None, scale=1.0) -> np.ndarray:
-        return np.asarray(self.framed(centre, scale)[0]) - points
+        if centre is None:  # the world: the light where it is
+            return in_frame(self.position) - points
+        return np.asarray(self.framed(centre, scale)[0]) - points  # (the far-light policy)
 
     def shadow_ray(self, points, centre=None, scale=1.0):
         D = self.toward(points, centre, scale)

@@ -4,7 +4,9 @@ Shading depends only on directions and distances, so the engine moves the scene 
 mesh's bounding-box centre at the origin and divides every coordinate by the largest half-extent.
 Coordinates near 1e8 or 1e-8 then become numbers near 1, where float32 keeps 7 digits, and the
 epsilons in :mod:`explorer.core.tolerances` mean the same thing for every mesh. Distances used for
-attenuation are scaled back (``kl·s`` and ``kq·s²``), so colours do not change.
+attenuation are scaled back (``kl·s`` and ``kq·s²``), so colours do not change. A light far
+from the mesh in this frame (beyond ``tolerances.FAR_LIGHT``), where ``d²`` would overflow, is
+shaded as a directional light toward it (:meth:`explorer.core.lights.PositionalLight.framed`).
 """
 
 from __future__ import annotations

@@ -16,6 +16,7 @@ from explorer.shading.effects.hdr import display, tone_map
 from explorer.shading.equation import equation_shade
 
 PRECISIONS = ("float64", "float32")
+TONES = ("clamp", "reinhard", "aces")
 MATERIAL = {
     "ambient": [0.1, 0.1, 0.1],
     "diffuse": [0.6, 0.5, 0.4],
@@ -137,6 +138,14 @@ def test_far_light_shadow_rays_point_at_it():
     assert (tmax > 1e6).all()
 
 
+def test_toward_in_the_world_keeps_the_light_where_it_is():
+    from explorer.core.lights import PointLight
+
+    P = np.array([[1e13, 0.0, 0.0], [3e13, 0.0, 0.0]])
+    D = PointLight(position=(2e13, 0.0, 0.0)).toward(P)  # no frame: no far-light policy
+    assert D[:, 0].tolist() == [1e13, -1e13]
+
+
 # -- HDR display -----------------------------------------------------------------------------
 @pytest.mark.parametrize("name", ["clamp", "reinhard", "aces"])
 def test_tone_maps_send_huge_and_inf_to_one(name):
@@ -199,22 +208,31 @@ def extreme_lights(draw):
     shift=triple(extreme(-300, 300)),
     precision=st.sampled_from(PRECISIONS),
     seed=st.integers(0, 2**16),
+    hdr=st.one_of(
+        st.none(),
+        st.fixed_dictionaries(
+            {"exposure": st.sampled_from([-16, 0, 16]), "tone_map": st.sampled_from(TONES)}
+        ),
+    ),
 )
 def test_extreme_finite_scenes_give_finite_colours_or_a_clean_error(
-    lights, exponent, shift, precision, seed
+    lights, exponent, shift, precision, seed, hdr
 ):
     P, N = vertices(seed, 12)
     with np.errstate(over="ignore"):
         P = P * 10.0**exponent + np.asarray(shift)
     if not np.isfinite(P).all():
         return
-    s = {**scene(), "lights": lights}
+    s = {**scene(), "lights": lights, **({"hdr": hdr} if hdr else {})}
     try:
-        c = explorer.shade(s, P, N, precision=precision)
+        c = explorer.shade(s, P, N, precision=precision, clamp=hdr is None)
     except ValueError as exc:  # refused: the message names what is wrong
         assert any(k in str(exc) for k in ("position", "attenuation", "degenerate", "vertices"))
         return
     assert c.shape == (len(P), 3)
-    assert np.isfinite(c).all() and (c >= 0).all() and (c <= 1).all()
-    ref = equation_shade(explorer.load_scene(s), P, N)
+    assert np.isfinite(c).all() and (c >= 0).all()
+    loaded = explorer.load_scene(s)
+    shown = display(c, loaded.hdr)
+    assert np.isfinite(shown).all() and (shown >= 0).all() and (shown <= 1).all()
+    ref = equation_shade(loaded, P, N, clamp=hdr is None)
     assert np.isfinite(ref).all()
