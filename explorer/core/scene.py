@@ -13,6 +13,7 @@ The scene-file schema (every key optional)::
       - {type: spot, position: [0, 4, 0], aim: [0, -1, 0], cutoff: 30, exponent: 8}
     mesh: sphere              # built-in name or mesh file (relative to the scene file)
     hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
+                              # (hdr: true: these defaults; hdr: false: off)
 
 Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
 light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.

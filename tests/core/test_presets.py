@@ -591,3 +591,22 @@ def test_hostile_keys_and_file_names_are_escaped_in_problems_and_notices(capsys,
     err = capsys.readouterr().err
     assert err.startswith("error: materials directory") and "no\\x1b[2Jdir" in err
     assert_no_raw_controls(err)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/urandom"), reason="no /dev/urandom")
+def test_a_device_as_a_preset_file_is_too_large_not_zero_bytes():
+    with pytest.raises(ValidationError) as exc:
+        load_material_file("/dev/urandom")
+    msg = str(exc.value)
+    assert f"more than {MAX_BYTES} bytes" in msg and " 0 bytes" not in msg
+
+
+def test_a_directory_named_like_a_preset_is_said_to_be_one(tmp_path, capsys):
+    (tmp_path / "shiny.yaml").mkdir()
+    with pytest.raises(ExplorerError) as exc:
+        find_preset("shiny", [tmp_path])
+    msg = str(exc.value)
+    assert str(tmp_path / "shiny.yaml") in msg and "is a directory" in msg
+    assert "did you mean" not in msg
+    assert main(["presets", "show", "shiny", "--materials", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err
