@@ -4,7 +4,8 @@ May import every other part of the package; nothing imports it. Each subcommand 
 own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
 ``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
 User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
-block on stderr, exit status 2, no traceback.
+block on stderr, exit status 2, no traceback; text a terminal would act on (from file names,
+keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import warnings
 
 from explorer.cli import bench, gui, plan, presets, render, sheet
 from explorer.core.errors import ExplorerError, Notice
+from explorer.core.text import printable
 from explorer.core.version import __version__
 
 #: subcommand -> (module, one-line help); each module has ``add_arguments`` and ``run``
@@ -49,7 +51,7 @@ def _show_notices() -> None:
 
     def show(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, Notice):
-            print(f"notice: {message}", file=sys.stderr)
+            print(f"notice: {printable(message, keep=chr(10))}", file=sys.stderr)
         else:
             original(message, category, filename, lineno, file, line)
 
@@ -65,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args._run(args) or 0)
     except ExplorerError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {printable(exc, keep=chr(10))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
 import os
 import sys
 
@@ -51,7 +52,22 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--exit-after", type=float, metavar="SECONDS", default=None,
         help="close the window after this many seconds (a safety net for scripts and tests)",
     )  # fmt: skip
+    p.add_argument(
+        "--force", action="store_true", help="replace the --state-file if it exists already",
+    )  # fmt: skip
     add_scene_arguments(p, force=False, mesh_default=gui.DEFAULT_MESH)
+
+
+def check_options(args) -> None:
+    """Refuse options that cannot work before anything opens: ``--exit-after`` must be a
+    finite number of seconds > 0; an existing ``--state-file`` is replaced only with
+    ``--force``."""
+    t = args.exit_after
+    if t is not None and not (math.isfinite(t) and t > 0):
+        raise ExplorerError(f"--exit-after must be a finite number of seconds > 0, got {t}")
+    f = args.state_file
+    if f is not None and os.path.lexists(f) and not args.force:
+        raise ExplorerError(f"--state-file {f!r}: already exists; use --force to replace it")
 
 
 def start(args):
@@ -62,8 +78,7 @@ def start(args):
     viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
     (:data:`explorer.app.window.MESH_CHOICES`) unless ``--resolution`` is given.
     """
-    if args.exit_after is not None and not args.exit_after > 0:
-        raise ExplorerError(f"--exit-after must be a number of seconds > 0, got {args.exit_after}")
+    check_options(args)
     if args.scene is None and args.preset is None:
         args.preset = gui.DEFAULT_PRESET
     args.mesh_default = gui.DEFAULT_MESH
@@ -87,6 +102,7 @@ def start(args):
 
 def run(args) -> int:
 
+    check_options(args)
     reason = gui.no_display_reason()
     if reason:
         print(gui.no_display_message(reason), file=sys.stderr)

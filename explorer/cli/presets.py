@@ -29,6 +29,7 @@ from explorer.core.presets import (
     load_material_file,
     locate_preset,
 )
+from explorer.core.text import printable
 from explorer.core.yamlio import dump_yaml
 
 #: Scene ambient used for the swatch (OpenGL's default light-model ambient).
@@ -75,8 +76,8 @@ def list_(materials_dirs, out=None, err=None) -> int:
         swatch = _swatch(p.material) + " " if colour else ""
         tag = "" if p.source == "builtin" else f" [{_source_label(p.source)}]"
         out.write(
-            f"{swatch}{p.name:<{width}}  {p.material.shininess:>7g}  "
-            f"{p.material.description}{tag}\n"
+            f"{swatch}{printable(p.name):<{width}}  {p.material.shininess:>7g}  "
+            f"{printable(p.material.description)}{printable(tag)}\n"
         )
     return 0
 
@@ -113,7 +114,7 @@ def _source_label(source: str) -> str:
 
 def _print_notices(notices, err) -> None:
     for n in notices:
-        err.write(f"notice: {n}\n")
+        err.write(f"notice: {printable(n, keep=chr(10))}\n")
 
 
 # -- show ------------------------------------------------------------------------------------
@@ -132,11 +133,12 @@ def show(name: str, materials_dirs, out=None, err=None) -> int:
         if hidden is not None:
             _print_notices([f"preset '{name}': {path} hides {hidden}"], err)
     ka, kd, ks = material.scalars()
-    out.write(origin + "\n")
+    out.write(printable(origin) + "\n")
     out.write(f"# scalars (largest channel of each term): ka {ka:g}, kd {kd:g}, ks {ks:g}\n")
     if use_colour(out):
         out.write(f"# swatch: {_swatch(material)}\n")
-    out.write(dump_yaml(material.to_mapping()))
+    # YAML escapes controls itself but writes a bidi override raw: shown escaped too
+    out.write(printable(dump_yaml(material.to_mapping()), keep="\n"))
     return 0
 
 

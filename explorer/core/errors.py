@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from explorer.core.text import printable
+
 
 class ExplorerError(Exception):
     """Base class of every error caused by user input (never by a bug)."""
@@ -34,8 +36,10 @@ class Problem:
     key: str | None = None
 
     def __str__(self) -> str:
+        """One line per problem: the file name, key and message come from files, so what a
+        terminal would act on is shown escaped (:func:`explorer.core.text.printable`)."""
         key = f"{self.key}: " if self.key else ""
-        return f"{self.where}{key}{self.message}"
+        return printable(f"{self.where}{key}") + printable(self.message, keep="\n")
 
     @property
     def where(self) -> str:

@@ -47,11 +47,14 @@ HDR_KEYS = tuple(HDR.KEYS)
 
 
 def parse_hdr(value, checker: Checker, path=("hdr",)) -> HDR | None:
-    """An :class:`HDR` from a scene's ``hdr`` mapping (``true`` means the defaults)."""
+    """An :class:`HDR` from a scene's ``hdr`` mapping (``true`` means the defaults; ``false``
+    means no HDR, as when the key is left out: None without a problem)."""
     if isinstance(value, HDR):
         return value
     if value is True:
         return HDR()
+    if value is False:
+        return None
     m = checker.mapping(value, path, "{exposure: stops, tone_map: clamp|reinhard|aces}")
     if m is None:
         return None

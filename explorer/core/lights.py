@@ -97,9 +97,16 @@ def _exponent(checker: Checker, value, path):
 
 
 # -- small vector helpers --------------------------------------------------------------------
-def _unit(v: Vec3) -> Vec3:
-    n = math.sqrt(sum(c * c for c in v))
-    return (v[0] / n, v[1] / n, v[2] / n)
+def unit_vector(v: Vec3) -> Vec3:
+    """``v`` (3 finite floats, not all zero) at unit length, for any scale: divided by its
+    largest absolute component first (so no square overflows to inf or underflows to 0, from
+    1e308 down to subnormals like 1e-320), then by the length of that (between 1 and √3)."""
+    m = max(abs(c) for c in v)
+    if not m > 0.0:
+        raise ValueError(f"a direction must be non-zero and finite, got {list(v)}")
+    w = (v[0] / m, v[1] / m, v[2] / m)
+    n = math.hypot(*w)
+    return (w[0] / n, w[1] / n, w[2] / n)
 
 
 def unit_rows(v: np.ndarray, eps: float, fallback) -> tuple[np.ndarray, np.ndarray]:
@@ -345,7 +352,7 @@ class DirectionalLight(Light):
     FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + ("to_light",)
 
     def _normalise(self) -> None:
-        object.__setattr__(self, "to_light", _unit(self.to_light))
+        object.__setattr__(self, "to_light", unit_vector(self.to_light))
 
     def _own_mapping(self) -> dict:
         return {"to_light": list(self.to_light)}
@@ -529,7 +536,7 @@ class SpotLight(PositionalLight):
     LIKE_DEFAULTS: ClassVar[dict] = {"cutoff": 25.0, "exponent": 10.0}
 
     def _normalise(self) -> None:
-        object.__setattr__(self, "aim", _unit(self.aim))
+        object.__setattr__(self, "aim", unit_vector(self.aim))
 
     def _own_mapping(self) -> dict:
         return {

@@ -188,7 +188,14 @@ def locate_preset(name: str, materials_dirs: Iterable = ()) -> tuple[Path, str, 
     dirs = search_dirs(materials_dirs)
     hits = [(d / f"{name}{SUFFIX}", s) for d, s in dirs if (d / f"{name}{SUFFIX}").is_file()]
     if not hits:
-        known = sorted(_scan(dirs, []))
+        for d, _ in dirs:  # the name is there, but not as a file: say what it is
+            path = d / f"{name}{SUFFIX}"
+            if path.exists() and not path.is_file():
+                kind = "a directory" if path.is_dir() else "not a regular file"
+                raise ExplorerError(
+                    f"material preset {name!r}: {path} is {kind}, not a preset file"
+                )
+        known = sorted(n for n, files in _scan(dirs, []).items() if files[0][0].is_file())
         hint = suggest(name.lower(), known) or suggest(name, known)
         where = "; ".join(f"{d} ({s})" for d, s in dirs)
         raise ExplorerError(

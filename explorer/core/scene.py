@@ -13,6 +13,7 @@ The scene-file schema (every key optional)::
       - {type: spot, position: [0, 4, 0], aim: [0, -1, 0], cutoff: 30, exponent: 8}
     mesh: sphere              # built-in name or mesh file (relative to the scene file)
     hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
+                              # (hdr: true: these defaults; hdr: false: off)
 
 Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
 light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
@@ -26,7 +27,6 @@ file.
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -35,7 +35,7 @@ from typing import ClassVar
 
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import HDR, parse_hdr
-from explorer.core.lights import DirectionalLight, parse_light
+from explorer.core.lights import DirectionalLight, parse_light, unit_vector
 from explorer.core.material import MODELS, Material, parse_material
 from explorer.core.presets import find_preset
 from explorer.core.validate import Check, Checker, check_fields, checked, old_keywords
@@ -85,9 +85,7 @@ class Viewer:
         checker.raise_if_any()
         checked(self, self.KEYS)
         if self.to_viewer is not None:
-            d = self.to_viewer
-            n = math.sqrt(sum(c * c for c in d))
-            object.__setattr__(self, "to_viewer", tuple(c / n for c in d))
+            object.__setattr__(self, "to_viewer", unit_vector(self.to_viewer))
 
     @property
     def local(self) -> bool:

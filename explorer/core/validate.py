@@ -225,13 +225,10 @@ class Checker:
         return self.triple(value, path, lo, hi)
 
     def direction(self, value, path: Path):
-        """A non-zero 3-vector (not normalised here)."""
+        """A non-zero 3-vector of finite numbers, any scale (normalised by its owner)."""
         v = self.triple(value, path)
         if v is not None and not any(v):
             self.problem(path, "must be a non-zero direction, got [0, 0, 0]")
-            return None
-        if v is not None and not math.isfinite(math.hypot(*v)):
-            self.problem(path, "is too long to normalise (length overflows)")
             return None
         return v
 

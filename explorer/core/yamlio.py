@@ -167,8 +167,9 @@ def _read_bytes(name: str, what: str) -> bytes:
         with open(name, "rb") as fh:
             raw = fh.read(MAX_BYTES + 1)
             if len(raw) > MAX_BYTES:
-                fh.seek(0, os.SEEK_END)
-                _fail(name, None, _too_big(fh.tell()))
+                # a device or a pipe has no size (0 from stat): say what was read
+                size = os.fstat(fh.fileno()).st_size
+                _fail(name, None, _too_big(size if size > MAX_BYTES else None))
             return raw
     except FileNotFoundError:
         _fail(name, None, f"cannot read {what}: no such file")
@@ -203,8 +204,10 @@ def _first_surrogate(text: str) -> int | None:
     return None if match is None else match.start()
 
 
-def _too_big(size: int) -> str:
-    return f"is too large: {size} bytes, the limit is {MAX_BYTES} bytes ({MAX_BYTES >> 20} MiB)"
+def _too_big(size: int | None) -> str:
+    """The message for ``size`` bytes, or None: more than :data:`MAX_BYTES` of unknown size."""
+    got = f"more than {MAX_BYTES}" if size is None else str(size)
+    return f"is too large: {got} bytes, the limit is {MAX_BYTES} bytes ({MAX_BYTES >> 20} MiB)"
 
 
 def _fail(file, line, message):

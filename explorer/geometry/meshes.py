@@ -31,6 +31,7 @@ import numpy as np
 from explorer.core.errors import ExplorerError
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
+from explorer.geometry.frame import frame_of
 
 #: resolution option of each built-in mesh: (default, lowest, highest); None = no option
 RESOLUTION: dict[str, tuple[int, int, int] | None] = {
@@ -126,6 +127,18 @@ def _face_cross(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(m, 3) cross products (b - a) × (c - a); length is twice the triangle's area."""
     a, b, c = (positions[faces[:, k]] for k in range(3))
     return np.cross(b - a, c - a)
+
+
+def has_area(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m,) bool: which triangles have a non-zero area, decided at any scale.
+
+    positions : (n, 3) finite float; faces : (m, 3) int
+    The cross products are taken in the normalised frame (:func:`frame_of`: coordinates in
+    [-1, 1]), so they neither overflow to inf or NaN for coordinates near 1e308 nor underflow
+    to zero for a mesh of size 1e-300."""
+    centre, scale = frame_of(positions)
+    p = (np.asarray(positions, np.float64) - centre) / scale
+    return np.linalg.norm(_face_cross(p, faces), axis=1) > 0
 
 
 def _unit_rows(v: np.ndarray) -> np.ndarray:
@@ -524,7 +537,7 @@ def load_mesh(path) -> Mesh:
     else:
         pos, _, faces = _weld(pos, np.zeros_like(pos), faces, decimals=12)
         nrm = area_weighted_normals(pos, faces)
-    if not (np.linalg.norm(_face_cross(pos, faces), axis=1) > 0).any():
+    if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")
     pos, nrm, faces = _drop_unused(pos, nrm, faces)
     return Mesh(pos, nrm, faces, os.path.basename(path))

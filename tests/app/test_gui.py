@@ -24,7 +24,7 @@ import explorer
 from explorer.analysis import comparison as A
 from explorer.app import layout as G
 from explorer.app import window as gui
-from explorer.cli import build_parser
+from explorer.cli import build_parser, main
 from explorer.cli.gui import start
 from explorer.core.lights import DirectionalLight, PointLight, direction_of
 from explorer.core.material import Material
@@ -771,6 +771,26 @@ def test_start_from_options_and_scene_file(tmp_path):
     assert scene.lights == (DirectionalLight(to_light=(1, 1, 1)),)
     with pytest.raises(explorer.ExplorerError, match="--exit-after"):
         start(_gui_args("--exit-after", "0"))
+
+
+@pytest.mark.parametrize("value", ["inf", "-inf", "nan", "-1", "0", "1e400"])
+def test_exit_after_must_be_a_finite_positive_number(value, capsys):
+    with pytest.raises(explorer.ExplorerError, match="--exit-after"):
+        start(_gui_args(f"--exit-after={value}"))
+    assert main(["gui", f"--exit-after={value}"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: --exit-after") and "Traceback" not in err[0]
+
+
+def test_state_file_is_never_replaced_without_force(tmp_path, capsys):
+    f = tmp_path / "state.json"
+    f.write_text("keep me")
+    assert main(["gui", "--state-file", str(f), "--exit-after", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and str(f) in err[0] and "--force" in err[0], err
+    assert f.read_text() == "keep me"
+    start(_gui_args("--state-file", str(f), "--force"))  # --force: accepted
+    start(_gui_args("--state-file", str(tmp_path / "new.json")))  # a new file: accepted
 
 
 @pytest.mark.parametrize("argv", [[], ["gui", "--preset", "jade"]])

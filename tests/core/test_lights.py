@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 
 import explorer
+from explorer.cli import build_parser
+from explorer.cli.options import light_from_options
 from explorer.core.errors import DeprecatedName, ExplorerError, Notice, ValidationError
 from explorer.core.lights import (
     LIGHT_CLASSES,
@@ -240,3 +242,51 @@ def test_as_type_keeps_colours_and_attenuation():
     assert p.as_type("point") is p
     with pytest.raises(ExplorerError):
         p.as_type("area")
+
+
+# -- scale-safe unit vectors (issue 19, item 3) -------------------------------------------------
+
+EXTREME_DIRECTIONS = [
+    (1e-200, 0, 0),
+    (1e-320, 0, 0),
+    (0, -5e-324, 0),
+    (1e-320, 1e-320, 0),
+    (1e200, 1e200, 0),
+    (1e308, 1e308, 1e308),
+    (-1.7e308, 1.7e308, 1.7e308),
+]
+
+
+@pytest.mark.parametrize("v", EXTREME_DIRECTIONS)
+def test_any_finite_nonzero_direction_becomes_a_unit_vector(v):
+    want = np.asarray(v, dtype=np.float64) / np.max(np.abs(v))
+    want /= np.linalg.norm(want)
+    for got in (
+        DirectionalLight(to_light=v).to_light,
+        SpotLight(aim=v).aim,
+        Viewer(to_viewer=v).to_viewer,
+    ):
+        assert np.linalg.norm(got) == pytest.approx(1.0, abs=1e-15)
+        np.testing.assert_allclose(got, want, atol=1e-15)
+
+
+def test_tiny_and_huge_directions_load_from_a_scene_file(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text(
+        "viewer: {to_viewer: [1e308, 1e308, 1e308]}\n"
+        "lights:\n"
+        "  - {type: directional, to_light: [1e-320, 0, 0]}\n"
+        "  - {type: spot, position: [0, 4, 0], aim: [0, -1e-300, 0]}\n"
+    )
+    scene = load_scene(f)
+    assert scene.lights[0].to_light == (1.0, 0.0, 0.0)
+    assert scene.lights[1].aim == (0.0, -1.0, 0.0)
+    np.testing.assert_allclose(scene.viewer.to_viewer, [3**-0.5] * 3)
+
+
+def test_tiny_light_direction_on_the_command_line_is_not_a_traceback():
+    for flag in ("--light-direction", "--light-to-light"):
+        args = build_parser().parse_args(["render", flag, "1e-200", "0", "0", "--out", "x.png"])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecatedName)
+            assert light_from_options(args).to_light == (1.0, 0.0, 0.0)

@@ -550,3 +550,63 @@ def test_cli_validate_a_directory(capsys, tmp_path):
     assert main(["presets", "validate", str(tmp_path)]) == 1
     out = capsys.readouterr().out.splitlines()
     assert len(out) == 2 and "gold.yaml" in out[0] and "shininess" in out[0] and "x" in out[1]
+
+
+# -- text from files never reaches the terminal raw (issue 19, item 8) ----------------------------
+ESC = "\x1b]0;pwned\x07\x1b[2J\x1b[1A\r\u202e\x9b"
+
+
+def assert_no_raw_controls(text: str) -> None:
+    """Only printable text and line breaks: no ESC, BEL, CR, C1 control or bidi override."""
+    bad = [c for c in text if c != "\n" and (not c.isprintable() and c != " ")]
+    assert not bad, f"raw control characters {bad!r} in {text!r}"
+
+
+def test_cli_list_and_show_escape_a_hostile_description(capsys, tmp_path):
+    write(tmp_path / "evil.yaml", f'description: "{ESC.encode("unicode_escape").decode()}"\n')
+    assert load_material_file(tmp_path / "evil.yaml").description == ESC
+    assert main(["presets", "--materials", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert_no_raw_controls(out)
+    assert "\\x1b]0;pwned\\x07\\x1b[2J" in out and "\\u202e" in out
+    assert main(["presets", "show", "evil", "--materials", str(tmp_path)]) == 0
+    assert_no_raw_controls(capsys.readouterr().out)
+
+
+def test_hostile_keys_and_file_names_are_escaped_in_problems_and_notices(capsys, tmp_path):
+    bad = write(tmp_path / "bad.yaml", '"\\e[2Jkd\\r": 0.5\n')
+    assert main(["presets", "validate", str(bad)]) == 1
+    out = capsys.readouterr().out
+    assert_no_raw_controls(out)
+    assert "\\x1b[2Jkd\\r: unknown key" in out
+    with pytest.raises(ValidationError) as exc:
+        load_material_file(bad)
+    assert_no_raw_controls(str(exc.value))
+    write(tmp_path / "x\x1b[2J.yaml", "kd: 0.5\n")  # not a preset name: a notice names it
+    assert main(["presets", "--materials", str(tmp_path)]) == 0
+    err = capsys.readouterr().err
+    assert "notice:" in err and "x\\x1b[2J.yaml" in err
+    assert_no_raw_controls(err)
+    assert main(["presets", "--materials", str(tmp_path / "no\x1b[2Jdir")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: materials directory") and "no\\x1b[2Jdir" in err
+    assert_no_raw_controls(err)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/urandom"), reason="no /dev/urandom")
+def test_a_device_as_a_preset_file_is_too_large_not_zero_bytes():
+    with pytest.raises(ValidationError) as exc:
+        load_material_file("/dev/urandom")
+    msg = str(exc.value)
+    assert f"more than {MAX_BYTES} bytes" in msg and " 0 bytes" not in msg
+
+
+def test_a_directory_named_like_a_preset_is_said_to_be_one(tmp_path, capsys):
+    (tmp_path / "shiny.yaml").mkdir()
+    with pytest.raises(ExplorerError) as exc:
+        find_preset("shiny", [tmp_path])
+    msg = str(exc.value)
+    assert str(tmp_path / "shiny.yaml") in msg and "is a directory" in msg
+    assert "did you mean" not in msg
+    assert main(["presets", "show", "shiny", "--materials", str(tmp_path)]) == 2
+    assert "is a directory" in capsys.readouterr().err

@@ -109,3 +109,13 @@ def test_file_only_forms_stay_in_the_parser():
     assert scene.material.name == "chrome" and scene.model == (scene.material.model or "blinn")
     with pytest.raises(ValidationError, match="material: must be a material mapping"):
         Scene(material="chrome")
+
+
+def test_hdr_false_means_no_hdr_like_leaving_it_out(tmp_path):
+    f = tmp_path / "s.yaml"
+    f.write_text("hdr: false\n")
+    assert load_scene(f) == Scene() and load_scene(f).hdr is None
+    assert load_scene({"hdr": False}).hdr is None and Scene(hdr=False).hdr is None
+    assert load_scene({"hdr": True}).hdr == HDR()
+    with pytest.raises(ValidationError, match="hdr: must be"):
+        load_scene({"hdr": "no"})

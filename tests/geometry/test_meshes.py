@@ -464,3 +464,23 @@ def test_get_mesh_names():
     assert M.get_mesh(None).name == M.DEFAULT_MESH
     m = M.cube()
     assert M.get_mesh(m) is m
+
+
+@pytest.mark.parametrize("normals", [True, False])
+@pytest.mark.parametrize("s", [1e308, 1.7e308, 1e-300, 1e-310])
+def test_a_valid_triangle_at_any_scale_is_not_degenerate(tmp_path, s, normals):
+    """The zero-area test runs in the normalised frame: (b - a) × (c - a) cannot overflow to
+    inf or NaN, nor underflow to 0, at 1e308 or at 1e-300 (issue 19, item 11)."""
+    corners = [(-s, -s, 0.0), (s, -s, 0.0), (-s, s, 0.0)]
+    text = "".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in corners)
+    text += "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nf 1//1 2//2 3//3\n" if normals else "f 1 2 3\n"
+    path = tmp_path / "big.obj"
+    path.write_text(text)
+    if normals:
+        m = M.load_mesh(path)
+        assert m.n_faces == 1 and np.isfinite(m.positions).all()
+    else:  # the degenerate check itself; the smooth normals' own scale is not this test's
+        pos = np.array(corners)
+        assert M.has_area(pos, np.array([[0, 1, 2]])).tolist() == [True]
+    flat = np.array([(-s, 0.0, 0.0), (0.0, 0.0, 0.0), (s, 0.0, 0.0)])
+    assert M.has_area(flat, np.array([[0, 1, 2]])).tolist() == [False]
