@@ -31,13 +31,16 @@ from __future__ import annotations
 
 import sys
 from collections import Counter
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 
 from explorer.core import lightrow as R
-from explorer.core.errors import ExplorerError
-from explorer.core.scene import Scene, Viewer, load_scene
-from explorer.geometry.frame import check_vertices, frame_of, to_frame
+from explorer.core.errors import ExplorerError, ExplorerTypeError
+from explorer.core.material import Material
+from explorer.core.presets import find_preset
+from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
+from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
 from explorer.shading.effects import EFFECTS
 from explorer.shading.plan import Plan, make_plan
@@ -119,6 +122,8 @@ class Shader:
         force_all: bool = False,
         cull: bool = True,
     ):
+        if not isinstance(precision, str):
+            raise ExplorerTypeError(f"precision must be one of {PRECISIONS}, got {precision!r}")
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
         self._T = np.float32 if precision == "float32" else np.float64
@@ -128,7 +133,8 @@ class Shader:
         self.stats: Counter = Counter()
         self.force_all = bool(force_all)
         self.cull = bool(cull)
-        self._scene = load_scene(scene, materials_dirs=materials_dirs)
+        self._materials_dirs = check_materials_dirs(materials_dirs)
+        self._scene = load_scene(scene, materials_dirs=self._materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
         self._lobe_memory = None  # (base, ws) arrays kept for reuse
@@ -150,11 +156,9 @@ class Shader:
 
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
-        self._P, self._N = check_vertices(positions, normals)
-        if faces is not None:
-            faces = np.asarray(faces, np.int64).reshape(-1, 3)
-            if len(faces) and (faces.min() < 0 or faces.max() >= len(self._P)):
-                raise ExplorerError("faces index vertices that do not exist")
+        P, N = check_vertices(positions, normals)  # normals scaled for the kernels
+        faces = None if faces is None else check_faces(faces, len(P))
+        self._P, self._N = P, N
         self._faces = faces
         self._convex = None  # decided when a light first asks for shadows
         self._vis_cache: dict = {}
@@ -186,13 +190,14 @@ class Shader:
         return _readonly(b)
 
     def set_scene(self, scene) -> None:
-        """Apply a new scene, invalidating only what its differences touch."""
-        new = load_scene(scene)
+        """Apply a new scene, invalidating only what its differences touch. A bad scene raises
+        before anything changes (the shader keeps its scene)."""
+        new = load_scene(scene, materials_dirs=self._materials_dirs)
         old = self._scene
         if new == old:
             return
-        self._scene = new
-        self._plan = self._make_plan(new)
+        plan = self._make_plan(new)
+        self._scene, self._plan = new, plan
         changed = invalidated(new, old)
         if "lights" in changed:
             self._lights_changed()
@@ -205,15 +210,30 @@ class Shader:
         self._aconst = ambient_constant(self._scene, self._plan)
 
     def set_material(self, material) -> None:
+        """material : a Material, a mapping of material keys, or a preset name (looked up in
+        the shader's ``materials_dirs``, then the built-ins)."""
+        if isinstance(material, str):
+            material = find_preset(material, self._materials_dirs)
+        elif not isinstance(material, (Material, Mapping)):
+            raise _wrong_type("material", "a Material, a mapping or a preset name", material)
         self.set_scene(self._scene.replace(material=material))
 
     def set_model(self, model: str) -> None:
+        """model : "blinn" or "phong"."""
+        if not isinstance(model, str):
+            raise _wrong_type("model", "'blinn' or 'phong'", model)
         self.set_scene(self._scene.replace(model=model))
 
     def set_viewer(self, viewer: Viewer) -> None:
+        """viewer : a Viewer or a mapping ``{eye: [x, y, z]}`` / ``{to_viewer: [x, y, z]}``."""
+        if not isinstance(viewer, (Viewer, Mapping)):
+            raise _wrong_type("viewer", "a Viewer or a mapping", viewer)
         self.set_scene(self._scene.replace(viewer=viewer))
 
     def set_lights(self, lights) -> None:
+        """lights : a list of lights (each a Light or a mapping of light keys)."""
+        if isinstance(lights, (str, bytes, Mapping)) or not isinstance(lights, Iterable):
+            raise _wrong_type("lights", "a list of lights", lights)
         self.set_scene(self._scene.replace(lights=tuple(lights)))
 
     # -- outputs -----------------------------------------------------------------------------
@@ -581,6 +601,11 @@ class _Memory:
         if len(self.colours) < 2:
             self.colours.append(buf)
         return buf
+
+
+def _wrong_type(name: str, wanted: str, value) -> ExplorerTypeError:
+    """The error for an argument ``name`` of the wrong type."""
+    return ExplorerTypeError(f"{name} must be {wanted}, got {type(value).__name__} {value!r:.60}")
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
