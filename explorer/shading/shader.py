@@ -122,8 +122,7 @@ class Shader:
         force_all: bool = False,
         cull: bool = True,
     ):
-        if not isinstance(precision, str):
-            raise ExplorerTypeError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+        _typed("precision", precision, str, f"one of {PRECISIONS}")
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
         self._T = np.float32 if precision == "float32" else np.float64
@@ -214,26 +213,21 @@ class Shader:
         the shader's ``materials_dirs``, then the built-ins)."""
         if isinstance(material, str):
             material = find_preset(material, self._materials_dirs)
-        elif not isinstance(material, (Material, Mapping)):
-            raise _wrong_type("material", "a Material, a mapping or a preset name", material)
+        material = _typed("material", material, (Material, Mapping), "a Material or a mapping")
         self.set_scene(self._scene.replace(material=material))
 
     def set_model(self, model: str) -> None:
         """model : "blinn" or "phong"."""
-        if not isinstance(model, str):
-            raise _wrong_type("model", "'blinn' or 'phong'", model)
-        self.set_scene(self._scene.replace(model=model))
+        self.set_scene(self._scene.replace(model=_typed("model", model, str, "'blinn' or 'phong'")))
 
     def set_viewer(self, viewer: Viewer) -> None:
         """viewer : a Viewer or a mapping ``{eye: [x, y, z]}`` / ``{to_viewer: [x, y, z]}``."""
-        if not isinstance(viewer, (Viewer, Mapping)):
-            raise _wrong_type("viewer", "a Viewer or a mapping", viewer)
+        viewer = _typed("viewer", viewer, (Viewer, Mapping), "a Viewer or a mapping")
         self.set_scene(self._scene.replace(viewer=viewer))
 
     def set_lights(self, lights) -> None:
         """lights : a list of lights (each a Light or a mapping of light keys)."""
-        if isinstance(lights, (str, bytes, Mapping)) or not isinstance(lights, Iterable):
-            raise _wrong_type("lights", "a list of lights", lights)
+        lights = _typed("lights", lights, Iterable, "a list of lights", not_types=(str, Mapping))
         self.set_scene(self._scene.replace(lights=tuple(lights)))
 
     # -- outputs -----------------------------------------------------------------------------
@@ -603,9 +597,13 @@ class _Memory:
         return buf
 
 
-def _wrong_type(name: str, wanted: str, value) -> ExplorerTypeError:
-    """The error for an argument ``name`` of the wrong type."""
-    return ExplorerTypeError(f"{name} must be {wanted}, got {type(value).__name__} {value!r:.60}")
+def _typed(name: str, value, types, wanted: str, not_types=()):
+    """``value`` if it is one of ``types`` and none of ``not_types``, else an
+    :class:`ExplorerTypeError` naming the argument ``name`` and what it must be (``wanted``)."""
+    if not isinstance(value, types) or isinstance(value, not_types):
+        shown = f"{value!r:.60}"
+        raise ExplorerTypeError(f"{name} must be {wanted}, got {type(value).__name__} {shown}")
+    return value
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
