@@ -99,7 +99,8 @@ def shade(
 class Shader:
     """Cached, stateful shading of one mesh (see the module docstring).
 
-    positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation)
+    positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation; any
+        normal outside NORMAL_RANGE is rescaled in a copy: see geometry.frame.scale_normals)
     precision : "float32" (default here: the interactive path) or "float64"
     keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
     faces : (m, 3) int triangles for shadows (None: no shadows)
