@@ -1,9 +1,12 @@
 """User-facing errors.
 
-Every mistake a user can make (a bad scene file, an unknown preset, a missing mesh) raises an
-:class:`ExplorerError`. The CLI prints its message and exits non-zero without a traceback. A
-validation pass collects every :class:`Problem` in a document before raising one
-:class:`ValidationError`, so the user sees all of them at once.
+Every mistake a user can make (a bad scene file, an unknown preset, a missing mesh, a bad array
+given to the library) raises an :class:`ExplorerError`, a :class:`ValueError`; an argument of the
+wrong type raises an :class:`ExplorerTypeError`, also a :class:`TypeError`. Library callers can
+catch them as ``ValueError`` / ``TypeError`` (or all of them as ``ExplorerError``). The CLI prints
+the message of any of them as one line and exits non-zero without a traceback. A validation pass
+collects every :class:`Problem` in a document before raising one :class:`ValidationError`, so the
+user sees all of them at once.
 
 Things the user should know that are not errors (a preset hiding another, a key's old name)
 are :class:`Notice` warnings; the CLI prints each as one ``notice: ...`` line.
@@ -16,8 +19,13 @@ from dataclasses import dataclass
 from explorer.core.text import printable
 
 
-class ExplorerError(Exception):
-    """Base class of every error caused by user input (never by a bug)."""
+class ExplorerError(ValueError):
+    """Base class of every error caused by user input (never by a bug): a bad value."""
+
+
+class ExplorerTypeError(ExplorerError, TypeError):
+    """An argument of the wrong type (a number where a list of lights goes, say); the message
+    names the argument."""
 
 
 @dataclass(frozen=True)
@@ -51,7 +59,7 @@ class Problem:
         return ""
 
 
-class ValidationError(ExplorerError, ValueError):
+class ValidationError(ExplorerError):
     """One or more :class:`Problem` found in a document; ``str()`` gives one line each."""
 
     def __init__(self, problems: list[Problem]):

@@ -28,12 +28,12 @@ file.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import ClassVar
 
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import ExplorerError, ExplorerTypeError
 from explorer.core.hdr import HDR, parse_hdr
 from explorer.core.lights import DirectionalLight, parse_light, unit_vector
 from explorer.core.material import MODELS, Material, parse_material
@@ -115,7 +115,14 @@ def parse_viewer(checker: Checker, value, path=("viewer",)) -> Viewer | None:
 
 def _material(checker: Checker, value, path):
     """A Material, or a mapping of material keys (a preset name is a file's form: see
-    :func:`load_scene`)."""
+    :func:`load_scene`; the constructor refuses it, naming the functions that take it)."""
+    if isinstance(value, str):
+        checker.problem(
+            path,
+            f"must be a Material or a mapping of material keys, got the text {value!r}; "
+            "a preset name is looked up by find_preset() or load_scene({'material': name})",
+        )
+        return None
     return value if isinstance(value, Material) else parse_material(value, checker, path)
 
 
@@ -228,6 +235,7 @@ def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
     :class:`~explorer.core.errors.ValidationError` naming the file, line and key.
     ``materials_dirs`` are extra preset directories searched before the built-in ones.
     """
+    materials_dirs = check_materials_dirs(materials_dirs)
     if scene is None:
         return Scene()
     if isinstance(scene, Scene):
@@ -238,9 +246,37 @@ def load_scene(scene=None, *, materials_dirs: Sequence = ()) -> Scene:
         return _parse(doc.data, checker, materials_dirs, os.path.dirname(os.fspath(scene)))
     if isinstance(scene, Mapping):
         return _parse(scene, Checker(None), materials_dirs, None)
-    raise ExplorerError(
-        f"a scene must be a scene-file path, a mapping or a Scene, got {type(scene).__name__}"
+    raise ExplorerTypeError(
+        f"scene must be a scene-file path, a mapping or a Scene, got {type(scene).__name__}"
     )
+
+
+def check_materials_dirs(materials_dirs) -> tuple:
+    """``materials_dirs`` as a tuple of directories (str or os.PathLike).
+
+    One path given alone (``"/tmp"``) is refused with an
+    :class:`~explorer.core.errors.ExplorerTypeError` rather than taken as one directory: a str is
+    also a sequence of one-letter names, and guessing which was meant would hide the mistake
+    wherever else a list is passed on. None means none.
+    """
+    if materials_dirs is None:
+        return ()
+    if isinstance(materials_dirs, (str, bytes, os.PathLike)):
+        raise ExplorerTypeError(
+            f"materials_dirs must be a list of directories, got one path {materials_dirs!r}: "
+            f"pass [{materials_dirs!r}]"
+        )
+    if not isinstance(materials_dirs, Iterable):
+        raise ExplorerTypeError(
+            f"materials_dirs must be a list of directories, got {type(materials_dirs).__name__}"
+        )
+    dirs = tuple(materials_dirs)
+    for d in dirs:
+        if not isinstance(d, (str, os.PathLike)):
+            raise ExplorerTypeError(
+                f"materials_dirs must hold directory paths, got {type(d).__name__} {d!r}"
+            )
+    return dirs
 
 
 def _parse(data, checker: Checker, materials_dirs, base_dir) -> Scene:

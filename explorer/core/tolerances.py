@@ -11,7 +11,17 @@ from __future__ import annotations
 
 #: A normal shorter than this is treated as absent: the vertex gets emission and ambient only
 #: (no diffuse, no specular). Unit-length normals are 1; mesh writers emit 0 for "unknown".
+#: The kernels test the normals after :data:`NORMAL_RANGE` scaling, so in practice only an
+#: all-zero normal is absent: a normal of length 1e-20 is a valid direction.
 NORMAL_EPS = 1e-12
+
+#: Before shading, a vertex normal whose largest component |c| lies outside this range is scaled
+#: by an exact power of two (:func:`explorer.geometry.frame.scale_normals`; directions unchanged,
+#: bit for bit) to bring |c| into [0.5, 1). Inside it, the squared length (at least 1e-12, at most
+#: 3e12) is far from float32's underflow (1e-38) and overflow (3e38) and far above NORMAL_EPS²,
+#: so any finite non-zero normal (1e-300 or 1e300 long) shades as its direction. Normals already
+#: in range (unit ones) are passed on unchanged, without a copy.
+NORMAL_RANGE = (1e-6, 1e6)
 
 #: A light (or the eye) closer to a vertex than this (in normalised units) is "at" the vertex:
 #: the direction to it is undefined, so the engine uses the vertex normal (fully facing).

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.core.errors import ExplorerError
+from explorer.core.tolerances import NORMAL_RANGE
 
 
 def frame_of(positions: np.ndarray) -> tuple[np.ndarray, float]:
@@ -42,33 +43,92 @@ def to_frame(point, centre: np.ndarray, scale: float) -> np.ndarray:
 
 def check_vertices(positions, normals) -> tuple[np.ndarray, np.ndarray]:
     """Validate vertex arrays; return them as C-contiguous float arrays (float32 or float64
-    kept, anything else converted to float64).
+    kept, anything else converted to float64), the normals scaled by :func:`scale_normals`.
 
-    positions, normals : (n, 3) array-like of finite numbers. NaN or inf raise an
-    :class:`~explorer.core.errors.ExplorerError` naming the first bad vertex (the engine never
-    guesses a value for it).
+    positions, normals : (n, 3) array-like of finite real numbers. Anything else (a ragged list,
+    text, complex numbers, the wrong shape, NaN or inf) raises an
+    :class:`~explorer.core.errors.ExplorerError` (a ValueError) naming the argument, and for a
+    non-finite value the first bad vertex (the engine never guesses a value for it).
     """
-
-    out = []
-    for name, a in (("positions", positions), ("normals", normals)):
-        arr = np.asarray(a)
-        if arr.dtype not in (np.float32, np.float64):
-            if not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool) or np.iscomplexobj(
-                arr
-            ):
-                raise ExplorerError(f"{name} must be an (n, 3) array of real numbers")
-            arr = arr.astype(np.float64)
-        if arr.ndim != 2 or arr.shape[1] != 3:
-            raise ExplorerError(f"{name} must have shape (n, 3), got {arr.shape}")
-        if not np.isfinite(arr.reshape(-1)).all():  # flat test first: one fast pass
-            i = int(np.argmax(~np.isfinite(arr).all(axis=1)))
-            raise ExplorerError(
-                f"{name}[{i}] is not finite: {arr[i].tolist()} (vertex {i} of {len(arr)}); "
-                "fix or drop such vertices before shading"
-            )
-        out.append(np.ascontiguousarray(arr))
-    if len(out[0]) != len(out[1]):
+    P = _vertex_array("positions", positions)
+    N = _vertex_array("normals", normals)
+    if len(P) != len(N):
         raise ExplorerError(
-            f"positions and normals must have the same length, got {len(out[0])} and {len(out[1])}"
+            f"positions and normals must have the same length, got {len(P)} and {len(N)}"
         )
-    return out[0], out[1]
+    return P, scale_normals(N)
+
+
+def _vertex_array(name: str, a) -> np.ndarray:
+    """One (n, 3) array of finite reals, C-contiguous float32/float64 (see check_vertices)."""
+    try:
+        arr = np.asarray(a)
+    except (ValueError, TypeError, OverflowError):  # a ragged list, say
+        arr = None
+    if arr is None or arr.dtype == object:
+        raise ExplorerError(f"{name} must be an (n, 3) array of real numbers (not a ragged list)")
+    if arr.dtype not in (np.float32, np.float64):
+        if not (np.issubdtype(arr.dtype, np.number) or arr.dtype == bool) or np.iscomplexobj(arr):
+            raise ExplorerError(f"{name} must be an (n, 3) array of real numbers, got {arr.dtype}")
+        arr = arr.astype(np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ExplorerError(f"{name} must have shape (n, 3), got {arr.shape}")
+    if not np.isfinite(arr.reshape(-1)).all():  # flat test first: one fast pass
+        i = int(np.argmax(~np.isfinite(arr).all(axis=1)))
+        raise ExplorerError(
+            f"{name}[{i}] is not finite: {arr[i].tolist()} (vertex {i} of {len(arr)}); "
+            "fix or drop such vertices before shading"
+        )
+    return np.ascontiguousarray(arr)
+
+
+def scale_normals(normals: np.ndarray) -> np.ndarray:
+    """Normals whose largest component lies in :data:`NORMAL_RANGE`, scaled by exact powers of
+    two (same directions, bit for bit): a normal of length 1e-20 or 1e300 is a direction, and its
+    squared length neither underflows nor overflows, in float32 too. Zero rows stay zero (no
+    normal: see :data:`explorer.core.tolerances.NORMAL_EPS`).
+
+    normals : (n, 3) float32/float64, finite. Returns the same array when every row is already in
+    range (the usual case: no copy), else a scaled copy, (n, 3), same dtype.
+    """
+    if len(normals) == 0:
+        return normals
+    big = np.abs(normals).max(axis=1)  # (n,) largest component of each normal
+    lo, hi = NORMAL_RANGE
+    out_of_range = (big > 0) & ((big < lo) | (big > hi))
+    if not out_of_range.any():
+        return normals
+    _, exponent = np.frexp(big[out_of_range])  # big = m · 2**exponent, m in [0.5, 1)
+    out = normals.copy()
+    out[out_of_range] = np.ldexp(out[out_of_range], -exponent[:, None].astype(np.int32))
+    return out
+
+
+def check_faces(faces, n_vertices: int, name: str = "faces") -> np.ndarray:
+    """Validate triangles: an (m, 3) array-like of whole numbers in [0, n_vertices).
+
+    Returns ``faces : (m, 3) int64``. An empty list gives (0, 3). Anything else (a ragged list,
+    rows of two, fractions, an index like 2**70 or -1) raises an
+    :class:`~explorer.core.errors.ExplorerError` (a ValueError) naming ``name``.
+    """
+    try:
+        arr = np.asarray(faces)
+        if arr.dtype == object:  # Python ints beyond int64: compare them as floats
+            arr = np.asarray(faces, dtype=np.float64)
+    except (ValueError, TypeError, OverflowError):
+        raise ExplorerError(f"{name} must be an (m, 3) array of vertex indices") from None
+    if arr.size == 0:
+        return np.zeros((0, 3), np.int64)
+    if arr.dtype == bool or not (np.issubdtype(arr.dtype, np.integer) or arr.dtype.kind == "f"):
+        raise ExplorerError(f"{name} must be an (m, 3) array of vertex indices, got {arr.dtype}")
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ExplorerError(f"{name} must have shape (m, 3): one row per triangle, got {arr.shape}")
+    if arr.dtype.kind == "f" and not (np.isfinite(arr).all() and (arr == np.round(arr)).all()):
+        raise ExplorerError(f"{name} must hold whole numbers (vertex indices)")
+    lo, hi = arr.min(), arr.max()  # compared in the array's own type: no overflow
+    if lo < 0 or hi >= n_vertices:
+        bad = lo if lo < 0 else hi
+        raise ExplorerError(
+            f"{name} index vertices that do not exist: {int(bad)} is not in [0, {n_vertices})"
+        )
+    return np.ascontiguousarray(arr, dtype=np.int64)

@@ -31,7 +31,7 @@ import numpy as np
 from explorer.core.errors import ExplorerError
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
-from explorer.geometry.frame import frame_of
+from explorer.geometry.frame import check_faces, check_vertices, frame_of
 
 #: resolution option of each built-in mesh: (default, lowest, highest); None = no option
 RESOLUTION: dict[str, tuple[int, int, int] | None] = {
@@ -69,16 +69,16 @@ class Mesh:
     name: str = "mesh"
 
     def __post_init__(self):
-        p = _frozen(self.positions, np.float64, "positions")
-        n = _frozen(self.normals, np.float64, "normals")
-        f = _frozen(self.faces, np.int64, "faces")
-        if n.shape != p.shape:
-            raise ValueError(f"normals {n.shape} must match positions {p.shape}")
-        if len(f) and (f.min() < 0 or f.max() >= len(p)):
-            raise ValueError("faces index vertices that do not exist")
-        object.__setattr__(self, "positions", p)
-        object.__setattr__(self, "normals", n)
-        object.__setattr__(self, "faces", f)
+        # the engine's checks (shapes, real finite numbers, index ranges), then read-only
+        # float64 / int64 copies; a mesh needs a vertex (bounds and radius of nothing are not
+        # defined)
+        p, n = check_vertices(self.positions, self.normals)
+        if len(p) == 0:
+            raise ExplorerError(f"mesh '{self.name}': positions must hold at least one vertex")
+        f = check_faces(self.faces, len(p))
+        object.__setattr__(self, "positions", _frozen(p, np.float64))
+        object.__setattr__(self, "normals", _frozen(n, np.float64))
+        object.__setattr__(self, "faces", _frozen(f, np.int64))
 
     @property
     def n_vertices(self) -> int:
@@ -110,12 +110,9 @@ class Mesh:
         return _unit_rows(_face_cross(self.positions, self.faces))
 
 
-def _frozen(a, dtype, name) -> np.ndarray:
+def _frozen(a: np.ndarray, dtype) -> np.ndarray:
+    """A read-only C-contiguous copy of a checked (n, 3) array."""
     arr = np.array(a, dtype=dtype, copy=True, order="C")
-    if arr.size == 0:
-        arr = arr.reshape(0, 3)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (n, 3), got {arr.shape}")
     arr.flags.writeable = False
     return arr
 

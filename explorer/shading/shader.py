@@ -31,13 +31,16 @@ from __future__ import annotations
 
 import sys
 from collections import Counter
+from collections.abc import Iterable, Mapping
 
 import numpy as np
 
 from explorer.core import lightrow as R
-from explorer.core.errors import ExplorerError
-from explorer.core.scene import Scene, Viewer, load_scene
-from explorer.geometry.frame import check_vertices, frame_of, to_frame
+from explorer.core.errors import ExplorerError, ExplorerTypeError
+from explorer.core.material import Material
+from explorer.core.presets import find_preset
+from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
+from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
 from explorer.shading.effects import EFFECTS
 from explorer.shading.plan import Plan, make_plan
@@ -96,7 +99,8 @@ def shade(
 class Shader:
     """Cached, stateful shading of one mesh (see the module docstring).
 
-    positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation)
+    positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation; any
+        normal outside NORMAL_RANGE is rescaled in a copy: see geometry.frame.scale_normals)
     precision : "float32" (default here: the interactive path) or "float64"
     keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
     faces : (m, 3) int triangles for shadows (None: no shadows)
@@ -119,6 +123,7 @@ class Shader:
         force_all: bool = False,
         cull: bool = True,
     ):
+        _typed("precision", precision, str, f"one of {PRECISIONS}")
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
         self._T = np.float32 if precision == "float32" else np.float64
@@ -128,7 +133,8 @@ class Shader:
         self.stats: Counter = Counter()
         self.force_all = bool(force_all)
         self.cull = bool(cull)
-        self._scene = load_scene(scene, materials_dirs=materials_dirs)
+        self._materials_dirs = check_materials_dirs(materials_dirs)
+        self._scene = load_scene(scene, materials_dirs=self._materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
         self._lobe_memory = None  # (base, ws) arrays kept for reuse
@@ -150,11 +156,9 @@ class Shader:
 
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
-        self._P, self._N = check_vertices(positions, normals)
-        if faces is not None:
-            faces = np.asarray(faces, np.int64).reshape(-1, 3)
-            if len(faces) and (faces.min() < 0 or faces.max() >= len(self._P)):
-                raise ExplorerError("faces index vertices that do not exist")
+        P, N = check_vertices(positions, normals)  # normals scaled for the kernels
+        faces = None if faces is None else check_faces(faces, len(P))
+        self._P, self._N = P, N
         self._faces = faces
         self._convex = None  # decided when a light first asks for shadows
         self._vis_cache: dict = {}
@@ -186,13 +190,14 @@ class Shader:
         return _readonly(b)
 
     def set_scene(self, scene) -> None:
-        """Apply a new scene, invalidating only what its differences touch."""
-        new = load_scene(scene)
+        """Apply a new scene, invalidating only what its differences touch. A bad scene raises
+        before anything changes (the shader keeps its scene)."""
+        new = load_scene(scene, materials_dirs=self._materials_dirs)
         old = self._scene
         if new == old:
             return
-        self._scene = new
-        self._plan = self._make_plan(new)
+        plan = self._make_plan(new)
+        self._scene, self._plan = new, plan
         changed = invalidated(new, old)
         if "lights" in changed:
             self._lights_changed()
@@ -205,15 +210,25 @@ class Shader:
         self._aconst = ambient_constant(self._scene, self._plan)
 
     def set_material(self, material) -> None:
+        """material : a Material, a mapping of material keys, or a preset name (looked up in
+        the shader's ``materials_dirs``, then the built-ins)."""
+        if isinstance(material, str):
+            material = find_preset(material, self._materials_dirs)
+        material = _typed("material", material, (Material, Mapping), "a Material or a mapping")
         self.set_scene(self._scene.replace(material=material))
 
     def set_model(self, model: str) -> None:
-        self.set_scene(self._scene.replace(model=model))
+        """model : "blinn" or "phong"."""
+        self.set_scene(self._scene.replace(model=_typed("model", model, str, "'blinn' or 'phong'")))
 
     def set_viewer(self, viewer: Viewer) -> None:
+        """viewer : a Viewer or a mapping ``{eye: [x, y, z]}`` / ``{to_viewer: [x, y, z]}``."""
+        viewer = _typed("viewer", viewer, (Viewer, Mapping), "a Viewer or a mapping")
         self.set_scene(self._scene.replace(viewer=viewer))
 
     def set_lights(self, lights) -> None:
+        """lights : a list of lights (each a Light or a mapping of light keys)."""
+        lights = _typed("lights", lights, Iterable, "a list of lights", not_types=(str, Mapping))
         self.set_scene(self._scene.replace(lights=tuple(lights)))
 
     # -- outputs -----------------------------------------------------------------------------
@@ -581,6 +596,15 @@ class _Memory:
         if len(self.colours) < 2:
             self.colours.append(buf)
         return buf
+
+
+def _typed(name: str, value, types, wanted: str, not_types=()):
+    """``value`` if it is one of ``types`` and none of ``not_types``, else an
+    :class:`ExplorerTypeError` naming the argument ``name`` and what it must be (``wanted``)."""
+    if not isinstance(value, types) or isinstance(value, not_types):
+        shown = f"{value!r:.60}"
+        raise ExplorerTypeError(f"{name} must be {wanted}, got {type(value).__name__} {shown}")
+    return value
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:

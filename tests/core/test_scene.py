@@ -107,7 +107,7 @@ def test_constructor_converts_like_the_file():
 def test_file_only_forms_stay_in_the_parser():
     scene = load_scene({"material": "chrome"})  # a preset name, and the model it names
     assert scene.material.name == "chrome" and scene.model == (scene.material.model or "blinn")
-    with pytest.raises(ValidationError, match="material: must be a material mapping"):
+    with pytest.raises(ValidationError, match="material: must be a Material or a mapping"):
         Scene(material="chrome")
 
 

@@ -374,15 +374,29 @@ def test_zero_and_non_unit_normals(precision):
     dark = [{**lt, "diffuse": [0, 0, 0], "specular": [0, 0, 0]} for lt in HARD["lights"]]
     no_normal = explorer.shade({**HARD, "lights": dark}, P[:1], N[:1], precision=precision)
     assert np.allclose(c[0], no_normal[0])  # emission + ambient only
-    assert np.allclose(c[1], c[0])  # below NORMAL_EPS counts as absent
+    assert np.allclose(c[1], c[3], atol=1e-6)  # a tiny normal is a direction (NORMAL_RANGE)
     assert np.allclose(c[2], c[3], atol=1e-6)  # length does not matter
+    assert not np.allclose(c[0], c[3])
+
+
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("length", [1e-310, 1e-200, 1e-20, 1e-15, 1e-7, 1e7, 1e20, 1e300])
+def test_normals_of_any_finite_length_are_directions(precision, length):
+    direction = unit([0.3, -0.2, 1.0])
+    N = np.array([direction, direction * length, [0.0, 0.0, 0.0]])
+    c = explorer.shade(HARD, np.zeros((3, 3)), N, precision=precision)
+    check_finite_in_range(c)
+    assert np.allclose(c[1], c[0], atol=1e-6), length  # same direction, same colour
+    assert not np.allclose(c[2], c[0])  # an all-zero normal is still absent
+    ref = equation_shade(load_scene(HARD), np.zeros((3, 3)), N)  # the spec agrees
+    assert np.allclose(ref[1], ref[0], atol=1e-9) and np.allclose(ref[:2], c[:2], atol=1e-4)
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 def test_nan_or_inf_input_names_the_vertex(bad):
     P = np.zeros((5, 3))
     P[3, 1] = bad
-    with pytest.raises(ExplorerError, match=r"positions\[3\] is not finite"):
+    with pytest.raises(ValueError, match=r"positions\[3\] is not finite"):
         explorer.shade(HARD, P, np.ones((5, 3)))
     with pytest.raises(ExplorerError, match=r"normals\[3\]"):
         explorer.shade(HARD, np.zeros((5, 3)), P)
