@@ -47,6 +47,9 @@ BUILTIN_MESHES: tuple[str, ...] = tuple(RESOLUTION)
 #: default mesh of a scene without one
 DEFAULT_MESH = "sphere"
 
+#: mesh sizes (largest half-extent) whose normals are computed where the mesh is; outside, the
+#: squared coordinates in a cross product could overflow or underflow
+NORMALS_IN_PLACE = (1e-100, 1e100)
 #: file suffixes :func:`load_mesh` is meant for (trimesh may read more)
 MESH_SUFFIXES = (".obj", ".stl", ".ply", ".off", ".glb", ".gltf")
 
@@ -153,6 +156,11 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     positions = np.asarray(positions, np.float64)
     faces = np.asarray(faces, np.int64).reshape(-1, 3)
     acc = np.zeros((len(positions), 3))
+    centre, scale = frame_of(positions)
+    if not NORMALS_IN_PLACE[0] < scale < NORMALS_IN_PLACE[1]:
+        # cross products of coordinates near 1e308 overflow, near 1e-300 underflow: take them
+        # in the normalised frame (same directions, same relative areas)
+        positions = (positions - centre) / scale
     cross = _face_cross(positions, faces)  # |cross| = 2·area, direction = face normal
     for k in range(3):
         np.add.at(acc, faces[:, k], cross)

@@ -484,3 +484,15 @@ def test_a_valid_triangle_at_any_scale_is_not_degenerate(tmp_path, s, normals):
         assert M.has_area(pos, np.array([[0, 1, 2]])).tolist() == [True]
     flat = np.array([(-s, 0.0, 0.0), (0.0, 0.0, 0.0), (s, 0.0, 0.0)])
     assert M.has_area(flat, np.array([[0, 1, 2]])).tolist() == [False]
+
+
+@pytest.mark.parametrize("size", [1e308, 1e-300])
+def test_smooth_normals_of_a_mesh_at_any_scale(size):
+    """Area-weighted normals of a tetrahedron scaled to 1e308 or 1e-300 equal the unit-size
+    ones (the cross products would overflow or underflow where the mesh is)."""
+    tet = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    faces = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    expected = M.area_weighted_normals(tet, faces)
+    got = M.area_weighted_normals(tet * (size / 2.0), faces)
+    assert np.isfinite(got).all()
+    assert np.allclose(got, expected, atol=1e-12)
