@@ -40,7 +40,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import angles_of, direction_of
 from explorer.core.material import Material
 from explorer.core.presets import MAX_NAME_LENGTH, list_presets, save_preset, user_dir
-from explorer.core.scene import Scene, Viewer
+from explorer.core.scene import Scene, Viewer, check_materials_dirs
 from explorer.geometry.meshes import Mesh, area_weighted_normals, get_mesh
 from explorer.render.camera import Camera, apply_camera, back_to_front, camera_for, camera_from_vtk
 from explorer.render.images import encode_png
@@ -351,7 +351,7 @@ class Explorer:
         lod_target: int = LOD_TARGET,
         background=None,
     ):
-        self.materials_dirs = tuple(materials_dirs)
+        self.materials_dirs = check_materials_dirs(materials_dirs)
         self.state_file = Path(state_file) if state_file else None
         self.output_dir = Path(output_dir) if output_dir else Path.cwd()
         self.preset_dir = preset_dir

@@ -11,6 +11,7 @@ keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 
@@ -65,9 +66,15 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:  # plain ``phong-explorer`` opens the window
         args = parser.parse_args(["gui"])
     try:
-        return int(args._run(args) or 0)
+        status = int(args._run(args) or 0)
+        sys.stdout.flush()  # here, so a reader that went away is met below, not at exit
+        return status
     except ExplorerError as exc:
         print(f"error: {printable(exc, keep=chr(10))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         return 130
+    except BrokenPipeError:  # the reader went away (``| head``): stop quietly, as cat does
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so the interpreter's final flush cannot fail
+        return 141

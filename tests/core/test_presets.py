@@ -610,3 +610,21 @@ def test_a_directory_named_like_a_preset_is_said_to_be_one(tmp_path, capsys):
     assert "did you mean" not in msg
     assert main(["presets", "show", "shiny", "--materials", str(tmp_path)]) == 2
     assert "is a directory" in capsys.readouterr().err
+
+
+def test_listing_into_a_closed_pipe_ends_quietly(tmp_path):
+    """``phong-explorer presets | head -1``: the reader goes away after one line; the command
+    stops without a BrokenPipeError traceback."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    r = subprocess.run(
+        f"{sys.executable} -m explorer.cli presets | head -1",
+        shell=True,
+        capture_output=True,
+        text=True,
+        env=env,
+    )
+    assert r.stdout.count("\n") == 1
+    assert "Traceback" not in r.stderr and "BrokenPipe" not in r.stderr, r.stderr
