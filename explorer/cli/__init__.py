@@ -4,14 +4,19 @@ May import every other part of the package; nothing imports it. Each subcommand 
 own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
 ``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
 User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
-block on stderr, exit status 2, no traceback.
+block on stderr, exit status 2, no traceback. SIGTERM (every command but ``gui``, whose window
+loop would hold it back) raises :class:`Terminated`, so that the writer's cleanup runs: the
+command stops with one ``error:`` line, exit status 143, and leaves no temporary file.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
+import threading
 import warnings
+from contextlib import contextmanager
 
 from explorer.cli import bench, gui, plan, presets, render, sheet
 from explorer.core.errors import ExplorerError, Notice
@@ -56,6 +61,33 @@ def _show_notices() -> None:
     warnings.showwarning = show
 
 
+#: exit status after SIGTERM (the shell's 128 + signal number)
+TERMINATED_STATUS = 128 + signal.SIGTERM
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread like Ctrl-C so that every ``finally`` runs (the
+    atomic writer removes its temporary files)."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated()
+
+
+@contextmanager
+def _sigterm_raises(enabled: bool = True):
+    """While inside, SIGTERM raises :class:`Terminated` (main thread only; the previous handler
+    is restored on the way out)."""
+    if not enabled or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     _show_notices()
     parser = build_parser()
@@ -63,9 +95,13 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:  # plain ``phong-explorer`` opens the window
         args = parser.parse_args(["gui"])
     try:
-        return int(args._run(args) or 0)
+        with _sigterm_raises(enabled=args.command != "gui"):
+            return int(args._run(args) or 0)
     except ExplorerError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("error: terminated (SIGTERM); no unfinished file was left", file=sys.stderr)
+        return TERMINATED_STATUS
     except KeyboardInterrupt:
         return 130
