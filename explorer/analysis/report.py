@@ -461,10 +461,19 @@ def _per_pixel_finding(table: dict) -> str | None:
 
 
 def plot(table: dict, path, *, overwrite: bool = False) -> bool:
-    """Draw accuracy.png: error against time per frame for each material, the Pareto
-    front marked; written atomically to ``path`` (an existing file only with ``overwrite``).
-    Returns False (and writes nothing) when matplotlib is not installed (it is the optional
-    ``bench`` extra)."""
+    """Draw accuracy.png (:func:`plot_png`), written atomically to ``path`` (an existing file
+    only with ``overwrite``). Returns False (and writes nothing) when matplotlib is not
+    installed (it is the optional ``bench`` extra)."""
+    png = plot_png(table)
+    if png is None:
+        return False
+    write_atomic(path, png, overwrite=overwrite)
+    return True
+
+
+def plot_png(table: dict) -> bytes | None:
+    """The PNG bytes of accuracy.png: error against time per frame for each material, the
+    Pareto front marked; None when matplotlib is not installed."""
     try:  # the optional ``bench`` extra, imported only to draw
         import matplotlib
 
@@ -472,7 +481,7 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
         import matplotlib.pyplot as plt
         from matplotlib.ticker import FuncFormatter, NullFormatter
     except ImportError:
-        return False
+        return None
     plain = FuncFormatter(lambda x, _pos: f"{x:g}")
     main = table["main_side"]
     labels = [x["label"] for x in table["scene"]["materials"]]
@@ -533,9 +542,7 @@ def plot(table: dict, path, *, overwrite: bool = False) -> bool:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90)
     plt.close(fig)
-
-    write_atomic(path, buf.getvalue(), overwrite=overwrite)
-    return True
+    return buf.getvalue()
 
 
 def table_bytes(table: dict) -> bytes:

@@ -5,15 +5,21 @@ own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
 ``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
 User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
 block on stderr, exit status 2, no traceback; text a terminal would act on (from file names,
-keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`).
+keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`). SIGTERM (every
+command but ``gui``, whose window loop would hold it back) raises :class:`Terminated`, so that
+the writer's cleanup runs: the command stops with one ``error:`` line, exit status 143, and
+leaves no temporary file.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 import warnings
+from contextlib import contextmanager
 
 from explorer.cli import bench, gui, plan, presets, render, sheet
 from explorer.core.errors import ExplorerError, Notice
@@ -59,6 +65,33 @@ def _show_notices() -> None:
     warnings.showwarning = show
 
 
+#: exit status after SIGTERM (the shell's 128 + signal number)
+TERMINATED_STATUS = 128 + signal.SIGTERM
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread like Ctrl-C so that every ``finally`` runs (the
+    atomic writer removes its temporary files)."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated()
+
+
+@contextmanager
+def _sigterm_raises(enabled: bool = True):
+    """While inside, SIGTERM raises :class:`Terminated` (main thread only; the previous handler
+    is restored on the way out)."""
+    if not enabled or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     _show_notices()
     parser = build_parser()
@@ -66,12 +99,16 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:  # plain ``phong-explorer`` opens the window
         args = parser.parse_args(["gui"])
     try:
-        status = int(args._run(args) or 0)
-        sys.stdout.flush()  # here, so a reader that went away is met below, not at exit
+        with _sigterm_raises(enabled=args.command != "gui"):
+            status = int(args._run(args) or 0)
+            sys.stdout.flush()  # here, so a reader that went away is met below, not at exit
         return status
     except ExplorerError as exc:
         print(f"error: {printable(exc, keep=chr(10))}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("error: terminated (SIGTERM); no unfinished file was left", file=sys.stderr)
+        return TERMINATED_STATUS
     except KeyboardInterrupt:
         return 130
     except BrokenPipeError:  # the reader went away (``| head``): stop quietly, as cat does

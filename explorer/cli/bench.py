@@ -11,8 +11,9 @@ Per-vertex shading of sphere tessellations against the per-pixel reference
 ``--out-dir DIR`` (which must exist): ``accuracy.json`` (the measured table),
 ``accuracy.png`` (the plot) and ``accuracy.md`` (the report, linking the plot). It checks
 before measuring that none of them exists, and replaces existing ones only with ``--force``;
-every file is written atomically. It never writes anywhere else: not into the installed
-package, not into a source checkout it runs from.
+the three are written all-or-nothing (if one cannot be written, none of the new files is
+left and the old ones stay), so a failed run can be re-run as it was. It never writes
+anywhere else: not into the installed package, not into a source checkout it runs from.
 
 The copies published with the project are made by the maintainer in a source checkout::
 
@@ -33,8 +34,8 @@ import sys
 from pathlib import Path
 
 from explorer.analysis.benchmark import BenchConfig, Progress, run_bench
-from explorer.analysis.report import markdown, plot, table_bytes
-from explorer.core.atomic import write_atomic
+from explorer.analysis.report import markdown, plot_png, table_bytes
+from explorer.core.atomic import write_all_atomic
 from explorer.core.errors import ExplorerError
 
 #: bench -> one-line help
@@ -103,18 +104,21 @@ def run_accuracy(args) -> int:
     command = "phong-explorer bench accuracy" + (" --quick" if args.quick else "")
     table = run_bench(config, progress=Progress())
     table["command"] = command
-    write_atomic(paths["json"], table_bytes(table), overwrite=args.force)
+    files = {paths["json"]: table_bytes(table)}
+    png = plot_png(table)
+    if png is not None:
+        files[paths["png"]] = png
+    rel = os.path.relpath(paths["png"], paths["md"].parent) if png is not None else None
+    files[paths["md"]] = markdown(table, plot=rel, command=command).encode("utf-8")
+    # all-or-nothing: a failure leaves none of the new files and the old ones as they were
+    write_all_atomic(files, overwrite=args.force)
     print(f"wrote {paths['json']}: {len(table['rows'])} rows")
-    drawn = plot(table, paths["png"], overwrite=args.force)
-    if drawn:
+    if png is not None:
         print(f"wrote {paths['png']}")
     else:
         print(
             "plot skipped: matplotlib is not installed (pip install 'phong-explorer[bench]')",
             file=sys.stderr,
         )
-    rel = os.path.relpath(paths["png"], paths["md"].parent) if drawn else None
-    text = markdown(table, plot=rel, command=command)
-    write_atomic(paths["md"], text.encode("utf-8"), overwrite=args.force)
     print(f"wrote {paths['md']}")
     return 0

@@ -4,15 +4,59 @@ One mechanism for every file the project writes (presets, renders, meshes, repor
 file in the target directory, flushed to disk and renamed into place, so a reader sees the old
 file or the complete new one, never a torn one; without ``overwrite`` the rename is a hard link,
 which fails if the target appeared in the meantime.
+
+Leftovers: an interrupted write removes its temporary file (the CLI turns SIGTERM into an
+exception so that this cleanup runs); a temporary file that survived anyway (``kill -9``, power
+loss) is swept by the next write into the same directory once it is older than
+:data:`STALE_TEMP_AGE`. :func:`write_all_atomic` writes several files all-or-nothing.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import stat
 import tempfile
+import time
+from collections.abc import Mapping
 from pathlib import Path
 
 from explorer.core.errors import ExplorerError
+
+#: A temporary file of this module's naming older than this (seconds) is a leftover of a killed
+#: run: the next write into its directory removes it. A live write keeps touching its file and
+#: takes well under a second per file, so a minute never catches one in progress.
+STALE_TEMP_AGE = 60.0
+#: The temporaries' names: ``.<target name>.<8 random characters of mkstemp>.tmp``.
+TEMP_NAME = re.compile(r"\..+\.[a-z0-9_]{8}\.tmp")
+
+
+def sweep_stale_temps(directory, *, now: float | None = None) -> list[Path]:
+    """Remove leftover temporaries of :func:`write_atomic` in ``directory``: regular files (not
+    symlinks) named like :data:`TEMP_NAME`, owned by this user, last modified more than
+    :data:`STALE_TEMP_AGE` seconds ago. Returns the files removed; never raises for a file
+    it cannot remove or a directory it cannot list."""
+    now = time.time() if now is None else now
+    uid = os.getuid() if hasattr(os, "getuid") else None
+    removed = []
+    try:
+        entries = list(os.scandir(directory))
+    except OSError:
+        return removed
+    for entry in entries:
+        if not TEMP_NAME.fullmatch(entry.name):
+            continue
+        try:
+            st = entry.stat(follow_symlinks=False)
+            if not stat.S_ISREG(st.st_mode) or (uid is not None and st.st_uid != uid):
+                continue
+            if now - st.st_mtime <= STALE_TEMP_AGE:
+                continue
+            os.unlink(entry.path)
+        except OSError:
+            continue
+        removed.append(Path(entry.path))
+    return removed
 
 
 def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool = False) -> Path:
@@ -37,14 +81,11 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
             ) from None
     elif not parent.is_dir():
         raise ExplorerError(f"{target}: directory {str(parent)!r} does not exist")
+    sweep_stale_temps(parent)
     tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=parent)
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
+        tmp = _new_temp(target)
+        _fill(tmp, data)
         if overwrite:
             os.replace(tmp, target)
         else:
@@ -62,6 +103,101 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
             except OSError:
                 pass
     return target
+
+
+def write_all_atomic(files: Mapping, *, overwrite: bool = False) -> list[Path]:
+    """Write several files all-or-nothing: ``files`` maps each path to its bytes.
+
+    Every file is first written to a temporary beside its target; only when all of them are
+    on disk are they renamed into place. If anything fails (a full disk, a target that
+    appeared, an interrupt) no new file is left and the files that were there before are
+    back as they were. Returns the paths written, in the order given. Each target's directory
+    must exist; ``overwrite`` as for :func:`write_atomic`.
+    """
+    targets = [(Path(os.fspath(p)), data) for p, data in files.items()]
+    for target, _ in targets:
+        if target.is_dir():
+            raise ExplorerError(f"{target}: is a directory; give a file name to write")
+        if target.exists() and not overwrite:
+            raise exists_error(target)
+        if not target.parent.is_dir():
+            raise ExplorerError(f"{target}: directory {str(target.parent)!r} does not exist")
+    for parent in {t.parent for t, _ in targets}:
+        sweep_stale_temps(parent)
+    temps: dict[Path, str] = {}  # target -> its new contents, not yet in place
+    backups: dict[Path, str] = {}  # target -> a hard link to the file it replaces
+    placed: list[Path] = []
+    current = None
+    try:
+        for current, data in targets:
+            temps[current] = _new_temp(current)
+            _fill(temps[current], data)
+        for current, _ in targets:
+            if overwrite and current.exists():
+                backups[current] = _backup(current)
+            if overwrite:
+                os.replace(temps[current], current)
+            else:
+                _link_no_clobber(temps[current], current)
+            del temps[current]
+            placed.append(current)
+        for parent in {t.parent for t, _ in targets}:
+            _fsync_dir(parent)
+    except BaseException as exc:
+        _roll_back(placed, backups)
+        if isinstance(exc, OSError):
+            raise ExplorerError(f"{current}: cannot write: {exc.strerror or exc}") from None
+        raise
+    finally:
+        for tmp in list(temps.values()) + list(backups.values()):
+            _unlink_quietly(tmp)
+    return [t for t, _ in targets]
+
+
+def _roll_back(placed: list[Path], backups: dict[Path, str]) -> None:
+    """Undo the renames of :func:`write_all_atomic`: old files back, new ones removed."""
+    for target in reversed(placed):
+        try:
+            if target in backups:
+                os.replace(backups.pop(target), target)
+            else:
+                os.unlink(target)
+        except OSError:
+            pass
+
+
+def _backup(target: Path) -> str:
+    """A hard link (or, where there are none, a copy) of ``target`` under a temporary name."""
+    tmp = _new_temp(target)
+    try:
+        os.unlink(tmp)
+        os.link(target, tmp)
+    except OSError:
+        _fill(tmp, target.read_bytes())
+    return tmp
+
+
+def _new_temp(target: Path) -> str:
+    """A new empty temporary file beside ``target`` (named like :data:`TEMP_NAME`)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    return tmp
+
+
+def _fill(tmp: str, data: bytes) -> None:
+    """Write ``data`` to the file ``tmp``, flush it to disk, give it the usual permissions."""
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.chmod(tmp, 0o666 & ~_umask())
+
+
+def _unlink_quietly(path) -> None:
+    try:
+        os.unlink(path)
+    except OSError:
+        pass
 
 
 def exists_error(target: Path) -> ExplorerError:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -30,7 +31,7 @@ from explorer.core.errors import ExplorerError, Notice, ValidationError
 from explorer.core.material import Material, parse_material
 from explorer.core.validate import Checker, suggest
 from explorer.core.version import __version__
-from explorer.core.yamlio import dump_yaml, load_yaml
+from explorer.core.yamlio import dump_yaml, file_kind, load_yaml
 
 #: Environment variable overriding the user's preset directory (used by the tests).
 ENV_VAR = "PHONG_EXPLORER_MATERIALS"
@@ -155,8 +156,23 @@ def _scan(dirs, notices) -> dict[str, list[tuple[Path, str]]]:
                     "digits and '_')",
                 )
                 continue
+            kind = _not_a_regular_file(path)
+            if kind is not None:
+                _notice(notices, f"{path}: ignored, it is {kind}, not a preset file")
+                continue
             found.setdefault(path.stem, []).append((path, source))
     return found
+
+
+def _not_a_regular_file(path: Path) -> str | None:
+    """What ``path`` is when it is not a regular file (following symlinks), else None. Only
+    ``stat``: a FIFO is never opened, so scanning never blocks. A file that cannot be
+    examined is kept (loading it reports why)."""
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return None
+    return None if stat.S_ISREG(mode) else file_kind(mode)
 
 
 def list_presets(materials_dirs: Iterable = (), *, notices: list | None = None) -> list[PresetInfo]:

@@ -126,3 +126,19 @@ FLOAT32_ROUTE_ABS_TOL = 1e-6
 #: below this. A change of 0.001 in one coefficient of a preset moves its colours by about 1e-3,
 #: far above it; one 8-bit level is 4e-3.
 GOLDEN_COLOR_ABS_TOL = 1e-9
+
+# --- caps on what a small input may make the program allocate ------------------------------
+
+#: Largest mesh file read (bytes). The largest meshes worth shading per vertex are a few
+#: million triangles, about 100 MiB as binary STL/PLY; a bigger file would take minutes and
+#: gigabytes before any error, so it is refused before it is read.
+MAX_MESH_FILE_BYTES = 256 << 20
+#: Largest total a compressed mesh file (a zip, bz2 or gzip archive, which trimesh unpacks in
+#: memory) may unpack to (bytes): a 2 MB zip can hold gigabytes of text. Zip members are
+#: checked by their declared sizes before anything is unpacked (reading stops at the declared
+#: size); bz2 and gzip streams are counted while unpacking and abandoned past the cap.
+MAX_MESH_UNPACKED_BYTES = 256 << 20
+#: Largest picture (width x height pixels) a render or a whole sheet may have: 8192 x 8192,
+#: 192 MiB as RGB bytes and several times that inside VTK while drawing. A sheet of large
+#: tiles is checked before anything is allocated (beyond it VTK aborts with std::bad_alloc).
+MAX_PICTURE_PIXELS = 8192 * 8192

@@ -12,7 +12,8 @@ Every document a user gives the explorer (scene files, material presets) is read
 What is refused (each as a :class:`~explorer.core.errors.ValidationError` naming file, line and key,
 all problems of one document in one pass; YAML syntax errors stop at the first one):
 
-* a missing or unreadable file, a directory, more than :data:`MAX_BYTES` bytes;
+* a missing or unreadable file, a directory, a FIFO, socket or device (never opened in a
+  way that could block), more than :data:`MAX_BYTES` bytes;
 * bytes that are not UTF-8 (the message gives the byte offset), control characters;
 * an empty document, or several documents in one file;
 * duplicate keys (PyYAML silently keeps the last one; here it is an error naming both lines);
@@ -36,6 +37,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
@@ -163,14 +165,11 @@ def parse_yaml(
 
 
 def _read_bytes(name: str, what: str) -> bytes:
+    """The bytes of the regular file ``name``. It is opened without blocking (a FIFO would
+    wait for a writer forever) and refused unless it is a regular file (a FIFO, socket or
+    device is named as such), or when larger than :data:`MAX_BYTES`."""
     try:
-        with open(name, "rb") as fh:
-            raw = fh.read(MAX_BYTES + 1)
-            if len(raw) > MAX_BYTES:
-                # a device or a pipe has no size (0 from stat): say what was read
-                size = os.fstat(fh.fileno()).st_size
-                _fail(name, None, _too_big(size if size > MAX_BYTES else None))
-            return raw
+        fd = os.open(name, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except FileNotFoundError:
         _fail(name, None, f"cannot read {what}: no such file")
     except IsADirectoryError:
@@ -181,6 +180,35 @@ def _read_bytes(name: str, what: str) -> bytes:
         if os.path.isdir(name):
             _fail(name, None, f"cannot read {what}: it is a directory, not a file")
         _fail(name, None, f"cannot read {what}: {exc.strerror or exc}")
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            _fail(name, None, f"cannot read {what}: it is {file_kind(st.st_mode)}, not a file")
+        if st.st_size > MAX_BYTES:
+            _fail(name, None, _too_big(st.st_size))
+    except BaseException:
+        os.close(fd)
+        raise
+    with os.fdopen(fd, "rb") as fh:
+        try:
+            raw = fh.read(MAX_BYTES + 1)
+        except OSError as exc:
+            _fail(name, None, f"cannot read {what}: {exc.strerror or exc}")
+        if len(raw) > MAX_BYTES:  # it grew since fstat
+            _fail(name, None, _too_big(len(raw)))
+        return raw
+
+
+def file_kind(mode: int) -> str:
+    """What a file that is not a regular file is, for messages ("a FIFO (named pipe)")."""
+    kinds = (
+        (stat.S_ISFIFO, "a FIFO (named pipe)"),
+        (stat.S_ISSOCK, "a socket"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISDIR, "a directory"),
+    )
+    return next((text for test, text in kinds if test(mode)), "not a regular file")
 
 
 def _decode(raw: bytes, file: str | None) -> str:

@@ -23,11 +23,16 @@ Every array of a :class:`Mesh` is read-only.
 
 from __future__ import annotations
 
+import bz2
+import gzip
 import os
+import stat
+import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
@@ -459,6 +464,56 @@ _BUILDERS = {
 # -- files ---------------------------------------------------------------------------------
 
 
+def check_mesh_file_size(path) -> None:
+    """Refuse, before anything is read or unpacked, a mesh file that is not a regular file
+    (a FIFO would block), is empty, is larger than ``MAX_MESH_FILE_BYTES``, or is an archive
+    unpacking to more than ``MAX_MESH_UNPACKED_BYTES`` (see
+    :mod:`explorer.core.tolerances`): an :class:`ExplorerError` naming the file and the cap."""
+    path = os.fspath(path)
+    mode = os.stat(path).st_mode
+    if not stat.S_ISREG(mode):
+        raise ExplorerError(f"mesh file '{path}' is not a regular file (a FIFO, socket or device)")
+    size = os.path.getsize(path)
+    if size == 0:
+        raise ExplorerError(f"mesh file '{path}' is empty")
+    if size > tol.MAX_MESH_FILE_BYTES:
+        raise ExplorerError(
+            f"mesh file '{path}' is too large: {size} bytes, the limit is "
+            f"{tol.MAX_MESH_FILE_BYTES} bytes ({tol.MAX_MESH_FILE_BYTES >> 20} MiB)"
+        )
+    unpacked = _unpacked_size(path, tol.MAX_MESH_UNPACKED_BYTES)
+    if unpacked is not None and unpacked > tol.MAX_MESH_UNPACKED_BYTES:
+        raise ExplorerError(
+            f"mesh file '{path}' is an archive that unpacks to more than "
+            f"{tol.MAX_MESH_UNPACKED_BYTES} bytes ({tol.MAX_MESH_UNPACKED_BYTES >> 20} MiB), "
+            "the limit for a mesh; unpack it yourself if it is really meant"
+        )
+
+
+def _unpacked_size(path: str, cap: int) -> int | None:
+    """The size an archive unpacks to (zip: the declared sizes; bz2 / gzip: counted while
+    unpacking, stopping once past ``cap``); None for a file that is no archive."""
+    with open(path, "rb") as fh:
+        magic = fh.read(3)
+    try:
+        if zipfile.is_zipfile(path):
+            with zipfile.ZipFile(path) as archive:
+                return sum(info.file_size for info in archive.infolist())
+        opener = {b"BZh": bz2.open, b"\x1f\x8b\x08": gzip.open}.get(magic)
+        if opener is None:
+            return None
+        total = 0
+        with opener(path, "rb") as stream:
+            while total <= cap:
+                chunk = stream.read(1 << 20)
+                if not chunk:
+                    break
+                total += len(chunk)
+        return total
+    except (OSError, EOFError, zipfile.BadZipFile, ValueError):
+        return None  # a damaged archive: the loader reports it
+
+
 def load_mesh(path) -> Mesh:
     """Read a triangle mesh with trimesh (OBJ, STL, PLY, OFF, GLB, ...).
 
@@ -467,7 +522,8 @@ def load_mesh(path) -> Mesh:
     (renormalised); a file without them gets vertices welded by position and smooth
     area-weighted normals. Vertices no triangle uses are dropped.
 
-    A missing, unreadable or empty file, or one holding no triangles (a point cloud, a
+    A missing, unreadable or empty file, one that is too large or unpacks to too much
+    (:func:`check_mesh_file_size`), or one holding no triangles (a point cloud, a
     drawing), raises an :class:`ExplorerError` naming the file and the reason.
     """
     path = os.fspath(path)
@@ -478,8 +534,7 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(f"mesh file '{shown}' is a directory, not a mesh file")
     if not os.access(path, os.R_OK):
         raise ExplorerError(f"mesh file '{shown}' cannot be read (permission denied)")
-    if os.path.getsize(path) == 0:
-        raise ExplorerError(f"mesh file '{shown}' is empty")
+    check_mesh_file_size(path)
     import logging
 
     import trimesh

@@ -8,6 +8,7 @@ import re
 import numpy as np
 
 from explorer.core.errors import ExplorerError
+from explorer.core.tolerances import MAX_PICTURE_PIXELS
 
 #: default image size (width, height)
 DEFAULT_SIZE = (400, 400)
@@ -30,7 +31,18 @@ def check_size(size) -> tuple[int, int]:
         raise ExplorerError(
             f"image size must be two whole numbers of pixels, each in [{lo}, {hi}], got {size!r}"
         )
+    check_picture_pixels(w, h, "image size")
     return w, h
+
+
+def check_picture_pixels(width: int, height: int, what: str) -> None:
+    """An :class:`ExplorerError` naming ``what`` when a ``width`` x ``height`` picture is more
+    than :data:`~explorer.core.tolerances.MAX_PICTURE_PIXELS`; call it before allocating."""
+    if width * height > MAX_PICTURE_PIXELS:
+        raise ExplorerError(
+            f"{what}: {width}x{height} is {width * height} pixels, more than the limit of "
+            f"{MAX_PICTURE_PIXELS} (8192x8192); use a smaller size"
+        )
 
 
 _SIZE_RE = re.compile(r"^\s*(\d+)\s*[xX×]\s*(\d+)\s*$")

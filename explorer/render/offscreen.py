@@ -29,7 +29,7 @@ import numpy as np
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera, Vec3, back_to_front, camera_for
-from explorer.render.images import DEFAULT_SIZE, check_size
+from explorer.render.images import DEFAULT_SIZE, check_picture_pixels, check_size
 from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import to_bytes, vertex_colors
 
@@ -249,8 +249,12 @@ def sheet(
     tw, th = check_size(tile)
     columns = max(1, min(int(columns), len(items)))
     rows = -(-len(items) // columns)
+    height, width = rows * th + (rows + 1) * gap, columns * tw + (columns + 1) * gap
+    check_picture_pixels(
+        width, height, f"sheet of {len(items)} tiles of {tw}x{th} in {columns} columns"
+    )
     bg = to_bytes([background])[0]
-    out = np.empty((rows * th + (rows + 1) * gap, columns * tw + (columns + 1) * gap, 3), np.uint8)
+    out = np.empty((height, width, 3), np.uint8)
     out[:] = bg
     with OffscreenRenderer((tw, th), background) as r:
         font = r.label_font_size(str(label) for label, _ in items)

@@ -7,6 +7,7 @@ import io
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -164,6 +165,75 @@ def test_plot_is_skipped_without_matplotlib(fake_bench, tmp_path, monkeypatch, c
     assert not (tmp_path / "accuracy.png").exists()
     doc = (tmp_path / "accuracy.md").read_text()
     assert "![" not in doc and "## Findings" in doc
+
+
+@pytest.mark.parametrize("force", [False, True])
+def test_bench_outputs_are_all_or_nothing(fake_bench, tmp_path, monkeypatch, capsys, force):
+    """The plot fails after the table was measured (a full disk, a broken matplotlib): no new
+    file is left, old files stay, and the same command can simply be run again."""
+    if force:
+        (tmp_path / "accuracy.json").write_bytes(b"old")
+    args = ["bench", "accuracy", "--out-dir", str(tmp_path)] + (["--force"] if force else [])
+
+    def broken(table):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(cli_bench, "plot_png", broken)
+    with pytest.raises(OSError):
+        main(args)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == (
+        {"accuracy.json": b"old"} if force else {}
+    )
+    monkeypatch.undo()
+    monkeypatch.setattr(cli_bench, "run_bench", lambda config, progress=None: dict(TABLE))
+    assert main(args) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "accuracy.json",
+        "accuracy.md",
+        "accuracy.png",
+    ]
+
+
+_SIGTERM_DRIVER = """
+import os, sys, time
+from explorer.analysis.advice import load_table
+from explorer.cli import bench, main
+
+real_fsync = os.fsync
+
+def slow_fsync(fd):  # the first temporary file is on disk: hold the write there
+    real_fsync(fd)
+    print("writing", flush=True)
+    time.sleep(60)
+
+os.fsync = slow_fsync
+bench.plot_png = lambda table: b"png"
+bench.run_bench = lambda config, progress=None: load_table()
+sys.exit(main(["bench", "accuracy", "--out-dir", sys.argv[1]]))
+"""
+
+
+def test_sigterm_during_a_write_leaves_no_temporary(tmp_path):
+    import os
+    import signal
+
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _SIGTERM_DRIVER, str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])},
+    )
+    try:
+        assert proc.stdout.readline() == "writing\n"
+        assert any(tmp_path.iterdir())  # the temporary file
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143
+    assert err.strip().splitlines() == ["error: terminated (SIGTERM); no unfinished file was left"]
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_import_stays_light():

@@ -3,8 +3,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import io
 import os
+import signal
 import tempfile
 import warnings
 from pathlib import Path
@@ -243,6 +245,56 @@ def test_files_that_are_not_preset_names_are_ignored_with_a_notice(isolated_user
     names = {p.name for p in list_presets(notices=notices)}
     assert "My Gold" not in names and "notes" not in names
     assert len(notices) == 1 and "My Gold" in notices[0]
+
+
+class Blocked(Exception):
+    """Raised by :func:`within` (not an OSError: the code under test must not swallow it)."""
+
+
+@contextlib.contextmanager
+def within(seconds: float):
+    """Fail (instead of hanging the suite) when the body blocks for more than ``seconds``."""
+
+    def blocked(signum, frame):
+        raise Blocked(f"blocked for more than {seconds} s")
+
+    previous = signal.signal(signal.SIGALRM, blocked)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def test_a_fifo_named_like_a_preset_is_skipped_not_opened(tmp_path, isolated_user_dir, capsys):
+    """A FIFO waits for a writer forever when opened: scanning only stats, skips it with a
+    notice; the presets next to it are still listed."""
+    write(isolated_user_dir / "my_gold.yaml", GOLDISH)
+    os.mkfifo(isolated_user_dir / "pipe.yaml")
+    extra = tmp_path / "extra"
+    extra.mkdir()
+    os.mkfifo(extra / "other.yaml")
+    notices: list = []
+    with within(10):
+        names = {p.name for p in list_presets([extra], notices=notices)}
+        assert main(["presets", "--materials-dir", str(extra)]) == 0
+    assert "my_gold" in names and "pipe" not in names and "other" not in names
+    assert sum("FIFO" in n and "ignored" in n for n in notices) == 2
+    captured = capsys.readouterr()
+    assert "my_gold" in captured.out and "pipe.yaml: ignored, it is a FIFO" in captured.err
+
+
+@pytest.mark.parametrize("special", ["fifo", "/dev/null"])
+def test_a_special_file_named_directly_is_refused_without_blocking(tmp_path, special):
+    path = tmp_path / "pipe.yaml"
+    if special == "fifo":
+        os.mkfifo(path)
+    else:
+        path = Path(special)
+    kind = "FIFO" if special == "fifo" else "character device"
+    with within(10), pytest.raises(ValidationError, match=f"it is a {kind}.*, not a file"):
+        load_material_file(path)
 
 
 def test_unknown_preset_suggests_and_says_where_it_looked(tmp_path):
@@ -594,11 +646,12 @@ def test_hostile_keys_and_file_names_are_escaped_in_problems_and_notices(capsys,
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/urandom"), reason="no /dev/urandom")
-def test_a_device_as_a_preset_file_is_too_large_not_zero_bytes():
+def test_a_device_as_a_preset_file_is_named_as_such_not_zero_bytes():
+    """/dev/urandom has no size (stat says 0): it is refused as a device, never read."""
     with pytest.raises(ValidationError) as exc:
         load_material_file("/dev/urandom")
     msg = str(exc.value)
-    assert f"more than {MAX_BYTES} bytes" in msg and " 0 bytes" not in msg
+    assert "character device" in msg and " 0 bytes" not in msg
 
 
 def test_a_directory_named_like_a_preset_is_said_to_be_one(tmp_path, capsys):

@@ -496,3 +496,69 @@ def test_smooth_normals_of_a_mesh_at_any_scale(size):
     got = M.area_weighted_normals(tet * (size / 2.0), faces)
     assert np.isfinite(got).all()
     assert np.allclose(got, expected, atol=1e-12)
+
+
+# -- caps on what a small file may make the loader read or unpack (issue 19) ------------------
+def _obj_text(copies: int) -> bytes:
+    """A valid OBJ: ``copies`` triangles (about 60 bytes each)."""
+    lines = []
+    for i in range(copies):
+        lines += [
+            f"v {i} 0 0",
+            f"v {i} 1 0",
+            f"v {i} 0 1",
+            f"f {3 * i + 1} {3 * i + 2} {3 * i + 3}",
+        ]
+    return ("\n".join(lines) + "\n").encode()
+
+
+@pytest.mark.parametrize("kind", ["zip", "bz2"])
+def test_an_archive_unpacking_beyond_the_cap_is_refused_before_unpacking(
+    tmp_path, monkeypatch, kind
+):
+    """A small archive holding much more text (a 2 MB zip of 2 GiB took 45 s and 6.5 GB):
+    refused by its declared (zip) or counted (bz2) size, naming the file and the cap. The cap
+    is lowered here so that the test archive stays small; the file itself is a valid mesh."""
+    import bz2
+    import zipfile
+
+    from explorer.core import tolerances
+
+    text = _obj_text(40_000)  # ~2 MiB unpacked
+    path = tmp_path / f"bomb.{kind}"
+    if kind == "zip":
+        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+            archive.writestr("bomb.obj", text)
+    else:
+        path = tmp_path / "bomb.obj.bz2"
+        path.write_bytes(bz2.compress(text))
+    assert path.stat().st_size < 1 << 20  # the file itself is within the file-size cap
+    monkeypatch.setattr(tolerances, "MAX_MESH_UNPACKED_BYTES", 1 << 20, raising=False)
+    with pytest.raises(ExplorerError, match=r"bomb.*unpacks to more than 1048576 bytes \(1 MiB\)"):
+        M.load_mesh(path)
+
+
+def test_a_mesh_file_beyond_the_size_cap_is_refused_before_reading(tmp_path, monkeypatch):
+    from explorer.core import tolerances
+
+    path = tmp_path / "big.obj"
+    path.write_bytes(_obj_text(40_000))
+    monkeypatch.setattr(tolerances, "MAX_MESH_FILE_BYTES", 1 << 20, raising=False)
+    with pytest.raises(ExplorerError, match=r"big.obj' is too large: \d+ bytes, the limit is 1048"):
+        M.load_mesh(path)
+
+
+def test_a_mesh_archive_within_the_cap_loads(tmp_path):
+    import zipfile
+
+    path = tmp_path / "small.zip"
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("small.obj", _obj_text(3))
+    assert M.load_mesh(path).faces.shape == (3, 3)
+
+
+def test_a_fifo_as_mesh_file_is_refused_without_blocking(tmp_path):
+    path = tmp_path / "pipe.obj"
+    os.mkfifo(path)
+    with pytest.raises(ExplorerError, match="not a regular file"):
+        M.load_mesh(path)

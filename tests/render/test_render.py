@@ -761,6 +761,27 @@ def test_cli_render_errors(tmp_path, capsys, argv, message):
     assert not (tmp_path / "o.png").exists()
 
 
+def test_a_sheet_beyond_the_picture_cap_is_refused_before_allocating(tmp_path, monkeypatch, capsys):
+    """``sheet --tile 8192x8192`` aborted inside VTK with std::bad_alloc: the whole sheet's
+    size is checked first (the renderer is never reached), and so is a render's size."""
+    from explorer.render import offscreen
+
+    def never(*args, **kwargs):
+        raise AssertionError("the renderer was reached")
+
+    monkeypatch.setattr(offscreen, "OffscreenRenderer", never)
+    out = tmp_path / "s.png"
+    args = ["sheet", "--out", str(out), "--tile", "8192x8192", "--preset", "gold"]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: sheet of 1 tiles of 8192x8192 in 1 columns: 8196x8196")
+    assert "more than the limit of 67108864" in err and not out.exists()
+    with pytest.raises(ExplorerError, match="more than the limit"):
+        offscreen.sheet(
+            [("a", Material())] * 2, explorer.Scene(), M.get_mesh("sphere"), tile=(4096, 8192)
+        )
+
+
 def test_cli_sheet(tmp_path, capsys):
     out = tmp_path / "sheet.png"
     rc = main(
