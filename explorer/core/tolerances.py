@@ -58,6 +58,12 @@ ATTENUATION_CAP = 1e30
 #: lit nothing.
 FAR_LIGHT = 1e12
 
+#: Smallest scale of the normalised frame (explorer.geometry.frame.frame_of): float64's smallest
+#: normal number. A mesh whose extent is subnormal (below 2.2e-308) would otherwise get a scale
+#: whose reciprocal overflows to inf (the float64 redo of ambiguous lanes multiplies by it: NaN
+#: colours); with this floor its normalised coordinates are merely smaller than 1.
+MIN_FRAME_SCALE = 2.2250738585072014e-308
+
 # --- rays (explorer.geometry.rays) ----------------------------------------------------------
 
 #: Shadow rays: a hit nearer than this (normalised units) is the ray's own surface, not an

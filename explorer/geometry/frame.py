@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.tolerances import NORMAL_RANGE
 
@@ -32,8 +33,11 @@ def frame_of(positions: np.ndarray) -> tuple[np.ndarray, float]:
     hi = np.array([positions[:, c].max() for c in range(3)], dtype=np.float64)
     centre = 0.5 * lo + 0.5 * hi  # halves first: lo + hi could overflow near 1e308
     half = float(np.max(0.5 * hi - 0.5 * lo))
-    scale = half if half > 0.0 and np.isfinite(half) else 1.0
-    return centre, scale
+    if half == 0.0:  # halving a subnormal extent can round to 0: use the whole extent
+        half = float(np.max(hi - lo))
+    if not (half > 0.0 and np.isfinite(half)):
+        return centre, 1.0
+    return centre, max(half, tol.MIN_FRAME_SCALE)  # 1 / scale must be finite too
 
 
 def to_frame(point, centre: np.ndarray, scale: float) -> np.ndarray:

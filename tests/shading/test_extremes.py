@@ -236,3 +236,89 @@ def test_extreme_finite_scenes_give_finite_colours_or_a_clean_error(
     assert np.isfinite(shown).all() and (shown >= 0).all() and (shown <= 1).all()
     ref = equation_shade(loaded, P, N, clamp=hdr is None)
     assert np.isfinite(ref).all()
+
+
+# -- hostile types ---------------------------------------------------------------------------
+
+#: where a hostile value goes: a key path in a valid scene mapping
+_PATHS = [
+    ("material",),
+    ("material", "diffuse"),
+    ("material", "shininess"),
+    ("material", "opacity"),
+    ("model",),
+    ("ambient",),
+    ("two_sided",),
+    ("viewer",),
+    ("viewer", "eye"),
+    ("lights",),
+    ("lights", 0),
+    ("lights", 0, "type"),
+    ("lights", 0, "position"),
+    ("lights", 0, "attenuation"),
+    ("lights", 0, "aim"),
+    ("lights", 0, "cutoff"),
+    ("hdr",),
+    ("hdr", "exposure"),
+]
+_HOSTILE = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.text(max_size=8),
+    st.integers(min_value=-(10**400), max_value=10**400),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.lists(st.one_of(st.text(max_size=3), st.none(), st.floats()), max_size=4),
+    st.dictionaries(st.text(max_size=4), st.integers(), max_size=2),
+)
+
+
+def _base_scene() -> dict:
+    return {
+        "material": {"diffuse": [0.8, 0.2, 0.1], "specular": [1, 1, 1], "shininess": 20},
+        "model": "blinn",
+        "ambient": [0.2, 0.2, 0.2],
+        "two_sided": False,
+        "viewer": {"eye": [0, 0, 5]},
+        "lights": [
+            {"type": "spot", "position": [2, 2, 2], "aim": [-1, -1, -1], "cutoff": 45,
+             "attenuation": [1, 0.1, 0]}
+        ],
+        "hdr": {"exposure": 0, "tone_map": "reinhard"},
+    }  # fmt: skip
+
+
+@given(path=st.sampled_from(_PATHS), value=_HOSTILE, precision=st.sampled_from(PRECISIONS))
+@settings(max_examples=60)
+def test_hostile_types_give_finite_colours_or_an_error_naming_the_key(path, value, precision):
+    """Any value of any type at any key: finite colours in [0, 1], or a ValueError / TypeError
+    whose message names the key (never an AttributeError, OverflowError or NaN)."""
+    scene = _base_scene()
+    node = scene
+    for part in path[:-1]:
+        node = node[part]
+    node[path[-1]] = value
+    P, N = vertices(7, 32)
+    try:
+        c = explorer.shade(scene, P, N, precision=precision)
+    except (ValueError, TypeError) as exc:
+        named = [p for p in path if isinstance(p, str)]
+        assert named[-1] in str(exc) or named[0] in str(exc), (path, str(exc))
+        return
+    assert c.shape == (len(P), 3) and np.isfinite(c).all()
+    assert c.min() >= 0.0 and c.max() <= 1.0
+
+
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("exponent", [-309, -315, -323])
+def test_a_mesh_of_subnormal_size_gives_finite_colours(precision, exponent):
+    """A mesh whose extent is below float64's smallest normal number (found by the fuzz at
+    1e-309): the frame's scale is floored at MIN_FRAME_SCALE, so its reciprocal stays finite."""
+    P, N = vertices(0, 12)
+    scene = {
+        "lights": [
+            {"type": "point", "diffuse": [0, 0, 1], "position": [0, 0, 0],
+             "attenuation": [0, 0, 1e-320]}
+        ]
+    }  # fmt: skip
+    c = explorer.shade(scene, P * 10.0**exponent, N, precision=precision)
+    assert np.isfinite(c).all() and c.min() >= 0.0 and c.max() <= 1.0
