@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from explorer.core.validate import Check, Checker, check_fields, checked
+from explorer.core.validate import Check, Checked, Checker, check_fields
 
 TONE_MAPS = ("clamp", "reinhard", "aces")
 #: accepted exposure, in stops
@@ -27,7 +27,7 @@ def _tone_map(checker: Checker, value, path):
 
 
 @dataclass(frozen=True)
-class HDR:
+class HDR(Checked):
     """How an unclamped colour is shown: exposure in stops and a tone map."""
 
     exposure: float = 0.0
@@ -35,9 +35,6 @@ class HDR:
 
     #: key -> its check, run by :func:`parse_hdr` and by the constructor
     KEYS: ClassVar[dict[str, Check]] = {"exposure": _exposure, "tone_map": _tone_map}
-
-    def __post_init__(self):
-        checked(self, self.KEYS)
 
     def to_mapping(self) -> dict:
         return {"exposure": self.exposure, "tone_map": self.tone_map}

@@ -43,7 +43,13 @@ import numpy as np
 from explorer.core import lightrow as R
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
-from explorer.core.validate import Check, Checker, check_fields, checked, new_keywords, old_keywords
+from explorer.core.validate import (
+    Check,
+    Checked,
+    Checker,
+    check_fields,
+    old_keywords,
+)
 
 Vec3 = tuple[float, float, float]
 RGB = tuple[float, float, float]
@@ -185,7 +191,7 @@ class LightWork:
 
 
 @dataclass(frozen=True)
-class Light:
+class Light(Checked):
     """What every light has: colours and whether it casts shadows (see the module docstring)."""
 
     ambient: RGB = (0.0, 0.0, 0.0)
@@ -209,16 +215,8 @@ class Light:
     #: fields a light made by :meth:`like` gets (a new spot's cone, say)
     LIKE_DEFAULTS: ClassVar[dict] = {}
 
-    def __post_init__(self):
-        checked(self, type(self).KEYS)
-        self._normalise()
-
-    def _normalise(self) -> None:
+    def _settle(self) -> None:
         """Store direction fields unit length (after the checks)."""
-
-    def replace(self, **changes):
-        """A copy with some fields changed (old key names are accepted, with a notice)."""
-        return replace(self, **new_keywords(type(self), changes))
 
     def to_mapping(self) -> dict:
         """The scene-file form of the light (plain Python values, new key names)."""
@@ -351,7 +349,7 @@ class DirectionalLight(Light):
     RENAMED: ClassVar[dict] = {"direction": ("to_light", "the direction toward the light")}
     FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + ("to_light",)
 
-    def _normalise(self) -> None:
+    def _settle(self) -> None:
         object.__setattr__(self, "to_light", unit_vector(self.to_light))
 
     def _own_mapping(self) -> dict:
@@ -535,7 +533,7 @@ class SpotLight(PositionalLight):
     #: the cone of a spot made from another light (:meth:`like`)
     LIKE_DEFAULTS: ClassVar[dict] = {"cutoff": 25.0, "exponent": 10.0}
 
-    def _normalise(self) -> None:
+    def _settle(self) -> None:
         object.__setattr__(self, "aim", unit_vector(self.aim))
 
     def _own_mapping(self) -> dict:

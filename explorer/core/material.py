@@ -41,11 +41,11 @@ both are black), specular uses white.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import partial
 from typing import ClassVar
 
-from explorer.core.validate import Check, Checker, check_fields, check_values, checked
+from explorer.core.validate import Check, Checked, Checker, check_fields, check_values
 
 RGB = tuple[float, float, float]
 
@@ -115,7 +115,7 @@ def _flag(checker: Checker, value, path):
 
 
 @dataclass(frozen=True)
-class Material:
+class Material(Checked):
     """Surface coefficients.
 
     ambient, diffuse, specular, emission : RGB triples in [0, 1] (``a_m, d_m, s_m, e_m``)
@@ -152,13 +152,6 @@ class Material:
         "fresnel": _fresnel,
         "energy_conserving": _flag,
     }
-
-    def __post_init__(self):
-        checked(self, self.KEYS)
-
-    def replace(self, **changes) -> Material:
-        """A copy with some fields changed (``m.replace(shininess=64)``)."""
-        return replace(self, **changes)
 
     def to_mapping(self) -> dict:
         """The nine-coefficient form as plain Python values (YAML-ready).

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import partial
 from typing import ClassVar
 
@@ -38,7 +38,7 @@ from explorer.core.hdr import HDR, parse_hdr
 from explorer.core.lights import DirectionalLight, parse_light, unit_vector
 from explorer.core.material import MODELS, Material, parse_material
 from explorer.core.presets import find_preset
-from explorer.core.validate import Check, Checker, check_fields, checked, old_keywords
+from explorer.core.validate import Check, Checked, Checker, check_fields, old_keywords
 from explorer.core.yamlio import load_yaml
 
 Vec3 = tuple[float, float, float]
@@ -66,7 +66,7 @@ def _one_viewer(checker: Checker, given: Mapping, path) -> bool:
 
 @old_keywords
 @dataclass(frozen=True)
-class Viewer:
+class Viewer(Checked):
     """Exactly one of ``eye`` (a local viewer at a point) or ``to_viewer`` (an infinite viewer:
     the unit vector from the scene toward the viewer)."""
 
@@ -78,12 +78,14 @@ class Viewer:
     RENAMED: ClassVar[dict] = {"direction": ("to_viewer", "the direction toward the viewer")}
     ONE_OF: ClassVar[str] = "needs exactly one of eye (local viewer) or to_viewer (infinite)"
 
-    def __post_init__(self):
+    def _check(self, checks) -> None:
         given = {k: getattr(self, k) for k in self.KEYS if getattr(self, k) is not None}
         checker = Checker(None)
         _one_viewer(checker, given, ())
         checker.raise_if_any()
-        checked(self, self.KEYS)
+        super()._check(checks)
+
+    def _settle(self) -> None:
         if self.to_viewer is not None:
             object.__setattr__(self, "to_viewer", unit_vector(self.to_viewer))
 
@@ -163,7 +165,7 @@ DEFAULT_LIGHTS: tuple = (DirectionalLight(to_light=(0.0, 0.0, 1.0)),)
 
 
 @dataclass(frozen=True)
-class Scene:
+class Scene(Checked):
     """Everything but the geometry.
 
     material : the surface's coefficients
@@ -200,13 +202,6 @@ class Scene:
         "mesh": _mesh,
         "hdr": _hdr,
     }
-
-    def __post_init__(self):
-        checked(self, self.KEYS)
-
-    def replace(self, **changes) -> Scene:
-        """A copy with some fields changed (``scene.replace(material=m)``)."""
-        return replace(self, **changes)
 
     def to_mapping(self) -> dict:
         """The scene-file form (plain Python values, YAML-ready)."""

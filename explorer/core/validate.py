@@ -19,6 +19,7 @@ one :class:`DeprecatedName` notice.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import functools
@@ -26,10 +27,11 @@ import math
 import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from numbers import Real
+from typing import ClassVar
 
 import numpy as np
 
-from explorer.core.errors import DeprecatedName, Problem, ValidationError
+from explorer.core.errors import DeprecatedName, ExplorerTypeError, Problem, ValidationError
 
 Path = tuple
 
@@ -263,6 +265,42 @@ def checked(obj, checks: Mapping[str, Check]) -> None:
     given = {k: getattr(obj, k) for k in checks if not (k in optional and getattr(obj, k) is None)}
     for k, v in check_values(checks, given).items():
         object.__setattr__(obj, k, v)
+
+
+class Checked:
+    """Base of the model's frozen dataclasses (material, lights, viewer, scene, HDR): each field
+    named in ``KEYS`` is checked and converted once, when the object is made (:func:`checked`),
+    and :meth:`replace` checks only the fields it changes: the others were checked when the
+    original was made (a slider moves one value many times a second; the rest need no new
+    look). Old key names of ``RENAMED`` are accepted by :meth:`replace` too."""
+
+    KEYS: ClassVar[Mapping[str, Check]] = {}
+    RENAMED: ClassVar[Mapping[str, tuple[str, str]]] = {}
+
+    def __post_init__(self):
+        self._check(type(self).KEYS)
+
+    def _check(self, checks: Mapping[str, Check]) -> None:
+        """Check the fields ``checks`` names, then :meth:`_settle` the whole object."""
+        checked(self, checks)
+        self._settle()
+
+    def _settle(self) -> None:
+        """What follows the checks on the whole object (storing directions unit length)."""
+
+    def replace(self, **changes):
+        """A copy with some fields changed (``m.replace(shininess=64)``); only those are
+        checked again."""
+        changes = new_keywords(type(self), changes) if type(self).RENAMED else changes
+        names = {f.name for f in dataclasses.fields(self)}
+        unknown = sorted(set(changes) - names)
+        if unknown:
+            raise ExplorerTypeError(f"{type(self).__name__} has no field {unknown[0]!r}")
+        new = copy.copy(self)
+        for k, v in changes.items():
+            object.__setattr__(new, k, v)
+        new._check({k: c for k, c in type(self).KEYS.items() if k in changes})
+        return new
 
 
 def notice(message: str) -> None:
