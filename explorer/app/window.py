@@ -46,7 +46,7 @@ from explorer.render.camera import Camera, apply_camera, back_to_front, camera_f
 from explorer.render.images import encode_png
 from explorer.render.offscreen import BACKGROUND
 from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
-from explorer.shading.display import display, engine_clamps, to_bytes
+from explorer.shading.display import engine_clamps, shown, to_bytes
 from explorer.shading.shader import Shader
 
 log = logging.getLogger(__name__)
@@ -283,7 +283,6 @@ class _View:
         self.mesh = mesh
         self.centre = mesh.centre  # (3,): Mesh computes these on every call
         self.radius = mesh.radius or 1.0
-        self.hdr = scene.hdr
         self.shader = Shader(
             scene,
             mesh.positions,
@@ -302,9 +301,9 @@ class _View:
         self.sorted_for = None  # camera the triangles were last sorted for (translucency)
 
     def colors(self) -> np.ndarray:
-        """(n, 3) display colours in [0, 1]: the shader's through
-        :func:`explorer.shading.display.display`."""
-        return display(self.shader.colors, self.hdr)
+        """(n, 3) display colours in [0, 1]: the shader's through the display pipeline
+        (:func:`explorer.shading.display.shown`)."""
+        return shown(self.shader.colors, self.shader.scene)
 
     def upload(self) -> None:
         """Write the display colours into VTK's array as 8-bit values

@@ -5,10 +5,11 @@ file in the target directory, flushed to disk and renamed into place, so a reade
 file or the complete new one, never a torn one; without ``overwrite`` the rename is a hard link,
 which fails if the target appeared in the meantime.
 
-Leftovers: an interrupted write removes its temporary file (the CLI turns SIGTERM into an
-exception so that this cleanup runs); a temporary file that survived anyway (``kill -9``, power
-loss) is swept by the next write into the same directory once it is older than
-:data:`STALE_TEMP_AGE`. :func:`write_all_atomic` writes several files all-or-nothing.
+Leftovers: an interrupted write removes its temporary file (the CLI turns SIGTERM into an exception
+so that this cleanup runs); a temporary file that survived anyway (``kill -9``, power loss) is swept
+by a later write into the same directory once it is older than :data:`STALE_TEMP_AGE` (a process
+lists a directory for this at most once per that age). :func:`write_all_atomic` writes several files
+all-or-nothing.
 """
 
 from __future__ import annotations
@@ -29,6 +30,10 @@ from explorer.core.errors import ExplorerError
 STALE_TEMP_AGE = 60.0
 #: The temporaries' names: ``.<target name>.<8 random characters of mkstemp>.tmp``.
 TEMP_NAME = re.compile(r"\..+\.[a-z0-9_]{8}\.tmp")
+#: directory -> when this process last swept it: a directory is listed at most once per
+#: STALE_TEMP_AGE (the window rewrites its state file after every frame; a leftover younger
+#: than that would not be removed anyway)
+_swept: dict[str, float] = {}
 
 
 def sweep_stale_temps(directory, *, now: float | None = None) -> list[Path]:
@@ -59,6 +64,15 @@ def sweep_stale_temps(directory, *, now: float | None = None) -> list[Path]:
     return removed
 
 
+def _sweep_now_and_then(directory) -> None:
+    """:func:`sweep_stale_temps` unless this process swept ``directory`` within the last
+    STALE_TEMP_AGE seconds."""
+    key, now = os.fspath(directory), time.monotonic()
+    if now - _swept.get(key, -STALE_TEMP_AGE) >= STALE_TEMP_AGE:
+        _swept[key] = now
+        sweep_stale_temps(directory)
+
+
 def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool = False) -> Path:
     """Write ``data`` to ``path`` atomically; returns the path written.
 
@@ -81,7 +95,7 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
             ) from None
     elif not parent.is_dir():
         raise ExplorerError(f"{target}: directory {str(parent)!r} does not exist")
-    sweep_stale_temps(parent)
+    _sweep_now_and_then(parent)
     tmp = None
     try:
         tmp = _new_temp(target)
@@ -123,7 +137,7 @@ def write_all_atomic(files: Mapping, *, overwrite: bool = False) -> list[Path]:
         if not target.parent.is_dir():
             raise ExplorerError(f"{target}: directory {str(target.parent)!r} does not exist")
     for parent in {t.parent for t, _ in targets}:
-        sweep_stale_temps(parent)
+        _sweep_now_and_then(parent)
     temps: dict[Path, str] = {}  # target -> its new contents, not yet in place
     backups: dict[Path, str] = {}  # target -> a hard link to the file it replaces
     placed: list[Path] = []

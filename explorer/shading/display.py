@@ -13,8 +13,7 @@ mesh exports)::
 :func:`shown` is the middle step (every effect's
 :meth:`~explorer.shading.effects.base.Effect.display`, in the order of ``EFFECTS``),
 :func:`display_colors` (and :func:`vertex_colors` for a mesh's vertices) the engine and
-:func:`shown` together. :func:`display` is the HDR step for a caller that holds the scene's
-``hdr`` setting rather than the scene (the window).
+:func:`shown` together.
 """
 
 from __future__ import annotations
@@ -25,10 +24,9 @@ import numpy as np
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.shading.effects import EFFECTS
-from explorer.shading.effects.hdr import display
 from explorer.shading.shader import shade
 
-__all__ = ["display", "display_colors", "engine_clamps", "shown", "to_bytes", "vertex_colors"]
+__all__ = ["display_colors", "engine_clamps", "shown", "to_bytes", "vertex_colors"]
 
 
 def engine_clamps(scene) -> bool:

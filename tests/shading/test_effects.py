@@ -24,9 +24,9 @@ from explorer.core.scene import load_scene
 from explorer.geometry import meshes as M
 from explorer.geometry.meshes import Mesh
 from explorer.render.images import read_png
-from explorer.shading.display import display, display_colors, engine_clamps, vertex_colors
+from explorer.shading.display import display_colors, engine_clamps, vertex_colors
 from explorer.shading.effects import EFFECTS, LEVELS, Effect, energy_factor, schlick
-from explorer.shading.effects.hdr import expose, srgb_decode, srgb_encode, tone_map
+from explorer.shading.effects.hdr import display, expose, srgb_decode, srgb_encode, tone_map
 from explorer.shading.equation import equation_shade
 from explorer.shading.plan import make_plan
 
