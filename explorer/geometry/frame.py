@@ -97,8 +97,14 @@ def scale_normals(normals: np.ndarray) -> np.ndarray:
     """
     if len(normals) == 0:
         return normals
-    big = np.abs(normals).max(axis=1)  # (n,) largest component of each normal
     lo, hi = NORMAL_RANGE
+    # the usual case in one fast pass: a squared length in [3·lo², hi²] puts the largest
+    # component in [lo, hi] (it lies between length/√3 and length); anything else (a zero row,
+    # or one whose square underflows) takes the exact path below
+    s = np.einsum("ij,ij->i", normals, normals, dtype=np.float64)
+    if ((s >= 3.0 * lo * lo) & (s <= hi * hi)).all():
+        return normals
+    big = np.abs(normals).max(axis=1)  # (n,) largest component of each normal
     out_of_range = (big > 0) & ((big < lo) | (big > hi))
     if not out_of_range.any():
         return normals
