@@ -18,9 +18,16 @@ below tell tests/test_goldens.py whether this session ran every golden test, whi
 find the golden files no test uses.
 
 Fixtures: ``renderer``, one 400×400 off-screen window per test module.
+
+The engine runs on its compiled tier throughout (``PHONG_EXPLORER_KERNELS=compiled``, inherited
+by the commands the tests start): the tests check the kernels, so a pass never falls back to the
+numpy tier while numba's cache is cold. tests/shading/test_tiers.py tests the tiers and mode
+``auto`` themselves.
 """
 
 import os
+
+os.environ["PHONG_EXPLORER_KERNELS"] = "compiled"  # before the package is imported
 
 import pytest
 from helpers import imagecompare

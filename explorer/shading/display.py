@@ -23,6 +23,7 @@ import numpy as np
 
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
+from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.shader import shade
 
@@ -98,7 +99,14 @@ def to_bytes(colors, opacity: float | None = None, *, out=None) -> np.ndarray:
         and out.flags.writeable
     )
     rgb = out if direct else np.empty(c.shape, np.uint8)
-    _round_bytes(c.reshape(-1), rgb.reshape(-1))
+    if tiers.compiled():
+        x = c.reshape(-1).view()
+        x.flags.writeable = False  # one signature for every caller's array
+        _round_bytes(x, rgb.reshape(-1))
+    else:  # the numpy tier: the same float64 steps
+        v = np.clip(c.astype(np.float64) * 255.0, 0.0, 255.0)
+        np.rint(v, out=v)
+        rgb[...] = v.astype(np.uint8)
     if out is not None:
         if not direct:
             out[...] = rgb

@@ -28,13 +28,18 @@ from explorer.geometry.frame import check_vertices, frame_of, to_frame
 from explorer.shading.effects import EFFECTS, Incident
 
 
-def equation_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np.ndarray]:
+def equation_terms(
+    scene: Scene, positions, normals, faces=None, *, visibility=None
+) -> dict[str, np.ndarray]:
     """Per-vertex light sums, independent of the material.
 
     Returns ``ambient``, ``diffuse``, ``specular`` : (n, 3) float64 such that the colour is
     ``e_m + a_m·ambient + d_m·diffuse + s_m·specular`` (``ambient`` includes the scene ambient).
     The specular sum uses the scene material's shininess and the scene's model.
     faces : (m, 3) int triangles for shadows, or None
+    visibility : (L, n) float, each light's shadow visibility already cast (the engine's numpy
+        tier passes the rows it keeps per light), instead of rays from ``faces``; (L, 0) or
+        None: none
     """
 
     P, N = check_vertices(positions, normals)
@@ -62,9 +67,12 @@ def equation_terms(scene: Scene, positions, normals, faces=None) -> dict[str, np
     ambient = np.tile(np.asarray(scene.ambient, dtype=np.float64), (n, 1))
     diffuse = np.zeros((n, 3))
     specular = np.zeros((n, 3))
-    for light in scene.lights:
+    cast = visibility is not None and np.shape(visibility)[-1] > 0
+    for i, light in enumerate(scene.lights):
         L, _, w = light.incident(P, N, centre, scale)  # what arrives and from where
         dif_w, spec_w = _effect_weights(scene, light, Incident(world, faces, L, V), w)
+        if cast:  # shadows cast by the caller
+            dif_w, spec_w = dif_w * visibility[i], spec_w * visibility[i]
 
         ndl = np.einsum("ij,ij->i", N, L)
         lit = ndl > 0.0  # f_i: specular only where N·L > 0

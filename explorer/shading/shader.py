@@ -25,6 +25,11 @@ so). ``force_all=True`` makes the plan skip nothing (same colours; for the bench
 A term the material does not need (``s_m = 0``, say) is not computed until it is needed.
 ``stats`` counts each kind of pass, so tests can check that a change costs what it should.
 Cached arrays are read-only.
+
+Each pass runs on the tier :mod:`explorer.shading.tiers` picks: the compiled kernels, or, while
+numba's cache does not hold them yet, the lighting equation in numpy (:mod:`.equation`, float64,
+every term at once; material changes still compose only, and shadow rows are kept per light).
+A shader switches to the compiled tier at its next pass once the kernels are loaded.
 """
 
 from __future__ import annotations
@@ -42,11 +47,15 @@ from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
 from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
+from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
+from explorer.shading.equation import equation_terms
 from explorer.shading.plan import Plan, make_plan
 from explorer.shading.shadows import is_convex, visibility_rows
 
 PRECISIONS = ("float64", "float32")
+#: the engine's tiers (see :mod:`explorer.shading.tiers`)
+TIERS = ("compiled", "numpy")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
@@ -107,6 +116,8 @@ class Shader:
     force_all : the plan skips nothing (same colours; benchmark only)
     cull : skip a light for runs of vertices that provably get nothing from it (the plan's
         ``culling``); False computes every vertex-light (same colours; benchmark and tests)
+    tier : "compiled" or "numpy" for every pass of this shader; None (default): the tier
+        :func:`explorer.shading.tiers.compiled` picks at each pass
     """
 
     def __init__(
@@ -122,8 +133,12 @@ class Shader:
         faces=None,
         force_all: bool = False,
         cull: bool = True,
+        tier: str | None = None,
     ):
         _typed("precision", precision, str, f"one of {PRECISIONS}")
+        if tier not in (None, *TIERS):
+            raise ExplorerError(f"tier must be None or one of {TIERS}, got {tier!r}")
+        self.tier = tier
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
         self._T = np.float32 if precision == "float32" else np.float64
@@ -157,6 +172,8 @@ class Shader:
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
         P, N = check_vertices(positions, normals)  # normals scaled for the kernels
+        if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
+            P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
         self._P, self._N = P, N
         self._faces = faces
@@ -165,10 +182,8 @@ class Shader:
         self._plan = self._make_plan(self._scene)
         self._centre, self._scale = frame_of(self._P)
         n = len(self._P)
-        self._G = np.empty((6, n), self._T)  # frame positions and unit normals, SoA
-        K.prepare(self._P, self._N, self._centre, 1.0 / self._scale, self._k, self._G)
-        self.stats["geometry"] += 1
-        self._bounds = self._chunk_bounds()
+        self._G = self._bounds = None  # the compiled tier's geometry, made at its first pass
+        self._np = None  # the numpy tier's sums
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._colors = None
@@ -177,6 +192,19 @@ class Shader:
         self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
         self._lights_changed()
+
+    def _compiled_geometry(self) -> None:
+        """The compiled tier's view of the geometry: frame positions and unit normals (6, n) in
+        the working precision, structure of arrays, and the chunk bounds for light culling."""
+        if self._G is not None:
+            return
+        G = np.empty((6, self.n), self._T)
+        K.prepare(
+            _readonly(self._P), _readonly(self._N), self._centre, 1.0 / self._scale, self._k, G
+        )
+        self.stats["geometry"] += 1
+        self._G = G
+        self._bounds = self._chunk_bounds()
 
     def _chunk_bounds(self) -> np.ndarray:
         """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices, for
@@ -249,6 +277,8 @@ class Shader:
         # every sum the lights can produce, whatever the current material needs
         self._update(force=(True, True, True))
         n = self.n
+        if self._np is not None and self._A is None:  # the numpy tier served
+            return {k: _readonly(v.astype(self._T)) for k, v in self._np.items()}
         A = np.broadcast_to(self._aconst.astype(self._T), (n, 3)).copy()
         if self._A is not None:
             A += self._A
@@ -263,6 +293,7 @@ class Shader:
 
     # -- invalidation --------------------------------------------------------------------------
     def _lights_changed(self):
+        self._np = None
         self._memory.retire(self._A, self._D, self._S)
         self._A = self._D = self._S = None
         self._base = self._ws = None
@@ -275,6 +306,7 @@ class Shader:
         if self._scene.two_sided:  # N·V decides which normals flip: every sum depends on V
             self._lights_changed()
             return
+        self._np = None
         self._memory.retire(self._S)
         self._S = None
         self._base = self._ws = None
@@ -285,6 +317,7 @@ class Shader:
         self._keep_lobe = False
 
     def _shininess_changed(self):
+        self._np = None
         self._memory.retire(self._S)
         self._S = None  # the stored bases and weights stay valid
         self._params = None  # an energy-conserving factor changes with n (cheap to redo)
@@ -330,7 +363,17 @@ class Shader:
         m = self._scene.material
         return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
 
+    def _compiled_tier(self) -> bool:
+        """Whether this pass runs on the compiled kernels (see :mod:`explorer.shading.tiers`)."""
+        if self.tier is not None:
+            return self.tier == "compiled"
+        return tiers.compiled()
+
     def _update(self, force=(False, False, False)):
+        if not self._compiled_tier():
+            self._update_numpy()
+            return
+        self._compiled_geometry()
         plan, scene, T = self._plan, self._scene, self._T
         self._colors = None
         self._out = self._memory.colour_buffer(self.n, self._T)
@@ -378,6 +421,25 @@ class Shader:
             self.stats["compose"] += 1
         self._colors = _readonly(self._out)
         self._out = None
+
+    def _update_numpy(self):
+        """A pass on the numpy tier: the equation's three sums (kept until the lights, viewer,
+        model or shininess change), composed with the material."""
+        self._colors = None
+        if self._np is None:
+            vis = self._visibility(np.float64)
+            self._np = equation_terms(self._scene, self._P, self._N, visibility=vis)
+            self.stats["numpy"] += 1
+        else:
+            self.stats["compose"] += 1
+        m = self._scene.material
+        c = np.asarray(m.emission, np.float64)  # e_m
+        c = c + np.asarray(m.ambient) * self._np["ambient"]  # a_m·(a_scene + Σ w·a_i)
+        c += np.asarray(m.diffuse) * self._np["diffuse"]  # d_m·Σ w·vis·(N·L)·d_i
+        c += np.asarray(m.specular) * self._np["specular"]  # s_m·Σ w·vis·f·(N·H)^n·s_i
+        if self.clamp:
+            np.clip(c, 0.0, 1.0, out=c)
+        self._colors = _readonly(c.astype(self._T, copy=False))
 
     def _params_for(self, dtype):
         if self._params is None:
@@ -464,8 +526,8 @@ class Shader:
             self.stats["fixup_vertices"] += K.fixup(
                 redo,
                 self._redo_count,
-                self._P,
-                self._N,
+                _readonly(self._P),
+                _readonly(self._N),
                 self._centre,
                 1.0 / self._scale,
                 params64,

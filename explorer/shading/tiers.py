@@ -1,0 +1,243 @@
+"""Which engine serves a shading pass: the compiled kernels, or numpy while they are prepared.
+
+numba compiles the engine's kernels (:mod:`explorer.shading.kernels`, the display's byte
+rounding, the ray casts) the first time they run and keeps them in its on-disk cache; on a fresh
+install that first compile takes minutes. So the engine has two tiers:
+
+``compiled``
+    the numba kernels (planned, blocked, float32 or float64: the fast path), loaded from numba's
+    cache in well under a second once it holds them;
+``numpy``
+    the lighting equation of :mod:`explorer.shading.equation` in float64 numpy: the
+    specification itself, exact, ready at once, slower on large meshes (it computes every term of
+    every light; the plan still decides which lights cast shadow rays).
+
+Mode ``auto`` (the default) uses the compiled tier when numba's cache holds every kernel the
+product calls: :mod:`explorer.shading.warm` compiles them all and then writes a *ready marker*
+into numba's cache directory, named by everything that invalidates numba's cache (the kernel
+sources' size and modification time, numba's and Python's versions, the CPU and the code
+generation options). Until the marker is there, passes run on the numpy tier, and the first one
+starts ``python -m explorer.shading.warm`` in the background (detached: it outlives the command
+that started it; a lock keeps one at a time per cache directory) and says so once, as a
+:class:`~explorer.core.errors.Notice` (the CLI prints it as one ``notice:`` line on stderr, the
+window shows :func:`status` in its status line). A process that finds the marker at its first
+pass uses the compiled tier from the start; one that sees it appear later (a window left open
+while the background compile ran) loads the kernels in a thread and switches when they are
+loaded, so no pass waits on the load.
+
+The environment variable ``PHONG_EXPLORER_KERNELS`` picks the mode: ``auto``, ``compiled``
+(compile in this process when needed, as numba does by default: the tests and the benchmarks)
+or ``numpy`` (never compile). Colours are the engine's contract on either tier: float64 within
+1e-5 of the GL 2.1 equation, float32 within 1/255 of float64 (the numpy tier computes float64
+and rounds to the pass's precision).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import os
+import platform
+import subprocess
+import sys
+import threading
+import time
+import warnings
+from pathlib import Path
+
+from explorer.core.errors import ExplorerError, Notice
+
+#: the environment variable that picks the mode
+ENV = "PHONG_EXPLORER_KERNELS"
+MODES = ("auto", "compiled", "numpy")
+#: modules whose numba functions the product calls (their sources name the marker)
+SOURCES = ("explorer.shading.kernels", "explorer.shading.display", "explorer.geometry.rays")
+#: environment variables that change what numba compiles (so they name the marker too)
+CODEGEN_ENV = ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "NUMBA_OPT", "PHONG_EXPLORER_WIDE_VECTORS")
+#: seconds between two looks for the marker while the numpy tier serves (a stat per look)
+POLL = 0.25
+#: what the user is told, once, when the background compile starts
+PREPARING = (
+    "preparing the compiled engine in the background (once per install, a few minutes); "
+    "meanwhile the numpy engine serves: the same colours, slower on large meshes"
+)
+
+_lock = threading.Lock()
+_state = {
+    "mode": None,  # set by set_mode, else read from ENV at first use
+    "compiled": None,  # True once this process uses the compiled tier
+    "started": False,  # the background compile was started (or found running) by this process
+    "loading": None,  # the loader thread, while it runs
+    "checked": 0.0,  # when the marker was last looked for
+    "failed": None,  # why the background compile could not be started
+}
+
+
+def mode() -> str:
+    """The mode: :func:`set_mode`'s, else the environment variable :data:`ENV` (default auto).
+    A value outside :data:`MODES` raises an :class:`ExplorerError` naming the variable."""
+    if _state["mode"] is None:
+        value = os.environ.get(ENV, "auto").strip().lower() or "auto"
+        if value not in MODES:
+            raise ExplorerError(
+                f"environment variable {ENV}={value!r}: must be one of {', '.join(MODES)}"
+            )
+        _state["mode"] = value
+    return _state["mode"]
+
+
+def set_mode(value: str | None) -> None:
+    """Pick the mode for this process (None: read :data:`ENV` again). Forgets what the last
+    mode decided."""
+    if value is not None and value not in MODES:
+        raise ExplorerError(f"kernels mode must be one of {', '.join(MODES)}, got {value!r}")
+    with _lock:
+        _state.update(mode=value, compiled=None, checked=0.0)
+
+
+def compiled() -> bool:
+    """True when the next pass should run on the compiled kernels (see the module docstring).
+    In mode auto this may start the background compile (and tell the user once) or the loader
+    thread; it never waits for either."""
+    m = mode()
+    if m != "auto":
+        return m == "compiled"
+    if _state["compiled"]:
+        return True
+    now = time.monotonic()
+    if _state["compiled"] is None:  # the first pass of this process: decide now
+        ready = marker_path().exists()
+        _state["compiled"] = ready
+        _state["checked"] = now
+        if not ready:
+            _start_background()
+        return ready
+    if _state["loading"] is None and now - _state["checked"] >= POLL:
+        _state["checked"] = now
+        if marker_path().exists():
+            _start_loading()
+    return False
+
+
+def status() -> str | None:
+    """A short line for a status bar while the numpy tier serves in mode auto, else None."""
+    if mode() != "auto" or _state["compiled"] is not False:
+        return None
+    if _state["failed"]:
+        return f"numpy engine (the compiled engine is unavailable: {_state['failed']})"
+    if _state["loading"] is not None:
+        return "numpy engine; loading the compiled engine"
+    return "numpy engine; preparing the compiled engine in the background"
+
+
+# -- the ready marker ------------------------------------------------------------------------------
+def cache_dir() -> Path:
+    """The directory numba caches :mod:`explorer.shading.kernels` in (the in-tree
+    ``__pycache__`` when writable, else ``NUMBA_CACHE_DIR`` or numba's user-wide directory)."""
+    from explorer.shading import kernels  # numba decides the directory when it decorates
+
+    return Path(kernels.shade.dispatcher._cache._cache_path)
+
+
+def marker_key() -> str:
+    """What names the ready marker: a hash of the kernel sources' stamps (as numba's own cache
+    index keys them), the versions and the code generation target."""
+    import llvmlite
+    import llvmlite.binding as llvm
+    import numba
+
+    parts = [numba.__version__, llvmlite.__version__, sys.version, platform.machine()]
+    for name in SOURCES:
+        origin = importlib.util.find_spec(name).origin
+        st = os.stat(origin)
+        parts.append(f"{origin}:{st.st_mtime_ns}:{st.st_size}")
+    try:
+        parts.append(llvm.get_host_cpu_name())
+        parts.append(llvm.get_host_cpu_features().flatten())
+    except RuntimeError:  # llvmlite cannot read this host: the CPU name alone
+        parts.append(platform.processor())
+    parts += [f"{k}={os.environ.get(k, '')}" for k in CODEGEN_ENV]
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:20]
+
+
+def marker_path() -> Path:
+    """The ready marker for this machine and these sources (see :func:`marker_key`)."""
+    return cache_dir() / f"explorer-ready-{marker_key()}.json"
+
+
+def lock_path() -> Path:
+    """The lock the background compile holds while it runs."""
+    return cache_dir() / "explorer-warm.lock"
+
+
+def log_path() -> Path:
+    """Where the background compile writes what it did (and any error)."""
+    return cache_dir() / "explorer-warm.log"
+
+
+def write_marker(seconds: float) -> Path:
+    """Write the ready marker (after every kernel compiled), atomically."""
+    from explorer.core.atomic import write_atomic
+
+    info = {"seconds": round(seconds, 1), "written": time.strftime("%Y-%m-%d %H:%M:%S")}
+    return write_atomic(marker_path(), json.dumps(info).encode(), overwrite=True)
+
+
+# -- the background compile and the loader -------------------------------------------------------
+def warm_command() -> list[str]:
+    """The background compile's command line."""
+    return [sys.executable, "-m", "explorer.shading.warm"]
+
+
+def _start_background() -> None:
+    """Start the background compile (at most once per process) and tell the user once."""
+    with _lock:
+        if _state["started"]:
+            return
+        _state["started"] = True
+    try:
+        directory = cache_dir()
+        directory.mkdir(parents=True, exist_ok=True)
+        env = dict(os.environ, **{ENV: "compiled"})
+        with open(log_path(), "ab") as log:
+            subprocess.Popen(
+                warm_command(),
+                stdin=subprocess.DEVNULL,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                cwd=directory,  # nothing in the user's directory shadows the package
+                env=env,
+                start_new_session=True,  # Ctrl-C in the terminal does not stop it
+                close_fds=True,
+            )
+    except OSError as exc:  # no writable cache directory, no interpreter to start
+        _state["failed"] = exc.strerror or str(exc)
+        warnings.warn(
+            f"the compiled engine cannot be prepared ({_state['failed']}); "
+            "the numpy engine serves: the same colours, slower on large meshes",
+            Notice,
+            stacklevel=3,
+        )
+        return
+    warnings.warn(PREPARING, Notice, stacklevel=3)
+
+
+def _start_loading() -> None:
+    """Load the compiled kernels from numba's cache in a thread; switch when they are loaded."""
+
+    def load():
+        from explorer.shading import warm
+
+        try:
+            warm.load()
+        except Exception as exc:  # noqa: BLE001 - a failed load keeps the numpy tier serving
+            _state["failed"] = f"{type(exc).__name__}: {exc}"
+            return
+        _state["compiled"] = True
+
+    with _lock:
+        if _state["loading"] is not None:
+            return
+        _state["loading"] = threading.Thread(target=load, name="explorer-load", daemon=True)
+    _state["loading"].start()

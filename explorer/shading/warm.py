@@ -1,0 +1,159 @@
+"""Fill numba's on-disk cache with every kernel the product calls: the background compile.
+
+``python -m explorer.shading.warm`` is what :mod:`explorer.shading.tiers` starts in the
+background on a machine whose cache lacks the kernels. It takes the lock
+(:func:`explorer.shading.tiers.lock_path`; a second one exits at once), runs :func:`exercise`
+with the compiled tier (every kind of pass the product makes, on small meshes, in both
+precisions: numba compiles each kernel signature once and writes it to its cache), then writes the
+ready marker. Progress and errors go to :func:`explorer.shading.tiers.log_path`.
+
+:func:`load` runs the same passes in a process whose cache already holds them: numba loads each
+kernel and compiles nothing (the loader thread of a process that saw the marker appear).
+tests/shading/test_tiers.py checks that the passes the product makes after :func:`exercise` meet
+no kernel signature it did not compile.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+import numpy as np
+
+from explorer.geometry.meshes import sphere, torus
+from explorer.shading import tiers
+from explorer.shading.display import to_bytes
+from explorer.shading.shader import Shader
+
+#: the lights of the exercise: one of each type, every option that takes its own kernel path
+LIGHTS = (
+    {"type": "point", "position": [2.0, 1.5, 3.0], "attenuation": [1.0, 0.1, 0.02]},
+    {"type": "spot", "position": [-1.0, 2.0, 2.0], "aim": [0.5, -1.0, -1.0], "cutoff": 40.0,
+     "exponent": 8.0, "shadows": True},
+    {"type": "directional", "to_light": [0.3, 1.0, 0.5], "diffuse": [0.9, 0.8, 0.7]},
+)  # fmt: skip
+MATERIAL = {"diffuse": [0.7, 0.5, 0.3], "specular": [0.6, 0.6, 0.6], "shininess": 25.0}
+#: scenes that between them take every kernel path: models, viewers, sidedness, effects, HDR
+SCENES = (
+    {"model": "blinn", "lights": LIGHTS, "viewer": {"eye": [0, 0, 5]}},
+    {"model": "phong", "lights": LIGHTS, "two_sided": True},
+    {"model": "blinn", "lights": LIGHTS[:1]},  # infinite viewer: a constant halfway vector
+    {"model": "phong", "lights": LIGHTS, "viewer": {"eye": [0, 0, 5]}, "hdr": True,
+     "material": dict(MATERIAL, fresnel=0.04, energy_conserving=True)},
+    {"model": "blinn", "lights": [{"type": "point", "position": [0, 3, 0], "diffuse": [0.7] * 3,
+     "specular": [0.7] * 3, "ambient": [0.1] * 3}]},  # grey lights: grey sums
+)  # fmt: skip
+
+
+def dispatchers() -> dict:
+    """Every numba function of :data:`explorer.shading.tiers.SOURCES`, by qualified name (the
+    kernels wrapped for wide vectors through their ``dispatcher``)."""
+    import importlib
+
+    from numba.core.registry import CPUDispatcher
+
+    found = {}
+    for name in tiers.SOURCES:
+        module = importlib.import_module(name)
+        for attr, obj in vars(module).items():
+            d = getattr(obj, "dispatcher", obj)
+            if isinstance(d, CPUDispatcher):
+                found[f"{name}.{attr}"] = d
+    return found
+
+
+def signatures() -> dict[str, set]:
+    """The signatures each function of :func:`dispatchers` holds in this process (compiled or
+    loaded from numba's cache)."""
+    return {name: set(d.signatures) for name, d in dispatchers().items()}
+
+
+def _meshes():
+    """Small meshes, each as the product passes them: read-only float64 (built-ins, files) and
+    writable float32 (arrays a caller made)."""
+    for mesh in (sphere(12), torus(12)):  # convex (no shadow rays) and concave (rays)
+        yield mesh.positions, mesh.normals, mesh.faces
+        P = mesh.positions.astype(np.float32)
+        yield P, mesh.normals.astype(np.float32), mesh.faces
+
+
+def _changes(shader: Shader) -> None:
+    """What the window and the CLI do to a shader after its first pass."""
+    material = shader.scene.material
+    for change in (
+        {"diffuse": [0.2, 0.5, 0.9]},  # compose only
+        {"shininess": 12.0},  # the specular sum
+        {"shininess": 40.0},  # the lobe alone, from stored bases
+        {"shininess": 0.0},  # a flat lobe
+        {"specular": [0.0, 0.0, 0.0]},  # no specular term
+        {"ambient": [0.0, 0.0, 0.0], "specular": [0.5, 0.5, 0.5], "shininess": 30.0},
+    ):
+        shader.set_material(material.replace(**change))
+        to_bytes(shader.colors)
+    shader.set_viewer({"eye": [0.5, 1.0, 4.0]})
+    to_bytes(shader.colors)
+    _ = shader.terms if shader.keep else None
+
+
+def exercise() -> int:
+    """Run every kind of pass the product makes on the compiled tier; returns the passes."""
+    passes = 0
+    for P, N, faces in _meshes():
+        for scene in SCENES:
+            for precision in ("float32", "float64"):
+                for keep in (True, False):
+                    for clamp in (True, False):
+                        s = Shader(
+                            {"material": MATERIAL, **scene},
+                            P,
+                            N,
+                            precision=precision,
+                            keep=keep,
+                            clamp=clamp,
+                            faces=faces,
+                            tier="compiled",
+                        )
+                        colors = s.colors
+                        to_bytes(colors)
+                        to_bytes(colors, 1.0)
+                        to_bytes(colors, out=np.empty(colors.shape, np.uint8))
+                        if keep:
+                            _changes(s)
+                        passes += s.stats["pass"]
+    return passes
+
+
+def load() -> None:
+    """Load every kernel from numba's cache (compiling what it does not hold)."""
+    exercise()
+
+
+def main() -> int:
+    """The background compile (see the module docstring). Exit status 0 unless it failed."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock (two compiles at once only cost time)
+        fcntl = None
+    if hasattr(os, "nice"):
+        os.nice(10)  # the user's own work first
+    lock = open(tiers.lock_path(), "a+")  # noqa: SIM115 - held until the process ends
+    try:
+        if fcntl is not None:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        print(f"{time.strftime('%H:%M:%S')} another compile holds the lock: nothing to do")
+        return 0
+    if tiers.marker_path().exists():
+        return 0
+    print(f"{time.strftime('%H:%M:%S')} compiling the kernels (pid {os.getpid()})", flush=True)
+    t = time.perf_counter()
+    passes = exercise()
+    seconds = time.perf_counter() - t
+    tiers.write_marker(seconds)
+    print(f"{time.strftime('%H:%M:%S')} ready: {passes} passes in {seconds:.1f} s", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

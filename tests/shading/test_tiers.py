@@ -1,0 +1,264 @@
+"""The engine's tiers (explorer.shading.tiers): the numpy tier's colours, caching and switch,
+mode auto on a cold cache (no compile in the foreground, one notice, the background compile
+started), and the background compile's coverage of every kernel signature the product calls."""
+
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import subprocess
+import sys
+import textwrap
+import time
+from contextlib import contextmanager
+
+import numpy as np
+import pytest
+from helpers.scenes import scenes, vertices
+from hypothesis import given
+from hypothesis import strategies as st
+
+import explorer
+from explorer.core.errors import ExplorerError
+from explorer.geometry.meshes import sphere, teapot, torus
+from explorer.shading import tiers, warm
+from explorer.shading.display import to_bytes
+from explorer.shading.equation import equation_shade
+from explorer.shading.shader import Shader
+
+SHADOWED = {
+    "material": {"diffuse": [0.8, 0.6, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20.0},
+    "lights": [
+        {"type": "point", "position": [1.5, 2.0, 1.0], "shadows": True},
+        {"type": "directional", "to_light": [-0.5, 1.0, 0.2], "shadows": True},
+    ],
+    "viewer": {"eye": [0.0, 1.0, 4.0]},
+}
+
+
+@given(scene=scenes(), seed=st.integers(0, 2**16), prec=st.sampled_from(["float32", "float64"]))
+def test_numpy_tier_is_the_equation_and_agrees_with_the_kernels(scene, seed, prec):
+    P, N = vertices(seed)
+    numpy_tier = Shader(scene, P, N, precision=prec, tier="numpy").colors
+    kernels = Shader(scene, P, N, precision="float64", tier="compiled").colors
+    assert numpy_tier.dtype == np.dtype(prec)
+    exact = equation_shade(explorer.load_scene(scene), P, N)
+    if prec == "float64":
+        np.testing.assert_array_equal(numpy_tier, exact)
+        np.testing.assert_allclose(kernels, numpy_tier, rtol=0, atol=1e-5)
+    else:  # float64 values rounded to float32
+        np.testing.assert_allclose(numpy_tier, exact, rtol=0, atol=1e-6)
+
+
+def test_numpy_tier_shadows_equal_the_equations_rays():
+    mesh = torus(24)
+    for prec in ("float64", "float32"):
+        s = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces, precision=prec,
+                   tier="numpy")  # fmt: skip
+        exact = equation_shade(explorer.load_scene(SHADOWED), mesh.positions, mesh.normals,
+                               faces=mesh.faces)  # fmt: skip
+        np.testing.assert_allclose(s.colors, exact, rtol=0, atol=1e-6)
+        compiled = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces,
+                          precision="float64", tier="compiled").colors  # fmt: skip
+        np.testing.assert_allclose(compiled, s.colors, rtol=0, atol=1e-5)
+    assert s.stats["shadow_rays"] > 0 and (exact < s.colors.max()).any()
+
+
+def test_numpy_tier_keeps_its_sums_for_a_material_change():
+    mesh = sphere(16)
+    s = Shader(SHADOWED, mesh.positions, mesh.normals, tier="numpy")
+    _ = s.colors
+    s.set_material({"diffuse": [0.1, 0.9, 0.1], "specular": [0.5, 0.5, 0.5], "shininess": 20.0})
+    green = s.colors
+    assert s.stats["numpy"] == 1 and s.stats["compose"] == 1  # composed, not recomputed
+    s.set_material({"diffuse": [0.1, 0.9, 0.1], "specular": [0.5, 0.5, 0.5], "shininess": 60.0})
+    _ = s.colors
+    assert s.stats["numpy"] == 2  # shininess changes the specular sum
+    assert s.stats["pass"] == 0  # no kernel ran
+    expected = Shader(s.scene.replace(material=s.scene.material.replace(shininess=20.0)),
+                      mesh.positions, mesh.normals, tier="compiled").colors  # fmt: skip
+    np.testing.assert_allclose(green.astype(np.float64), expected, atol=1 / 255)
+
+
+def test_terms_on_the_numpy_tier():
+    mesh = sphere(12)
+    s = Shader(SHADOWED, mesh.positions, mesh.normals, tier="numpy")
+    k = Shader(SHADOWED, mesh.positions, mesh.normals, tier="compiled", precision="float64")
+    for name, value in s.terms.items():
+        assert not value.flags.writeable
+        np.testing.assert_allclose(value, k.terms[name], atol=1e-5)
+
+
+def test_a_shader_switches_tier_at_its_next_pass(monkeypatch):
+    mesh = teapot(8)
+    ready = {"now": False}
+    monkeypatch.setattr(tiers, "compiled", lambda: ready["now"])
+    s = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces, precision="float32")
+    before = s.colors
+    assert s.stats["numpy"] == 1 and s.stats["pass"] == 0
+    rays = s.stats["shadow_rays"]
+    assert rays > 0
+    ready["now"] = True
+    s.set_material({"diffuse": [0.9, 0.2, 0.2], "specular": [0.5, 0.5, 0.5], "shininess": 20.0})
+    after = s.colors
+    assert s.stats["pass"] == 1  # the compiled tier computed its own sums
+    assert s.stats["shadow_rays"] == rays  # the shadow rows are kept across the switch
+    expected = Shader(s.scene, mesh.positions, mesh.normals, faces=mesh.faces, tier="numpy")
+    np.testing.assert_allclose(after, expected.colors, atol=1 / 255)
+    assert not np.array_equal(before, after)
+
+
+def test_mode_comes_from_the_environment(monkeypatch):
+    monkeypatch.setenv(tiers.ENV, "numpy")
+    tiers.set_mode(None)
+    try:
+        assert tiers.mode() == "numpy" and not tiers.compiled()
+        monkeypatch.setenv(tiers.ENV, "jit")
+        tiers.set_mode(None)
+        with pytest.raises(ExplorerError, match="PHONG_EXPLORER_KERNELS='jit'.*auto, compiled"):
+            tiers.mode()
+        with pytest.raises(ExplorerError, match="kernels mode"):
+            tiers.set_mode("fast")
+    finally:
+        monkeypatch.setenv(tiers.ENV, "compiled")
+        tiers.set_mode(None)
+    assert tiers.compiled()
+
+
+def test_to_bytes_rounds_alike_on_both_tiers(monkeypatch):
+    rng = np.random.default_rng(3)
+    c = np.concatenate([rng.uniform(-0.1, 1.1, (500, 3)), np.arange(256)[:, None] / 255 * [1, 1, 1],
+                        (np.arange(256)[:, None] + 0.5) / 255 * [1, 1, 1]])  # fmt: skip
+    for dtype in (np.float32, np.float64):
+        x = c.astype(dtype)
+        compiled = to_bytes(x)
+        monkeypatch.setattr(tiers, "compiled", lambda: False)
+        np.testing.assert_array_equal(to_bytes(x), compiled)
+        monkeypatch.undo()
+
+
+def test_the_loader_switches_once_the_marker_appears(monkeypatch, tmp_path):
+    marker = tmp_path / "explorer-ready-test.json"
+    monkeypatch.setattr(tiers, "marker_path", lambda: marker)
+    monkeypatch.setattr(tiers, "cache_dir", lambda: tmp_path)
+    monkeypatch.setattr(tiers, "warm_command", lambda: [sys.executable, "-c", "pass"])
+    monkeypatch.setattr(tiers, "POLL", 0.0)
+    tiers.set_mode("auto")
+    try:
+        with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
+            assert not tiers.compiled()  # cold: the background compile starts
+        assert "preparing" in tiers.status()
+        assert not tiers.compiled()
+        marker.write_text("{}")
+        assert not tiers.compiled()  # seen: loaded in a thread, the numpy tier serves meanwhile
+        loader = tiers._state["loading"]
+        assert loader is not None
+        loader.join(timeout=600)
+        assert tiers.compiled() and tiers.status() is None
+    finally:
+        tiers.set_mode(None)
+        tiers._state.update(started=False, loading=None, failed=None)
+
+
+COLD = textwrap.dedent(
+    """
+    import json, warnings
+    import explorer
+    from explorer.geometry.meshes import teapot
+    from explorer.shading import warm
+    from explorer.shading.display import to_bytes
+    warnings.simplefilter("always")
+    mesh = teapot(16)
+    kinds = [{"lights": [{"type": t, "position": [1, 2, 3]}]} for t in ("point", "spot")]
+    kinds += [{"model": "phong", "two_sided": True, "viewer": {"to_viewer": [0, 0, 1]}},
+              {"material": {"fresnel": 0.04, "energy_conserving": True}, "hdr": True}]
+    for scene in kinds:
+        for precision in ("float32", "float64"):
+            to_bytes(explorer.shade(scene, mesh.positions, mesh.normals, precision=precision))
+    print(json.dumps({k: len(v) for k, v in warm.signatures().items() if v}))
+    """
+)
+
+
+@contextmanager
+def _cold_cache(tmp_path):
+    """An empty numba cache in mode auto, with the background compile's lock held, as if one
+    were running already: a background compile started meanwhile must see it and leave (it is
+    waited for on exit), so no test compiles the kernels for minutes."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    env[tiers.ENV] = "auto"
+    probe = "from explorer.shading import tiers; print(tiers.lock_path())"
+    lock_file = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                               text=True, check=True).stdout.strip()  # fmt: skip
+    os.makedirs(os.path.dirname(lock_file), exist_ok=True)
+    log = os.path.join(os.path.dirname(lock_file), "explorer-warm.log")
+    with open(lock_file, "a+") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        yield env, log
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and "holds the lock" not in _read(log):
+            time.sleep(0.1)
+
+
+def _read(path) -> str:
+    try:
+        with open(path) as f:
+            return f.read()
+    except FileNotFoundError:
+        return ""
+
+
+def test_auto_on_a_cold_cache_compiles_nothing_in_the_foreground(tmp_path):
+    with _cold_cache(tmp_path) as (env, log):
+        out = subprocess.run([sys.executable, "-c", COLD], env=env, capture_output=True,
+                             text=True, cwd=tmp_path, timeout=300)  # fmt: skip
+        assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == {}  # no kernel compiled or loaded
+    assert out.stderr.count("preparing the compiled engine") == 1, out.stderr  # told once
+    assert "holds the lock" in _read(log)  # the background compile started, and left
+
+
+def test_the_quick_start_render_on_a_cold_cache(tmp_path):
+    with _cold_cache(tmp_path) as (env, log):
+        out = subprocess.run(
+            [sys.executable, "-m", "explorer.cli", "render", "--preset", "bronze", "--mesh",
+             "teapot", "--out", str(tmp_path / "bronze.png")],
+            env=env, capture_output=True, text=True, cwd=tmp_path, timeout=300,
+        )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    assert (tmp_path / "bronze.png").stat().st_size > 1000
+    assert out.stderr.strip().splitlines() == [f"notice: {tiers.PREPARING}"], out.stderr
+    assert "holds the lock" in _read(log)
+
+
+def test_the_background_compile_covers_what_the_product_calls():
+    warm.exercise()
+    before = warm.signatures()
+    # what the product does beyond the exercise: one-shot shading of every input form, the
+    # window's shader, the display pipeline
+    mesh = teapot(8)
+    P64, N64 = np.array(mesh.positions), np.array(mesh.normals)
+    for P, N in (
+        (mesh.positions, mesh.normals),
+        (P64, N64),
+        (P64.astype(np.float32), N64),
+        (P64.tolist(), N64.tolist()),
+        (P64.astype(np.float32), N64.astype(np.float32)),
+    ):
+        for precision in ("float64", "float32"):
+            for faces in (None, mesh.faces):
+                c = explorer.shade(SHADOWED, P, N, precision=precision, faces=faces)
+                to_bytes(c)
+                to_bytes(c.astype(np.float32), 0.5)
+    s = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces)
+    for shininess in (5.0, 50.0, 0.0, 128.0):
+        s.set_material(s.scene.material.replace(shininess=shininess))
+        to_bytes(s.colors, out=np.zeros((s.n, 3), np.uint8))
+    s.set_model("phong")
+    s.set_lights([{"type": "spot", "position": [0, 3, 0], "aim": [0, -1, 0], "cutoff": 30}])
+    s.set_viewer({"to_viewer": [0, 0, 1]})
+    _ = s.colors
+    after = warm.signatures()
+    new = {k: after[k] - before[k] for k in after if after[k] - before[k]}
+    assert not new, f"kernel signatures the background compile does not make: {new}"
