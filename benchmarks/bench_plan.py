@@ -19,6 +19,7 @@ import statistics
 import sys
 import time
 
+import common  # noqa: F401 - the compiled tier (benchmarks/common.py)
 import numba
 import numpy as np
 

@@ -1,8 +1,17 @@
-"""Meshes the benchmarks share (no GUI imports: bench_engine runs without VTK)."""
+"""Meshes the benchmarks share (no GUI imports: bench_engine runs without VTK).
+
+Importing it puts the engine on its compiled tier (compiled in the process when numba's cache
+lacks it): the benchmarks measure the kernels, never the numpy tier that serves while the cache
+is filled (explorer.shading.tiers).
+"""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
+
+os.environ.setdefault("PHONG_EXPLORER_KERNELS", "compiled")
 
 from explorer.geometry import meshes as M
 

@@ -270,10 +270,11 @@ class _References:
 
 
 def _shade_fn(scene, path: str, P, N) -> Callable[[], np.ndarray]:
-    """The timed shading call of a variant's path."""
+    """The timed shading call of a variant's path (the engine's compiled tier, compiled in this
+    process first if numba's cache lacks it: its speed is what is measured)."""
     if path == "plan off":
         return lambda: equation_shade(scene, P, N)
-    return lambda: shade(scene, P, N, precision=path)
+    return lambda: shade(scene, P, N, precision=path, tier="compiled")
 
 
 def _measure_mesh(r, refs, cov, mesh, mats, main: bool, repeats: int) -> list[dict]:

@@ -80,6 +80,7 @@ def shade(
     clamp: bool = True,
     materials_dirs=(),
     faces=None,
+    tier: str | None = None,
 ) -> np.ndarray:
     """Per-vertex colours of a mesh under a scene.
 
@@ -90,6 +91,7 @@ def shade(
     precision : "float64" (exact path) or "float32" (fast path, within 1/255 of float64)
     clamp : clamp to [0, 1] (OpenGL); False keeps the unclamped sums (>= 0) for HDR
     faces : (m, 3) int triangles, needed for shadows (None: no shadows)
+    tier : "compiled", "numpy", or None: the tier :mod:`explorer.shading.tiers` picks
     Returns colours : (n, 3) float64.
     """
     s = Shader(
@@ -101,6 +103,7 @@ def shade(
         materials_dirs=materials_dirs,
         keep=False,
         faces=faces,
+        tier=tier,
     )
     return np.asarray(s.colors, dtype=np.float64)
 
