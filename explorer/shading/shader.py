@@ -138,12 +138,7 @@ class Shader:
         cull: bool = True,
         tier: str | None = None,
     ):
-        _typed("precision", precision, str, f"one of {PRECISIONS}")
-        if tier not in (None, *TIERS):
-            raise ExplorerError(f"tier must be None or one of {TIERS}, got {tier!r}")
-        self.tier = tier
-        if precision not in PRECISIONS:
-            raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+        self.tier = _check_options(precision, tier)
         self._T = np.float32 if precision == "float32" else np.float64
         self.precision = precision
         self.clamp = bool(clamp)
@@ -207,18 +202,7 @@ class Shader:
         )
         self.stats["geometry"] += 1
         self._G = G
-        self._bounds = self._chunk_bounds()
-
-    def _chunk_bounds(self) -> np.ndarray:
-        """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices, for
-        light culling (see :func:`explorer.shading.kernels.bounds`), read-only; (N_BOUNDS, 0) when
-        fewer than one chunk in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled
-        vertices, say): too little could be culled to pay for the tests."""
-        b = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
-        K.bounds(self._G, b)
-        if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
-            b = b[:, :0]
-        return _readonly(b)
+        self._bounds = chunk_bounds(G)
 
     def set_scene(self, scene) -> None:
         """Apply a new scene, invalidating only what its differences touch. A bad scene raises
@@ -279,20 +263,9 @@ class Shader:
             raise ExplorerError("terms need a Shader with keep=True")
         # every sum the lights can produce, whatever the current material needs
         self._update(force=(True, True, True))
-        n = self.n
         if self._np is not None and self._A is None:  # the numpy tier served
             return {k: _readonly(v.astype(self._T)) for k, v in self._np.items()}
-        A = np.broadcast_to(self._aconst.astype(self._T), (n, 3)).copy()
-        if self._A is not None:
-            A += self._A
-        out = {
-            "ambient": A,
-            "diffuse": self._D if self._D is not None else np.zeros((n, 1), self._T),
-            "specular": self._S if self._S is not None else np.zeros((n, 1), self._T),
-        }
-        # grey sums (n, 1) are shown as (n, 3), every channel the same (a read-only view)
-        out = {k: np.broadcast_to(v, (n, 3)) for k, v in out.items()}
-        return {k: _readonly(v) for k, v in out.items()}
+        return stored_terms(self._aconst, self._A, self._D, self._S, self.n, self._T)
 
     # -- invalidation --------------------------------------------------------------------------
     def _lights_changed(self):
@@ -347,25 +320,14 @@ class Shader:
         scene, plan = self._scene, self._plan
         if not plan.shadows:
             return np.zeros((len(scene.lights), 0), dtype)
-        vis, rays = visibility_rows(
-            self._P,
-            self._N,
-            self._faces,
-            scene.lights,
-            [lp.shadows for lp in plan.lights],
-            two_sided=scene.two_sided,
-            force_all=self.force_all,
-            cache=self._vis_cache,
-            dtype=dtype,
-        )
+        shadowed = [lp.shadows for lp in plan.lights]
+        vis, rays = visibility_rows(self._P, self._N, self._faces, scene.lights, shadowed,
+                                    two_sided=scene.two_sided, force_all=self.force_all,
+                                    cache=self._vis_cache, dtype=dtype)  # fmt: skip
         self.stats["shadow_rays"] += rays
         return vis
 
     # -- the work ------------------------------------------------------------------------------
-    def _material_vector(self, dtype) -> np.ndarray:
-        m = self._scene.material
-        return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
-
     def _compiled_tier(self) -> bool:
         """Whether this pass runs on the compiled kernels (see :mod:`explorer.shading.tiers`)."""
         if self.tier is not None:
@@ -405,7 +367,7 @@ class Shader:
             self._spec_shininess = shininess
             self.stats["lobe"] += 1
             do_spec = False
-        mat = self._material_vector(T)
+        mat = material_vector(self._scene.material, T)
         aconst = self._aconst.astype(T)
         if do_amb or do_dif or do_spec:
             self._run(do_amb, do_dif, do_spec, flat, mat, aconst)
@@ -435,13 +397,7 @@ class Shader:
             self.stats["numpy"] += 1
         else:
             self.stats["compose"] += 1
-        m = self._scene.material
-        c = np.asarray(m.emission, np.float64)  # e_m
-        c = c + np.asarray(m.ambient) * self._np["ambient"]  # a_m·(a_scene + Σ w·a_i)
-        c += np.asarray(m.diffuse) * self._np["diffuse"]  # d_m·Σ w·vis·(N·L)·d_i
-        c += np.asarray(m.specular) * self._np["specular"]  # s_m·Σ w·vis·f·(N·H)^n·s_i
-        if self.clamp:
-            np.clip(c, 0.0, 1.0, out=c)
+        c = compose_terms(self._scene.material, self._np, self.clamp)
         self._colors = _readonly(c.astype(self._T, copy=False))
 
     def _params_for(self, dtype):
@@ -526,29 +482,12 @@ class Shader:
             self.stats[name] += int(bool(do))
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
             params64, _, view64 = self._params_for(np.float64)
+            mat64 = material_vector(self._scene.material, np.float64)
             self.stats["fixup_vertices"] += K.fixup(
-                redo,
-                self._redo_count,
-                _readonly(self._P),
-                _readonly(self._N),
-                self._centre,
-                1.0 / self._scale,
-                params64,
-                flags,
-                view64,
-                opts,
-                self._material_vector(np.float64),
-                self._aconst,
-                np.float64(scene.material.shininess),
-                self._k64,
-                A,
-                D,
-                S,
-                base,
-                ws,
-                vis,
-                self._out,
-            )
+                redo, self._redo_count, _readonly(self._P), _readonly(self._N), self._centre,
+                1.0 / self._scale, params64, flags, view64, opts, mat64, self._aconst,
+                np.float64(scene.material.shininess), self._k64, A, D, S, base, ws, vis, self._out,
+            )  # fmt: skip
         if keep:
             if do_amb:
                 self._A = A
@@ -560,6 +499,47 @@ class Shader:
                     self._base = base if not flat else None
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
+
+
+def chunk_bounds(G: np.ndarray) -> np.ndarray:
+    """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
+    prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
+    read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
+    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests."""
+    b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
+    K.bounds(G, b)
+    if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
+        b = b[:, :0]
+    return _readonly(b)
+
+
+def stored_terms(aconst, A, D, S, n: int, dtype) -> dict[str, np.ndarray]:
+    """The compiled tier's sums as :attr:`Shader.terms` gives them: (n, 3) read-only each, the
+    constant ambient ``aconst`` (3,) added to the per-vertex ambient ``A``, sums not computed
+    (None) as zeros, grey sums (n, 1) shown as (n, 3) (every channel the same, a view)."""
+    ambient = np.broadcast_to(aconst.astype(dtype), (n, 3)).copy()
+    if A is not None:
+        ambient += A
+    zero = np.zeros((n, 1), dtype)
+    out = {
+        "ambient": ambient,
+        "diffuse": zero if D is None else D,
+        "specular": zero if S is None else S,
+    }
+    return {k: _readonly(np.broadcast_to(v, (n, 3))) for k, v in out.items()}
+
+
+def compose_terms(material: Material, terms: Mapping, clamp: bool) -> np.ndarray:
+    """The numpy tier's colours (n, 3) float64 from the equation's sums ``terms`` (ambient,
+    diffuse, specular, each (n, 3)): clamped to [0, 1] when ``clamp``."""
+    m = material
+    c = np.asarray(m.emission, np.float64)  # e_m
+    c = c + np.asarray(m.ambient) * terms["ambient"]  # a_m·(a_scene + Σ w·a_i)
+    c += np.asarray(m.diffuse) * terms["diffuse"]  # d_m·Σ w·vis·(N·L)·d_i
+    c += np.asarray(m.specular) * terms["specular"]  # s_m·Σ w·vis·f·(N·H)^n·s_i
+    if clamp:
+        np.clip(c, 0.0, 1.0, out=c)
+    return c
 
 
 def invalidated(new: Scene, old: Scene) -> set[str]:
@@ -661,6 +641,23 @@ class _Memory:
         if len(self.colours) < 2:
             self.colours.append(buf)
         return buf
+
+
+def _check_options(precision, tier):
+    """Check a shader's ``precision`` and ``tier`` arguments; returns the tier."""
+    _typed("precision", precision, str, f"one of {PRECISIONS}")
+    if precision not in PRECISIONS:
+        raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+    if tier not in (None, *TIERS):
+        raise ExplorerError(f"tier must be None or one of {TIERS}, got {tier!r}")
+    return tier
+
+
+def material_vector(material: Material, dtype) -> np.ndarray:
+    """(12,) the material's emission, ambient, diffuse and specular colours, as the kernels
+    read them."""
+    m = material
+    return np.concatenate([m.emission, m.ambient, m.diffuse, m.specular]).astype(dtype)
 
 
 def _typed(name: str, value, types, wanted: str, not_types=()):

@@ -46,6 +46,7 @@ import time
 import warnings
 from pathlib import Path
 
+from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Notice
 
 #: the environment variable that picks the mode
@@ -178,8 +179,6 @@ def log_path() -> Path:
 
 def write_marker(seconds: float) -> Path:
     """Write the ready marker (after every kernel compiled), atomically."""
-    from explorer.core.atomic import write_atomic
-
     info = {"seconds": round(seconds, 1), "written": time.strftime("%Y-%m-%d %H:%M:%S")}
     return write_atomic(marker_path(), json.dumps(info).encode(), overwrite=True)
 
@@ -227,7 +226,7 @@ def _start_loading() -> None:
     """Load the compiled kernels from numba's cache in a thread; switch when they are loaded."""
 
     def load():
-        from explorer.shading import warm
+        from explorer.shading import warm  # a cycle: warm runs Shaders, which ask this module
 
         try:
             warm.load()
