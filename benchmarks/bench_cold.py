@@ -133,8 +133,8 @@ def window_start(env, display: str) -> float:
     env = dict(env, DISPLAY=display)
     env.pop("VTK_DEFAULT_OPENGL_WINDOW", None)
     t = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", "explorer.cli", "gui", "--mesh", "teapot"],
-                            env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    cmd = [sys.executable, "-m", "explorer.cli", "gui", "--mesh", "teapot"]
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         subprocess.run(["xdotool", "search", "--sync", "--onlyvisible", "--name",
                         "phong-explorer"], env=env, capture_output=True, timeout=600)  # fmt: skip
