@@ -99,7 +99,7 @@ def to_bytes(colors, opacity: float | None = None, *, out=None) -> np.ndarray:
         and out.flags.writeable
     )
     rgb = out if direct else np.empty(c.shape, np.uint8)
-    if tiers.compiled():
+    if tiers.loaded():
         x = c.reshape(-1).view()
         x.flags.writeable = False  # one signature for every caller's array
         _round_bytes(x, rgb.reshape(-1))

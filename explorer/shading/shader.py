@@ -332,7 +332,7 @@ class Shader:
         """Whether this pass runs on the compiled kernels (see :mod:`explorer.shading.tiers`)."""
         if self.tier is not None:
             return self.tier == "compiled"
-        return tiers.compiled()
+        return tiers.compiled(self.n * max(1, len(self._scene.lights)))
 
     def _update(self, force=(False, False, False)):
         if not self._compiled_tier():

@@ -20,10 +20,15 @@ generation options). Until the marker is there, passes run on the numpy tier, an
 starts ``python -m explorer.shading.warm`` in the background (detached: it outlives the command
 that started it; a lock keeps one at a time per cache directory) and says so once, as a
 :class:`~explorer.core.errors.Notice` (the CLI prints it as one ``notice:`` line on stderr, the
-window shows :func:`status` in its status line). A process that finds the marker at its first
-pass uses the compiled tier from the start; one that sees it appear later (a window left open
-while the background compile ran) loads the kernels in a thread and switches when they are
-loaded, so no pass waits on the load.
+window shows :func:`status` in its status line).
+
+Loading the kernels from numba's cache costs a process about half a second to a second, more
+than the numpy tier takes for a small mesh: so a process loads them once it has served
+:data:`LOAD_WORTH` vertex-lights on the numpy tier (the pass that crosses it loads them and runs
+compiled), and a one-shot render of a small mesh never loads them at all. A process that lives
+on (the window) calls :func:`preload`: the kernels load in a thread as soon as the cache holds
+them (at start, or when the background compile finishes while the window is open) and the
+shaders switch at their next pass, so no pass waits on a load.
 
 The environment variable ``PHONG_EXPLORER_KERNELS`` picks the mode: ``auto``, ``compiled``
 (compile in this process when needed, as numba does by default: the tests and the benchmarks)
@@ -64,14 +69,22 @@ PREPARING = (
     "meanwhile the numpy engine serves: the same colours, slower on large meshes"
 )
 
+#: vertex-lights a process serves on the numpy tier before it loads the compiled kernels from
+#: numba's cache (a load costs about what the numpy tier takes for this much work, so small
+#: one-shot jobs, like the quick start's render, never pay for it)
+LOAD_WORTH = 2_000_000
+
 _lock = threading.Lock()
 _state = {
     "mode": None,  # set by set_mode, else read from ENV at first use
-    "compiled": None,  # True once this process uses the compiled tier
-    "started": False,  # the background compile was started (or found running) by this process
-    "loading": None,  # the loader thread, while it runs
+    "ready": None,  # numba's cache holds the kernels (the marker): None until first looked for
+    "loaded": False,  # this process uses the compiled tier from now on
+    "numpy_work": 0,  # vertex-lights the numpy tier served while the kernels were ready
+    "preload": False,  # load the kernels in a thread as soon as they are ready (a window)
+    "started": False,  # the background compile was started by this process
+    "loading": None,  # the loader thread, once started
     "checked": 0.0,  # when the marker was last looked for
-    "failed": None,  # why the background compile could not be started
+    "failed": None,  # why the compiled engine is unavailable
 }
 
 
@@ -94,42 +107,73 @@ def set_mode(value: str | None) -> None:
     if value is not None and value not in MODES:
         raise ExplorerError(f"kernels mode must be one of {', '.join(MODES)}, got {value!r}")
     with _lock:
-        _state.update(mode=value, compiled=None, checked=0.0)
+        _state.update(mode=value, ready=None, loaded=False, numpy_work=0, checked=0.0)
 
 
-def compiled() -> bool:
-    """True when the next pass should run on the compiled kernels (see the module docstring).
-    In mode auto this may start the background compile (and tell the user once) or the loader
-    thread; it never waits for either."""
+def compiled(work: int = 0) -> bool:
+    """True when a pass of ``work`` vertex-lights should run on the compiled kernels (see the
+    module docstring). In mode auto: once they are loaded in this process; else when numba's
+    cache holds them and this process has served :data:`LOAD_WORTH` vertex-lights on the numpy
+    tier (a pass that decides so loads them). May start the background compile (and tell the
+    user once) or the loader thread; never waits for either."""
     m = mode()
     if m != "auto":
         return m == "compiled"
-    if _state["compiled"]:
+    if _state["loaded"]:
+        return True
+    if not _ready() or _state["loading"] is not None:
+        return False
+    _state["numpy_work"] += int(work)
+    if _state["numpy_work"] >= LOAD_WORTH:
+        _state["loaded"] = True
+    return _state["loaded"]
+
+
+def loaded() -> bool:
+    """Whether the compiled kernels serve in this process now (no side effects)."""
+    return mode() == "compiled" or (mode() == "auto" and _state["loaded"])
+
+
+def preload() -> None:
+    """For a process that lives on (the window): load the compiled kernels in a thread as soon
+    as numba's cache holds them (now, or when the background compile has filled it), and switch
+    to them when loaded; the numpy tier serves meanwhile."""
+    if mode() != "auto" or _state["loaded"]:
+        return
+    _state["preload"] = True
+    if _ready():
+        _start_loading()
+
+
+def _ready() -> bool:
+    """Whether numba's cache holds the kernels: the marker, looked for at most every
+    :data:`POLL` seconds. The first look that finds none starts the background compile."""
+    if _state["ready"]:
         return True
     now = time.monotonic()
-    if _state["compiled"] is None:  # the first pass of this process: decide now
-        ready = marker_path().exists()
-        _state["compiled"] = ready
+    if _state["ready"] is None or now - _state["checked"] >= POLL:
+        first = _state["ready"] is None
         _state["checked"] = now
-        if not ready:
+        _state["ready"] = marker_path().exists()
+        if first and not _state["ready"]:
             _start_background()
-        return ready
-    if _state["loading"] is None and now - _state["checked"] >= POLL:
-        _state["checked"] = now
-        if marker_path().exists():
+        if _state["ready"] and _state["preload"]:
             _start_loading()
-    return False
+    return bool(_state["ready"])
 
 
 def status() -> str | None:
-    """A short line for a status bar while the numpy tier serves in mode auto, else None."""
-    if mode() != "auto" or _state["compiled"] is not False:
+    """A short line for a status bar while the numpy tier serves in mode auto for want of the
+    compiled kernels, else None."""
+    if mode() != "auto" or _state["loaded"]:
         return None
     if _state["failed"]:
         return f"numpy engine (the compiled engine is unavailable: {_state['failed']})"
     if _state["loading"] is not None:
         return "numpy engine; loading the compiled engine"
-    return "numpy engine; preparing the compiled engine in the background"
+    if _state["ready"] is False:
+        return "numpy engine; preparing the compiled engine in the background"
+    return None
 
 
 # -- the ready marker ------------------------------------------------------------------------------
@@ -233,7 +277,7 @@ def _start_loading() -> None:
         except Exception as exc:  # noqa: BLE001 - a failed load keeps the numpy tier serving
             _state["failed"] = f"{type(exc).__name__}: {exc}"
             return
-        _state["compiled"] = True
+        _state["loaded"] = True
 
     with _lock:
         if _state["loading"] is not None:

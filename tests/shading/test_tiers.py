@@ -93,7 +93,7 @@ def test_terms_on_the_numpy_tier():
 def test_a_shader_switches_tier_at_its_next_pass(monkeypatch):
     mesh = teapot(8)
     ready = {"now": False}
-    monkeypatch.setattr(tiers, "compiled", lambda: ready["now"])
+    monkeypatch.setattr(tiers, "compiled", lambda work=0: ready["now"])
     s = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces, precision="float32")
     before = s.colors
     assert s.stats["numpy"] == 1 and s.stats["pass"] == 0
@@ -133,32 +133,52 @@ def test_to_bytes_rounds_alike_on_both_tiers(monkeypatch):
     for dtype in (np.float32, np.float64):
         x = c.astype(dtype)
         compiled = to_bytes(x)
-        monkeypatch.setattr(tiers, "compiled", lambda: False)
+        monkeypatch.setattr(tiers, "loaded", lambda: False)
         np.testing.assert_array_equal(to_bytes(x), compiled)
         monkeypatch.undo()
 
 
-def test_the_loader_switches_once_the_marker_appears(monkeypatch, tmp_path):
+@pytest.fixture
+def auto(monkeypatch, tmp_path):
+    """Mode auto on a cache with no marker yet (its path under tmp_path); the background compile
+    replaced by a process that does nothing."""
     marker = tmp_path / "explorer-ready-test.json"
     monkeypatch.setattr(tiers, "marker_path", lambda: marker)
     monkeypatch.setattr(tiers, "cache_dir", lambda: tmp_path)
     monkeypatch.setattr(tiers, "warm_command", lambda: [sys.executable, "-c", "pass"])
     monkeypatch.setattr(tiers, "POLL", 0.0)
     tiers.set_mode("auto")
-    try:
-        with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
-            assert not tiers.compiled()  # cold: the background compile starts
-        assert "preparing" in tiers.status()
-        assert not tiers.compiled()
-        marker.write_text("{}")
-        assert not tiers.compiled()  # seen: loaded in a thread, the numpy tier serves meanwhile
-        loader = tiers._state["loading"]
-        assert loader is not None
-        loader.join(timeout=600)
-        assert tiers.compiled() and tiers.status() is None
-    finally:
-        tiers.set_mode(None)
-        tiers._state.update(started=False, loading=None, failed=None)
+    yield marker
+    tiers.set_mode(None)
+    tiers._state.update(started=False, loading=None, failed=None, preload=False)
+
+
+def test_a_window_loads_the_kernels_in_a_thread_once_they_are_ready(auto):
+    with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
+        assert not tiers.compiled(10**9)  # cold: the background compile starts
+    tiers.preload()
+    assert "preparing" in tiers.status()
+    assert not tiers.compiled(10**9)
+    auto.write_text("{}")  # the background compile is done
+    assert not tiers.compiled(10**9)  # seen: loading in a thread, the numpy tier serves meanwhile
+    loader = tiers._state["loading"]
+    assert loader is not None and "loading" in tiers.status()
+    loader.join(timeout=600)
+    assert tiers.compiled(1) and tiers.loaded() and tiers.status() is None
+
+
+def test_a_one_shot_process_loads_the_kernels_only_for_enough_work(auto):
+    auto.write_text("{}")  # the cache holds the kernels
+    mesh = sphere(16)
+    s = Shader(SHADOWED, mesh.positions, mesh.normals, keep=False)
+    _ = s.colors
+    assert s.stats["numpy"] == 1 and not tiers.loaded()  # a small job: no load
+    assert not tiers.compiled(tiers.LOAD_WORTH // 2)
+    assert tiers.compiled(tiers.LOAD_WORTH // 2)  # enough work served: load and compile
+    s.set_lights(SHADOWED["lights"][:1])
+    _ = s.colors
+    assert s.stats["pass"] == 1 and tiers.loaded()
+    assert tiers._state["loading"] is None  # loaded by the pass itself, no thread
 
 
 COLD = textwrap.dedent(
