@@ -144,6 +144,13 @@ MAX_MESH_FILE_BYTES = 256 << 20
 #: checked by their declared sizes before anything is unpacked (reading stops at the declared
 #: size); bz2 and gzip streams are counted while unpacking and abandoned past the cap.
 MAX_MESH_UNPACKED_BYTES = 256 << 20
+#: Largest .mtl file read (bytes). A material library is text of a few lines per material; the
+#: largest real ones (scenes of thousands of materials) are a few MiB, so anything larger is
+#: refused before it is read.
+MAX_MTL_FILE_BYTES = 16 << 20
+#: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
+#: full off-screen render held in memory until the animation is encoded.
+MAX_TURNTABLE_FRAMES = 360
 #: Largest picture (width x height pixels) a render or a whole sheet may have: 8192 x 8192,
 #: 192 MiB as RGB bytes and several times that inside VTK while drawing. A sheet of large
 #: tiles is checked before anything is allocated (beyond it VTK aborts with std::bad_alloc).
