@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass
 from xml.sax.saxutils import quoteattr
 
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.material import Material
 from explorer.core.mtl import format_mtl, lost_in_mtl
@@ -96,9 +97,10 @@ def to_threejs(material: Material, name: str) -> Converted:
         "values; the exact floats are kept in userData.phong_explorer",
         "ambient is dropped: MeshPhongMaterial has no ambient colour (an AmbientLight lights "
         "'color' instead)",
-        "three.js divides diffuse by π and normalises the highlight, (n/2 + 1)/π · (N·H)^n, "
-        "with Schlick's Fresnel on 'specular' and a visibility of 1/4: under the same lights "
-        "the highlight is brighter and tighter-edged than OpenGL's",
+        "three.js's shader divides diffuse by π and weights the highlight (N·H)^n by "
+        "(n/2 + 1)/(4π) with Schlick's Fresnel on 'specular': under lights of intensity π "
+        "diffuse matches OpenGL's and the highlight's peak is (n/2 + 1)/4 = "
+        f"{(material.shininess / 2 + 1) / 4:.3g} times OpenGL's (more at grazing angles)",
     ]
     if material.model == "phong":
         notes.append("model phong becomes Blinn-Phong (three.js's only Phong lobe)")
@@ -149,7 +151,7 @@ def to_x3d(material: Material, name: str) -> Converted:
     notes = []
     near = tuple(k * d for d in material.diffuse)
     off = max(abs(a - b) for a, b in zip(near, material.ambient, strict=True))
-    if off > 0.0:
+    if off > tol.X3D_AMBIENT_TOLERANCE:
         notes.append(
             f"ambient {_triple(material.ambient)} becomes ambientIntensity {k:.6g} × diffuse "
             f"= {_triple(near, '.4g')} (X3D's ambient is one number times diffuseColor; off "

@@ -133,6 +133,11 @@ FLOAT32_ROUTE_ABS_TOL = 1e-6
 #: far above it; one 8-bit level is 4e-3.
 GOLDEN_COLOR_ABS_TOL = 1e-9
 
+#: Largest difference between a material's ambient and X3D's ``ambientIntensity × diffuseColor``
+#: reported as exact: the least-squares ``ambientIntensity`` of an ambient that is a multiple of
+#: the diffuse colour reproduces it to a few ulps (about 1e-16), far below one 8-bit level.
+X3D_AMBIENT_TOLERANCE = 1e-9
+
 # --- caps on what a small input may make the program allocate ------------------------------
 
 #: Largest mesh file read (bytes). The largest meshes worth shading per vertex are a few
