@@ -38,13 +38,13 @@ def group_materials(mesh: Mesh, fallback: Material) -> tuple[tuple[Material, ...
         for m in materials:
             found.setdefault(m.name, m.material.replace(name=m.name))
             warnings.extend(m.warnings)
-    out = []
-    for name in groups.names:
-        if name in found:
-            out.append(found[name])
-            continue
-        out.append(fallback)
-        what = f"material '{name}'" if name else "faces without a material"
-        if groups.libraries and not (len(groups.names) == 1 and not name and not found):
-            warnings.append(f"{mesh.name}: {what}: not in its mtllib; the scene's material is used")
+    out = [found.get(name, fallback) for name in groups.names]
+    missing = [name for name in groups.used if name not in found]
+    if missing and found:
+        names = ", ".join(f"'{name}'" for name in missing)
+        warnings.append(
+            f"{mesh.name}: usemtl {names}: not in its mtllib; the scene's material is used there"
+        )
+    elif "" in groups.names and found:
+        warnings.append(f"{mesh.name}: faces without a usemtl get the scene's material")
     return tuple(out), warnings

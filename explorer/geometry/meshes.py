@@ -135,11 +135,14 @@ class MaterialGroups:
     names : the ``usemtl`` names, in the order first met
     of_vertex : (n,) int32 index into ``names`` of each vertex, read-only
     libraries : the ``mtllib`` files the OBJ names, as paths next to it
+    used : every name the OBJ's ``usemtl`` lines give (faces whose material no library
+        defines are in the group named ``""``)
     """
 
     names: tuple[str, ...]
     of_vertex: np.ndarray
     libraries: tuple[str, ...] = ()
+    used: tuple[str, ...] = ()
 
     def __post_init__(self):
         keys = np.array(self.of_vertex, dtype=np.int32, copy=True)
@@ -603,7 +606,7 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(
             f"mesh file '{shown}' holds {reason}: a mesh needs triangles (or polygons)"
         )
-    libraries = mtl_libraries(path) if ext == ".obj" else ()
+    libraries, used_names = obj_material_names(path) if ext == ".obj" else ((), ())
     _say_unread_materials(shown, parts, libraries)
     group_names: list[str] = []
     keys = []
@@ -656,9 +659,9 @@ def load_mesh(path) -> Mesh:
     pos, nrm, faces = _drop_unused(pos, nrm, faces)
     groups = None
     if group_names:
-        groups = MaterialGroups(tuple(group_names), keys[used], libraries)
+        groups = MaterialGroups(tuple(group_names), keys[used], libraries, used_names)
     elif libraries:  # no usemtl matched a material trimesh found: one group, named nothing
-        groups = MaterialGroups(("",), np.zeros(len(pos), np.int32), libraries)
+        groups = MaterialGroups(("",), np.zeros(len(pos), np.int32), libraries, used_names)
     return Mesh(pos, nrm, faces, os.path.basename(path), groups)
 
 
@@ -668,20 +671,28 @@ def _used(pos, faces) -> np.ndarray:
     return used
 
 
-def mtl_libraries(path: str) -> tuple[str, ...]:
-    """The ``mtllib`` files an OBJ names, as paths next to it (the names as written; a name
-    with blanks in it cannot be told from two names, as in every OBJ reader)."""
+def obj_material_names(path: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """``(libraries, used)``: the ``mtllib`` files an OBJ names, as paths next to it (a name
+    with blanks in it cannot be told from two names, as in every OBJ reader), and the names
+    its ``usemtl`` lines give, in the order first met."""
     folder = os.path.dirname(path)
-    out: list[str] = []
+    libraries: list[str] = []
+    used: list[str] = []
     with open(path, "rb") as fh:
         for raw in fh:
-            if raw[:6] != b"mtllib":
+            if raw[:6] not in (b"mtllib", b"usemtl"):
                 continue
-            for word in raw[6:].decode("utf-8", "replace").split("#", 1)[0].split():
+            words = raw[6:].decode("utf-8", "replace").split("#", 1)[0].split()
+            if raw[:6] == b"usemtl":
+                name = " ".join(words)
+                if name and name not in used:
+                    used.append(name)
+                continue
+            for word in words:
                 lib = os.path.join(folder, word)
-                if lib not in out:
-                    out.append(lib)
-    return tuple(out)
+                if lib not in libraries:
+                    libraries.append(lib)
+    return tuple(libraries), tuple(used)
 
 
 def _say_unread_materials(shown: str, parts, libraries) -> None:
