@@ -98,9 +98,10 @@ def to_threejs(material: Material, name: str) -> Converted:
         "ambient is dropped: MeshPhongMaterial has no ambient colour (an AmbientLight lights "
         "'color' instead)",
         "three.js's shader divides diffuse by π and weights the highlight (N·H)^n by "
-        "(n/2 + 1)/(4π) with Schlick's Fresnel on 'specular': under lights of intensity π "
-        "diffuse matches OpenGL's and the highlight's peak is (n/2 + 1)/4 = "
-        f"{(material.shininess / 2 + 1) / 4:.3g} times OpenGL's (more at grazing angles)",
+        "(n/2 + 1)/(4π) · N·L with Schlick's Fresnel on 'specular': under lights of intensity "
+        "π diffuse matches OpenGL's and the highlight's peak is (n/2 + 1)/4 = "
+        f"{(material.shininess / 2 + 1) / 4:.3g} times OpenGL's (less towards the terminator, "
+        "whiter at grazing angles)",
     ]
     if material.model == "phong":
         notes.append("model phong becomes Blinn-Phong (three.js's only Phong lobe)")

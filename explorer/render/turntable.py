@@ -72,17 +72,25 @@ def orbit_scene(scene, mesh: Mesh, angle: float):
 
 
 def orbit_camera(scene, mesh: Mesh, aspect: float) -> Camera:
-    """The frame's camera: :func:`camera_for`, with a parallel view centred on the mesh's
-    bounding sphere (the same size in every frame)."""
+    """The frame's camera: :func:`camera_for`, with a parallel view fitted to the cylinder
+    about the turning axis that holds the mesh (the same size and centre in every frame)."""
     cam = camera_for(scene, mesh, aspect)
     if not cam.parallel:
         return cam
-    radius = max(float(mesh.radius), 1e-12)
-    centre = np.asarray(mesh.centre, np.float64)
-    offset = np.subtract(cam.position, cam.focal_point)
-    scale = radius * FRAME_MARGIN / min(1.0, aspect)
+    p = mesh.positions
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    centre = np.array([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])])
+    r_xz = float(np.sqrt(np.max((p[:, 0] - centre[0]) ** 2 + (p[:, 2] - centre[2]) ** 2)))
+    half_y = 0.5 * float(hi[1] - lo[1])
+    toward = np.subtract(cam.position, cam.focal_point)
+    toward = toward / np.linalg.norm(toward)
+    tilt = abs(float(toward[1]))  # sine of the viewer's elevation
+    flat = math.sqrt(max(0.0, 1.0 - tilt * tilt))
+    half_h = half_y * flat + r_xz * tilt
+    scale = max(half_h, r_xz / aspect, 1e-12) * FRAME_MARGIN
+    dist = float(np.linalg.norm(np.subtract(cam.position, cam.focal_point)))
     return Camera(
-        tuple(centre + offset),
+        tuple(centre + toward * dist),
         tuple(centre),
         cam.view_up,
         True,
