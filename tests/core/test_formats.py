@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 
 from explorer.cli import main
-from explorer.core import presets
 from explorer.core.formats import (
     blender_settings,
     convert,
@@ -25,12 +24,7 @@ from explorer.core.presets import find_preset, load_material_file
 DATA = Path(__file__).resolve().parents[1] / "data" / "mtl"
 
 
-@pytest.fixture(autouse=True)
-def isolated_user_dir(tmp_path, monkeypatch):
-    d = tmp_path / "user-config" / "materials"
-    monkeypatch.setenv(presets.ENV_VAR, str(d))
-    monkeypatch.setattr(presets, "_NOTICED", set())
-    return d
+pytestmark = pytest.mark.usefixtures("isolated_user_dir")  # tests/core/conftest.py
 
 
 # -- the conversions -------------------------------------------------------------------------
