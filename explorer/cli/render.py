@@ -100,7 +100,7 @@ def run(args) -> int:
         return run_per_pixel(args, scene, mesh, size, background, suffix)
     name = scene.material.name or "material"
     if materials:
-        name = f"{len(materials)} materials of the file"
+        name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
     if turntable:
         return run_turntable(args, scene, mesh, materials, size, background, suffix)
     colors = colors_of(scene, mesh, materials)
@@ -111,7 +111,9 @@ def run(args) -> int:
         data = encode_png(image)
         what = f"{size[0]}x{size[1]} picture"
     else:
-        data = mesh_file_bytes(mesh, colors, suffix, scene.material.opacity)
+        data = mesh_file_bytes(
+            mesh, colors, suffix, scene.material.opacity, double_sided=scene.two_sided
+        )
         what = f"{mesh.n_vertices} vertices with colours"
     write_atomic(args.out, data, overwrite=args.force)
     print(f"wrote {args.out}: {what} ({mesh.name}, {name}, {scene.model})")

@@ -281,8 +281,8 @@ class _Builder:
             self._warn_at(
                 "ka",
                 "'Ka 1 1 1' (Blender's exporter writes it: it holds Blender's 'metallic', not "
-                "an ambient colour) lights the whole surface with the scene's ambient; set "
-                "ambient to the diffuse colour times 0.2 for OpenGL's default look",
+                "an ambient colour) adds the scene's whole ambient light, in white, to every "
+                "vertex (a washed-out look); the diffuse colour times 0.2 is OpenGL's default",
             )
         if m.shininess == 0.0 and max(m.specular) > 0.0:
             self._warn_at(

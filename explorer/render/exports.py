@@ -37,12 +37,15 @@ _FLOAT, _UINT = 5126, 5125  # glTF componentType: float32, uint32
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 
 
-def mesh_file_bytes(mesh: Mesh, colors, suffix: str, opacity: float = 1.0) -> bytes:
+def mesh_file_bytes(
+    mesh: Mesh, colors, suffix: str, opacity: float = 1.0, *, double_sided: bool = False
+) -> bytes:
     """A PLY or GLB file (by ``suffix``) holding the mesh, its normals and its per-vertex
-    colours (see the module docstring)."""
+    colours (see the module docstring); ``double_sided``: the GLB material's flag (the
+    scene's ``two_sided``)."""
     kind = suffix.lower().lstrip(".")
     if kind == "glb":
-        return glb_bytes(mesh, colors, opacity)
+        return glb_bytes(mesh, colors, opacity, double_sided=double_sided)
     if kind != "ply":
         raise ExplorerError(f"mesh export writes .ply or .glb, got {suffix!r}")
     import trimesh

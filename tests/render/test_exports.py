@@ -94,7 +94,10 @@ def test_cli_glb_matches_the_engine(tmp_path):
     argv = ["render", "--preset", "copper", "--mesh", "icosphere", "--resolution", "2"]
     assert main([*argv, "--out", str(out)]) == 0
     gltf = pygltflib.GLTF2().load(str(out))
-    assert gltf.materials[0].alphaMode == "OPAQUE"
+    assert gltf.materials[0].alphaMode == "OPAQUE" and gltf.materials[0].doubleSided is False
+    two = tmp_path / "two.glb"
+    assert main([*argv, "--two-sided", "--out", str(two)]) == 0
+    assert pygltflib.GLTF2().load(str(two)).materials[0].doubleSided is True
     accessor = gltf.accessors[gltf.meshes[0].primitives[0].attributes.COLOR_0]
     view = gltf.bufferViews[accessor.bufferView]
     rgba = np.frombuffer(gltf.binary_blob(), np.float32, accessor.count * 4, view.byteOffset)
