@@ -29,8 +29,8 @@ from explorer.core.version import __version__
 #: subcommand -> (module, one-line help); each module has ``add_arguments`` and ``run``
 COMMANDS = {
     "plan": (plan, "print the work plan for a scene and why each term is in or out"),
-    "presets": (presets, "list, show and validate material presets"),
-    "render": (render, "render a scene off-screen to PNG, PLY or GLB"),
+    "presets": (presets, "list, show, validate, import (.mtl) and export material presets"),
+    "render": (render, "render a scene off-screen to PNG, PLY, GLB, OBJ or a GIF/MP4 turntable"),
     "sheet": (sheet, "render every preset in one labelled grid"),
     "gui": (gui, "open the interactive explorer window"),
     "bench": (bench, "measure what accuracy costs in time"),

@@ -12,13 +12,18 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
+
+import numpy as np
 
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, load_scene
+from explorer.core.text import printable
 from explorer.core.validate import Checker, notice
+from explorer.geometry.filematerials import group_materials
 from explorer.geometry.meshes import BUILTIN_MESHES, RESOLUTION, get_mesh
 from explorer.render.images import parse_size
 from explorer.render.offscreen import BACKGROUND
@@ -284,3 +289,53 @@ def size_from_option(text: str, flag: str) -> tuple[int, int]:
         return parse_size(text)
     except ExplorerError as exc:
         raise ExplorerError(f"{flag} {text}: {exc}") from None
+
+
+def mesh_materials(args, scene, mesh):
+    """``(scene, materials)``: the materials of a mesh file's groups (an OBJ's ``usemtl``
+    groups, read from its ``mtllib``), one per group, or None when the mesh has none or
+    ``--preset`` gives the material. With materials, the scene's material becomes that of the
+    largest group (its opacity is the picture's); every warning of the .mtl reader is printed.
+    """
+    if mesh.groups is None or isinstance(getattr(args, "preset", None), str):
+        return scene, None
+    materials, warnings = group_materials(mesh, scene.material)
+    for w in warnings:
+        print(f"warning: {printable(w)}", file=sys.stderr)
+    sizes = np.bincount(mesh.groups.of_vertex, minlength=len(materials))
+    main = materials[int(np.argmax(sizes))]
+    opacities = {m.opacity for m, size in zip(materials, sizes, strict=True) if size}
+    if len(opacities) > 1:
+        print(
+            f"warning: {mesh.name}: its materials' opacities differ "
+            f"({', '.join(f'{o:g}' for o in sorted(opacities))}); the whole mesh is drawn "
+            f"with {main.opacity:g}",
+            file=sys.stderr,
+        )
+    return scene.replace(material=main), materials
+
+
+class ProgressBar:
+    """A one-line progress bar on a terminal (nothing when ``stream`` is not one)."""
+
+    WIDTH = 30
+
+    def __init__(self, stream, label: str):
+        self.stream, self.label = stream, label
+        isatty = getattr(stream, "isatty", None)
+        self.shown = bool(isatty and isatty())
+        self.drawn = False
+
+    def update(self, done: int, total: int) -> None:
+        if not self.shown:
+            return
+        filled = self.WIDTH * done // max(total, 1)
+        bar = "#" * filled + "-" * (self.WIDTH - filled)
+        self.stream.write(f"\r{self.label} [{bar}] {done}/{total}")
+        self.stream.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        if self.drawn:
+            self.stream.write("\n")
+            self.stream.flush()

@@ -6,6 +6,14 @@
     phong-explorer presets show NAME|FILE    its values (copy-pastable YAML) and where it is from
     phong-explorer presets validate PATH...  check files (directories: every *.yaml in them);
                                              one line per problem on stdout, exit status 1
+    phong-explorer presets show NAME --as mtl|threejs|x3d|blender
+                                             the preset as that tool holds it, and what changes
+    phong-explorer presets import FILE.mtl [--into DIR] [--force]
+                                             one preset per newmtl (default DIR: the user's
+                                             preset directory), warnings for what is dropped
+    phong-explorer presets export NAME --out FILE.mtl|.json|.x3d [--force]
+                                             MTL (exact), three.js MeshPhongMaterial JSON or an
+                                             X3D Material, and the approximations made
 
 ``--materials-dir DIR`` (repeatable) adds preset directories searched before the user's and the
 built-in ones. The colour swatch is drawn with 24-bit ANSI colour only when stdout is a
@@ -20,14 +28,19 @@ import sys
 from pathlib import Path
 
 from explorer.cli.options import add_materials_dir_option
+from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Problem, ValidationError
+from explorer.core.formats import EXPORT_SUFFIXES, SHOW_FORMATS, convert
 from explorer.core.material import Material
+from explorer.core.mtl import MtlError, preset_name, preset_names, read_mtl
 from explorer.core.presets import (
     SUFFIX,
     is_valid_name,
     list_presets,
     load_material_file,
     locate_preset,
+    save_preset,
+    user_dir,
 )
 from explorer.core.text import printable
 from explorer.core.yamlio import dump_yaml
@@ -42,11 +55,31 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     p_list = sub.add_parser("list", help="list every preset (the default)")
     p_show = sub.add_parser("show", help="print a preset's values and the file it came from")
     p_show.add_argument("name", metavar="NAME", help="preset name, or a material file")
+    p_show.add_argument(
+        "--as", dest="as_format", choices=SHOW_FORMATS, default=None,
+        help="show it as that tool holds it (MTL, three.js MeshPhongMaterial JSON, X3D "
+        "Material, Blender's Principled BSDF), with what changes",
+    )  # fmt: skip
+    p_imp = sub.add_parser("import", help="one preset per material of an .mtl file")
+    p_imp.add_argument("file", metavar="FILE.mtl", help="Wavefront material library")
+    p_imp.add_argument(
+        "--into", metavar="DIR", default=None,
+        help="preset directory to write to (default: the user's preset directory)",
+    )  # fmt: skip
+    p_imp.add_argument("--force", action="store_true", help="replace presets that exist")
+    p_exp = sub.add_parser("export", help="write a preset as .mtl, three.js .json or .x3d")
+    p_exp.add_argument("name", metavar="NAME", help="preset name, or a material file")
+    p_exp.add_argument(
+        "--out", required=True, metavar="FILE",
+        help="output: .mtl (exact), .json (three.js MeshPhongMaterial), .x3d (X3D Material)",
+    )  # fmt: skip
+    p_exp.add_argument("--force", action="store_true", help="replace the output file")
     p_val = sub.add_parser("validate", help="check material files; exit 1 if any has a problem")
     p_val.add_argument(
-        "paths", nargs="+", metavar="PATH", help="material file, or directory of *.yaml files"
-    )
-    for p in (p_list, p_show):
+        "paths", nargs="+", metavar="PATH",
+        help="material file (.yaml, or an .mtl library), or directory of *.yaml files",
+    )  # fmt: skip
+    for p in (p_list, p_show, p_exp):
         add_materials_dir_option(p, dest="materials_dirs_after")
 
 
@@ -56,7 +89,13 @@ def run(args) -> int:
     )
     command = getattr(args, "presets_command", None) or "list"
     if command == "show":
+        if args.as_format is not None:
+            return show_as(args.name, args.as_format, materials_dirs)
         return show(args.name, materials_dirs)
+    if command == "import":
+        return import_mtl(args.file, args.into, args.force)
+    if command == "export":
+        return export(args.name, args.out, args.force, materials_dirs)
     if command == "validate":
         return validate(args.paths)
     return list_(materials_dirs)
@@ -142,6 +181,76 @@ def show(name: str, materials_dirs, out=None, err=None) -> int:
     return 0
 
 
+def _load(name: str, materials_dirs) -> tuple[Material, str, str]:
+    """``(material, preset name, where it came from)`` of a preset name or a material file."""
+    if name.endswith((SUFFIX, ".yml")) or os.sep in name or "/" in name:
+        path = Path(name)
+        material = load_material_file(path)
+        return material, preset_name(path.stem), f"the file {path}"
+    path, source, _ = locate_preset(name, materials_dirs)
+    return load_material_file(path), name, f"preset '{name}' ({_source_label(source)}): {path}"
+
+
+def show_as(name: str, fmt: str, materials_dirs, out=None, err=None) -> int:
+    """``presets show NAME --as FMT``: the text on ``out``, each approximation on ``err``."""
+    out = out or sys.stdout
+    err = err or sys.stderr
+    material, preset, _ = _load(name, materials_dirs)
+    converted = convert(material, preset, fmt)
+    out.write(printable(converted.text, keep="\n"))
+    for note in converted.notes:
+        err.write(f"note: {printable(note)}\n")
+    return 0
+
+
+# -- import / export -------------------------------------------------------------------------
+def import_mtl(file: str, into, force: bool, out=None, err=None) -> int:
+    """``presets import FILE.mtl``: every material of the file as a preset in ``into`` (the
+    user's directory by default). Nothing is written when the file has a problem, or when a
+    preset file exists and ``force`` is not given."""
+    out = out or sys.stdout
+    err = err or sys.stderr
+    found = read_mtl(file)
+    directory = user_dir() if into is None else Path(into).expanduser()
+    names = preset_names([m.name for m in found])
+    targets = [directory / f"{name}{SUFFIX}" for name in names]
+    existing = [str(t) for t in targets if t.exists()]
+    if existing and not force:
+        raise ExplorerError(
+            f"{len(existing)} preset file{'s' if len(existing) != 1 else ''} already exist: "
+            f"{', '.join(existing)}; nothing was written (use --force to replace them)"
+        )
+    for m, name in zip(found, names, strict=True):
+        material = m.material.replace(description=f"imported from {Path(file).name}: {m.name}")
+        path = save_preset(material, name, directory, overwrite=force)
+        renamed = "" if name == m.name else f" (newmtl {m.name})"
+        out.write(f"wrote {printable(path)}{printable(renamed)}\n")
+        for w in m.warnings:
+            err.write(f"warning: {printable(w)}\n")
+    n = len(found)
+    out.write(f"{n} preset{'s' if n != 1 else ''} imported into {printable(directory)}\n")
+    return 0
+
+
+def export(name: str, out_path: str, force: bool, materials_dirs, out=None, err=None) -> int:
+    """``presets export NAME --out FILE``: the format by the file's suffix
+    (:data:`~explorer.core.formats.EXPORT_SUFFIXES`); each approximation on ``err``."""
+    out = out or sys.stdout
+    err = err or sys.stderr
+    suffix = Path(out_path).suffix.lower()
+    if suffix not in EXPORT_SUFFIXES:
+        raise ExplorerError(
+            f"--out {out_path!r}: the file name must end in {' or '.join(EXPORT_SUFFIXES)}"
+        )
+    material, preset, origin = _load(name, materials_dirs)
+    converted = convert(material, preset, EXPORT_SUFFIXES[suffix])
+    write_atomic(out_path, converted.text.encode("utf-8"), overwrite=force)
+    out.write(f"wrote {printable(out_path)}: {printable(origin)} as {EXPORT_SUFFIXES[suffix]}\n")
+    for note in converted.notes:
+        err.write(f"note: {printable(note)}\n")
+    return 0
+
+
 # -- validate --------------------------------------------------------------------------------
 def validate(paths, out=None, err=None) -> int:
     """Check every file; one line per problem on ``out``; 1 if any problem, else 0."""
@@ -161,7 +270,12 @@ def validate(paths, out=None, err=None) -> int:
             files.append(path)
     for path in files:
         try:
+            if path.suffix.lower() == ".mtl":
+                read_mtl(path)  # its warnings are not problems: 'presets import' prints them
+                continue
             load_material_file(path)
+        except MtlError as exc:
+            problems.append(Problem(str(exc)))
         except ValidationError as exc:
             problems.extend(exc.problems)
         except ExplorerError as exc:  # pragma: no cover - the loader raises ValidationError

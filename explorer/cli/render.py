@@ -5,36 +5,60 @@
     phong-explorer render [SCENE] --preset gold --mesh teapot --out gold.png --size 400x400
     phong-explorer render --preset jade --light-type point --light-position 2 2 2 --out j.ply
     phong-explorer render --preset jade --per-pixel --out reference.png
+    phong-explorer render --mesh model.obj --out model.png         (the OBJ's own materials)
+    phong-explorer render --preset gold --mesh teapot --out gold.glb   (unlit glTF)
+    phong-explorer render --preset gold --mesh teapot --out gold.obj   (gold.obj + gold.mtl)
+    phong-explorer render --preset gold --mesh teapot --turntable 36 --out spin.gif
 
-The scene options are in :mod:`explorer.cli.options`.
+An OBJ whose ``mtllib`` defines materials is drawn with them, each ``usemtl`` group in its own
+material; ``--preset`` draws the whole mesh in one preset instead. The scene options are in
+:mod:`explorer.cli.options`.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from explorer.cli.options import (
+    ProgressBar,
     add_scene_arguments,
     background_from_options,
     build_scene,
     check_out,
+    mesh_materials,
     size_from_option,
 )
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import energy_warnings
-from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes
+from explorer.core.mtl import preset_name, preset_names
+from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
-from explorer.shading.display import vertex_colors
+from explorer.render.turntable import (
+    FPS,
+    TURNTABLE_SUFFIXES,
+    check_frames,
+    encode,
+    turntable_frames,
+)
+from explorer.shading.display import group_vertex_colors, vertex_colors
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--out", required=True, metavar="FILE",
-        help="output: .png (picture), .ply or .glb (mesh with per-vertex colours)",
+        help="output: .png (picture), .ply or .glb (mesh with per-vertex colours; the GLB "
+        "unlit, so glTF viewers show the engine's colours), .obj (with an .mtl of its "
+        "material), or with --turntable .gif / .mp4",
+    )  # fmt: skip
+    p.add_argument(
+        "--turntable", type=int, metavar="N", default=None,
+        help=f"N frames of the camera orbiting the mesh (a full turn, {FPS} frames/s) into "
+        "--out .gif or .mp4",
     )  # fmt: skip
     p.add_argument("--preset", metavar="NAME", help="material preset (overrides the scene's)")
     p.add_argument(
@@ -53,27 +77,96 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
 
-    suffix = check_out(args.out, OUTPUT_SUFFIXES, args.force)
+    turntable = args.turntable is not None
+    suffixes = TURNTABLE_SUFFIXES if turntable else OUTPUT_SUFFIXES
+    suffix = check_out(args.out, suffixes, args.force)
+    if turntable:
+        check_frames(args.turntable)
     size = size_from_option(args.size, "--size")
     background = background_from_options(args)
     args.mesh_default = "sphere"
     scene, mesh = build_scene(args)
+    scene, materials = mesh_materials(args, scene, mesh)
     if scene.hdr is not None:
-        for w in energy_warnings(scene.material):
-            print(f"warning: {w}", file=sys.stderr)
+        for m in materials or (scene.material,):
+            for w in energy_warnings(m):
+                print(f"warning: {w}", file=sys.stderr)
     if args.per_pixel:
+        if materials:
+            raise ExplorerError(
+                "--per-pixel draws one material: give --preset NAME for a mesh with its own "
+                "materials"
+            )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
-    colors = vertex_colors(scene, mesh)
+    name = scene.material.name or "material"
+    if materials:
+        name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
+    if turntable:
+        return run_turntable(args, scene, mesh, materials, size, background, suffix)
+    colors = colors_of(scene, mesh, materials)
+    if suffix == ".obj":
+        return run_obj(args, scene, mesh, materials)
     if suffix == ".png":
         image = render_image(scene, mesh, size, background=background, colors=colors)
         data = encode_png(image)
         what = f"{size[0]}x{size[1]} picture"
     else:
-        data = mesh_file_bytes(mesh, colors, suffix, scene.material.opacity)
+        data = mesh_file_bytes(
+            mesh, colors, suffix, scene.material.opacity, double_sided=scene.two_sided
+        )
         what = f"{mesh.n_vertices} vertices with colours"
     write_atomic(args.out, data, overwrite=args.force)
-    name = scene.material.name or "material"
     print(f"wrote {args.out}: {what} ({mesh.name}, {name}, {scene.model})")
+    return 0
+
+
+def colors_of(scene, mesh, materials):
+    """Display colours of the mesh's vertices: each group in its material, or the scene's."""
+    if materials:
+        return group_vertex_colors(scene, mesh, materials)
+    return vertex_colors(scene, mesh)
+
+
+def run_obj(args, scene, mesh, materials) -> int:
+    """``--out x.obj``: the mesh and ``x.mtl`` beside it; neither replaces a file without
+    ``--force`` (both are checked before either is written)."""
+    out = Path(args.out)
+    mtl_path = out.with_suffix(".mtl")
+    if mtl_path.exists() and not args.force:
+        raise ExplorerError(f"{mtl_path}: already exists; use --force to replace it")
+    if materials:
+        names = preset_names([n or "default" for n in mesh.groups.names])
+        pairs = list(zip(names, materials, strict=True))
+    else:
+        pairs = [(preset_name(scene.material.name or "material"), scene.material)]
+    obj, mtl = obj_files(mesh, pairs, mtl_path.name)
+    write_atomic(mtl_path, mtl, overwrite=args.force)
+    write_atomic(out, obj, overwrite=args.force)
+    print(
+        f"wrote {out} and {mtl_path}: {mesh.n_vertices} vertices, "
+        f"{len(pairs)} material{'s' if len(pairs) != 1 else ''} ({mesh.name})"
+    )
+    return 0
+
+
+def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -> int:
+    """``--turntable N``: N frames of the orbit into a GIF or MP4, with a progress bar."""
+    bar = ProgressBar(sys.stderr, "turntable")
+    frames = turntable_frames(
+        scene,
+        mesh,
+        args.turntable,
+        lambda s: colors_of(s, mesh, materials),
+        size,
+        background=background,
+        progress=bar.update,
+    )
+    bar.close()
+    write_atomic(args.out, encode(frames, suffix), overwrite=args.force)
+    print(
+        f"wrote {args.out}: {args.turntable} frames of {size[0]}x{size[1]} at {FPS} frames/s "
+        f"({mesh.name}, {scene.model})"
+    )
     return 0
 
 

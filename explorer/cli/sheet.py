@@ -3,6 +3,10 @@
 ::
 
     phong-explorer sheet --out presets.png --mesh teapot --columns 6 --tile 200x200
+
+A mesh file with its own materials (an OBJ's ``mtllib``) gets a first tile in them, each
+``usemtl`` group in its own material, before the presets; with ``--preset`` only the presets
+named are drawn.
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from explorer.cli.options import (
     background_from_options,
     build_scene,
     check_out,
+    mesh_materials,
     size_from_option,
 )
 from explorer.core.atomic import write_atomic
@@ -51,6 +56,9 @@ def run(args) -> int:
         items = [(name, find_preset(name, materials_dirs)) for name in chosen]
     else:
         items = [(info.name, info.material) for info in list_presets(materials_dirs)]
+        _, own = mesh_materials(args, scene, mesh)
+        if own:
+            items.insert(0, (f"{mesh.name} (its materials)", own))
     image = sheet(
         items, scene, mesh, tile=tile, columns=args.columns, background=background,
         model=args.model,

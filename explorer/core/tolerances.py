@@ -133,6 +133,11 @@ FLOAT32_ROUTE_ABS_TOL = 1e-6
 #: far above it; one 8-bit level is 4e-3.
 GOLDEN_COLOR_ABS_TOL = 1e-9
 
+#: Largest difference between a material's ambient and X3D's ``ambientIntensity × diffuseColor``
+#: reported as exact: the least-squares ``ambientIntensity`` of an ambient that is a multiple of
+#: the diffuse colour reproduces it to a few ulps (about 1e-16), far below one 8-bit level.
+X3D_AMBIENT_TOLERANCE = 1e-9
+
 # --- caps on what a small input may make the program allocate ------------------------------
 
 #: Largest mesh file read (bytes). The largest meshes worth shading per vertex are a few
@@ -144,6 +149,13 @@ MAX_MESH_FILE_BYTES = 256 << 20
 #: checked by their declared sizes before anything is unpacked (reading stops at the declared
 #: size); bz2 and gzip streams are counted while unpacking and abandoned past the cap.
 MAX_MESH_UNPACKED_BYTES = 256 << 20
+#: Largest .mtl file read (bytes). A material library is text of a few lines per material; the
+#: largest real ones (scenes of thousands of materials) are a few MiB, so anything larger is
+#: refused before it is read.
+MAX_MTL_FILE_BYTES = 16 << 20
+#: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
+#: full off-screen render held in memory until the animation is encoded.
+MAX_TURNTABLE_FRAMES = 360
 #: Largest picture (width x height pixels) a render or a whole sheet may have: 8192 x 8192,
 #: 192 MiB as RGB bytes and several times that inside VTK while drawing. A sheet of large
 #: tiles is checked before anything is allocated (beyond it VTK aborts with std::bad_alloc).

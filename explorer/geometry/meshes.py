@@ -27,13 +27,14 @@ import bz2
 import gzip
 import os
 import stat
+import warnings
 import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
 from explorer.core import tolerances as tol
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import ExplorerError, Notice
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
 from explorer.geometry.frame import check_faces, check_vertices, frame_of
@@ -69,12 +70,14 @@ class Mesh:
         specular light)
     faces : (m, 3) int64 indices into positions, counter-clockwise seen from outside
     name : the built-in name or the file name
+    groups : the file's material groups (an OBJ's ``usemtl``), or None
     """
 
     positions: np.ndarray
     normals: np.ndarray
     faces: np.ndarray
     name: str = "mesh"
+    groups: MaterialGroups | None = None
 
     def __post_init__(self):
         # the engine's checks (shapes, real finite numbers, index ranges), then read-only
@@ -84,6 +87,11 @@ class Mesh:
         if len(p) == 0:
             raise ExplorerError(f"mesh '{self.name}': positions must hold at least one vertex")
         f = check_faces(self.faces, len(p))
+        if self.groups is not None and len(self.groups.of_vertex) != len(p):
+            raise ExplorerError(
+                f"mesh '{self.name}': groups.of_vertex must hold one group per vertex "
+                f"({len(p)}), got {len(self.groups.of_vertex)}"
+            )
         object.__setattr__(self, "positions", _frozen(p, np.float64))
         object.__setattr__(self, "normals", _frozen(n, np.float64))
         object.__setattr__(self, "faces", _frozen(f, np.int64))
@@ -116,6 +124,38 @@ class Mesh:
     def face_normals(self) -> np.ndarray:
         """(m, 3) float64 unit normals of the triangles (zero for degenerate ones)."""
         return _unit_rows(_face_cross(self.positions, self.faces))
+
+
+@dataclass(frozen=True, eq=False)
+class MaterialGroups:
+    """Which material each vertex of a mesh file has: an OBJ's ``usemtl`` groups. A vertex is
+    in one group only: where two groups meet, the file's vertices are split (each side keeps
+    its own copy), so each side keeps its colour.
+
+    names : the ``usemtl`` names, in the order first met
+    of_vertex : (n,) int32 index into ``names`` of each vertex, read-only
+    libraries : the ``mtllib`` files the OBJ names, as paths next to it
+    used : every name the OBJ's ``usemtl`` lines give (faces whose material no library
+        defines are in the group named ``""``)
+    """
+
+    names: tuple[str, ...]
+    of_vertex: np.ndarray
+    libraries: tuple[str, ...] = ()
+    used: tuple[str, ...] = ()
+
+    def __post_init__(self):
+        keys = np.array(self.of_vertex, dtype=np.int32, copy=True)
+        if keys.ndim != 1 or (len(keys) and not 0 <= keys.min() <= keys.max() < len(self.names)):
+            raise ExplorerError(
+                f"of_vertex must be (n,) indices into the {len(self.names)} group names"
+            )
+        keys.flags.writeable = False
+        object.__setattr__(self, "of_vertex", keys)
+
+    def vertices(self, group: int) -> np.ndarray:
+        """(k,) int64 indices of the vertices of ``group``."""
+        return np.flatnonzero(self.of_vertex == group)
 
 
 def _frozen(a: np.ndarray, dtype) -> np.ndarray:
@@ -172,9 +212,10 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     return _unit_rows(acc)
 
 
-def _weld(positions, normals, faces, keys=None, decimals: int = 9):
+def _weld(positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False):
     """Merge vertices at the same position (and the same key); average their normals; drop
-    triangles that become degenerate. keys : (n,) int group of each vertex or None."""
+    triangles that become degenerate. keys : (n,) int group of each vertex or None.
+    sources : also return (k,) the index of a source vertex of each new vertex."""
     q = np.round(positions, decimals)
     q[q == 0] = 0.0  # -0.0 and 0.0 are the same place
     table = q if keys is None else np.column_stack([q, keys])
@@ -191,6 +232,8 @@ def _weld(positions, normals, faces, keys=None, decimals: int = 9):
     keep = (
         (new_f[:, 0] != new_f[:, 1]) & (new_f[:, 1] != new_f[:, 2]) & (new_f[:, 0] != new_f[:, 2])
     )
+    if sources:
+        return new_p, _unit_rows(acc), new_f[keep], first[order]
     return new_p, _unit_rows(acc), new_f[keep]
 
 
@@ -563,9 +606,17 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(
             f"mesh file '{shown}' holds {reason}: a mesh needs triangles (or polygons)"
         )
+    libraries, used_names = obj_material_names(path) if ext == ".obj" else ((), ())
+    _say_unread_materials(shown, parts, libraries)
+    group_names: list[str] = []
+    keys = []
     positions, normals, faces, has_normals = [], [], [], True
     base = 0
     for m, matrix in parts:
+        name = _material_name(m) if libraries else None
+        if name is not None and name not in group_names:
+            group_names.append(name)
+        keys.append(np.full(len(m.vertices), -1 if name is None else group_names.index(name)))
         p = np.asarray(m.vertices, np.float64)
         f = np.asarray(m.faces, np.int64)
         n = None
@@ -587,6 +638,10 @@ def load_mesh(path) -> Mesh:
         normals.append(n)
     pos = np.vstack(positions)
     faces = np.vstack(faces)
+    keys = np.concatenate(keys)
+    if (keys < 0).any() and group_names:  # faces before any usemtl, or an unknown material
+        group_names.append("")
+        keys[keys < 0] = len(group_names) - 1
     if not np.isfinite(pos).all():
         raise ExplorerError(f"mesh file '{shown}' has vertices that are not finite numbers")
     if has_normals:
@@ -595,12 +650,73 @@ def load_mesh(path) -> Mesh:
         if missing.any():
             nrm[missing] = area_weighted_normals(pos, faces)[missing]
     else:
-        pos, _, faces = _weld(pos, np.zeros_like(pos), faces, decimals=12)
+        pos, _, faces, src = _weld(pos, np.zeros_like(pos), faces, keys, 12, sources=True)
+        keys = keys[src]
         nrm = area_weighted_normals(pos, faces)
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")
+    used = _used(pos, faces)
     pos, nrm, faces = _drop_unused(pos, nrm, faces)
-    return Mesh(pos, nrm, faces, os.path.basename(path))
+    groups = None
+    if group_names:
+        groups = MaterialGroups(tuple(group_names), keys[used], libraries, used_names)
+    elif libraries:  # no usemtl matched a material trimesh found: one group, named nothing
+        groups = MaterialGroups(("",), np.zeros(len(pos), np.int32), libraries, used_names)
+    return Mesh(pos, nrm, faces, os.path.basename(path), groups)
+
+
+def _used(pos, faces) -> np.ndarray:
+    used = np.zeros(len(pos), bool)
+    used[faces.ravel()] = True
+    return used
+
+
+def obj_material_names(path: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """``(libraries, used)``: the ``mtllib`` files an OBJ names, as paths next to it (a name
+    with blanks in it cannot be told from two names, as in every OBJ reader), and the names
+    its ``usemtl`` lines give, in the order first met."""
+    folder = os.path.dirname(path)
+    libraries: list[str] = []
+    used: list[str] = []
+    with open(path, "rb") as fh:
+        for raw in fh:
+            if raw[:6] not in (b"mtllib", b"usemtl"):
+                continue
+            words = raw[6:].decode("utf-8", "replace").split("#", 1)[0].split()
+            if raw[:6] == b"usemtl":
+                name = " ".join(words)
+                if name and name not in used:
+                    used.append(name)
+                continue
+            for word in words:
+                lib = os.path.join(folder, word)
+                if lib not in libraries:
+                    libraries.append(lib)
+    return tuple(libraries), tuple(used)
+
+
+def _say_unread_materials(shown: str, parts, libraries) -> None:
+    """A :class:`~explorer.core.errors.Notice` when the file carries colours or materials the
+    engine does not read (anything but an OBJ's .mtl materials)."""
+    kinds = {getattr(getattr(m, "visual", None), "kind", None) for m, _ in parts}
+    if libraries:
+        kinds.discard("texture")  # an OBJ's usemtl materials: read from the .mtl
+    kinds.discard(None)
+    if kinds:
+        what = "texture materials" if kinds == {"texture"} else "colours or materials"
+        warnings.warn(
+            f"mesh file '{shown}': its {what} are not read (only an OBJ's .mtl materials "
+            "are); the scene's material is used",
+            Notice,
+            stacklevel=3,
+        )
+
+
+def _material_name(part) -> str | None:
+    """The name of the material trimesh's OBJ reader gave a part (one per ``usemtl``)."""
+    material = getattr(getattr(part, "visual", None), "material", None)
+    name = getattr(material, "name", None)
+    return name if isinstance(name, str) and name else None
 
 
 def _triangle_parts(loaded) -> list:

@@ -31,7 +31,7 @@ from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera, Vec3, back_to_front, camera_for
 from explorer.render.images import DEFAULT_SIZE, check_picture_pixels, check_size
 from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
-from explorer.shading.display import to_bytes, vertex_colors
+from explorer.shading.display import group_vertex_colors, to_bytes, vertex_colors
 
 #: background colour of every render (linear RGB in [0, 1]): a neutral mid-dark grey on which
 #: both black rubber and white plastic read
@@ -237,7 +237,9 @@ def sheet(
 ) -> np.ndarray:
     """Every material on the same mesh, in a labelled grid: (H, W, 3) uint8.
 
-    materials : (label, Material) pairs, drawn left to right, top to bottom
+    materials : (label, Material) pairs, drawn left to right, top to bottom; a tuple of
+        Materials instead of one gives each group of ``mesh.groups`` its own (the mesh
+        file's own materials; the tile's opacity is the first one's)
     scene : lights, viewer, model; each tile replaces its material
     model : specular model of every tile; None: the material's own model when it has one,
         else the scene's
@@ -259,8 +261,11 @@ def sheet(
     with OffscreenRenderer((tw, th), background) as r:
         font = r.label_font_size(str(label) for label, _ in items)
         for i, (label, material) in enumerate(items):
-            s = scene.replace(material=material, model=model or material.model or scene.model)
-            img = r.render(s, mesh, label=str(label), label_size=font)
+            per_group = isinstance(material, tuple)
+            first = material[0] if per_group else material
+            s = scene.replace(material=first, model=model or first.model or scene.model)
+            colors = group_vertex_colors(s, mesh, material) if per_group else None
+            img = r.render(s, mesh, colors, label=str(label), label_size=font)
             y0 = gap + (i // columns) * (th + gap)
             x0 = gap + (i % columns) * (tw + gap)
             out[y0 : y0 + th, x0 : x0 + tw] = img

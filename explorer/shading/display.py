@@ -25,9 +25,16 @@ from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
-from explorer.shading.shader import shade
+from explorer.shading.shader import Shader, shade
 
-__all__ = ["display_colors", "engine_clamps", "shown", "to_bytes", "vertex_colors"]
+__all__ = [
+    "display_colors",
+    "engine_clamps",
+    "group_vertex_colors",
+    "shown",
+    "to_bytes",
+    "vertex_colors",
+]
 
 
 def engine_clamps(scene) -> bool:
@@ -74,6 +81,35 @@ def vertex_colors(scene, mesh: Mesh, *, precision: str = "float64") -> np.ndarra
     return display_colors(
         scene, mesh.positions, mesh.normals, faces=mesh.faces, precision=precision
     )
+
+
+def group_vertex_colors(scene, mesh: Mesh, materials, *, precision: str = "float64") -> np.ndarray:
+    """Display colours of the mesh's vertices, each group of ``mesh.groups`` in its own
+    material (:func:`vertex_colors` per group): (n, 3) float64 in [0, 1].
+
+    materials : one :class:`~explorer.core.material.Material` per name of ``mesh.groups``
+    The light sums are computed once (a :class:`~explorer.shading.shader.Shader` keeps them);
+    each material only recomposes them, and the shininess lobe when it changes.
+    """
+    groups = mesh.groups
+    if groups is None or len(materials) != len(groups.names):
+        n = 0 if groups is None else len(groups.names)
+        raise ExplorerError(f"need one material per group of the mesh ({n}), got {len(materials)}")
+    shader = Shader(
+        scene,
+        mesh.positions,
+        mesh.normals,
+        precision=precision,
+        clamp=engine_clamps(scene),
+        faces=mesh.faces,
+    )
+    out = np.zeros((mesh.n_vertices, 3), np.float64)
+    for g, material in enumerate(materials):
+        rows = groups.vertices(g)
+        if len(rows):
+            shader.set_material(material)
+            out[rows] = shader.colors[rows]
+    return shown(out, scene)
 
 
 def to_bytes(colors, opacity: float | None = None, *, out=None) -> np.ndarray:

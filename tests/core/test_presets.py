@@ -72,13 +72,8 @@ opengl_default:  {ambient: [0.2, 0.2, 0.2],               diffuse: [0.8, 0.8, 0.
 TABLE = yaml.safe_load(REFERENCE)
 
 
-@pytest.fixture(autouse=True)
-def isolated_user_dir(tmp_path, monkeypatch):
-    """Every test gets its own (empty, not yet existing) user preset directory."""
-    d = tmp_path / "user-config" / "materials"
-    monkeypatch.setenv(presets.ENV_VAR, str(d))
-    monkeypatch.setattr(presets, "_NOTICED", set())
-    return d
+#: every test gets its own (empty, not yet existing) user preset directory (tests/core/conftest.py)
+pytestmark = pytest.mark.usefixtures("isolated_user_dir")
 
 
 def write(path: Path, text: str) -> Path:
