@@ -182,7 +182,8 @@ def cache_dir() -> Path:
     ``__pycache__`` when writable, else ``NUMBA_CACHE_DIR`` or numba's user-wide directory)."""
     from explorer.shading import kernels  # numba decides the directory when it decorates
 
-    return Path(kernels.shade.dispatcher._cache._cache_path)
+    dispatcher = getattr(kernels.shade, "dispatcher", kernels.shade)  # wide-vector wrapper
+    return Path(dispatcher._cache._cache_path)
 
 
 def marker_key() -> str:

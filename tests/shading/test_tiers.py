@@ -7,6 +7,7 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -107,6 +108,21 @@ def test_a_shader_switches_tier_at_its_next_pass(monkeypatch):
     expected = Shader(s.scene, mesh.positions, mesh.normals, faces=mesh.faces, tier="numpy")
     np.testing.assert_allclose(after, expected.colors, atol=1 / 255)
     assert not np.array_equal(before, after)
+
+
+def test_every_module_with_numba_code_names_the_marker():
+    # a module whose kernels the marker does not cover could be compiled in the foreground
+    root = os.path.dirname(explorer.__file__)
+    found = set()
+    for folder, _, files in os.walk(root):
+        for name in files:
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                with open(path, encoding="utf-8") as f:
+                    if re.search(r"\bnjit\b", f.read()):  # compiles numba code
+                        rel = os.path.relpath(path, os.path.dirname(root))[:-3]
+                        found.add(rel.replace(os.sep, "."))
+    assert found == set(tiers.SOURCES)
 
 
 def test_mode_comes_from_the_environment(monkeypatch):
