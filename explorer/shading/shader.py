@@ -44,7 +44,7 @@ from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_fr
 from explorer.shading import kernels as K
 from explorer.shading.effects import EFFECTS
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.shadows import is_convex, visibility_rows
+from explorer.shading.shadows import visibility_rows
 
 PRECISIONS = ("float64", "float32")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
@@ -160,7 +160,6 @@ class Shader:
         faces = None if faces is None else check_faces(faces, len(P))
         self._P, self._N = P, N
         self._faces = faces
-        self._convex = None  # decided when a light first asks for shadows
         self._vis_cache: dict = {}
         self._plan = self._make_plan(self._scene)
         self._centre, self._scale = frame_of(self._P)
@@ -294,14 +293,8 @@ class Shader:
 
     # -- shadows -------------------------------------------------------------------------------
     def _mesh_kind(self, scene) -> str | None:
-        """What the plan knows of the mesh: None (no faces), "convex" or "concave"."""
-        if self._faces is None:
-            return None
-        if not any(e.needs_mesh(scene) for e in EFFECTS):
-            return "concave"  # not asked: no need to decide
-        if self._convex is None:
-            self._convex = is_convex(self._P, self._faces)
-        return "convex" if self._convex else "concave"
+        """What the plan knows of the mesh: None (no faces) or "faces"."""
+        return None if self._faces is None else "faces"
 
     def _make_plan(self, scene) -> Plan:
         return make_plan(scene, mesh=self._mesh_kind(scene), force_all=self.force_all)
