@@ -29,7 +29,7 @@ import math
 import os
 import threading
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, TimeoutError
 from dataclasses import dataclass
 
 import numba as nb
@@ -52,6 +52,8 @@ BINS = 16
 MEDIAN_DEPTH = 64
 #: the traversal stack; MEDIAN_DEPTH + 64 levels holds any mesh that fits in memory
 STACK = 128
+#: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
+POLL = 0.05
 #: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
 _BIG = 1e300
 
@@ -85,9 +87,13 @@ class BVH:
         return len(self.child)
 
 
-def build_bvh(triangles) -> BVH:
+def build_bvh(triangles, *, cancelled=None) -> BVH:
     """The BVH of ``triangles`` : (m, 3, 3) float (corners counter-clockwise seen from the
-    front)."""
+    front).
+
+    cancelled : () -> bool, asked every :data:`POLL` seconds while the tree is built (True:
+        raise :class:`~explorer.core.errors.Cancelled`); Ctrl-C stops the build the same way
+    """
     tri = np.ascontiguousarray(triangles, np.float64).reshape(-1, 3, 3)
     m = len(tri)
     v0, e1, e2 = triangle_edges(tri)
@@ -95,10 +101,7 @@ def build_bvh(triangles) -> BVH:
         child = np.full((1, 2), -1, np.int64)
         cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), np.zeros(0, np.int64))
-    lo = tri.min(axis=1)
-    hi = tri.max(axis=1)
-    pad = BVH_BOX_PAD * max(float(np.abs(tri).max()), 1.0)
-    box, link, order = _build(lo, hi, 0.5 * (lo + hi), pad)
+    box, link, order = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
     hi32 = box64[:, 1::2].astype(np.float32)
@@ -111,6 +114,23 @@ def build_bvh(triangles) -> BVH:
 
 
 # -- building ------------------------------------------------------------------------------
+
+
+def _stoppable(build, args, cancelled):
+    """Run ``build(*args, stop)`` on a worker thread while this one waits, so that Ctrl-C and
+    ``cancelled`` stop it: ``stop[0] = 1`` ends the build within 1024 nodes."""
+    stop = np.zeros(1, np.uint8)
+    future = _get_pool().submit(build, *args, stop)
+    try:
+        while True:
+            try:
+                return future.result(timeout=POLL)
+            except TimeoutError:
+                _check(cancelled)
+    finally:
+        if not future.done():
+            stop[0] = 1
+            future.exception()  # waits for the build to notice
 
 
 @nb.njit(cache=True, inline="always")
@@ -126,13 +146,13 @@ def _bin(c, c0, scale):
 
 
 @nb.njit(cache=True)
-def _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, node_area):
+def _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, node_area, cnt, bb, right):
     """The bin boundary (1..BINS-1) with the lowest surface-area cost for
-    idx[start:end] along ``axis``, or -1 when no split beats a leaf (only for small nodes)."""
+    idx[start:end] along ``axis``, or -1 when no split beats a leaf (only for small nodes).
+    cnt : (BINS,) int64, bb : (BINS + 1, 6), right : (BINS, 2) scratch."""
     scale = BINS / (c1 - c0)
-    cnt = np.zeros(BINS, np.int64)
-    bb = np.empty((BINS, 6))
     for b in range(BINS):
+        cnt[b] = 0
         for a in range(3):
             bb[b, 2 * a] = math.inf
             bb[b, 2 * a + 1] = -math.inf
@@ -144,18 +164,19 @@ def _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, node_area):
             bb[b, 2 * a] = min(bb[b, 2 * a], lo[t, a])
             bb[b, 2 * a + 1] = max(bb[b, 2 * a + 1], hi[t, a])
     # right-to-left sweep: area and count of bins s..BINS-1
-    right_area = np.zeros(BINS)
-    right_cnt = np.zeros(BINS, np.int64)
-    acc = np.array([math.inf, -math.inf, math.inf, -math.inf, math.inf, -math.inf])
+    acc = bb[BINS]
+    for a in range(6):
+        acc[a] = math.inf if a % 2 == 0 else -math.inf
+    right[:, :] = 0.0  # area and count of the bins s..BINS-1
     n = 0
     for s in range(BINS - 1, 0, -1):
         n += cnt[s]
         for a in range(3):
             acc[2 * a] = min(acc[2 * a], bb[s, 2 * a])
             acc[2 * a + 1] = max(acc[2 * a + 1], bb[s, 2 * a + 1])
-        right_cnt[s] = n
+        right[s, 1] = n
         if n > 0:
-            right_area[s] = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5])
+            right[s, 0] = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5])
     best, best_s = math.inf, -1
     for a in range(6):
         acc[a] = math.inf if a % 2 == 0 else -math.inf
@@ -165,10 +186,10 @@ def _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, node_area):
         for a in range(3):
             acc[2 * a] = min(acc[2 * a], bb[s - 1, 2 * a])
             acc[2 * a + 1] = max(acc[2 * a + 1], bb[s - 1, 2 * a + 1])
-        if n == 0 or right_cnt[s] == 0:
+        if n == 0 or right[s, 1] == 0:
             continue
         cost = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5]) * n
-        cost += right_area[s] * right_cnt[s]
+        cost += right[s, 0] * right[s, 1]
         if cost < best:
             best, best_s = cost, s
     count = end - start
@@ -179,9 +200,22 @@ def _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, node_area):
 
 
 @nb.njit(cache=True)
-def _build(lo, hi, cent, pad):
-    """Top-down build in depth-first order; returns (box, link, order)."""
-    m = lo.shape[0]
+def _build(tri, stop):
+    """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order),
+    or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""
+    m = tri.shape[0]
+    lo = np.empty((m, 3))
+    hi = np.empty((m, 3))
+    cent = np.empty((m, 3))
+    size = 1.0
+    for t in range(m):
+        for a in range(3):
+            x, y, z = tri[t, 0, a], tri[t, 1, a], tri[t, 2, a]
+            lo[t, a] = min(x, y, z)
+            hi[t, a] = max(x, y, z)
+            cent[t, a] = 0.5 * (lo[t, a] + hi[t, a])
+            size = max(size, abs(lo[t, a]), abs(hi[t, a]))
+    pad = BVH_BOX_PAD * size
     idx = np.arange(m)
     cap = 2 * m
     box = np.empty((cap, 6))
@@ -192,7 +226,12 @@ def _build(lo, hi, cent, pad):
     n_nodes = 0
     b = np.empty(6)  # the node's box
     c = np.empty(6)  # its centroids' box
+    cnt = np.zeros(BINS, np.int64)
+    bb = np.empty((BINS + 1, 6))
+    right = np.empty((BINS, 2))
     while sp > 0:
+        if n_nodes % 1024 == 0 and stop[0]:
+            return box[:0].copy(), link[:0].copy(), idx[:0].copy()
         sp -= 1
         start, end, parent, depth = st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3]
         node = n_nodes
@@ -223,7 +262,7 @@ def _build(lo, hi, cent, pad):
         mid = -1
         if c1 > c0 and depth < MEDIAN_DEPTH:
             area = _area(b[0], b[1], b[2], b[3], b[4], b[5])
-            s = _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, area)
+            s = _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, area, cnt, bb, right)
             if s < 0:
                 link[node, 0], link[node, 1] = start, count
                 continue
