@@ -7,16 +7,19 @@ import math
 
 import numpy as np
 import pytest
+from numba import njit
 
 import explorer
 from explorer.analysis.comparison import compare, coverage
 from explorer.cli import main
+from explorer.core.errors import Cancelled
 from explorer.core.hdr import HDR
 from explorer.core.lights import DirectionalLight
 from explorer.core.presets import builtin_dir, load_material_file
 from explorer.core.scene import Viewer
 from explorer.geometry import meshes as M
 from explorer.geometry.meshes import Mesh
+from explorer.geometry.rays import ray_triangle, triangle_edges
 from explorer.render.camera import (
     Camera,
     apply_camera,
@@ -347,3 +350,49 @@ def test_render_per_pixel_command(tmp_path, capsys):
     assert main(["render", "--per-pixel", "--out", str(tmp_path / "x.ply")]) == 2
     assert "--per-pixel draws a picture" in capsys.readouterr().err
     assert not (tmp_path / "x.ply").exists()
+
+
+@njit(cache=True)
+def _brute_nearest(O, D, v0, e1, e2, t_min):
+    """Every pixel ray against every triangle in index order (the first of equal hits)."""
+    best = np.full(O.shape[0], np.inf)
+    tri = np.full(O.shape[0], -1)
+    for r in range(O.shape[0]):
+        for f in range(v0.shape[0]):
+            t, _, _ = ray_triangle(
+                O[r, 0], O[r, 1], O[r, 2], D[r, 0], D[r, 1], D[r, 2],
+                v0[f, 0], v0[f, 1], v0[f, 2], e1[f, 0], e1[f, 1], e1[f, 2],
+                e2[f, 0], e2[f, 1], e2[f, 2], 0.0, False,
+            )  # fmt: skip
+            if t > t_min and t < best[r]:
+                best[r], tri[r] = t, f
+    return best, tri
+
+
+def test_ray_cast_equals_testing_every_triangle():
+    """The per-pixel rays through the mesh's BVH hit what testing every triangle hits: the
+    same pixels, at the same distances."""
+    mesh = M.teapot(4)
+    scene = _scene(Viewer(eye=(2.0, 1.5, 3.0)))
+    size = (64, 48)
+    cam = camera_for(scene, mesh, size[0] / size[1])
+    h = mesh_hits(cam, size, mesh)
+    origins, dirs = (a.reshape(-1, 3) for a in pixel_rays(cam, size))
+    best, _ = _brute_nearest(origins, dirs, *triangle_edges(mesh.positions[mesh.faces]), 1e-9)
+    seen = np.isfinite(best)
+    assert np.array_equal(h.mask.ravel(), seen) and seen.sum() > 300
+    assert np.array_equal(h.positions, origins[seen] + best[seen][:, None] * dirs[seen])
+
+
+def test_reference_can_be_cancelled():
+    mesh = M.teapot(4)
+    scene = _scene()
+    asked = []
+    with pytest.raises(Cancelled):  # asked before the rays, then before the colours
+        reference(scene, mesh, (40, 30), cancelled=lambda: asked.append(1) or len(asked) > 1)
+    assert len(asked) == 2
+    with pytest.raises(Cancelled):  # and between chunks of rays
+        reference(scene, mesh, (400, 300), cancelled=lambda: asked.append(1) or len(asked) > 4)
+    assert len(asked) == 5
+    ref = reference(scene, mesh, (40, 30), cancelled=lambda: False)
+    assert np.array_equal(ref.image(), reference(scene, mesh, (40, 30)).image())
