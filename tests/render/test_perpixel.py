@@ -396,3 +396,49 @@ def test_reference_can_be_cancelled():
     assert len(asked) == 5
     ref = reference(scene, mesh, (40, 30), cancelled=lambda: False)
     assert np.array_equal(ref.image(), reference(scene, mesh, (40, 30)).image())
+
+
+#: a render whose ray chunks are slowed down (each sleeps), so Ctrl-C lands in the ray work
+_SLOW_RENDER = """
+import sys, time
+import explorer.geometry.bvh as B
+kernel = B._nearest_chunk
+def slow(*args):
+    print("chunk", file=sys.stderr, flush=True)
+    time.sleep(0.1)
+    return kernel(*args)
+B._nearest_chunk = slow
+from explorer.cli import main
+sys.exit(main(["render", "--per-pixel", "--mesh", "teapot", "--size", "640x480",
+               "--out", sys.argv[1]]))
+"""
+
+
+def test_ctrl_c_stops_ray_work_within_a_second(tmp_path):
+    """SIGINT in the middle of the per-pixel rays: the command ends within a second with one
+    line and exit status 130, and leaves no file (not even a temporary one)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "pp.png"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _SLOW_RENDER, str(out)],
+        stderr=subprocess.PIPE, text=True, env=env,
+    )  # fmt: skip
+    try:
+        assert proc.stderr.readline() == "chunk\n"  # the rays have started (38 chunks to go)
+        proc.send_signal(signal.SIGINT)
+        start = time.perf_counter()
+        err = proc.communicate(timeout=30)[1]
+        took = time.perf_counter() - start
+    finally:
+        proc.kill()
+    lines = [ln for ln in err.splitlines() if ln != "chunk"]
+    assert proc.returncode == 130
+    assert lines == ["error: interrupted (Ctrl-C); no unfinished file was left"]
+    assert took < 1.0
+    assert list(tmp_path.iterdir()) == []
