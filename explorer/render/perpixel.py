@@ -43,7 +43,7 @@ from explorer.render.camera import camera_for, pixel_rays
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
-from explorer.shading.equation import equation_terms
+from explorer.shading.shader import shade
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -239,6 +239,18 @@ def point_colors(scene, positions, normals, *, mesh=None, precision: str = "floa
     return both[mesh.n_vertices :]
 
 
+def specular_sums(scene, positions, normals) -> np.ndarray:
+    """The unclamped specular light sum of each point, summed over RGB: (k,) float64.
+
+    The engine's colours with a material that keeps only its specular, at 1 (the lobe, Fresnel
+    and energy factors stay): ``colour = s_m · S`` with ``s_m = 1`` is the specular sum ``S`` of
+    :func:`explorer.shading.equation.equation_terms`, computed by the compiled kernels.
+    """
+    black = (0.0, 0.0, 0.0)
+    m = scene.material.replace(ambient=black, diffuse=black, emission=black, specular=(1.0,) * 3)
+    return shade(scene.replace(material=m), positions, normals, clamp=False).sum(axis=1)
+
+
 def reference(
     scene,
     mesh,
@@ -263,7 +275,7 @@ def reference(
         raise Cancelled("the per-pixel reference was cancelled")
     if len(h.positions):
         colors = point_colors(scene, h.positions, h.normals, mesh=mesh, precision=precision)
-        spec = equation_terms(scene, h.positions, h.normals)["specular"].sum(axis=1)
+        spec = specular_sums(scene, h.positions, h.normals)
     else:
         colors = np.zeros((0, 3))
         spec = np.zeros(0)
