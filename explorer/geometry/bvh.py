@@ -37,7 +37,7 @@ import numpy as np
 
 from explorer.core.errors import Cancelled
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
-from explorer.geometry.rays import ray_triangle, triangle_edges
+from explorer.geometry.rays import pack_triangles, ray_triangle_row
 
 #: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
 CHUNK = 8192
@@ -68,7 +68,7 @@ class BVH:
         pad and rounded outward to float32
     leaf : (q, 2) int64 per leaf: first triangle and count
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
-        (:func:`~explorer.geometry.rays.triangle_edges`)
+        (:func:`~explorer.geometry.rays.pack_triangles`)
     order : (m,) int64 the original index of each triangle in leaf order
     """
 
@@ -96,7 +96,6 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     """
     tri = np.ascontiguousarray(triangles, np.float64).reshape(-1, 3, 3)
     m = len(tri)
-    v0, e1, e2 = triangle_edges(tri)
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
         cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
@@ -109,8 +108,7 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     hi32 = np.where(hi32 < box64[:, 1::2], np.nextafter(hi32, np.float32(np.inf)), hi32)
     cbox = np.empty(box64.shape, np.float32)
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
-    packed = np.concatenate([v0, e1, e2], axis=1)[order]
-    return BVH(child, cbox, leaf, np.ascontiguousarray(packed), order)
+    return BVH(child, cbox, leaf, np.ascontiguousarray(pack_triangles(tri)[order]), order)
 
 
 # -- building ------------------------------------------------------------------------------
@@ -337,6 +335,13 @@ def _inv(d):
 
 
 @nb.njit(cache=True, inline="always")
+def _ray(O, D, r):
+    """Ray ``r``: origin, direction and the direction's reciprocals (:func:`_inv`)."""
+    dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
+    return O[r, 0], O[r, 1], O[r, 2], dx, dy, dz, _inv(dx), _inv(dy), _inv(dz)
+
+
+@nb.njit(cache=True, inline="always")
 def _slab(b, o, ox, oy, oz, ix, iy, iz, t1):
     """Where the ray enters the box ``b[o:o + 6]`` within [0, t1], or inf when it does not."""
     p = (b[o] - ox) * ix
@@ -355,21 +360,29 @@ def _slab(b, o, ox, oy, oz, ix, iy, iz, t1):
 
 
 @nb.njit(cache=True, inline="always")
-def _test(tri, j, ox, oy, oz, dx, dy, dz, det_min, front_only):
-    return ray_triangle(
-        ox, oy, oz, dx, dy, dz,
-        tri[j, 0], tri[j, 1], tri[j, 2],
-        tri[j, 3], tri[j, 4], tri[j, 5],
-        tri[j, 6], tri[j, 7], tri[j, 8],
-        det_min, front_only,
-    )  # fmt: skip
+def _next(stack, sp, ca, cb, ta, tb):
+    """The next inner node: the nearer of the children the ray enters (``t < inf``; the other
+    one is pushed), else the top of the stack; (-1, 0) when nothing is left."""
+    if ta < math.inf and tb < math.inf:
+        if ta <= tb:
+            stack[sp] = cb
+            return ca, sp + 1
+        stack[sp] = ca
+        return cb, sp + 1
+    if ta < math.inf:
+        return ca, sp
+    if tb < math.inf:
+        return cb, sp
+    if sp == 0:
+        return np.int64(-1), 0
+    return stack[sp - 1], sp - 1
 
 
 @nb.njit(cache=True, inline="always")
 def _leaf_any(leaf, c, tri, ox, oy, oz, dx, dy, dz, t_eps, tm, det_eps):
     first = leaf[~c, 0]
     for j in range(first, first + leaf[~c, 1]):
-        t, _, _ = _test(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
+        t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
         if t > t_eps and t < tm:
             return True
     return False
@@ -379,9 +392,7 @@ def _leaf_any(leaf, c, tri, ox, oy, oz, dx, dy, dz, t_eps, tm, det_eps):
 def _any_hit_chunk(r0, r1, O, D, tmax, child, cbox, leaf, tri, t_eps, det_eps, out):
     stack = np.empty(STACK, np.int64)
     for r in range(r0, r1):
-        ox, oy, oz = O[r, 0], O[r, 1], O[r, 2]
-        dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
-        ix, iy, iz = _inv(dx), _inv(dy), _inv(dz)
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
         tm = tmax[r] - t_eps
         hit = False
         sp = 0
@@ -401,21 +412,9 @@ def _any_hit_chunk(r0, r1, O, D, tmax, child, cbox, leaf, tri, t_eps, det_eps, o
                     hit = True
                     break
                 tb = math.inf
-            if ta < math.inf and tb < math.inf:  # both: the nearer now, the other later
-                if ta <= tb:
-                    stack[sp], node = cb, ca
-                else:
-                    stack[sp], node = ca, cb
-                sp += 1
-            elif ta < math.inf:
-                node = ca
-            elif tb < math.inf:
-                node = cb
-            elif sp == 0:
+            node, sp = _next(stack, sp, ca, cb, ta, tb)
+            if node < 0:
                 break
-            else:
-                sp -= 1
-                node = stack[sp]
         out[r] = hit
 
 
@@ -423,9 +422,7 @@ def _any_hit_chunk(r0, r1, O, D, tmax, child, cbox, leaf, tri, t_eps, det_eps, o
 def _nearest_chunk(r0, r1, O, D, t_min, child, cbox, leaf, tri, order, best_t, best_f, bu, bv):
     stack = np.empty(STACK, np.int64)
     for r in range(r0, r1):
-        ox, oy, oz = O[r, 0], O[r, 1], O[r, 2]
-        dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
-        ix, iy, iz = _inv(dx), _inv(dy), _inv(dz)
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
         best, bf, u_, v_ = best_t[r], np.int64(-1), 0.0, 0.0
         sp = 0
         node = 0
@@ -440,7 +437,7 @@ def _nearest_chunk(r0, r1, O, D, t_min, child, cbox, leaf, tri, order, best_t, b
                     continue
                 first = leaf[~c, 0]
                 for j in range(first, first + leaf[~c, 1]):
-                    t, u, v = _test(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
+                    t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
                     if t > t_min and (
                         t < best or (t == best and t < math.inf and (bf < 0 or order[j] < bf))
                     ):
@@ -449,22 +446,9 @@ def _nearest_chunk(r0, r1, O, D, t_min, child, cbox, leaf, tri, order, best_t, b
                     ta = math.inf
                 else:
                     tb = math.inf
-            ca, cb = child[node, 0], child[node, 1]
-            if ta < math.inf and tb < math.inf:
-                if ta <= tb:
-                    stack[sp], node = cb, ca
-                else:
-                    stack[sp], node = ca, cb
-                sp += 1
-            elif ta < math.inf:
-                node = ca
-            elif tb < math.inf:
-                node = cb
-            elif sp == 0:
+            node, sp = _next(stack, sp, child[node, 0], child[node, 1], ta, tb)
+            if node < 0:
                 break
-            else:
-                sp -= 1
-                node = stack[sp]
         if bf >= 0:
             best_t[r] = best
             best_f[r] = bf

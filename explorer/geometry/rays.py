@@ -79,26 +79,41 @@ def triangle_edges(triangles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return v0, e1, e2
 
 
+def pack_triangles(triangles) -> np.ndarray:
+    """The casts' triangle rows: (m, 9) float64 C-contiguous, ``v0, e1, e2`` of each triangle
+    (:func:`triangle_edges`) side by side.
+
+    triangles : (m, 3, 3) float, corners in counter-clockwise order seen from the front
+    """
+    return np.ascontiguousarray(np.concatenate(triangle_edges(triangles), axis=1))
+
+
+@nb.njit(inline="always")
+def ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_min, front_only):
+    """:func:`ray_triangle` against row ``j`` of :func:`pack_triangles`' rows ``tri``."""
+    return ray_triangle(
+        ox, oy, oz, dx, dy, dz,
+        tri[j, 0], tri[j, 1], tri[j, 2],
+        tri[j, 3], tri[j, 4], tri[j, 5],
+        tri[j, 6], tri[j, 7], tri[j, 8],
+        det_min, front_only,
+    )  # fmt: skip
+
+
 # -- any hit: shadow rays --------------------------------------------------------------------
 
 
 @nb.njit(parallel=True, cache=True, boundscheck=False)
-def _any_hit(O, D, tmax, v0, e1, e2, t_eps, det_eps, out):
+def _any_hit(O, D, tmax, tri, t_eps, det_eps, out):
     """Every ray against every triangle, front sides only (det >= det_eps), a hit at t in
     (t_eps, tmax - t_eps); each ray stops at its first hit."""
-    m = v0.shape[0]
+    m = tri.shape[0]
     for r in nb.prange(O.shape[0]):
         ox, oy, oz = O[r, 0], O[r, 1], O[r, 2]
         dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
         tm = tmax[r] - t_eps
         for j in range(m):
-            t, _, _ = ray_triangle(
-                ox, oy, oz, dx, dy, dz,
-                v0[j, 0], v0[j, 1], v0[j, 2],
-                e1[j, 0], e1[j, 1], e1[j, 2],
-                e2[j, 0], e2[j, 1], e2[j, 2],
-                det_eps, True,
-            )  # fmt: skip
+            t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
             if t > t_eps and t < tm:
                 out[r] = True
                 break
@@ -114,14 +129,11 @@ def any_hit(origins, directions, tmax, triangles) -> np.ndarray:
     Returns (k,) bool.
     """
     hit = np.zeros(len(origins), np.bool_)
-    v0, e1, e2 = triangle_edges(triangles)
     _any_hit(
         np.ascontiguousarray(origins, np.float64),
         np.ascontiguousarray(directions, np.float64),
         np.ascontiguousarray(tmax, np.float64),
-        v0,
-        e1,
-        e2,
+        pack_triangles(triangles),
         RAY_T_EPS,
         DET_EPS,
         hit,

@@ -7,34 +7,14 @@ import threading
 
 import numpy as np
 import pytest
-from numba import njit
+from helpers.brute_rays import brute_nearest
 
 from explorer.core.errors import Cancelled
 from explorer.geometry import bvh as B
 from explorer.geometry.frame import frame_of
 from explorer.geometry.meshes import get_mesh, plane, sphere
 from explorer.geometry.rays import any_hit as brute_any_hit
-from explorer.geometry.rays import ray_triangle, triangle_edges
-
-
-@njit(cache=True)
-def _brute_nearest(O, D, v0, e1, e2, t_min):
-    """Every ray against every triangle in index order; the first of equal nearest hits."""
-    k = O.shape[0]
-    bt = np.full(k, np.inf)
-    bf = np.full(k, -1, np.int64)
-    bu = np.zeros(k)
-    bv = np.zeros(k)
-    for r in range(k):
-        for f in range(v0.shape[0]):
-            t, u, v = ray_triangle(
-                O[r, 0], O[r, 1], O[r, 2], D[r, 0], D[r, 1], D[r, 2],
-                v0[f, 0], v0[f, 1], v0[f, 2], e1[f, 0], e1[f, 1], e1[f, 2],
-                e2[f, 0], e2[f, 1], e2[f, 2], 0.0, False,
-            )  # fmt: skip
-            if t > t_min and t < bt[r]:
-                bt[r], bf[r], bu[r], bv[r] = t, f, u, v
-    return bt, bf, bu, bv
+from explorer.geometry.rays import pack_triangles
 
 
 def _frame(mesh):
@@ -106,7 +86,7 @@ def test_nearest_hits_equal_brute_force(name):
     D = target - O
     D /= np.linalg.norm(D, axis=1, keepdims=True)
     got = B.nearest_hits(bvh, O, D, 1e-9)
-    want = _brute_nearest(O, D, *triangle_edges(tri), 1e-9)
+    want = brute_nearest(O, D, tri, 1e-9)
     for a, b in zip(got, want, strict=True):
         assert np.array_equal(a, b)
     assert (got[1] >= 0).mean() > 0.3
@@ -120,7 +100,7 @@ def test_nearest_hits_tie_goes_to_the_lowest_index():
     O = np.array([[0.0, 0.0, 5.0]])
     D = np.array([[0.0, 0.0, -1.0]])
     t, f, _, _ = B.nearest_hits(bvh, O, D, 0.0)
-    want = _brute_nearest(O, D, *triangle_edges(tri), 0.0)
+    want = brute_nearest(O, D, tri, 0.0)
     assert f[0] == want[1][0] and t[0] == want[0][0]
 
 
@@ -128,8 +108,7 @@ def test_tree_holds_every_triangle_once_inside_its_boxes():
     tri = _soup(2000, 6)
     bvh = B.build_bvh(tri)
     assert sorted(bvh.order.tolist()) == list(range(2000))
-    v0, e1, e2 = triangle_edges(tri[bvh.order])
-    assert np.array_equal(bvh.tri, np.concatenate([v0, e1, e2], axis=1))
+    assert np.array_equal(bvh.tri, pack_triangles(tri[bvh.order]))
     covered = np.zeros(2000, int)
     # walk the tree: every leaf's triangles lie inside the box its parent keeps for it
     stack = [0]
