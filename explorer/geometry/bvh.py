@@ -144,10 +144,13 @@ def _bin(c, c0, scale):
 
 
 @nb.njit(cache=True)
-def _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, node_area, cnt, bb, right):
+def _sah_split(boxes, idx, start, end, axis, c0, c1, node_area, scratch):
     """The bin boundary (1..BINS-1) with the lowest surface-area cost for
     idx[start:end] along ``axis``, or -1 when no split beats a leaf (only for small nodes).
-    cnt : (BINS,) int64, bb : (BINS + 1, 6), right : (BINS, 2) scratch."""
+    boxes : (lo, hi, cent), each (m, 3): the triangles' boxes and centroids
+    scratch : (cnt, bb, right): (BINS,) int64, (BINS + 1, 6), (BINS, 2)"""
+    lo, hi, cent = boxes
+    cnt, bb, right = scratch
     scale = BINS / (c1 - c0)
     for b in range(BINS):
         cnt[b] = 0
@@ -224,9 +227,8 @@ def _build(tri, stop):
     n_nodes = 0
     b = np.empty(6)  # the node's box
     c = np.empty(6)  # its centroids' box
-    cnt = np.zeros(BINS, np.int64)
-    bb = np.empty((BINS + 1, 6))
-    right = np.empty((BINS, 2))
+    scratch = (np.zeros(BINS, np.int64), np.empty((BINS + 1, 6)), np.empty((BINS, 2)))
+    boxes = (lo, hi, cent)
     while sp > 0:
         if n_nodes % 1024 == 0 and stop[0]:
             return box[:0].copy(), link[:0].copy(), idx[:0].copy()
@@ -260,7 +262,7 @@ def _build(tri, stop):
         mid = -1
         if c1 > c0 and depth < MEDIAN_DEPTH:
             area = _area(b[0], b[1], b[2], b[3], b[4], b[5])
-            s = _sah_split(lo, hi, cent, idx, start, end, axis, c0, c1, area, cnt, bb, right)
+            s = _sah_split(boxes, idx, start, end, axis, c0, c1, area, scratch)
             if s < 0:
                 link[node, 0], link[node, 1] = start, count
                 continue
@@ -379,7 +381,9 @@ def _next(stack, sp, ca, cb, ta, tb):
 
 
 @nb.njit(cache=True, inline="always")
-def _leaf_any(leaf, c, tri, ox, oy, oz, dx, dy, dz, t_eps, tm, det_eps):
+def _leaf_any(leaf, c, tri, ray, t_eps, tm, det_eps):
+    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``~c``."""
+    ox, oy, oz, dx, dy, dz = ray
     first = leaf[~c, 0]
     for j in range(first, first + leaf[~c, 1]):
         t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
@@ -389,7 +393,12 @@ def _leaf_any(leaf, c, tri, ox, oy, oz, dx, dy, dz, t_eps, tm, det_eps):
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def _any_hit_chunk(r0, r1, O, D, tmax, child, cbox, leaf, tri, t_eps, det_eps, out):
+def _any_hit_chunk(r0, r1, rays, tree, eps, out):
+    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) with
+    eps = (t_eps, det_eps): out[r] True where the ray is blocked."""
+    O, D, tmax = rays
+    child, cbox, leaf, tri = tree
+    t_eps, det_eps = eps
     stack = np.empty(STACK, np.int64)
     for r in range(r0, r1):
         ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
@@ -403,12 +412,12 @@ def _any_hit_chunk(r0, r1, O, D, tmax, child, cbox, leaf, tri, t_eps, det_eps, o
             tb = _slab(b, 6, ox, oy, oz, ix, iy, iz, tm)
             ca, cb = child[node, 0], child[node, 1]
             if ta < math.inf and ca < 0:
-                if _leaf_any(leaf, ca, tri, ox, oy, oz, dx, dy, dz, t_eps, tm, det_eps):
+                if _leaf_any(leaf, ca, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
                     hit = True
                     break
                 ta = math.inf
             if tb < math.inf and cb < 0:
-                if _leaf_any(leaf, cb, tri, ox, oy, oz, dx, dy, dz, t_eps, tm, det_eps):
+                if _leaf_any(leaf, cb, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
                     hit = True
                     break
                 tb = math.inf
@@ -419,7 +428,12 @@ def _any_hit_chunk(r0, r1, O, D, tmax, child, cbox, leaf, tri, t_eps, det_eps, o
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def _nearest_chunk(r0, r1, O, D, t_min, child, cbox, leaf, tri, order, best_t, best_f, bu, bv):
+def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
+    """Rays r0..r1 of rays = (O, D) through tree = (child, cbox, leaf, tri); writes the
+    nearest hit into out = (best_t, best_f, bu, bv) (best_t in: the farthest t accepted)."""
+    O, D = rays
+    child, cbox, leaf, tri = tree
+    best_t, best_f, bu, bv = out
     stack = np.empty(STACK, np.int64)
     for r in range(r0, r1):
         ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
@@ -517,6 +531,10 @@ def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUN
 # -- the casts -----------------------------------------------------------------------------
 
 
+def _tree(bvh: BVH) -> tuple:
+    return bvh.child, bvh.cbox, bvh.leaf, bvh.tri
+
+
 def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
     O = np.ascontiguousarray(origins, np.float64).reshape(-1, 3)
     D = np.ascontiguousarray(directions, np.float64).reshape(-1, 3)
@@ -538,7 +556,7 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarra
     tm = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)))
     hit = np.zeros(len(O), np.bool_)
     if bvh.n_triangles:
-        args = (O, D, tm, bvh.child, bvh.cbox, bvh.leaf, bvh.tri, RAY_T_EPS, DET_EPS, hit)
+        args = ((O, D, tm), _tree(bvh), (RAY_T_EPS, DET_EPS), hit)
         run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
     return hit
 
@@ -557,6 +575,6 @@ def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None)
     best_f = np.full(k, -1, np.int64)
     bu, bv = np.zeros(k), np.zeros(k)
     if bvh.n_triangles:
-        args = (O, D, float(t_min), bvh.child, bvh.cbox, bvh.leaf, bvh.tri, bvh.order)
-        run_chunks(_nearest_chunk, k, args + (best_t, best_f, bu, bv), cancelled=cancelled)
+        args = ((O, D), float(t_min), _tree(bvh), bvh.order, (best_t, best_f, bu, bv))
+        run_chunks(_nearest_chunk, k, args, cancelled=cancelled)
     return best_t, best_f, bu, bv
