@@ -39,7 +39,7 @@ import numpy as np
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import PIXEL_RAY_T_MIN
 from explorer.geometry.bvh import BVH, build_bvh, nearest_hits
-from explorer.render.camera import camera_for, pixel_rays
+from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
@@ -111,6 +111,28 @@ def mesh_bvh(mesh) -> BVH:
     return bvh
 
 
+def _screen_rect(camera, size, mesh) -> tuple[int, int, int, int] | None:
+    """The pixels whose rays may meet the mesh, as (col0, col1, row0, row1) inclusive: the
+    projection of its bounding box grown by one pixel, clipped to the picture (the whole
+    picture when a corner is behind a perspective camera); None when it covers no pixel."""
+    w, h = (int(v) for v in size)
+    if mesh.n_faces == 0:
+        return None
+    lo, hi = mesh.bounds
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                        for z in (lo[2], hi[2])])  # fmt: skip
+    col, row, z = project(camera, corners, (w, h))
+    if not (np.isfinite(col).all() and np.isfinite(row).all()) or (
+        not camera.parallel and (z <= 0.0).any()
+    ):
+        return 0, w - 1, 0, h - 1
+    c0 = max(int(np.floor(col.min())) - 1, 0)
+    c1 = min(int(np.ceil(col.max())) + 1, w - 1)
+    r0 = max(int(np.floor(row.min())) - 1, 0)
+    r1 = min(int(np.ceil(row.max())) + 1, h - 1)
+    return (c0, c1, r0, r1) if c0 <= c1 and r0 <= r1 else None
+
+
 def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     """Ray-cast hits of the pixel rays on a mesh's triangles, with interpolated normals.
 
@@ -121,7 +143,11 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     hit's normal is ``(1-u-v)·n0 + u·n1 + v·n2`` normalised (zero stays zero).
     """
     w, h = (int(v) for v in size)
-    origins, dirs = pixel_rays(camera, (w, h))
+    mask = np.zeros((h, w), bool)
+    rect = _screen_rect(camera, (w, h), mesh)
+    if rect is None:
+        return Hits(mask, np.zeros((0, 3)), np.zeros((0, 3)), "raycast")
+    origins, dirs = pixel_rays(camera, (w, h), rect)
     O = np.ascontiguousarray(origins.reshape(-1, 3))
     D = np.ascontiguousarray(dirs.reshape(-1, 3))
     P = np.asarray(mesh.positions, np.float64)
@@ -130,8 +156,9 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     best_t, best_tri, best_u, best_v = nearest_hits(
         mesh_bvh(mesh), O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
     )
-    mask = (best_tri >= 0).reshape(h, w)
+    c0, c1, r0, r1 = rect
     hit = best_tri >= 0
+    mask[r0 : r1 + 1, c0 : c1 + 1] = hit.reshape(r1 - r0 + 1, c1 - c0 + 1)
     f = best_tri[hit]
     u, v = best_u[hit], best_v[hit]
     pos = O[hit] + best_t[hit][:, None] * D[hit]

@@ -428,3 +428,11 @@ def test_ctrl_c_stops_ray_work_at_the_end_of_the_current_chunk(tmp_path):
     ]
     assert proc.returncode == 130
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("index", range(len(_cameras())))
+def test_pixel_rays_of_a_rectangle_are_those_of_the_whole_picture(index):
+    cam, size = _cameras()[index][0], (37, 23)
+    origins, dirs = pixel_rays(cam, size)
+    o, d = pixel_rays(cam, size, (5, 20, 3, 11))
+    assert np.array_equal(o, origins[3:12, 5:21]) and np.array_equal(d, dirs[3:12, 5:21])
