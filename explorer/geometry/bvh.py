@@ -63,9 +63,10 @@ class BVH:
     """A bounding-volume hierarchy over ``m`` triangles, as the casts read it.
 
     child : (k, 2) int64 the two children of each inner node: ``c >= 0`` an inner node,
-        ``c < 0`` the leaf ``~c`` (``-1``: nothing); node 0 is the root
+        ``c < 0`` the leaf ``~c``; node 0 is the root (a tree of one leaf, or none, has a root
+        whose other child's box is empty)
     cbox : (k, 12) float32 the children's boxes, (x0, x1, y0, y1, z0, z1) each, grown by the
-        pad and rounded outward to float32
+        pad and rounded outward to float32 (an empty box, x0 > x1, is never entered)
     leaf : (q, 2) int64 per leaf: first triangle and count
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
@@ -117,6 +118,7 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
 def _stoppable(build, args, cancelled):
     """Run ``build(*args, stop)`` on a worker thread while this one waits, so that Ctrl-C and
     ``cancelled`` stop it: ``stop[0] = 1`` ends the build within 1024 nodes."""
+    _check(cancelled)
     stop = np.zeros(1, np.uint8)
     future = _get_pool().submit(build, *args, stop)
     try:

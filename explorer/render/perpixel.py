@@ -98,14 +98,16 @@ _bvh_cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _bvh_lock = threading.Lock()
 
 
-def mesh_bvh(mesh) -> BVH:
+def mesh_bvh(mesh, *, cancelled=None) -> BVH:
     """The BVH of a mesh's triangles in world coordinates, built on first use and kept while
-    the mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only)."""
+    the mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only).
+    cancelled : () -> bool, asked while the tree is built (:func:`~explorer.geometry.bvh.build_bvh`)
+    """
     with _bvh_lock:
         bvh = _bvh_cache.get(mesh)
     if bvh is None:
         P = np.asarray(mesh.positions, np.float64)
-        bvh = build_bvh(P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)])
+        bvh = build_bvh(P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)], cancelled=cancelled)
         with _bvh_lock:
             _bvh_cache[mesh] = bvh
     return bvh
@@ -154,7 +156,7 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
     scale = max(float(np.abs(P).max(initial=0.0)), 1.0)
     best_t, best_tri, best_u, best_v = nearest_hits(
-        mesh_bvh(mesh), O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
+        mesh_bvh(mesh, cancelled=cancelled), O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
     )
     c0, c1, r0, r1 = rect
     hit = best_tri >= 0
