@@ -339,6 +339,12 @@ def _inv(d):
 
 
 @nb.njit(cache=True, inline="always")
+def _enter(b, ox, oy, oz, ix, iy, iz, t1):
+    """Where the ray enters each of a node's two child boxes ``b`` (12,) (:func:`_slab`)."""
+    return _slab(b, 0, ox, oy, oz, ix, iy, iz, t1), _slab(b, 6, ox, oy, oz, ix, iy, iz, t1)
+
+
+@nb.njit(cache=True, inline="always")
 def _ray(O, D, r):
     """Ray ``r``: origin, direction and the direction's reciprocals (:func:`_inv`)."""
     dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
@@ -409,9 +415,7 @@ def _any_hit_chunk(r0, r1, rays, tree, eps, out):
         sp = 0
         node = 0
         while True:
-            b = cbox[node]
-            ta = _slab(b, 0, ox, oy, oz, ix, iy, iz, tm)
-            tb = _slab(b, 6, ox, oy, oz, ix, iy, iz, tm)
+            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, tm)
             ca, cb = child[node, 0], child[node, 1]
             if ta < math.inf and ca < 0:
                 if _leaf_any(leaf, ca, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
@@ -444,9 +448,7 @@ def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
         node = 0
         while True:
             # boxes entered at t == best are still visited: a tie may go to a lower index
-            b = cbox[node]
-            ta = _slab(b, 0, ox, oy, oz, ix, iy, iz, best)
-            tb = _slab(b, 6, ox, oy, oz, ix, iy, iz, best)
+            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, best)
             for side in range(2):
                 c = child[node, side]
                 if c >= 0 or (ta if side == 0 else tb) == math.inf:
