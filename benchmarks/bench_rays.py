@@ -101,6 +101,7 @@ def measure_rays(mesh, repeat: int, light=LIGHT, embree: bool = True) -> dict:
     from explorer.geometry.rays import any_hit as brute
 
     O, D, tmax, tri = shadow_rays(mesh, light)
+    B.build_bvh(tri[:64])  # load the compiled builder before timing it
     distinct = len(O)
     if len(O) < MIN_RAYS:
         reps = -(-MIN_RAYS // len(O))
