@@ -20,13 +20,11 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import statistics
 import sys
-import time
 
 import numba
 import numpy as np
-from common import uv_sphere  # benchmarks/common.py
+from common import cpu_name, load_average, timed, uv_sphere  # benchmarks/common.py
 
 import explorer
 from explorer.core.lights import PointLight, SpotLight
@@ -37,32 +35,12 @@ from explorer.shading.equation import equation_shade
 
 
 def machine() -> str:
-    cpu = platform.processor() or "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     return (
-        f"{cpu}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
+        f"{cpu_name()}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
         f"float32 vectors: {'16 lanes (AVX-512)' if K.WIDE_FLOAT32 else 'LLVM default width'}; "
-        f"load average {load:.2f}"
+        f"load average {load_average():.2f}"
     )
-
-
-def timed(fn, repeat: int) -> tuple[float, float]:
-    fn()  # compile / warm up
-    ts = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        ts.append(time.perf_counter() - t)
-    return statistics.median(ts), min(ts)
 
 
 def sphere_points(n: int, rng) -> tuple[np.ndarray, np.ndarray]:

@@ -5,7 +5,7 @@
 
 Each case shades one mesh from scratch (a new :class:`explorer.Shader`, float32, shadows
 included) twice: as the plan decides, and with ``force_all=True`` (every term of every light per
-vertex, per-vertex halfway vectors, shadow rays from every vertex even on a convex mesh). Both
+vertex, per-vertex halfway vectors, shadow rays from every vertex, facing the light or not). Both
 give the same colours (checked); the table prints the median wall time of ``--repeat`` runs
 after a warm-up run (compilation excluded), and the ratio forced / planned.
 """
@@ -40,7 +40,7 @@ def cases(res: int):
             teapot,
         ),
         (
-            "convex sphere, shadows: true: no shadow rays",
+            "sphere, shadows: true: rays from lit vertices only",
             {"material": "gold",
              "lights": [{"type": "directional", "to_light": [1, 1, 1], "shadows": True}]},
             sphere,

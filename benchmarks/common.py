@@ -1,4 +1,4 @@
-"""Meshes the benchmarks share (no GUI imports: bench_engine runs without VTK).
+"""Meshes and helpers the benchmarks share (no GUI imports: bench_engine runs without VTK).
 
 Importing it puts the engine on its compiled tier (compiled in the process when numba's cache
 lacks it): the benchmarks measure the kernels, never the numpy tier that serves while the cache
@@ -8,6 +8,9 @@ is filled (explorer.shading.tiers).
 from __future__ import annotations
 
 import os
+import platform
+import statistics
+import time
 
 import numpy as np
 
@@ -29,3 +32,30 @@ def uv_sphere(around: int, rings: int) -> M.Mesh:
     c, d = a + around, b + around
     faces = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)]).reshape(-1, 3)
     return M.Mesh(pos, pos.copy(), faces, "uv_sphere")
+
+
+def cpu_name() -> str:
+    """The processor's model name (``/proc/cpuinfo``), else what ``platform`` says."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def load_average() -> float:
+    return os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+
+
+def timed(fn, repeat: int) -> tuple[float, float]:
+    """(median, best) seconds of ``repeat`` calls of ``fn`` after one warm-up call."""
+    fn()  # compile / warm up
+    ts = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t)
+    return statistics.median(ts), min(ts)

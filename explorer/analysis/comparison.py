@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import Cancelled, ExplorerError
 from explorer.render.camera import camera_for
 from explorer.render.images import check_size
 from explorer.render.offscreen import OffscreenRenderer
@@ -59,6 +59,12 @@ class Comparison:
         return {"rmse": self.rmse, "max": self.max, "peak": self.peak}[name]
 
 
+def channel_max(image: np.ndarray) -> np.ndarray:
+    """(h, w) the largest of each pixel's three channels of an (h, w, 3) picture (elementwise
+    over the channel planes: a reduction over the short last axis is many times slower)."""
+    return np.maximum(np.maximum(image[..., 0], image[..., 1]), image[..., 2])
+
+
 def compare(vertex_image, reference, coverage) -> Comparison:
     """Compare a per-vertex picture with a per-pixel reference.
 
@@ -72,7 +78,7 @@ def compare(vertex_image, reference, coverage) -> Comparison:
         raise ExplorerError(f"pictures differ in size: {img.shape} and {ref_img.shape}")
     mask = np.asarray(coverage, bool) & reference.mask
     diff = np.abs(img.astype(np.int16) - ref_img.astype(np.int16))
-    levels = diff.max(axis=2).astype(np.int64)
+    levels = channel_max(diff).astype(np.int64)
     levels[~mask] = 0
     d = diff[mask].astype(np.float64)
     rmse = float(np.sqrt(np.mean(d * d))) if d.size else 0.0
@@ -89,7 +95,7 @@ def coverage(renderer, scene, mesh, camera) -> np.ndarray:
     :class:`~explorer.render.offscreen.OffscreenRenderer` with a black background), drawn white."""
     white = np.ones((mesh.n_vertices, 3))
     img = renderer.render(_opaque(scene), mesh, white, camera=camera)
-    return img.max(axis=2) > 127
+    return channel_max(img) > 127
 
 
 def _opaque(scene):
@@ -120,22 +126,29 @@ class ViewComparer:
         self._picture.close()
         self._cover.close()
 
-    def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto"):
+    def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto",
+                cancelled=None):  # fmt: skip
         """See :func:`compare_view`."""
 
         w, h = self.size
         if camera is None:
             camera = camera_for(scene, mesh, w / h)
+        ref = reference(scene, mesh, (w, h), camera=camera, method=method, cancelled=cancelled)
         if colors is None:
             colors = vertex_colors(scene, mesh)
+        _check(cancelled)
         img = self._picture.render(_opaque(scene), mesh, colors, camera=camera)
         cov = coverage(self._cover, scene, mesh, camera)
-        ref = reference(scene, mesh, (w, h), camera=camera, method=method)
         return compare(img, ref, cov)
 
 
+def _check(cancelled) -> None:
+    if cancelled is not None and cancelled():
+        raise Cancelled("the comparison was cancelled")
+
+
 def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
-                 method: str = "auto") -> Comparison:  # fmt: skip
+                 method: str = "auto", cancelled=None) -> Comparison:  # fmt: skip
     """The per-pixel difference of a view (the window's difference view).
 
     scene, mesh : what is shown
@@ -145,13 +158,17 @@ def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
         :func:`explorer.render.camera.camera_from_vtk`
     colors : (n, 3) float, the vertex colours shown (default: shaded as the renderer shades them)
     method : the per-pixel reference's (:func:`explorer.render.perpixel.hits`)
+    cancelled : () -> bool, asked between chunks of the reference's rays and before the
+        pictures are drawn; when it returns True the work stops with
+        :class:`~explorer.core.errors.Cancelled` (a window's worker cancels a stale view)
 
     Renders the per-vertex picture and the coverage off-screen, so the window's own overlays
     never enter the comparison; :class:`ViewComparer` keeps the windows for repeated calls.
     Translucent materials are compared as if opaque.
     """
     with ViewComparer(size) as v:
-        return v.compare(scene, mesh, camera=camera, colors=colors, method=method)
+        return v.compare(scene, mesh, camera=camera, colors=colors, method=method,
+                         cancelled=cancelled)  # fmt: skip
 
 
 #: the heat map's colour ramp: 0 levels black, then blue, green, yellow, red, white at ``vmax``

@@ -8,7 +8,9 @@ block on stderr, exit status 2, no traceback; text a terminal would act on (from
 keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`). SIGTERM (every
 command but ``gui``, whose window loop would hold it back) raises :class:`Terminated`, so that
 the writer's cleanup runs: the command stops with one ``error:`` line, exit status 143, and
-leaves no temporary file.
+leaves no temporary file. Ctrl-C does the same with exit status 130: long ray work runs in
+chunks (:mod:`explorer.geometry.bvh`) and stops at the end of the current one, well within a
+second, with one ``error: interrupted ...`` line.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import warnings
 from contextlib import contextmanager
 
 from explorer.cli import bench, gui, plan, presets, render, sheet
-from explorer.core.errors import ExplorerError, Notice
+from explorer.core.errors import Cancelled, ExplorerError, Notice
 from explorer.core.text import printable
 from explorer.core.version import __version__
 
@@ -67,6 +69,8 @@ def _show_notices() -> None:
 
 #: exit status after SIGTERM (the shell's 128 + signal number)
 TERMINATED_STATUS = 128 + signal.SIGTERM
+#: exit status after Ctrl-C (SIGINT)
+INTERRUPTED_STATUS = 128 + signal.SIGINT
 
 
 class Terminated(KeyboardInterrupt):
@@ -109,8 +113,9 @@ def main(argv: list[str] | None = None) -> int:
     except Terminated:
         print("error: terminated (SIGTERM); no unfinished file was left", file=sys.stderr)
         return TERMINATED_STATUS
-    except KeyboardInterrupt:
-        return 130
+    except (KeyboardInterrupt, Cancelled):
+        print("error: interrupted (Ctrl-C); no unfinished file was left", file=sys.stderr)
+        return INTERRUPTED_STATUS
     except BrokenPipeError:  # the reader went away (``| head``): stop quietly, as cat does
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the interpreter's final flush cannot fail

@@ -8,7 +8,6 @@ from explorer.cli.options import add_materials_dir_option
 from explorer.core.scene import load_scene
 from explorer.geometry.meshes import DEFAULT_MESH, get_mesh
 from explorer.shading.plan import make_plan
-from explorer.shading.shadows import is_convex
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -22,8 +21,8 @@ def run(args) -> int:
     mesh_kind = None
     if any(lt.shadows for lt in scene.lights):  # shadows depend on the mesh: look at it
         mesh = get_mesh(scene.mesh or DEFAULT_MESH)
-        mesh_kind = "convex" if is_convex(mesh.positions, mesh.faces) else "concave"
-        print(f"mesh {mesh.name}: {mesh_kind} ({mesh.n_faces} triangles)")
+        mesh_kind = "faces" if mesh.n_faces else None
+        print(f"mesh {mesh.name}: {mesh.n_faces} triangles")
     plan = make_plan(scene, mesh=mesh_kind)
     m = scene.material
     viewer = (

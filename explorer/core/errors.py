@@ -73,3 +73,9 @@ class Notice(UserWarning):
 
 class DeprecatedName(Notice):
     """A key, keyword or flag was given by its old name; it still works."""
+
+
+class Cancelled(Exception):
+    """Long work (ray casting in chunks) was stopped because its ``cancelled`` callable returned
+    True. Not a user mistake, so not an :class:`ExplorerError`: a caller that cancelled the
+    work catches it (the CLI prints one line)."""

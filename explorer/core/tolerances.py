@@ -85,6 +85,13 @@ SHADOW_NDL_MARGIN = 1e-6
 #: sides are seen, as VTK draws them).
 PIXEL_RAY_T_MIN = 1e-9
 
+#: BVH (explorer.geometry.bvh): every node's box is grown by this times the mesh's size
+#: (max(largest absolute coordinate, 1)) on each side. The box test then errs only toward
+#: visiting a node: a ray that the Möller-Trumbore test finds hitting a triangle always enters
+#: the boxes above it despite rounding, so the BVH reports exactly the hits of testing every
+#: triangle.
+BVH_BOX_PAD = 1e-9
+
 # --- float32 fast path ----------------------------------------------------------------------
 
 #: A float32 dot product of unit vectors is within about 1e-6 of the float64 one after the

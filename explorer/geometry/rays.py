@@ -1,4 +1,4 @@
-"""Rays against triangles: one Möller-Trumbore test and the two casts built on it.
+"""Rays against triangles: the Möller-Trumbore test, and the brute-force shadow cast.
 
 :func:`ray_triangle` is the intersection test (Möller & Trumbore 1997): for a ray ``O + t·D``
 and a triangle ``v0, v0 + e1, v0 + e2`` it solves ``O + t·D = v0 + u·e1 + v·e2`` with
@@ -9,13 +9,10 @@ and a triangle ``v0, v0 + e1, v0 + e2`` it solves ``O + t·D = v0 + u·e1 + v·e
 a hit when ``u >= 0``, ``v >= 0`` and ``u + v <= 1``. ``det`` is ``-D · (e1 × e2)``: positive
 when the ray meets the triangle's front (counter-clockwise) side.
 
-Two casts call it (compiled with numba, the test inlined into their loops):
-
-- :func:`nearest_hits`: the nearest hit of each pixel's ray, front or back side (the per-pixel
-  reference, :mod:`explorer.render.perpixel`); each triangle is tested against the rays of the
-  pixels its projection covers.
-- :func:`any_hit`: whether each ray meets a triangle's front side before a distance (shadow
-  rays, :mod:`explorer.shading.shadows`).
+The casts of the project go through a bounding-volume hierarchy (:mod:`explorer.geometry.bvh`)
+whose leaves call this test. :func:`any_hit` here tests every ray against every triangle (cost
+rays × triangles): the brute force that the BVH's answers are tested and benchmarked against
+(``tests/geometry/test_bvh.py``, ``benchmarks/bench_rays.py``).
 
 The epsilons are in :mod:`explorer.core.tolerances` (``RAY_T_EPS``, ``DET_EPS``,
 ``PIXEL_RAY_T_MIN``).
@@ -69,7 +66,7 @@ def ray_triangle(ox, oy, oz, dx, dy, dz, ax, ay, az, px, py, pz, qx, qy, qz, det
 
 
 def triangle_edges(triangles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The casts' triangle layout: first corners ``v0`` and edges ``e1 = v1 - v0``,
+    """The triangle layout of the casts: first corners ``v0`` and edges ``e1 = v1 - v0``,
     ``e2 = v2 - v0``.
 
     triangles : (m, 3, 3) float, corners in counter-clockwise order seen from the front
@@ -82,62 +79,41 @@ def triangle_edges(triangles) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return v0, e1, e2
 
 
-# -- nearest hit: the per-pixel reference ----------------------------------------------------
+def pack_triangles(triangles) -> np.ndarray:
+    """The casts' triangle rows: (m, 9) float64 C-contiguous, ``v0, e1, e2`` of each triangle
+    (:func:`triangle_edges`) side by side.
 
-
-@nb.njit(cache=True, nogil=True)
-def nearest_hits(v0, e1, e2, box, orig, dirs, t_min, best_t, best_tri, best_u, best_v):
-    """The nearest hit, front or back side, of the rays of a picture.
-
-    v0, e1, e2 : (m, 3) float64 (:func:`triangle_edges`)
-    box : (m, 4) int64 inclusive pixel ranges (col0, col1, row0, row1) whose rays are tested
-        against each triangle (empty when col0 > col1 or row0 > row1)
-    orig, dirs : (h, w, 3) float64 ray origins and directions
-    t_min : hits at ``t <= t_min`` are ignored
-    best_t : (h, w) float64, in: the farthest ``t`` accepted (inf: any), out: the hit's ``t``
-    best_tri, best_u, best_v : (h, w) out: the hit triangle (unchanged where none is nearer
-        than ``best_t``) and the barycentric coordinates there
+    triangles : (m, 3, 3) float, corners in counter-clockwise order seen from the front
     """
-    m = v0.shape[0]
-    for f in range(m):
-        c0, c1, r0, r1 = box[f, 0], box[f, 1], box[f, 2], box[f, 3]
-        a0, a1, a2 = v0[f, 0], v0[f, 1], v0[f, 2]
-        p0, p1, p2 = e1[f, 0], e1[f, 1], e1[f, 2]
-        q0, q1, q2 = e2[f, 0], e2[f, 1], e2[f, 2]
-        for r in range(r0, r1 + 1):
-            for c in range(c0, c1 + 1):
-                t, u, v = ray_triangle(
-                    orig[r, c, 0], orig[r, c, 1], orig[r, c, 2],
-                    dirs[r, c, 0], dirs[r, c, 1], dirs[r, c, 2],
-                    a0, a1, a2, p0, p1, p2, q0, q1, q2, 0.0, False,
-                )  # fmt: skip
-                if t > t_min and t < best_t[r, c]:
-                    best_t[r, c] = t
-                    best_tri[r, c] = f
-                    best_u[r, c] = u
-                    best_v[r, c] = v
+    return np.ascontiguousarray(np.concatenate(triangle_edges(triangles), axis=1))
+
+
+@nb.njit(inline="always")
+def ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_min, front_only):
+    """:func:`ray_triangle` against row ``j`` of :func:`pack_triangles`' rows ``tri``."""
+    return ray_triangle(
+        ox, oy, oz, dx, dy, dz,
+        tri[j, 0], tri[j, 1], tri[j, 2],
+        tri[j, 3], tri[j, 4], tri[j, 5],
+        tri[j, 6], tri[j, 7], tri[j, 8],
+        det_min, front_only,
+    )  # fmt: skip
 
 
 # -- any hit: shadow rays --------------------------------------------------------------------
 
 
 @nb.njit(parallel=True, cache=True, boundscheck=False)
-def _any_hit(O, D, tmax, v0, e1, e2, t_eps, det_eps, out):
+def _any_hit(O, D, tmax, tri, t_eps, det_eps, out):
     """Every ray against every triangle, front sides only (det >= det_eps), a hit at t in
     (t_eps, tmax - t_eps); each ray stops at its first hit."""
-    m = v0.shape[0]
+    m = tri.shape[0]
     for r in nb.prange(O.shape[0]):
         ox, oy, oz = O[r, 0], O[r, 1], O[r, 2]
         dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
         tm = tmax[r] - t_eps
         for j in range(m):
-            t, _, _ = ray_triangle(
-                ox, oy, oz, dx, dy, dz,
-                v0[j, 0], v0[j, 1], v0[j, 2],
-                e1[j, 0], e1[j, 1], e1[j, 2],
-                e2[j, 0], e2[j, 1], e2[j, 2],
-                det_eps, True,
-            )  # fmt: skip
+            t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
             if t > t_eps and t < tm:
                 out[r] = True
                 break
@@ -153,14 +129,11 @@ def any_hit(origins, directions, tmax, triangles) -> np.ndarray:
     Returns (k,) bool.
     """
     hit = np.zeros(len(origins), np.bool_)
-    v0, e1, e2 = triangle_edges(triangles)
     _any_hit(
         np.ascontiguousarray(origins, np.float64),
         np.ascontiguousarray(directions, np.float64),
         np.ascontiguousarray(tmax, np.float64),
-        v0,
-        e1,
-        e2,
+        pack_triangles(triangles),
         RAY_T_EPS,
         DET_EPS,
         hit,

@@ -20,26 +20,30 @@ sampled at its centre, normalised device coordinates ``x = 2(c + ½)/w - 1``, ``
 distance. ``tests/render/test_perpixel.py`` checks this against VTK's own projection matrix and a
 per-pixel render of a fine sphere against VTK's render of it.
 
-The ray caster is :func:`explorer.geometry.rays.nearest_hits` (no R-tree or Embree needed): each
-triangle's projected bounding box selects the pixels whose rays are tested against it exactly
-(Möller-Trumbore), and the nearest hit wins. Nothing here imports VTK.
+The ray caster is :func:`explorer.geometry.bvh.nearest_hits`: the pixels' rays go through the
+mesh's bounding-volume hierarchy (the one the shadow rays use, built once per mesh and kept
+while the mesh lives), in chunks that a ``cancelled`` callable can stop; the nearest hit wins,
+at equal distance the lowest triangle index, exactly as testing every triangle would answer.
+Nothing here imports VTK.
 """
 
 from __future__ import annotations
 
+import threading
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import PIXEL_RAY_T_MIN
-from explorer.geometry.rays import nearest_hits, triangle_edges
+from explorer.geometry.bvh import BVH, build_bvh, nearest_hits
 from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
-from explorer.shading.equation import equation_terms
+from explorer.shading.shader import shade
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -90,73 +94,76 @@ def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0)
     return Hits(mask, P, N, "sphere")
 
 
-def _pixel_boxes(camera, size, tri: np.ndarray) -> np.ndarray:
-    """Inclusive pixel ranges (col0, col1, row0, row1) whose rays may meet each triangle: its
-    projected bounding box grown by one pixel, clipped to the picture (empty, col0 > col1 or
-    row0 > row1, when off it); the whole picture for a triangle that reaches behind a
-    perspective camera. tri : (m, 3, 3). Returns (m, 4) int64."""
+_bvh_cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_bvh_lock = threading.Lock()
+
+
+def mesh_bvh(mesh, *, cancelled=None) -> BVH:
+    """The BVH of a mesh's triangles in world coordinates, built on first use and kept while
+    the mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only).
+    cancelled : () -> bool, asked while the tree is built (:func:`~explorer.geometry.bvh.build_bvh`)
+    """
+    with _bvh_lock:
+        bvh = _bvh_cache.get(mesh)
+    if bvh is None:
+        P = np.asarray(mesh.positions, np.float64)
+        bvh = build_bvh(P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)], cancelled=cancelled)
+        with _bvh_lock:
+            _bvh_cache[mesh] = bvh
+    return bvh
+
+
+def _screen_rect(camera, size, mesh) -> tuple[int, int, int, int] | None:
+    """The pixels whose rays may meet the mesh, as (col0, col1, row0, row1) inclusive: the
+    projection of its bounding box grown by one pixel, clipped to the picture (the whole
+    picture when a corner is behind a perspective camera); None when it covers no pixel."""
     w, h = (int(v) for v in size)
-    m = len(tri)
-    col, row, z = (a.reshape(m, 3) for a in project(camera, tri.reshape(-1, 3), size))
-    ok = np.isfinite(col).all(1) & np.isfinite(row).all(1)
-    if not camera.parallel:
-        ok &= (z > 0.0).all(1)
-    col = np.where(ok[:, None], col, 0.0)
-    row = np.where(ok[:, None], row, 0.0)
-    box = np.stack(
-        [
-            np.floor(col.min(1)) - 1.0,
-            np.ceil(col.max(1)) + 1.0,
-            np.floor(row.min(1)) - 1.0,
-            np.ceil(row.max(1)) + 1.0,
-        ],
-        1,
-    )
-    box[~ok] = (0, w - 1, 0, h - 1)
-    box[:, 0] = np.clip(box[:, 0], 0, w)  # col0 = w: empty
-    box[:, 1] = np.clip(box[:, 1], -1, w - 1)  # col1 = -1: empty
-    box[:, 2] = np.clip(box[:, 2], 0, h)
-    box[:, 3] = np.clip(box[:, 3], -1, h - 1)
-    return box.astype(np.int64)
+    if mesh.n_faces == 0:
+        return None
+    lo, hi = mesh.bounds
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                        for z in (lo[2], hi[2])])  # fmt: skip
+    col, row, z = project(camera, corners, (w, h))
+    if not (np.isfinite(col).all() and np.isfinite(row).all()) or (
+        not camera.parallel and (z <= 0.0).any()
+    ):
+        return 0, w - 1, 0, h - 1
+    c0 = max(int(np.floor(col.min())) - 1, 0)
+    c1 = min(int(np.ceil(col.max())) + 1, w - 1)
+    r0 = max(int(np.floor(row.min())) - 1, 0)
+    r1 = min(int(np.ceil(row.max())) + 1, h - 1)
+    return (c0, c1, r0, r1) if c0 <= c1 and r0 <= r1 else None
 
 
-def mesh_hits(camera, size: Sequence[int], mesh) -> Hits:
+def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     """Ray-cast hits of the pixel rays on a mesh's triangles, with interpolated normals.
 
     mesh : an :class:`explorer.geometry.meshes.Mesh`
+    cancelled : () -> bool, asked between chunks of rays (True: raise
+        :class:`~explorer.core.errors.Cancelled`)
     The nearest hit of each ray over all triangles (front or back, as VTK draws both); the
     hit's normal is ``(1-u-v)·n0 + u·n1 + v·n2`` normalised (zero stays zero).
     """
     w, h = (int(v) for v in size)
-    origins, dirs = pixel_rays(camera, (w, h))
+    mask = np.zeros((h, w), bool)
+    rect = _screen_rect(camera, (w, h), mesh)
+    if rect is None:
+        return Hits(mask, np.zeros((0, 3)), np.zeros((0, 3)), "raycast")
+    origins, dirs = pixel_rays(camera, (w, h), rect)
+    O = np.ascontiguousarray(origins.reshape(-1, 3))
+    D = np.ascontiguousarray(dirs.reshape(-1, 3))
     P = np.asarray(mesh.positions, np.float64)
-    F = np.asarray(mesh.faces, np.int64)
-    tri = P[F]  # (m, 3, 3)
-    v0, e1, e2 = triangle_edges(tri)
-    box = np.ascontiguousarray(_pixel_boxes(camera, (w, h), tri))
-    best_t = np.full((h, w), np.inf)
-    best_tri = np.full((h, w), -1, np.int64)
-    best_u = np.zeros((h, w))
-    best_v = np.zeros((h, w))
+    F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
     scale = max(float(np.abs(P).max(initial=0.0)), 1.0)
-    if len(F):
-        nearest_hits(
-            v0,
-            e1,
-            e2,
-            box,
-            np.ascontiguousarray(origins),
-            np.ascontiguousarray(dirs),
-            PIXEL_RAY_T_MIN * scale,
-            best_t,
-            best_tri,
-            best_u,
-            best_v,
-        )
-    mask = best_tri >= 0
-    f = best_tri[mask]
-    u, v = best_u[mask], best_v[mask]
-    pos = origins[mask] + best_t[mask][:, None] * dirs[mask]
+    best_t, best_tri, best_u, best_v = nearest_hits(
+        mesh_bvh(mesh, cancelled=cancelled), O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
+    )
+    c0, c1, r0, r1 = rect
+    hit = best_tri >= 0
+    mask[r0 : r1 + 1, c0 : c1 + 1] = hit.reshape(r1 - r0 + 1, c1 - c0 + 1)
+    f = best_tri[hit]
+    u, v = best_u[hit], best_v[hit]
+    pos = O[hit] + best_t[hit][:, None] * D[hit]
     Nv = np.asarray(mesh.normals, np.float64)
     n = (1.0 - u - v)[:, None] * Nv[F[f, 0]] + u[:, None] * Nv[F[f, 1]] + v[:, None] * Nv[F[f, 2]]
     length = np.linalg.norm(n, axis=1, keepdims=True)
@@ -173,12 +180,15 @@ def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:
     return bool(np.all(np.abs(r - 1.0) < tol) and np.allclose(mesh.normals, mesh.positions))
 
 
-def hits(scene, mesh, size: Sequence[int], *, camera=None, method: str = "auto") -> Hits:
+def hits(
+    scene, mesh, size: Sequence[int], *, camera=None, method: str = "auto", cancelled=None
+) -> Hits:
     """What each pixel sees: :func:`sphere_hits` for a built-in sphere (``method="auto"`` or
     ``"sphere"``), :func:`mesh_hits` otherwise (or with ``method="raycast"``).
 
     camera : default :func:`explorer.render.camera.camera_for` (scene, mesh, w / h), the camera of a
         per-vertex render of the same scene
+    cancelled : () -> bool, asked between chunks of rays (:func:`mesh_hits`)
     """
 
     w, h = check_size(size)
@@ -192,7 +202,7 @@ def hits(scene, mesh, size: Sequence[int], *, camera=None, method: str = "auto")
                 f"mesh {mesh.name!r} is not a built-in unit sphere; use method='raycast'"
             )
         return sphere_hits(camera, (w, h))
-    return mesh_hits(camera, (w, h), mesh)
+    return mesh_hits(camera, (w, h), mesh, cancelled=cancelled)
 
 
 # -- colours and pictures ------------------------------------------------------------------
@@ -258,6 +268,18 @@ def point_colors(scene, positions, normals, *, mesh=None, precision: str = "floa
     return both[mesh.n_vertices :]
 
 
+def specular_sums(scene, positions, normals) -> np.ndarray:
+    """The unclamped specular light sum of each point, summed over RGB: (k,) float64.
+
+    The engine's colours with a material that keeps only its specular, at 1 (the lobe, Fresnel
+    and energy factors stay): ``colour = s_m · S`` with ``s_m = 1`` is the specular sum ``S`` of
+    :func:`explorer.shading.equation.equation_terms`, computed by the compiled kernels.
+    """
+    black = (0.0, 0.0, 0.0)
+    m = scene.material.replace(ambient=black, diffuse=black, emission=black, specular=(1.0,) * 3)
+    return shade(scene.replace(material=m), positions, normals, clamp=False).sum(axis=1)
+
+
 def reference(
     scene,
     mesh,
@@ -266,18 +288,23 @@ def reference(
     camera=None,
     method: str = "auto",
     precision: str = "float64",
+    cancelled=None,
 ) -> Reference:
     """The per-pixel reference of a scene on a mesh (see the module docstring).
 
     The colours come from :func:`point_colors` (the engine, :func:`explorer.shade`) on the hit
     positions and normals; the scene is used unchanged (model, lights, viewer, material).
+    cancelled : () -> bool, asked between chunks of rays and before the colours (True: raise
+        :class:`~explorer.core.errors.Cancelled`)
     Returns a :class:`Reference`.
     """
 
-    h = hits(scene, mesh, size, camera=camera, method=method)
+    h = hits(scene, mesh, size, camera=camera, method=method, cancelled=cancelled)
+    if cancelled is not None and cancelled():
+        raise Cancelled("the per-pixel reference was cancelled")
     if len(h.positions):
         colors = point_colors(scene, h.positions, h.normals, mesh=mesh, precision=precision)
-        spec = equation_terms(scene, h.positions, h.normals)["specular"].sum(axis=1)
+        spec = specular_sums(scene, h.positions, h.normals)
     else:
         colors = np.zeros((0, 3))
         spec = np.zeros(0)

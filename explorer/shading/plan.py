@@ -129,16 +129,16 @@ class Plan:
 
 
 #: what :func:`make_plan` knows of the mesh for shadows
-MESH_KINDS = (None, "convex", "concave")
+MESH_KINDS = (None, "faces")
 
 
 def make_plan(scene: Scene, *, mesh: str | None = None, force_all: bool = False) -> Plan:
     """Decide the work for ``scene`` (see the module docstring).
 
     mesh : what the shader knows of the mesh, for shadows: None (no faces given: nothing can
-        cast a shadow), "convex" (cannot shadow itself) or "concave"
+        cast a shadow) or "faces" (triangles that can cast shadows)
     force_all : skip nothing (every term of every light per vertex, shadow rays from every
-        vertex even on a convex mesh); the colours are the same. For the benchmark only.
+        vertex, facing the light or not); the colours are the same. For the benchmark only.
     """
     if mesh not in MESH_KINDS:
         raise ValueError(f"mesh must be one of {MESH_KINDS}, got {mesh!r}")
@@ -298,7 +298,7 @@ def _view(scene: Scene, specular: bool, flat: bool, effect_view: bool, r: _Reaso
 def _light_plan(i: int, lt, scene: Scene, mesh, terms: Terms) -> LightPlan:
     """The light's own decisions (:meth:`explorer.core.lights.Light.work`), what the
     material, model, viewer make of its terms, and what the effects plan for it (the mesh:
-    None, "convex" or "concave")."""
+    None or "faces")."""
     m = scene.material
     work = lt.work()
     r = _Reasons(work.reasons)

@@ -51,7 +51,7 @@ from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import equation_terms
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.shadows import is_convex, visibility_rows
+from explorer.shading.shadows import visibility_rows
 
 PRECISIONS = ("float64", "float32")
 #: the engine's tiers (see :mod:`explorer.shading.tiers`)
@@ -175,7 +175,6 @@ class Shader:
         faces = None if faces is None else check_faces(faces, len(P))
         self._P, self._N = P, N
         self._faces = faces
-        self._convex = None  # decided when a light first asks for shadows
         self._vis_cache: dict = {}
         self._plan = self._make_plan(self._scene)
         self._centre, self._scale = frame_of(self._P)
@@ -303,14 +302,8 @@ class Shader:
 
     # -- shadows -------------------------------------------------------------------------------
     def _mesh_kind(self, scene) -> str | None:
-        """What the plan knows of the mesh: None (no faces), "convex" or "concave"."""
-        if self._faces is None:
-            return None
-        if not any(e.needs_mesh(scene) for e in EFFECTS):
-            return "concave"  # not asked: no need to decide
-        if self._convex is None:
-            self._convex = is_convex(self._P, self._faces)
-        return "convex" if self._convex else "concave"
+        """What the plan knows of the mesh: None (no faces) or "faces"."""
+        return None if self._faces is None else "faces"
 
     def _make_plan(self, scene) -> Plan:
         return make_plan(scene, mesh=self._mesh_kind(scene), force_all=self.force_all)

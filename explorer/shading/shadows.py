@@ -13,18 +13,17 @@ Visibility is 1 (lit) or 0 (shadowed); the engine multiplies it into the light's
 specular weight (ambient light is not shadowed, as in OpenGL practice). Between vertices the
 renderer interpolates colours, so a shadow edge is as sharp as the mesh is fine.
 
-Ray engine: :func:`explorer.geometry.rays.any_hit`, a compiled Möller-Trumbore test of every
-ray against every triangle on both cores (instant for the built-in meshes, seconds for meshes of
-100k triangles). trimesh's embree- or rtree-backed intersectors report the nearest hit
-only, which cannot skip back faces and the triangles at the ray's own vertex, so they are not
-used.
+Ray engine: :func:`explorer.geometry.bvh.any_hit` through a bounding-volume hierarchy of the
+mesh (:mod:`explorer.geometry.bvh`), built once per geometry. It runs the same Möller-Trumbore
+test as the brute-force :func:`explorer.geometry.rays.any_hit` on the same numbers, only on the
+triangles whose boxes a ray crosses, so the shadowed vertices are exactly the brute force's.
+Rays run in chunks on the cores; ``cancelled`` (and Ctrl-C) stops them between chunks.
 
-With these rules a convex closed mesh can never shadow itself (a line meets a convex body in
-one segment: a ray that starts on it never re-enters it), so skipping it changes nothing.
-
-The plan skips rays where they cannot change anything: lights without ``shadows: true``,
-vertices facing away from the light (N·L <= 0: no diffuse or specular to shadow), and convex
-meshes (:func:`is_convex`: a convex surface cannot shadow itself).
+The plan skips rays where they cannot change anything: lights without ``shadows: true``, and
+vertices facing away from the light (N·L <= 0: no diffuse or specular to shadow). It does not
+skip meshes that look convex: a convexity test with a tolerance calls a fine torus convex
+although its far side is shadowed, and no test is exact at every resolution, so every mesh
+casts its rays (a convex mesh's rays leave it after a few boxes).
 """
 
 from __future__ import annotations
@@ -32,43 +31,44 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.core import tolerances as tol
+from explorer.geometry.bvh import BVH, any_hit, build_bvh
 from explorer.geometry.frame import frame_of
-from explorer.geometry.rays import any_hit
+
+#: the key under which :func:`visibility_rows` keeps the geometry's frame and BVH in its cache
+GEOMETRY_KEY = "geometry"
 
 
-def is_convex(positions, faces) -> bool:
-    """True when the mesh is a closed convex surface (trimesh ``is_convex``): it cannot shadow
-    itself. Open or non-convex meshes (a plane under a sphere) are False."""
-    import trimesh
+def frame_bvh(positions, faces) -> tuple[np.ndarray, float, np.ndarray, BVH]:
+    """The normalised frame of ``positions`` and the BVH of ``faces`` in it.
 
-    if faces is None or len(faces) == 0:
-        return True
-    tm = trimesh.Trimesh(np.asarray(positions), np.asarray(faces), process=False)
-    if not tm.is_watertight:  # seams with duplicated vertices: merge before deciding
-        tm = trimesh.Trimesh(np.asarray(positions), np.asarray(faces), process=True)
-    return bool(tm.is_convex)
+    positions : (n, 3) float; faces : (m, 3) int
+    Returns centre (3,), scale, the frame positions Q (n, 3) = (positions - centre) / scale,
+    and the BVH of Q[faces] (:data:`~explorer.core.tolerances.RAY_T_EPS` is relative to it).
+    """
+    P = np.asarray(positions, np.float64)
+    centre, scale = frame_of(P)
+    Q = (P - centre) / scale
+    return centre, scale, Q, build_bvh(Q[np.asarray(faces, np.int64).reshape(-1, 3)])
 
 
-def visibility(positions, faces, light, *, only=None):
+def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=None):
     """Visibility of ``light`` at each vertex: (n,) float64, 1 lit, 0 shadowed.
 
     positions : (n, 3) float; faces : (m, 3) int (counter-clockwise seen from the front)
     light : a light of :mod:`explorer.core.lights` (it gives the rays: :meth:`shadow_ray`)
     only : (n,) bool, the vertices to cast rays from (the others get 1); default all
+    geometry : :func:`frame_bvh` of these positions and faces, when the caller keeps it
+    cancelled : () -> bool, asked between chunks of rays (True: raise
+        :class:`~explorer.core.errors.Cancelled`)
     """
-    P = np.asarray(positions, np.float64)
-    n = len(P)
+    n = len(positions)
     vis = np.ones(n)
-    faces = np.asarray(faces, np.int64).reshape(-1, 3)
     idx = np.arange(n) if only is None else np.flatnonzero(only)
     if len(idx) == 0 or len(faces) == 0:
         return vis
-    centre, scale = frame_of(P)
-    Q = (P - centre) / scale  # the normalised frame: RAY_T_EPS is relative to the mesh
+    centre, scale, Q, bvh = frame_bvh(positions, faces) if geometry is None else geometry
     D, tmax = light.shadow_ray(Q[idx], centre, scale)
-    D = np.ascontiguousarray(D)
-    tri = Q[faces]
-    hit = any_hit(Q[idx], D, tmax, tri)
+    hit = any_hit(bvh, Q[idx], D, tmax, cancelled=cancelled)
     vis[idx[hit]] = 0.0
     return vis
 
@@ -83,8 +83,9 @@ def visibility_rows(
     two_sided : N flips with V: rays from every vertex with a normal (either side may be lit)
     force_all : rays from every vertex (benchmark); else only where N·L > -SHADOW_NDL_MARGIN
         (:mod:`explorer.core.tolerances`)
-    cache : dict kept by the caller for this geometry: a light whose rays are unchanged (same
-        position or direction) reuses its row
+    cache : dict kept by the caller for this geometry: it keeps the frame and the BVH
+        (:data:`GEOMETRY_KEY`), and a light whose rays are unchanged (same position or
+        direction) reuses its row
     Returns the rows and the number of rays cast."""
     P = positions
     n = len(P)
@@ -104,7 +105,9 @@ def visibility_rows(
                 ndl = np.einsum("ij,ij->i", light.toward(P), unit)
                 # a margin: a ray more than needed is harmless, one fewer is not
                 only = length > 0 if two_sided else ndl > -tol.SHADOW_NDL_MARGIN
-            v = visibility(P, faces, light, only=only)
+            if GEOMETRY_KEY not in cache:
+                cache[GEOMETRY_KEY] = frame_bvh(P, faces)
+            v = visibility(P, faces, light, only=only, geometry=cache[GEOMETRY_KEY])
             cache[key] = v
             rays += int(n if only is None else only.sum())
         vis[i] = v

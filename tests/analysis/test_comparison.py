@@ -10,7 +10,7 @@ import pytest
 
 from explorer.analysis import comparison as C
 from explorer.analysis.benchmark import bench_scene
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.presets import builtin_dir, load_material_file
 from explorer.core.scene import Viewer
 from explorer.geometry import meshes as M
@@ -104,3 +104,27 @@ def test_compare_view_for_the_gui():
         again = [v.compare(scene, M.sphere(12), camera=cam), v.compare(scene, M.teapot(4))]
     assert np.array_equal(again[0].levels, coarse.levels)
     assert np.array_equal(again[1].levels, teapot.levels)
+
+
+def test_compare_view_can_be_cancelled_and_leaves_nothing_behind():
+    """A cancelled comparison raises Cancelled; the next one on the same windows equals a
+    direct comparison (nothing of the cancelled one is left in them)."""
+    chrome = load_material_file(builtin_dir() / "chrome.yaml")
+    scene = bench_scene(chrome).replace(viewer=Viewer(eye=(0.3, 0.4, 3.5)))
+    size = (320, 240)
+    mesh = M.teapot(6)
+    asked = []
+
+    def cancelled():
+        asked.append(1)
+        return len(asked) > 3
+
+    with pytest.raises(Cancelled):
+        C.compare_view(scene, mesh, size, cancelled=cancelled)
+    assert len(asked) == 4  # stopped in the middle of the rays
+    with C.ViewComparer(size) as v:
+        with pytest.raises(Cancelled):
+            v.compare(scene, M.sphere(12), cancelled=lambda: True)
+        after = v.compare(scene, mesh, cancelled=lambda: False)
+    direct = C.compare_view(scene, mesh, size)
+    assert np.array_equal(after.levels, direct.levels) and after.mask.sum() > 1000

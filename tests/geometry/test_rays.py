@@ -1,4 +1,4 @@
-"""The ray-triangle test and the two casts built on it."""
+"""The ray-triangle test and the brute-force shadow cast."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 from numba import njit
 
 from explorer.core.tolerances import RAY_T_EPS
-from explorer.geometry.rays import any_hit, nearest_hits, ray_triangle, triangle_edges
+from explorer.geometry.rays import any_hit, ray_triangle, triangle_edges
 
 #: the triangle (0,0,1), (1,0,1), (0,1,1): its front (counter-clockwise) side faces +z
 TRI = np.array([[[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]]])
@@ -58,18 +58,3 @@ def test_any_hit_front_sides_before_tmax():
     assert any_hit(o[[1]], d[[1]], tmax[[1]], TRI).tolist() == [True]
     flipped = TRI[:, ::-1]  # front side toward -z
     assert any_hit(o, d, tmax, flipped).tolist() == [True, False, False, False]
-
-
-def test_nearest_hits_keeps_the_nearest():
-    # two parallel triangles at z = 1 and z = 2, one pixel looking up +z from z = 0
-    tris = np.concatenate([TRI + [0, 0, 1.0], TRI])
-    v0, e1, e2 = triangle_edges(tris)
-    box = np.zeros((2, 4), np.int64)  # both cover pixel (0, 0)
-    orig = np.array([[[0.2, 0.2, 0.0]]])
-    dirs = np.array([[[0.0, 0.0, 1.0]]])
-    best_t = np.full((1, 1), np.inf)
-    best_tri = np.full((1, 1), -1, np.int64)
-    best_u, best_v = np.zeros((1, 1)), np.zeros((1, 1))
-    nearest_hits(v0, e1, e2, box, orig, dirs, 1e-9, best_t, best_tri, best_u, best_v)
-    assert best_t[0, 0] == 1.0 and best_tri[0, 0] == 1  # the back side of the nearer one
-    assert best_u[0, 0] == 0.2 and best_v[0, 0] == 0.2

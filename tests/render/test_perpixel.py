@@ -4,13 +4,19 @@ casting with interpolated normals, agreement with a fine per-vertex render, rend
 from __future__ import annotations
 
 import math
+import os
+import signal
+import subprocess
+import sys
 
 import numpy as np
 import pytest
+from helpers.brute_rays import brute_nearest
 
 import explorer
 from explorer.analysis.comparison import compare, coverage
 from explorer.cli import main
+from explorer.core.errors import Cancelled
 from explorer.core.hdr import HDR
 from explorer.core.lights import DirectionalLight
 from explorer.core.presets import builtin_dir, load_material_file
@@ -347,3 +353,86 @@ def test_render_per_pixel_command(tmp_path, capsys):
     assert main(["render", "--per-pixel", "--out", str(tmp_path / "x.ply")]) == 2
     assert "--per-pixel draws a picture" in capsys.readouterr().err
     assert not (tmp_path / "x.ply").exists()
+
+
+def test_ray_cast_equals_testing_every_triangle():
+    """The per-pixel rays through the mesh's BVH hit what testing every triangle hits: the
+    same pixels, at the same distances."""
+    mesh = M.teapot(4)
+    scene = _scene(Viewer(eye=(2.0, 1.5, 3.0)))
+    size = (64, 48)
+    cam = camera_for(scene, mesh, size[0] / size[1])
+    h = mesh_hits(cam, size, mesh)
+    origins, dirs = (a.reshape(-1, 3) for a in pixel_rays(cam, size))
+    best = brute_nearest(origins, dirs, mesh.positions[mesh.faces], 1e-9)[0]
+    seen = np.isfinite(best)
+    assert np.array_equal(h.mask.ravel(), seen) and seen.sum() > 300
+    assert np.array_equal(h.positions, origins[seen] + best[seen][:, None] * dirs[seen])
+
+
+def test_reference_can_be_cancelled():
+    mesh = M.teapot(4)
+    scene = _scene()
+    asked = []
+    with pytest.raises(Cancelled):  # asked before the rays, then before the colours
+        reference(scene, mesh, (40, 30), cancelled=lambda: asked.append(1) or len(asked) > 1)
+    assert len(asked) == 2
+    with pytest.raises(Cancelled):  # and between chunks of rays
+        reference(scene, mesh, (400, 300), cancelled=lambda: asked.append(1) or len(asked) > 4)
+    assert len(asked) == 5
+    ref = reference(scene, mesh, (40, 30), cancelled=lambda: False)
+    assert np.array_equal(ref.image(), reference(scene, mesh, (40, 30)).image())
+
+
+#: a render whose ray chunks are slowed down (each sleeps), so Ctrl-C lands in the ray work
+_SLOW_RENDER = """
+import sys, time
+import explorer.geometry.bvh as B
+kernel = B._nearest_chunk
+def slow(*args):
+    print("chunk", file=sys.stderr, flush=True)
+    time.sleep(0.1)
+    return kernel(*args)
+B._nearest_chunk = slow
+from explorer.cli import main
+sys.exit(main(["render", "--per-pixel", "--mesh", "teapot", "--size", "640x480",
+               "--out", sys.argv[1]]))
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_ctrl_c_stops_ray_work_at_the_end_of_the_current_chunk(tmp_path):
+    """SIGINT in the middle of the per-pixel rays (38 chunks of 0.1 s or more): the command
+    stops after the chunks already running, with one line and exit status 130, and leaves no
+    file (not even a temporary one). Counted in chunks, not timed."""
+    out = tmp_path / "pp.png"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _SLOW_RENDER, str(out)],
+        stderr=subprocess.PIPE, text=True, env=env,
+        # a shell starts background jobs with SIGINT ignored, and Python then leaves it so
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
+    try:
+        assert proc.stderr.readline() == "chunk\n"  # the rays have started
+        proc.send_signal(signal.SIGINT)
+        err = proc.communicate(timeout=60)[1]
+    finally:
+        proc.kill()
+    lines = err.splitlines()
+    # at most the other thread's chunk started before the signal, and one chunk per thread
+    # that was already handed out
+    assert lines.count("chunk") <= 4
+    assert [ln for ln in lines if ln != "chunk"] == [
+        "error: interrupted (Ctrl-C); no unfinished file was left"
+    ]
+    assert proc.returncode == 130
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("index", range(len(_cameras())))
+def test_pixel_rays_of_a_rectangle_are_those_of_the_whole_picture(index):
+    cam, size = _cameras()[index][0], (37, 23)
+    origins, dirs = pixel_rays(cam, size)
+    o, d = pixel_rays(cam, size, (5, 20, 3, 11))
+    assert np.array_equal(o, origins[3:12, 5:21]) and np.array_equal(d, dirs[3:12, 5:21])

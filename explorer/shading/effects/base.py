@@ -81,16 +81,12 @@ class Effect:
         return None, []
 
     def plan_light(self, light, mesh, terms: Terms, own: LightTerms) -> tuple[object, list[Row]]:
-        """The value for one light and its rows. mesh : None (no faces), "convex", "concave"."""
+        """The value for one light and its rows. mesh : None (no faces) or "faces"."""
         return None, []
 
     def forced_light(self, light, mesh):
         """The value for one light in a plan that skips nothing (benchmark)."""
         return None
-
-    def needs_mesh(self, scene) -> bool:
-        """The plan must know whether the mesh is convex (the shader decides it only then)."""
-        return False
 
     def needs_view(self, value) -> bool:
         """The effect reads V per vertex even for a flat lobe."""

@@ -13,7 +13,7 @@ from explorer.shading.shadows import visibility
 
 class HardShadows(Effect):
     """Per light. Value: shadow rays are cast for the light (``shadows: true``, faces given,
-    the mesh can shadow itself, the light has diffuse or specular)."""
+    the light has diffuse or specular)."""
 
     name = "shadows"
     invalidates = "lights"
@@ -24,19 +24,18 @@ class HardShadows(Effect):
     def active(self, scene) -> bool:
         return any(lt.shadows for lt in scene.lights)
 
-    def needs_mesh(self, scene) -> bool:
-        return self.active(scene)
-
     def plan_light(self, light, mesh, terms, own):
         if not light.shadows:
             return False, [(self.name, "out", "shadows is false")]
         if mesh is None:
             return False, [(self.name, "out", "no mesh faces given: nothing can cast a shadow")]
-        if mesh == "convex":
-            return False, [(self.name, "out", "convex mesh: it cannot shadow itself")]
         if not ((own.diffuse and terms.diffuse) or (own.specular and terms.specular)):
             return False, [(self.name, "out", "no diffuse or specular from this light to shadow")]
-        why = "rays toward the light from vertices with N·L > 0 (others: none)"
+        why = (
+            "rays toward the light from vertices with N·L > 0 (others: none), through the"
+            " mesh's BVH; every mesh, convex-looking ones too (no convexity test is exact at"
+            " every resolution)"
+        )
         return True, [(self.name, "in", why)]
 
     def forced_light(self, light, mesh):

@@ -1,0 +1,317 @@
+"""Rays through the BVH against the brute force, in one run: shadow rays, scaling, the engine's
+shadow update and the window's difference view.
+
+    python benchmarks/bench_rays.py [--repeat N] [--section shadows scaling engine view]
+
+Sections (all by default):
+
+- ``shadows``: the engine's shadow rays on the 100,578-vertex teapot (tessellation 56, 200,256
+  triangles) toward a point light, from the vertices with N·L > -margin (the ones the engine
+  casts from): rays per second through the BVH (:func:`explorer.geometry.bvh.any_hit`, every
+  thread), the brute force (:func:`explorer.geometry.rays.any_hit`, every triangle, every
+  thread) on a random sample of the same rays (its cost per ray does not depend on the count),
+  and, when the package is installed, embreex's occlusion query on the same rays (float32, one
+  call: its answers count back faces as occluders, so they differ; how many is printed).
+- ``scaling``: the same on tori from 1,024 to 1,048,576 triangles (a point light near the
+  ring's plane, so the far side is shadowed), with the BVH's build time.
+- ``engine``: a float32 :class:`explorer.Shader` on the 100k-vertex teapot with two point
+  lights that cast shadows: the first colours (BVH build and both lights' rays), then one
+  update after a light moves (that light's rays again), next to the same update without
+  shadows.
+- ``view``: the per-pixel reference and the difference view's comparison
+  (:class:`explorer.analysis.comparison.ViewComparer`, windows reused) of the window's default
+  teapot (tessellation 24, 18,530 vertices) at the window's default size (1100x720). This
+  section uses only what the revisions before the BVH had too, so the same command run with
+  ``PYTHONPATH`` on an older checkout times the old code.
+
+Every figure is wall-clock: median and best of ``--repeat`` runs after a warm-up; the machine
+and its load average are printed with the tables. Compare rows of one run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import platform
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+from common import cpu_name, load_average, timed  # benchmarks/common.py
+
+from explorer.core.scene import load_scene
+from explorer.geometry.meshes import get_mesh
+
+SECTIONS = ("shadows", "scaling", "engine", "view")
+#: the brute force's sample is sized to about this many ray-triangle tests
+BRUTE_TESTS = 3e8
+#: a small mesh's rays are repeated up to this many, so that a cast is not all overhead
+MIN_RAYS = 65536
+LIGHT = (2.0, 3.0, 1.5)
+
+
+def machine() -> str:
+    import numba
+
+    try:
+        from explorer.geometry.bvh import workers
+
+        threads = f"ray threads {workers()}"
+    except ImportError:  # a checkout before the BVH
+        threads = f"numba threads {numba.get_num_threads()}"
+    embree = "embreex " + _version("embreex") if _has("embreex") else "embreex not installed"
+    return (
+        f"{cpu_name()}; {os.cpu_count()} cores, {threads}; Python {platform.python_version()}, "
+        f"numpy {np.__version__}, numba {numba.__version__}; {embree}; "
+        f"load average {load_average():.2f}"
+    )
+
+
+def _has(name: str) -> bool:
+    return importlib.util.find_spec(name) is not None
+
+
+def _version(name: str) -> str:
+    from importlib.metadata import version
+
+    return version(name)
+
+
+def shadow_rays(mesh, light_position):
+    """The engine's shadow rays of a point light: frame positions, directions, distances, and
+    the frame triangles (m, 3, 3)."""
+    from explorer.core import tolerances as tol
+    from explorer.core.lights import PointLight
+    from explorer.geometry.frame import frame_of
+
+    light = PointLight(position=light_position)
+    centre, scale = frame_of(mesh.positions)
+    Q = (mesh.positions - centre) / scale
+    lit = np.einsum("ij,ij->i", light.toward(mesh.positions), mesh.normals)
+    keep = lit > -tol.SHADOW_NDL_MARGIN
+    D, tmax = light.shadow_ray(Q[keep], centre, scale)
+    return np.ascontiguousarray(Q[keep]), D, tmax, Q[mesh.faces]
+
+
+def measure_rays(mesh, repeat: int, light=LIGHT, embree: bool = True) -> dict:
+    """Rays per second of the BVH, the brute force and embreex on the mesh's shadow rays."""
+    from explorer.geometry import bvh as B
+    from explorer.geometry.rays import any_hit as brute
+
+    O, D, tmax, tri = shadow_rays(mesh, light)
+    B.build_bvh(tri[:64])  # load the compiled builder before timing it
+    distinct = len(O)
+    if len(O) < MIN_RAYS:
+        reps = -(-MIN_RAYS // len(O))
+        O, D, tmax = (np.ascontiguousarray(np.concatenate([a] * reps)) for a in (O, D, tmax))
+    t = time.perf_counter()
+    tree = B.build_bvh(tri)
+    build = time.perf_counter() - t
+    med, best = timed(lambda: B.any_hit(tree, O, D, tmax), repeat)
+    hit = B.any_hit(tree, O, D, tmax)
+    k = int(np.clip(BRUTE_TESTS / len(tri), 50, len(O)))
+    pick = np.random.default_rng(0).choice(len(O), k, replace=False)
+    bmed, bbest = timed(lambda: brute(O[pick], D[pick], tmax[pick], tri), max(1, repeat // 3))
+    same = bool(np.array_equal(brute(O[pick], D[pick], tmax[pick], tri), hit[pick]))
+    row = {
+        "triangles": len(tri),
+        "rays": distinct,
+        "cast": len(O),
+        "build_s": build,
+        "bvh": len(O) / med,
+        "bvh_best": len(O) / best,
+        "brute": k / bmed,
+        "brute_rays": k,
+        "same": same,
+        "shadowed": float(hit.mean()),
+    }
+    if embree and _has("embreex"):
+        row.update(embree_rays(O, D, tmax, tri, hit, repeat))
+    return row
+
+
+def embree_rays(O, D, tmax, tri, hit, repeat: int) -> dict:
+    """embreex's occlusion query on the same rays (both sides occlude; float32; origins moved
+    1e-5 along the ray, off the triangles around the vertex)."""
+    from embreex import rtcore_scene
+    from embreex.mesh_construction import TriangleMesh
+
+    t = time.perf_counter()
+    scene = rtcore_scene.EmbreeScene()
+    TriangleMesh(scene=scene, vertices=tri.astype(np.float32))
+    build = time.perf_counter() - t
+    O32 = (O + 1e-5 * D).astype(np.float32)
+    D32 = D.astype(np.float32)
+    far = np.minimum(tmax - 2e-5, 1e30).astype(np.float32)
+
+    def run():
+        return np.asarray(scene.run(O32, D32, query="OCCLUDED", dists=far))
+
+    med, _ = timed(run, repeat)
+    occluded = run() != -1  # the index of a hit geometry, -1 for none
+    half = len(O) // 2
+    with ThreadPoolExecutor(2) as pool:  # does a call let the other thread run?
+
+        def both():
+            parts = [(0, half), (half, len(O))]
+            return list(pool.map(lambda p: scene.run(O32[p[0] : p[1]], D32[p[0] : p[1]],
+                                                     query="OCCLUDED", dists=far[p[0] : p[1]]),
+                                 parts))  # fmt: skip
+
+        med2, _ = timed(both, repeat)
+    front = _front_normals(tri)
+
+    def by_the_rule():
+        """Nearest hits, passing through back faces (re-cast from just beyond them) until a
+        front face (shadowed) or nothing (lit): the engine's rule with Embree's queries."""
+        out = np.zeros(len(O), bool)
+        todo = np.arange(len(O))
+        o, left = O32.copy(), far.copy()
+        while len(todo):
+            r = scene.run(o[todo], D32[todo], query="INTERSECT", dists=left[todo], output=1)
+            prim, t = r["primID"], r["tfar"]
+            got = prim >= 0
+            is_front = np.zeros(len(todo), bool)
+            is_front[got] = np.einsum("ij,ij->i", front[prim[got]], D32[todo[got]]) < 0
+            out[todo[is_front]] = True
+            back = got & ~is_front
+            step = t[back] + 1e-5
+            o[todo[back]] += step[:, None] * D32[todo[back]]
+            left[todo[back]] -= step
+            todo = todo[back]
+        return out
+
+    rmed, _ = timed(by_the_rule, repeat)
+    ruled = by_the_rule()
+    return {
+        "embree": len(O) / med,
+        "embree_two_threads": len(O) / med2,
+        "embree_build_s": build,
+        "embree_differs": float(np.mean(occluded != hit)),
+        "embree_rule": len(O) / rmed,
+        "embree_rule_differs": float(np.mean(ruled != hit)),
+    }
+
+
+def _front_normals(tri) -> np.ndarray:
+    """(m, 3) float32 e1 × e2 of each triangle: a ray with D·n < 0 meets its front side."""
+    return np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]).astype(np.float32)
+
+
+def section_shadows(repeat: int) -> None:
+    mesh = get_mesh("teapot", 56)
+    r = measure_rays(mesh, repeat)
+    print(f"\n## Shadow rays, 100k-vertex teapot ({mesh.n_vertices:,} vertices, "
+          f"{r['triangles']:,} triangles), point light at {list(LIGHT)}\n")  # fmt: skip
+    print(f"{r['rays']:,} rays (the vertices with N·L > -margin), {r['shadowed']:.1%} shadowed")
+    print("\n| ray engine | M rays/s (median) | best | vs brute force | build s |")
+    print("|---|---:|---:|---:|---:|")
+    print(f"| BVH (numba) | {r['bvh'] / 1e6:.2f} | {r['bvh_best'] / 1e6:.2f} | "
+          f"{r['bvh'] / r['brute']:,.0f}x | {r['build_s']:.2f} |")  # fmt: skip
+    print(f"| brute force (every triangle; {r['brute_rays']:,} of the rays) | "
+          f"{r['brute'] / 1e6:.4f} | | 1x | 0 |")  # fmt: skip
+    if "embree" in r:
+        print(f"| embreex occlusion (float32, one thread, back faces occlude: answers differ on "
+              f"{r['embree_differs']:.1%} of the rays) | {r['embree'] / 1e6:.2f} | | "
+              f"{r['embree'] / r['brute']:,.0f}x | {r['embree_build_s']:.2f} |")  # fmt: skip
+        print(f"| embreex occlusion, the rays in two halves on two threads | "
+              f"{r['embree_two_threads'] / 1e6:.2f} | | "
+              f"{r['embree_two_threads'] / r['brute']:,.0f}x | |")  # fmt: skip
+        rule = r["embree_rule"]
+        print(f"| embreex nearest hits through back faces (the engine's rule; float32, one "
+              f"thread: answers differ on {r['embree_rule_differs']:.2%}) | "
+              f"{rule / 1e6:.2f} | | {rule / r['brute']:,.0f}x | |")  # fmt: skip
+    print(f"\nBVH answers equal the brute force's on its sample: {r['same']}")
+
+
+def section_scaling(repeat: int) -> None:
+    print("\n## Scaling: tori, point light near the ring's plane\n")
+    print(f"(a mesh with fewer than {MIN_RAYS:,} rays casts them repeatedly up to that many)\n")
+    print("| triangles | rays | build s | BVH M rays/s | brute force M rays/s | BVH / brute | "
+          "shadowed | equal |")  # fmt: skip
+    print("|---:|---:|---:|---:|---:|---:|---:|---|")
+    for res in (32, 100, 316, 1000):
+        r = measure_rays(get_mesh("torus", res), repeat, light=(2.5, 0.6, 0.5), embree=False)
+        print(f"| {r['triangles']:,} | {r['rays']:,} | {r['build_s']:.3f} | {r['bvh'] / 1e6:.2f} | "
+              f"{r['brute'] / 1e6:.4f} | {r['bvh'] / r['brute']:,.0f}x | {r['shadowed']:.1%} | "
+              f"{r['same']} |")  # fmt: skip
+        sys.stdout.flush()
+
+
+def section_engine(repeat: int) -> None:
+    import explorer
+
+    mesh = get_mesh("teapot", 56)
+
+    def lights(shadows: bool, step: int):
+        a = 0.4 * step
+        moved = [2.5 * np.cos(a), 2.5, 2.5 * np.sin(a)]
+        return [{"type": "point", "position": moved, "shadows": shadows},
+                {"type": "point", "position": [-2.5, 1.0, 1.5], "shadows": shadows}]  # fmt: skip
+
+    print(f"\n## Engine: float32 Shader, {mesh.n_vertices:,}-vertex teapot, two point lights\n")
+    print("| case | median ms | best ms |")
+    print("|---|---:|---:|")
+    for shadows in (True, False):
+        scene = load_scene({"material": "gold", "lights": lights(shadows, 0)})
+        t = time.perf_counter()
+        sh = explorer.Shader(scene, mesh.positions, mesh.normals, faces=mesh.faces,
+                             precision="float32")  # fmt: skip
+        _ = sh.colors
+        first = time.perf_counter() - t
+        step = [0]
+
+        def move(sh=sh, shadows=shadows, step=step):
+            step[0] += 1  # a new place every time: no cached rays
+            sh.set_lights(lights(shadows, step[0]))
+            return sh.colors
+
+        med, best = timed(move, repeat)
+        what = "shadows: true" if shadows else "no shadows"
+        work = " (BVH build, every light's rays)" if shadows else ""
+        print(f"| first colours, {what}{work} | {first * 1e3:.1f} | |")
+        print(f"| one light moved, {what} | {med * 1e3:.1f} | {best * 1e3:.1f} |")
+        if shadows:
+            before = sh.stats["shadow_rays"]
+            move()
+            rays = sh.stats["shadow_rays"] - before
+            print(f"| (shadow rays cast per move: {rays:,}) | | |")
+
+
+def section_view(repeat: int) -> None:
+    from explorer.analysis.comparison import ViewComparer
+    from explorer.render.camera import camera_for
+    from explorer.render.perpixel import reference
+
+    mesh = get_mesh("teapot", 24)
+    size = (1100, 720)
+    scene = load_scene({"material": "gold", "lights": [{"type": "point", "position": [2, 3, 2]}]})
+    cam = camera_for(scene, mesh, size[0] / size[1])
+    print(f"\n## Difference view: {mesh.n_vertices:,}-vertex teapot at {size[0]}x{size[1]}\n")
+    print("| step | median ms | best ms |")
+    print("|---|---:|---:|")
+    med, best = timed(lambda: reference(scene, mesh, size, camera=cam), repeat)
+    print(f"| per-pixel reference (ray cast + colours) | {med * 1e3:.0f} | {best * 1e3:.0f} |")
+    with ViewComparer(size) as v:
+        med, best = timed(lambda: v.compare(scene, mesh, camera=cam), repeat)
+    print(f"| comparison (reference + 2 off-screen renders + difference) | {med * 1e3:.0f} | "
+          f"{best * 1e3:.0f} |")  # fmt: skip
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--repeat", type=int, default=7, help="timed runs per figure (default 7)")
+    p.add_argument("--section", nargs="+", choices=SECTIONS, default=list(SECTIONS))
+    args = p.parse_args(argv)
+    print("machine:", machine())
+    for name in args.section:
+        globals()[f"section_{name}"](args.repeat)
+        sys.stdout.flush()
+    print("\nload average after:", f"{load_average():.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,584 @@
+"""A bounding-volume hierarchy over triangles, and the two ray casts that go through it.
+
+:class:`BVH` is a binary tree of axis-aligned boxes built once per mesh (binned surface-area
+heuristic, :func:`build_bvh`); a ray visits only the boxes it crosses, so a cast costs about
+``log(triangles)`` box tests and a few triangle tests instead of one test per triangle. Its
+triangle test is :func:`explorer.geometry.rays.ray_triangle`, the one the brute-force casts
+use, on the same ``v0, e1, e2`` numbers, and every box is grown by
+:data:`~explorer.core.tolerances.BVH_BOX_PAD` so that rounding in the box test can only add
+visits, never drop a triangle. The casts therefore answer exactly what testing every triangle
+answers:
+
+- :func:`any_hit`: whether each ray meets a triangle's front side (``det >= DET_EPS``) at
+  ``t`` in ``(RAY_T_EPS, tmax - RAY_T_EPS)``: shadow rays (:mod:`explorer.shading.shadows`);
+- :func:`nearest_hits`: the nearest hit, either side, beyond ``t_min``; among hits at the same
+  ``t`` the lowest triangle index wins, as in a loop over the triangles in order: the
+  per-pixel reference (:mod:`explorer.render.perpixel`).
+
+The rays run in chunks of :data:`CHUNK` on a small pool of threads (the compiled kernels
+release the GIL), at most one chunk in flight per thread for each call, so two callers (the
+window's engine and a background comparison) share the cores instead of queueing behind each
+other. Between chunks a ``cancelled`` callable is asked whether to stop (it raises
+:class:`~explorer.core.errors.Cancelled`); Ctrl-C (KeyboardInterrupt) stops the work the same
+way. No numba threading layer is involved, so the casts may run from any thread.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import threading
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor, TimeoutError
+from dataclasses import dataclass
+
+import numba as nb
+import numpy as np
+
+from explorer.core.errors import Cancelled
+from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
+from explorer.geometry.rays import pack_triangles, ray_triangle_row
+
+#: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
+CHUNK = 8192
+#: a node with at most this many triangles is always a leaf
+LEAF_SIZE = 4
+#: a node with more triangles than this is always split
+MAX_LEAF = 16
+#: bins of the surface-area heuristic along the chosen axis
+BINS = 16
+#: below this depth the builder splits by the heuristic; deeper, at the median (so the tree
+#: is never deeper than about MEDIAN_DEPTH + log2(triangles))
+MEDIAN_DEPTH = 64
+#: the traversal stack; MEDIAN_DEPTH + 64 levels holds any mesh that fits in memory
+STACK = 128
+#: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
+POLL = 0.05
+#: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
+_BIG = 1e300
+
+
+@dataclass(frozen=True, eq=False)
+class BVH:
+    """A bounding-volume hierarchy over ``m`` triangles, as the casts read it.
+
+    child : (k, 2) int64 the two children of each inner node: ``c >= 0`` an inner node,
+        ``c < 0`` the leaf ``~c``; node 0 is the root (a tree of one leaf, or none, has a root
+        whose other child's box is empty)
+    cbox : (k, 12) float32 the children's boxes, (x0, x1, y0, y1, z0, z1) each, grown by the
+        pad and rounded outward to float32 (an empty box, x0 > x1, is never entered)
+    leaf : (q, 2) int64 per leaf: first triangle and count
+    tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
+        (:func:`~explorer.geometry.rays.pack_triangles`)
+    order : (m,) int64 the original index of each triangle in leaf order
+    """
+
+    child: np.ndarray
+    cbox: np.ndarray
+    leaf: np.ndarray
+    tri: np.ndarray
+    order: np.ndarray
+
+    @property
+    def n_triangles(self) -> int:
+        return len(self.order)
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.child)
+
+
+def build_bvh(triangles, *, cancelled=None) -> BVH:
+    """The BVH of ``triangles`` : (m, 3, 3) float (corners counter-clockwise seen from the
+    front).
+
+    cancelled : () -> bool, asked every :data:`POLL` seconds while the tree is built (True:
+        raise :class:`~explorer.core.errors.Cancelled`); Ctrl-C stops the build the same way
+    """
+    tri = np.ascontiguousarray(triangles, np.float64).reshape(-1, 3, 3)
+    m = len(tri)
+    if m == 0:  # a root whose children are nothing
+        child = np.full((1, 2), -1, np.int64)
+        cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
+        return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), np.zeros(0, np.int64))
+    box, link, order = _stoppable(_build, (tri,), cancelled)
+    child, box64, leaf = _children(box, link)
+    lo32 = box64[:, 0::2].astype(np.float32)
+    hi32 = box64[:, 1::2].astype(np.float32)
+    lo32 = np.where(lo32 > box64[:, 0::2], np.nextafter(lo32, np.float32(-np.inf)), lo32)
+    hi32 = np.where(hi32 < box64[:, 1::2], np.nextafter(hi32, np.float32(np.inf)), hi32)
+    cbox = np.empty(box64.shape, np.float32)
+    cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
+    return BVH(child, cbox, leaf, np.ascontiguousarray(pack_triangles(tri)[order]), order)
+
+
+# -- building ------------------------------------------------------------------------------
+
+
+def _stoppable(build, args, cancelled):
+    """Run ``build(*args, stop)`` on a worker thread while this one waits, so that Ctrl-C and
+    ``cancelled`` stop it: ``stop[0] = 1`` ends the build within 1024 nodes."""
+    _check(cancelled)
+    stop = np.zeros(1, np.uint8)
+    future = _get_pool().submit(build, *args, stop)
+    try:
+        while True:
+            try:
+                return future.result(timeout=POLL)
+            except TimeoutError:
+                _check(cancelled)
+    finally:
+        if not future.done():
+            stop[0] = 1
+            future.exception()  # waits for the build to notice
+
+
+@nb.njit(cache=True, inline="always")
+def _area(x0, x1, y0, y1, z0, z1):
+    dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
+    return dx * dy + dy * dz + dz * dx  # half the surface area: only ratios matter
+
+
+@nb.njit(cache=True, inline="always")
+def _bin(c, c0, scale):
+    b = int((c - c0) * scale)
+    return min(max(b, 0), BINS - 1)
+
+
+@nb.njit(cache=True)
+def _sah_split(boxes, idx, start, end, axis, c0, c1, node_area, scratch):
+    """The bin boundary (1..BINS-1) with the lowest surface-area cost for
+    idx[start:end] along ``axis``, or -1 when no split beats a leaf (only for small nodes).
+    boxes : (lo, hi, cent), each (m, 3): the triangles' boxes and centroids
+    scratch : (cnt, bb, right): (BINS,) int64, (BINS + 1, 6), (BINS, 2)"""
+    lo, hi, cent = boxes
+    cnt, bb, right = scratch
+    scale = BINS / (c1 - c0)
+    for b in range(BINS):
+        cnt[b] = 0
+        for a in range(3):
+            bb[b, 2 * a] = math.inf
+            bb[b, 2 * a + 1] = -math.inf
+    for k in range(start, end):
+        t = idx[k]
+        b = _bin(cent[t, axis], c0, scale)
+        cnt[b] += 1
+        for a in range(3):
+            bb[b, 2 * a] = min(bb[b, 2 * a], lo[t, a])
+            bb[b, 2 * a + 1] = max(bb[b, 2 * a + 1], hi[t, a])
+    # right-to-left sweep: area and count of bins s..BINS-1
+    acc = bb[BINS]
+    for a in range(6):
+        acc[a] = math.inf if a % 2 == 0 else -math.inf
+    right[:, :] = 0.0  # area and count of the bins s..BINS-1
+    n = 0
+    for s in range(BINS - 1, 0, -1):
+        n += cnt[s]
+        for a in range(3):
+            acc[2 * a] = min(acc[2 * a], bb[s, 2 * a])
+            acc[2 * a + 1] = max(acc[2 * a + 1], bb[s, 2 * a + 1])
+        right[s, 1] = n
+        if n > 0:
+            right[s, 0] = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5])
+    best, best_s = math.inf, -1
+    for a in range(6):
+        acc[a] = math.inf if a % 2 == 0 else -math.inf
+    n = 0
+    for s in range(1, BINS):
+        n += cnt[s - 1]
+        for a in range(3):
+            acc[2 * a] = min(acc[2 * a], bb[s - 1, 2 * a])
+            acc[2 * a + 1] = max(acc[2 * a + 1], bb[s - 1, 2 * a + 1])
+        if n == 0 or right[s, 1] == 0:
+            continue
+        cost = _area(acc[0], acc[1], acc[2], acc[3], acc[4], acc[5]) * n
+        cost += right[s, 0] * right[s, 1]
+        if cost < best:
+            best, best_s = cost, s
+    count = end - start
+    # traversal 1, triangle test 1 per triangle: a leaf costs ``count``
+    if count <= MAX_LEAF and (best_s < 0 or 1.0 + best / max(node_area, 1e-300) >= count):
+        return -1
+    return best_s
+
+
+@nb.njit(cache=True)
+def _build(tri, stop):
+    """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order),
+    or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""
+    m = tri.shape[0]
+    lo = np.empty((m, 3))
+    hi = np.empty((m, 3))
+    cent = np.empty((m, 3))
+    size = 1.0
+    for t in range(m):
+        for a in range(3):
+            x, y, z = tri[t, 0, a], tri[t, 1, a], tri[t, 2, a]
+            lo[t, a] = min(x, y, z)
+            hi[t, a] = max(x, y, z)
+            cent[t, a] = 0.5 * (lo[t, a] + hi[t, a])
+            size = max(size, abs(lo[t, a]), abs(hi[t, a]))
+    pad = BVH_BOX_PAD * size
+    idx = np.arange(m)
+    cap = 2 * m
+    box = np.empty((cap, 6))
+    link = np.zeros((cap, 3), np.int64)
+    st = np.empty((2 * STACK + 8, 4), np.int64)  # start, end, parent, depth
+    st[0, 0], st[0, 1], st[0, 2], st[0, 3] = 0, m, -1, 0
+    sp = 1
+    n_nodes = 0
+    b = np.empty(6)  # the node's box
+    c = np.empty(6)  # its centroids' box
+    scratch = (np.zeros(BINS, np.int64), np.empty((BINS + 1, 6)), np.empty((BINS, 2)))
+    boxes = (lo, hi, cent)
+    while sp > 0:
+        if n_nodes % 1024 == 0 and stop[0]:
+            return box[:0].copy(), link[:0].copy(), idx[:0].copy()
+        sp -= 1
+        start, end, parent, depth = st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3]
+        node = n_nodes
+        n_nodes += 1
+        if parent >= 0:
+            link[parent, 0] = node
+        for a in range(6):
+            b[a] = c[a] = math.inf if a % 2 == 0 else -math.inf
+        for k in range(start, end):
+            t = idx[k]
+            for a in range(3):
+                b[2 * a] = min(b[2 * a], lo[t, a])
+                b[2 * a + 1] = max(b[2 * a + 1], hi[t, a])
+                c[2 * a] = min(c[2 * a], cent[t, a])
+                c[2 * a + 1] = max(c[2 * a + 1], cent[t, a])
+        for a in range(3):
+            box[node, 2 * a] = b[2 * a] - pad
+            box[node, 2 * a + 1] = b[2 * a + 1] + pad
+        count = end - start
+        if count <= LEAF_SIZE:
+            link[node, 0], link[node, 1] = start, count
+            continue
+        axis = 0
+        for a in range(1, 3):
+            if c[2 * a + 1] - c[2 * a] > c[2 * axis + 1] - c[2 * axis]:
+                axis = a
+        c0, c1 = c[2 * axis], c[2 * axis + 1]
+        mid = -1
+        if c1 > c0 and depth < MEDIAN_DEPTH:
+            area = _area(b[0], b[1], b[2], b[3], b[4], b[5])
+            s = _sah_split(boxes, idx, start, end, axis, c0, c1, area, scratch)
+            if s < 0:
+                link[node, 0], link[node, 1] = start, count
+                continue
+            scale = BINS / (c1 - c0)
+            i, j = start, end - 1
+            while i <= j:  # partition: bins below s to the left
+                if _bin(cent[idx[i], axis], c0, scale) < s:
+                    i += 1
+                else:
+                    idx[i], idx[j] = idx[j], idx[i]
+                    j -= 1
+            mid = i
+        if mid <= start or mid >= end:  # equal centroids, or too deep: split at the median
+            if c1 == c0 and count <= MAX_LEAF:
+                link[node, 0], link[node, 1] = start, count
+                continue
+            part = idx[start:end]
+            idx[start:end] = part[np.argsort(cent[part, axis], kind="mergesort")]
+            mid = start + count // 2
+        link[node, 2] = axis
+        st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3] = mid, end, node, depth + 1
+        st[sp + 1, 0], st[sp + 1, 1], st[sp + 1, 2], st[sp + 1, 3] = start, mid, -1, depth + 1
+        sp += 2
+    return box[:n_nodes].copy(), link[:n_nodes].copy(), idx
+
+
+@nb.njit(cache=True)
+def _children(box, link):
+    """The depth-first tree of :func:`_build` as child pairs: (child, cbox float64, leaf)."""
+    n = box.shape[0]
+    ident = np.empty(n, np.int64)  # inner node: its index; leaf: ~its leaf index
+    ni = 0
+    nl = 0
+    for i in range(n):
+        if link[i, 1] == 0:
+            ident[i] = ni
+            ni += 1
+        else:
+            ident[i] = ~nl
+            nl += 1
+    leaf = np.empty((nl, 2), np.int64)
+    for i in range(n):
+        if link[i, 1] > 0:
+            leaf[~ident[i], 0] = link[i, 0]
+            leaf[~ident[i], 1] = link[i, 1]
+    k = max(ni, 1)
+    child = np.empty((k, 2), np.int64)
+    cbox = np.empty((k, 12))
+    if ni == 0:  # the root is a leaf: one child, and a box nothing enters
+        child[0, 0], child[0, 1] = ident[0], ident[0]
+        for a in range(6):
+            cbox[0, a] = box[0, a]
+            cbox[0, 6 + a] = 1.0 if a % 2 == 0 else -1.0
+        return child, cbox, leaf
+    for i in range(n):
+        if link[i, 1] == 0:
+            j = ident[i]
+            right = link[i, 0]
+            child[j, 0], child[j, 1] = ident[i + 1], ident[right]
+            for a in range(6):
+                cbox[j, a] = box[i + 1, a]
+                cbox[j, 6 + a] = box[right, a]
+    return child, cbox, leaf
+
+
+# -- traversal -----------------------------------------------------------------------------
+
+
+@nb.njit(cache=True, inline="always")
+def _inv(d):
+    return 1.0 / d if d != 0.0 else math.copysign(_BIG, d)
+
+
+@nb.njit(cache=True, inline="always")
+def _enter(b, ox, oy, oz, ix, iy, iz, t1):
+    """Where the ray enters each of a node's two child boxes ``b`` (12,) (:func:`_slab`)."""
+    return _slab(b, 0, ox, oy, oz, ix, iy, iz, t1), _slab(b, 6, ox, oy, oz, ix, iy, iz, t1)
+
+
+@nb.njit(cache=True, inline="always")
+def _ray(O, D, r):
+    """Ray ``r``: origin, direction and the direction's reciprocals (:func:`_inv`)."""
+    dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
+    return O[r, 0], O[r, 1], O[r, 2], dx, dy, dz, _inv(dx), _inv(dy), _inv(dz)
+
+
+@nb.njit(cache=True, inline="always")
+def _slab(b, o, ox, oy, oz, ix, iy, iz, t1):
+    """Where the ray enters the box ``b[o:o + 6]`` within [0, t1], or inf when it does not."""
+    p = (b[o] - ox) * ix
+    q = (b[o + 1] - ox) * ix
+    t0 = min(p, q)
+    tf = max(p, q)
+    p = (b[o + 2] - oy) * iy
+    q = (b[o + 3] - oy) * iy
+    t0 = max(t0, min(p, q))
+    tf = min(tf, max(p, q))
+    p = (b[o + 4] - oz) * iz
+    q = (b[o + 5] - oz) * iz
+    t0 = max(t0, min(p, q), 0.0)
+    tf = min(tf, max(p, q), t1)
+    return t0 if t0 <= tf else math.inf
+
+
+@nb.njit(cache=True, inline="always")
+def _next(stack, sp, ca, cb, ta, tb):
+    """The next inner node: the nearer of the children the ray enters (``t < inf``; the other
+    one is pushed), else the top of the stack; (-1, 0) when nothing is left."""
+    if ta < math.inf and tb < math.inf:
+        if ta <= tb:
+            stack[sp] = cb
+            return ca, sp + 1
+        stack[sp] = ca
+        return cb, sp + 1
+    if ta < math.inf:
+        return ca, sp
+    if tb < math.inf:
+        return cb, sp
+    if sp == 0:
+        return np.int64(-1), 0
+    return stack[sp - 1], sp - 1
+
+
+@nb.njit(cache=True, inline="always")
+def _leaf_any(leaf, c, tri, ray, t_eps, tm, det_eps):
+    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``~c``."""
+    ox, oy, oz, dx, dy, dz = ray
+    first = leaf[~c, 0]
+    for j in range(first, first + leaf[~c, 1]):
+        t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
+        if t > t_eps and t < tm:
+            return True
+    return False
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def _any_hit_chunk(r0, r1, rays, tree, eps, out):
+    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) with
+    eps = (t_eps, det_eps): out[r] True where the ray is blocked."""
+    O, D, tmax = rays
+    child, cbox, leaf, tri = tree
+    t_eps, det_eps = eps
+    stack = np.empty(STACK, np.int64)
+    for r in range(r0, r1):
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
+        tm = tmax[r] - t_eps
+        hit = False
+        sp = 0
+        node = 0
+        while True:
+            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, tm)
+            ca, cb = child[node, 0], child[node, 1]
+            if ta < math.inf and ca < 0:
+                if _leaf_any(leaf, ca, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
+                    hit = True
+                    break
+                ta = math.inf
+            if tb < math.inf and cb < 0:
+                if _leaf_any(leaf, cb, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
+                    hit = True
+                    break
+                tb = math.inf
+            node, sp = _next(stack, sp, ca, cb, ta, tb)
+            if node < 0:
+                break
+        out[r] = hit
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
+    """Rays r0..r1 of rays = (O, D) through tree = (child, cbox, leaf, tri); writes the
+    nearest hit into out = (best_t, best_f, bu, bv) (best_t in: the farthest t accepted)."""
+    O, D = rays
+    child, cbox, leaf, tri = tree
+    best_t, best_f, bu, bv = out
+    stack = np.empty(STACK, np.int64)
+    for r in range(r0, r1):
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
+        best, bf, u_, v_ = best_t[r], np.int64(-1), 0.0, 0.0
+        sp = 0
+        node = 0
+        while True:
+            # boxes entered at t == best are still visited: a tie may go to a lower index
+            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, best)
+            for side in range(2):
+                c = child[node, side]
+                if c >= 0 or (ta if side == 0 else tb) == math.inf:
+                    continue
+                first = leaf[~c, 0]
+                for j in range(first, first + leaf[~c, 1]):
+                    t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
+                    if t > t_min and (
+                        t < best or (t == best and t < math.inf and (bf < 0 or order[j] < bf))
+                    ):
+                        best, bf, u_, v_ = t, order[j], u, v
+                if side == 0:
+                    ta = math.inf
+                else:
+                    tb = math.inf
+            node, sp = _next(stack, sp, child[node, 0], child[node, 1], ta, tb)
+            if node < 0:
+                break
+        if bf >= 0:
+            best_t[r] = best
+            best_f[r] = bf
+            bu[r] = u_
+            bv[r] = v_
+
+
+# -- running in chunks ---------------------------------------------------------------------
+
+_pool: ThreadPoolExecutor | None = None
+_pool_lock = threading.Lock()
+
+
+def workers() -> int:
+    """Threads the casts use: numba's thread count (``NUMBA_NUM_THREADS``), else the cores."""
+    return max(1, int(nb.config.NUMBA_NUM_THREADS or os.cpu_count() or 1))
+
+
+def _get_pool() -> ThreadPoolExecutor:
+    global _pool
+    with _pool_lock:
+        if _pool is None:
+            _pool = ThreadPoolExecutor(workers(), thread_name_prefix="explorer-rays")
+        return _pool
+
+
+def _check(cancelled: Callable[[], bool] | None) -> None:
+    if cancelled is not None and cancelled():
+        raise Cancelled("ray casting was cancelled")
+
+
+def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK) -> None:
+    """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of ``chunk`` rays, on
+    :func:`workers` threads, asking ``cancelled()`` before each chunk.
+
+    Raises :class:`~explorer.core.errors.Cancelled` when ``cancelled()`` returns True. On any
+    exception (Ctrl-C too) chunks not started are dropped and the running ones are waited for,
+    so nothing writes into the outputs after this returns or raises.
+    """
+    _check(cancelled)
+    starts = list(range(0, n, chunk))
+    threads = workers()
+    if len(starts) <= 1 or threads == 1:
+        for s in starts:
+            _check(cancelled)
+            kernel(s, min(s + chunk, n), *args)
+        return
+    pool = _get_pool()
+    pending = []
+    try:
+        for s in starts:
+            if len(pending) >= threads:
+                pending.pop(0).result()
+                _check(cancelled)
+            pending.append(pool.submit(kernel, s, min(s + chunk, n), *args))
+        while pending:
+            pending.pop(0).result()
+    finally:
+        for f in pending:
+            f.cancel()
+        for f in pending:
+            if not f.cancelled():
+                f.exception()  # waits; the first exception (if any) is already propagating
+
+
+# -- the casts -----------------------------------------------------------------------------
+
+
+def _tree(bvh: BVH) -> tuple:
+    return bvh.child, bvh.cbox, bvh.leaf, bvh.tri
+
+
+def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
+    O = np.ascontiguousarray(origins, np.float64).reshape(-1, 3)
+    D = np.ascontiguousarray(directions, np.float64).reshape(-1, 3)
+    if O.shape != D.shape:
+        raise ValueError(f"origins {O.shape} and directions {D.shape} differ in shape")
+    return O, D
+
+
+def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarray:
+    """Whether each ray meets the front side of a triangle between :data:`RAY_T_EPS` and
+    ``tmax - RAY_T_EPS`` (the same answer as :func:`explorer.geometry.rays.any_hit`).
+
+    origins, directions : (k, 3) float (directions of unit length, in the triangles' units)
+    tmax : (k,) float, the distance to the light (inf: none)
+    cancelled : () -> bool, asked between chunks (True: raise Cancelled)
+    Returns (k,) bool.
+    """
+    O, D = _rays(origins, directions)
+    tm = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)))
+    hit = np.zeros(len(O), np.bool_)
+    if bvh.n_triangles:
+        args = ((O, D, tm), _tree(bvh), (RAY_T_EPS, DET_EPS), hit)
+        run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
+    return hit
+
+
+def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):
+    """The nearest hit of each ray, front or back side, at ``t > t_min``; at equal ``t`` the
+    lowest triangle index.
+
+    origins, directions : (k, 3) float
+    Returns (t, triangle, u, v): (k,) float64 ``t`` (inf: no hit), (k,) int64 original
+    triangle index (-1: no hit), (k,) float64 barycentric ``u``, ``v`` of the hit.
+    """
+    O, D = _rays(origins, directions)
+    k = len(O)
+    best_t = np.full(k, np.inf)
+    best_f = np.full(k, -1, np.int64)
+    bu, bv = np.zeros(k), np.zeros(k)
+    if bvh.n_triangles:
+        args = ((O, D), float(t_min), _tree(bvh), bvh.order, (best_t, best_f, bu, bv))
+        run_chunks(_nearest_chunk, k, args, cancelled=cancelled)
+    return best_t, best_f, bu, bv

@@ -1,0 +1,90 @@
+"""Shadow rays through the BVH: the brute force's shadowed vertices, and no convexity shortcut."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import explorer
+from explorer.core.scene import load_scene
+from explorer.geometry.frame import frame_of
+from explorer.geometry.meshes import get_mesh
+from explorer.geometry.rays import any_hit as brute_any_hit
+from explorer.shading.shadows import GEOMETRY_KEY, frame_bvh, visibility, visibility_rows
+
+LIGHTS = [
+    {"type": "point", "position": [1.5, 2.0, 1.0], "shadows": True},
+    {"type": "directional", "to_light": [-1, 0.4, 0.2], "shadows": True},
+    {"type": "spot", "position": [0.2, 2.5, 0.3], "aim": [0, -1, 0], "cutoff": 60, "shadows": True},
+]
+
+
+def _brute_rows(mesh, lights):
+    """Visibility by testing every ray against every triangle, from the vertices the engine
+    casts from (N·L > -SHADOW_NDL_MARGIN)."""
+    centre, scale = frame_of(mesh.positions)
+    Q = (mesh.positions - centre) / scale
+    rows = np.ones((len(lights), len(Q)))
+    for i, light in enumerate(lights):
+        lit = np.einsum("ij,ij->i", light.toward(mesh.positions), mesh.normals) > -1e-6
+        D, tmax = light.shadow_ray(Q[lit], centre, scale)
+        rows[i, np.flatnonzero(lit)[brute_any_hit(Q[lit], D, tmax, Q[mesh.faces])]] = 0.0
+    return rows
+
+
+@pytest.mark.parametrize("name, resolution", [("teapot", 8), ("torus", 32)])
+def test_shadowed_vertices_are_the_brute_force_ones(name, resolution):
+    mesh = get_mesh(name, resolution)
+    lights = load_scene({"lights": LIGHTS}).lights
+    cache: dict = {}
+    rows, rays = visibility_rows(
+        mesh.positions, mesh.normals, mesh.faces, lights, [True] * 3,
+        two_sided=False, force_all=False, cache=cache,
+    )  # fmt: skip
+    expected = _brute_rows(mesh, lights)
+    assert np.array_equal(rows, expected)
+    assert ((expected == 0).sum(axis=1) > 0).all()  # every light shadows something
+    assert GEOMETRY_KEY in cache and rays > 0
+
+
+def test_a_shader_with_shadows_shades_as_the_brute_force_says():
+    mesh = get_mesh("teapot", 8)
+    scene = {"lights": LIGHTS[:2], "material": "gold"}
+    shaded = explorer.shade(scene, mesh.positions, mesh.normals, faces=mesh.faces)
+    plain = explorer.shade(
+        {**scene, "lights": [{**lt, "shadows": False} for lt in LIGHTS[:2]]},
+        mesh.positions, mesh.normals,
+    )  # fmt: skip
+    rows = _brute_rows(mesh, load_scene(scene).lights)
+    dark = (rows == 0).any(axis=0)
+    assert (shaded[dark].sum(axis=1) < plain[dark].sum(axis=1)).mean() > 0.9
+    assert np.array_equal(shaded[~dark], plain[~dark])
+
+
+def test_the_fine_torus_is_shadowed():
+    """At resolution 1024 a tolerance-based convexity test called the torus convex and no ray
+    was cast; its far side is shadowed by the near side of the ring."""
+    mesh = get_mesh("torus", 1024)
+    scene = load_scene(
+        {"lights": [{"type": "directional", "to_light": [1, 0.2, 0], "shadows": True}]}
+    )
+    plan = explorer.Shader(scene, mesh.positions[:3], mesh.normals[:3], faces=[[0, 1, 2]]).plan
+    assert plan.shadows  # the plan does not skip a mesh for looking convex
+    light = scene.lights[0]
+    lit = np.flatnonzero(mesh.normals @ np.asarray(light.to_light) > 0)
+    rng = np.random.default_rng(0)
+    sample = rng.choice(lit, 2000, replace=False)
+    only = np.zeros(mesh.n_vertices, bool)
+    only[sample] = True
+    geometry = frame_bvh(mesh.positions, mesh.faces)
+    vis = visibility(mesh.positions, mesh.faces, light, only=only, geometry=geometry)
+    shadowed = sample[vis[sample] == 0]
+    # the light lies in the ring's plane: the far half of the ring (behind the centre as seen
+    # from the light), where it faces the light across the hole, lies behind the near half
+    assert len(shadowed) > 200
+    assert (mesh.positions[shadowed] @ np.asarray(light.to_light) < 0).all()
+    # a few of them against the brute force (every triangle: 1M of them)
+    centre, scale, Q, _ = geometry
+    few = sample[:150]
+    D, tmax = light.shadow_ray(Q[few], centre, scale)
+    assert np.array_equal(vis[few] == 0, brute_any_hit(Q[few], D, tmax, Q[mesh.faces]))
