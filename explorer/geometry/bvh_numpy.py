@@ -12,7 +12,9 @@ hierarchy only decides which triangles are tested, and its boxes are padded
 
 The hierarchy is built level by level, every node of a level at once: each node's triangles are
 split at the median of their centres along the longest axis of the centres' bounds (one sort per
-level). The casts walk it breadth first: a frontier of (ray, node) pairs, each level's box tests
+level). :func:`build_bvh`, :func:`any_hit` and :func:`nearest_hits` take the arguments of their compiled
+namesakes, so a caller picks either module (:func:`explorer.shading.tiers.ray_engine`). The casts
+walk it breadth first: a frontier of (ray, node) pairs, each level's box tests
 and leaf tests done for every pair at once.
 """
 
@@ -49,8 +51,9 @@ class NumpyBVH:
     count: np.ndarray
 
 
-def build(triangles) -> NumpyBVH:
-    """The hierarchy of ``triangles`` : (m, 3, 3) float (see the module docstring)."""
+def build_bvh(triangles, *, cancelled=None) -> NumpyBVH:
+    """The hierarchy of ``triangles`` : (m, 3, 3) float (see the module docstring).
+    cancelled : () -> bool, asked once per level (True: raise Cancelled)"""
     tri = np.asarray(triangles, np.float64).reshape(-1, 3, 3)
     m = len(tri)
     cent = tri.mean(axis=1)
@@ -58,6 +61,7 @@ def build(triangles) -> NumpyBVH:
     first, count, parent = [0], [m], [-1]  # the nodes, root first
     level = np.array([0]) if m > LEAF else np.zeros(0, np.int64)
     while len(level):
+        _check(cancelled)
         s = np.array([first[i] for i in level])
         n = np.array([count[i] for i in level])
         seg = np.repeat(np.arange(len(level)), n)  # segment of each triangle of the level

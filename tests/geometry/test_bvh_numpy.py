@@ -45,10 +45,10 @@ def test_any_hit_equals_the_compiled_bvh_and_brute_force(name):
     D = light - O
     tmax = np.linalg.norm(D, axis=1)
     D /= tmax[:, None]
-    got = NB.any_hit(NB.build(tri), O, D, tmax)
+    got = NB.any_hit(NB.build_bvh(tri), O, D, tmax)
     np.testing.assert_array_equal(got, B.any_hit(B.build_bvh(tri), O, D, tmax))
     np.testing.assert_array_equal(got, brute_any_hit(O, D, tmax, tri))
-    inf = NB.any_hit(NB.build(tri), O, D, np.inf)  # a directional light
+    inf = NB.any_hit(NB.build_bvh(tri), O, D, np.inf)  # a directional light
     np.testing.assert_array_equal(inf, brute_any_hit(O, D, np.full(len(O), np.inf), tri))
 
 
@@ -61,7 +61,7 @@ def test_nearest_hits_equal_the_compiled_bvh(name):
     D[:5] = [0, 0, 1]  # axis-aligned rays: zero direction components
     D /= np.linalg.norm(D, axis=1)[:, None]
     want = B.nearest_hits(B.build_bvh(tri), O, D, 1e-9)
-    got = NB.nearest_hits(NB.build(tri), O, D, 1e-9)
+    got = NB.nearest_hits(NB.build_bvh(tri), O, D, 1e-9)
     for a, b in zip(got, want, strict=True):
         np.testing.assert_array_equal(a, b)
     assert (got[1] >= 0).any() or len(tri) < 10
@@ -70,16 +70,16 @@ def test_nearest_hits_equal_the_compiled_bvh(name):
 def test_ties_go_to_the_lowest_triangle_index():
     tri = np.array([[[-1, -1, 0], [1, -1, 0], [0, 1, 0]]] * 3, np.float64)  # three alike
     O = np.array([[0.0, 0.0, 2.0]])
-    t, f, _, _ = NB.nearest_hits(NB.build(tri), O, [[0, 0, -1.0]], 0.0)
+    t, f, _, _ = NB.nearest_hits(NB.build_bvh(tri), O, [[0, 0, -1.0]], 0.0)
     assert f[0] == 0 and t[0] == 2.0
 
 
 def test_empty_mesh_and_planes():
-    empty = NB.build(np.zeros((0, 3, 3)))
+    empty = NB.build_bvh(np.zeros((0, 3, 3)))
     assert not NB.any_hit(empty, [[0, 0, 0]], [[0, 0, 1]], 1.0).any()
     assert NB.nearest_hits(empty, [[0, 0, 0]], [[0, 0, 1]], 0.0)[1][0] == -1
     tri = plane(8).positions[plane(8).faces]
-    bvh = NB.build(tri)
+    bvh = NB.build_bvh(tri)
     assert (
         bvh.box.shape[0] == bvh.child.shape[0] and (bvh.count[bvh.child[:, 0] < 0] <= NB.LEAF).all()
     )
@@ -89,7 +89,7 @@ def test_empty_mesh_and_planes():
 
 def test_every_triangle_sits_in_exactly_one_leaf_and_inside_every_box_above_it():
     tri = sphere(10).positions[sphere(10).faces]
-    bvh = NB.build(tri)
+    bvh = NB.build_bvh(tri)
     leaves = np.flatnonzero(bvh.child[:, 0] < 0)
     covered = np.concatenate(
         [np.arange(f, f + c) for f, c in zip(bvh.first[leaves], bvh.count[leaves], strict=True)]
@@ -105,5 +105,5 @@ def test_every_triangle_sits_in_exactly_one_leaf_and_inside_every_box_above_it()
 def test_a_cast_can_be_cancelled():
     tri = _soup(200, 4)
     with pytest.raises(Cancelled):
-        NB.any_hit(NB.build(tri), np.zeros((10, 3)), np.ones((10, 3)) / 3**0.5, 5.0,
+        NB.any_hit(NB.build_bvh(tri), np.zeros((10, 3)), np.ones((10, 3)) / 3**0.5, 5.0,
                    cancelled=lambda: True)  # fmt: skip
