@@ -12,10 +12,11 @@ hierarchy only decides which triangles are tested, and its boxes are padded
 
 The hierarchy is built level by level, every node of a level at once: each node's triangles are
 split at the median of their centres along the longest axis of the centres' bounds (one sort per
-level). :func:`build_bvh`, :func:`any_hit` and :func:`nearest_hits` take the arguments of their compiled
-namesakes, so a caller picks either module (:func:`explorer.shading.tiers.ray_engine`). The casts
-walk it breadth first: a frontier of (ray, node) pairs, each level's box tests
+level). The casts walk it breadth first: a frontier of (ray, node) pairs, each level's box tests
 and leaf tests done for every pair at once.
+
+:func:`build_bvh`, :func:`any_hit` and :func:`nearest_hits` take the arguments of their compiled
+namesakes, so a caller picks either module (:func:`explorer.shading.tiers.ray_engine`).
 """
 
 from __future__ import annotations
