@@ -38,12 +38,12 @@ import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import PIXEL_RAY_T_MIN
-from explorer.geometry.bvh import BVH, build_bvh, nearest_hits
 from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
 from explorer.shading.shader import shade
+from explorer.shading.tiers import ray_engine
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -98,18 +98,22 @@ _bvh_cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _bvh_lock = threading.Lock()
 
 
-def mesh_bvh(mesh, *, cancelled=None) -> BVH:
+def mesh_bvh(mesh, *, cancelled=None, engine=None):
     """The BVH of a mesh's triangles in world coordinates, built on first use and kept while
     the mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only).
     cancelled : () -> bool, asked while the tree is built (:func:`~explorer.geometry.bvh.build_bvh`)
+    engine : the ray engine that builds and casts (:func:`explorer.shading.tiers.ray_engine`,
+        the default); each keeps its own tree
     """
+    engine = ray_engine() if engine is None else engine
     with _bvh_lock:
-        bvh = _bvh_cache.get(mesh)
+        bvh = _bvh_cache.get(mesh, {}).get(engine.__name__)
     if bvh is None:
         P = np.asarray(mesh.positions, np.float64)
-        bvh = build_bvh(P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)], cancelled=cancelled)
+        tri = P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)]
+        bvh = engine.build_bvh(tri, cancelled=cancelled)
         with _bvh_lock:
-            _bvh_cache[mesh] = bvh
+            _bvh_cache.setdefault(mesh, {})[engine.__name__] = bvh
     return bvh
 
 
@@ -155,8 +159,10 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     P = np.asarray(mesh.positions, np.float64)
     F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
     scale = max(float(np.abs(P).max(initial=0.0)), 1.0)
-    best_t, best_tri, best_u, best_v = nearest_hits(
-        mesh_bvh(mesh, cancelled=cancelled), O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
+    engine = ray_engine()
+    tree = mesh_bvh(mesh, cancelled=cancelled, engine=engine)
+    best_t, best_tri, best_u, best_v = engine.nearest_hits(
+        tree, O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
     )
     c0, c1, r0, r1 = rect
     hit = best_tri >= 0
@@ -273,7 +279,7 @@ def specular_sums(scene, positions, normals) -> np.ndarray:
 
     The engine's colours with a material that keeps only its specular, at 1 (the lobe, Fresnel
     and energy factors stay): ``colour = s_m · S`` with ``s_m = 1`` is the specular sum ``S`` of
-    :func:`explorer.shading.equation.equation_terms`, computed by the compiled kernels.
+    :func:`explorer.shading.equation.equation_terms`, computed by the engine (:func:`shade`).
     """
     black = (0.0, 0.0, 0.0)
     m = scene.material.replace(ambient=black, diffuse=black, emission=black, specular=(1.0,) * 3)

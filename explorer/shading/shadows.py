@@ -31,24 +31,29 @@ from __future__ import annotations
 import numpy as np
 
 from explorer.core import tolerances as tol
-from explorer.geometry.bvh import BVH, any_hit, build_bvh
 from explorer.geometry.frame import frame_of
+from explorer.shading.tiers import ray_engine
 
 #: the key under which :func:`visibility_rows` keeps the geometry's frame and BVH in its cache
+#: (with the name of the ray engine that built it)
 GEOMETRY_KEY = "geometry"
 
 
-def frame_bvh(positions, faces) -> tuple[np.ndarray, float, np.ndarray, BVH]:
+def frame_bvh(positions, faces, engine=None) -> tuple:
     """The normalised frame of ``positions`` and the BVH of ``faces`` in it.
 
     positions : (n, 3) float; faces : (m, 3) int
+    engine : the ray engine (:func:`explorer.shading.tiers.ray_engine`, the default)
     Returns centre (3,), scale, the frame positions Q (n, 3) = (positions - centre) / scale,
-    and the BVH of Q[faces] (:data:`~explorer.core.tolerances.RAY_T_EPS` is relative to it).
+    the BVH of Q[faces] (:data:`~explorer.core.tolerances.RAY_T_EPS` is relative to it) and the
+    engine that casts through it.
     """
+    engine = ray_engine() if engine is None else engine
     P = np.asarray(positions, np.float64)
     centre, scale = frame_of(P)
     Q = (P - centre) / scale
-    return centre, scale, Q, build_bvh(Q[np.asarray(faces, np.int64).reshape(-1, 3)])
+    tree = engine.build_bvh(Q[np.asarray(faces, np.int64).reshape(-1, 3)])
+    return centre, scale, Q, tree, engine
 
 
 def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=None):
@@ -66,9 +71,9 @@ def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=N
     idx = np.arange(n) if only is None else np.flatnonzero(only)
     if len(idx) == 0 or len(faces) == 0:
         return vis
-    centre, scale, Q, bvh = frame_bvh(positions, faces) if geometry is None else geometry
+    centre, scale, Q, bvh, engine = frame_bvh(positions, faces) if geometry is None else geometry
     D, tmax = light.shadow_ray(Q[idx], centre, scale)
-    hit = any_hit(bvh, Q[idx], D, tmax, cancelled=cancelled)
+    hit = engine.any_hit(bvh, Q[idx], D, tmax, cancelled=cancelled)
     vis[idx[hit]] = 0.0
     return vis
 
@@ -84,8 +89,8 @@ def visibility_rows(
     force_all : rays from every vertex (benchmark); else only where N·L > -SHADOW_NDL_MARGIN
         (:mod:`explorer.core.tolerances`)
     cache : dict kept by the caller for this geometry: it keeps the frame and the BVH
-        (:data:`GEOMETRY_KEY`), and a light whose rays are unchanged (same position or
-        direction) reuses its row
+        (:data:`GEOMETRY_KEY` and the ray engine's name), and a light whose rays are unchanged
+        (same position or direction) reuses its row
     Returns the rows and the number of rays cast."""
     P = positions
     n = len(P)
@@ -105,9 +110,11 @@ def visibility_rows(
                 ndl = np.einsum("ij,ij->i", light.toward(P), unit)
                 # a margin: a ray more than needed is harmless, one fewer is not
                 only = length > 0 if two_sided else ndl > -tol.SHADOW_NDL_MARGIN
-            if GEOMETRY_KEY not in cache:
-                cache[GEOMETRY_KEY] = frame_bvh(P, faces)
-            v = visibility(P, faces, light, only=only, geometry=cache[GEOMETRY_KEY])
+            engine = ray_engine()
+            geometry = (GEOMETRY_KEY, engine.__name__)
+            if geometry not in cache:
+                cache[geometry] = frame_bvh(P, faces, engine)
+            v = visibility(P, faces, light, only=only, geometry=cache[geometry])
             cache[key] = v
             rays += int(n if only is None else only.sum())
         vis[i] = v

@@ -53,12 +53,18 @@ from pathlib import Path
 
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Notice
+from explorer.geometry import bvh, bvh_numpy
 
 #: the environment variable that picks the mode
 ENV = "PHONG_EXPLORER_KERNELS"
 MODES = ("auto", "compiled", "numpy")
 #: modules whose numba functions the product calls (their sources name the marker)
-SOURCES = ("explorer.shading.kernels", "explorer.shading.display", "explorer.geometry.rays")
+SOURCES = (
+    "explorer.shading.kernels",
+    "explorer.shading.display",
+    "explorer.geometry.rays",
+    "explorer.geometry.bvh",
+)
 #: environment variables that change what numba compiles (so they name the marker too)
 CODEGEN_ENV = ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "NUMBA_OPT", "PHONG_EXPLORER_WIDE_VECTORS")
 #: seconds between two looks for the marker while the numpy tier serves (a stat per look)
@@ -160,6 +166,13 @@ def _ready() -> bool:
         if _state["ready"] and _state["preload"]:
             _start_loading()
     return bool(_state["ready"])
+
+
+def ray_engine():
+    """The module that casts rays now: :mod:`explorer.geometry.bvh` (compiled) once the kernels
+    serve (:func:`loaded`), else :mod:`explorer.geometry.bvh_numpy` (the same answers, no
+    compile). Both have ``build_bvh``, ``any_hit`` and ``nearest_hits``."""
+    return bvh if loaded() else bvh_numpy
 
 
 def status() -> str | None:

@@ -21,6 +21,7 @@ import time
 
 import numpy as np
 
+from explorer.geometry import bvh
 from explorer.geometry.meshes import sphere, torus
 from explorer.shading import tiers
 from explorer.shading.display import to_bytes
@@ -96,8 +97,20 @@ def _changes(shader: Shader) -> None:
     _ = shader.terms if shader.keep else None
 
 
+def _pixel_rays() -> None:
+    """The per-pixel reference's casts (:mod:`explorer.render.perpixel`) through the compiled
+    BVH: a tree of a mesh's world triangles, nearest hits of a grid of rays."""
+    mesh = torus(12)
+    tree = bvh.build_bvh(mesh.positions[mesh.faces])
+    y, x = np.mgrid[-1:1:8j, -1:1:8j]
+    O = np.stack([x.ravel(), y.ravel(), np.full(x.size, 3.0)], axis=1)
+    D = np.ascontiguousarray(np.broadcast_to([0.0, 0.0, -1.0], O.shape))
+    bvh.nearest_hits(tree, O, D, 1e-9)
+
+
 def exercise() -> int:
     """Run every kind of pass the product makes on the compiled tier; returns the passes."""
+    _pixel_rays()
     passes = 0
     for P, N, faces in _meshes():
         for scene in SCENES:

@@ -44,7 +44,7 @@ def test_shadowed_vertices_are_the_brute_force_ones(name, resolution):
     expected = _brute_rows(mesh, lights)
     assert np.array_equal(rows, expected)
     assert ((expected == 0).sum(axis=1) > 0).all()  # every light shadows something
-    assert GEOMETRY_KEY in cache and rays > 0
+    assert (GEOMETRY_KEY, "explorer.geometry.bvh") in cache and rays > 0  # the compiled tier
 
 
 def test_a_shader_with_shadows_shades_as_the_brute_force_says():
@@ -84,7 +84,7 @@ def test_the_fine_torus_is_shadowed():
     assert len(shadowed) > 200
     assert (mesh.positions[shadowed] @ np.asarray(light.to_light) < 0).all()
     # a few of them against the brute force (every triangle: 1M of them)
-    centre, scale, Q, _ = geometry
+    centre, scale, Q, _, _ = geometry
     few = sample[:150]
     D, tmax = light.shadow_ray(Q[few], centre, scale)
     assert np.array_equal(vis[few] == 0, brute_any_hit(Q[few], D, tmax, Q[mesh.faces]))
