@@ -209,9 +209,15 @@ COLD = textwrap.dedent(
     kinds = [{"lights": [{"type": t, "position": [1, 2, 3]}]} for t in ("point", "spot")]
     kinds += [{"model": "phong", "two_sided": True, "viewer": {"to_viewer": [0, 0, 1]}},
               {"material": {"fresnel": 0.04, "energy_conserving": True}, "hdr": True}]
+    kinds += [{"lights": [{"type": "point", "position": [1, 2, 3], "shadows": True}]}]
     for scene in kinds:
         for precision in ("float32", "float64"):
-            to_bytes(explorer.shade(scene, mesh.positions, mesh.normals, precision=precision))
+            c = explorer.shade(scene, mesh.positions, mesh.normals, precision=precision,
+                               faces=mesh.faces)
+            to_bytes(c)
+    from explorer.render.perpixel import mesh_hits
+    from explorer.render.camera import camera_for
+    mesh_hits(camera_for(explorer.load_scene({}), mesh), (64, 48), mesh)  # pixel rays
     print(json.dumps({k: len(v) for k, v in warm.signatures().items() if v}))
     """
 )
