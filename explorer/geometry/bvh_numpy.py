@@ -182,6 +182,22 @@ def _check(cancelled) -> None:
         raise Cancelled("ray cast cancelled")
 
 
+def _walk(bvh: NumpyBVH, O, inv, limit, cancelled):
+    """Walk the tree breadth first; yield each level's (ray, triangle) pairs at the leaves the
+    rays enter within [0, limit[ray]]. ``limit`` (k,) is read at every level: the caller lowers
+    it as hits are found (below 0: the ray is done)."""
+    rays, nodes = np.arange(len(O)), np.zeros(len(O), np.int64)
+    while len(rays):
+        _check(cancelled)
+        enter = _slab(bvh.box[nodes], O[rays], inv[rays], limit[rays]) < np.inf
+        rays, nodes = rays[enter], nodes[enter]
+        leaf = bvh.child[nodes, 0] < 0
+        yield _leaf_pairs(bvh, rays[leaf], nodes[leaf])
+        rays, nodes = rays[~leaf], nodes[~leaf]
+        rays = np.concatenate([rays, rays])
+        nodes = np.concatenate([bvh.child[nodes, 0], bvh.child[nodes, 1]])
+
+
 def any_hit(bvh: NumpyBVH, origins, directions, tmax, *, cancelled=None) -> np.ndarray:
     """Whether each ray meets the front side of a triangle between RAY_T_EPS and
     ``tmax - RAY_T_EPS``: (k,) bool (see :func:`explorer.geometry.bvh.any_hit`).
@@ -191,23 +207,15 @@ def any_hit(bvh: NumpyBVH, origins, directions, tmax, *, cancelled=None) -> np.n
     """
     O, D, inv = _rays(origins, directions)
     tm = np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)) - RAY_T_EPS
+    limit = tm.copy()
     hit = np.zeros(len(O), np.bool_)
     if len(bvh.tri) == 0:
         return hit
-    rays, nodes = np.arange(len(O)), np.zeros(len(O), np.int64)
-    while len(rays):
-        _check(cancelled)
-        enter = _slab(bvh.box[nodes], O[rays], inv[rays], tm[rays]) < np.inf
-        rays, nodes = rays[enter], nodes[enter]
-        leaf = bvh.child[nodes, 0] < 0
-        r, j = _leaf_pairs(bvh, rays[leaf], nodes[leaf])
+    for r, j in _walk(bvh, O, inv, limit, cancelled):
         t, _, _ = _moller_trumbore(O[r], D[r], bvh.tri[j], True)
-        hit[r[(t > RAY_T_EPS) & (t < tm[r])]] = True
-        rays, nodes = rays[~leaf], nodes[~leaf]
-        rays = np.concatenate([rays, rays])
-        nodes = np.concatenate([bvh.child[nodes, 0], bvh.child[nodes, 1]])
-        keep = ~hit[rays]
-        rays, nodes = rays[keep], nodes[keep]
+        found = r[(t > RAY_T_EPS) & (t < tm[r])]
+        hit[found] = True
+        limit[found] = -1.0  # done: no box is entered below t = 0
     return hit
 
 
@@ -221,13 +229,7 @@ def nearest_hits(bvh: NumpyBVH, origins, directions, t_min: float, *, cancelled=
     bu, bv = np.zeros(k), np.zeros(k)
     if len(bvh.tri) == 0:
         return best_t, best_f, bu, bv
-    rays, nodes = np.arange(k), np.zeros(k, np.int64)
-    while len(rays):
-        _check(cancelled)
-        enter = _slab(bvh.box[nodes], O[rays], inv[rays], best_t[rays]) < np.inf
-        rays, nodes = rays[enter], nodes[enter]
-        leaf = bvh.child[nodes, 0] < 0
-        r, j = _leaf_pairs(bvh, rays[leaf], nodes[leaf])
+    for r, j in _walk(bvh, O, inv, best_t, cancelled):  # boxes beyond the best so far: skipped
         t, u, v = _moller_trumbore(O[r], D[r], bvh.tri[j], False)
         f = bvh.order[j]
         ok = t > t_min
@@ -239,7 +241,4 @@ def nearest_hits(bvh: NumpyBVH, origins, directions, t_min: float, *, cancelled=
             better = (t < best_t[r]) | ((t == best_t[r]) & (f < best_f[r]))
             r, t, u, v, f = (x[better] for x in (r, t, u, v, f))
             best_t[r], best_f[r], bu[r], bv[r] = t, f, u, v
-        rays, nodes = rays[~leaf], nodes[~leaf]
-        rays = np.concatenate([rays, rays])
-        nodes = np.concatenate([bvh.child[nodes, 0], bvh.child[nodes, 1]])
     return best_t, best_f, bu, bv
