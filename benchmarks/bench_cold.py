@@ -37,6 +37,8 @@ from pathlib import Path
 
 from bench_engine import machine
 
+from explorer.shading import tiers
+
 QUICK = ["-m", "explorer.cli", "render", "--preset", "bronze", "--mesh", "teapot", "--out"]
 
 #: first calls in a cold process: each kind of scene, then the window's relights
@@ -87,6 +89,32 @@ FIRST_CALLS = textwrap.dedent(
         _ = s.colors
         out[name] = time.perf_counter() - t
     print(json.dumps(out))
+    """
+)
+
+
+#: in a warm process: what loading the compiled kernels from numba's cache costs, against the
+#: numpy tier's time per vertex-light (tiers.LOAD_WORTH is the break-even between the two)
+LOAD = textwrap.dedent(
+    """
+    import json, time
+    import numpy as np
+    import explorer
+    from explorer.geometry.meshes import sphere
+    from explorer.shading.display import to_bytes
+    small = sphere(8)
+    t = time.perf_counter()
+    for precision in ("float64", "float32"):
+        to_bytes(explorer.shade({}, small.positions, small.normals, precision=precision,
+                                tier="compiled"))
+    load = time.perf_counter() - t
+    big = sphere(400)
+    scene = {"lights": [{"type": "point", "position": [2.0, 1.0 + i, 3.0]} for i in range(4)]}
+    explorer.shade(scene, big.positions, big.normals, tier="numpy")
+    t = time.perf_counter()
+    explorer.shade(scene, big.positions, big.normals, tier="numpy")
+    per = (time.perf_counter() - t) / (len(big.positions) * 4)
+    print(json.dumps({"load": load, "numpy_per_vertex_light": per}))
     """
 )
 
@@ -181,6 +209,9 @@ def main(argv=None) -> int:
         cold_window = window_start(dict(env), display)
     fill = wait_for(marker_ready(env), args.timeout)
     warm = statistics.median(quick_start(work, env, f"warm{i}") for i in range(3))
+    out = subprocess.run([sys.executable, "-c", LOAD], env=env, cwd=work, capture_output=True,
+                         text=True)  # fmt: skip
+    load = json.loads(out.stdout.strip().splitlines()[-1])
     rows.append(("quick start render", f"{cold:.2f} s", f"{warm:.2f} s", f"{cold / warm:.2f}x"))
     if window:
         warm_window = statistics.median(window_start(dict(env), display) for _ in range(3))
@@ -196,6 +227,11 @@ def main(argv=None) -> int:
     for r in rows:
         print(f"| {' | '.join(r)} |")
     print(f"\nbackground compile until the ready marker: {fill:.1f} s after the cold render ended")
+    per = load["numpy_per_vertex_light"]
+    print(f"loading the compiled kernels from the cache (both precisions): {load['load']:.2f} s; "
+          f"the numpy tier: {per * 1e9:.0f} ns per vertex-light, so the load is worth "
+          f"{load['load'] / per / 1e6:.1f} M vertex-lights (tiers.LOAD_WORTH: "
+          f"{tiers.LOAD_WORTH / 1e6:.1f} M)")  # fmt: skip
     n = first.pop("vertices")
     print(f"\nfirst calls in a process on a cold cache ({n:,} vertices):\n")
     print("| call | seconds |\n|---|---:|")
