@@ -101,11 +101,9 @@ class LightsTab(QtWidgets.QWidget):
         form.addWidget(self.attenuation_box)
         self.cutoff = ValueSlider("cutoff", 0.0, 90.0, decimals=1, suffix="°")
         self.exponent = ValueSlider("exponent", *SPOT_EXPONENT_RANGE, decimals=1)
-        for s in (self.cutoff, self.exponent):
+        for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
             form.addWidget(s)
-            s.edited.connect(
-                lambda v, n=s.objectName(): self.act(M.set_light_field, n, v, label=n, merge=n)
-            )
+            s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
             s.released.connect(lambda: self.act(None))
         box.addWidget(self.controls)
         self.none = QtWidgets.QLabel("The scene has no lights: add one.")

@@ -50,6 +50,7 @@ class State:
 
     scene : material, model, lights, viewer (the camera's), ambient, hdr
     mesh : the mesh chooser's name (a built-in name or a file path)
+    resolution : the built-in mesh's resolution, or None (the explorer's choice)
     centre, radius : the mesh's bounding-box centre and radius (world units): lights are
         placed around them
     preset : name of the preset the material came from, or None
@@ -65,6 +66,7 @@ class State:
 
     scene: Scene
     mesh: str
+    resolution: int | None = None
     centre: Vec3 = (0.0, 0.0, 0.0)
     radius: float = 1.0
     preset: str | None = None
@@ -362,7 +364,9 @@ def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = 
         d = (d or 0.0) * radius / state.radius
         lights.append(light.placed(az, el, d, centre) if d > 0 else light)
     scene = state.scene.replace(lights=tuple(lights), mesh=spec or name)
-    return state.replace(scene=scene, mesh=name, centre=centre, radius=radius, camera=None)
+    return state.replace(
+        scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None
+    )
 
 
 # -- the store -----------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ A session file is YAML (or JSON, which YAML reads too)::
     session: 1                 # the format
     scene: {...}               # the scene-file schema: material, model, lights, viewer, mesh
     mesh: teapot               # the mesh chooser's name (a built-in name or a file path)
+    resolution: null           # a built-in mesh's resolution (null: the explorer's)
     preset: gold               # the preset the material came from, or null
     hidden: [specular]         # terms not drawn
     light: 1                   # the light the controls move (1 is the first)
@@ -40,7 +41,7 @@ from explorer.render.camera import Camera
 
 FORMAT = 1
 KEYS = (
-    "session", "scene", "mesh", "preset", "hidden", "light", "handle_distance", "camera",
+    "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance", "camera",
     "difference", "window",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
@@ -50,7 +51,8 @@ LAST_SESSION_ENV = "PHONG_EXPLORER_LAST_SESSION"
 
 def last_session_path() -> Path:
     """Where the window keeps the last session on quit (``gui --last`` reopens it):
-    ``$PHONG_EXPLORER_LAST_SESSION``, else ``<user config dir>/phong-explorer/last-session.yaml``."""
+    ``$PHONG_EXPLORER_LAST_SESSION``, else
+    ``<user config dir>/phong-explorer/last-session.yaml``."""
     env = os.environ.get(LAST_SESSION_ENV)
     if env:
         return Path(env).expanduser()
@@ -74,6 +76,7 @@ def session_mapping(state: State) -> dict:
         "session": FORMAT,
         "scene": state.scene.to_mapping(),
         "mesh": state.mesh,
+        "resolution": state.resolution,
         "preset": state.preset,
         "hidden": [t for t in TERMS if t in state.hidden],
         "light": state.light + 1,
@@ -104,9 +107,13 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     m = checker.mapping(doc.data, (), "a mapping of session keys")
     checker.raise_if_any()
     checker.keys(m, (), KEYS, required=("session", "scene", "mesh"))
-    if "session" in m:
-        checker.choice(m["session"], ("session",), (FORMAT,))
+    if "session" in m and m["session"] != FORMAT:
+        checker.problem(("session",), f"must be {FORMAT} (this version's format)")
     name = checker.string(m.get("mesh"), ("mesh",)) if "mesh" in m else None
+    resolution = m.get("resolution")
+    if resolution is not None and (isinstance(resolution, bool) or not isinstance(resolution, int)
+                                   or resolution < 1):  # fmt: skip
+        checker.problem(("resolution",), f"must be a whole number >= 1 or null, got {resolution!r}")
     preset = m.get("preset")
     if preset is not None:
         preset = checker.string(preset, ("preset",))
@@ -123,8 +130,9 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         scene = load_scene(m["scene"], materials_dirs=materials_dirs)
     except ExplorerError as exc:
         raise ExplorerError(f"{os.fspath(path)}: scene: {exc}") from None
-    mesh = load_mesh_choice(name)
-    state = first_state(scene, mesh, name=name, preset=preset, materials_dirs=materials_dirs)
+    mesh = load_mesh_choice(name, resolution)
+    state = first_state(scene, mesh, name=name, preset=preset, materials_dirs=materials_dirs,
+                        resolution=resolution)  # fmt: skip
     n = len(scene.lights)
     light = m.get("light", 1)
     if n and (isinstance(light, bool) or not isinstance(light, int) or not 1 <= light <= n):

@@ -65,10 +65,11 @@ def default_viewer(mesh: Mesh) -> Viewer:
 
 def first_state(
     scene: Scene, mesh: Mesh, *, name: str | None = None, preset: str | None = None,
-    materials_dirs=(),
+    materials_dirs=(), resolution: int | None = None,
 ) -> State:  # fmt: skip
     """The explorer's state for ``scene`` on ``mesh`` (shown as ``name`` in the mesh
-    chooser, default the mesh's name), under preset ``preset`` (marked clean when the library's
+    chooser, default the mesh's name; ``resolution`` its built-in resolution, None for the
+    explorer's), under preset ``preset`` (marked clean when the library's
     preset of that name has this material)."""
     name = name or scene.mesh or mesh.name
     clean = None
@@ -80,6 +81,7 @@ def first_state(
     return State(
         scene=scene.replace(mesh=scene.mesh or name),
         mesh=name,
+        resolution=resolution,
         centre=tuple(float(c) for c in mesh.centre),
         radius=float(mesh.radius or 1.0),
         preset=preset,

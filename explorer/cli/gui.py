@@ -111,6 +111,7 @@ def start(args):
 
 def start_state(args):
     """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s."""
+    check_options(args)
     dirs = tuple(args.materials_dirs)
     if args.last:
         path = S.last_session_path()
@@ -120,7 +121,9 @@ def start_state(args):
     if args.session is not None:
         return S.load_session(args.session, materials_dirs=dirs)
     scene, mesh, preset = start(args)
-    return gui.first_state(scene, mesh, preset=preset, materials_dirs=dirs), mesh
+    state = gui.first_state(scene, mesh, preset=preset, materials_dirs=dirs,
+                            resolution=args.resolution)  # fmt: skip
+    return state, mesh
 
 
 def run(args) -> int:
