@@ -68,6 +68,31 @@ def help_text() -> str:
     return "\n".join(lines)
 
 
+class ViewKeys(QtCore.QObject):
+    """The 3D view's keys: :data:`VIEW_KEYS` run their commands; every other plain key is
+    kept from VTK and PyVista, whose own keys (w wireframe, s surface, 3 stereo, ...) would
+    change the picture behind the state's back. Keys with Ctrl or Alt go on to the menus."""
+
+    def __init__(self, window):
+        super().__init__(window)
+        self.window = window
+        self.calls = {
+            key: window._guard(getattr(window, method), f"key {key}")
+            for key, (_, method) in VIEW_KEYS.items()
+        }
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        kind = event.type()
+        if kind not in (QtCore.QEvent.Type.KeyPress, QtCore.QEvent.Type.KeyRelease):
+            return False
+        mods = QtCore.Qt.KeyboardModifier
+        if event.modifiers() & (mods.ControlModifier | mods.AltModifier | mods.MetaModifier):
+            return False
+        if kind == QtCore.QEvent.Type.KeyPress and event.text() in self.calls:
+            self.calls[event.text()]()
+        return True
+
+
 class Commands:
     """Menus, shortcuts and the commands behind them (needs the window's ``store``, ``view``,
     ``plotter``, ``act``, ``report`` and ``show_status``)."""
@@ -122,10 +147,8 @@ class Commands:
         h = bar.addMenu("&Help")
         add(h, "help", "&Keys and mouse", self.toggle_help, "F1")
         self.panel.material.save.clicked.connect(self._guard(self.save_preset_as, "save preset"))
-        for key, (_, method) in VIEW_KEYS.items():
-            sc = QtGui.QShortcut(QtGui.QKeySequence(key), self.plotter)
-            sc.setContext(QtCore.Qt.ShortcutContext.WidgetWithChildrenShortcut)
-            sc.activated.connect(self._guard(getattr(self, method), f"key {key}"))
+        self._view_keys = ViewKeys(self)
+        self.plotter.installEventFilter(self._view_keys)
         self.help = None
 
     def update_edit_actions(self) -> None:

@@ -477,6 +477,6 @@ def angles_from_point(state: State, point) -> tuple[float, float, float]:
     control's range."""
     az, el, d = angles_of(np.subtract(point, state.centre))
     lo, hi = state.distance_range()
-    if abs(el) >= POLE and state.held_azimuth is not None:
-        az = state.held_azimuth
+    if abs(el) >= POLE and state.selected_light is not None:
+        az = state.placement()[0]  # at a pole the azimuth stays where it was
     return az, el, min(max(d, lo), hi)

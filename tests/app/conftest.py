@@ -1,0 +1,70 @@
+"""Fixtures of the window tests: a private Xvfb server for Qt (its xcb platform is the only
+one that hosts the VTK view, so in-process widget tests need an X server too)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+
+def start_xvfb():
+    """A private Xvfb server (its display number chosen by the server): (process, ":N")."""
+    r, w = os.pipe()
+    proc = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
+        pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    os.close(w)
+    with os.fdopen(r) as f:
+        number = f.readline().strip()
+    if not number:
+        proc.terminate()
+        pytest.fail("Xvfb did not start")
+    return proc, f":{number}"
+
+
+@pytest.fixture(scope="session")
+def xserver():
+    """One Xvfb for the session's in-process Qt tests (Qt keeps its connection until the
+    process ends, so the server lives as long)."""
+    if sys.platform in ("darwin", "win32") or shutil.which("Xvfb") is None:
+        pytest.skip("needs Xvfb for the Qt window (apt-get install -y xvfb)")
+    pytest.importorskip("PySide6")
+    pytest.importorskip("pyvistaqt")
+    proc, display = start_xvfb()
+    yield display
+    proc.terminate()
+    proc.wait(timeout=10)
+
+
+@pytest.fixture
+def xdisplay(xserver, monkeypatch):
+    """DISPLAY and Qt's xcb platform for one test (VTK's window class left to VTK)."""
+    monkeypatch.setenv("DISPLAY", xserver)
+    monkeypatch.setenv("QT_QPA_PLATFORM", "xcb")
+    monkeypatch.delenv("VTK_DEFAULT_OPENGL_WINDOW", raising=False)
+    return xserver
+
+
+@pytest.fixture(scope="session")
+def qapp(xserver):
+    """pytest-qt's QApplication, made on the private Xvfb (a session fixture is made before
+    any test's own fixtures, so the display is given here). The environment is restored
+    afterwards: Qt keeps its connection, and later tests see the machine's own."""
+    saved = {k: os.environ.get(k) for k in ("DISPLAY", "QT_QPA_PLATFORM")}
+    os.environ.update(DISPLAY=xserver, QT_QPA_PLATFORM="xcb")
+    try:
+        from PySide6 import QtWidgets
+
+        app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(["pytest-qt"])
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    yield app
