@@ -176,7 +176,9 @@ def test_the_handle_moves_the_light_and_keeps_the_azimuth_at_the_pole(win):
     win.view.handle.SetCenter(*point)
     win._on_handle(point)
     az2, el, d = win.store.state.placement()
-    assert el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
+    assert (
+        el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
+    )
     assert win.panel.lights.sliders["azimuth"].value() == pytest.approx(az, abs=0.1)
 
 
