@@ -41,8 +41,8 @@ from explorer.render.camera import Camera
 
 FORMAT = 1
 KEYS = (
-    "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance", "camera",
-    "difference", "window",
+    "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
+    "camera", "difference", "window",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in

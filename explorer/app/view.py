@@ -17,13 +17,20 @@ PyVista and VTK are imported inside the functions that need them.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from explorer.app.model import State, handle_point
 from explorer.geometry.meshes import Mesh, area_weighted_normals
-from explorer.render.camera import Camera, apply_camera, back_to_front, camera_for
+from explorer.render.camera import (
+    Camera,
+    apply_camera,
+    back_to_front,
+    camera_for,
+    camera_from_vtk,
+)
 from explorer.render.vtk import add_unlit, cells, polydata
 from explorer.shading.display import engine_clamps, shown, to_bytes
 from explorer.shading.shader import Shader
@@ -84,6 +91,18 @@ def widen_to_show(camera: Camera, points, aspect: float, *, pad: float = 0.0,
         return replace(camera, parallel_scale=max(camera.parallel_scale, need))
     angle = math.degrees(2.0 * math.atan(need))
     return replace(camera, view_angle=max(camera.view_angle, min(angle, MAX_VIEW_ANGLE)))
+
+
+def view_camera(vtk_camera, centre, radius: float) -> Camera:
+    """The view's camera with a clipping range around the mesh (centre (3,), radius): what the
+    state records and the difference view compares (the window's own range follows what is
+    visible, and the mesh is hidden while the heat map shows)."""
+    cam = camera_from_vtk(vtk_camera, window_center=(0.0, 0.0))
+    pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
+    ahead = (focal - pos) / max(float(np.linalg.norm(focal - pos)), 1e-300)
+    d = float((np.asarray(centre) - pos) @ ahead)
+    r = 1.01 * radius
+    return dataclasses.replace(cam, clipping_range=(max(d - r, 1e-3 * r), max(d + r, 2e-3 * r)))
 
 
 def framed_camera(state: State, mesh: Mesh, aspect: float) -> Camera:

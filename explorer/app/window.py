@@ -29,12 +29,12 @@ from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
 from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE, NoDisplayError
-from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, framed_camera
+from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, framed_camera, view_camera
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import Camera, camera_from_vtk
+from explorer.render.camera import Camera
 from explorer.render.offscreen import BACKGROUND
 
 log = logging.getLogger(__name__)
@@ -43,18 +43,6 @@ log = logging.getLogger(__name__)
 PANEL_FRACTION = 0.34
 #: how long a status message stays (ms); errors stay until the next message
 MESSAGE_MS = 6000
-
-
-def view_camera(vtk_camera, centre, radius: float) -> Camera:
-    """The view's camera with a clipping range around the mesh (centre (3,), radius): what the
-    state records and the difference view compares (the window's own range follows what is
-    visible, and the mesh is hidden while the heat map shows)."""
-    cam = camera_from_vtk(vtk_camera, window_center=(0.0, 0.0))
-    pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
-    ahead = (focal - pos) / max(float(np.linalg.norm(focal - pos)), 1e-300)
-    d = float((np.asarray(centre) - pos) @ ahead)
-    r = 1.01 * radius
-    return dataclasses.replace(cam, clipping_range=(max(d - r, 1e-3 * r), max(d + r, 2e-3 * r)))
 
 
 class ExplorerWindow(Commands, QtWidgets.QMainWindow):
