@@ -309,7 +309,7 @@ def main(argv=None) -> int:
             ("kd", "explorer view, kd slider (compose)"),
             ("shininess", "explorer view, shininess slider (lobe)"),
             ("azimuth", "explorer view, azimuth slider (all light sums)"),
-            ("camera", "explorer window, camera rotation (specular)"),
+            ("camera", "explorer view, camera rotation (specular)"),
         ):
             rows.append((label, count, ex[name], ex[name][0] / ref))
     lod = None

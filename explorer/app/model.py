@@ -62,6 +62,9 @@ class State:
     held_azimuth : the azimuth asked for last, kept while the light sits at a pole
     camera : the view's camera, or None (framed from the scene's viewer)
     difference : the per-pixel difference view is on
+    compare : side B's material when the A / B compare view is on, else None
+    compare_model, compare_preset : side B's specular model and preset name
+    compare_difference : side B's pane shows the difference A − B instead of B
     """
 
     scene: Scene
@@ -77,6 +80,10 @@ class State:
     held_azimuth: float | None = None
     camera: Camera | None = None
     difference: bool = False
+    compare: Material | None = None
+    compare_model: str | None = None
+    compare_preset: str | None = None
+    compare_difference: bool = False
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)
@@ -201,6 +208,67 @@ def set_camera(state: State, camera: Camera | None) -> State:
     viewer = viewer_of_camera(camera)
     scene = state.scene if viewer == state.scene.viewer else state.scene.replace(viewer=viewer)
     return state.replace(camera=camera, scene=scene)
+
+
+# -- the A / B compare view ----------------------------------------------------------------------
+
+
+def start_compare(state: State) -> State:
+    """Side B starts as this material under the other specular model (Blinn beside Phong)."""
+    other = "phong" if state.scene.model == "blinn" else "blinn"
+    return state.replace(compare=state.material, compare_model=other,
+                         compare_preset=state.preset)  # fmt: skip
+
+
+def stop_compare(state: State) -> State:
+    return state.replace(compare=None, compare_model=None, compare_preset=None,
+                         compare_difference=False)  # fmt: skip
+
+
+def set_compare(state: State, on: bool) -> State:
+    if bool(on) == (state.compare is not None):
+        return state
+    return start_compare(state) if on else stop_compare(state)
+
+
+def _needs_compare(state: State) -> None:
+    if state.compare is None:
+        raise ExplorerError("the compare view is off: turn it on first")
+
+
+def set_compare_preset(state: State, name: str, material: Material) -> State:
+    """Side B shows preset ``name`` (and its specular model when it has one)."""
+    _needs_compare(state)
+    model = material.model or state.compare_model
+    return state.replace(compare=material, compare_model=model, compare_preset=name)
+
+
+def set_compare_model(state: State, model: str) -> State:
+    _needs_compare(state)
+    state.scene.replace(model=model)  # the scene checks the name
+    return state.replace(compare_model=model)
+
+
+def set_compare_difference(state: State, on: bool) -> State:
+    _needs_compare(state)
+    return state.replace(compare_difference=bool(on))
+
+
+def swap_compare(state: State) -> State:
+    """A becomes B and B becomes A (the panel edits side A)."""
+    _needs_compare(state)
+    scene = state.scene.replace(material=state.compare, model=state.compare_model)
+    return state.replace(
+        scene=scene, preset=state.compare_preset, preset_material=None,
+        compare=state.material, compare_model=state.scene.model, compare_preset=state.preset,
+    )  # fmt: skip
+
+
+def side_b(state: State) -> State:
+    """The state side B shows: B's material and model, everything else shared."""
+    _needs_compare(state)
+    scene = state.scene.replace(material=state.compare, model=state.compare_model)
+    return state.replace(scene=scene, preset=state.compare_preset, preset_material=None)
 
 
 # -- light actions -------------------------------------------------------------------------------

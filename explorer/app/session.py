@@ -13,6 +13,8 @@ A session file is YAML (or JSON, which YAML reads too)::
     camera: {position: [..], focal_point: [..], view_up: [..], parallel: false,
              parallel_scale: 1.0, view_angle: 30.0}
     difference: false
+    compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
+                               # the A / B compare view's side B
     window: {...}              # optional: what the window reported (the --state-file's
                                # extras); never read back
 
@@ -34,6 +36,7 @@ from explorer.app.model import TERMS, State
 from explorer.app.start import first_state, load_mesh_choice
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.material import MODELS, parse_material
 from explorer.core.scene import load_scene
 from explorer.core.yamlio import dump_yaml, load_yaml
 from explorer.geometry.meshes import Mesh
@@ -42,7 +45,7 @@ from explorer.render.camera import Camera
 FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
-    "camera", "difference", "window",
+    "camera", "difference", "compare", "window",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -85,6 +88,13 @@ def session_mapping(state: State) -> dict:
     }
     if state.camera is not None:
         out["camera"] = camera_mapping(state.camera)
+    if state.compare is not None:
+        out["compare"] = {
+            "material": state.compare.to_mapping(),
+            "model": state.compare_model,
+            "preset": state.compare_preset,
+            "difference": bool(state.compare_difference),
+        }
     return out
 
 
@@ -125,6 +135,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
                             lo_open=True)  # fmt: skip
     difference = checker.boolean(m.get("difference", False), ("difference",))
     camera = _camera(checker, m["camera"]) if "camera" in m else None
+    compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
     checker.raise_if_any()
     try:
         scene = load_scene(m["scene"], materials_dirs=materials_dirs)
@@ -144,8 +155,27 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         handle_distance=handle,
         camera=camera,
         difference=bool(difference),
+        **compare,
     )
     return state, mesh
+
+
+def _compare(checker, value) -> dict:
+    """The ``compare`` section: side B's State fields."""
+    path = ("compare",)
+    c = checker.mapping(value, path)
+    if c is None:
+        return {}
+    checker.keys(c, path, ("material", "model", "preset", "difference"),
+                 required=("material", "model"))  # fmt: skip
+    material = parse_material(c.get("material"), checker, path + ("material",))
+    model = checker.choice(c.get("model"), path + ("model",), MODELS)
+    preset = c.get("preset")
+    if preset is not None:
+        preset = checker.string(preset, path + ("preset",))
+    difference = checker.boolean(c.get("difference", False), path + ("difference",))
+    return {"compare": material, "compare_model": model, "compare_preset": preset,
+            "compare_difference": bool(difference)}  # fmt: skip
 
 
 def _camera(checker, value) -> Camera | None:

@@ -377,6 +377,15 @@ class SceneView:
         axes = [(x0 + pad, y0 + side / 2), (x0 + side - pad, y0 + side / 2)]
         _set_lines(self._lobe_polys["frame"], [frame, axes])
         _set_lines(self._lobe_polys["reference"], [_lobe_points(1.0)])
+        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
+        from vtkmodules.vtkRenderingCore import vtkTextActor
+
+        self.lobe_caption = vtkTextActor()
+        self.lobe_caption.SetPosition(x0, y0 + side + 4)
+        prop = self.lobe_caption.GetTextProperty()
+        prop.SetFontSize(13)
+        prop.SetColor(*LOBE_REFERENCE_COLOR)
+        self.plotter.renderer.AddViewProp(self.lobe_caption)
         self._lobe_n = None
         self._update_lobe(self.state.material.shininess)
 
@@ -385,6 +394,7 @@ class SceneView:
             return
         self._lobe_n = n
         _set_lines(self._lobe_polys["lobe"], [_lobe_points(n)])
+        self.lobe_caption.SetInput(f"specular lobe cos^n, n = {n:g}")
 
     # -- pixels ---------------------------------------------------------------------------------
     def world_to_window(self, point) -> list[int]:

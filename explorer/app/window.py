@@ -105,6 +105,7 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
         self.status_label.setObjectName("status")
         self.statusBar().addPermanentWidget(self.status_label)
         self.view_aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)
+        self._frame_on_show = state.camera is None  # framed again for the view's real shape
         if state.camera is None:
             state = M.set_camera(state, self._framed(state, mesh))
         self.start_state = state
@@ -399,6 +400,17 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
             "message": self.message,
             "errors": list(self.errors),
         }  # fmt: skip
+
+    def showEvent(self, event: QtGui.QShowEvent) -> None:  # noqa: N802 - Qt's name
+        super().showEvent(event)
+        if self._frame_on_show:
+            self._frame_on_show = False
+            w, h = self.plotter.width(), self.plotter.height()
+            if w > 1 and h > 1:
+                self.view_aspect = w / h
+                cam = self._framed(self.store.state, self.view.mesh)
+                self.start_state = M.set_camera(self.start_state, cam)
+                self.store.set_camera(cam)
 
     # -- closing --------------------------------------------------------------------------------
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802 - Qt's name
