@@ -42,6 +42,8 @@ VIEW_KEYS = {
     "t": ("next light type (directional / point / spot)", "next_light_type"),
     "l": ("control the next light", "next_light"),
     "i": ("save a screenshot of the view (never over a file)", "screenshot"),
+    "c": ("compare A | B on / off (two panes, linked cameras)", "toggle_compare"),
+    "x": ("swap A and B", "swap_sides"),
 }
 #: mouse controls of the view, for the help
 MOUSE = (
@@ -144,6 +146,8 @@ class Commands:
         v = bar.addMenu("&View")
         add(v, "reset_camera", "Reset &camera (r)", self.reset_camera)
         add(v, "toggle_difference", "&Difference view (d)", self.toggle_difference)
+        add(v, "toggle_compare", "&Compare A | B (c)", self.toggle_compare)
+        add(v, "swap_sides", "&Swap A and B (x)", self.swap_sides)
         h = bar.addMenu("&Help")
         add(h, "help", "&Keys and mouse", self.toggle_help, "F1")
         self.panel.material.save.clicked.connect(self._guard(self.save_preset_as, "save preset"))
@@ -188,6 +192,12 @@ class Commands:
     # -- keys -------------------------------------------------------------------------------------
     def toggle_difference(self) -> None:
         self.act(M.set_difference, not self.store.state.difference, label="difference")
+
+    def toggle_compare(self) -> None:
+        self.act(M.set_compare, self.store.state.compare is None, label="compare")
+
+    def swap_sides(self) -> None:
+        self.act(M.swap_compare, label="swap A and B")
 
     def toggle_model(self) -> None:
         model = "phong" if self.store.state.scene.model == "blinn" else "blinn"

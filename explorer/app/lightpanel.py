@@ -206,7 +206,68 @@ class ViewTab(QtWidgets.QWidget):
         self.advice.setWordWrap(True)
         box.addWidget(self.legend)
         box.addWidget(self.advice)
+        self._build_compare(box)
         box.addStretch(1)
+
+    def _build_compare(self, box) -> None:
+        """The A / B compare view: side B's preset and model, swap, and B as A − B."""
+        act = self.act
+        self.compare = QtWidgets.QCheckBox("compare A | B")
+        self.compare.setObjectName("compare")
+        self.compare.setToolTip("two panes with linked cameras and the same lights (key c)")
+        self.compare.toggled.connect(lambda on: act(M.set_compare, on, label="compare"))
+        box.addWidget(self.compare)
+        self.compare_box = QtWidgets.QWidget()
+        form = QtWidgets.QGridLayout(self.compare_box)
+        form.setContentsMargins(0, 0, 0, 0)
+        self.compare_preset = QtWidgets.QComboBox()
+        self.compare_preset.setObjectName("compare_preset")
+        self.compare_preset.setSizeAdjustPolicy(
+            QtWidgets.QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon
+        )
+        self.compare_preset.setMinimumContentsLength(8)
+        self.compare_preset.activated.connect(self._compare_preset)
+        form.addWidget(QtWidgets.QLabel("B preset"), 0, 0)
+        form.addWidget(self.compare_preset, 0, 1, 1, 2)
+        form.addWidget(QtWidgets.QLabel("B model"), 1, 0)
+        self.compare_model = {}
+        group = QtWidgets.QButtonGroup(self)
+        for i, name in enumerate(("blinn", "phong")):
+            r = QtWidgets.QRadioButton(name)
+            r.setObjectName(f"compare_{name}")
+            group.addButton(r)
+            r.toggled.connect(
+                lambda on, n=name: on and act(M.set_compare_model, n, label="B model")
+            )
+            form.addWidget(r, 1, 1 + i)
+            self.compare_model[name] = r
+        self.swap = QtWidgets.QPushButton("swap A and B")
+        self.swap.setObjectName("swap")
+        self.swap.clicked.connect(lambda: act(M.swap_compare, label="swap A and B"))
+        form.addWidget(self.swap, 2, 0, 1, 3)
+        self.compare_difference = QtWidgets.QCheckBox("B shows A − B")
+        self.compare_difference.setObjectName("compare_difference")
+        self.compare_difference.setToolTip(
+            "pane B shows the difference of the two sides' colours (largest channel, 1/255 "
+            "levels, the difference view's colours)"
+        )
+        self.compare_difference.toggled.connect(
+            lambda on: act(M.set_compare_difference, on, label="A − B")
+        )
+        form.addWidget(self.compare_difference, 3, 0, 1, 3)
+        box.addWidget(self.compare_box)
+        self._presets = {}
+
+    def set_presets(self, infos) -> None:
+        self._presets = {p.name: p for p in infos}
+        with QtCore.QSignalBlocker(self.compare_preset):
+            self.compare_preset.clear()
+            self.compare_preset.addItems(list(self._presets))
+
+    def _compare_preset(self, i: int) -> None:
+        info = self._presets.get(self.compare_preset.itemText(i))
+        if info is not None:
+            self.act(M.set_compare_preset, info.name, info.material, label=f"B {info.name}")
 
     def set_meshes(self, choices: dict) -> None:
         """``choices``: chooser name -> label shown."""
@@ -224,6 +285,19 @@ class ViewTab(QtWidgets.QWidget):
             self.difference.setChecked(s.difference)
         self.legend.setVisible(s.difference)
         self.advice.setVisible(s.difference)
+        on = s.compare is not None
+        with QtCore.QSignalBlocker(self.compare):
+            self.compare.setChecked(on)
+        self.compare_box.setVisible(on)
+        if on:
+            with QtCore.QSignalBlocker(self.compare_preset):
+                self.compare_preset.setCurrentIndex(self.compare_preset.findText(
+                    s.compare_preset or ""))  # fmt: skip
+            for name, r in self.compare_model.items():
+                with QtCore.QSignalBlocker(r):
+                    r.setChecked(s.compare_model == name)
+            with QtCore.QSignalBlocker(self.compare_difference):
+                self.compare_difference.setChecked(s.compare_difference)
 
 
 class Panel(QtWidgets.QTabWidget):

@@ -22,6 +22,8 @@ import math
 
 import numpy as np
 
+from explorer.analysis.comparison import heat_map
+from explorer.app.difference import VMAX
 from explorer.app.model import State, handle_point
 from explorer.geometry.meshes import Mesh, area_weighted_normals
 from explorer.render.camera import (
@@ -279,6 +281,29 @@ class SceneView:
     def displayed_colors(self) -> np.ndarray:
         """(n, 3) uint8 colours VTK draws for the full mesh (a copy)."""
         return np.array(self.drawings[0].rgb)
+
+    def set_caption(self, text: str) -> None:
+        """A line at the top left of the view (which side of the compare view it is)."""
+        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
+        from vtkmodules.vtkRenderingCore import vtkTextActor
+
+        if getattr(self, "caption", None) is None:
+            self.caption = vtkTextActor()
+            self.caption.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            self.caption.SetPosition(0.02, 0.94)
+            prop = self.caption.GetTextProperty()
+            prop.SetFontSize(14)
+            prop.SetColor(0.92, 0.92, 0.92)
+            self.plotter.renderer.AddViewProp(self.caption)
+        self.caption.SetInput(text)
+        self.caption.SetVisibility(bool(text))
+
+    def paint_levels(self, levels) -> None:
+        """Draw ``levels`` (n,) per-vertex errors in 1/255 levels on the full mesh in the
+        difference view's colours (until the next :meth:`show_state`)."""
+        d = self.drawings[0]
+        d.rgb[:] = heat_map(np.asarray(levels)[None, :], vmax=VMAX)[0]
+        d.vtk_colors.Modified()
 
     # -- the handle ---------------------------------------------------------------------------
     def add_handle(self, callback) -> None:

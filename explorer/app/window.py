@@ -24,6 +24,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.commands import Commands
+from explorer.app.compare import ComparePane
 from explorer.app.difference import PENDING, DifferenceWorker, HeatMap, Job, advice_lines
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
@@ -45,7 +46,7 @@ PANEL_FRACTION = 0.34
 MESSAGE_MS = 6000
 
 
-class ExplorerWindow(Commands, QtWidgets.QMainWindow):
+class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
     """The explorer window.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
@@ -87,14 +88,17 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
         w, h = (int(v) for v in size)
         self.resize(w, h)
         self.splitter = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
-        self.plotter = QtInteractor(self.splitter, multi_samples=0, auto_update=False)
+        self.views = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
+        self.views.setChildrenCollapsible(False)
+        self.plotter = QtInteractor(self.views, multi_samples=0, auto_update=False)
         self.plotter.setObjectName("view")
         self.plotter.setMinimumSize(200, 150)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.plotter.disable_anti_aliasing()
         self.plotter.set_background(BACKGROUND if background is None else background)
         self.panel = Panel(self.act, self.choose_mesh)
-        self.splitter.addWidget(self.plotter)
+        self.views.addWidget(self.plotter)
+        self.splitter.addWidget(self.views)
         self.splitter.addWidget(self.panel)
         self.splitter.setStretchFactor(0, 1)
         self.splitter.setStretchFactor(1, 0)
@@ -117,12 +121,15 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
         self.heat = HeatMap(self.plotter.renderer)
         self.worker = DifferenceWorker(self.difference_ready.emit)
         self.difference_ready.connect(self._guard(self._on_difference, "difference view"))
+        self.plotter_b = self.view_b = None  # the compare view's side B, made when first shown
+        self._syncing = False
         self.presets = []
         self.reload_presets()
         self._set_mesh_choices()
         self._observe()
         self.build_menus()
         self.store.subscribe(self._on_change)
+        self._show_compare(None, state)
         self._show_panel(state)
         self._update_difference()
 
@@ -162,6 +169,7 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
         for text in notices:
             log.warning("%s", text)
         self.panel.material.set_presets(self.presets)
+        self.panel.view.set_presets(self.presets)
 
     def _set_mesh_choices(self) -> None:
         labels = {n: (Path(n).name if n not in MESH_CHOICES else n) for n in self.mesh_choices}
@@ -238,6 +246,7 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
             self.view.set_mesh(self.meshes[new.mesh], new)
         else:
             self.view.show_state(new)
+        self._show_compare(old, new)
         only_camera = dataclasses.replace(old, camera=None, scene=old.scene.replace(
             viewer=new.scene.viewer)) == dataclasses.replace(new, camera=None)  # fmt: skip
         if new.camera is not None and not self._in_frame:
@@ -280,9 +289,16 @@ class ExplorerWindow(Commands, QtWidgets.QMainWindow):
         self.plotter.renderer.ResetCameraClippingRange()
 
     def _after_frame(self, *_) -> None:
-        """Render window EndEvent: count and time the frame, then write the state file (after
-        the frame, so a reader never races the pixels)."""
+        """Render window EndEvent: count and time the frame, draw side B of the compare view
+        (same camera), then write the state file (after the frame, so a reader never races
+        the pixels)."""
         self.frames += 1
+        if self.plotter_b is not None and self.plotter_b.isVisible() and not self._syncing:
+            self._syncing = True
+            try:
+                self.plotter_b.render_window.Render()
+            finally:
+                self._syncing = False
         if self._t0 is not None:
             self.frame_ms = 1000.0 * (time.perf_counter() - self._t0)
             self._t0 = None

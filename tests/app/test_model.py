@@ -270,3 +270,17 @@ def test_no_display_one_line_and_exit_status_3(argv):
 
 def test_point_light_default_is_kept(state):
     assert isinstance(state.scene.lights[0], PointLight)
+
+
+def test_compare_actions(state):
+    s = M.start_compare(state)
+    assert s.compare == state.material and s.compare_model == "phong"
+    assert M.side_b(s).scene.model == "phong" and M.side_b(s).material == state.material
+    jade = find_preset("jade")
+    s = M.set_compare_preset(s, "jade", jade)
+    s = M.swap_compare(s)
+    assert s.material == jade and s.preset == "jade" and s.compare == state.material
+    assert s.scene.model == (jade.model or "phong") and s.compare_model == "blinn"
+    assert M.stop_compare(s).compare is None
+    with pytest.raises(explorer.ExplorerError, match="compare view is off"):
+        M.swap_compare(state)

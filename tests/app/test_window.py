@@ -93,6 +93,7 @@ def test_shininess_slider_is_log_scale_with_zero_at_the_left(win):
     assert win.store.state.material.shininess == 1000.0
     s.slider.setValue(667)  # two thirds along: 10^2
     assert win.store.state.material.shininess == pytest.approx(100.0, rel=0.01)
+    assert win.view.lobe_caption.GetInput().endswith(f"n = {win.store.state.material.shininess:g}")
 
 
 def test_colour_buttons_through_the_dialog(win, qtbot):
@@ -294,3 +295,37 @@ def test_reset_all_can_be_undone(win):
 def test_status_bar_takes_a_message(win):
     win.show_status("preparing the engine's kernels")
     assert win.statusBar().currentMessage() == "preparing the engine's kernels"
+
+
+def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
+    win.panel.view.compare.click()
+    s = win.store.state
+    assert s.compare == s.material and s.compare_model == "phong" and win.plotter_b.isVisible()
+    qtbot.waitUntil(lambda: win.plotter_b.width() > 100)
+    b = win.view_b
+    mesh = b.mesh
+    want = to_bytes(explorer.shade(M.side_b(s).shown_scene(), mesh.positions, mesh.normals))
+    assert np.abs(b.displayed_colors().astype(int) - want.astype(int)).max() <= 1
+    assert win.plotter_b.renderer.GetActiveCamera() is win.plotter.renderer.GetActiveCamera()
+    i = win.panel.view.compare_preset.findText("jade")
+    win.panel.view.compare_preset.activated.emit(i)
+    assert win.store.state.compare_preset == "jade"
+    win.panel.view.swap.click()
+    s = win.store.state
+    assert s.preset == "jade" and s.compare_preset == A.DEFAULT_PRESET
+    win.render()
+    drawn_equals_engine(win)
+    win.panel.view.compare_difference.click()
+    a = win.view.displayed_colors().astype(int)
+    other = to_bytes(win.view_b.drawings[0].colors()).astype(int)
+    levels = np.abs(a - other).max(axis=1)
+    from explorer.analysis.comparison import heat_map
+
+    assert np.array_equal(win.view_b.displayed_colors(), heat_map(levels[None, :], vmax=16)[0])
+    path = S.save_session(win.output_dir / "ab.yaml", win.store.state)
+    back, _ = S.load_session(path)
+    assert back.compare == s.compare and back.compare_difference
+    qtbot.keyClick(win.plotter, "c")
+    assert win.store.state.compare is None and not win.plotter_b.isVisible()
+    win.undo()
+    assert win.store.state.compare is not None and win.plotter_b.isVisible()
