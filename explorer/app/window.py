@@ -434,9 +434,3 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
         self.worker.close()
         self.plotter.close()
         super().closeEvent(event)
-
-
-def check_window(plotter) -> None:
-    """Raise :class:`NoDisplayError` when VTK could not make an on-screen window."""
-    if not plotter.render_window.IsDirect() and not plotter.render_window.GetMapped():
-        raise NoDisplayError("VTK could not open an OpenGL window on this display")
