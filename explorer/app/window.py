@@ -29,7 +29,7 @@ from explorer.app.difference import PENDING, DifferenceWorker, HeatMap, Job, adv
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
-from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE, NoDisplayError
+from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
 from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, framed_camera, view_camera
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
