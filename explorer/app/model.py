@@ -510,10 +510,17 @@ class Store:
 
     def undo(self) -> bool:
         """Back one step (the camera stays where it is)."""
-        if not self._past:
+        return self._step(self._past, self._future)
+
+    def redo(self) -> bool:
+        return self._step(self._future, self._past)
+
+    def _step(self, source: list, target: list) -> bool:
+        """Move the present onto ``target`` and take ``source``'s last state."""
+        if not source:
             return False
-        state, label = self._past.pop()
-        self._future.append((self.state, label))
+        state, label = source.pop()
+        target.append((self.state, label))
         self._merge = None
         self._set(self._keep_camera(state))
         return True
@@ -523,15 +530,6 @@ class Store:
         if state.mesh != self.state.mesh or self.state.camera is None:
             return state
         return set_camera(state, self.state.camera)
-
-    def redo(self) -> bool:
-        if not self._future:
-            return False
-        state, label = self._future.pop()
-        self._past.append((self.state, label))
-        self._merge = None
-        self._set(self._keep_camera(state))
-        return True
 
 
 def handle_point(state: State) -> np.ndarray:
