@@ -11,7 +11,7 @@ import numpy as np
 
 from explorer.app import model as M
 from explorer.app.commands import ViewKeys
-from explorer.app.view import SceneView
+from explorer.app.view import SceneView, view_camera
 from explorer.shading.display import to_bytes
 
 
@@ -51,6 +51,12 @@ class ComparePane:
                     self._syncing = False
 
         pl.render_window.AddObserver("EndEvent", self._guard(draw_a, "compare"))
+
+        def before_frame(*_):
+            s = self.store.state
+            self.view_b.before_frame(view_camera(pl.camera, s.centre, s.radius))
+
+        pl.renderer.AddObserver("StartEvent", self._guard(before_frame, "compare"))
 
     def _show_compare(self, old: M.State | None, new: M.State) -> None:
         """Side B's pane: made, shown, hidden, and given side B's state (or A − B)."""

@@ -51,8 +51,11 @@ GLYPH_COLOR = (1.0, 0.85, 0.2)
 HANDLE_FRAMING = 5.5
 #: widest view angle (degrees) the framing may use to show the handle
 MAX_VIEW_ANGLE = 60.0
-#: the lobe inset: left, bottom and side in pixels; colours; samples of the curve
-LOBE_BOX = (12, 12, 120)
+#: the lobe inset: left and bottom margin in pixels, its side as a fraction of the view's
+#: smaller side held within LOBE_SIDE (pixels); colours; samples of the curve
+LOBE_MARGIN = 12
+LOBE_FRACTION = 0.2
+LOBE_SIDE = (60, 120)
 LOBE_COLOR = (1.0, 0.85, 0.2)
 LOBE_REFERENCE_COLOR = (0.55, 0.55, 0.6)
 LOBE_FRAME_COLOR = (0.35, 0.35, 0.38)
@@ -255,9 +258,11 @@ class SceneView:
         self._update_lobe(state.material.shininess)
 
     def before_frame(self, camera: Camera) -> None:
-        """Keep translucent triangles sorted back to front for the camera."""
+        """Before a frame: translucent triangles sorted back to front for the camera, the lobe
+        inset sized for the view."""
         if self.state.material.opacity < 1.0:
             self.active.sort_for(camera)
+        self._layout_lobe()
 
     def begin_drag(self) -> None:
         self.dragging += 1
@@ -379,7 +384,6 @@ class SceneView:
         from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
         from vtkmodules.vtkRenderingCore import vtkActor2D, vtkPolyDataMapper2D
 
-        x0, y0, side = LOBE_BOX
         self._lobe_polys = {}
         for key, color, width in (
             ("frame", LOBE_FRAME_COLOR, 1.0),
@@ -397,20 +401,33 @@ class SceneView:
             actor.GetProperty().SetLineWidth(width)
             self.plotter.renderer.AddViewProp(actor)
             self._lobe_polys[key] = poly
-        pad = 8
-        frame = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side), (x0, y0)]
-        axes = [(x0 + pad, y0 + side / 2), (x0 + side - pad, y0 + side / 2)]
-        _set_lines(self._lobe_polys["frame"], [frame, axes])
-        _set_lines(self._lobe_polys["reference"], [_lobe_points(1.0)])
         import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
         from vtkmodules.vtkRenderingCore import vtkTextActor
 
         self.lobe_caption = vtkTextActor()
-        self.lobe_caption.SetPosition(x0, y0 + side + 4)
         prop = self.lobe_caption.GetTextProperty()
-        prop.SetFontSize(13)
         prop.SetColor(*LOBE_REFERENCE_COLOR)
         self.plotter.renderer.AddViewProp(self.lobe_caption)
+        self._lobe_n = None
+        self._lobe_side = None
+        self._layout_lobe()
+
+    def _layout_lobe(self) -> None:
+        """Size the inset for the view (:data:`LOBE_FRACTION` of its smaller side)."""
+        w, h = self.plotter.window_size
+        lo, hi = LOBE_SIDE
+        side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi))
+        if side == self._lobe_side:
+            return
+        self._lobe_side = side
+        x0 = y0 = LOBE_MARGIN
+        pad = 8
+        frame = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side), (x0, y0)]
+        axes = [(x0 + pad, y0 + side / 2), (x0 + side - pad, y0 + side / 2)]
+        _set_lines(self._lobe_polys["frame"], [frame, axes])
+        _set_lines(self._lobe_polys["reference"], [_lobe_points(1.0, side)])
+        self.lobe_caption.SetPosition(x0, y0 + side + 4)
+        self.lobe_caption.GetTextProperty().SetFontSize(13 if side >= 100 else 11)
         self._lobe_n = None
         self._update_lobe(self.state.material.shininess)
 
@@ -418,7 +435,7 @@ class SceneView:
         if n == self._lobe_n or not hasattr(self, "_lobe_polys"):
             return
         self._lobe_n = n
-        _set_lines(self._lobe_polys["lobe"], [_lobe_points(n)])
+        _set_lines(self._lobe_polys["lobe"], [_lobe_points(n, self._lobe_side)])
         self.lobe_caption.SetInput(f"specular lobe cos^n, n = {n:g}")
 
     # -- pixels ---------------------------------------------------------------------------------
@@ -450,8 +467,8 @@ class SceneView:
         self.plotter.renderer.ResetCameraClippingRange()
 
 
-def _lobe_points(n: float) -> np.ndarray:
-    x0, y0, side = LOBE_BOX
+def _lobe_points(n: float, side: int) -> np.ndarray:
+    x0 = y0 = LOBE_MARGIN
     pad = 8
     p = lobe_curve(n)
     scale = side - 2 * pad

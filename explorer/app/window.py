@@ -286,6 +286,7 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
         finally:
             self._in_frame = False
         self.view.before_frame(cam)
+        self._update_difference()  # the view's size may have changed (a resize)
         self.plotter.renderer.ResetCameraClippingRange()
 
     def _after_frame(self, *_) -> None:
@@ -352,12 +353,13 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
         self.view.show_mesh(not current)
         legend.setText(self.heat.legend() if current else PENDING)
         advice.setText(advice_lines(self.heat.result.advice) if current else "")
-        if current or self.view.dragging or key == self._requested:
-            return
+        size = tuple(int(v) for v in self.plotter.window_size)
+        if current or self.view.dragging or key == self._requested or min(size) < 16:
+            return  # (a view not laid out yet asks at its first frame)
         self._requested = key
         self.worker.submit(Job(
             key, s.shown_scene(), self.view.mesh, self.view.drawings[0].colors().copy(),
-            s.camera, tuple(int(v) for v in self.plotter.window_size),
+            s.camera, size,
             tuple(self.plotter.renderer.GetBackground()),
         ))  # fmt: skip
 

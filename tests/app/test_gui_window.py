@@ -149,7 +149,16 @@ class Window:
         self.xdotool(*self.move(*at), "click", 1)
 
     def key(self, name: str) -> None:
-        self.xdotool("key", "--window", self.wid, name)
+        # no window manager: X's focus follows the pointer (PointerRoot), so the key goes, as
+        # a real key press (XTEST), to the window under the pointer, which is moved inside it
+        s = self.state()
+        x, y, w, h = s["window"]["view_box"] if s else (10, 30, 10, 10)
+        self.xdotool(*self.move(x + 10, y + h - 10), "key", name)
+
+    def focus_view(self) -> None:
+        """A click in the view (no drag: the camera stays) gives it the keyboard."""
+        x, y, w, h = self.state()["window"]["view_box"]
+        self.click((x + 10, y + h - 10))
 
     def close(self) -> None:
         if self.proc.poll() is None:
@@ -239,8 +248,7 @@ def test_real_window(display, tmp_path):
         kept = s
 
         # q in the view quits; the window keeps the session
-        vx, vy, vw, vh = s["window"]["view_box"]
-        win.click((vx + 10, vy + vh - 10))
+        win.focus_view()
         win.key("q")
         assert win.proc.wait(timeout=STEP_TIMEOUT) == 0
         log = win.log.read_text(errors="replace")
@@ -258,8 +266,7 @@ def test_real_window(display, tmp_path):
         assert s["scene"]["lights"] == kept["scene"]["lights"] and s["mesh"] == MESH
         assert s["camera"]["position"] == pytest.approx(kept["camera"]["position"])
         check_probe(again, mesh)
-        vx, vy, vw, vh = s["window"]["view_box"]
-        again.click((vx + 10, vy + vh - 10))
+        again.focus_view()
         again.key("ctrl+q")
         assert again.proc.wait(timeout=STEP_TIMEOUT) == 0
     finally:
