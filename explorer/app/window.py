@@ -30,7 +30,15 @@ from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
 from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
-from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, framed_camera, view_camera
+from explorer.app.view import (
+    HANDLE_RADIUS,
+    LOD_TARGET,
+    LOD_VERTICES,
+    SceneView,
+    framed_camera,
+    view_camera,
+    widen_to_show,
+)
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.presets import list_presets
@@ -80,6 +88,7 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
         self.frame_ms = float("nan")
         self._t0: float | None = None
         self._in_frame = False
+        self._holding_handle = False
         self._requested = None
         self.meshes: dict[str, Mesh] = {state.mesh: mesh}
         self.mesh_choices = dict(MESH_CHOICES)
@@ -148,8 +157,17 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
             style.AddObserver("StartInteractionEvent", self._guard(self._begin_drag, "camera"))
             style.AddObserver("EndInteractionEvent", self._guard(self._end_drag, "camera"))
         handle = self.view.handle
-        handle.AddObserver("StartInteractionEvent", self._guard(self._begin_drag, "handle"))
-        handle.AddObserver("EndInteractionEvent", self._guard(self._end_drag, "handle"))
+
+        def grab(*_):
+            self._holding_handle = True
+            self._begin_drag()
+
+        def release(*_):
+            self._holding_handle = False
+            self._end_drag()
+
+        handle.AddObserver("StartInteractionEvent", self._guard(grab, "handle"))
+        handle.AddObserver("EndInteractionEvent", self._guard(release, "handle"))
         for s in self.panel.findChildren(ValueSlider):
             s.pressed.connect(self._guard(self._begin_drag, s.objectName()))
             s.released.connect(self._guard(self._end_drag_if_dragging, s.objectName()))
@@ -258,6 +276,21 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
         self._update_difference()
         if not self._in_frame:
             self.render()
+        self._keep_handle_in_view(old, new)  # last: it may change the camera
+
+    def _keep_handle_in_view(self, old: M.State, new: M.State) -> None:
+        """A light moved from the panel or a key keeps its handle in view: the view is widened
+        (the camera's position, and so the viewer, stay)."""
+        if (new.selected_light is None or new.camera is None or self._holding_handle
+                or new.scene.lights == old.scene.lights):  # fmt: skip
+            return
+        w, h = self.plotter.window_size
+        if min(w, h) < 16:
+            return
+        pad = HANDLE_RADIUS * new.radius
+        cam = widen_to_show(new.camera, [M.handle_point(new)], w / h, pad=pad)
+        if cam != new.camera:
+            self.store.set_camera(cam)
 
     def _show_panel(self, state: M.State) -> None:
         self.panel.show_state(state, self.view.mesh.n_vertices)

@@ -329,3 +329,14 @@ def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
     assert win.store.state.compare is None and not win.plotter_b.isVisible()
     win.undo()
     assert win.store.state.compare is not None and win.plotter_b.isVisible()
+
+
+def test_a_light_moved_from_the_panel_keeps_its_handle_in_view(win):
+    tab = win.panel.lights
+    tab.sliders["distance"].field.setValue(3.0)
+    tab.sliders["elevation"].field.setValue(90.0)  # straight up: above the framed view
+    win.render()
+    x, y = win.view.world_to_window(M.handle_point(win.store.state))
+    w, h = win.plotter.window_size
+    assert 0 <= x < w and 0 <= y < h
+    assert win.store.state.scene.viewer.eye == pytest.approx(win.store.state.camera.position)
