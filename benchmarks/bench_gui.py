@@ -277,6 +277,48 @@ def lod_frames(mesh, repeat: int) -> dict:
     return out
 
 
+def qt_frames(mesh, repeat: int) -> dict:
+    """The Qt window itself (panel refresh included): a number field set, then the frame.
+    Needs an X display; a private Xvfb is started when DISPLAY is not set."""
+    import subprocess
+
+    server = None
+    if not os.environ.get("DISPLAY"):
+        r, w = os.pipe()
+        server = subprocess.Popen(
+            ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
+            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+        os.close(w)
+        with os.fdopen(r) as f:
+            os.environ["DISPLAY"] = ":" + f.readline().strip()
+    from explorer.app.qtmain import application
+    from explorer.app.window import ExplorerWindow
+
+    app = application()
+    scene = scene_for(mesh, 1)
+    win = ExplorerWindow(first_state(scene, mesh, name=mesh.name), mesh, size=(1150, 640))
+    win.show()
+    app.processEvents()
+    win.render()
+    fields = win.panel.material.sliders
+    values = {"kd": lambda i: 0.3 + 0.4 * (i % 2), "shininess": lambda i: 16.0 + 48.0 * (i % 2)}
+    out = {"view": tuple(win.plotter.window_size)}
+    for name, value in values.items():
+
+        def step(i, name=name, value=value):
+            fields[name].field.setValue(value(i))  # action, panel, engine, upload, frame
+            finish(win.plotter)
+
+        out[name] = timed(step, repeat)
+    win.close()
+    app.processEvents()
+    if server is not None:
+        server.terminate()
+        server.wait()
+    return out
+
+
 def fmt(t) -> str:
     return f"{t[0]:.1f} ({t[1]:.1f})"
 
@@ -287,6 +329,8 @@ def main(argv=None) -> int:
     ap.add_argument("--lights", type=int, nargs="+", default=[1, 4, 8])
     ap.add_argument("--no-write", action="store_true", help="do not write docs/gui_bench.md")
     ap.add_argument("--skip-1m", action="store_true", help="leave out the 1M-vertex rows")
+    ap.add_argument("--qt", action="store_true",
+                    help="also time the Qt window itself (needs Xvfb or a display)")  # fmt: skip
     args = ap.parse_args(argv)
 
     before = load()
@@ -317,6 +361,7 @@ def main(argv=None) -> int:
     if not args.skip_1m:
         sphere = uv_sphere(1000, 999)
         lod = lod_frames(sphere, args.repeat)
+    qt = qt_frames(teapot, args.repeat) if args.qt else None
     after = load()
 
     lines = ["# GUI benchmark", "", "Machine:", ""]
@@ -342,7 +387,23 @@ def main(argv=None) -> int:
         for k, t in lod.items():
             if k != "lod vertices":
                 lines.append(f"| {k} | {fmt(t)} | {1000.0 / t[0]:.0f} |")
-    lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}`"]
+    if qt is not None:
+        bare1 = next(t for c, n, t, _ in rows if n == 1 and c.startswith("engine + unlit"))
+        vw, vh = qt["view"]
+        lines += [
+            "",
+            f"The Qt window itself (1 point light, the same teapot, its view {vw}x{vh}): a "
+            "number field set to a new value, through the action, the panel's refresh, the "
+            "engine, the upload and the frame; median (best) ms, and the ratio to the bare "
+            "mesh draw above (1 light; its window is 800x600):",
+            "",
+            "| case | ms | / bare draw |",
+            "|---|---:|---:|",
+        ]
+        for k in ("kd", "shininess"):
+            lines.append(f"| Qt window, {k} field | {fmt(qt[k])} | {qt[k][0] / bare1[0]:.2f} |")
+    qt_flag = " --qt" if qt is not None else ""
+    lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}{qt_flag}`"]
     text = "\n".join(lines) + "\n"
     print(text)
     if not args.no_write:

@@ -1,5 +1,8 @@
-"""The A / B compare view of the explorer window (a mix-in of
-:class:`explorer.app.window.ExplorerWindow`): side B's pane beside the 3D view, with the same
+"""The explorer window's extra panes (mix-ins of :class:`explorer.app.window.ExplorerWindow`).
+
+:class:`DifferencePane`: the difference view's heat map, requested from the worker thread and
+shown only when it matches the view. :class:`ComparePane`: the A / B compare view, side B's
+pane beside the 3D view, with the same
 camera (one ``vtkCamera`` for both), the same lights and mesh, and side B's material and model;
 or, as "A − B", the difference of the two sides' colours per vertex, largest channel in 1/255
 levels, in the difference view's colours (interpolated across each triangle, like the colours).
@@ -11,6 +14,7 @@ import numpy as np
 
 from explorer.app import model as M
 from explorer.app.commands import ViewKeys
+from explorer.app.difference import PENDING, Job, advice_lines
 from explorer.app.view import SceneView, view_camera
 from explorer.shading.display import to_bytes
 
@@ -86,3 +90,52 @@ class ComparePane:
             self.plotter_b.show()
             half = max(self.views.width() // 2, 1)
             self.views.setSizes([half, half])
+
+
+class DifferencePane:
+    """The difference view (needs the window's ``store``, ``plotter``, ``view``, ``heat``,
+    ``worker``, ``panel``, ``act`` and ``render``)."""
+
+    # -- the difference view --------------------------------------------------------------------
+    def _difference_key(self) -> tuple:
+        s = self.store.state
+        return (repr(s.shown_scene()), s.mesh, s.camera, tuple(self.plotter.window_size))
+
+    def _update_difference(self) -> None:
+        """The heat map when it matches the view; else the live view, and a request for the
+        map unless something is being dragged (then it waits for the release)."""
+        s = self.store.state
+        legend, advice = self.panel.view.legend, self.panel.view.advice
+        if not s.difference:
+            self.worker.cancel()
+            self._requested = None
+            self.heat.show(False)
+            self.view.show_mesh(True)
+            return
+        key = self._difference_key()
+        current = self.heat.result is not None and self.heat.result.job.key == key
+        self.heat.show(current)
+        self.view.show_mesh(not current)
+        legend.setText(self.heat.legend() if current else PENDING)
+        advice.setText(advice_lines(self.heat.result.advice) if current else "")
+        size = tuple(int(v) for v in self.plotter.window_size)
+        if current or self.view.dragging or key == self._requested or min(size) < 16:
+            return  # (a view not laid out yet asks at its first frame)
+        self._requested = key
+        self.worker.submit(Job(
+            key, s.shown_scene(), self.view.mesh, self.view.drawings[0].colors().copy(),
+            s.camera, size,
+            tuple(self.plotter.renderer.GetBackground()),
+        ))  # fmt: skip
+
+    def _on_difference(self, result) -> None:
+        """A comparison is done (in the GUI thread now): shown if it is still the view's."""
+        if result.error is not None:
+            self._requested = None
+            self.act(M.set_difference, False, label="difference")
+            raise result.error
+        if result.job.key != self._difference_key():
+            return  # stale: a newer request is on its way
+        self.heat.set(result)
+        self._update_difference()
+        self.render()

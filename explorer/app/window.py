@@ -24,8 +24,8 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.commands import Commands
-from explorer.app.compare import ComparePane
-from explorer.app.difference import PENDING, DifferenceWorker, HeatMap, Job, advice_lines
+from explorer.app.compare import ComparePane, DifferencePane
+from explorer.app.difference import DifferenceWorker, HeatMap
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
@@ -54,7 +54,7 @@ PANEL_FRACTION = 0.34
 MESSAGE_MS = 6000
 
 
-class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
+class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
     """The explorer window.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
@@ -363,50 +363,6 @@ class ExplorerWindow(Commands, ComparePane, QtWidgets.QMainWindow):
         az, el, d = M.angles_from_point(s, centre)
         if d > 0:
             self.act(M.place_light, az, el, d, label="light handle", merge="handle")
-
-    # -- the difference view --------------------------------------------------------------------
-    def _difference_key(self) -> tuple:
-        s = self.store.state
-        return (repr(s.shown_scene()), s.mesh, s.camera, tuple(self.plotter.window_size))
-
-    def _update_difference(self) -> None:
-        """The heat map when it matches the view; else the live view, and a request for the
-        map unless something is being dragged (then it waits for the release)."""
-        s = self.store.state
-        legend, advice = self.panel.view.legend, self.panel.view.advice
-        if not s.difference:
-            self.worker.cancel()
-            self._requested = None
-            self.heat.show(False)
-            self.view.show_mesh(True)
-            return
-        key = self._difference_key()
-        current = self.heat.result is not None and self.heat.result.job.key == key
-        self.heat.show(current)
-        self.view.show_mesh(not current)
-        legend.setText(self.heat.legend() if current else PENDING)
-        advice.setText(advice_lines(self.heat.result.advice) if current else "")
-        size = tuple(int(v) for v in self.plotter.window_size)
-        if current or self.view.dragging or key == self._requested or min(size) < 16:
-            return  # (a view not laid out yet asks at its first frame)
-        self._requested = key
-        self.worker.submit(Job(
-            key, s.shown_scene(), self.view.mesh, self.view.drawings[0].colors().copy(),
-            s.camera, size,
-            tuple(self.plotter.renderer.GetBackground()),
-        ))  # fmt: skip
-
-    def _on_difference(self, result) -> None:
-        """A comparison is done (in the GUI thread now): shown if it is still the view's."""
-        if result.error is not None:
-            self._requested = None
-            self.act(M.set_difference, False, label="difference")
-            raise result.error
-        if result.job.key != self._difference_key():
-            return  # stale: a newer request is on its way
-        self.heat.set(result)
-        self._update_difference()
-        self.render()
 
     # -- reporting ------------------------------------------------------------------------------
     def widget_box(self, widget: QtWidgets.QWidget) -> list[int]:
