@@ -37,7 +37,7 @@ from common import uv_sphere  # benchmarks/common.py
 
 import explorer
 from explorer.app import model as AM
-from explorer.app.start import first_state
+from explorer.app.start import first_state, start_xvfb
 from explorer.app.view import SceneView, framed_camera, view_camera
 from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
@@ -280,18 +280,9 @@ def lod_frames(mesh, repeat: int) -> dict:
 def qt_frames(mesh, repeat: int) -> dict:
     """The Qt window itself (panel refresh included): a number field set, then the frame.
     Needs an X display; a private Xvfb is started when DISPLAY is not set."""
-    import subprocess
-
     server = None
     if not os.environ.get("DISPLAY"):
-        r, w = os.pipe()
-        server = subprocess.Popen(
-            ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
-            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        )  # fmt: skip
-        os.close(w)
-        with os.fdopen(r) as f:
-            os.environ["DISPLAY"] = ":" + f.readline().strip()
+        server, os.environ["DISPLAY"] = start_xvfb()
     from explorer.app.qtmain import application
     from explorer.app.window import ExplorerWindow
 

@@ -21,16 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
-
-def xvfb() -> tuple[subprocess.Popen, str]:
-    r, w = os.pipe()
-    proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
-        pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-    os.close(w)
-    with os.fdopen(r) as f:
-        return proc, ":" + f.readline().strip()
+from explorer.app.start import start_xvfb
 
 
 def start_once(display: str, env_extra: dict, timeout: float) -> float:
@@ -68,7 +59,7 @@ def main(argv=None) -> int:
     ap.add_argument("--cold", action="store_true", help="also start with an empty numba cache")
     ap.add_argument("--timeout", type=float, default=900.0)
     args = ap.parse_args(argv)
-    proc, display = xvfb()
+    proc, display = start_xvfb()
     try:
         start_once(display, {}, args.timeout)  # warms the cache the warm rows use
         rows = {"warm": [start_once(display, {}, args.timeout) for _ in range(args.repeat)]}

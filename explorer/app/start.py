@@ -137,6 +137,34 @@ def _x_display_opens(display: str) -> bool:
     return True
 
 
+def start_xvfb(size=(1280, 900)):
+    """A private Xvfb server for scripts, benchmarks and tests: ``(process, ":N")``, the
+    display number chosen by the server. On Linux the server ends with the calling process
+    (``PR_SET_PDEATHSIG``), even when that one crashes."""
+    import signal
+    import subprocess
+
+    def die_with_parent():
+        try:
+            ctypes.CDLL("libc.so.6").prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+        except OSError:
+            pass
+
+    r, w = os.pipe()
+    proc = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(w), "-screen", "0", "{}x{}x24".format(*size), "-nolisten",
+         "tcp"], pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        preexec_fn=die_with_parent if sys.platform.startswith("linux") else None,
+    )  # fmt: skip
+    os.close(w)
+    with os.fdopen(r) as f:
+        number = f.readline().strip()
+    if not number:
+        proc.terminate()
+        raise ExplorerError("Xvfb did not start")
+    return proc, f":{number}"
+
+
 def round_sig(x: float, digits: int = 3) -> float:
     """``x`` rounded to ``digits`` significant digits (0 stays 0)."""
     if x == 0 or not math.isfinite(x):

@@ -3,14 +3,13 @@ one that hosts the VTK view, so in-process widget tests need an X server too).""
 
 from __future__ import annotations
 
-import ctypes
 import os
 import shutil
-import signal
-import subprocess
 import sys
 
 import pytest
+
+from explorer.app.start import start_xvfb
 
 #: modules whose tests open Qt windows in the test process
 QT_MODULES = ("test_window.py",)
@@ -25,30 +24,6 @@ def pytest_collection_modifyitems(session, config, items):
     if qt:
         rest = [i for i in items if i not in set(qt)]
         items[:] = rest + qt
-
-
-def _die_with_parent():  # Linux: the server ends when the test process does, even on a crash
-    try:
-        ctypes.CDLL("libc.so.6").prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except OSError:
-        pass
-
-
-def start_xvfb():
-    """A private Xvfb server (its display number chosen by the server): (process, ":N")."""
-    r, w = os.pipe()
-    proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
-        pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
-    )  # fmt: skip
-    os.close(w)
-    with os.fdopen(r) as f:
-        number = f.readline().strip()
-    if not number:
-        proc.terminate()
-        pytest.fail("Xvfb did not start")
-    return proc, f":{number}"
 
 
 @pytest.fixture(scope="session")

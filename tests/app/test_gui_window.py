@@ -51,21 +51,10 @@ START_TIMEOUT = 120.0
 @pytest.fixture
 def display():
     """A private Xvfb server; its display name (":N") chosen by the server itself."""
-    r, w = os.pipe()
-    proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
-        pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-    os.close(w)
-    try:
-        with os.fdopen(r) as f:
-            number = f.readline().strip()
-        if not number:
-            pytest.fail("Xvfb did not start")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        proc.wait(timeout=10)
+    proc, name = gui.start_xvfb()
+    yield name
+    proc.terminate()
+    proc.wait(timeout=10)
 
 
 class Window:
