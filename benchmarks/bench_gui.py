@@ -302,6 +302,14 @@ def qt_frames(mesh, repeat: int) -> dict:
             finish(win.plotter)
 
         out[name] = timed(step, repeat)
+    # where a kd change's time goes: the panel's refresh, the engine and upload, the frame
+    state = win.store.state
+    out["panel refresh"] = timed(lambda i: win.panel.show_state(state, mesh.n_vertices), repeat)
+    out["engine + upload"] = timed(
+        lambda i: win.view.show_state(AM.set_coefficient(state, "kd", 0.3 + 0.4 * (i % 2))),
+        repeat,
+    )
+    out["frame"] = timed(lambda i: (win.render(), finish(win.plotter)), repeat)
     win.close()
     app.processEvents()
     if server is not None:
@@ -393,6 +401,8 @@ def main(argv=None) -> int:
         ]
         for k in ("kd", "shininess"):
             lines.append(f"| Qt window, {k} field | {fmt(qt[k])} | {qt[k][0] / bare1[0]:.2f} |")
+        for k in ("panel refresh", "engine + upload", "frame"):
+            lines.append(f"| of a kd change: {k} | {fmt(qt[k])} | |")
     qt_flag = " --qt" if qt is not None else ""
     lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}{qt_flag}`"]
     text = "\n".join(lines) + "\n"
