@@ -6,7 +6,8 @@
 - :mod:`explorer.app.view`, :mod:`explorer.app.difference`: the VTK view and the difference
   view's worker thread (VTK and PyVista imported inside functions; no Qt).
 - :mod:`explorer.app.panel`, :mod:`explorer.app.lightpanel`, :mod:`explorer.app.commands`,
-  :mod:`explorer.app.window`, :mod:`explorer.app.qtmain`: the Qt window (PySide6, pyvistaqt).
+  :mod:`explorer.app.compare`, :mod:`explorer.app.window`, :mod:`explorer.app.qtmain`: the Qt
+  window (PySide6, pyvistaqt).
 
 May import everything below it (:mod:`explorer.core`, :mod:`explorer.geometry`,
 :mod:`explorer.shading`, :mod:`explorer.render`) and, of :mod:`explorer.analysis`, the
