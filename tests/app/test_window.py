@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import trimesh
 from PySide6 import QtCore, QtGui
 
 import explorer
@@ -234,6 +235,19 @@ def test_open_mesh_files_and_errors_in_one_line(win, tmp_path):
     assert win.store.state.mesh == "cube" and win.view.mesh.name == "cube"
     win.undo()
     assert win.store.state.mesh == "icosphere"
+    scene = tmp_path / "scene.yaml"
+    scene.write_text("material: ruby\nlights: [{type: directional, to_light: [0, 1, 0]}]\n")
+    win.open_file(scene)
+    s = win.store.state
+    assert s.preset == "ruby" and s.material == explorer.load_scene(str(scene)).material
+    assert [light.type for light in s.scene.lights] == ["directional"]
+    win.render()
+    drawn_equals_engine(win)
+    stl = tmp_path / "box.stl"
+    trimesh.creation.box().export(stl)
+    win.open_file(stl)
+    assert win.store.state.mesh == str(stl) and win.view.mesh.n_vertices > 0
+    assert win.panel.view.mesh.currentText() == "box.stl"
 
 
 def test_difference_view_from_the_worker(win, qtbot):
