@@ -7,7 +7,8 @@ Everything runs off-screen in one process, 800x600, anti-aliasing and multisampl
 same meshes:
 
 - 100k vertices (the Utah teapot at tessellation 56), 1, 4 and 8 point lights:
-  * ``explorer``: the explorer window (sliders, buttons, texts, lobe inset) as a slider fires:
+  * ``explorer``: the explorer window's update path (its Store and SceneView: mesh, handle,
+    lobe inset; no Qt widgets) as a slider's action arrives:
     the engine's update (kd: compose only; shininess: the lobe; azimuth: every light sum), the
     uint8 colour upload and the frame;
   * ``engine + unlit mesh``: the same engine update and upload on a bare window (no widgets);
@@ -35,7 +36,9 @@ import numpy as np
 from common import uv_sphere  # benchmarks/common.py
 
 import explorer
-from explorer.app import window as gui
+from explorer.app import model as AM
+from explorer.app.start import first_state, start_xvfb
+from explorer.app.view import SceneView, framed_camera, view_camera
 from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer
@@ -110,24 +113,50 @@ def finish(plotter) -> None:
 # -- the three ways of drawing a slider change ----------------------------------------------------
 
 
-def explorer_frames(mesh, count: int, repeat: int, **kw) -> dict:
-    """The explorer window: a slider's InteractionEvent, then the frame."""
-    from vtkmodules.vtkCommonCore import vtkCommand
+class Driven:
+    """The explorer window's update path without Qt: a Store and the window's SceneView in an
+    off-screen plotter. A change goes state -> view (engine update, uint8 upload) -> frame, and
+    each frame records the camera into the state first, exactly as the window does; the Qt
+    widgets and event loop are not part of it."""
 
-    app = gui.Explorer(scene_for(mesh, count), mesh, off_screen=True, window_size=SIZE, **kw)
+    def __init__(self, mesh, scene, **kw):
+        self.plotter = plotter(SIZE, BACKGROUND)
+        state = first_state(scene, mesh, name=mesh.name)
+        state = AM.set_camera(state, framed_camera(state, mesh, SIZE[0] / SIZE[1]))
+        self.store = AM.Store(state)
+        self.view = SceneView(self.plotter, mesh, state, **kw)
+        self.view.add_handle(lambda *_: None)
+        self.view.apply_camera(state.camera)
+        self.store.subscribe(lambda old, new: self.view.show_state(new))
+
+    def render(self) -> None:
+        s = self.store.state
+        cam = view_camera(self.plotter.camera, s.centre, s.radius)
+        self.store.set_camera(cam)
+        self.view.before_frame(cam)
+        self.plotter.render_window.Render()
+
+    def close(self) -> None:
+        self.plotter.close()
+
+
+#: slider name -> the action its value sends
+SLIDERS = {
+    "kd": lambda i: (AM.set_coefficient, "kd", 0.3 + 0.4 * (i % 2)),
+    "shininess": lambda i: (AM.set_shininess, round(10 ** (1.2 + 0.8 * (i % 2)), 1)),
+    "azimuth": lambda i: (AM.place_light, 20.0 + 30.0 * (i % 2)),
+}
+
+
+def explorer_frames(mesh, count: int, repeat: int, **kw) -> dict:
+    """The explorer's update path: a slider's action, then the frame."""
+    app = Driven(mesh, scene_for(mesh, count), **kw)
     app.render()
     out = {}
-    values = {
-        "kd": lambda i: 0.3 + 0.4 * (i % 2),
-        "shininess": lambda i: 1.2 + 0.8 * (i % 2),
-        "azimuth": lambda i: 20.0 + 30.0 * (i % 2),
-    }
-    for name, value in values.items():
-        w = app.sliders[name]
+    for name, action in SLIDERS.items():
 
-        def step(i, w=w, value=value):
-            w.GetRepresentation().SetValue(value(i))
-            w.InvokeEvent(vtkCommand.InteractionEvent)
+        def step(i, action=action):
+            app.store.apply(*action(i), merge="bench")
             app.render()
             finish(app.plotter)
 
@@ -209,17 +238,12 @@ def vtk_lighting_frames(mesh, count: int, repeat: int) -> dict:
 def lod_frames(mesh, repeat: int) -> dict:
     """1M vertices: slider frames while dragging (LOD), the frame on release, and slider frames
     drawn on the full mesh (no LOD)."""
-    from vtkmodules.vtkCommonCore import vtkCommand
-
     out = {}
-    app = gui.Explorer(scene_for(mesh, 1), mesh, off_screen=True, window_size=SIZE)
+    app = Driven(mesh, scene_for(mesh, 1))
     app.render()
-    w = app.sliders["kd"]
-    rep = w.GetRepresentation()
 
     def drag(i):
-        rep.SetValue(0.3 + 0.4 * (i % 2))
-        w.InvokeEvent(vtkCommand.InteractionEvent)
+        app.store.apply(*SLIDERS["kd"](i), merge="bench")
         app.render()
         finish(app.plotter)
 
@@ -228,21 +252,21 @@ def lod_frames(mesh, repeat: int) -> dict:
         app.render()
         finish(app.plotter)
 
-    w.InvokeEvent(vtkCommand.StartInteractionEvent)
-    out["lod vertices"] = app._views[1].mesh.n_vertices
+    app.view.begin_drag()
+    out["lod vertices"] = app.view.drawings[1].mesh.n_vertices
     out["drag kd (LOD)"] = timed(drag, repeat)
     out["drag camera (LOD)"] = timed(rotate, repeat)
 
     def release(i):
-        w.InvokeEvent(vtkCommand.StartInteractionEvent)
+        app.view.begin_drag()
         drag(i)
         t = time.perf_counter()
-        w.InvokeEvent(vtkCommand.EndInteractionEvent)
+        app.view.end_drag()
         app.render()
         finish(app.plotter)
         return 1000.0 * (time.perf_counter() - t)
 
-    w.InvokeEvent(vtkCommand.EndInteractionEvent)
+    app.view.end_drag()
     app.render()
     ts = [release(i) for i in range(max(3, repeat // 3))]
     out["release (full mesh)"] = (statistics.median(ts), min(ts))
@@ -250,6 +274,47 @@ def lod_frames(mesh, repeat: int) -> dict:
     full = explorer_frames(mesh, 1, max(3, repeat // 3), lod_vertices=10**9)
     out["kd, no LOD (full mesh)"] = full["kd"]
     full["app"].close()
+    return out
+
+
+def qt_frames(mesh, repeat: int) -> dict:
+    """The Qt window itself (panel refresh included): a number field set, then the frame.
+    Needs an X display; a private Xvfb is started when DISPLAY is not set."""
+    server = None
+    if not os.environ.get("DISPLAY"):
+        server, os.environ["DISPLAY"] = start_xvfb()
+    from explorer.app.qtmain import application
+    from explorer.app.window import ExplorerWindow
+
+    app = application()
+    scene = scene_for(mesh, 1)
+    win = ExplorerWindow(first_state(scene, mesh, name=mesh.name), mesh, size=(1150, 640))
+    win.show()
+    app.processEvents()
+    win.render()
+    fields = win.panel.material.sliders
+    values = {"kd": lambda i: 0.3 + 0.4 * (i % 2), "shininess": lambda i: 16.0 + 48.0 * (i % 2)}
+    out = {"view": tuple(win.plotter.window_size)}
+    for name, value in values.items():
+
+        def step(i, name=name, value=value):
+            fields[name].field.setValue(value(i))  # action, panel, engine, upload, frame
+            finish(win.plotter)
+
+        out[name] = timed(step, repeat)
+    # where a kd change's time goes: the panel's refresh, the engine and upload, the frame
+    state = win.store.state
+    out["panel refresh"] = timed(lambda i: win.panel.show_state(state, mesh.n_vertices), repeat)
+    out["engine + upload"] = timed(
+        lambda i: win.view.show_state(AM.set_coefficient(state, "kd", 0.3 + 0.4 * (i % 2))),
+        repeat,
+    )
+    out["frame"] = timed(lambda i: (win.render(), finish(win.plotter)), repeat)
+    win.close()
+    app.processEvents()
+    if server is not None:
+        server.terminate()
+        server.wait()
     return out
 
 
@@ -263,6 +328,8 @@ def main(argv=None) -> int:
     ap.add_argument("--lights", type=int, nargs="+", default=[1, 4, 8])
     ap.add_argument("--no-write", action="store_true", help="do not write docs/gui_bench.md")
     ap.add_argument("--skip-1m", action="store_true", help="leave out the 1M-vertex rows")
+    ap.add_argument("--qt", action="store_true",
+                    help="also time the Qt window itself (needs Xvfb or a display)")  # fmt: skip
     args = ap.parse_args(argv)
 
     before = load()
@@ -282,10 +349,10 @@ def main(argv=None) -> int:
             ("engine + unlit mesh (bare window), kd", count, bare["kd"], bare["kd"][0] / ref)
         )
         for name, label in (
-            ("kd", "explorer window, kd slider (compose)"),
-            ("shininess", "explorer window, shininess slider (lobe)"),
-            ("azimuth", "explorer window, azimuth slider (all light sums)"),
-            ("camera", "explorer window, camera rotation (specular)"),
+            ("kd", "explorer view, kd slider (compose)"),
+            ("shininess", "explorer view, shininess slider (lobe)"),
+            ("azimuth", "explorer view, azimuth slider (all light sums)"),
+            ("camera", "explorer view, camera rotation (specular)"),
         ):
             rows.append((label, count, ex[name], ex[name][0] / ref))
     lod = None
@@ -293,6 +360,7 @@ def main(argv=None) -> int:
     if not args.skip_1m:
         sphere = uv_sphere(1000, 999)
         lod = lod_frames(sphere, args.repeat)
+    qt = qt_frames(teapot, args.repeat) if args.qt else None
     after = load()
 
     lines = ["# GUI benchmark", "", "Machine:", ""]
@@ -318,7 +386,25 @@ def main(argv=None) -> int:
         for k, t in lod.items():
             if k != "lod vertices":
                 lines.append(f"| {k} | {fmt(t)} | {1000.0 / t[0]:.0f} |")
-    lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}`"]
+    if qt is not None:
+        bare1 = next(t for c, n, t, _ in rows if n == 1 and c.startswith("engine + unlit"))
+        vw, vh = qt["view"]
+        lines += [
+            "",
+            f"The Qt window itself (1 point light, the same teapot, its view {vw}x{vh}): a "
+            "number field set to a new value, through the action, the panel's refresh, the "
+            "engine, the upload and the frame; median (best) ms, and the ratio to the bare "
+            "mesh draw above (1 light; its window is 800x600):",
+            "",
+            "| case | ms | / bare draw |",
+            "|---|---:|---:|",
+        ]
+        for k in ("kd", "shininess"):
+            lines.append(f"| Qt window, {k} field | {fmt(qt[k])} | {qt[k][0] / bare1[0]:.2f} |")
+        for k in ("panel refresh", "engine + upload", "frame"):
+            lines.append(f"| of a kd change: {k} | {fmt(qt[k])} | |")
+    qt_flag = " --qt" if qt is not None else ""
+    lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}{qt_flag}`"]
     text = "\n".join(lines) + "\n"
     print(text)
     if not args.no_write:

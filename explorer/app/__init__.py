@@ -1,6 +1,15 @@
-"""The desktop explorer window.
+"""The desktop explorer.
+
+- :mod:`explorer.app.model`, :mod:`explorer.app.session`, :mod:`explorer.app.start`: the state,
+  its actions and undo history, sessions, the start: plain Python that imports neither Qt, VTK
+  nor PyVista (a second front end can reuse them).
+- :mod:`explorer.app.view`, :mod:`explorer.app.difference`: the VTK view and the difference
+  view's worker thread (VTK and PyVista imported inside functions; no Qt).
+- :mod:`explorer.app.panel`, :mod:`explorer.app.lightpanel`, :mod:`explorer.app.commands`,
+  :mod:`explorer.app.compare`, :mod:`explorer.app.window`, :mod:`explorer.app.qtmain`: the Qt
+  window (PySide6, pyvistaqt).
 
 May import everything below it (:mod:`explorer.core`, :mod:`explorer.geometry`,
-:mod:`explorer.shading`, :mod:`explorer.render`) and, of :mod:`explorer.analysis`, the comparison
-and the advice only. PyVista / VTK are imported inside the functions that open windows.
+:mod:`explorer.shading`, :mod:`explorer.render`) and, of :mod:`explorer.analysis`, the
+comparison and the advice only. Importing this package imports nothing of Qt, VTK or PyVista.
 """

@@ -1,80 +1,175 @@
-"""The explorer's difference view: the per-pixel error of the current view as a heat map.
+"""The explorer's difference view: the per-pixel error of the current view as a heat map,
+computed off the GUI thread.
 
-The toggle ``difference`` (a check box in the mesh section of the panel, key ``d``) compares
-what the window shows, per-vertex colours interpolated across each triangle, with the same
-lighting evaluated at every pixel (:func:`explorer.analysis.comparison.compare_view`: the exact
-sphere for the built-in spheres, ray casting with interpolated normals for any other mesh), for
-the current camera, window size, mesh, material and lights. The error of each pixel, in 1/255
-levels, is drawn with :func:`explorer.analysis.comparison.heat_map` as the renderer's background
-while the mesh is hidden, so the map sits exactly where the mesh is drawn. A legend gives the
-RMSE and the worst pixel, and a second text gives :func:`explorer.analysis.advice.advice`: which
-tessellation keeps the error within one level for the current shininess at this window's size.
+The toggle ``difference`` compares what the window shows, per-vertex colours interpolated
+across each triangle, with the same lighting evaluated at every pixel
+(:func:`explorer.analysis.comparison.compare_view`: the exact sphere for the built-in spheres,
+ray casting with interpolated normals for any other mesh), for the current camera, view size,
+mesh, material and lights. The error of each pixel, in 1/255 levels, is drawn with
+:func:`explorer.analysis.comparison.heat_map` as the renderer's background while the mesh is
+hidden, so the map sits exactly where the mesh is drawn.
 
-One comparison costs two off-screen renders and the per-pixel reference at the window's size
-(a few hundred ms), so the explorer computes it once a change is complete: at once after a key
-or a button, on release after a drag; while something is dragged the live view is shown.
-PyVista and VTK are imported only inside the methods that need them.
+One comparison costs two off-screen renders and the per-pixel reference, so it runs in
+:class:`DifferenceWorker`'s thread: a new request cancels the one running (it is passed a
+``cancelled`` callable when ``compare_view`` takes one, and its result is dropped in any case),
+so frames keep coming and a stale map is never shown as the current one. No Qt here: the
+worker hands results to a callback, which the window forwards to its GUI thread.
 """
 
 from __future__ import annotations
 
+import inspect
+import threading
+import time
+from dataclasses import dataclass
+
 import numpy as np
 
-from explorer.analysis import comparison as A
+from explorer.analysis import advice as A
+from explorer.analysis import comparison as C
+from explorer.core import errors
 from explorer.shading.display import to_bytes
 
 #: the error (1/255 levels) drawn white; the ramp below it is logarithmic (see heat_map)
 VMAX = 16.0
+#: the legend while a comparison is being made or waits for a drag to end
+PENDING = "difference: computing the map for this view (the live view meanwhile)"
+#: meshes the measured accuracy table is about (others get its advice as a guide only)
+TABLE_MESHES = ("sphere", "icosphere")
 
-#: what the legend says while a comparison is being made or waits for a drag to end
-PENDING = "difference: waiting for the change to end (the live view meanwhile)"
+
+@dataclass(frozen=True)
+class Job:
+    """One comparison to make. key : what the map is for (the window decides what goes in
+    it); scene, mesh, colors (n, 3) in [0, 1], camera, size (w, h), background RGB in [0, 1]"""
+
+    key: object
+    scene: object
+    mesh: object
+    colors: np.ndarray
+    camera: object
+    size: tuple
+    background: tuple
 
 
-class DifferenceView:
-    """The heat map, shown in a renderer's background, and what it was computed for.
+@dataclass(frozen=True)
+class Result:
+    """A finished comparison: the job, the heat map (h, w, 3) uint8, the comparison, the
+    advice line, the time it took (ms); or the error that stopped it."""
 
-    renderer : the explorer's vtkRenderer
-    on : the toggle
-    comparison : the last :class:`explorer.analysis.comparison.Comparison` (or None)
-    key : what the shown map was computed for (the explorer decides what goes in it)
+    job: Job
+    image: np.ndarray | None = None
+    comparison: object = None
+    advice: str = ""
+    ms: float = 0.0
+    error: BaseException | None = None
+
+
+def takes_cancelled(fn=None) -> bool:
+    """Whether ``compare_view`` accepts a ``cancelled`` callable."""
+    try:
+        return "cancelled" in inspect.signature(fn or C.compare_view).parameters
+    except (TypeError, ValueError):
+        return False
+
+
+def run_job(job: Job, cancelled=lambda: False) -> Result:
+    """Make one comparison (in any thread)."""
+    t = time.perf_counter()
+    extra = {"cancelled": cancelled} if takes_cancelled() else {}
+    c = C.compare_view(job.scene, job.mesh, job.size, camera=job.camera, colors=job.colors,
+                       **extra)  # fmt: skip
+    bg = tuple(int(v) for v in to_bytes([job.background])[0])
+    image = C.heat_map(c.levels, c.mask, vmax=VMAX, background=bg)
+    m = job.scene.material
+    advice = A.advice(m.shininess, job.size, model=job.scene.model)
+    mesh_name = getattr(job.mesh, "name", "")
+    if not any(mesh_name.startswith(name) for name in TABLE_MESHES):
+        advice = f"measured on spheres (a guide for this mesh): {advice}"
+    return Result(job, image, c, advice, 1000.0 * (time.perf_counter() - t))
+
+
+class DifferenceWorker:
+    """One background thread making the latest requested comparison.
+
+    deliver : called with each :class:`Result` that was not cancelled, in the worker's thread
     """
+
+    def __init__(self, deliver):
+        self._deliver = deliver
+        self._lock = threading.Condition()
+        self._pending: Job | None = None
+        self._running: Job | None = None
+        self._cancel = threading.Event()
+        self._closed = False
+        self._thread = threading.Thread(target=self._loop, name="difference", daemon=True)
+        self._thread.start()
+
+    def submit(self, job: Job) -> None:
+        """Make ``job`` next; the one running and any waiting are cancelled."""
+        with self._lock:
+            self._pending = job
+            self._cancel.set()
+            self._lock.notify()
+
+    def cancel(self) -> None:
+        """Drop what is waiting and cancel what runs."""
+        with self._lock:
+            self._pending = None
+            self._cancel.set()
+
+    @property
+    def busy(self) -> bool:
+        with self._lock:
+            return self._pending is not None or self._running is not None
+
+    def close(self, timeout: float = 30.0) -> None:
+        with self._lock:
+            self._closed = True
+            self._pending = None
+            self._cancel.set()
+            self._lock.notify()
+        self._thread.join(timeout)
+
+    def _loop(self) -> None:
+        cancelled_error = getattr(errors, "Cancelled", None)
+        while True:
+            with self._lock:
+                while self._pending is None and not self._closed:
+                    self._lock.wait()
+                if self._closed:
+                    return
+                job, self._pending, self._running = self._pending, None, self._pending
+                self._cancel = cancel = threading.Event()
+            try:
+                result = run_job(job, cancel.is_set)
+            except Exception as exc:  # noqa: BLE001 - handed to the window, which shows it
+                if cancelled_error is not None and isinstance(exc, cancelled_error):
+                    result = None
+                else:
+                    result = Result(job, error=exc)
+            with self._lock:
+                self._running = None
+                stale = cancel.is_set() or self._closed
+            if result is not None and not stale:
+                self._deliver(result)
+
+
+class HeatMap:
+    """The heat map shown as a renderer's background (the mesh hidden meanwhile)."""
 
     def __init__(self, renderer):
         self.renderer = renderer
-        self.on = False
-        self.comparison = None
-        self.key = None
+        self.result: Result | None = None
         self.shown = False
-        self._comparer = None
         self._texture = None
 
-    def stale(self, key) -> bool:
-        """Whether the shown map no longer matches ``key``."""
-        return self.comparison is None or key != self.key
-
-    def compute(self, scene, mesh, colors, camera, size, key, background) -> None:
-        """Compare the view and make its heat map (not shown until :meth:`show`).
-
-        scene, mesh : what the window shows; colors : (n, 3) the displayed colours in [0, 1]
-        camera : an :class:`explorer.render.camera.Camera` of the window's camera
-        size : (width, height) of the window; background : RGB in [0, 1] for uncovered pixels
-        """
-
-        size = tuple(int(v) for v in size)
-        if self._comparer is None or self._comparer.size != size:
-            self.close()
-            self._comparer = A.ViewComparer(size)
-        c = self._comparer.compare(scene, mesh, camera=camera, colors=colors)
-        bg = tuple(int(v) for v in to_bytes([background])[0])
-        self._set_image(A.heat_map(c.levels, c.mask, vmax=VMAX, background=bg))
-        self.comparison = c
-        self.key = key
-
-    def _set_image(self, image: np.ndarray) -> None:
+    def set(self, result: Result) -> None:
         from vtkmodules.util.numpy_support import numpy_to_vtk
         from vtkmodules.vtkCommonDataModel import vtkImageData
         from vtkmodules.vtkRenderingCore import vtkTexture
 
+        image = result.image
         h, w, _ = image.shape
         data = vtkImageData()
         data.SetDimensions(w, h, 1)
@@ -87,6 +182,7 @@ class DifferenceView:
         tex.InterpolateOff()  # one texel per pixel: no blur
         self._texture = tex
         self.renderer.SetBackgroundTexture(tex)
+        self.result = result
 
     def show(self, visible: bool) -> None:
         """Draw the heat map as the background (True) or the plain background (False)."""
@@ -95,31 +191,27 @@ class DifferenceView:
         self.renderer.SetTexturedBackground(visible)
 
     def legend(self) -> str:
-        """Two lines: what the map shows, with its RMSE and worst pixel, and the colour ramp."""
-        c = self.comparison
-        if c is None:
+        """What the map shows: its RMSE and worst pixel, and the colour ramp."""
+        if self.result is None:
             return PENDING
+        c = self.result.comparison
         return (
             f"per-pixel difference from the exact lighting: RMSE {c.rmse:.2f}, worst pixel "
-            f"{c.max} levels (1/255)\nblack 0, blue 1, then green, yellow, red, white "
+            f"{c.max} levels (1/255); black 0, blue 1, then green, yellow, red, white "
             f">= {VMAX:g} levels; {int(c.mask.sum()):,} pixels compared"
         )
 
     def state(self) -> dict:
-        c = self.comparison
+        r = self.result
+        c = None if r is None else r.comparison
         return {
-            "on": self.on,
             "shown": self.shown,
             "rmse": None if c is None else c.rmse,
             "max": None if c is None else c.max,
             "pixels": None if c is None else int(c.mask.sum()),
+            "ms": None if r is None else r.ms,
+            "advice": None if r is None else r.advice,
         }
-
-    def close(self) -> None:
-        """Release the off-screen windows (made again when needed)."""
-        if self._comparer is not None:
-            self._comparer.close()
-            self._comparer = None
 
 
 def advice_lines(text: str) -> str:

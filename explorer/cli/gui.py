@@ -5,6 +5,8 @@
     phong-explorer                                   # gold on the teapot under one point light
     phong-explorer gui --preset jade --mesh torus
     phong-explorer gui scene.yaml --mesh bunny.obj
+    phong-explorer gui --session my.yaml             # a saved session, exactly
+    phong-explorer gui --last                        # the session kept when the window closed
 
 A SCENE file gives the start (material, lights, viewer, mesh); the options are the ``render``
 command's and override their part of it. The window needs a display: without one the command
@@ -19,13 +21,12 @@ import math
 import os
 import sys
 
-import numpy as np
-
-from explorer.app import window as gui
+from explorer.app import session as S
+from explorer.app import start as gui
+from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
-from explorer.core.scene import Viewer
 from explorer.geometry.meshes import get_mesh
 from explorer.render.images import parse_size
 
@@ -36,7 +37,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
     )  # fmt: skip
     p.add_argument(
-        "--size", default="{}x{}".format(*gui.G.WINDOW_SIZE), metavar="WxH",
+        "--size", default="{}x{}".format(*gui.WINDOW_SIZE), metavar="WxH",
         help="window size in pixels (default %(default)s)",
     )  # fmt: skip
     p.add_argument(
@@ -55,6 +56,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--force", action="store_true", help="replace the --state-file if it exists already",
     )  # fmt: skip
+    p.add_argument(
+        "--session", metavar="FILE", default=None,
+        help="open a saved session (File > Save session, or a --state-file) exactly as it was",
+    )  # fmt: skip
+    p.add_argument(
+        "--last", action="store_true",
+        help="reopen the session the window kept when it was last closed",
+    )  # fmt: skip
     add_scene_arguments(p, force=False, mesh_default=gui.DEFAULT_MESH)
 
 
@@ -68,15 +77,17 @@ def check_options(args) -> None:
     f = args.state_file
     if f is not None and os.path.lexists(f) and not args.force:
         raise ExplorerError(f"--state-file {f!r}: already exists; use --force to replace it")
+    if args.session is not None and args.last:
+        raise ExplorerError("--session and --last both name a session: give one")
 
 
 def start(args):
-    """The start of the explorer from the command line: ``(scene, mesh, preset name)``.
+    """The explorer's start from the command line: ``(scene, mesh, preset name)``.
 
-    Without a SCENE file the start is :data:`explorer.app.window.DEFAULT_PRESET` on the teapot under
-    one point light placed at :data:`explorer.app.window.DEFAULT_PLACEMENT`, seen from a local
-    viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
-    (:data:`explorer.app.window.MESH_CHOICES`) unless ``--resolution`` is given.
+    Without a SCENE file the start is :data:`explorer.app.start.DEFAULT_PRESET` on the teapot
+    under one point light placed at :data:`explorer.app.model.DEFAULT_PLACEMENT`, seen from a
+    local viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
+    (:data:`explorer.app.start.MESH_CHOICES`) unless ``--resolution`` is given.
     """
     check_options(args)
     if args.scene is None and args.preset is None:
@@ -90,14 +101,29 @@ def start(args):
         mesh = get_mesh(spec, gui.MESH_CHOICES[spec])
     r = mesh.radius or 1.0
     if scene.lights == (placeholder,):  # no scene lights and no --light-* option
-        az, el, d = gui.DEFAULT_PLACEMENT
+        az, el, d = DEFAULT_PLACEMENT
         scene = scene.replace(lights=(PointLight().placed(az, el, d * r, mesh.centre),))
     if args.scene is None and args.viewer_eye is None and args.viewer_to_viewer is None:
-        e = np.asarray(gui.DEFAULT_EYE_DIRECTION, dtype=np.float64)
-        eye = mesh.centre + gui.DEFAULT_EYE_DISTANCE * r * e / np.linalg.norm(e)
-        scene = scene.replace(viewer=Viewer(eye=tuple(eye)))
+        scene = scene.replace(viewer=gui.default_viewer(mesh))
     preset = args.preset if isinstance(args.preset, str) else scene.material.name
     return scene, mesh, preset
+
+
+def start_state(args):
+    """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s."""
+    check_options(args)
+    dirs = tuple(args.materials_dirs)
+    if args.last:
+        path = S.last_session_path()
+        if not path.is_file():
+            raise ExplorerError(f"--last: no session kept yet ({path} does not exist)")
+        return S.load_session(path, materials_dirs=dirs)
+    if args.session is not None:
+        return S.load_session(args.session, materials_dirs=dirs)
+    scene, mesh, preset = start(args)
+    state = gui.first_state(scene, mesh, preset=preset, materials_dirs=dirs,
+                            resolution=args.resolution)  # fmt: skip
+    return state, mesh
 
 
 def run(args) -> int:
@@ -114,15 +140,16 @@ def run(args) -> int:
     size = parse_size(args.size)
     if args.screenshot_dir is not None and not os.path.isdir(args.screenshot_dir):
         raise ExplorerError(f"--screenshot-dir: {args.screenshot_dir!r} is not a directory")
-    scene, mesh, preset = start(args)
+    state, mesh = start_state(args)
+    # Qt is loaded only when a window opens (every other command starts without it)
+    from explorer.app.qtmain import run_window
+
     try:
-        app = gui.Explorer(
-            scene, mesh, preset=preset, materials_dirs=tuple(args.materials_dirs),
-            window_size=size, state_file=args.state_file, output_dir=args.screenshot_dir,
-            background=background_from_options(args),
+        return run_window(
+            state, mesh, materials_dirs=tuple(args.materials_dirs), size=size,
+            state_file=args.state_file, output_dir=args.screenshot_dir,
+            background=background_from_options(args), exit_after=args.exit_after,
         )  # fmt: skip
     except gui.NoDisplayError as exc:
         print(gui.no_display_message(str(exc)), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS
-    app.show(exit_after=args.exit_after)
-    return 0

@@ -1,15 +1,15 @@
 """The explorer in a real X window (Xvfb), driven by xdotool like a person would.
 
-One run of ``phong-explorer gui`` on a private Xvfb server: drag the kd slider, drag the light
-handle, rotate the camera, switch the preset with its button, show and hide the difference view
-(its button, then key d), open the help with a key, quit
-with ``q``. After each step the test polls the app's state file (written atomically after each
-frame) and the window's pixels (``xwd``), never sleeping a fixed time: the pixel where the vertex
-facing the camera lands must lie within the colours the engine gives the triangles around that
-vertex, computed here from the reported scene.
+``phong-explorer gui`` on a private Xvfb server: drag the kd slider, undo with Ctrl+Z, redo
+with Ctrl+Shift+Z, quit with ``q`` in the view (the window keeps the session), reopen it with
+``gui --last`` and check it is the same, then open the ``--state-file`` as a session too.
+After each step the test polls the app's state file (written atomically after each frame) and
+the window's pixels (``xwd``), never sleeping a fixed time: the pixel where the vertex facing
+the camera lands must lie within the colours the engine gives the triangles around that vertex,
+computed here from the reported scene.
 
-Needs ``Xvfb``, ``xdotool`` and ``xwd`` (``apt-get install -y xvfb xdotool x11-apps``); skipped
-with the reason when one is missing.
+Needs ``Xvfb``, ``xdotool`` and ``xwd`` (``apt-get install -y xvfb xdotool x11-apps``) and the
+Qt xcb libraries; skipped with the reason when a tool is missing.
 """
 
 from __future__ import annotations
@@ -26,7 +26,8 @@ import numpy as np
 import pytest
 
 import explorer
-from explorer.app import window as gui
+from explorer.app import session as S
+from explorer.app import start as gui
 from explorer.geometry import meshes as M
 from explorer.shading.display import to_bytes
 
@@ -50,33 +51,24 @@ START_TIMEOUT = 120.0
 @pytest.fixture
 def display():
     """A private Xvfb server; its display name (":N") chosen by the server itself."""
-    r, w = os.pipe()
-    proc = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(w), "-screen", "0", "1280x900x24", "-nolisten", "tcp"],
-        pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-    )  # fmt: skip
-    os.close(w)
-    try:
-        with os.fdopen(r) as f:
-            number = f.readline().strip()
-        if not number:
-            pytest.fail("Xvfb did not start")
-        yield f":{number}"
-    finally:
-        proc.terminate()
-        proc.wait(timeout=10)
+    proc, name = gui.start_xvfb()
+    yield name
+    proc.terminate()
+    proc.wait(timeout=10)
 
 
 class Window:
     """The app under test: its process, its X window and its state file."""
 
-    def __init__(self, display, tmp: Path):
+    def __init__(self, display, tmp: Path, *extra, name="state.json"):
         self.env = {k: v for k, v in os.environ.items() if k != "VTK_DEFAULT_OPENGL_WINDOW"}
-        self.env.update(DISPLAY=display, PHONG_EXPLORER_MATERIALS=str(tmp / "presets"))
-        self.state_file = tmp / "state.json"
-        self.log = tmp / "app.log"
+        self.env.update(DISPLAY=display, PHONG_EXPLORER_MATERIALS=str(tmp / "presets"),
+                        QT_QPA_PLATFORM="xcb",
+                        PHONG_EXPLORER_LAST_SESSION=str(tmp / "last.yaml"))  # fmt: skip
+        self.state_file = tmp / name
+        self.log = tmp / f"{name}.log"
         cmd = [
-            sys.executable, "-m", "explorer.cli", "gui", "--mesh", MESH,
+            sys.executable, "-m", "explorer.cli", "gui", *(extra or ("--mesh", MESH)),
             "--state-file", str(self.state_file), "--exit-after", "90",
             "--screenshot-dir", str(tmp),
         ]  # fmt: skip
@@ -94,7 +86,7 @@ class Window:
 
     def find(self) -> None:
         out = self.xdotool(
-            "search", "--sync", "--onlyvisible", "--name", gui.G.TITLE, timeout=START_TIMEOUT
+            "search", "--sync", "--onlyvisible", "--name", gui.TITLE, timeout=START_TIMEOUT
         )
         self.wid = out.split()[0]
 
@@ -146,8 +138,16 @@ class Window:
         self.xdotool(*self.move(*at), "click", 1)
 
     def key(self, name: str) -> None:
-        # no window manager: the key goes to the window under the pointer
-        self.xdotool(*self.move(20, 20), "key", name)
+        # no window manager: X's focus follows the pointer (PointerRoot), so the key goes, as
+        # a real key press (XTEST), to the window under the pointer, which is moved inside it
+        s = self.state()
+        x, y, w, h = s["window"]["view_box"] if s else (10, 30, 10, 10)
+        self.xdotool(*self.move(x + 10, y + h - 10), "key", name)
+
+    def focus_view(self) -> None:
+        """A click in the view (no drag: the camera stays) gives it the keyboard."""
+        x, y, w, h = self.state()["window"]["view_box"]
+        self.click((x + 10, y + h - 10))
 
     def close(self) -> None:
         if self.proc.poll() is None:
@@ -186,11 +186,11 @@ def check_probe(win: Window, mesh: M.Mesh) -> dict:
     end = time.monotonic() + STEP_TIMEOUT
     while True:
         s = win.state()
-        assert s["n_vertices"] == mesh.n_vertices
+        assert s["window"]["n_vertices"] == mesh.n_vertices
         scene = explorer.load_scene(s["scene"])
         colours = to_bytes(explorer.shade(scene, mesh.positions, mesh.normals)).astype(int)
-        i = s["probe"]["vertex"]
-        x, y = s["probe"]["px"]
+        i = s["window"]["probe"]["vertex"]
+        x, y = s["window"]["probe"]["px"]
         around = np.unique(mesh.faces[(mesh.faces == i).any(axis=1)])
         lo = colours[around].min(axis=0) - 2
         hi = colours[around].max(axis=0) + 2
@@ -202,73 +202,63 @@ def check_probe(win: Window, mesh: M.Mesh) -> dict:
         time.sleep(0.05)
 
 
+def kd(s) -> float:
+    return max(s["scene"]["material"]["diffuse"])
+
+
 @pytest.mark.slow  # a real X window driven with xdotool, waiting for each frame
 def test_real_window(display, tmp_path):
     mesh = M.get_mesh(MESH, gui.MESH_CHOICES[MESH])
     win = Window(display, tmp_path)
     try:
         win.find()
-        s = win.wait("the first frame", lambda s: s["frame"] >= 1, timeout=START_TIMEOUT)
-        assert s["mesh"] == MESH and s["preset"] == gui.DEFAULT_PRESET and not s["errors"]
+        s = win.wait("the first frame", lambda s: s["window"]["frame"] >= 1,
+                     timeout=START_TIMEOUT)  # fmt: skip
+        assert s["mesh"] == MESH and s["preset"] == gui.DEFAULT_PRESET
+        assert not s["window"]["errors"]
         check_probe(win, mesh)
 
-        # drag the kd slider's knob 80 pixels to the left
-        kd = s["sliders"]["kd"]
-        (x_lo, y), (x_hi, _) = kd["ends_px"]
-        x0 = kd["knob_px"][0]
-        x1 = x0 - 80
-        want = (x1 - x_lo) / (x_hi - x_lo)
-        win.drag((x0, y), (x1, y))
-        s = win.wait(
-            "kd to follow the drag",
-            lambda s: not s["dragging"] and abs(s["material"]["kd"] - want) < 0.012,
-        )
-        assert s["sliders"]["kd"]["value"] == pytest.approx(s["material"]["kd"], abs=6e-4)
+        # drag the kd slider's knob 60 pixels to the left: one undo step
+        start = kd(s)
+        x, y, w, h = s["window"]["widgets"]["kd_slider"]
+        knob = x + 8 + start * (w - 16)  # the knob's centre (the groove is inset by the knob)
+        win.drag((knob, y + h // 2), (knob - 60, y + h // 2))
+        s = win.wait("kd to follow the drag",
+                     lambda s: not s["window"]["dragging"] and kd(s) < start - 0.1)  # fmt: skip
+        dragged = kd(s)
         check_probe(win, mesh)
 
-        # drag the light's handle to the left and down
-        before = s["light"]
-        hx, hy = s["handle_px"]
-        win.drag((hx, hy), (hx - 160, hy + 60))
-        s = win.wait(
-            "the light to move",
-            lambda s: not s["dragging"] and abs(s["light"]["azimuth"] - before["azimuth"]) > 5.0,
-        )
-        for name in ("azimuth", "elevation", "distance"):  # handle and sliders agree
-            assert s["sliders"][name]["value"] == pytest.approx(s["light"][name], abs=1e-6)
+        win.key("ctrl+z")
+        s = win.wait("undo", lambda s: kd(s) == pytest.approx(start, abs=1e-9))
+        assert not s["window"]["can_undo"] and s["window"]["can_redo"]
         check_probe(win, mesh)
+        win.key("ctrl+shift+z")
+        s = win.wait("redo", lambda s: kd(s) == pytest.approx(dragged, abs=1e-9))
+        kept = s
 
-        # rotate the camera: the viewer follows it
-        eye = s["scene"]["viewer"]["eye"]
-        win.drag((120, 560), (260, 540))
-        s = win.wait(
-            "the viewer to follow the camera", lambda s: s["scene"]["viewer"] != {"eye": eye}
-        )
-        assert s["scene"]["viewer"] == {"eye": s["camera"]["position"]}
-        check_probe(win, mesh)
-
-        # the next preset, with the button
-        nxt = s["presets"][s["presets"].index(s["preset"]) + 1]
-        win.click(s["buttons"]["preset_next"]["px"])
-        s = win.wait(f"preset {nxt}", lambda s: s["preset"] == nxt)
-        check_probe(win, mesh)
-
-        # the difference view: its button (the map is made once the event loop is free), then
-        # the key turns it off and the engine's colours are on the screen again
-        win.click(s["buttons"]["difference"]["px"])
-        s = win.wait("the heat map", lambda s: s["difference"]["shown"])
-        assert s["difference"]["pixels"] > 1000 and "every pixel" in s["difference"]["advice"]
-        win.key("d")
-        s = win.wait("the live view", lambda s: not s["difference"]["on"])
-        check_probe(win, mesh)
-
-        win.key("h")
-        s = win.wait("the help overlay", lambda s: s["help_visible"])
-        assert not s["errors"]
-
+        # q in the view quits; the window keeps the session
+        win.focus_view()
         win.key("q")
         assert win.proc.wait(timeout=STEP_TIMEOUT) == 0
         log = win.log.read_text(errors="replace")
         assert "exit-after" not in log and "Traceback" not in log, log
     finally:
         win.close()
+
+    # gui --last reopens it exactly
+    again = Window(display, tmp_path, "--last", name="again.json")
+    try:
+        again.find()
+        s = again.wait("the first frame", lambda s: s["window"]["frame"] >= 1,
+                       timeout=START_TIMEOUT)  # fmt: skip
+        assert s["scene"]["material"] == kept["scene"]["material"]
+        assert s["scene"]["lights"] == kept["scene"]["lights"] and s["mesh"] == MESH
+        assert s["camera"]["position"] == pytest.approx(kept["camera"]["position"])
+        check_probe(again, mesh)
+        again.focus_view()
+        again.key("ctrl+q")
+        assert again.proc.wait(timeout=STEP_TIMEOUT) == 0
+    finally:
+        again.close()
+    state, _ = S.load_session(tmp_path / "state.json")  # the --state-file is a session too
+    assert state.scene.material.diffuse == tuple(kept["scene"]["material"]["diffuse"])

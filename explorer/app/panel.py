@@ -1,0 +1,329 @@
+"""The explorer's control panel: Qt widgets that show a :class:`~explorer.app.model.State` and
+send actions. Nothing of the model lives here: every widget is set from the state
+(:meth:`Panel.show_state`, signals blocked) and every user change goes to the window's
+``act(action, *args, label=..., merge=...)``.
+
+Three tabs: ``material`` (preset list, coefficients, colours, model and terms), ``lights`` (the
+scene's lights and the selected one's type, colour, placement, attenuation and cone) and
+``view`` (mesh, difference view). Each widget is named like the scene file's key it sets.
+"""
+
+from __future__ import annotations
+
+import math
+
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from explorer.app import model as M
+from explorer.core.material import RGB_KEYS
+
+#: slider steps (QSlider is integral)
+STEPS = 1000
+#: the shininess slider's log scale: step 0 is n = 0, steps 1..STEPS are 10**0 to 10**LOG_MAX
+LOG_MAX = 3.0
+#: the light intensity control's slider range (the number field takes more)
+INTENSITY_RANGE = (0.0, 2.0)
+MAX_INTENSITY = 1000.0
+
+
+def shininess_to_step(n: float) -> int:
+    """Slider step of exponent ``n`` (0 at the left end, then log10 n from 0 to 3)."""
+    if n <= 0.0:
+        return 0
+    t = min(max(math.log10(max(n, 1.0)) / LOG_MAX, 0.0), 1.0)
+    return 1 + round(t * (STEPS - 1))
+
+
+def step_to_shininess(step: int) -> float:
+    """Exponent of a shininess slider step, to 3 significant digits (step 0 is 0)."""
+    if step <= 0:
+        return 0.0
+    n = 10.0 ** (LOG_MAX * (min(step, STEPS) - 1) / (STEPS - 1))
+    return float(f"{n:.3g}")
+
+
+def rgb_text(rgb) -> str:
+    return ", ".join(f"{c:.3f}" for c in rgb)
+
+
+class ValueSlider(QtWidgets.QWidget):
+    """A labelled slider with a number field. ``edited(value)`` while the user drags or
+    types; ``released()`` when a drag ends (one undo step).
+
+    lo, hi : the slider's range (the field may take ``field_range``); log : the shininess scale
+    """
+
+    edited = QtCore.Signal(float)
+    pressed = QtCore.Signal()
+    released = QtCore.Signal()
+
+    def __init__(self, name: str, lo: float, hi: float, *, decimals: int = 3, log: bool = False,
+                 field_range=None, suffix: str = "", parent=None):  # fmt: skip
+        super().__init__(parent)
+        self.setObjectName(name)
+        self.lo, self.hi, self.log = float(lo), float(hi), log
+        self.label = QtWidgets.QLabel(name)
+        self.label.setMinimumWidth(64)
+        self.slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.slider.setObjectName(f"{name}_slider")
+        self.slider.setRange(0, STEPS)
+        self.slider.setMinimumWidth(60)
+        self.field = QtWidgets.QDoubleSpinBox()
+        self.field.setObjectName(f"{name}_field")
+        self.field.setDecimals(decimals)
+        flo, fhi = field_range or (lo, hi)
+        self.field.setRange(flo, fhi)
+        self.field.setSingleStep(10 ** -min(decimals, 2))
+        self.field.setKeyboardTracking(False)
+        self.field.setSuffix(suffix)
+        self.field.setMinimumWidth(72)
+        self.note = QtWidgets.QLabel("")  # a second line (the distance in world units)
+        self.note.setVisible(False)
+        grid = QtWidgets.QGridLayout(self)
+        grid.setContentsMargins(0, 0, 0, 0)
+        grid.addWidget(self.label, 0, 0)
+        grid.addWidget(self.slider, 0, 1)
+        grid.addWidget(self.field, 0, 2)
+        grid.addWidget(self.note, 1, 1, 1, 2)
+        grid.setColumnStretch(1, 1)
+        self.slider.valueChanged.connect(self._from_slider)
+        self.slider.sliderPressed.connect(self.pressed)
+        self.slider.sliderReleased.connect(self.released)
+        self.field.valueChanged.connect(self._from_field)
+
+    def _to_step(self, v: float) -> int:
+        if self.log:
+            return shininess_to_step(v)
+        t = (v - self.lo) / (self.hi - self.lo) if self.hi > self.lo else 0.0
+        return round(min(max(t, 0.0), 1.0) * STEPS)
+
+    def _from_step(self, step: int) -> float:
+        if self.log:
+            return step_to_shininess(step)
+        return self.lo + (self.hi - self.lo) * step / STEPS
+
+    def _from_slider(self, step: int) -> None:
+        v = round(self._from_step(step), self.field.decimals())
+        with QtCore.QSignalBlocker(self.field):
+            self.field.setValue(v)
+        self.edited.emit(v)
+        if not self.slider.isSliderDown():  # a click or a key: a whole step
+            self.released.emit()
+
+    def _from_field(self, v: float) -> None:
+        with QtCore.QSignalBlocker(self.slider):
+            self.slider.setValue(self._to_step(v))
+        self.edited.emit(float(v))
+        self.released.emit()
+
+    def set_range(self, lo: float, hi: float) -> None:
+        self.lo, self.hi = float(lo), float(hi)
+        self.field.setRange(min(self.field.minimum(), lo), max(self.field.maximum(), hi))
+
+    def set_value(self, v: float) -> None:
+        """Show ``v`` (no signal)."""
+        with QtCore.QSignalBlocker(self.slider), QtCore.QSignalBlocker(self.field):
+            self.slider.setValue(self._to_step(v))
+            self.field.setValue(v)
+
+    def value(self) -> float:
+        return float(self.field.value())
+
+
+class ColourButton(QtWidgets.QPushButton):
+    """A button showing a colour and its RGB; a click opens a colour dialog (non-native, so
+    it can be driven in tests), and ``picked(rgb)`` carries the choice."""
+
+    picked = QtCore.Signal(tuple)
+
+    def __init__(self, name: str, parent=None):
+        super().__init__(parent)
+        self.setObjectName(name)
+        self.name = name
+        self.rgb = (0.0, 0.0, 0.0)
+        self.dialog: QtWidgets.QColorDialog | None = None
+        self.clicked.connect(self.open_dialog)
+
+    def set_rgb(self, rgb) -> None:
+        self.rgb = tuple(float(c) for c in rgb)
+        q = QtGui.QColor.fromRgbF(*(min(max(c, 0.0), 1.0) for c in self.rgb))
+        text = "#000" if q.lightnessF() > 0.5 else "#fff"
+        self.setStyleSheet(f"background-color: {q.name()}; color: {text}; padding: 3px;")
+        self.setText(rgb_text(self.rgb))
+        self.setToolTip(f"{self.name}: {rgb_text(self.rgb)} (click to pick)")
+
+    def open_dialog(self) -> QtWidgets.QColorDialog:
+        d = QtWidgets.QColorDialog(self)
+        d.setObjectName(f"{self.name}_dialog")
+        d.setOption(QtWidgets.QColorDialog.ColorDialogOption.DontUseNativeDialog, True)
+        d.setWindowTitle(f"{self.name} colour")
+        d.setCurrentColor(QtGui.QColor.fromRgbF(*(min(max(c, 0.0), 1.0) for c in self.rgb)))
+        d.colorSelected.connect(lambda c: self.picked.emit((c.redF(), c.greenF(), c.blueF())))
+        d.finished.connect(lambda _: setattr(self, "dialog", None))
+        self.dialog = d
+        d.open()
+        return d
+
+
+def _form(parent=None) -> QtWidgets.QVBoxLayout:
+    box = QtWidgets.QVBoxLayout(parent)
+    box.setContentsMargins(6, 6, 6, 6)
+    box.setSpacing(6)
+    return box
+
+
+def _scroll(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
+    area = QtWidgets.QScrollArea()
+    area.setWidget(widget)
+    area.setWidgetResizable(True)
+    area.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    area.setFrameShape(QtWidgets.QFrame.Shape.NoFrame)
+    return area
+
+
+def swatch(material, size: int = 18) -> QtGui.QIcon:
+    """A small square of the material's diffuse colour with its specular colour in a corner."""
+    pm = QtGui.QPixmap(size, size)
+    pm.fill(QtGui.QColor.fromRgbF(*(min(c, 1.0) for c in material.diffuse)))
+    p = QtGui.QPainter(pm)
+    spec = QtGui.QColor.fromRgbF(*(min(c, 1.0) for c in material.specular))
+    p.fillRect(size // 2, 0, size - size // 2, size // 2, spec)
+    p.end()
+    return QtGui.QIcon(pm)
+
+
+class MaterialTab(QtWidgets.QWidget):
+    """Presets (searchable, with descriptions and swatches), coefficients, colours, model and
+    terms."""
+
+    def __init__(self, act, parent=None):
+        super().__init__(parent)
+        self.act = act
+        box = _form(self)
+        self.search = QtWidgets.QLineEdit()
+        self.search.setObjectName("preset_search")
+        self.search.setPlaceholderText("search presets")
+        self.search.setClearButtonEnabled(True)
+        self.presets = QtWidgets.QListWidget()
+        self.presets.setObjectName("presets")
+        self.presets.setMinimumHeight(90)
+        self.presets.setIconSize(QtCore.QSize(18, 18))
+        self.description = QtWidgets.QLabel("")
+        self.description.setObjectName("preset_description")
+        self.description.setWordWrap(True)
+        self.preset_label = QtWidgets.QLabel("")
+        self.preset_label.setObjectName("preset")
+        self.preset_label.setWordWrap(True)
+        for w in (self.preset_label, self.search, self.presets, self.description):
+            box.addWidget(w)
+        self.sliders = {
+            "ka": ValueSlider("ka", 0.0, 1.0),
+            "kd": ValueSlider("kd", 0.0, 1.0),
+            "ks": ValueSlider("ks", 0.0, 1.0),
+            "shininess": ValueSlider("shininess", 0.0, 1000.0, decimals=1, log=True),
+            "opacity": ValueSlider("opacity", 0.0, 1.0),
+        }
+        actions = {
+            "ka": lambda v: (M.set_coefficient, "ka", v),
+            "kd": lambda v: (M.set_coefficient, "kd", v),
+            "ks": lambda v: (M.set_coefficient, "ks", v),
+            "shininess": lambda v: (M.set_shininess, v),
+            "opacity": lambda v: (M.set_opacity, v),
+        }
+        for name, s in self.sliders.items():
+            box.addWidget(s)
+            s.edited.connect(lambda v, n=name: self.act(*actions[n](v), label=n, merge=n))
+            s.released.connect(lambda: self.act(None))
+        colours = QtWidgets.QGridLayout()
+        self.colours = {}
+        for i, term in enumerate(RGB_KEYS):
+            b = ColourButton(term)
+            b.picked.connect(lambda rgb, t=term: self.act(M.set_colour, t, rgb, label=t))
+            colours.addWidget(QtWidgets.QLabel(term), i, 0)
+            colours.addWidget(b, i, 1)
+            self.colours[term] = b
+        colours.setColumnStretch(1, 1)
+        box.addLayout(colours)
+        row = QtWidgets.QHBoxLayout()
+        self.model = {}
+        group = QtWidgets.QButtonGroup(self)
+        row.addWidget(QtWidgets.QLabel("model"))
+        for name in ("blinn", "phong"):
+            r = QtWidgets.QRadioButton(name)
+            r.setObjectName(name)
+            group.addButton(r)
+            r.toggled.connect(lambda on, n=name: on and self.act(M.set_model, n, label="model"))
+            row.addWidget(r)
+            self.model[name] = r
+        row.addStretch(1)
+        box.addLayout(row)
+        row = QtWidgets.QHBoxLayout()
+        self.terms = {}
+        for term in M.TERMS:
+            c = QtWidgets.QCheckBox(term)
+            c.setObjectName(f"show_{term}")
+            c.setToolTip(f"draw the {term} term (the material is unchanged)")
+            c.toggled.connect(lambda on, t=term: self.act(M.set_term, t, on, label=f"{t} term"))
+            row.addWidget(c)
+            self.terms[term] = c
+        row.addStretch(1)
+        box.addLayout(row)
+        self.save = QtWidgets.QPushButton("Save preset as…")
+        self.save.setObjectName("save_preset")
+        box.addWidget(self.save)
+        box.addStretch(1)
+        self.search.textChanged.connect(self._filter)
+        self.presets.itemClicked.connect(self._chosen)
+        self.presets.currentItemChanged.connect(self._describe)
+        self._infos = {}
+
+    def set_presets(self, infos) -> None:
+        """The preset list (``explorer.core.presets.PresetInfo`` items)."""
+        self._infos = {p.name: p for p in infos}
+        with QtCore.QSignalBlocker(self.presets):
+            self.presets.clear()
+            for p in infos:
+                item = QtWidgets.QListWidgetItem(swatch(p.material), p.name)
+                item.setToolTip(p.material.description or p.name)
+                self.presets.addItem(item)
+        self._filter(self.search.text())
+
+    def _filter(self, text: str) -> None:
+        t = text.strip().lower()
+        for i in range(self.presets.count()):
+            item = self.presets.item(i)
+            info = self._infos.get(item.text())
+            hay = item.text() + " " + (info.material.description if info else "")
+            item.setHidden(bool(t) and t not in hay.lower())
+
+    def _chosen(self, item) -> None:
+        info = self._infos.get(item.text())
+        if info is not None:
+            self.act(M.apply_preset, info.name, info.material, label=f"preset {info.name}")
+
+    def _describe(self, item, _previous=None) -> None:
+        info = self._infos.get(item.text()) if item is not None else None
+        self.description.setText(info.material.description if info else "")
+
+    def show_state(self, s: M.State) -> None:
+        m = s.material
+        ka, kd, ks = m.scalars()
+        for name, v in (("ka", ka), ("kd", kd), ("ks", ks), ("shininess", m.shininess),
+                        ("opacity", m.opacity)):  # fmt: skip
+            self.sliders[name].set_value(v)
+        for term, b in self.colours.items():
+            b.set_rgb(getattr(m, term))
+        for name, r in self.model.items():
+            with QtCore.QSignalBlocker(r):
+                r.setChecked(s.scene.model == name)
+        for term, c in self.terms.items():
+            with QtCore.QSignalBlocker(c):
+                c.setChecked(term not in s.hidden)
+        name = s.preset or "(scene material)"
+        self.preset_label.setText(f"preset: <b>{name}</b>" + (" (edited)" if s.edited else ""))
+        with QtCore.QSignalBlocker(self.presets):
+            found = self.presets.findItems(s.preset or "", QtCore.Qt.MatchFlag.MatchExactly)
+            self.presets.setCurrentItem(found[0] if found and s.preset else None)
+            if found and s.preset:
+                self.presets.scrollToItem(found[0])
+        self._describe(found[0] if found and s.preset else None)

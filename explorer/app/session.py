@@ -1,0 +1,199 @@
+"""Sessions: the explorer's state as a file, and back.
+
+A session file is YAML (or JSON, which YAML reads too)::
+
+    session: 1                 # the format
+    scene: {...}               # the scene-file schema: material, model, lights, viewer, mesh
+    mesh: teapot               # the mesh chooser's name (a built-in name or a file path)
+    resolution: null           # a built-in mesh's resolution (null: the explorer's)
+    preset: gold               # the preset the material came from, or null
+    hidden: [specular]         # terms not drawn
+    light: 1                   # the light the controls move (1 is the first)
+    handle_distance: 2.5       # where a directional light's handle sits, in mesh radii
+    camera: {position: [..], focal_point: [..], view_up: [..], parallel: false,
+             parallel_scale: 1.0, view_angle: 30.0}
+    difference: false
+    compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
+                               # the A / B compare view's side B
+    window: {...}              # optional: what the window reported (the --state-file's
+                               # extras); never read back
+
+:func:`session_mapping` makes the mapping, :func:`save_session` writes it atomically (never
+over a file unless asked), :func:`load_session` reads one back with every problem named by file,
+line and key. The ``--state-file`` the window writes after each frame is such a mapping, so it
+reopens as a session.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+from platformdirs import user_config_dir
+
+from explorer.app.model import TERMS, State
+from explorer.app.start import first_state, load_mesh_choice
+from explorer.core.atomic import write_atomic
+from explorer.core.errors import ExplorerError
+from explorer.core.material import MODELS, parse_material
+from explorer.core.scene import load_scene
+from explorer.core.yamlio import dump_yaml, load_yaml
+from explorer.geometry.meshes import Mesh
+from explorer.render.camera import Camera
+
+FORMAT = 1
+KEYS = (
+    "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
+    "camera", "difference", "compare", "window",
+)  # fmt: skip
+CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
+#: environment variable naming the file the window keeps its last session in
+LAST_SESSION_ENV = "PHONG_EXPLORER_LAST_SESSION"
+
+
+def last_session_path() -> Path:
+    """Where the window keeps the last session on quit (``gui --last`` reopens it):
+    ``$PHONG_EXPLORER_LAST_SESSION``, else
+    ``<user config dir>/phong-explorer/last-session.yaml``."""
+    env = os.environ.get(LAST_SESSION_ENV)
+    if env:
+        return Path(env).expanduser()
+    return Path(user_config_dir("phong-explorer")) / "last-session.yaml"
+
+
+def camera_mapping(camera: Camera) -> dict:
+    return {
+        "position": [float(c) for c in camera.position],
+        "focal_point": [float(c) for c in camera.focal_point],
+        "view_up": [float(c) for c in camera.view_up],
+        "parallel": bool(camera.parallel),
+        "parallel_scale": float(camera.parallel_scale),
+        "view_angle": float(camera.view_angle),
+    }
+
+
+def session_mapping(state: State) -> dict:
+    """The session file's mapping of ``state`` (plain Python values)."""
+    out = {
+        "session": FORMAT,
+        "scene": state.scene.to_mapping(),
+        "mesh": state.mesh,
+        "resolution": state.resolution,
+        "preset": state.preset,
+        "hidden": [t for t in TERMS if t in state.hidden],
+        "light": state.light + 1,
+        "handle_distance": float(state.handle_distance),
+        "difference": bool(state.difference),
+    }
+    if state.camera is not None:
+        out["camera"] = camera_mapping(state.camera)
+    if state.compare is not None:
+        out["compare"] = {
+            "material": state.compare.to_mapping(),
+            "model": state.compare_model,
+            "preset": state.compare_preset,
+            "difference": bool(state.compare_difference),
+        }
+    return out
+
+
+def save_session(path, state: State, *, overwrite: bool = False) -> Path:
+    """Write ``state`` as a session file (YAML; ``.json`` names get JSON), atomically; an
+    existing file is replaced only with ``overwrite``."""
+    data = session_mapping(state)
+    if os.fspath(path).lower().endswith(".json"):
+        text = json.dumps(data, indent=1)
+    else:
+        text = dump_yaml(data, header="phong-explorer session (phong-explorer gui --session FILE)")
+    return write_atomic(path, text.encode("utf-8"), overwrite=overwrite, make_dirs=True)
+
+
+def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
+    """The state and mesh of a session file. Every problem raises one
+    :class:`~explorer.core.errors.ExplorerError` naming the file, line and key."""
+    doc = load_yaml(path, what="session", collect=True)
+    checker = doc.checker()
+    m = checker.mapping(doc.data, (), "a mapping of session keys")
+    checker.raise_if_any()
+    checker.keys(m, (), KEYS, required=("session", "scene", "mesh"))
+    if "session" in m and m["session"] != FORMAT:
+        checker.problem(("session",), f"must be {FORMAT} (this version's format)")
+    name = checker.string(m.get("mesh"), ("mesh",)) if "mesh" in m else None
+    resolution = m.get("resolution")
+    if resolution is not None and (isinstance(resolution, bool) or not isinstance(resolution, int)
+                                   or resolution < 1):  # fmt: skip
+        checker.problem(("resolution",), f"must be a whole number >= 1 or null, got {resolution!r}")
+    preset = m.get("preset")
+    if preset is not None:
+        preset = checker.string(preset, ("preset",))
+    hidden = m.get("hidden", [])
+    if not isinstance(hidden, list) or any(h not in TERMS for h in hidden):
+        checker.problem(("hidden",), f"must be a list of terms from {', '.join(TERMS)}")
+        hidden = []
+    handle = checker.number(m.get("handle_distance", 2.5), ("handle_distance",), 0.0, 1e6,
+                            lo_open=True)  # fmt: skip
+    difference = checker.boolean(m.get("difference", False), ("difference",))
+    camera = _camera(checker, m["camera"]) if "camera" in m else None
+    compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
+    checker.raise_if_any()
+    try:
+        scene = load_scene(m["scene"], materials_dirs=materials_dirs)
+    except ExplorerError as exc:
+        raise ExplorerError(f"{os.fspath(path)}: scene: {exc}") from None
+    mesh = load_mesh_choice(name, resolution)
+    state = first_state(scene, mesh, name=name, preset=preset, materials_dirs=materials_dirs,
+                        resolution=resolution)  # fmt: skip
+    n = len(scene.lights)
+    light = m.get("light", 1)
+    if n and (isinstance(light, bool) or not isinstance(light, int) or not 1 <= light <= n):
+        checker.problem(("light",), f"must be a whole number from 1 to {n}, got {light!r}")
+    checker.raise_if_any()
+    state = state.replace(
+        hidden=frozenset(hidden),
+        light=(light - 1) if n else 0,
+        handle_distance=handle,
+        camera=camera,
+        difference=bool(difference),
+        **compare,
+    )
+    return state, mesh
+
+
+def _compare(checker, value) -> dict:
+    """The ``compare`` section: side B's State fields."""
+    path = ("compare",)
+    c = checker.mapping(value, path)
+    if c is None:
+        return {}
+    checker.keys(c, path, ("material", "model", "preset", "difference"),
+                 required=("material", "model"))  # fmt: skip
+    material = parse_material(c.get("material"), checker, path + ("material",))
+    model = checker.choice(c.get("model"), path + ("model",), MODELS)
+    preset = c.get("preset")
+    if preset is not None:
+        preset = checker.string(preset, path + ("preset",))
+    difference = checker.boolean(c.get("difference", False), path + ("difference",))
+    return {"compare": material, "compare_model": model, "compare_preset": preset,
+            "compare_difference": bool(difference)}  # fmt: skip
+
+
+def _camera(checker, value) -> Camera | None:
+    path = ("camera",)
+    c = checker.mapping(value, path)
+    if c is None:
+        return None
+    if not checker.keys(c, path, CAMERA_KEYS, required=CAMERA_KEYS):
+        return None
+    pos = checker.triple(c["position"], path + ("position",))
+    focal = checker.triple(c["focal_point"], path + ("focal_point",))
+    up = checker.direction(c["view_up"], path + ("view_up",))
+    parallel = checker.boolean(c["parallel"], path + ("parallel",))
+    scale = checker.number(c["parallel_scale"], path + ("parallel_scale",), 0.0, lo_open=True)
+    angle = checker.number(c["view_angle"], path + ("view_angle",), 0.0, 179.0, lo_open=True)
+    if None in (pos, focal, up, parallel, scale, angle):
+        return None
+    if pos == focal:
+        checker.problem(path + ("focal_point",), "must differ from the position")
+        return None
+    return Camera(pos, focal, tuple(up), parallel, scale, angle, (0.01, 1000.0))

@@ -1,0 +1,181 @@
+"""What the explorer starts from, and whether a window can open here: no Qt, VTK or PyVista.
+
+The defaults (preset, mesh, light placement, camera distance), the meshes the chooser offers,
+the first :class:`~explorer.app.model.State` for a scene and a mesh, and the no-display check
+with its one-line message (the ``gui`` command exits with :data:`NO_DISPLAY_STATUS`).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import math
+import os
+import sys
+
+import numpy as np
+
+from explorer.app.model import State
+from explorer.core.errors import ExplorerError
+from explorer.core.presets import list_presets
+from explorer.core.scene import Scene, Viewer
+from explorer.geometry.meshes import Mesh, get_mesh
+
+#: built-in meshes offered by the mesh chooser, with the resolution the explorer uses
+MESH_CHOICES: dict[str, int | None] = {
+    "teapot": 24,
+    "sphere": 128,
+    "icosphere": 5,
+    "torus": 128,
+    "cube": None,
+    "plane": 64,
+}
+DEFAULT_PRESET = "gold"
+DEFAULT_MESH = "teapot"
+#: where the start camera sits (a local viewer): direction from the mesh centre, and the
+#: distance in mesh radii
+DEFAULT_EYE_DIRECTION = (0.0, 0.3, 1.0)
+DEFAULT_EYE_DISTANCE = 6.5
+#: the window's title (the real-window test finds the window by it) and default size
+TITLE = "phong-explorer"
+WINDOW_SIZE = (1100, 720)
+#: the smallest window the panel lays itself out in without clipping
+MIN_WINDOW_SIZE = (640, 480)
+#: exit status when no window can be opened
+NO_DISPLAY_STATUS = 3
+
+
+class NoDisplayError(ExplorerError):
+    """No window can be opened here (no X display, or VTK forced off-screen)."""
+
+
+def load_mesh_choice(name: str, resolution: int | None = None) -> Mesh:
+    """A chooser's mesh: a built-in name at the explorer's resolution, or a file."""
+    if resolution is None:
+        resolution = MESH_CHOICES.get(name)
+    return get_mesh(name, resolution)
+
+
+def default_viewer(mesh: Mesh) -> Viewer:
+    """The start camera: :data:`DEFAULT_EYE_DISTANCE` radii from the mesh centre."""
+    e = np.asarray(DEFAULT_EYE_DIRECTION, dtype=np.float64)
+    eye = mesh.centre + DEFAULT_EYE_DISTANCE * (mesh.radius or 1.0) * e / np.linalg.norm(e)
+    return Viewer(eye=tuple(float(c) for c in eye))
+
+
+def first_state(
+    scene: Scene, mesh: Mesh, *, name: str | None = None, preset: str | None = None,
+    materials_dirs=(), resolution: int | None = None,
+) -> State:  # fmt: skip
+    """The explorer's state for ``scene`` on ``mesh`` (shown as ``name`` in the mesh
+    chooser, default the mesh's name; ``resolution`` its built-in resolution, None for the
+    explorer's), under preset ``preset`` (marked clean when the library's
+    preset of that name has this material)."""
+    name = name or scene.mesh or mesh.name
+    clean = None
+    if preset is not None:
+        for info in list_presets(materials_dirs):
+            if info.name == preset:
+                clean = info.material
+                break
+    return State(
+        scene=scene.replace(mesh=scene.mesh or name),
+        mesh=name,
+        resolution=resolution,
+        centre=tuple(float(c) for c in mesh.centre),
+        radius=float(mesh.radius or 1.0),
+        preset=preset,
+        preset_material=clean,
+    )
+
+
+def no_display_reason(environ=None) -> str | None:
+    """Why no window can open here, or None when it looks possible (Linux / X11 only; other
+    systems are left to Qt)."""
+    env = os.environ if environ is None else environ
+    if sys.platform in ("darwin", "win32"):
+        return None
+    forced = env.get("VTK_DEFAULT_OPENGL_WINDOW", "")
+    if forced and forced not in ("vtkXOpenGLRenderWindow", "vtkGenericOpenGLRenderWindow"):
+        return f"VTK_DEFAULT_OPENGL_WINDOW={forced} makes VTK render off-screen only"
+    platform = env.get("QT_QPA_PLATFORM", "")
+    if platform and not platform.startswith("xcb"):
+        return f"QT_QPA_PLATFORM={platform} cannot show the 3D view (it needs xcb)"
+    display = env.get("DISPLAY")
+    if not display:
+        return "no display (DISPLAY is not set)"
+    if not _x_display_opens(display):
+        return f"cannot open the X display {display!r}"
+    return None
+
+
+def no_display_message(reason: str) -> str:
+    """The one line printed when no window can open: why, and what to run instead."""
+    return (
+        f"phong-explorer: {reason}, so the explorer window cannot open; for pictures run "
+        "'phong-explorer render --out FILE.png' (off-screen), or give the window a virtual "
+        "display: 'xvfb-run -s \"-screen 0 1280x900x24\" phong-explorer gui'"
+    )
+
+
+def _x_display_opens(display: str) -> bool:
+    """True if Xlib can connect to ``display`` (True when libX11 is not found: Qt decides)."""
+    name = ctypes.util.find_library("X11")
+    if not name:
+        return True
+    try:
+        x11 = ctypes.CDLL(name)
+    except OSError:
+        return True
+    x11.XOpenDisplay.restype = ctypes.c_void_p
+    x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+    x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+    handle = x11.XOpenDisplay(display.encode())
+    if not handle:
+        return False
+    x11.XCloseDisplay(handle)
+    return True
+
+
+def start_xvfb(size=(1280, 900)):
+    """A private Xvfb server for scripts, benchmarks and tests: ``(process, ":N")``, the
+    display number chosen by the server. On Linux the server ends with the calling process
+    (``PR_SET_PDEATHSIG``), even when that one crashes."""
+    import signal
+    import subprocess
+
+    def die_with_parent():
+        try:
+            ctypes.CDLL("libc.so.6").prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+        except OSError:
+            pass
+
+    r, w = os.pipe()
+    proc = subprocess.Popen(
+        ["Xvfb", "-displayfd", str(w), "-screen", "0", "{}x{}x24".format(*size), "-nolisten",
+         "tcp"], pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        preexec_fn=die_with_parent if sys.platform.startswith("linux") else None,
+    )  # fmt: skip
+    os.close(w)
+    with os.fdopen(r) as f:
+        number = f.readline().strip()
+    if not number:
+        proc.terminate()
+        raise ExplorerError("Xvfb did not start")
+    return proc, f":{number}"
+
+
+def round_sig(x: float, digits: int = 3) -> float:
+    """``x`` rounded to ``digits`` significant digits (0 stays 0)."""
+    if x == 0 or not math.isfinite(x):
+        return float(x)
+    return float(f"{x:.{digits}g}")
+
+
+def free_name(stem: str, taken) -> str:
+    """The first of ``stem_1``, ``stem_2``, ... not in ``taken``."""
+    taken = set(taken)
+    i = 1
+    while f"{stem}_{i}" in taken:
+        i += 1
+    return f"{stem}_{i}"

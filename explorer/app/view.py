@@ -1,0 +1,489 @@
+"""The explorer's 3D view: the engine's colours on the mesh, the light's handle, the specular
+lobe inset and the difference heat map, drawn by VTK into a PyVista plotter (pyvistaqt's
+``QtInteractor`` in the window, an off-screen ``Plotter`` in benchmarks). No Qt here.
+
+Every state goes the same way::
+
+    state.shown_scene() -> Shader.set_scene (the engine recomputes only what changed)
+                        -> uint8 colours written in place into the mesh's point data -> render
+
+The colours are drawn as RGB point scalars with VTK's lighting off, so VTK adds nothing to the
+engine's colours. Meshes above :data:`LOD_VERTICES` get a lighter level of detail (quadric
+clustering to about :data:`LOD_TARGET` vertices, shaded by its own Shader) drawn while something
+is dragged; the full mesh is shaded and drawn on release.
+
+PyVista and VTK are imported inside the functions that need them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from explorer.analysis.comparison import heat_map
+from explorer.app.difference import VMAX
+from explorer.app.model import State, handle_point
+from explorer.geometry.meshes import Mesh, area_weighted_normals
+from explorer.render.camera import (
+    Camera,
+    apply_camera,
+    back_to_front,
+    camera_for,
+    camera_from_vtk,
+)
+from explorer.render.vtk import add_unlit, cells, polydata
+from explorer.shading.display import engine_clamps, shown, to_bytes
+from explorer.shading.shader import Shader
+
+#: meshes with more vertices than this get a level of detail drawn while dragging
+LOD_VERTICES = 250_000
+#: about how many vertices the level of detail has
+LOD_TARGET = 60_000
+#: the light handle's radius, in mesh radii
+HANDLE_RADIUS = 0.07
+HANDLE_COLOR = (1.0, 0.85, 0.2)
+#: the handle's glyph (arrow for directional, cone for spot), in mesh radii
+GLYPH_LENGTH = 0.6
+GLYPH_COLOR = (1.0, 0.85, 0.2)
+#: a handle nearer than this (mesh radii) is kept in view when the camera is framed
+HANDLE_FRAMING = 5.5
+#: widest view angle (degrees) the framing may use to show the handle
+MAX_VIEW_ANGLE = 60.0
+#: the lobe inset: left and bottom margin in pixels, its side as a fraction of the view's
+#: smaller side held within LOBE_SIDE (pixels); colours; samples of the curve
+LOBE_MARGIN = 12
+LOBE_FRACTION = 0.2
+LOBE_SIDE = (60, 120)
+LOBE_COLOR = (1.0, 0.85, 0.2)
+LOBE_REFERENCE_COLOR = (0.55, 0.55, 0.6)
+LOBE_FRAME_COLOR = (0.35, 0.35, 0.38)
+LOBE_SAMPLES = 181
+
+
+def lobe_curve(n: float, samples: int = LOBE_SAMPLES) -> np.ndarray:
+    """The specular lobe ``r = cos^n(t)`` for -90° <= t <= 90° in polar coordinates around the
+    mirror direction (the x axis), as the lecture notes draw it: (samples, 2) float64 points
+    ``(r cos t, r sin t)``."""
+    t = np.linspace(-0.5 * math.pi, 0.5 * math.pi, int(samples))
+    c = np.clip(np.cos(t), 0.0, 1.0)
+    r = c ** float(n) if n > 0 else np.ones_like(c)
+    return np.column_stack([r * np.cos(t), r * np.sin(t)])
+
+
+def widen_to_show(camera: Camera, points, aspect: float, *, pad: float = 0.0,
+                  margin: float = 1.1) -> Camera:  # fmt: skip
+    """``camera`` with its view widened just enough to show ``points`` (each a sphere of radius
+    ``pad``) too, in a picture of ``aspect`` (width / height); points behind a perspective
+    camera are left out. Position, direction and up are kept (the viewer does not move)."""
+    from dataclasses import replace
+
+    fwd = camera.direction
+    up = np.asarray(camera.view_up, dtype=np.float64)
+    right = np.cross(fwd, up)
+    origin = np.asarray(camera.focal_point if camera.parallel else camera.position)
+    need = 0.0
+    for p in points:
+        rel = np.asarray(p, dtype=np.float64) - origin
+        x, y, z = abs(rel @ right) + pad, abs(rel @ up) + pad, rel @ fwd
+        if camera.parallel:
+            need = max(need, y, x / aspect)
+        elif z > pad:
+            need = max(need, y / (z - pad), x / (aspect * (z - pad)))
+    need *= margin
+    if camera.parallel:
+        return replace(camera, parallel_scale=max(camera.parallel_scale, need))
+    angle = math.degrees(2.0 * math.atan(need))
+    return replace(camera, view_angle=max(camera.view_angle, min(angle, MAX_VIEW_ANGLE)))
+
+
+def view_camera(vtk_camera, centre, radius: float) -> Camera:
+    """The view's camera with a clipping range around the mesh (centre (3,), radius): what the
+    state records and the difference view compares (the window's own range follows what is
+    visible, and the mesh is hidden while the heat map shows)."""
+    cam = camera_from_vtk(vtk_camera, window_center=(0.0, 0.0))
+    pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
+    ahead = (focal - pos) / max(float(np.linalg.norm(focal - pos)), 1e-300)
+    d = float((np.asarray(centre) - pos) @ ahead)
+    r = 1.01 * radius
+    return dataclasses.replace(cam, clipping_range=(max(d - r, 1e-3 * r), max(d + r, 2e-3 * r)))
+
+
+def framed_camera(state: State, mesh: Mesh, aspect: float) -> Camera:
+    """The camera at the scene's viewer framing the mesh, widened to show a near handle."""
+    cam = camera_for(state.scene, mesh, aspect)
+    if state.selected_light is not None:
+        d = state.placement()[2]
+        if d <= HANDLE_FRAMING * state.radius:
+            pad = HANDLE_RADIUS * state.radius
+            cam = widen_to_show(cam, [handle_point(state)], aspect, pad=pad)
+    return cam
+
+
+def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
+    """A lighter version of ``mesh`` with about ``target`` vertices (VTK quadric clustering),
+    with smooth area-weighted normals. Used only while dragging."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkFiltersCore import vtkQuadricClustering
+
+    poly = polydata(mesh, float32=True, normals=False)
+
+    def cluster(divisions: int):
+        q = vtkQuadricClustering()
+        q.SetInputData(poly)
+        q.SetAutoAdjustNumberOfDivisions(False)
+        q.SetNumberOfDivisions(divisions, divisions, divisions)
+        q.Update()
+        return q.GetOutput()
+
+    # a surface's vertex count grows as the divisions squared, until it saturates at the
+    # mesh's own count: a few corrections reach the target within ~25 %
+    d = max(4, int(0.5 * math.sqrt(target)))
+    out = cluster(d)
+    for _ in range(6):
+        count = out.GetNumberOfPoints()
+        if count == 0 or abs(count - target) <= 0.25 * target:
+            break
+        step = 0.5 if count >= 0.8 * mesh.n_vertices else math.sqrt(target / count)
+        d = max(4, int(round(d * step)))
+        out = cluster(d)
+    pos = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
+    faces = vtk_to_numpy(out.GetPolys().GetConnectivityArray()).astype(np.int64).reshape(-1, 3)
+    return Mesh(pos, area_weighted_normals(pos, faces), faces, f"{mesh.name} (LOD)")
+
+
+class MeshDrawing:
+    """One drawn version of the mesh (the full mesh or its level of detail): its Shader, its
+    PolyData and actor, and the uint8 colour array VTK draws, written in place."""
+
+    def __init__(self, plotter, mesh: Mesh, scene):
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+
+        self.mesh = mesh
+        self.shader = Shader(
+            scene, mesh.positions, mesh.normals, precision="float32",
+            clamp=engine_clamps(scene), faces=mesh.faces,
+        )  # fmt: skip
+        self.poly = polydata(
+            mesh, np.zeros((mesh.n_vertices, 3), np.uint8), float32=True, normals=False
+        )
+        self.actor = add_unlit(plotter, self.poly)
+        self.vtk_colors = self.poly.GetPointData().GetArray("colors")
+        self.rgb = vtk_to_numpy(self.vtk_colors)  # a view of VTK's memory
+        self.sorted_for = None  # camera the triangles were last sorted for (translucency)
+
+    def colors(self) -> np.ndarray:
+        """(n, 3) display colours in [0, 1] (:func:`explorer.shading.display.shown`)."""
+        return shown(self.shader.colors, self.shader.scene)
+
+    def upload(self) -> None:
+        """Write the display colours into VTK's array as 8-bit values and mark it modified."""
+        to_bytes(self.colors(), out=self.rgb)
+        self.vtk_colors.Modified()
+
+    def sort_for(self, camera: Camera) -> None:
+        """Draw the triangles back to front for ``camera`` (translucency)."""
+        key = (camera.position, camera.focal_point, camera.parallel)
+        if self.sorted_for != key:
+            self.poly.faces = cells(self.mesh.faces[back_to_front(self.mesh, camera)])
+            self.sorted_for = key
+
+    def show(self, visible: bool) -> None:
+        self.actor.SetVisibility(bool(visible))
+
+
+class SceneView:
+    """The mesh, handle, glyph and lobe inset in ``plotter``, showing one :class:`State`.
+
+    plotter : a PyVista plotter (``QtInteractor`` or off-screen); mesh, state : the start
+    lod_vertices, lod_target : see :data:`LOD_VERTICES`, :data:`LOD_TARGET`
+    """
+
+    def __init__(self, plotter, mesh: Mesh, state: State, *, lod_vertices: int = LOD_VERTICES,
+                 lod_target: int = LOD_TARGET):  # fmt: skip
+        self.plotter = plotter
+        self.lod_vertices = int(lod_vertices)
+        self.lod_target = int(lod_target)
+        self.state = state
+        self.drawings: list[MeshDrawing] = []
+        self.dragging = 0
+        self._lods: dict[str, Mesh] = {}
+        self._lobe_n = None
+        self.handle = None
+        self._glyph = None
+        self._glyph_kind = None
+        self.set_mesh(mesh, state)
+        self._build_lobe()
+
+    # -- mesh --------------------------------------------------------------------------------
+    @property
+    def mesh(self) -> Mesh:
+        return self.drawings[0].mesh
+
+    @property
+    def active(self) -> MeshDrawing:
+        return self.drawings[1] if self.lod_active else self.drawings[0]
+
+    @property
+    def lod_active(self) -> bool:
+        return self.dragging > 0 and len(self.drawings) > 1
+
+    def set_mesh(self, mesh: Mesh, state: State) -> None:
+        for d in self.drawings:
+            self.plotter.remove_actor(d.actor)
+        scene = state.shown_scene()
+        self.drawings = [MeshDrawing(self.plotter, mesh, scene)]
+        if mesh.n_vertices > self.lod_vertices:
+            if mesh.name not in self._lods:
+                self._lods = {mesh.name: lod_mesh(mesh, self.lod_target)}
+            lod = MeshDrawing(self.plotter, self._lods[mesh.name], scene)
+            lod.show(False)
+            self.drawings.append(lod)
+        self.state = None  # everything is shown afresh
+        self.show_state(state)
+
+    # -- state -------------------------------------------------------------------------------
+    def show_state(self, state: State) -> None:
+        """Give the shown scene to every drawing's Shader (each recomputes only what changed)
+        and upload the drawn one's colours; move the handle and its glyph; redraw the lobe."""
+        old, self.state = self.state, state
+        if old is None or old.scene != state.scene or old.hidden != state.hidden:
+            scene = state.shown_scene()
+            for d in self.drawings:
+                d.shader.set_scene(scene)
+                d.actor.GetProperty().SetOpacity(state.material.opacity)
+            self.active.upload()
+        self._show_handle(state)
+        self._update_lobe(state.material.shininess)
+
+    def before_frame(self, camera: Camera) -> None:
+        """Before a frame: translucent triangles sorted back to front for the camera, the lobe
+        inset sized for the view."""
+        if self.state.material.opacity < 1.0:
+            self.active.sort_for(camera)
+        self._layout_lobe()
+
+    def begin_drag(self) -> None:
+        self.dragging += 1
+        if self.dragging == 1 and len(self.drawings) > 1:
+            self.drawings[0].show(False)
+            self.drawings[1].show(True)
+            self.drawings[1].upload()
+
+    def end_drag(self) -> None:
+        self.dragging = max(0, self.dragging - 1)
+        if self.dragging == 0 and len(self.drawings) > 1:
+            self.drawings[1].show(False)
+            self.drawings[0].show(True)
+            self.drawings[0].upload()
+
+    def show_mesh(self, visible: bool) -> None:
+        """Show the mesh (False while the heat map stands in for it)."""
+        for i, d in enumerate(self.drawings):
+            d.show(visible and (i == 1) == self.lod_active)
+
+    def displayed_colors(self) -> np.ndarray:
+        """(n, 3) uint8 colours VTK draws for the full mesh (a copy)."""
+        return np.array(self.drawings[0].rgb)
+
+    def set_caption(self, text: str) -> None:
+        """A line at the top left of the view (which side of the compare view it is)."""
+        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
+        from vtkmodules.vtkRenderingCore import vtkTextActor
+
+        if getattr(self, "caption", None) is None:
+            self.caption = vtkTextActor()
+            self.caption.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            self.caption.SetPosition(0.02, 0.94)
+            prop = self.caption.GetTextProperty()
+            prop.SetFontSize(14)
+            prop.SetColor(0.92, 0.92, 0.92)
+            self.plotter.renderer.AddViewProp(self.caption)
+        self.caption.SetInput(text)
+        self.caption.SetVisibility(bool(text))
+
+    def paint_levels(self, levels) -> None:
+        """Draw ``levels`` (n,) per-vertex errors in 1/255 levels on the full mesh in the
+        difference view's colours (until the next :meth:`show_state`)."""
+        d = self.drawings[0]
+        d.rgb[:] = heat_map(np.asarray(levels)[None, :], vmax=VMAX)[0]
+        d.vtk_colors.Modified()
+
+    # -- the handle ---------------------------------------------------------------------------
+    def add_handle(self, callback) -> None:
+        """The light's handle: a sphere widget calling ``callback(centre)`` while dragged."""
+        r = HANDLE_RADIUS * self.state.radius
+        self.handle = self.plotter.add_sphere_widget(
+            callback, center=tuple(handle_point(self.state)) if self.state.scene.lights
+            else (0.0, 0.0, 0.0), radius=r, theta_resolution=20, phi_resolution=12,
+            color=HANDLE_COLOR, selected_color=(1.0, 1.0, 1.0), test_callback=False,
+            interaction_event="always",
+        )  # fmt: skip
+        self.handle.ScaleOff()  # right-drag would resize it
+        self._show_handle(self.state)
+
+    def _show_handle(self, state: State) -> None:
+        if self.handle is None:
+            return
+        light = state.selected_light
+        if light is None:
+            self.handle.Off()
+            self._set_glyph(None, state)
+            return
+        self.handle.SetRadius(HANDLE_RADIUS * state.radius)
+        self.handle.SetCenter(*handle_point(state))
+        self.handle.On()
+        self._set_glyph(light, state)
+
+    def _set_glyph(self, light, state: State) -> None:
+        """An arrow toward the mesh for a directional light, the spot's cone for a spot,
+        nothing for a point light."""
+        import pyvista as pv
+
+        kind = None if light is None else light.type
+        if kind not in ("directional", "spot"):
+            if self._glyph is not None:
+                self._glyph.SetVisibility(False)
+            return
+        at = handle_point(state)
+        toward = np.asarray(state.centre) - at
+        toward /= max(float(np.linalg.norm(toward)), 1e-300)
+        length = GLYPH_LENGTH * state.radius
+        if kind == "directional":
+            shape = pv.Arrow(start=at, direction=toward, scale=length, tip_length=0.3,
+                             tip_radius=0.12, shaft_radius=0.04)  # fmt: skip
+        else:
+            cutoff = min(float(light.cutoff), 89.0)
+            aim = np.asarray(light.aim)
+            shape = pv.Cone(center=at + 0.5 * length * aim, direction=-aim, height=length,
+                            radius=length * math.tan(math.radians(cutoff)), resolution=32,
+                            capping=False)  # fmt: skip
+        if self._glyph is None:
+            self._glyph_poly = shape
+            self._glyph = self.plotter.add_mesh(
+                self._glyph_poly, color=GLYPH_COLOR, opacity=0.55 if kind == "spot" else 1.0,
+                lighting=False, reset_camera=False, pickable=False,
+            )  # fmt: skip
+        else:
+            self._glyph_poly.copy_from(shape)
+            self._glyph.GetProperty().SetOpacity(0.55 if kind == "spot" else 1.0)
+        self._glyph.SetVisibility(True)
+        self._glyph_kind = kind
+
+    @property
+    def glyph_kind(self) -> str | None:
+        """ "directional" (arrow), "spot" (cone) or None: what the handle shows."""
+        if self._glyph is None or not self._glyph.GetVisibility():
+            return None
+        return self._glyph_kind
+
+    # -- the lobe inset ---------------------------------------------------------------------
+    def _build_lobe(self) -> None:
+        from vtkmodules.vtkCommonCore import vtkPoints
+        from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+        from vtkmodules.vtkRenderingCore import vtkActor2D, vtkPolyDataMapper2D
+
+        self._lobe_polys = {}
+        for key, color, width in (
+            ("frame", LOBE_FRAME_COLOR, 1.0),
+            ("reference", LOBE_REFERENCE_COLOR, 1.0),
+            ("lobe", LOBE_COLOR, 2.0),
+        ):
+            poly = vtkPolyData()
+            poly.SetPoints(vtkPoints())
+            poly.SetLines(vtkCellArray())
+            mapper = vtkPolyDataMapper2D()
+            mapper.SetInputData(poly)
+            actor = vtkActor2D()
+            actor.SetMapper(mapper)
+            actor.GetProperty().SetColor(*color)
+            actor.GetProperty().SetLineWidth(width)
+            self.plotter.renderer.AddViewProp(actor)
+            self._lobe_polys[key] = poly
+        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
+        from vtkmodules.vtkRenderingCore import vtkTextActor
+
+        self.lobe_caption = vtkTextActor()
+        prop = self.lobe_caption.GetTextProperty()
+        prop.SetColor(*LOBE_REFERENCE_COLOR)
+        self.plotter.renderer.AddViewProp(self.lobe_caption)
+        self._lobe_n = None
+        self._lobe_side = None
+        self._layout_lobe()
+
+    def _layout_lobe(self) -> None:
+        """Size the inset for the view (:data:`LOBE_FRACTION` of its smaller side)."""
+        w, h = self.plotter.window_size
+        lo, hi = LOBE_SIDE
+        side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi))
+        if side == self._lobe_side:
+            return
+        self._lobe_side = side
+        x0 = y0 = LOBE_MARGIN
+        pad = 8
+        frame = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side), (x0, y0)]
+        axes = [(x0 + pad, y0 + side / 2), (x0 + side - pad, y0 + side / 2)]
+        _set_lines(self._lobe_polys["frame"], [frame, axes])
+        _set_lines(self._lobe_polys["reference"], [_lobe_points(1.0, side)])
+        self.lobe_caption.SetPosition(x0, y0 + side + 4)
+        self.lobe_caption.GetTextProperty().SetFontSize(13 if side >= 100 else 11)
+        self._lobe_n = None
+        self._update_lobe(self.state.material.shininess)
+
+    def _update_lobe(self, n: float) -> None:
+        if n == self._lobe_n or not hasattr(self, "_lobe_polys"):
+            return
+        self._lobe_n = n
+        _set_lines(self._lobe_polys["lobe"], [_lobe_points(n, self._lobe_side)])
+        self.lobe_caption.SetInput(f"specular lobe cos^n, n = {n:g}")
+
+    # -- pixels ---------------------------------------------------------------------------------
+    def world_to_window(self, point) -> list[int]:
+        """Window pixel (origin top-left) of a world point."""
+        ren = self.plotter.renderer
+        ren.SetWorldPoint(*point, 1.0)
+        ren.WorldToDisplay()
+        x, y, _ = ren.GetDisplayPoint()
+        _, h = self.plotter.window_size
+        return [int(round(x)), int(round(h - 1 - y))]
+
+    def probe_vertex(self) -> int:
+        """Index of the full mesh's vertex that faces the camera most (on a convex mesh it is
+        visible): the window test reads its pixel."""
+        mesh = self.mesh
+        c = self.plotter.camera
+        if c.GetParallelProjection():
+            v = np.subtract(c.GetPosition(), c.GetFocalPoint())[None, :]
+        else:
+            v = np.asarray(c.GetPosition()) - mesh.positions
+        v = v / np.linalg.norm(v, axis=1, keepdims=True)
+        return int(np.argmax(np.einsum("ij,ij->i", mesh.normals, v)))
+
+    def apply_camera(self, camera: Camera) -> None:
+        """Point the plotter's camera (PyVista will not reset it at the first frame)."""
+        self.plotter.camera_set = True
+        apply_camera(self.plotter.camera, camera)
+        self.plotter.renderer.ResetCameraClippingRange()
+
+
+def _lobe_points(n: float, side: int) -> np.ndarray:
+    x0 = y0 = LOBE_MARGIN
+    pad = 8
+    p = lobe_curve(n)
+    scale = side - 2 * pad
+    return np.column_stack([x0 + pad + p[:, 0] * scale, y0 + side / 2 + p[:, 1] * scale])
+
+
+def _set_lines(poly, polylines) -> None:
+    from vtkmodules.vtkCommonCore import vtkPoints
+    from vtkmodules.vtkCommonDataModel import vtkCellArray
+
+    pts = vtkPoints()
+    lines = vtkCellArray()
+    for line in polylines:
+        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in line]
+        lines.InsertNextCell(len(ids), ids)
+    poly.SetPoints(pts)
+    poly.SetLines(lines)
+    poly.Modified()

@@ -1,0 +1,70 @@
+"""Fixtures of the window tests: a private Xvfb server for Qt (its xcb platform is the only
+one that hosts the VTK view, so in-process widget tests need an X server too)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+
+import pytest
+
+from explorer.app.start import start_xvfb
+
+#: modules whose tests open Qt windows in the test process
+QT_MODULES = ("test_window.py",)
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """The in-process Qt tests run last: after a Qt window has existed in the process, VTK's
+    off-screen pictures of translucent meshes no longer match between a reused and a fresh
+    window (tests/render/test_render.py::test_reused_window_matches_fresh_one), so the other
+    tests run before any Qt window is made."""
+    qt = [i for i in items if i.path.name in QT_MODULES and i.path.parent.name == "app"]
+    if qt:
+        rest = [i for i in items if i not in set(qt)]
+        items[:] = rest + qt
+
+
+@pytest.fixture(scope="session")
+def xserver():
+    """One Xvfb for the session's in-process Qt tests (Qt keeps its connection until the
+    process ends, so the server lives as long)."""
+    if sys.platform in ("darwin", "win32") or shutil.which("Xvfb") is None:
+        pytest.skip("needs Xvfb for the Qt window (apt-get install -y xvfb)")
+    pytest.importorskip("PySide6")
+    pytest.importorskip("pyvistaqt")
+    _proc, display = start_xvfb()
+    # left running: Qt keeps its connection to the end of the process, and a server gone
+    # before that makes Xlib end the process with an I/O error; the server ends with the
+    # process (PR_SET_PDEATHSIG)
+    return display
+
+
+@pytest.fixture
+def xdisplay(xserver, monkeypatch):
+    """DISPLAY and Qt's xcb platform for one test (VTK's window class left to VTK)."""
+    monkeypatch.setenv("DISPLAY", xserver)
+    monkeypatch.setenv("QT_QPA_PLATFORM", "xcb")
+    monkeypatch.delenv("VTK_DEFAULT_OPENGL_WINDOW", raising=False)
+    return xserver
+
+
+@pytest.fixture(scope="session")
+def qapp(xserver):
+    """pytest-qt's QApplication, made on the private Xvfb (a session fixture is made before
+    any test's own fixtures, so the display is given here). The environment is restored
+    afterwards: Qt keeps its connection, and later tests see the machine's own."""
+    saved = {k: os.environ.get(k) for k in ("DISPLAY", "QT_QPA_PLATFORM")}
+    os.environ.update(DISPLAY=xserver, QT_QPA_PLATFORM="xcb")
+    try:
+        from PySide6 import QtWidgets
+
+        app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(["pytest-qt"])
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+    yield app

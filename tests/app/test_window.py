@@ -1,0 +1,356 @@
+"""The Qt window in-process under Xvfb (pytest-qt): every control changes the state, the
+colours VTK draws equal ``explorer.shade`` run afresh in float64 (within one 8-bit level),
+undo / redo, presets and sessions saved through the window's dialogs (answered
+programmatically), the difference view from its worker thread, and keys."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+from PySide6 import QtCore, QtGui
+
+import explorer
+from explorer.app import model as M
+from explorer.app import session as S
+from explorer.app import start as A
+from explorer.app.window import ExplorerWindow
+from explorer.cli import build_parser
+from explorer.cli.gui import start_state
+from explorer.shading.display import to_bytes
+
+pytestmark = pytest.mark.usefixtures("xdisplay")
+WAIT_MS = 60_000
+
+
+@pytest.fixture
+def win(xdisplay, qtbot, tmp_path, monkeypatch):
+    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
+    args = build_parser().parse_args(["gui", "--mesh", "icosphere", "--resolution", "3"])
+    state, mesh = start_state(args)
+    w = ExplorerWindow(state, mesh, output_dir=tmp_path, state_file=tmp_path / "state.json",
+                       last_session=tmp_path / "last.yaml", size=(1000, 700))  # fmt: skip
+    qtbot.addWidget(w)
+    w.show()
+    qtbot.waitExposed(w)
+    w.render()
+    yield w
+    assert not w.errors, w.errors
+
+
+def drawn_equals_engine(w):
+    s = w.store.state
+    mesh = w.view.mesh
+    want = to_bytes(explorer.shade(s.shown_scene(), mesh.positions, mesh.normals)).astype(int)
+    diff = np.abs(w.view.displayed_colors().astype(int) - want)
+    assert diff.max() <= 1, f"drawn colours differ from the engine's by up to {diff.max()}/255"
+
+
+@pytest.mark.parametrize(
+    ("name", "value", "read"),
+    [
+        ("ka", 0.1, lambda s: s.material.scalars()[0]),
+        ("kd", 0.3, lambda s: s.material.scalars()[1]),
+        ("ks", 0.9, lambda s: s.material.scalars()[2]),
+        ("shininess", 200.0, lambda s: s.material.shininess),
+        ("opacity", 0.5, lambda s: s.material.opacity),
+    ],
+)
+def test_material_fields_and_sliders(win, name, value, read):
+    s0 = win.store.state
+    win.panel.material.sliders[name].field.setValue(value)
+    assert read(win.store.state) == pytest.approx(value)
+    assert win.store.state.edited and "(edited)" in win.panel.material.preset_label.text()
+    win.render()
+    drawn_equals_engine(win)
+    win.undo()
+    assert win.store.state == s0
+    drawn_equals_engine(win)
+
+
+def test_a_slider_drag_is_one_undo_step(win, qtbot):
+    slider = win.panel.material.sliders["kd"].slider
+    before = win.store.state
+    slider.setSliderDown(True)
+    win.panel.material.sliders["kd"].pressed.emit()
+    for step in (700, 600, 500, 400):
+        slider.setValue(step)
+    assert win.view.dragging
+    slider.setSliderDown(False)
+    win.panel.material.sliders["kd"].released.emit()
+    assert not win.view.dragging
+    assert win.store.state.material.scalars()[1] == pytest.approx(0.4)
+    win.undo()
+    assert win.store.state == before and not win.store.can_undo
+    win.redo()
+    assert win.store.state.material.scalars()[1] == pytest.approx(0.4)
+
+
+def test_shininess_slider_is_log_scale_with_zero_at_the_left(win):
+    s = win.panel.material.sliders["shininess"]
+    s.slider.setValue(0)
+    assert win.store.state.material.shininess == 0.0
+    s.slider.setValue(s.slider.maximum())
+    assert win.store.state.material.shininess == 1000.0
+    s.slider.setValue(667)  # two thirds along: 10^2
+    assert win.store.state.material.shininess == pytest.approx(100.0, rel=0.01)
+    assert win.view.lobe_caption.GetInput().endswith(f"n = {win.store.state.material.shininess:g}")
+
+
+def test_colour_buttons_through_the_dialog(win, qtbot):
+    for term in ("ambient", "diffuse", "specular", "emission"):
+        button = win.panel.material.colours[term]
+        qtbot.mouseClick(button, QtCore.Qt.MouseButton.LeftButton)
+        dialog = button.dialog
+        assert dialog is not None and dialog.isVisible()
+        dialog.setCurrentColor(QtGui.QColor(255, 0, 51))
+        dialog.accept()
+        assert getattr(win.store.state.material, term) == pytest.approx((1.0, 0.0, 0.2))
+        assert button.text() == "1.000, 0.000, 0.200"
+    win.render()
+    drawn_equals_engine(win)
+
+
+def test_model_terms_and_presets(win, qtbot):
+    tab = win.panel.material
+    tab.model["phong"].click()
+    assert win.store.state.scene.model == "phong"
+    tab.terms["specular"].click()
+    assert win.store.state.hidden == {"specular"}
+    win.render()
+    drawn_equals_engine(win)
+    tab.search.setText("green")
+    shown = [tab.presets.item(i).text() for i in range(tab.presets.count())
+             if not tab.presets.item(i).isHidden()]  # fmt: skip
+    assert shown and all("green" in n or "green" in tab._infos[n].material.description.lower()
+                         for n in shown)  # fmt: skip
+    item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
+    tab.search.clear()
+    tab.presets.scrollToItem(item)
+    qtbot.mouseClick(tab.presets.viewport(), QtCore.Qt.MouseButton.LeftButton,
+                     pos=tab.presets.visualItemRect(item).center())  # fmt: skip
+    s = win.store.state
+    assert s.preset == "jade" and not s.edited and "jade" in tab.preset_label.text()
+    assert tab.description.text() == s.material.description
+    win.render()
+    drawn_equals_engine(win)
+
+
+def test_every_light_control(win):
+    tab = win.panel.lights
+    tab.buttons["add"].click()
+    assert len(win.store.state.scene.lights) == 2 and tab.list.count() == 2
+    tab.buttons["duplicate"].click()
+    tab.buttons["remove"].click()
+    assert len(win.store.state.scene.lights) == 2
+    tab.list.setCurrentRow(0)
+    assert win.store.state.light == 0
+    tab.sliders["azimuth"].field.setValue(-60.0)
+    tab.sliders["elevation"].field.setValue(20.0)
+    tab.sliders["distance"].field.setValue(3.0)
+    s = win.store.state
+    assert s.placement() == pytest.approx((-60.0, 20.0, 3.0 * s.radius))
+    assert "world units" in tab.sliders["distance"].note.text()
+    tab.sliders["intensity"].field.setValue(0.7)
+    assert M.light_colour(win.store.state.selected_light)[1] == pytest.approx(0.7)
+    tab.attenuation[1].setValue(0.2)
+    assert win.store.state.selected_light.attenuation[1] == pytest.approx(0.2)
+    tab.type.activated.emit(2)  # spot
+    light = win.store.state.selected_light
+    assert light.type == "spot" and tab.cutoff.isVisibleTo(tab)
+    assert win.view.glyph_kind == "spot"
+    tab.cutoff.field.setValue(12.0)
+    tab.exponent.field.setValue(3.0)
+    light = win.store.state.selected_light
+    assert (light.cutoff, light.exponent) == (12.0, 3.0)
+    tab.colour.open_dialog().colorSelected.emit(QtGui.QColor(255, 128, 0))
+    assert M.light_colour(win.store.state.selected_light)[0][1] == pytest.approx(128 / 255)
+    tab.type.activated.emit(0)  # directional: an arrow, no attenuation
+    assert win.view.glyph_kind == "directional" and not tab.attenuation_box.isVisibleTo(tab)
+    win.render()
+    drawn_equals_engine(win)
+
+
+def test_the_handle_moves_the_light_and_keeps_the_azimuth_at_the_pole(win):
+    s = win.store.state
+    point = np.asarray(s.centre) + 2.0 * s.radius * np.array([0.0, 1.0, 0.0])  # straight up
+    az = s.placement()[0]
+    win.view.handle.SetCenter(*point)
+    win._on_handle(point)
+    az2, el, d = win.store.state.placement()
+    assert (
+        el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
+    )
+    assert win.panel.lights.sliders["azimuth"].value() == pytest.approx(az, abs=0.1)
+
+
+def test_save_preset_as_asks_for_a_name_and_before_replacing(win, tmp_path, monkeypatch):
+    answers = iter(["my_gold", "Bad Name"])
+    monkeypatch.setattr(win, "ask_text", lambda *a: next(answers))
+    asked = []
+    monkeypatch.setattr(win, "ask_yes", lambda q: asked.append(q) or False)
+    win.panel.material.sliders["kd"].field.setValue(0.33)
+    path = win.save_preset_as()
+    assert path == tmp_path / "presets" / "my_gold.yaml" and path.exists()
+    s = win.store.state
+    assert s.preset == "my_gold" and not s.edited and "(edited)" not in (
+        win.panel.material.preset_label.text())  # fmt: skip
+    text = path.read_text()
+    assert win.save_preset_as("my_gold") is None and asked  # asked, said no: not replaced
+    assert path.read_text() == text
+    win.menu_actions["save_preset"].trigger()  # "Bad Name": refused, shown, nothing written
+    assert "not a valid preset name" in win.message
+    win.errors.clear()
+
+
+def test_sessions_save_and_reopen_exactly(win, qtbot, tmp_path, monkeypatch):
+    win.panel.material.sliders["ks"].field.setValue(0.2)
+    win.panel.lights.buttons["add"].click()
+    win.panel.material.terms["ambient"].click()
+    monkeypatch.setattr(win, "ask_path", lambda *a, **k: str(tmp_path / "mine.yaml"))
+    path = win.save_session_as()
+    saved = win.store.state
+    win.reset_all()
+    assert win.store.state.scene != saved.scene
+    win.open_file(path)
+    s = win.store.state
+    assert s.scene == saved.scene and s.hidden == saved.hidden and s.mesh == saved.mesh
+    win.render()
+    drawn_equals_engine(win)
+    state_file, _ = S.load_session(tmp_path / "state.json")  # the --state-file is a session
+    assert state_file.scene == s.scene
+    win.close()
+    last, _ = S.load_session(tmp_path / "last.yaml")
+    assert last.scene == s.scene
+
+
+def test_open_mesh_files_and_errors_in_one_line(win, tmp_path):
+    bad = tmp_path / "broken.obj"
+    bad.write_text("v 0 0\n")
+    win._guard(win.open_file, "open")(str(bad))
+    assert win.errors and win.message.startswith("error (") and "\n" not in win.message
+    assert "broken.obj" in win.message and win.store.state.mesh == "icosphere"
+    win.errors.clear()
+    win.panel.view.mesh.activated.emit(win.panel.view.mesh.findData("cube"))
+    assert win.store.state.mesh == "cube" and win.view.mesh.name == "cube"
+    win.undo()
+    assert win.store.state.mesh == "icosphere"
+    scene = tmp_path / "scene.yaml"
+    scene.write_text("material: ruby\nlights: [{type: directional, to_light: [0, 1, 0]}]\n")
+    win.open_file(scene)
+    s = win.store.state
+    assert s.preset == "ruby" and s.material == explorer.load_scene(str(scene)).material
+    assert [light.type for light in s.scene.lights] == ["directional"]
+    win.render()
+    drawn_equals_engine(win)
+    stl = tmp_path / "box.stl"
+    trimesh.creation.box().export(stl)
+    win.open_file(stl)
+    assert win.store.state.mesh == str(stl) and win.view.mesh.n_vertices > 0
+    assert win.panel.view.mesh.currentText() == "box.stl"
+
+
+def test_difference_view_from_the_worker(win, qtbot):
+    win.panel.view.difference.click()
+    qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
+    r = win.heat.result
+    assert r.job.key == win._difference_key() and r.comparison.mask.sum() > 1000
+    assert "RMSE" in win.panel.view.legend.text() and win.panel.view.advice.text()
+    assert not win.view.drawings[0].actor.GetVisibility()  # the map stands in for the mesh
+    win.panel.material.sliders["shininess"].field.setValue(300.0)
+    assert not win.heat.shown  # stale: the live view until the new map comes
+    qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
+    assert win.heat.result.job.scene.material.shininess == 300.0
+    qtbot.keyClick(win.plotter, "d")
+    assert not win.store.state.difference and win.view.drawings[0].actor.GetVisibility()
+
+
+def test_keys_of_the_view(win, qtbot):
+    win.plotter.setFocus()
+    qtbot.keyClick(win.plotter, "b")
+    assert win.store.state.scene.model == "phong"
+    qtbot.keyClick(win.plotter, "3")
+    assert win.store.state.hidden == {"specular"}
+    qtbot.keyClick(win.plotter, "n")
+    assert win.store.state.preset != A.DEFAULT_PRESET
+    qtbot.keyClick(win.plotter, "l")
+    assert "nothing to switch" in win.message  # one light: said so
+    before = win.store.state
+    for key in "wse":  # VTK's wireframe / surface / ...: switched off
+        qtbot.keyClick(win.plotter, key)
+    assert win.store.state == before
+    assert win.view.drawings[0].actor.GetProperty().GetRepresentation() == 2  # surface
+    cam = win.store.state.camera
+    win.plotter.camera.Azimuth(30)
+    win.render()
+    assert win.store.state.camera != cam  # the camera moved, and so the viewer
+    assert win.store.state.scene.viewer.eye == pytest.approx(win.store.state.camera.position)
+    drawn_equals_engine(win)
+    qtbot.keyClick(win.plotter, "r")
+    assert win.store.state.camera == cam and win.store.state.scene.model == "phong"
+    path = None
+    qtbot.keyClick(win.plotter, "i")
+    path = win.message.split("saved screenshot ", 1)[1]
+    qtbot.keyClick(win.plotter, "i")
+    assert win.message.split("saved screenshot ", 1)[1] != path  # never over a file
+    qtbot.keyClick(win.plotter, "h")
+    assert win.help.isVisible() and "Ctrl+Z" in win.help.text()
+
+
+def test_reset_all_can_be_undone(win):
+    win.panel.material.sliders["kd"].field.setValue(0.1)
+    changed = win.store.state
+    win.reset_all()
+    assert win.store.state.scene == win.start_state.scene
+    win.undo()
+    assert win.store.state.scene == changed.scene
+
+
+def test_status_bar_takes_a_message(win):
+    win.show_status("preparing the engine's kernels")
+    assert win.statusBar().currentMessage() == "preparing the engine's kernels"
+
+
+def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
+    win.panel.view.compare.click()
+    s = win.store.state
+    assert s.compare == s.material and s.compare_model == "phong" and win.plotter_b.isVisible()
+    qtbot.waitUntil(lambda: win.plotter_b.width() > 100)
+    b = win.view_b
+    mesh = b.mesh
+    want = to_bytes(explorer.shade(M.side_b(s).shown_scene(), mesh.positions, mesh.normals))
+    assert np.abs(b.displayed_colors().astype(int) - want.astype(int)).max() <= 1
+    assert win.plotter_b.renderer.GetActiveCamera() is win.plotter.renderer.GetActiveCamera()
+    i = win.panel.view.compare_preset.findText("jade")
+    win.panel.view.compare_preset.activated.emit(i)
+    assert win.store.state.compare_preset == "jade"
+    win.panel.view.swap.click()
+    s = win.store.state
+    assert s.preset == "jade" and s.compare_preset == A.DEFAULT_PRESET
+    win.render()
+    drawn_equals_engine(win)
+    win.panel.view.compare_difference.click()
+    a = win.view.displayed_colors().astype(int)
+    other = to_bytes(win.view_b.drawings[0].colors()).astype(int)
+    levels = np.abs(a - other).max(axis=1)
+    from explorer.analysis.comparison import heat_map
+
+    assert np.array_equal(win.view_b.displayed_colors(), heat_map(levels[None, :], vmax=16)[0])
+    path = S.save_session(win.output_dir / "ab.yaml", win.store.state)
+    back, _ = S.load_session(path)
+    assert back.compare == s.compare and back.compare_difference
+    qtbot.keyClick(win.plotter, "c")
+    assert win.store.state.compare is None and not win.plotter_b.isVisible()
+    win.undo()
+    assert win.store.state.compare is not None and win.plotter_b.isVisible()
+
+
+def test_a_light_moved_from_the_panel_keeps_its_handle_in_view(win):
+    tab = win.panel.lights
+    tab.sliders["distance"].field.setValue(3.0)
+    tab.sliders["elevation"].field.setValue(90.0)  # straight up: above the framed view
+    win.render()
+    x, y = win.view.world_to_window(M.handle_point(win.store.state))
+    w, h = win.plotter.window_size
+    assert 0 <= x < w and 0 <= y < h
+    assert win.store.state.scene.viewer.eye == pytest.approx(win.store.state.camera.position)
