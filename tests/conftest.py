@@ -26,6 +26,7 @@ numpy tier while numba's cache is cold. tests/shading/test_tiers.py tests the ti
 """
 
 import os
+import sys
 
 os.environ["PHONG_EXPLORER_KERNELS"] = "compiled"  # before the package is imported
 
@@ -93,3 +94,24 @@ def renderer():
 
     with OffscreenRenderer(RENDER_SIZE) as r:
         yield r
+
+
+@pytest.fixture
+def cold_tiers(monkeypatch, tmp_path):
+    """The engine's tiers in mode auto on a cache that holds no kernels yet: yields the ready
+    marker's path (absent; write it to say the background compile finished). The background
+    compile is a process that does nothing, and the marker is looked for at every pass."""
+    from explorer.shading import tiers
+
+    marker = tmp_path / "explorer-ready-test.json"
+    monkeypatch.setattr(tiers, "marker_path", lambda: marker)
+    monkeypatch.setattr(tiers, "cache_dir", lambda: tmp_path)
+    monkeypatch.setattr(tiers, "warm_command", lambda: [sys.executable, "-c", "pass"])
+    monkeypatch.setattr(tiers, "POLL", 0.0)
+    tiers.set_mode("auto")
+    yield marker
+    loader = tiers._state["loading"]
+    if loader is not None:
+        loader.join(timeout=600)
+    tiers.set_mode(None)
+    tiers._state.update(started=False, loading=None, failed=None, preload=False)

@@ -10,15 +10,14 @@ mesh, material and lights. The error of each pixel, in 1/255 levels, is drawn wi
 hidden, so the map sits exactly where the mesh is drawn.
 
 One comparison costs two off-screen renders and the per-pixel reference, so it runs in
-:class:`DifferenceWorker`'s thread: a new request cancels the one running (it is passed a
-``cancelled`` callable when ``compare_view`` takes one, and its result is dropped in any case),
-so frames keep coming and a stale map is never shown as the current one. No Qt here: the
+:class:`DifferenceWorker`'s thread: a new request cancels the one running (``compare_view``'s
+``cancelled`` callable stops its ray casts between chunks; a result that finishes anyway is
+dropped), so frames keep coming and a stale map is never shown as the current one. No Qt here: the
 worker hands results to a callback, which the window forwards to its GUI thread.
 """
 
 from __future__ import annotations
 
-import inspect
 import threading
 import time
 from dataclasses import dataclass
@@ -27,7 +26,7 @@ import numpy as np
 
 from explorer.analysis import advice as A
 from explorer.analysis import comparison as C
-from explorer.core import errors
+from explorer.core.errors import Cancelled
 from explorer.shading.display import to_bytes
 
 #: the error (1/255 levels) drawn white; the ramp below it is logarithmic (see heat_map)
@@ -65,20 +64,11 @@ class Result:
     error: BaseException | None = None
 
 
-def takes_cancelled(fn=None) -> bool:
-    """Whether ``compare_view`` accepts a ``cancelled`` callable."""
-    try:
-        return "cancelled" in inspect.signature(fn or C.compare_view).parameters
-    except (TypeError, ValueError):
-        return False
-
-
 def run_job(job: Job, cancelled=lambda: False) -> Result:
     """Make one comparison (in any thread)."""
     t = time.perf_counter()
-    extra = {"cancelled": cancelled} if takes_cancelled() else {}
     c = C.compare_view(job.scene, job.mesh, job.size, camera=job.camera, colors=job.colors,
-                       **extra)  # fmt: skip
+                       cancelled=cancelled)  # fmt: skip
     bg = tuple(int(v) for v in to_bytes([job.background])[0])
     image = C.heat_map(c.levels, c.mask, vmax=VMAX, background=bg)
     m = job.scene.material
@@ -132,7 +122,6 @@ class DifferenceWorker:
         self._thread.join(timeout)
 
     def _loop(self) -> None:
-        cancelled_error = getattr(errors, "Cancelled", None)
         while True:
             with self._lock:
                 while self._pending is None and not self._closed:
@@ -144,7 +133,7 @@ class DifferenceWorker:
             try:
                 result = run_job(job, cancel.is_set)
             except Exception as exc:  # noqa: BLE001 - handed to the window, which shows it
-                if cancelled_error is not None and isinstance(exc, cancelled_error):
+                if isinstance(exc, Cancelled):
                     result = None
                 else:
                     result = Result(job, error=exc)

@@ -45,11 +45,14 @@ from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
 from explorer.render.offscreen import BACKGROUND
+from explorer.shading import tiers
 
 log = logging.getLogger(__name__)
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
+#: how often the status bar asks whether the compiled kernels are ready yet (ms)
+ENGINE_POLL_MS = 500
 #: how long a status message stays (ms); errors stay until the next message
 MESSAGE_MS = 6000
 
@@ -117,6 +120,7 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
         self.status_label = QtWidgets.QLabel("")
         self.status_label.setObjectName("status")
         self.statusBar().addPermanentWidget(self.status_label)
+        self._watch_engine()
         self.view_aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)
         self._frame_on_show = state.camera is None  # framed again for the view's real shape
         if state.camera is None:
@@ -225,6 +229,27 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
         bar = self.statusBar()
         bar.setStyleSheet("color: #ff7766;" if error else "")
         bar.showMessage(text, 0 if error else int(msecs))
+
+    def _watch_engine(self) -> None:
+        """Load the compiled kernels in a thread as soon as numba's cache holds them (the numpy
+        tier draws meanwhile; :func:`explorer.shading.tiers.preload`), and say so in the
+        status bar while it lasts."""
+        tiers.preload()
+        self.engine_label = QtWidgets.QLabel("")
+        self.engine_label.setObjectName("engine")
+        self.statusBar().addPermanentWidget(self.engine_label)
+        self._engine_timer = QtCore.QTimer(self)
+        self._engine_timer.timeout.connect(self._show_engine)
+        self._engine_timer.start(ENGINE_POLL_MS)
+        self._show_engine()
+
+    def _show_engine(self) -> None:
+        tiers.preload()  # looks for the ready marker (a stat at most every tiers.POLL seconds)
+        text = tiers.status() or ""
+        if text != self.engine_label.text():
+            self.engine_label.setText(text)
+        if not text and (tiers.loaded() or tiers.mode() != "auto"):
+            self._engine_timer.stop()
 
     # -- actions --------------------------------------------------------------------------------
     def act(self, action, *args, label: str | None = None, merge=None) -> bool:

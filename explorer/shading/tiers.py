@@ -143,7 +143,8 @@ def loaded() -> bool:
 def preload() -> None:
     """For a process that lives on (the window): load the compiled kernels in a thread as soon
     as numba's cache holds them (now, or when the background compile has filled it), and switch
-    to them when loaded; the numpy tier serves meanwhile."""
+    to them when loaded; the numpy tier serves meanwhile. Call it again now and then (it looks
+    for the marker at most every :data:`POLL` seconds) to notice the background compile end."""
     if mode() != "auto" or _state["loaded"]:
         return
     _state["preload"] = True

@@ -17,14 +17,14 @@ from explorer.app import start as A
 from explorer.app.window import ExplorerWindow
 from explorer.cli import build_parser
 from explorer.cli.gui import start_state
+from explorer.shading import tiers
 from explorer.shading.display import to_bytes
 
 pytestmark = pytest.mark.usefixtures("xdisplay")
 WAIT_MS = 60_000
 
 
-@pytest.fixture
-def win(xdisplay, qtbot, tmp_path, monkeypatch):
+def _open(qtbot, tmp_path, monkeypatch) -> ExplorerWindow:
     monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
     args = build_parser().parse_args(["gui", "--mesh", "icosphere", "--resolution", "3"])
     state, mesh = start_state(args)
@@ -34,7 +34,34 @@ def win(xdisplay, qtbot, tmp_path, monkeypatch):
     w.show()
     qtbot.waitExposed(w)
     w.render()
+    return w
+
+
+@pytest.fixture
+def win(xdisplay, qtbot, tmp_path, monkeypatch):
+    w = _open(qtbot, tmp_path, monkeypatch)
     yield w
+    assert not w.errors, w.errors
+
+
+def test_the_window_draws_at_once_and_says_while_the_compiled_engine_is_prepared(
+    xdisplay, qtbot, tmp_path, monkeypatch, cold_tiers
+):
+    with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
+        w = _open(qtbot, tmp_path, monkeypatch)
+    assert "preparing the compiled engine" in w.engine_label.text()
+    drawn_equals_engine(w)
+    assert (
+        w.view.drawings[0].shader.stats["numpy"] >= 1
+        and w.view.drawings[0].shader.stats["pass"] == 0
+    )
+    cold_tiers.write_text("{}")  # the background compile is done: load, then switch
+    qtbot.waitUntil(lambda: w.engine_label.text() == "", timeout=WAIT_MS)
+    assert tiers.loaded()
+    assert w.act(M.set_coefficient, "kd", 0.4)
+    w.render()
+    assert w.view.drawings[0].shader.stats["pass"] >= 1  # the compiled kernels drew this frame
+    drawn_equals_engine(w)
     assert not w.errors, w.errors
 
 

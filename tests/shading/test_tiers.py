@@ -154,28 +154,13 @@ def test_to_bytes_rounds_alike_on_both_tiers(monkeypatch):
         monkeypatch.undo()
 
 
-@pytest.fixture
-def auto(monkeypatch, tmp_path):
-    """Mode auto on a cache with no marker yet (its path under tmp_path); the background compile
-    replaced by a process that does nothing."""
-    marker = tmp_path / "explorer-ready-test.json"
-    monkeypatch.setattr(tiers, "marker_path", lambda: marker)
-    monkeypatch.setattr(tiers, "cache_dir", lambda: tmp_path)
-    monkeypatch.setattr(tiers, "warm_command", lambda: [sys.executable, "-c", "pass"])
-    monkeypatch.setattr(tiers, "POLL", 0.0)
-    tiers.set_mode("auto")
-    yield marker
-    tiers.set_mode(None)
-    tiers._state.update(started=False, loading=None, failed=None, preload=False)
-
-
-def test_a_window_loads_the_kernels_in_a_thread_once_they_are_ready(auto):
+def test_a_window_loads_the_kernels_in_a_thread_once_they_are_ready(cold_tiers):
     with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
         assert not tiers.compiled(10**9)  # cold: the background compile starts
     tiers.preload()
     assert "preparing" in tiers.status()
     assert not tiers.compiled(10**9)
-    auto.write_text("{}")  # the background compile is done
+    cold_tiers.write_text("{}")  # the background compile is done
     assert not tiers.compiled(10**9)  # seen: loading in a thread, the numpy tier serves meanwhile
     loader = tiers._state["loading"]
     assert loader is not None and "loading" in tiers.status()
@@ -183,8 +168,8 @@ def test_a_window_loads_the_kernels_in_a_thread_once_they_are_ready(auto):
     assert tiers.compiled(1) and tiers.loaded() and tiers.status() is None
 
 
-def test_a_one_shot_process_loads_the_kernels_only_for_enough_work(auto):
-    auto.write_text("{}")  # the cache holds the kernels
+def test_a_one_shot_process_loads_the_kernels_only_for_enough_work(cold_tiers):
+    cold_tiers.write_text("{}")  # the cache holds the kernels
     mesh = sphere(16)
     s = Shader(SHADOWED, mesh.positions, mesh.normals, keep=False)
     _ = s.colors
