@@ -390,7 +390,8 @@ import sys, time
 import explorer.geometry.bvh as B
 kernel = B._nearest_chunk
 def slow(*args):
-    print("chunk", file=sys.stderr, flush=True)
+    sys.stderr.write("chunk\\n")  # one write: the two threads' lines never interleave
+    sys.stderr.flush()
     time.sleep(0.1)
     return kernel(*args)
 B._nearest_chunk = slow
