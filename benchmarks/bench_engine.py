@@ -35,6 +35,8 @@ from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
 from explorer.shading.equation import equation_shade
 
+WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
+
 
 def machine() -> str:
     cpu = platform.processor() or "unknown CPU"
@@ -50,7 +52,7 @@ def machine() -> str:
     return (
         f"{cpu}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
-        f"float32 vectors: {'16 lanes (AVX-512)' if K.WIDE_FLOAT32 else 'LLVM default width'}; "
+        f"vectors: {WIDTH[K.WIDE_VECTORS]}; "
         f"load average {load:.2f}"
     )
 

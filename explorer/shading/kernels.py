@@ -32,9 +32,9 @@ Leaf kernels are compiled without numba's reference counting (``_nrt=False``): e
 shared array would otherwise be an atomic increment and decrement of its count, which the two
 threads of a pass contend for (about a fifth of a full pass at 1M vertices).
 
-On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many Intel cores still picks 256-bit
-ones; the float32 entry points are compiled with 16-lane vectors there, two vector iterations
-interleaved (see :func:`wide_vectors`).
+On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many x86 cores still picks 256-bit
+ones; the entry points are compiled with 512-bit vectors there (16 float32 or 8 float64 lanes),
+two vector iterations interleaved (see :func:`wide_vectors`).
 """
 
 from __future__ import annotations
@@ -44,6 +44,7 @@ import functools
 import os
 import sys
 import tempfile
+from typing import NamedTuple
 
 import llvmlite.binding as llvm
 import numba as nb
@@ -77,6 +78,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
+from explorer.shading.vmath import fpow
 
 BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
@@ -113,7 +115,6 @@ N_OPTS = 13
     R_LX,
     R_LY,
     R_LZ,
-    R_D,
     R_W,
     R_BASE,
     R_WS,
@@ -121,8 +122,8 @@ N_OPTS = 13
     R_GD,
     R_GS,
     R_NV,
-) = range(29)
-N_ROWS = 29
+) = range(28)
+N_ROWS = 28
 # R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
 # policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
 # (explorer.core.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
@@ -180,98 +181,6 @@ def constants(dtype) -> np.ndarray:
     )
 
 
-# --------------------------------------------------------------------------------------------
-# pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
-# log2 x from the exponent bits plus ln(1 + z) = z - z²/2 + z³·P(z), z in [-0.29, 0.41] (P of
-# degree 5, fitted like Cephes logf); 2**t = 2**k · 2**f with f in [-0.5, 0.5] (degree-5 fit)
-# and 2**k written as exponent bits. Relative error about 1e-6 (tests/shading/test_kernels.py).
-# Results below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per
-# element, which does not vectorise; this one inlines into the shading loop
-# (benchmarks/bench_lean_kernel.py times the loop with it).
-
-
-@intrinsic
-def i2f(typingctx, x):
-    """An integer's low 32 bits read as a float32."""
-    if not isinstance(x, types.Integer):
-        return None
-
-    def codegen(context, builder, sig, args):
-        v = args[0]
-        if v.type.width > 32:
-            v = builder.trunc(v, ir.IntType(32))
-        return builder.bitcast(v, ir.FloatType())
-
-    return types.float32(x), codegen
-
-
-#: log2's split point: x = 2**k · m with m in [sqrt(1/2), sqrt(2)), so ln m = ln(1 + z) has
-#: |z| <= 0.41 (the range of the polynomial below)
-_SPLIT = 0x3F3504F3  # the bits of float32 sqrt(1/2)
-
-
-@intrinsic
-def split32(typingctx, x):
-    """x = 2**k · m for a positive float32 x, m in [sqrt(1/2), sqrt(2)): (k, m) as float32.
-
-    In 32-bit integer operations and without a branch or blend (numba's own integer arithmetic
-    widens to int64, which costs cross-lane conversions in SIMD code): subtracting the bits of
-    sqrt(1/2) moves the split point to an exponent boundary, so the shifted difference is k and
-    the bits of x minus k's exponent bits are m. x = 0 gives k = -127, m = 1.
-    """
-    if x != types.float32:
-        return None
-
-    def codegen(context, builder, sig, args):
-        i32 = ir.IntType(32)
-        ix = builder.bitcast(args[0], i32)
-        tmp = builder.sub(ix, ir.Constant(i32, _SPLIT))
-        k = builder.ashr(tmp, ir.Constant(i32, 23))
-        im = builder.sub(ix, builder.and_(tmp, ir.Constant(i32, -(1 << 23))))
-        kf = builder.sitofp(k, ir.FloatType())
-        m = builder.bitcast(im, ir.FloatType())
-        return context.make_tuple(builder, sig.return_type, (kf, m))
-
-    return types.UniTuple(types.float32, 2)(types.float32), codegen
-
-
-@nb.njit(inline="always", **_LEAF)
-def log2_32(x):
-    """log2 x for a positive, finite float32 x (-127 for x = 0)."""
-    e, f = split32(x)
-    z = f - np.float32(1.0)
-    p = np.float32(-0.10746953303517079)  # least-squares fit, |error| <= 3.5e-7 on the range
-    p = p * z + np.float32(0.15904727806564242)
-    p = p * z + np.float32(-0.16972990678158706)
-    p = p * z + np.float32(0.1993995441108155)
-    p = p * z + np.float32(-0.24992546983782263)
-    p = p * z + np.float32(0.33333703609427834)
-    ln = z + z * z * (z * p - np.float32(0.5))
-    return e + ln * np.float32(1.4426950408889634)
-
-
-@nb.njit(inline="always", **_LEAF)
-def exp2_32(t):
-    """2**t for float32 t; 0 for t <= -127."""
-    t = max(t, np.float32(-127.0))
-    k = np.rint(t)
-    fr = t - k
-    q = np.float32(0.0013390867352163702)  # 2**f = 1 + f·Q(f), least squares, rel. err 2e-7
-    q = q * fr + np.float32(0.00966637369320816)
-    q = q * fr + np.float32(0.05550357104250901)
-    q = q * fr + np.float32(0.24022348940946955)
-    q = q * fr + np.float32(0.6931471880293432)
-    q = q * fr + np.float32(1.0)  # exact at f = 0: 1**y == 1
-    return q * i2f((np.int32(k) + np.int32(127)) << 23)
-
-
-@nb.njit(inline="always", **_LEAF)
-def pow32(x, y):
-    """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
-    t = y * log2_32(x)
-    return exp2_32(t if x > np.float32(0.0) else np.float32(-200.0))
-
-
 def unit(k):
     """1 in the precision of ``k`` (an array), as a compile-time constant: ``k[K_ONE]`` is a
     run-time value, so ``k[K_ONE] / np.sqrt(x)`` costs a multiply the constant does not."""
@@ -298,18 +207,6 @@ def _nil_overload(k):
     if k.dtype == types.float32:
         return lambda k: np.float32(0.0)
     return lambda k: np.float64(0.0)
-
-
-def fpow(x, y):
-    """x**y in the working precision: :func:`pow32` for float32, libm for float64."""
-    return x**y
-
-
-@overload(fpow, jit_options=_LEAF)
-def _fpow_overload(x, y):
-    if x == types.float32:
-        return lambda x, y: pow32(x, y)
-    return lambda x, y: x**y
 
 
 @intrinsic
@@ -560,73 +457,117 @@ def _reach(bd, c0, nc, q, fl, back, act):
 
 
 # --------------------------------------------------------------------------------------------
-# One light over one block. The loop is specialised at compile time: `_light` is overloaded on a
-# literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular, bit 5
-# inline, bit 6 attenuated, bit 7 grey), so each combination gets a loop that holds exactly the
-# terms the plan asks for and no run-time test: where L comes from (constant, the rows a
-# positional pre-pass filled, or computed inline), how the lobe's base is found (flat, constant H,
-# Blinn, Phong), and whether the diffuse and specular sums are touched.
+# One light over one block: the light loop. It is specialised at compile time on a few named
+# choices (a :class:`Loop`), so that each combination is a loop that holds exactly the terms it
+# needs and no run-time test:
 #
-# Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
-# and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
-# or per-vertex ambient: no L or weight rows are written or read. They keep l = position - P
-# unnormalised (N·L = (N·l)/|l|, L + V = l/|l| + V in one fused step each) and take N·H's
-# numerator as N·L + N·V, with N·V computed once per block (row R_NV). Every light that
-# stores its lobe (the first pass of a shininess drag) writes base and weight rows from the same
-# arithmetic as a pass that does not, so a shininess change and a fresh pass agree bit for bit
-# in the base. A grey light (r = g = b for its diffuse and
-# its specular colour, as most lights are) adds one number per vertex to a grey row instead of
-# three to the RGB rows; the block adds the grey rows to every channel once. Inline variants also
-# drop the exact policies inside the ambiguity bands (a light at the vertex, L = -V): there they
-# only keep every value finite and mark the lane, which the engine redoes in float64, where the
-# policies hold.
+# - ``source``, where L and the weight w come from: SRC_CONST (a directional light: L constant,
+#   w = 1), SRC_ROWS (rows the light's pre-passes filled: L, w = attenuation · spot · shadow ...,
+#   see :func:`_light_run`), SRC_INLINE (a plain point light: L and the attenuation computed in
+#   the loop itself, no rows written or read);
+# - ``lobe``, how the specular lobe's base is found: LOBE_FLAT (shininess 0: base^0 = 1),
+#   LOBE_CONST_H (Blinn with a constant halfway vector), LOBE_BLINN, LOBE_PHONG, or LOBE_NONE
+#   (no specular: the diffuse alone);
+# - ``grey`` (inline only): the light's diffuse and specular colours are grey (r = g = b, as most
+#   lights are): it adds one number per vertex to a grey row instead of three to the RGB rows; the
+#   block adds the grey rows to every channel once.
+#
+# Every valid combination is in :data:`LIGHT_LOOPS`; :func:`_light_loop` calls the one a light
+# needs (its code from :func:`_loop_code`), through a chain of tests the compiler writes from that
+# tuple (:func:`_pick_loop`): no table is written by hand, and all of them are compiled with
+# the entry point that calls them (the module docstring gives the cost). What is cheap to decide
+# at run time is not a variant: whether the light adds diffuse (a specular-only pass adds w·N·L
+# times a zero colour), whether it is attenuated (1, 0, 0 otherwise: w = 1 exactly).
+#
+# Inline loops keep l = position - P unnormalised (N·L = (N·l)/|l|, L + V = l/|l| + V in one
+# fused step each) and take N·H's numerator as N·L + N·V, with N·V computed once per block (row
+# R_NV). On the float32 path (ambiguity tracking on) they drop the exact policies inside the
+# ambiguity bands (a light at the vertex, L = -V): there they only keep every value finite and
+# mark the lane, which the engine redoes in float64. On the float64 path they apply the policies
+# with selects (L = N at the vertex; a zero lobe where L = -V), as the row pre-passes do. Every
+# light that stores its lobe (the first pass of a shininess drag) writes base and weight rows
+# from the same arithmetic as a pass that does not, so a shininess change and a fresh pass agree
+# bit for bit in the base.
+
+SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
+LOBE_NONE = 4  # (after the LOBE_* modes above)
 
 
-def _light(scr, m, dx, gd, q, y, k, variant):  # pragma: no cover - replaced by the overload below
+class Loop(NamedTuple):
+    """The compile-time choices of one light loop (see the comment above)."""
+
+    source: int
+    lobe: int
+    grey: bool
+
+
+def loop_code(loop: Loop) -> int:
+    """A loop's code: the literal the light loop is compiled for (and :func:`_loop_code`)."""
+    return loop.source | loop.lobe << 2 | int(loop.grey) << 5
+
+
+def loop_of(code: int) -> Loop:
+    return Loop(code & 3, (code >> 2) & 7, bool(code & 32))
+
+
+def _valid(loop: Loop) -> bool:
+    inline = loop.source == SRC_INLINE
+    return (inline or not loop.grey) and not (inline and loop.lobe == LOBE_CONST_H)
+
+
+#: every light loop that is compiled (codes, see :func:`loop_code`)
+LIGHT_LOOPS = tuple(
+    loop_code(lp)
+    for lp in (
+        Loop(s, lobe, g)
+        for s in (SRC_CONST, SRC_ROWS, SRC_INLINE)
+        for lobe in (LOBE_NONE, LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG)
+        for g in (False, True)
+    )
+    if _valid(lp)
+)
+
+
+def _light(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - replaced by the overload
     raise NotImplementedError
 
 
 @overload(_light, prefer_literal=True, jit_options=_LEAF)
-def _light_overload(scr, m, dx, gd, q, y, k, variant):
-    if not isinstance(variant, types.IntegerLiteral):
-        raise TypingError("_light needs a literal variant")
-    v = variant.literal_value
-    positional = bool(v & 1)
-    mode = (v >> 1) & 3
-    dif = bool(v & 8)
-    spec = bool(v & 16)
-    inline = bool(v & 32)
-    atten = bool(v & 64)
-    grey = bool(v & 128)
+def _light_overload(scr, m, q, y, k, atten, l_dif, code):
+    """The light loop for a literal ``code`` (see the comment above)."""
+    if not isinstance(code, types.IntegerLiteral):
+        raise TypingError("_light needs a literal code")
+    loop = loop_of(code.literal_value)
+    inline, const = loop.source == SRC_INLINE, loop.source == SRC_CONST
+    spec = loop.lobe != LOBE_NONE
+    mode = loop.lobe
     lobe_on = spec and mode != LOBE_FLAT
+    grey = loop.grey
     track = scr.dtype == types.float32  # only the float32 path marks ambiguous lanes
-    if inline and not track:
-
-        def never(scr, m, dx, gd, q, y, k, variant):
-            raise AssertionError("inline light loops are float32 only")
-
-        return never
-
     # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
     # it interleaves them; the row-path loops read and write too many rows for such checks
     row = _row_checked if inline else _row
 
-    def impl(scr, m, dx, gd, q, y, k, variant):
+    def impl(scr, m, q, y, k, atten, l_dif, code):
         # rows as separate 1-D arrays: lets the compiler vectorise
         px, py, pz = row(scr, R_PX, m), row(scr, R_PY, m), row(scr, R_PZ, m)
         nx, ny, nz = row(scr, R_NX, m), row(scr, R_NY, m), row(scr, R_NZ, m)
         vx, vy, vz, NV = row(scr, R_VX, m), row(scr, R_VY, m), row(scr, R_VZ, m), row(scr, R_NV, m)
         Lx, Ly, Lz, W = row(scr, R_LX, m), row(scr, R_LY, m), row(scr, R_LZ, m), row(scr, R_W, m)
-        Dx, Dy, Dz = row(scr, dx, m), row(scr, dx + 1, m), row(scr, dx + 2, m)
+        Dx, Dy, Dz = row(scr, R_DX, m), row(scr, R_DY, m), row(scr, R_DZ, m)
         Sx, Sy, Sz = row(scr, R_SX, m), row(scr, R_SY, m), row(scr, R_SZ, m)
         B, WS, TRK = row(scr, R_BASE, m), row(scr, R_WS, m), row(scr, R_TRK, m)
-        GD, GS = row(scr, gd, m), row(scr, R_GS, m)
+        GD, GS = row(scr, R_GD, m), row(scr, R_GS, m)
         zero, one, two = k[K_ZERO], unit(k), k[K_TWO]
         # (squares and abs: provably >= 0, which keeps the square roots vectorisable; see nil)
         h_eps2, p_eps2, floor = abs(k[K_HALF_EPS2]), k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
         c_dot, c_len2, c_dist2 = k[K_MARGIN_DOT], k[K_MARGIN_LEN2], k[K_MARGIN_DIST2]
-        kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
-        dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
+        # not attenuated: 1 / max(1 + 0·d, floor) = 1
+        kc = q[P_ATT] if atten else one
+        kl = q[P_ATT + 1] if atten else zero
+        kq = q[P_ATT + 2] if atten else zero
+        # a specular-only pass adds 0 to the diffuse sums it does not recompute
+        dr, dg, db = (q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]) if l_dif else (zero, zero, zero)
         sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
         qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
         hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
@@ -640,28 +581,32 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
                 yy = qy - py[i]
                 z = qz - pz[i]
                 d2 = x * x + yy * yy + z * z
-                inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (then marked)
-                if atten:  # w = 1 / (kc + kl·d + kq·d²)
+                if track:
+                    inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (marked)
                     d = d2 * inv
-                    w = one / max(kc + (kl + kq * d) * d, floor)
-                else:
-                    w = one
+                else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = |l|
+                    at = d2 < p_eps2
+                    inv = one / np.sqrt(one if at else d2)
+                    d = np.sqrt(d2) if at else d2 * inv
+                    x = a if at else x
+                    yy = b if at else yy
+                    z = c if at else z
+                w = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
                 ndl = (a * x + b * yy + c * z) * inv  # N·L
                 margin = d2 * c_dist2
             else:
-                if positional:  # L and w = att·spot from the pre-pass rows
-                    lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
-                else:  # directional: constant L, never attenuated
+                if const:  # directional: constant L, never attenuated
                     lx, ly, lz, w = qx, qy, qz, one
+                else:  # L and w from the pre-pass rows
+                    lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
                 ndl = a * lx + b * ly + c * lz  # N·L
-            if dif:  # w·max(N·L, 0)·d_i
-                t = w * max(ndl, zero)
-                if grey:
-                    GD[i] += t * dr
-                else:
-                    Dx[i] += t * dr
-                    Dy[i] += t * dg
-                    Dz[i] += t * db
+            t = w * max(ndl, zero)  # w·max(N·L, 0)·d_i
+            if grey:
+                GD[i] += t * dr
+            else:
+                Dx[i] += t * dr
+                Dy[i] += t * dg
+                Dz[i] += t * db
             if spec:
                 ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
                 margin = min(margin, abs(ndl) * c_dot)
@@ -714,98 +659,41 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
     return impl
 
 
-@nb.njit(**_LEAF)
-def _light_inline(scr, m, dx, gd, q, y, k, atten, mode, l_spec, grey):
-    """Call the inline point-light loop compiled for this combination (diffuse always on)."""
-    if grey and atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 6)
+def _pick_loop(scr, m, q, y, k, atten, l_dif, code, at):  # pragma: no cover - overloaded
+    raise NotImplementedError
+
+
+@overload(_pick_loop, prefer_literal=True, jit_options=_LEAF)
+def _pick_loop_overload(scr, m, q, y, k, atten, l_dif, code, at):
+    """``_light`` for the run-time ``code``: tests it against LIGHT_LOOPS[at], then the
+    entries after it (a chain the compiler unrolls, one literal call each)."""
+    if not isinstance(at, types.IntegerLiteral):
+        raise TypingError("_pick_loop needs a literal position")
+    j = at.literal_value
+    if j >= len(LIGHT_LOOPS):
+        return lambda scr, m, q, y, k, atten, l_dif, code, at: None  # (not a compiled loop)
+    this, after = LIGHT_LOOPS[j], j + 1
+
+    def impl(scr, m, q, y, k, atten, l_dif, code, at):
+        if code == this:
+            _light(scr, m, q, y, k, atten, l_dif, this)
         else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 4)
-    elif grey and not atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 4)
-    elif not grey and atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 4)
-    elif not grey and not atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 4)
+            _pick_loop(scr, m, q, y, k, atten, l_dif, code, after)
+
+    return impl
 
 
 @nb.njit(**_LEAF)
-def _light_any(scr, m, q, y, k, positional, mode, l_dif, l_spec):
-    """Call the light loop compiled for this combination (each call site passes a literal)."""
-    if not positional:
-        if not l_spec:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 8)
-        elif mode == LOBE_FLAT:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 24)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 16)
-        elif mode == LOBE_CONST_H:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 26)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 18)
-        elif mode == LOBE_BLINN:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 28)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 20)
-        elif mode == LOBE_PHONG:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 30)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 22)
-    else:
-        if not l_spec:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 9)
-        elif mode == LOBE_FLAT:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 25)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 17)
-        elif mode == LOBE_CONST_H:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 27)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 19)
-        elif mode == LOBE_BLINN:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 29)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 21)
-        elif mode == LOBE_PHONG:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 31)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 23)
+def _light_loop(scr, m, q, y, k, atten, l_dif, code):
+    """Run the light loop compiled for ``code`` (see :func:`loop_code`)."""
+    _pick_loop(scr, m, q, y, k, atten, l_dif, code, 0)
+
+
+@nb.njit(**_LEAF)
+def _loop_code(source, mode, l_spec, grey):
+    """The code of the loop for a light (as :func:`loop_code`, at run time)."""
+    lobe = mode if l_spec else LOBE_NONE
+    return source | lobe << 2 | (32 if grey else 0)
 
 
 @nb.njit(**_LEAF)
@@ -1006,11 +894,10 @@ def _mode(fl, flat, phong):
 
 
 @nb.njit(**_LEAF)
-def _is_inline(fl, track, l_dif, l_spec, mode):
-    """A plain point light on the float32 path: L and attenuation computed in the light loop."""
+def _is_inline(fl, l_dif, l_spec, mode):
+    """A plain point light: L and attenuation computed in the light loop (no pre-pass)."""
     return (
-        track
-        and (l_dif or l_spec)
+        (l_dif or l_spec)
         and (fl & AMBIENT) == 0  # the path depends on the light only, not on the pass
         and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
         and not (l_spec and (fl & FRESNEL) != 0)
@@ -1027,13 +914,12 @@ def grey_pass(flags, opts, diffuse_grey):
     third of the memory traffic of (n, 3) ones."""
     if opts[O_DO_SPEC] == 0 or not (opts[O_DO_DIF] != 0 or diffuse_grey):
         return False
-    track = opts[O_TRACK] != 0
     flat, phong = opts[O_FLAT] != 0, opts[O_PHONG] != 0
     for li in range(flags.shape[0]):
         fl = flags[li]
         l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
         if (l_dif or l_spec) and not (
-            (fl & GREY) != 0 and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong))
+            (fl & GREY) != 0 and _is_inline(fl, l_dif, l_spec, _mode(fl, flat, phong))
         ):
             return False
     return True
@@ -1081,18 +967,17 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
 @nb.njit(inline="always", **_LEAF)
 def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
     """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
-    ``scr`` starts at the run's first lane, see _block); ``vis`` : (m,) its visibility, or (0,)."""
-    if inline:  # a plain point light on the float32 path (see _is_inline)
-        atten, grey = (fl & ATTEN) != 0, (fl & GREY) != 0
-        if l_dif:
-            _light_inline(scr, m, R_DX, R_GD, q, shininess, k, atten, mode, l_spec, grey)
-        else:  # specular only: the diffuse goes to rows nobody reads (zeroed by _block)
-            _light_inline(scr, m, R_LX, R_D, q, shininess, k, atten, mode, True, grey)
+    ``scr`` starts at the run's first lane, see _block): its pre-passes (rows L and the weight
+    w), then its light loop; ``vis`` : (m,) its visibility, or (0,)."""
+    atten = (fl & ATTEN) != 0
+    if inline:  # a plain point light (see _is_inline): no pre-pass
+        code = _loop_code(SRC_INLINE, mode, l_spec, (fl & GREY) != 0)
+        _light_loop(scr, m, q, shininess, k, atten, l_dif, code)
         return
     fres = l_spec and (fl & FRESNEL) != 0
     rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
     if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
-        _to_light(scr, m, q, k, (fl & ATTEN) != 0)
+        _to_light(scr, m, q, k, atten)
         if fl & SPOT:
             _spot(scr, m, q, k, (fl & SPOT_EXP) != 0)
         if l_amb:
@@ -1101,13 +986,16 @@ def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inl
         _dir_rows(scr, m, q, k[K_ONE])
     if fl & SHADOW:  # after the ambient: ambient light is not shadowed
         _shadow(scr, m, vis)
+    source = SRC_ROWS if rows else SRC_CONST
     if fres:  # diffuse with w, then specular with w·F
         if l_dif:
-            _light_any(scr, m, q, shininess, k, True, mode, True, False)
+            _light_loop(
+                scr, m, q, shininess, k, False, True, _loop_code(source, mode, False, False)
+            )
         _fresnel(scr, m, q, k)
-        _light_any(scr, m, q, shininess, k, True, mode, False, True)
-    else:
-        _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
+        _light_loop(scr, m, q, shininess, k, False, False, _loop_code(source, mode, True, False))
+    elif l_dif or l_spec:  # (the weight rows hold the attenuation: not again in the loop)
+        _light_loop(scr, m, q, shininess, k, False, l_dif, _loop_code(source, mode, l_spec, False))
 
 
 @nb.njit(**_LEAF)
@@ -1156,7 +1044,6 @@ def _block(
     two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
     do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
     store_lobe = opts[O_STORE_LOBE] != 0
-    track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
     px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
     # (two-sided flips these copies)
     nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
@@ -1171,9 +1058,6 @@ def _block(
     Dx, Dy, Dz = _row(scr, R_DX, m), _row(scr, R_DY, m), _row(scr, R_DZ, m)
     Sx, Sy, Sz = _row(scr, R_SX, m), _row(scr, R_SY, m), _row(scr, R_SZ, m)
     trk = _row(scr, R_TRK, m)
-    # the inline loops always add a diffuse term: for a specular-only pass it goes to the rows
-    # R_LX, R_LY, R_LZ (RGB) and R_D (grey), which the inline loops never read
-    junk_zeroed = False
 
     _fill(trk, k[K_INF])  # no lane is near a decision until a light says so
     used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
@@ -1195,7 +1079,7 @@ def _block(
             _fill(vz, view[2])
     if two_sided:
         _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
-    if track and do_spec and not flat:  # N·V, for the inline lobes
+    if do_spec and not flat:  # N·V, for the inline lobes
         _dot(nx, ny, nz, vx, vy, vz, _row(scr, R_NV, m))
 
     # the sums: recomputed ones start at 0, the others come from the caches
@@ -1218,18 +1102,13 @@ def _block(
         if not (l_amb or l_dif or l_spec):
             continue
         mode = _mode(fl, flat, phong)
-        inline = _is_inline(fl, track, l_dif, l_spec, mode)  # L, attenuation inline
+        inline = _is_inline(fl, l_dif, l_spec, mode)  # L, attenuation inline
         if inline:
             grey = (fl & GREY) != 0
             if grey and not used_grey:
                 _fill(_row(scr, R_GD, m), zero)
                 _fill(_row(scr, R_GS, m), zero)
             used_grey = used_grey or grey
-            # specular only (a viewer change): the diffuse goes to rows nobody reads
-            if not l_dif and not junk_zeroed:
-                for row in (R_LX, R_LY, R_LZ, R_D):
-                    _fill(_row(scr, row, m), zero)
-                junk_zeroed = True
         reach = nc
         if cull:
             reach = 0
@@ -1384,11 +1263,13 @@ def _host_has_avx512() -> bool:
         return False
 
 
-#: float32 loops are vectorised 16 lanes wide where the CPU has AVX-512 (LLVM's Intel tunings
-#: prefer 256-bit vectors; 512-bit ones shade about 12% faster here). Set the environment
-#: variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's choice (numba's on-disk cache keeps
-#: whichever was compiled first: clear it, or use another NUMBA_CACHE_DIR, to compare).
-WIDE_FLOAT32 = (
+#: loops are vectorised 512 bits wide (16 float32 or 8 float64 lanes) where the CPU has AVX-512
+#: (LLVM's tunings for many x86 cores prefer 256-bit vectors; 512-bit ones shade about 12%
+#: faster here in float32, and the float64 light loop, whose power is long, gains more; see
+#: benchmarks/bench_engine.py). Set the environment variable PHONG_EXPLORER_WIDE_VECTORS=0 to
+#: keep LLVM's choice (numba's on-disk cache keeps whichever was compiled first: clear it, or use
+#: another NUMBA_CACHE_DIR, to compare).
+WIDE_VECTORS = (
     os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
     and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
     and _host_has_avx512()
@@ -1427,15 +1308,16 @@ INTERLEAVE = 2
 
 
 @contextlib.contextmanager
-def wide_vectors():
-    """Compile numba code inside this block with 16-lane vectors where :data:`WIDE_FLOAT32`
-    (else a no-op). LLVM's ``-force-vector-width`` is a process-wide option: it is set for the
-    block only and reset to 0 (LLVM's own choice) after, so other numba code is not affected."""
-    if not WIDE_FLOAT32:
+def wide_vectors(lanes: int = 16):
+    """Compile numba code inside this block with ``lanes``-lane vectors (16 for float32, 8 for
+    float64: 512 bits) where :data:`WIDE_VECTORS` (else a no-op). LLVM's
+    ``-force-vector-width`` is a process-wide option: it is set for the block only and reset to 0
+    (LLVM's own choice) after, so other numba code is not affected."""
+    if not WIDE_VECTORS:
         yield
         return
     with _quiet_llvm_remarks():
-        llvm.set_option("", "-force-vector-width=16")
+        llvm.set_option("", f"-force-vector-width={lanes}")
         llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
         try:
             yield
@@ -1445,11 +1327,11 @@ def wide_vectors():
 
 
 def _wide(kernel, dtype_arg: int):
-    """Call ``kernel`` so that a signature it meets for the first time with float32 data (the
-    dtype of positional argument ``dtype_arg``) is compiled with 16-lane vectors
+    """Call ``kernel`` so that a signature it meets for the first time with float data of a
+    dtype (that of positional argument ``dtype_arg``) is compiled with 512-bit vectors
     (:func:`wide_vectors` around such first calls, which compile or load from numba's cache);
     later calls go straight to the kernel."""
-    if not WIDE_FLOAT32:
+    if not WIDE_VECTORS:
         return kernel
     seen: set = set()
 
@@ -1458,10 +1340,10 @@ def _wide(kernel, dtype_arg: int):
         dt = args[dtype_arg].dtype
         if dt in seen:
             return kernel(*args)
-        if dt != np.float32:
+        if dt not in (np.float32, np.float64):
             seen.add(dt)
             return kernel(*args)
-        with wide_vectors():
+        with wide_vectors(64 // dt.itemsize):
             try:
                 return kernel(*args)
             finally:

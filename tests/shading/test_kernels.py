@@ -9,28 +9,6 @@ from explorer.shading import kernels as K
 from explorer.shading.equation import equation_shade
 
 
-@pytest.mark.parametrize("y", [1e-6, 0.5, 1.0, 12.8, 76.8, 128.0, 1000.0, 1e4])
-def test_pow32_matches_float64_pow(y):
-    x = np.concatenate([np.linspace(0, 1, 100001), [1e-30, 1e-38, 0.5, 1.0]]).astype(np.float32)
-    got = np.array(
-        [K.pow32(v, np.float32(y)) for v in x[::97]] + [K.pow32(v, np.float32(y)) for v in x[-4:]]
-    )
-    xs = np.concatenate([x[::97], x[-4:]]).astype(np.float64)
-    want = xs**y
-    assert np.all(np.isfinite(got))
-    assert np.abs(got - want).max() <= 1e-6
-    # relative accuracy where the lobe is visible (tiny results: the absolute bound above)
-    normal = (xs >= 2.0**-126) & (want > 1e-4)
-    rel = np.abs(got - want)[normal] / want[normal]
-    assert rel.max() <= 1e-5
-
-
-def test_pow32_edge_values():
-    assert K.pow32(np.float32(0.0), np.float32(3.0)) == 0.0
-    assert K.pow32(np.float32(1.0), np.float32(1e4)) == 1.0
-    assert K.pow32(np.float32(1e-30), np.float32(1e-6)) == pytest.approx(1e-30**1e-6, rel=1e-6)
-
-
 def test_stream_is_the_bandwidth_yardstick():
     P = np.arange(30, dtype=np.float32).reshape(10, 3)
     out = np.empty_like(P)
@@ -77,7 +55,7 @@ def test_wide_vectors_can_be_switched_off():
 
     code = (
         "from explorer.shading import kernels as K; import numba; "
-        "assert not K.WIDE_FLOAT32; "
+        "assert not K.WIDE_VECTORS; "
         "assert isinstance(K.shade, numba.core.registry.CPUDispatcher); print('ok')"
     )
     env = dict(os.environ, PHONG_EXPLORER_WIDE_VECTORS="0")
