@@ -12,7 +12,7 @@ points is compiled by the first that calls it (``fixup`` reuses much of ``shade`
 column sums to the session's total, and each figure is what that call adds.
 
 The row "shade, one light variant" compiles the same session with the light loop's variants cut
-down to the one the scene uses (:data:`explorer.shading.kernels.LIGHT_VARIANTS` set to it in
+down to the one the scene uses (:data:`explorer.shading.kernels.LIGHT_LOOPS` set to it in
 the child, or the old dispatch tables replaced at revisions that had them): its difference
 from "shade" is what the literal-dispatched variants cost to compile.
 
@@ -44,8 +44,8 @@ from explorer.shading import display, kernels as K
 assert explorer.__file__.startswith({root!r}), explorer.__file__
 import_s = time.perf_counter() - t0
 if cut:
-    if hasattr(K, "LIGHT_VARIANTS"):
-        K.LIGHT_VARIANTS = K.variants_for_scene_kinds(("point",), dtype == "float32")
+    if hasattr(K, "LIGHT_LOOPS"):
+        K.LIGHT_LOOPS = (K.loop_code(K.Loop(K.SRC_INLINE, K.LOBE_BLINN, True)),)
     else:  # the hand-written tables of older revisions: one branch each
         import numba as nb
         from explorer.core.lightrow import POSITIONAL

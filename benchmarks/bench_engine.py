@@ -195,6 +195,8 @@ def main(argv=None) -> int:
 
     one_shot = timed(lambda: explorer.shade(scene, P, N, precision="float32"), R)
     row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
+    one_shot = timed(lambda: explorer.shade(scene, P, N), R)
+    row("one-shot `shade()` float64 (the default), incl. preparing the geometry", *one_shot, n * L)
 
     # interactive updates, float32 Shader
     sh = explorer.Shader(scene, P, N, precision="float32")

@@ -7,8 +7,9 @@ Each revision is checked out in a temporary git worktree (its numba cache is its
 first process of each compiles: not timed) and imported from there. Processes alternate A, B,
 A, B, ... so that this VM's drift from one minute to the next falls on both alike. Each process
 times a light change on a float32 ``Shader`` (1M vertices, 8 point lights, Blinn, local viewer:
-``bench_engine.py``'s first row) 25 times; the table gives the best and the median of the
-per-process medians, and the ratio.
+``bench_engine.py``'s first row) 25 times, on random points (every vertex-light computed) and
+on a UV sphere with as many vertices in mesh order (light culling skips what faces away); the
+table gives the best and the median of the per-process medians, and the ratios.
 """
 
 from __future__ import annotations
@@ -29,25 +30,32 @@ import statistics, sys, time
 sys.path.insert(0, {bench!r})
 import numpy as np
 from bench_engine import scene_with, sphere_points
+from common import uv_sphere
 import explorer
 assert explorer.__file__.startswith({root!r}), explorer.__file__
 P, N = sphere_points({n}, np.random.default_rng(0))
+around = max(8, int(round(np.sqrt({n}))))
+Pm = uv_sphere(around, max(2, {n} // around - 1)).positions.astype(np.float32)
 scene = scene_with(8, np.random.default_rng(0))
-flip = [scene.lights, scene_with(8, np.random.default_rng(1)).lights]
-sh = explorer.Shader(scene, P, N, precision="float32")
-def relight():
-    flip.reverse()
-    sh.set_lights(flip[0])
-    return sh.colors
-relight(); relight()  # compile (or load from the cache), warm up
-ts = []
-for _ in range(25):
-    t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
-print(min(ts) * 1e3, statistics.median(ts) * 1e3)
+for P_, N_ in ((P, N), (Pm, Pm)):
+    flip = [scene.lights, scene_with(8, np.random.default_rng(1)).lights]
+    sh = explorer.Shader(scene, P_, N_, precision="float32")
+    def relight():
+        flip.reverse()
+        sh.set_lights(flip[0])
+        return sh.colors
+    relight(); relight()  # compile (or load from the cache), warm up
+    ts = []
+    for _ in range(25):
+        t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
+    print(min(ts) * 1e3, statistics.median(ts) * 1e3)
+    del sh, relight
 """
 
+CASES = ("random points (every vertex-light)", "UV sphere, mesh order (light culling)")
 
-def run(root: Path, n: int) -> tuple[float, float]:
+
+def run(root: Path, n: int) -> list[tuple[float, float]]:
     env = dict(os.environ, PYTHONPATH=str(root))
     # the revision's own bench_engine helpers: they build scenes with that revision's classes
     own = Path(root) / "benchmarks"
@@ -59,8 +67,8 @@ def run(root: Path, n: int) -> tuple[float, float]:
     )
     if out.returncode != 0:
         sys.exit(f"{root}: the benchmark failed:\n{out.stderr[-3000:]}")
-    best, median = map(float, out.stdout.split())
-    return best, median
+    values = list(map(float, out.stdout.split()))
+    return [(values[i], values[i + 1]) for i in range(0, len(values), 2)]
 
 
 def main(argv=None) -> int:
@@ -86,7 +94,7 @@ def main(argv=None) -> int:
         try:
             for root in roots.values():
                 run(root, 1000)  # compile each revision's kernels once, untimed
-            res: dict[str, list[tuple[float, float]]] = {rev: [] for rev in roots}
+            res: dict[str, list] = {rev: [] for rev in roots}
             for _ in range(args.rounds):
                 for rev, root in roots.items():
                     res[rev].append(run(root, args.vertices))
@@ -103,15 +111,18 @@ def main(argv=None) -> int:
         f"full float32 pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
         "alternating processes per revision, 25 light changes each\n"
     )
-    print("| revision | best ms | median of medians ms | G vertex-lights/s (median) |")
-    print("|---|---:|---:|---:|")
-    med = {}
-    for rev, rows in res.items():
-        best = min(r[0] for r in rows)
-        med[rev] = statistics.median(r[1] for r in rows)
-        rate = args.vertices * 8 / med[rev] / 1e6
-        print(f"| {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
-    print(f"\n{args.a} / {args.b} (median): {med[args.a] / med[args.b]:.2f}x")
+    print("| case | revision | best ms | median of medians ms | G vertex-lights/s (median) |")
+    print("|---|---|---:|---:|---:|")
+    ratios = []
+    for c, case in enumerate(CASES):
+        med = {}
+        for rev, rows in res.items():
+            best = min(r[c][0] for r in rows)
+            med[rev] = statistics.median(r[c][1] for r in rows)
+            rate = args.vertices * 8 / med[rev] / 1e6
+            print(f"| {case} | {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
+        ratios.append(f"{case}: {args.a} / {args.b} (median) {med[args.a] / med[args.b]:.2f}x")
+    print("\n" + "\n".join(ratios))
     return 0
 
 

@@ -999,46 +999,24 @@ def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inl
 
 
 @nb.njit(**_LEAF)
-def _block(
-    gpx,
-    gpy,
-    gpz,
-    gx,
-    gy,
-    gz,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    redo,
-    redo_count,
-    out,
-    scr,
-    grey_only,
-    dw,
-    sw,
-    act,
-    culled,
-):
-    """One block; every array argument is already sliced to the block's vertices (``mark``,
-    ``culled``: this block's one-element slices of the marked-lane and skipped vertex-light
-    counts; ``act``: (L, chunks) int32, which of its chunks each light can reach (see
-    :func:`_reach`), or (L, 0): no culling).
+def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layout, act, culled):
+    """One block; every array is already sliced to the block's vertices (``marks``: its lanes
+    and its one-element slice of the per-block counts; ``culled``: its one-element slice of the
+    skipped vertex-light counts; ``act``: (L, chunks) int32, which of its chunks each light can
+    reach (see :func:`_reach`), or (L, 0): no culling; ``layout``: (grey_only, dw, sw), see
+    :func:`_task`).
 
-    gpx, gpy, gpz, gx, gy, gz : (m,) T prepared positions and normals (read only), copied into
-    the scratch rows, so that every light loop takes the scratch array alone (a call that passes
-    a tuple of rows copies each row's array structure: ~1 µs per light and block)
+    g : six (m,) T rows, prepared positions and normals (read only), copied into the scratch
+    rows, so that every light loop takes the scratch array alone (a call that passes a tuple of
+    rows copies each row's array structure: ~1 µs per light and block)
     """
+    gpx, gpy, gpz, gx, gy, gz = g
+    params, flags, view = lights
+    mat, aconst, shininess = surface
+    A, D, S = sums
+    base_out, ws_out = lobes
+    redo, redo_count = marks
+    grey_only, dw, sw = layout
     m = gpx.shape[0]
     zero = k[K_ZERO]
     two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
@@ -1178,43 +1156,25 @@ def _block(
 
 @nb.njit(**_LEAF)
 def _task(
-    G,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    redo,
-    redo_count,
-    out,
-    scr,
-    act,
-    b0,
-    b1,
-    grey_only,
-    dw,
-    sw,
-    bounds,
-    culled,
+    G, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, act, b0, b1, layout, cull
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
-    arrays here costs no atomic operations on their counts, which both threads would contend)."""
+    arrays here costs no atomic operations on their counts, which both threads would contend).
+    ``sums`` and ``out`` are flat (see :func:`_flat`); ``layout`` is (grey_only, dw, sw): the
+    pass keeps its sums in the grey rows alone (:func:`grey_pass`), and the widths of the D and
+    S sums (1: grey); ``cull`` : :class:`Culling`."""
+    params, flags = lights.params, lights.flags
+    A, D, S = sums
+    redo, redo_count = marks
+    bounds, culled = cull
+    dw, sw = layout[1], layout[2]
     n = G.shape[1]
     # light culling: which chunks of the task's blocks each light can reach, one vectorised
     # _reach per light (per block, its 16 chunks are fewer than one vector iteration); not
     # two-sided (N flips with V)
     c0, c1 = b0 * CHUNKS, min(bounds.shape[1], b1 * CHUNKS)
-    cull = bounds.shape[1] > 0 and opts[O_TWO_SIDED] == 0
-    if cull:
+    cull_on = bounds.shape[1] > 0 and opts[O_TWO_SIDED] == 0
+    if cull_on:
         do_amb = opts[O_DO_AMB] != 0
         for li in range(params.shape[0]):
             fl = flags[li]
@@ -1224,34 +1184,19 @@ def _task(
         s = b * BLOCK
         e = min(n, s + BLOCK)
         _block(
-            G[0, s:e],
-            G[1, s:e],
-            G[2, s:e],
-            G[3, s:e],
-            G[4, s:e],
-            G[5, s:e],
-            params,
-            flags,
-            view,
+            (G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e]),
+            lights,
             opts,
-            mat,
-            aconst,
-            shininess,
+            surface,
             k,
-            A[3 * s : 3 * e],
-            D[dw * s : dw * e],
-            S[sw * s : sw * e],
-            base_out[:, s:e],
-            ws_out[:, s:e],
+            Sums(A[3 * s : 3 * e], D[dw * s : dw * e], S[sw * s : sw * e]),
+            Lobes(lobes.base[:, s:e], lobes.ws[:, s:e]),
             vis[:, s:e],
-            redo[s:e],
-            redo_count[b : b + 1],
+            Marks(redo[s:e], redo_count[b : b + 1]),
             out[3 * s : 3 * e],
             scr,
-            grey_only,
-            dw,
-            sw,
-            act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull else act[:, :0],
+            layout,
+            act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull_on else act[:, :0],
             culled[b : b + 1],
         )
 
@@ -1398,54 +1343,79 @@ def _flat(A, D, S, out):
     return A.reshape(-1), D.reshape(-1), S.reshape(-1), out.reshape(-1)
 
 
+class Lights(NamedTuple):
+    """A pass's lights in the normalised frame: ``params`` (L, N_PARAMS) T, one row per light
+    (:mod:`explorer.core.lightrow`); ``flags`` (L,) int32; ``view`` (3,) T, the eye (local
+    viewer) or V (infinite viewer)."""
+
+    params: np.ndarray
+    flags: np.ndarray
+    view: np.ndarray
+
+
+class Surface(NamedTuple):
+    """The material as the kernel reads it: ``mat`` (12,) T, e, a, d, s; ``aconst`` (3,) T, the
+    constant ambient sum (scene and constant light ambient); ``shininess`` T."""
+
+    mat: np.ndarray
+    aconst: np.ndarray
+    shininess: float
+
+
+class Sums(NamedTuple):
+    """The cached light sums, ambient ``A``, diffuse ``D``, specular ``S``: (n, 3) T, or (0, 3)
+    for none; D and S may be grey, (n, 1): one value for every channel, written only by a pass
+    that keeps its sums in the grey rows alone (:func:`grey_pass`, which the caller asks before
+    it allocates them)."""
+
+    A: np.ndarray
+    D: np.ndarray
+    S: np.ndarray
+
+
+class Lobes(NamedTuple):
+    """Each light's specular base and weight, (L, n) T (or (L, 0): not kept), so that a
+    shininess change only re-runs the lobe (:func:`lobe`)."""
+
+    base: np.ndarray
+    ws: np.ndarray
+
+
+class Marks(NamedTuple):
+    """Ambiguous float32 lanes (redone in float64): ``redo`` (n,) bool, ``count`` (nblocks,)
+    int32 marked lanes per block of BLOCK vertices (both (0,) when not tracking); a block that
+    marks none leaves its part of ``redo`` as it was: read them with :func:`marked`."""
+
+    redo: np.ndarray
+    count: np.ndarray
+
+
+class Culling(NamedTuple):
+    """Light culling: ``bounds`` (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds (see
+    :func:`bounds`), or (N_BOUNDS, 0): no culling; ``culled`` (nblocks,) int32 out: vertex-lights
+    each block skipped."""
+
+    bounds: np.ndarray
+    culled: np.ndarray
+
+
 @nb.njit(parallel=True, **_OPTS)
-def shade(
-    G,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    redo,
-    redo_count,
-    out,
-    bounds,
-    culled,
-):
+def shade(G, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     """Shade every vertex (see the module docstring).
 
-    G : (6, n) T prepared geometry (see :func:`prepare`)
-    params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
-    opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
-    shininess : T; k : constants(T)
-    A, D, S : (n, 3) T caches (or (0, 3)); D and S may be grey, (n, 1): read as one value
-    for every channel, and written only by a pass that keeps its sums in the grey rows alone
-    (:func:`grey_pass`, which the caller asks before it allocates them)
-    base_out, ws_out : (L, n) T (or (L, 0))
-    vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
-    redo : (n,) bool lanes marked ambiguous in float32 (redone in float64), redo_count :
-    (nblocks,) int32 marked lanes per block of BLOCK vertices (both (0,) when not tracking); a
-    block that marks none leaves its part of ``redo`` as it was: read them with :func:`marked`
-    out : (n, 3) colours
-    bounds : (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds for light culling (see
-    :func:`bounds`), or (N_BOUNDS, 0): no culling
-    culled : (nblocks,) int32 out: vertex-lights each block skipped by culling
+    G : (6, n) T prepared geometry (see :func:`prepare`); lights : :class:`Lights`
+    opts : (N_OPTS,) int64; surface : :class:`Surface`; k : constants(T)
+    sums : :class:`Sums` (read where not recomputed, written where stored); lobes :
+    :class:`Lobes`; vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
+    marks : :class:`Marks`; out : (n, 3) colours; culling : :class:`Culling`
     """
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
-    Af, Df, Sf, outf = _flat(A, D, S, out)
+    D, S = sums.D, sums.S
+    Af, Df, Sf, outf = _flat(sums.A, D, S, out)
     # once per pass: a diffuse sum not recomputed here must be grey already, or absent
-    grey_only = grey_pass(flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
+    grey_only = grey_pass(lights.flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
     dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
     # a pass that is not grey writes three values per vertex: a grey sum would overflow
     if not grey_only and opts[O_STORE] != 0:
@@ -1453,40 +1423,33 @@ def shade(
             opts[O_DO_SPEC] != 0 and sw == 1 and S.shape[0]
         ):
             raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
+    culls = culling.bounds.shape[1] > 0
+    L = lights.params.shape[0]
     for t in nb.prange(ntasks):
-        scr = _scratch(params.dtype)  # once per task: no allocation per block
+        scr = _scratch(lights.params.dtype)  # once per task: no allocation per block
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
-        r = _spread(np.int64(t), np.int64(ntasks)) if bounds.shape[1] else np.int64(t)
+        r = _spread(np.int64(t), np.int64(ntasks)) if culls else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
-        act = np.empty((params.shape[0], (b1 - b0) * CHUNKS if bounds.shape[1] else 0), np.int32)
+        act = np.empty((L, (b1 - b0) * CHUNKS if culls else 0), np.int32)
+        flat = Sums(Af, Df, Sf)
+        layout = (grey_only, dw, sw)
         _task(
             G,
-            params,
-            flags,
-            view,
+            lights,
             opts,
-            mat,
-            aconst,
-            shininess,
+            surface,
             k,
-            Af,
-            Df,
-            Sf,
-            base_out,
-            ws_out,
+            flat,
+            lobes,
             vis,
-            redo,
-            redo_count,
+            marks,
             outf,
             scr,
             act,
             b0,
             b1,
-            grey_only,
-            dw,
-            sw,
-            bounds,
-            culled,
+            layout,
+            culling,
         )
 
 
@@ -1518,45 +1481,26 @@ def _gather_sum(X, idx):
 
 
 @nb.njit(**_OPTS)
-def fixup(
-    redo,
-    redo_count,
-    P,
-    N,
-    centre,
-    inv_scale,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    out,
-):
+def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes, vis, out):
     """Redo the lanes a float32 pass marked in float64, where the policies hold exactly, and
     write the results over the float32 ones; returns how many lanes.
 
-    redo, redo_count : the pass's marks (see :func:`marked`)
+    marks : the pass's :class:`Marks` (see :func:`marked`)
     P, N : (n, 3) world positions and normals; centre, inv_scale : the frame (:func:`prepare`)
-    params, view, mat, aconst, shininess, k : the pass's inputs in float64; flags, opts : the
-    pass's (ambiguity tracking is switched off here)
-    A, D, S, base_out, ws_out, vis, out : the pass's float32 arrays, written at the marked lanes
+    lights, surface, k : the pass's inputs in float64 (:class:`Lights`, :class:`Surface`,
+    constants); opts : the pass's (ambiguity tracking is switched off here)
+    sums, lobes, vis, out : the pass's float32 arrays, written at the marked lanes
     (one compiled call: gathering, shading and scattering ~150 lanes from Python cost about as
     much as a light at 1M vertices)
     """
+    redo, redo_count = marks
+    A, D, S = sums
+    base_out, ws_out = lobes
     idx = marked(redo, redo_count)
     m = idx.shape[0]
     if m == 0:
         return 0
-    L = params.shape[0]
+    L = lights.params.shape[0]
     Pm, Nm = np.empty((m, 3)), np.empty((m, 3))
     for j in range(m):
         for c in range(3):
@@ -1575,35 +1519,25 @@ def fixup(
         for j in range(vm.shape[1]):
             vm[li, j] = vis[li, idx[j]]
     om = np.empty((m, 3))
-    grey = o[O_TRACK] != 0  # (False: the float64 pass keeps RGB sums)
+    none = Marks(np.zeros(0, np.bool_), np.zeros(0, np.int32))
+    layout = (False, Dm.shape[1], Sm.shape[1])  # (the float64 pass keeps RGB sums)
     _task(
         G,
-        params,
-        flags,
-        view,
+        lights,
         o,
-        mat,
-        aconst,
-        shininess,
+        surface,
         k,
-        Am.reshape(-1),
-        Dm.reshape(-1),
-        Sm.reshape(-1),
-        bm,
-        wm,
+        Sums(Am.reshape(-1), Dm.reshape(-1), Sm.reshape(-1)),
+        Lobes(bm, wm),
         vm,
-        np.zeros(0, np.bool_),
-        np.zeros(0, np.int32),
+        none,
         om.reshape(-1),
         _scratch(np.float64),
         np.empty((L, 0), np.int32),
         0,
         nblocks,
-        grey,
-        Dm.shape[1],
-        Sm.shape[1],
-        np.zeros((N_BOUNDS, 0)),  # (no culling: the lanes are not in chunks)
-        np.zeros(nblocks, np.int32),
+        layout,
+        Culling(np.zeros((N_BOUNDS, 0)), np.zeros(nblocks, np.int32)),  # (lanes not in chunks)
     )
     for j in range(m):
         i = idx[j]
@@ -1838,7 +1772,7 @@ def _add(p, q, o):
 # the number is the argument whose dtype picks the precision
 prepare = _wide(prepare, 5)
 bounds = _wide(bounds, 0)
-shade = _wide(shade, 1)
+shade = _wide(shade, 0)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)
 stream = _wide(stream, 2)

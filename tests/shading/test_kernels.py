@@ -67,13 +67,13 @@ def test_marked_reads_only_the_blocks_that_count_marks():
     # a block that counts no marks does not write them: what its part of the array holds is
     # stale and must not be read
     n = 2 * K.BLOCK + 7
-    amb = np.ones(n, np.bool_)  # stale everywhere
-    amb[K.BLOCK :] = False  # blocks 1 and 2 write their marks: three in all
-    amb[[K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]] = True
+    redo = np.ones(n, np.bool_)  # stale everywhere
+    redo[K.BLOCK :] = False  # blocks 1 and 2 write their marks: three in all
+    redo[[K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]] = True
     marks = np.array([0, 2, 1], np.int32)
-    idx = K.marked(amb, marks)
+    idx = K.marked(redo, marks)
     assert idx.tolist() == [K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]
-    assert K.marked(amb, np.zeros(3, np.int32)).size == 0
+    assert K.marked(redo, np.zeros(3, np.int32)).size == 0
 
 
 @pytest.mark.parametrize("precision", [np.float32, np.float64])
@@ -118,10 +118,8 @@ def test_shade_refuses_grey_sums_for_a_pass_that_is_not_grey(monkeypatch):
     monkeypatch.setattr(K, "shade", lambda *a: (seen.append(a), shade(*a))[1])
     _ = sh.colors
     args = list(seen[0])
-    D, S = args[10], args[11]
-    assert D.shape == S.shape == (700, 1)  # a grey pass (white light)
-    opts = args[4].copy()
-    opts[K.O_TRACK] = 0  # no inline loops: not a grey pass
-    args[4] = opts
+    sums = args[5]
+    assert sums.D.shape == sums.S.shape == (700, 1)  # a grey pass (white light)
+    args[1] = args[1]._replace(flags=args[1].flags & ~K.GREY)  # RGB lights: not a grey pass
     with pytest.raises(ValueError, match="grey pass"):
         shade(*args)
