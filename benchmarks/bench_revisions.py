@@ -2,6 +2,7 @@
 
     python benchmarks/bench_revisions.py 5c40425 HEAD            # before / after a change
     python benchmarks/bench_revisions.py HEAD~3 HEAD --rounds 5
+    python benchmarks/bench_revisions.py 7552fa3 HEAD --precision float64
 
 Each revision is checked out in a temporary git worktree (its numba cache is its own, so the
 first process of each compiles: not timed) and imported from there. Processes alternate A, B,
@@ -39,7 +40,7 @@ Pm = uv_sphere(around, max(2, {n} // around - 1)).positions.astype(np.float32)
 scene = scene_with(8, np.random.default_rng(0))
 for P_, N_ in ((P, N), (Pm, Pm)):
     flip = [scene.lights, scene_with(8, np.random.default_rng(1)).lights]
-    sh = explorer.Shader(scene, P_, N_, precision="float32")
+    sh = explorer.Shader(scene, P_, N_, precision={precision!r})
     def relight():
         flip.reverse()
         sh.set_lights(flip[0])
@@ -55,12 +56,15 @@ for P_, N_ in ((P, N), (Pm, Pm)):
 CASES = ("random points (every vertex-light)", "UV sphere, mesh order (light culling)")
 
 
-def run(root: Path, n: int) -> list[tuple[float, float]]:
+def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, float]]:
     env = dict(os.environ, PYTHONPATH=str(root))
     # the revision's own bench_engine helpers: they build scenes with that revision's classes
     own = Path(root) / "benchmarks"
     code = CHILD.format(
-        bench=str(own if (own / "bench_engine.py").exists() else HERE), root=str(root), n=n
+        bench=str(own if (own / "bench_engine.py").exists() else HERE),
+        root=str(root),
+        n=n,
+        precision=precision,
     )
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
@@ -77,6 +81,7 @@ def main(argv=None) -> int:
     ap.add_argument("b", help="another git revision")
     ap.add_argument("--rounds", type=int, default=3, help="processes per revision")
     ap.add_argument("--vertices", type=int, default=1_000_000)
+    ap.add_argument("--precision", choices=("float32", "float64"), default="float32")
     args = ap.parse_args(argv)
     repo = subprocess.run(
         ["git", "rev-parse", "--show-toplevel"], cwd=HERE, capture_output=True, text=True
@@ -93,11 +98,11 @@ def main(argv=None) -> int:
             roots[rev] = root
         try:
             for root in roots.values():
-                run(root, 1000)  # compile each revision's kernels once, untimed
+                run(root, 1000, args.precision)  # compile each revision's kernels, untimed
             res: dict[str, list] = {rev: [] for rev in roots}
             for _ in range(args.rounds):
                 for rev, root in roots.items():
-                    res[rev].append(run(root, args.vertices))
+                    res[rev].append(run(root, args.vertices, args.precision))
         finally:
             for root in roots.values():
                 subprocess.run(
@@ -108,7 +113,7 @@ def main(argv=None) -> int:
 
     print(f"machine: {machine()}")
     print(
-        f"full float32 pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
+        f"full {args.precision} pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
         "alternating processes per revision, 25 light changes each\n"
     )
     print("| case | revision | best ms | median of medians ms | G vertex-lights/s (median) |")
