@@ -2,7 +2,7 @@
 
 Vertices are processed in blocks of :data:`BLOCK`. Each block is converted once to the
 normalised frame (:mod:`explorer.geometry.frame`) in float64 and then to the working precision ``T``
-(the dtype of ``params``: float32 for the fast path, float64 for the exact path), stored as
+(the dtype of ``G``: float32 for the fast path, float64 for the exact path), stored as
 structure-of-arrays scratch rows that stay in cache. Every light then runs a few short stage loops
 over the block (direction, weight, diffuse, lobe), each a branch-free loop the compiler turns into
 SIMD code; decisions the plan makes per light are taken once per block, outside those loops.
@@ -27,6 +27,27 @@ no mask logic); the mark is "margin below 1".
 (3n,) views, indexed ``3 * i + c``: LLVM then knows the stride and vectorises the interleaved
 accesses; through numba's 2-D indexing (a run-time stride) those loops stayed scalar, at half
 the speed or less.
+
+Inputs come as a few named records (:class:`Lights`, :class:`Surface`, :class:`Sums`,
+:class:`Lobes`, :class:`Marks`, :class:`Culling`: numba takes named tuples of arrays), so an
+entry point has about ten arguments, each with one meaning.
+
+Light loops, variants and what they cost to compile. Each light of a pass runs its pre-passes
+(:func:`_light_run`: rows L and the weight w for a positional light, its spot cone, shadow,
+Fresnel, per-vertex ambient) and then one light loop (:func:`_light`), compiled for a few named
+compile-time choices (:class:`Loop`: where L comes from, how the lobe's base is found, grey or
+RGB sums; see the comment above :func:`_light`). :data:`LIGHT_LOOPS` lists the 18 valid
+combinations; a light's loop is picked at run time from its flags (:func:`_loop_code`), through a
+chain of tests the compiler writes from that tuple, so no table spells the combinations out.
+Everything cheap to decide at run time is decided there (whether a light adds diffuse, whether
+it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and fills the rows
+the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
+:mod:`explorer.shading.equation`). Every loop is compiled with the entry point that first meets
+a precision (``shade``; ``fixup`` for the float64 redo of a float32 pass), and numba caches
+the result on disk (``cache=True``: per source file and machine; an edit to this module, or to
+:mod:`explorer.shading.vmath` followed by touching this file, recompiles). What that costs is
+measured by ``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of
+the loops a scene does not use (its docstring keeps the last table, with the machine).
 
 Leaf kernels are compiled without numba's reference counting (``_nrt=False``): every slice of a
 shared array would otherwise be an atomic increment and decrement of its count, which the two
@@ -362,18 +383,18 @@ def bounds(G, out):
     for c in nb.prange(out.shape[1]):
         s = c * CHUNK
         e = min(n, s + CHUNK)
-        lo = np.full(3, np.inf)
-        hi = np.full(3, -np.inf)
+        # (scalars, not small arrays: an allocation per chunk cost more than the chunk)
+        lx = ly = lz = np.inf
+        hx = hy = hz = -np.inf
         ax = ay = az = 0.0
         for i in range(s, e):
-            for d in range(3):
-                v = np.float64(G[d, i])
-                lo[d] = min(lo[d], v)
-                hi[d] = max(hi[d], v)
+            x, y, z = np.float64(G[0, i]), np.float64(G[1, i]), np.float64(G[2, i])
+            lx, ly, lz = min(lx, x), min(ly, y), min(lz, z)
+            hx, hy, hz = max(hx, x), max(hy, y), max(hz, z)
             ax += np.float64(G[3, i])
             ay += np.float64(G[4, i])
             az += np.float64(G[5, i])
-        cx, cy, cz = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])
+        cx, cy, cz = 0.5 * (lx + hx), 0.5 * (ly + hy), 0.5 * (lz + hz)
         r2 = 0.0
         for i in range(s, e):
             x = np.float64(G[0, i]) - cx
@@ -528,6 +549,18 @@ LIGHT_LOOPS = tuple(
 )
 
 
+@nb.njit(inline="always", **_LEAF)
+def _add_light(G, X, Y, Z, i, t, r, g, b, grey):
+    """Lane i of a sum += t·(r, g, b): of the grey row G (r = g = b), or of the rows X, Y, Z
+    (``grey`` is a compile-time constant where the light loops call it)."""
+    if grey:
+        G[i] += t * r
+    else:
+        X[i] += t * r
+        Y[i] += t * g
+        Z[i] += t * b
+
+
 def _light(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - replaced by the overload
     raise NotImplementedError
 
@@ -600,13 +633,7 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                 else:  # L and w from the pre-pass rows
                     lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
                 ndl = a * lx + b * ly + c * lz  # N·L
-            t = w * max(ndl, zero)  # w·max(N·L, 0)·d_i
-            if grey:
-                GD[i] += t * dr
-            else:
-                Dx[i] += t * dr
-                Dy[i] += t * dg
-                Dz[i] += t * db
+            _add_light(GD, Dx, Dy, Dz, i, w * max(ndl, zero), dr, dg, db, grey)  # w·(N·L)⁺·d_i
             if spec:
                 ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
                 margin = min(margin, abs(ndl) * c_dot)
@@ -645,13 +672,7 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                     base = max(base, zero)
                     lob = fpow(base, y)  # base^n
                     B[i] = base  # kept for a lobe store
-                t = ws * lob  # w·f·base^n·s_i
-                if grey:
-                    GS[i] += t * sr
-                else:
-                    Sx[i] += t * sr
-                    Sy[i] += t * sg
-                    Sz[i] += t * sb
+                _add_light(GS, Sx, Sy, Sz, i, ws * lob, sr, sg, sb, grey)  # w·f·base^n·s_i
                 WS[i] = ws
             if track and (spec or inline):
                 TRK[i] = min(TRK[i], margin)

@@ -21,6 +21,9 @@ t = y·log2 x itself, |t|·2**-53, dominates: **the relative error is below (|t|
 2**54 first, so it is as exact. Results below 2**-1022 flush to 0 (an absolute error below
 2.3e-308); t is capped at 1023 (x > 1 with a huge y: the result saturates near 2**1023, finite).
 As OpenGL: 0**0 = 1, 0**y = 0 for y > 0, 1**y = 1.
+
+numba's on-disk cache checks only the file of the function it compiled: after an edit here,
+touch :mod:`explorer.shading.kernels` (or clear its cache), or the kernels keep the old code.
 """
 
 from __future__ import annotations
