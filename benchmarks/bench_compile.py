@@ -128,7 +128,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rev", action="append", default=[], help="also measure a git revision")
     ap.add_argument("--skip-tree", action="store_true", help="measure the revisions only")
     args = ap.parse_args(argv)
-    sys.path.insert(0, str(HERE))
+    sys.path[:0] = [str(ROOT), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
 
     out = [f"machine: {machine()}"]
