@@ -109,6 +109,7 @@ def main(argv=None) -> int:
                     ["git", "-C", repo, "worktree", "remove", "--force", str(root)],
                     capture_output=True,
                 )
+    sys.path[:0] = [str(HERE.parent), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
 
     print(f"machine: {machine()}")
