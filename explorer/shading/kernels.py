@@ -37,8 +37,9 @@ Light loops, variants and what they cost to compile. Each light of a pass runs i
 Fresnel, per-vertex ambient) and then one light loop (:func:`_light`), compiled for a few named
 compile-time choices (:class:`Loop`: where L comes from, how the lobe's base is found, grey or
 RGB sums; see the comment above :func:`_light`). :data:`LIGHT_LOOPS` lists the 18 valid
-combinations; a light's loop is picked at run time from its flags (:func:`_loop_code`), through a
-chain of tests the compiler writes from that tuple, so no table spells the combinations out.
+combinations; a light's loop is picked at run time from its flags (:func:`_loop_code`), through
+tests written from that tuple when :func:`_light_loop` is compiled, so no table spells the
+combinations out.
 Everything cheap to decide at run time is decided there (whether a light adds diffuse, whether
 it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and fills the rows
 the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
@@ -494,8 +495,8 @@ def _reach(bd, c0, nc, q, fl, back, act):
 #   block adds the grey rows to every channel once.
 #
 # Every valid combination is in :data:`LIGHT_LOOPS`; :func:`_light_loop` calls the one a light
-# needs (its code from :func:`_loop_code`), through a chain of tests the compiler writes from that
-# tuple (:func:`_pick_loop`): no table is written by hand, and all of them are compiled with
+# needs (its code from :func:`_loop_code`), through tests written from that tuple when it is
+# compiled: no table is written by hand, and all of them are compiled with
 # the entry point that calls them (the module docstring gives the cost). What is cheap to decide
 # at run time is not a variant: whether the light adds diffuse (a specular-only pass adds w·N·L
 # times a zero colour), whether it is attenuated (1, 0, 0 otherwise: w = 1 exactly).
@@ -680,34 +681,23 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
     return impl
 
 
-def _pick_loop(scr, m, q, y, k, atten, l_dif, code, at):  # pragma: no cover - overloaded
+def _light_loop(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - overloaded below
     raise NotImplementedError
 
 
-@overload(_pick_loop, prefer_literal=True, jit_options=_LEAF)
-def _pick_loop_overload(scr, m, q, y, k, atten, l_dif, code, at):
-    """``_light`` for the run-time ``code``: tests it against LIGHT_LOOPS[at], then the
-    entries after it (a chain the compiler unrolls, one literal call each)."""
-    if not isinstance(at, types.IntegerLiteral):
-        raise TypingError("_pick_loop needs a literal position")
-    j = at.literal_value
-    if j >= len(LIGHT_LOOPS):
-        return lambda scr, m, q, y, k, atten, l_dif, code, at: None  # (not a compiled loop)
-    this, after = LIGHT_LOOPS[j], j + 1
-
-    def impl(scr, m, q, y, k, atten, l_dif, code, at):
-        if code == this:
-            _light(scr, m, q, y, k, atten, l_dif, this)
-        else:
-            _pick_loop(scr, m, q, y, k, atten, l_dif, code, after)
-
-    return impl
-
-
-@nb.njit(**_LEAF)
-def _light_loop(scr, m, q, y, k, atten, l_dif, code):
-    """Run the light loop compiled for ``code`` (see :func:`loop_code`)."""
-    _pick_loop(scr, m, q, y, k, atten, l_dif, code, 0)
+@overload(_light_loop, jit_options=dict(_LEAF, cache=False))  # (cached with its callers)
+def _light_loop_overload(scr, m, q, y, k, atten, l_dif, code):
+    """Run the light loop compiled for the run-time ``code`` (see :func:`loop_code`): one test
+    and one literal call per entry of :data:`LIGHT_LOOPS`, written from that tuple into one
+    function (not a chain of functions each calling the next: LLVM would optimise every loop
+    again at each link of the chain)."""
+    src = ["def impl(scr, m, q, y, k, atten, l_dif, code):"]
+    for c in LIGHT_LOOPS:
+        src += [f"    if code == {c}:", f"        _light(scr, m, q, y, k, atten, l_dif, {c})"]
+        src += ["        return"]
+    space = {"_light": _light}
+    exec("\n".join(src), space)  # noqa: S102 (source written above, from LIGHT_LOOPS)
+    return space["impl"]
 
 
 @nb.njit(**_LEAF)
