@@ -33,12 +33,14 @@ from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
 from explorer.shading.equation import equation_shade
 
+WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
+
 
 def machine() -> str:
     return (
         f"{cpu_name()}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
-        f"float32 vectors: {'16 lanes (AVX-512)' if K.WIDE_FLOAT32 else 'LLVM default width'}; "
+        f"vectors: {WIDTH[K.WIDE_VECTORS]}; "
         f"load average {load_average():.2f}"
     )
 
@@ -171,6 +173,8 @@ def main(argv=None) -> int:
 
     one_shot = timed(lambda: explorer.shade(scene, P, N, precision="float32"), R)
     row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
+    one_shot = timed(lambda: explorer.shade(scene, P, N), R)
+    row("one-shot `shade()` float64 (the default), incl. preparing the geometry", *one_shot, n * L)
 
     # interactive updates, float32 Shader
     sh = explorer.Shader(scene, P, N, precision="float32")

@@ -5,7 +5,7 @@ engine's guarantees costs on top of it.
     python benchmarks/bench_lean_kernel.py --rounds 10
 
 The lean kernel is the hot loop alone: blocks of 512 vertices, view vector, then per point light
-L, attenuation, N·L, Blinn's N·H and pow (the engine's own :func:`explorer.shading.kernels.pow32`),
+L, attenuation, N·L, Blinn's N·H and pow (the engine's own :func:`explorer.shading.vmath.pow32`),
 grey sums, and the compose into (n, 3) colours. It has none of the engine's guarantees, so it is
 not a usable shader; it shows how far the engine's full pass (``bench_engine.py``, "full shading,
 float32") is from the bare arithmetic, and which guarantee costs what:
@@ -34,7 +34,8 @@ from bench_engine import machine, scene_with, sphere_points  # its machine line,
 import explorer
 from explorer.core import tolerances as tol
 from explorer.shading import kernels as K
-from explorer.shading.kernels import _LEAF, _OPTS, pow32
+from explorer.shading.kernels import _LEAF, _OPTS
+from explorer.shading.vmath import pow32
 
 BLOCK = 512
 F = np.float32

@@ -2,13 +2,15 @@
 
     python benchmarks/bench_revisions.py 5c40425 HEAD            # before / after a change
     python benchmarks/bench_revisions.py HEAD~3 HEAD --rounds 5
+    python benchmarks/bench_revisions.py 7552fa3 HEAD --precision float64
 
 Each revision is checked out in a temporary git worktree (its numba cache is its own, so the
 first process of each compiles: not timed) and imported from there. Processes alternate A, B,
 A, B, ... so that this VM's drift from one minute to the next falls on both alike. Each process
 times a light change on a float32 ``Shader`` (1M vertices, 8 point lights, Blinn, local viewer:
-``bench_engine.py``'s first row) 25 times; the table gives the best and the median of the
-per-process medians, and the ratio.
+``bench_engine.py``'s first row) 25 times, on random points (every vertex-light computed) and
+on a UV sphere with as many vertices in mesh order (light culling skips what faces away); the
+table gives the best and the median of the per-process medians, and the ratios.
 """
 
 from __future__ import annotations
@@ -29,38 +31,48 @@ import statistics, sys, time
 sys.path.insert(0, {bench!r})
 import numpy as np
 from bench_engine import scene_with, sphere_points
+from common import uv_sphere
 import explorer
 assert explorer.__file__.startswith({root!r}), explorer.__file__
 P, N = sphere_points({n}, np.random.default_rng(0))
+around = max(8, int(round(np.sqrt({n}))))
+Pm = uv_sphere(around, max(2, {n} // around - 1)).positions.astype(np.float32)
 scene = scene_with(8, np.random.default_rng(0))
-flip = [scene.lights, scene_with(8, np.random.default_rng(1)).lights]
-sh = explorer.Shader(scene, P, N, precision="float32")
-def relight():
-    flip.reverse()
-    sh.set_lights(flip[0])
-    return sh.colors
-relight(); relight()  # compile (or load from the cache), warm up
-ts = []
-for _ in range(25):
-    t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
-print(min(ts) * 1e3, statistics.median(ts) * 1e3)
+for P_, N_ in ((P, N), (Pm, Pm)):
+    flip = [scene.lights, scene_with(8, np.random.default_rng(1)).lights]
+    sh = explorer.Shader(scene, P_, N_, precision={precision!r})
+    def relight():
+        flip.reverse()
+        sh.set_lights(flip[0])
+        return sh.colors
+    relight(); relight()  # compile (or load from the cache), warm up
+    ts = []
+    for _ in range(25):
+        t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
+    print(min(ts) * 1e3, statistics.median(ts) * 1e3)
+    del sh, relight
 """
 
+CASES = ("random points (every vertex-light)", "UV sphere, mesh order (light culling)")
 
-def run(root: Path, n: int) -> tuple[float, float]:
+
+def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, float]]:
     env = dict(os.environ, PYTHONPATH=str(root))
     # the revision's own bench_engine helpers: they build scenes with that revision's classes
     own = Path(root) / "benchmarks"
     code = CHILD.format(
-        bench=str(own if (own / "bench_engine.py").exists() else HERE), root=str(root), n=n
+        bench=str(own if (own / "bench_engine.py").exists() else HERE),
+        root=str(root),
+        n=n,
+        precision=precision,
     )
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
     )
     if out.returncode != 0:
         sys.exit(f"{root}: the benchmark failed:\n{out.stderr[-3000:]}")
-    best, median = map(float, out.stdout.split())
-    return best, median
+    values = list(map(float, out.stdout.split()))
+    return [(values[i], values[i + 1]) for i in range(0, len(values), 2)]
 
 
 def main(argv=None) -> int:
@@ -69,6 +81,7 @@ def main(argv=None) -> int:
     ap.add_argument("b", help="another git revision")
     ap.add_argument("--rounds", type=int, default=3, help="processes per revision")
     ap.add_argument("--vertices", type=int, default=1_000_000)
+    ap.add_argument("--precision", choices=("float32", "float64"), default="float32")
     args = ap.parse_args(argv)
     repo = subprocess.run(
         ["git", "rev-parse", "--show-toplevel"], cwd=HERE, capture_output=True, text=True
@@ -85,33 +98,37 @@ def main(argv=None) -> int:
             roots[rev] = root
         try:
             for root in roots.values():
-                run(root, 1000)  # compile each revision's kernels once, untimed
-            res: dict[str, list[tuple[float, float]]] = {rev: [] for rev in roots}
+                run(root, 1000, args.precision)  # compile each revision's kernels, untimed
+            res: dict[str, list] = {rev: [] for rev in roots}
             for _ in range(args.rounds):
                 for rev, root in roots.items():
-                    res[rev].append(run(root, args.vertices))
+                    res[rev].append(run(root, args.vertices, args.precision))
         finally:
             for root in roots.values():
                 subprocess.run(
                     ["git", "-C", repo, "worktree", "remove", "--force", str(root)],
                     capture_output=True,
                 )
+    sys.path[:0] = [str(HERE.parent), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
 
     print(f"machine: {machine()}")
     print(
-        f"full float32 pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
+        f"full {args.precision} pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
         "alternating processes per revision, 25 light changes each\n"
     )
-    print("| revision | best ms | median of medians ms | G vertex-lights/s (median) |")
-    print("|---|---:|---:|---:|")
-    med = {}
-    for rev, rows in res.items():
-        best = min(r[0] for r in rows)
-        med[rev] = statistics.median(r[1] for r in rows)
-        rate = args.vertices * 8 / med[rev] / 1e6
-        print(f"| {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
-    print(f"\n{args.a} / {args.b} (median): {med[args.a] / med[args.b]:.2f}x")
+    print("| case | revision | best ms | median of medians ms | G vertex-lights/s (median) |")
+    print("|---|---|---:|---:|---:|")
+    ratios = []
+    for c, case in enumerate(CASES):
+        med = {}
+        for rev, rows in res.items():
+            best = min(r[c][0] for r in rows)
+            med[rev] = statistics.median(r[c][1] for r in rows)
+            rate = args.vertices * 8 / med[rev] / 1e6
+            print(f"| {case} | {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
+        ratios.append(f"{case}: {args.a} / {args.b} (median) {med[args.a] / med[args.b]:.2f}x")
+    print("\n" + "\n".join(ratios))
     return 0
 
 

@@ -2,7 +2,7 @@
 
 Vertices are processed in blocks of :data:`BLOCK`. Each block is converted once to the
 normalised frame (:mod:`explorer.geometry.frame`) in float64 and then to the working precision ``T``
-(the dtype of ``params``: float32 for the fast path, float64 for the exact path), stored as
+(the dtype of ``G``: float32 for the fast path, float64 for the exact path), stored as
 structure-of-arrays scratch rows that stay in cache. Every light then runs a few short stage loops
 over the block (direction, weight, diffuse, lobe), each a branch-free loop the compiler turns into
 SIMD code; decisions the plan makes per light are taken once per block, outside those loops.
@@ -28,13 +28,35 @@ no mask logic); the mark is "margin below 1".
 accesses; through numba's 2-D indexing (a run-time stride) those loops stayed scalar, at half
 the speed or less.
 
+Inputs come as a few named records (:class:`Lights`, :class:`Surface`, :class:`Sums`,
+:class:`Lobes`, :class:`Marks`, :class:`Culling`: numba takes named tuples of arrays), so an
+entry point has about ten arguments, each with one meaning.
+
+Light loops, variants and what they cost to compile. Each light of a pass runs its pre-passes
+(:func:`_light_run`: rows L and the weight w for a positional light, its spot cone, shadow,
+Fresnel, per-vertex ambient) and then one light loop (:func:`_light`), compiled for a few named
+compile-time choices (:class:`Loop`: where L comes from, how the lobe's base is found, grey or
+RGB sums; see the comment above :func:`_light`). :data:`LIGHT_LOOPS` lists the 18 valid
+combinations; a light's loop is picked at run time from its flags (:func:`_loop_code`), through
+tests written from that tuple when :func:`_light_loop` is compiled, so no table spells the
+combinations out.
+Everything cheap to decide at run time is decided there (whether a light adds diffuse, whether
+it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and fills the rows
+the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
+:mod:`explorer.shading.equation`). Every loop is compiled with the entry point that first meets
+a precision (``shade``; ``fixup`` for the float64 redo of a float32 pass), and numba caches
+the result on disk (``cache=True``: per source file and machine; an edit to this module, or to
+:mod:`explorer.shading.vmath` followed by touching this file, recompiles). What that costs is
+measured by ``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of
+the loops a scene does not use (its docstring keeps the last table, with the machine).
+
 Leaf kernels are compiled without numba's reference counting (``_nrt=False``): every slice of a
 shared array would otherwise be an atomic increment and decrement of its count, which the two
 threads of a pass contend for (about a fifth of a full pass at 1M vertices).
 
-On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many Intel cores still picks 256-bit
-ones; the float32 entry points are compiled with 16-lane vectors there, two vector iterations
-interleaved (see :func:`wide_vectors`).
+On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many x86 cores still picks 256-bit
+ones; the entry points are compiled with 512-bit vectors there (16 float32 or 8 float64 lanes),
+two vector iterations interleaved (see :func:`wide_vectors`).
 """
 
 from __future__ import annotations
@@ -44,6 +66,7 @@ import functools
 import os
 import sys
 import tempfile
+from typing import NamedTuple
 
 import llvmlite.binding as llvm
 import numba as nb
@@ -77,6 +100,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
+from explorer.shading.vmath import fpow
 
 BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
@@ -113,7 +137,6 @@ N_OPTS = 13
     R_LX,
     R_LY,
     R_LZ,
-    R_D,
     R_W,
     R_BASE,
     R_WS,
@@ -121,8 +144,8 @@ N_OPTS = 13
     R_GD,
     R_GS,
     R_NV,
-) = range(29)
-N_ROWS = 29
+) = range(28)
+N_ROWS = 28
 # R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
 # policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
 # (explorer.core.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
@@ -180,98 +203,6 @@ def constants(dtype) -> np.ndarray:
     )
 
 
-# --------------------------------------------------------------------------------------------
-# pow that vectorises in float32: x**y for x in [0, ~1], y > 0, as 2**(y·log2 x).
-# log2 x from the exponent bits plus ln(1 + z) = z - z²/2 + z³·P(z), z in [-0.29, 0.41] (P of
-# degree 5, fitted like Cephes logf); 2**t = 2**k · 2**f with f in [-0.5, 0.5] (degree-5 fit)
-# and 2**k written as exponent bits. Relative error about 1e-6 (tests/shading/test_kernels.py).
-# Results below 2**-126 flush to 0 (an error below 1.2e-38). numba's pow calls libm per
-# element, which does not vectorise; this one inlines into the shading loop
-# (benchmarks/bench_lean_kernel.py times the loop with it).
-
-
-@intrinsic
-def i2f(typingctx, x):
-    """An integer's low 32 bits read as a float32."""
-    if not isinstance(x, types.Integer):
-        return None
-
-    def codegen(context, builder, sig, args):
-        v = args[0]
-        if v.type.width > 32:
-            v = builder.trunc(v, ir.IntType(32))
-        return builder.bitcast(v, ir.FloatType())
-
-    return types.float32(x), codegen
-
-
-#: log2's split point: x = 2**k · m with m in [sqrt(1/2), sqrt(2)), so ln m = ln(1 + z) has
-#: |z| <= 0.41 (the range of the polynomial below)
-_SPLIT = 0x3F3504F3  # the bits of float32 sqrt(1/2)
-
-
-@intrinsic
-def split32(typingctx, x):
-    """x = 2**k · m for a positive float32 x, m in [sqrt(1/2), sqrt(2)): (k, m) as float32.
-
-    In 32-bit integer operations and without a branch or blend (numba's own integer arithmetic
-    widens to int64, which costs cross-lane conversions in SIMD code): subtracting the bits of
-    sqrt(1/2) moves the split point to an exponent boundary, so the shifted difference is k and
-    the bits of x minus k's exponent bits are m. x = 0 gives k = -127, m = 1.
-    """
-    if x != types.float32:
-        return None
-
-    def codegen(context, builder, sig, args):
-        i32 = ir.IntType(32)
-        ix = builder.bitcast(args[0], i32)
-        tmp = builder.sub(ix, ir.Constant(i32, _SPLIT))
-        k = builder.ashr(tmp, ir.Constant(i32, 23))
-        im = builder.sub(ix, builder.and_(tmp, ir.Constant(i32, -(1 << 23))))
-        kf = builder.sitofp(k, ir.FloatType())
-        m = builder.bitcast(im, ir.FloatType())
-        return context.make_tuple(builder, sig.return_type, (kf, m))
-
-    return types.UniTuple(types.float32, 2)(types.float32), codegen
-
-
-@nb.njit(inline="always", **_LEAF)
-def log2_32(x):
-    """log2 x for a positive, finite float32 x (-127 for x = 0)."""
-    e, f = split32(x)
-    z = f - np.float32(1.0)
-    p = np.float32(-0.10746953303517079)  # least-squares fit, |error| <= 3.5e-7 on the range
-    p = p * z + np.float32(0.15904727806564242)
-    p = p * z + np.float32(-0.16972990678158706)
-    p = p * z + np.float32(0.1993995441108155)
-    p = p * z + np.float32(-0.24992546983782263)
-    p = p * z + np.float32(0.33333703609427834)
-    ln = z + z * z * (z * p - np.float32(0.5))
-    return e + ln * np.float32(1.4426950408889634)
-
-
-@nb.njit(inline="always", **_LEAF)
-def exp2_32(t):
-    """2**t for float32 t; 0 for t <= -127."""
-    t = max(t, np.float32(-127.0))
-    k = np.rint(t)
-    fr = t - k
-    q = np.float32(0.0013390867352163702)  # 2**f = 1 + f·Q(f), least squares, rel. err 2e-7
-    q = q * fr + np.float32(0.00966637369320816)
-    q = q * fr + np.float32(0.05550357104250901)
-    q = q * fr + np.float32(0.24022348940946955)
-    q = q * fr + np.float32(0.6931471880293432)
-    q = q * fr + np.float32(1.0)  # exact at f = 0: 1**y == 1
-    return q * i2f((np.int32(k) + np.int32(127)) << 23)
-
-
-@nb.njit(inline="always", **_LEAF)
-def pow32(x, y):
-    """x**y for float32 x in [0, ~1] and y > 0 (see the comment above); SIMD-friendly."""
-    t = y * log2_32(x)
-    return exp2_32(t if x > np.float32(0.0) else np.float32(-200.0))
-
-
 def unit(k):
     """1 in the precision of ``k`` (an array), as a compile-time constant: ``k[K_ONE]`` is a
     run-time value, so ``k[K_ONE] / np.sqrt(x)`` costs a multiply the constant does not."""
@@ -298,18 +229,6 @@ def _nil_overload(k):
     if k.dtype == types.float32:
         return lambda k: np.float32(0.0)
     return lambda k: np.float64(0.0)
-
-
-def fpow(x, y):
-    """x**y in the working precision: :func:`pow32` for float32, libm for float64."""
-    return x**y
-
-
-@overload(fpow, jit_options=_LEAF)
-def _fpow_overload(x, y):
-    if x == types.float32:
-        return lambda x, y: pow32(x, y)
-    return lambda x, y: x**y
 
 
 @intrinsic
@@ -465,18 +384,18 @@ def bounds(G, out):
     for c in nb.prange(out.shape[1]):
         s = c * CHUNK
         e = min(n, s + CHUNK)
-        lo = np.full(3, np.inf)
-        hi = np.full(3, -np.inf)
+        # (scalars, not small arrays: an allocation per chunk cost more than the chunk)
+        lx = ly = lz = np.inf
+        hx = hy = hz = -np.inf
         ax = ay = az = 0.0
         for i in range(s, e):
-            for d in range(3):
-                v = np.float64(G[d, i])
-                lo[d] = min(lo[d], v)
-                hi[d] = max(hi[d], v)
+            x, y, z = np.float64(G[0, i]), np.float64(G[1, i]), np.float64(G[2, i])
+            lx, ly, lz = min(lx, x), min(ly, y), min(lz, z)
+            hx, hy, hz = max(hx, x), max(hy, y), max(hz, z)
             ax += np.float64(G[3, i])
             ay += np.float64(G[4, i])
             az += np.float64(G[5, i])
-        cx, cy, cz = 0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])
+        cx, cy, cz = 0.5 * (lx + hx), 0.5 * (ly + hy), 0.5 * (lz + hz)
         r2 = 0.0
         for i in range(s, e):
             x = np.float64(G[0, i]) - cx
@@ -560,73 +479,129 @@ def _reach(bd, c0, nc, q, fl, back, act):
 
 
 # --------------------------------------------------------------------------------------------
-# One light over one block. The loop is specialised at compile time: `_light` is overloaded on a
-# literal `variant` (bit 0 positional, bits 1-2 lobe mode, bit 3 diffuse, bit 4 specular, bit 5
-# inline, bit 6 attenuated, bit 7 grey), so each combination gets a loop that holds exactly the
-# terms the plan asks for and no run-time test: where L comes from (constant, the rows a
-# positional pre-pass filled, or computed inline), how the lobe's base is found (flat, constant H,
-# Blinn, Phong), and whether the diffuse and specular sums are touched.
+# One light over one block: the light loop. It is specialised at compile time on a few named
+# choices (a :class:`Loop`), so that each combination is a loop that holds exactly the terms it
+# needs and no run-time test:
 #
-# Inline variants (float32 only, with ambiguity tracking on) compute L = normalize(position - P)
-# and the attenuation in the light loop itself, for a point light without cone, shadow, Fresnel
-# or per-vertex ambient: no L or weight rows are written or read. They keep l = position - P
-# unnormalised (N·L = (N·l)/|l|, L + V = l/|l| + V in one fused step each) and take N·H's
-# numerator as N·L + N·V, with N·V computed once per block (row R_NV). Every light that
-# stores its lobe (the first pass of a shininess drag) writes base and weight rows from the same
-# arithmetic as a pass that does not, so a shininess change and a fresh pass agree bit for bit
-# in the base. A grey light (r = g = b for its diffuse and
-# its specular colour, as most lights are) adds one number per vertex to a grey row instead of
-# three to the RGB rows; the block adds the grey rows to every channel once. Inline variants also
-# drop the exact policies inside the ambiguity bands (a light at the vertex, L = -V): there they
-# only keep every value finite and mark the lane, which the engine redoes in float64, where the
-# policies hold.
+# - ``source``, where L and the weight w come from: SRC_CONST (a directional light: L constant,
+#   w = 1), SRC_ROWS (rows the light's pre-passes filled: L, w = attenuation · spot · shadow ...,
+#   see :func:`_light_run`), SRC_INLINE (a plain point light: L and the attenuation computed in
+#   the loop itself, no rows written or read);
+# - ``lobe``, how the specular lobe's base is found: LOBE_FLAT (shininess 0: base^0 = 1),
+#   LOBE_CONST_H (Blinn with a constant halfway vector), LOBE_BLINN, LOBE_PHONG, or LOBE_NONE
+#   (no specular: the diffuse alone);
+# - ``grey`` (inline only): the light's diffuse and specular colours are grey (r = g = b, as most
+#   lights are): it adds one number per vertex to a grey row instead of three to the RGB rows; the
+#   block adds the grey rows to every channel once.
+#
+# Every valid combination is in :data:`LIGHT_LOOPS`; :func:`_light_loop` calls the one a light
+# needs (its code from :func:`_loop_code`), through tests written from that tuple when it is
+# compiled: no table is written by hand, and all of them are compiled with
+# the entry point that calls them (the module docstring gives the cost). What is cheap to decide
+# at run time is not a variant: whether the light adds diffuse (a specular-only pass adds w·N·L
+# times a zero colour), whether it is attenuated (1, 0, 0 otherwise: w = 1 exactly).
+#
+# Inline loops keep l = position - P unnormalised (N·L = (N·l)/|l|, L + V = l/|l| + V in one
+# fused step each) and take N·H's numerator as N·L + N·V, with N·V computed once per block (row
+# R_NV). On the float32 path (ambiguity tracking on) they drop the exact policies inside the
+# ambiguity bands (a light at the vertex, L = -V): there they only keep every value finite and
+# mark the lane, which the engine redoes in float64. On the float64 path they apply the policies
+# with selects (L = N at the vertex; a zero lobe where L = -V), as the row pre-passes do. Every
+# light that stores its lobe (the first pass of a shininess drag) writes base and weight rows
+# from the same arithmetic as a pass that does not, so a shininess change and a fresh pass agree
+# bit for bit in the base.
+
+SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
+LOBE_NONE = 4  # (after the LOBE_* modes above)
 
 
-def _light(scr, m, dx, gd, q, y, k, variant):  # pragma: no cover - replaced by the overload below
+class Loop(NamedTuple):
+    """The compile-time choices of one light loop (see the comment above)."""
+
+    source: int
+    lobe: int
+    grey: bool
+
+
+def loop_code(loop: Loop) -> int:
+    """A loop's code: the literal the light loop is compiled for (and :func:`_loop_code`)."""
+    return loop.source | loop.lobe << 2 | int(loop.grey) << 5
+
+
+def loop_of(code: int) -> Loop:
+    return Loop(code & 3, (code >> 2) & 7, bool(code & 32))
+
+
+def _valid(loop: Loop) -> bool:
+    inline = loop.source == SRC_INLINE
+    return (inline or not loop.grey) and not (inline and loop.lobe == LOBE_CONST_H)
+
+
+#: every light loop that is compiled (codes, see :func:`loop_code`)
+LIGHT_LOOPS = tuple(
+    loop_code(lp)
+    for lp in (
+        Loop(s, lobe, g)
+        for s in (SRC_CONST, SRC_ROWS, SRC_INLINE)
+        for lobe in (LOBE_NONE, LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG)
+        for g in (False, True)
+    )
+    if _valid(lp)
+)
+
+
+@nb.njit(inline="always", **_LEAF)
+def _add_light(G, X, Y, Z, i, t, r, g, b, grey):
+    """Lane i of a sum += t·(r, g, b): of the grey row G (r = g = b), or of the rows X, Y, Z
+    (``grey`` is a compile-time constant where the light loops call it)."""
+    if grey:
+        G[i] += t * r
+    else:
+        X[i] += t * r
+        Y[i] += t * g
+        Z[i] += t * b
+
+
+def _light(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - replaced by the overload
     raise NotImplementedError
 
 
 @overload(_light, prefer_literal=True, jit_options=_LEAF)
-def _light_overload(scr, m, dx, gd, q, y, k, variant):
-    if not isinstance(variant, types.IntegerLiteral):
-        raise TypingError("_light needs a literal variant")
-    v = variant.literal_value
-    positional = bool(v & 1)
-    mode = (v >> 1) & 3
-    dif = bool(v & 8)
-    spec = bool(v & 16)
-    inline = bool(v & 32)
-    atten = bool(v & 64)
-    grey = bool(v & 128)
+def _light_overload(scr, m, q, y, k, atten, l_dif, code):
+    """The light loop for a literal ``code`` (see the comment above)."""
+    if not isinstance(code, types.IntegerLiteral):
+        raise TypingError("_light needs a literal code")
+    loop = loop_of(code.literal_value)
+    inline, const = loop.source == SRC_INLINE, loop.source == SRC_CONST
+    spec = loop.lobe != LOBE_NONE
+    mode = loop.lobe
     lobe_on = spec and mode != LOBE_FLAT
+    grey = loop.grey
     track = scr.dtype == types.float32  # only the float32 path marks ambiguous lanes
-    if inline and not track:
-
-        def never(scr, m, dx, gd, q, y, k, variant):
-            raise AssertionError("inline light loops are float32 only")
-
-        return never
-
     # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
     # it interleaves them; the row-path loops read and write too many rows for such checks
     row = _row_checked if inline else _row
 
-    def impl(scr, m, dx, gd, q, y, k, variant):
+    def impl(scr, m, q, y, k, atten, l_dif, code):
         # rows as separate 1-D arrays: lets the compiler vectorise
         px, py, pz = row(scr, R_PX, m), row(scr, R_PY, m), row(scr, R_PZ, m)
         nx, ny, nz = row(scr, R_NX, m), row(scr, R_NY, m), row(scr, R_NZ, m)
         vx, vy, vz, NV = row(scr, R_VX, m), row(scr, R_VY, m), row(scr, R_VZ, m), row(scr, R_NV, m)
         Lx, Ly, Lz, W = row(scr, R_LX, m), row(scr, R_LY, m), row(scr, R_LZ, m), row(scr, R_W, m)
-        Dx, Dy, Dz = row(scr, dx, m), row(scr, dx + 1, m), row(scr, dx + 2, m)
+        Dx, Dy, Dz = row(scr, R_DX, m), row(scr, R_DY, m), row(scr, R_DZ, m)
         Sx, Sy, Sz = row(scr, R_SX, m), row(scr, R_SY, m), row(scr, R_SZ, m)
         B, WS, TRK = row(scr, R_BASE, m), row(scr, R_WS, m), row(scr, R_TRK, m)
-        GD, GS = row(scr, gd, m), row(scr, R_GS, m)
+        GD, GS = row(scr, R_GD, m), row(scr, R_GS, m)
         zero, one, two = k[K_ZERO], unit(k), k[K_TWO]
         # (squares and abs: provably >= 0, which keeps the square roots vectorisable; see nil)
         h_eps2, p_eps2, floor = abs(k[K_HALF_EPS2]), k[K_POINT_EPS] ** 2, k[K_ATT_FLOOR]
         c_dot, c_len2, c_dist2 = k[K_MARGIN_DOT], k[K_MARGIN_LEN2], k[K_MARGIN_DIST2]
-        kc, kl, kq = q[P_ATT], q[P_ATT + 1], q[P_ATT + 2]
-        dr, dg, db = q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]
+        # not attenuated: 1 / max(1 + 0·d, floor) = 1
+        kc = q[P_ATT] if atten else one
+        kl = q[P_ATT + 1] if atten else zero
+        kq = q[P_ATT + 2] if atten else zero
+        # a specular-only pass adds 0 to the diffuse sums it does not recompute
+        dr, dg, db = (q[P_DIF], q[P_DIF + 1], q[P_DIF + 2]) if l_dif else (zero, zero, zero)
         sr, sg, sb = q[P_SPEC], q[P_SPEC + 1], q[P_SPEC + 2]
         qx, qy, qz = q[P_POS], q[P_POS + 1], q[P_POS + 2]
         hx, hy, hz = q[P_H], q[P_H + 1], q[P_H + 2]
@@ -640,28 +615,26 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
                 yy = qy - py[i]
                 z = qz - pz[i]
                 d2 = x * x + yy * yy + z * z
-                inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (then marked)
-                if atten:  # w = 1 / (kc + kl·d + kq·d²)
+                if track:
+                    inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (marked)
                     d = d2 * inv
-                    w = one / max(kc + (kl + kq * d) * d, floor)
-                else:
-                    w = one
+                else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = |l|
+                    at = d2 < p_eps2
+                    inv = one / np.sqrt(one if at else d2)
+                    d = np.sqrt(d2) if at else d2 * inv
+                    x = a if at else x
+                    yy = b if at else yy
+                    z = c if at else z
+                w = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
                 ndl = (a * x + b * yy + c * z) * inv  # N·L
                 margin = d2 * c_dist2
             else:
-                if positional:  # L and w = att·spot from the pre-pass rows
-                    lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
-                else:  # directional: constant L, never attenuated
+                if const:  # directional: constant L, never attenuated
                     lx, ly, lz, w = qx, qy, qz, one
+                else:  # L and w from the pre-pass rows
+                    lx, ly, lz, w = Lx[i], Ly[i], Lz[i], W[i]
                 ndl = a * lx + b * ly + c * lz  # N·L
-            if dif:  # w·max(N·L, 0)·d_i
-                t = w * max(ndl, zero)
-                if grey:
-                    GD[i] += t * dr
-                else:
-                    Dx[i] += t * dr
-                    Dy[i] += t * dg
-                    Dz[i] += t * db
+            _add_light(GD, Dx, Dy, Dz, i, w * max(ndl, zero), dr, dg, db, grey)  # w·(N·L)⁺·d_i
             if spec:
                 ws = w if ndl > zero else zero  # f_i: specular only where N·L > 0
                 margin = min(margin, abs(ndl) * c_dot)
@@ -700,13 +673,7 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
                     base = max(base, zero)
                     lob = fpow(base, y)  # base^n
                     B[i] = base  # kept for a lobe store
-                t = ws * lob  # w·f·base^n·s_i
-                if grey:
-                    GS[i] += t * sr
-                else:
-                    Sx[i] += t * sr
-                    Sy[i] += t * sg
-                    Sz[i] += t * sb
+                _add_light(GS, Sx, Sy, Sz, i, ws * lob, sr, sg, sb, grey)  # w·f·base^n·s_i
                 WS[i] = ws
             if track and (spec or inline):
                 TRK[i] = min(TRK[i], margin)
@@ -714,98 +681,30 @@ def _light_overload(scr, m, dx, gd, q, y, k, variant):
     return impl
 
 
-@nb.njit(**_LEAF)
-def _light_inline(scr, m, dx, gd, q, y, k, atten, mode, l_spec, grey):
-    """Call the inline point-light loop compiled for this combination (diffuse always on)."""
-    if grey and atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 128 | 16 | 4)
-    elif grey and not atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 128 | 16 | 4)
-    elif not grey and atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 64 | 16 | 4)
-    elif not grey and not atten:
-        if not l_spec:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32)
-        elif mode == LOBE_FLAT:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16)
-        elif mode == LOBE_PHONG:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 6)
-        else:
-            _light(scr, m, dx, gd, q, y, k, 1 | 8 | 32 | 16 | 4)
+def _light_loop(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - overloaded below
+    raise NotImplementedError
+
+
+@overload(_light_loop, jit_options=dict(_LEAF, cache=False))  # (cached with its callers)
+def _light_loop_overload(scr, m, q, y, k, atten, l_dif, code):
+    """Run the light loop compiled for the run-time ``code`` (see :func:`loop_code`): one test
+    and one literal call per entry of :data:`LIGHT_LOOPS`, written from that tuple into one
+    function (not a chain of functions each calling the next: LLVM would optimise every loop
+    again at each link of the chain)."""
+    src = ["def impl(scr, m, q, y, k, atten, l_dif, code):"]
+    for c in LIGHT_LOOPS:
+        src += [f"    if code == {c}:", f"        _light(scr, m, q, y, k, atten, l_dif, {c})"]
+        src += ["        return"]
+    space = {"_light": _light}
+    exec("\n".join(src), space)  # noqa: S102 (source written above, from LIGHT_LOOPS)
+    return space["impl"]
 
 
 @nb.njit(**_LEAF)
-def _light_any(scr, m, q, y, k, positional, mode, l_dif, l_spec):
-    """Call the light loop compiled for this combination (each call site passes a literal)."""
-    if not positional:
-        if not l_spec:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 8)
-        elif mode == LOBE_FLAT:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 24)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 16)
-        elif mode == LOBE_CONST_H:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 26)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 18)
-        elif mode == LOBE_BLINN:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 28)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 20)
-        elif mode == LOBE_PHONG:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 30)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 22)
-    else:
-        if not l_spec:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 9)
-        elif mode == LOBE_FLAT:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 25)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 17)
-        elif mode == LOBE_CONST_H:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 27)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 19)
-        elif mode == LOBE_BLINN:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 29)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 21)
-        elif mode == LOBE_PHONG:
-            if l_dif:
-                _light(scr, m, R_DX, R_GD, q, y, k, 31)
-            else:
-                _light(scr, m, R_DX, R_GD, q, y, k, 23)
+def _loop_code(source, mode, l_spec, grey):
+    """The code of the loop for a light (as :func:`loop_code`, at run time)."""
+    lobe = mode if l_spec else LOBE_NONE
+    return source | lobe << 2 | (32 if grey else 0)
 
 
 @nb.njit(**_LEAF)
@@ -1006,11 +905,10 @@ def _mode(fl, flat, phong):
 
 
 @nb.njit(**_LEAF)
-def _is_inline(fl, track, l_dif, l_spec, mode):
-    """A plain point light on the float32 path: L and attenuation computed in the light loop."""
+def _is_inline(fl, l_dif, l_spec, mode):
+    """A plain point light: L and attenuation computed in the light loop (no pre-pass)."""
     return (
-        track
-        and (l_dif or l_spec)
+        (l_dif or l_spec)
         and (fl & AMBIENT) == 0  # the path depends on the light only, not on the pass
         and (fl & (POSITIONAL | SPOT | SHADOW)) == POSITIONAL
         and not (l_spec and (fl & FRESNEL) != 0)
@@ -1027,13 +925,12 @@ def grey_pass(flags, opts, diffuse_grey):
     third of the memory traffic of (n, 3) ones."""
     if opts[O_DO_SPEC] == 0 or not (opts[O_DO_DIF] != 0 or diffuse_grey):
         return False
-    track = opts[O_TRACK] != 0
     flat, phong = opts[O_FLAT] != 0, opts[O_PHONG] != 0
     for li in range(flags.shape[0]):
         fl = flags[li]
         l_dif, l_spec = (fl & DIFFUSE) != 0, (fl & SPECULAR) != 0
         if (l_dif or l_spec) and not (
-            (fl & GREY) != 0 and _is_inline(fl, track, l_dif, l_spec, _mode(fl, flat, phong))
+            (fl & GREY) != 0 and _is_inline(fl, l_dif, l_spec, _mode(fl, flat, phong))
         ):
             return False
     return True
@@ -1081,18 +978,17 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
 @nb.njit(inline="always", **_LEAF)
 def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
     """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
-    ``scr`` starts at the run's first lane, see _block); ``vis`` : (m,) its visibility, or (0,)."""
-    if inline:  # a plain point light on the float32 path (see _is_inline)
-        atten, grey = (fl & ATTEN) != 0, (fl & GREY) != 0
-        if l_dif:
-            _light_inline(scr, m, R_DX, R_GD, q, shininess, k, atten, mode, l_spec, grey)
-        else:  # specular only: the diffuse goes to rows nobody reads (zeroed by _block)
-            _light_inline(scr, m, R_LX, R_D, q, shininess, k, atten, mode, True, grey)
+    ``scr`` starts at the run's first lane, see _block): its pre-passes (rows L and the weight
+    w), then its light loop; ``vis`` : (m,) its visibility, or (0,)."""
+    atten = (fl & ATTEN) != 0
+    if inline:  # a plain point light (see _is_inline): no pre-pass
+        code = _loop_code(SRC_INLINE, mode, l_spec, (fl & GREY) != 0)
+        _light_loop(scr, m, q, shininess, k, atten, l_dif, code)
         return
     fres = l_spec and (fl & FRESNEL) != 0
     rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
     if fl & POSITIONAL:  # pre-pass: L, d and w = att·spot rows
-        _to_light(scr, m, q, k, (fl & ATTEN) != 0)
+        _to_light(scr, m, q, k, atten)
         if fl & SPOT:
             _spot(scr, m, q, k, (fl & SPOT_EXP) != 0)
         if l_amb:
@@ -1101,62 +997,42 @@ def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inl
         _dir_rows(scr, m, q, k[K_ONE])
     if fl & SHADOW:  # after the ambient: ambient light is not shadowed
         _shadow(scr, m, vis)
+    source = SRC_ROWS if rows else SRC_CONST
     if fres:  # diffuse with w, then specular with w·F
         if l_dif:
-            _light_any(scr, m, q, shininess, k, True, mode, True, False)
+            _light_loop(
+                scr, m, q, shininess, k, False, True, _loop_code(source, mode, False, False)
+            )
         _fresnel(scr, m, q, k)
-        _light_any(scr, m, q, shininess, k, True, mode, False, True)
-    else:
-        _light_any(scr, m, q, shininess, k, rows, mode, l_dif, l_spec)
+        _light_loop(scr, m, q, shininess, k, False, False, _loop_code(source, mode, True, False))
+    elif l_dif or l_spec:  # (the weight rows hold the attenuation: not again in the loop)
+        _light_loop(scr, m, q, shininess, k, False, l_dif, _loop_code(source, mode, l_spec, False))
 
 
 @nb.njit(**_LEAF)
-def _block(
-    gpx,
-    gpy,
-    gpz,
-    gx,
-    gy,
-    gz,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    redo,
-    redo_count,
-    out,
-    scr,
-    grey_only,
-    dw,
-    sw,
-    act,
-    culled,
-):
-    """One block; every array argument is already sliced to the block's vertices (``mark``,
-    ``culled``: this block's one-element slices of the marked-lane and skipped vertex-light
-    counts; ``act``: (L, chunks) int32, which of its chunks each light can reach (see
-    :func:`_reach`), or (L, 0): no culling).
+def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layout, act, culled):
+    """One block; every array is already sliced to the block's vertices (``marks``: its lanes
+    and its one-element slice of the per-block counts; ``culled``: its one-element slice of the
+    skipped vertex-light counts; ``act``: (L, chunks) int32, which of its chunks each light can
+    reach (see :func:`_reach`), or (L, 0): no culling; ``layout``: (grey_only, dw, sw), see
+    :func:`_task`).
 
-    gpx, gpy, gpz, gx, gy, gz : (m,) T prepared positions and normals (read only), copied into
-    the scratch rows, so that every light loop takes the scratch array alone (a call that passes
-    a tuple of rows copies each row's array structure: ~1 µs per light and block)
+    g : six (m,) T rows, prepared positions and normals (read only), copied into the scratch
+    rows, so that every light loop takes the scratch array alone (a call that passes a tuple of
+    rows copies each row's array structure: ~1 µs per light and block)
     """
+    gpx, gpy, gpz, gx, gy, gz = g
+    params, flags, view = lights
+    mat, aconst, shininess = surface
+    A, D, S = sums
+    base_out, ws_out = lobes
+    redo, redo_count = marks
+    grey_only, dw, sw = layout
     m = gpx.shape[0]
     zero = k[K_ZERO]
     two_sided, phong, flat = opts[O_TWO_SIDED] != 0, opts[O_PHONG] != 0, opts[O_FLAT] != 0
     do_amb, do_dif, do_spec = opts[O_DO_AMB] != 0, opts[O_DO_DIF] != 0, opts[O_DO_SPEC] != 0
     store_lobe = opts[O_STORE_LOBE] != 0
-    track = opts[O_TRACK] != 0  # float32: ambiguous lanes are marked (and redone in float64)
     px, py, pz = _row(scr, R_PX, m), _row(scr, R_PY, m), _row(scr, R_PZ, m)
     # (two-sided flips these copies)
     nx, ny, nz = _row(scr, R_NX, m), _row(scr, R_NY, m), _row(scr, R_NZ, m)
@@ -1171,9 +1047,6 @@ def _block(
     Dx, Dy, Dz = _row(scr, R_DX, m), _row(scr, R_DY, m), _row(scr, R_DZ, m)
     Sx, Sy, Sz = _row(scr, R_SX, m), _row(scr, R_SY, m), _row(scr, R_SZ, m)
     trk = _row(scr, R_TRK, m)
-    # the inline loops always add a diffuse term: for a specular-only pass it goes to the rows
-    # R_LX, R_LY, R_LZ (RGB) and R_D (grey), which the inline loops never read
-    junk_zeroed = False
 
     _fill(trk, k[K_INF])  # no lane is near a decision until a light says so
     used_grey = False  # grey lights add to the grey rows (zeroed when the first one comes)
@@ -1195,7 +1068,7 @@ def _block(
             _fill(vz, view[2])
     if two_sided:
         _two_sided(nx, ny, nz, vx, vy, vz, trk, k)
-    if track and do_spec and not flat:  # N·V, for the inline lobes
+    if do_spec and not flat:  # N·V, for the inline lobes
         _dot(nx, ny, nz, vx, vy, vz, _row(scr, R_NV, m))
 
     # the sums: recomputed ones start at 0, the others come from the caches
@@ -1218,18 +1091,13 @@ def _block(
         if not (l_amb or l_dif or l_spec):
             continue
         mode = _mode(fl, flat, phong)
-        inline = _is_inline(fl, track, l_dif, l_spec, mode)  # L, attenuation inline
+        inline = _is_inline(fl, l_dif, l_spec, mode)  # L, attenuation inline
         if inline:
             grey = (fl & GREY) != 0
             if grey and not used_grey:
                 _fill(_row(scr, R_GD, m), zero)
                 _fill(_row(scr, R_GS, m), zero)
             used_grey = used_grey or grey
-            # specular only (a viewer change): the diffuse goes to rows nobody reads
-            if not l_dif and not junk_zeroed:
-                for row in (R_LX, R_LY, R_LZ, R_D):
-                    _fill(_row(scr, row, m), zero)
-                junk_zeroed = True
         reach = nc
         if cull:
             reach = 0
@@ -1299,43 +1167,25 @@ def _block(
 
 @nb.njit(**_LEAF)
 def _task(
-    G,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    redo,
-    redo_count,
-    out,
-    scr,
-    act,
-    b0,
-    b1,
-    grey_only,
-    dw,
-    sw,
-    bounds,
-    culled,
+    G, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, act, b0, b1, layout, cull
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
-    arrays here costs no atomic operations on their counts, which both threads would contend)."""
+    arrays here costs no atomic operations on their counts, which both threads would contend).
+    ``sums`` and ``out`` are flat (see :func:`_flat`); ``layout`` is (grey_only, dw, sw): the
+    pass keeps its sums in the grey rows alone (:func:`grey_pass`), and the widths of the D and
+    S sums (1: grey); ``cull`` : :class:`Culling`."""
+    params, flags = lights.params, lights.flags
+    A, D, S = sums
+    redo, redo_count = marks
+    bounds, culled = cull
+    dw, sw = layout[1], layout[2]
     n = G.shape[1]
     # light culling: which chunks of the task's blocks each light can reach, one vectorised
     # _reach per light (per block, its 16 chunks are fewer than one vector iteration); not
     # two-sided (N flips with V)
     c0, c1 = b0 * CHUNKS, min(bounds.shape[1], b1 * CHUNKS)
-    cull = bounds.shape[1] > 0 and opts[O_TWO_SIDED] == 0
-    if cull:
+    cull_on = bounds.shape[1] > 0 and opts[O_TWO_SIDED] == 0
+    if cull_on:
         do_amb = opts[O_DO_AMB] != 0
         for li in range(params.shape[0]):
             fl = flags[li]
@@ -1345,34 +1195,19 @@ def _task(
         s = b * BLOCK
         e = min(n, s + BLOCK)
         _block(
-            G[0, s:e],
-            G[1, s:e],
-            G[2, s:e],
-            G[3, s:e],
-            G[4, s:e],
-            G[5, s:e],
-            params,
-            flags,
-            view,
+            (G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e]),
+            lights,
             opts,
-            mat,
-            aconst,
-            shininess,
+            surface,
             k,
-            A[3 * s : 3 * e],
-            D[dw * s : dw * e],
-            S[sw * s : sw * e],
-            base_out[:, s:e],
-            ws_out[:, s:e],
+            Sums(A[3 * s : 3 * e], D[dw * s : dw * e], S[sw * s : sw * e]),
+            Lobes(lobes.base[:, s:e], lobes.ws[:, s:e]),
             vis[:, s:e],
-            redo[s:e],
-            redo_count[b : b + 1],
+            Marks(redo[s:e], redo_count[b : b + 1]),
             out[3 * s : 3 * e],
             scr,
-            grey_only,
-            dw,
-            sw,
-            act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull else act[:, :0],
+            layout,
+            act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull_on else act[:, :0],
             culled[b : b + 1],
         )
 
@@ -1384,11 +1219,13 @@ def _host_has_avx512() -> bool:
         return False
 
 
-#: float32 loops are vectorised 16 lanes wide where the CPU has AVX-512 (LLVM's Intel tunings
-#: prefer 256-bit vectors; 512-bit ones shade about 12% faster here). Set the environment
-#: variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's choice (numba's on-disk cache keeps
-#: whichever was compiled first: clear it, or use another NUMBA_CACHE_DIR, to compare).
-WIDE_FLOAT32 = (
+#: loops are vectorised 512 bits wide (16 float32 or 8 float64 lanes) where the CPU has AVX-512
+#: (LLVM's tunings for many x86 cores prefer 256-bit vectors; 512-bit ones shade about 12%
+#: faster here in float32, and the float64 light loop, whose power is long, gains more; see
+#: benchmarks/bench_engine.py). Set the environment variable PHONG_EXPLORER_WIDE_VECTORS=0 to
+#: keep LLVM's choice (numba's on-disk cache keeps whichever was compiled first: clear it, or use
+#: another NUMBA_CACHE_DIR, to compare).
+WIDE_VECTORS = (
     os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
     and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
     and _host_has_avx512()
@@ -1427,15 +1264,16 @@ INTERLEAVE = 2
 
 
 @contextlib.contextmanager
-def wide_vectors():
-    """Compile numba code inside this block with 16-lane vectors where :data:`WIDE_FLOAT32`
-    (else a no-op). LLVM's ``-force-vector-width`` is a process-wide option: it is set for the
-    block only and reset to 0 (LLVM's own choice) after, so other numba code is not affected."""
-    if not WIDE_FLOAT32:
+def wide_vectors(lanes: int = 16):
+    """Compile numba code inside this block with ``lanes``-lane vectors (16 for float32, 8 for
+    float64: 512 bits) where :data:`WIDE_VECTORS` (else a no-op). LLVM's
+    ``-force-vector-width`` is a process-wide option: it is set for the block only and reset to 0
+    (LLVM's own choice) after, so other numba code is not affected."""
+    if not WIDE_VECTORS:
         yield
         return
     with _quiet_llvm_remarks():
-        llvm.set_option("", "-force-vector-width=16")
+        llvm.set_option("", f"-force-vector-width={lanes}")
         llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
         try:
             yield
@@ -1445,11 +1283,11 @@ def wide_vectors():
 
 
 def _wide(kernel, dtype_arg: int):
-    """Call ``kernel`` so that a signature it meets for the first time with float32 data (the
-    dtype of positional argument ``dtype_arg``) is compiled with 16-lane vectors
+    """Call ``kernel`` so that a signature it meets for the first time with float data of a
+    dtype (that of positional argument ``dtype_arg``) is compiled with 512-bit vectors
     (:func:`wide_vectors` around such first calls, which compile or load from numba's cache);
     later calls go straight to the kernel."""
-    if not WIDE_FLOAT32:
+    if not WIDE_VECTORS:
         return kernel
     seen: set = set()
 
@@ -1458,10 +1296,10 @@ def _wide(kernel, dtype_arg: int):
         dt = args[dtype_arg].dtype
         if dt in seen:
             return kernel(*args)
-        if dt != np.float32:
+        if dt not in (np.float32, np.float64):
             seen.add(dt)
             return kernel(*args)
-        with wide_vectors():
+        with wide_vectors(64 // dt.itemsize):
             try:
                 return kernel(*args)
             finally:
@@ -1516,54 +1354,79 @@ def _flat(A, D, S, out):
     return A.reshape(-1), D.reshape(-1), S.reshape(-1), out.reshape(-1)
 
 
+class Lights(NamedTuple):
+    """A pass's lights in the normalised frame: ``params`` (L, N_PARAMS) T, one row per light
+    (:mod:`explorer.core.lightrow`); ``flags`` (L,) int32; ``view`` (3,) T, the eye (local
+    viewer) or V (infinite viewer)."""
+
+    params: np.ndarray
+    flags: np.ndarray
+    view: np.ndarray
+
+
+class Surface(NamedTuple):
+    """The material as the kernel reads it: ``mat`` (12,) T, e, a, d, s; ``aconst`` (3,) T, the
+    constant ambient sum (scene and constant light ambient); ``shininess`` T."""
+
+    mat: np.ndarray
+    aconst: np.ndarray
+    shininess: float
+
+
+class Sums(NamedTuple):
+    """The cached light sums, ambient ``A``, diffuse ``D``, specular ``S``: (n, 3) T, or (0, 3)
+    for none; D and S may be grey, (n, 1): one value for every channel, written only by a pass
+    that keeps its sums in the grey rows alone (:func:`grey_pass`, which the caller asks before
+    it allocates them)."""
+
+    A: np.ndarray
+    D: np.ndarray
+    S: np.ndarray
+
+
+class Lobes(NamedTuple):
+    """Each light's specular base and weight, (L, n) T (or (L, 0): not kept), so that a
+    shininess change only re-runs the lobe (:func:`lobe`)."""
+
+    base: np.ndarray
+    ws: np.ndarray
+
+
+class Marks(NamedTuple):
+    """Ambiguous float32 lanes (redone in float64): ``redo`` (n,) bool, ``count`` (nblocks,)
+    int32 marked lanes per block of BLOCK vertices (both (0,) when not tracking); a block that
+    marks none leaves its part of ``redo`` as it was: read them with :func:`marked`."""
+
+    redo: np.ndarray
+    count: np.ndarray
+
+
+class Culling(NamedTuple):
+    """Light culling: ``bounds`` (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds (see
+    :func:`bounds`), or (N_BOUNDS, 0): no culling; ``culled`` (nblocks,) int32 out: vertex-lights
+    each block skipped."""
+
+    bounds: np.ndarray
+    culled: np.ndarray
+
+
 @nb.njit(parallel=True, **_OPTS)
-def shade(
-    G,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    redo,
-    redo_count,
-    out,
-    bounds,
-    culled,
-):
+def shade(G, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     """Shade every vertex (see the module docstring).
 
-    G : (6, n) T prepared geometry (see :func:`prepare`)
-    params : (L, N_PARAMS) T; flags : (L,) int32; view : (3,) T eye or V (normalised frame)
-    opts : (N_OPTS,) int64; mat : (12,) T e, a, d, s; aconst : (3,) T constant ambient sum
-    shininess : T; k : constants(T)
-    A, D, S : (n, 3) T caches (or (0, 3)); D and S may be grey, (n, 1): read as one value
-    for every channel, and written only by a pass that keeps its sums in the grey rows alone
-    (:func:`grey_pass`, which the caller asks before it allocates them)
-    base_out, ws_out : (L, n) T (or (L, 0))
-    vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
-    redo : (n,) bool lanes marked ambiguous in float32 (redone in float64), redo_count :
-    (nblocks,) int32 marked lanes per block of BLOCK vertices (both (0,) when not tracking); a
-    block that marks none leaves its part of ``redo`` as it was: read them with :func:`marked`
-    out : (n, 3) colours
-    bounds : (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds for light culling (see
-    :func:`bounds`), or (N_BOUNDS, 0): no culling
-    culled : (nblocks,) int32 out: vertex-lights each block skipped by culling
+    G : (6, n) T prepared geometry (see :func:`prepare`); lights : :class:`Lights`
+    opts : (N_OPTS,) int64; surface : :class:`Surface`; k : constants(T)
+    sums : :class:`Sums` (read where not recomputed, written where stored); lobes :
+    :class:`Lobes`; vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
+    marks : :class:`Marks`; out : (n, 3) colours; culling : :class:`Culling`
     """
     n = G.shape[1]
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
-    Af, Df, Sf, outf = _flat(A, D, S, out)
+    D, S = sums.D, sums.S
+    Af, Df, Sf, outf = _flat(sums.A, D, S, out)
     # once per pass: a diffuse sum not recomputed here must be grey already, or absent
-    grey_only = grey_pass(flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
+    grey_only = grey_pass(lights.flags, opts, D.shape[0] == 0 or D.shape[1] == 1)
     dw, sw = D.shape[1], S.shape[1]  # 1 for a grey sum, else 3
     # a pass that is not grey writes three values per vertex: a grey sum would overflow
     if not grey_only and opts[O_STORE] != 0:
@@ -1571,40 +1434,33 @@ def shade(
             opts[O_DO_SPEC] != 0 and sw == 1 and S.shape[0]
         ):
             raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
+    culls = culling.bounds.shape[1] > 0
+    L = lights.params.shape[0]
     for t in nb.prange(ntasks):
-        scr = _scratch(params.dtype)  # once per task: no allocation per block
+        scr = _scratch(lights.params.dtype)  # once per task: no allocation per block
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
-        r = _spread(np.int64(t), np.int64(ntasks)) if bounds.shape[1] else np.int64(t)
+        r = _spread(np.int64(t), np.int64(ntasks)) if culls else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
-        act = np.empty((params.shape[0], (b1 - b0) * CHUNKS if bounds.shape[1] else 0), np.int32)
+        act = np.empty((L, (b1 - b0) * CHUNKS if culls else 0), np.int32)
+        flat = Sums(Af, Df, Sf)
+        layout = (grey_only, dw, sw)
         _task(
             G,
-            params,
-            flags,
-            view,
+            lights,
             opts,
-            mat,
-            aconst,
-            shininess,
+            surface,
             k,
-            Af,
-            Df,
-            Sf,
-            base_out,
-            ws_out,
+            flat,
+            lobes,
             vis,
-            redo,
-            redo_count,
+            marks,
             outf,
             scr,
             act,
             b0,
             b1,
-            grey_only,
-            dw,
-            sw,
-            bounds,
-            culled,
+            layout,
+            culling,
         )
 
 
@@ -1636,45 +1492,26 @@ def _gather_sum(X, idx):
 
 
 @nb.njit(**_OPTS)
-def fixup(
-    redo,
-    redo_count,
-    P,
-    N,
-    centre,
-    inv_scale,
-    params,
-    flags,
-    view,
-    opts,
-    mat,
-    aconst,
-    shininess,
-    k,
-    A,
-    D,
-    S,
-    base_out,
-    ws_out,
-    vis,
-    out,
-):
+def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes, vis, out):
     """Redo the lanes a float32 pass marked in float64, where the policies hold exactly, and
     write the results over the float32 ones; returns how many lanes.
 
-    redo, redo_count : the pass's marks (see :func:`marked`)
+    marks : the pass's :class:`Marks` (see :func:`marked`)
     P, N : (n, 3) world positions and normals; centre, inv_scale : the frame (:func:`prepare`)
-    params, view, mat, aconst, shininess, k : the pass's inputs in float64; flags, opts : the
-    pass's (ambiguity tracking is switched off here)
-    A, D, S, base_out, ws_out, vis, out : the pass's float32 arrays, written at the marked lanes
+    lights, surface, k : the pass's inputs in float64 (:class:`Lights`, :class:`Surface`,
+    constants); opts : the pass's (ambiguity tracking is switched off here)
+    sums, lobes, vis, out : the pass's float32 arrays, written at the marked lanes
     (one compiled call: gathering, shading and scattering ~150 lanes from Python cost about as
     much as a light at 1M vertices)
     """
+    redo, redo_count = marks
+    A, D, S = sums
+    base_out, ws_out = lobes
     idx = marked(redo, redo_count)
     m = idx.shape[0]
     if m == 0:
         return 0
-    L = params.shape[0]
+    L = lights.params.shape[0]
     Pm, Nm = np.empty((m, 3)), np.empty((m, 3))
     for j in range(m):
         for c in range(3):
@@ -1693,35 +1530,25 @@ def fixup(
         for j in range(vm.shape[1]):
             vm[li, j] = vis[li, idx[j]]
     om = np.empty((m, 3))
-    grey = o[O_TRACK] != 0  # (False: the float64 pass keeps RGB sums)
+    none = Marks(np.zeros(0, np.bool_), np.zeros(0, np.int32))
+    layout = (False, Dm.shape[1], Sm.shape[1])  # (the float64 pass keeps RGB sums)
     _task(
         G,
-        params,
-        flags,
-        view,
+        lights,
         o,
-        mat,
-        aconst,
-        shininess,
+        surface,
         k,
-        Am.reshape(-1),
-        Dm.reshape(-1),
-        Sm.reshape(-1),
-        bm,
-        wm,
+        Sums(Am.reshape(-1), Dm.reshape(-1), Sm.reshape(-1)),
+        Lobes(bm, wm),
         vm,
-        np.zeros(0, np.bool_),
-        np.zeros(0, np.int32),
+        none,
         om.reshape(-1),
         _scratch(np.float64),
         np.empty((L, 0), np.int32),
         0,
         nblocks,
-        grey,
-        Dm.shape[1],
-        Sm.shape[1],
-        np.zeros((N_BOUNDS, 0)),  # (no culling: the lanes are not in chunks)
-        np.zeros(nblocks, np.int32),
+        layout,
+        Culling(np.zeros((N_BOUNDS, 0)), np.zeros(nblocks, np.int32)),  # (lanes not in chunks)
     )
     for j in range(m):
         i = idx[j]
@@ -1956,7 +1783,7 @@ def _add(p, q, o):
 # the number is the argument whose dtype picks the precision
 prepare = _wide(prepare, 5)
 bounds = _wide(bounds, 0)
-shade = _wide(shade, 1)
+shade = _wide(shade, 0)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)
 stream = _wide(stream, 2)

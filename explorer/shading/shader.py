@@ -449,25 +449,18 @@ class Shader:
         shin = T(scene.material.shininess)
         K.shade(
             self._G,
-            params,
-            flags,
-            view,
+            K.Lights(params, flags, view),
             opts,
-            mat,
-            aconst,
-            shin,
+            K.Surface(mat, aconst, shin),
             self._k,
-            A,
-            D,
-            S,
-            base,
-            ws,
+            K.Sums(A, D, S),
+            K.Lobes(base, ws),
             vis,
-            redo,
-            self._redo_count,
+            K.Marks(redo, self._redo_count),
             self._out,
-            self._bounds if self._plan.cull and self.cull else self._bounds[:, :0],
-            self._culled,
+            K.Culling(
+                self._bounds if self._plan.cull and self.cull else self._bounds[:, :0], self._culled
+            ),
         )
         self.stats["pass"] += 1
         self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
@@ -475,12 +468,25 @@ class Shader:
             self.stats[name] += int(bool(do))
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
             params64, _, view64 = self._params_for(np.float64)
-            mat64 = material_vector(self._scene.material, np.float64)
             self.stats["fixup_vertices"] += K.fixup(
-                redo, self._redo_count, _readonly(self._P), _readonly(self._N), self._centre,
-                1.0 / self._scale, params64, flags, view64, opts, mat64, self._aconst,
-                np.float64(scene.material.shininess), self._k64, A, D, S, base, ws, vis, self._out,
-            )  # fmt: skip
+                K.Marks(redo, self._redo_count),
+                _readonly(self._P),
+                _readonly(self._N),
+                self._centre,
+                1.0 / self._scale,
+                K.Lights(params64, flags, view64),
+                opts,
+                K.Surface(
+                    material_vector(self._scene.material, np.float64),
+                    self._aconst,
+                    np.float64(scene.material.shininess),
+                ),
+                self._k64,
+                K.Sums(A, D, S),
+                K.Lobes(base, ws),
+                vis,
+                self._out,
+            )
         if keep:
             if do_amb:
                 self._A = A

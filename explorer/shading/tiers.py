@@ -61,6 +61,7 @@ MODES = ("auto", "compiled", "numpy")
 #: modules whose numba functions the product calls (their sources name the marker)
 SOURCES = (
     "explorer.shading.kernels",
+    "explorer.shading.vmath",
     "explorer.shading.display",
     "explorer.geometry.rays",
     "explorer.geometry.bvh",

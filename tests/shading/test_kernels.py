@@ -9,28 +9,6 @@ from explorer.shading import kernels as K
 from explorer.shading.equation import equation_shade
 
 
-@pytest.mark.parametrize("y", [1e-6, 0.5, 1.0, 12.8, 76.8, 128.0, 1000.0, 1e4])
-def test_pow32_matches_float64_pow(y):
-    x = np.concatenate([np.linspace(0, 1, 100001), [1e-30, 1e-38, 0.5, 1.0]]).astype(np.float32)
-    got = np.array(
-        [K.pow32(v, np.float32(y)) for v in x[::97]] + [K.pow32(v, np.float32(y)) for v in x[-4:]]
-    )
-    xs = np.concatenate([x[::97], x[-4:]]).astype(np.float64)
-    want = xs**y
-    assert np.all(np.isfinite(got))
-    assert np.abs(got - want).max() <= 1e-6
-    # relative accuracy where the lobe is visible (tiny results: the absolute bound above)
-    normal = (xs >= 2.0**-126) & (want > 1e-4)
-    rel = np.abs(got - want)[normal] / want[normal]
-    assert rel.max() <= 1e-5
-
-
-def test_pow32_edge_values():
-    assert K.pow32(np.float32(0.0), np.float32(3.0)) == 0.0
-    assert K.pow32(np.float32(1.0), np.float32(1e4)) == 1.0
-    assert K.pow32(np.float32(1e-30), np.float32(1e-6)) == pytest.approx(1e-30**1e-6, rel=1e-6)
-
-
 def test_stream_is_the_bandwidth_yardstick():
     P = np.arange(30, dtype=np.float32).reshape(10, 3)
     out = np.empty_like(P)
@@ -77,7 +55,7 @@ def test_wide_vectors_can_be_switched_off():
 
     code = (
         "from explorer.shading import kernels as K; import numba; "
-        "assert not K.WIDE_FLOAT32; "
+        "assert not K.WIDE_VECTORS; "
         "assert isinstance(K.shade, numba.core.registry.CPUDispatcher); print('ok')"
     )
     env = dict(os.environ, PHONG_EXPLORER_WIDE_VECTORS="0")
@@ -89,13 +67,13 @@ def test_marked_reads_only_the_blocks_that_count_marks():
     # a block that counts no marks does not write them: what its part of the array holds is
     # stale and must not be read
     n = 2 * K.BLOCK + 7
-    amb = np.ones(n, np.bool_)  # stale everywhere
-    amb[K.BLOCK :] = False  # blocks 1 and 2 write their marks: three in all
-    amb[[K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]] = True
+    redo = np.ones(n, np.bool_)  # stale everywhere
+    redo[K.BLOCK :] = False  # blocks 1 and 2 write their marks: three in all
+    redo[[K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]] = True
     marks = np.array([0, 2, 1], np.int32)
-    idx = K.marked(amb, marks)
+    idx = K.marked(redo, marks)
     assert idx.tolist() == [K.BLOCK + 3, K.BLOCK + 400, 2 * K.BLOCK + 6]
-    assert K.marked(amb, np.zeros(3, np.int32)).size == 0
+    assert K.marked(redo, np.zeros(3, np.int32)).size == 0
 
 
 @pytest.mark.parametrize("precision", [np.float32, np.float64])
@@ -140,10 +118,8 @@ def test_shade_refuses_grey_sums_for_a_pass_that_is_not_grey(monkeypatch):
     monkeypatch.setattr(K, "shade", lambda *a: (seen.append(a), shade(*a))[1])
     _ = sh.colors
     args = list(seen[0])
-    D, S = args[10], args[11]
-    assert D.shape == S.shape == (700, 1)  # a grey pass (white light)
-    opts = args[4].copy()
-    opts[K.O_TRACK] = 0  # no inline loops: not a grey pass
-    args[4] = opts
+    sums = args[5]
+    assert sums.D.shape == sums.S.shape == (700, 1)  # a grey pass (white light)
+    args[1] = args[1]._replace(flags=args[1].flags & ~K.GREY)  # RGB lights: not a grey pass
     with pytest.raises(ValueError, match="grey pass"):
         shade(*args)

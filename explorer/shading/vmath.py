@@ -1,0 +1,228 @@
+"""Powers that vectorise: x**y for the lobe and the spot factor, in float32 and float64.
+
+numba's ``x ** y`` calls libm's ``pow`` once per element, and a loop with a call stays scalar:
+the whole light loop around it then runs one lane at a time. These are inlined polynomials and
+bit manipulations with no call and no branch, so the loop around them vectorises. Both compute
+x**y = 2**(y·log2 x) for x in [0, ~1] and y >= 0:
+
+- log2 x: x = 2**k · m with m in [sqrt(1/2), sqrt(2)) from the exponent bits, then ln m;
+- 2**t = 2**j · 2**f with j = rint(t), f in [-1/2, 1/2], 2**j written as exponent bits.
+
+:func:`pow32` (the float32 path): ln m = z - z²/2 + z³·P(z), z = m - 1 (P of degree 5, fitted
+like Cephes logf), 2**f by a degree-5 fit; relative error about 1e-6, results below 2**-126
+flush to 0.
+
+:func:`pow64` (the float64 path): ln m = 2·atanh(s), s = (m - 1)/(m + 1), |s| <= 0.1716, by a
+polynomial in s² (degree 6), and 2**f = 1 + f·Q(f) (Q of degree 9), both fitted at Chebyshev
+nodes (near-minimax; relative error of each about 1e-16, at double rounding). The rounding of
+t = y·log2 x itself, |t|·2**-53, dominates: **the relative error is below (|t| + 4)·2**-51**
+(for t >= -1022, the normal results; about 4.6e-13 at the smallest), which
+``tests/shading/test_vmath.py`` checks against exact powers (mpmath). Subnormal x is scaled by
+2**54 first, so it is as exact. Results below 2**-1022 flush to 0 (an absolute error below
+2.3e-308); t is capped at 1023 (x > 1 with a huge y: the result saturates near 2**1023, finite).
+As OpenGL: 0**0 = 1, 0**y = 0 for y > 0, 1**y = 1.
+
+numba's on-disk cache checks only the file of the function it compiled: after an edit here,
+touch :mod:`explorer.shading.kernels` (or clear its cache), or the kernels keep the old code.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.extending import intrinsic, overload
+
+_FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
+_LEAF = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True, _nrt=False)
+
+# --------------------------------------------------------------------------------------------
+# float32
+
+
+@intrinsic
+def i2f(typingctx, x):
+    """An integer's low 32 bits read as a float32."""
+    if not isinstance(x, types.Integer):
+        return None
+
+    def codegen(context, builder, sig, args):
+        v = args[0]
+        if v.type.width > 32:
+            v = builder.trunc(v, ir.IntType(32))
+        return builder.bitcast(v, ir.FloatType())
+
+    return types.float32(x), codegen
+
+
+#: log2's split point: x = 2**k · m with m in [sqrt(1/2), sqrt(2)), so ln m = ln(1 + z) has
+#: |z| <= 0.41 (the range of the polynomial below)
+_SPLIT = 0x3F3504F3  # the bits of float32 sqrt(1/2)
+
+
+@intrinsic
+def split32(typingctx, x):
+    """x = 2**k · m for a positive float32 x, m in [sqrt(1/2), sqrt(2)): (k, m) as float32.
+
+    In 32-bit integer operations and without a branch or blend (numba's own integer arithmetic
+    widens to int64, which costs cross-lane conversions in SIMD code): subtracting the bits of
+    sqrt(1/2) moves the split point to an exponent boundary, so the shifted difference is k and
+    the bits of x minus k's exponent bits are m. x = 0 gives k = -127, m = 1.
+    """
+    if x != types.float32:
+        return None
+
+    def codegen(context, builder, sig, args):
+        i32 = ir.IntType(32)
+        ix = builder.bitcast(args[0], i32)
+        tmp = builder.sub(ix, ir.Constant(i32, _SPLIT))
+        k = builder.ashr(tmp, ir.Constant(i32, 23))
+        im = builder.sub(ix, builder.and_(tmp, ir.Constant(i32, -(1 << 23))))
+        kf = builder.sitofp(k, ir.FloatType())
+        m = builder.bitcast(im, ir.FloatType())
+        return context.make_tuple(builder, sig.return_type, (kf, m))
+
+    return types.UniTuple(types.float32, 2)(types.float32), codegen
+
+
+@nb.njit(inline="always", **_LEAF)
+def log2_32(x):
+    """log2 x for a positive, finite float32 x (-127 for x = 0)."""
+    e, f = split32(x)
+    z = f - np.float32(1.0)
+    p = np.float32(-0.10746953303517079)  # least-squares fit, |error| <= 3.5e-7 on the range
+    p = p * z + np.float32(0.15904727806564242)
+    p = p * z + np.float32(-0.16972990678158706)
+    p = p * z + np.float32(0.1993995441108155)
+    p = p * z + np.float32(-0.24992546983782263)
+    p = p * z + np.float32(0.33333703609427834)
+    ln = z + z * z * (z * p - np.float32(0.5))
+    return e + ln * np.float32(1.4426950408889634)
+
+
+@nb.njit(inline="always", **_LEAF)
+def exp2_32(t):
+    """2**t for float32 t; 0 for t <= -127."""
+    t = max(t, np.float32(-127.0))
+    k = np.rint(t)
+    fr = t - k
+    q = np.float32(0.0013390867352163702)  # 2**f = 1 + f·Q(f), least squares, rel. err 2e-7
+    q = q * fr + np.float32(0.00966637369320816)
+    q = q * fr + np.float32(0.05550357104250901)
+    q = q * fr + np.float32(0.24022348940946955)
+    q = q * fr + np.float32(0.6931471880293432)
+    q = q * fr + np.float32(1.0)  # exact at f = 0: 1**y == 1
+    return q * i2f((np.int32(k) + np.int32(127)) << 23)
+
+
+@nb.njit(inline="always", **_LEAF)
+def pow32(x, y):
+    """x**y for float32 x in [0, ~1] and y > 0 (see the module docstring); SIMD-friendly."""
+    t = y * log2_32(x)
+    return exp2_32(t if x > np.float32(0.0) else np.float32(-200.0))
+
+
+# --------------------------------------------------------------------------------------------
+# float64
+
+_SPLIT64 = 0x3FE6A09E667F3BCD  # the bits of float64 sqrt(1/2)
+_TINY64 = 2.0**-1022  # below: subnormal, scaled by 2**54 before the split
+_LOG2E = 1.4426950408889634
+
+
+@intrinsic
+def split64(typingctx, x):
+    """x = 2**k · m for a positive, normal float64 x, m in [sqrt(1/2), sqrt(2)): (k, m) as
+    float64 (as :func:`split32`, in 64-bit integers; k goes through int32, whose conversion to
+    float64 vectorises on every x86-64 vector unit)."""
+    if x != types.float64:
+        return None
+
+    def codegen(context, builder, sig, args):
+        i64 = ir.IntType(64)
+        ix = builder.bitcast(args[0], i64)
+        tmp = builder.sub(ix, ir.Constant(i64, _SPLIT64))
+        k = builder.ashr(tmp, ir.Constant(i64, 52))
+        im = builder.sub(ix, builder.and_(tmp, ir.Constant(i64, -(1 << 52))))
+        kf = builder.sitofp(builder.trunc(k, ir.IntType(32)), ir.DoubleType())
+        m = builder.bitcast(im, ir.DoubleType())
+        return context.make_tuple(builder, sig.return_type, (kf, m))
+
+    return types.UniTuple(types.float64, 2)(types.float64), codegen
+
+
+@intrinsic
+def exp2i64(typingctx, j):
+    """2**j for an integral float64 j in [-1022, 1023], from its exponent bits."""
+    if j != types.float64:
+        return None
+
+    def codegen(context, builder, sig, args):
+        i64 = ir.IntType(64)
+        k = builder.sext(builder.fptosi(args[0], ir.IntType(32)), i64)
+        bits = builder.shl(builder.add(k, ir.Constant(i64, 1023)), ir.Constant(i64, 52))
+        return builder.bitcast(bits, ir.DoubleType())
+
+    return types.float64(j), codegen
+
+
+@nb.njit(inline="always", **_LEAF)
+def log2_64(x):
+    """log2 x for a positive, finite float64 x (subnormals included)."""
+    sub = x < _TINY64
+    e, m = split64(x * 18014398509481984.0 if sub else x)  # (2**54)
+    e = e - 54.0 if sub else e
+    s = (m - 1.0) / (m + 1.0)
+    w = s * s
+    p = 0.07308224842521703  # (atanh(s)/s - 1)/w, fitted at Chebyshev nodes on [0, 0.0295]
+    p = p * w + 0.07665860800278021
+    p = p * w + 0.09091444562630861
+    p = p * w + 0.1111110556739754
+    p = p * w + 0.14285714312987743
+    p = p * w + 0.19999999999949752
+    p = p * w + 0.3333333333333335
+    ln = 2.0 * s + (2.0 * s) * (w * p)  # ln m = 2·atanh(s)
+    return e + ln * _LOG2E
+
+
+@nb.njit(inline="always", **_LEAF)
+def exp2_64(t):
+    """2**t for float64 t <= 1023; 0 for t < -1022."""
+    j = np.rint(max(t, -1022.0))
+    f = t - j  # in [-1/2, 1/2]
+    q = 7.070977866508138e-09  # (2**f - 1)/f, fitted at Chebyshev nodes on [-1/2, 1/2]
+    q = q * f + 1.0205905413765595e-07
+    q = q * f + 1.3215451633221434e-06
+    q = q * f + 1.5252672924850737e-05
+    q = q * f + 0.00015403530424776529
+    q = q * f + 0.0013333558200794592
+    q = q * f + 0.009618129107618665
+    q = q * f + 0.05550410866465167
+    q = q * f + 0.24022650695910075
+    q = q * f + 0.6931471805599462
+    q = q * f + 1.0  # exact at f = 0: 1**y == 1
+    r = q * exp2i64(j)
+    return r if t >= -1022.0 else 0.0
+
+
+@nb.njit(inline="always", **_LEAF)
+def pow64(x, y):
+    """x**y for float64 x in [0, ~1] and y >= 0, relative error below (|t| + 4)·2**-51 with
+    t = y·log2 x (see the module docstring); SIMD-friendly. 0**0 = 1."""
+    pos = x > 0.0
+    t = y * log2_64(x if pos else 1.0)
+    t = t if pos else (-2000.0 if y > 0.0 else 0.0)
+    return exp2_64(min(t, 1023.0))
+
+
+def fpow(x, y):
+    """x**y in the working precision: :func:`pow32` for float32, :func:`pow64` for float64."""
+    return x**y
+
+
+@overload(fpow, inline="always", jit_options=_LEAF)
+def _fpow_overload(x, y):
+    if x == types.float32:
+        return lambda x, y: pow32(x, y)
+    return lambda x, y: pow64(x, y)
