@@ -58,7 +58,9 @@ def test_a_shader_with_shadows_shades_as_the_brute_force_says():
     rows = _brute_rows(mesh, load_scene(scene).lights)
     dark = (rows == 0).any(axis=0)
     assert (shaded[dark].sum(axis=1) < plain[dark].sum(axis=1)).mean() > 0.9
-    assert np.array_equal(shaded[~dark], plain[~dark])
+    # lit vertices keep their colours (to rounding: a shadowed light takes the kernel's row
+    # path, an unshadowed one may take an inline loop)
+    np.testing.assert_allclose(shaded[~dark], plain[~dark], rtol=0, atol=1e-12)
 
 
 def test_the_fine_torus_is_shadowed():
