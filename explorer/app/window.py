@@ -237,7 +237,8 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
         tiers.preload()
         self.engine_label = QtWidgets.QLabel("")
         self.engine_label.setObjectName("engine")
-        self.statusBar().addPermanentWidget(self.engine_label)
+        self.engine_label.setContentsMargins(0, 0, 16, 0)  # apart from the preset and model
+        self.statusBar().insertPermanentWidget(0, self.engine_label)
         self._engine_timer = QtCore.QTimer(self)
         self._engine_timer.timeout.connect(self._show_engine)
         self._engine_timer.start(ENGINE_POLL_MS)
