@@ -325,7 +325,10 @@ class Shader:
         """Whether this pass runs on the compiled kernels (see :mod:`explorer.shading.tiers`)."""
         if self.tier is not None:
             return self.tier == "compiled"
-        return tiers.compiled(self.n * max(1, len(self._scene.lights)))
+        # the vertex-lights this pass would compute on the numpy tier: none when its sums are
+        # kept and only the material changed (a compose is not work the kernels would save)
+        work = 0 if self._np is not None else self.n * max(1, len(self._scene.lights))
+        return tiers.compiled(work)
 
     def _update(self, force=(False, False, False)):
         if not self._compiled_tier():

@@ -174,6 +174,10 @@ def test_a_one_shot_process_loads_the_kernels_only_for_enough_work(cold_tiers):
     s = Shader(SHADOWED, mesh.positions, mesh.normals, keep=False)
     _ = s.colors
     assert s.stats["numpy"] == 1 and not tiers.loaded()  # a small job: no load
+    served = tiers._state["numpy_work"]
+    s.set_material({"diffuse": [0.2, 0.3, 0.9], "specular": [0.5, 0.5, 0.5], "shininess": 20.0})
+    _ = s.colors  # a compose on the numpy tier's kept sums: no vertex-light work counted
+    assert tiers._state["numpy_work"] == served and s.stats["numpy"] == 1
     assert not tiers.compiled(tiers.LOAD_WORTH // 2)
     assert tiers.compiled(tiers.LOAD_WORTH // 2)  # enough work served: load and compile
     s.set_lights(SHADOWED["lights"][:1])
