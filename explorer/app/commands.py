@@ -33,7 +33,7 @@ VIEW_KEYS = {
     "r": ("reset the camera (the material and lights stay)", "reset_camera"),
     "q": ("quit (the session is kept for 'gui --last')", "close"),
     "d": ("show / hide the per-pixel difference", "toggle_difference"),
-    "b": ("switch the specular model (blinn / phong)", "toggle_model"),
+    "b": ("next specular model (blinn / phong / threejs)", "toggle_model"),
     "1": ("show / hide the ambient term", "toggle_ambient"),
     "2": ("show / hide the diffuse term", "toggle_diffuse"),
     "3": ("show / hide the specular term", "toggle_specular"),
@@ -200,8 +200,7 @@ class Commands:
         self.act(M.swap_compare, label="swap A and B")
 
     def toggle_model(self) -> None:
-        model = "phong" if self.store.state.scene.model == "blinn" else "blinn"
-        self.act(M.set_model, model, label="model")
+        self.act(M.set_model, M.next_model(self.store.state.scene.model), label="model")
 
     def _toggle_term(self, term: str) -> None:
         shown = term not in self.store.state.hidden

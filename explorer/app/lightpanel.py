@@ -15,6 +15,7 @@ from explorer.app.panel import (
     _scroll,
 )
 from explorer.core.lights import LIGHT_TYPES, SPOT_EXPONENT_RANGE
+from explorer.core.material import MODELS
 
 
 def light_summary(i: int, light, state: M.State) -> str:
@@ -232,7 +233,7 @@ class ViewTab(QtWidgets.QWidget):
         form.addWidget(QtWidgets.QLabel("B model"), 1, 0)
         self.compare_model = {}
         group = QtWidgets.QButtonGroup(self)
-        for i, name in enumerate(("blinn", "phong")):
+        for i, name in enumerate(MODELS):
             r = QtWidgets.QRadioButton(name)
             r.setObjectName(f"compare_{name}")
             group.addButton(r)

@@ -23,7 +23,7 @@ import numpy as np
 
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
-from explorer.core.material import RGB_KEYS, Material
+from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import Scene, Viewer
 from explorer.render.camera import Camera
 
@@ -104,8 +104,13 @@ class State:
 
     def shown_scene(self) -> Scene:
         """The scene the engine shades: hidden terms have coefficient 0 (``ambient`` takes
-        the emission with it)."""
-        return self.scene.replace(material=display_material(self.material, self.hidden))
+        the emission with it). A hidden specular term under ``threejs`` is drawn under
+        ``blinn``: the two differ only in the specular term, and threejs's has a part (Schlick's
+        F toward 1) that no coefficient turns off."""
+        scene = self.scene.replace(material=display_material(self.material, self.hidden))
+        if "specular" in self.hidden and scene.model == "threejs":
+            scene = scene.replace(model="blinn")
+        return scene
 
     def placement(self, index: int | None = None) -> tuple[float, float, float]:
         """``(azimuth, elevation, distance)`` of a light (default: the selected one) around
@@ -181,6 +186,11 @@ def set_model(state: State, model: str) -> State:
     return state.replace(scene=state.scene.replace(model=model))
 
 
+def next_model(model: str) -> str:
+    """The specular model after ``model`` in :data:`~explorer.core.material.MODELS` (cycling)."""
+    return MODELS[(MODELS.index(model) + 1) % len(MODELS)]
+
+
 def set_term(state: State, term: str, shown: bool) -> State:
     if term not in TERMS:
         raise ExplorerError(f"term must be one of {TERMS}, got {term!r}")
@@ -214,8 +224,9 @@ def set_camera(state: State, camera: Camera | None) -> State:
 
 
 def start_compare(state: State) -> State:
-    """Side B starts as this material under the other specular model (Blinn beside Phong)."""
-    other = "phong" if state.scene.model == "blinn" else "blinn"
+    """Side B starts as this material under another specular model (Phong beside Blinn or
+    threejs, Blinn beside Phong)."""
+    other = "phong" if state.scene.model != "phong" else "blinn"
     return state.replace(compare=state.material, compare_model=other,
                          compare_preset=state.preset)  # fmt: skip
 

@@ -15,7 +15,7 @@ import math
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
-from explorer.core.material import RGB_KEYS
+from explorer.core.material import MODELS, RGB_KEYS
 
 #: slider steps (QSlider is integral)
 STEPS = 1000
@@ -248,7 +248,7 @@ class MaterialTab(QtWidgets.QWidget):
         self.model = {}
         group = QtWidgets.QButtonGroup(self)
         row.addWidget(QtWidgets.QLabel("model"))
-        for name in ("blinn", "phong"):
+        for name in MODELS:
             r = QtWidgets.QRadioButton(name)
             r.setObjectName(name)
             group.addButton(r)

@@ -19,6 +19,7 @@ import numpy as np
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
+from explorer.core.material import MODELS
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.core.text import printable
@@ -82,11 +83,27 @@ def add_materials_dir_option(p: argparse.ArgumentParser, dest: str = "materials_
     )  # fmt: skip
 
 
+def model_list(text: str) -> tuple[str, ...]:
+    """``--model a,b``: the names, each one of MODELS, no repeats (argparse's type)."""
+    names = tuple(t.strip() for t in text.split(","))
+    bad = [n for n in names if n not in MODELS]
+    if bad or len(set(names)) != len(names):
+        raise argparse.ArgumentTypeError(
+            f"expected names from {', '.join(MODELS)}, comma-separated, each once; got {text!r}"
+        )
+    return names
+
+
 def add_scene_arguments(
-    p: argparse.ArgumentParser, *, mesh_default: str | None, force: bool = True
+    p: argparse.ArgumentParser,
+    *,
+    mesh_default: str | None,
+    force: bool = True,
+    models: bool = False,
 ) -> None:
     """The SCENE argument and the options that override its parts; ``force``: also
-    ``--force`` (commands that write a file)."""
+    ``--force`` (commands that write a file); ``models``: ``--model`` takes a comma-separated
+    list (a tuple of names; the sheet draws each material under each)."""
     p.add_argument("scene", nargs="?", metavar="SCENE", help="scene file (YAML); optional")
     add_materials_dir_option(p)
 
@@ -100,7 +117,13 @@ def add_scene_arguments(
         help="built-in mesh detail: sphere/torus segments, icosphere subdivisions, plane "
         "subdivisions, teapot samples per patch edge",
     )  # fmt: skip
-    p.add_argument("--model", choices=("blinn", "phong"), help="specular model")
+    if models:
+        p.add_argument(
+            "--model", type=model_list, metavar="MODEL[,MODEL...]",
+            help=f"specular model(s), side by side: {', '.join(MODELS)} (e.g. blinn,threejs)",
+        )  # fmt: skip
+    else:
+        p.add_argument("--model", choices=MODELS, help="specular model")
     p.add_argument(
         "--two-sided", action=argparse.BooleanOptionalAction, default=None,
         help="light back faces with the flipped normal",

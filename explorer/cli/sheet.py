@@ -3,6 +3,10 @@
 ::
 
     phong-explorer sheet --out presets.png --mesh teapot --columns 6 --tile 200x200
+    phong-explorer sheet --out models.png --model blinn,threejs --preset bronze --preset chrome
+
+``--model a,b`` draws each preset under each model, side by side (the same numbers under
+OpenGL's Blinn-Phong and three.js's MeshPhongMaterial, say).
 
 A mesh file with its own materials (an OBJ's ``mtllib``) gets a first tile in them, each
 ``usemtl`` group in its own material, before the presets; with ``--preset`` only the presets
@@ -37,7 +41,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument("--columns", type=int, default=6, metavar="N", help="tiles per row (6)")
     p.add_argument("--tile", default="200x150", metavar="WxH", help="tile size (200x150)")
-    add_scene_arguments(p, mesh_default="teapot")
+    add_scene_arguments(p, mesh_default="teapot", models=True)
 
 
 def run(args) -> int:
@@ -50,6 +54,7 @@ def run(args) -> int:
     args.mesh_default = "teapot"
     chosen = args.preset
     args.preset = None  # the sheet's --preset selects tiles; it does not set the material
+    models, args.model = args.model, None  # each tile's model: the sheet's, else its own
     scene, mesh = build_scene(args, default_light=DirectionalLight(to_light=SHEET_LIGHT_DIRECTION))
     materials_dirs = tuple(args.materials_dirs)
     if chosen:
@@ -61,9 +66,10 @@ def run(args) -> int:
             items.insert(0, (f"{mesh.name} (its materials)", own))
     image = sheet(
         items, scene, mesh, tile=tile, columns=args.columns, background=background,
-        model=args.model,
+        model=models,
     )  # fmt: skip
     write_atomic(args.out, encode_png(image), overwrite=args.force)
     h, w = image.shape[:2]
-    print(f"wrote {args.out}: {len(items)} presets on {mesh.name}, {w}x{h}")
+    under = f" under {', '.join(models)}" if models else ""
+    print(f"wrote {args.out}: {len(items)} presets{under} on {mesh.name}, {w}x{h}")
     return 0

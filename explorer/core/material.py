@@ -73,7 +73,9 @@ COEFFICIENT_RANGE = (0.0, 1.0)
 OPACITY_RANGE = (0.0, 1.0)
 #: Allowed Schlick reflectance at normal incidence ``F0`` (``fresnel``).
 FRESNEL_RANGE = (0.0, 1.0)
-MODELS = ("blinn", "phong")
+#: The specular models: OpenGL's Blinn-Phong ``(N·H)^n`` and Phong ``(R·V)^n``, and three.js's
+#: normalised Blinn-Phong (MeshPhongMaterial; see :mod:`explorer.shading.equation`).
+MODELS = ("blinn", "phong", "threejs")
 
 #: term -> its scalar key, and the scalar defaults applied to ``color`` (OpenGL's 0.2 / 0.8).
 TERM_SCALARS = {"ambient": "ka", "diffuse": "kd", "specular": "ks"}

@@ -3,7 +3,7 @@
 The scene-file schema (every key optional)::
 
     material: bronze          # a preset name, or an inline mapping of the material keys
-    model: blinn              # or phong (default: the material's model, else blinn)
+    model: blinn              # or phong, threejs (default: the material's model, else blinn)
     ambient: [0.2, 0.2, 0.2]  # scene ambient (OpenGL's default)
     viewer: {eye: [0, 0, 5]}  # local viewer; or {to_viewer: [0, 0, 1]} (infinite, the default)
     two_sided: false
@@ -169,7 +169,9 @@ class Scene(Checked):
     """Everything but the geometry.
 
     material : the surface's coefficients
-    model : "blinn" ((N·H)^n) or "phong" ((R·V)^n)
+    model : "blinn" ((N·H)^n), "phong" ((R·V)^n) or "threejs" (three.js's MeshPhongMaterial:
+        (n/2+1)/4·(N·H)^n·(N·L)·Schlick's F on the specular colour; see
+        :mod:`explorer.shading.equation`)
     ambient : scene ambient RGB (``a_scene``), never attenuated
     viewer : local or infinite
     two_sided : light back faces with -N

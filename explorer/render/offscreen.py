@@ -233,7 +233,7 @@ def sheet(
     columns: int = SHEET_COLUMNS,
     background=BACKGROUND,
     gap: int = 2,
-    model: str | None = None,
+    model: str | Sequence[str] | None = None,
 ) -> np.ndarray:
     """Every material on the same mesh, in a labelled grid: (H, W, 3) uint8.
 
@@ -242,10 +242,15 @@ def sheet(
         file's own materials; the tile's opacity is the first one's)
     scene : lights, viewer, model; each tile replaces its material
     model : specular model of every tile; None: the material's own model when it has one,
-        else the scene's
+        else the scene's; several models: each material once under each, side by side,
+        labelled "label · model"
     tile : (width, height) of one cell; gap : pixels between cells (background colour)
     """
     items = list(materials)
+    if model is not None and not isinstance(model, str):
+        items = [(f"{label} · {m}", mat, m) for label, mat in items for m in model]
+    else:
+        items = [(label, mat, model) for label, mat in items]
     if not items:
         raise ExplorerError("no materials to put on the sheet")
     tw, th = check_size(tile)
@@ -259,8 +264,8 @@ def sheet(
     out = np.empty((height, width, 3), np.uint8)
     out[:] = bg
     with OffscreenRenderer((tw, th), background) as r:
-        font = r.label_font_size(str(label) for label, _ in items)
-        for i, (label, material) in enumerate(items):
+        font = r.label_font_size(str(label) for label, _, _ in items)
+        for i, (label, material, model) in enumerate(items):
             per_group = isinstance(material, tuple)
             first = material[0] if per_group else material
             s = scene.replace(material=first, model=model or first.model or scene.model)

@@ -15,6 +15,22 @@ with the per-vertex weights of the effects (:mod:`explorer.shading.effects`, eac
 ``vis_i`` the shadow visibility (1 without ``shadows: true`` or without faces; rays from every
 vertex, even on a convex mesh), ``F_i`` Schlick's Fresnel weight (1 without ``fresnel``) and
 ``E`` the energy-conserving normalisation (1 without ``energy_conserving``).
+
+The ``threejs`` model is three.js's MeshPhongMaterial (``BRDF_BlinnPhong`` in three.js's
+``src/renderers/shaders/ShaderChunk/bsdfs.glsl.js``, ``RE_Direct_BlinnPhong`` in
+``lights_phong_pars_fragment.glsl.js``), with each light's intensity π times the OpenGL one (what
+three.js's legacy light mode did by itself), so that its diffuse ``(d_m/π)·π·(N·L)·d_i`` and
+ambient terms are OpenGL's and only the specular term differs::
+
+    f_i·F_i·E·(N·H)^n·s_m·s_i   becomes   max(N·L, 0)·(n/2 + 1)/4·max(N·H, 0)^n·F·s_i
+    F = s_m·(1 - g) + g,   g = 2^((-5.55473·(V·H) - 6.98316)·(V·H))
+
+(D = (n/2 + 1)/π·(N·H)^n, G = 1/4, Schlick's F on the specular colour toward 1 with Epic's
+exponential form of (1 - V·H)^5, times π·(N·L)). ``g`` does not depend on the material, so the
+specular term splits into ``s_m·specular + specular_f90``: even a black specular colour shows a
+highlight at grazing angles. The material's ``fresnel`` and ``energy_conserving`` do not apply
+(the model has both built in); the ambient term keeps the material's ambient colour (three.js has
+none: an AmbientLight there reflects the diffuse colour; ``presets show --as threejs`` says so).
 """
 
 from __future__ import annotations
@@ -27,6 +43,9 @@ from explorer.core.scene import Scene
 from explorer.geometry.frame import check_vertices, frame_of, to_frame
 from explorer.shading.effects import EFFECTS, Incident
 
+#: three.js's F_Schlick: g = 2^((A·c + B)·c) for c = V·H, Epic's fit of (1 - c)^5 (bsdfs.glsl.js)
+THREEJS_FRESNEL = (-5.55473, -6.98316)
+
 
 def equation_terms(
     scene: Scene, positions, normals, faces=None, *, visibility=None
@@ -34,7 +53,9 @@ def equation_terms(
     """Per-vertex light sums, independent of the material.
 
     Returns ``ambient``, ``diffuse``, ``specular`` : (n, 3) float64 such that the colour is
-    ``e_m + a_m·ambient + d_m·diffuse + s_m·specular`` (``ambient`` includes the scene ambient).
+    ``e_m + a_m·ambient + d_m·diffuse + s_m·specular`` (``ambient`` includes the scene ambient),
+    and for the ``threejs`` model ``specular_f90`` (n, 3) too, added as it is (the part of
+    Schlick's F that does not depend on the specular colour).
     The specular sum uses the scene material's shininess and the scene's model.
     faces : (m, 3) int triangles for shadows, or None
     visibility : (L, n) float, each light's shadow visibility already cast (the engine's numpy
@@ -67,6 +88,8 @@ def equation_terms(
     ambient = np.tile(np.asarray(scene.ambient, dtype=np.float64), (n, 1))
     diffuse = np.zeros((n, 3))
     specular = np.zeros((n, 3))
+    threejs = scene.model == "threejs"
+    f90 = np.zeros((n, 3)) if threejs else None
     cast = visibility is not None and np.shape(visibility)[-1] > 0
     for i, light in enumerate(scene.lights):
         L, _, w = light.incident(P, N, centre, scale)  # what arrives and from where
@@ -76,20 +99,39 @@ def equation_terms(
 
         ndl = np.einsum("ij,ij->i", N, L)
         lit = ndl > 0.0  # f_i: specular only where N·L > 0
-        if scene.model == "blinn":
+        if scene.model == "phong":
+            R = 2.0 * ndl[:, None] * N - L
+            base = np.einsum("ij,ij->i", R, V)
+        else:
             H = L + V
             h2 = np.einsum("ij,ij->i", H, H)
             ok = h2 > tol.HALFWAY_EPS2  # H undefined for L = -V: N·H taken as 0
             base = np.where(ok, np.einsum("ij,ij->i", N, H) / np.sqrt(np.where(ok, h2, 1.0)), 0.0)
-        else:
-            R = 2.0 * ndl[:, None] * N - L
-            base = np.einsum("ij,ij->i", R, V)
         lobe = np.maximum(base, 0.0) ** shininess  # numpy: 0.0 ** 0.0 == 1.0
+        s_i = np.asarray(light.specular)
 
         ambient += w[:, None] * np.asarray(light.ambient)  # a_i (attenuated)
         diffuse += (dif_w * np.maximum(ndl, 0.0))[:, None] * np.asarray(light.diffuse)  # d_i
-        specular += (spec_w * lit * lobe)[:, None] * np.asarray(light.specular)  # s_i
-    return {"ambient": ambient, "diffuse": diffuse, "specular": specular}
+        if not threejs:
+            specular += (spec_w * lit * lobe)[:, None] * s_i  # s_i
+            continue
+        g = threejs_fresnel(np.einsum("ij,ij->i", V, L))  # 1 - g weighs s_m, g weighs 1
+        d = spec_w * np.maximum(ndl, 0.0) * (shininess / 2.0 + 1.0) / 4.0 * lobe  # π·(N·L)·D·G
+        specular += (d * (1.0 - g))[:, None] * s_i  # s_m·(1 - g)·s_i
+        f90 += (d * g)[:, None] * s_i  # g·s_i
+    out = {"ambient": ambient, "diffuse": diffuse, "specular": specular}
+    if threejs:
+        out["specular_f90"] = f90
+    return out
+
+
+def threejs_fresnel(v_dot_l) -> np.ndarray:
+    """three.js's Schlick weight toward 1, ``g = 2^((A·c + B)·c)`` with ``c = V·H`` (``A, B`` =
+    :data:`THREEJS_FRESNEL`), for unit L and V with cosine ``v_dot_l`` between them: (n,)
+    float64. ``V·H = sqrt((1 + V·L) / 2)``; for L = -V (H undefined) c = 0 and g = 1."""
+    c = np.sqrt(np.maximum((1.0 + np.asarray(v_dot_l, np.float64)) * 0.5, 0.0))
+    a, b = THREEJS_FRESNEL
+    return np.exp2((a * c + b) * c)
 
 
 def _effect_weights(scene: Scene, light, at: Incident, w: np.ndarray):
@@ -109,12 +151,20 @@ def equation_shade(
     scene: Scene, positions, normals, *, clamp: bool = True, faces=None
 ) -> np.ndarray:
     """Colours (n, 3) float64 by the full equation (see module docstring)."""
-    t = equation_terms(scene, positions, normals, faces)
-    m = scene.material
-    c = (
-        np.asarray(m.emission)  # e_m
-        + np.asarray(m.ambient) * t["ambient"]  # a_m·(a_scene + Σ w·a_i)
-        + np.asarray(m.diffuse) * t["diffuse"]  # d_m·Σ w·(N·L)·d_i
-        + np.asarray(m.specular) * t["specular"]  # s_m·Σ w·f·(N·H)^n·s_i
-    )
-    return np.clip(c, 0.0, 1.0) if clamp else c
+    return compose_terms(scene.material, equation_terms(scene, positions, normals, faces), clamp)
+
+
+def compose_terms(material, terms, clamp: bool) -> np.ndarray:
+    """Colours (n, 3) float64 from the sums ``terms`` of :func:`equation_terms` (ambient,
+    diffuse, specular, and specular_f90 when present, each (n, 3)) and a material: clamped to
+    [0, 1] when ``clamp``."""
+    m = material
+    c = np.asarray(m.emission, np.float64)  # e_m
+    c = c + np.asarray(m.ambient) * terms["ambient"]  # a_m·(a_scene + Σ w·a_i)
+    c += np.asarray(m.diffuse) * terms["diffuse"]  # d_m·Σ w·vis·(N·L)·d_i
+    c += np.asarray(m.specular) * terms["specular"]  # s_m·Σ w·vis·f·(N·H)^n·s_i
+    if "specular_f90" in terms:
+        c += terms["specular_f90"]  # threejs: Σ w·vis·(N·L)·D·G·g·s_i
+    if clamp:
+        np.clip(c, 0.0, 1.0, out=c)
+    return c

@@ -204,7 +204,12 @@ def _make_plan(scene: Scene, mesh) -> Plan:
             if flat
             else f"pow(base, {m.shininess:g}) per vertex",
         )
-    view = _view(scene, specular, flat, any(e.needs_view(v) for e, v, _ in effects), r)
+    threejs = scene.model == "threejs"
+    if threejs:
+        r.why("model", True, "threejs: three.js's normalised Blinn-Phong, computed by the numpy "
+              "tier (the compiled kernels implement OpenGL's blinn and phong)")  # fmt: skip
+    needs_view = threejs and specular or any(e.needs_view(v) for e, v, _ in effects)
+    view = _view(scene, specular, flat, needs_view, r)
     r.why(
         "two-sided",
         scene.two_sided,
@@ -212,9 +217,11 @@ def _make_plan(scene: Scene, mesh) -> Plan:
     )
     cull = r.why(
         "culling",
-        not scene.two_sided,
+        not (scene.two_sided or threejs),
         "two-sided: N flips with V, so no vertex is known to face away from a light"
         if scene.two_sided
+        else "the numpy tier computes every vertex-light"
+        if threejs
         else f"runs of {CHUNK} vertices that all face away from a light (or lie outside a "
         "spot's cone) skip it: how many, the mesh decides",
     )
@@ -226,6 +233,8 @@ def _make_plan(scene: Scene, mesh) -> Plan:
     if specular and not flat:
         if scene.model == "phong":
             halfway = "reflection"
+        elif threejs:
+            halfway = "per-vertex"  # the numpy tier computes H per vertex
         elif scene.viewer.local or any(lp.positional for lp in lplans if lp.specular):
             halfway = "per-vertex"
         else:
@@ -266,13 +275,18 @@ def _terms(scene: Scene, r: _Reasons) -> tuple[bool, bool, bool, bool]:
         else ("scene and light ambient are 0" if not any_amb else "a_m and an ambient light"),
     )
     diffuse = _lit_term(r, "diffuse", "d", m.diffuse, lights)
-    specular = _lit_term(r, "specular", "s", m.specular, lights)
+    specular = _lit_term(r, "specular", "s", m.specular, lights, scene.model == "threejs")
     return emission, ambient, diffuse, specular
 
 
-def _lit_term(r, term: str, symbol: str, material_rgb, lights) -> bool:
-    """The diffuse or specular term: in when the material and some light both have it."""
+def _lit_term(r, term: str, symbol: str, material_rgb, lights, f90: bool = False) -> bool:
+    """The diffuse or specular term: in when the material and some light both have it.
+    f90 : the term has a part that does not depend on the material (the threejs model's
+    Fresnel toward 1), so a light alone makes it non-zero"""
     lit = any(_nonzero(getattr(lt, term)) for lt in lights)
+    if f90 and lit and not _nonzero(material_rgb):
+        why = f"material {term} 0, but threejs's Schlick F rises to 1 at grazing angles"
+        return r.why(term, True, why)
     if not _nonzero(material_rgb):
         reason = f"material {term} 0"
     elif not lit:
@@ -327,6 +341,9 @@ def _light_plan(i: int, lt, scene: Scene, mesh, terms: Terms) -> LightPlan:
     )
     if not spec:
         r.why("specular", False, "light specular 0")
+    elif scene.model == "threejs":
+        why = "three.js: max(N·L, 0)·(n/2+1)/4·(N·H)^n·F, F = s_m + (1 - s_m)·g(V·H)"
+        r.why("specular", True, why)
     elif not _nonzero(m.specular):
         r.why("specular", False, "material specular 0")
     elif m.shininess == 0.0:

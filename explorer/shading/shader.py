@@ -42,20 +42,22 @@ import numpy as np
 
 from explorer.core import lightrow as R
 from explorer.core.errors import ExplorerError, ExplorerTypeError
-from explorer.core.material import Material
+from explorer.core.material import MODELS, Material
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
 from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_frame
 from explorer.shading import kernels as K
 from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
-from explorer.shading.equation import equation_terms
+from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
 from explorer.shading.shadows import visibility_rows
 
 PRECISIONS = ("float64", "float32")
 #: the engine's tiers (see :mod:`explorer.shading.tiers`)
 TIERS = ("compiled", "numpy")
+#: the specular models the compiled kernels implement; the others run on the numpy tier
+COMPILED_MODELS = ("blinn", "phong")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
@@ -120,7 +122,8 @@ class Shader:
     cull : skip a light for runs of vertices that provably get nothing from it (the plan's
         ``culling``); False computes every vertex-light (same colours; benchmark and tests)
     tier : "compiled" or "numpy" for every pass of this shader; None (default): the tier
-        :func:`explorer.shading.tiers.compiled` picks at each pass
+        :func:`explorer.shading.tiers.compiled` picks at each pass. The ``threejs`` model is
+        always computed by the numpy tier (the kernels implement :data:`COMPILED_MODELS`).
     """
 
     def __init__(
@@ -181,6 +184,7 @@ class Shader:
         n = len(self._P)
         self._G = self._bounds = None  # the compiled tier's geometry, made at its first pass
         self._np = None  # the numpy tier's sums
+        self._served = None  # the tier of the last pass
         self._A = self._D = self._S = None
         self._base = self._ws = None
         self._colors = None
@@ -232,8 +236,8 @@ class Shader:
         self.set_scene(self._scene.replace(material=material))
 
     def set_model(self, model: str) -> None:
-        """model : "blinn" or "phong"."""
-        self.set_scene(self._scene.replace(model=_typed("model", model, str, "'blinn' or 'phong'")))
+        """model : one of :data:`explorer.core.material.MODELS`."""
+        self.set_scene(self._scene.replace(model=_typed("model", model, str, f"one of {MODELS}")))
 
     def set_viewer(self, viewer: Viewer) -> None:
         """viewer : a Viewer or a mapping ``{eye: [x, y, z]}`` / ``{to_viewer: [x, y, z]}``."""
@@ -257,12 +261,13 @@ class Shader:
     def terms(self) -> dict[str, np.ndarray]:
         """Per-vertex sums (n, 3), read-only: ``ambient`` (scene ambient included),
         ``diffuse``, ``specular``, so that colour = e + a_m·ambient + d_m·diffuse +
-        s_m·specular. Terms the plan skips are zeros."""
+        s_m·specular (plus ``specular_f90`` under the ``threejs`` model, which adds that sum
+        as it is). Terms the plan skips are zeros."""
         if not self.keep:
             raise ExplorerError("terms need a Shader with keep=True")
         # every sum the lights can produce, whatever the current material needs
         self._update(force=(True, True, True))
-        if self._np is not None and self._A is None:  # the numpy tier served
+        if self._served == "numpy":
             return {k: _readonly(v.astype(self._T)) for k, v in self._np.items()}
         return stored_terms(self._aconst, self._A, self._D, self._S, self.n, self._T)
 
@@ -323,6 +328,8 @@ class Shader:
     # -- the work ------------------------------------------------------------------------------
     def _compiled_tier(self) -> bool:
         """Whether this pass runs on the compiled kernels (see :mod:`explorer.shading.tiers`)."""
+        if self._scene.model not in COMPILED_MODELS:  # threejs: the equation computes it
+            return False
         if self.tier is not None:
             return self.tier == "compiled"
         # the vertex-lights this pass would compute on the numpy tier: none when its sums are
@@ -333,7 +340,9 @@ class Shader:
     def _update(self, force=(False, False, False)):
         if not self._compiled_tier():
             self._update_numpy()
+            self._served = "numpy"
             return
+        self._served = "compiled"
         self._compiled_geometry()
         plan, scene, T = self._plan, self._scene, self._T
         self._colors = None
@@ -529,19 +538,6 @@ def stored_terms(aconst, A, D, S, n: int, dtype) -> dict[str, np.ndarray]:
         "specular": zero if S is None else S,
     }
     return {k: _readonly(np.broadcast_to(v, (n, 3))) for k, v in out.items()}
-
-
-def compose_terms(material: Material, terms: Mapping, clamp: bool) -> np.ndarray:
-    """The numpy tier's colours (n, 3) float64 from the equation's sums ``terms`` (ambient,
-    diffuse, specular, each (n, 3)): clamped to [0, 1] when ``clamp``."""
-    m = material
-    c = np.asarray(m.emission, np.float64)  # e_m
-    c = c + np.asarray(m.ambient) * terms["ambient"]  # a_m·(a_scene + Σ w·a_i)
-    c += np.asarray(m.diffuse) * terms["diffuse"]  # d_m·Σ w·vis·(N·L)·d_i
-    c += np.asarray(m.specular) * terms["specular"]  # s_m·Σ w·vis·f·(N·H)^n·s_i
-    if clamp:
-        np.clip(c, 0.0, 1.0, out=c)
-    return c
 
 
 def invalidated(new: Scene, old: Scene) -> set[str]:

@@ -15,7 +15,7 @@ from explorer.core.scene import DEFAULT_LIGHTS, Scene, Viewer, load_scene
 
 # (key, bad value, the message of the file and of the constructor)
 SCENE_BAD = [
-    ("model", "phon", "must be one of blinn, phong, got 'phon' (did you mean 'phong'?)"),
+    ("model", "phon", "must be one of blinn, phong, threejs, got 'phon' (did you mean 'phong'?)"),
     ("ambient", [0.2, -0.1, 0.2], "must be >= 0, got -0.1"),
     ("ambient", [0.2, 0.2], "must be a list of 3 numbers each >= 0, got a list of 2 [0.2, 0.2]"),
     ("two_sided", "yes", "must be true or false, got text 'yes'"),
@@ -68,7 +68,7 @@ def test_a_file_reports_every_scene_problem_with_file_and_line(tmp_path):
     with pytest.raises(ValidationError) as err:
         load_scene(str(f))
     assert str(err.value).splitlines() == [
-        f"{f}:1: model: must be one of blinn, phong, got 'flat'",
+        f"{f}:1: model: must be one of blinn, phong, threejs, got 'flat'",
         f"{f}:2: ambient[2]: must be >= 0, got -1",
         f"{f}:3: two_sided: must be true or false, got int 1",
         f"{f}:4: hdr.exposure: must be in [-16, 16], got 20",

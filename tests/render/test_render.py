@@ -462,6 +462,15 @@ FEATURES = {
         "sphere",
         None,
     ),
+    "model_threejs": (
+        {
+            "material": _SPHERE_MAT,
+            "model": "threejs",
+            "lights": [{"type": "directional", "to_light": [1.5, 0.4, 0.3]}],
+        },
+        "sphere",
+        None,
+    ),
     "two_sided": (
         {
             "material": _WHITE,
@@ -562,7 +571,9 @@ def test_golden_features_show_their_feature(renderer):
     """The feature scenes really differ where they should (so each golden guards something)."""
     blinn = _feature_image(renderer, "model_blinn")
     phong = _feature_image(renderer, "model_phong")
+    threejs = _feature_image(renderer, "model_threejs")
     assert not compare(blinn, phong).ok
+    assert not compare(blinn, threejs).ok
     mapping, _, _ = FEATURES["two_sided"]
     one_sided = renderer.render(explorer.load_scene({**mapping, "two_sided": False}), M.plane(32))
     two_sided = _feature_image(renderer, "two_sided")
@@ -868,3 +879,36 @@ def test_window_setting_not_left_behind(monkeypatch):
         r.render(explorer.Scene(), M.cube())
         assert type(r.plotter.render_window).__name__ == "vtkEGLRenderWindow"
     assert "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ
+
+
+def test_cli_sheet_under_several_models(tmp_path, capsys):
+    """``--model blinn,threejs``: each preset once under each model, side by side, each tile
+    as a one-model sheet draws it; a bad model list is one usage error, no file."""
+    out = tmp_path / "models.png"
+    args = ["sheet", "--out", str(out), "--tile", "64x48", "--preset", "gold", "--preset",
+            "jade", "--mesh", "sphere", "--resolution", "12"]  # fmt: skip
+    assert main([*args, "--model", "blinn,threejs"]) == 0
+    assert "2 presets under blinn, threejs" in capsys.readouterr().out
+    img = read_png(out)
+    gap = 2
+    assert img.shape == (48 + 2 * gap, 4 * 64 + 5 * gap, 3)
+    tiles = [
+        img[gap : gap + 48, gap + i * (64 + gap) : gap + i * (64 + gap) + 64] for i in range(4)
+    ]
+    scene = explorer.Scene(lights=(DirectionalLight(to_light=SHEET_LIGHT_DIRECTION),))
+    labels = ["gold · blinn", "gold · threejs", "jade · blinn", "jade · threejs"]
+    with OffscreenRenderer((64, 48)) as r:
+        size = r.label_font_size(labels)
+        for tile, label in zip(tiles, labels, strict=True):
+            name, model = label.split(" · ")
+            s = scene.replace(
+                material=explorer.load_scene({"material": name}).material, model=model
+            )
+            want = r.render(s, M.sphere(12), label=label, label_size=size)
+            assert np.array_equal(tile, want), label
+    assert not np.array_equal(tiles[0][:40], tiles[1][:40])  # the highlights differ
+    bad = tmp_path / "bad.png"
+    with pytest.raises(SystemExit) as e:
+        main(["sheet", "--out", str(bad), "--model", "blinn,gouraud"])
+    assert e.value.code == 2 and not bad.exists()
+    assert "expected names from blinn, phong, threejs" in capsys.readouterr().err

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 from helpers.gl21_oracle import gl_vertex_color
+from helpers.scenes import random_gl_scene, to_gl
 
 import explorer
 from explorer.core import tolerances as tol
@@ -27,81 +28,6 @@ def unit(v):
 
 def one_vertex(scene, p=(0, 0, 0), n=(0, 0, 1), precision="float64", clamp=True):
     return explorer.shade(scene, [p], [n], precision=precision, clamp=clamp)[0]
-
-
-def random_gl_scene(rng: np.random.Generator) -> dict:
-    """A random blinn scene inside OpenGL's ranges, in the engine's schema."""
-
-    def rgb():
-        return rng.uniform(0, 1, 3).round(6).tolist()
-
-    lights = []
-    for _ in range(rng.integers(1, 5)):
-        kind = rng.choice(["directional", "point", "spot"])
-        light = {"type": str(kind), "ambient": rgb(), "diffuse": rgb(), "specular": rgb()}
-        if kind == "directional":
-            light["to_light"] = rng.normal(size=3).tolist()
-        else:
-            light["position"] = (rng.normal(size=3) * 3).tolist()
-            light["attenuation"] = [
-                float(rng.uniform(0.5, 2)),
-                float(rng.uniform(0, 0.5)),
-                float(rng.uniform(0, 0.2)),
-            ]
-        if kind == "spot":
-            light["aim"] = rng.normal(size=3).tolist()
-            light["cutoff"] = float(rng.choice([rng.uniform(5, 90), 180.0]))
-            light["exponent"] = float(rng.uniform(0, 128))
-        lights.append(light)
-    viewer = (
-        {"eye": (rng.normal(size=3) * 4).tolist()}
-        if rng.random() < 0.5
-        else {"to_viewer": rng.normal(size=3).tolist()}
-    )
-    return {
-        "material": {
-            "ambient": rgb(),
-            "diffuse": rgb(),
-            "specular": rgb(),
-            "emission": rgb(),
-            "shininess": float(rng.choice([0.0, rng.uniform(0, 128)])),
-        },
-        "model": "blinn",
-        "ambient": rgb(),
-        "viewer": viewer,
-        "lights": lights,
-    }
-
-
-def to_gl(scene: dict) -> dict:
-    """The same scene in the oracle's OpenGL terms (w = 0 for directional lights)."""
-    gl_lights = []
-    for lt in scene["lights"]:
-        if lt["type"] == "directional":
-            pos = [*lt["to_light"], 0.0]
-        else:
-            pos = [*lt["position"], 1.0]
-        gl_lights.append(
-            {
-                "position": pos,
-                "ambient": lt["ambient"],
-                "diffuse": lt["diffuse"],
-                "specular": lt["specular"],
-                "attenuation": lt.get("attenuation", [1, 0, 0]),
-                "spot_direction": lt.get("aim", [0, 0, -1]) if lt["type"] == "spot" else None,
-                "spot_cutoff": lt.get("cutoff", 180.0) if lt["type"] == "spot" else 180.0,
-                "spot_exponent": lt.get("exponent", 0.0) if lt["type"] == "spot" else 0.0,
-            }
-        )
-    v = scene["viewer"]
-    return {
-        "material": scene["material"],
-        "ambient": scene["ambient"],
-        "local_viewer": "eye" in v,
-        "eye": v.get("eye"),
-        "view_dir": v.get("to_viewer"),
-        "lights": gl_lights,
-    }
 
 
 # --- 3. correctness against an independent OpenGL 2.1 implementation ----------------------------

@@ -28,7 +28,9 @@ def energy_factor(model: str, shininess: float) -> float:
 def specular_scale(scene) -> float:
     """The constant the scene's specular lobe is multiplied by (1 when the option is off)."""
     m = scene.material
-    return energy_factor(scene.model, m.shininess) if m.energy_conserving else 1.0
+    if not m.energy_conserving or scene.model == "threejs":  # threejs: normalised already
+        return 1.0
+    return energy_factor(scene.model, m.shininess)
 
 
 class EnergyConserving(Effect):
@@ -47,6 +49,9 @@ class EnergyConserving(Effect):
         scale = specular_scale(scene)
         if not scene.material.energy_conserving:
             return 1.0, [(self.name, "out", "material energy_conserving is false")]
+        if scene.model == "threejs":
+            why = "energy_conserving not used: the threejs lobe is normalised, (n/2+1)/4"
+            return 1.0, [(self.name, "out", why)]
         if not terms.specular:
             why = "energy_conserving, but there is no specular term to normalise"
             return 1.0, [(self.name, "out", why)]

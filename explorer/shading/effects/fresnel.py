@@ -38,6 +38,9 @@ class Fresnel(Effect):
         f0 = scene.material.fresnel
         if f0 is None:
             return None, [(self.name, "out", "material fresnel not set")]
+        if scene.model == "threejs":
+            why = f"F0 = {f0:g} not used: the threejs model has its own Fresnel (on s_m)"
+            return None, [(self.name, "out", why)]
         if not terms.specular:
             return None, [
                 (self.name, "out", f"F0 = {f0:g} but there is no specular term to weight")
@@ -55,6 +58,6 @@ class Fresnel(Effect):
 
     def weights(self, scene, light, at):
         f0 = scene.material.fresnel
-        if f0 is None:
+        if f0 is None or scene.model == "threejs":
             return None, None
         return None, schlick(f0, np.einsum("ij,ij->i", at.V, at.L))
