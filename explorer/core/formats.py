@@ -101,7 +101,7 @@ def to_threejs(material: Material, name: str) -> Converted:
         "(n/2 + 1)/(4π) · N·L with Schlick's Fresnel on 'specular': under lights of intensity "
         "π diffuse matches OpenGL's and the highlight's peak is (n/2 + 1)/4 = "
         f"{(material.shininess / 2 + 1) / 4:.3g} times OpenGL's (less towards the terminator, "
-        "whiter at grazing angles)",
+        "whiter at grazing angles); see it with --model threejs",
     ]
     if material.model == "phong":
         notes.append("model phong becomes Blinn-Phong (three.js's only Phong lobe)")
