@@ -210,7 +210,12 @@ def advice(shininess: float, size: Sequence[int], *, model: str = "blinn",
            max_error: float = 1.0, table: dict | None = None) -> str:  # fmt: skip
     """One line for the window: which tessellation keeps the error within ``max_error`` levels for
     this shininess and picture size: the RMSE (the picture as a whole), then every pixel
-    (:func:`mesh_for_error` with ``metric="rmse"`` and ``"max"``, UV sphere and icosphere)."""
+    (:func:`mesh_for_error` with ``metric="rmse"`` and ``"max"``, UV sphere and icosphere).
+    The table measures OpenGL's models; ``threejs`` is advised from ``blinn``'s rows (its lobe
+    is Blinn's ``(N·H)^n`` times factors that vary slowly over the surface) and says so."""
+    shown = model
+    if model == "threejs":
+        model, shown = "blinn", "threejs, from blinn's measurements"
     try:
         recs = {
             (metric, mesh): mesh_for_error(
@@ -236,7 +241,7 @@ def advice(shininess: float, size: Sequence[int], *, model: str = "blinn",
         return " or ".join(names)
 
     return (
-        f"shininess {float(shininess):g} ({model}), error within {lv}: RMSE from {both('rmse')}; "
+        f"shininess {float(shininess):g} ({shown}), error within {lv}: RMSE from {both('rmse')}; "
         f"every pixel: {both('max')}"
     )
 

@@ -132,6 +132,8 @@ def test_advice_line_names_the_recommendations():
             else:
                 assert f"{rec.mesh} {rec.finest[0]}" in text
     assert "levels" in A.advice(1000, (200, 200), model="phong", max_error=4)
+    three = A.advice(76.8, (400, 400), model="threejs")
+    assert three == line.replace("(blinn)", "(threejs, from blinn's measurements)")
 
 
 def test_interpolated_recommendation_holds_when_measured():
