@@ -160,3 +160,19 @@ def to_gl(scene: dict) -> dict:
         "view_dir": v.get("to_viewer"),
         "lights": gl_lights,
     }
+
+
+def check_oracle(scene: dict, oracle, rng: np.random.Generator, n: int) -> None:
+    """The engine's float64 colours of ``scene`` at n random vertices equal ``oracle(vertex,
+    normal, to_gl(scene))`` within ORACLE_ABS_TOL, and float32 is within 1/255 of float64."""
+    import explorer
+    from explorer.core import tolerances as tol
+
+    P = rng.normal(size=(n, 3)) * 1.5
+    N = rng.normal(size=(n, 3))
+    got = explorer.shade(scene, P, N)
+    gl = to_gl(scene)
+    want = np.array([oracle(p.tolist(), v.tolist(), gl) for p, v in zip(P, N, strict=True)])
+    assert np.abs(got - want).max() <= tol.ORACLE_ABS_TOL
+    fast = explorer.shade(scene, P, N, precision="float32")
+    assert np.abs(fast - got).max() <= tol.FLOAT32_MAX_ABS_ERROR

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from helpers.gl21_oracle import gl_vertex_color
-from helpers.scenes import random_gl_scene, to_gl
+from helpers.scenes import check_oracle, random_gl_scene
 
 import explorer
 from explorer.core import tolerances as tol
@@ -36,17 +36,7 @@ def one_vertex(scene, p=(0, 0, 0), n=(0, 0, 1), precision="float64", clamp=True)
 @pytest.mark.parametrize("seed", range(12))
 def test_blinn_equals_opengl_21_on_random_scenes(seed):
     rng = np.random.default_rng(seed)
-    scene = random_gl_scene(rng)
-    P = rng.normal(size=(300, 3)) * 1.5
-    N = rng.normal(size=(300, 3))
-    got = explorer.shade(scene, P, N)
-    gl = to_gl(scene)
-    want = np.array(
-        [gl_vertex_color(p.tolist(), n.tolist(), gl) for p, n in zip(P, N, strict=True)]
-    )
-    assert np.abs(got - want).max() <= tol.ORACLE_ABS_TOL
-    fast = explorer.shade(scene, P, N, precision="float32")
-    assert np.abs(fast - got).max() <= tol.FLOAT32_MAX_ABS_ERROR
+    check_oracle(random_gl_scene(rng), gl_vertex_color, rng, 300)
 
 
 # --- closed forms --------------------------------------------------------------------------

@@ -8,14 +8,13 @@ import math
 
 import numpy as np
 import pytest
-from helpers.scenes import random_gl_scene, to_gl
+from helpers.scenes import check_oracle, random_gl_scene
 from helpers.threejs_oracle import threejs_vertex_color
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import explorer
 from explorer.app.model import State, next_model, set_term
-from explorer.core import tolerances as tol
 from explorer.core.material import MODELS
 from explorer.core.presets import find_preset
 from explorer.geometry import meshes as M
@@ -92,17 +91,7 @@ def test_equals_three_js_glsl_on_random_scenes(seed):
     """Random scenes (directional, point and spot lights; local and infinite viewers) against
     the scalar transcription of three.js's shader; float32 within 1/255 of float64."""
     rng = np.random.default_rng(100 + seed)
-    scene = dict(random_gl_scene(rng), model="threejs")
-    P = rng.normal(size=(200, 3)) * 1.5
-    N = rng.normal(size=(200, 3))
-    got = explorer.shade(scene, P, N)
-    gl = to_gl(scene)
-    want = np.array(
-        [threejs_vertex_color(p.tolist(), n.tolist(), gl) for p, n in zip(P, N, strict=True)]
-    )
-    assert np.abs(got - want).max() <= tol.ORACLE_ABS_TOL
-    fast = explorer.shade(scene, P, N, precision="float32")
-    assert np.abs(fast - got).max() <= tol.FLOAT32_MAX_ABS_ERROR
+    check_oracle(dict(random_gl_scene(rng), model="threejs"), threejs_vertex_color, rng, 200)
 
 
 @settings(max_examples=40, deadline=None)
