@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import strategies as st
 
+import explorer
+from explorer.core import tolerances as tol
 from explorer.core.material import SHININESS_RANGE, Material
 
 unit_float = st.floats(0, 1, allow_nan=False, allow_infinity=False)
@@ -165,9 +167,6 @@ def to_gl(scene: dict) -> dict:
 def check_oracle(scene: dict, oracle, rng: np.random.Generator, n: int) -> None:
     """The engine's float64 colours of ``scene`` at n random vertices equal ``oracle(vertex,
     normal, to_gl(scene))`` within ORACLE_ABS_TOL, and float32 is within 1/255 of float64."""
-    import explorer
-    from explorer.core import tolerances as tol
-
     P = rng.normal(size=(n, 3)) * 1.5
     N = rng.normal(size=(n, 3))
     got = explorer.shade(scene, P, N)
