@@ -26,10 +26,11 @@ from explorer.app import model as M
 from explorer.app.commands import Commands
 from explorer.app.compare import ComparePane, DifferencePane
 from explorer.app.difference import DifferenceWorker, HeatMap
+from explorer.app.filemenu import FileCommands
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
-from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
+from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE, add_mesh_materials
 from explorer.app.view import (
     HANDLE_RADIUS,
     LOD_TARGET,
@@ -41,6 +42,7 @@ from explorer.app.view import (
 )
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.mtl import MtlError
 from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
@@ -57,7 +59,7 @@ ENGINE_POLL_MS = 500
 MESSAGE_MS = 6000
 
 
-class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
+class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
     """The explorer window.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
@@ -267,8 +269,9 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
             self.report(exc, label or action.__name__)
             return False
 
-    def choose_mesh(self, name: str) -> None:
-        """Show mesh ``name`` (a chooser name): loaded once, the camera framed anew."""
+    def choose_mesh(self, name: str) -> bool:
+        """Show mesh ``name`` (a chooser name): loaded once, the camera framed anew, with the
+        materials its file brings. Returns False (the error shown) when it cannot."""
         try:
             mesh = self.meshes.get(name)
             if mesh is None:
@@ -281,9 +284,27 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
                 self._set_mesh_choices()
             state = M.set_mesh(self.store.state, name, mesh.centre, mesh.radius)
             state = M.set_camera(state, self._framed(state, mesh))
+            state, warnings = self._with_mesh_materials(state, mesh)
             self.store.commit(state, f"mesh {Path(name).name}")
         except ExplorerError as exc:
             self.report(exc, "mesh")
+            return False
+        if warnings:
+            for w in warnings:
+                log.warning("%s", w)
+            n = len(warnings)
+            self.show_status(f"{mesh.name}: its materials read with {n} warning"
+                             f"{'s' * (n != 1)}: {warnings[0]}", msecs=3 * MESSAGE_MS)  # fmt: skip
+        return True
+
+    def _with_mesh_materials(self, state: M.State, mesh: Mesh) -> tuple[M.State, list[str]]:
+        """``state`` showing the materials the mesh file brings; a library the reader cannot
+        take is reported (file and line) and the mesh is drawn in the present material."""
+        try:
+            return add_mesh_materials(state, mesh)
+        except MtlError as exc:
+            self.report(exc, "mesh materials")
+            return state, []
 
     def _on_change(self, old: M.State, new: M.State) -> None:
         if new.mesh != old.mesh:
@@ -321,7 +342,10 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
     def _show_panel(self, state: M.State) -> None:
         self.panel.show_state(state, self.view.mesh.n_vertices)
         self.update_edit_actions()
-        parts = [state.preset or "(scene material)", state.scene.model]
+        what = state.preset or "(scene material)"
+        if state.groups is not None:
+            what = f"{state.mesh_materials.source}'s materials"
+        parts = [what, state.scene.model]
         if state.hidden:
             parts.append("hidden: " + ", ".join(t for t in M.TERMS if t in state.hidden))
         self.status_label.setText(";  ".join(parts))
