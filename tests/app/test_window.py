@@ -14,9 +14,6 @@ import explorer
 from explorer.app import model as M
 from explorer.app import session as S
 from explorer.app import start as A
-from explorer.app.window import ExplorerWindow
-from explorer.cli import build_parser
-from explorer.cli.gui import start_state
 from explorer.shading import tiers
 from explorer.shading.display import to_bytes
 
@@ -24,31 +21,11 @@ pytestmark = pytest.mark.usefixtures("xdisplay")
 WAIT_MS = 60_000
 
 
-def _open(qtbot, tmp_path, monkeypatch) -> ExplorerWindow:
-    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
-    args = build_parser().parse_args(["gui", "--mesh", "icosphere", "--resolution", "3"])
-    state, mesh = start_state(args)
-    w = ExplorerWindow(state, mesh, output_dir=tmp_path, state_file=tmp_path / "state.json",
-                       last_session=tmp_path / "last.yaml", size=(1000, 700))  # fmt: skip
-    qtbot.addWidget(w)
-    w.show()
-    qtbot.waitExposed(w)
-    w.render()
-    return w
-
-
-@pytest.fixture
-def win(xdisplay, qtbot, tmp_path, monkeypatch):
-    w = _open(qtbot, tmp_path, monkeypatch)
-    yield w
-    assert not w.errors, w.errors
-
-
 def test_the_window_draws_at_once_and_says_while_the_compiled_engine_is_prepared(
-    xdisplay, qtbot, tmp_path, monkeypatch, cold_tiers
+    xdisplay, qtbot, open_window, cold_tiers
 ):
     with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
-        w = _open(qtbot, tmp_path, monkeypatch)
+        w = open_window()
     assert "preparing the compiled engine" in w.engine_label.text()
     drawn_equals_engine(w)
     assert (
