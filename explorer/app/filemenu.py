@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 from PySide6 import QtCore, QtWidgets
 
+from explorer.app import model as M
 from explorer.app.session import last_session_path
+from explorer.app.start import add_mesh_materials, load_mesh_choice
 from explorer.app.turntablejob import DEFAULT_FRAMES, TurntableJob, turntable_size
 from explorer.core import tolerances as tol
 from explorer.core.atomic import write_atomic
@@ -27,6 +29,7 @@ from explorer.core.formats import EXPORT_SUFFIXES, convert
 from explorer.core.mtl import MtlError, format_mtl, preset_name, preset_names, read_mtl
 from explorer.core.presets import SUFFIX, save_preset, user_dir
 from explorer.core.yamlio import dump_yaml
+from explorer.geometry.meshes import Mesh
 from explorer.render.images import encode_png
 from explorer.render.turntable import TURNTABLE_SUFFIXES
 
@@ -42,6 +45,8 @@ MATERIAL_FILTER = (
     "Wavefront MTL (*.mtl);;three.js MeshPhongMaterial JSON (*.json);;X3D Material (*.x3d);;"
     "phong-explorer preset (*.yaml *.yml)"
 )
+#: how long the status bar shows what a mesh's materials were read with (ms)
+STATUS_MS = 18_000
 #: how often the turntable's timer takes a step (ms; 0: whenever the event loop is idle)
 TURNTABLE_STEP_MS = 0
 
@@ -91,6 +96,42 @@ class FileCommands:
         add(f, "quit", "&Quit", self.close, "Ctrl+Q")
         self.turntable = None
         self._show_recent()
+
+    # -- meshes -------------------------------------------------------------------------------
+    def choose_mesh(self, name: str) -> bool:
+        """Show mesh ``name`` (a chooser name): loaded once, the camera framed anew, with the
+        materials its file brings. Returns False (the error shown) when it cannot."""
+        try:
+            mesh = self.meshes.get(name)
+            if mesh is None:
+                mesh = load_mesh_choice(name, self.mesh_choices.get(name))
+                self.meshes[name] = mesh
+            if name not in self.mesh_choices:
+                self.mesh_choices[name] = None
+                self._set_mesh_choices()
+            state = M.set_mesh(self.store.state, name, mesh.centre, mesh.radius)
+            state = M.set_camera(state, self._framed(state, mesh))
+            state, warnings = self._with_mesh_materials(state, mesh)
+            self.store.commit(state, f"mesh {Path(name).name}")
+        except ExplorerError as exc:
+            self.report(exc, "mesh")
+            return False
+        if warnings:
+            for w in warnings:
+                log.warning("%s", w)
+            n = len(warnings)
+            self.show_status(f"{mesh.name}: its materials read with {n} warning"
+                             f"{'s' * (n != 1)}: {warnings[0]}", msecs=STATUS_MS)  # fmt: skip
+        return True
+
+    def _with_mesh_materials(self, state: M.State, mesh: Mesh) -> tuple[M.State, list[str]]:
+        """``state`` showing the materials the mesh file brings; a library the reader cannot
+        take is reported (file and line) and the mesh is drawn in the present material."""
+        try:
+            return add_mesh_materials(state, mesh)
+        except MtlError as exc:
+            self.report(exc, "mesh materials")
+            return state, []
 
     # -- recent files -------------------------------------------------------------------------
     def recent_file(self) -> Path | None:

@@ -30,7 +30,7 @@ from explorer.app.filemenu import FileCommands
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
-from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE, add_mesh_materials
+from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
 from explorer.app.view import (
     HANDLE_RADIUS,
     LOD_TARGET,
@@ -42,7 +42,6 @@ from explorer.app.view import (
 )
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
-from explorer.core.mtl import MtlError
 from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
@@ -268,43 +267,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         except ExplorerError as exc:
             self.report(exc, label or action.__name__)
             return False
-
-    def choose_mesh(self, name: str) -> bool:
-        """Show mesh ``name`` (a chooser name): loaded once, the camera framed anew, with the
-        materials its file brings. Returns False (the error shown) when it cannot."""
-        try:
-            mesh = self.meshes.get(name)
-            if mesh is None:
-                from explorer.app.start import load_mesh_choice  # noqa: I001 (the chooser's resolution)
-
-                mesh = load_mesh_choice(name, self.mesh_choices.get(name))
-                self.meshes[name] = mesh
-            if name not in self.mesh_choices:
-                self.mesh_choices[name] = None
-                self._set_mesh_choices()
-            state = M.set_mesh(self.store.state, name, mesh.centre, mesh.radius)
-            state = M.set_camera(state, self._framed(state, mesh))
-            state, warnings = self._with_mesh_materials(state, mesh)
-            self.store.commit(state, f"mesh {Path(name).name}")
-        except ExplorerError as exc:
-            self.report(exc, "mesh")
-            return False
-        if warnings:
-            for w in warnings:
-                log.warning("%s", w)
-            n = len(warnings)
-            self.show_status(f"{mesh.name}: its materials read with {n} warning"
-                             f"{'s' * (n != 1)}: {warnings[0]}", msecs=3 * MESSAGE_MS)  # fmt: skip
-        return True
-
-    def _with_mesh_materials(self, state: M.State, mesh: Mesh) -> tuple[M.State, list[str]]:
-        """``state`` showing the materials the mesh file brings; a library the reader cannot
-        take is reported (file and line) and the mesh is drawn in the present material."""
-        try:
-            return add_mesh_materials(state, mesh)
-        except MtlError as exc:
-            self.report(exc, "mesh materials")
-            return state, []
 
     def _on_change(self, old: M.State, new: M.State) -> None:
         if new.mesh != old.mesh:
