@@ -51,6 +51,11 @@ STATUS_MS = 18_000
 TURNTABLE_STEP_MS = 0
 
 
+def plural(n: int, noun: str) -> str:
+    """``"1 preset"``, ``"2 presets"``."""
+    return f"{n} {noun}{'s' * (n != 1)}"
+
+
 class FileCommands:
     """The File menu and its commands (needs the window's ``store``, ``view``, ``plotter``,
     ``add_action``, ``render``, ``report``, ``show_status``, ``reload_presets`` and the
@@ -71,6 +76,29 @@ class FileCommands:
         if details:
             box.setDetailedText(details)
         box.exec()
+
+    def _output_path(self, path, title: str, default: str, filter: str, suffixes) -> Path | None:
+        """``path``, or the one the user gives (None: given up), checked to end in one of
+        ``suffixes``; ``default`` is a name in the output directory."""
+        if path is None:
+            path = self.ask_path(title, save=True, default=str(self.output_dir / default),
+                                 filter=filter)  # fmt: skip
+            if not path:
+                return None
+        path = Path(path)
+        if path.suffix.lower() not in suffixes:
+            raise ExplorerError(f"{path}: the file name must end in {', '.join(suffixes)}")
+        return path
+
+    def _say_done(self, title: str, text: str, notes, noun: str) -> None:
+        """``text`` on the status bar; with ``notes`` (each logged) their count, and a dialog
+        that lists them."""
+        for note in notes:
+            log.warning("%s", note)
+        if notes:
+            text += f" ({plural(len(notes), noun)})"
+            self.tell(title, text, details="\n".join(notes))
+        self.show_status(text)
 
     def _ask_replace(self, path: Path) -> bool:
         """True when ``path`` may be written: it does not exist, or the user said yes."""
@@ -119,9 +147,9 @@ class FileCommands:
         if warnings:
             for w in warnings:
                 log.warning("%s", w)
-            n = len(warnings)
-            self.show_status(f"{mesh.name}: its materials read with {n} warning"
-                             f"{'s' * (n != 1)}: {warnings[0]}", msecs=STATUS_MS)  # fmt: skip
+            self.show_status(f"{mesh.name}: its materials read with "
+                             f"{plural(len(warnings), 'warning')}: {warnings[0]}",
+                             msecs=STATUS_MS)  # fmt: skip
         return True
 
     def _with_mesh_materials(self, state: M.State, mesh: Mesh) -> tuple[M.State, list[str]]:
@@ -214,7 +242,7 @@ class FileCommands:
         targets = [directory / f"{name}{SUFFIX}" for name in names]
         existing = [t for t in targets if t.exists()]
         if existing and not self.ask_yes(
-            f"{len(existing)} preset file{'s' * (len(existing) != 1)} of {Path(path).name} "
+            f"{plural(len(existing), 'preset file')} of {Path(path).name} "
             f"exist already:\n" + "\n".join(str(t) for t in existing) + "\n\nReplace them?"
         ):
             self.show_status(f"nothing imported from {path}: the preset files exist")
@@ -225,15 +253,9 @@ class FileCommands:
             written.append(save_preset(material, name, directory, overwrite=target in existing))
             warnings.extend(m.warnings)
         self.reload_presets()
-        n = len(written)
-        text = (f"imported {n} preset{'s' * (n != 1)} from {Path(path).name} into {directory}: "
-                + ", ".join(names))  # fmt: skip
-        for w in warnings:
-            log.warning("%s", w)
-        if warnings:
-            text += f" ({len(warnings)} warning{'s' * (len(warnings) != 1)})"
-            self.tell("Import materials", text, details="\n".join(warnings))
-        self.show_status(text)
+        text = (f"imported {plural(len(written), 'preset')} from {Path(path).name} into "
+                f"{directory}: " + ", ".join(names))  # fmt: skip
+        self._say_done("Import materials", text, warnings, "warning")
         return written
 
     def _material_name(self) -> str:
@@ -249,17 +271,11 @@ class FileCommands:
         hold the edited group's. The approximations a format makes are shown."""
         s = self.store.state
         name = self._material_name()
-        if path is None:
-            path = self.ask_path("Export material", save=True, filter=MATERIAL_FILTER,
-                                 default=str(self.output_dir / f"{name}.mtl"))  # fmt: skip
-            if not path:
-                return None
-        path = Path(path)
-        suffix = path.suffix.lower()
-        if suffix not in MATERIAL_SUFFIXES:
-            raise ExplorerError(f"{path}: the file name must end in {', '.join(MATERIAL_SUFFIXES)}")
-        if not self._ask_replace(path):
+        path = self._output_path(path, "Export material", f"{name}.mtl", MATERIAL_FILTER,
+                                 tuple(MATERIAL_SUFFIXES))  # fmt: skip
+        if path is None or not self._ask_replace(path):
             return None
+        suffix = path.suffix.lower()
         material = s.material.replace(model=s.scene.model)
         if suffix == ".mtl" and s.groups is not None:
             names = preset_names([n or "material" for n in s.mesh_materials.names])
@@ -274,12 +290,7 @@ class FileCommands:
             text, notes, what = dump_yaml(material.to_mapping(), header=header), [], f"'{name}'"
         written = write_atomic(path, text.encode("utf-8"), overwrite=os.path.lexists(path))
         message = f"exported {what} to {written} as {MATERIAL_SUFFIXES[suffix]}"
-        for note in notes:
-            log.info("%s: %s", written, note)
-        if notes:
-            message += f" ({len(notes)} approximation{'s' * (len(notes) != 1)})"
-            self.tell("Export material", message, details="\n".join(notes))
-        self.show_status(message)
+        self._say_done("Export material", message, notes, "approximation")
         return written
 
     # -- pictures -----------------------------------------------------------------------------
@@ -297,16 +308,9 @@ class FileCommands:
 
     def export_render(self, path=None) -> Path | None:
         """The 3D view as a PNG file of the user's choice (asks before replacing one)."""
-        if path is None:
-            default = str(self.output_dir / f"{self._picture_stem()}.png")
-            path = self.ask_path("Export view as PNG", save=True, default=default,
-                                 filter="PNG pictures (*.png)")  # fmt: skip
-            if not path:
-                return None
-        path = Path(path)
-        if path.suffix.lower() != ".png":
-            raise ExplorerError(f"{path}: the view is written as a PNG: name it *.png")
-        if not self._ask_replace(path):
+        path = self._output_path(path, "Export view as PNG", f"{self._picture_stem()}.png",
+                                 "PNG pictures (*.png)", (".png",))  # fmt: skip
+        if path is None or not self._ask_replace(path):
             return None
         written = write_atomic(path, self._view_png(), overwrite=os.path.lexists(path))
         self.show_status(f"exported the view to {written}")
@@ -320,17 +324,11 @@ class FileCommands:
         if self.turntable is not None and self.turntable.stage in ("render", "encode"):
             raise ExplorerError("a turntable is being made: wait for it, or cancel it")
         s = self.store.state
+        path = self._output_path(path, "Export turntable",
+                                 f"{self._picture_stem()}-turntable.gif",
+                                 "GIF (*.gif);;MP4 (*.mp4)", TURNTABLE_SUFFIXES)  # fmt: skip
         if path is None:
-            default = str(self.output_dir / f"{self._picture_stem()}-turntable.gif")
-            path = self.ask_path("Export turntable", save=True, default=default,
-                                 filter="GIF (*.gif);;MP4 (*.mp4)")  # fmt: skip
-            if not path:
-                return None
-        path = Path(path)
-        if path.suffix.lower() not in TURNTABLE_SUFFIXES:
-            raise ExplorerError(
-                f"{path}: a turntable is written as {' or '.join(TURNTABLE_SUFFIXES)}"
-            )
+            return None
         if frames is None:
             frames = self.ask_number("Export turntable", "frames in a full turn:",
                                      DEFAULT_FRAMES, 2, tol.MAX_TURNTABLE_FRAMES)  # fmt: skip

@@ -15,40 +15,17 @@ from explorer.cli.gui import start_state
 from explorer.core.errors import ExplorerError
 from explorer.core.presets import find_preset
 
-# two unit squares side by side, each its own usemtl group (red on the left, blue on the right)
-TWO_GROUPS_OBJ = """mtllib two.mtl
-v 0 0 0
-v 1 0 0
-v 1 1 0
-v 0 1 0
-v 2 0 0
-v 2 1 0
-vn 0 0 1
-usemtl left_red
-f 1//1 2//1 3//1
-f 1//1 3//1 4//1
-usemtl right_blue
-f 2//1 5//1 6//1
-f 2//1 6//1 3//1
-"""
-TWO_GROUPS_MTL = """newmtl left_red
-Ka 0.2 0 0
-Kd 1 0 0
-Ks 0.5 0.5 0.5
-Ns 30
-
-newmtl right_blue
-Ka 0 0 0.2
-Kd 0 0 1
-Ns 80
-"""
+#: two unit squares side by side, each its own usemtl group (red on the left, blue on the
+#: right), and their .mtl
+TWO_GROUPS = Path(__file__).parent.parent / "data" / "obj" / "two_groups.obj"
 
 
 def write_two_groups(directory: Path) -> Path:
-    """``two.obj`` and its ``two.mtl`` in ``directory``."""
-    (directory / "two.mtl").write_text(TWO_GROUPS_MTL)
+    """A copy of :data:`TWO_GROUPS` and its .mtl in ``directory``, as ``two.obj``."""
+    mtl = TWO_GROUPS.with_suffix(".mtl")
+    (directory / mtl.name).write_bytes(mtl.read_bytes())
     path = directory / "two.obj"
-    path.write_text(TWO_GROUPS_OBJ)
+    path.write_bytes(TWO_GROUPS.read_bytes())
     return path
 
 
