@@ -237,8 +237,8 @@ class MeshMaterialsBox(QtWidgets.QFrame):
         self._shown = key
         if own:
             self.label.setText(
-                f"<b>{mm.source}</b> brings its own materials ({k} group{'s' * (k != 1)}), "
-                f"drawn each on its group: the controls below edit group {mm.label(s.group)}"
+                f"<b>{mm.source}</b> brings its own materials, one per group ({k}); the "
+                f"controls below edit group {mm.label(s.group)}"
             )
         else:
             self.label.setText(

@@ -202,7 +202,13 @@ def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp
     win.export_turntable(size=(48, 40))
     job = win.turntable
     assert job.dialog.isVisible()
+    seen = []  # the event loop runs between the frames: the window keeps painting
+    other = QtCore.QTimer()
+    other.timeout.connect(lambda: seen.append(job.done))
+    other.start(0)
     qtbot.waitUntil(lambda: job.stage == "written", timeout=WAIT_MS)
+    other.stop()
+    assert {1, 2, 3} <= set(seen)
     frames = iio.imread(out, index=None)
     assert frames.shape[:3] == (3, 40, 48) and "wrote" in win.message
     assert not (frames[0] == frames[1]).all()  # the lights and camera turned
