@@ -282,9 +282,11 @@ class Commands:
 
     def save_preset_as(self, name: str | None = None) -> Path | None:
         """Save the material (with the current specular model) as a preset: asks for a name,
-        checks it, asks before replacing a file or hiding another preset."""
+        checks it, asks before replacing a file or hiding another preset. The preset is then
+        shown clean; while the mesh shows its own materials the edited group's is saved, and
+        the groups stay."""
         s = self.store.state
-        stem = (s.preset or "material")[: MAX_NAME_LENGTH - 8]
+        stem = (s.preset or self.material_name())[: MAX_NAME_LENGTH - 8]
         taken = {p.name for p in self.presets}
         if name is None:
             name = self.ask_text(
@@ -315,7 +317,7 @@ class Commands:
         written = save_preset(material, name, directory, overwrite=overwrite)
         self.reload_presets()
         info = next((p for p in self.presets if p.name == name), None)
-        if info is not None:
+        if info is not None and s.groups is None:
             self.act(M.apply_preset, name, info.material, label=f"save preset {name}")
         self.show_status(f"saved preset '{name}' to {written}")
         return written

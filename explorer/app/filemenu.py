@@ -258,7 +258,8 @@ class FileCommands:
         self._say_done("Import materials", text, warnings, "warning")
         return written
 
-    def _material_name(self) -> str:
+    def material_name(self) -> str:
+        """A file or preset name for the material shown: the preset's, or the edited group's."""
         s = self.store.state
         if s.groups is not None:
             return preset_name(s.mesh_materials.names[s.group] or "material")
@@ -270,7 +271,7 @@ class FileCommands:
         materials, an ``.mtl`` holds every group's (a library for the OBJ); the other formats
         hold the edited group's. The approximations a format makes are shown."""
         s = self.store.state
-        name = self._material_name()
+        name = self.material_name()
         path = self._output_path(path, "Export material", f"{name}.mtl", MATERIAL_FILTER,
                                  tuple(MATERIAL_SUFFIXES))  # fmt: skip
         if path is None or not self._ask_replace(path):

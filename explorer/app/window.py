@@ -434,6 +434,8 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
     # -- closing --------------------------------------------------------------------------------
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802 - Qt's name
         self.keep_last_session()
+        if self.turntable is not None:
+            self.turntable.cancel()  # nothing written
         self.worker.close()
         self.plotter.close()
         super().closeEvent(event)

@@ -86,6 +86,10 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     assert np.array_equal(group_rgb(win, "left_red"), before)
     win.render()
     drawn_equals_groups(win)
+    # the edited group's material saved as a preset: the groups stay
+    path = win.save_preset_as("my_blue")
+    assert load_material_file(path).diffuse == win.store.state.groups[i].diffuse
+    assert win.store.state.groups is not None and "my_blue" in {p.name for p in win.presets}
     # a preset covers the whole mesh; undo brings the groups back; so does the button
     tab = win.panel.material
     item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
