@@ -246,3 +246,14 @@ def test_recent_files(win, answers, tmp_path):
     win.errors.clear()
     assert S.last_session_path  # the list lives beside the last session
     assert (tmp_path / "recent-files.json").is_file()
+
+
+def test_an_obj_whose_mtl_is_bad_opens_in_the_present_material(win, tmp_path):
+    two = write_two_groups(tmp_path)
+    (tmp_path / "two_groups.mtl").write_text("newmtl left_red\nKd 1 zero 0\n")
+    before = win.store.state.material
+    win.open_file(two)
+    s = win.store.state
+    assert s.mesh == str(two) and s.groups is None and s.material == before
+    assert "two_groups.mtl:2" in win.message and win.message.startswith("error")
+    win.errors.clear()
