@@ -206,7 +206,9 @@ class MeshMaterialsBox(QtWidgets.QFrame):
         self.label = QtWidgets.QLabel("")
         self.label.setObjectName("mesh_materials_label")
         self.label.setWordWrap(True)
-        row = QtWidgets.QHBoxLayout()
+        self.group_row = QtWidgets.QWidget()
+        row = QtWidgets.QHBoxLayout(self.group_row)
+        row.setContentsMargins(0, 0, 0, 0)
         row.addWidget(QtWidgets.QLabel("group"))
         self.group = QtWidgets.QComboBox()
         self.group.setObjectName("group")
@@ -217,7 +219,7 @@ class MeshMaterialsBox(QtWidgets.QFrame):
         self.use.setObjectName("use_mesh_materials")
         self.use.setToolTip("draw each group in the material its file gives (undoable)")
         box.addWidget(self.label)
-        box.addLayout(row)
+        box.addWidget(self.group_row)
         box.addWidget(self.use)
         self.group.activated.connect(lambda i: self.act(M.select_group, i, label="group"))
         self.use.clicked.connect(lambda: self.act(M.use_mesh_materials, label="mesh materials"))
@@ -246,13 +248,13 @@ class MeshMaterialsBox(QtWidgets.QFrame):
                 f"{'preset ' + repr(s.preset) if s.preset else 'one material'} covers the "
                 "whole mesh instead"
             )
-        materials = s.groups if own else mm.materials
-        with QtCore.QSignalBlocker(self.group):
-            self.group.clear()
-            for i, m in enumerate(materials):
-                self.group.addItem(swatch(m, 16), mm.names[i] or "(no usemtl)")
-            self.group.setCurrentIndex(s.group if own else -1)
-        self.group.setEnabled(own)
+        if own:
+            with QtCore.QSignalBlocker(self.group):
+                self.group.clear()
+                for name, m in zip(mm.names, s.groups, strict=True):
+                    self.group.addItem(swatch(m, 16), name or "(no usemtl)")
+                self.group.setCurrentIndex(s.group)
+        self.group_row.setVisible(own)
         self.use.setVisible(not own)
 
 

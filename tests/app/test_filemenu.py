@@ -96,6 +96,7 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     tab._chosen(item)
     s = win.store.state
     assert s.groups is None and s.preset == "jade" and box.use.isVisibleTo(win.panel)
+    assert not box.group_row.isVisibleTo(win.panel)
     assert "preset 'jade' covers the whole mesh" in box.label.text()
     want = to_bytes(vertex_colors(s.shown_scene(), win.view.mesh)).astype(int)
     assert np.abs(win.view.displayed_colors().astype(int) - want).max() <= 1  # jade all over
