@@ -340,6 +340,7 @@ class FileCommands:
         size = turntable_size(*(size or self.plotter.window_size))
         job = TurntableJob(
             s.shown_scene(), self.view.mesh, frames, size, path, groups=s.shown_groups(),
+            camera=s.camera,
             background=tuple(self.plotter.renderer.GetBackground()),
             overwrite=os.path.lexists(path),
         )  # fmt: skip
