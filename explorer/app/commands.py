@@ -11,7 +11,6 @@ import logging
 import os
 from pathlib import Path
 
-import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
@@ -24,7 +23,6 @@ from explorer.core.presets import MAX_NAME_LENGTH, check_name, save_preset, user
 from explorer.core.scene import load_scene
 from explorer.core.yamlio import load_yaml
 from explorer.geometry.meshes import MESH_SUFFIXES
-from explorer.render.images import encode_png
 
 log = logging.getLogger(__name__)
 
@@ -269,14 +267,10 @@ class Commands:
     # -- files ------------------------------------------------------------------------------------
     def screenshot(self) -> Path:
         """Save the 3D view as a PNG in the output directory (a new file every time)."""
-        self.render()
-        img = self.plotter.screenshot(return_img=True)
-        s = self.store.state
-        stem = f"phong-explorer-{s.preset or 'material'}-{Path(s.mesh).stem}"
-        stem = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in stem)
+        stem = self.picture_stem()
         taken = {p.stem for p in self.output_dir.glob(f"{stem}_*.png")}
         path = self.output_dir / f"{free_name(stem, taken)}.png"
-        write_atomic(path, encode_png(np.ascontiguousarray(img[:, :, :3])))
+        write_atomic(path, self.view_png())
         self.show_status(f"saved screenshot {path}")
         return path
 

@@ -295,13 +295,14 @@ class FileCommands:
         return written
 
     # -- pictures -----------------------------------------------------------------------------
-    def _view_png(self) -> bytes:
+    def view_png(self) -> bytes:
         """The 3D view as it is drawn now, PNG-encoded."""
         self.render()
         img = self.plotter.screenshot(return_img=True)
         return encode_png(np.ascontiguousarray(img[:, :, :3]))
 
-    def _picture_stem(self) -> str:
+    def picture_stem(self) -> str:
+        """``phong-explorer-<preset or mesh file>-<mesh>``, safe as a file name."""
         s = self.store.state
         what = s.preset or (s.mesh_materials.source if s.groups is not None else "material")
         stem = f"phong-explorer-{Path(what).stem}-{Path(s.mesh).stem}"
@@ -309,11 +310,11 @@ class FileCommands:
 
     def export_render(self, path=None) -> Path | None:
         """The 3D view as a PNG file of the user's choice (asks before replacing one)."""
-        path = self._output_path(path, "Export view as PNG", f"{self._picture_stem()}.png",
+        path = self._output_path(path, "Export view as PNG", f"{self.picture_stem()}.png",
                                  "PNG pictures (*.png)", (".png",))  # fmt: skip
         if path is None or not self._ask_replace(path):
             return None
-        written = write_atomic(path, self._view_png(), overwrite=os.path.lexists(path))
+        written = write_atomic(path, self.view_png(), overwrite=os.path.lexists(path))
         self.show_status(f"exported the view to {written}")
         return written
 
@@ -326,7 +327,7 @@ class FileCommands:
             raise ExplorerError("a turntable is being made: wait for it, or cancel it")
         s = self.store.state
         path = self._output_path(path, "Export turntable",
-                                 f"{self._picture_stem()}-turntable.gif",
+                                 f"{self.picture_stem()}-turntable.gif",
                                  "GIF (*.gif);;MP4 (*.mp4)", TURNTABLE_SUFFIXES)  # fmt: skip
         if path is None:
             return None
