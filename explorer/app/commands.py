@@ -18,6 +18,7 @@ from explorer.app.session import last_session_path, load_session, save_session
 from explorer.app.start import add_mesh_materials, free_name, load_mesh_choice
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.material import MODELS
 from explorer.core.mtl import MtlError
 from explorer.core.presets import MAX_NAME_LENGTH, check_name, save_preset, user_dir
 from explorer.core.scene import load_scene
@@ -32,7 +33,7 @@ VIEW_KEYS = {
     "r": ("reset the camera (the material and lights stay)", "reset_camera"),
     "q": ("quit (the session is kept for 'gui --last')", "close"),
     "d": ("show / hide the per-pixel difference", "toggle_difference"),
-    "b": ("switch the specular model (blinn / phong)", "toggle_model"),
+    "b": (f"next specular model ({' / '.join(MODELS)})", "toggle_model"),
     "1": ("show / hide the ambient term", "toggle_ambient"),
     "2": ("show / hide the diffuse term", "toggle_diffuse"),
     "3": ("show / hide the specular term", "toggle_specular"),
@@ -203,8 +204,12 @@ class Commands:
         self.act(M.swap_compare, label="swap A and B")
 
     def toggle_model(self) -> None:
-        model = "phong" if self.store.state.scene.model == "blinn" else "blinn"
-        self.act(M.set_model, model, label="model")
+        """The next specular model of :data:`explorer.core.material.MODELS`."""
+        model = self.store.state.scene.model
+        following = (
+            MODELS[(MODELS.index(model) + 1) % len(MODELS)] if model in MODELS else MODELS[0]
+        )
+        self.act(M.set_model, following, label="model")
 
     def _toggle_term(self, term: str) -> None:
         shown = term not in self.store.state.hidden
