@@ -206,10 +206,8 @@ class Commands:
     def toggle_model(self) -> None:
         """The next specular model of :data:`explorer.core.material.MODELS`."""
         model = self.store.state.scene.model
-        following = (
-            MODELS[(MODELS.index(model) + 1) % len(MODELS)] if model in MODELS else MODELS[0]
-        )
-        self.act(M.set_model, following, label="model")
+        i = MODELS.index(model) + 1 if model in MODELS else 0
+        self.act(M.set_model, MODELS[i % len(MODELS)], label="model")
 
     def _toggle_term(self, term: str) -> None:
         shown = term not in self.store.state.hidden
