@@ -279,7 +279,9 @@ class FileCommands:
         suffix = path.suffix.lower()
         material = s.material.replace(model=s.scene.model)
         if suffix == ".mtl" and s.groups is not None:
-            names = preset_names([n or "material" for n in s.mesh_materials.names])
+            # the usemtl names as they are, so the file serves as the OBJ's library
+            names = [n if n and not any(c.isspace() for c in n) else preset_name(n or "material")
+                     for n in s.mesh_materials.names]  # fmt: skip
             models = [m.replace(model=s.scene.model) for m in s.groups]
             pairs = list(zip(names, models, strict=True))
             text, notes, what = format_mtl(pairs), [], f"{len(pairs)} materials of the mesh"

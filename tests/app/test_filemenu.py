@@ -182,10 +182,25 @@ def test_export_material_never_replaces_unasked(win, answers, tmp_path):
 
 def test_export_material_of_a_grouped_mesh_writes_every_group(win, answers, tmp_path):
     two = write_two_groups(tmp_path)
+    text = two.read_text().replace("left_red", "Left_Red")
+    two.write_text(text)
+    mtl = tmp_path / "two_groups.mtl"
+    mtl.write_text(mtl.read_text().replace("left_red", "Left_Red"))
     win.open_file(two)
+    win.panel.material.sliders["ks"].field.setValue(0.25)  # the edited group, as edited
+    s = win.store.state
     path = win.export_material(tmp_path / "out.mtl")
-    read = {m.name: m.material.diffuse for m in read_mtl(path)}
-    assert read == {"left_red": (1.0, 0.0, 0.0), "right_blue": (0.0, 0.0, 1.0)}
+    read = {m.name: m.material for m in read_mtl(path)}
+    assert {n: m.diffuse for n, m in read.items()} == {"Left_Red": (1.0, 0.0, 0.0),
+                                                      "right_blue": (0.0, 0.0, 1.0)}  # fmt: skip
+    name = s.mesh_materials.names[s.group]
+    assert read[name].specular == s.groups[s.group].specular and max(read[name].specular) == 0.25
+    # the exported library serves the OBJ: it reopens with the same materials
+    (tmp_path / "two_groups.mtl").write_bytes(path.read_bytes())
+    win.meshes.clear()
+    win.choose_mesh("cube")
+    win.open_file(two)
+    assert [m.specular for m in win.store.state.groups] == [m.specular for m in s.groups]
 
 
 def test_export_view_png_asks_before_replacing(win, answers, tmp_path):
