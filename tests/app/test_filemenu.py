@@ -273,3 +273,19 @@ def test_an_obj_whose_mtl_is_bad_opens_in_the_present_material(win, tmp_path):
     assert s.mesh == str(two) and s.groups is None and s.material == before
     assert "two_groups.mtl:2" in win.message and win.message.startswith("error")
     win.errors.clear()
+
+
+def test_compare_beside_the_mesh_materials(win, tmp_path, qtbot):
+    win.open_file(write_two_groups(tmp_path))
+    win.toggle_compare()
+    s = win.store.state
+    assert s.groups is not None and s.compare == s.material and win.plotter_b.isVisible()
+    qtbot.waitUntil(lambda: win.plotter_b.width() > 100)
+    mesh = win.view_b.mesh
+    want = to_bytes(vertex_colors(M.side_b(s).shown_scene(), mesh)).astype(int)
+    assert np.abs(win.view_b.displayed_colors().astype(int) - want).max() <= 1  # B: one material
+    drawn_equals_groups(win)  # A: the groups
+    win.swap_sides()
+    assert win.store.state.groups is None
+    win.undo()
+    assert win.store.state.groups is not None
