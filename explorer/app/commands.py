@@ -332,6 +332,7 @@ class Commands:
             return None
         written = save_session(path, self.store.state, overwrite=overwrite)
         self.session_path = written
+        self.remember_recent(written)
         self.show_status(f"saved session {written}")
         return written
 

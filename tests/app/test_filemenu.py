@@ -248,7 +248,7 @@ def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp
 def test_recent_files(win, answers, tmp_path):
     two = write_two_groups(tmp_path)
     win.open_file(two)
-    win.open_file(win.save_session_as(tmp_path / "s.yaml"))
+    win.save_session_as(tmp_path / "s.yaml")
     recent = win.recent_files()
     assert recent == [str(tmp_path / "s.yaml"), str(two)]
     actions = [a for a in win.recent_menu.actions() if a.objectName().startswith("recent_")]
