@@ -11,19 +11,19 @@ import logging
 import os
 from pathlib import Path
 
-import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.session import last_session_path, load_session, save_session
-from explorer.app.start import free_name, load_mesh_choice
+from explorer.app.start import add_mesh_materials, free_name, load_mesh_choice
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.material import MODELS
+from explorer.core.mtl import MtlError
 from explorer.core.presets import MAX_NAME_LENGTH, check_name, save_preset, user_dir
 from explorer.core.scene import load_scene
 from explorer.core.yamlio import load_yaml
 from explorer.geometry.meshes import MESH_SUFFIXES
-from explorer.render.images import encode_png
 
 log = logging.getLogger(__name__)
 
@@ -33,7 +33,7 @@ VIEW_KEYS = {
     "r": ("reset the camera (the material and lights stay)", "reset_camera"),
     "q": ("quit (the session is kept for 'gui --last')", "close"),
     "d": ("show / hide the per-pixel difference", "toggle_difference"),
-    "b": ("next specular model (blinn / phong / threejs)", "toggle_model"),
+    "b": (f"next specular model ({' / '.join(MODELS)})", "toggle_model"),
     "1": ("show / hide the ambient term", "toggle_ambient"),
     "2": ("show / hide the diffuse term", "toggle_diffuse"),
     "3": ("show / hide the specular term", "toggle_specular"),
@@ -63,7 +63,10 @@ def help_text() -> str:
     lines = ["Keys in the 3D view (VTK's own keys are switched off):"]
     lines += [f"  {key}   {what}" for key, (what, _) in VIEW_KEYS.items()]
     lines += ["", "Window shortcuts:", "  Ctrl+Z / Ctrl+Shift+Z   undo / redo",
-              "  Ctrl+O   open a mesh, scene or session", "  Ctrl+S   save the session",
+              "  Ctrl+O   open a mesh, scene or session",
+              "  Ctrl+I / Ctrl+E   import materials (.mtl) / export the material",
+              "  Ctrl+Shift+E / Ctrl+T   export the view (PNG) / a turntable (GIF, MP4)",
+              "  Ctrl+S   save the session",
               "  Ctrl+Shift+S   save the material as a preset", "  Ctrl+Q   quit",
               "  F1   this help", "", "Mouse in the 3D view:"]  # fmt: skip
     lines += [f"  {how}: {what}" for how, what in MOUSE]
@@ -110,34 +113,35 @@ class Commands:
 
     def ask_path(self, title: str, *, save: bool = False, default: str = "",
                  filter: str = "") -> str | None:  # fmt: skip
+        """A file name from Qt's file dialog, or None. Saving, the dialog does not ask about
+        an existing file: the command asks (:meth:`ask_yes`), whoever gave the name."""
         if save:
-            path, _ = QtWidgets.QFileDialog.getSaveFileName(self, title, default, filter)
+            path, _ = QtWidgets.QFileDialog.getSaveFileName(
+                self, title, default, filter,
+                options=QtWidgets.QFileDialog.Option.DontConfirmOverwrite,
+            )  # fmt: skip
         else:
             path, _ = QtWidgets.QFileDialog.getOpenFileName(self, title, default, filter)
         return path or None
 
     # -- menus and keys -------------------------------------------------------------------------
+    def add_action(self, menu, name: str, text: str, slot, shortcut: str | None = None):
+        """A menu entry named ``name`` (``menu_actions[name]``) running ``slot()`` with its
+        errors shown; ``shortcut``: key sequences separated by ``|``."""
+        a = QtGui.QAction(text, self)
+        a.setObjectName(name)
+        if shortcut:
+            a.setShortcuts([QtGui.QKeySequence(s) for s in shortcut.split("|")])
+        a.triggered.connect(self._guard(lambda _=False: slot(), name))
+        menu.addAction(a)
+        self.menu_actions[name] = a
+        return a
+
     def build_menus(self) -> None:
         bar = self.menuBar()
         self.menu_actions: dict[str, QtGui.QAction] = {}
-
-        def add(menu, name, text, slot, shortcut=None):
-            a = QtGui.QAction(text, self)
-            a.setObjectName(name)
-            if shortcut:
-                a.setShortcuts([QtGui.QKeySequence(s) for s in shortcut.split("|")])
-            a.triggered.connect(self._guard(lambda _=False: slot(), name))
-            menu.addAction(a)
-            self.menu_actions[name] = a
-            return a
-
-        f = bar.addMenu("&File")
-        add(f, "open", "&Open mesh, scene or session…", self.open_file, "Ctrl+O")
-        add(f, "save_session", "&Save session…", self.save_session_as, "Ctrl+S")
-        add(f, "save_preset", "Save &preset as…", self.save_preset_as, "Ctrl+Shift+S")
-        add(f, "screenshot", "Save screens&hot", self.screenshot)
-        f.addSeparator()
-        add(f, "quit", "&Quit", self.close, "Ctrl+Q")
+        add = self.add_action
+        self.build_file_menu(bar.addMenu("&File"))
         e = bar.addMenu("&Edit")
         add(e, "undo", "&Undo", self.undo, "Ctrl+Z")
         add(e, "redo", "&Redo", self.redo, "Ctrl+Shift+Z|Ctrl+Y")
@@ -200,6 +204,7 @@ class Commands:
         self.act(M.swap_compare, label="swap A and B")
 
     def toggle_model(self) -> None:
+        """The next specular model of :data:`explorer.core.material.MODELS`."""
         self.act(M.set_model, M.next_model(self.store.state.scene.model), label="model")
 
     def _toggle_term(self, term: str) -> None:
@@ -263,22 +268,20 @@ class Commands:
     # -- files ------------------------------------------------------------------------------------
     def screenshot(self) -> Path:
         """Save the 3D view as a PNG in the output directory (a new file every time)."""
-        self.render()
-        img = self.plotter.screenshot(return_img=True)
-        s = self.store.state
-        stem = f"phong-explorer-{s.preset or 'material'}-{Path(s.mesh).stem}"
-        stem = "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in stem)
+        stem = self.picture_stem()
         taken = {p.stem for p in self.output_dir.glob(f"{stem}_*.png")}
         path = self.output_dir / f"{free_name(stem, taken)}.png"
-        write_atomic(path, encode_png(np.ascontiguousarray(img[:, :, :3])))
+        write_atomic(path, self.view_png())
         self.show_status(f"saved screenshot {path}")
         return path
 
     def save_preset_as(self, name: str | None = None) -> Path | None:
         """Save the material (with the current specular model) as a preset: asks for a name,
-        checks it, asks before replacing a file or hiding another preset."""
+        checks it, asks before replacing a file or hiding another preset. The preset is then
+        shown clean; while the mesh shows its own materials the edited group's is saved, and
+        the groups stay."""
         s = self.store.state
-        stem = (s.preset or "material")[: MAX_NAME_LENGTH - 8]
+        stem = (s.preset or self.material_name())[: MAX_NAME_LENGTH - 8]
         taken = {p.name for p in self.presets}
         if name is None:
             name = self.ask_text(
@@ -309,7 +312,7 @@ class Commands:
         written = save_preset(material, name, directory, overwrite=overwrite)
         self.reload_presets()
         info = next((p for p in self.presets if p.name == name), None)
-        if info is not None:
+        if info is not None and s.groups is None:
             self.act(M.apply_preset, name, info.material, label=f"save preset {name}")
         self.show_status(f"saved preset '{name}' to {written}")
         return written
@@ -327,6 +330,7 @@ class Commands:
             return None
         written = save_session(path, self.store.state, overwrite=overwrite)
         self.session_path = written
+        self.remember_recent(written)
         self.show_status(f"saved session {written}")
         return written
 
@@ -340,19 +344,22 @@ class Commands:
         if not os.path.isfile(path):
             raise ExplorerError(f"{path}: no such file")
         if path.lower().endswith(MESH_SUFFIXES):
-            self.choose_mesh(os.path.abspath(path))
+            if self.choose_mesh(os.path.abspath(path)):
+                self.remember_recent(path)
             return
         doc = load_yaml(path, what="scene or session")
         if isinstance(doc.data, dict) and "session" in doc.data:
             self.open_session(path)
-            return
-        scene = load_scene(path, materials_dirs=self.materials_dirs)
-        self._open_scene(scene, path)
+        else:
+            scene = load_scene(path, materials_dirs=self.materials_dirs)
+            self._open_scene(scene, path)
+        self.remember_recent(path)
 
     def _open_scene(self, scene, path: str) -> None:
-        s = self.store.state
+        s = self.store.state  # the scene's material covers the mesh (groups=None)
         new = s.replace(scene=scene.replace(mesh=s.mesh), preset=scene.material.name,
-                        preset_material=None, light=0, held_azimuth=None)  # fmt: skip
+                        preset_material=None, light=0, held_azimuth=None,
+                        groups=None)  # fmt: skip
         if scene.mesh is not None and scene.mesh != s.mesh:
             mesh = load_mesh_choice(scene.mesh)
             self.meshes[scene.mesh] = mesh
@@ -361,6 +368,10 @@ class Commands:
                 self._set_mesh_choices()
             new = M.set_mesh(new, scene.mesh, mesh.centre, mesh.radius)
             new = new.replace(scene=new.scene.replace(lights=scene.lights))
+            try:
+                new, _ = add_mesh_materials(new, mesh, use=False)
+            except MtlError as exc:
+                self.report(exc, "mesh materials")
         new = M.set_camera(new, self._framed(new, self.meshes[new.mesh]))
         self.store.commit(new, f"open {Path(path).name}")
         self.show_status(f"opened scene {path}")

@@ -45,6 +45,27 @@ POLE = 89.999
 
 
 @dataclass(frozen=True)
+class MeshMaterials:
+    """The materials a mesh file brings: an OBJ's ``usemtl`` groups read from its ``mtllib``.
+
+    source : the mesh file's name (for labels)
+    names : (k,) the group names (``mesh.groups.names``; ``""`` for faces without a material)
+    materials : (k,) one :class:`~explorer.core.material.Material` per group, as read
+    main : the group with the most vertices (the one the panel edits first)
+    """
+
+    source: str
+    names: tuple[str, ...]
+    materials: tuple[Material, ...]
+    main: int = 0
+
+    def label(self, group: int) -> str:
+        """``'name'`` of a group (``(no usemtl)`` for the unnamed one)."""
+        name = self.names[group]
+        return f"'{name}'" if name else "(no usemtl)"
+
+
+@dataclass(frozen=True)
 class State:
     """Everything the explorer shows.
 
@@ -65,6 +86,11 @@ class State:
     compare : side B's material when the A / B compare view is on, else None
     compare_model, compare_preset : side B's specular model and preset name
     compare_difference : side B's pane shows the difference A − B instead of B
+    mesh_materials : the materials the mesh file brings (:class:`MeshMaterials`), or None
+    groups : each group's material as shown (the mesh's own materials, edited), or None when
+        one material (:attr:`material`: a preset, the scene's) covers the whole mesh
+    group : the group the panel edits: while :attr:`groups` is shown, :attr:`material` is
+        ``groups[group]`` (every material action edits that group)
     """
 
     scene: Scene
@@ -84,6 +110,9 @@ class State:
     compare_model: str | None = None
     compare_preset: str | None = None
     compare_difference: bool = False
+    mesh_materials: MeshMaterials | None = None
+    groups: tuple[Material, ...] | None = None
+    group: int = 0
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)
@@ -111,6 +140,12 @@ class State:
         if "specular" in self.hidden and scene.model == "threejs":
             scene = scene.replace(model="blinn")
         return scene
+
+    def shown_groups(self) -> tuple[Material, ...] | None:
+        """Each group's material as drawn (hidden terms 0), or None (one material)."""
+        if self.groups is None:
+            return None
+        return tuple(display_material(m, self.hidden) for m in self.groups)
 
     def placement(self, index: int | None = None) -> tuple[float, float, float]:
         """``(azimuth, elevation, distance)`` of a light (default: the selected one) around
@@ -144,7 +179,13 @@ def display_material(material: Material, hidden) -> Material:
 
 
 def _material(state: State, material: Material) -> State:
-    return state.replace(scene=state.scene.replace(material=material))
+    """The material the panel edits: the whole mesh's, or the edited group's."""
+    new = state.replace(scene=state.scene.replace(material=material))
+    if state.groups is not None:
+        groups = list(state.groups)
+        groups[state.group] = material
+        new = new.replace(groups=tuple(groups))
+    return new
 
 
 def set_coefficient(state: State, name: str, value: float) -> State:
@@ -170,11 +211,50 @@ def set_colour(state: State, term: str, rgb) -> State:
 
 
 def apply_preset(state: State, name: str, material: Material) -> State:
-    """Show preset ``name`` (its material, and its specular model when it has one)."""
+    """Show preset ``name`` (its material, and its specular model when it has one) over the
+    whole mesh: it overrides the mesh's own materials (:func:`use_mesh_materials` brings them
+    back)."""
     scene = state.scene.replace(material=material)
     if material.model is not None:
         scene = scene.replace(model=material.model)
-    return state.replace(scene=scene, preset=name, preset_material=material)
+    return state.replace(scene=scene, preset=name, preset_material=material, groups=None)
+
+
+def use_mesh_materials(state: State) -> State:
+    """Show the mesh's own materials as its file has them, each group its own; the panel
+    edits the group it edited last (at first the largest). The difference view, which
+    compares one material, is turned off."""
+    mm = state.mesh_materials
+    if mm is None:
+        raise ExplorerError(f"the mesh '{state.mesh}' brings no materials of its own")
+    group = state.group if 0 <= state.group < len(mm.materials) else mm.main
+    material = mm.materials[group]
+    return state.replace(
+        scene=state.scene.replace(material=material), groups=mm.materials, group=group,
+        preset=None, preset_material=material, difference=False,
+    )  # fmt: skip
+
+
+def select_group(state: State, index: int) -> State:
+    """Edit group ``index`` of the mesh's own materials (its material goes to the panel)."""
+    if state.groups is None:
+        raise ExplorerError("the mesh's own materials are not shown: there is no group to edit")
+    n = len(state.groups)
+    if isinstance(index, bool) or not 0 <= int(index) < n:
+        raise ExplorerError(f"group must be 1 to {n}, got {index + 1}")
+    i = int(index)
+    return state.replace(
+        scene=state.scene.replace(material=state.groups[i]), group=i,
+        preset_material=state.mesh_materials.materials[i],
+    )  # fmt: skip
+
+
+def with_mesh_materials(state: State, materials: MeshMaterials | None, *, use: bool = True):
+    """``state`` knowing the materials its mesh file brings, shown when ``use`` (else the
+    present material covers the mesh, and :func:`use_mesh_materials` can show them)."""
+    state = state.replace(mesh_materials=materials, groups=None,
+                          group=materials.main if materials else 0)  # fmt: skip
+    return use_mesh_materials(state) if materials is not None and use else state
 
 
 def mark_saved(state: State, name: str, material: Material) -> State:
@@ -200,6 +280,11 @@ def set_term(state: State, term: str, shown: bool) -> State:
 
 
 def set_difference(state: State, on: bool) -> State:
+    if on and state.groups is not None:
+        raise ExplorerError(
+            "the difference view compares one material over the whole mesh, and the mesh shows "
+            "its own materials: choose a preset to compare"
+        )
     return state.replace(difference=bool(on))
 
 
@@ -270,16 +355,18 @@ def swap_compare(state: State) -> State:
     _needs_compare(state)
     scene = state.scene.replace(material=state.compare, model=state.compare_model)
     return state.replace(
-        scene=scene, preset=state.compare_preset, preset_material=None,
+        scene=scene, preset=state.compare_preset, preset_material=None, groups=None,
         compare=state.material, compare_model=state.scene.model, compare_preset=state.preset,
     )  # fmt: skip
 
 
 def side_b(state: State) -> State:
-    """The state side B shows: B's material and model, everything else shared."""
+    """The state side B shows: B's material (over the whole mesh) and model, everything else
+    shared."""
     _needs_compare(state)
     scene = state.scene.replace(material=state.compare, model=state.compare_model)
-    return state.replace(scene=scene, preset=state.compare_preset, preset_material=None)
+    return state.replace(scene=scene, preset=state.compare_preset, preset_material=None,
+                         groups=None)  # fmt: skip
 
 
 # -- light actions -------------------------------------------------------------------------------
@@ -434,7 +521,8 @@ def remove_light(state: State) -> State:
 
 def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = None) -> State:
     """Show another mesh: each light keeps its place relative to the mesh, scaled to the new
-    mesh's size. ``spec`` is the scene's ``mesh`` value (default: ``name``)."""
+    mesh's size; the material shown is kept over the whole mesh (:func:`with_mesh_materials`
+    adds the new mesh's own). ``spec`` is the scene's ``mesh`` value (default: ``name``)."""
     centre = tuple(float(c) for c in np.asarray(centre, dtype=np.float64))
     radius = float(radius) or 1.0
     lights = []
@@ -444,8 +532,9 @@ def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = 
         lights.append(light.placed(az, el, d, centre) if d > 0 else light)
     scene = state.scene.replace(lights=tuple(lights), mesh=spec or name)
     return state.replace(
-        scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None
-    )
+        scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None,
+        mesh_materials=None, groups=None, group=0,
+    )  # fmt: skip
 
 
 # -- the store -----------------------------------------------------------------------------------

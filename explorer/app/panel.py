@@ -192,6 +192,72 @@ def swatch(material, size: int = 18) -> QtGui.QIcon:
     return QtGui.QIcon(pm)
 
 
+class MeshMaterialsBox(QtWidgets.QFrame):
+    """What the panel says of a mesh file's own materials (shown only when the mesh brings
+    some): whether they are drawn or a preset covers the mesh, the group the controls edit
+    (``group``), and a button to draw them again (``use_mesh_materials``)."""
+
+    def __init__(self, act, parent=None):
+        super().__init__(parent)
+        self.setObjectName("mesh_materials")
+        self.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
+        self.act = act
+        box = _form(self)
+        self.label = QtWidgets.QLabel("")
+        self.label.setObjectName("mesh_materials_label")
+        self.label.setWordWrap(True)
+        self.group_row = QtWidgets.QWidget()
+        row = QtWidgets.QHBoxLayout(self.group_row)
+        row.setContentsMargins(0, 0, 0, 0)
+        row.addWidget(QtWidgets.QLabel("group"))
+        self.group = QtWidgets.QComboBox()
+        self.group.setObjectName("group")
+        self.group.setToolTip("the group of the mesh whose material the controls below edit")
+        self.group.setIconSize(QtCore.QSize(16, 16))
+        row.addWidget(self.group, 1)
+        self.use = QtWidgets.QPushButton("Use the mesh's materials")
+        self.use.setObjectName("use_mesh_materials")
+        self.use.setToolTip("draw each group in the material its file gives (undoable)")
+        box.addWidget(self.label)
+        box.addWidget(self.group_row)
+        box.addWidget(self.use)
+        self.group.activated.connect(lambda i: self.act(M.select_group, i, label="group"))
+        self.use.clicked.connect(lambda: self.act(M.use_mesh_materials, label="mesh materials"))
+        self._shown = None
+        self.setVisible(False)
+
+    def show_state(self, s: M.State) -> None:
+        mm = s.mesh_materials
+        self.setVisible(mm is not None)
+        if mm is None:
+            return
+        k = len(mm.names)
+        own = s.groups is not None
+        key = (mm, s.groups, s.group, s.preset)
+        if key == self._shown:
+            return
+        self._shown = key
+        if own:
+            self.label.setText(
+                f"<b>{mm.source}</b> brings its own materials, one per group ({k}); the "
+                f"controls below edit group {mm.label(s.group)}"
+            )
+        else:
+            self.label.setText(
+                f"<b>{mm.source}</b> brings {k} material{'s' * (k != 1)} of its own; "
+                f"{'preset ' + repr(s.preset) if s.preset else 'one material'} covers the "
+                "whole mesh instead"
+            )
+        if own:
+            with QtCore.QSignalBlocker(self.group):
+                self.group.clear()
+                for name, m in zip(mm.names, s.groups, strict=True):
+                    self.group.addItem(swatch(m, 16), name or "(no usemtl)")
+                self.group.setCurrentIndex(s.group)
+        self.group_row.setVisible(own)
+        self.use.setVisible(not own)
+
+
 class MaterialTab(QtWidgets.QWidget):
     """Presets (searchable, with descriptions and swatches), coefficients, colours, model and
     terms."""
@@ -214,7 +280,9 @@ class MaterialTab(QtWidgets.QWidget):
         self.preset_label = QtWidgets.QLabel("")
         self.preset_label.setObjectName("preset")
         self.preset_label.setWordWrap(True)
-        for w in (self.preset_label, self.search, self.presets, self.description):
+        self.mesh_materials = MeshMaterialsBox(act)
+        for w in (self.mesh_materials, self.preset_label, self.search, self.presets,
+                  self.description):  # fmt: skip
             box.addWidget(w)
         self.sliders = {
             "ka": ValueSlider("ka", 0.0, 1.0),
@@ -319,8 +387,14 @@ class MaterialTab(QtWidgets.QWidget):
         for term, c in self.terms.items():
             with QtCore.QSignalBlocker(c):
                 c.setChecked(term not in s.hidden)
-        name = s.preset or "(scene material)"
-        self.preset_label.setText(f"preset: <b>{name}</b>" + (" (edited)" if s.edited else ""))
+        self.mesh_materials.show_state(s)
+        edited = " (edited)" if s.edited else ""
+        if s.groups is not None:
+            label = s.mesh_materials.label(s.group)
+            self.preset_label.setText(f"material: <b>{label}</b> of the mesh{edited}")
+        else:
+            name = s.preset or "(scene material)"
+            self.preset_label.setText(f"preset: <b>{name}</b>{edited}")
         with QtCore.QSignalBlocker(self.presets):
             found = self.presets.findItems(s.preset or "", QtCore.Qt.MatchFlag.MatchExactly)
             self.presets.setCurrentItem(found[0] if found and s.preset else None)

@@ -15,6 +15,9 @@ A session file is YAML (or JSON, which YAML reads too)::
     difference: false
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
                                # the A / B compare view's side B
+    groups: {group: 1, materials: [{...}, ...]}   # optional: the mesh file's own materials
+                               # as shown (one per usemtl group, edited), the group edited;
+                               # absent: one material covers the mesh
     window: {...}              # optional: what the window reported (the --state-file's
                                # extras); never read back
 
@@ -33,10 +36,11 @@ from pathlib import Path
 from platformdirs import user_config_dir
 
 from explorer.app.model import TERMS, State
-from explorer.app.start import first_state, load_mesh_choice
+from explorer.app.start import add_mesh_materials, first_state, load_mesh_choice
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS, parse_material
+from explorer.core.mtl import MtlError
 from explorer.core.scene import load_scene
 from explorer.core.yamlio import dump_yaml, load_yaml
 from explorer.geometry.meshes import Mesh
@@ -45,7 +49,7 @@ from explorer.render.camera import Camera
 FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
-    "camera", "difference", "compare", "window",
+    "camera", "difference", "compare", "groups", "window",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -95,6 +99,11 @@ def session_mapping(state: State) -> dict:
             "preset": state.compare_preset,
             "difference": bool(state.compare_difference),
         }
+    if state.groups is not None:
+        out["groups"] = {
+            "group": state.group + 1,
+            "materials": [m.to_mapping() for m in state.groups],
+        }
     return out
 
 
@@ -136,6 +145,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     difference = checker.boolean(m.get("difference", False), ("difference",))
     camera = _camera(checker, m["camera"]) if "camera" in m else None
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
+    groups = _groups(checker, m["groups"]) if m.get("groups") is not None else None
     checker.raise_if_any()
     try:
         scene = load_scene(m["scene"], materials_dirs=materials_dirs)
@@ -144,6 +154,13 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     mesh = load_mesh_choice(name, resolution)
     state = first_state(scene, mesh, name=name, preset=preset, materials_dirs=materials_dirs,
                         resolution=resolution)  # fmt: skip
+    try:
+        state, _ = add_mesh_materials(state, mesh, use=False)
+    except MtlError:
+        if groups is not None:
+            raise
+    if groups is not None:
+        state = _with_groups(checker, state, *groups)
     n = len(scene.lights)
     light = m.get("light", 1)
     if n and (isinstance(light, bool) or not isinstance(light, int) or not 1 <= light <= n):
@@ -176,6 +193,39 @@ def _compare(checker, value) -> dict:
     difference = checker.boolean(c.get("difference", False), path + ("difference",))
     return {"compare": material, "compare_model": model, "compare_preset": preset,
             "compare_difference": bool(difference)}  # fmt: skip
+
+
+def _groups(checker, value) -> tuple[int, tuple] | None:
+    """The ``groups`` section: ``(group index, materials)``."""
+    path = ("groups",)
+    g = checker.mapping(value, path)
+    if g is None or not checker.keys(g, path, ("group", "materials"), required=("materials",)):
+        return None
+    items = g["materials"]
+    if not isinstance(items, list) or not items:
+        checker.problem(path + ("materials",), "must be a list of materials, one per group")
+        return None
+    materials = tuple(parse_material(v, checker, path + ("materials", i))
+                      for i, v in enumerate(items))  # fmt: skip
+    group = g.get("group", 1)
+    if isinstance(group, bool) or not isinstance(group, int) or not 1 <= group <= len(items):
+        checker.problem(path + ("group",), f"must be a whole number from 1 to {len(items)}")
+        return None
+    return group - 1, materials
+
+
+def _with_groups(checker, state: State, group: int, materials) -> State:
+    """``state`` showing the session's group materials (as many as the mesh has groups)."""
+    have = state.mesh_materials
+    n = 0 if have is None else len(have.materials)
+    if n != len(materials):
+        checker.problem(("groups", "materials"), f"the mesh '{state.mesh}' has {n} material "
+                        f"groups of its own, the session {len(materials)}")  # fmt: skip
+        checker.raise_if_any()
+    return state.replace(
+        scene=state.scene.replace(material=materials[group]), groups=tuple(materials),
+        group=group, preset=None, preset_material=have.materials[group],
+    )  # fmt: skip
 
 
 def _camera(checker, value) -> Camera | None:

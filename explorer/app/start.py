@@ -15,10 +15,12 @@ import sys
 
 import numpy as np
 
-from explorer.app.model import State
+from explorer.app.model import MeshMaterials, State, with_mesh_materials
 from explorer.core.errors import ExplorerError
+from explorer.core.material import Material
 from explorer.core.presets import list_presets
 from explorer.core.scene import Scene, Viewer
+from explorer.geometry.filematerials import group_materials
 from explorer.geometry.meshes import Mesh, get_mesh
 
 #: built-in meshes offered by the mesh chooser, with the resolution the explorer uses
@@ -87,6 +89,28 @@ def first_state(
         preset=preset,
         preset_material=clean,
     )
+
+
+def read_mesh_materials(mesh: Mesh, fallback: Material) -> tuple[MeshMaterials | None, list]:
+    """``(materials, warnings)``: the materials ``mesh``'s file brings (an OBJ's ``usemtl``
+    groups read from its ``mtllib``; ``fallback`` for a group no library defines), or None
+    when it brings none; the .mtl reader's warnings, one sentence each. A library with a
+    problem raises its :class:`~explorer.core.mtl.MtlError` (file and line)."""
+    materials, warnings = group_materials(mesh, fallback)
+    if not materials or all(m is fallback for m in materials):
+        return None, warnings
+    sizes = np.bincount(mesh.groups.of_vertex, minlength=len(materials))
+    found = MeshMaterials(mesh.name, tuple(mesh.groups.names), tuple(materials),
+                          int(np.argmax(sizes)))  # fmt: skip
+    return found, warnings
+
+
+def add_mesh_materials(state: State, mesh: Mesh, *, use: bool = True) -> tuple[State, list]:
+    """``(state, warnings)``: ``state`` with the materials its mesh file brings
+    (:func:`read_mesh_materials`, the state's material for groups no library defines), shown
+    when ``use``."""
+    found, warnings = read_mesh_materials(mesh, state.material)
+    return with_mesh_materials(state, found, use=use), warnings
 
 
 def no_display_reason(environ=None) -> str | None:

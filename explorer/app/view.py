@@ -10,7 +10,9 @@ Every state goes the same way::
 The colours are drawn as RGB point scalars with VTK's lighting off, so VTK adds nothing to the
 engine's colours. Meshes above :data:`LOD_VERTICES` get a lighter level of detail (quadric
 clustering to about :data:`LOD_TARGET` vertices, shaded by its own Shader) drawn while something
-is dragged; the full mesh is shaded and drawn on release.
+is dragged; the full mesh is shaded and drawn on release (a mesh with material groups has no
+level of detail: its groups would be lost). A mesh file's own materials
+(``State.groups``) are drawn group by group from one Shader's light sums.
 
 PyVista and VTK are imported inside the functions that need them.
 """
@@ -172,10 +174,30 @@ class MeshDrawing:
         self.vtk_colors = self.poly.GetPointData().GetArray("colors")
         self.rgb = vtk_to_numpy(self.vtk_colors)  # a view of VTK's memory
         self.sorted_for = None  # camera the triangles were last sorted for (translucency)
+        self.groups = None  # one material per group of mesh.groups, or None: the scene's
+        self._rows = None
+
+    def set_groups(self, materials) -> None:
+        """Draw each group of ``mesh.groups`` in its own material (a tuple, one per group),
+        or the whole mesh in the scene's (None)."""
+        if materials is not None and self._rows is None:
+            g = self.mesh.groups
+            self._rows = [g.vertices(i) for i in range(len(g.names))]
+        self.groups = materials
 
     def colors(self) -> np.ndarray:
-        """(n, 3) display colours in [0, 1] (:func:`explorer.shading.display.shown`)."""
-        return shown(self.shader.colors, self.shader.scene)
+        """(n, 3) display colours in [0, 1] (:func:`explorer.shading.display.shown`): each
+        group in its material when :attr:`groups` is set (the Shader keeps the light sums;
+        each material recomposes them)."""
+        if self.groups is None:
+            return shown(self.shader.colors, self.shader.scene)
+        scene = self.shader.scene
+        out = np.empty((self.mesh.n_vertices, 3), np.float64)
+        for rows, material in zip(self._rows, self.groups, strict=True):
+            self.shader.set_material(material)
+            out[rows] = self.shader.colors[rows]
+        self.shader.set_material(scene.material)
+        return shown(out, scene)
 
     def upload(self) -> None:
         """Write the display colours into VTK's array as 8-bit values and mark it modified."""
@@ -234,7 +256,7 @@ class SceneView:
             self.plotter.remove_actor(d.actor)
         scene = state.shown_scene()
         self.drawings = [MeshDrawing(self.plotter, mesh, scene)]
-        if mesh.n_vertices > self.lod_vertices:
+        if mesh.n_vertices > self.lod_vertices and mesh.groups is None:
             if mesh.name not in self._lods:
                 self._lods = {mesh.name: lod_mesh(mesh, self.lod_target)}
             lod = MeshDrawing(self.plotter, self._lods[mesh.name], scene)
@@ -248,10 +270,13 @@ class SceneView:
         """Give the shown scene to every drawing's Shader (each recomputes only what changed)
         and upload the drawn one's colours; move the handle and its glyph; redraw the lobe."""
         old, self.state = self.state, state
-        if old is None or old.scene != state.scene or old.hidden != state.hidden:
+        if (old is None or old.scene != state.scene or old.hidden != state.hidden
+                or old.groups != state.groups):  # fmt: skip
             scene = state.shown_scene()
+            groups = state.shown_groups()
             for d in self.drawings:
                 d.shader.set_scene(scene)
+                d.set_groups(groups if d.mesh.groups is not None else None)
                 d.actor.GetProperty().SetOpacity(state.material.opacity)
             self.active.upload()
         self._show_handle(state)

@@ -26,6 +26,7 @@ from explorer.app import model as M
 from explorer.app.commands import Commands
 from explorer.app.compare import ComparePane, DifferencePane
 from explorer.app.difference import DifferenceWorker, HeatMap
+from explorer.app.filemenu import FileCommands
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
@@ -57,7 +58,7 @@ ENGINE_POLL_MS = 500
 MESSAGE_MS = 6000
 
 
-class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
+class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
     """The explorer window.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
@@ -267,24 +268,6 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
             self.report(exc, label or action.__name__)
             return False
 
-    def choose_mesh(self, name: str) -> None:
-        """Show mesh ``name`` (a chooser name): loaded once, the camera framed anew."""
-        try:
-            mesh = self.meshes.get(name)
-            if mesh is None:
-                from explorer.app.start import load_mesh_choice  # noqa: I001 (the chooser's resolution)
-
-                mesh = load_mesh_choice(name, self.mesh_choices.get(name))
-                self.meshes[name] = mesh
-            if name not in self.mesh_choices:
-                self.mesh_choices[name] = None
-                self._set_mesh_choices()
-            state = M.set_mesh(self.store.state, name, mesh.centre, mesh.radius)
-            state = M.set_camera(state, self._framed(state, mesh))
-            self.store.commit(state, f"mesh {Path(name).name}")
-        except ExplorerError as exc:
-            self.report(exc, "mesh")
-
     def _on_change(self, old: M.State, new: M.State) -> None:
         if new.mesh != old.mesh:
             self.view.set_mesh(self.meshes[new.mesh], new)
@@ -321,7 +304,10 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
     def _show_panel(self, state: M.State) -> None:
         self.panel.show_state(state, self.view.mesh.n_vertices)
         self.update_edit_actions()
-        parts = [state.preset or "(scene material)", state.scene.model]
+        what = state.preset or "(scene material)"
+        if state.groups is not None:
+            what = f"{state.mesh_materials.source}'s materials"
+        parts = [what, state.scene.model]
         if state.hidden:
             parts.append("hidden: " + ", ".join(t for t in M.TERMS if t in state.hidden))
         self.status_label.setText(";  ".join(parts))
@@ -448,6 +434,8 @@ class ExplorerWindow(Commands, ComparePane, DifferencePane, QtWidgets.QMainWindo
     # -- closing --------------------------------------------------------------------------------
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802 - Qt's name
         self.keep_last_session()
+        if self.turntable is not None:
+            self.turntable.cancel()  # nothing written
         self.worker.close()
         self.plotter.close()
         super().closeEvent(event)

@@ -27,6 +27,7 @@ from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
+from explorer.core.text import printable
 from explorer.geometry.meshes import get_mesh
 from explorer.render.images import parse_size
 
@@ -110,7 +111,8 @@ def start(args):
 
 
 def start_state(args):
-    """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s."""
+    """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s; a mesh
+    file's own materials are shown unless ``--preset`` is given (as ``render`` does)."""
     check_options(args)
     dirs = tuple(args.materials_dirs)
     if args.last:
@@ -120,9 +122,13 @@ def start_state(args):
         return S.load_session(path, materials_dirs=dirs)
     if args.session is not None:
         return S.load_session(args.session, materials_dirs=dirs)
+    own = not isinstance(args.preset, str)  # --preset overrides the mesh's own materials
     scene, mesh, preset = start(args)
     state = gui.first_state(scene, mesh, preset=preset, materials_dirs=dirs,
                             resolution=args.resolution)  # fmt: skip
+    state, warnings = gui.add_mesh_materials(state, mesh, use=own)
+    for w in warnings:
+        print(f"warning: {printable(w)}", file=sys.stderr)
     return state, mesh
 
 

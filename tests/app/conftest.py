@@ -12,7 +12,7 @@ import pytest
 from explorer.app.start import start_xvfb
 
 #: modules whose tests open Qt windows in the test process
-QT_MODULES = ("test_window.py",)
+QT_MODULES = ("test_window.py", "test_filemenu.py")
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -68,3 +68,37 @@ def qapp(xserver):
             else:
                 os.environ[k] = v
     yield app
+
+
+@pytest.fixture
+def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
+    """``open_window(*gui_args)``: the explorer window (default: ``gui --mesh icosphere
+    --resolution 3``), shown at 1000x700 and drawn once; presets are saved in
+    ``tmp_path/presets``, screenshots and the ``--state-file`` go to ``tmp_path``, and the
+    last session is kept in ``tmp_path/last.yaml``."""
+    from explorer.app.window import ExplorerWindow
+    from explorer.cli import build_parser
+    from explorer.cli.gui import start_state
+
+    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
+
+    def make(*argv):
+        argv = argv or ("--mesh", "icosphere", "--resolution", "3")
+        state, mesh = start_state(build_parser().parse_args(["gui", *argv]))
+        w = ExplorerWindow(state, mesh, output_dir=tmp_path, state_file=tmp_path / "state.json",
+                           last_session=tmp_path / "last.yaml", size=(1000, 700))  # fmt: skip
+        qtbot.addWidget(w)
+        w.show()
+        qtbot.waitExposed(w)
+        w.render()
+        return w
+
+    return make
+
+
+@pytest.fixture
+def win(open_window):
+    """The default window; the test fails if any error was shown and not cleared."""
+    w = open_window()
+    yield w
+    assert not w.errors, w.errors
