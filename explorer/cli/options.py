@@ -20,6 +20,7 @@ from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
 from explorer.core.material import MODELS
+from explorer.core.mtl import MtlError
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.core.text import printable
@@ -322,7 +323,10 @@ def mesh_materials(args, scene, mesh):
     """
     if mesh.groups is None or isinstance(getattr(args, "preset", None), str):
         return scene, None
-    materials, warnings = group_materials(mesh, scene.material)
+    try:
+        materials, warnings = group_materials(mesh, scene.material)
+    except MtlError as exc:
+        raise MtlError(f"{exc}: give --preset NAME to draw the mesh in one preset") from None
     for w in warnings:
         print(f"warning: {printable(w)}", file=sys.stderr)
     sizes = np.bincount(mesh.groups.of_vertex, minlength=len(materials))

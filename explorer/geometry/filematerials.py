@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 
 from explorer.core.material import Material
-from explorer.core.mtl import MtlError, read_mtl
+from explorer.core.mtl import read_mtl
 from explorer.geometry.meshes import Mesh
 
 
@@ -20,7 +20,7 @@ def group_materials(mesh: Mesh, fallback: Material) -> tuple[tuple[Material, ...
     group no library defines) and what the reader warned of, one sentence each.
 
     A library with a problem raises its :class:`~explorer.core.mtl.MtlError` (the file and
-    line), saying how to render without it.
+    line).
     """
     groups = mesh.groups
     if groups is None:
@@ -31,10 +31,7 @@ def group_materials(mesh: Mesh, fallback: Material) -> tuple[tuple[Material, ...
         if not os.path.isfile(lib):
             warnings.append(f"mtllib {lib}: no such file; its materials are not read")
             continue
-        try:
-            materials = read_mtl(lib)
-        except MtlError as exc:
-            raise MtlError(f"{exc} (give --preset NAME to draw the mesh in one preset)") from None
+        materials = read_mtl(lib)
         for m in materials:
             found.setdefault(m.name, m.material.replace(name=m.name))
             warnings.extend(m.warnings)

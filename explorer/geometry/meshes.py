@@ -658,7 +658,11 @@ def load_mesh(path) -> Mesh:
     used = _used(pos, faces)
     pos, nrm, faces = _drop_unused(pos, nrm, faces)
     groups = None
-    if group_names:
+    if group_names:  # in the file's order (trimesh's parts come in another)
+        rank = [used_names.index(g) if g in used_names else len(used_names) for g in group_names]
+        order = np.argsort(rank, kind="stable")
+        keys = np.argsort(order)[keys]  # old index -> new index
+        group_names = [group_names[i] for i in order]
         groups = MaterialGroups(tuple(group_names), keys[used], libraries, used_names)
     elif libraries:  # no usemtl matched a material trimesh found: one group, named nothing
         groups = MaterialGroups(("",), np.zeros(len(pos), np.int32), libraries, used_names)

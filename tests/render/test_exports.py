@@ -129,6 +129,7 @@ def test_each_group_is_shaded_in_its_own_material(two_groups):
         rows = mesh.groups.vertices(g)
         alone = vertex_colors(scene.replace(material=material), mesh)
         assert np.array_equal(colors[rows], alone[rows])
+    assert mesh.groups.names == ("left_red", "right_blue")  # the file's order
     red = colors[mesh.groups.vertices(mesh.groups.names.index("left_red"))]
     blue = colors[mesh.groups.vertices(mesh.groups.names.index("right_blue"))]
     assert (red[:, 0] > 0.5).all() and (red[:, 2] == 0).all()
