@@ -92,6 +92,14 @@ PIXEL_RAY_T_MIN = 1e-9
 #: triangle.
 BVH_BOX_PAD = 1e-9
 
+#: Shadow rays toward one light (explorer.geometry.occluders): a triangle is left out of the
+#: casts when the light is in front of it by more than this times the longest ray (sine of the
+#: angle between the triangle's plane and the light), and it is no sliver (|e1 × e2| >= this
+#: times |e1|·|e2|). Then every ray toward the light meets its plane from behind with a
+#: determinant below -OCCLUDER_MARGIN² |e1| |e2|, a thousand times the determinant's rounding,
+#: or beyond the light: it cannot block one (the module docstring has the argument).
+OCCLUDER_MARGIN = 1e-6
+
 # --- float32 fast path ----------------------------------------------------------------------
 
 #: A float32 dot product of unit vectors is within about 1e-6 of the float64 one after the

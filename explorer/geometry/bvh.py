@@ -37,6 +37,7 @@ import numpy as np
 
 from explorer.core.errors import Cancelled
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
+from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
 
 #: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
@@ -52,6 +53,12 @@ BINS = 16
 MEDIAN_DEPTH = 64
 #: the traversal stack; MEDIAN_DEPTH + 64 levels holds any mesh that fits in memory
 STACK = 128
+#: shadow rays go through boxes refitted around their light's possible occluders
+#: (:func:`toward_light`, cost about one ray per 50 triangles) when they number at least the
+#: triangles divided by this
+OCCLUDER_RAYS = 16
+#: leaves per chunk when the triangles facing a light are found
+FACING_CHUNK = 16384
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
 #: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
@@ -71,6 +78,9 @@ class BVH:
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
     order : (m,) int64 the original index of each triangle in leaf order
+    tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
+    normals : (m, 3) float64 its unit normal (zero for a sliver): what
+        :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
     """
 
     child: np.ndarray
@@ -78,6 +88,8 @@ class BVH:
     leaf: np.ndarray
     tri: np.ndarray
     order: np.ndarray
+    tbox: np.ndarray
+    normals: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -100,8 +112,10 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
         cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
-        return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), np.zeros(0, np.int64))
-    box, link, order = _stoppable(_build, (tri,), cancelled)
+        none = np.zeros((0, 9))
+        return BVH(child, cbox, np.zeros((0, 2), np.int64), none, np.zeros(0, np.int64),
+                   np.zeros((0, 6), np.float32), np.zeros((0, 3)))  # fmt: skip
+    box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
     hi32 = box64[:, 1::2].astype(np.float32)
@@ -109,7 +123,9 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     hi32 = np.where(hi32 < box64[:, 1::2], np.nextafter(hi32, np.float32(np.inf)), hi32)
     cbox = np.empty(box64.shape, np.float32)
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
-    return BVH(child, cbox, leaf, np.ascontiguousarray(pack_triangles(tri)[order]), order)
+    rows = np.ascontiguousarray(pack_triangles(tri)[order])
+    return BVH(child, cbox, leaf, rows, order, occ.triangle_boxes(rows, pad),
+               occ.unit_normals(rows))  # fmt: skip
 
 
 # -- building ------------------------------------------------------------------------------
@@ -204,8 +220,8 @@ def _sah_split(boxes, idx, start, end, axis, c0, c1, node_area, scratch):
 
 @nb.njit(cache=True)
 def _build(tri, stop):
-    """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order),
-    or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""
+    """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order,
+    pad), or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""
     m = tri.shape[0]
     lo = np.empty((m, 3))
     hi = np.empty((m, 3))
@@ -233,7 +249,7 @@ def _build(tri, stop):
     boxes = (lo, hi, cent)
     while sp > 0:
         if n_nodes % 1024 == 0 and stop[0]:
-            return box[:0].copy(), link[:0].copy(), idx[:0].copy()
+            return box[:0].copy(), link[:0].copy(), idx[:0].copy(), pad
         sp -= 1
         start, end, parent, depth = st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3]
         node = n_nodes
@@ -288,7 +304,7 @@ def _build(tri, stop):
         st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3] = mid, end, node, depth + 1
         st[sp + 1, 0], st[sp + 1, 1], st[sp + 1, 2], st[sp + 1, 3] = start, mid, -1, depth + 1
         sp += 2
-    return box[:n_nodes].copy(), link[:n_nodes].copy(), idx
+    return box[:n_nodes].copy(), link[:n_nodes].copy(), idx, pad
 
 
 @nb.njit(cache=True)
@@ -389,11 +405,11 @@ def _next(stack, sp, ca, cb, ta, tb):
 
 
 @nb.njit(cache=True, inline="always")
-def _leaf_any(leaf, c, tri, ray, t_eps, tm, det_eps):
-    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``~c``."""
+def _leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
+    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``q``."""
     ox, oy, oz, dx, dy, dz = ray
-    first = leaf[~c, 0]
-    for j in range(first, first + leaf[~c, 1]):
+    first = leaf[q, 0]
+    for j in range(first, first + leaf[q, 1]):
         t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
         if t > t_eps and t < tm:
             return True
@@ -403,14 +419,20 @@ def _leaf_any(leaf, c, tri, ray, t_eps, tm, det_eps):
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def _any_hit_chunk(r0, r1, rays, tree, eps, out):
     """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) with
-    eps = (t_eps, det_eps): out[r] True where the ray is blocked."""
+    eps = (t_eps, det_eps): out[r] True where the ray is blocked. The leaf that blocked the
+    previous ray is tried first (neighbouring rays tend to share their occluder)."""
     O, D, tmax = rays
     child, cbox, leaf, tri = tree
     t_eps, det_eps = eps
     stack = np.empty(STACK, np.int64)
+    last = np.int64(-1)
     for r in range(r0, r1):
         ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
+        ray = (ox, oy, oz, dx, dy, dz)
         tm = tmax[r] - t_eps
+        if last >= 0 and _leaf_any(leaf, last, tri, ray, t_eps, tm, det_eps):
+            out[r] = True
+            continue
         hit = False
         sp = 0
         node = 0
@@ -418,13 +440,13 @@ def _any_hit_chunk(r0, r1, rays, tree, eps, out):
             ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, tm)
             ca, cb = child[node, 0], child[node, 1]
             if ta < math.inf and ca < 0:
-                if _leaf_any(leaf, ca, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
-                    hit = True
+                if _leaf_any(leaf, ~ca, tri, ray, t_eps, tm, det_eps):
+                    hit, last = True, ~ca
                     break
                 ta = math.inf
             if tb < math.inf and cb < 0:
-                if _leaf_any(leaf, cb, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
-                    hit = True
+                if _leaf_any(leaf, ~cb, tri, ray, t_eps, tm, det_eps):
+                    hit, last = True, ~cb
                     break
                 tb = math.inf
             node, sp = _next(stack, sp, ca, cb, ta, tb)
@@ -555,14 +577,40 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarra
     tmax : (k,) float, the distance to the light (inf: none)
     cancelled : () -> bool, asked between chunks (True: raise Cancelled)
     Returns (k,) bool.
+
+    Rays that all go to one light (shadow rays) and are at least 1/:data:`OCCLUDER_RAYS` of
+    the triangles in number go through :func:`toward_light`'s boxes.
     """
     O, D = _rays(origins, directions)
     tm = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)))
     hit = np.zeros(len(O), np.bool_)
     if bvh.n_triangles:
+        if len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
+            bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
         args = ((O, D, tm), _tree(bvh), (RAY_T_EPS, DET_EPS), hit)
         run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
     return hit
+
+
+def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
+    """``bvh`` with its boxes refitted around the triangles that can block the rays, when the
+    rays all end at one point or all run one way (:mod:`explorer.geometry.occluders`); else
+    ``bvh`` itself. Casting the rays through either gives the same answers.
+
+    origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
+    """
+    end = occ.shared_end(origins, directions, tmax)
+    if end is None or not bvh.n_triangles:
+        return bvh
+    kind, L, eps, reach = end
+    corner = np.maximum(np.abs(bvh.cbox[0, 0::2]), np.abs(bvh.cbox[0, 1::2])).astype(np.float64)
+    corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
+    radius = max(float(np.sqrt(corner @ corner)), reach)
+    lbox = np.empty((len(bvh.leaf), 6), np.float32)
+    args = (bvh.leaf, bvh.tri, bvh.normals, bvh.tbox, (np.int64(kind), L, eps, radius), lbox)
+    run_chunks(occ.leaf_boxes, len(bvh.leaf), args, cancelled=cancelled, chunk=FACING_CHUNK)
+    cbox = occ.node_boxes(bvh.child, lbox)
+    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.tbox, bvh.normals)
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):

@@ -188,6 +188,6 @@ def test_building_can_be_stopped():
     tri = _soup(5000, 10)
     with pytest.raises(Cancelled):  # asked before the build starts, then while it runs
         B.build_bvh(tri, cancelled=lambda: True)
-    box, link, order = B._build(tri, np.ones(1, np.uint8))  # the flag a waiting caller sets
+    box, link, order, _ = B._build(tri, np.ones(1, np.uint8))  # the flag a waiting caller sets
     assert len(box) == len(link) == len(order) == 0
     assert B.build_bvh(tri, cancelled=lambda: False).n_triangles == 5000
