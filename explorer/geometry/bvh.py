@@ -39,6 +39,7 @@ from explorer.core.errors import Cancelled
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
+from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
 
 #: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
 CHUNK = 8192
@@ -51,8 +52,6 @@ BINS = 16
 #: below this depth the builder splits by the heuristic; deeper, at the median (so the tree
 #: is never deeper than about MEDIAN_DEPTH + log2(triangles))
 MEDIAN_DEPTH = 64
-#: the traversal stack; MEDIAN_DEPTH + 64 levels holds any mesh that fits in memory
-STACK = 128
 #: shadow rays go through boxes refitted around their light's possible occluders
 #: (:func:`toward_light`, cost about one ray per 50 triangles) when they number at least the
 #: triangles divided by this
@@ -61,8 +60,6 @@ OCCLUDER_RAYS = 16
 FACING_CHUNK = 16384
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
-#: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
-_BIG = 1e300
 
 
 @dataclass(frozen=True, eq=False)
@@ -349,110 +346,16 @@ def _children(box, link):
 # -- traversal -----------------------------------------------------------------------------
 
 
-@nb.njit(cache=True, inline="always")
-def _inv(d):
-    return 1.0 / d if d != 0.0 else math.copysign(_BIG, d)
-
-
-@nb.njit(cache=True, inline="always")
-def _enter(b, ox, oy, oz, ix, iy, iz, t1):
-    """Where the ray enters each of a node's two child boxes ``b`` (12,) (:func:`_slab`)."""
-    return _slab(b, 0, ox, oy, oz, ix, iy, iz, t1), _slab(b, 6, ox, oy, oz, ix, iy, iz, t1)
-
-
-@nb.njit(cache=True, inline="always")
-def _ray(O, D, r):
-    """Ray ``r``: origin, direction and the direction's reciprocals (:func:`_inv`)."""
-    dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
-    return O[r, 0], O[r, 1], O[r, 2], dx, dy, dz, _inv(dx), _inv(dy), _inv(dz)
-
-
-@nb.njit(cache=True, inline="always")
-def _slab(b, o, ox, oy, oz, ix, iy, iz, t1):
-    """Where the ray enters the box ``b[o:o + 6]`` within [0, t1], or inf when it does not."""
-    p = (b[o] - ox) * ix
-    q = (b[o + 1] - ox) * ix
-    t0 = min(p, q)
-    tf = max(p, q)
-    p = (b[o + 2] - oy) * iy
-    q = (b[o + 3] - oy) * iy
-    t0 = max(t0, min(p, q))
-    tf = min(tf, max(p, q))
-    p = (b[o + 4] - oz) * iz
-    q = (b[o + 5] - oz) * iz
-    t0 = max(t0, min(p, q), 0.0)
-    tf = min(tf, max(p, q), t1)
-    return t0 if t0 <= tf else math.inf
-
-
-@nb.njit(cache=True, inline="always")
-def _next(stack, sp, ca, cb, ta, tb):
-    """The next inner node: the nearer of the children the ray enters (``t < inf``; the other
-    one is pushed), else the top of the stack; (-1, 0) when nothing is left."""
-    if ta < math.inf and tb < math.inf:
-        if ta <= tb:
-            stack[sp] = cb
-            return ca, sp + 1
-        stack[sp] = ca
-        return cb, sp + 1
-    if ta < math.inf:
-        return ca, sp
-    if tb < math.inf:
-        return cb, sp
-    if sp == 0:
-        return np.int64(-1), 0
-    return stack[sp - 1], sp - 1
-
-
-@nb.njit(cache=True, inline="always")
-def _leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
-    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``q``."""
-    ox, oy, oz, dx, dy, dz = ray
-    first = leaf[q, 0]
-    for j in range(first, first + leaf[q, 1]):
-        t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
-        if t > t_eps and t < tm:
-            return True
-    return False
-
-
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def _any_hit_chunk(r0, r1, rays, tree, eps, out):
     """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) with
     eps = (t_eps, det_eps): out[r] True where the ray is blocked. The leaf that blocked the
     previous ray is tried first (neighbouring rays tend to share their occluder)."""
     O, D, tmax = rays
-    child, cbox, leaf, tri = tree
-    t_eps, det_eps = eps
     stack = np.empty(STACK, np.int64)
     last = np.int64(-1)
     for r in range(r0, r1):
-        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
-        ray = (ox, oy, oz, dx, dy, dz)
-        tm = tmax[r] - t_eps
-        if last >= 0 and _leaf_any(leaf, last, tri, ray, t_eps, tm, det_eps):
-            out[r] = True
-            continue
-        hit = False
-        sp = 0
-        node = 0
-        while True:
-            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, tm)
-            ca, cb = child[node, 0], child[node, 1]
-            if ta < math.inf and ca < 0:
-                if _leaf_any(leaf, ~ca, tri, ray, t_eps, tm, det_eps):
-                    hit, last = True, ~ca
-                    break
-                ta = math.inf
-            if tb < math.inf and cb < 0:
-                if _leaf_any(leaf, ~cb, tri, ray, t_eps, tm, det_eps):
-                    hit, last = True, ~cb
-                    break
-                tb = math.inf
-            node, sp = _next(stack, sp, ca, cb, ta, tb)
-            if node < 0:
-                break
-        out[r] = hit
+        out[r], last = any_one(O, D, tmax, r, tree, eps, stack, last)
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
@@ -464,13 +367,13 @@ def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
     best_t, best_f, bu, bv = out
     stack = np.empty(STACK, np.int64)
     for r in range(r0, r1):
-        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
         best, bf, u_, v_ = best_t[r], np.int64(-1), 0.0, 0.0
         sp = 0
         node = 0
         while True:
             # boxes entered at t == best are still visited: a tie may go to a lower index
-            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, best)
+            ta, tb = enter(cbox[node], ox, oy, oz, ix, iy, iz, best)
             for side in range(2):
                 c = child[node, side]
                 if c >= 0 or (ta if side == 0 else tb) == math.inf:
@@ -486,7 +389,7 @@ def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
                     ta = math.inf
                 else:
                     tb = math.inf
-            node, sp = _next(stack, sp, child[node, 0], child[node, 1], ta, tb)
+            node, sp = next_node(stack, sp, child[node, 0], child[node, 1], ta, tb)
             if node < 0:
                 break
         if bf >= 0:
