@@ -75,6 +75,7 @@ class BVH:
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
     order : (m,) int64 the original index of each triangle in leaf order
+    parent : (k,) int64 each inner node's parent (-1 for the root)
     tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
     normals : (m, 3) float64 its unit normal (zero for a sliver): what
         :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
@@ -85,6 +86,7 @@ class BVH:
     leaf: np.ndarray
     tri: np.ndarray
     order: np.ndarray
+    parent: np.ndarray
     tbox: np.ndarray
     normals: np.ndarray
 
@@ -109,8 +111,9 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
         cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
-        none = np.zeros((0, 9))
-        return BVH(child, cbox, np.zeros((0, 2), np.int64), none, np.zeros(0, np.int64),
+        no = np.zeros(0, np.int64)
+        root = np.full(1, -1, np.int64)
+        return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
                    np.zeros((0, 6), np.float32), np.zeros((0, 3)))  # fmt: skip
     box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
@@ -121,8 +124,16 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     cbox = np.empty(box64.shape, np.float32)
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
-    return BVH(child, cbox, leaf, rows, order, occ.triangle_boxes(rows, pad),
+    return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
                occ.unit_normals(rows))  # fmt: skip
+
+
+def _parents(child) -> np.ndarray:
+    """(k,) int64 the parent of each inner node of ``child`` (k, 2); -1 for the root."""
+    parent = np.full(len(child), -1, np.int64)
+    inner = child >= 0
+    parent[child[inner]] = np.nonzero(inner)[0]
+    return parent
 
 
 # -- building ------------------------------------------------------------------------------
@@ -347,15 +358,15 @@ def _children(box, link):
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def _any_hit_chunk(r0, r1, rays, tree, eps, out):
-    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) with
-    eps = (t_eps, det_eps): out[r] True where the ray is blocked. The leaf that blocked the
-    previous ray is tried first (neighbouring rays tend to share their occluder)."""
+def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
+    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) (``parent``
+    (k,) each inner node's parent) with eps = (t_eps, det_eps): out[r] True where the ray is
+    blocked (:func:`~explorer.geometry.traverse.any_one`)."""
     O, D, tmax = rays
     stack = np.empty(STACK, np.int64)
-    last = np.int64(-1)
+    near = np.int64(-1)
     for r in range(r0, r1):
-        out[r], last = any_one(O, D, tmax, r, tree, eps, stack, last)
+        out[r], near = any_one(O, D, tmax, r, tree, parent, eps, stack, near)
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
@@ -373,7 +384,7 @@ def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
         node = 0
         while True:
             # boxes entered at t == best are still visited: a tie may go to a lower index
-            ta, tb = enter(cbox[node], ox, oy, oz, ix, iy, iz, best)
+            ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, best)
             for side in range(2):
                 c = child[node, side]
                 if c >= 0 or (ta if side == 0 else tb) == math.inf:
@@ -487,11 +498,12 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarra
     O, D = _rays(origins, directions)
     tm = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)))
     hit = np.zeros(len(O), np.bool_)
-    if bvh.n_triangles:
-        if len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
-            bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
-        args = ((O, D, tm), _tree(bvh), (RAY_T_EPS, DET_EPS), hit)
-        run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
+    if not bvh.n_triangles:
+        return hit
+    if len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
+        bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
+    args = ((O, D, tm), _tree(bvh), bvh.parent, (RAY_T_EPS, DET_EPS), hit)
+    run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
     return hit
 
 
@@ -513,7 +525,7 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     args = (bvh.leaf, bvh.tri, bvh.normals, bvh.tbox, (np.int64(kind), L, eps, radius), lbox)
     run_chunks(occ.leaf_boxes, len(bvh.leaf), args, cancelled=cancelled, chunk=FACING_CHUNK)
     cbox = occ.node_boxes(bvh.child, lbox)
-    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.tbox, bvh.normals)
+    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.normals)
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):
