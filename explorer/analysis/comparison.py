@@ -65,12 +65,13 @@ def channel_max(image: np.ndarray) -> np.ndarray:
     return np.maximum(np.maximum(image[..., 0], image[..., 1]), image[..., 2])
 
 
-def compare(vertex_image, reference, coverage) -> Comparison:
+def compare(vertex_image, reference, coverage, *, peak: bool = True) -> Comparison:
     """Compare a per-vertex picture with a per-pixel reference.
 
     vertex_image : (h, w, 3) uint8 from the renderer
     reference : a :class:`~explorer.render.perpixel.Reference` of the same camera and size
     coverage : (h, w) bool, pixels the per-vertex picture's mesh covers (:func:`coverage`)
+    peak : False: leave ``peak`` None (the reference's specular sums are then not computed)
     """
     img = np.asarray(vertex_image)
     ref_img = reference.image()
@@ -83,11 +84,11 @@ def compare(vertex_image, reference, coverage) -> Comparison:
     d = diff[mask].astype(np.float64)
     rmse = float(np.sqrt(np.mean(d * d))) if d.size else 0.0
     worst = int(levels.max()) if mask.any() else 0
-    peak = None
-    p = reference.peak_index()
+    at_peak = None
+    p = reference.peak_index() if peak else None
     if p is not None and mask[p]:
-        peak = int(levels[p])
-    return Comparison(levels, mask, rmse, worst, peak, img, ref_img)
+        at_peak = int(levels[p])
+    return Comparison(levels, mask, rmse, worst, at_peak, img, ref_img)
 
 
 def coverage(renderer, scene, mesh, camera) -> np.ndarray:
@@ -127,7 +128,7 @@ class ViewComparer:
         self._cover.close()
 
     def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto",
-                cancelled=None):  # fmt: skip
+                cancelled=None, peak: bool = True):  # fmt: skip
         """See :func:`compare_view`."""
 
         w, h = self.size
@@ -139,7 +140,7 @@ class ViewComparer:
         _check(cancelled)
         img = self._picture.render(_opaque(scene), mesh, colors, camera=camera)
         cov = coverage(self._cover, scene, mesh, camera)
-        return compare(img, ref, cov)
+        return compare(img, ref, cov, peak=peak)
 
 
 def _check(cancelled) -> None:

@@ -85,6 +85,10 @@ SHADOW_NDL_MARGIN = 1e-6
 #: sides are seen, as VTK draws them).
 PIXEL_RAY_T_MIN = 1e-9
 
+#: Per-pixel reference: an interpolated normal shorter than this (the corners' normals cancel
+#: out) is left zero rather than normalised (no lighting from a direction that is noise).
+SURFACE_NORMAL_MIN = 1e-12
+
 #: BVH (explorer.geometry.bvh): every node's box is grown by this times the mesh's size
 #: (max(largest absolute coordinate, 1)) on each side. The box test then errs only toward
 #: visiting a node: a ray that the Möller-Trumbore test finds hitting a triangle always enters

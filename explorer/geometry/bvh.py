@@ -36,7 +36,7 @@ import numba as nb
 import numpy as np
 
 from explorer.core.errors import Cancelled
-from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
+from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
 from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
@@ -369,45 +369,56 @@ def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
         out[r], near = any_one(O, D, tmax, r, tree, parent, eps, stack, near)
 
 
+@nb.njit(cache=True, inline="always")
+def _leaf_nearest(leaf, q, tri, order, ray, t_min, best):
+    """Leaf ``q``'s hits of the ray ``(ox, oy, oz, dx, dy, dz)`` against best = (t, triangle,
+    u, v, leaf): the nearer hit beyond ``t_min``, at equal ``t`` the lower triangle index."""
+    ox, oy, oz, dx, dy, dz = ray
+    bt, bf, bu, bv, bq = best
+    first = leaf[q, 0]
+    for j in range(first, first + leaf[q, 1]):
+        t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
+        if t > t_min and (t < bt or (t == bt and t < math.inf and (bf < 0 or order[j] < bf))):
+            bt, bf, bu, bv, bq = t, order[j], u, v, q
+    return bt, bf, bu, bv, bq
+
+
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
     """Rays r0..r1 of rays = (O, D) through tree = (child, cbox, leaf, tri); writes the
-    nearest hit into out = (best_t, best_f, bu, bv) (best_t in: the farthest t accepted)."""
+    nearest hit into out = (best_t, best_f, bu, bv) (best_t in: the farthest t accepted).
+    The leaf the previous ray's hit is in is tested first: neighbouring pixels tend to see
+    the same few triangles, and a near ``best`` early keeps the walk from boxes beyond it."""
     O, D = rays
     child, cbox, leaf, tri = tree
     best_t, best_f, bu, bv = out
     stack = np.empty(STACK, np.int64)
+    last = np.int64(-1)
     for r in range(r0, r1):
         ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
-        best, bf, u_, v_ = best_t[r], np.int64(-1), 0.0, 0.0
+        ray = (ox, oy, oz, dx, dy, dz)
+        best = (best_t[r], np.int64(-1), 0.0, 0.0, np.int64(-1))
+        if last >= 0:
+            best = _leaf_nearest(leaf, last, tri, order, ray, t_min, best)
         sp = 0
         node = 0
         while True:
             # boxes entered at t == best are still visited: a tie may go to a lower index
-            ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, best)
-            for side in range(2):
-                c = child[node, side]
-                if c >= 0 or (ta if side == 0 else tb) == math.inf:
-                    continue
-                first = leaf[~c, 0]
-                for j in range(first, first + leaf[~c, 1]):
-                    t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
-                    if t > t_min and (
-                        t < best or (t == best and t < math.inf and (bf < 0 or order[j] < bf))
-                    ):
-                        best, bf, u_, v_ = t, order[j], u, v
-                if side == 0:
-                    ta = math.inf
-                else:
-                    tb = math.inf
-            node, sp = next_node(stack, sp, child[node, 0], child[node, 1], ta, tb)
+            ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, best[0])
+            ca, cb = child[node, 0], child[node, 1]
+            if ca < 0 and ta < math.inf:
+                best = _leaf_nearest(leaf, ~ca, tri, order, ray, t_min, best)
+                ta = math.inf
+            if cb < 0 and tb < math.inf:
+                best = _leaf_nearest(leaf, ~cb, tri, order, ray, t_min, best)
+                tb = math.inf
+            node, sp = next_node(stack, sp, ca, cb, ta, tb)
             if node < 0:
                 break
-        if bf >= 0:
-            best_t[r] = best
-            best_f[r] = bf
-            bu[r] = u_
-            bv[r] = v_
+        if best[1] >= 0:
+            best_t[r], best_f[r], bu[r], bv[r], last = best
+        else:
+            last = np.int64(-1)
 
 
 # -- running in chunks ---------------------------------------------------------------------
@@ -545,3 +556,36 @@ def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None)
         args = ((O, D), float(t_min), _tree(bvh), bvh.order, (best_t, best_f, bu, bv))
         run_chunks(_nearest_chunk, k, args, cancelled=cancelled)
     return best_t, best_f, bu, bv
+
+
+def surface_points(origins, directions, t, triangle, u, v, faces, normals):
+    """The points the rays hit and the normals there (the same numbers as
+    :func:`explorer.geometry.bvh_numpy.surface_points`, compiled).
+
+    origins, directions : (k, 3) float64; t, u, v : (k,) float64; triangle : (k,) int64
+    (:func:`nearest_hits`' answers); faces : (m, 3) int64; normals : (n, 3) float64
+    Returns (hit (k,) bool, positions (h, 3), normals (h, 3)) for the h hits in ray order.
+    """
+    hit = triangle >= 0
+    h = int(hit.sum())
+    pos, n = np.empty((h, 3)), np.empty((h, 3))
+    _surface(origins, directions, t, triangle, u, v, faces, normals, pos, n)
+    return hit, pos, n
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def _surface(O, D, t, f, u, v, faces, normals, pos, nrm):
+    k = 0
+    for r in range(len(f)):
+        if f[r] < 0:
+            continue
+        a, b = u[r], v[r]
+        w = 1.0 - a - b
+        i0, i1, i2 = faces[f[r], 0], faces[f[r], 1], faces[f[r], 2]
+        for c in range(3):
+            pos[k, c] = O[r, c] + t[r] * D[r, c]
+            nrm[k, c] = w * normals[i0, c] + a * normals[i1, c] + b * normals[i2, c]
+        length = math.sqrt(nrm[k, 0] * nrm[k, 0] + nrm[k, 1] * nrm[k, 1] + nrm[k, 2] * nrm[k, 2])
+        for c in range(3):
+            nrm[k, c] = nrm[k, c] / length if length > SURFACE_NORMAL_MIN else 0.0
+        k += 1

@@ -23,6 +23,7 @@ from explorer.core.presets import builtin_dir, load_material_file
 from explorer.core.scene import Viewer
 from explorer.geometry import meshes as M
 from explorer.geometry.meshes import Mesh
+from explorer.render import perpixel as PP
 from explorer.render.camera import (
     Camera,
     apply_camera,
@@ -368,6 +369,20 @@ def test_ray_cast_equals_testing_every_triangle():
     seen = np.isfinite(best)
     assert np.array_equal(h.mask.ravel(), seen) and seen.sum() > 300
     assert np.array_equal(h.positions, origins[seen] + best[seen][:, None] * dirs[seen])
+
+
+def test_specular_sums_are_made_when_first_asked_for(monkeypatch):
+    mesh = M.teapot(4)
+    scene = _scene()
+    calls = []
+    real = PP.specular_sums
+    monkeypatch.setattr(PP, "specular_sums", lambda *a: calls.append(1) or real(*a))
+    ref = reference(scene, mesh, (60, 40))
+    assert not calls  # the colours alone
+    want = real(scene, ref.hits.positions, ref.hits.normals)
+    assert np.array_equal(ref.specular, want) and ref.specular.max() > 0 and calls == [1]
+    assert ref.specular is ref.specular and calls == [1]  # kept
+    assert ref.peak_index() is not None
 
 
 def test_reference_can_be_cancelled():
