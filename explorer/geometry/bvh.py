@@ -226,7 +226,7 @@ def _sah_split(boxes, idx, start, end, axis, c0, c1, node_area, scratch):
     return best_s
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _build(tri, stop):
     """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order,
     pad), or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""

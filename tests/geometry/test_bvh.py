@@ -191,3 +191,13 @@ def test_building_can_be_stopped():
     box, link, order, _ = B._build(tri, np.ones(1, np.uint8))  # the flag a waiting caller sets
     assert len(box) == len(link) == len(order) == 0
     assert B.build_bvh(tri, cancelled=lambda: False).n_triangles == 5000
+
+
+def test_a_build_lets_the_waiting_thread_ask_while_it_runs():
+    """The builder releases the GIL, so the waiting thread asks ``cancelled`` (and takes Ctrl-C)
+    while a large tree is being built, not only once it is done."""
+    tri = _soup(400_000, 11)
+    asked = []
+    with pytest.raises(Cancelled):
+        B.build_bvh(tri, cancelled=lambda: asked.append(1) or len(asked) > 2)
+    assert len(asked) == 3  # before the build, then twice while it ran
