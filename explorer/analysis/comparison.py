@@ -179,6 +179,17 @@ _RAMP = np.array(
 )  # fmt: skip
 
 
+def _ramp(lv: np.ndarray, vmax: float) -> np.ndarray:
+    """(..., 3) uint8 colours of the levels ``lv`` (float64) on the heat map's ramp."""
+    t = np.where(
+        lv <= 0.0, 0.0, 1.0 + (len(_RAMP) - 2) * np.log(np.maximum(lv, 1.0)) / np.log(vmax)
+    )
+    t = np.clip(t, 0.0, len(_RAMP) - 1.0)
+    i = np.minimum(t.astype(np.int64), len(_RAMP) - 2)
+    f = (t - i)[..., None]
+    return np.rint(_RAMP[i] * (1.0 - f) + _RAMP[i + 1] * f).astype(np.uint8)
+
+
 def heat_map(levels, mask=None, *, vmax: float = 16.0, background=(0, 0, 0)) -> np.ndarray:
     """A heat map of per-pixel errors: (h, w, 3) uint8.
 
@@ -188,16 +199,13 @@ def heat_map(levels, mask=None, *, vmax: float = 16.0, background=(0, 0, 0)) -> 
         yellow, red up to ``vmax`` (so 1-level rounding noise stays dark and a missed
         highlight glows)
     """
-    lv = np.asarray(levels, np.float64)
     if vmax <= 1.0:
         raise ExplorerError(f"heat map vmax must be above 1 level, got {vmax}")
-    t = np.where(
-        lv <= 0.0, 0.0, 1.0 + (len(_RAMP) - 2) * np.log(np.maximum(lv, 1.0)) / np.log(vmax)
-    )
-    t = np.clip(t, 0.0, len(_RAMP) - 1.0)
-    i = np.minimum(t.astype(np.int64), len(_RAMP) - 2)
-    f = (t - i)[..., None]
-    out = np.rint(_RAMP[i] * (1.0 - f) + _RAMP[i + 1] * f).astype(np.uint8)
+    lv = np.asarray(levels)
+    if lv.dtype.kind in "iu" and lv.size and 0 <= lv.min() and lv.max() <= 255:
+        out = _ramp(np.arange(256.0), vmax)[lv]  # whole levels: one colour each, looked up
+    else:
+        out = _ramp(lv.astype(np.float64), vmax)
     if mask is not None:
         out[~np.asarray(mask, bool)] = np.asarray(background, np.uint8)
     return out

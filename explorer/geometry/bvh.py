@@ -494,7 +494,7 @@ def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
     return O, D
 
 
-def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarray:
+def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None, refit=True) -> np.ndarray:
     """Whether each ray meets the front side of a triangle between :data:`RAY_T_EPS` and
     ``tmax - RAY_T_EPS`` (the same answer as :func:`explorer.geometry.rays.any_hit`).
 
@@ -504,14 +504,15 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarra
     Returns (k,) bool.
 
     Rays that all go to one light (shadow rays) and are at least 1/:data:`OCCLUDER_RAYS` of
-    the triangles in number go through :func:`toward_light`'s boxes.
+    the triangles in number go through :func:`toward_light`'s boxes (``refit=False``: never;
+    the same answers, for benchmarks).
     """
     O, D = _rays(origins, directions)
     tm = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)))
     hit = np.zeros(len(O), np.bool_)
     if not bvh.n_triangles:
         return hit
-    if len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
+    if refit and len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
         bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
     args = ((O, D, tm), _tree(bvh), bvh.parent, (RAY_T_EPS, DET_EPS), hit)
     run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
