@@ -446,16 +446,20 @@ def _check(cancelled: Callable[[], bool] | None) -> None:
 
 
 def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK) -> None:
-    """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of ``chunk`` rays, on
-    :func:`workers` threads, asking ``cancelled()`` before each chunk.
+    """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of at most ``chunk`` rays, on
+    :func:`workers` threads, asking ``cancelled()`` before each chunk. More than one chunk's
+    worth is cut into equal chunks, a whole number of them per thread (no thread left with a
+    last chunk alone).
 
     Raises :class:`~explorer.core.errors.Cancelled` when ``cancelled()`` returns True. On any
     exception (Ctrl-C too) chunks not started are dropped and the running ones are waited for,
     so nothing writes into the outputs after this returns or raises.
     """
     _check(cancelled)
-    starts = list(range(0, n, chunk))
     threads = workers()
+    if n > chunk and threads > 1:
+        chunk = -(-n // (threads * -(-n // (threads * chunk))))
+    starts = list(range(0, n, chunk))
     if len(starts) <= 1 or threads == 1:
         for s in starts:
             _check(cancelled)
