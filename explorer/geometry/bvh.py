@@ -10,7 +10,11 @@ visits, never drop a triangle. The casts therefore answer exactly what testing e
 answers:
 
 - :func:`any_hit`: whether each ray meets a triangle's front side (``det >= DET_EPS``) at
-  ``t`` in ``(RAY_T_EPS, tmax - RAY_T_EPS)``: shadow rays (:mod:`explorer.shading.shadows`);
+  ``t`` in ``(RAY_T_EPS, tmax - RAY_T_EPS)``: shadow rays (:mod:`explorer.shading.shadows`).
+  Rays that all go to one light walk a copy of the tree whose boxes are refitted around the
+  triangles that can block them (:func:`toward_light`, :mod:`explorer.geometry.occluders`:
+  those facing away from the light), and each ray first walks the subtree just above the leaf
+  that blocked the last blocked ray (:func:`explorer.geometry.traverse.any_one`);
 - :func:`nearest_hits`: the nearest hit, either side, beyond ``t_min``; among hits at the same
   ``t`` the lowest triangle index wins, as in a loop over the triangles in order: the
   per-pixel reference (:mod:`explorer.render.perpixel`).

@@ -17,7 +17,10 @@ Ray engine: :func:`explorer.geometry.bvh.any_hit` through a bounding-volume hier
 mesh (:mod:`explorer.geometry.bvh`), built once per geometry. It runs the same Möller-Trumbore
 test as the brute-force :func:`explorer.geometry.rays.any_hit` on the same numbers, only on the
 triangles whose boxes a ray crosses, so the shadowed vertices are exactly the brute force's.
-Rays run in chunks on the cores; ``cancelled`` (and Ctrl-C) stops them between chunks.
+A light's rays go through the tree's boxes refitted around the triangles that face away from
+it, the only ones that can block them (:mod:`explorer.geometry.occluders`). Rays run in chunks
+on the cores; ``cancelled`` (a :class:`~explorer.shading.shader.Shader`'s ``cancelled``) and
+Ctrl-C stop them between chunks and the tree's build while it runs.
 
 The plan skips rays where they cannot change anything: lights without ``shadows: true``, and
 vertices facing away from the light (N·L <= 0: no diffuse or specular to shadow). It does not
