@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import os
-import signal
-import subprocess
 import sys
 
 import numpy as np
 import pytest
+from helpers.interrupt import interrupt_ray_work
 
 import explorer
 from explorer.core.errors import Cancelled
@@ -112,49 +110,19 @@ def test_a_shader_pass_can_be_cancelled_and_the_next_one_is_whole():
     assert (fresh.colors < explorer.Shader(scene, mesh.positions, mesh.normals).colors).any()
 
 
-#: a render whose shadow-ray chunks are slowed down (each sleeps), so Ctrl-C lands in the rays
-_SLOW_RENDER = """
-import sys, time
-import explorer.geometry.bvh as B
-kernel = B._any_hit_chunk
-def slow(*args):
-    sys.stderr.write("chunk\\n")  # one write: the two threads' lines never interleave
-    sys.stderr.flush()
-    time.sleep(0.1)
-    return kernel(*args)
-B._any_hit_chunk = slow
-from explorer.cli import main
-sys.exit(main(["render", sys.argv[1], "--mesh", "teapot", "--resolution", "40",
-               "--out", sys.argv[2]]))
-"""
-
-
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 def test_ctrl_c_stops_a_render_with_shadows_in_its_rays(tmp_path):
-    """SIGINT in the middle of the shadow rays (two lights, 7 chunks each of 0.1 s or more):
-    the command stops after the chunks already running, with one line and exit status 130,
-    and leaves no file. Counted in chunks, not timed."""
+    """SIGINT in the middle of the shadow rays (two lights, several chunks each of 0.1 s or
+    more): the command stops after the chunks already running, with one line and exit status
+    130, and leaves no file. Counted in chunks, not timed."""
     scene = tmp_path / "scene.yaml"
     scene.write_text("material: gold\nlights:\n" + "".join(
         f"  - {{type: point, position: {p}, shadows: true}}\n"
         for p in ([2, 3, 1.5], [-2.5, 1, 1.5])))  # fmt: skip
-    out = tmp_path / "out.png"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _SLOW_RENDER, str(scene), str(out)],
-        stderr=subprocess.PIPE, text=True, env=env,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )  # fmt: skip
-    try:
-        assert proc.stderr.readline() == "chunk\n"  # the rays have started
-        proc.send_signal(signal.SIGINT)
-        err = proc.communicate(timeout=60)[1]
-    finally:
-        proc.kill()
-    lines = err.splitlines()
-    assert lines.count("chunk") <= 4
-    assert [ln for ln in lines if ln != "chunk"] == [
-        "error: interrupted (Ctrl-C); no unfinished file was left"
-    ]
-    assert proc.returncode == 130
+    argv = ["render", str(scene), "--mesh", "teapot", "--resolution", "40",
+            "--out", str(tmp_path / "out.png")]  # fmt: skip
+    lines, chunks, status = interrupt_ray_work("_any_hit_chunk", argv)
+    assert chunks <= 4
+    assert lines == ["error: interrupted (Ctrl-C); no unfinished file was left"]
+    assert status == 130
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.yaml"]
