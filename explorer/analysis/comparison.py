@@ -202,10 +202,12 @@ def heat_map(levels, mask=None, *, vmax: float = 16.0, background=(0, 0, 0)) -> 
     if vmax <= 1.0:
         raise ExplorerError(f"heat map vmax must be above 1 level, got {vmax}")
     lv = np.asarray(levels)
+    bg = np.asarray(background, np.uint8)
     if lv.dtype.kind in "iu" and lv.size and 0 <= lv.min() and lv.max() <= 255:
-        out = _ramp(np.arange(256.0), vmax)[lv]  # whole levels: one colour each, looked up
-    else:
-        out = _ramp(lv.astype(np.float64), vmax)
+        # whole levels: one colour each, looked up; row 256 is the background
+        table = np.vstack([_ramp(np.arange(256.0), vmax), bg[None, :]])
+        return table[lv if mask is None else np.where(np.asarray(mask, bool), lv, 256)]
+    out = _ramp(lv.astype(np.float64), vmax)
     if mask is not None:
-        out[~np.asarray(mask, bool)] = np.asarray(background, np.uint8)
+        out[~np.asarray(mask, bool)] = bg
     return out
