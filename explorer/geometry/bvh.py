@@ -81,8 +81,9 @@ class BVH:
     order : (m,) int64 the original index of each triangle in leaf order
     parent : (k,) int64 each inner node's parent (-1 for the root)
     tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
-    normals : (m, 3) float64 its unit normal (zero for a sliver): what
-        :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
+    plane : (m, 4) float64 its unit normal and the normal's dot with ``v0`` (zero for a
+        sliver): what :mod:`~explorer.geometry.occluders` refits the boxes from for the rays
+        toward one light
     """
 
     child: np.ndarray
@@ -92,7 +93,7 @@ class BVH:
     order: np.ndarray
     parent: np.ndarray
     tbox: np.ndarray
-    normals: np.ndarray
+    plane: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -118,7 +119,7 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
         no = np.zeros(0, np.int64)
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
-                   np.zeros((0, 6), np.float32), np.zeros((0, 3)))  # fmt: skip
+                   np.zeros((0, 6), np.float32), np.zeros((0, 4)))  # fmt: skip
     box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
@@ -129,7 +130,7 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
     return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
-               occ.unit_normals(rows))  # fmt: skip
+               occ.planes(rows))  # fmt: skip
 
 
 def _parents(child) -> np.ndarray:
@@ -542,10 +543,10 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
     radius = max(float(np.sqrt(corner @ corner)), reach)
     lbox = np.empty((len(bvh.leaf), 6), np.float32)
-    args = (bvh.leaf, bvh.tri, bvh.normals, bvh.tbox, (np.int64(kind), L, eps, radius), lbox)
+    args = (bvh.leaf, bvh.plane, bvh.tbox, (np.int64(kind), L, eps, radius), lbox)
     run_chunks(occ.leaf_boxes, len(bvh.leaf), args, cancelled=cancelled, chunk=FACING_CHUNK)
     cbox = occ.node_boxes(bvh.child, lbox)
-    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.normals)
+    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane)
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):

@@ -19,11 +19,12 @@ Why no blocking triangle is dropped (the margin is
 triangle with corner ``v0`` and a light at ``L``, the triangle is dropped only when the light's
 height over its plane ``h = (L - v0)·n̂`` exceeds both ``μ·(|L - v0| + 2R)`` (``R`` bounds every
 corner's and ray origin's distance from the frame's origin, so ``|L - v0| + 2R`` bounds every
-ray's length to the light) and ``2(ε + ulp)/μ`` (``ε``: how far the rays' ends lie from ``L``).
-A ray from ``O`` then has ``D·n̂ >= (h - (O - v0)·n̂ - ε)/tmax``: when its origin is behind the
-plane this is ``>= μ/2``, so ``-D·n`` is negative by far more than the rounding of ``det``
-(``|n| >= μ·|e1|·|e2|`` is required: slivers are kept); when the origin is in front, the ray's
-plane crossing lies at least ``h·tmax/(O - v0)·n̂`` beyond the light, far beyond rounding and
+ray's length to the light; the kernel tests the larger ``μ(|L| + 3R)``) and ``2(ε + ulp)/μ``
+(``ε``: how far the rays' ends lie from ``L``). A ray from ``O`` then has
+``D·n̂ >= (h - (O - v0)·n̂ - ε)/tmax``. When its origin is behind the plane this is
+``>= μ/2``, so ``-D·n`` is negative by far more than the rounding of ``det`` (``|n| >=
+μ·|e1|·|e2|`` is required: slivers are kept); when the origin is in front, the ray's plane
+crossing lies at least ``h·tmax/(O - v0)·n̂`` beyond the light, far beyond rounding and
 ``RAY_T_EPS``. For a directional light ``D·n̂ > μ`` is required. So every hit the full tree
 reports, the refitted one reports: ``tests/geometry/test_occluders.py`` checks the answers
 against the brute force, lights grazing and near the surface included.
@@ -45,18 +46,20 @@ SHARED_END = 1e-9
 _ULP = 4.0 * 2.0**-53
 
 
-def unit_normals(tri) -> np.ndarray:
-    """(m, 3) float64 unit normals ``e1 × e2 / |e1 × e2|`` of :func:`~explorer.geometry.rays.
-    pack_triangles` rows ``tri`` (m, 9) (``v0, e1, e2``); zero for a sliver (``|e1 × e2| <
-    μ·|e1|·|e2|``) or a degenerate triangle, which is then never dropped."""
+def planes(tri) -> np.ndarray:
+    """(m, 4) float64 the plane of each of :func:`~explorer.geometry.rays.pack_triangles`' rows
+    ``tri`` (m, 9) (``v0, e1, e2``): the unit normal ``n̂ = e1 × e2 / |e1 × e2|`` and ``n̂·v0``;
+    all zero for a sliver (``|e1 × e2| < μ·|e1|·|e2|``) or a degenerate triangle, which is then
+    never dropped."""
     e1, e2 = tri[:, 3:6], tri[:, 6:9]
     n = np.cross(e1, e2)
     length = np.sqrt(np.einsum("ij,ij->i", n, n))
     big = np.sqrt(np.einsum("ij,ij->i", e1, e1) * np.einsum("ij,ij->i", e2, e2))
     keep = length >= OCCLUDER_MARGIN * big
-    unit = np.zeros_like(n)
-    unit[keep] = n[keep] / length[keep, None]
-    return np.ascontiguousarray(unit)
+    out = np.zeros((len(tri), 4))
+    out[keep, :3] = n[keep] / length[keep, None]
+    out[:, 3] = np.einsum("ij,ij->i", out[:, :3], tri[:, 0:3])
+    return out
 
 
 def triangle_boxes(tri, pad: float) -> np.ndarray:
@@ -119,37 +122,41 @@ def shared_end(origins, directions, tmax) -> tuple[int, np.ndarray, float, float
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def leaf_boxes(q0, q1, leaf, tri, normals, tbox, light, lbox):
+def leaf_boxes(q0, q1, leaf, plane, tbox, light, lbox):
     """Leaves q0..q1: lbox[q] (6,) float32 the box of leaf ``q``'s triangles that do not face
     the light with the margin (see the module docstring); empty (x0 > x1) when none.
-    light = (kind, L, ε, R): kind 0 a point ``L``, 1 a direction ``L``; R bounds every
-    corner's and origin's distance from the frame's origin."""
+    plane : (m, 4) :func:`planes`; light = (kind, L, ε, R): kind 0 a point ``L``, 1 a
+    direction ``L``; R bounds every corner's and origin's distance from the frame's origin.
+
+    A triangle faces a point light when ``h = n̂·L - n̂·v0`` exceeds ``μ(|L| + 3R)`` (which
+    bounds ``μ(|L - v0| + 2R)``) and ``2(ε + ulp)/μ``, both grown by the rounding of ``h``."""
     kind, L, eps, R = light
     mu = OCCLUDER_MARGIN
     lx, ly, lz = L[0], L[1], L[2]
-    low = 2.0 * (eps + _ULP * (abs(lx) + abs(ly) + abs(lz) + R)) / mu
+    size = math.sqrt(lx * lx + ly * ly + lz * lz)
+    slack = _ULP * (size + R)
+    low = max(mu * (size + 3.0 * R), 2.0 * (eps + slack) / mu) + 4.0 * slack
+    if kind == 1:
+        low = mu
     inf = np.float32(np.inf)
     for q in range(q0, q1):
-        for a in range(0, 6, 2):
-            lbox[q, a] = inf
-            lbox[q, a + 1] = -inf
+        x0 = y0 = z0 = inf
+        x1 = y1 = z1 = -inf
         first = leaf[q, 0]
         for j in range(first, first + leaf[q, 1]):
-            nx, ny, nz = normals[j, 0], normals[j, 1], normals[j, 2]
-            if kind == 1:
-                facing = lx * nx + ly * ny + lz * nz > mu
-            else:
-                wx, wy, wz = lx - tri[j, 0], ly - tri[j, 1], lz - tri[j, 2]
-                h = wx * nx + wy * ny + wz * nz
-                room = h - 2.0 * mu * R  # h > μ(|w| + 2R)  <=>  room > 0 and room² > μ²|w|²
-                facing = (
-                    h > low and room > 0.0 and room * room > mu * mu * (wx * wx + wy * wy + wz * wz)
-                )
-            if facing:
-                continue
-            for a in range(0, 6, 2):
-                lbox[q, a] = min(lbox[q, a], tbox[j, a])
-                lbox[q, a + 1] = max(lbox[q, a + 1], tbox[j, a + 1])
+            h = lx * plane[j, 0] + ly * plane[j, 1] + lz * plane[j, 2]
+            if kind == 0:
+                h -= plane[j, 3]
+            if h > low:
+                continue  # faces the light: cannot block its rays
+            x0 = min(x0, tbox[j, 0])
+            x1 = max(x1, tbox[j, 1])
+            y0 = min(y0, tbox[j, 2])
+            y1 = max(y1, tbox[j, 3])
+            z0 = min(z0, tbox[j, 4])
+            z1 = max(z1, tbox[j, 5])
+        lbox[q, 0], lbox[q, 1], lbox[q, 2] = x0, x1, y0
+        lbox[q, 3], lbox[q, 4], lbox[q, 5] = y1, z0, z1
 
 
 @nb.njit(cache=True, boundscheck=False)
@@ -167,14 +174,14 @@ def node_boxes(child, lbox):
             nbox[i, a + 1] = -inf
         for s in range(2):
             c = child[i, s]
-            src = lbox[~c] if c < 0 else nbox[c]
-            if src[0] > src[1]:  # empty
+            o = 6 * s
+            for a in range(6):
+                cbox[i, o + a] = lbox[~c, a] if c < 0 else nbox[c, a]
+            if cbox[i, o] > cbox[i, o + 1]:  # empty
                 for a in range(6):
-                    cbox[i, 6 * s + a] = inf
+                    cbox[i, o + a] = inf
                 continue
             for a in range(0, 6, 2):
-                cbox[i, 6 * s + a] = src[a]
-                cbox[i, 6 * s + a + 1] = src[a + 1]
-                nbox[i, a] = min(nbox[i, a], src[a])
-                nbox[i, a + 1] = max(nbox[i, a + 1], src[a + 1])
+                nbox[i, a] = min(nbox[i, a], cbox[i, o + a])
+                nbox[i, a + 1] = max(nbox[i, a + 1], cbox[i, o + a + 1])
     return cbox

@@ -125,8 +125,9 @@ def test_slivers_and_degenerate_triangles_are_never_dropped():
     tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]],
                     [[0, 0, 0], [1, 0, 0], [2, OCCLUDER_MARGIN / 4, 0]],
                     [[0, 0, 0], [1, 1, 1], [2, 2, 2]]], float)  # fmt: skip
-    n = occ.unit_normals(B.pack_triangles(tri))
-    assert np.allclose(n[0], [0, 0, 1]) and not n[1:].any()
+    tri[:, :, 2] += 0.5
+    n = occ.planes(B.pack_triangles(tri))
+    assert np.allclose(n[0], [0, 0, 1, 0.5]) and not n[1:].any()
 
 
 def test_few_rays_keep_the_full_tree(monkeypatch):
