@@ -60,8 +60,6 @@ MEDIAN_DEPTH = 64
 #: (:func:`toward_light`, cost about one ray per 50 triangles) when they number at least the
 #: triangles divided by this
 OCCLUDER_RAYS = 16
-#: leaves per chunk when the triangles facing a light are found
-FACING_CHUNK = 16384
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
 
@@ -542,9 +540,12 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     corner = np.maximum(np.abs(bvh.cbox[0, 0::2]), np.abs(bvh.cbox[0, 1::2])).astype(np.float64)
     corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
     radius = max(float(np.sqrt(corner @ corner)), reach)
+    _check(cancelled)
     lbox = np.empty((len(bvh.leaf), 6), np.float32)
-    args = (bvh.leaf, bvh.plane, bvh.tbox, (np.int64(kind), L, eps, radius), lbox)
-    run_chunks(occ.leaf_boxes, len(bvh.leaf), args, cancelled=cancelled, chunk=FACING_CHUNK)
+    # on this thread: the pass is bound by reading each triangle's 40 bytes once, and handing
+    # it to the pool costs about what a second thread would save
+    occ.leaf_boxes(0, len(bvh.leaf), bvh.leaf, bvh.plane, bvh.tbox,
+                   (np.int64(kind), L, eps, radius), lbox)  # fmt: skip
     cbox = occ.node_boxes(bvh.child, lbox)
     return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane)
 
