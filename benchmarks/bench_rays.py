@@ -28,7 +28,9 @@ Sections (all by default):
   the BVH, the reference's colours, the two renders, the comparison). Run with ``PYTHONPATH``
   on an older checkout, it times what that checkout has (a step it lacks is left out).
 Every figure is wall-clock: median and best of ``--repeat`` runs after a warm-up; the machine
-and its load average are printed with the tables. Compare rows of one run.
+and its load average are printed with the tables. Compare rows of one run. One line gives the
+BVH cast's CPU time per ray instead (every thread's, over ``--repeat`` casts): on a VM whose
+other jobs hold a core, it says what two idle cores would do.
 """
 
 from __future__ import annotations
