@@ -7,25 +7,30 @@ Sections (all by default):
 
 - ``shadows``: the engine's shadow rays on the 100,578-vertex teapot (tessellation 56, 200,256
   triangles) toward a point light, from the vertices with N·L > -margin (the ones the engine
-  casts from): rays per second through the BVH (:func:`explorer.geometry.bvh.any_hit`, every
-  thread), the brute force (:func:`explorer.geometry.rays.any_hit`, every triangle, every
-  thread) on a random sample of the same rays (its cost per ray does not depend on the count),
-  and, when the package is installed, embreex's occlusion query on the same rays (float32, one
-  call: its answers count back faces as occluders, so they differ; how many is printed).
+  casts from; the others face away and need no ray): rays per second through the BVH as the
+  engine casts them (:func:`explorer.geometry.bvh.any_hit`, every thread: the boxes refitted
+  around the triangles that can block this light, then the rays), the refit alone, the rays
+  alone through the refitted boxes, the same rays through the full tree (``refit=False``), the
+  brute force (:func:`explorer.geometry.rays.any_hit`, every triangle, every thread) on a
+  random sample of the same rays (its cost per ray does not depend on the count), and, when
+  the package is installed, embreex's occlusion query on the same rays (float32, one call: its
+  answers count back faces as occluders, so they differ; how many is printed).
 - ``scaling``: the same on tori from 1,024 to 1,048,576 triangles (a point light near the
   ring's plane, so the far side is shadowed), with the BVH's build time.
 - ``engine``: a float32 :class:`explorer.Shader` on the 100k-vertex teapot with two point
   lights that cast shadows: the first colours (BVH build and both lights' rays), then one
   update after a light moves (that light's rays again), next to the same update without
   shadows.
-- ``view``: the per-pixel reference and the difference view's comparison
-  (:class:`explorer.analysis.comparison.ViewComparer`, windows reused) of the window's default
-  teapot (tessellation 24, 18,530 vertices) at the window's default size (1100x720). This
-  section uses only what the revisions before the BVH had too, so the same command run with
-  ``PYTHONPATH`` on an older checkout times the old code.
-
+- ``view``: the window's difference view of its default teapot (tessellation 24, 18,530
+  vertices) at the window's default size (1100x720): one comparison as the window's worker
+  makes it (:func:`explorer.app.difference.run_job` on kept off-screen windows: per-pixel
+  reference, two off-screen renders, difference, heat map), and its steps (pixel rays through
+  the BVH, the reference's colours, the two renders, the comparison). Run with ``PYTHONPATH``
+  on an older checkout, it times what that checkout has (a step it lacks is left out).
 Every figure is wall-clock: median and best of ``--repeat`` runs after a warm-up; the machine
-and its load average are printed with the tables. Compare rows of one run.
+and its load average are printed with the tables. Compare rows of one run. One line gives the
+BVH cast's CPU time per ray instead (every thread's, over ``--repeat`` casts): on a VM whose
+other jobs hold a core, it says what two idle cores would do.
 """
 
 from __future__ import annotations
@@ -110,23 +115,25 @@ def measure_rays(mesh, repeat: int, light=LIGHT, embree: bool = True) -> dict:
     tree = B.build_bvh(tri)
     build = time.perf_counter() - t
     med, best = timed(lambda: B.any_hit(tree, O, D, tmax), repeat)
-    hit = B.any_hit(tree, O, D, tmax)
+    cpu = time.process_time()  # every thread's
+    for _ in range(repeat):
+        hit = B.any_hit(tree, O, D, tmax)
+    cpu = (time.process_time() - cpu) / repeat
+    row = {"triangles": len(tri), "rays": distinct, "cast": len(O), "build_s": build,
+           "bvh": len(O) / med, "bvh_best": len(O) / best, "cpu_ns": cpu / len(O) * 1e9,
+           "shadowed": float(hit.mean())}  # fmt: skip
+    if hasattr(B, "toward_light"):  # the refit for one light, then the rays alone
+        fmed, _ = timed(lambda: B.toward_light(tree, O, D, tmax), repeat)
+        light_tree = B.toward_light(tree, O, D, tmax)
+        cmed, _ = timed(lambda: B.any_hit(light_tree, O, D, tmax, refit=False), repeat)
+        full, _ = timed(lambda: B.any_hit(tree, O, D, tmax, refit=False), repeat)
+        same = np.array_equal(B.any_hit(tree, O, D, tmax, refit=False), hit)
+        row.update(refit_ms=fmed * 1e3, alone=len(O) / cmed, full=len(O) / full, same_full=same)
     k = int(np.clip(BRUTE_TESTS / len(tri), 50, len(O)))
     pick = np.random.default_rng(0).choice(len(O), k, replace=False)
     bmed, bbest = timed(lambda: brute(O[pick], D[pick], tmax[pick], tri), max(1, repeat // 3))
-    same = bool(np.array_equal(brute(O[pick], D[pick], tmax[pick], tri), hit[pick]))
-    row = {
-        "triangles": len(tri),
-        "rays": distinct,
-        "cast": len(O),
-        "build_s": build,
-        "bvh": len(O) / med,
-        "bvh_best": len(O) / best,
-        "brute": k / bmed,
-        "brute_rays": k,
-        "same": same,
-        "shadowed": float(hit.mean()),
-    }
+    row["same"] = bool(np.array_equal(brute(O[pick], D[pick], tmax[pick], tri), hit[pick]))
+    row.update(brute=k / bmed, brute_rays=k)
     if embree and _has("embreex"):
         row.update(embree_rays(O, D, tmax, tri, hit, repeat))
     return row
@@ -205,38 +212,56 @@ def section_shadows(repeat: int) -> None:
     r = measure_rays(mesh, repeat)
     print(f"\n## Shadow rays, 100k-vertex teapot ({mesh.n_vertices:,} vertices, "
           f"{r['triangles']:,} triangles), point light at {list(LIGHT)}\n")  # fmt: skip
-    print(f"{r['rays']:,} rays (the vertices with N·L > -margin), {r['shadowed']:.1%} shadowed")
+    print(f"{r['rays']:,} rays cast (the vertices with N·L > -margin; the other "
+          f"{mesh.n_vertices - r['rays']:,} face away and need none), {r['shadowed']:.1%} "
+          f"shadowed; per vertex of the mesh that is {mesh.n_vertices / r['rays']:.2f}x the "
+          "rays per second below")  # fmt: skip
     print("\n| ray engine | M rays/s (median) | best | vs brute force | build s |")
     print("|---|---:|---:|---:|---:|")
-    print(f"| BVH (numba) | {r['bvh'] / 1e6:.2f} | {r['bvh_best'] / 1e6:.2f} | "
-          f"{r['bvh'] / r['brute']:,.0f}x | {r['build_s']:.2f} |")  # fmt: skip
+    x = r["brute"]
+    refit = f" (of which the refit {r['refit_ms']:.1f} ms)" if "refit_ms" in r else ""
+    print(f"| BVH (numba), as the engine casts: refit for the light + rays{refit} | "
+          f"{r['bvh'] / 1e6:.2f} | {r['bvh_best'] / 1e6:.2f} | {r['bvh'] / x:,.0f}x | "
+          f"{r['build_s']:.2f} |")  # fmt: skip
+    if "alone" in r:
+        print(f"| BVH, the rays alone through the refitted boxes | {r['alone'] / 1e6:.2f} | | "
+              f"{r['alone'] / x:,.0f}x | |")  # fmt: skip
+        print(f"| BVH, the rays through the full tree (refit=False) | {r['full'] / 1e6:.2f} | | "
+              f"{r['full'] / x:,.0f}x | |")  # fmt: skip
     print(f"| brute force (every triangle; {r['brute_rays']:,} of the rays) | "
-          f"{r['brute'] / 1e6:.4f} | | 1x | 0 |")  # fmt: skip
+          f"{x / 1e6:.4f} | | 1x | 0 |")  # fmt: skip
     if "embree" in r:
         print(f"| embreex occlusion (float32, one thread, back faces occlude: answers differ on "
               f"{r['embree_differs']:.1%} of the rays) | {r['embree'] / 1e6:.2f} | | "
-              f"{r['embree'] / r['brute']:,.0f}x | {r['embree_build_s']:.2f} |")  # fmt: skip
+              f"{r['embree'] / x:,.0f}x | {r['embree_build_s']:.2f} |")  # fmt: skip
         print(f"| embreex occlusion, the rays in two halves on two threads | "
               f"{r['embree_two_threads'] / 1e6:.2f} | | "
-              f"{r['embree_two_threads'] / r['brute']:,.0f}x | |")  # fmt: skip
+              f"{r['embree_two_threads'] / x:,.0f}x | |")  # fmt: skip
         rule = r["embree_rule"]
         print(f"| embreex nearest hits through back faces (the engine's rule; float32, one "
               f"thread: answers differ on {r['embree_rule_differs']:.2%}) | "
-              f"{rule / 1e6:.2f} | | {rule / r['brute']:,.0f}x | |")  # fmt: skip
-    print(f"\nBVH answers equal the brute force's on its sample: {r['same']}")
+              f"{rule / 1e6:.2f} | | {rule / x:,.0f}x | |")  # fmt: skip
+    print(
+        f"\nCPU time of one BVH cast (every thread, refit included): {r['cpu_ns']:.0f} ns per "
+        f"ray, i.e. {2e3 / r['cpu_ns']:.1f} M rays/s if two idle cores shared it evenly"
+    )
+    same_full = f"; with the full tree: {r['same_full']}" if "same_full" in r else ""
+    print(f"\nBVH answers equal the brute force's on its sample: {r['same']}{same_full}")
 
 
 def section_scaling(repeat: int) -> None:
     print("\n## Scaling: tori, point light near the ring's plane\n")
-    print(f"(a mesh with fewer than {MIN_RAYS:,} rays casts them repeatedly up to that many)\n")
-    print("| triangles | rays | build s | BVH M rays/s | brute force M rays/s | BVH / brute | "
-          "shadowed | equal |")  # fmt: skip
-    print("|---:|---:|---:|---:|---:|---:|---:|---|")
+    print(f"(a mesh with fewer than {MIN_RAYS:,} rays casts them repeatedly up to that many; "
+          "BVH = as the engine casts, refit included; full tree = refit=False)\n")  # fmt: skip
+    print("| triangles | rays | build s | BVH M rays/s | full tree M rays/s | brute force M rays/s "
+          "| BVH / brute | shadowed | equal |")  # fmt: skip
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for res in (32, 100, 316, 1000):
         r = measure_rays(get_mesh("torus", res), repeat, light=(2.5, 0.6, 0.5), embree=False)
+        full = f"{r['full'] / 1e6:.2f}" if "full" in r else "-"
         print(f"| {r['triangles']:,} | {r['rays']:,} | {r['build_s']:.3f} | {r['bvh'] / 1e6:.2f} | "
-              f"{r['brute'] / 1e6:.4f} | {r['bvh'] / r['brute']:,.0f}x | {r['shadowed']:.1%} | "
-              f"{r['same']} |")  # fmt: skip
+              f"{full} | {r['brute'] / 1e6:.4f} | {r['bvh'] / r['brute']:,.0f}x | "
+              f"{r['shadowed']:.1%} | {r['same'] and r.get('same_full', True)} |")  # fmt: skip
         sys.stdout.flush()
 
 
@@ -281,23 +306,56 @@ def section_engine(repeat: int) -> None:
 
 
 def section_view(repeat: int) -> None:
-    from explorer.analysis.comparison import ViewComparer
+    from explorer.analysis import comparison as C
+    from explorer.render import perpixel as PP
     from explorer.render.camera import camera_for
-    from explorer.render.perpixel import reference
+    from explorer.shading.display import vertex_colors
 
     mesh = get_mesh("teapot", 24)
     size = (1100, 720)
     scene = load_scene({"material": "gold", "lights": [{"type": "point", "position": [2, 3, 2]}]})
     cam = camera_for(scene, mesh, size[0] / size[1])
+    colors = vertex_colors(scene, mesh)
     print(f"\n## Difference view: {mesh.n_vertices:,}-vertex teapot at {size[0]}x{size[1]}\n")
     print("| step | median ms | best ms |")
     print("|---|---:|---:|")
-    med, best = timed(lambda: reference(scene, mesh, size, camera=cam), repeat)
-    print(f"| per-pixel reference (ray cast + colours) | {med * 1e3:.0f} | {best * 1e3:.0f} |")
-    with ViewComparer(size) as v:
-        med, best = timed(lambda: v.compare(scene, mesh, camera=cam), repeat)
-    print(f"| comparison (reference + 2 off-screen renders + difference) | {med * 1e3:.0f} | "
-          f"{best * 1e3:.0f} |")  # fmt: skip
+
+    def row(what, f):
+        med, best = timed(f, repeat)
+        print(f"| {what} | {med * 1e3:.0f} | {best * 1e3:.0f} |")
+        sys.stdout.flush()
+
+    with C.ViewComparer(size) as v:
+        try:
+            from explorer.app.difference import Job, run_job
+        except ImportError:  # a checkout without the window
+            run_job = None
+        if run_job is not None:
+            job = Job(0, scene, mesh, colors, cam, size, (0.1, 0.1, 0.1))
+            try:
+                run_job(job, comparer=v)
+                row("one comparison as the window's worker makes it (windows kept)",
+                    lambda: run_job(job, comparer=v))  # fmt: skip
+            except TypeError:  # a worker that makes new windows for every comparison
+                row("one comparison as the window's worker makes it (new windows)",
+                    lambda: run_job(job))  # fmt: skip
+        row("comparison (reference + 2 off-screen renders + difference), windows kept",
+            lambda: v.compare(scene, mesh, camera=cam, colors=colors))  # fmt: skip
+        h = PP.mesh_hits(cam, size, mesh)
+        row(f"step: pixel rays through the BVH, hit points and normals ({len(h.positions):,} "
+            "hits)", lambda: PP.mesh_hits(cam, size, mesh))  # fmt: skip
+        row("step: the reference's colours",
+            lambda: PP.point_colors(scene, h.positions, h.normals, mesh=mesh))  # fmt: skip
+        row("step: the specular sums (the highlight peak; the window does not show it)",
+            lambda: PP.specular_sums(scene, h.positions, h.normals))  # fmt: skip
+        row("step: the two off-screen renders (picture and coverage)",
+            lambda: (v._picture.render(C._opaque(scene), mesh, colors, camera=cam),
+                     C.coverage(v._cover, scene, mesh, cam)))  # fmt: skip
+        img = v._picture.render(C._opaque(scene), mesh, colors, camera=cam)
+        cov = C.coverage(v._cover, scene, mesh, cam)
+        ref = PP.reference(scene, mesh, size, camera=cam)
+        _ = ref.specular
+        row("step: the difference of the pictures", lambda: C.compare(img, ref, cov))
 
 
 def main(argv=None) -> int:

@@ -65,12 +65,13 @@ def channel_max(image: np.ndarray) -> np.ndarray:
     return np.maximum(np.maximum(image[..., 0], image[..., 1]), image[..., 2])
 
 
-def compare(vertex_image, reference, coverage) -> Comparison:
+def compare(vertex_image, reference, coverage, *, peak: bool = True) -> Comparison:
     """Compare a per-vertex picture with a per-pixel reference.
 
     vertex_image : (h, w, 3) uint8 from the renderer
     reference : a :class:`~explorer.render.perpixel.Reference` of the same camera and size
     coverage : (h, w) bool, pixels the per-vertex picture's mesh covers (:func:`coverage`)
+    peak : False: leave ``peak`` None (the reference's specular sums are then not computed)
     """
     img = np.asarray(vertex_image)
     ref_img = reference.image()
@@ -83,11 +84,11 @@ def compare(vertex_image, reference, coverage) -> Comparison:
     d = diff[mask].astype(np.float64)
     rmse = float(np.sqrt(np.mean(d * d))) if d.size else 0.0
     worst = int(levels.max()) if mask.any() else 0
-    peak = None
-    p = reference.peak_index()
+    at_peak = None
+    p = reference.peak_index() if peak else None
     if p is not None and mask[p]:
-        peak = int(levels[p])
-    return Comparison(levels, mask, rmse, worst, peak, img, ref_img)
+        at_peak = int(levels[p])
+    return Comparison(levels, mask, rmse, worst, at_peak, img, ref_img)
 
 
 def coverage(renderer, scene, mesh, camera) -> np.ndarray:
@@ -127,7 +128,7 @@ class ViewComparer:
         self._cover.close()
 
     def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto",
-                cancelled=None):  # fmt: skip
+                cancelled=None, peak: bool = True):  # fmt: skip
         """See :func:`compare_view`."""
 
         w, h = self.size
@@ -139,7 +140,7 @@ class ViewComparer:
         _check(cancelled)
         img = self._picture.render(_opaque(scene), mesh, colors, camera=camera)
         cov = coverage(self._cover, scene, mesh, camera)
-        return compare(img, ref, cov)
+        return compare(img, ref, cov, peak=peak)
 
 
 def _check(cancelled) -> None:
@@ -178,6 +179,17 @@ _RAMP = np.array(
 )  # fmt: skip
 
 
+def _ramp(lv: np.ndarray, vmax: float) -> np.ndarray:
+    """(..., 3) uint8 colours of the levels ``lv`` (float64) on the heat map's ramp."""
+    t = np.where(
+        lv <= 0.0, 0.0, 1.0 + (len(_RAMP) - 2) * np.log(np.maximum(lv, 1.0)) / np.log(vmax)
+    )
+    t = np.clip(t, 0.0, len(_RAMP) - 1.0)
+    i = np.minimum(t.astype(np.int64), len(_RAMP) - 2)
+    f = (t - i)[..., None]
+    return np.rint(_RAMP[i] * (1.0 - f) + _RAMP[i + 1] * f).astype(np.uint8)
+
+
 def heat_map(levels, mask=None, *, vmax: float = 16.0, background=(0, 0, 0)) -> np.ndarray:
     """A heat map of per-pixel errors: (h, w, 3) uint8.
 
@@ -187,16 +199,15 @@ def heat_map(levels, mask=None, *, vmax: float = 16.0, background=(0, 0, 0)) -> 
         yellow, red up to ``vmax`` (so 1-level rounding noise stays dark and a missed
         highlight glows)
     """
-    lv = np.asarray(levels, np.float64)
     if vmax <= 1.0:
         raise ExplorerError(f"heat map vmax must be above 1 level, got {vmax}")
-    t = np.where(
-        lv <= 0.0, 0.0, 1.0 + (len(_RAMP) - 2) * np.log(np.maximum(lv, 1.0)) / np.log(vmax)
-    )
-    t = np.clip(t, 0.0, len(_RAMP) - 1.0)
-    i = np.minimum(t.astype(np.int64), len(_RAMP) - 2)
-    f = (t - i)[..., None]
-    out = np.rint(_RAMP[i] * (1.0 - f) + _RAMP[i + 1] * f).astype(np.uint8)
+    lv = np.asarray(levels)
+    bg = np.asarray(background, np.uint8)
+    if lv.dtype.kind in "iu" and lv.size and 0 <= lv.min() and lv.max() <= 255:
+        # whole levels: one colour each, looked up; row 256 is the background
+        table = np.vstack([_ramp(np.arange(256.0), vmax), bg[None, :]])
+        return table[lv if mask is None else np.where(np.asarray(mask, bool), lv, 256)]
+    out = _ramp(lv.astype(np.float64), vmax)
     if mask is not None:
-        out[~np.asarray(mask, bool)] = np.asarray(background, np.uint8)
+        out[~np.asarray(mask, bool)] = bg
     return out

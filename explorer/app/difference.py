@@ -10,7 +10,8 @@ mesh, material and lights. The error of each pixel, in 1/255 levels, is drawn wi
 hidden, so the map sits exactly where the mesh is drawn.
 
 One comparison costs two off-screen renders and the per-pixel reference, so it runs in
-:class:`DifferenceWorker`'s thread: a new request cancels the one running (``compare_view``'s
+:class:`DifferenceWorker`'s thread (which keeps its off-screen windows from one comparison to
+the next while the view's size holds): a new request cancels the one running (``compare_view``'s
 ``cancelled`` callable stops its ray casts between chunks; a result that finishes anyway is
 dropped), so frames keep coming and a stale map is never shown as the current one. No Qt here: the
 worker hands results to a callback, which the window forwards to its GUI thread.
@@ -64,11 +65,19 @@ class Result:
     error: BaseException | None = None
 
 
-def run_job(job: Job, cancelled=lambda: False) -> Result:
-    """Make one comparison (in any thread)."""
+def run_job(job: Job, cancelled=lambda: False, comparer=None) -> Result:
+    """Make one comparison (in any thread).
+
+    comparer : a :class:`~explorer.analysis.comparison.ViewComparer` of ``job.size`` made in
+        this thread, whose off-screen windows are reused (default: new ones for this job)
+    The highlight peak's error is not computed (the map and its legend do not show it).
+    """
     t = time.perf_counter()
-    c = C.compare_view(job.scene, job.mesh, job.size, camera=job.camera, colors=job.colors,
-                       cancelled=cancelled)  # fmt: skip
+    if comparer is None:
+        with C.ViewComparer(job.size) as own:
+            return run_job(job, cancelled, own)
+    c = comparer.compare(job.scene, job.mesh, camera=job.camera, colors=job.colors,
+                         cancelled=cancelled, peak=False)  # fmt: skip
     bg = tuple(int(v) for v in to_bytes([job.background])[0])
     image = C.heat_map(c.levels, c.mask, vmax=VMAX, background=bg)
     m = job.scene.material
@@ -122,26 +131,33 @@ class DifferenceWorker:
         self._thread.join(timeout)
 
     def _loop(self) -> None:
-        while True:
-            with self._lock:
-                while self._pending is None and not self._closed:
-                    self._lock.wait()
-                if self._closed:
-                    return
-                job, self._pending, self._running = self._pending, None, self._pending
-                self._cancel = cancel = threading.Event()
-            try:
-                result = run_job(job, cancel.is_set)
-            except Exception as exc:  # noqa: BLE001 - handed to the window, which shows it
-                if isinstance(exc, Cancelled):
-                    result = None
-                else:
-                    result = Result(job, error=exc)
-            with self._lock:
-                self._running = None
-                stale = cancel.is_set() or self._closed
-            if result is not None and not stale:
-                self._deliver(result)
+        comparer = None  # off-screen windows made in this thread, kept while the size holds
+        try:
+            while True:
+                with self._lock:
+                    while self._pending is None and not self._closed:
+                        self._lock.wait()
+                    if self._closed:
+                        return
+                    job, self._pending, self._running = self._pending, None, self._pending
+                    self._cancel = cancel = threading.Event()
+                try:
+                    if comparer is not None and comparer.size != tuple(job.size):
+                        comparer.close()
+                        comparer = None
+                    if comparer is None:
+                        comparer = C.ViewComparer(job.size)
+                    result = run_job(job, cancel.is_set, comparer)
+                except Exception as exc:  # noqa: BLE001 - handed to the window, which shows it
+                    result = None if isinstance(exc, Cancelled) else Result(job, error=exc)
+                with self._lock:
+                    self._running = None
+                    stale = cancel.is_set() or self._closed
+                if result is not None and not stale:
+                    self._deliver(result)
+        finally:
+            if comparer is not None:
+                comparer.close()
 
 
 class HeatMap:

@@ -85,12 +85,24 @@ SHADOW_NDL_MARGIN = 1e-6
 #: sides are seen, as VTK draws them).
 PIXEL_RAY_T_MIN = 1e-9
 
+#: Per-pixel reference: an interpolated normal shorter than this (the corners' normals cancel
+#: out) is left zero rather than normalised (no lighting from a direction that is noise).
+SURFACE_NORMAL_MIN = 1e-12
+
 #: BVH (explorer.geometry.bvh): every node's box is grown by this times the mesh's size
 #: (max(largest absolute coordinate, 1)) on each side. The box test then errs only toward
 #: visiting a node: a ray that the Möller-Trumbore test finds hitting a triangle always enters
 #: the boxes above it despite rounding, so the BVH reports exactly the hits of testing every
 #: triangle.
 BVH_BOX_PAD = 1e-9
+
+#: Shadow rays toward one light (explorer.geometry.occluders): a triangle is left out of the
+#: casts when the light is in front of it by more than this times the longest ray (sine of the
+#: angle between the triangle's plane and the light), and it is no sliver (|e1 × e2| >= this
+#: times |e1|·|e2|). Then every ray toward the light meets its plane from behind with a
+#: determinant below -OCCLUDER_MARGIN² |e1| |e2|, a thousand times the determinant's rounding,
+#: or beyond the light: it cannot block one (the module docstring has the argument).
+OCCLUDER_MARGIN = 1e-6
 
 # --- float32 fast path ----------------------------------------------------------------------
 

@@ -10,7 +10,11 @@ visits, never drop a triangle. The casts therefore answer exactly what testing e
 answers:
 
 - :func:`any_hit`: whether each ray meets a triangle's front side (``det >= DET_EPS``) at
-  ``t`` in ``(RAY_T_EPS, tmax - RAY_T_EPS)``: shadow rays (:mod:`explorer.shading.shadows`);
+  ``t`` in ``(RAY_T_EPS, tmax - RAY_T_EPS)``: shadow rays (:mod:`explorer.shading.shadows`).
+  Rays that all go to one light walk a copy of the tree whose boxes are refitted around the
+  triangles that can block them (:func:`toward_light`, :mod:`explorer.geometry.occluders`:
+  those facing away from the light), and each ray first walks the subtree just above the leaf
+  that blocked the last blocked ray (:func:`explorer.geometry.traverse.any_one`);
 - :func:`nearest_hits`: the nearest hit, either side, beyond ``t_min``; among hits at the same
   ``t`` the lowest triangle index wins, as in a loop over the triangles in order: the
   per-pixel reference (:mod:`explorer.render.perpixel`).
@@ -36,8 +40,10 @@ import numba as nb
 import numpy as np
 
 from explorer.core.errors import Cancelled
-from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
+from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
+from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
+from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
 
 #: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
 CHUNK = 8192
@@ -50,12 +56,12 @@ BINS = 16
 #: below this depth the builder splits by the heuristic; deeper, at the median (so the tree
 #: is never deeper than about MEDIAN_DEPTH + log2(triangles))
 MEDIAN_DEPTH = 64
-#: the traversal stack; MEDIAN_DEPTH + 64 levels holds any mesh that fits in memory
-STACK = 128
+#: shadow rays go through boxes refitted around their light's possible occluders
+#: (:func:`toward_light`, cost about one ray per 50 triangles) when they number at least the
+#: triangles divided by this
+OCCLUDER_RAYS = 16
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
-#: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
-_BIG = 1e300
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,6 +77,11 @@ class BVH:
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
     order : (m,) int64 the original index of each triangle in leaf order
+    parent : (k,) int64 each inner node's parent (-1 for the root)
+    tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
+    plane : (m, 4) float64 its unit normal and the normal's dot with ``v0`` (zero for a
+        sliver): what :mod:`~explorer.geometry.occluders` refits the boxes from for the rays
+        toward one light
     """
 
     child: np.ndarray
@@ -78,6 +89,9 @@ class BVH:
     leaf: np.ndarray
     tri: np.ndarray
     order: np.ndarray
+    parent: np.ndarray
+    tbox: np.ndarray
+    plane: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -100,8 +114,11 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
         cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
-        return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), np.zeros(0, np.int64))
-    box, link, order = _stoppable(_build, (tri,), cancelled)
+        no = np.zeros(0, np.int64)
+        root = np.full(1, -1, np.int64)
+        return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
+                   np.zeros((0, 6), np.float32), np.zeros((0, 4)))  # fmt: skip
+    box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
     hi32 = box64[:, 1::2].astype(np.float32)
@@ -109,7 +126,17 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     hi32 = np.where(hi32 < box64[:, 1::2], np.nextafter(hi32, np.float32(np.inf)), hi32)
     cbox = np.empty(box64.shape, np.float32)
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
-    return BVH(child, cbox, leaf, np.ascontiguousarray(pack_triangles(tri)[order]), order)
+    rows = np.ascontiguousarray(pack_triangles(tri)[order])
+    return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
+               occ.planes(rows))  # fmt: skip
+
+
+def _parents(child) -> np.ndarray:
+    """(k,) int64 the parent of each inner node of ``child`` (k, 2); -1 for the root."""
+    parent = np.full(len(child), -1, np.int64)
+    inner = child >= 0
+    parent[child[inner]] = np.nonzero(inner)[0]
+    return parent
 
 
 # -- building ------------------------------------------------------------------------------
@@ -202,10 +229,10 @@ def _sah_split(boxes, idx, start, end, axis, c0, c1, node_area, scratch):
     return best_s
 
 
-@nb.njit(cache=True)
+@nb.njit(cache=True, nogil=True)
 def _build(tri, stop):
-    """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order),
-    or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""
+    """Top-down build over ``tri`` (m, 3, 3) in depth-first order; returns (box, link, order,
+    pad), or empty arrays when ``stop[0]`` became non-zero (it is read every 1024 nodes)."""
     m = tri.shape[0]
     lo = np.empty((m, 3))
     hi = np.empty((m, 3))
@@ -233,7 +260,7 @@ def _build(tri, stop):
     boxes = (lo, hi, cent)
     while sp > 0:
         if n_nodes % 1024 == 0 and stop[0]:
-            return box[:0].copy(), link[:0].copy(), idx[:0].copy()
+            return box[:0].copy(), link[:0].copy(), idx[:0].copy(), pad
         sp -= 1
         start, end, parent, depth = st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3]
         node = n_nodes
@@ -288,7 +315,7 @@ def _build(tri, stop):
         st[sp, 0], st[sp, 1], st[sp, 2], st[sp, 3] = mid, end, node, depth + 1
         st[sp + 1, 0], st[sp + 1, 1], st[sp + 1, 2], st[sp + 1, 3] = start, mid, -1, depth + 1
         sp += 2
-    return box[:n_nodes].copy(), link[:n_nodes].copy(), idx
+    return box[:n_nodes].copy(), link[:n_nodes].copy(), idx, pad
 
 
 @nb.njit(cache=True)
@@ -333,145 +360,68 @@ def _children(box, link):
 # -- traversal -----------------------------------------------------------------------------
 
 
-@nb.njit(cache=True, inline="always")
-def _inv(d):
-    return 1.0 / d if d != 0.0 else math.copysign(_BIG, d)
-
-
-@nb.njit(cache=True, inline="always")
-def _enter(b, ox, oy, oz, ix, iy, iz, t1):
-    """Where the ray enters each of a node's two child boxes ``b`` (12,) (:func:`_slab`)."""
-    return _slab(b, 0, ox, oy, oz, ix, iy, iz, t1), _slab(b, 6, ox, oy, oz, ix, iy, iz, t1)
-
-
-@nb.njit(cache=True, inline="always")
-def _ray(O, D, r):
-    """Ray ``r``: origin, direction and the direction's reciprocals (:func:`_inv`)."""
-    dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
-    return O[r, 0], O[r, 1], O[r, 2], dx, dy, dz, _inv(dx), _inv(dy), _inv(dz)
-
-
-@nb.njit(cache=True, inline="always")
-def _slab(b, o, ox, oy, oz, ix, iy, iz, t1):
-    """Where the ray enters the box ``b[o:o + 6]`` within [0, t1], or inf when it does not."""
-    p = (b[o] - ox) * ix
-    q = (b[o + 1] - ox) * ix
-    t0 = min(p, q)
-    tf = max(p, q)
-    p = (b[o + 2] - oy) * iy
-    q = (b[o + 3] - oy) * iy
-    t0 = max(t0, min(p, q))
-    tf = min(tf, max(p, q))
-    p = (b[o + 4] - oz) * iz
-    q = (b[o + 5] - oz) * iz
-    t0 = max(t0, min(p, q), 0.0)
-    tf = min(tf, max(p, q), t1)
-    return t0 if t0 <= tf else math.inf
-
-
-@nb.njit(cache=True, inline="always")
-def _next(stack, sp, ca, cb, ta, tb):
-    """The next inner node: the nearer of the children the ray enters (``t < inf``; the other
-    one is pushed), else the top of the stack; (-1, 0) when nothing is left."""
-    if ta < math.inf and tb < math.inf:
-        if ta <= tb:
-            stack[sp] = cb
-            return ca, sp + 1
-        stack[sp] = ca
-        return cb, sp + 1
-    if ta < math.inf:
-        return ca, sp
-    if tb < math.inf:
-        return cb, sp
-    if sp == 0:
-        return np.int64(-1), 0
-    return stack[sp - 1], sp - 1
-
-
-@nb.njit(cache=True, inline="always")
-def _leaf_any(leaf, c, tri, ray, t_eps, tm, det_eps):
-    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``~c``."""
-    ox, oy, oz, dx, dy, dz = ray
-    first = leaf[~c, 0]
-    for j in range(first, first + leaf[~c, 1]):
-        t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
-        if t > t_eps and t < tm:
-            return True
-    return False
-
-
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def _any_hit_chunk(r0, r1, rays, tree, eps, out):
-    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) with
-    eps = (t_eps, det_eps): out[r] True where the ray is blocked."""
+def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
+    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) (``parent``
+    (k,) each inner node's parent) with eps = (t_eps, det_eps): out[r] True where the ray is
+    blocked (:func:`~explorer.geometry.traverse.any_one`)."""
     O, D, tmax = rays
-    child, cbox, leaf, tri = tree
-    t_eps, det_eps = eps
     stack = np.empty(STACK, np.int64)
+    near = np.int64(-1)
     for r in range(r0, r1):
-        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
-        tm = tmax[r] - t_eps
-        hit = False
-        sp = 0
-        node = 0
-        while True:
-            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, tm)
-            ca, cb = child[node, 0], child[node, 1]
-            if ta < math.inf and ca < 0:
-                if _leaf_any(leaf, ca, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
-                    hit = True
-                    break
-                ta = math.inf
-            if tb < math.inf and cb < 0:
-                if _leaf_any(leaf, cb, tri, (ox, oy, oz, dx, dy, dz), t_eps, tm, det_eps):
-                    hit = True
-                    break
-                tb = math.inf
-            node, sp = _next(stack, sp, ca, cb, ta, tb)
-            if node < 0:
-                break
-        out[r] = hit
+        out[r], near = any_one(O, D, tmax, r, tree, parent, eps, stack, near)
+
+
+@nb.njit(cache=True, inline="always")
+def _leaf_nearest(leaf, q, tri, order, ray, t_min, best):
+    """Leaf ``q``'s hits of the ray ``(ox, oy, oz, dx, dy, dz)`` against best = (t, triangle,
+    u, v, leaf): the nearer hit beyond ``t_min``, at equal ``t`` the lower triangle index."""
+    ox, oy, oz, dx, dy, dz = ray
+    bt, bf, bu, bv, bq = best
+    first = leaf[q, 0]
+    for j in range(first, first + leaf[q, 1]):
+        t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
+        if t > t_min and (t < bt or (t == bt and t < math.inf and (bf < 0 or order[j] < bf))):
+            bt, bf, bu, bv, bq = t, order[j], u, v, q
+    return bt, bf, bu, bv, bq
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def _nearest_chunk(r0, r1, rays, t_min, tree, order, out):
     """Rays r0..r1 of rays = (O, D) through tree = (child, cbox, leaf, tri); writes the
-    nearest hit into out = (best_t, best_f, bu, bv) (best_t in: the farthest t accepted)."""
+    nearest hit into out = (best_t, best_f, bu, bv) (best_t in: the farthest t accepted).
+    The leaf the previous ray's hit is in is tested first: neighbouring pixels tend to see
+    the same few triangles, and a near ``best`` early keeps the walk from boxes beyond it."""
     O, D = rays
     child, cbox, leaf, tri = tree
     best_t, best_f, bu, bv = out
     stack = np.empty(STACK, np.int64)
+    last = np.int64(-1)
     for r in range(r0, r1):
-        ox, oy, oz, dx, dy, dz, ix, iy, iz = _ray(O, D, r)
-        best, bf, u_, v_ = best_t[r], np.int64(-1), 0.0, 0.0
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
+        ray = (ox, oy, oz, dx, dy, dz)
+        best = (best_t[r], np.int64(-1), 0.0, 0.0, np.int64(-1))
+        if last >= 0:
+            best = _leaf_nearest(leaf, last, tri, order, ray, t_min, best)
         sp = 0
         node = 0
         while True:
             # boxes entered at t == best are still visited: a tie may go to a lower index
-            ta, tb = _enter(cbox[node], ox, oy, oz, ix, iy, iz, best)
-            for side in range(2):
-                c = child[node, side]
-                if c >= 0 or (ta if side == 0 else tb) == math.inf:
-                    continue
-                first = leaf[~c, 0]
-                for j in range(first, first + leaf[~c, 1]):
-                    t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
-                    if t > t_min and (
-                        t < best or (t == best and t < math.inf and (bf < 0 or order[j] < bf))
-                    ):
-                        best, bf, u_, v_ = t, order[j], u, v
-                if side == 0:
-                    ta = math.inf
-                else:
-                    tb = math.inf
-            node, sp = _next(stack, sp, child[node, 0], child[node, 1], ta, tb)
+            ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, best[0])
+            ca, cb = child[node, 0], child[node, 1]
+            if ca < 0 and ta < math.inf:
+                best = _leaf_nearest(leaf, ~ca, tri, order, ray, t_min, best)
+                ta = math.inf
+            if cb < 0 and tb < math.inf:
+                best = _leaf_nearest(leaf, ~cb, tri, order, ray, t_min, best)
+                tb = math.inf
+            node, sp = next_node(stack, sp, ca, cb, ta, tb)
             if node < 0:
                 break
-        if bf >= 0:
-            best_t[r] = best
-            best_f[r] = bf
-            bu[r] = u_
-            bv[r] = v_
+        if best[1] >= 0:
+            best_t[r], best_f[r], bu[r], bv[r], last = best
+        else:
+            last = np.int64(-1)
 
 
 # -- running in chunks ---------------------------------------------------------------------
@@ -499,16 +449,20 @@ def _check(cancelled: Callable[[], bool] | None) -> None:
 
 
 def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK) -> None:
-    """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of ``chunk`` rays, on
-    :func:`workers` threads, asking ``cancelled()`` before each chunk.
+    """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of at most ``chunk`` rays, on
+    :func:`workers` threads, asking ``cancelled()`` before each chunk. More than one chunk's
+    worth is cut into equal chunks, a whole number of them per thread (no thread left with a
+    last chunk alone).
 
     Raises :class:`~explorer.core.errors.Cancelled` when ``cancelled()`` returns True. On any
     exception (Ctrl-C too) chunks not started are dropped and the running ones are waited for,
     so nothing writes into the outputs after this returns or raises.
     """
     _check(cancelled)
-    starts = list(range(0, n, chunk))
     threads = workers()
+    if n > chunk and threads > 1:
+        chunk = -(-n // (threads * -(-n // (threads * chunk))))
+    starts = list(range(0, n, chunk))
     if len(starts) <= 1 or threads == 1:
         for s in starts:
             _check(cancelled)
@@ -547,7 +501,7 @@ def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
     return O, D
 
 
-def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarray:
+def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None, refit=True) -> np.ndarray:
     """Whether each ray meets the front side of a triangle between :data:`RAY_T_EPS` and
     ``tmax - RAY_T_EPS`` (the same answer as :func:`explorer.geometry.rays.any_hit`).
 
@@ -555,14 +509,45 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> np.ndarra
     tmax : (k,) float, the distance to the light (inf: none)
     cancelled : () -> bool, asked between chunks (True: raise Cancelled)
     Returns (k,) bool.
+
+    Rays that all go to one light (shadow rays) and are at least 1/:data:`OCCLUDER_RAYS` of
+    the triangles in number go through :func:`toward_light`'s boxes (``refit=False``: never;
+    the same answers, for benchmarks).
     """
     O, D = _rays(origins, directions)
     tm = np.ascontiguousarray(np.broadcast_to(np.asarray(tmax, np.float64), (len(O),)))
     hit = np.zeros(len(O), np.bool_)
-    if bvh.n_triangles:
-        args = ((O, D, tm), _tree(bvh), (RAY_T_EPS, DET_EPS), hit)
-        run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
+    if not bvh.n_triangles:
+        return hit
+    if refit and len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
+        bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
+    args = ((O, D, tm), _tree(bvh), bvh.parent, (RAY_T_EPS, DET_EPS), hit)
+    run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
     return hit
+
+
+def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
+    """``bvh`` with its boxes refitted around the triangles that can block the rays, when the
+    rays all end at one point or all run one way (:mod:`explorer.geometry.occluders`); else
+    ``bvh`` itself. Casting the rays through either gives the same answers.
+
+    origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
+    """
+    end = occ.shared_end(origins, directions, tmax)
+    if end is None or not bvh.n_triangles:
+        return bvh
+    kind, L, eps, reach = end
+    corner = np.maximum(np.abs(bvh.cbox[0, 0::2]), np.abs(bvh.cbox[0, 1::2])).astype(np.float64)
+    corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
+    radius = max(float(np.sqrt(corner @ corner)), reach)
+    _check(cancelled)
+    lbox = np.empty((len(bvh.leaf), 6), np.float32)
+    # on this thread: the pass is bound by reading each triangle's 40 bytes once, and handing
+    # it to the pool costs about what a second thread would save
+    occ.leaf_boxes(0, len(bvh.leaf), bvh.leaf, bvh.plane, bvh.tbox,
+                   (np.int64(kind), L, eps, radius), lbox)  # fmt: skip
+    cbox = occ.node_boxes(bvh.child, lbox)
+    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane)
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):
@@ -582,3 +567,36 @@ def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None)
         args = ((O, D), float(t_min), _tree(bvh), bvh.order, (best_t, best_f, bu, bv))
         run_chunks(_nearest_chunk, k, args, cancelled=cancelled)
     return best_t, best_f, bu, bv
+
+
+def surface_points(origins, directions, t, triangle, u, v, faces, normals):
+    """The points the rays hit and the normals there (the same numbers as
+    :func:`explorer.geometry.bvh_numpy.surface_points`, compiled).
+
+    origins, directions : (k, 3) float64; t, u, v : (k,) float64; triangle : (k,) int64
+    (:func:`nearest_hits`' answers); faces : (m, 3) int64; normals : (n, 3) float64
+    Returns (hit (k,) bool, positions (h, 3), normals (h, 3)) for the h hits in ray order.
+    """
+    hit = triangle >= 0
+    h = int(hit.sum())
+    pos, n = np.empty((h, 3)), np.empty((h, 3))
+    _surface(origins, directions, t, triangle, u, v, faces, normals, pos, n)
+    return hit, pos, n
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def _surface(O, D, t, f, u, v, faces, normals, pos, nrm):
+    k = 0
+    for r in range(len(f)):
+        if f[r] < 0:
+            continue
+        a, b = u[r], v[r]
+        w = 1.0 - a - b
+        i0, i1, i2 = faces[f[r], 0], faces[f[r], 1], faces[f[r], 2]
+        for c in range(3):
+            pos[k, c] = O[r, c] + t[r] * D[r, c]
+            nrm[k, c] = w * normals[i0, c] + a * normals[i1, c] + b * normals[i2, c]
+        length = math.sqrt(nrm[k, 0] * nrm[k, 0] + nrm[k, 1] * nrm[k, 1] + nrm[k, 2] * nrm[k, 2])
+        for c in range(3):
+            nrm[k, c] = nrm[k, c] / length if length > SURFACE_NORMAL_MIN else 0.0
+        k += 1

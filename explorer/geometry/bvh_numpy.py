@@ -15,8 +15,9 @@ split at the median of their centres along the longest axis of the centres' boun
 level). The casts walk it breadth first: a frontier of (ray, node) pairs, each level's box tests
 and leaf tests done for every pair at once.
 
-:func:`build_bvh`, :func:`any_hit` and :func:`nearest_hits` take the arguments of their compiled
-namesakes, so a caller picks either module (:func:`explorer.shading.tiers.ray_engine`).
+:func:`build_bvh`, :func:`any_hit`, :func:`nearest_hits` and :func:`surface_points` take the
+arguments of their compiled namesakes, so a caller picks either module
+(:func:`explorer.shading.tiers.ray_engine`).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import Cancelled
-from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS
+from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
 
 #: triangles per leaf (at most)
 LEAF = 4
@@ -242,3 +243,24 @@ def nearest_hits(bvh: NumpyBVH, origins, directions, t_min: float, *, cancelled=
             r, t, u, v, f = (x[better] for x in (r, t, u, v, f))
             best_t[r], best_f[r], bu[r], bv[r] = t, f, u, v
     return best_t, best_f, bu, bv
+
+
+def surface_points(origins, directions, t, triangle, u, v, faces, normals):
+    """The points the rays hit and the normals there: for each ray with ``triangle >= 0``,
+    ``O + t·D`` and ``(1-u-v)·n0 + u·n1 + v·n2`` of its triangle's corners' ``normals``,
+    normalised (zero stays zero).
+
+    origins, directions : (k, 3) float64; t, u, v : (k,) float64; triangle : (k,) int64
+    (:func:`nearest_hits`' answers); faces : (m, 3) int64; normals : (n, 3) float64
+    Returns (hit (k,) bool, positions (h, 3), normals (h, 3)) for the h hits in ray order.
+    """
+    hit = triangle >= 0
+    f = triangle[hit]
+    a, b = u[hit], v[hit]
+    pos = origins[hit] + t[hit][:, None] * directions[hit]
+    corners = faces[f]
+    n = ((1.0 - a - b)[:, None] * normals[corners[:, 0]] + a[:, None] * normals[corners[:, 1]]
+         + b[:, None] * normals[corners[:, 2]])  # fmt: skip
+    length = np.sqrt(n[:, 0] * n[:, 0] + n[:, 1] * n[:, 1] + n[:, 2] * n[:, 2])[:, None]
+    n = np.divide(n, length, out=np.zeros_like(n), where=length > SURFACE_NORMAL_MIN)
+    return hit, pos, n

@@ -165,15 +165,9 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
         tree, O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
     )
     c0, c1, r0, r1 = rect
-    hit = best_tri >= 0
-    mask[r0 : r1 + 1, c0 : c1 + 1] = hit.reshape(r1 - r0 + 1, c1 - c0 + 1)
-    f = best_tri[hit]
-    u, v = best_u[hit], best_v[hit]
-    pos = O[hit] + best_t[hit][:, None] * D[hit]
     Nv = np.asarray(mesh.normals, np.float64)
-    n = (1.0 - u - v)[:, None] * Nv[F[f, 0]] + u[:, None] * Nv[F[f, 1]] + v[:, None] * Nv[F[f, 2]]
-    length = np.linalg.norm(n, axis=1, keepdims=True)
-    n = np.divide(n, length, out=np.zeros_like(n), where=length > 1e-12)
+    hit, pos, n = engine.surface_points(O, D, best_t, best_tri, best_u, best_v, F, Nv)
+    mask[r0 : r1 + 1, c0 : c1 + 1] = hit.reshape(r1 - r0 + 1, c1 - c0 + 1)
     return Hits(mask, pos, n, "raycast")
 
 
@@ -220,13 +214,20 @@ class Reference:
 
     hits : what the pixels see (:class:`Hits`)
     colors : (k, 3) float64 engine colours of the hits, in [0, 1]
-    specular : (k,) float64 unclamped specular light sum (sum of RGB channels) of the hits:
-        its largest value marks the highlight peak
+    sums : :attr:`specular`, or a function of no arguments that computes it on first use
     """
 
     hits: Hits
     colors: np.ndarray
-    specular: np.ndarray
+    sums: object
+
+    @property
+    def specular(self) -> np.ndarray:
+        """(k,) float64 unclamped specular light sum (sum of RGB channels) of the hits: its
+        largest value marks the highlight peak."""
+        if callable(self.sums):
+            object.__setattr__(self, "sums", np.asarray(self.sums(), np.float64))
+        return self.sums
 
     @property
     def mask(self) -> np.ndarray:
@@ -299,7 +300,8 @@ def reference(
     """The per-pixel reference of a scene on a mesh (see the module docstring).
 
     The colours come from :func:`point_colors` (the engine, :func:`explorer.shade`) on the hit
-    positions and normals; the scene is used unchanged (model, lights, viewer, material).
+    positions and normals; the scene is used unchanged (model, lights, viewer, material). The
+    specular sums (:attr:`Reference.specular`) are computed when first asked for.
     cancelled : () -> bool, asked between chunks of rays and before the colours (True: raise
         :class:`~explorer.core.errors.Cancelled`)
     Returns a :class:`Reference`.
@@ -310,8 +312,6 @@ def reference(
         raise Cancelled("the per-pixel reference was cancelled")
     if len(h.positions):
         colors = point_colors(scene, h.positions, h.normals, mesh=mesh, precision=precision)
-        spec = specular_sums(scene, h.positions, h.normals)
     else:
         colors = np.zeros((0, 3))
-        spec = np.zeros(0)
-    return Reference(h, colors, spec)
+    return Reference(h, colors, lambda: specular_sums(scene, h.positions, h.normals))

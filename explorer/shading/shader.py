@@ -124,6 +124,9 @@ class Shader:
     tier : "compiled" or "numpy" for every pass of this shader; None (default): the tier
         :func:`explorer.shading.tiers.compiled` picks at each pass. The ``threejs`` model is
         always computed by the numpy tier (the kernels implement :data:`COMPILED_MODELS`).
+    cancelled : () -> bool (the attribute ``cancelled``, settable), asked while the shadow
+        rays' BVH is built and between chunks of rays: True stops the pass with
+        :class:`~explorer.core.errors.Cancelled` (the next one starts afresh)
     """
 
     def __init__(
@@ -140,8 +143,10 @@ class Shader:
         force_all: bool = False,
         cull: bool = True,
         tier: str | None = None,
+        cancelled=None,
     ):
         self.tier = _check_options(precision, tier)
+        self.cancelled = cancelled
         self._T = np.float32 if precision == "float32" else np.float64
         self.precision = precision
         self.clamp = bool(clamp)
@@ -321,7 +326,8 @@ class Shader:
         shadowed = [lp.shadows for lp in plan.lights]
         vis, rays = visibility_rows(self._P, self._N, self._faces, scene.lights, shadowed,
                                     two_sided=scene.two_sided, force_all=self.force_all,
-                                    cache=self._vis_cache, dtype=dtype)  # fmt: skip
+                                    cache=self._vis_cache, dtype=dtype,
+                                    cancelled=self.cancelled)  # fmt: skip
         self.stats["shadow_rays"] += rays
         return vis
 

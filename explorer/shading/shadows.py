@@ -17,7 +17,10 @@ Ray engine: :func:`explorer.geometry.bvh.any_hit` through a bounding-volume hier
 mesh (:mod:`explorer.geometry.bvh`), built once per geometry. It runs the same Möller-Trumbore
 test as the brute-force :func:`explorer.geometry.rays.any_hit` on the same numbers, only on the
 triangles whose boxes a ray crosses, so the shadowed vertices are exactly the brute force's.
-Rays run in chunks on the cores; ``cancelled`` (and Ctrl-C) stops them between chunks.
+A light's rays go through the tree's boxes refitted around the triangles that face away from
+it, the only ones that can block them (:mod:`explorer.geometry.occluders`). Rays run in chunks
+on the cores; ``cancelled`` (a :class:`~explorer.shading.shader.Shader`'s ``cancelled``) and
+Ctrl-C stop them between chunks and the tree's build while it runs.
 
 The plan skips rays where they cannot change anything: lights without ``shadows: true``, and
 vertices facing away from the light (N·L <= 0: no diffuse or specular to shadow). It does not
@@ -39,11 +42,12 @@ from explorer.shading.tiers import ray_engine
 GEOMETRY_KEY = "geometry"
 
 
-def frame_bvh(positions, faces, engine=None) -> tuple:
+def frame_bvh(positions, faces, engine=None, *, cancelled=None) -> tuple:
     """The normalised frame of ``positions`` and the BVH of ``faces`` in it.
 
     positions : (n, 3) float; faces : (m, 3) int
     engine : the ray engine (:func:`explorer.shading.tiers.ray_engine`, the default)
+    cancelled : () -> bool, asked while the BVH is built (True: raise Cancelled)
     Returns centre (3,), scale, the frame positions Q (n, 3) = (positions - centre) / scale,
     the BVH of Q[faces] (:data:`~explorer.core.tolerances.RAY_T_EPS` is relative to it) and the
     engine that casts through it.
@@ -52,7 +56,7 @@ def frame_bvh(positions, faces, engine=None) -> tuple:
     P = np.asarray(positions, np.float64)
     centre, scale = frame_of(P)
     Q = (P - centre) / scale
-    tree = engine.build_bvh(Q[np.asarray(faces, np.int64).reshape(-1, 3)])
+    tree = engine.build_bvh(Q[np.asarray(faces, np.int64).reshape(-1, 3)], cancelled=cancelled)
     return centre, scale, Q, tree, engine
 
 
@@ -79,7 +83,17 @@ def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=N
 
 
 def visibility_rows(
-    positions, normals, faces, lights, shadowed, *, two_sided, force_all, cache, dtype=np.float64
+    positions,
+    normals,
+    faces,
+    lights,
+    shadowed,
+    *,
+    two_sided,
+    force_all,
+    cache,
+    dtype=np.float64,
+    cancelled=None,
 ):
     """(L, n) ``dtype`` visibility rows, one per light (rows of lights not ``shadowed`` are 1).
 
@@ -91,6 +105,8 @@ def visibility_rows(
     cache : dict kept by the caller for this geometry: it keeps the frame and the BVH
         (:data:`GEOMETRY_KEY` and the ray engine's name), and a light whose rays are unchanged
         (same position or direction) reuses its row
+    cancelled : () -> bool, asked while the BVH is built and between chunks of rays (True:
+        raise :class:`~explorer.core.errors.Cancelled`; the rows finished so far stay cached)
     Returns the rows and the number of rays cast."""
     P = positions
     n = len(P)
@@ -113,8 +129,9 @@ def visibility_rows(
             engine = ray_engine()
             geometry = (GEOMETRY_KEY, engine.__name__)
             if geometry not in cache:
-                cache[geometry] = frame_bvh(P, faces, engine)
-            v = visibility(P, faces, light, only=only, geometry=cache[geometry])
+                cache[geometry] = frame_bvh(P, faces, engine, cancelled=cancelled)
+            v = visibility(P, faces, light, only=only, geometry=cache[geometry],
+                           cancelled=cancelled)  # fmt: skip
             cache[key] = v
             rays += int(n if only is None else only.sum())
         vis[i] = v

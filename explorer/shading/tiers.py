@@ -64,6 +64,8 @@ SOURCES = (
     "explorer.shading.vmath",
     "explorer.shading.display",
     "explorer.geometry.rays",
+    "explorer.geometry.traverse",
+    "explorer.geometry.occluders",
     "explorer.geometry.bvh",
 )
 #: environment variables that change what numba compiles (so they name the marker too)

@@ -99,13 +99,16 @@ def _changes(shader: Shader) -> None:
 
 def _pixel_rays() -> None:
     """The per-pixel reference's casts (:mod:`explorer.render.perpixel`) through the compiled
-    BVH: a tree of a mesh's world triangles, nearest hits of a grid of rays."""
+    BVH: a tree of a mesh's world triangles, nearest hits of a grid of rays, the hit points and
+    normals (the mesh's read-only arrays, as the reference passes them)."""
     mesh = torus(12)
     tree = bvh.build_bvh(mesh.positions[mesh.faces])
     y, x = np.mgrid[-1:1:8j, -1:1:8j]
     O = np.stack([x.ravel(), y.ravel(), np.full(x.size, 3.0)], axis=1)
     D = np.ascontiguousarray(np.broadcast_to([0.0, 0.0, -1.0], O.shape))
-    bvh.nearest_hits(tree, O, D, 1e-9)
+    t, f, u, v = bvh.nearest_hits(tree, O, D, 1e-9)
+    faces = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
+    bvh.surface_points(O, D, t, f, u, v, faces, np.asarray(mesh.normals, np.float64))
 
 
 def exercise() -> int:

@@ -84,6 +84,18 @@ def test_heat_map():
         C.heat_map(levels, vmax=1.0)
 
 
+def test_heat_map_of_whole_levels_is_the_ramp_of_those_levels():
+    rng = np.random.default_rng(3)
+    levels = rng.integers(0, 256, (40, 30))
+    levels[0, :4] = [0, 1, 16, 255]
+    mask = rng.random((40, 30)) < 0.8
+    for vmax in (16.0, 3.5, 300.0):
+        want = C.heat_map(levels.astype(float), mask, vmax=vmax, background=(9, 8, 7))
+        got = C.heat_map(levels, mask, vmax=vmax, background=(9, 8, 7))
+        assert np.array_equal(got, want) and got.dtype == np.uint8
+    assert np.array_equal(C.heat_map(levels.astype(np.uint8)), C.heat_map(levels.astype(float)))
+
+
 def test_compare_view_for_the_gui():
     """The GUI's comparison of a live view: a coarse sphere glows, a fine one does not."""
 

@@ -188,6 +188,16 @@ def test_building_can_be_stopped():
     tri = _soup(5000, 10)
     with pytest.raises(Cancelled):  # asked before the build starts, then while it runs
         B.build_bvh(tri, cancelled=lambda: True)
-    box, link, order = B._build(tri, np.ones(1, np.uint8))  # the flag a waiting caller sets
+    box, link, order, _ = B._build(tri, np.ones(1, np.uint8))  # the flag a waiting caller sets
     assert len(box) == len(link) == len(order) == 0
     assert B.build_bvh(tri, cancelled=lambda: False).n_triangles == 5000
+
+
+def test_work_on_other_threads_releases_the_gil():
+    """The builder and the casts run on the pool's threads while the caller's thread waits for
+    them, asking ``cancelled`` and taking Ctrl-C: they must not hold the GIL meanwhile (a
+    builder that did made Ctrl-C wait for a whole 2M-triangle build)."""
+    from explorer.geometry import occluders as occ
+
+    for kernel in (B._build, B._any_hit_chunk, B._nearest_chunk, occ.leaf_boxes):
+        assert kernel.targetoptions.get("nogil"), kernel.__name__

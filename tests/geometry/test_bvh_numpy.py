@@ -67,6 +67,27 @@ def test_nearest_hits_equal_the_compiled_bvh(name):
     assert (got[1] >= 0).any() or len(tri) < 10
 
 
+def test_surface_points_equal_the_compiled_ones():
+    mesh = get_mesh("teapot", 6)
+    P, F = mesh.positions, np.asarray(mesh.faces, np.int64)
+    normals = np.array(mesh.normals, np.float64)
+    normals[F[3]] = [[0, 0, 0], [1.0, 0, 0], [-1.0, 0, 0]]  # cancel out mid-edge of triangle 3
+    rng = np.random.default_rng(12)
+    O = rng.uniform(-3, 3, (600, 3))
+    D = P[rng.integers(0, len(P), 600)] - O
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    t, f, u, v = B.nearest_hits(B.build_bvh(P[F]), O, D, 1e-9)
+    f[:40], u[:40], v[:40], t[:40] = 3, 0.5, 0.5, 1.0  # hits on the edge where normals cancel
+    got = NB.surface_points(O, D, t, f, u, v, F, normals)
+    want = B.surface_points(O, D, t, f, u, v, F, normals)
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
+    hit, pos, n = got
+    assert 100 < hit.sum() <= 600 and not n[:40].any()
+    np.testing.assert_allclose(np.linalg.norm(n[40:], axis=1), 1.0, rtol=1e-12)
+    np.testing.assert_allclose(pos, O[hit] + t[hit][:, None] * D[hit], rtol=0, atol=0)
+
+
 def test_ties_go_to_the_lowest_triangle_index():
     tri = np.array([[[-1, -1, 0], [1, -1, 0], [0, 1, 0]]] * 3, np.float64)  # three alike
     O = np.array([[0.0, 0.0, 2.0]])

@@ -4,14 +4,12 @@ casting with interpolated normals, agreement with a fine per-vertex render, rend
 from __future__ import annotations
 
 import math
-import os
-import signal
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 from helpers.brute_rays import brute_nearest
+from helpers.interrupt import interrupt_ray_work
 
 import explorer
 from explorer.analysis.comparison import compare, coverage
@@ -23,6 +21,7 @@ from explorer.core.presets import builtin_dir, load_material_file
 from explorer.core.scene import Viewer
 from explorer.geometry import meshes as M
 from explorer.geometry.meshes import Mesh
+from explorer.render import perpixel as PP
 from explorer.render.camera import (
     Camera,
     apply_camera,
@@ -370,6 +369,20 @@ def test_ray_cast_equals_testing_every_triangle():
     assert np.array_equal(h.positions, origins[seen] + best[seen][:, None] * dirs[seen])
 
 
+def test_specular_sums_are_made_when_first_asked_for(monkeypatch):
+    mesh = M.teapot(4)
+    scene = _scene()
+    calls = []
+    real = PP.specular_sums
+    monkeypatch.setattr(PP, "specular_sums", lambda *a: calls.append(1) or real(*a))
+    ref = reference(scene, mesh, (60, 40))
+    assert not calls  # the colours alone
+    want = real(scene, ref.hits.positions, ref.hits.normals)
+    assert np.array_equal(ref.specular, want) and ref.specular.max() > 0 and calls == [1]
+    assert ref.specular is ref.specular and calls == [1]  # kept
+    assert ref.peak_index() is not None
+
+
 def test_reference_can_be_cancelled():
     mesh = M.teapot(4)
     scene = _scene()
@@ -384,50 +397,19 @@ def test_reference_can_be_cancelled():
     assert np.array_equal(ref.image(), reference(scene, mesh, (40, 30)).image())
 
 
-#: a render whose ray chunks are slowed down (each sleeps), so Ctrl-C lands in the ray work
-_SLOW_RENDER = """
-import sys, time
-import explorer.geometry.bvh as B
-kernel = B._nearest_chunk
-def slow(*args):
-    sys.stderr.write("chunk\\n")  # one write: the two threads' lines never interleave
-    sys.stderr.flush()
-    time.sleep(0.1)
-    return kernel(*args)
-B._nearest_chunk = slow
-from explorer.cli import main
-sys.exit(main(["render", "--per-pixel", "--mesh", "teapot", "--size", "640x480",
-               "--out", sys.argv[1]]))
-"""
-
-
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 def test_ctrl_c_stops_ray_work_at_the_end_of_the_current_chunk(tmp_path):
-    """SIGINT in the middle of the per-pixel rays (38 chunks of 0.1 s or more): the command
+    """SIGINT in the middle of the per-pixel rays (many chunks of 0.1 s or more): the command
     stops after the chunks already running, with one line and exit status 130, and leaves no
     file (not even a temporary one). Counted in chunks, not timed."""
-    out = tmp_path / "pp.png"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    proc = subprocess.Popen(
-        [sys.executable, "-c", _SLOW_RENDER, str(out)],
-        stderr=subprocess.PIPE, text=True, env=env,
-        # a shell starts background jobs with SIGINT ignored, and Python then leaves it so
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )  # fmt: skip
-    try:
-        assert proc.stderr.readline() == "chunk\n"  # the rays have started
-        proc.send_signal(signal.SIGINT)
-        err = proc.communicate(timeout=60)[1]
-    finally:
-        proc.kill()
-    lines = err.splitlines()
+    argv = ["render", "--per-pixel", "--mesh", "teapot", "--size", "640x480",
+            "--out", str(tmp_path / "pp.png")]  # fmt: skip
+    lines, chunks, status = interrupt_ray_work("_nearest_chunk", argv)
     # at most the other thread's chunk started before the signal, and one chunk per thread
     # that was already handed out
-    assert lines.count("chunk") <= 4
-    assert [ln for ln in lines if ln != "chunk"] == [
-        "error: interrupted (Ctrl-C); no unfinished file was left"
-    ]
-    assert proc.returncode == 130
+    assert chunks <= 4
+    assert lines == ["error: interrupted (Ctrl-C); no unfinished file was left"]
+    assert status == 130
     assert list(tmp_path.iterdir()) == []
 
 

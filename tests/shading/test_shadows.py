@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
+from helpers.interrupt import interrupt_ray_work
 
 import explorer
+from explorer.core.errors import Cancelled
 from explorer.core.scene import load_scene
 from explorer.geometry.frame import frame_of
 from explorer.geometry.meshes import get_mesh
@@ -90,3 +94,35 @@ def test_the_fine_torus_is_shadowed():
     few = sample[:150]
     D, tmax = light.shadow_ray(Q[few], centre, scale)
     assert np.array_equal(vis[few] == 0, brute_any_hit(Q[few], D, tmax, Q[mesh.faces]))
+
+
+def test_a_shader_pass_can_be_cancelled_and_the_next_one_is_whole():
+    mesh = get_mesh("teapot", 16)
+    scene = load_scene({"material": "gold", "lights": LIGHTS[:2]})
+    asked = []
+    sh = explorer.Shader(scene, mesh.positions, mesh.normals, faces=mesh.faces,
+                         cancelled=lambda: asked.append(1) or len(asked) > 3)  # fmt: skip
+    with pytest.raises(Cancelled):  # asked while the BVH is built and between chunks of rays
+        _ = sh.colors
+    sh.cancelled = None
+    fresh = explorer.Shader(scene, mesh.positions, mesh.normals, faces=mesh.faces)
+    assert np.array_equal(sh.colors, fresh.colors)
+    assert (fresh.colors < explorer.Shader(scene, mesh.positions, mesh.normals).colors).any()
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_ctrl_c_stops_a_render_with_shadows_in_its_rays(tmp_path):
+    """SIGINT in the middle of the shadow rays (two lights, several chunks each of 0.1 s or
+    more): the command stops after the chunks already running, with one line and exit status
+    130, and leaves no file. Counted in chunks, not timed."""
+    scene = tmp_path / "scene.yaml"
+    scene.write_text("material: gold\nlights:\n" + "".join(
+        f"  - {{type: point, position: {p}, shadows: true}}\n"
+        for p in ([2, 3, 1.5], [-2.5, 1, 1.5])))  # fmt: skip
+    argv = ["render", str(scene), "--mesh", "teapot", "--resolution", "40",
+            "--out", str(tmp_path / "out.png")]  # fmt: skip
+    lines, chunks, status = interrupt_ray_work("_any_hit_chunk", argv)
+    assert chunks <= 4
+    assert lines == ["error: interrupted (Ctrl-C); no unfinished file was left"]
+    assert status == 130
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.yaml"]
