@@ -1,4 +1,4 @@
-"""The engine's full float32 pass at two git revisions, in alternating processes.
+"""The engine's full pass at two git revisions, in alternating processes.
 
     python benchmarks/bench_revisions.py 5c40425 HEAD            # before / after a change
     python benchmarks/bench_revisions.py HEAD~3 HEAD --rounds 5
@@ -7,10 +7,12 @@
 Each revision is checked out in a temporary git worktree (its numba cache is its own, so the
 first process of each compiles: not timed) and imported from there. Processes alternate A, B,
 A, B, ... so that this VM's drift from one minute to the next falls on both alike. Each process
-times a light change on a float32 ``Shader`` (1M vertices, 8 point lights, Blinn, local viewer:
-``bench_engine.py``'s first row) 25 times, on random points (every vertex-light computed) and
-on a UV sphere with as many vertices in mesh order (light culling skips what faces away); the
-table gives the best and the median of the per-process medians, and the ratios.
+times a light change on a ``Shader`` (float32, or ``--precision``; 1M vertices, 8 point lights,
+Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on random points (every
+vertex-light computed) and on a UV sphere with as many vertices in mesh order (light culling
+skips what faces away), then a one-shot ``explorer.shade`` (10 calls) and a viewer change on a
+kept ``Shader`` (25), both on the random points, in the same precision; the table gives the
+best and the median of the per-process medians, and the ratios.
 """
 
 from __future__ import annotations
@@ -51,9 +53,27 @@ for P_, N_ in ((P, N), (Pm, Pm)):
         t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
     print(min(ts) * 1e3, statistics.median(ts) * 1e3)
     del sh, relight
+ts = []  # one-shot shade(): geometry preparation and one pass that keeps no sums
+for _ in range(11):
+    t = time.perf_counter(); explorer.shade(scene, P, N, precision={precision!r})
+    ts.append(time.perf_counter() - t)
+print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
+sh = explorer.Shader(scene, P, N, precision={precision!r})
+sh.colors
+eyes = [dict(eye=[0.0, 0.0, 5.0]), dict(eye=[1.0, 2.0, 5.0])]
+ts = []  # a viewer change: the specular sum alone is recomputed
+for _ in range(26):
+    eyes.reverse(); t = time.perf_counter(); sh.set_viewer(eyes[0]); sh.colors
+    ts.append(time.perf_counter() - t)
+print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
 """
 
-CASES = ("random points (every vertex-light)", "UV sphere, mesh order (light culling)")
+CASES = (
+    "random points (every vertex-light)",
+    "UV sphere, mesh order (light culling)",
+    "one-shot shade(), random points (incl. geometry)",
+    "viewer change, random points (specular only)",
+)
 
 
 def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, float]]:

@@ -45,7 +45,14 @@ from explorer.core.errors import ExplorerError, ExplorerTypeError
 from explorer.core.material import Material
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
-from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_frame
+from explorer.geometry.frame import (
+    check_faces,
+    check_vertices,
+    frame_from_extent,
+    frame_of,
+    scale_normals,
+    to_frame,
+)
 from explorer.shading import kernels as K
 from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
@@ -169,15 +176,17 @@ class Shader:
 
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
-        P, N = check_vertices(positions, normals)  # normals scaled for the kernels
+        # normals scaled for the kernels when a pass needs them (see _normals)
+        P, N = check_vertices(positions, normals, scale=False)
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
         self._P, self._N = P, N
+        self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
         self._vis_cache: dict = {}
         self._plan = self._make_plan(self._scene)
-        self._centre, self._scale = frame_of(self._P)
+        self._centre, self._scale = None, 1.0  # the frame, found with the compiled geometry
         n = len(self._P)
         self._G = self._bounds = None  # the compiled tier's geometry, made at its first pass
         self._np = None  # the numpy tier's sums
@@ -195,13 +204,29 @@ class Shader:
         the working precision, structure of arrays, and the chunk bounds for light culling."""
         if self._G is not None:
             return
+        if self.n:  # (the frame of frame_of, its extent found in one compiled pass)
+            self._centre, self._scale = frame_from_extent(*K.extent(_readonly(self._P)))
+        else:
+            self._centre, self._scale = frame_of(self._P)
         G = np.empty((6, self.n), self._T)
-        K.prepare(
-            _readonly(self._P), _readonly(self._N), self._centre, 1.0 / self._scale, self._k, G
-        )
+        inv_scale = 1.0 / self._scale
+        if K.prepare(_readonly(self._P), _readonly(self._N), self._centre, inv_scale, self._k, G):
+            # some normal lies outside NORMAL_RANGE (prepare tests what scale_normals would)
+            K.prepare(
+                _readonly(self._P), _readonly(self._normals()), self._centre, inv_scale, self._k, G
+            )
+        self._scaled = True
         self.stats["geometry"] += 1
         self._G = G
         self._bounds = chunk_bounds(G)
+
+    def _normals(self) -> np.ndarray:
+        """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
+        the same array when they lie in it already, as the compiled geometry found)."""
+        if not self._scaled:
+            self._N = scale_normals(self._N)
+            self._scaled = True
+        return self._N
 
     def set_scene(self, scene) -> None:
         """Apply a new scene, invalidating only what its differences touch. A bad scene raises
@@ -314,7 +339,7 @@ class Shader:
         if not plan.shadows:
             return np.zeros((len(scene.lights), 0), dtype)
         shadowed = [lp.shadows for lp in plan.lights]
-        vis, rays = visibility_rows(self._P, self._N, self._faces, scene.lights, shadowed,
+        vis, rays = visibility_rows(self._P, self._normals(), self._faces, scene.lights, shadowed,
                                     two_sided=scene.two_sided, force_all=self.force_all,
                                     cache=self._vis_cache, dtype=dtype)  # fmt: skip
         self.stats["shadow_rays"] += rays
@@ -389,7 +414,7 @@ class Shader:
         self._colors = None
         if self._np is None:
             vis = self._visibility(np.float64)
-            self._np = equation_terms(self._scene, self._P, self._N, visibility=vis)
+            self._np = equation_terms(self._scene, self._P, self._normals(), visibility=vis)
             self.stats["numpy"] += 1
         else:
             self.stats["compose"] += 1
@@ -474,7 +499,7 @@ class Shader:
             self.stats["fixup_vertices"] += K.fixup(
                 K.Marks(redo, self._redo_count),
                 _readonly(self._P),
-                _readonly(self._N),
+                _readonly(self._normals()),
                 self._centre,
                 1.0 / self._scale,
                 K.Lights(params64, flags, view64),
