@@ -293,11 +293,13 @@ def _load_positions(P, centre, inv_scale, px, py, pz):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def prepare(P, N, centre, inv_scale, k, G):
-    """Geometry in the normalised frame, structure of arrays, working precision.
+def prepare(P, N, centre, inv_scale, k, G, B):
+    """Geometry in the normalised frame, structure of arrays, working precision, and the chunk
+    bounds light culling reads (each block's while it is in cache).
 
     P, N : (n, 3) float32/float64 world positions and normals
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
+    B : (N_BOUNDS, ceil(n / CHUNK)) float64 out: :func:`bounds` of G; or (N_BOUNDS, 0): none
     Returns how many blocks hold a normal outside :data:`explorer.core.tolerances.NORMAL_RANGE`
     (by the test of :func:`explorer.geometry.frame.scale_normals`): 0, or scale the normals with
     it and prepare again.
@@ -307,12 +309,12 @@ def prepare(P, N, centre, inv_scale, k, G):
     nblocks = (n + BLOCK - 1) // BLOCK
     outside = 0
     for b in nb.prange(nblocks):
-        outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
+        outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1, B)
     return outside
 
 
 @nb.njit(**_LEAF)
-def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
+def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1, B):
     """Blocks b0 to b1 - 1 of :func:`prepare`; returns how many hold a normal out of range."""
     n = G.shape[1]
     outside = 0
@@ -321,6 +323,8 @@ def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
         e = min(n, s + BLOCK)
         _load_positions(Pf[3 * s : 3 * e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
         outside += _load_normals(Nf[3 * s : 3 * e], G[3, s:e], G[4, s:e], G[5, s:e], k)
+        for c in range(b * CHUNKS, min(B.shape[1], (b + 1) * CHUNKS)):
+            _chunk_bounds(G, c, B)
     return outside
 
 
@@ -1599,7 +1603,8 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
             Nm[j, c] = N[idx[j], c]
     nblocks = (m + BLOCK - 1) // BLOCK
     G = np.empty((6, m))
-    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks)
+    nob = np.empty((N_BOUNDS, 0))  # (no culling here)
+    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks, nob)
     o = opts.copy()
     o[O_TRACK] = 0
     Am, Dm, Sm = _gather_sum(A, idx), _gather_sum(D, idx), _gather_sum(S, idx)

@@ -209,16 +209,15 @@ class Shader:
         else:
             self._centre, self._scale = frame_of(self._P)
         G = np.empty((6, self.n), self._T)
-        inv_scale = 1.0 / self._scale
-        if K.prepare(_readonly(self._P), _readonly(self._N), self._centre, inv_scale, self._k, G):
+        B = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
+        frame = (self._centre, 1.0 / self._scale, self._k)
+        if K.prepare(_readonly(self._P), _readonly(self._N), *frame, G, B):
             # some normal lies outside NORMAL_RANGE (prepare tests what scale_normals would)
-            K.prepare(
-                _readonly(self._P), _readonly(self._normals()), self._centre, inv_scale, self._k, G
-            )
+            K.prepare(_readonly(self._P), _readonly(self._normals()), *frame, G, B)
         self._scaled = True
         self.stats["geometry"] += 1
         self._G = G
-        self._bounds = chunk_bounds(G)
+        self._bounds = culling_bounds(B)
 
     def _normals(self) -> np.ndarray:
         """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
@@ -528,13 +527,11 @@ class Shader:
                 self._spec_shininess = scene.material.shininess
 
 
-def chunk_bounds(G: np.ndarray) -> np.ndarray:
-    """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
-    prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
-    read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
-    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests."""
-    b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
-    K.bounds(G, b)
+def culling_bounds(b: np.ndarray) -> np.ndarray:
+    """The chunk bounds ``b`` (N_BOUNDS, ceil(n / CHUNK)) float64 of the prepared geometry (see
+    :func:`explorer.shading.kernels.bounds`) as light culling takes them, read-only; (N_BOUNDS, 0)
+    when fewer than one chunk in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled
+    vertices, say): too little could be culled to pay for the tests."""
     if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
         b = b[:, :0]
     return _readonly(b)

@@ -74,6 +74,7 @@ def test_bounds_hold_every_vertex_of_their_chunk(name):
     assert np.all(cosine[cone] >= b[K.B_COS, chunk][cone])
     assert np.all(b[K.B_COS] ** 2 + b[K.B_SIN] ** 2 >= 1 - 1e-12)  # sine never too small
     assert cone.mean() > 0.5  # a smooth mesh in its own order: most cones are narrow
+    assert np.array_equal(sh._bounds, b)  # the shader's, found while preparing the geometry
 
 
 def test_shuffled_vertices_are_not_tested_at_all():
