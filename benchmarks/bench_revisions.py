@@ -12,7 +12,10 @@ Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on random points
 vertex-light computed) and on a UV sphere with as many vertices in mesh order (light culling
 skips what faces away), then a one-shot ``explorer.shade`` (10 calls) and a viewer change on a
 kept ``Shader`` (25), both on the random points, in the same precision; the table gives the
-best and the median of the per-process medians, and the ratios.
+best and the median of the per-process medians, and the ratios. ``--cpu`` runs each process on
+one numba thread and times the process's CPU seconds instead of the wall clock: the work each
+revision does, unaffected by other processes taking a core (a parallel pass waits for its slowest
+thread, so on a busy machine the wall clock mostly measures the others).
 """
 
 from __future__ import annotations
@@ -36,6 +39,10 @@ from bench_engine import scene_with, sphere_points
 from common import uv_sphere
 import explorer
 assert explorer.__file__.startswith({root!r}), explorer.__file__
+if {cpu!r}:  # one thread, timed by the process's CPU time: other processes' load falls out
+    import numba
+    numba.set_num_threads(1)
+    time.perf_counter = time.process_time
 P, N = sphere_points({n}, np.random.default_rng(0))
 around = max(8, int(round(np.sqrt({n}))))
 Pm = uv_sphere(around, max(2, {n} // around - 1)).positions.astype(np.float32)
@@ -76,7 +83,7 @@ CASES = (
 )
 
 
-def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, float]]:
+def run(root: Path, n: int, precision: str = "float32", cpu=False) -> list[tuple[float, float]]:
     env = dict(os.environ, PYTHONPATH=str(root))
     # the revision's own bench_engine helpers: they build scenes with that revision's classes
     own = Path(root) / "benchmarks"
@@ -85,6 +92,7 @@ def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, flo
         root=str(root),
         n=n,
         precision=precision,
+        cpu=cpu,
     )
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
@@ -102,6 +110,11 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=3, help="processes per revision")
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--precision", choices=("float32", "float64"), default="float32")
+    ap.add_argument(
+        "--cpu",
+        action="store_true",
+        help="one numba thread, CPU seconds of the process: the work, whatever else runs",
+    )
     args = ap.parse_args(argv)
     repo = subprocess.run(
         ["git", "rev-parse", "--show-toplevel"], cwd=HERE, capture_output=True, text=True
@@ -122,7 +135,7 @@ def main(argv=None) -> int:
             res: dict[str, list] = {rev: [] for rev in roots}
             for _ in range(args.rounds):
                 for rev, root in roots.items():
-                    res[rev].append(run(root, args.vertices, args.precision))
+                    res[rev].append(run(root, args.vertices, args.precision, args.cpu))
         finally:
             for root in roots.values():
                 subprocess.run(
@@ -133,9 +146,10 @@ def main(argv=None) -> int:
     from bench_engine import machine
 
     print(f"machine: {machine()}")
+    clock = "CPU time of one thread" if args.cpu else "wall time, all threads"
     print(
         f"full {args.precision} pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
-        "alternating processes per revision, 25 light changes each\n"
+        f"alternating processes per revision, 25 light changes each; {clock}\n"
     )
     print("| case | revision | best ms | median of medians ms | G vertex-lights/s (median) |")
     print("|---|---|---:|---:|---:|")
