@@ -293,13 +293,11 @@ def _load_positions(P, centre, inv_scale, px, py, pz):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def prepare(P, N, centre, inv_scale, k, G, B):
-    """Geometry in the normalised frame, structure of arrays, working precision, and the chunk
-    bounds light culling reads (each block's while it is in cache).
+def prepare(P, N, centre, inv_scale, k, G):
+    """Geometry in the normalised frame, structure of arrays, working precision.
 
     P, N : (n, 3) float32/float64 world positions and normals
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
-    B : (N_BOUNDS, ceil(n / CHUNK)) float64 out: :func:`bounds` of G; or (N_BOUNDS, 0): none
     Returns how many blocks hold a normal outside :data:`explorer.core.tolerances.NORMAL_RANGE`
     (by the test of :func:`explorer.geometry.frame.scale_normals`): 0, or scale the normals with
     it and prepare again.
@@ -309,12 +307,12 @@ def prepare(P, N, centre, inv_scale, k, G, B):
     nblocks = (n + BLOCK - 1) // BLOCK
     outside = 0
     for b in nb.prange(nblocks):
-        outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1, B)
+        outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
     return outside
 
 
 @nb.njit(**_LEAF)
-def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1, B):
+def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
     """Blocks b0 to b1 - 1 of :func:`prepare`; returns how many hold a normal out of range."""
     n = G.shape[1]
     outside = 0
@@ -323,8 +321,6 @@ def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1, B):
         e = min(n, s + BLOCK)
         _load_positions(Pf[3 * s : 3 * e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
         outside += _load_normals(Nf[3 * s : 3 * e], G[3, s:e], G[4, s:e], G[5, s:e], k)
-        for c in range(b * CHUNKS, min(B.shape[1], (b + 1) * CHUNKS)):
-            _chunk_bounds(G, c, B)
     return outside
 
 
@@ -429,7 +425,7 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def bounds(G, out):
+def bounds(G, out, step):
     """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
 
     G : (6, n) T prepared geometry (see :func:`prepare`)
@@ -438,9 +434,11 @@ def bounds(G, out):
     mean direction; half-angle: the widest normal from it), both widened by
     :data:`explorer.core.tolerances.CULL_GUARD`. A cone of 90° or more, or a chunk with an absent
     (zero) normal, gets cosine -1: never culled.
+    step : every chunk (1), or every ``step``-th one (columns 0, step, 2·step ...; the others
+    are left as they were): a sample, to see whether culling can pay before finding them all
     """
-    for c in nb.prange(out.shape[1]):
-        _chunk_bounds(G, c, out)
+    for j in nb.prange((out.shape[1] + step - 1) // step):
+        _chunk_bounds(G, j * step, out)
 
 
 @nb.njit(**_LEAF)
@@ -1603,8 +1601,7 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
             Nm[j, c] = N[idx[j], c]
     nblocks = (m + BLOCK - 1) // BLOCK
     G = np.empty((6, m))
-    nob = np.empty((N_BOUNDS, 0))  # (no culling here)
-    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks, nob)
+    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks)
     o = opts.copy()
     o[O_TRACK] = 0
     Am, Dm, Sm = _gather_sum(A, idx), _gather_sum(D, idx), _gather_sum(S, idx)

@@ -66,6 +66,8 @@ TIERS = ("compiled", "numpy")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
+#: :func:`chunk_bounds` tests that share on every CULL_SAMPLE-th chunk before it finds them all
+CULL_SAMPLE = 16
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
 #: (:func:`invalidated`)
@@ -209,15 +211,14 @@ class Shader:
         else:
             self._centre, self._scale = frame_of(self._P)
         G = np.empty((6, self.n), self._T)
-        B = np.empty((K.N_BOUNDS, -(-self.n // K.CHUNK)), np.float64)
         frame = (self._centre, 1.0 / self._scale, self._k)
-        if K.prepare(_readonly(self._P), _readonly(self._N), *frame, G, B):
+        if K.prepare(_readonly(self._P), _readonly(self._N), *frame, G):
             # some normal lies outside NORMAL_RANGE (prepare tests what scale_normals would)
-            K.prepare(_readonly(self._P), _readonly(self._normals()), *frame, G, B)
+            K.prepare(_readonly(self._P), _readonly(self._normals()), *frame, G)
         self._scaled = True
         self.stats["geometry"] += 1
         self._G = G
-        self._bounds = culling_bounds(B)
+        self._bounds = chunk_bounds(G)
 
     def _normals(self) -> np.ndarray:
         """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
@@ -527,11 +528,19 @@ class Shader:
                 self._spec_shininess = scene.material.shininess
 
 
-def culling_bounds(b: np.ndarray) -> np.ndarray:
-    """The chunk bounds ``b`` (N_BOUNDS, ceil(n / CHUNK)) float64 of the prepared geometry (see
-    :func:`explorer.shading.kernels.bounds`) as light culling takes them, read-only; (N_BOUNDS, 0)
-    when fewer than one chunk in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled
-    vertices, say): too little could be culled to pay for the tests."""
+def chunk_bounds(G: np.ndarray) -> np.ndarray:
+    """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
+    prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
+    read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
+    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests.
+    Every CULL_SAMPLE-th chunk is found first: when those already fall short, the rest are not
+    (on vertices in no particular order most of the bounds' cost)."""
+    b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
+    K.bounds(G, b, CULL_SAMPLE)
+    sample = b[K.B_COS, ::CULL_SAMPLE]
+    if np.count_nonzero(sample > 0) * CULL_MIN_SHARE < sample.size:
+        return _readonly(b[:, :0])
+    K.bounds(G, b, 1)
     if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
         b = b[:, :0]
     return _readonly(b)

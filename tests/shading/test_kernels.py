@@ -150,6 +150,6 @@ def test_prepare_counts_the_blocks_scale_normals_would_change(dtype, length):
     N[K.BLOCK + 3] = N[K.BLOCK + 3] * dtype(length)  # one normal in the second block
     P = np.zeros((n, 3), dtype)
     G = np.empty((6, n), dtype)
-    outside = K.prepare(P, N, np.zeros(3), 1.0, K.constants(dtype), G, np.empty((K.N_BOUNDS, 0)))
+    outside = K.prepare(P, N, np.zeros(3), 1.0, K.constants(dtype), G)
     assert outside == (0 if scale_normals(N) is N else 1)
     assert outside == (0 if length in (0.0, 1.0) else 1)
