@@ -153,3 +153,27 @@ def test_prepare_counts_the_blocks_scale_normals_would_change(dtype, length):
     outside = K.prepare(P, N, np.zeros(3), 1.0, K.constants(dtype), G)
     assert outside == (0 if scale_normals(N) is N else 1)
     assert outside == (0 if length in (0.0, 1.0) else 1)
+
+
+def test_one_shot_calls_share_only_memory_nobody_else_sees():
+    # shade() hands its prepared geometry to the next call (shader._GEOMETRY): a later call on
+    # other vertices of the same count shades those, and colours returned earlier stay as they were
+    import explorer
+    from explorer.shading import shader
+
+    rng = np.random.default_rng(9)
+    n = 2 * K.BLOCK + 3
+    scene = {
+        "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20},
+        "lights": [{"type": "point", "position": [2, 3, 1]}],
+    }
+    meshes = [(rng.normal(size=(n, 3)), rng.normal(size=(n, 3))) for _ in range(3)]
+    for precision in ("float32", "float64"):
+        first = explorer.shade(scene, *meshes[0], precision=precision)
+        kept = first.copy()
+        assert np.dtype(precision) in shader._GEOMETRY._spare  # left for the next call
+        for P, N in meshes[1:]:
+            got = explorer.shade(scene, P, N, precision=precision)
+            want = equation_shade(explorer.load_scene(scene), P, N)
+            assert np.abs(got - want).max() <= (1e-9 if precision == "float64" else 1 / 255)
+        assert np.array_equal(first, kept)
