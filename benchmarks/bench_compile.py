@@ -124,23 +124,24 @@ def child(root: Path, dtype: str, cut: bool) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def measure(root: Path, label: str) -> list[str]:
+def measure(root: Path, label: str, dtypes=("float32", "float64")) -> list[str]:
     res = {}
-    for dtype in ("float32", "float64"):
+    for dtype in dtypes:
         res[dtype] = child(root, dtype, False)
         res[dtype + " cut"] = child(root, dtype, True)
-    lines = [f"\n{label}\n", "| entry point | float32 s | float64 s |", "|---|---:|---:|"]
+
+    def row(name, values):
+        return f"| {name} | " + " | ".join(f"{v:.1f}" for v in values) + " |"
+
+    lines = [f"\n{label}\n", "| entry point | " + " | ".join(f"{d} s" for d in dtypes) + " |"]
+    lines.append("|---|" + "---:|" * len(dtypes))
     for e in ENTRIES:
-        lines.append(f"| {e} | {res['float32'].get(e, 0):.1f} | {res['float64'].get(e, 0):.1f} |")
-    total = {d: sum(res[d].get(e, 0) for e in ENTRIES) for d in ("float32", "float64")}
-    lines.append(f"| **session total** | {total['float32']:.1f} | {total['float64']:.1f} |")
-    cut = {d: res[d + " cut"].get("shade", 0) for d in ("float32", "float64")}
-    lines.append(f"| shade, one light variant | {cut['float32']:.1f} | {cut['float64']:.1f} |")
-    lines.append(
-        "| shade: what the other variants add | "
-        f"{res['float32']['shade'] - cut['float32']:.1f} | "
-        f"{res['float64']['shade'] - cut['float64']:.1f} |"
-    )
+        lines.append(row(e, [res[d].get(e, 0) for d in dtypes]))
+    lines.append(row("**session total**", [sum(res[d].get(e, 0) for e in ENTRIES) for d in dtypes]))
+    cut = [res[d + " cut"].get("shade", 0) for d in dtypes]
+    lines.append(row("shade, one light variant", cut))
+    more = [res[d]["shade"] - c for d, c in zip(dtypes, cut, strict=True)]
+    lines.append(row("shade: what the other variants add", more))
     return lines
 
 
@@ -148,10 +149,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rev", action="append", default=[], help="also measure a git revision")
     ap.add_argument("--skip-tree", action="store_true", help="measure the revisions only")
+    ap.add_argument("--precision", choices=("float32", "float64"), help="this one only")
     args = ap.parse_args(argv)
     sys.path[:0] = [str(ROOT), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
 
+    dtypes = (args.precision,) if args.precision else ("float32", "float64")
     out = [f"machine: {machine()}"]
     with tempfile.TemporaryDirectory() as tmp:
         for rev in args.rev:
@@ -161,9 +164,9 @@ def main(argv=None) -> int:
                 ["git", "-C", str(ROOT), "archive", rev], check=True, capture_output=True
             ).stdout
             subprocess.run(["tar", "-x", "-C", str(root)], input=arc, check=True)
-            out += measure(root, f"revision {rev}")
+            out += measure(root, f"revision {rev}", dtypes)
         if not args.skip_tree:
-            out += measure(ROOT, "this tree")
+            out += measure(ROOT, "this tree", dtypes)
     out.append(f"\nload average after: {os.getloadavg()[0]:.2f}")
     print("\n".join(out))
     return 0
