@@ -11,7 +11,9 @@ only a mesh whose vertex order keeps neighbours together allows.
 Prints the machine, then one row per case: median and best wall time over ``--repeat`` runs (the
 first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
 floor of a recolour (read positions and normals once, write colours once) is measured in the
-same run, on the same arrays, so "recolour / floor" is a like-for-like ratio.
+same run, on the same arrays, so "recolour / floor" is a like-for-like ratio; so are the rows
+"geometry preparation" (what a one-shot ``shade()`` does before its pass: check the vertices,
+find the frame, prepare the geometry in the working precision, the chunk bounds) against it.
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 

@@ -67,7 +67,8 @@ for _ in range(11):
 print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
 sh = explorer.Shader(scene, P, N, precision={precision!r})
 sh.colors
-eyes = [dict(eye=[0.0, 0.0, 5.0]), dict(eye=[1.0, 2.0, 5.0])]
+from bench_engine import Viewer  # (the revision's own Viewer class)
+eyes = [Viewer(eye=(0.0, 0.0, 5.0)), Viewer(eye=(1.0, 2.0, 5.0))]
 ts = []  # a viewer change: the specular sum alone is recomputed
 for _ in range(26):
     eyes.reverse(); t = time.perf_counter(); sh.set_viewer(eyes[0]); sh.colors
