@@ -209,19 +209,10 @@ class Shader:
         the working precision, structure of arrays, and the chunk bounds for light culling."""
         if self._G is not None:
             return
-        if self.n:  # (the frame of frame_of, its extent found in one compiled pass)
-            self._centre, self._scale = frame_from_extent(*K.extent(_readonly(self._P)))
-        else:
-            self._centre, self._scale = frame_of(self._P)
-        G = _GEOMETRY.take((6, self.n), self._T)
-        frame = (self._centre, 1.0 / self._scale, self._k)
-        if K.prepare(_readonly(self._P), _readonly(self._N), *frame, G):
-            # some normal lies outside NORMAL_RANGE (prepare tests what scale_normals would)
-            K.prepare(_readonly(self._P), _readonly(self._normals()), *frame, G)
+        geometry = prepared_geometry(self._P, self._N, self._T, self._k)
+        self._centre, self._scale, self._G, self._bounds, self._N = geometry
         self._scaled = True
         self.stats["geometry"] += 1
-        self._G = G
-        self._bounds = chunk_bounds(G)
 
     def _normals(self) -> np.ndarray:
         """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
@@ -529,6 +520,22 @@ class Shader:
                     self._base = base if not flat else None
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
+
+
+def prepared_geometry(P, N, dtype, k) -> tuple:
+    """The compiled tier's geometry of positions ``P`` and normals ``N`` (n, 3) in precision
+    ``dtype`` (``k``: its constants): (centre, scale) of the normalised frame (:func:`frame_of`,
+    the extent found in one compiled pass), ``G`` (6, n) (:func:`explorer.shading.kernels.prepare`),
+    the chunk bounds (:func:`chunk_bounds`) and the normals as prepared: ``N``, or scaled into
+    NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would)."""
+    n = len(P)
+    centre, scale = frame_from_extent(*K.extent(_readonly(P))) if n else frame_of(P)
+    G = _GEOMETRY.take((6, n), dtype)
+    frame = (centre, 1.0 / scale, k)
+    if K.prepare(_readonly(P), _readonly(N), *frame, G):
+        N = scale_normals(N)
+        K.prepare(_readonly(P), _readonly(N), *frame, G)
+    return centre, scale, G, chunk_bounds(G), N
 
 
 def chunk_bounds(G: np.ndarray) -> np.ndarray:
