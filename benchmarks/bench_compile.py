@@ -35,6 +35,10 @@ during the other, so the comparison is rough):
 | shade, one light variant | 99.0 | 96.2 | 22.1 | 22.1 |
 | shade: what the other variants add | 77.0 | 90.2 | 83.7 | 33.9 |
 
+``--rev 6fec099 --precision float64`` after the float64 lobe moved into a loop of its own (load
+1.3 to 2.4, beside other jobs: rough): session total 109.0 s at 6fec099, 68.0 s after; shade
+88.0 / 53.2 s; the float32 loops are unchanged.
+
 7552fa3 had 34 hand-listed variants (16 inline ones in float32 only); the light loops are the
 18 of ``LIGHT_LOOPS`` in both precisions.
 """
