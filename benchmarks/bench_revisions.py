@@ -19,7 +19,7 @@ thread, so on a busy machine the wall clock mostly measures the others).
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; medians of per-process medians):
 
-| case | 6fec099 float64 ms | 0253568+ float64 ms | ratio |
+| case | 6fec099 float64 ms | k10 float64 ms | ratio |
 |---|---:|---:|---:|
 | random points, wall (load 0.5-1.3) | 28.06 | 22.54 | 1.24x |
 | UV sphere, mesh order, wall | 14.74 | 13.22 | 1.12x |
