@@ -6,10 +6,10 @@
 Each case runs in a child process with an empty ``NUMBA_CACHE_DIR`` (nothing loaded from disk),
 which drives a small :class:`explorer.Shader` through what a session does (geometry, a full
 pass, a material change, two shininess changes) and times the first call of each compiled entry
-point on the way: ``prepare``, ``bounds``, ``shade``, ``fixup`` (float32: ambiguous lanes redone
-in float64), ``compose``, ``lobe``, then ``display._round_bytes``. A routine shared by two entry
-points is compiled by the first that calls it (``fixup`` reuses much of ``shade``), so the
-column sums to the session's total, and each figure is what that call adds.
+point on the way: ``extent``, ``prepare``, ``bounds``, ``shade``, ``fixup`` (float32:
+ambiguous lanes redone in float64), ``compose``, ``lobe``, then ``display._round_bytes``. A
+routine shared by two entry points is compiled by the first that calls it (``fixup`` reuses much
+of ``shade``), so the column sums to the session's total, and each figure is what that call adds.
 
 The row "shade, one light variant" compiles the same session with the light loop's variants cut
 down to the one the scene uses (:data:`explorer.shading.kernels.LIGHT_LOOPS` set to it in
@@ -34,6 +34,10 @@ during the other, so the comparison is rough):
 | session total | 339.1 | 234.4 | 182.2 | 69.8 |
 | shade, one light variant | 99.0 | 96.2 | 22.1 | 22.1 |
 | shade: what the other variants add | 77.0 | 90.2 | 83.7 | 33.9 |
+
+``--rev 6fec099 --precision float64`` after the float64 lobe moved into a loop of its own (load
+1.3 to 2.4, beside other jobs: rough): session total 109.0 s at 6fec099, 68.0 s after; shade
+88.0 / 53.2 s; the float32 loops are unchanged.
 
 7552fa3 had 34 hand-listed variants (16 inline ones in float32 only); the light loops are the
 18 of ``LIGHT_LOOPS`` in both precisions.
@@ -86,8 +90,9 @@ def timing(name, fn):
         finally:
             times[name] = time.perf_counter() - t
     return call
-for name in ("prepare", "bounds", "shade", "fixup", "compose", "lobe"):
-    setattr(K, name, timing(name, getattr(K, name)))
+for name in ("extent", "prepare", "bounds", "shade", "fixup", "compose", "lobe"):
+    if hasattr(K, name):  # (older revisions found the frame in numpy)
+        setattr(K, name, timing(name, getattr(K, name)))
 display._round_bytes = timing("_round_bytes", display._round_bytes)
 rng = np.random.default_rng(0)
 n = 3 * K.BLOCK + 5
@@ -108,7 +113,7 @@ display.to_bytes(np.asarray(sh.colors, np.float64))
 print(json.dumps({{"import": import_s, **times}}))
 """
 
-ENTRIES = ("prepare", "bounds", "shade", "fixup", "compose", "lobe", "_round_bytes")
+ENTRIES = ("extent", "prepare", "bounds", "shade", "fixup", "compose", "lobe", "_round_bytes")
 
 
 def child(root: Path, dtype: str, cut: bool) -> dict:
@@ -123,23 +128,24 @@ def child(root: Path, dtype: str, cut: bool) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def measure(root: Path, label: str) -> list[str]:
+def measure(root: Path, label: str, dtypes=("float32", "float64")) -> list[str]:
     res = {}
-    for dtype in ("float32", "float64"):
+    for dtype in dtypes:
         res[dtype] = child(root, dtype, False)
         res[dtype + " cut"] = child(root, dtype, True)
-    lines = [f"\n{label}\n", "| entry point | float32 s | float64 s |", "|---|---:|---:|"]
+
+    def row(name, values):
+        return f"| {name} | " + " | ".join(f"{v:.1f}" for v in values) + " |"
+
+    lines = [f"\n{label}\n", "| entry point | " + " | ".join(f"{d} s" for d in dtypes) + " |"]
+    lines.append("|---|" + "---:|" * len(dtypes))
     for e in ENTRIES:
-        lines.append(f"| {e} | {res['float32'].get(e, 0):.1f} | {res['float64'].get(e, 0):.1f} |")
-    total = {d: sum(res[d].get(e, 0) for e in ENTRIES) for d in ("float32", "float64")}
-    lines.append(f"| **session total** | {total['float32']:.1f} | {total['float64']:.1f} |")
-    cut = {d: res[d + " cut"].get("shade", 0) for d in ("float32", "float64")}
-    lines.append(f"| shade, one light variant | {cut['float32']:.1f} | {cut['float64']:.1f} |")
-    lines.append(
-        "| shade: what the other variants add | "
-        f"{res['float32']['shade'] - cut['float32']:.1f} | "
-        f"{res['float64']['shade'] - cut['float64']:.1f} |"
-    )
+        lines.append(row(e, [res[d].get(e, 0) for d in dtypes]))
+    lines.append(row("**session total**", [sum(res[d].get(e, 0) for e in ENTRIES) for d in dtypes]))
+    cut = [res[d + " cut"].get("shade", 0) for d in dtypes]
+    lines.append(row("shade, one light variant", cut))
+    more = [res[d]["shade"] - c for d, c in zip(dtypes, cut, strict=True)]
+    lines.append(row("shade: what the other variants add", more))
     return lines
 
 
@@ -147,10 +153,12 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rev", action="append", default=[], help="also measure a git revision")
     ap.add_argument("--skip-tree", action="store_true", help="measure the revisions only")
+    ap.add_argument("--precision", choices=("float32", "float64"), help="this one only")
     args = ap.parse_args(argv)
     sys.path[:0] = [str(ROOT), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
 
+    dtypes = (args.precision,) if args.precision else ("float32", "float64")
     out = [f"machine: {machine()}"]
     with tempfile.TemporaryDirectory() as tmp:
         for rev in args.rev:
@@ -160,9 +168,9 @@ def main(argv=None) -> int:
                 ["git", "-C", str(ROOT), "archive", rev], check=True, capture_output=True
             ).stdout
             subprocess.run(["tar", "-x", "-C", str(root)], input=arc, check=True)
-            out += measure(root, f"revision {rev}")
+            out += measure(root, f"revision {rev}", dtypes)
         if not args.skip_tree:
-            out += measure(ROOT, "this tree")
+            out += measure(ROOT, "this tree", dtypes)
     out.append(f"\nload average after: {os.getloadavg()[0]:.2f}")
     print("\n".join(out))
     return 0

@@ -11,7 +11,9 @@ only a mesh whose vertex order keeps neighbours together allows.
 Prints the machine, then one row per case: median and best wall time over ``--repeat`` runs (the
 first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
 floor of a recolour (read positions and normals once, write colours once) is measured in the
-same run, on the same arrays, so "recolour / floor" is a like-for-like ratio.
+same run, on the same arrays, so "recolour / floor" is a like-for-like ratio; so are the rows
+"geometry preparation" (what a one-shot ``shade()`` does before its pass: check the vertices,
+find the frame, prepare the geometry in the working precision, the chunk bounds) against it.
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 
@@ -175,6 +177,17 @@ def main(argv=None) -> int:
     row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
     one_shot = timed(lambda: explorer.shade(scene, P, N), R)
     row("one-shot `shade()` float64 (the default), incl. preparing the geometry", *one_shot, n * L)
+    # what a one-shot call does before its pass: check the vertices, find the frame, prepare
+    # the geometry in the working precision and the chunk bounds for culling
+    geometry = {}
+    for precision in ("float32", "float64"):
+
+        def prep(precision=precision):
+            sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
+            sh._compiled_geometry()  # (what the first pass does first)
+
+        geometry[precision] = timed(prep, R)
+        row(f"geometry preparation, {precision} (of a one-shot call)", *geometry[precision])
 
     # interactive updates, float32 Shader
     sh = explorer.Shader(scene, P, N, precision="float32")
@@ -234,6 +247,11 @@ def main(argv=None) -> int:
         f"recolour / bandwidth floor: {recol[0] / floor[0]:.2f}x (median), "
         f"{recol[1] / floor[1]:.2f}x (best)"
     )
+    for precision, (med, best) in geometry.items():
+        print(
+            f"geometry preparation {precision} / bandwidth floor: {med / floor[0]:.2f}x (median), "
+            f"{best / floor[1]:.2f}x (best)"
+        )
     print(f"full float32 shading vs plain numpy reference: {ref[0] * n / sub / full32:.1f}x faster")
     print(
         f"UV sphere, mesh order vs shuffled (light culling): {shuffled32 / mesh32:.2f}x faster "

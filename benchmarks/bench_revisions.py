@@ -1,4 +1,4 @@
-"""The engine's full float32 pass at two git revisions, in alternating processes.
+"""The engine's full pass at two git revisions, in alternating processes.
 
     python benchmarks/bench_revisions.py 5c40425 HEAD            # before / after a change
     python benchmarks/bench_revisions.py HEAD~3 HEAD --rounds 5
@@ -7,10 +7,29 @@
 Each revision is checked out in a temporary git worktree (its numba cache is its own, so the
 first process of each compiles: not timed) and imported from there. Processes alternate A, B,
 A, B, ... so that this VM's drift from one minute to the next falls on both alike. Each process
-times a light change on a float32 ``Shader`` (1M vertices, 8 point lights, Blinn, local viewer:
-``bench_engine.py``'s first row) 25 times, on random points (every vertex-light computed) and
-on a UV sphere with as many vertices in mesh order (light culling skips what faces away); the
-table gives the best and the median of the per-process medians, and the ratios.
+times a light change on a ``Shader`` (float32, or ``--precision``; 1M vertices, 8 point lights,
+Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on random points (every
+vertex-light computed) and on a UV sphere with as many vertices in mesh order (light culling
+skips what faces away), then a one-shot ``explorer.shade`` (10 calls) and a viewer change on a
+kept ``Shader`` (25), both on the random points, in the same precision; the table gives the
+best and the median of the per-process medians, and the ratios. ``--cpu`` runs each process on
+one numba thread and times the process's CPU seconds instead of the wall clock: the work each
+revision does, unaffected by other processes taking a core (a parallel pass waits for its slowest
+thread, so on a busy machine the wall clock mostly measures the others).
+
+Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; medians of per-process medians):
+
+| case | 6fec099 float64 ms | k10 float64 ms | ratio |
+|---|---:|---:|---:|
+| random points, wall (load 0.5-1.3) | 28.06 | 22.54 | 1.24x |
+| UV sphere, mesh order, wall | 14.74 | 13.22 | 1.12x |
+| one-shot shade(), wall | 47.91 | 26.71 | 1.79x |
+| viewer change, wall | 26.98 | 22.60 | 1.19x |
+| random points, ``--cpu`` (one thread) | 45.08 | 42.51 | 1.06x |
+| one-shot shade(), ``--cpu`` | 68.79 | 47.33 | 1.45x |
+
+float32 against cb71986, ``--cpu --rounds 3`` (beside a test run: best of the processes 17.04 /
+17.38 ms random points, 12.38 / 12.41 ms UV sphere; medians 0.95x and 0.92x).
 """
 
 from __future__ import annotations
@@ -34,6 +53,10 @@ from bench_engine import scene_with, sphere_points
 from common import uv_sphere
 import explorer
 assert explorer.__file__.startswith({root!r}), explorer.__file__
+if {cpu!r}:  # one thread, timed by the process's CPU time: other processes' load falls out
+    import numba
+    numba.set_num_threads(1)
+    time.perf_counter = time.process_time
 P, N = sphere_points({n}, np.random.default_rng(0))
 around = max(8, int(round(np.sqrt({n}))))
 Pm = uv_sphere(around, max(2, {n} // around - 1)).positions.astype(np.float32)
@@ -51,12 +74,31 @@ for P_, N_ in ((P, N), (Pm, Pm)):
         t = time.perf_counter(); relight(); ts.append(time.perf_counter() - t)
     print(min(ts) * 1e3, statistics.median(ts) * 1e3)
     del sh, relight
+ts = []  # one-shot shade(): geometry preparation and one pass that keeps no sums
+for _ in range(11):
+    t = time.perf_counter(); explorer.shade(scene, P, N, precision={precision!r})
+    ts.append(time.perf_counter() - t)
+print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
+sh = explorer.Shader(scene, P, N, precision={precision!r})
+sh.colors
+from bench_engine import Viewer  # (the revision's own Viewer class)
+eyes = [Viewer(eye=(0.0, 0.0, 5.0)), Viewer(eye=(1.0, 2.0, 5.0))]
+ts = []  # a viewer change: the specular sum alone is recomputed
+for _ in range(26):
+    eyes.reverse(); t = time.perf_counter(); sh.set_viewer(eyes[0]); sh.colors
+    ts.append(time.perf_counter() - t)
+print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
 """
 
-CASES = ("random points (every vertex-light)", "UV sphere, mesh order (light culling)")
+CASES = (
+    "random points (every vertex-light)",
+    "UV sphere, mesh order (light culling)",
+    "one-shot shade(), random points (incl. geometry)",
+    "viewer change, random points (specular only)",
+)
 
 
-def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, float]]:
+def run(root: Path, n: int, precision: str = "float32", cpu=False) -> list[tuple[float, float]]:
     env = dict(os.environ, PYTHONPATH=str(root))
     # the revision's own bench_engine helpers: they build scenes with that revision's classes
     own = Path(root) / "benchmarks"
@@ -65,6 +107,7 @@ def run(root: Path, n: int, precision: str = "float32") -> list[tuple[float, flo
         root=str(root),
         n=n,
         precision=precision,
+        cpu=cpu,
     )
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True
@@ -82,6 +125,11 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=3, help="processes per revision")
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--precision", choices=("float32", "float64"), default="float32")
+    ap.add_argument(
+        "--cpu",
+        action="store_true",
+        help="one numba thread, CPU seconds of the process: the work, whatever else runs",
+    )
     args = ap.parse_args(argv)
     repo = subprocess.run(
         ["git", "rev-parse", "--show-toplevel"], cwd=HERE, capture_output=True, text=True
@@ -102,7 +150,7 @@ def main(argv=None) -> int:
             res: dict[str, list] = {rev: [] for rev in roots}
             for _ in range(args.rounds):
                 for rev, root in roots.items():
-                    res[rev].append(run(root, args.vertices, args.precision))
+                    res[rev].append(run(root, args.vertices, args.precision, args.cpu))
         finally:
             for root in roots.values():
                 subprocess.run(
@@ -113,9 +161,10 @@ def main(argv=None) -> int:
     from bench_engine import machine
 
     print(f"machine: {machine()}")
+    clock = "CPU time of one thread" if args.cpu else "wall time, all threads"
     print(
         f"full {args.precision} pass, {args.vertices} vertices x 8 point lights; {args.rounds} "
-        "alternating processes per revision, 25 light changes each\n"
+        f"alternating processes per revision, 25 light changes each; {clock}\n"
     )
     print("| case | revision | best ms | median of medians ms | G vertex-lights/s (median) |")
     print("|---|---|---:|---:|---:|")

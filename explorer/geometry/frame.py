@@ -31,6 +31,13 @@ def frame_of(positions: np.ndarray) -> tuple[np.ndarray, float]:
     # column by column: numpy's axis-0 reduction of a strided (n, 3) array is much slower
     lo = np.array([positions[:, c].min() for c in range(3)], dtype=np.float64)
     hi = np.array([positions[:, c].max() for c in range(3)], dtype=np.float64)
+    return frame_from_extent(lo, hi)
+
+
+def frame_from_extent(lo, hi) -> tuple[np.ndarray, float]:
+    """:func:`frame_of` from the positions' smallest and largest coordinates ``lo``, ``hi``
+    (3,) float (the compiled engine finds them in one parallel pass)."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
     centre = 0.5 * lo + 0.5 * hi  # halves first: lo + hi could overflow near 1e308
     half = float(np.max(0.5 * hi - 0.5 * lo))
     if half == 0.0:  # halving a subnormal extent can round to 0: use the whole extent
@@ -45,9 +52,10 @@ def to_frame(point, centre: np.ndarray, scale: float) -> np.ndarray:
     return (np.asarray(point, dtype=np.float64) - centre) / scale
 
 
-def check_vertices(positions, normals) -> tuple[np.ndarray, np.ndarray]:
+def check_vertices(positions, normals, scale: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Validate vertex arrays; return them as C-contiguous float arrays (float32 or float64
-    kept, anything else converted to float64), the normals scaled by :func:`scale_normals`.
+    kept, anything else converted to float64), the normals scaled by :func:`scale_normals`
+    (``scale`` False: as given, for a caller that tests their range in a pass of its own).
 
     positions, normals : (n, 3) array-like of finite real numbers. Anything else (a ragged list,
     text, complex numbers, the wrong shape, NaN or inf) raises an
@@ -60,7 +68,7 @@ def check_vertices(positions, normals) -> tuple[np.ndarray, np.ndarray]:
         raise ExplorerError(
             f"positions and normals must have the same length, got {len(P)} and {len(N)}"
         )
-    return P, scale_normals(N)
+    return P, scale_normals(N) if scale else N
 
 
 def _vertex_array(name: str, a) -> np.ndarray:

@@ -298,28 +298,44 @@ def prepare(P, N, centre, inv_scale, k, G):
 
     P, N : (n, 3) float32/float64 world positions and normals
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
+    Returns how many blocks hold a normal outside :data:`explorer.core.tolerances.NORMAL_RANGE`
+    (by the test of :func:`explorer.geometry.frame.scale_normals`): 0, or scale the normals with
+    it and prepare again.
     """
     n = P.shape[0]
     Pf, Nf = P.reshape(-1), N.reshape(-1)  # flat: x0 y0 z0 x1 ... (see the module docstring)
     nblocks = (n + BLOCK - 1) // BLOCK
+    outside = 0
     for b in nb.prange(nblocks):
-        _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
+        outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
+    return outside
 
 
 @nb.njit(**_LEAF)
 def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
+    """Blocks b0 to b1 - 1 of :func:`prepare`; returns how many hold a normal out of range."""
     n = G.shape[1]
+    outside = 0
     for b in range(b0, b1):
         s = b * BLOCK
         e = min(n, s + BLOCK)
         _load_positions(Pf[3 * s : 3 * e], centre, inv_scale, G[0, s:e], G[1, s:e], G[2, s:e])
-        _load_normals(Nf[3 * s : 3 * e], G[3, s:e], G[4, s:e], G[5, s:e], k)
+        outside += _load_normals(Nf[3 * s : 3 * e], G[3, s:e], G[4, s:e], G[5, s:e], k)
+    return outside
+
+
+#: squared lengths that put a normal's largest component inside NORMAL_RANGE (the fast test of
+#: explorer.geometry.frame.scale_normals: the largest lies between length/√3 and length)
+_NN_LO, _NN_HI = 3.0 * tol.NORMAL_RANGE[0] ** 2, tol.NORMAL_RANGE[1] ** 2
 
 
 @nb.njit(**_LEAF)
 def _load_normals(N, nx, ny, nz, k):
-    """Unit normals in T; zero where |N|² <= NORMAL_EPS² (no diffuse, no specular there)."""
+    """Unit normals in T; zero where |N|² <= NORMAL_EPS² (no diffuse, no specular there).
+    Returns 1 if some normal is neither zero nor inside NORMAL_RANGE (by its squared length in
+    float64, see _NN_LO), else 0."""
     zero, one, eps2 = k[K_ZERO], k[K_ONE], k[K_NORMAL_EPS2]
+    outside = np.int32(0)
     for i in range(nx.shape[0]):
         a = N[3 * i] * one
         b = N[3 * i + 1] * one
@@ -330,6 +346,46 @@ def _load_normals(N, nx, ny, nz, k):
         nx[i] = a * inv if ok else zero
         ny[i] = b * inv if ok else zero
         nz[i] = c * inv if ok else zero
+        x, y, z = np.float64(N[3 * i]), np.float64(N[3 * i + 1]), np.float64(N[3 * i + 2])
+        s = x * x + y * y + z * z
+        zero_row = x == 0.0 and y == 0.0 and z == 0.0  # (not s == 0: s underflows at 1e-170)
+        fine = (s >= _NN_LO and s <= _NN_HI) or zero_row
+        outside |= np.int32(0) if fine else np.int32(1)
+    return outside
+
+
+@nb.njit(parallel=True, **_OPTS)
+def extent(P):
+    """The smallest and largest coordinates of positions ``P`` (n, 3) float32/float64, finite:
+    (2, 3) float64, row 0 the smallest x, y, z, row 1 the largest (see
+    :func:`explorer.geometry.frame.frame_from_extent`); n >= 1."""
+    n = P.shape[0]
+    Pf = P.reshape(-1)
+    ntasks = _tasks((n + BLOCK - 1) // BLOCK)
+    part = np.empty((ntasks, 6))
+    for t in nb.prange(ntasks):
+        s, e = t * n // ntasks, (t + 1) * n // ntasks
+        _extent_run(Pf[3 * s : 3 * e], part[t])
+    out = np.empty((2, 3))
+    for c in range(3):
+        out[0, c], out[1, c] = part[0, c], part[0, 3 + c]
+        for t in range(1, ntasks):
+            out[0, c] = min(out[0, c], part[t, c])
+            out[1, c] = max(out[1, c], part[t, 3 + c])
+    return out
+
+
+@nb.njit(**_LEAF)
+def _extent_run(Pf, out):
+    """Smallest and largest x, y, z of flat positions Pf (3m,), m >= 1, into out (6,)."""
+    lx, hx, ly, hy, lz, hz = Pf[0], Pf[0], Pf[1], Pf[1], Pf[2], Pf[2]
+    for i in range(Pf.shape[0] // 3):
+        x, y, z = Pf[3 * i], Pf[3 * i + 1], Pf[3 * i + 2]
+        lx, hx = min(lx, x), max(hx, x)
+        ly, hy = min(ly, y), max(hy, y)
+        lz, hz = min(lz, z), max(hz, z)
+    out[0], out[1], out[2] = lx, ly, lz
+    out[3], out[4], out[5] = hx, hy, hz
 
 
 @nb.njit(**_LEAF)
@@ -369,7 +425,7 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def bounds(G, out):
+def bounds(G, out, step):
     """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
 
     G : (6, n) T prepared geometry (see :func:`prepare`)
@@ -378,46 +434,54 @@ def bounds(G, out):
     mean direction; half-angle: the widest normal from it), both widened by
     :data:`explorer.core.tolerances.CULL_GUARD`. A cone of 90° or more, or a chunk with an absent
     (zero) normal, gets cosine -1: never culled.
+    step : every chunk (1), or every ``step``-th one (columns 0, step, 2·step ...; the others
+    are left as they were): a sample, to see whether culling can pay before finding them all
     """
+    for j in nb.prange((out.shape[1] + step - 1) // step):
+        _chunk_bounds(G, j * step, out)
+
+
+@nb.njit(**_LEAF)
+def _chunk_bounds(G, c, out):
+    """Column ``c`` of :func:`bounds`' ``out``: chunk ``c`` of the prepared geometry ``G``."""
     n = G.shape[1]
     guard = tol.CULL_GUARD
-    for c in nb.prange(out.shape[1]):
-        s = c * CHUNK
-        e = min(n, s + CHUNK)
-        # (scalars, not small arrays: an allocation per chunk cost more than the chunk)
-        lx = ly = lz = np.inf
-        hx = hy = hz = -np.inf
-        ax = ay = az = 0.0
+    s = c * CHUNK
+    e = min(n, s + CHUNK)
+    # (scalars, not small arrays: an allocation per chunk cost more than the chunk)
+    lx = ly = lz = np.inf
+    hx = hy = hz = -np.inf
+    ax = ay = az = 0.0
+    for i in range(s, e):
+        x, y, z = np.float64(G[0, i]), np.float64(G[1, i]), np.float64(G[2, i])
+        lx, ly, lz = min(lx, x), min(ly, y), min(lz, z)
+        hx, hy, hz = max(hx, x), max(hy, y), max(hz, z)
+        ax += np.float64(G[3, i])
+        ay += np.float64(G[4, i])
+        az += np.float64(G[5, i])
+    cx, cy, cz = 0.5 * (lx + hx), 0.5 * (ly + hy), 0.5 * (lz + hz)
+    r2 = 0.0
+    for i in range(s, e):
+        x = np.float64(G[0, i]) - cx
+        y = np.float64(G[1, i]) - cy
+        z = np.float64(G[2, i]) - cz
+        r2 = max(r2, x * x + y * y + z * z)
+    r = np.sqrt(r2) * (1.0 + guard) + guard
+    la = np.sqrt(ax * ax + ay * ay + az * az)
+    ct = -1.0
+    if la > 0.0:
+        ax, ay, az = ax / la, ay / la, az / la
+        ct = 1.0
         for i in range(s, e):
-            x, y, z = np.float64(G[0, i]), np.float64(G[1, i]), np.float64(G[2, i])
-            lx, ly, lz = min(lx, x), min(ly, y), min(lz, z)
-            hx, hy, hz = max(hx, x), max(hy, y), max(hz, z)
-            ax += np.float64(G[3, i])
-            ay += np.float64(G[4, i])
-            az += np.float64(G[5, i])
-        cx, cy, cz = 0.5 * (lx + hx), 0.5 * (ly + hy), 0.5 * (lz + hz)
-        r2 = 0.0
-        for i in range(s, e):
-            x = np.float64(G[0, i]) - cx
-            y = np.float64(G[1, i]) - cy
-            z = np.float64(G[2, i]) - cz
-            r2 = max(r2, x * x + y * y + z * z)
-        r = np.sqrt(r2) * (1.0 + guard) + guard
-        la = np.sqrt(ax * ax + ay * ay + az * az)
+            nn = ax * G[3, i] + ay * G[4, i] + az * G[5, i]
+            ct = min(ct, nn)  # an absent normal gives 0: never culled
+        ct -= guard
+    if ct <= 0.0:
         ct = -1.0
-        if la > 0.0:
-            ax, ay, az = ax / la, ay / la, az / la
-            ct = 1.0
-            for i in range(s, e):
-                nn = ax * G[3, i] + ay * G[4, i] + az * G[5, i]
-                ct = min(ct, nn)  # an absent normal gives 0: never culled
-            ct -= guard
-        if ct <= 0.0:
-            ct = -1.0
-        out[B_CX, c], out[B_CY, c], out[B_CZ, c], out[B_R, c] = cx, cy, cz, r
-        out[B_AX, c], out[B_AY, c], out[B_AZ, c] = ax, ay, az
-        out[B_COS, c] = ct
-        out[B_SIN, c] = np.sqrt(max(1.0 - ct * ct, 0.0)) + guard
+    out[B_CX, c], out[B_CY, c], out[B_CZ, c], out[B_R, c] = cx, cy, cz, r
+    out[B_AX, c], out[B_AY, c], out[B_AZ, c] = ax, ay, az
+    out[B_COS, c] = ct
+    out[B_SIN, c] = np.sqrt(max(1.0 - ct * ct, 0.0)) + guard
 
 
 @nb.njit(**_LEAF)
@@ -509,7 +573,11 @@ def _reach(bd, c0, nc, q, fl, back, act):
 # with selects (L = N at the vertex; a zero lobe where L = -V), as the row pre-passes do. Every
 # light that stores its lobe (the first pass of a shininess drag) writes base and weight rows
 # from the same arithmetic as a pass that does not, so a shininess change and a fresh pass agree
-# bit for bit in the base.
+# bit for bit in the base. On the float64 path a loop with a lobe stops at those rows, and a
+# second loop adds w·f·base^n·s_i from them: the float64 chain of one lane (square roots,
+# divisions, pow64) is too long for the core to overlap two lanes' chains within one loop
+# (``benchmarks/bench_revisions.py --precision float64`` compares); float32 keeps the lobe in the
+# one loop (its chain is shorter).
 
 SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
 LOBE_NONE = 4  # (after the LOBE_* modes above)
@@ -578,6 +646,9 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
     lobe_on = spec and mode != LOBE_FLAT
     grey = loop.grey
     track = scr.dtype == types.float32  # only the float32 path marks ambiguous lanes
+    # float64: the lobe (base^n) in a second loop over the rows B and WS the first writes (see
+    # the comment above)
+    split = lobe_on and not track
     # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
     # it interleaves them; the row-path loops read and write too many rows for such checks
     row = _row_checked if inline else _row
@@ -618,14 +689,19 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                 if track:
                     inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (marked)
                     d = d2 * inv
+                    w = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
                 else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = |l|
                     at = d2 < p_eps2
-                    inv = one / np.sqrt(one if at else d2)
-                    d = np.sqrt(d2) if at else d2 * inv
+                    d = np.sqrt(d2)
+                    r = one if at else d
                     x = a if at else x
                     yy = b if at else yy
                     z = c if at else z
-                w = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
+                    # one division for 1/|l| and w = 1 / (kc + kl·d + kq·d²): 1 / (|l|·att)
+                    att = max(kc + (kl + kq * d) * d, floor)
+                    rcp = one / (r * att)
+                    inv = att * rcp
+                    w = r * rcp if atten else one
                 ndl = (a * x + b * yy + c * z) * inv  # N·L
                 margin = d2 * c_dist2
             else:
@@ -671,12 +747,17 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                         margin = min(margin, h2 * c_len2)
                     margin = min(margin, abs(base) * c_dot)
                     base = max(base, zero)
-                    lob = fpow(base, y)  # base^n
-                    B[i] = base  # kept for a lobe store
-                _add_light(GS, Sx, Sy, Sz, i, ws * lob, sr, sg, sb, grey)  # w·f·base^n·s_i
+                    B[i] = base  # kept for a lobe store (and the lobe loop below)
+                    if not split:
+                        lob = fpow(base, y)  # base^n
+                if not split:
+                    _add_light(GS, Sx, Sy, Sz, i, ws * lob, sr, sg, sb, grey)  # w·f·base^n·s_i
                 WS[i] = ws
             if track and (spec or inline):
                 TRK[i] = min(TRK[i], margin)
+        if split:
+            for i in range(m):
+                _add_light(GS, Sx, Sy, Sz, i, WS[i] * fpow(B[i], y), sr, sg, sb, grey)
 
     return impl
 
@@ -1282,11 +1363,12 @@ def wide_vectors(lanes: int = 16):
             llvm.set_option("", "-force-vector-interleave=0")
 
 
-def _wide(kernel, dtype_arg: int):
+def _wide(kernel, dtype_arg: int, lanes: int = 0):
     """Call ``kernel`` so that a signature it meets for the first time with float data of a
     dtype (that of positional argument ``dtype_arg``) is compiled with 512-bit vectors
     (:func:`wide_vectors` around such first calls, which compile or load from numba's cache);
-    later calls go straight to the kernel."""
+    later calls go straight to the kernel. ``lanes``: a fixed width instead (8: a kernel whose
+    arithmetic is float64 whatever its data)."""
     if not WIDE_VECTORS:
         return kernel
     seen: set = set()
@@ -1299,7 +1381,7 @@ def _wide(kernel, dtype_arg: int):
         if dt not in (np.float32, np.float64):
             seen.add(dt)
             return kernel(*args)
-        with wide_vectors(64 // dt.itemsize):
+        with wide_vectors(lanes or 64 // dt.itemsize):
             try:
                 return kernel(*args)
             finally:
@@ -1782,7 +1864,8 @@ def _add(p, q, o):
 # the entry points, each compiled with wide float32 vectors where the CPU has them (see _wide);
 # the number is the argument whose dtype picks the precision
 prepare = _wide(prepare, 5)
-bounds = _wide(bounds, 0)
+extent = _wide(extent, 0)
+bounds = _wide(bounds, 0, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
 shade = _wide(shade, 0)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)

@@ -35,6 +35,7 @@ A shader switches to the compiled tier at its next pass once the kernels are loa
 from __future__ import annotations
 
 import sys
+import threading
 from collections import Counter
 from collections.abc import Iterable, Mapping
 
@@ -45,7 +46,14 @@ from explorer.core.errors import ExplorerError, ExplorerTypeError
 from explorer.core.material import MODELS, Material
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
-from explorer.geometry.frame import check_faces, check_vertices, frame_of, to_frame
+from explorer.geometry.frame import (
+    check_faces,
+    check_vertices,
+    frame_from_extent,
+    frame_of,
+    scale_normals,
+    to_frame,
+)
 from explorer.shading import kernels as K
 from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
@@ -61,6 +69,8 @@ COMPILED_MODELS = ("blinn", "phong")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
+#: :func:`chunk_bounds` tests that share on every CULL_SAMPLE-th chunk before it finds them all
+CULL_SAMPLE = 16
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
 #: (:func:`invalidated`)
@@ -107,7 +117,9 @@ def shade(
         faces=faces,
         tier=tier,
     )
-    return np.asarray(s.colors, dtype=np.float64)
+    colours = np.asarray(s.colors, dtype=np.float64)
+    _GEOMETRY.give(s._G)  # (the shader is dropped: its prepared geometry serves the next call)
+    return colours
 
 
 class Shader:
@@ -177,15 +189,17 @@ class Shader:
 
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
-        P, N = check_vertices(positions, normals)  # normals scaled for the kernels
+        # normals scaled for the kernels when a pass needs them (see _normals)
+        P, N = check_vertices(positions, normals, scale=False)
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
         self._P, self._N = P, N
+        self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
         self._vis_cache: dict = {}
         self._plan = self._make_plan(self._scene)
-        self._centre, self._scale = frame_of(self._P)
+        self._centre, self._scale = None, 1.0  # the frame, found with the compiled geometry
         n = len(self._P)
         self._G = self._bounds = None  # the compiled tier's geometry, made at its first pass
         self._np = None  # the numpy tier's sums
@@ -204,13 +218,18 @@ class Shader:
         the working precision, structure of arrays, and the chunk bounds for light culling."""
         if self._G is not None:
             return
-        G = np.empty((6, self.n), self._T)
-        K.prepare(
-            _readonly(self._P), _readonly(self._N), self._centre, 1.0 / self._scale, self._k, G
-        )
+        geometry = prepared_geometry(self._P, self._N, self._T, self._k)
+        self._centre, self._scale, self._G, self._bounds, self._N = geometry
+        self._scaled = True
         self.stats["geometry"] += 1
-        self._G = G
-        self._bounds = chunk_bounds(G)
+
+    def _normals(self) -> np.ndarray:
+        """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
+        the same array when they lie in it already, as the compiled geometry found)."""
+        if not self._scaled:
+            self._N = scale_normals(self._N)
+            self._scaled = True
+        return self._N
 
     def set_scene(self, scene) -> None:
         """Apply a new scene, invalidating only what its differences touch. A bad scene raises
@@ -324,7 +343,7 @@ class Shader:
         if not plan.shadows:
             return np.zeros((len(scene.lights), 0), dtype)
         shadowed = [lp.shadows for lp in plan.lights]
-        vis, rays = visibility_rows(self._P, self._N, self._faces, scene.lights, shadowed,
+        vis, rays = visibility_rows(self._P, self._normals(), self._faces, scene.lights, shadowed,
                                     two_sided=scene.two_sided, force_all=self.force_all,
                                     cache=self._vis_cache, dtype=dtype,
                                     cancelled=self.cancelled)  # fmt: skip
@@ -404,7 +423,7 @@ class Shader:
         self._colors = None
         if self._np is None:
             vis = self._visibility(np.float64)
-            self._np = equation_terms(self._scene, self._P, self._N, visibility=vis)
+            self._np = equation_terms(self._scene, self._P, self._normals(), visibility=vis)
             self.stats["numpy"] += 1
         else:
             self.stats["compose"] += 1
@@ -489,7 +508,7 @@ class Shader:
             self.stats["fixup_vertices"] += K.fixup(
                 K.Marks(redo, self._redo_count),
                 _readonly(self._P),
-                _readonly(self._N),
+                _readonly(self._normals()),
                 self._centre,
                 1.0 / self._scale,
                 K.Lights(params64, flags, view64),
@@ -518,13 +537,35 @@ class Shader:
                 self._spec_shininess = scene.material.shininess
 
 
+def prepared_geometry(P, N, dtype, k) -> tuple:
+    """The compiled tier's geometry of positions ``P`` and normals ``N`` (n, 3) in precision
+    ``dtype`` (``k``: its constants): (centre, scale) of the normalised frame (:func:`frame_of`,
+    the extent found in one compiled pass), ``G`` (6, n) (:func:`explorer.shading.kernels.prepare`),
+    the chunk bounds (:func:`chunk_bounds`) and the normals as prepared: ``N``, or scaled into
+    NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would)."""
+    n = len(P)
+    centre, scale = frame_from_extent(*K.extent(_readonly(P))) if n else frame_of(P)
+    G = _GEOMETRY.take((6, n), dtype)
+    frame = (centre, 1.0 / scale, k)
+    if K.prepare(_readonly(P), _readonly(N), *frame, G):
+        N = scale_normals(N)
+        K.prepare(_readonly(P), _readonly(N), *frame, G)
+    return centre, scale, G, chunk_bounds(G), N
+
+
 def chunk_bounds(G: np.ndarray) -> np.ndarray:
     """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
     prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
     read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
-    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests."""
+    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests.
+    Every CULL_SAMPLE-th chunk is found first: when those already fall short, the rest are not
+    (on vertices in no particular order most of the bounds' cost)."""
     b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
-    K.bounds(G, b)
+    K.bounds(G, b, CULL_SAMPLE)
+    sample = b[K.B_COS, ::CULL_SAMPLE]
+    if np.count_nonzero(sample > 0) * CULL_MIN_SHARE < sample.size:
+        return _readonly(b[:, :0])
+    K.bounds(G, b, 1)
     if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
         b = b[:, :0]
     return _readonly(b)
@@ -605,6 +646,33 @@ def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.n
     opts[K.O_TRACK] = dtype is np.float32
     opts[K.O_VIEW] = any(e.needs_view(plan.effect(e.name)) for e in EFFECTS)
     return opts
+
+
+class _Spare:
+    """One array of each dtype that a finished one-shot :func:`shade` left, for the next call
+    (its prepared geometry: 6n values, 48 MB at 1M vertices in float64, whose first touch costs
+    more page faults than preparing it costs work). Thread-safe: an array is taken by one shader,
+    which owns it from then on."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._spare: dict = {}
+
+    def take(self, shape: tuple, dtype) -> np.ndarray:
+        """The spare array of this shape and dtype, or a new one."""
+        with self._lock:
+            a = self._spare.pop(np.dtype(dtype), None)
+        return a if a is not None and a.shape == shape else np.empty(shape, dtype)
+
+    def give(self, a) -> None:
+        """Keep ``a`` (nothing else may use it any more) as the spare of its dtype; None: none."""
+        if a is not None:
+            with self._lock:
+                self._spare[a.dtype] = a
+
+
+#: the spare prepared geometry of one-shot calls
+_GEOMETRY = _Spare()
 
 
 class _Memory:

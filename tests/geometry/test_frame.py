@@ -7,7 +7,13 @@ import numpy as np
 import pytest
 
 from explorer.core.errors import ExplorerError
-from explorer.geometry.frame import check_faces, check_vertices, scale_normals
+from explorer.geometry.frame import (
+    check_faces,
+    check_vertices,
+    frame_from_extent,
+    frame_of,
+    scale_normals,
+)
 from explorer.geometry.meshes import Mesh
 
 TRI = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
@@ -89,3 +95,18 @@ def test_scale_normals_is_exact_and_copies_only_when_needed(dtype):
         ratio = out[i][nz].astype(np.float64) / N[i][nz]
         assert np.all(ratio == ratio[0]) and np.log2(ratio[0]) % 1 == 0
     assert np.array_equal(out[3], N[3])
+
+
+def test_frame_from_extent_is_frame_of():
+    rng = np.random.default_rng(1)
+    for P in (rng.normal(size=(50, 3)) * 1e8 + 3e8, np.array([[1.0, 2.0, 3.0]]), np.zeros((4, 3))):
+        centre, scale = frame_from_extent(P.min(axis=0), P.max(axis=0))
+        want = frame_of(P)
+        assert np.array_equal(centre, want[0]) and scale == want[1]
+
+
+def test_check_vertices_can_leave_the_normals_as_given():
+    N = np.array([[0.0, 0.0, 1e-20]])  # outside NORMAL_RANGE: scaled unless told not to
+    assert check_vertices(np.zeros((1, 3)), N, scale=False)[1] is N
+    scaled = check_vertices(np.zeros((1, 3)), N)[1]
+    assert scaled is not N and 0.5 <= scaled[0, 2] < 1

@@ -65,7 +65,7 @@ def test_bounds_hold_every_vertex_of_their_chunk(name):
     _ = sh.colors  # the compiled tier prepares its geometry at its first pass
     G = sh._G.astype(np.float64)
     b = np.empty((K.N_BOUNDS, -(-sh.n // K.CHUNK)))
-    K.bounds(sh._G, b)
+    K.bounds(sh._G, b, 1)
     chunk = np.arange(sh.n) // K.CHUNK
     d = np.linalg.norm(G[:3].T - b[[K.B_CX, K.B_CY, K.B_CZ]][:, chunk].T, axis=1)
     assert np.all(d <= b[K.B_R, chunk])
@@ -74,6 +74,23 @@ def test_bounds_hold_every_vertex_of_their_chunk(name):
     assert np.all(cosine[cone] >= b[K.B_COS, chunk][cone])
     assert np.all(b[K.B_COS] ** 2 + b[K.B_SIN] ** 2 >= 1 - 1e-12)  # sine never too small
     assert cone.mean() > 0.5  # a smooth mesh in its own order: most cones are narrow
+    assert np.array_equal(sh._bounds, b)  # the shader's, found while preparing the geometry
+
+
+def test_bounds_can_be_sampled_every_kth_chunk():
+    # chunk_bounds first finds every CULL_SAMPLE-th chunk's bounds: those columns as the full
+    # pass finds them, the others left untouched
+    mesh = _mesh("sphere")
+    sh = explorer.Shader({"material": MATERIAL}, mesh.positions, mesh.normals)
+    _ = sh.colors
+    full = np.empty((K.N_BOUNDS, -(-sh.n // K.CHUNK)))
+    K.bounds(sh._G, full, 1)
+    sampled = np.full_like(full, np.nan)
+    K.bounds(sh._G, sampled, 5)
+    assert np.array_equal(sampled[:, ::5], full[:, ::5])
+    keep = np.ones(full.shape[1], bool)
+    keep[::5] = False
+    assert np.isnan(sampled[:, keep]).all()
 
 
 def test_shuffled_vertices_are_not_tested_at_all():

@@ -123,3 +123,57 @@ def test_shade_refuses_grey_sums_for_a_pass_that_is_not_grey(monkeypatch):
     args[1] = args[1]._replace(flags=args[1].flags & ~K.GREY)  # RGB lights: not a grey pass
     with pytest.raises(ValueError, match="grey pass"):
         shade(*args)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_extent_is_the_positions_smallest_and_largest_coordinates(dtype):
+    # more points than parallel tasks, spread so every task holds a different extreme
+    rng = np.random.default_rng(3)
+    n = K.TASKS * K.BLOCK + 7
+    P = (rng.normal(size=(n, 3)) * [1.0, 1e3, 1e-3] + [5.0, -2.0, 0.0]).astype(dtype)
+    got = K.extent(P)
+    assert np.array_equal(got, np.stack([P.min(axis=0), P.max(axis=0)]).astype(np.float64))
+    assert np.array_equal(K.extent(P[:1]), np.stack([P[0], P[0]]).astype(np.float64))
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("length", [0.0, 1.0, 1e-7, 1e-20, 1e-310, 1e7, 1e20])
+def test_prepare_counts_the_blocks_scale_normals_would_change(dtype, length):
+    # prepare tests each normal as scale_normals does: a block counts when some normal is neither
+    # zero nor in NORMAL_RANGE (the caller then scales them and prepares again)
+    from explorer.geometry.frame import scale_normals
+
+    if length and not np.isfinite(dtype(length)) or (length and dtype(length) == 0):
+        pytest.skip("not a finite non-zero value in this dtype")
+    n = 3 * K.BLOCK + 5
+    N = np.tile(np.array([0.6, 0.0, 0.8], dtype), (n, 1))
+    N[K.BLOCK + 3] = N[K.BLOCK + 3] * dtype(length)  # one normal in the second block
+    P = np.zeros((n, 3), dtype)
+    G = np.empty((6, n), dtype)
+    outside = K.prepare(P, N, np.zeros(3), 1.0, K.constants(dtype), G)
+    assert outside == (0 if scale_normals(N) is N else 1)
+    assert outside == (0 if length in (0.0, 1.0) else 1)
+
+
+def test_one_shot_calls_share_only_memory_nobody_else_sees():
+    # shade() hands its prepared geometry to the next call (shader._GEOMETRY): a later call on
+    # other vertices of the same count shades those, and colours returned earlier stay as they were
+    import explorer
+    from explorer.shading import shader
+
+    rng = np.random.default_rng(9)
+    n = 2 * K.BLOCK + 3
+    scene = {
+        "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.5, 0.5], "shininess": 20},
+        "lights": [{"type": "point", "position": [2, 3, 1]}],
+    }
+    meshes = [(rng.normal(size=(n, 3)), rng.normal(size=(n, 3))) for _ in range(3)]
+    for precision in ("float32", "float64"):
+        first = explorer.shade(scene, *meshes[0], precision=precision)
+        kept = first.copy()
+        assert np.dtype(precision) in shader._GEOMETRY._spare  # left for the next call
+        for P, N in meshes[1:]:
+            got = explorer.shade(scene, P, N, precision=precision)
+            want = equation_shade(explorer.load_scene(scene), P, N)
+            assert np.abs(got - want).max() <= (1e-9 if precision == "float64" else 1 / 255)
+        assert np.array_equal(first, kept)
