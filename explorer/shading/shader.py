@@ -384,15 +384,8 @@ class Shader:
             # the lobe alone: bases and weights are stored, only n changed
             params, flags, _ = self._params_for(T)
             S = self._memory.fresh((self.n, 3), self._T)
-            K.lobe(
-                self._base if self._base is not None else self._ws,
-                self._ws,
-                params,
-                flags,
-                T(shininess),
-                self._k,
-                S,
-            )
+            base = self._base if self._base is not None else self._ws
+            K.lobe(base, self._ws, params, flags, T(shininess), self._k, S)
             self._S = S
             self._spec_shininess = shininess
             self.stats["lobe"] += 1
@@ -402,17 +395,9 @@ class Shader:
         if do_amb or do_dif or do_spec:
             self._run(do_amb, do_dif, do_spec, flat, mat, aconst)
         else:
-            empty = np.zeros((0, 3), T)
-            K.compose(
-                mat,
-                aconst,
-                self._A if self._A is not None and need_amb else empty,
-                self._D if self._D is not None and need_dif else empty,
-                self._S if self._S is not None and need_spec else empty,
-                self.clamp,
-                self._k,
-                self._out,
-            )
+            kept = ((self._A, need_amb), (self._D, need_dif), (self._S, need_spec))
+            sums = [x if x is not None and need else np.zeros((0, 3), T) for x, need in kept]
+            K.compose(mat, aconst, *sums, self.clamp, self._k, self._out)
             self.stats["compose"] += 1
         self._colors = _readonly(self._out)
         self._out = None
