@@ -30,6 +30,16 @@ Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; medians of per-process m
 
 float32 against cb71986, ``--cpu --rounds 3`` (beside a test run: best of the processes 17.04 /
 17.38 ms random points, 12.38 / 12.41 ms UV sphere; medians 0.95x and 0.92x).
+
+What bounds the float64 pass (k10): a standalone copy of the inline point-light Blinn loop,
+compiled as the kernel is (512-bit, interleave 2), has 215 vector instructions per 16
+vertex-lights (the pow64 loop 123, the L / attenuation / diffuse / base loop 92: 13.4 per
+vertex-light) and runs about 1.2 of them per cycle, 11 cycles per vertex-light on one thread;
+the engine takes 13.8 (the rest is memory: a kept float64 pass moves about 128 MB), and two
+threads give 1.6-1.9x one. Tried on that copy and not kept: float32-seeded reciprocal and square
+root with Newton steps (291 instructions instead of 215), Estrin polynomials (no gain),
+interleave 4 (3% on top of the split loop, more compile time), cheaper pow polynomials (about
+2%), compacting the lanes whose pow is 0 (no vector compress from LLVM 20; scalar costs more).
 """
 
 from __future__ import annotations
