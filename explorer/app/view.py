@@ -36,7 +36,7 @@ from explorer.render.camera import (
     camera_from_vtk,
 )
 from explorer.render.vtk import add_unlit, cells, polydata
-from explorer.shading.display import engine_clamps, shown, to_bytes
+from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import Shader
 
 #: meshes with more vertices than this get a level of detail drawn while dragging
@@ -191,13 +191,7 @@ class MeshDrawing:
         each material recomposes them)."""
         if self.groups is None:
             return shown(self.shader.colors, self.shader.scene)
-        scene = self.shader.scene
-        out = np.empty((self.mesh.n_vertices, 3), np.float64)
-        for rows, material in zip(self._rows, self.groups, strict=True):
-            self.shader.set_material(material)
-            out[rows] = self.shader.colors[rows]
-        self.shader.set_material(scene.material)
-        return shown(out, scene)
+        return shown(grouped_colors(self.shader, self._rows, self.groups), self.shader.scene)
 
     def upload(self) -> None:
         """Write the display colours into VTK's array as 8-bit values and mark it modified."""

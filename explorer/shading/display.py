@@ -31,6 +31,7 @@ __all__ = [
     "display_colors",
     "engine_clamps",
     "group_vertex_colors",
+    "grouped_colors",
     "shown",
     "to_bytes",
     "vertex_colors",
@@ -103,13 +104,23 @@ def group_vertex_colors(scene, mesh: Mesh, materials, *, precision: str = "float
         clamp=engine_clamps(scene),
         faces=mesh.faces,
     )
-    out = np.zeros((mesh.n_vertices, 3), np.float64)
-    for g, material in enumerate(materials):
-        rows = groups.vertices(g)
-        if len(rows):
+    rows = [groups.vertices(g) for g in range(len(groups.names))]
+    return shown(grouped_colors(shader, rows, materials), scene)
+
+
+def grouped_colors(shader: Shader, rows, materials) -> np.ndarray:
+    """A shader's colours (n, 3) float64 with each group of vertices in its own material:
+    the light sums are computed once, each material recomposes them (and re-runs the lobe when
+    its shininess differs). rows : one index array per group; materials : one Material per
+    group. The shader is left with its own scene's material."""
+    own = shader.scene.material
+    out = np.zeros((shader.n, 3), np.float64)
+    for r, material in zip(rows, materials, strict=True):
+        if len(r):
             shader.set_material(material)
-            out[rows] = shader.colors[rows]
-    return shown(out, scene)
+            out[r] = shader.colors[r]
+    shader.set_material(own)
+    return out
 
 
 def to_bytes(colors, opacity: float | None = None, *, out=None) -> np.ndarray:
