@@ -26,8 +26,8 @@ from explorer.core import tolerances as tol
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.formats import EXPORT_SUFFIXES, convert
-from explorer.core.mtl import MtlError, format_mtl, preset_name, preset_names, read_mtl
-from explorer.core.presets import SUFFIX, save_preset, user_dir
+from explorer.core.mtl import MtlError, format_mtl, mtl_import, preset_name
+from explorer.core.presets import user_dir
 from explorer.core.yamlio import dump_yaml
 from explorer.geometry.meshes import Mesh
 from explorer.render.images import encode_png
@@ -231,27 +231,23 @@ class FileCommands:
                                  "all files (*)")  # fmt: skip
             if not path:
                 return []
+        directory = Path(self.preset_dir) if self.preset_dir else user_dir()
         try:
-            found = read_mtl(path)
+            job = mtl_import(path, directory)
         except MtlError as exc:
             self.show_status(f"error (import materials): {exc}", error=True)
             self.tell("Import materials", f"{exc}\n\nNothing was imported.", error=True)
             return []
-        directory = Path(self.preset_dir) if self.preset_dir else user_dir()
-        names = preset_names([m.name for m in found])
-        targets = [directory / f"{name}{SUFFIX}" for name in names]
-        existing = [t for t in targets if t.exists()]
+        existing = job.existing
         if existing and not self.ask_yes(
             f"{plural(len(existing), 'preset file')} of {Path(path).name} "
             f"exist already:\n" + "\n".join(str(t) for t in existing) + "\n\nReplace them?"
         ):
             self.show_status(f"nothing imported from {path}: the preset files exist")
             return []
-        written, warnings = [], []
-        for m, name, target in zip(found, names, targets, strict=True):
-            material = m.material.replace(description=f"imported from {Path(path).name}: {m.name}")
-            written.append(save_preset(material, name, directory, overwrite=target in existing))
-            warnings.extend(m.warnings)
+        written = job.write(overwrite=bool(existing))
+        warnings = [w for m in job.found for w in m.warnings]
+        names = job.names
         self.reload_presets()
         text = (f"imported {plural(len(written), 'preset')} from {Path(path).name} into "
                 f"{directory}: " + ", ".join(names))  # fmt: skip

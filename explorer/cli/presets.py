@@ -32,14 +32,13 @@ from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.formats import EXPORT_SUFFIXES, SHOW_FORMATS, convert
 from explorer.core.material import Material
-from explorer.core.mtl import MtlError, preset_name, preset_names, read_mtl
+from explorer.core.mtl import MtlError, mtl_import, preset_name, read_mtl
 from explorer.core.presets import (
     SUFFIX,
     is_valid_name,
     list_presets,
     load_material_file,
     locate_preset,
-    save_preset,
     user_dir,
 )
 from explorer.core.text import printable
@@ -210,19 +209,16 @@ def import_mtl(file: str, into, force: bool, out=None, err=None) -> int:
     preset file exists and ``force`` is not given."""
     out = out or sys.stdout
     err = err or sys.stderr
-    found = read_mtl(file)
     directory = user_dir() if into is None else Path(into).expanduser()
-    names = preset_names([m.name for m in found])
-    targets = [directory / f"{name}{SUFFIX}" for name in names]
-    existing = [str(t) for t in targets if t.exists()]
+    job = mtl_import(file, directory)
+    existing = [str(t) for t in job.existing]
     if existing and not force:
         raise ExplorerError(
             f"{len(existing)} preset file{'s' if len(existing) != 1 else ''} already exist: "
             f"{', '.join(existing)}; nothing was written (use --force to replace them)"
         )
-    for m, name in zip(found, names, strict=True):
-        material = m.material.replace(description=f"imported from {Path(file).name}: {m.name}")
-        path = save_preset(material, name, directory, overwrite=force)
+    found = job.found
+    for m, name, path in zip(found, job.names, job.write(force), strict=True):
         renamed = "" if name == m.name else f" (newmtl {m.name})"
         out.write(f"wrote {printable(path)}{printable(renamed)}\n")
         for w in m.warnings:

@@ -28,6 +28,7 @@ import math
 import os
 import re
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
@@ -37,7 +38,7 @@ from explorer.core.material import (
     SHININESS_RANGE,
     Material,
 )
-from explorer.core.presets import MAX_NAME_LENGTH
+from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_preset
 
 #: colour statement -> the material field it sets
 COLOUR_KEYS = {"ka": "ambient", "kd": "diffuse", "ks": "specular", "ke": "emission"}
@@ -380,6 +381,47 @@ def preset_names(names: list[str]) -> list[str]:
             k += 1
         out.append(candidate)
     return out
+
+
+@dataclass(frozen=True)
+class MtlImport:
+    """What importing an .mtl file into a preset directory writes (``presets import``, the
+    window's Import materials): one preset per ``newmtl``, named by :func:`preset_names`.
+
+    found : the file's materials; names : their preset names; targets : the preset files
+    """
+
+    source: str
+    found: tuple
+    names: tuple
+    targets: tuple
+
+    @property
+    def existing(self) -> list[Path]:
+        """The targets that exist already (replaced only when asked)."""
+        return [t for t in self.targets if t.exists()]
+
+    def write(self, overwrite: bool) -> list[Path]:
+        """Write every preset (atomically; an existing file only with ``overwrite``)."""
+        origin = Path(self.source).name
+        return [
+            save_preset(
+                m.material.replace(description=f"imported from {origin}: {m.name}"),
+                name,
+                t.parent,
+                overwrite=overwrite,
+            )  # fmt: skip
+            for m, name, t in zip(self.found, self.names, self.targets, strict=True)
+        ]
+
+
+def mtl_import(path, directory) -> MtlImport:
+    """Read ``path`` (:func:`read_mtl`: a problem raises :class:`MtlError`) and name the preset
+    files it makes in ``directory``; nothing is written yet (:meth:`MtlImport.write`)."""
+    found = read_mtl(path)
+    names = preset_names([m.name for m in found])
+    targets = tuple(Path(directory) / f"{name}{SUFFIX}" for name in names)
+    return MtlImport(str(path), tuple(found), tuple(names), targets)
 
 
 # -- writing ---------------------------------------------------------------------------------
