@@ -16,6 +16,7 @@ second, with one ``error: interrupted ...`` line.
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import signal
 import sys
@@ -23,30 +24,34 @@ import threading
 import warnings
 from contextlib import contextmanager
 
-from explorer.cli import bench, gui, plan, presets, render, sheet
 from explorer.core.errors import Cancelled, ExplorerError, Notice
 from explorer.core.text import printable
 from explorer.core.version import __version__
 
-#: subcommand -> (module, one-line help); each module has ``add_arguments`` and ``run``
+#: subcommand -> one-line help; each is the module ``explorer.cli.<name>``, with
+#: ``add_arguments`` and ``run``
 COMMANDS = {
-    "plan": (plan, "print the work plan for a scene and why each term is in or out"),
-    "presets": (presets, "list, show, validate, import (.mtl) and export material presets"),
-    "render": (render, "render a scene off-screen to PNG, PLY, GLB, OBJ or a GIF/MP4 turntable"),
-    "sheet": (sheet, "render every preset in one labelled grid"),
-    "gui": (gui, "open the interactive explorer window"),
-    "bench": (bench, "measure what accuracy costs in time"),
+    "plan": "print the work plan for a scene and why each term is in or out",
+    "presets": "list, show, validate, import (.mtl) and export material presets",
+    "render": "render a scene off-screen to PNG, PLY, GLB, OBJ or a GIF/MP4 turntable",
+    "sheet": "render every preset in one labelled grid",
+    "gui": "open the interactive explorer window",
+    "bench": "measure what accuracy costs in time",
 }
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The command's parser. Imports every subcommand's module (and with them numpy and the
+    engine: about half a second), which this module itself does not, so that :func:`main`
+    starts inside its own Ctrl-C handling."""
     parser = argparse.ArgumentParser(
         prog="phong-explorer",
         description="Explore materials under the Phong / Blinn-Phong illumination model.",
     )
     parser.add_argument("--version", action="version", version=f"phong-explorer {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name, (mod, help_) in COMMANDS.items():
+    for name, help_ in COMMANDS.items():
+        mod = importlib.import_module(f"explorer.cli.{name}")
         p = sub.add_parser(name, help=help_, description=help_)
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run)
@@ -98,7 +103,11 @@ def _sigterm_raises(enabled: bool = True):
 
 def main(argv: list[str] | None = None) -> int:
     _show_notices()
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except KeyboardInterrupt:  # Ctrl-C while the engine loads: nothing was started
+        print("error: interrupted (Ctrl-C)", file=sys.stderr)
+        return INTERRUPTED_STATUS
     args = parser.parse_args(argv)
     if args.command is None:  # plain ``phong-explorer`` opens the window
         args = parser.parse_args(["gui"])

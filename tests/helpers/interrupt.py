@@ -1,6 +1,7 @@
-"""Ctrl-C in the middle of a command's ray work: the command runs in a child process whose ray
-kernel is slowed down (each chunk announces itself on stderr and sleeps 0.1 s), and SIGINT is
-sent once the first chunk has started. Counted in chunks, never timed."""
+"""Ctrl-C in the middle of a command: the command runs in a child process whose work is slowed
+down (its ray kernel: each chunk announces itself on stderr and sleeps 0.1 s; or its start: the
+first subcommand module announces its import and sleeps before it), and SIGINT is sent once that
+work has started. Counted in chunks, never timed."""
 
 from __future__ import annotations
 
@@ -25,13 +26,40 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
+#: the child for :func:`interrupt_start`: the import of the first subcommand module is slowed
+_START = """
+import importlib, sys, time
+import explorer.cli as cli
+assert "numpy" not in sys.modules  # main() starts before the engine loads
+load = importlib.import_module
+def slow(name, package=None):
+    if name.startswith("explorer.cli."):
+        sys.stderr.write("chunk\\n")
+        sys.stderr.flush()
+        time.sleep(0.1)
+    return load(name, package)
+importlib.import_module = slow
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
 def interrupt_ray_work(kernel: str, argv: list[str]) -> tuple[list[str], int, int]:
     """Run ``phong-explorer argv`` with ``kernel`` slowed down and send SIGINT once its first
     chunk has started. Returns (stderr's lines other than the chunks', the chunks started after
     the first, the exit status)."""
+    return _interrupt(_CHILD.format(kernel=kernel), argv)
+
+
+def interrupt_start(argv: list[str]) -> tuple[list[str], int, int]:
+    """Run ``phong-explorer argv`` and send SIGINT while it imports its subcommands (the engine,
+    numpy, numba: about half a second of a real start); returns as :func:`interrupt_ray_work`."""
+    return _interrupt(_START, argv)
+
+
+def _interrupt(child: str, argv: list[str]) -> tuple[list[str], int, int]:
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     proc = subprocess.Popen(
-        [sys.executable, "-c", _CHILD.format(kernel=kernel), *argv],
+        [sys.executable, "-c", child, *argv],
         stderr=subprocess.PIPE, text=True, env=env,
         # a shell starts background jobs with SIGINT ignored, and Python then leaves it so
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
