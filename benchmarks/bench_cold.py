@@ -15,7 +15,10 @@ run the product; every cold measurement is a new process in that state. Rows:
    (``benchmarks/bench_gui_start.py``'s measure).
 3. The first ``explorer.shade`` call for each kind of scene on a 20k-vertex mesh in a process
    on a cold cache (float32 and float64), and the first relight of a float32 Shader (the
-   window's path) to each light type and model.
+   window's path) to each light type and model; then the window's difference view of the
+   default teapot as its worker makes it (from the rasteriser's triangles while the compiled
+   rays are not loaded; the first opens its off-screen windows), and with the numpy tier's rays
+   for comparison.
 4. With ``PHONG_EXPLORER_KERNELS=compiled`` (the behaviour before the tiers: the first call
    compiles in the foreground), the quick start on a cold cache, for comparison in the same run.
 
@@ -91,6 +94,27 @@ FIRST_CALLS = textwrap.dedent(
         change()
         _ = s.colors
         out[name] = time.perf_counter() - t
+    # the window's difference view, default teapot at 1100x720, as its worker makes it: the
+    # rasteriser's triangles while the compiled rays are not loaded; the numpy tier's rays
+    from explorer.analysis.comparison import ViewComparer
+    from explorer.app.difference import Job, run_job
+    from explorer.core.scene import load_scene
+    from explorer.render.camera import camera_for
+    from explorer.shading.display import vertex_colors
+    view, size = teapot(), (1100, 720)
+    scene = load_scene({"material": "gold"})
+    job = Job(0, scene, view, vertex_colors(scene, view), camera_for(scene, view, 1100 / 720),
+              size, (0.32, 0.32, 0.32))
+    with ViewComparer(size) as v:
+        for name, method in (("difference view, first (rasteriser's triangles)", "auto"),
+                             ("difference view, again (rasteriser's triangles)", "auto"),
+                             ("difference view (the numpy tier's rays)", "raycast")):
+            t = time.perf_counter()
+            if method == "auto":
+                run_job(job, comparer=v)
+            else:
+                v.compare(scene, view, camera=job.camera, colors=job.colors, method=method)
+            out[name] = time.perf_counter() - t
     print(json.dumps(out))
     """
 )

@@ -28,10 +28,12 @@ import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.render.camera import camera_for
+from explorer.render.faceids import MAX_FACES, FaceIdRenderer
 from explorer.render.images import check_size
 from explorer.render.offscreen import OffscreenRenderer
-from explorer.render.perpixel import reference
+from explorer.render.perpixel import is_unit_sphere, raster_hits, reference, reference_of
 from explorer.shading.display import vertex_colors
+from explorer.shading.tiers import loaded
 
 
 @dataclass(frozen=True, eq=False)
@@ -116,6 +118,7 @@ class ViewComparer:
         self.size = check_size(size)
         self._picture = OffscreenRenderer(self.size)
         self._cover = OffscreenRenderer(self.size, (0, 0, 0))
+        self._faces = FaceIdRenderer(self.size)  # (its window opens on first use)
 
     def __enter__(self):
         return self
@@ -126,6 +129,7 @@ class ViewComparer:
     def close(self) -> None:
         self._picture.close()
         self._cover.close()
+        self._faces.close()
 
     def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto",
                 cancelled=None, peak: bool = True):  # fmt: skip
@@ -134,13 +138,33 @@ class ViewComparer:
         w, h = self.size
         if camera is None:
             camera = camera_for(scene, mesh, w / h)
-        ref = reference(scene, mesh, (w, h), camera=camera, method=method, cancelled=cancelled)
+        if rasterised(method, mesh):
+            seen = self._faces.render(mesh, camera)
+            hits = raster_hits(camera, (w, h), mesh, seen)
+            ref = reference_of(scene, mesh, hits, cancelled=cancelled)
+            cov = seen >= 0
+        else:
+            ref = reference(scene, mesh, (w, h), camera=camera, method=method,
+                            cancelled=cancelled)  # fmt: skip
+            cov = None
         if colors is None:
             colors = vertex_colors(scene, mesh)
         _check(cancelled)
         img = self._picture.render(_opaque(scene), mesh, colors, camera=camera)
-        cov = coverage(self._cover, scene, mesh, camera)
+        if cov is None:
+            cov = coverage(self._cover, scene, mesh, camera)
         return compare(img, ref, cov, peak=peak)
+
+
+def rasterised(method: str, mesh) -> bool:
+    """Whether :meth:`ViewComparer.compare` finds the pixels' surface points from a picture of
+    triangle indices (:mod:`explorer.render.faceids`) rather than rays: ``method`` "raster", or
+    "auto" for a mesh that is no built-in sphere while the compiled ray kernels are not loaded
+    (a fresh install: the numpy tier's rays take seconds for a window-sized view)."""
+    if method == "raster":
+        return True
+    return method == "auto" and not loaded() and not is_unit_sphere(mesh) and (
+        mesh.n_faces <= MAX_FACES)  # fmt: skip
 
 
 def _check(cancelled) -> None:
@@ -158,7 +182,9 @@ def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
         :func:`explorer.render.camera.camera_for`); for a live VTK camera use
         :func:`explorer.render.camera.camera_from_vtk`
     colors : (n, 3) float, the vertex colours shown (default: shaded as the renderer shades them)
-    method : the per-pixel reference's (:func:`explorer.render.perpixel.hits`)
+    method : the per-pixel reference's (:func:`explorer.render.perpixel.hits`), or "raster":
+        the surface points from a picture of triangle indices (see :func:`rasterised`, which
+        also says when "auto" takes it)
     cancelled : () -> bool, asked between chunks of the reference's rays and before the
         pictures are drawn; when it returns True the work stops with
         :class:`~explorer.core.errors.Cancelled` (a window's worker cancels a stale view)

@@ -37,7 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
-from explorer.core.tolerances import PIXEL_RAY_T_MIN
+from explorer.core.tolerances import DET_EPS, PIXEL_RAY_T_MIN
+from explorer.geometry.bvh_numpy import surface_points
 from explorer.render.camera import camera_for, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
@@ -169,6 +170,48 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     hit, pos, n = engine.surface_points(O, D, best_t, best_tri, best_u, best_v, F, Nv)
     mask[r0 : r1 + 1, c0 : c1 + 1] = hit.reshape(r1 - r0 + 1, c1 - c0 + 1)
     return Hits(mask, pos, n, "raycast")
+
+
+def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hits:
+    """The hits of the pixel rays on the triangles a rasteriser says the pixels show: no search,
+    each pixel's ray meets the plane of its own triangle (the Möller-Trumbore arithmetic of
+    :func:`explorer.geometry.rays.ray_triangle`, without its inside test: at a shared edge the
+    rasteriser and the ray may pick neighbours, whose point and interpolated normal agree).
+
+    faces_seen : (h, w) int triangle index per pixel, -1 where none
+        (:class:`explorer.render.faceids.FaceIdRenderer`, same camera and size)
+    A pixel whose ray runs within DET_EPS of its triangle's plane counts as a miss. Returns
+    :class:`Hits` (method "raster").
+    """
+    w, h = (int(v) for v in size)
+    seen = np.asarray(faces_seen)
+    if seen.shape != (h, w):
+        raise ExplorerError(f"faces_seen must have shape ({h}, {w}), got {seen.shape}")
+    rows, cols = np.nonzero(seen >= 0)
+    if rows.size == 0:
+        return Hits(np.zeros((h, w), bool), np.zeros((0, 3)), np.zeros((0, 3)), "raster")
+    r0, c0 = int(rows.min()), int(cols.min())
+    origins, dirs = pixel_rays(camera, (w, h), (c0, int(cols.max()), r0, int(rows.max())))
+    O, D = origins[rows - r0, cols - c0], dirs[rows - r0, cols - c0]
+    f = seen[rows, cols].astype(np.int64)
+    F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
+    P = np.asarray(mesh.positions, np.float64)
+    a = P[F[f, 0]]
+    e1, e2 = P[F[f, 1]] - a, P[F[f, 2]] - a
+    p = np.cross(D, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > DET_EPS
+    inv = 1.0 / np.where(ok, det, 1.0)
+    s = O - a
+    q = np.cross(s, e1)
+    u = np.einsum("ij,ij->i", s, p) * inv
+    v = np.einsum("ij,ij->i", D, q) * inv
+    t = np.einsum("ij,ij->i", e2, q) * inv
+    tri = np.where(ok, f, -1)
+    hit, pos, n = surface_points(O, D, t, tri, u, v, F, np.asarray(mesh.normals, np.float64))
+    mask = np.zeros((h, w), bool)
+    mask[rows[hit], cols[hit]] = True
+    return Hits(mask, pos, n, "raster")
 
 
 def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:
@@ -308,6 +351,12 @@ def reference(
     """
 
     h = hits(scene, mesh, size, camera=camera, method=method, cancelled=cancelled)
+    return reference_of(scene, mesh, h, precision=precision, cancelled=cancelled)
+
+
+def reference_of(scene, mesh, h: Hits, *, precision: str = "float64", cancelled=None):
+    """The per-pixel reference of the hits ``h`` (as :func:`reference`, whose hits are found
+    by :func:`hits`; :func:`raster_hits` gives others). Returns a :class:`Reference`."""
     if cancelled is not None and cancelled():
         raise Cancelled("the per-pixel reference was cancelled")
     if len(h.positions):

@@ -14,6 +14,7 @@ from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.presets import builtin_dir, load_material_file
 from explorer.core.scene import Viewer
 from explorer.geometry import meshes as M
+from explorer.render import perpixel as PP
 from explorer.render.camera import camera_for
 from explorer.render.perpixel import Hits, Reference
 
@@ -140,3 +141,37 @@ def test_compare_view_can_be_cancelled_and_leaves_nothing_behind():
         after = v.compare(scene, mesh, cancelled=lambda: False)
     direct = C.compare_view(scene, mesh, size)
     assert np.array_equal(after.levels, direct.levels) and after.mask.sum() > 1000
+
+
+def test_raster_reference_compares_as_the_ray_cast_one():
+    """The difference view from the rasteriser's triangles equals the ray-cast one but for
+    pixel centres on a silhouette or shared edge."""
+    chrome = load_material_file(builtin_dir() / "chrome.yaml")
+    scene = bench_scene(chrome).replace(viewer=Viewer(eye=(0.3, 0.4, 3.5)))
+    mesh = M.teapot(6)
+    with C.ViewComparer((200, 150)) as v:
+        raster = v.compare(scene, mesh, method="raster")
+        cast = v.compare(scene, mesh, method="raycast")
+    assert raster.mask.sum() > 4000 and (raster.mask ^ cast.mask).sum() <= 3
+    same = raster.levels == cast.levels
+    assert same.mean() > 0.999 and np.abs(raster.levels - cast.levels).max() <= 2
+    assert abs(raster.rmse - cast.rmse) < 0.01 and cast.rmse > 0.3
+
+
+def test_cold_difference_view_casts_no_rays(monkeypatch):
+    """While the compiled ray kernels are not loaded (a fresh install), "auto" takes the
+    rasteriser's triangles for a mesh and never the numpy tier's rays; the built-in spheres
+    keep their closed form."""
+    teapot, sphere = M.teapot(4), M.sphere(16)
+    assert not C.rasterised("auto", teapot)  # the suite runs on the compiled kernels
+    monkeypatch.setattr(C, "loaded", lambda: False)
+    assert C.rasterised("auto", teapot) and C.rasterised("raster", sphere)
+    assert not C.rasterised("auto", sphere) and not C.rasterised("raycast", teapot)
+
+    def no_rays(*args, **kwargs):
+        raise AssertionError("rays cast")
+
+    monkeypatch.setattr(PP, "mesh_hits", no_rays)
+    scene = bench_scene(load_material_file(builtin_dir() / "gold.yaml"))
+    c = C.compare_view(scene, teapot, (120, 90))
+    assert c.mask.sum() > 1000 and c.max >= 1

@@ -32,12 +32,14 @@ from explorer.render.camera import (
     project,
     sphere_camera,
 )
+from explorer.render.faceids import MAX_FACES, FaceIdRenderer, decode, index_colors
 from explorer.render.images import read_png
 from explorer.render.offscreen import OffscreenRenderer
 from explorer.render.perpixel import (
     hits,
     mesh_hits,
     point_colors,
+    raster_hits,
     reference,
     sphere_hits,
 )
@@ -419,3 +421,49 @@ def test_pixel_rays_of_a_rectangle_are_those_of_the_whole_picture(index):
     origins, dirs = pixel_rays(cam, size)
     o, d = pixel_rays(cam, size, (5, 20, 3, 11))
     assert np.array_equal(o, origins[3:12, 5:21]) and np.array_equal(d, dirs[3:12, 5:21])
+
+
+# -- the rasteriser's triangles ----------------------------------------------------------------
+
+
+def test_triangle_index_colours_round_trip():
+    codes = index_colors(MAX_FACES)[[0, 255, 256, 65535, 65536, MAX_FACES - 1]]
+    assert np.array_equal(decode(codes[None]), [[0, 255, 256, 65535, 65536, MAX_FACES - 1]])
+    assert decode(np.zeros((2, 3, 3), np.uint8)).tolist() == [[-1] * 3] * 2  # the background
+    with pytest.raises(explorer.ExplorerError, match="at most 16,777,215"):
+        index_colors(MAX_FACES + 1)
+
+
+def test_raster_hits_are_the_ray_casts_hits():
+    """The triangle the rasteriser shows at each pixel gives the ray cast's surface point and
+    normal (teapot, perspective and parallel), and its pixels are the coverage render's."""
+    mesh = M.teapot(6)
+    size = (160, 120)
+    for viewer in (Viewer(eye=(2.0, 1.5, 3.0)), Viewer(to_viewer=(1, 2, 3))):
+        scene = _scene(viewer)
+        cam = camera_for(scene, mesh, size[0] / size[1])
+        with FaceIdRenderer(size) as r:
+            seen = r.render(mesh, cam)
+            again = r.render(mesh, cam)
+        with OffscreenRenderer(size, (0, 0, 0)) as r:
+            white = r.render(scene, mesh, np.ones((mesh.n_vertices, 3)), camera=cam)
+        assert np.array_equal(seen, again) and seen.max() < mesh.n_faces
+        assert np.array_equal(seen >= 0, white.max(axis=2) > 127)
+        raster, cast = raster_hits(cam, size, mesh, seen), mesh_hits(cam, size, mesh)
+        assert raster.method == "raster" and raster.mask.sum() > 3000
+        assert (raster.mask ^ cast.mask).sum() <= 3  # pixel centres on a silhouette edge
+        both = raster.mask & cast.mask
+        kr, kc = np.flatnonzero(both[raster.mask]), np.flatnonzero(both[cast.mask])
+        dp = np.abs(raster.positions[kr] - cast.positions[kc]).max(axis=1)
+        dn = np.abs(raster.normals[kr] - cast.normals[kc]).max(axis=1)
+        assert np.mean(dp < 1e-12) > 0.99 and dp.max() < 0.01  # neighbours at shared edges
+        assert np.mean(dn < 1e-12) > 0.99 and dn.max() < 0.05
+
+
+def test_raster_hits_check_the_picture_size():
+    mesh = M.teapot(4)
+    cam = camera_for(_scene(), mesh, 1.0)
+    empty = raster_hits(cam, (8, 6), mesh, np.full((6, 8), -1))
+    assert empty.mask.shape == (6, 8) and not empty.mask.any() and empty.positions.shape == (0, 3)
+    with pytest.raises(explorer.ExplorerError, match=r"shape \(6, 8\)"):
+        raster_hits(cam, (8, 6), mesh, np.full((8, 6), -1))
