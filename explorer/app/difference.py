@@ -4,7 +4,9 @@ computed off the GUI thread.
 The toggle ``difference`` compares what the window shows, per-vertex colours interpolated
 across each triangle, with the same lighting evaluated at every pixel
 (:func:`explorer.analysis.comparison.compare_view`: the exact sphere for the built-in spheres,
-ray casting with interpolated normals for any other mesh), for the current camera, view size,
+ray casting with interpolated normals for any other mesh, or the rasteriser's triangles while
+the compiled ray kernels are not loaded: see :func:`explorer.analysis.comparison.rasterised`),
+for the current camera, view size,
 mesh, material and lights. The error of each pixel, in 1/255 levels, is drawn with
 :func:`explorer.analysis.comparison.heat_map` as the renderer's background while the mesh is
 hidden, so the map sits exactly where the mesh is drawn.
