@@ -32,7 +32,7 @@ from explorer.render.faceids import MAX_FACES, FaceIdRenderer
 from explorer.render.images import check_size
 from explorer.render.offscreen import OffscreenRenderer
 from explorer.render.perpixel import is_unit_sphere, raster_hits, reference, reference_of
-from explorer.shading.display import vertex_colors
+from explorer.shading.display import group_vertex_colors, vertex_colors
 from explorer.shading.tiers import loaded
 
 
@@ -132,7 +132,7 @@ class ViewComparer:
         self._faces.close()
 
     def compare(self, scene, mesh, *, camera=None, colors=None, method: str = "auto",
-                cancelled=None, peak: bool = True):  # fmt: skip
+                cancelled=None, peak: bool = True, materials=None):  # fmt: skip
         """See :func:`compare_view`."""
 
         w, h = self.size
@@ -141,14 +141,15 @@ class ViewComparer:
         if rasterised(method, mesh):
             seen = self._faces.render(mesh, camera)
             hits = raster_hits(camera, (w, h), mesh, seen)
-            ref = reference_of(scene, mesh, hits, cancelled=cancelled)
+            ref = reference_of(scene, mesh, hits, materials=materials, cancelled=cancelled)
             cov = seen >= 0
         else:
             ref = reference(scene, mesh, (w, h), camera=camera, method=method,
-                            cancelled=cancelled)  # fmt: skip
+                            cancelled=cancelled, materials=materials)  # fmt: skip
             cov = None
         if colors is None:
-            colors = vertex_colors(scene, mesh)
+            colors = (vertex_colors(scene, mesh) if materials is None
+                      else group_vertex_colors(scene, mesh, materials))  # fmt: skip
         _check(cancelled)
         img = self._picture.render(_opaque(scene), mesh, colors, camera=camera)
         if cov is None:
@@ -173,7 +174,7 @@ def _check(cancelled) -> None:
 
 
 def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
-                 method: str = "auto", cancelled=None) -> Comparison:  # fmt: skip
+                 method: str = "auto", cancelled=None, materials=None) -> Comparison:  # fmt: skip
     """The per-pixel difference of a view (the window's difference view).
 
     scene, mesh : what is shown
@@ -188,6 +189,9 @@ def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
     cancelled : () -> bool, asked between chunks of the reference's rays and before the
         pictures are drawn; when it returns True the work stops with
         :class:`~explorer.core.errors.Cancelled` (a window's worker cancels a stale view)
+    materials : one Material per group of ``mesh.groups`` when the view shows a mesh file's own
+        materials (:func:`explorer.render.perpixel.reference`; the default ``colors`` are then
+        :func:`explorer.shading.display.group_vertex_colors`)
 
     Renders the per-vertex picture and the coverage off-screen, so the window's own overlays
     never enter the comparison; :class:`ViewComparer` keeps the windows for repeated calls.
@@ -195,7 +199,7 @@ def compare_view(scene, mesh, size: Sequence[int], *, camera=None, colors=None,
     """
     with ViewComparer(size) as v:
         return v.compare(scene, mesh, camera=camera, colors=colors, method=method,
-                         cancelled=cancelled)  # fmt: skip
+                         cancelled=cancelled, materials=materials)  # fmt: skip
 
 
 #: the heat map's colour ramp: 0 levels black, then blue, green, yellow, red, white at ``vmax``

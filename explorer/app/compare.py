@@ -99,7 +99,8 @@ class DifferencePane:
     # -- the difference view --------------------------------------------------------------------
     def _difference_key(self) -> tuple:
         s = self.store.state
-        return (repr(s.shown_scene()), s.mesh, s.camera, tuple(self.plotter.window_size))
+        return (repr(s.shown_scene()), repr(s.shown_groups()), s.mesh, s.camera,
+                tuple(self.plotter.window_size))  # fmt: skip
 
     def _update_difference(self) -> None:
         """The heat map when it matches the view; else the live view, and a request for the
@@ -125,7 +126,7 @@ class DifferencePane:
         self.worker.submit(Job(
             key, s.shown_scene(), self.view.mesh, self.view.drawings[0].colors().copy(),
             s.camera, size,
-            tuple(self.plotter.renderer.GetBackground()),
+            tuple(self.plotter.renderer.GetBackground()), s.shown_groups(),
         ))  # fmt: skip
 
     def _on_difference(self, result) -> None:

@@ -43,7 +43,8 @@ TABLE_MESHES = ("sphere", "icosphere")
 @dataclass(frozen=True)
 class Job:
     """One comparison to make. key : what the map is for (the window decides what goes in
-    it); scene, mesh, colors (n, 3) in [0, 1], camera, size (w, h), background RGB in [0, 1]"""
+    it); scene, mesh, colors (n, 3) in [0, 1], camera, size (w, h), background RGB in [0, 1];
+    materials : each group's material as shown when the mesh shows its own, else None"""
 
     key: object
     scene: object
@@ -52,6 +53,7 @@ class Job:
     camera: object
     size: tuple
     background: tuple
+    materials: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -79,7 +81,7 @@ def run_job(job: Job, cancelled=lambda: False, comparer=None) -> Result:
         with C.ViewComparer(job.size) as own:
             return run_job(job, cancelled, own)
     c = comparer.compare(job.scene, job.mesh, camera=job.camera, colors=job.colors,
-                         cancelled=cancelled, peak=False)  # fmt: skip
+                         cancelled=cancelled, peak=False, materials=job.materials)  # fmt: skip
     bg = tuple(int(v) for v in to_bytes([job.background])[0])
     image = C.heat_map(c.levels, c.mask, vmax=VMAX, background=bg)
     m = job.scene.material

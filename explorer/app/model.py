@@ -222,8 +222,7 @@ def apply_preset(state: State, name: str, material: Material) -> State:
 
 def use_mesh_materials(state: State) -> State:
     """Show the mesh's own materials as its file has them, each group its own; the panel
-    edits the group it edited last (at first the largest). The difference view, which
-    compares one material, is turned off."""
+    edits the group it edited last (at first the largest)."""
     mm = state.mesh_materials
     if mm is None:
         raise ExplorerError(f"the mesh '{state.mesh}' brings no materials of its own")
@@ -231,7 +230,7 @@ def use_mesh_materials(state: State) -> State:
     material = mm.materials[group]
     return state.replace(
         scene=state.scene.replace(material=material), groups=mm.materials, group=group,
-        preset=None, preset_material=material, difference=False,
+        preset=None, preset_material=material,
     )  # fmt: skip
 
 
@@ -280,11 +279,6 @@ def set_term(state: State, term: str, shown: bool) -> State:
 
 
 def set_difference(state: State, on: bool) -> State:
-    if on and state.groups is not None:
-        raise ExplorerError(
-            "the difference view compares one material over the whole mesh, and the mesh shows "
-            "its own materials: choose a preset to compare"
-        )
     return state.replace(difference=bool(on))
 
 

@@ -63,13 +63,16 @@ class Hits:
     positions : (k, 3) float64 world positions of the hits, k = mask.sum(), in row-major
         pixel order (``image[mask]`` order)
     normals : (k, 3) float64 unit normals there
-    method : "sphere" (closed form) or "raycast" (triangles, interpolated normals)
+    method : "sphere" (closed form), "raycast" (triangles, interpolated normals) or "raster"
+        (:func:`raster_hits`)
+    triangles : (k,) int64 the triangle of the mesh each hit lies on (None for the closed form)
     """
 
     mask: np.ndarray
     positions: np.ndarray
     normals: np.ndarray
     method: str
+    triangles: np.ndarray | None = None
 
 
 def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0) -> Hits:
@@ -153,7 +156,7 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     mask = np.zeros((h, w), bool)
     rect = _screen_rect(camera, (w, h), mesh)
     if rect is None:
-        return Hits(mask, np.zeros((0, 3)), np.zeros((0, 3)), "raycast")
+        return Hits(mask, np.zeros((0, 3)), np.zeros((0, 3)), "raycast", np.zeros(0, np.int64))
     origins, dirs = pixel_rays(camera, (w, h), rect)
     O = np.ascontiguousarray(origins.reshape(-1, 3))
     D = np.ascontiguousarray(dirs.reshape(-1, 3))
@@ -169,7 +172,7 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     Nv = np.asarray(mesh.normals, np.float64)
     hit, pos, n = engine.surface_points(O, D, best_t, best_tri, best_u, best_v, F, Nv)
     mask[r0 : r1 + 1, c0 : c1 + 1] = hit.reshape(r1 - r0 + 1, c1 - c0 + 1)
-    return Hits(mask, pos, n, "raycast")
+    return Hits(mask, pos, n, "raycast", best_tri[hit])
 
 
 def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hits:
@@ -189,7 +192,8 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
         raise ExplorerError(f"faces_seen must have shape ({h}, {w}), got {seen.shape}")
     rows, cols = np.nonzero(seen >= 0)
     if rows.size == 0:
-        return Hits(np.zeros((h, w), bool), np.zeros((0, 3)), np.zeros((0, 3)), "raster")
+        none = np.zeros((0, 3))
+        return Hits(np.zeros((h, w), bool), none, none, "raster", np.zeros(0, np.int64))
     r0, c0 = int(rows.min()), int(cols.min())
     origins, dirs = pixel_rays(camera, (w, h), (c0, int(cols.max()), r0, int(rows.max())))
     O, D = origins[rows - r0, cols - c0], dirs[rows - r0, cols - c0]
@@ -211,7 +215,7 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
     hit, pos, n = surface_points(O, D, t, tri, u, v, F, np.asarray(mesh.normals, np.float64))
     mask = np.zeros((h, w), bool)
     mask[rows[hit], cols[hit]] = True
-    return Hits(mask, pos, n, "raster")
+    return Hits(mask, pos, n, "raster", tri[hit])
 
 
 def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:
@@ -339,6 +343,7 @@ def reference(
     method: str = "auto",
     precision: str = "float64",
     cancelled=None,
+    materials=None,
 ) -> Reference:
     """The per-pixel reference of a scene on a mesh (see the module docstring).
 
@@ -347,20 +352,53 @@ def reference(
     specular sums (:attr:`Reference.specular`) are computed when first asked for.
     cancelled : () -> bool, asked between chunks of rays and before the colours (True: raise
         :class:`~explorer.core.errors.Cancelled`)
+    materials : one :class:`~explorer.core.material.Material` per group of ``mesh.groups`` (a
+        mesh file's own materials): each pixel in its triangle's group's material, as
+        :func:`explorer.shading.display.group_vertex_colors` colours the vertices (method
+        "auto" then casts rays); None: the scene's material everywhere
     Returns a :class:`Reference`.
     """
 
+    if materials is not None and method == "auto":
+        method = "raycast"  # (the triangle of each hit names its group)
     h = hits(scene, mesh, size, camera=camera, method=method, cancelled=cancelled)
-    return reference_of(scene, mesh, h, precision=precision, cancelled=cancelled)
+    return reference_of(scene, mesh, h, materials=materials, precision=precision,
+                        cancelled=cancelled)  # fmt: skip
 
 
-def reference_of(scene, mesh, h: Hits, *, precision: str = "float64", cancelled=None):
+def reference_of(scene, mesh, h: Hits, *, materials=None, precision: str = "float64",
+                 cancelled=None) -> Reference:  # fmt: skip
     """The per-pixel reference of the hits ``h`` (as :func:`reference`, whose hits are found
     by :func:`hits`; :func:`raster_hits` gives others). Returns a :class:`Reference`."""
     if cancelled is not None and cancelled():
         raise Cancelled("the per-pixel reference was cancelled")
-    if len(h.positions):
-        colors = point_colors(scene, h.positions, h.normals, mesh=mesh, precision=precision)
-    else:
-        colors = np.zeros((0, 3))
-    return Reference(h, colors, lambda: specular_sums(scene, h.positions, h.normals))
+    parts = _parts(scene, mesh, h, materials)
+    colors = np.zeros((len(h.positions), 3))
+    for rows, sc in parts:
+        if len(rows):
+            P, N = h.positions[rows], h.normals[rows]
+            colors[rows] = point_colors(sc, P, N, mesh=mesh, precision=precision)
+
+    def sums():
+        out = np.zeros(len(h.positions))
+        for rows, sc in parts:
+            if len(rows):
+                out[rows] = specular_sums(sc, h.positions[rows], h.normals[rows])
+        return out
+
+    return Reference(h, colors, sums)
+
+
+def _parts(scene, mesh, h: Hits, materials) -> list[tuple[np.ndarray, object]]:
+    """Which hits each material shades: [(rows (j,) int64, the scene in that material)]."""
+    every = np.arange(len(h.positions))
+    if materials is None:
+        return [(every, scene)]
+    groups = mesh.groups
+    if groups is None or len(materials) != len(groups.names):
+        n = 0 if groups is None else len(groups.names)
+        raise ExplorerError(f"need one material per group of the mesh ({n}), got {len(materials)}")
+    if h.triangles is None:
+        raise ExplorerError("per-group colours need the triangle of each hit (method 'raycast')")
+    of_hit = groups.of_vertex[np.asarray(mesh.faces, np.int64)[h.triangles, 0]]
+    return [(every[of_hit == g], scene.replace(material=m)) for g, m in enumerate(materials)]

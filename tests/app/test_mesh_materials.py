@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from explorer.app import model as M
@@ -92,8 +93,6 @@ def test_group_actions_refuse_what_cannot_be(two):
     state, _ = gui_state("--mesh", str(two))
     with pytest.raises(ExplorerError, match="group must be 1 to 2, got 3"):
         M.select_group(state, 2)
-    with pytest.raises(ExplorerError, match="difference view compares one material"):
-        M.set_difference(state, True)
     plain, _ = gui_state("--mesh", "icosphere")
     with pytest.raises(ExplorerError, match="brings no materials of its own"):
         M.use_mesh_materials(plain)
@@ -125,3 +124,34 @@ def test_a_session_with_the_wrong_number_of_groups_names_the_key(two, tmp_path):
     path.write_text(json.dumps(data))
     with pytest.raises(ExplorerError, match=r"bad\.json.*groups\.materials.*has 2 material groups"):
         S.load_session(path)
+
+
+def test_difference_view_follows_the_groups(two):
+    """With the mesh's own materials shown, the difference view compares each pixel in its
+    triangle's group's material: red pixels on the left square, blue on the right, and the
+    worker's map equals a direct comparison (ray cast, and from the rasteriser's triangles)."""
+    from explorer.analysis import comparison as C
+    from explorer.app.difference import Job, run_job
+    from explorer.render.camera import camera_for
+    from explorer.render.perpixel import reference
+    from explorer.shading.display import group_vertex_colors
+
+    state, mesh = gui_state("--mesh", str(two))
+    state = M.set_difference(state, True)
+    assert M.use_mesh_materials(state).difference  # showing the groups keeps it on
+    scene, materials = state.shown_scene(), state.shown_groups()
+    size = (120, 80)
+    cam = camera_for(scene, mesh, size[0] / size[1])
+    ref = reference(scene, mesh, size, camera=cam, materials=materials)
+    cols = np.nonzero(ref.mask)[1]
+    left, right = ref.colors[cols < 60], ref.colors[cols >= 60]
+    assert len(left) > 500 and len(right) > 500
+    assert (left[:, 0] > left[:, 2]).all() and (right[:, 2] > right[:, 0]).all()
+    colors = group_vertex_colors(scene, mesh, materials)
+    job = Job(0, scene, mesh, colors, cam, size, (0.3, 0.3, 0.3), materials)
+    got = run_job(job).comparison
+    for method in ("raycast", "raster"):
+        want = C.compare_view(scene, mesh, size, camera=cam, method=method, materials=materials)
+        assert np.array_equal(got.levels, want.levels) and got.mask.sum() > 1000
+    one = C.compare_view(scene, mesh, size, camera=cam, colors=colors)  # one material: wrong
+    assert one.max > got.max + 20
