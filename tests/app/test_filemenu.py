@@ -105,10 +105,22 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     win.redo()
     qtbot.mouseClick(box.use, QtCore.Qt.MouseButton.LeftButton)
     assert win.store.state.groups == win.store.state.mesh_materials.materials
-    # the difference view compares one material: refused, with the reason
+    # the difference view compares each group in its own material; editing a group that is
+    # not the one drawn by the scene's material asks for a new map
     win.toggle_difference()
-    assert "compares one material" in win.message and not win.store.state.difference
-    win.errors.clear()
+    qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
+    job = win.heat.result.job
+    assert job.materials == win.store.state.shown_groups() and len(job.materials) == 2
+    assert win.heat.result.comparison.mask.sum() > 1000
+    edited = win.store.state.group
+    win.act(M.select_group, 1 - edited, label="group")
+    win.panel.material.sliders["shininess"].field.setValue(7.0)
+    assert not win.heat.shown  # stale: the live view until the new map comes
+    qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
+    assert win.heat.result.job.materials[1 - edited].shininess == 7.0
+    win.undo()
+    win.act(M.select_group, edited, label="group")
+    win.toggle_difference()
     # the session keeps the mesh and its materials
     win.panel.material.sliders["shininess"].field.setValue(5.0)
     saved = win.store.state
