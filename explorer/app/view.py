@@ -10,8 +10,8 @@ Every state goes the same way::
 The colours are drawn as RGB point scalars with VTK's lighting off, so VTK adds nothing to the
 engine's colours. Meshes above :data:`LOD_VERTICES` get a lighter level of detail (quadric
 clustering to about :data:`LOD_TARGET` vertices, shaded by its own Shader) drawn while something
-is dragged; the full mesh is shaded and drawn on release (a mesh with material groups has no
-level of detail: its groups would be lost). A mesh file's own materials
+is dragged; the full mesh is shaded and drawn on release (a mesh with material groups is
+clustered group by group, so its level of detail keeps them). A mesh file's own materials
 (``State.groups``) are drawn group by group from one Shader's light sums.
 
 PyVista and VTK are imported inside the functions that need them.
@@ -43,6 +43,8 @@ from explorer.shading.shader import Shader
 LOD_VERTICES = 250_000
 #: about how many vertices the level of detail has
 LOD_TARGET = 60_000
+#: the fewest vertices a material group's part of the level of detail is clustered to
+LOD_GROUP_MIN = 64
 #: the light handle's radius, in mesh radii
 HANDLE_RADIUS = 0.07
 HANDLE_COLOR = (1.0, 0.85, 0.2)
@@ -125,7 +127,34 @@ def framed_camera(state: State, mesh: Mesh, aspect: float) -> Camera:
 
 def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
     """A lighter version of ``mesh`` with about ``target`` vertices (VTK quadric clustering),
-    with smooth area-weighted normals. Used only while dragging."""
+    with smooth area-weighted normals. Used only while dragging. A mesh with material groups
+    (``mesh.groups``) is clustered group by group, each to its share of ``target``, so every
+    vertex of the lighter mesh keeps its group (and its colour)."""
+    groups = mesh.groups
+    if groups is None:
+        pos, faces = _clustered(mesh, target)
+        return Mesh(pos, area_weighted_normals(pos, faces), faces, f"{mesh.name} (LOD)")
+    F = np.asarray(mesh.faces, np.int64)
+    of_face = groups.of_vertex[F[:, 0]]  # (a face's corners share their group: see MaterialGroups)
+    parts, keys, offset = [], [], 0
+    for g in range(len(groups.names)):
+        used, inverse = np.unique(F[of_face == g], return_inverse=True)
+        if not len(used):
+            continue
+        part = Mesh(mesh.positions[used], mesh.normals[used], inverse.reshape(-1, 3), mesh.name)
+        pos, faces = _clustered(part, max(LOD_GROUP_MIN, target * len(used) // mesh.n_vertices))
+        parts.append((pos, faces + offset))
+        keys.append(np.full(len(pos), g, np.int32))
+        offset += len(pos)
+    pos = np.vstack([p for p, _ in parts])
+    faces = np.vstack([f for _, f in parts])
+    kept = dataclasses.replace(groups, of_vertex=np.concatenate(keys))
+    return Mesh(pos, area_weighted_normals(pos, faces), faces, f"{mesh.name} (LOD)", kept)
+
+
+def _clustered(mesh: Mesh, target: int) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (k, 3) float64 and faces (j, 3) int64 of ``mesh`` clustered to about
+    ``target`` vertices (see :func:`lod_mesh`)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkFiltersCore import vtkQuadricClustering
 
@@ -152,7 +181,7 @@ def lod_mesh(mesh: Mesh, target: int = LOD_TARGET) -> Mesh:
         out = cluster(d)
     pos = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
     faces = vtk_to_numpy(out.GetPolys().GetConnectivityArray()).astype(np.int64).reshape(-1, 3)
-    return Mesh(pos, area_weighted_normals(pos, faces), faces, f"{mesh.name} (LOD)")
+    return pos, faces
 
 
 class MeshDrawing:
@@ -250,7 +279,7 @@ class SceneView:
             self.plotter.remove_actor(d.actor)
         scene = state.shown_scene()
         self.drawings = [MeshDrawing(self.plotter, mesh, scene)]
-        if mesh.n_vertices > self.lod_vertices and mesh.groups is None:
+        if mesh.n_vertices > self.lod_vertices:
             if mesh.name not in self._lods:
                 self._lods = {mesh.name: lod_mesh(mesh, self.lod_target)}
             lod = MeshDrawing(self.plotter, self._lods[mesh.name], scene)

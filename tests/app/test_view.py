@@ -1,0 +1,82 @@
+"""The explorer's 3D view without Qt (an off-screen plotter): the level of detail drawn while
+dragging, for a plain mesh and for a mesh file's material groups."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from explorer.app import model as M
+from explorer.app.view import SceneView, lod_mesh
+from explorer.cli import build_parser
+from explorer.cli.gui import start_state
+from explorer.geometry import meshes as G
+from explorer.render.vtk import plotter
+from explorer.shading.display import group_vertex_colors, to_bytes
+
+
+def write_two_tori(directory, resolution: int = 96):
+    """An OBJ of two tori side by side, ``usemtl red`` and ``usemtl blue``, and its .mtl."""
+    t = G.torus(resolution)
+    (directory / "tori.mtl").write_text("newmtl red\nKd 1 0 0\nKs 0.5 0.5 0.5\nNs 40\n"
+                                        "newmtl blue\nKd 0 0 1\nNs 10\n")  # fmt: skip
+    lines = ["mtllib tori.mtl"]
+    n = t.n_vertices
+    for shift in (-1.2, 1.2):
+        lines += [f"v {x + shift} {y} {z}" for x, y, z in t.positions]
+    lines += [f"vn {x} {y} {z}" for x, y, z in np.vstack([t.normals, t.normals])]
+    for g, name in enumerate(("red", "blue")):
+        lines.append(f"usemtl {name}")
+        lines += [f"f {a}//{a} {b}//{b} {c}//{c}" for a, b, c in t.faces + 1 + g * n]
+    path = directory / "tori.obj"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.fixture
+def tori(tmp_path):
+    return start_state(build_parser().parse_args(["gui", "--mesh", str(write_two_tori(tmp_path))]))
+
+
+def test_level_of_detail_of_a_plain_mesh():
+    mesh = G.sphere(256)
+    lod = lod_mesh(mesh, 2000)
+    assert 1500 <= lod.n_vertices <= 2500 and lod.groups is None
+    assert np.allclose(np.linalg.norm(lod.normals, axis=1), 1.0)
+    assert np.abs(np.linalg.norm(lod.positions, axis=1) - 1.0).max() < 0.05  # on the sphere
+
+
+def test_level_of_detail_keeps_each_vertex_in_its_group(tori):
+    state, mesh = tori
+    lod = lod_mesh(mesh, 1000)
+    assert lod.groups.names == mesh.groups.names == ("red", "blue")
+    counts = np.bincount(lod.groups.of_vertex, minlength=2)
+    assert 700 <= counts.sum() <= 1300 and abs(counts[0] - counts[1]) < 0.2 * counts.sum()
+    # the tori lie apart (x < 0: red, x > 0: blue), so a vertex's side names its group
+    assert np.array_equal(lod.groups.of_vertex, (lod.positions[:, 0] > 0).astype(np.int32))
+
+
+def test_dragging_draws_the_groups_level_of_detail_in_their_materials(tori):
+    state, mesh = tori
+    assert state.groups is not None
+    pl = plotter((200, 150), (0.3, 0.3, 0.3))
+    try:
+        view = SceneView(pl, mesh, state, lod_vertices=1000, lod_target=800)
+        assert len(view.drawings) == 2
+        view.begin_drag()
+        lod = view.drawings[1]
+        assert view.active is lod and lod.actor.GetVisibility()
+        assert not view.drawings[0].actor.GetVisibility()
+        state = M.set_coefficient(state, "kd", 0.4)  # edits the group the panel edits
+        view.show_state(state)
+        want = to_bytes(group_vertex_colors(state.shown_scene(), lod.mesh, state.shown_groups()))
+        assert np.abs(lod.rgb.astype(int) - want.astype(int)).max() <= 1
+        red, blue = lod.rgb[lod.mesh.groups.of_vertex == 0], lod.rgb[lod.mesh.groups.of_vertex == 1]
+        assert (red[:, 0] >= red[:, 2]).all() and (blue[:, 2] >= blue[:, 0]).all()
+        view.end_drag()
+        full = view.drawings[0]
+        assert view.active is full and full.actor.GetVisibility()
+        want = to_bytes(group_vertex_colors(state.shown_scene(), mesh, state.shown_groups()))
+        assert np.abs(full.rgb.astype(int) - want.astype(int)).max() <= 1
+    finally:
+        pl.close()
