@@ -21,8 +21,8 @@ import numpy as np
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
-from explorer.render.images import check_size
-from explorer.render.vtk import plotter, polydata, set_camera
+from explorer.render.offscreen import OffscreenWindow
+from explorer.render.vtk import polydata, set_camera
 
 #: triangles a picture of indices can tell apart (24 bits; 0 is the background)
 MAX_FACES = (1 << 24) - 1
@@ -43,36 +43,23 @@ def decode(picture: np.ndarray) -> np.ndarray:
     return (p[..., 0] << 16 | p[..., 1] << 8 | p[..., 2]) - 1
 
 
-class FaceIdRenderer:
-    """One off-screen window that draws pictures of triangle indices (see the module docstring).
-    Use as a context manager, or call :meth:`close`.
+class FaceIdRenderer(OffscreenWindow):
+    """An off-screen window that draws pictures of triangle indices (see the module
+    docstring). Use as a context manager, or call :meth:`close`.
 
     size : (width, height) in pixels
     """
 
     def __init__(self, size: Sequence[int]):
-        self.size = check_size(size)
-        self._pl = None
-        self._mesh = None
-        self._actor = None
+        super().__init__(size, (0.0, 0.0, 0.0))
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
-
-    def close(self) -> None:
-        if self._pl is not None:
-            self._pl.close()
-            self._pl = self._mesh = self._actor = None
+    def _forget(self) -> None:
+        self._mesh = self._actor = None
 
     def render(self, mesh: Mesh, camera: Camera) -> np.ndarray:
         """(h, w) int64: the index of the triangle of ``mesh`` each pixel shows, -1 where none
         (see :func:`decode`)."""
-        if self._pl is None:
-            self._pl = plotter(self.size, (0.0, 0.0, 0.0))
-        pl = self._pl
+        pl = self.plotter
         if self._mesh is not mesh:
             if self._actor is not None:
                 pl.remove_actor(self._actor)

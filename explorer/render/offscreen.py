@@ -50,23 +50,23 @@ LABEL_HEIGHT = 0.085
 # -- the off-screen renderer ---------------------------------------------------------------
 
 
-class OffscreenRenderer:
-    """One off-screen VTK window reused for many pictures of the same size (cheap: no new
-    OpenGL context per picture). Use as a context manager, or call :meth:`close`.
+class OffscreenWindow:
+    """One off-screen VTK window of a fixed size, opened on first use and reused for many
+    pictures (no new OpenGL context per picture). Use as a context manager, or call
+    :meth:`close`.
 
     size : (width, height) in pixels
     background : RGB in [0, 1]
     """
 
-    def __init__(self, size: Sequence[int] = DEFAULT_SIZE, background=BACKGROUND):
+    def __init__(self, size: Sequence[int], background):
         self.size = check_size(size)
         self.background = tuple(float(c) for c in background)
         self._pl = None
-        self._actor = None
-        self._mesh = None
-        self._poly = None
-        self._text = None
-        self._sorted = False
+        self._forget()
+
+    def _forget(self) -> None:
+        """Drop what the subclass keeps of the closed window's contents."""
 
     def __enter__(self):
         return self
@@ -78,13 +78,28 @@ class OffscreenRenderer:
         if self._pl is not None:
             self._pl.close()
             self._pl = None
-            self._actor = self._mesh = self._poly = self._text = None
+            self._forget()
 
     @property
     def plotter(self):
         if self._pl is None:
             self._pl = plotter(self.size, self.background)
         return self._pl
+
+
+class OffscreenRenderer(OffscreenWindow):
+    """An :class:`OffscreenWindow` that draws the engine's colours on a mesh.
+
+    size : (width, height) in pixels
+    background : RGB in [0, 1]
+    """
+
+    def __init__(self, size: Sequence[int] = DEFAULT_SIZE, background=BACKGROUND):
+        super().__init__(size, background)
+
+    def _forget(self) -> None:
+        self._actor = self._mesh = self._poly = self._text = None
+        self._sorted = False
 
     def render(
         self,
