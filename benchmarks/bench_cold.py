@@ -239,7 +239,8 @@ def main(argv=None) -> int:
     print("| call | seconds |\n|---|---:|")
     for name, t in first.items():
         print(f"| {name} | {t:.3f} |")
-    print(f"\nslowest first call: {max(first.values()):.3f} s")
+    calls = [t for name, t in first.items() if not name.startswith("difference view")]
+    print(f"\nslowest first call (the difference view's rows aside): {max(calls):.3f} s")
     shutil.rmtree(work, ignore_errors=True)
     return 0
 
