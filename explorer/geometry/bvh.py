@@ -80,8 +80,11 @@ class BVH:
     parent : (k,) int64 each inner node's parent (-1 for the root)
     tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
     plane : (m, 4) float64 its unit normal and the normal's dot with ``v0`` (zero for a
-        sliver): what :mod:`~explorer.geometry.occluders` refits the boxes from for the rays
-        toward one light
+        sliver),
+    cone : (k, 8) float32 the normal cone of each node's two children
+        (:func:`~explorer.geometry.occluders.cones`) and
+    span : (k,) int64 the inner nodes in each inner node's subtree: what
+        :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
     """
 
     child: np.ndarray
@@ -92,6 +95,8 @@ class BVH:
     parent: np.ndarray
     tbox: np.ndarray
     plane: np.ndarray
+    cone: np.ndarray
+    span: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -117,7 +122,8 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
         no = np.zeros(0, np.int64)
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
-                   np.zeros((0, 6), np.float32), np.zeros((0, 4)))  # fmt: skip
+                   np.zeros((0, 6), np.float32), np.zeros((0, 4)),
+                   np.zeros((1, 8), np.float32), np.ones(1, np.int64))  # fmt: skip
     box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
@@ -127,8 +133,9 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     cbox = np.empty(box64.shape, np.float32)
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
+    plane = occ.planes(rows)
     return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
-               occ.planes(rows))  # fmt: skip
+               plane, occ.cones(child, leaf, plane), occ.spans(child))  # fmt: skip
 
 
 def _parents(child) -> np.ndarray:
@@ -541,13 +548,14 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
     radius = max(float(np.sqrt(corner @ corner)), reach)
     _check(cancelled)
-    lbox = np.empty((len(bvh.leaf), 6), np.float32)
-    # on this thread: the pass is bound by reading each triangle's 40 bytes once, and handing
-    # it to the pool costs about what a second thread would save
-    occ.leaf_boxes(0, len(bvh.leaf), bvh.leaf, bvh.plane, bvh.tbox,
-                   (np.int64(kind), L, eps, radius), lbox)  # fmt: skip
-    cbox = occ.node_boxes(bvh.child, lbox)
-    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane)
+    # on this thread: the walk opens only the nodes whose triangles face the light on one side
+    # and away on the other, and copies the rest; a second thread would save less than handing
+    # it over costs
+    tree = (bvh.child, bvh.cbox, bvh.leaf, bvh.plane, bvh.tbox)
+    cbox = bvh.cbox.copy()
+    occ.refit(tree, bvh.cone, bvh.span, (np.int64(kind), L, eps, radius), cbox)
+    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
+               bvh.cone, bvh.span)  # fmt: skip
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):

@@ -44,6 +44,17 @@ from explorer.core.tolerances import OCCLUDER_MARGIN
 SHARED_END = 1e-9
 #: float64's unit roundoff, with room for the few operations that compute a ray's end
 _ULP = 4.0 * 2.0**-53
+#: a normal cone's bound on ``h`` must beat the threshold by this times ``|L - c| + r``: its
+#: rounding is a few float64 ulps of those (the sine comes from a cross product, not from
+#: ``1 - cos²``)
+_CONE_SLACK = 1e-12
+#: an inner node's cone angle is its children's widened by this (as a cosine) per level: the
+#: angle between two unit vectors from their dot product ``g`` near 1 is off by up to
+#: ``sqrt(2 ulp)`` ≈ 1.5e-8
+_CONE_WIDEN = 1e-7
+#: the stored ``κ`` is lowered by this: the axis is stored in float32 (its direction off by up
+#: to about 1e-7 rad) and so is ``κ`` (off by up to 3e-8 near 1)
+_CONE_ROUND = 1e-6
 
 
 def planes(tri) -> np.ndarray:
@@ -121,67 +132,231 @@ def shared_end(origins, directions, tmax) -> tuple[int, np.ndarray, float, float
     return 0, L, math.sqrt(3.0) * (spread + _ULP * reach), r
 
 
-@nb.njit(cache=True, nogil=True, boundscheck=False)
-def leaf_boxes(q0, q1, leaf, plane, tbox, light, lbox):
-    """Leaves q0..q1: lbox[q] (6,) float32 the box of leaf ``q``'s triangles that do not face
-    the light with the margin (see the module docstring); empty (x0 > x1) when none.
-    plane : (m, 4) :func:`planes`; light = (kind, L, ε, R): kind 0 a point ``L``, 1 a
-    direction ``L``; R bounds every corner's and origin's distance from the frame's origin.
-
-    A triangle faces a point light when ``h = n̂·L - n̂·v0`` exceeds ``μ(|L| + 3R)`` (which
-    bounds ``μ(|L - v0| + 2R)``) and ``2(ε + ulp)/μ``, both grown by the rounding of ``h``."""
+@nb.njit(cache=True, inline="always")
+def _threshold(light):
+    """The height ``h`` over a triangle's plane beyond which the light is in front of it with
+    the margin: ``μ(|L| + 3R)`` (which bounds ``μ(|L - v0| + 2R)``) and ``2(ε + ulp)/μ`` for a
+    point light, both grown by the rounding of ``h``; ``μ`` for a direction (see the module
+    docstring)."""
     kind, L, eps, R = light
     mu = OCCLUDER_MARGIN
-    lx, ly, lz = L[0], L[1], L[2]
-    size = math.sqrt(lx * lx + ly * ly + lz * lz)
-    slack = _ULP * (size + R)
-    low = max(mu * (size + 3.0 * R), 2.0 * (eps + slack) / mu) + 4.0 * slack
     if kind == 1:
-        low = mu
-    inf = np.float32(np.inf)
-    for q in range(q0, q1):
-        x0 = y0 = z0 = inf
-        x1 = y1 = z1 = -inf
-        first = leaf[q, 0]
-        for j in range(first, first + leaf[q, 1]):
-            h = lx * plane[j, 0] + ly * plane[j, 1] + lz * plane[j, 2]
-            if kind == 0:
-                h -= plane[j, 3]
-            if h > low:
-                continue  # faces the light: cannot block its rays
-            x0 = min(x0, tbox[j, 0])
-            x1 = max(x1, tbox[j, 1])
-            y0 = min(y0, tbox[j, 2])
-            y1 = max(y1, tbox[j, 3])
-            z0 = min(z0, tbox[j, 4])
-            z1 = max(z1, tbox[j, 5])
-        lbox[q, 0], lbox[q, 1], lbox[q, 2] = x0, x1, y0
-        lbox[q, 3], lbox[q, 4], lbox[q, 5] = y1, z0, z1
+        return mu
+    size = math.sqrt(L[0] * L[0] + L[1] * L[1] + L[2] * L[2])
+    slack = _ULP * (size + R)
+    return max(mu * (size + 3.0 * R), 2.0 * (eps + slack) / mu) + 4.0 * slack
 
 
-@nb.njit(cache=True, boundscheck=False)
-def node_boxes(child, lbox):
-    """The child boxes (k, 12) float32 of the tree ``child`` (k, 2) whose leaves' boxes are
-    ``lbox`` (q, 6): each node's box the union of its children's; a box with nothing in it is
-    all +inf (no ray enters it)."""
+@nb.njit(cache=True, inline="always")
+def _leaf_box(q, leaf, plane, tbox, light, low, out, i, o):
+    """out[i, o:o + 6] the box of leaf ``q``'s triangles whose height ``h`` under the light
+    (:func:`_threshold`) is at most ``low``: the ones that can block its rays; all +inf when
+    there are none."""
+    kind, L = light[0], light[1]
+    lx, ly, lz = L[0], L[1], L[2]
     inf = np.float32(np.inf)
+    x0 = y0 = z0 = inf
+    x1 = y1 = z1 = -inf
+    first = leaf[q, 0]
+    for j in range(first, first + leaf[q, 1]):
+        h = lx * plane[j, 0] + ly * plane[j, 1] + lz * plane[j, 2]
+        if kind == 0:
+            h -= plane[j, 3]
+        if h > low:
+            continue  # faces the light: cannot block its rays
+        x0 = min(x0, tbox[j, 0])
+        x1 = max(x1, tbox[j, 1])
+        y0 = min(y0, tbox[j, 2])
+        y1 = max(y1, tbox[j, 3])
+        z0 = min(z0, tbox[j, 4])
+        z1 = max(z1, tbox[j, 5])
+    if x0 > x1:
+        x0 = x1 = y0 = y1 = z0 = z1 = inf
+    out[i, o], out[i, o + 1], out[i, o + 2] = x0, x1, y0
+    out[i, o + 3], out[i, o + 4], out[i, o + 5] = y1, z0, z1
+
+
+#: what :func:`_classify` says of the triangles under a child box
+_MIXED, _ALL, _NONE = 0, 1, 2
+
+
+@nb.njit(cache=True, inline="always")
+def _classify(cbox, cone, i, s, light, low):
+    """Whether every triangle under child ``s`` of node ``i`` has the light in front of it
+    beyond ``low`` (_ALL: the child is left out), none has (_NONE: its boxes stay as built), or
+    neither can be told from the child's box and normal cone (_MIXED).
+
+    A triangle under the box (centre ``c``, half-diagonal ``r``) whose unit normal ``n̂`` is
+    within angle ``θ`` of the cone's axis ``â`` (``cos θ = κ``) has ``h = n̂·(L - v0) =
+    n̂·w + n̂·(c - v0) >= |w| cos(φ + θ) - r`` for ``w = L - c`` at angle ``φ`` from ``â``
+    (``φ + θ <= π/2`` when it is positive); for a direction ``h = n̂·L >= cos(φ + θ)``. The
+    bound is computed from the cross product (no cancellation) and must exceed ``low`` by
+    :data:`_CONE_SLACK` of the magnitudes: far more than its rounding."""
+    kind, L = light[0], light[1]
+    o = 6 * s
+    x0, x1 = np.float64(cbox[i, o]), np.float64(cbox[i, o + 1])
+    y0, y1 = np.float64(cbox[i, o + 2]), np.float64(cbox[i, o + 3])
+    z0, z1 = np.float64(cbox[i, o + 4]), np.float64(cbox[i, o + 5])
+    if not (x0 <= x1 and y0 <= y1 and z0 <= z1):  # an empty box stays empty
+        return _NONE
+    wx, wy, wz, r = L[0], L[1], L[2], 0.0
+    if kind == 0:
+        hx, hy, hz = 0.5 * (x1 - x0), 0.5 * (y1 - y0), 0.5 * (z1 - z0)
+        r = math.sqrt(hx * hx + hy * hy + hz * hz)
+        wx, wy, wz = wx - 0.5 * (x0 + x1), wy - 0.5 * (y0 + y1), wz - 0.5 * (z0 + z1)
+    c = 4 * s
+    ax, ay, az = np.float64(cone[i, c]), np.float64(cone[i, c + 1]), np.float64(cone[i, c + 2])
+    kappa = np.float64(cone[i, c + 3])
+    an = math.sqrt(ax * ax + ay * ay + az * az)
+    if not an > 0.0:
+        return _MIXED
+    ax, ay, az = ax / an, ay / an, az / an
+    wl = math.sqrt(wx * wx + wy * wy + wz * wz)
+    p = ax * wx + ay * wy + az * wz  # |w| cos φ
+    cx, cy, cz = ay * wz - az * wy, az * wx - ax * wz, ax * wy - ay * wx
+    q = math.sqrt(cx * cx + cy * cy + cz * cz)  # |w| sin φ
+    st = math.sqrt(max(1.0 - kappa * kappa, 0.0))  # sin θ
+    slack = _CONE_SLACK * (wl + r)
+    if kappa > 0.0 and p * kappa - q * st - r > low + slack:
+        return _ALL
+    top = wl if p >= wl * kappa else p * kappa + q * st  # |w| cos(max(φ - θ, 0))
+    if top + r < low - slack:
+        return _NONE
+    return _MIXED
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def refit(tree, cone, span, light, out):
+    """out (k, 12) float32, a copy of tree's ``cbox``: the child boxes of tree = (child, cbox,
+    leaf, plane, tbox) for the rays toward ``light`` = (kind, L, ε, R) (kind 0 a point ``L``, 1 a
+    direction ``L``; R bounds every corner's and origin's distance from the frame's origin):
+    each box holds only the triangles under it that do not face the light with the margin (the
+    module docstring); a box with nothing in it is all +inf (no ray enters it).
+
+    The walk goes down from the root: a child whose triangles all face the light
+    (:func:`_classify`, by its normal cone ``cone`` (k, 8) of :func:`cones`) is left out whole,
+    one whose triangles all face away keeps its subtree's boxes as built (``span`` (k,): each
+    inner node's subtree is the nodes ``i .. i + span[i] - 1``, skipped), and only the others
+    are opened: a leaf among them boxes its triangles one by one, an inner node's box is the
+    union of its children's. The boxes of nodes not opened stay as built."""
+    child, cbox, leaf, plane, tbox = tree
+    low = _threshold(light)
     k = child.shape[0]
-    nbox = np.empty((k, 6), np.float32)
-    cbox = np.empty((k, 12), np.float32)
-    for i in range(k - 1, -1, -1):  # children come after their parent (depth-first order)
-        for a in range(0, 6, 2):
-            nbox[i, a] = inf
-            nbox[i, a + 1] = -inf
+    opened = np.zeros(k, np.uint8)
+    order = np.empty(k, np.int64)  # the opened inner nodes, parents before children
+    n = 0
+    opened[0] = 1
+    i = 0
+    while i < k:
+        if not opened[i]:
+            i += span[i]  # a subtree kept as built, or left out
+            continue
+        order[n] = i
+        n += 1
         for s in range(2):
             c = child[i, s]
             o = 6 * s
-            for a in range(6):
-                cbox[i, o + a] = lbox[~c, a] if c < 0 else nbox[c, a]
-            if cbox[i, o] > cbox[i, o + 1]:  # empty
+            kind = _classify(cbox, cone, i, s, light, low)
+            if kind == _ALL:
                 for a in range(6):
-                    cbox[i, o + a] = inf
+                    out[i, o + a] = np.inf
+            elif c < 0 and kind == _MIXED:
+                _leaf_box(~c, leaf, plane, tbox, light, low, out, i, o)
+            elif kind == _MIXED:
+                opened[c] = 1
+        i += 1
+    for m in range(n - 1, -1, -1):  # children's boxes before their parents'
+        i = order[m]
+        for s in range(2):
+            c = child[i, s]
+            if c < 0 or not opened[c]:
                 continue
+            o = 6 * s
             for a in range(0, 6, 2):
-                nbox[i, a] = min(nbox[i, a], cbox[i, o + a])
-                nbox[i, a + 1] = max(nbox[i, a + 1], cbox[i, o + a + 1])
-    return cbox
+                out[i, o + a] = np.inf
+                out[i, o + a + 1] = -np.inf
+            for h in range(0, 12, 6):
+                if not out[c, h] <= out[c, h + 1] or out[c, h] == np.inf:  # empty
+                    continue
+                for a in range(0, 6, 2):
+                    out[i, o + a] = min(out[i, o + a], out[c, h + a])
+                    out[i, o + a + 1] = max(out[i, o + a + 1], out[c, h + a + 1])
+            if out[i, o] > out[i, o + 1]:
+                for a in range(6):
+                    out[i, o + a] = np.inf
+
+
+@nb.njit(cache=True, boundscheck=False)
+def cones(child, leaf, plane):
+    """The normal cone of each child of each node: (k, 8) float32, ``cone[i, 4s:4s + 4]`` the
+    axis (3,) and ``κ``: every triangle under child ``s`` of node ``i`` has its unit normal
+    (``plane`` (m, 4) of :func:`planes`) within angle ``acos κ`` of the axis; ``κ = -1`` (no
+    bound) when a sliver is among them. Leaves are bounded triangle by triangle, inner nodes from
+    their children's cones (wider by :data:`_CONE_WIDEN` a level for the rounding of the
+    angles), and ``κ`` is lowered by :data:`_CONE_ROUND` for the axis' rounding to float32.
+
+    child : (k, 2) int64 the tree (children after their parents); leaf : (q, 2) int64"""
+    k, q = child.shape[0], leaf.shape[0]
+    lsum = np.zeros((q, 3))  # sum of the normals, and κ about their direction
+    lkap = np.empty(q)
+    for lf in range(q):
+        first, count = leaf[lf, 0], leaf[lf, 1]
+        sliver = False
+        for j in range(first, first + count):
+            sliver = sliver or (plane[j, 0] == 0.0 and plane[j, 1] == 0.0 and plane[j, 2] == 0.0)
+            for a in range(3):
+                lsum[lf, a] += plane[j, a]
+        length = math.sqrt(lsum[lf, 0] ** 2 + lsum[lf, 1] ** 2 + lsum[lf, 2] ** 2)
+        kap = -1.0
+        if not sliver and length > 0.0:
+            kap = 1.0
+            for j in range(first, first + count):
+                d = (lsum[lf, 0] * plane[j, 0] + lsum[lf, 1] * plane[j, 1]
+                     + lsum[lf, 2] * plane[j, 2]) / length  # fmt: skip
+                kap = min(kap, d)
+        lkap[lf] = kap
+    nsum = np.zeros((k, 3))
+    nkap = np.empty(k)
+    out = np.empty((k, 8), np.float32)
+    for i in range(k - 1, -1, -1):
+        for s in range(2):  # each child's own cone, as the node stores it
+            c = child[i, s]
+            sc = lsum[~c] if c < 0 else nsum[c]
+            kc = lkap[~c] if c < 0 else nkap[c]
+            lc = math.sqrt(sc[0] ** 2 + sc[1] ** 2 + sc[2] ** 2)
+            for a in range(3):
+                out[i, 4 * s + a] = sc[a] / lc if lc > 0.0 else 0.0
+                nsum[i, a] += sc[a]
+            out[i, 4 * s + 3] = kc - _CONE_ROUND if kc > -1.0 and lc > 0.0 else -1.0
+        length = math.sqrt(nsum[i, 0] ** 2 + nsum[i, 1] ** 2 + nsum[i, 2] ** 2)
+        kap = 1.0
+        for s in range(2):  # the node's cone about the sum of its normals holds both
+            c = child[i, s]
+            sc = lsum[~c] if c < 0 else nsum[c]
+            kc = lkap[~c] if c < 0 else nkap[c]
+            lc = math.sqrt(sc[0] ** 2 + sc[1] ** 2 + sc[2] ** 2)
+            if kc <= -1.0 or not lc > 0.0 or not length > 0.0:
+                kap = -1.0
+                continue
+            g = (nsum[i, 0] * sc[0] + nsum[i, 1] * sc[1] + nsum[i, 2] * sc[2]) / (length * lc)
+            g = min(max(g, -1.0), 1.0)
+            if g < -kc:  # the two angles add up beyond π: no bound
+                kap = -1.0
+                continue
+            both = g * kc - math.sqrt(1.0 - g * g) * math.sqrt(max(1.0 - kc * kc, 0.0))
+            kap = min(kap, both - _CONE_WIDEN)
+        nkap[i] = max(kap, -1.0)
+    return out
+
+
+@nb.njit(cache=True, boundscheck=False)
+def spans(child):
+    """(k,) int64 the number of inner nodes in each inner node's subtree (itself included) of
+    ``child`` (k, 2) in depth-first order: the subtree of ``i`` is ``i .. i + span[i] - 1``."""
+    k = child.shape[0]
+    span = np.ones(k, np.int64)
+    for i in range(k - 1, -1, -1):
+        for s in range(2):
+            if child[i, s] >= 0:
+                span[i] += span[child[i, s]]
+    return span

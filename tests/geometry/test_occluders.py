@@ -28,12 +28,23 @@ def _toward(O, light):
 
 
 def _refitted(bvh, O, D, tmax):
-    """The refitted tree, and the share of leaves left empty (dropped whole)."""
+    """The refitted tree, and the share of leaves no ray can reach (left out under an empty
+    box, theirs or an ancestor's)."""
     tree = B.toward_light(bvh, O, D, tmax)
     assert tree is not bvh, "the rays share an end: the boxes are refitted"
-    empty = np.mean([tree.cbox[i, 6 * s] == np.inf for i in range(len(tree.child))
-                     for s in range(2) if tree.child[i, s] < 0])  # fmt: skip
-    return tree, empty
+    reached, todo = 0, [0]
+    while todo:
+        i = todo.pop()
+        for s in range(2):
+            box = tree.cbox[i, 6 * s : 6 * s + 6]
+            if box[0] == np.inf or box[0] > box[1]:
+                continue
+            c = tree.child[i, s]
+            if c < 0:
+                reached += 1
+            else:
+                todo.append(c)
+    return tree, 1.0 - reached / len(tree.leaf)
 
 
 def _check(tree, O, D, tmax, tri):
