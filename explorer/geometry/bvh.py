@@ -45,8 +45,12 @@ from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
 from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
 
-#: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
+#: rays per chunk at most: the unit of work a thread takes, and how often ``cancelled`` is asked
 CHUNK = 8192
+#: more rays than a chunk are cut into about this many chunks per thread (fewer when that
+#: would make them smaller than :data:`MIN_CHUNK`)
+SPLIT = 8
+MIN_CHUNK = 1024
 #: a node with at most this many triangles is always a leaf
 LEAF_SIZE = 4
 #: a node with more triangles than this is always split
@@ -457,40 +461,53 @@ def _check(cancelled: Callable[[], bool] | None) -> None:
 
 def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK) -> None:
     """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of at most ``chunk`` rays, on
-    :func:`workers` threads, asking ``cancelled()`` before each chunk. More than one chunk's
-    worth is cut into equal chunks, a whole number of them per thread (no thread left with a
-    last chunk alone).
+    :func:`workers` threads: this one and helpers from the pool, each taking the next chunk
+    when it is done with one (rays cost unequally: a shadowed one several lit ones), about
+    :data:`SPLIT` chunks per thread. This thread asks ``cancelled()`` before each of its chunks.
+    A helper that has not started when the work is done is withdrawn, so two callers share the
+    cores instead of one waiting for the other's work.
 
     Raises :class:`~explorer.core.errors.Cancelled` when ``cancelled()`` returns True. On any
-    exception (Ctrl-C too) chunks not started are dropped and the running ones are waited for,
-    so nothing writes into the outputs after this returns or raises.
+    exception (Ctrl-C too) no chunk starts any more and the running ones are waited for, so
+    nothing writes into the outputs after this returns or raises.
     """
     _check(cancelled)
     threads = workers()
     if n > chunk and threads > 1:
-        chunk = -(-n // (threads * -(-n // (threads * chunk))))
-    starts = list(range(0, n, chunk))
-    if len(starts) <= 1 or threads == 1:
-        for s in starts:
+        chunk = max(MIN_CHUNK, -(-n // (threads * SPLIT)))
+    if n <= chunk or threads == 1:
+        for s in range(0, n, chunk):
             _check(cancelled)
             kernel(s, min(s + chunk, n), *args)
         return
-    pool = _get_pool()
-    pending = []
+    state = [0, False]  # the next chunk's first ray; stop
+    lock = threading.Lock()
+
+    def take() -> int:
+        with lock:
+            s = state[0]
+            state[0] = n if state[1] else s + chunk
+            return s
+
+    def work() -> None:
+        while (s := take()) < n:
+            kernel(s, min(s + chunk, n), *args)
+
+    helpers = [_get_pool().submit(work) for _ in range(threads - 1)]
     try:
-        for s in starts:
-            if len(pending) >= threads:
-                pending.pop(0).result()
-                _check(cancelled)
-            pending.append(pool.submit(kernel, s, min(s + chunk, n), *args))
-        while pending:
-            pending.pop(0).result()
-    finally:
-        for f in pending:
-            f.cancel()
-        for f in pending:
-            if not f.cancelled():
-                f.exception()  # waits; the first exception (if any) is already propagating
+        while (s := take()) < n:
+            kernel(s, min(s + chunk, n), *args)
+            _check(cancelled)
+    except BaseException:
+        with lock:
+            state[1] = True
+        for f in helpers:
+            if not f.cancel():
+                f.exception()  # waits for its chunk; the caller's exception propagates
+        raise
+    for f in helpers:
+        if not f.cancel():
+            f.result()  # waits for its last chunk (and raises what it raised)
 
 
 # -- the casts -----------------------------------------------------------------------------
