@@ -85,7 +85,7 @@ class BVH:
     tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
     plane : (m, 4) float64 its unit normal and the normal's dot with ``v0`` (zero for a
         sliver),
-    cone : (k, 8) float32 the normal cone of each node's two children
+    cone : (k, 10) float32 the normal cone of each node's two children
         (:func:`~explorer.geometry.occluders.cones`) and
     span : (k,) int64 the inner nodes in each inner node's subtree: what
         :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
@@ -127,7 +127,7 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
                    np.zeros((0, 6), np.float32), np.zeros((0, 4)),
-                   np.zeros((1, 8), np.float32), np.ones(1, np.int64))  # fmt: skip
+                   np.zeros((1, 10), np.float32), np.ones(1, np.int64))  # fmt: skip
     box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)

@@ -44,17 +44,18 @@ from explorer.core.tolerances import OCCLUDER_MARGIN
 SHARED_END = 1e-9
 #: float64's unit roundoff, with room for the few operations that compute a ray's end
 _ULP = 4.0 * 2.0**-53
-#: a normal cone's bound on ``h`` must beat the threshold by this times ``|L - c| + r``: its
-#: rounding is a few float64 ulps of those (the sine comes from a cross product, not from
-#: ``1 - cos²``)
-_CONE_SLACK = 1e-12
+#: a normal cone's bound on ``h`` must beat the threshold by this times ``|L - c| + r``: the
+#: axis is stored in float32 (its dot and cross products with ``L - c`` off by up to 3e-7 of
+#: ``|L - c|``); the rounding of the float64 bound is a few ulps of those (the sine comes from
+#: a cross product, not from ``1 - cos²``)
+_CONE_SLACK = 1e-6
 #: an inner node's cone angle is its children's widened by this (as a cosine) per level: the
 #: angle between two unit vectors from their dot product ``g`` near 1 is off by up to
 #: ``sqrt(2 ulp)`` ≈ 1.5e-8
 _CONE_WIDEN = 1e-7
-#: the stored ``κ`` is lowered by this: the axis is stored in float32 (its direction off by up
-#: to about 1e-7 rad) and so is ``κ`` (off by up to 3e-8 near 1)
-_CONE_ROUND = 1e-6
+#: the stored cosine ``κ`` of a cone's angle is lowered and its sine raised by this: both are
+#: stored in float32 (off by up to 3e-8 near 1)
+_CONE_ROUND = 1e-7
 
 
 def planes(tri) -> np.ndarray:
@@ -187,11 +188,11 @@ def _classify(cbox, cone, i, s, light, low):
     neither can be told from the child's box and normal cone (_MIXED).
 
     A triangle under the box (centre ``c``, half-diagonal ``r``) whose unit normal ``n̂`` is
-    within angle ``θ`` of the cone's axis ``â`` (``cos θ = κ``) has ``h = n̂·(L - v0) =
-    n̂·w + n̂·(c - v0) >= |w| cos(φ + θ) - r`` for ``w = L - c`` at angle ``φ`` from ``â``
-    (``φ + θ <= π/2`` when it is positive); for a direction ``h = n̂·L >= cos(φ + θ)``. The
-    bound is computed from the cross product (no cancellation) and must exceed ``low`` by
-    :data:`_CONE_SLACK` of the magnitudes: far more than its rounding."""
+    within angle ``θ`` of the cone's unit axis ``â`` has ``h = n̂·(L - v0) = n̂·w + n̂·(c - v0)
+    >= |w| cos(φ + θ) - r`` for ``w = L - c`` at angle ``φ`` from ``â`` (``φ + θ <= π/2`` when
+    it is positive); for a direction ``h = n̂·L >= cos(φ + θ)``. ``|w| cos φ`` and ``|w| sin
+    φ`` come from the dot and the cross product with the stored axis, within 3e-7 |w| of the
+    true axis' (float32): the bound must beat ``low`` by :data:`_CONE_SLACK` of ``|w| + r``."""
     kind, L = light[0], light[1]
     o = 6 * s
     x0, x1 = np.float64(cbox[i, o]), np.float64(cbox[i, o + 1])
@@ -204,23 +205,18 @@ def _classify(cbox, cone, i, s, light, low):
         hx, hy, hz = 0.5 * (x1 - x0), 0.5 * (y1 - y0), 0.5 * (z1 - z0)
         r = math.sqrt(hx * hx + hy * hy + hz * hz)
         wx, wy, wz = wx - 0.5 * (x0 + x1), wy - 0.5 * (y0 + y1), wz - 0.5 * (z0 + z1)
-    c = 4 * s
+    c = 5 * s
     ax, ay, az = np.float64(cone[i, c]), np.float64(cone[i, c + 1]), np.float64(cone[i, c + 2])
-    kappa = np.float64(cone[i, c + 3])
-    an = math.sqrt(ax * ax + ay * ay + az * az)
-    if not an > 0.0:
-        return _MIXED
-    ax, ay, az = ax / an, ay / an, az / an
-    wl = math.sqrt(wx * wx + wy * wy + wz * wz)
+    kappa, st = np.float64(cone[i, c + 3]), np.float64(cone[i, c + 4])  # cos θ, sin θ
     p = ax * wx + ay * wy + az * wz  # |w| cos φ
     cx, cy, cz = ay * wz - az * wy, az * wx - ax * wz, ax * wy - ay * wx
     q = math.sqrt(cx * cx + cy * cy + cz * cz)  # |w| sin φ
-    st = math.sqrt(max(1.0 - kappa * kappa, 0.0))  # sin θ
-    slack = _CONE_SLACK * (wl + r)
+    slack = _CONE_SLACK * (abs(wx) + abs(wy) + abs(wz) + r)
     if kappa > 0.0 and p * kappa - q * st - r > low + slack:
         return _ALL
-    top = wl if p >= wl * kappa else p * kappa + q * st  # |w| cos(max(φ - θ, 0))
-    if top + r < low - slack:
+    if st * p - kappa * q >= 0.0:  # φ <= θ: the light is within the cone
+        return _MIXED
+    if p * kappa + q * st + r < low - slack:  # |w| cos(φ - θ) + r: the highest h
         return _NONE
     return _MIXED
 
@@ -234,7 +230,7 @@ def refit(tree, cone, span, light, out):
     module docstring); a box with nothing in it is all +inf (no ray enters it).
 
     The walk goes down from the root: a child whose triangles all face the light
-    (:func:`_classify`, by its normal cone ``cone`` (k, 8) of :func:`cones`) is left out whole,
+    (:func:`_classify`, by its normal cone ``cone`` (k, 10) of :func:`cones`) is left out whole,
     one whose triangles all face away keeps its subtree's boxes as built (``span`` (k,): each
     inner node's subtree is the nodes ``i .. i + span[i] - 1``, skipped), and only the others
     are opened: a leaf among them boxes its triangles one by one, an inner node's box is the
@@ -288,12 +284,13 @@ def refit(tree, cone, span, light, out):
 
 @nb.njit(cache=True, boundscheck=False)
 def cones(child, leaf, plane):
-    """The normal cone of each child of each node: (k, 8) float32, ``cone[i, 4s:4s + 4]`` the
-    axis (3,) and ``κ``: every triangle under child ``s`` of node ``i`` has its unit normal
-    (``plane`` (m, 4) of :func:`planes`) within angle ``acos κ`` of the axis; ``κ = -1`` (no
-    bound) when a sliver is among them. Leaves are bounded triangle by triangle, inner nodes from
-    their children's cones (wider by :data:`_CONE_WIDEN` a level for the rounding of the
-    angles), and ``κ`` is lowered by :data:`_CONE_ROUND` for the axis' rounding to float32.
+    """The normal cone of each child of each node: (k, 10) float32, ``cone[i, 5s:5s + 5]`` the
+    unit axis (3,), ``cos θ`` and ``sin θ``: every triangle under child ``s`` of node ``i`` has
+    its unit normal (``plane`` (m, 4) of :func:`planes`) within angle ``θ`` of the axis (the
+    float64 axis the float32 one rounds); ``cos θ = -1`` (no bound) when a sliver is among them.
+    Leaves are bounded triangle by triangle, inner nodes from their children's cones (wider by
+    :data:`_CONE_WIDEN` a level for the rounding of the angles); the stored angle is widened by
+    :data:`_CONE_ROUND` for its rounding to float32.
 
     child : (k, 2) int64 the tree (children after their parents); leaf : (q, 2) int64"""
     k, q = child.shape[0], leaf.shape[0]
@@ -317,7 +314,7 @@ def cones(child, leaf, plane):
         lkap[lf] = kap
     nsum = np.zeros((k, 3))
     nkap = np.empty(k)
-    out = np.empty((k, 8), np.float32)
+    out = np.empty((k, 10), np.float32)
     for i in range(k - 1, -1, -1):
         for s in range(2):  # each child's own cone, as the node stores it
             c = child[i, s]
@@ -325,9 +322,11 @@ def cones(child, leaf, plane):
             kc = lkap[~c] if c < 0 else nkap[c]
             lc = math.sqrt(sc[0] ** 2 + sc[1] ** 2 + sc[2] ** 2)
             for a in range(3):
-                out[i, 4 * s + a] = sc[a] / lc if lc > 0.0 else 0.0
+                out[i, 5 * s + a] = sc[a] / lc if lc > 0.0 else 0.0
                 nsum[i, a] += sc[a]
-            out[i, 4 * s + 3] = kc - _CONE_ROUND if kc > -1.0 and lc > 0.0 else -1.0
+            kc = kc - _CONE_ROUND if kc > -1.0 and lc > 0.0 else -1.0
+            out[i, 5 * s + 3] = kc
+            out[i, 5 * s + 4] = min(math.sqrt(max(1.0 - kc * kc, 0.0)) + _CONE_ROUND, 1.0)
         length = math.sqrt(nsum[i, 0] ** 2 + nsum[i, 1] ** 2 + nsum[i, 2] ** 2)
         kap = 1.0
         for s in range(2):  # the node's cone about the sum of its normals holds both
