@@ -239,9 +239,9 @@ def refit(tree, cone, span, light, out):
     low = _threshold(light)
     k = child.shape[0]
     opened = np.zeros(k, np.uint8)
+    opened[0] = 1
     order = np.empty(k, np.int64)  # the opened inner nodes, parents before children
     n = 0
-    opened[0] = 1
     i = 0
     while i < k:
         if not opened[i]:
@@ -252,7 +252,7 @@ def refit(tree, cone, span, light, out):
         for s in range(2):
             c = child[i, s]
             o = 6 * s
-            kind = _classify(cbox, cone, i, s, light, low)
+            kind = _classify(out, cone, i, s, light, low)  # out: the copy, still as built here
             if kind == _ALL:
                 for a in range(6):
                     out[i, o + a] = np.inf
