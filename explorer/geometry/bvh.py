@@ -51,6 +51,10 @@ CHUNK = 8192
 #: would make them smaller than :data:`MIN_CHUNK`)
 SPLIT = 8
 MIN_CHUNK = 1024
+#: the per-light refit (:func:`toward_light`) of a tree with at least this many nodes opens the
+#: subtrees this many levels below the root on every thread
+REFIT_NODES = 16384
+REFIT_DEPTH = 3
 #: a node with at most this many triangles is always a leaf
 LEAF_SIZE = 4
 #: a node with more triangles than this is always split
@@ -459,13 +463,15 @@ def _check(cancelled: Callable[[], bool] | None) -> None:
         raise Cancelled("ray casting was cancelled")
 
 
-def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK) -> None:
+def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK,
+               split: bool = True) -> None:  # fmt: skip
     """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of at most ``chunk`` rays, on
     :func:`workers` threads: this one and helpers from the pool, each taking the next chunk
     when it is done with one (rays cost unequally: a shadowed one several lit ones), about
-    :data:`SPLIT` chunks per thread. This thread asks ``cancelled()`` before each of its chunks.
-    A helper that has not started when the work is done is withdrawn, so two callers share the
-    cores instead of one waiting for the other's work.
+    :data:`SPLIT` chunks per thread (``split=False``: chunks of ``chunk``). This thread asks
+    ``cancelled()`` before each of its chunks. A helper that has not started when the work is
+    done is withdrawn, so two callers share the cores instead of one waiting for the other's
+    work.
 
     Raises :class:`~explorer.core.errors.Cancelled` when ``cancelled()`` returns True. On any
     exception (Ctrl-C too) no chunk starts any more and the running ones are waited for, so
@@ -473,7 +479,7 @@ def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUN
     """
     _check(cancelled)
     threads = workers()
-    if n > chunk and threads > 1:
+    if split and n > chunk and threads > 1:
         chunk = max(MIN_CHUNK, -(-n // (threads * SPLIT)))
     if n <= chunk or threads == 1:
         for s in range(0, n, chunk):
@@ -557,6 +563,9 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
 
     origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
     """
+    big = bvh.n_nodes >= REFIT_NODES and workers() > 1
+    # a large tree's copy of the boxes is made on another thread meanwhile
+    copy = _get_pool().submit(np.copy, bvh.cbox) if big else None
     end = occ.shared_end(origins, directions, tmax)
     if end is None or not bvh.n_triangles:
         return bvh
@@ -565,12 +574,23 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
     radius = max(float(np.sqrt(corner @ corner)), reach)
     _check(cancelled)
-    # on this thread: the walk opens only the nodes whose triangles face the light on one side
-    # and away on the other, and copies the rest; a second thread would save less than handing
-    # it over costs
     tree = (bvh.child, bvh.cbox, bvh.leaf, bvh.plane, bvh.tbox)
-    cbox = bvh.cbox.copy()
-    occ.refit(tree, bvh.cone, bvh.span, (np.int64(kind), L, eps, radius), cbox)
+    light = (np.int64(kind), L, eps, radius)
+    k = bvh.n_nodes
+    cbox = bvh.cbox.copy() if copy is None or copy.cancel() else copy.result()
+    opened = np.zeros(k, np.uint8)
+    order = np.empty(k, np.int64)
+    # the walk is bound by reading the nodes it opens from memory: a large tree's subtrees
+    # REFIT_DEPTH levels down go to every thread
+    if big:
+        top, roots = occ.refit_top(tree, bvh.cone, light, opened, cbox, REFIT_DEPTH)
+        args = (roots, tree, bvh.cone, bvh.span, light, opened, order, cbox)
+        run_chunks(occ.refit, len(roots), args, cancelled=cancelled, chunk=1, split=False)
+        occ.refit_unions(top, bvh.child, opened, cbox)
+    else:
+        opened[0] = 1
+        occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light, opened, order,
+                  cbox)  # fmt: skip
     return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
                bvh.cone, bvh.span)  # fmt: skip
 

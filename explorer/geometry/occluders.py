@@ -89,7 +89,7 @@ def triangle_boxes(tri, pad: float) -> np.ndarray:
     return box
 
 
-@nb.njit(cache=True, boundscheck=False)
+@nb.njit(cache=True, nogil=True, boundscheck=False)
 def _ends(O, D, tmax):
     """(same direction, all ends finite, spread of the ends from the first, the first end,
     the largest ``|O| + tmax``, the largest ``|O|²``) of rays ``O, D`` (k, 3), ``tmax`` (k,)."""
@@ -221,65 +221,120 @@ def _classify(cbox, cone, i, s, light, low):
     return _MIXED
 
 
-@nb.njit(cache=True, nogil=True, boundscheck=False)
-def refit(tree, cone, span, light, out):
-    """out (k, 12) float32, a copy of tree's ``cbox``: the child boxes of tree = (child, cbox,
-    leaf, plane, tbox) for the rays toward ``light`` = (kind, L, ε, R) (kind 0 a point ``L``, 1 a
-    direction ``L``; R bounds every corner's and origin's distance from the frame's origin):
-    each box holds only the triangles under it that do not face the light with the margin (the
-    module docstring); a box with nothing in it is all +inf (no ray enters it).
-
-    The walk goes down from the root: a child whose triangles all face the light
-    (:func:`_classify`, by its normal cone ``cone`` (k, 10) of :func:`cones`) is left out whole,
-    one whose triangles all face away keeps its subtree's boxes as built (``span`` (k,): each
-    inner node's subtree is the nodes ``i .. i + span[i] - 1``, skipped), and only the others
-    are opened: a leaf among them boxes its triangles one by one, an inner node's box is the
-    union of its children's. The boxes of nodes not opened stay as built."""
+@nb.njit(cache=True, inline="always")
+def _open(i, tree, cone, light, low, opened, out):
+    """Classify the two children of node ``i`` (:func:`_classify`): left out (+inf), kept as
+    built, boxed triangle by triangle (a leaf), or marked opened (an inner node)."""
     child, cbox, leaf, plane, tbox = tree
-    low = _threshold(light)
-    k = child.shape[0]
-    opened = np.zeros(k, np.uint8)
-    opened[0] = 1
-    order = np.empty(k, np.int64)  # the opened inner nodes, parents before children
-    n = 0
-    i = 0
-    while i < k:
-        if not opened[i]:
-            i += span[i]  # a subtree kept as built, or left out
-            continue
-        order[n] = i
-        n += 1
-        for s in range(2):
-            c = child[i, s]
-            o = 6 * s
-            kind = _classify(out, cone, i, s, light, low)  # out: the copy, still as built here
-            if kind == _ALL:
-                for a in range(6):
-                    out[i, o + a] = np.inf
-            elif c < 0 and kind == _MIXED:
-                _leaf_box(~c, leaf, plane, tbox, light, low, out, i, o)
-            elif kind == _MIXED:
-                opened[c] = 1
-        i += 1
-    for m in range(n - 1, -1, -1):  # children's boxes before their parents'
-        i = order[m]
-        for s in range(2):
-            c = child[i, s]
-            if c < 0 or not opened[c]:
-                continue
-            o = 6 * s
-            for a in range(0, 6, 2):
+    for s in range(2):
+        c = child[i, s]
+        o = 6 * s
+        kind = _classify(out, cone, i, s, light, low)  # out: the copy, still as built here
+        if kind == _ALL:
+            for a in range(6):
                 out[i, o + a] = np.inf
-                out[i, o + a + 1] = -np.inf
-            for h in range(0, 12, 6):
-                if not out[c, h] <= out[c, h + 1] or out[c, h] == np.inf:  # empty
-                    continue
-                for a in range(0, 6, 2):
-                    out[i, o + a] = min(out[i, o + a], out[c, h + a])
-                    out[i, o + a + 1] = max(out[i, o + a + 1], out[c, h + a + 1])
-            if out[i, o] > out[i, o + 1]:
-                for a in range(6):
-                    out[i, o + a] = np.inf
+        elif c < 0 and kind == _MIXED:
+            _leaf_box(~c, leaf, plane, tbox, light, low, out, i, o)
+        elif kind == _MIXED:
+            opened[c] = 1
+
+
+@nb.njit(cache=True, inline="always")
+def _union(i, child, opened, out):
+    """Node ``i``'s boxes of its opened children: the union of each one's two boxes."""
+    for s in range(2):
+        c = child[i, s]
+        if c < 0 or not opened[c]:
+            continue
+        o = 6 * s
+        for a in range(0, 6, 2):
+            out[i, o + a] = np.inf
+            out[i, o + a + 1] = -np.inf
+        for h in range(0, 12, 6):
+            if not out[c, h] <= out[c, h + 1] or out[c, h] == np.inf:  # empty
+                continue
+            for a in range(0, 6, 2):
+                out[i, o + a] = min(out[i, o + a], out[c, h + a])
+                out[i, o + a + 1] = max(out[i, o + a + 1], out[c, h + a + 1])
+        if out[i, o] > out[i, o + 1]:
+            for a in range(6):
+                out[i, o + a] = np.inf
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def refit(r0, r1, roots, tree, cone, span, light, opened, order, out):
+    """The boxes for the rays toward ``light`` in the subtrees of the opened inner nodes
+    roots[r0:r1]: writes into out (k, 12) float32, a copy of tree's ``cbox``, the child boxes
+    of every node opened there, each holding only the triangles under it that do not face the
+    light with the margin (the module docstring); a box with nothing in it is all +inf (no ray
+    enters it).
+
+    tree = (child, cbox, leaf, plane, tbox); cone (k, 10) of :func:`cones`; span (k,): each
+    inner node's subtree is the nodes ``i .. i + span[i] - 1``; light = (kind, L, ε, R): kind
+    0 a point ``L``, 1 a direction ``L``; R bounds every corner's and origin's distance from the
+    frame's origin; opened (k,) uint8: 1 for the roots (and the nodes above them), 0 below;
+    order (k,) int64 scratch (a subtree uses its own nodes' places).
+
+    The walk goes down from each root: a child whose triangles all face the light
+    (:func:`_classify`, by its normal cone) is left out whole, one whose triangles all face away
+    keeps its subtree's boxes as built (skipped), and only the others are opened: a leaf among
+    them boxes its triangles one by one, an inner node's box is the union of its children's.
+    The boxes of nodes not opened stay as built."""
+    child = tree[0]
+    low = _threshold(light)
+    for j in range(r0, r1):
+        root = roots[j]
+        end = root + span[root]
+        n = root
+        i = root
+        while i < end:
+            if not opened[i]:
+                i += span[i]  # a subtree kept as built, or left out
+                continue
+            order[n] = i
+            n += 1
+            _open(i, tree, cone, light, low, opened, out)
+            i += 1
+        for m in range(n - 1, root - 1, -1):  # children's boxes before their parents'
+            _union(order[m], child, opened, out)
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def refit_top(tree, cone, light, opened, out, depth):
+    """:func:`refit` for the nodes less than ``depth`` levels below the root, without their
+    unions (:func:`refit_unions`, after :func:`refit` below them). Returns (those nodes,
+    parents first; the opened inner nodes ``depth`` levels down: the roots for :func:`refit`)."""
+    child = tree[0]
+    low = _threshold(light)
+    top = np.empty(2**depth, np.int64)
+    roots = np.empty(2**depth, np.int64)
+    opened[0] = 1
+    n = nr = 0
+    level = np.zeros(1, np.int64)  # the nodes of this level
+    for _ in range(depth):
+        below = np.empty(2 * len(level), np.int64)
+        nb_ = 0
+        for i in level:
+            top[n] = i
+            n += 1
+            _open(i, tree, cone, light, low, opened, out)
+            for s in range(2):
+                c = child[i, s]
+                if c >= 0 and opened[c]:
+                    below[nb_] = c
+                    nb_ += 1
+        level = below[:nb_]
+    for i in level:
+        roots[nr] = i
+        nr += 1
+    return top[:n], roots[:nr]
+
+
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def refit_unions(top, child, opened, out):
+    """The unions of :func:`refit_top`'s nodes, children before parents."""
+    for m in range(len(top) - 1, -1, -1):
+        _union(top[m], child, opened, out)
 
 
 @nb.njit(cache=True, boundscheck=False)

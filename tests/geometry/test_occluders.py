@@ -241,3 +241,16 @@ def test_normal_cones_hold_every_normal_under_them():
                     sines = np.linalg.norm(np.cross(n, a), axis=1)
                     assert np.all(sines <= bvh.cone[i, 5 * s + 4] + 3e-7), (i, s)
     assert bounded > len(bvh.child)  # most children have a cone
+
+
+def test_the_refit_on_every_thread_equals_the_refit_on_one(monkeypatch):
+    Q, tri = _frame(get_mesh("teapot", 12))
+    bvh = B.build_bvh(tri)
+    D, tmax = _toward(Q, np.array([2.0, 3.0, 1.5]))
+    monkeypatch.setattr(B, "REFIT_NODES", 1 << 60)
+    one = B.toward_light(bvh, Q, D, tmax)
+    monkeypatch.setattr(B, "REFIT_NODES", 0)
+    monkeypatch.setattr(B, "workers", lambda: 2)
+    split = B.toward_light(bvh, Q, D, tmax)
+    assert np.array_equal(one.cbox, split.cbox)
+    assert not np.array_equal(one.cbox, bvh.cbox)
