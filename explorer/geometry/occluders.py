@@ -10,9 +10,15 @@ whose boxes hold only the other triangles lets such a ray skip its own neighbour
 (``benchmarks/bench_rays.py`` has the timings).
 
 :func:`shared_end` finds the light from the rays themselves (their ends ``O + tmax·D`` agree,
-or their directions are equal), :func:`leaf_boxes` boxes each leaf's triangles that do not face
-it with a margin, and :func:`node_boxes` gives the hierarchy's child boxes from those; the tree
-itself (children, leaves, triangle rows) is kept, so the casts run unchanged on the new boxes.
+or their directions are equal). :func:`refit_top` and :func:`refit` go down the tree from the
+root: with the cone around the normals under each child of a node (:func:`cones`, made with the
+tree) and the child's box, :func:`_classify` bounds the light's height over every triangle under
+it, so a child whose triangles all face the light with the margin is left out whole and one whose
+triangles all face away keeps its boxes as built; only the others are opened, a leaf among them
+boxing its triangles that do not face the light one by one, an inner node's box the union of its
+children's (:func:`refit_unions`). The result is the box of those triangles wherever a ray can
+get; the tree itself (children, leaves, triangle rows) is kept, so the casts run unchanged on the
+new boxes.
 
 Why no blocking triangle is dropped (the margin is
 :data:`~explorer.core.tolerances.OCCLUDER_MARGIN`, ``μ``): for unit normal ``n̂`` of a
