@@ -45,8 +45,16 @@ from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
 from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
 
-#: rays per chunk: the unit of work handed to a thread, and how often ``cancelled`` is asked
+#: rays per chunk at most: the unit of work a thread takes, and how often ``cancelled`` is asked
 CHUNK = 8192
+#: more rays than a chunk are cut into about this many chunks per thread (fewer when that
+#: would make them smaller than :data:`MIN_CHUNK`)
+SPLIT = 8
+MIN_CHUNK = 1024
+#: the per-light refit (:func:`toward_light`) of a tree with at least this many nodes opens the
+#: subtrees this many levels below the root on every thread
+REFIT_NODES = 16384
+REFIT_DEPTH = 3
 #: a node with at most this many triangles is always a leaf
 LEAF_SIZE = 4
 #: a node with more triangles than this is always split
@@ -80,8 +88,11 @@ class BVH:
     parent : (k,) int64 each inner node's parent (-1 for the root)
     tbox : (m, 6) float32 each triangle's padded box, rounded outward (leaf order), and
     plane : (m, 4) float64 its unit normal and the normal's dot with ``v0`` (zero for a
-        sliver): what :mod:`~explorer.geometry.occluders` refits the boxes from for the rays
-        toward one light
+        sliver),
+    cone : (k, 10) float32 the normal cone of each node's two children
+        (:func:`~explorer.geometry.occluders.cones`) and
+    span : (k,) int64 the inner nodes in each inner node's subtree: what
+        :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
     """
 
     child: np.ndarray
@@ -92,6 +103,8 @@ class BVH:
     parent: np.ndarray
     tbox: np.ndarray
     plane: np.ndarray
+    cone: np.ndarray
+    span: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -117,7 +130,8 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
         no = np.zeros(0, np.int64)
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
-                   np.zeros((0, 6), np.float32), np.zeros((0, 4)))  # fmt: skip
+                   np.zeros((0, 6), np.float32), np.zeros((0, 4)),
+                   np.zeros((1, 10), np.float32), np.ones(1, np.int64))  # fmt: skip
     box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
@@ -127,8 +141,9 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     cbox = np.empty(box64.shape, np.float32)
     cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
+    plane = occ.planes(rows)
     return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
-               occ.planes(rows))  # fmt: skip
+               plane, occ.cones(child, leaf, plane), occ.spans(child))  # fmt: skip
 
 
 def _parents(child) -> np.ndarray:
@@ -448,42 +463,57 @@ def _check(cancelled: Callable[[], bool] | None) -> None:
         raise Cancelled("ray casting was cancelled")
 
 
-def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK) -> None:
+def run_chunks(kernel, n: int, args: tuple, *, cancelled=None, chunk: int = CHUNK,
+               split: bool = True) -> None:  # fmt: skip
     """Call ``kernel(r0, r1, *args)`` over ``[0, n)`` in chunks of at most ``chunk`` rays, on
-    :func:`workers` threads, asking ``cancelled()`` before each chunk. More than one chunk's
-    worth is cut into equal chunks, a whole number of them per thread (no thread left with a
-    last chunk alone).
+    :func:`workers` threads: this one and helpers from the pool, each taking the next chunk
+    when it is done with one (rays cost unequally: a shadowed one several lit ones), about
+    :data:`SPLIT` chunks per thread (``split=False``: chunks of ``chunk``). This thread asks
+    ``cancelled()`` before each of its chunks. A helper that has not started when the work is
+    done is withdrawn, so two callers share the cores instead of one waiting for the other's
+    work.
 
     Raises :class:`~explorer.core.errors.Cancelled` when ``cancelled()`` returns True. On any
-    exception (Ctrl-C too) chunks not started are dropped and the running ones are waited for,
-    so nothing writes into the outputs after this returns or raises.
+    exception (Ctrl-C too) no chunk starts any more and the running ones are waited for, so
+    nothing writes into the outputs after this returns or raises.
     """
     _check(cancelled)
     threads = workers()
-    if n > chunk and threads > 1:
-        chunk = -(-n // (threads * -(-n // (threads * chunk))))
-    starts = list(range(0, n, chunk))
-    if len(starts) <= 1 or threads == 1:
-        for s in starts:
+    if split and n > chunk and threads > 1:
+        chunk = max(MIN_CHUNK, -(-n // (threads * SPLIT)))
+    if n <= chunk or threads == 1:
+        for s in range(0, n, chunk):
             _check(cancelled)
             kernel(s, min(s + chunk, n), *args)
         return
-    pool = _get_pool()
-    pending = []
+    state = [0, False]  # the next chunk's first ray; stop
+    lock = threading.Lock()
+
+    def take() -> int:
+        with lock:
+            s = state[0]
+            state[0] = n if state[1] else s + chunk
+            return s
+
+    def work() -> None:
+        while (s := take()) < n:
+            kernel(s, min(s + chunk, n), *args)
+
+    helpers = [_get_pool().submit(work) for _ in range(threads - 1)]
     try:
-        for s in starts:
-            if len(pending) >= threads:
-                pending.pop(0).result()
-                _check(cancelled)
-            pending.append(pool.submit(kernel, s, min(s + chunk, n), *args))
-        while pending:
-            pending.pop(0).result()
-    finally:
-        for f in pending:
-            f.cancel()
-        for f in pending:
-            if not f.cancelled():
-                f.exception()  # waits; the first exception (if any) is already propagating
+        while (s := take()) < n:
+            kernel(s, min(s + chunk, n), *args)
+            _check(cancelled)
+    except BaseException:
+        with lock:
+            state[1] = True
+        for f in helpers:
+            if not f.cancel():
+                f.exception()  # waits for its chunk; the caller's exception propagates
+        raise
+    for f in helpers:
+        if not f.cancel():
+            f.result()  # waits for its last chunk (and raises what it raised)
 
 
 # -- the casts -----------------------------------------------------------------------------
@@ -533,6 +563,9 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
 
     origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
     """
+    big = bvh.n_nodes >= REFIT_NODES and workers() > 1
+    # a large tree's copy of the boxes is made on another thread meanwhile
+    copy = _get_pool().submit(np.copy, bvh.cbox) if big else None
     end = occ.shared_end(origins, directions, tmax)
     if end is None or not bvh.n_triangles:
         return bvh
@@ -541,13 +574,25 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
     radius = max(float(np.sqrt(corner @ corner)), reach)
     _check(cancelled)
-    lbox = np.empty((len(bvh.leaf), 6), np.float32)
-    # on this thread: the pass is bound by reading each triangle's 40 bytes once, and handing
-    # it to the pool costs about what a second thread would save
-    occ.leaf_boxes(0, len(bvh.leaf), bvh.leaf, bvh.plane, bvh.tbox,
-                   (np.int64(kind), L, eps, radius), lbox)  # fmt: skip
-    cbox = occ.node_boxes(bvh.child, lbox)
-    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane)
+    tree = (bvh.child, bvh.cbox, bvh.leaf, bvh.plane, bvh.tbox)
+    light = (np.int64(kind), L, eps, radius)
+    k = bvh.n_nodes
+    cbox = bvh.cbox.copy() if copy is None or copy.cancel() else copy.result()
+    opened = np.zeros(k, np.uint8)
+    order = np.empty(k, np.int64)
+    # the walk is bound by reading the nodes it opens from memory: a large tree's subtrees
+    # REFIT_DEPTH levels down go to every thread
+    if big:
+        top, roots = occ.refit_top(tree, bvh.cone, light, opened, cbox, REFIT_DEPTH)
+        args = (roots, tree, bvh.cone, bvh.span, light, opened, order, cbox)
+        run_chunks(occ.refit, len(roots), args, cancelled=cancelled, chunk=1, split=False)
+        occ.refit_unions(top, bvh.child, opened, cbox)
+    else:
+        opened[0] = 1
+        occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light, opened, order,
+                  cbox)  # fmt: skip
+    return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
+               bvh.cone, bvh.span)  # fmt: skip
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):

@@ -199,5 +199,5 @@ def test_work_on_other_threads_releases_the_gil():
     builder that did made Ctrl-C wait for a whole 2M-triangle build)."""
     from explorer.geometry import occluders as occ
 
-    for kernel in (B._build, B._any_hit_chunk, B._nearest_chunk, occ.leaf_boxes):
+    for kernel in (B._build, B._any_hit_chunk, B._nearest_chunk, occ.refit, occ.refit_top):
         assert kernel.targetoptions.get("nogil"), kernel.__name__

@@ -28,12 +28,22 @@ def _toward(O, light):
 
 
 def _refitted(bvh, O, D, tmax):
-    """The refitted tree, and the share of leaves left empty (dropped whole)."""
+    """The refitted tree, and the share of leaves no ray can reach (left out under an empty
+    box, theirs or an ancestor's)."""
     tree = B.toward_light(bvh, O, D, tmax)
     assert tree is not bvh, "the rays share an end: the boxes are refitted"
-    empty = np.mean([tree.cbox[i, 6 * s] == np.inf for i in range(len(tree.child))
-                     for s in range(2) if tree.child[i, s] < 0])  # fmt: skip
-    return tree, empty
+    reached, todo = 0, [0]
+    while todo:
+        i = todo.pop()
+        for s in range(2):
+            if _empty(tree.cbox[i, 6 * s : 6 * s + 6]):
+                continue
+            c = tree.child[i, s]
+            if c < 0:
+                reached += 1
+            else:
+                todo.append(c)
+    return tree, 1.0 - reached / len(tree.leaf)
 
 
 def _check(tree, O, D, tmax, tri):
@@ -143,3 +153,104 @@ def test_few_rays_keep_the_full_tree(monkeypatch):
     D, tmax = _toward(Q, np.array([2.0, 0, 0]))
     B.any_hit(bvh, Q, D, tmax)
     assert seen
+
+
+def _empty(box) -> bool:
+    return box[0] == np.inf or box[0] > box[1]
+
+
+def _reference_boxes(bvh, light):
+    """The child boxes of ``bvh`` refitted triangle by triangle (numpy): every triangle whose
+    height under the light is at most the threshold, nothing else."""
+    kind, L, eps, R = light
+    low = occ._threshold((np.int64(kind), L, eps, R))
+    h = bvh.plane[:, :3] @ L - (bvh.plane[:, 3] if kind == 0 else 0.0)
+    keep = ~(h > low)
+    empty = np.array([1, -1] * 3, np.float32) * np.inf
+    leaf_box = np.tile(empty, (len(bvh.leaf), 1))
+    for q, (first, count) in enumerate(bvh.leaf):
+        rows = bvh.tbox[first : first + count][keep[first : first + count]]
+        if len(rows):
+            leaf_box[q, 0::2], leaf_box[q, 1::2] = rows[:, 0::2].min(0), rows[:, 1::2].max(0)
+    node_box = np.tile(empty, (len(bvh.child), 1))
+    cbox = np.full((len(bvh.child), 12), np.inf, np.float32)
+    for i in range(len(bvh.child) - 1, -1, -1):
+        for s, c in enumerate(bvh.child[i]):
+            box = leaf_box[~c] if c < 0 else node_box[c]
+            if box[0] <= box[1]:
+                cbox[i, 6 * s : 6 * s + 6] = box
+                node_box[i, 0::2] = np.minimum(node_box[i, 0::2], box[0::2])
+                node_box[i, 1::2] = np.maximum(node_box[i, 1::2], box[1::2])
+    return cbox
+
+
+@pytest.mark.parametrize("name", ["teapot 8", "torus 32", "sphere 24", "cube"])
+def test_the_refit_by_normal_cones_equals_the_refit_triangle_by_triangle(name):
+    """Wherever a ray can get (every box under the root that is not empty), the boxes the cones
+    give are those of boxing every triangle that does not face the light (up to float32
+    rounding): no triangle that can block is left out, and none that cannot is kept."""
+    kind, *res = name.split()
+    mesh = {"sphere": sphere, "cube": cube}.get(kind, lambda r: get_mesh(kind, r))(*map(int, res))
+    Q, tri = _frame(mesh)
+    bvh = B.build_bvh(tri)
+    rng = np.random.default_rng(9)
+    for light in [np.array([2.0, 3.0, 1.5]), np.array([0.0, 0.1, 0.0]), *rng.normal(size=(3, 3))]:
+        D, tmax = _toward(Q, light)
+        tree = B.toward_light(bvh, Q, D, tmax)
+        kind_, L, eps, reach = occ.shared_end(Q, D, tmax)
+        corner = np.abs(bvh.cbox[0]).astype(np.float64).reshape(2, 3, 2).max(axis=(0, 2))
+        R = max(float(np.sqrt(corner @ corner)), reach)
+        want = _reference_boxes(bvh, (kind_, L, eps, R))
+        todo, seen = [0], 0
+        while todo:
+            i = todo.pop()
+            for s in range(2):
+                box, ref = tree.cbox[i, 6 * s : 6 * s + 6], want[i, 6 * s : 6 * s + 6]
+                if _empty(box):
+                    assert _empty(ref), (name, light, i, s)
+                    continue
+                # a box kept as built may differ from its triangles' boxes in rounding only
+                assert np.allclose(box, ref, rtol=1e-6, atol=1e-8), (name, light, i, s)
+                seen += 1
+                if tree.child[i, s] >= 0:
+                    todo.append(tree.child[i, s])
+        assert seen > 1
+
+
+def test_normal_cones_hold_every_normal_under_them():
+    mesh = get_mesh("teapot", 8)
+    _, tri = _frame(mesh)
+    bvh = B.build_bvh(tri)
+
+    def under(c):
+        if c < 0:
+            f, n = bvh.leaf[~c]
+            return np.arange(f, f + n)
+        return np.concatenate([under(g) for g in bvh.child[c]])
+
+    bounded = 0
+    for i in range(len(bvh.child)):
+        for s in range(2):
+            axis, cos = bvh.cone[i, 5 * s : 5 * s + 3], bvh.cone[i, 5 * s + 3]
+            n = bvh.plane[under(bvh.child[i, s]), :3]
+            if cos > -1:
+                bounded += 1
+                a = axis.astype(np.float64)
+                assert np.all(n @ a >= cos - 3e-7), (i, s)
+                if cos > 0:  # within a half-angle below 90°: the sine bounds the angle too
+                    sines = np.linalg.norm(np.cross(n, a), axis=1)
+                    assert np.all(sines <= bvh.cone[i, 5 * s + 4] + 3e-7), (i, s)
+    assert bounded > len(bvh.child)  # most children have a cone
+
+
+def test_the_refit_on_every_thread_equals_the_refit_on_one(monkeypatch):
+    Q, tri = _frame(get_mesh("teapot", 12))
+    bvh = B.build_bvh(tri)
+    D, tmax = _toward(Q, np.array([2.0, 3.0, 1.5]))
+    monkeypatch.setattr(B, "REFIT_NODES", 1 << 60)
+    one = B.toward_light(bvh, Q, D, tmax)
+    monkeypatch.setattr(B, "REFIT_NODES", 0)
+    monkeypatch.setattr(B, "workers", lambda: 2)
+    split = B.toward_light(bvh, Q, D, tmax)
+    assert np.array_equal(one.cbox, split.cbox)
+    assert not np.array_equal(one.cbox, bvh.cbox)
