@@ -10,9 +10,10 @@ A, B, ... so that this VM's drift from one minute to the next falls on both alik
 times a light change on a ``Shader`` (float32, or ``--precision``; 1M vertices, 8 point lights,
 Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on random points (every
 vertex-light computed) and on a UV sphere with as many vertices in mesh order (light culling
-skips what faces away), then a one-shot ``explorer.shade`` (10 calls) and a viewer change on a
-kept ``Shader`` (25), both on the random points, in the same precision; the table gives the
-best and the median of the per-process medians, and the ratios. ``--cpu`` runs each process on
+skips what faces away), then a one-shot ``explorer.shade`` (10 calls), the geometry preparation
+of a one-shot call (11: ``bench_engine.py``'s row, the prepared geometry handed back as the call
+does) and a viewer change on a kept ``Shader`` (25), all on the random points, in the same
+precision; the table gives the best and the median of the per-process medians, and the ratios. ``--cpu`` runs each process on
 one numba thread and times the process's CPU seconds instead of the wall clock: the work each
 revision does, unaffected by other processes taking a core (a parallel pass waits for its slowest
 thread, so on a busy machine the wall clock mostly measures the others).
@@ -89,6 +90,18 @@ for _ in range(11):
     t = time.perf_counter(); explorer.shade(scene, P, N, precision={precision!r})
     ts.append(time.perf_counter() - t)
 print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
+from explorer.shading import shader as shader_module
+spare = getattr(shader_module, "_GEOMETRY", None)  # (revisions before k10 keep no spare)
+ts = []  # geometry preparation of a one-shot call (bench_engine's row): the shader's checks,
+for _ in range(12):  # frame, prepared geometry and chunk bounds; its geometry then the spare
+    t = time.perf_counter()
+    sh = explorer.Shader(scene, P, N, precision={precision!r}, keep=False)
+    sh._compiled_geometry()
+    ts.append(time.perf_counter() - t)
+    if spare is not None:
+        spare.give(sh._G)
+    del sh
+print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
 sh = explorer.Shader(scene, P, N, precision={precision!r})
 sh.colors
 from bench_engine import Viewer  # (the revision's own Viewer class)
@@ -104,8 +117,11 @@ CASES = (
     "random points (every vertex-light)",
     "UV sphere, mesh order (light culling)",
     "one-shot shade(), random points (incl. geometry)",
+    "geometry preparation of a one-shot call",
     "viewer change, random points (specular only)",
 )
+#: cases that shade no vertex-light (no rate)
+NO_RATE = {"geometry preparation of a one-shot call"}
 
 
 def run(root: Path, n: int, precision: str = "float32", cpu=False) -> list[tuple[float, float]]:
@@ -184,8 +200,8 @@ def main(argv=None) -> int:
         for rev, rows in res.items():
             best = min(r[c][0] for r in rows)
             med[rev] = statistics.median(r[c][1] for r in rows)
-            rate = args.vertices * 8 / med[rev] / 1e6
-            print(f"| {case} | {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
+            rate = "" if case in NO_RATE else f"{args.vertices * 8 / med[rev] / 1e6:.2f}"
+            print(f"| {case} | {rev} | {best:.2f} | {med[rev]:.2f} | {rate} |")
         ratios.append(f"{case}: {args.a} / {args.b} (median) {med[args.a] / med[args.b]:.2f}x")
     print("\n" + "\n".join(ratios))
     return 0
