@@ -100,7 +100,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
-from explorer.shading.vmath import compress8, expand8, fpow
+from explorer.shading.vmath import compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
@@ -296,14 +296,17 @@ def _load_positions(P, centre, inv_scale, px, py, pz):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def prepare(P, N, centre, inv_scale, k, G):
+def prepare(P, N, centre, inv_scale, k, G, sample, step):
     """Geometry in the normalised frame, structure of arrays, working precision.
 
     P, N : (n, 3) float32/float64 world positions and normals
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
+    sample : (N_BOUNDS, ceil(n / CHUNK)) float64 out: columns 0, step, 2·step ... get the bounds
+    of their chunks (as :func:`bounds` finds them), each found while its block is in cache; the
+    other columns are left as they were (step 0: none)
     Returns how many blocks hold a normal outside :data:`explorer.core.tolerances.NORMAL_RANGE`
-    (by the test of :func:`explorer.geometry.frame.scale_normals`): 0, or scale the normals with
-    it and prepare again.
+    (by the test of :func:`explorer.geometry.frame.scale_normals`) or a value that is not
+    finite: 0, or test and scale the normals and prepare again.
     """
     n = P.shape[0]
     Pf, Nf = P.reshape(-1), N.reshape(-1)  # flat: x0 y0 z0 x1 ... (see the module docstring)
@@ -311,6 +314,10 @@ def prepare(P, N, centre, inv_scale, k, G):
     outside = 0
     for b in nb.prange(nblocks):
         outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
+        if step > 0:  # the sampled chunks of this block
+            c0, c1 = b * CHUNKS, min((b + 1) * CHUNKS, sample.shape[1])
+            for c in range((c0 + step - 1) // step * step, c1, step):
+                _chunk_bounds(G, c, sample)
     return outside
 
 
@@ -389,9 +396,13 @@ def extent(P):
 def _extent_run(Pf, out):
     """Smallest and largest x, y, z of flat positions Pf (3m,), m >= 1, into out[:6]; out[6]
     0, or NaN when some coordinate is not finite."""
-    lx, hx, ly, hy, lz, hz = Pf[0], Pf[0], Pf[1], Pf[1], Pf[2], Pf[2]
+    # on order keys (vmath.order_key): a float min/max reduction stays scalar without nnan,
+    # an integer one vectorises (2.5x faster in float32)
+    lx = hx = order_key(Pf[0])
+    ly = hy = order_key(Pf[1])
+    lz = hz = order_key(Pf[2])
     for i in range(Pf.shape[0] // 3):
-        x, y, z = Pf[3 * i], Pf[3 * i + 1], Pf[3 * i + 2]
+        x, y, z = order_key(Pf[3 * i]), order_key(Pf[3 * i + 1]), order_key(Pf[3 * i + 2])
         lx, hx = min(lx, x), max(hx, x)
         ly, hy = min(ly, y), max(hy, y)
         lz, hz = min(lz, z), max(hz, z)
@@ -401,8 +412,8 @@ def _extent_run(Pf, out):
     bad = Pf[0] * 0
     for i in range(Pf.shape[0]):
         bad += Pf[i] * 0
-    out[0], out[1], out[2] = lx, ly, lz
-    out[3], out[4], out[5] = hx, hy, hz
+    out[0], out[1], out[2] = from_key(lx), from_key(ly), from_key(lz)
+    out[3], out[4], out[5] = from_key(hx), from_key(hy), from_key(hz)
     out[6] = bad
 
 

@@ -27,6 +27,10 @@ and put them back (AVX-512's ``vcompresspd`` / ``vexpandpd``; LLVM's generic int
 machines get equivalent, slower code): the float64 lobe loop computes its power only for lanes
 whose lobe weight is positive (:func:`explorer.shading.kernels._split_lobe`).
 
+:func:`order_key` maps a float to an integer of the same order (and :func:`from_key` back):
+a smallest or largest value found on the keys is a reduction LLVM vectorises without
+fast-math's no-NaN promise, which the kernels never make.
+
 numba's on-disk cache checks only the file of the function it compiled: after an edit here,
 touch :mod:`explorer.shading.kernels` (or clear its cache), or the kernels keep the old code.
 """
@@ -311,3 +315,52 @@ def expand8(typingctx, src, k, w, i, dst):
         return count
 
     return sig, codegen
+
+
+# --------------------------------------------------------------------------------------------
+# ordered integer keys
+
+
+def _key_types(t):
+    if t == types.float32:
+        return types.int32, 32
+    if t == types.float64:
+        return types.int64, 64
+    return None, 0
+
+
+def _flip(builder, i, width):
+    """i ^ ((i >> (width - 1)) >>> 1): the bits of a negative float reversed but for its sign,
+    so that integer order is float order (its own inverse)."""
+    sign = builder.ashr(i, ir.Constant(ir.IntType(width), width - 1))
+    return builder.xor(i, builder.lshr(sign, ir.Constant(ir.IntType(width), 1)))
+
+
+@intrinsic
+def order_key(typingctx, x):
+    """An integer (int32 for float32 x, int64 for float64) whose order is the order of x, for
+    x not NaN (-0.0 just below +0.0); :func:`from_key` gives x back."""
+    it, width = _key_types(x)
+    if it is None:
+        return None
+
+    def codegen(context, builder, sig, args):
+        return _flip(builder, builder.bitcast(args[0], ir.IntType(width)), width)
+
+    return it(x), codegen
+
+
+@intrinsic
+def from_key(typingctx, k):
+    """The float whose :func:`order_key` is ``k`` (int32: float32, int64: float64)."""
+    if k == types.int32:
+        ft, width, lt = types.float32, 32, ir.FloatType()
+    elif k == types.int64:
+        ft, width, lt = types.float64, 64, ir.DoubleType()
+    else:
+        return None
+
+    def codegen(context, builder, sig, args):
+        return builder.bitcast(_flip(builder, args[0], width), lt)
+
+    return ft(k), codegen
