@@ -606,7 +606,8 @@ def _reach(bd, c0, nc, q, fl, back, act):
 # second loop adds w·f·base^n·s_i from them: the float64 chain of one lane (square roots,
 # divisions, pow64) is too long for the core to overlap two lanes' chains within one loop
 # (``benchmarks/bench_revisions.py --precision float64`` compares); float32 keeps the lobe in the
-# one loop (its chain is shorter).
+# one loop (its chain is shorter). That second loop (:func:`_split_lobe`) raises to the power
+# only the lanes with a lobe weight when many have none (the vertices facing away from the light).
 
 SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
 LOBE_NONE = 4  # (after the LOBE_* modes above)
