@@ -13,10 +13,11 @@ vertex-light computed) and on a UV sphere with as many vertices in mesh order (l
 skips what faces away), then a one-shot ``explorer.shade`` (10 calls), the geometry preparation
 of a one-shot call (11: ``bench_engine.py``'s row, the prepared geometry handed back as the call
 does) and a viewer change on a kept ``Shader`` (25), all on the random points, in the same
-precision; the table gives the best and the median of the per-process medians, and the ratios. ``--cpu`` runs each process on
-one numba thread and times the process's CPU seconds instead of the wall clock: the work each
-revision does, unaffected by other processes taking a core (a parallel pass waits for its slowest
-thread, so on a busy machine the wall clock mostly measures the others).
+precision; the table gives the best and the median of the per-process medians, and the ratios.
+``--cpu`` runs each process on one numba thread and times the process's CPU seconds instead of
+the wall clock: the work each revision does, unaffected by other processes taking a core (a
+parallel pass waits for its slowest thread, so on a busy machine the wall clock mostly measures
+the others).
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; medians of per-process medians):
 
