@@ -42,6 +42,38 @@ threads give 1.6-1.9x one. Tried on that copy and not kept: float32-seeded recip
 root with Newton steps (291 instructions instead of 215), Estrin polynomials (no gain),
 interleave 4 (3% on top of the split loop, more compile time), cheaper pow polynomials (about
 2%), compacting the lanes whose pow is 0 (no vector compress from LLVM 20; scalar costs more).
+
+k11 (952533b -> k11, float64, ``--rounds 3``): the lobe loop packs the lanes with a lobe weight
+(``vmath.compress8`` / ``expand8``, AVX-512's vcompresspd / vexpandpd, written as LLVM
+intrinsics: the vectoriser does not make them) and takes the power of those only; extent on
+integer order keys; the shader prepares the compiled geometry at once and its passes test NaN
+and inf (no numpy pass); prepare finds the sampled chunk bounds.
+
+| case | 952533b ms | k11 ms | ratio |
+|---|---:|---:|---:|
+| random points, wall (load 1.0-2.0; best 22.18 / 18.14) | 26.09 | 21.00 | 1.24x |
+| UV sphere, mesh order, wall | 14.44 | 12.98 | 1.11x |
+| one-shot shade(), wall | 26.27 | 22.03 | 1.19x |
+| geometry preparation of a one-shot call, wall | 4.50 | 3.61 | 1.25x |
+| viewer change, wall | 23.15 | 19.51 | 1.19x |
+| random points, ``--cpu`` (load 1.0-1.2) | 42.32 | 40.66 | 1.04x |
+| one-shot shade(), ``--cpu`` | 54.38 | 46.86 | 1.16x |
+| geometry preparation, ``--cpu`` | 9.95 | 6.65 | 1.50x |
+
+float32, ``--cpu --rounds 3`` (load 1.0): random points 17.09 / 17.44 ms (0.98x), UV sphere
+12.85 / 12.67 (1.01x), viewer change 17.39 / 18.17 (0.96x), geometry 6.22 / 5.09 (1.22x).
+
+What the packing saves, on a standalone copy of the float64 loops (one thread, lanes per light
+per block; ``loop2`` is the lobe loop): with 40% of the lanes weighted (random points, a light
+at ~5 radii) loop2 1.73 -> 1.12-1.15 ns per lane; with every lane weighted the packing would
+cost 0.4 ns more (so it is skipped above ``kernels.PACK_SHARE`` = 3/4 weighted); the L / base
+loop 1.8-2.2 ns stays. On the engine, one thread, 1M vertices: 3.87 -> 3.29 ms per light (the
+slope from 1 to 8 lights), 41.2 -> 36.1 ms for 8. Measured on that copy and not kept: the
+square root and division for 1/|L + V| replaced by a float32-seeded reciprocal square root with
+one Newton step (loop1 about 5% faster, but a relative error of 3e-14 in the base, which n up to
+128 makes 4e-12 in the lobe: above the 1e-12 the float64 tests hold), a float32 division seeding
+pow's (m - 1)/(m + 1) (slower), 8 fewer polynomial terms in pow (loop2 -27%, far looser than the
+stated bound).
 """
 
 from __future__ import annotations

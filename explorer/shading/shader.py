@@ -190,9 +190,7 @@ class Shader:
 
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
-        # normals scaled for the kernels when a pass needs them (see _normals); when the
-        # compiled tier serves, the geometry is prepared now, and its passes find NaN and inf
-        now = self._prepares_now()
+        now = _compiled_now(self.tier, self._scene.model)  # prepared now: finds NaN, inf too
         P, N = check_vertices(positions, normals, scale=False, finite=not now)
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
@@ -203,9 +201,9 @@ class Shader:
         self._faces = faces
         self._vis_cache: dict = {}
         self._plan = self._make_plan(self._scene)
-        self._centre, self._scale = None, 1.0  # the frame, found with the compiled geometry
         n = len(self._P)
-        self._G = self._bounds = None  # the compiled tier's geometry (now, or at its first pass)
+        # the frame and the compiled tier's geometry (below, or at its first pass)
+        self._centre, self._scale, self._G, self._bounds = None, 1.0, None, None
         self._np = None  # the numpy tier's sums
         self._served = None  # the tier of the last pass
         self._A = self._D = self._S = None
@@ -216,26 +214,17 @@ class Shader:
         self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
         if geometry is not None:
-            self._keep_geometry(geometry)
+            self._compiled_geometry(geometry)
         self._lights_changed()
 
-    def _prepares_now(self) -> bool:
-        """Whether :meth:`set_geometry` prepares the compiled geometry at once: the compiled
-        tier serves this shader's passes (its kernels are loaded, or asked for)."""
-        if self.tier == "numpy" or self._scene.model not in COMPILED_MODELS:
-            return False
-        return self.tier == "compiled" or tiers.loaded()
-
-    def _compiled_geometry(self) -> None:
-        """The compiled tier's view of the geometry: frame positions and unit normals (6, n) in
-        the working precision, structure of arrays, and the chunk bounds for light culling."""
+    def _compiled_geometry(self, geometry=None) -> None:
+        """The compiled tier's geometry (:func:`prepared_geometry`; ``geometry``: found already):
+        frame positions, unit normals (6, n) in the working precision, the chunk bounds."""
         if self._G is None:
-            self._keep_geometry(prepared_geometry(self._P, self._N, self._T, self._k))
-
-    def _keep_geometry(self, geometry: tuple) -> None:
-        self._centre, self._scale, self._G, self._bounds, self._N = geometry
-        self._scaled = True
-        self.stats["geometry"] += 1
+            geometry = geometry or prepared_geometry(self._P, self._N, self._T, self._k)
+            self._centre, self._scale, self._G, self._bounds, self._N = geometry
+            self._scaled = True
+            self.stats["geometry"] += 1
 
     def _normals(self) -> np.ndarray:
         """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
@@ -534,6 +523,15 @@ class Shader:
                     self._base = base if not flat else None
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
+
+
+def _compiled_now(tier: str | None, model: str) -> bool:
+    """Whether a shader prepares the compiled geometry with its vertices (and leaves their test
+    for NaN and inf to those passes): the compiled tier serves its passes (``tier``; None:
+    :mod:`explorer.shading.tiers` has the kernels loaded) and computes ``model``."""
+    if tier == "numpy" or model not in COMPILED_MODELS:
+        return False
+    return tier == "compiled" or tiers.loaded()
 
 
 def prepared_geometry(P, N, dtype, k) -> tuple:
