@@ -296,14 +296,11 @@ def _load_positions(P, centre, inv_scale, px, py, pz):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def prepare(P, N, centre, inv_scale, k, G, sample, step):
+def prepare(P, N, centre, inv_scale, k, G):
     """Geometry in the normalised frame, structure of arrays, working precision.
 
     P, N : (n, 3) float32/float64 world positions and normals
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
-    sample : (N_BOUNDS, ceil(n / CHUNK)) float64 out: columns 0, step, 2·step ... get the bounds
-    of their chunks (as :func:`bounds` finds them), each found while its block is in cache; the
-    other columns are left as they were (step 0: none)
     Returns how many blocks hold a normal outside :data:`explorer.core.tolerances.NORMAL_RANGE`
     (by the test of :func:`explorer.geometry.frame.scale_normals`) or a value that is not
     finite: 0, or test and scale the normals and prepare again.
@@ -314,10 +311,6 @@ def prepare(P, N, centre, inv_scale, k, G, sample, step):
     outside = 0
     for b in nb.prange(nblocks):
         outside += _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b, b + 1)
-        if step > 0:  # the sampled chunks of this block
-            c0, c1 = b * CHUNKS, min((b + 1) * CHUNKS, sample.shape[1])
-            for c in range((c0 + step - 1) // step * step, c1, step):
-                _chunk_bounds(G, c, sample)
     return outside
 
 

@@ -551,27 +551,23 @@ def prepared_geometry(P, N, dtype, k) -> tuple:
     else:
         centre, scale = frame_of(P)
     G = _GEOMETRY.take((6, n), dtype)
-    b = np.empty((K.N_BOUNDS, -(-n // K.CHUNK)), np.float64)  # chunk_bounds' sample, found by
-    frame = (centre, 1.0 / scale, k, G, b, CULL_SAMPLE)  # prepare with each block in cache
-    if K.prepare(_readonly(P), _readonly(N), *frame):  # (NaN and inf are outside too)
+    frame = (centre, 1.0 / scale, k)
+    if K.prepare(_readonly(P), _readonly(N), *frame, G):  # (NaN and inf are outside too)
         check_finite("normals", N)
         N = scale_normals(N)
-        K.prepare(_readonly(P), _readonly(N), *frame)
-    return centre, scale, G, chunk_bounds(G, b), N
+        K.prepare(_readonly(P), _readonly(N), *frame, G)
+    return centre, scale, G, chunk_bounds(G), N
 
 
-def chunk_bounds(G: np.ndarray, sampled: np.ndarray | None = None) -> np.ndarray:
+def chunk_bounds(G: np.ndarray) -> np.ndarray:
     """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
     prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
     read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
     narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests.
-    Every CULL_SAMPLE-th chunk is found first (``sampled``: an array of that shape holding them
-    already, as :func:`explorer.shading.kernels.prepare` finds them): when those already fall
-    short, the rest are not (on vertices in no particular order most of the bounds' cost)."""
-    b = sampled
-    if b is None:
-        b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
-        K.bounds(G, b, CULL_SAMPLE)
+    Every CULL_SAMPLE-th chunk is found first: when those already fall short, the rest are not
+    (on vertices in no particular order most of the bounds' cost)."""
+    b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
+    K.bounds(G, b, CULL_SAMPLE)
     sample = b[K.B_COS, ::CULL_SAMPLE]
     if np.count_nonzero(sample > 0) * CULL_MIN_SHARE < sample.size:
         return _readonly(b[:, :0])

@@ -150,26 +150,6 @@ def test_extent_is_nan_when_a_coordinate_is_not_finite(dtype, bad, where):
     assert np.isfinite(K.extent(P)).all()
 
 
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-@pytest.mark.parametrize("step", [1, 3, 16, 40])
-def test_prepare_finds_the_sampled_chunk_bounds_as_bounds_does(dtype, step):
-    # prepare finds every step-th chunk's bounds with the block it prepares (shader.chunk_bounds'
-    # sample): the same numbers as bounds() over the prepared geometry; the others untouched
-    rng = np.random.default_rng(step)
-    n = 5 * K.BLOCK + 45
-    P = rng.normal(size=(n, 3)).astype(dtype)
-    N = (P + 0.1 * rng.normal(size=(n, 3))).astype(dtype)
-    N[7] = 0.0  # an absent normal: never culled
-    G = np.empty((6, n), dtype)
-    nc = -(-n // K.CHUNK)
-    got = np.full((K.N_BOUNDS, nc), -7.0)
-    K.prepare(P, N, np.zeros(3), 0.5, K.constants(dtype), G, got, step)
-    want = np.full((K.N_BOUNDS, nc), -7.0)
-    K.bounds(G, want, step)
-    assert np.array_equal(got, want)
-    assert np.all(got[:, np.arange(nc) % step != 0] == -7.0)
-
-
 @pytest.mark.parametrize("n", [1, 7, 9, K.BLOCK - 5, K.BLOCK + 33, 3 * K.BLOCK + 13])
 def test_float64_lobe_packing_keeps_every_lane(n):
     # the float64 lobe computes its power only for lanes with a lobe weight, packed (see
@@ -208,7 +188,7 @@ def test_prepare_counts_the_blocks_scale_normals_would_change(dtype, length):
     N[K.BLOCK + 3] = N[K.BLOCK + 3] * dtype(length)  # one normal in the second block
     P = np.zeros((n, 3), dtype)
     G = np.empty((6, n), dtype)
-    outside = K.prepare(P, N, np.zeros(3), 1.0, K.constants(dtype), G, np.empty((9, 0)), 0)
+    outside = K.prepare(P, N, np.zeros(3), 1.0, K.constants(dtype), G)
     assert outside == (0 if scale_normals(N) is N else 1)
     assert outside == (0 if length in (0.0, 1.0) else 1)
 
