@@ -52,17 +52,20 @@ block (0.6 ms more than the separate sampled pass, 0.2-0.3 ms).
 
 | case | 952533b ms | k11 ms | ratio |
 |---|---:|---:|---:|
-| random points, wall (load 1.0-2.0; best 22.18 / 18.14) | 26.09 | 21.00 | 1.24x |
-| UV sphere, mesh order, wall | 14.44 | 12.98 | 1.11x |
-| one-shot shade(), wall | 26.27 | 22.03 | 1.19x |
-| geometry preparation of a one-shot call, wall | 4.50 | 3.61 | 1.25x |
-| viewer change, wall | 23.15 | 19.51 | 1.19x |
-| random points, ``--cpu`` (load 1.0-1.2) | 42.32 | 40.66 | 1.04x |
-| one-shot shade(), ``--cpu`` | 54.38 | 46.86 | 1.16x |
-| geometry preparation, ``--cpu`` | 9.95 | 6.65 | 1.50x |
+| random points, wall (load 1.3-1.7; best 20.22 / 18.44) | 21.27 | 19.93 | 1.07x |
+| UV sphere, mesh order, wall | 12.91 | 12.67 | 1.02x |
+| one-shot shade(), wall | 24.97 | 21.38 | 1.17x |
+| geometry preparation of a one-shot call, wall | 4.12 | 2.16 | 1.91x |
+| viewer change, wall | 21.84 | 19.93 | 1.10x |
+| random points, ``--cpu`` (load 1.1-1.3) | 40.36 | 36.34 | 1.11x |
+| UV sphere, mesh order, ``--cpu`` | 23.82 | 24.92 | 0.96x |
+| one-shot shade(), ``--cpu`` | 45.70 | 42.01 | 1.09x |
+| geometry preparation, ``--cpu`` | 6.44 | 4.96 | 1.30x |
 
-float32, ``--cpu --rounds 3`` (load 1.0): random points 17.09 / 17.44 ms (0.98x), UV sphere
-12.85 / 12.67 (1.01x), viewer change 17.39 / 18.17 (0.96x), geometry 6.22 / 5.09 (1.22x).
+An earlier wall run of the packing alone (load 1.0-2.0) gave 26.09 -> 21.00 ms on the random
+points (1.24x): the VM moves these figures by 10-20% from run to run. float32, ``--cpu --rounds
+3`` (load 1.0): random points 17.09 / 17.44 ms (0.98x), UV sphere 12.85 / 12.67 (1.01x), viewer
+change 17.39 / 18.17 (0.96x).
 
 What the packing saves, on a standalone copy of the float64 loops (one thread, lanes per light
 per block; ``loop2`` is the lobe loop): with 40% of the lanes weighted (random points, a light
