@@ -39,6 +39,9 @@ during the other, so the comparison is rough):
 1.3 to 2.4, beside other jobs: rough): session total 109.0 s at 6fec099, 68.0 s after; shade
 88.0 / 53.2 s; the float32 loops are unchanged.
 
+``--rev 952533b --precision float64`` after the float64 lobe packs its lanes (k11, load 1.0-1.1):
+session total 70.2 s at 952533b, 71.9 s after; shade 54.8 / 56.7 s.
+
 7552fa3 had 34 hand-listed variants (16 inline ones in float32 only); the light loops are the
 18 of ``LIGHT_LOOPS`` in both precisions.
 """

@@ -10,12 +10,14 @@ A, B, ... so that this VM's drift from one minute to the next falls on both alik
 times a light change on a ``Shader`` (float32, or ``--precision``; 1M vertices, 8 point lights,
 Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on random points (every
 vertex-light computed) and on a UV sphere with as many vertices in mesh order (light culling
-skips what faces away), then a one-shot ``explorer.shade`` (10 calls) and a viewer change on a
-kept ``Shader`` (25), both on the random points, in the same precision; the table gives the
-best and the median of the per-process medians, and the ratios. ``--cpu`` runs each process on
-one numba thread and times the process's CPU seconds instead of the wall clock: the work each
-revision does, unaffected by other processes taking a core (a parallel pass waits for its slowest
-thread, so on a busy machine the wall clock mostly measures the others).
+skips what faces away), then a one-shot ``explorer.shade`` (10 calls), the geometry preparation
+of a one-shot call (11: ``bench_engine.py``'s row, the prepared geometry handed back as the call
+does) and a viewer change on a kept ``Shader`` (25), all on the random points, in the same
+precision; the table gives the best and the median of the per-process medians, and the ratios.
+``--cpu`` runs each process on one numba thread and times the process's CPU seconds instead of
+the wall clock: the work each revision does, unaffected by other processes taking a core (a
+parallel pass waits for its slowest thread, so on a busy machine the wall clock mostly measures
+the others).
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; medians of per-process medians):
 
@@ -40,6 +42,42 @@ threads give 1.6-1.9x one. Tried on that copy and not kept: float32-seeded recip
 root with Newton steps (291 instructions instead of 215), Estrin polynomials (no gain),
 interleave 4 (3% on top of the split loop, more compile time), cheaper pow polynomials (about
 2%), compacting the lanes whose pow is 0 (no vector compress from LLVM 20; scalar costs more).
+
+k11 (952533b -> k11, float64, ``--rounds 3``): the lobe loop packs the lanes with a lobe weight
+(``vmath.compress8`` / ``expand8``, AVX-512's vcompresspd / vexpandpd, written as LLVM
+intrinsics: the vectoriser does not make them) and takes the power of those only; extent on
+integer order keys; the shader prepares the compiled geometry at once and its passes test NaN
+and inf (no numpy pass). Tried and not kept: the chunk bounds' sample found by prepare with each
+block (0.6 ms more than the separate sampled pass, 0.2-0.3 ms).
+
+| case | 952533b ms | k11 ms | ratio |
+|---|---:|---:|---:|
+| random points, wall (load 1.3-1.7; best 20.22 / 18.44) | 21.27 | 19.93 | 1.07x |
+| UV sphere, mesh order, wall | 12.91 | 12.67 | 1.02x |
+| one-shot shade(), wall | 24.97 | 21.38 | 1.17x |
+| geometry preparation of a one-shot call, wall | 4.12 | 2.16 | 1.91x |
+| viewer change, wall | 21.84 | 19.93 | 1.10x |
+| random points, ``--cpu`` (load 1.1-1.3) | 40.36 | 36.34 | 1.11x |
+| UV sphere, mesh order, ``--cpu`` | 23.82 | 24.92 | 0.96x |
+| one-shot shade(), ``--cpu`` | 45.70 | 42.01 | 1.09x |
+| geometry preparation, ``--cpu`` | 6.44 | 4.96 | 1.30x |
+
+An earlier wall run of the packing alone (load 1.0-2.0) gave 26.09 -> 21.00 ms on the random
+points (1.24x): the VM moves these figures by 10-20% from run to run. float32, ``--cpu --rounds
+3`` (load 1.0): random points 17.09 / 17.44 ms (0.98x), UV sphere 12.85 / 12.67 (1.01x), viewer
+change 17.39 / 18.17 (0.96x).
+
+What the packing saves, on a standalone copy of the float64 loops (one thread, lanes per light
+per block; ``loop2`` is the lobe loop): with 40% of the lanes weighted (random points, a light
+at ~5 radii) loop2 1.73 -> 1.12-1.15 ns per lane; with every lane weighted the packing would
+cost 0.4 ns more (so it is skipped above ``kernels.PACK_SHARE`` = 3/4 weighted); the L / base
+loop 1.8-2.2 ns stays. On the engine, one thread, 1M vertices: 3.87 -> 3.29 ms per light (the
+slope from 1 to 8 lights), 41.2 -> 36.1 ms for 8. Measured on that copy and not kept: the
+square root and division for 1/|L + V| replaced by a float32-seeded reciprocal square root with
+one Newton step (loop1 about 5% faster, but a relative error of 3e-14 in the base, which n up to
+128 makes 4e-12 in the lobe: above the 1e-12 the float64 tests hold), a float32 division seeding
+pow's (m - 1)/(m + 1) (slower), 8 fewer polynomial terms in pow (loop2 -27%, far looser than the
+stated bound).
 """
 
 from __future__ import annotations
@@ -89,6 +127,18 @@ for _ in range(11):
     t = time.perf_counter(); explorer.shade(scene, P, N, precision={precision!r})
     ts.append(time.perf_counter() - t)
 print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
+from explorer.shading import shader as shader_module
+spare = getattr(shader_module, "_GEOMETRY", None)  # (revisions before k10 keep no spare)
+ts = []  # geometry preparation of a one-shot call (bench_engine's row): the shader's checks,
+for _ in range(12):  # frame, prepared geometry and chunk bounds; its geometry then the spare
+    t = time.perf_counter()
+    sh = explorer.Shader(scene, P, N, precision={precision!r}, keep=False)
+    sh._compiled_geometry()
+    ts.append(time.perf_counter() - t)
+    if spare is not None:
+        spare.give(sh._G)
+    del sh
+print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
 sh = explorer.Shader(scene, P, N, precision={precision!r})
 sh.colors
 from bench_engine import Viewer  # (the revision's own Viewer class)
@@ -104,8 +154,11 @@ CASES = (
     "random points (every vertex-light)",
     "UV sphere, mesh order (light culling)",
     "one-shot shade(), random points (incl. geometry)",
+    "geometry preparation of a one-shot call",
     "viewer change, random points (specular only)",
 )
+#: cases that shade no vertex-light (no rate)
+NO_RATE = {"geometry preparation of a one-shot call"}
 
 
 def run(root: Path, n: int, precision: str = "float32", cpu=False) -> list[tuple[float, float]]:
@@ -184,8 +237,8 @@ def main(argv=None) -> int:
         for rev, rows in res.items():
             best = min(r[c][0] for r in rows)
             med[rev] = statistics.median(r[c][1] for r in rows)
-            rate = args.vertices * 8 / med[rev] / 1e6
-            print(f"| {case} | {rev} | {best:.2f} | {med[rev]:.2f} | {rate:.2f} |")
+            rate = "" if case in NO_RATE else f"{args.vertices * 8 / med[rev] / 1e6:.2f}"
+            print(f"| {case} | {rev} | {best:.2f} | {med[rev]:.2f} | {rate} |")
         ratios.append(f"{case}: {args.a} / {args.b} (median) {med[args.a] / med[args.b]:.2f}x")
     print("\n" + "\n".join(ratios))
     return 0

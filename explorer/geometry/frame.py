@@ -52,7 +52,9 @@ def to_frame(point, centre: np.ndarray, scale: float) -> np.ndarray:
     return (np.asarray(point, dtype=np.float64) - centre) / scale
 
 
-def check_vertices(positions, normals, scale: bool = True) -> tuple[np.ndarray, np.ndarray]:
+def check_vertices(
+    positions, normals, scale: bool = True, finite: bool = True
+) -> tuple[np.ndarray, np.ndarray]:
     """Validate vertex arrays; return them as C-contiguous float arrays (float32 or float64
     kept, anything else converted to float64), the normals scaled by :func:`scale_normals`
     (``scale`` False: as given, for a caller that tests their range in a pass of its own).
@@ -61,9 +63,11 @@ def check_vertices(positions, normals, scale: bool = True) -> tuple[np.ndarray, 
     text, complex numbers, the wrong shape, NaN or inf) raises an
     :class:`~explorer.core.errors.ExplorerError` (a ValueError) naming the argument, and for a
     non-finite value the first bad vertex (the engine never guesses a value for it).
+    ``finite`` False leaves out the test for NaN and inf, for a caller whose own pass over the
+    arrays finds them (it then calls :func:`check_finite` for the error).
     """
-    P = _vertex_array("positions", positions)
-    N = _vertex_array("normals", normals)
+    P = _vertex_array("positions", positions, finite)
+    N = _vertex_array("normals", normals, finite)
     if len(P) != len(N):
         raise ExplorerError(
             f"positions and normals must have the same length, got {len(P)} and {len(N)}"
@@ -71,7 +75,7 @@ def check_vertices(positions, normals, scale: bool = True) -> tuple[np.ndarray, 
     return P, scale_normals(N) if scale else N
 
 
-def _vertex_array(name: str, a) -> np.ndarray:
+def _vertex_array(name: str, a, finite: bool = True) -> np.ndarray:
     """One (n, 3) array of finite reals, C-contiguous float32/float64 (see check_vertices)."""
     try:
         arr = np.asarray(a)
@@ -85,13 +89,20 @@ def _vertex_array(name: str, a) -> np.ndarray:
         arr = arr.astype(np.float64)
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise ExplorerError(f"{name} must have shape (n, 3), got {arr.shape}")
+    if finite:
+        check_finite(name, arr)
+    return np.ascontiguousarray(arr)
+
+
+def check_finite(name: str, arr: np.ndarray) -> None:
+    """Raise an :class:`~explorer.core.errors.ExplorerError` naming ``name`` and the first
+    vertex of ``arr`` (n, 3) float with a NaN or an infinite value, if any."""
     if not np.isfinite(arr.reshape(-1)).all():  # flat test first: one fast pass
         i = int(np.argmax(~np.isfinite(arr).all(axis=1)))
         raise ExplorerError(
             f"{name}[{i}] is not finite: {arr[i].tolist()} (vertex {i} of {len(arr)}); "
             "fix or drop such vertices before shading"
         )
-    return np.ascontiguousarray(arr)
 
 
 def scale_normals(normals: np.ndarray) -> np.ndarray:

@@ -100,7 +100,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
-from explorer.shading.vmath import fpow
+from explorer.shading.vmath import compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
@@ -144,12 +144,15 @@ N_OPTS = 13
     R_GD,
     R_GS,
     R_NV,
-) = range(28)
-N_ROWS = 28
+    R_PACK,
+    R_LOBE,
+) = range(30)
+N_ROWS = 30
 # R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
 # policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
 # (explorer.core.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
-# R_NV holds N·V (after a two-sided flip), for the inline lobes.
+# R_NV holds N·V (after a two-sided flip), for the inline lobes. R_PACK and R_LOBE: the float64
+# lobe loop's packed bases and their powers (see _split_lobe).
 
 # lobe modes
 LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
@@ -299,8 +302,8 @@ def prepare(P, N, centre, inv_scale, k, G):
     P, N : (n, 3) float32/float64 world positions and normals
     G : (6, n) T out: px, py, pz (frame coordinates), nx, ny, nz (unit, or 0 where absent)
     Returns how many blocks hold a normal outside :data:`explorer.core.tolerances.NORMAL_RANGE`
-    (by the test of :func:`explorer.geometry.frame.scale_normals`): 0, or scale the normals with
-    it and prepare again.
+    (by the test of :func:`explorer.geometry.frame.scale_normals`) or a value that is not
+    finite: 0, or test and scale the normals and prepare again.
     """
     n = P.shape[0]
     Pf, Nf = P.reshape(-1), N.reshape(-1)  # flat: x0 y0 z0 x1 ... (see the module docstring)
@@ -356,13 +359,14 @@ def _load_normals(N, nx, ny, nz, k):
 
 @nb.njit(parallel=True, **_OPTS)
 def extent(P):
-    """The smallest and largest coordinates of positions ``P`` (n, 3) float32/float64, finite:
-    (2, 3) float64, row 0 the smallest x, y, z, row 1 the largest (see
-    :func:`explorer.geometry.frame.frame_from_extent`); n >= 1."""
+    """The smallest and largest coordinates of positions ``P`` (n, 3) float32/float64: (2, 3)
+    float64, row 0 the smallest x, y, z, row 1 the largest (see
+    :func:`explorer.geometry.frame.frame_from_extent`); n >= 1. Every value NaN when some
+    coordinate is not finite (the one pass over the positions is their finiteness test too)."""
     n = P.shape[0]
     Pf = P.reshape(-1)
     ntasks = _tasks((n + BLOCK - 1) // BLOCK)
-    part = np.empty((ntasks, 6))
+    part = np.empty((ntasks, 7))
     for t in nb.prange(ntasks):
         s, e = t * n // ntasks, (t + 1) * n // ntasks
         _extent_run(Pf[3 * s : 3 * e], part[t])
@@ -372,20 +376,38 @@ def extent(P):
         for t in range(1, ntasks):
             out[0, c] = min(out[0, c], part[t, c])
             out[1, c] = max(out[1, c], part[t, 3 + c])
+    bad = 0.0
+    for t in range(ntasks):
+        bad += part[t, 6]
+    for c in range(3):
+        out[0, c] += bad
+        out[1, c] += bad
     return out
 
 
 @nb.njit(**_LEAF)
 def _extent_run(Pf, out):
-    """Smallest and largest x, y, z of flat positions Pf (3m,), m >= 1, into out (6,)."""
-    lx, hx, ly, hy, lz, hz = Pf[0], Pf[0], Pf[1], Pf[1], Pf[2], Pf[2]
+    """Smallest and largest x, y, z of flat positions Pf (3m,), m >= 1, into out[:6]; out[6]
+    0, or NaN when some coordinate is not finite."""
+    # on order keys (vmath.order_key): a float min/max reduction stays scalar without nnan,
+    # an integer one vectorises (2.5x faster in float32)
+    lx = hx = order_key(Pf[0])
+    ly = hy = order_key(Pf[1])
+    lz = hz = order_key(Pf[2])
     for i in range(Pf.shape[0] // 3):
-        x, y, z = Pf[3 * i], Pf[3 * i + 1], Pf[3 * i + 2]
+        x, y, z = order_key(Pf[3 * i]), order_key(Pf[3 * i + 1]), order_key(Pf[3 * i + 2])
         lx, hx = min(lx, x), max(hx, x)
         ly, hy = min(ly, y), max(hy, y)
         lz, hz = min(lz, z), max(hz, z)
-    out[0], out[1], out[2] = lx, ly, lz
-    out[3], out[4], out[5] = hx, hy, hz
+    # the finiteness test: a second pass over the run, in cache and contiguous (inside the loop
+    # above it cost half as much as the whole loop); x·0 is 0, or NaN for a NaN or an infinite
+    # x (not folded to 0: the kernels never allow nnan/ninf; x - x would be, by reassociation)
+    bad = Pf[0] * 0
+    for i in range(Pf.shape[0]):
+        bad += Pf[i] * 0
+    out[0], out[1], out[2] = from_key(lx), from_key(ly), from_key(lz)
+    out[3], out[4], out[5] = from_key(hx), from_key(hy), from_key(hz)
+    out[6] = bad
 
 
 @nb.njit(**_LEAF)
@@ -577,7 +599,8 @@ def _reach(bd, c0, nc, q, fl, back, act):
 # second loop adds w·f·base^n·s_i from them: the float64 chain of one lane (square roots,
 # divisions, pow64) is too long for the core to overlap two lanes' chains within one loop
 # (``benchmarks/bench_revisions.py --precision float64`` compares); float32 keeps the lobe in the
-# one loop (its chain is shorter).
+# one loop (its chain is shorter). That second loop (:func:`_split_lobe`) raises to the power
+# only the lanes with a lobe weight when many have none (the vertices facing away from the light).
 
 SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
 LOBE_NONE = 4  # (after the LOBE_* modes above)
@@ -756,10 +779,54 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
             if track and (spec or inline):
                 TRK[i] = min(TRK[i], margin)
         if split:
-            for i in range(m):
-                _add_light(GS, Sx, Sy, Sz, i, WS[i] * fpow(B[i], y), sr, sg, sb, grey)
+            _split_lobe(scr, m, y, sr, sg, sb, grey)
 
     return impl
+
+
+#: the float64 lobe loop packs the lanes that have a lobe weight before it takes their powers
+#: when they are at most this share of its lanes (see :func:`_split_lobe`)
+PACK_SHARE = 0.75
+
+
+@nb.njit(**_LEAF)
+def _split_lobe(scr, m, y, sr, sg, sb, grey):
+    """The float64 light loops' lobe: S += ws·base^n·s_i from the rows R_BASE and R_WS.
+
+    A lane whose weight ws is 0 (facing away from the light, outside its cone, in shadow) adds
+    0 whatever its power, and the power is most of the loop's work: when such lanes are at least
+    1 - PACK_SHARE of the run, the others are packed to the front of row R_PACK
+    (:func:`explorer.shading.vmath.compress8`), raised to the power there, and put back in their
+    lanes of row R_LOBE (:func:`explorer.shading.vmath.expand8`; 0 elsewhere). Every lane gets
+    the same value as from the loop over all lanes."""
+    B, WS = _row(scr, R_BASE, m), _row(scr, R_WS, m)
+    GS, Sx, Sy, Sz = _row(scr, R_GS, m), _row(scr, R_SX, m), _row(scr, R_SY, m), _row(scr, R_SZ, m)
+    kept = 0.0
+    for i in range(m):
+        kept += 1.0 if WS[i] > 0.0 else 0.0
+    if kept > PACK_SHARE * m:
+        for i in range(m):
+            _add_light(GS, Sx, Sy, Sz, i, WS[i] * fpow(B[i], y), sr, sg, sb, grey)
+        return
+    C, E = _row(scr, R_PACK, m), _row(scr, R_LOBE, m)
+    whole = m - m % 8  # lanes in whole groups of 8; the rest one by one
+    nc = 0
+    for i in range(0, whole, 8):
+        nc += compress8(B, WS, i, C, nc)
+    for i in range(whole, m):
+        if WS[i] > 0.0:
+            C[nc] = B[i]
+            nc += 1
+    for j in range(nc):
+        C[j] = fpow(C[j], y)
+    k = 0
+    for i in range(0, whole, 8):
+        k += expand8(C, k, WS, i, E)
+    for i in range(whole, m):
+        E[i] = C[k] if WS[i] > 0.0 else 0.0
+        k += 1 if WS[i] > 0.0 else 0
+    for i in range(m):
+        _add_light(GS, Sx, Sy, Sz, i, WS[i] * E[i], sr, sg, sb, grey)
 
 
 def _light_loop(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - overloaded below

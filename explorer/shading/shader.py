@@ -48,6 +48,7 @@ from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
 from explorer.geometry.frame import (
     check_faces,
+    check_finite,
     check_vertices,
     frame_from_extent,
     frame_of,
@@ -189,19 +190,20 @@ class Shader:
 
     def set_geometry(self, positions, normals, faces=None) -> None:
         """New vertices (and triangles, for shadows): every cached sum is invalid."""
-        # normals scaled for the kernels when a pass needs them (see _normals)
-        P, N = check_vertices(positions, normals, scale=False)
+        now = _compiled_now(self.tier, self._scene.model)  # prepared now: finds NaN, inf too
+        P, N = check_vertices(positions, normals, scale=False, finite=not now)
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
+        geometry = prepared_geometry(P, N, self._T, self._k) if now else None
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
         self._vis_cache: dict = {}
         self._plan = self._make_plan(self._scene)
-        self._centre, self._scale = None, 1.0  # the frame, found with the compiled geometry
         n = len(self._P)
-        self._G = self._bounds = None  # the compiled tier's geometry, made at its first pass
+        # the frame and the compiled tier's geometry (below, or at its first pass)
+        self._centre, self._scale, self._G, self._bounds = None, 1.0, None, None
         self._np = None  # the numpy tier's sums
         self._served = None  # the tier of the last pass
         self._A = self._D = self._S = None
@@ -211,17 +213,18 @@ class Shader:
         self._redo = np.zeros(n if self._T is np.float32 else 0, np.bool_)
         self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
+        if geometry is not None:
+            self._compiled_geometry(geometry)
         self._lights_changed()
 
-    def _compiled_geometry(self) -> None:
-        """The compiled tier's view of the geometry: frame positions and unit normals (6, n) in
-        the working precision, structure of arrays, and the chunk bounds for light culling."""
-        if self._G is not None:
-            return
-        geometry = prepared_geometry(self._P, self._N, self._T, self._k)
-        self._centre, self._scale, self._G, self._bounds, self._N = geometry
-        self._scaled = True
-        self.stats["geometry"] += 1
+    def _compiled_geometry(self, geometry=None) -> None:
+        """The compiled tier's geometry (:func:`prepared_geometry`; ``geometry``: found already):
+        frame positions, unit normals (6, n) in the working precision, the chunk bounds."""
+        if self._G is None:
+            geometry = geometry or prepared_geometry(self._P, self._N, self._T, self._k)
+            self._centre, self._scale, self._G, self._bounds, self._N = geometry
+            self._scaled = True
+            self.stats["geometry"] += 1
 
     def _normals(self) -> np.ndarray:
         """The normals scaled into NORMAL_RANGE (:func:`explorer.geometry.frame.scale_normals`:
@@ -522,17 +525,35 @@ class Shader:
                 self._spec_shininess = scene.material.shininess
 
 
+def _compiled_now(tier: str | None, model: str) -> bool:
+    """Whether a shader prepares the compiled geometry with its vertices (and leaves their test
+    for NaN and inf to those passes): the compiled tier serves its passes (``tier``; None:
+    :mod:`explorer.shading.tiers` has the kernels loaded) and computes ``model``."""
+    if tier == "numpy" or model not in COMPILED_MODELS:
+        return False
+    return tier == "compiled" or tiers.loaded()
+
+
 def prepared_geometry(P, N, dtype, k) -> tuple:
     """The compiled tier's geometry of positions ``P`` and normals ``N`` (n, 3) in precision
     ``dtype`` (``k``: its constants): (centre, scale) of the normalised frame (:func:`frame_of`,
     the extent found in one compiled pass), ``G`` (6, n) (:func:`explorer.shading.kernels.prepare`),
     the chunk bounds (:func:`chunk_bounds`) and the normals as prepared: ``N``, or scaled into
-    NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would)."""
+    NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would).
+    These passes test the values too: a NaN or an infinite value raises the error of
+    :func:`~explorer.geometry.frame.check_finite` naming the first such vertex."""
     n = len(P)
-    centre, scale = frame_from_extent(*K.extent(_readonly(P))) if n else frame_of(P)
+    if n:
+        lohi = K.extent(_readonly(P))  # (all NaN when some coordinate is not finite)
+        if np.isnan(lohi[0, 0]):
+            check_finite("positions", P)
+        centre, scale = frame_from_extent(*lohi)
+    else:
+        centre, scale = frame_of(P)
     G = _GEOMETRY.take((6, n), dtype)
     frame = (centre, 1.0 / scale, k)
-    if K.prepare(_readonly(P), _readonly(N), *frame, G):
+    if K.prepare(_readonly(P), _readonly(N), *frame, G):  # (NaN and inf are outside too)
+        check_finite("normals", N)
         N = scale_normals(N)
         K.prepare(_readonly(P), _readonly(N), *frame, G)
     return centre, scale, G, chunk_bounds(G), N

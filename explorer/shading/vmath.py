@@ -22,6 +22,15 @@ t = y·log2 x itself, |t|·2**-53, dominates: **the relative error is below (|t|
 2.3e-308); t is capped at 1023 (x > 1 with a huge y: the result saturates near 2**1023, finite).
 As OpenGL: 0**0 = 1, 0**y = 0 for y > 0, 1**y = 1.
 
+:func:`compress8` and :func:`expand8` pack the float64 lanes a mask keeps to the front of a row
+and put them back (AVX-512's ``vcompresspd`` / ``vexpandpd``; LLVM's generic intrinsics, so other
+machines get equivalent, slower code): the float64 lobe loop computes its power only for lanes
+whose lobe weight is positive (:func:`explorer.shading.kernels._split_lobe`).
+
+:func:`order_key` maps a float to an integer of the same order (and :func:`from_key` back):
+a smallest or largest value found on the keys is a reduction LLVM vectorises without
+fast-math's no-NaN promise, which the kernels never make.
+
 numba's on-disk cache checks only the file of the function it compiled: after an edit here,
 touch :mod:`explorer.shading.kernels` (or clear its cache), or the kernels keep the old code.
 """
@@ -32,6 +41,7 @@ import numba as nb
 import numpy as np
 from llvmlite import ir
 from numba import types
+from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
@@ -226,3 +236,131 @@ def _fpow_overload(x, y):
     if x == types.float32:
         return lambda x, y: pow32(x, y)
     return lambda x, y: pow64(x, y)
+
+
+# --------------------------------------------------------------------------------------------
+# lane compaction (float64, 8 lanes)
+
+_V8 = ir.VectorType(ir.DoubleType(), 8)
+_M8 = ir.VectorType(ir.IntType(1), 8)
+
+
+def _lanes(context, builder, aryty, ary, i):
+    """A pointer to element ``i`` of a 1-D array, as a pointer to 8 float64 lanes."""
+    a = context.make_array(aryty)(context, builder, value=ary)
+    return builder.bitcast(builder.gep(a.data, [i]), _V8.as_pointer())
+
+
+def _positive(builder, w):
+    """The mask w > 0 of 8 lanes, and how many lanes it keeps (int64)."""
+    mask = builder.fcmp_ordered(">", w, ir.Constant(_V8, [0.0] * 8))
+    bits = builder.bitcast(mask, ir.IntType(8))
+    fnty = ir.FunctionType(ir.IntType(8), [ir.IntType(8)])
+    count = builder.call(
+        cgutils.get_or_insert_function(builder.module, fnty, "llvm.ctpop.i8"), [bits]
+    )
+    return mask, builder.zext(count, ir.IntType(64))
+
+
+def _is_row64(a):
+    return isinstance(a, types.Array) and a.ndim == 1 and a.dtype == types.float64
+
+
+@intrinsic
+def compress8(typingctx, src, w, i, dst, k):
+    """dst[k : k + 8] <- the lanes j of src[i : i + 8] with w[j] > 0, in order, then zeros;
+    returns how many (int64). 1-D float64 arrays, i + 8 <= len(src), len(w); k + 8 <= len(dst)
+    (no bounds checks: with k <= i, compacting a row into another as long never leaves it)."""
+    if not (_is_row64(src) and _is_row64(w) and _is_row64(dst)):
+        return None
+    sig = types.int64(src, w, types.intp, dst, types.intp)
+
+    def codegen(context, builder, sig, args):
+        tsrc, tw, _, tdst, _ = sig.args
+        s = builder.load(_lanes(context, builder, tsrc, args[0], args[2]), align=8)
+        mask, count = _positive(
+            builder, builder.load(_lanes(context, builder, tw, args[1], args[2]), align=8)
+        )
+        fnty = ir.FunctionType(_V8, [_V8, _M8, _V8])
+        fn = cgutils.get_or_insert_function(
+            builder.module, fnty, "llvm.experimental.vector.compress.v8f64"
+        )
+        packed = builder.call(fn, [s, mask, ir.Constant(_V8, [0.0] * 8)])
+        builder.store(packed, _lanes(context, builder, tdst, args[3], args[4]), align=8)
+        return count
+
+    return sig, codegen
+
+
+@intrinsic
+def expand8(typingctx, src, k, w, i, dst):
+    """dst[i : i + 8] <- src[k], src[k + 1] ... in the lanes j with w[j] > 0 (w[i : i + 8]), in
+    order, 0 in the others (the inverse of :func:`compress8`); returns how many it took (int64).
+    Reads only those; 1-D float64 arrays, i + 8 <= len(w), len(dst), no bounds checks."""
+    if not (_is_row64(src) and _is_row64(w) and _is_row64(dst)):
+        return None
+    sig = types.int64(src, types.intp, w, types.intp, dst)
+
+    def codegen(context, builder, sig, args):
+        tsrc, _, tw, _, tdst = sig.args
+        mask, count = _positive(
+            builder, builder.load(_lanes(context, builder, tw, args[2], args[3]), align=8)
+        )
+        a = context.make_array(tsrc)(context, builder, value=args[0])
+        first = builder.gep(a.data, [args[1]])
+        fnty = ir.FunctionType(_V8, [ir.DoubleType().as_pointer(), _M8, _V8])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.masked.expandload.v8f64")
+        lanes = builder.call(fn, [first, mask, ir.Constant(_V8, [0.0] * 8)])
+        builder.store(lanes, _lanes(context, builder, tdst, args[4], args[3]), align=8)
+        return count
+
+    return sig, codegen
+
+
+# --------------------------------------------------------------------------------------------
+# ordered integer keys
+
+
+def _key_types(t):
+    if t == types.float32:
+        return types.int32, 32
+    if t == types.float64:
+        return types.int64, 64
+    return None, 0
+
+
+def _flip(builder, i, width):
+    """i ^ ((i >> (width - 1)) >>> 1): the bits of a negative float reversed but for its sign,
+    so that integer order is float order (its own inverse)."""
+    sign = builder.ashr(i, ir.Constant(ir.IntType(width), width - 1))
+    return builder.xor(i, builder.lshr(sign, ir.Constant(ir.IntType(width), 1)))
+
+
+@intrinsic
+def order_key(typingctx, x):
+    """An integer (int32 for float32 x, int64 for float64) whose order is the order of x, for
+    x not NaN (-0.0 just below +0.0); :func:`from_key` gives x back."""
+    it, width = _key_types(x)
+    if it is None:
+        return None
+
+    def codegen(context, builder, sig, args):
+        return _flip(builder, builder.bitcast(args[0], ir.IntType(width)), width)
+
+    return it(x), codegen
+
+
+@intrinsic
+def from_key(typingctx, k):
+    """The float whose :func:`order_key` is ``k`` (int32: float32, int64: float64)."""
+    if k == types.int32:
+        ft, width, lt = types.float32, 32, ir.FloatType()
+    elif k == types.int64:
+        ft, width, lt = types.float64, 64, ir.DoubleType()
+    else:
+        return None
+
+    def codegen(context, builder, sig, args):
+        return builder.bitcast(_flip(builder, args[0], width), lt)
+
+    return ft(k), codegen

@@ -9,6 +9,7 @@ import pytest
 from explorer.core.errors import ExplorerError
 from explorer.geometry.frame import (
     check_faces,
+    check_finite,
     check_vertices,
     frame_from_extent,
     frame_of,
@@ -110,3 +111,21 @@ def test_check_vertices_can_leave_the_normals_as_given():
     assert check_vertices(np.zeros((1, 3)), N, scale=False)[1] is N
     scaled = check_vertices(np.zeros((1, 3)), N)[1]
     assert scaled is not N and 0.5 <= scaled[0, 2] < 1
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_check_vertices_can_leave_the_finiteness_test_to_its_caller(bad):
+    # (the compiled engine's own passes find NaN and inf, then call check_finite for the error)
+    P = np.zeros((4, 3))
+    P[2, 0] = bad
+    with pytest.raises(ExplorerError, match=r"positions\[2\] is not finite"):
+        check_vertices(P, np.ones((4, 3)))
+    got, _ = check_vertices(P, np.ones((4, 3)), finite=False)
+    assert got is P
+    with pytest.raises(
+        ExplorerError, match=r"normals\[2\] is not finite: \[.*\] \(vertex 2 of 4\)"
+    ):
+        check_finite("normals", P)
+    check_finite("normals", np.ones((4, 3), np.float32))  # finite: nothing to say
+    with pytest.raises(ExplorerError, match="must have shape"):  # the other checks still run
+        check_vertices(np.zeros((4, 2)), np.ones((4, 3)), finite=False)

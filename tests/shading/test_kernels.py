@@ -137,6 +137,44 @@ def test_extent_is_the_positions_smallest_and_largest_coordinates(dtype):
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+@pytest.mark.parametrize("where", [0, 1, K.BLOCK + 2, "last"])
+def test_extent_is_nan_when_a_coordinate_is_not_finite(dtype, bad, where):
+    # the extent's pass is the positions' finiteness test (shader.prepared_geometry)
+    n = K.TASKS * K.BLOCK + 7
+    P = np.random.default_rng(4).normal(size=(n, 3)).astype(dtype)
+    i = n - 1 if where == "last" else where
+    P[i, i % 3] = bad
+    assert np.isnan(K.extent(P)).all()
+    P[i, i % 3] = dtype(3e38)  # large but finite: an extent
+    assert np.isfinite(K.extent(P)).all()
+
+
+@pytest.mark.parametrize("n", [1, 7, 9, K.BLOCK - 5, K.BLOCK + 33, 3 * K.BLOCK + 13])
+def test_float64_lobe_packing_keeps_every_lane(n):
+    # the float64 lobe computes its power only for lanes with a lobe weight, packed (see
+    # kernels._split_lobe): lights on one side light a few lanes of each run (packed), lights
+    # all around most of them (not packed); runs of any length, tails of any size
+    import explorer
+
+    rng = np.random.default_rng(n)
+    P, N = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    for positions in ([[4.0, 0.0, 0.0]], [[0, 0, 9], [9, 1, 0], [-9, 0, 1], [0, -9, 0]]):
+        scene = {
+            "material": {"diffuse": [0.6, 0.5, 0.4], "specular": [0.5, 0.4, 0.3], "shininess": 30},
+            "viewer": {"eye": [0, 0, 6]},
+            "lights": [
+                {"type": "point", "position": p, "specular": [1, 0.5, 0.2]} for p in positions
+            ]
+            + [{"type": "point", "position": [p[0], p[1], -p[2]]} for p in positions],
+        }
+        want = equation_shade(explorer.load_scene(scene), P, N)
+        for cull in (True, False):
+            s = explorer.Shader(scene, P, N, precision="float64", cull=cull, tier="compiled")
+            assert np.abs(s.colors - want).max() <= 1e-12
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
 @pytest.mark.parametrize("length", [0.0, 1.0, 1e-7, 1e-20, 1e-310, 1e7, 1e20])
 def test_prepare_counts_the_blocks_scale_normals_would_change(dtype, length):
     # prepare tests each normal as scale_normals does: a block counts when some normal is neither

@@ -83,3 +83,21 @@ def test_shade_refuses_bad_arguments_by_name(kw, error, match):
         explorer.shade({"material": "gold"}, **args)
     with pytest.raises(error, match=match):
         explorer.Shader({"material": "gold"}, **args)
+
+
+@pytest.mark.parametrize("tier", [None, "compiled", "numpy"])
+@pytest.mark.parametrize("which", ["positions", "normals"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_nan_or_inf_vertices_are_refused_before_any_state_changes(tier, which, bad):
+    # on the compiled tier the geometry is prepared at once and its passes find such values
+    # (kernels.extent, kernels.prepare); on the numpy tier check_vertices does: the same error
+    s = explorer.Shader({"material": "gold"}, MESH.positions, MESH.normals, tier=tier)
+    assert s.stats["geometry"] == (0 if tier == "numpy" else 1)  # prepared by the constructor
+    scene, colours = s.scene, s.colors.copy()
+    P, N = MESH.positions.copy(), MESH.normals.copy()
+    (P if which == "positions" else N)[5, 1] = bad
+    with pytest.raises(ExplorerError, match=rf"{which}\[5\] is not finite"):
+        s.set_geometry(P, N)
+    same_state(s, scene, colours)
+    with pytest.raises(ExplorerError, match=rf"{which}\[5\] is not finite"):
+        explorer.Shader(scene, P, N, tier=tier)
