@@ -95,11 +95,12 @@ def leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
 
 @nb.njit(cache=True, inline="always")
 def walk(start, ray, inv, tm, tree, eps, stack):
-    """Walk the subtree under inner node ``start`` of tree = (child, cbox, leaf, tri) with a
+    """Walk the subtree under inner node ``start`` of tree = (link, cbox, leaf, tri) (``link``
+    the int32 view of the node rows ``cbox``: columns 12, 13 the children) with a
     shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's reciprocals, ``tm`` its
     end), eps = (t_eps, det_eps); returns the node whose leaf holds a front side the ray
     meets, or -1."""
-    child, cbox, leaf, tri = tree
+    link, cbox, leaf, tri = tree
     t_eps, det_eps = eps
     ox, oy, oz = ray[0], ray[1], ray[2]
     ix, iy, iz = inv
@@ -107,7 +108,7 @@ def walk(start, ray, inv, tm, tree, eps, stack):
     node = start
     while True:
         ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, tm)
-        ca, cb = child[node, 0], child[node, 1]
+        ca, cb = np.int64(link[node, 12]), np.int64(link[node, 13])
         if ta < math.inf and ca < 0:
             if leaf_any(leaf, ~ca, tri, ray, t_eps, tm, det_eps):
                 return node
@@ -123,7 +124,7 @@ def walk(start, ray, inv, tm, tree, eps, stack):
 
 @nb.njit(cache=True, inline="always")
 def any_one(O, D, tmax, r, tree, parent, eps, stack, near):
-    """Whether ray ``r`` of (O, D, tmax) meets a front side in tree = (child, cbox, leaf, tri)
+    """Whether ray ``r`` of (O, D, tmax) meets a front side in tree = (link, cbox, leaf, tri)
     (``parent`` (k,) each inner node's parent, -1 for the root) with eps = (t_eps, det_eps).
 
     The subtree under ``near`` (-1: none) is walked first: pass what the previous call
