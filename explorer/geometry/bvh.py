@@ -68,6 +68,9 @@ MEDIAN_DEPTH = 64
 #: (:func:`toward_light`, cost about one ray per 50 triangles) when they number at least the
 #: triangles divided by this
 OCCLUDER_RAYS = 16
+#: a tree holds fewer triangles than this: the node rows pack a leaf's first triangle and count
+#: (at most :data:`MAX_LEAF`, 5 bits) into one int32
+MAX_TRIANGLES = 1 << 26
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
 
@@ -82,8 +85,10 @@ class BVH:
     cbox : (k, 16) float32 one 64-byte row per node (the array starts on a 64-byte boundary,
         :func:`node_rows`): columns 0-11 the children's boxes, (x0, x1, y0, y1, z0, z1) each,
         grown by the pad and rounded outward to float32 (an empty box, x0 > x1, is never
-        entered); columns 12 and 13 hold ``child``'s row as int32 (read through
-        ``cbox.view(np.int32)``: a shadow ray's walk reads one cache line per node), 14-15 zero
+        entered); columns 12 and 13 hold ``child``'s row as int32, and 14 and 15 for a child
+        that is a leaf its first triangle * 32 + its count, else zero (read through
+        ``cbox.view(np.int32)``: a shadow ray's walk reads one cache line per node and none
+        for the leaves' ranges)
     leaf : (q, 2) int64 per leaf: first triangle and count
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
@@ -127,9 +132,12 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     """
     tri = np.ascontiguousarray(triangles, np.float64).reshape(-1, 3, 3)
     m = len(tri)
+    if m >= MAX_TRIANGLES:
+        raise ValueError(f"{m:,} triangles: a BVH holds fewer than {MAX_TRIANGLES:,}")
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
-        cbox = node_rows(child, np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2)))
+        box = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
+        cbox = node_rows(child, box, np.zeros((0, 2), np.int64))
         no = np.zeros(0, np.int64)
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
@@ -143,7 +151,7 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     hi32 = np.where(hi32 < box64[:, 1::2], np.nextafter(hi32, np.float32(np.inf)), hi32)
     box32 = np.empty(box64.shape, np.float32)
     box32[:, 0::2], box32[:, 1::2] = lo32, hi32
-    cbox = node_rows(child, box32)
+    cbox = node_rows(child, box32, leaf)
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
     plane = occ.planes(rows)
     return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
@@ -157,14 +165,16 @@ def aligned_rows(k: int) -> np.ndarray:
     return raw[skip : skip + 16 * k].reshape(k, 16)
 
 
-def node_rows(child, boxes) -> np.ndarray:
-    """The (k, 16) float32 node rows of :class:`BVH`'s ``cbox`` from ``child`` (k, 2) int and
-    the children's boxes ``boxes`` (k, 12) float32."""
+def node_rows(child, boxes, leaf) -> np.ndarray:
+    """The (k, 16) float32 node rows of :class:`BVH`'s ``cbox`` from ``child`` (k, 2) int, the
+    children's boxes ``boxes`` (k, 12) float32 and ``leaf`` (q, 2) int (first, count)."""
     rows = aligned_rows(len(child))
     rows[:, :12] = boxes
     link = rows.view(np.int32)
     link[:, 12:14] = child
-    link[:, 14:] = 0
+    q = np.where(child < 0, ~child, 0)
+    packed = leaf[q, 0] * 32 + leaf[q, 1] if len(leaf) else np.zeros_like(child)
+    link[:, 14:] = np.where(child < 0, packed, 0)
     return rows
 
 

@@ -82,11 +82,12 @@ def next_node(stack, sp, ca, cb, ta, tb):
 
 
 @nb.njit(cache=True, inline="always")
-def leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
-    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``q``."""
+def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
+    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in the leaf whose first
+    triangle and count are ``packed`` (first * 32 + count, as the node rows hold them)."""
     ox, oy, oz, dx, dy, dz = ray
-    first = leaf[q, 0]
-    for j in range(first, first + leaf[q, 1]):
+    first = np.int64(packed) >> 5
+    for j in range(first, first + (np.int64(packed) & 31)):
         t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
         if t > t_eps and t < tm:
             return True
@@ -96,11 +97,12 @@ def leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
 @nb.njit(cache=True, inline="always")
 def walk(start, ray, inv, tm, tree, eps, stack):
     """Walk the subtree under inner node ``start`` of tree = (link, cbox, leaf, tri) (``link``
-    the int32 view of the node rows ``cbox``: columns 12, 13 the children) with a
+    the int32 view of the node rows ``cbox``: columns 12, 13 the children, 14, 15 their
+    leaves' triangles) with a
     shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's reciprocals, ``tm`` its
     end), eps = (t_eps, det_eps); returns the node whose leaf holds a front side the ray
     meets, or -1."""
-    link, cbox, leaf, tri = tree
+    link, cbox, _, tri = tree
     t_eps, det_eps = eps
     ox, oy, oz = ray[0], ray[1], ray[2]
     ix, iy, iz = inv
@@ -110,11 +112,11 @@ def walk(start, ray, inv, tm, tree, eps, stack):
         ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, tm)
         ca, cb = np.int64(link[node, 12]), np.int64(link[node, 13])
         if ta < math.inf and ca < 0:
-            if leaf_any(leaf, ~ca, tri, ray, t_eps, tm, det_eps):
+            if leaf_any(link[node, 14], tri, ray, t_eps, tm, det_eps):
                 return node
             ta = math.inf
         if tb < math.inf and cb < 0:
-            if leaf_any(leaf, ~cb, tri, ray, t_eps, tm, det_eps):
+            if leaf_any(link[node, 15], tri, ray, t_eps, tm, det_eps):
                 return node
             tb = math.inf
         node, sp = next_node(stack, sp, ca, cb, ta, tb)

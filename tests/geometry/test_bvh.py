@@ -136,7 +136,20 @@ def test_each_node_is_one_cache_line_holding_its_children(m):
         assert rows.dtype == np.float32 and rows.shape == (len(bvh.child), 16)
         assert rows.flags.c_contiguous and rows.ctypes.data % 64 == 0
         link = rows.view(np.int32)
-        assert np.array_equal(link[:, 12:14], bvh.child) and not link[:, 14:].any()
+        assert np.array_equal(link[:, 12:14], bvh.child)
+        for s in range(2):  # a leaf child's first triangle and count, packed
+            c = bvh.child[:, s]
+            packed = link[:, 14 + s]
+            assert not packed[c >= 0].any()
+            if m:
+                assert np.array_equal(packed[c < 0] >> 5, bvh.leaf[~c[c < 0], 0])
+                assert np.array_equal(packed[c < 0] & 31, bvh.leaf[~c[c < 0], 1])
+
+
+def test_too_many_triangles_for_the_node_rows(monkeypatch):
+    monkeypatch.setattr(B, "MAX_TRIANGLES", 40)
+    with pytest.raises(ValueError, match="40 triangles: a BVH holds fewer than 40"):
+        B.build_bvh(_soup(40, 1))
 
 
 @pytest.mark.parametrize("m", [0, 1, 3, 40])
