@@ -43,7 +43,7 @@ from explorer.core.errors import Cancelled
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
-from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
+from explorer.geometry.traverse import LEAF_BITS, STACK, any_one, enter, next_node, ray_of
 
 #: rays per chunk at most: the unit of work a thread takes, and how often ``cancelled`` is asked
 CHUNK = 8192
@@ -69,7 +69,7 @@ MEDIAN_DEPTH = 64
 #: triangles divided by this
 OCCLUDER_RAYS = 16
 #: a tree holds fewer triangles than this: the node rows pack a leaf's first triangle and count
-#: (at most :data:`MAX_LEAF`, 5 bits) into one int32
+#: (at most :data:`MAX_LEAF`) into one int32 (:data:`~explorer.geometry.traverse.LEAF_BITS`)
 MAX_TRIANGLES = 1 << 26
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
@@ -86,9 +86,9 @@ class BVH:
         :func:`node_rows`): columns 0-11 the children's boxes, (x0, x1, y0, y1, z0, z1) each,
         grown by the pad and rounded outward to float32 (an empty box, x0 > x1, is never
         entered); columns 12 and 13 hold ``child``'s row as int32, and 14 and 15 for a child
-        that is a leaf its first triangle * 32 + its count, else zero (read through
-        ``cbox.view(np.int32)``: a shadow ray's walk reads one cache line per node and none
-        for the leaves' ranges)
+        that is a leaf its first triangle and count (``first << LEAF_BITS | count``), else
+        zero (read through ``cbox.view(np.int32)``: a shadow ray's walk reads one cache line
+        per node and none for the leaves' ranges)
     leaf : (q, 2) int64 per leaf: first triangle and count
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
@@ -173,7 +173,7 @@ def node_rows(child, boxes, leaf) -> np.ndarray:
     link = rows.view(np.int32)
     link[:, 12:14] = child
     q = np.where(child < 0, ~child, 0)
-    packed = leaf[q, 0] * 32 + leaf[q, 1] if len(leaf) else np.zeros_like(child)
+    packed = (leaf[q, 0] << LEAF_BITS | leaf[q, 1]) if len(leaf) else np.zeros_like(child)
     link[:, 14:] = np.where(child < 0, packed, 0)
     return rows
 

@@ -17,6 +17,8 @@ from explorer.geometry.rays import ray_triangle_row
 STACK = 128
 #: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
 BIG = 1e300
+#: a node row packs a leaf child's first triangle and count as ``first << LEAF_BITS | count``
+LEAF_BITS = 5
 #: a shadow ray first walks the subtree this many levels above the leaf that blocked the last
 #: blocked ray (:func:`any_one`)
 UP = 4
@@ -84,10 +86,10 @@ def next_node(stack, sp, ca, cb, ta, tb):
 @nb.njit(cache=True, inline="always")
 def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
     """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in the leaf whose first
-    triangle and count are ``packed`` (first * 32 + count, as the node rows hold them)."""
+    triangle and count are ``packed`` (:data:`LEAF_BITS`, as the node rows hold them)."""
     ox, oy, oz, dx, dy, dz = ray
-    first = np.int64(packed) >> 5
-    for j in range(first, first + (np.int64(packed) & 31)):
+    first = np.int64(packed) >> LEAF_BITS
+    for j in range(first, first + (np.int64(packed) & ((1 << LEAF_BITS) - 1))):
         t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
         if t > t_eps and t < tm:
             return True
@@ -98,10 +100,9 @@ def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
 def walk(start, ray, inv, tm, tree, eps, stack):
     """Walk the subtree under inner node ``start`` of tree = (link, cbox, leaf, tri) (``link``
     the int32 view of the node rows ``cbox``: columns 12, 13 the children, 14, 15 their
-    leaves' triangles) with a
-    shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's reciprocals, ``tm`` its
-    end), eps = (t_eps, det_eps); returns the node whose leaf holds a front side the ray
-    meets, or -1."""
+    leaves' triangles) with a shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's
+    reciprocals, ``tm`` its end), eps = (t_eps, det_eps); returns the node whose leaf holds a
+    front side the ray meets, or -1."""
     link, cbox, _, tri = tree
     t_eps, det_eps = eps
     ox, oy, oz = ray[0], ray[1], ray[2]

@@ -137,12 +137,13 @@ def test_each_node_is_one_cache_line_holding_its_children(m):
         assert rows.flags.c_contiguous and rows.ctypes.data % 64 == 0
         link = rows.view(np.int32)
         assert np.array_equal(link[:, 12:14], bvh.child)
+        assert B.MAX_LEAF < 1 << B.LEAF_BITS
         for s in range(2):  # a leaf child's first triangle and count, packed
             c = bvh.child[:, s]
             packed = link[:, 14 + s]
             assert not packed[c >= 0].any()
             if m:
-                assert np.array_equal(packed[c < 0] >> 5, bvh.leaf[~c[c < 0], 0])
+                assert np.array_equal(packed[c < 0] >> B.LEAF_BITS, bvh.leaf[~c[c < 0], 0])
                 assert np.array_equal(packed[c < 0] & 31, bvh.leaf[~c[c < 0], 1])
 
 
