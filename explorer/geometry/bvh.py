@@ -43,7 +43,7 @@ from explorer.core.errors import Cancelled
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
-from explorer.geometry.traverse import STACK, any_one, enter, next_node, ray_of
+from explorer.geometry.traverse import LEAF_BITS, STACK, any_one, enter, next_node, ray_of
 
 #: rays per chunk at most: the unit of work a thread takes, and how often ``cancelled`` is asked
 CHUNK = 8192
@@ -68,6 +68,9 @@ MEDIAN_DEPTH = 64
 #: (:func:`toward_light`, cost about one ray per 50 triangles) when they number at least the
 #: triangles divided by this
 OCCLUDER_RAYS = 16
+#: a tree holds fewer triangles than this: the node rows pack a leaf's first triangle and count
+#: (at most :data:`MAX_LEAF`) into one int32 (:data:`~explorer.geometry.traverse.LEAF_BITS`)
+MAX_TRIANGLES = 1 << 26
 #: how often (seconds) a waiting caller asks ``cancelled`` while a tree is built
 POLL = 0.05
 
@@ -79,8 +82,13 @@ class BVH:
     child : (k, 2) int64 the two children of each inner node: ``c >= 0`` an inner node,
         ``c < 0`` the leaf ``~c``; node 0 is the root (a tree of one leaf, or none, has a root
         whose other child's box is empty)
-    cbox : (k, 12) float32 the children's boxes, (x0, x1, y0, y1, z0, z1) each, grown by the
-        pad and rounded outward to float32 (an empty box, x0 > x1, is never entered)
+    cbox : (k, 16) float32 one 64-byte row per node (the array starts on a 64-byte boundary,
+        :func:`node_rows`): columns 0-11 the children's boxes, (x0, x1, y0, y1, z0, z1) each,
+        grown by the pad and rounded outward to float32 (an empty box, x0 > x1, is never
+        entered); columns 12 and 13 hold ``child``'s row as int32, and 14 and 15 for a child
+        that is a leaf its first triangle and count (``first << LEAF_BITS | count``), else
+        zero (read through ``cbox.view(np.int32)``: a shadow ray's walk reads one cache line
+        per node and none for the leaves' ranges)
     leaf : (q, 2) int64 per leaf: first triangle and count
     tri : (m, 9) float64 the triangles in leaf order, ``v0, e1, e2`` of each in a row
         (:func:`~explorer.geometry.rays.pack_triangles`)
@@ -124,9 +132,12 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     """
     tri = np.ascontiguousarray(triangles, np.float64).reshape(-1, 3, 3)
     m = len(tri)
+    if m >= MAX_TRIANGLES:
+        raise ValueError(f"{m:,} triangles: a BVH holds fewer than {MAX_TRIANGLES:,}")
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
-        cbox = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
+        box = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))
+        cbox = node_rows(child, box, np.zeros((0, 2), np.int64))
         no = np.zeros(0, np.int64)
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
@@ -138,12 +149,40 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     hi32 = box64[:, 1::2].astype(np.float32)
     lo32 = np.where(lo32 > box64[:, 0::2], np.nextafter(lo32, np.float32(-np.inf)), lo32)
     hi32 = np.where(hi32 < box64[:, 1::2], np.nextafter(hi32, np.float32(np.inf)), hi32)
-    cbox = np.empty(box64.shape, np.float32)
-    cbox[:, 0::2], cbox[:, 1::2] = lo32, hi32
+    box32 = np.empty(box64.shape, np.float32)
+    box32[:, 0::2], box32[:, 1::2] = lo32, hi32
+    cbox = node_rows(child, box32, leaf)
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
     plane = occ.planes(rows)
     return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
                plane, occ.cones(child, leaf, plane), occ.spans(child))  # fmt: skip
+
+
+def aligned_rows(k: int) -> np.ndarray:
+    """An uninitialised (k, 16) float32 array whose rows each fill one 64-byte cache line."""
+    raw = np.empty(16 * k + 16, np.float32)
+    skip = (-raw.ctypes.data % 64) // 4
+    return raw[skip : skip + 16 * k].reshape(k, 16)
+
+
+def node_rows(child, boxes, leaf) -> np.ndarray:
+    """The (k, 16) float32 node rows of :class:`BVH`'s ``cbox`` from ``child`` (k, 2) int, the
+    children's boxes ``boxes`` (k, 12) float32 and ``leaf`` (q, 2) int (first, count)."""
+    rows = aligned_rows(len(child))
+    rows[:, :12] = boxes
+    link = rows.view(np.int32)
+    link[:, 12:14] = child
+    q = np.where(child < 0, ~child, 0)
+    packed = (leaf[q, 0] << LEAF_BITS | leaf[q, 1]) if len(leaf) else np.zeros_like(child)
+    link[:, 14:] = np.where(child < 0, packed, 0)
+    return rows
+
+
+def copy_rows(cbox) -> np.ndarray:
+    """A copy of node rows ``cbox`` (k, 16) float32, aligned like them (:func:`aligned_rows`)."""
+    rows = aligned_rows(len(cbox))
+    rows.view(np.int32)[:] = cbox.view(np.int32)  # bits as they are (a child may read as NaN)
+    return rows
 
 
 def _parents(child) -> np.ndarray:
@@ -377,7 +416,8 @@ def _children(box, link):
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
-    """Rays r0..r1 of rays = (O, D, tmax) through tree = (child, cbox, leaf, tri) (``parent``
+    """Rays r0..r1 of rays = (O, D, tmax) through tree = (link, cbox, leaf, tri) (``link`` the
+    int32 view of ``cbox``'s rows, :class:`BVH`; ``parent``
     (k,) each inner node's parent) with eps = (t_eps, det_eps): out[r] True where the ray is
     blocked (:func:`~explorer.geometry.traverse.any_one`)."""
     O, D, tmax = rays
@@ -551,7 +591,8 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None, refit=True) 
         return hit
     if refit and len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
         bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
-    args = ((O, D, tm), _tree(bvh), bvh.parent, (RAY_T_EPS, DET_EPS), hit)
+    tree = (bvh.cbox.view(np.int32), bvh.cbox, bvh.leaf, bvh.tri)
+    args = ((O, D, tm), tree, bvh.parent, (RAY_T_EPS, DET_EPS), hit)
     run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
     return hit
 
@@ -565,19 +606,20 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     """
     big = bvh.n_nodes >= REFIT_NODES and workers() > 1
     # a large tree's copy of the boxes is made on another thread meanwhile
-    copy = _get_pool().submit(np.copy, bvh.cbox) if big else None
+    copy = _get_pool().submit(copy_rows, bvh.cbox) if big else None
     end = occ.shared_end(origins, directions, tmax)
     if end is None or not bvh.n_triangles:
         return bvh
     kind, L, eps, reach = end
-    corner = np.maximum(np.abs(bvh.cbox[0, 0::2]), np.abs(bvh.cbox[0, 1::2])).astype(np.float64)
+    corner = np.maximum(np.abs(bvh.cbox[0, 0:12:2]), np.abs(bvh.cbox[0, 1:12:2]))
+    corner = corner.astype(np.float64)
     corner = np.maximum(corner[:3], corner[3:])  # the root's two children's boxes
     radius = max(float(np.sqrt(corner @ corner)), reach)
     _check(cancelled)
     tree = (bvh.child, bvh.cbox, bvh.leaf, bvh.plane, bvh.tbox)
     light = (np.int64(kind), L, eps, radius)
     k = bvh.n_nodes
-    cbox = bvh.cbox.copy() if copy is None or copy.cancel() else copy.result()
+    cbox = copy_rows(bvh.cbox) if copy is None or copy.cancel() else copy.result()
     opened = np.zeros(k, np.uint8)
     order = np.empty(k, np.int64)
     # the walk is bound by reading the nodes it opens from memory: a large tree's subtrees

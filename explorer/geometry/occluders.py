@@ -270,7 +270,7 @@ def _union(i, child, opened, out):
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def refit(r0, r1, roots, tree, cone, span, light, opened, order, out):
     """The boxes for the rays toward ``light`` in the subtrees of the opened inner nodes
-    roots[r0:r1]: writes into out (k, 12) float32, a copy of tree's ``cbox``, the child boxes
+    roots[r0:r1]: writes into out (k, 16) float32, a copy of tree's ``cbox``, the child boxes
     of every node opened there, each holding only the triangles under it that do not face the
     light with the margin (the module docstring); a box with nothing in it is all +inf (no ray
     enters it).

@@ -17,6 +17,8 @@ from explorer.geometry.rays import ray_triangle_row
 STACK = 128
 #: stands for 1/0 in the slab test (finite, so no 0·inf = NaN)
 BIG = 1e300
+#: a node row packs a leaf child's first triangle and count as ``first << LEAF_BITS | count``
+LEAF_BITS = 5
 #: a shadow ray first walks the subtree this many levels above the leaf that blocked the last
 #: blocked ray (:func:`any_one`)
 UP = 4
@@ -82,11 +84,12 @@ def next_node(stack, sp, ca, cb, ta, tb):
 
 
 @nb.njit(cache=True, inline="always")
-def leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
-    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in leaf ``q``."""
+def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
+    """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in the leaf whose first
+    triangle and count are ``packed`` (:data:`LEAF_BITS`, as the node rows hold them)."""
     ox, oy, oz, dx, dy, dz = ray
-    first = leaf[q, 0]
-    for j in range(first, first + leaf[q, 1]):
+    first = np.int64(packed) >> LEAF_BITS
+    for j in range(first, first + (np.int64(packed) & ((1 << LEAF_BITS) - 1))):
         t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
         if t > t_eps and t < tm:
             return True
@@ -95,11 +98,12 @@ def leaf_any(leaf, q, tri, ray, t_eps, tm, det_eps):
 
 @nb.njit(cache=True, inline="always")
 def walk(start, ray, inv, tm, tree, eps, stack):
-    """Walk the subtree under inner node ``start`` of tree = (child, cbox, leaf, tri) with a
-    shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's reciprocals, ``tm`` its
-    end), eps = (t_eps, det_eps); returns the node whose leaf holds a front side the ray
-    meets, or -1."""
-    child, cbox, leaf, tri = tree
+    """Walk the subtree under inner node ``start`` of tree = (link, cbox, leaf, tri) (``link``
+    the int32 view of the node rows ``cbox``: columns 12, 13 the children, 14, 15 their
+    leaves' triangles) with a shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's
+    reciprocals, ``tm`` its end), eps = (t_eps, det_eps); returns the node whose leaf holds a
+    front side the ray meets, or -1."""
+    link, cbox, _, tri = tree
     t_eps, det_eps = eps
     ox, oy, oz = ray[0], ray[1], ray[2]
     ix, iy, iz = inv
@@ -107,13 +111,13 @@ def walk(start, ray, inv, tm, tree, eps, stack):
     node = start
     while True:
         ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, tm)
-        ca, cb = child[node, 0], child[node, 1]
+        ca, cb = np.int64(link[node, 12]), np.int64(link[node, 13])
         if ta < math.inf and ca < 0:
-            if leaf_any(leaf, ~ca, tri, ray, t_eps, tm, det_eps):
+            if leaf_any(link[node, 14], tri, ray, t_eps, tm, det_eps):
                 return node
             ta = math.inf
         if tb < math.inf and cb < 0:
-            if leaf_any(leaf, ~cb, tri, ray, t_eps, tm, det_eps):
+            if leaf_any(link[node, 15], tri, ray, t_eps, tm, det_eps):
                 return node
             tb = math.inf
         node, sp = next_node(stack, sp, ca, cb, ta, tb)
@@ -123,7 +127,7 @@ def walk(start, ray, inv, tm, tree, eps, stack):
 
 @nb.njit(cache=True, inline="always")
 def any_one(O, D, tmax, r, tree, parent, eps, stack, near):
-    """Whether ray ``r`` of (O, D, tmax) meets a front side in tree = (child, cbox, leaf, tri)
+    """Whether ray ``r`` of (O, D, tmax) meets a front side in tree = (link, cbox, leaf, tri)
     (``parent`` (k,) each inner node's parent, -1 for the root) with eps = (t_eps, det_eps).
 
     The subtree under ``near`` (-1: none) is walked first: pass what the previous call

@@ -128,6 +128,31 @@ def test_tree_holds_every_triangle_once_inside_its_boxes():
     assert (bvh.leaf[:, 1] <= B.MAX_LEAF).all()
 
 
+@pytest.mark.parametrize("m", [0, 1, 2000])
+def test_each_node_is_one_cache_line_holding_its_children(m):
+    bvh = B.build_bvh(_soup(m, 6) if m else np.zeros((0, 3, 3)))
+    O, D = np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]])
+    for rows in (bvh.cbox, B.toward_light(bvh, O, D, np.full(1, 9.0)).cbox):
+        assert rows.dtype == np.float32 and rows.shape == (len(bvh.child), 16)
+        assert rows.flags.c_contiguous and rows.ctypes.data % 64 == 0
+        link = rows.view(np.int32)
+        assert np.array_equal(link[:, 12:14], bvh.child)
+        assert B.MAX_LEAF < 1 << B.LEAF_BITS
+        for s in range(2):  # a leaf child's first triangle and count, packed
+            c = bvh.child[:, s]
+            packed = link[:, 14 + s]
+            assert not packed[c >= 0].any()
+            if m:
+                assert np.array_equal(packed[c < 0] >> B.LEAF_BITS, bvh.leaf[~c[c < 0], 0])
+                assert np.array_equal(packed[c < 0] & 31, bvh.leaf[~c[c < 0], 1])
+
+
+def test_too_many_triangles_for_the_node_rows(monkeypatch):
+    monkeypatch.setattr(B, "MAX_TRIANGLES", 40)
+    with pytest.raises(ValueError, match="40 triangles: a BVH holds fewer than 40"):
+        B.build_bvh(_soup(40, 1))
+
+
 @pytest.mark.parametrize("m", [0, 1, 3, 40])
 def test_small_and_degenerate_trees(m):
     tri = np.tile([[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]], (m, 1, 1))  # all equal
