@@ -67,10 +67,15 @@ points (1.24x): the VM moves these figures by 10-20% from run to run. float32, `
 3`` (load 1.0): random points 17.09 / 17.44 ms (0.98x), UV sphere 12.85 / 12.67 (1.01x), viewer
 change 17.39 / 18.17 (0.96x).
 
+``PACK_SHARE`` 3/4 (the helper's) against 1/2 (lead, after the merge; ``--rounds 3``, load
+1.2, wall): random points 21.40 / 19.78 ms (1.08x, 0.40 G), UV sphere in mesh order 14.15 /
+13.03 (1.09x; 3/4 had made it 0.87x of 952533b's 12.86 in the run before), one-shot 25.09 /
+23.52 (1.07x), viewer change 21.25 / 19.31 (1.10x): 1/2 kept.
+
 What the packing saves, on a standalone copy of the float64 loops (one thread, lanes per light
 per block; ``loop2`` is the lobe loop): with 40% of the lanes weighted (random points, a light
 at ~5 radii) loop2 1.73 -> 1.12-1.15 ns per lane; with every lane weighted the packing would
-cost 0.4 ns more (so it is skipped above ``kernels.PACK_SHARE`` = 3/4 weighted); the L / base
+cost 0.4 ns more (so it is skipped above ``kernels.PACK_SHARE`` weighted); the L / base
 loop 1.8-2.2 ns stays. On the engine, one thread, 1M vertices: 3.87 -> 3.29 ms per light (the
 slope from 1 to 8 lights), 41.2 -> 36.1 ms for 8. Measured on that copy and not kept: the
 square root and division for 1/|L + V| replaced by a float32-seeded reciprocal square root with

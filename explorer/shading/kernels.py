@@ -794,8 +794,9 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
 
 
 #: the float64 lobe loop packs the lanes that have a lobe weight before it takes their powers
-#: when they are at most this share of its lanes (see :func:`_split_lobe`)
-PACK_SHARE = 0.75
+#: when they are at most this share of its lanes (see :func:`_split_lobe`; 1/2 against 3/4 was
+#: faster on random points and on a mesh in its own order: ``benchmarks/bench_revisions.py``)
+PACK_SHARE = 0.5
 
 
 @nb.njit(**_LEAF)
