@@ -104,6 +104,21 @@ BVH_BOX_PAD = 1e-9
 #: or beyond the light: it cannot block one (the module docstring has the argument).
 OCCLUDER_MARGIN = 1e-6
 
+# Normal cones of the BVH's nodes (explorer.geometry.occluders: a child whose triangles all
+# face a light is left out of its shadow rays' boxes whole):
+#: a normal cone's bound on ``h`` must beat the threshold by this times ``|L - c| + r``: the
+#: axis is stored in float32 (its dot and cross products with ``L - c`` off by up to 3e-7 of
+#: ``|L - c|``); the rounding of the float64 bound is a few ulps of those (the sine comes from
+#: a cross product, not from ``1 - cos²``)
+CONE_SLACK = 1e-6
+#: an inner node's cone angle is its children's widened by this (as a cosine) per level: the
+#: angle between two unit vectors from their dot product ``g`` near 1 is off by up to
+#: ``sqrt(2 ulp)`` ≈ 1.5e-8
+CONE_WIDEN = 1e-7
+#: the stored cosine ``κ`` of a cone's angle is lowered and its sine raised by this: both are
+#: stored in float32 (off by up to 3e-8 near 1)
+CONE_ROUND = 1e-7
+
 # --- float32 fast path ----------------------------------------------------------------------
 
 #: A float32 dot product of unit vectors is within about 1e-6 of the float64 one after the

@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numba as nb
 import numpy as np
 
-from explorer.core.errors import Cancelled
+from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
@@ -133,7 +133,10 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     tri = np.ascontiguousarray(triangles, np.float64).reshape(-1, 3, 3)
     m = len(tri)
     if m >= MAX_TRIANGLES:
-        raise ValueError(f"{m:,} triangles: a BVH holds fewer than {MAX_TRIANGLES:,}")
+        raise ExplorerError(
+            f"{m:,} triangles: a BVH holds fewer than {MAX_TRIANGLES:,} (shadow rays and the "
+            "per-pixel reference need one: turn shadows off, or decimate the mesh)"
+        )
     if m == 0:  # a root whose children are nothing
         child = np.full((1, 2), -1, np.int64)
         box = np.tile(np.array([1, -1, 1, -1, 1, -1], np.float32), (1, 2))

@@ -43,25 +43,13 @@ import math
 import numba as nb
 import numpy as np
 
-from explorer.core.tolerances import OCCLUDER_MARGIN
+from explorer.core.tolerances import CONE_ROUND, CONE_SLACK, CONE_WIDEN, OCCLUDER_MARGIN
 
 #: the rays share an end when their ends ``O + tmax·D`` lie within this times (1 + |end|) of the
 #: first ray's (shadow rays toward a point light: about 1e-15)
 SHARED_END = 1e-9
 #: float64's unit roundoff, with room for the few operations that compute a ray's end
 _ULP = 4.0 * 2.0**-53
-#: a normal cone's bound on ``h`` must beat the threshold by this times ``|L - c| + r``: the
-#: axis is stored in float32 (its dot and cross products with ``L - c`` off by up to 3e-7 of
-#: ``|L - c|``); the rounding of the float64 bound is a few ulps of those (the sine comes from
-#: a cross product, not from ``1 - cos²``)
-_CONE_SLACK = 1e-6
-#: an inner node's cone angle is its children's widened by this (as a cosine) per level: the
-#: angle between two unit vectors from their dot product ``g`` near 1 is off by up to
-#: ``sqrt(2 ulp)`` ≈ 1.5e-8
-_CONE_WIDEN = 1e-7
-#: the stored cosine ``κ`` of a cone's angle is lowered and its sine raised by this: both are
-#: stored in float32 (off by up to 3e-8 near 1)
-_CONE_ROUND = 1e-7
 
 
 def planes(tri) -> np.ndarray:
@@ -198,7 +186,7 @@ def _classify(cbox, cone, i, s, light, low):
     >= |w| cos(φ + θ) - r`` for ``w = L - c`` at angle ``φ`` from ``â`` (``φ + θ <= π/2`` when
     it is positive); for a direction ``h = n̂·L >= cos(φ + θ)``. ``|w| cos φ`` and ``|w| sin
     φ`` come from the dot and the cross product with the stored axis, within 3e-7 |w| of the
-    true axis' (float32): the bound must beat ``low`` by :data:`_CONE_SLACK` of ``|w| + r``."""
+    true axis' (float32): the bound must beat ``low`` by :data:`CONE_SLACK` of ``|w| + r``."""
     kind, L = light[0], light[1]
     o = 6 * s
     x0, x1 = np.float64(cbox[i, o]), np.float64(cbox[i, o + 1])
@@ -217,7 +205,7 @@ def _classify(cbox, cone, i, s, light, low):
     p = ax * wx + ay * wy + az * wz  # |w| cos φ
     cx, cy, cz = ay * wz - az * wy, az * wx - ax * wz, ax * wy - ay * wx
     q = math.sqrt(cx * cx + cy * cy + cz * cz)  # |w| sin φ
-    slack = _CONE_SLACK * (abs(wx) + abs(wy) + abs(wz) + r)
+    slack = CONE_SLACK * (abs(wx) + abs(wy) + abs(wz) + r)
     if kappa > 0.0 and p * kappa - q * st - r > low + slack:
         return _ALL
     if st * p - kappa * q >= 0.0:  # φ <= θ: the light is within the cone
@@ -350,8 +338,8 @@ def cones(child, leaf, plane):
     its unit normal (``plane`` (m, 4) of :func:`planes`) within angle ``θ`` of the axis (the
     float64 axis the float32 one rounds); ``cos θ = -1`` (no bound) when a sliver is among them.
     Leaves are bounded triangle by triangle, inner nodes from their children's cones (wider by
-    :data:`_CONE_WIDEN` a level for the rounding of the angles); the stored angle is widened by
-    :data:`_CONE_ROUND` for its rounding to float32.
+    :data:`CONE_WIDEN` a level for the rounding of the angles); the stored angle is widened by
+    :data:`CONE_ROUND` for its rounding to float32.
 
     child : (k, 2) int64 the tree (children after their parents); leaf : (q, 2) int64"""
     k, q = child.shape[0], leaf.shape[0]
@@ -385,9 +373,9 @@ def cones(child, leaf, plane):
             for a in range(3):
                 out[i, 5 * s + a] = sc[a] / lc if lc > 0.0 else 0.0
                 nsum[i, a] += sc[a]
-            kc = kc - _CONE_ROUND if kc > -1.0 and lc > 0.0 else -1.0
+            kc = kc - CONE_ROUND if kc > -1.0 and lc > 0.0 else -1.0
             out[i, 5 * s + 3] = kc
-            out[i, 5 * s + 4] = min(math.sqrt(max(1.0 - kc * kc, 0.0)) + _CONE_ROUND, 1.0)
+            out[i, 5 * s + 4] = min(math.sqrt(max(1.0 - kc * kc, 0.0)) + CONE_ROUND, 1.0)
         length = math.sqrt(nsum[i, 0] ** 2 + nsum[i, 1] ** 2 + nsum[i, 2] ** 2)
         kap = 1.0
         for s in range(2):  # the node's cone about the sum of its normals holds both
@@ -404,7 +392,7 @@ def cones(child, leaf, plane):
                 kap = -1.0
                 continue
             both = g * kc - math.sqrt(1.0 - g * g) * math.sqrt(max(1.0 - kc * kc, 0.0))
-            kap = min(kap, both - _CONE_WIDEN)
+            kap = min(kap, both - CONE_WIDEN)
         nkap[i] = max(kap, -1.0)
     return out
 
