@@ -375,25 +375,27 @@ def reference_of(scene, mesh, h: Hits, *, materials=None, precision: str = "floa
     parts = _parts(scene, mesh, h, materials)
     colors = np.zeros((len(h.positions), 3))
     for rows, sc in parts:
-        if len(rows):
-            P, N = h.positions[rows], h.normals[rows]
+        P, N = h.positions[rows], h.normals[rows]
+        if len(P):
             colors[rows] = point_colors(sc, P, N, mesh=mesh, precision=precision)
 
     def sums():
         out = np.zeros(len(h.positions))
         for rows, sc in parts:
-            if len(rows):
-                out[rows] = specular_sums(sc, h.positions[rows], h.normals[rows])
+            P, N = h.positions[rows], h.normals[rows]
+            if len(P):
+                out[rows] = specular_sums(sc, P, N)
         return out
 
     return Reference(h, colors, sums)
 
 
-def _parts(scene, mesh, h: Hits, materials) -> list[tuple[np.ndarray, object]]:
-    """Which hits each material shades: [(rows (j,) int64, the scene in that material)]."""
-    every = np.arange(len(h.positions))
+def _parts(scene, mesh, h: Hits, materials) -> list[tuple[object, object]]:
+    """Which hits each material shades: [(rows: a slice of every hit, or (j,) int64 indices;
+    the scene in that material)]."""
     if materials is None:
-        return [(every, scene)]
+        return [(slice(None), scene)]  # (a view: no copy of the hits)
+    every = np.arange(len(h.positions))
     groups = mesh.groups
     if groups is None or len(materials) != len(groups.names):
         n = 0 if groups is None else len(groups.names)
