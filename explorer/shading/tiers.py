@@ -20,7 +20,11 @@ generation options). Until the marker is there, passes run on the numpy tier, an
 starts ``python -m explorer.shading.warm`` in the background (detached: it outlives the command
 that started it; a lock keeps one at a time per cache directory) and says so once, as a
 :class:`~explorer.core.errors.Notice` (the CLI prints it as one ``notice:`` line on stderr, the
-window shows :func:`status` in its status line).
+window shows :func:`status` in its status line). Each background compile counts itself in an
+*attempt* file beside the marker (:func:`attempt_path`, with its error if it raised one); when
+:data:`MAX_ATTEMPTS` of them ended without the marker (an error, a crash of the compiler, a
+killed process) and none is running, no other is started: the numpy tier serves on, and the
+first pass says why, once, and how to try again.
 
 Loading the kernels from numba's cache costs a process about half a second to a second, more
 than the numpy tier takes for a small mesh: so a process loads them once it has served
@@ -77,6 +81,9 @@ PREPARING = (
     "preparing the compiled engine in the background (once per install, a few minutes); "
     "meanwhile the numpy engine serves: the same colours, slower on large meshes"
 )
+
+#: background compiles that may end without the ready marker before no other is started
+MAX_ATTEMPTS = 2
 
 #: vertex-lights a process serves on the numpy tier before it loads the compiled kernels from
 #: numba's cache (a load costs about what the numpy tier takes for this much work, so small
@@ -166,7 +173,18 @@ def _ready() -> bool:
         _state["checked"] = now
         _state["ready"] = marker_path().exists()
         if first and not _state["ready"]:
-            _start_background()
+            why = given_up()
+            if why is None:
+                _start_background()
+            else:
+                _state["failed"] = why
+                warnings.warn(
+                    f"the compiled engine could not be prepared on this machine: {why}; the "
+                    "numpy engine serves: the same colours, slower on large meshes (to try "
+                    f"again, remove {attempt_path()})",
+                    Notice,
+                    stacklevel=4,
+                )
         if _state["ready"] and _state["preload"]:
             _start_loading()
     return bool(_state["ready"])
@@ -195,8 +213,8 @@ def status() -> str | None:
 
 # -- the ready marker ------------------------------------------------------------------------------
 def cache_dir() -> Path:
-    """The directory numba caches :mod:`explorer.shading.kernels` in (the in-tree
-    ``__pycache__`` when writable, else ``NUMBA_CACHE_DIR`` or numba's user-wide directory)."""
+    """The directory numba caches :mod:`explorer.shading.kernels` in (``NUMBA_CACHE_DIR`` when
+    set, else the in-tree ``__pycache__`` when writable, else numba's user-wide directory)."""
     from explorer.shading import kernels  # numba decides the directory when it decorates
 
     dispatcher = getattr(kernels.shade, "dispatcher", kernels.shade)  # wide-vector wrapper
@@ -240,9 +258,64 @@ def log_path() -> Path:
 
 
 def write_marker(seconds: float) -> Path:
-    """Write the ready marker (after every kernel compiled), atomically."""
+    """Write the ready marker (after every kernel compiled), atomically; the attempts are
+    forgotten."""
     info = {"seconds": round(seconds, 1), "written": time.strftime("%Y-%m-%d %H:%M:%S")}
-    return write_atomic(marker_path(), json.dumps(info).encode(), overwrite=True)
+    path = write_atomic(marker_path(), json.dumps(info).encode(), overwrite=True)
+    attempt_path().unlink(missing_ok=True)
+    return path
+
+
+def attempt_path() -> Path:
+    """Where the background compiles for this marker count themselves (see the module
+    docstring): JSON ``{"attempts": n, "error": "..." or null}``."""
+    return cache_dir() / f"explorer-attempt-{marker_key()}.json"
+
+
+def attempts() -> dict:
+    """The attempt file's record; ``{"attempts": 0, "error": None}`` when there is none or it
+    cannot be read."""
+    try:
+        info = json.loads(attempt_path().read_text())
+        return {"attempts": int(info["attempts"]), "error": info.get("error")}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {"attempts": 0, "error": None}
+
+
+def record_attempt(error: str | None = None) -> None:
+    """Count one more background compile (``error``: None), or write the error the current one
+    ended with (the count stays)."""
+    info = attempts()
+    info = {"attempts": info["attempts"] + (error is None), "error": error or info["error"]}
+    write_atomic(attempt_path(), json.dumps(info).encode(), overwrite=True)
+
+
+def compile_running() -> bool:
+    """Whether a background compile holds the lock now (False where locks are not available)."""
+    try:
+        import fcntl
+    except ImportError:
+        return False
+    try:
+        lock = open(lock_path(), "a+")  # noqa: SIM115 - closed below
+    except OSError:  # no cache directory: nothing runs there
+        return False
+    with lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)  # released when closed
+        except OSError:
+            return True
+    return False
+
+
+def given_up() -> str | None:
+    """Why no background compile should be started any more (:data:`MAX_ATTEMPTS` ended without
+    the marker and none is running), else None."""
+    info = attempts()
+    if info["attempts"] < MAX_ATTEMPTS or compile_running():
+        return None
+    what = info["error"] or f"no error written, see {log_path()}"
+    return f"{info['attempts']} background compiles ended without finishing ({what})"
 
 
 # -- the background compile and the loader -------------------------------------------------------

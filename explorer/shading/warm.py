@@ -5,7 +5,9 @@ background on a machine whose cache lacks the kernels. It takes the lock
 (:func:`explorer.shading.tiers.lock_path`; a second one exits at once), runs :func:`exercise`
 with the compiled tier (every kind of pass the product makes, on small meshes, in both
 precisions: numba compiles each kernel signature once and writes it to its cache), then writes the
-ready marker. Progress and errors go to :func:`explorer.shading.tiers.log_path`.
+ready marker. Progress and errors go to :func:`explorer.shading.tiers.log_path`; each run counts
+itself first (:func:`explorer.shading.tiers.record_attempt`), so that runs that end without the
+marker (an error, a crash of the compiler) are not started again and again.
 
 :func:`load` runs the same passes in a process whose cache already holds them: numba loads each
 kernel and compiles nothing (the loader thread of a process that saw the marker appear).
@@ -18,6 +20,7 @@ from __future__ import annotations
 import os
 import sys
 import time
+import traceback
 
 import numpy as np
 
@@ -163,8 +166,14 @@ def main() -> int:
     if tiers.marker_path().exists():
         return 0
     print(f"{time.strftime('%H:%M:%S')} compiling the kernels (pid {os.getpid()})", flush=True)
+    tiers.record_attempt()
     t = time.perf_counter()
-    passes = exercise()
+    try:
+        passes = exercise()
+    except Exception as exc:  # noqa: BLE001 - written for the next process to tell the user
+        traceback.print_exc(file=sys.stdout)
+        tiers.record_attempt(f"{type(exc).__name__}: {exc}")
+        return 1
     seconds = time.perf_counter() - t
     tiers.write_marker(seconds)
     print(f"{time.strftime('%H:%M:%S')} ready: {passes} passes in {seconds:.1f} s", flush=True)

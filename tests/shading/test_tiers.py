@@ -293,3 +293,68 @@ def test_the_background_compile_covers_what_the_product_calls():
     after = warm.signatures()
     new = {k: after[k] - before[k] for k in after if after[k] - before[k]}
     assert not new, f"kernel signatures the background compile does not make: {new}"
+
+
+def test_after_failed_background_compiles_the_numpy_tier_serves_and_says_why(cold_tiers):
+    # one compile that ended without the marker: another is started
+    tiers.record_attempt()
+    with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
+        assert not tiers.compiled(10**9)
+    assert tiers._state["started"]
+    # two: no more; the first pass says why, once, and how to try again
+    tiers.record_attempt()
+    tiers.record_attempt("RuntimeError: LLVM ERROR")
+    assert tiers.attempts() == {"attempts": 2, "error": "RuntimeError: LLVM ERROR"}
+    tiers.set_mode("auto")
+    tiers._state.update(started=False)
+    with pytest.warns(explorer.core.errors.Notice) as told:
+        assert not tiers.compiled(10**9)
+        assert not tiers.compiled(10**9)
+    assert len(told) == 1
+    said = str(told[0].message)
+    assert "could not be prepared" in said and "LLVM ERROR" in said
+    assert f"remove {tiers.attempt_path()}" in said
+    assert not tiers._state["started"]  # none started
+    assert "unavailable" in tiers.status() and "LLVM ERROR" in tiers.status()
+    mesh = sphere(8)
+    c = explorer.shade(SHADOWED, mesh.positions, mesh.normals)  # the numpy tier serves
+    assert np.allclose(c, equation_shade(explorer.load_scene(SHADOWED), mesh.positions,
+                                         mesh.normals, faces=None), atol=1e-12)  # fmt: skip
+    # a compile that is running now (it holds the lock) is not given up on
+    with open(tiers.lock_path(), "a+") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert tiers.given_up() is None
+    assert "2 background compiles" in tiers.given_up()
+    # the marker forgets the attempts
+    tiers.write_marker(1.0)
+    assert not tiers.attempt_path().exists() and tiers.attempts()["attempts"] == 0
+
+
+CRASH = textwrap.dedent(
+    """
+    import os, sys
+    from explorer.shading import warm
+    warm.exercise = (lambda: os.abort()) if sys.argv[1] == "abort" else (lambda: 1 / 0)
+    sys.exit(warm.main())
+    """
+)
+
+
+def test_a_background_compile_that_crashes_is_counted(tmp_path):
+    # the compiler aborting the process (as LLVM's assertions do) or an exception: each run
+    # counted, the exception's text kept for the next process to tell
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    env[tiers.ENV] = "auto"
+    probe = "from explorer.shading import tiers; print(tiers.attempt_path())"
+    path = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                          text=True, check=True).stdout.strip()  # fmt: skip
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    first = subprocess.run([sys.executable, "-c", CRASH, "abort"], env=env, capture_output=True)
+    assert first.returncode != 0
+    assert json.loads(_read(path)) == {"attempts": 1, "error": None}
+    second = subprocess.run([sys.executable, "-c", CRASH, "raise"], env=env, capture_output=True)
+    assert second.returncode == 1
+    assert json.loads(_read(path)) == {
+        "attempts": 2,
+        "error": "ZeroDivisionError: division by zero",
+    }
