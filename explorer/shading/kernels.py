@@ -101,7 +101,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
-from explorer.shading.vmath import compress8, expand8, fpow, from_key, order_key
+from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
 
@@ -795,8 +795,10 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
 
 #: the float64 lobe loop packs the lanes that have a lobe weight before it takes their powers
 #: when they are at most this share of its lanes (see :func:`_split_lobe`; 1/2 against 3/4 was
-#: faster on random points and on a mesh in its own order: ``benchmarks/bench_revisions.py``)
-PACK_SHARE = 0.5
+#: faster on random points and on a mesh in its own order: ``benchmarks/bench_revisions.py``).
+#: Without AVX-512 the packing is written out lane by lane (see :mod:`explorer.shading.vmath`)
+#: and costs more than it saves: there only a run with no weight at all skips its powers (0)
+PACK_SHARE = 0.5 if NATIVE_COMPRESS else 0.0
 
 
 @nb.njit(**_LEAF)

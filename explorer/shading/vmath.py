@@ -23,9 +23,13 @@ t = y·log2 x itself, |t|·2**-53, dominates: **the relative error is below (|t|
 As OpenGL: 0**0 = 1, 0**y = 0 for y > 0, 1**y = 1.
 
 :func:`compress8` and :func:`expand8` pack the float64 lanes a mask keeps to the front of a row
-and put them back (AVX-512's ``vcompresspd`` / ``vexpandpd``; LLVM's generic intrinsics, so other
-machines get equivalent, slower code): the float64 lobe loop computes its power only for lanes
-whose lobe weight is positive (:func:`explorer.shading.kernels._split_lobe`).
+and put them back (AVX-512's ``vcompresspd`` / ``vexpandpd``): the float64 lobe loop computes its
+power only for lanes whose lobe weight is positive (:func:`explorer.shading.kernels._split_lobe`).
+Where the target numba compiles for has AVX-512F (:data:`NATIVE_COMPRESS`) the packing is
+LLVM's register-form vector compress (one instruction); elsewhere it is a masked compress-store,
+which LLVM writes out lane by lane on every target (its generic expansion of the register form
+aborts on CPUs without AVX-512: ``tests/shading/test_portable.py``), and the kernels do not pack
+there (:data:`explorer.shading.kernels.PACK_SHARE`).
 
 :func:`order_key` maps a float to an integer of the same order (and :func:`from_key` back):
 a smallest or largest value found on the keys is a reduction LLVM vectorises without
@@ -41,7 +45,8 @@ import numba as nb
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils
+from numba.core import cgutils, config
+from numba.core.codegen import get_host_cpu_features
 from numba.extending import intrinsic, overload
 
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
@@ -245,6 +250,16 @@ _V8 = ir.VectorType(ir.DoubleType(), 8)
 _M8 = ir.VectorType(ir.IntType(1), 8)
 
 
+def target_features() -> str:
+    """The CPU features numba compiles for (LLVM's "+name,-name,..." string): the host's, or
+    what ``NUMBA_CPU_FEATURES`` says (numba's own rule, ``JITCPUCodegen``)."""
+    return config.CPU_FEATURES if config.CPU_FEATURES is not None else get_host_cpu_features()
+
+
+#: whether the compiled code may use AVX-512F's register-form compress (see the module docstring)
+NATIVE_COMPRESS = "+avx512f" in target_features().split(",")
+
+
 def _lanes(context, builder, aryty, ary, i):
     """A pointer to element ``i`` of a 1-D array, as a pointer to 8 float64 lanes."""
     a = context.make_array(aryty)(context, builder, value=ary)
@@ -281,12 +296,21 @@ def compress8(typingctx, src, w, i, dst, k):
         mask, count = _positive(
             builder, builder.load(_lanes(context, builder, tw, args[1], args[2]), align=8)
         )
-        fnty = ir.FunctionType(_V8, [_V8, _M8, _V8])
-        fn = cgutils.get_or_insert_function(
-            builder.module, fnty, "llvm.experimental.vector.compress.v8f64"
-        )
-        packed = builder.call(fn, [s, mask, ir.Constant(_V8, [0.0] * 8)])
-        builder.store(packed, _lanes(context, builder, tdst, args[3], args[4]), align=8)
+        to = _lanes(context, builder, tdst, args[3], args[4])
+        zeros = ir.Constant(_V8, [0.0] * 8)
+        if NATIVE_COMPRESS:
+            fnty = ir.FunctionType(_V8, [_V8, _M8, _V8])
+            fn = cgutils.get_or_insert_function(
+                builder.module, fnty, "llvm.experimental.vector.compress.v8f64"
+            )
+            builder.store(builder.call(fn, [s, mask, zeros]), to, align=8)
+        else:  # zeros, then the kept lanes over them
+            builder.store(zeros, to, align=8)
+            fnty = ir.FunctionType(ir.VoidType(), [_V8, ir.DoubleType().as_pointer(), _M8])
+            fn = cgutils.get_or_insert_function(
+                builder.module, fnty, "llvm.masked.compressstore.v8f64"
+            )
+            builder.call(fn, [s, builder.bitcast(to, ir.DoubleType().as_pointer()), mask])
         return count
 
     return sig, codegen

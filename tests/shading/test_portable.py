@@ -1,0 +1,85 @@
+"""The kernels' hand-written LLVM code (explorer.shading.vmath's intrinsics) on CPUs without
+AVX-512.
+
+The float64 lobe's lane packing (vmath.compress8 / expand8) emits LLVM's vector compress and
+masked expand intrinsics, which AVX-512 does in one instruction each and LLVM writes out
+otherwise (its generic expansion of the register-form compress aborted the process on such CPUs,
+hence vmath.NATIVE_COMPRESS). This machine may have AVX-512, so the intrinsics are compiled here
+for portable x86-64 targets (numba's ``NUMBA_CPU_NAME`` / ``NUMBA_CPU_FEATURES``, in a
+subprocess with a cache directory of its own) and must give what they give on this host: the
+packing's lanes, the powers (pow32 / pow64: their bit tricks) and the ordered keys.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+# the round trip of tests/shading/test_vmath.py, with weights of every kind (0, -0, NaN,
+# subnormal, infinite), checked against numpy inside the subprocess
+ROUND_TRIP = """
+import numba as nb, numpy as np
+from explorer.shading import vmath
+
+@nb.njit(error_model="numpy", boundscheck=False)
+def round_trip(src, w):
+    packed = np.full(src.shape[0], -1.0)
+    back = np.full(src.shape[0], -1.0)
+    nc = 0
+    for i in range(0, src.shape[0] - 7, 8):
+        nc += vmath.compress8(src, w, i, packed, nc)
+    k = 0
+    for i in range(0, src.shape[0] - 7, 8):
+        k += vmath.expand8(packed, k, w, i, back)
+    return packed, back, nc, k
+
+rng = np.random.default_rng(7)
+kinds = [0.0, -0.0, np.nan, 5e-324, -5e-324, np.inf, -np.inf, 1.0]
+for n in (8, 16, 64):
+    for w in (rng.normal(size=n), np.zeros(n), rng.random(n) + 1e-300, rng.choice(kinds, n)):
+        src = rng.normal(size=n)
+        packed, back, nc, k = round_trip(src, w)
+        keep = w > 0
+        assert nc == k == np.count_nonzero(keep), (n, w)
+        assert np.array_equal(packed[:nc], src[keep]), (n, w)
+        assert np.array_equal(back, np.where(keep, src, 0.0)), (n, w)
+
+@nb.njit(error_model="numpy")
+def powers_and_keys(x, y, x32, y32):
+    p64, p32, back = np.empty_like(x), np.empty_like(x32), np.empty_like(x)
+    for i in range(x.shape[0]):
+        p64[i] = vmath.pow64(x[i], y[i])
+        p32[i] = vmath.pow32(x32[i], y32[i])
+        back[i] = vmath.from_key(vmath.order_key(x[i]))
+    return p64, p32, back
+
+x, y = rng.random(4096), rng.random(4096) * 128
+p64, p32, back = powers_and_keys(x, y, x.astype(np.float32), y.astype(np.float32))
+assert np.allclose(p64, x**y, rtol=1e-12, atol=1e-300)
+assert np.allclose(p32, x.astype(np.float32) ** y.astype(np.float32), rtol=1e-4, atol=1e-30)
+assert np.array_equal(back, x)
+asm = next(iter(round_trip.inspect_asm().values()))
+print("ok", vmath.NATIVE_COMPRESS, "zmm" in asm)
+"""
+
+
+# (numba takes the host's features for a named CPU unless NUMBA_CPU_FEATURES says otherwise)
+@pytest.mark.parametrize("cpu", ["x86-64", "znver3"])  # SSE2 only; AVX2 (Zen 3)
+def test_intrinsics_on_cpus_without_avx512(cpu, tmp_path):
+    if os.uname().machine not in ("x86_64", "AMD64"):
+        pytest.skip("x86-64 targets")
+    env = dict(
+        os.environ,
+        NUMBA_CPU_NAME=cpu,
+        NUMBA_CPU_FEATURES="-avx512f",
+        NUMBA_CACHE_DIR=str(tmp_path),
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", ROUND_TRIP], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    # compiled for the target asked for: the packing's portable form, no 512-bit registers
+    assert out.stdout.split() == ["ok", "False", "False"], out.stdout + out.stderr
