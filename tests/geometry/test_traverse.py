@@ -62,7 +62,7 @@ def _check_wide(bvh, cbox, wide):
                 assert wlink[w, 24 + j] == -1 and wlink[w, 28 + j] == link[i, 14 + s]
     assert sorted(wid.values()) == list(range(n))  # every wide node is a binary node's
     assert bvh.wparent[0] == -1
-    for w, j in zip(*np.nonzero(~used)):  # a lane nothing became: never entered
+    for w, j in zip(*np.nonzero(~used), strict=True):  # a lane nothing became: never entered
         box = _lane_box(wide, w, j)
         assert (box[0::2] > box[1::2]).all() and wlink[w, 24 + j] == -1
 
