@@ -16,7 +16,7 @@ answers:
   those facing away from the light); the rays walk the tree's wide rows (four children a
   node, tested in one vector operation: :func:`explorer.geometry.traverse.wide_rows`), each
   first the subtree just above the leaf that blocked the last blocked ray
-  (:func:`explorer.geometry.traverse.any_one`);
+  (:func:`explorer.geometry.traverse.any_range`);
 - :func:`nearest_hits`: the nearest hit, either side, beyond ``t_min``; among hits at the same
   ``t`` the lowest triangle index wins, as in a loop over the triangles in order: the
   per-pixel reference (:mod:`explorer.render.perpixel`).
@@ -50,7 +50,7 @@ from explorer.geometry.traverse import (
     STACK,
     WIDE,
     WIDE_STACK,
-    any_one,
+    any_range,
     enter,
     next_node,
     ray_of,
@@ -454,12 +454,8 @@ def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
     """Rays r0..r1 of rays = (O, D, tmax) through tree = (link, wide, tri) (``wide`` the wide
     rows of :class:`BVH`, ``link`` their int32 view; ``parent`` (n,) each wide node's parent)
     with eps = (t_eps, det_eps): out[r] True where the ray is blocked
-    (:func:`~explorer.geometry.traverse.any_one`)."""
-    O, D, tmax = rays
-    stack = np.empty(WIDE_STACK, np.int64)
-    near = np.int64(-1)
-    for r in range(r0, r1):
-        out[r], near = any_one(O, D, tmax, r, tree, parent, eps, stack, near)
+    (:func:`~explorer.geometry.traverse.any_range`)."""
+    any_range(r0, r1, rays, tree, parent, eps, out, np.empty(WIDE_STACK, np.int64))
 
 
 @nb.njit(cache=True, inline="always")

@@ -1,6 +1,6 @@
 """The compiled pieces every BVH cast is made of: a ray's reciprocals, the slab test of a node's
 two child boxes, the next node of a depth-first walk, the front-side test of a leaf, and the
-walk of one shadow ray (:func:`any_one`). :mod:`explorer.geometry.bvh` builds its casts from them.
+walks of shadow rays (:func:`any_range`). :mod:`explorer.geometry.bvh` builds its casts from them.
 
 Shadow rays walk the tree's wide rows (:func:`wide_rows`): the binary tree with every other
 level folded in, so that a wide node holds up to four children (its binary node's grandchildren,
@@ -31,7 +31,7 @@ BIG = 1e300
 #: a node row packs a leaf child's first triangle and count as ``first << LEAF_BITS | count``
 LEAF_BITS = 5
 #: a shadow ray first walks the subtree this many wide levels above the leaf that blocked the
-#: last blocked ray (:func:`any_one`)
+#: previous ray (:func:`any_range`)
 UP = 2
 #: columns of a wide row (:func:`wide_rows`): 4 lanes of (x0, x1, y0, y1, z0, z1), then each
 #: lane's child and packed leaf as int32
@@ -192,28 +192,35 @@ def walk(start, ray, inv, tm, tree, eps, stack):
 
 
 @nb.njit(cache=True, inline="always")
-def any_one(O, D, tmax, r, tree, parent, eps, stack, near):
-    """Whether ray ``r`` of (O, D, tmax) meets a front side in tree = (link, wide, tri)
-    (:func:`walk`; ``parent`` (n,) each wide node's parent, -1 for the root) with eps = (t_eps,
-    det_eps); ``stack`` (:data:`WIDE_STACK`,) int64 scratch.
+def any_range(r0, r1, rays, tree, parent, eps, out, stack):
+    """out[r] for rays r0..r1 of rays = (O, D, tmax): whether ray ``r`` meets a front side in
+    tree = (link, wide, tri) (:func:`walk`; ``parent`` (n,) each wide node's parent, -1 for
+    the root) with eps = (t_eps, det_eps); ``stack`` (:data:`WIDE_STACK`,) int64 scratch.
 
-    The wide subtree under ``near`` (-1: none) is walked first: pass what the previous call
-    returned, :data:`UP` wide levels above the leaf that blocked the last blocked ray
-    (neighbouring rays tend to share their occluders). Returns (hit, the next ``near``).
+    A ray first walks the wide subtree :data:`UP` wide levels above the leaf that blocked the
+    previous ray, when that ray was blocked (neighbouring rays tend to share their occluders,
+    and lit rays come in runs), then, if that finds nothing, the whole tree.
     """
-    ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
-    ray = (ox, oy, oz, dx, dy, dz)
-    inv = (ix, iy, iz)
-    tm = tmax[r] - eps[0]
-    if near >= 0 and walk(near, ray, inv, tm, tree, eps, stack) >= 0:
-        return True, near
-    node = walk(0, ray, inv, tm, tree, eps, stack)
-    if node < 0:
-        return False, near
-    for _ in range(UP):
-        if parent[node] >= 0:
-            node = parent[node]
-    return True, node
+    O, D, tmax = rays
+    near = np.int64(-1)
+    for r in range(r0, r1):
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
+        ray = (ox, oy, oz, dx, dy, dz)
+        inv = (ix, iy, iz)
+        tm = tmax[r] - eps[0]
+        if near >= 0 and walk(near, ray, inv, tm, tree, eps, stack) >= 0:
+            out[r] = True
+            continue
+        node = walk(0, ray, inv, tm, tree, eps, stack)
+        if node < 0:
+            out[r] = False
+            near = -1
+            continue
+        for _ in range(UP):
+            if parent[node] >= 0:
+                node = parent[node]
+        out[r] = True
+        near = node
 
 
 @nb.njit(cache=True, boundscheck=False)
