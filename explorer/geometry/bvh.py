@@ -55,7 +55,6 @@ from explorer.geometry.traverse import (
     next_node,
     ray_of,
     wide_count,
-    wide_refit,
     wide_rows,
 )
 
@@ -657,14 +656,13 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     # REFIT_DEPTH levels down go to every thread
     if big:
         top, roots = occ.refit_top(tree, bvh.cone, light, opened, cbox, REFIT_DEPTH)
-        args = (roots, tree, bvh.cone, bvh.span, light, opened, order, cbox)
+        args = (roots, tree, bvh.cone, bvh.span, light, opened, order, cbox, (bvh.slot, wide))
         run_chunks(occ.refit, len(roots), args, cancelled=cancelled, chunk=1, split=False)
-        occ.refit_unions(top, bvh.child, opened, cbox)
+        occ.refit_unions(top, bvh.child, opened, cbox, (bvh.slot, wide))
     else:
         opened[0] = 1
         occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light, opened, order,
-                  cbox)  # fmt: skip
-    wide_refit(opened, bvh.slot, cbox, wide)
+                  cbox, (bvh.slot, wide))  # fmt: skip
     return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
                bvh.cone, bvh.span, wide, bvh.wparent, bvh.slot)  # fmt: skip
 

@@ -303,18 +303,15 @@ def wide_count(child):
     return n
 
 
-@nb.njit(cache=True, nogil=True, boundscheck=False)
-def wide_refit(opened, slot, cbox, rows):
-    """Copy the child boxes of the binary nodes marked in ``opened`` (k,) uint8 from ``cbox``
-    (k, 16) into their lanes of the wide rows ``rows`` (n, :data:`WIDE`) (``slot`` of
-    :func:`wide_rows`; a folded-away box is skipped)."""
-    flat = rows.reshape(-1)
-    for i in range(opened.shape[0]):
-        if not opened[i]:
+@nb.njit(cache=True, inline="always")
+def to_lanes(i, slot, cbox, rows):
+    """Copy binary node ``i``'s two child boxes from its row of ``cbox`` (k, 16) into their
+    lanes of the wide rows ``rows`` (n, :data:`WIDE`) (``slot`` of :func:`wide_rows`; a
+    folded-away box is skipped)."""
+    for s in range(2):
+        at = slot[i, s]
+        if at < 0:
             continue
-        for s in range(2):
-            at = slot[i, s]
-            if at < 0:
-                continue
-            for a in range(6):
-                flat[at + 8 * (a // 2) + 4 * (a % 2)] = cbox[i, 6 * s + a]
+        w, j = at // WIDE, at % WIDE
+        for a in range(6):
+            rows[w, 8 * (a // 2) + 4 * (a % 2) + j] = cbox[i, 6 * s + a]

@@ -140,3 +140,15 @@ def test_the_vector_box_test_enters_what_the_slab_test_enters():
                 assert out[r, 0, j] == want, (w, j, r)
                 entered += want
     assert 0.1 * 12 * k < entered < 0.9 * 12 * k  # both answers are common
+
+
+def test_the_refit_on_every_thread_fills_the_lanes(monkeypatch):
+    bvh = B.build_bvh(_soup(3000, 2))
+    O = np.random.default_rng(1).uniform(-1, 1, (50, 3))
+    D = np.array([0.3, 2.0, 0.5]) - O
+    tmax = np.linalg.norm(D, axis=1)
+    monkeypatch.setattr(B, "REFIT_NODES", 0)
+    monkeypatch.setattr(B, "workers", lambda: 2)
+    lit = B.toward_light(bvh, O, D / tmax[:, None], tmax)
+    _check_wide(lit, lit.cbox, lit.wide)
+    assert not np.array_equal(lit.wide, bvh.wide)
