@@ -635,8 +635,8 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
     """
     big = bvh.n_nodes >= REFIT_NODES and workers() > 1
-    # a large tree's copies of the boxes are made on another thread meanwhile
-    copy = _get_pool().submit(_copies, bvh) if big else None
+    # a large tree's copy of the binary rows is made on another thread meanwhile
+    copy = _get_pool().submit(copy_rows, bvh.cbox) if big else None
     end = occ.shared_end(origins, directions, tmax)
     if end is None or not bvh.n_triangles:
         return bvh
@@ -649,7 +649,8 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     tree = (bvh.child, bvh.cbox, bvh.leaf, bvh.plane, bvh.tbox)
     light = (np.int64(kind), L, eps, radius)
     k = bvh.n_nodes
-    cbox, wide = _copies(bvh) if copy is None or copy.cancel() else copy.result()
+    wide = copy_rows(bvh.wide)
+    cbox = copy_rows(bvh.cbox) if copy is None or copy.cancel() else copy.result()
     opened = np.zeros(k, np.uint8)
     order = np.empty(k, np.int64)
     # the walk is bound by reading the nodes it opens from memory: a large tree's subtrees
@@ -665,10 +666,6 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
                   cbox, (bvh.slot, wide))  # fmt: skip
     return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
                bvh.cone, bvh.span, wide, bvh.wparent, bvh.slot)  # fmt: skip
-
-
-def _copies(bvh: BVH) -> tuple[np.ndarray, np.ndarray]:
-    return copy_rows(bvh.cbox), copy_rows(bvh.wide)
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):
