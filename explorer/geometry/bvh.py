@@ -15,7 +15,7 @@ answers:
   triangles that can block them (:func:`toward_light`, :mod:`explorer.geometry.occluders`:
   those facing away from the light); the rays walk the tree's wide rows (four children a
   node, tested in one vector operation: :func:`explorer.geometry.traverse.wide_rows`), each
-  first the subtree just above the leaf that blocked the last blocked ray
+  first the subtree just above the leaf that blocked the previous ray, when it was blocked
   (:func:`explorer.geometry.traverse.any_range`);
 - :func:`nearest_hits`: the nearest hit, either side, beyond ``t_min``; among hits at the same
   ``t`` the lowest triangle index wins, as in a loop over the triangles in order: the
@@ -657,13 +657,13 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     # REFIT_DEPTH levels down go to every thread
     if big:
         top, roots = occ.refit_top(tree, bvh.cone, light, opened, cbox, REFIT_DEPTH)
-        args = (roots, tree, bvh.cone, bvh.span, light, opened, order, cbox, (bvh.slot, wide))
+        args = (roots, tree, bvh.cone, bvh.span, light, (opened, order), cbox, (bvh.slot, wide))
         run_chunks(occ.refit, len(roots), args, cancelled=cancelled, chunk=1, split=False)
         occ.refit_unions(top, bvh.child, opened, cbox, (bvh.slot, wide))
     else:
         opened[0] = 1
-        occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light, opened, order,
-                  cbox, (bvh.slot, wide))  # fmt: skip
+        occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light,
+                  (opened, order), cbox, (bvh.slot, wide))  # fmt: skip
     return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
                bvh.cone, bvh.span, wide, bvh.wparent, bvh.slot)  # fmt: skip
 

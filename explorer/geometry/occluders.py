@@ -257,7 +257,7 @@ def _union(i, child, opened, out):
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def refit(r0, r1, roots, tree, cone, span, light, opened, order, out, lanes):
+def refit(r0, r1, roots, tree, cone, span, light, marks, out, lanes):
     """The boxes for the rays toward ``light`` in the subtrees of the opened inner nodes
     roots[r0:r1]: writes into out (k, 16) float32, a copy of tree's ``cbox``, the child boxes
     of every node opened there, each holding only the triangles under it that do not face the
@@ -267,10 +267,10 @@ def refit(r0, r1, roots, tree, cone, span, light, opened, order, out, lanes):
     tree = (child, cbox, leaf, plane, tbox); cone (k, 10) of :func:`cones`; span (k,): each
     inner node's subtree is the nodes ``i .. i + span[i] - 1``; light = (kind, L, ε, R): kind
     0 a point ``L``, 1 a direction ``L``; R bounds every corner's and origin's distance from the
-    frame's origin; opened (k,) uint8: 1 for the roots (and the nodes above them), 0 below;
-    order (k,) int64 scratch (a subtree uses its own nodes' places); lanes = (slot, rows): the
-    boxes of every node opened are copied into their lanes of the wide rows ``rows`` too
-    (:func:`~explorer.geometry.traverse.to_lanes`).
+    frame's origin; marks = (opened, order): opened (k,) uint8, 1 for the roots (and the nodes
+    above them), 0 below; order (k,) int64 scratch (a subtree uses its own nodes' places);
+    lanes = (slot, rows): the boxes of every node opened are copied into their lanes of the
+    wide rows ``rows`` too (:func:`~explorer.geometry.traverse.to_lanes`).
 
     The walk goes down from each root: a child whose triangles all face the light
     (:func:`_classify`, by its normal cone) is left out whole, one whose triangles all face away
@@ -278,6 +278,7 @@ def refit(r0, r1, roots, tree, cone, span, light, opened, order, out, lanes):
     them boxes its triangles one by one, an inner node's box is the union of its children's.
     The boxes of nodes not opened stay as built."""
     child = tree[0]
+    opened, order = marks
     low = _threshold(light)
     for j in range(r0, r1):
         root = roots[j]
