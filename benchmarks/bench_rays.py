@@ -8,8 +8,9 @@ Sections (all by default):
 - ``shadows``: the engine's shadow rays on the 100,578-vertex teapot (tessellation 56, 200,256
   triangles) toward a point light, from the vertices with N·L > -margin (the ones the engine
   casts from; the others face away and need no ray): rays per second through the BVH as the
-  engine casts them (:func:`explorer.geometry.bvh.any_hit`, every thread: the boxes refitted
-  around the triangles that can block this light, then the rays), the refit alone (repeated:
+  engine casts them (:func:`explorer.geometry.bvh.any_hit` on the light's rays, once a call,
+  every thread: the boxes refitted around the triangles that can block this light, then the
+  rays), the refit alone (repeated:
   its data stays in the caches; the line below the table gives its share of a cast), the rays
   alone through the refitted boxes, the same rays through the full tree (``refit=False``), the
   brute force (:func:`explorer.geometry.rays.any_hit`, every triangle, every thread) on a
@@ -101,16 +102,18 @@ def shadow_rays(mesh, light_position):
     return np.ascontiguousarray(Q[keep]), D, tmax, Q[mesh.faces]
 
 
-def measure_rays(mesh, repeat: int, light=LIGHT, embree: bool = True) -> dict:
-    """Rays per second of the BVH, the brute force and embreex on the mesh's shadow rays."""
+def measure_rays(mesh, repeat: int, light=LIGHT, embree: bool = True,
+                 min_rays: int = MIN_RAYS) -> dict:  # fmt: skip
+    """Rays per second of the BVH, the brute force and embreex on the mesh's shadow rays (cast
+    repeatedly up to ``min_rays`` when fewer: one refit for all of them)."""
     from explorer.geometry import bvh as B
     from explorer.geometry.rays import any_hit as brute
 
     O, D, tmax, tri = shadow_rays(mesh, light)
     B.build_bvh(tri[:64])  # load the compiled builder before timing it
     distinct = len(O)
-    if len(O) < MIN_RAYS:
-        reps = -(-MIN_RAYS // len(O))
+    if len(O) < min_rays:
+        reps = -(-min_rays // len(O))
         O, D, tmax = (np.ascontiguousarray(np.concatenate([a] * reps)) for a in (O, D, tmax))
     t = time.perf_counter()
     tree = B.build_bvh(tri)
@@ -210,7 +213,7 @@ def _front_normals(tri) -> np.ndarray:
 
 def section_shadows(repeat: int) -> None:
     mesh = get_mesh("teapot", 56)
-    r = measure_rays(mesh, repeat)
+    r = measure_rays(mesh, repeat, min_rays=0)  # the light's rays once, as the engine casts
     print(f"\n## Shadow rays, 100k-vertex teapot ({mesh.n_vertices:,} vertices, "
           f"{r['triangles']:,} triangles), point light at {list(LIGHT)}\n")  # fmt: skip
     print(f"{r['rays']:,} rays cast (the vertices with N·L > -margin; the other "

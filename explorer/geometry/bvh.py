@@ -13,8 +13,10 @@ answers:
   ``t`` in ``(RAY_T_EPS, tmax - RAY_T_EPS)``: shadow rays (:mod:`explorer.shading.shadows`).
   Rays that all go to one light walk a copy of the tree whose boxes are refitted around the
   triangles that can block them (:func:`toward_light`, :mod:`explorer.geometry.occluders`:
-  those facing away from the light), and each ray first walks the subtree just above the leaf
-  that blocked the last blocked ray (:func:`explorer.geometry.traverse.any_one`);
+  those facing away from the light); the rays walk the tree's wide rows (four children a
+  node, tested in one vector operation: :func:`explorer.geometry.traverse.wide_rows`), each
+  first the subtree just above the leaf that blocked the previous ray, when it was blocked
+  (:func:`explorer.geometry.traverse.any_range`);
 - :func:`nearest_hits`: the nearest hit, either side, beyond ``t_min``; among hits at the same
   ``t`` the lowest triangle index wins, as in a loop over the triangles in order: the
   per-pixel reference (:mod:`explorer.render.perpixel`).
@@ -43,7 +45,18 @@ from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
-from explorer.geometry.traverse import LEAF_BITS, STACK, any_one, enter, next_node, ray_of
+from explorer.geometry.traverse import (
+    LEAF_BITS,
+    STACK,
+    WIDE,
+    WIDE_STACK,
+    any_range,
+    enter,
+    next_node,
+    ray_of,
+    wide_count,
+    wide_rows,
+)
 
 #: rays per chunk at most: the unit of work a thread takes, and how often ``cancelled`` is asked
 CHUNK = 8192
@@ -101,6 +114,12 @@ class BVH:
         (:func:`~explorer.geometry.occluders.cones`) and
     span : (k,) int64 the inner nodes in each inner node's subtree: what
         :mod:`~explorer.geometry.occluders` refits the boxes from for the rays toward one light
+    wide : (n, 32) float32 the wide rows the shadow rays walk, 128 bytes each, 64-byte aligned
+        (:func:`~explorer.geometry.traverse.wide_rows`: up to four children a node, their boxes
+        as in ``cbox``), with
+    wparent : (n,) int64 each wide node's parent (-1 for the root) and
+    slot : (k, 2) int64 where each child box of ``cbox`` is in ``wide.ravel()`` (-1: folded
+        away)
     """
 
     child: np.ndarray
@@ -113,6 +132,9 @@ class BVH:
     plane: np.ndarray
     cone: np.ndarray
     span: np.ndarray
+    wide: np.ndarray
+    wparent: np.ndarray
+    slot: np.ndarray
 
     @property
     def n_triangles(self) -> int:
@@ -145,7 +167,8 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
         root = np.full(1, -1, np.int64)
         return BVH(child, cbox, np.zeros((0, 2), np.int64), np.zeros((0, 9)), no, root,
                    np.zeros((0, 6), np.float32), np.zeros((0, 4)),
-                   np.zeros((1, 10), np.float32), np.ones(1, np.int64))  # fmt: skip
+                   np.zeros((1, 10), np.float32), np.ones(1, np.int64),
+                   *_wide(child, cbox))  # fmt: skip
     box, link, order, pad = _stoppable(_build, (tri,), cancelled)
     child, box64, leaf = _children(box, link)
     lo32 = box64[:, 0::2].astype(np.float32)
@@ -158,14 +181,22 @@ def build_bvh(triangles, *, cancelled=None) -> BVH:
     rows = np.ascontiguousarray(pack_triangles(tri)[order])
     plane = occ.planes(rows)
     return BVH(child, cbox, leaf, rows, order, _parents(child), occ.triangle_boxes(rows, pad),
-               plane, occ.cones(child, leaf, plane), occ.spans(child))  # fmt: skip
+               plane, occ.cones(child, leaf, plane), occ.spans(child),
+               *_wide(child, cbox))  # fmt: skip
 
 
-def aligned_rows(k: int) -> np.ndarray:
-    """An uninitialised (k, 16) float32 array whose rows each fill one 64-byte cache line."""
-    raw = np.empty(16 * k + 16, np.float32)
+def _wide(child, cbox) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(wide, wparent, slot) of :class:`BVH` for the binary tree ``child``, ``cbox``."""
+    wide = aligned_rows(wide_count(child), WIDE)
+    return (wide, *wide_rows(child, cbox, wide))
+
+
+def aligned_rows(k: int, width: int = 16) -> np.ndarray:
+    """An uninitialised (k, width) float32 array starting on a 64-byte boundary (width 16: a
+    row fills one cache line)."""
+    raw = np.empty(width * k + 16, np.float32)
     skip = (-raw.ctypes.data % 64) // 4
-    return raw[skip : skip + 16 * k].reshape(k, 16)
+    return raw[skip : skip + width * k].reshape(k, width)
 
 
 def node_rows(child, boxes, leaf) -> np.ndarray:
@@ -182,8 +213,8 @@ def node_rows(child, boxes, leaf) -> np.ndarray:
 
 
 def copy_rows(cbox) -> np.ndarray:
-    """A copy of node rows ``cbox`` (k, 16) float32, aligned like them (:func:`aligned_rows`)."""
-    rows = aligned_rows(len(cbox))
+    """A copy of node rows ``cbox`` (k, w) float32, aligned like them (:func:`aligned_rows`)."""
+    rows = aligned_rows(*cbox.shape)
     rows.view(np.int32)[:] = cbox.view(np.int32)  # bits as they are (a child may read as NaN)
     return rows
 
@@ -419,15 +450,11 @@ def _children(box, link):
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
 def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
-    """Rays r0..r1 of rays = (O, D, tmax) through tree = (link, cbox, leaf, tri) (``link`` the
-    int32 view of ``cbox``'s rows, :class:`BVH`; ``parent``
-    (k,) each inner node's parent) with eps = (t_eps, det_eps): out[r] True where the ray is
-    blocked (:func:`~explorer.geometry.traverse.any_one`)."""
-    O, D, tmax = rays
-    stack = np.empty(STACK, np.int64)
-    near = np.int64(-1)
-    for r in range(r0, r1):
-        out[r], near = any_one(O, D, tmax, r, tree, parent, eps, stack, near)
+    """Rays r0..r1 of rays = (O, D, tmax) through tree = (link, wide, tri) (``wide`` the wide
+    rows of :class:`BVH`, ``link`` their int32 view; ``parent`` (n,) each wide node's parent)
+    with eps = (t_eps, det_eps): out[r] True where the ray is blocked
+    (:func:`~explorer.geometry.traverse.any_range`)."""
+    any_range(r0, r1, rays, tree, parent, eps, out, np.empty(WIDE_STACK, np.int64))
 
 
 @nb.njit(cache=True, inline="always")
@@ -594,8 +621,8 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None, refit=True) 
         return hit
     if refit and len(O) * OCCLUDER_RAYS >= bvh.n_triangles:
         bvh = toward_light(bvh, O, D, tm, cancelled=cancelled)
-    tree = (bvh.cbox.view(np.int32), bvh.cbox, bvh.leaf, bvh.tri)
-    args = ((O, D, tm), tree, bvh.parent, (RAY_T_EPS, DET_EPS), hit)
+    tree = (bvh.wide.view(np.int32), bvh.wide, bvh.tri)
+    args = ((O, D, tm), tree, bvh.wparent, (RAY_T_EPS, DET_EPS), hit)
     run_chunks(_any_hit_chunk, len(O), args, cancelled=cancelled)
     return hit
 
@@ -608,7 +635,7 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
     """
     big = bvh.n_nodes >= REFIT_NODES and workers() > 1
-    # a large tree's copy of the boxes is made on another thread meanwhile
+    # a large tree's copy of the binary rows is made on another thread meanwhile
     copy = _get_pool().submit(copy_rows, bvh.cbox) if big else None
     end = occ.shared_end(origins, directions, tmax)
     if end is None or not bvh.n_triangles:
@@ -622,6 +649,7 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     tree = (bvh.child, bvh.cbox, bvh.leaf, bvh.plane, bvh.tbox)
     light = (np.int64(kind), L, eps, radius)
     k = bvh.n_nodes
+    wide = copy_rows(bvh.wide)
     cbox = copy_rows(bvh.cbox) if copy is None or copy.cancel() else copy.result()
     opened = np.zeros(k, np.uint8)
     order = np.empty(k, np.int64)
@@ -629,15 +657,15 @@ def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
     # REFIT_DEPTH levels down go to every thread
     if big:
         top, roots = occ.refit_top(tree, bvh.cone, light, opened, cbox, REFIT_DEPTH)
-        args = (roots, tree, bvh.cone, bvh.span, light, opened, order, cbox)
+        args = (roots, tree, bvh.cone, bvh.span, light, (opened, order), cbox, (bvh.slot, wide))
         run_chunks(occ.refit, len(roots), args, cancelled=cancelled, chunk=1, split=False)
-        occ.refit_unions(top, bvh.child, opened, cbox)
+        occ.refit_unions(top, bvh.child, opened, cbox, (bvh.slot, wide))
     else:
         opened[0] = 1
-        occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light, opened, order,
-                  cbox)  # fmt: skip
+        occ.refit(0, 1, np.zeros(1, np.int64), tree, bvh.cone, bvh.span, light,
+                  (opened, order), cbox, (bvh.slot, wide))  # fmt: skip
     return BVH(bvh.child, cbox, bvh.leaf, bvh.tri, bvh.order, bvh.parent, bvh.tbox, bvh.plane,
-               bvh.cone, bvh.span)  # fmt: skip
+               bvh.cone, bvh.span, wide, bvh.wparent, bvh.slot)  # fmt: skip
 
 
 def nearest_hits(bvh: BVH, origins, directions, t_min: float, *, cancelled=None):

@@ -44,6 +44,7 @@ import numba as nb
 import numpy as np
 
 from explorer.core.tolerances import CONE_ROUND, CONE_SLACK, CONE_WIDEN, OCCLUDER_MARGIN
+from explorer.geometry.traverse import to_lanes
 
 #: the rays share an end when their ends ``O + tmax·D`` lie within this times (1 + |end|) of the
 #: first ray's (shadow rays toward a point light: about 1e-15)
@@ -256,7 +257,7 @@ def _union(i, child, opened, out):
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def refit(r0, r1, roots, tree, cone, span, light, opened, order, out):
+def refit(r0, r1, roots, tree, cone, span, light, marks, out, lanes):
     """The boxes for the rays toward ``light`` in the subtrees of the opened inner nodes
     roots[r0:r1]: writes into out (k, 16) float32, a copy of tree's ``cbox``, the child boxes
     of every node opened there, each holding only the triangles under it that do not face the
@@ -266,8 +267,10 @@ def refit(r0, r1, roots, tree, cone, span, light, opened, order, out):
     tree = (child, cbox, leaf, plane, tbox); cone (k, 10) of :func:`cones`; span (k,): each
     inner node's subtree is the nodes ``i .. i + span[i] - 1``; light = (kind, L, ε, R): kind
     0 a point ``L``, 1 a direction ``L``; R bounds every corner's and origin's distance from the
-    frame's origin; opened (k,) uint8: 1 for the roots (and the nodes above them), 0 below;
-    order (k,) int64 scratch (a subtree uses its own nodes' places).
+    frame's origin; marks = (opened, order): opened (k,) uint8, 1 for the roots (and the nodes
+    above them), 0 below; order (k,) int64 scratch (a subtree uses its own nodes' places);
+    lanes = (slot, rows): the boxes of every node opened are copied into their lanes of the
+    wide rows ``rows`` too (:func:`~explorer.geometry.traverse.to_lanes`).
 
     The walk goes down from each root: a child whose triangles all face the light
     (:func:`_classify`, by its normal cone) is left out whole, one whose triangles all face away
@@ -275,6 +278,7 @@ def refit(r0, r1, roots, tree, cone, span, light, opened, order, out):
     them boxes its triangles one by one, an inner node's box is the union of its children's.
     The boxes of nodes not opened stay as built."""
     child = tree[0]
+    opened, order = marks
     low = _threshold(light)
     for j in range(r0, r1):
         root = roots[j]
@@ -291,6 +295,8 @@ def refit(r0, r1, roots, tree, cone, span, light, opened, order, out):
             i += 1
         for m in range(n - 1, root - 1, -1):  # children's boxes before their parents'
             _union(order[m], child, opened, out)
+        for m in range(root, n):
+            to_lanes(order[m], lanes[0], out, lanes[1])
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
@@ -325,10 +331,13 @@ def refit_top(tree, cone, light, opened, out, depth):
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def refit_unions(top, child, opened, out):
-    """The unions of :func:`refit_top`'s nodes, children before parents."""
+def refit_unions(top, child, opened, out, lanes):
+    """The unions of :func:`refit_top`'s nodes, children before parents, and their boxes in
+    the wide rows (lanes = (slot, rows), as :func:`refit`)."""
     for m in range(len(top) - 1, -1, -1):
         _union(top[m], child, opened, out)
+    for i in top:
+        to_lanes(i, lanes[0], out, lanes[1])
 
 
 @nb.njit(cache=True, boundscheck=False)

@@ -1,6 +1,13 @@
 """The compiled pieces every BVH cast is made of: a ray's reciprocals, the slab test of a node's
 two child boxes, the next node of a depth-first walk, the front-side test of a leaf, and the
-walk of one shadow ray (:func:`any_one`). :mod:`explorer.geometry.bvh` builds its casts from them.
+walks of shadow rays (:func:`any_range`). :mod:`explorer.geometry.bvh` builds its casts from them.
+
+Shadow rays walk the tree's wide rows (:func:`wide_rows`): the binary tree with every other
+level folded in, so that a wide node holds up to four children (its binary node's grandchildren,
+or a leaf child) and one ray enters half as many nodes. A wide row keeps the four children's
+boxes side by side (x0 of the four, x1 of the four, ...), and :func:`enter4` tests them in one
+vector operation: the same float64 arithmetic as :func:`slab`, lane by lane, so a ray enters a
+box in a wide row exactly when it enters that box in the binary tree.
 """
 
 from __future__ import annotations
@@ -9,6 +16,10 @@ import math
 
 import numba as nb
 import numpy as np
+from llvmlite import ir
+from numba import types
+from numba.cpython.unsafe.numbers import trailing_zeros
+from numba.extending import intrinsic
 
 from explorer.geometry.rays import ray_triangle_row
 
@@ -19,9 +30,15 @@ STACK = 128
 BIG = 1e300
 #: a node row packs a leaf child's first triangle and count as ``first << LEAF_BITS | count``
 LEAF_BITS = 5
-#: a shadow ray first walks the subtree this many levels above the leaf that blocked the last
-#: blocked ray (:func:`any_one`)
-UP = 4
+#: a shadow ray first walks the subtree this many wide levels above the leaf that blocked the
+#: previous ray (:func:`any_range`)
+UP = 2
+#: columns of a wide row (:func:`wide_rows`): 4 lanes of (x0, x1, y0, y1, z0, z1), then each
+#: lane's child and packed leaf as int32
+WIDE = 32
+#: the wide walk's stack: a wide node pushes at most three children more than it pops, and the
+#: wide tree has at most STACK / 2 + 1 levels
+WIDE_STACK = 2 * STACK
 
 
 @nb.njit(cache=True, inline="always")
@@ -96,54 +113,205 @@ def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
     return False
 
 
+@intrinsic
+def enter4(typingctx, wide, w, ox, oy, oz, ix, iy, iz, t1):
+    """The lanes of wide row ``wide[w]`` (:func:`wide_rows`) whose boxes the ray (origin ``o``,
+    reciprocals ``i`` of its direction, :func:`inv`) enters within [0, t1], as the bits of an
+    int64 (bit j: lane j). Each lane is :func:`slab`'s arithmetic in float64 on the float32
+    box, its min and max as numba's (``b if b < a else a``), four lanes in one vector."""
+    if not (isinstance(wide, types.Array) and wide.dtype == types.float32 and wide.ndim == 2
+            and wide.layout == "C"):  # fmt: skip
+        return None
+    sig = types.int64(wide, types.int64, *(types.float64,) * 7)
+
+    def codegen(context, builder, sig, args):
+        i32, i64 = ir.IntType(32), ir.IntType(64)
+        v4f, v4d = ir.VectorType(ir.FloatType(), 4), ir.VectorType(ir.DoubleType(), 4)
+        row = context.make_array(sig.args[0])(context, builder, args[0])
+        base = builder.gep(row.data, [builder.mul(args[1], ir.Constant(i64, WIDE))])
+
+        def load(col):  # four float32 of the row, as float64
+            ptr = builder.gep(base, [ir.Constant(i64, col)])
+            return builder.fpext(builder.load(builder.bitcast(ptr, v4f.as_pointer()), align=4),
+                                 v4d)  # fmt: skip
+
+        def splat(x):
+            v = ir.Constant(v4d, ir.Undefined)
+            for j in range(4):
+                v = builder.insert_element(v, x, ir.Constant(i32, j))
+            return v
+
+        def vmin(a, b):
+            return builder.select(builder.fcmp_ordered("<", b, a), b, a)
+
+        def vmax(a, b):
+            return builder.select(builder.fcmp_ordered(">", b, a), b, a)
+
+        t0 = tf = None
+        for a in range(3):
+            o, inv_ = splat(args[2 + a]), splat(args[5 + a])
+            p = builder.fmul(builder.fsub(load(8 * a), o), inv_)
+            q = builder.fmul(builder.fsub(load(8 * a + 4), o), inv_)
+            t0 = vmin(p, q) if t0 is None else vmax(t0, vmin(p, q))
+            tf = vmax(p, q) if tf is None else vmin(tf, vmax(p, q))
+        t0 = vmax(t0, splat(ir.Constant(ir.DoubleType(), 0.0)))
+        tf = vmin(tf, splat(args[8]))
+        bits = builder.bitcast(builder.fcmp_ordered("<=", t0, tf), ir.IntType(4))
+        return builder.zext(bits, i64)
+
+    return sig, codegen
+
+
 @nb.njit(cache=True, inline="always")
 def walk(start, ray, inv, tm, tree, eps, stack):
-    """Walk the subtree under inner node ``start`` of tree = (link, cbox, leaf, tri) (``link``
-    the int32 view of the node rows ``cbox``: columns 12, 13 the children, 14, 15 their
-    leaves' triangles) with a shadow ray (ray = (ox, oy, oz, dx, dy, dz), inv its direction's
-    reciprocals, ``tm`` its end), eps = (t_eps, det_eps); returns the node whose leaf holds a
-    front side the ray meets, or -1."""
-    link, cbox, _, tri = tree
+    """Walk the wide subtree under wide node ``start`` of tree = (link, wide, tri) (``wide``
+    the wide rows of :func:`wide_rows`, ``link`` their int32 view) with a shadow ray (ray =
+    (ox, oy, oz, dx, dy, dz), inv its direction's reciprocals, ``tm`` its end), eps = (t_eps,
+    det_eps); returns the wide node whose leaf holds a front side the ray meets, or -1."""
+    link, wide, tri = tree
     t_eps, det_eps = eps
     ox, oy, oz = ray[0], ray[1], ray[2]
     ix, iy, iz = inv
     sp = 0
     node = start
     while True:
-        ta, tb = enter(cbox, node, ox, oy, oz, ix, iy, iz, tm)
-        ca, cb = np.int64(link[node, 12]), np.int64(link[node, 13])
-        if ta < math.inf and ca < 0:
-            if leaf_any(link[node, 14], tri, ray, t_eps, tm, det_eps):
+        lanes = enter4(wide, node, ox, oy, oz, ix, iy, iz, tm)
+        while lanes:
+            j = trailing_zeros(lanes)
+            lanes &= lanes - 1
+            c = np.int64(link[node, 24 + j])
+            if c >= 0:
+                stack[sp] = c
+                sp += 1
+            elif leaf_any(link[node, 28 + j], tri, ray, t_eps, tm, det_eps):
                 return node
-            ta = math.inf
-        if tb < math.inf and cb < 0:
-            if leaf_any(link[node, 15], tri, ray, t_eps, tm, det_eps):
-                return node
-            tb = math.inf
-        node, sp = next_node(stack, sp, ca, cb, ta, tb)
-        if node < 0:
+        if sp == 0:
             return np.int64(-1)
+        sp -= 1
+        node = stack[sp]
 
 
 @nb.njit(cache=True, inline="always")
-def any_one(O, D, tmax, r, tree, parent, eps, stack, near):
-    """Whether ray ``r`` of (O, D, tmax) meets a front side in tree = (link, cbox, leaf, tri)
-    (``parent`` (k,) each inner node's parent, -1 for the root) with eps = (t_eps, det_eps).
+def any_range(r0, r1, rays, tree, parent, eps, out, stack):
+    """out[r] for rays r0..r1 of rays = (O, D, tmax): whether ray ``r`` meets a front side in
+    tree = (link, wide, tri) (:func:`walk`; ``parent`` (n,) each wide node's parent, -1 for
+    the root) with eps = (t_eps, det_eps); ``stack`` (:data:`WIDE_STACK`,) int64 scratch.
 
-    The subtree under ``near`` (-1: none) is walked first: pass what the previous call
-    returned, :data:`UP` levels above the leaf that blocked the last blocked ray (neighbouring
-    rays tend to share their occluders). Returns (hit, the next ``near``).
+    A ray first walks the wide subtree :data:`UP` wide levels above the leaf that blocked the
+    previous ray, when that ray was blocked (neighbouring rays tend to share their occluders,
+    and lit rays come in runs), then, if that finds nothing, the whole tree.
     """
-    ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
-    ray = (ox, oy, oz, dx, dy, dz)
-    inv = (ix, iy, iz)
-    tm = tmax[r] - eps[0]
-    if near >= 0 and walk(near, ray, inv, tm, tree, eps, stack) >= 0:
-        return True, near
-    node = walk(0, ray, inv, tm, tree, eps, stack)
-    if node < 0:
-        return False, near
-    for _ in range(UP):
-        if parent[node] >= 0:
-            node = parent[node]
-    return True, node
+    O, D, tmax = rays
+    near = np.int64(-1)
+    for r in range(r0, r1):
+        ox, oy, oz, dx, dy, dz, ix, iy, iz = ray_of(O, D, r)
+        ray = (ox, oy, oz, dx, dy, dz)
+        inv = (ix, iy, iz)
+        tm = tmax[r] - eps[0]
+        if near >= 0 and walk(near, ray, inv, tm, tree, eps, stack) >= 0:
+            out[r] = True
+            continue
+        node = walk(0, ray, inv, tm, tree, eps, stack)
+        if node < 0:
+            out[r] = False
+            near = -1
+            continue
+        for _ in range(UP):
+            if parent[node] >= 0:
+                node = parent[node]
+        out[r] = True
+        near = node
+
+
+@nb.njit(cache=True, boundscheck=False)
+def wide_rows(child, cbox, rows):
+    """Fill ``rows`` (n, :data:`WIDE`) float32 (n from :func:`wide_count`) with the wide tree of
+    the binary ``child`` (k, 2) and its node rows ``cbox`` (k, 16) float32 (int32 view: the
+    packed leaves in columns 14, 15). The wide nodes are the binary nodes an even number of
+    inner levels below the root, in depth-first order (the root is wide node 0); a wide node's
+    lanes are its binary node's children, each inner one replaced by its own two children.
+    Row ``w``: columns ``8a + j`` and ``8a + 4 + j`` lane ``j``'s box along axis ``a`` (as
+    ``cbox`` holds it), ``24 + j`` (int32) the lane's wide node (-1: a leaf, or no child: the
+    box (1, -1) is never entered), ``28 + j`` a leaf's packed first triangle and count, else 0.
+
+    Returns (parent (n,) int64 each wide node's parent, -1 for the root; slot (k, 2) int64 the
+    index into ``rows.ravel()`` of each binary child box's x0 in its wide row, -1 for an inner
+    child whose box is folded away)."""
+    k = child.shape[0]
+    n = rows.shape[0]
+    link = cbox.view(np.int32)
+    wlink = rows.view(np.int32)
+    wid = np.full(k, -1, np.int64)
+    order = np.empty(n, np.int64)
+    stack = np.empty(4 * STACK, np.int64)
+    stack[0] = 0
+    sp, w = 1, 0
+    while sp:  # number the wide nodes depth-first
+        sp -= 1
+        b = stack[sp]
+        wid[b] = w
+        order[w] = b
+        w += 1
+        for s in range(1, -1, -1):
+            c = child[b, s]
+            for t in range(1, -1, -1):
+                if c >= 0 and child[c, t] >= 0:
+                    stack[sp] = child[c, t]
+                    sp += 1
+    parent = np.full(n, -1, np.int64)
+    slot = np.full((k, 2), -1, np.int64)
+    for w in range(n):
+        for j in range(4):
+            for a in range(3):
+                rows[w, 8 * a + j], rows[w, 8 * a + 4 + j] = 1.0, -1.0
+            wlink[w, 24 + j], wlink[w, 28 + j] = -1, 0
+        b = order[w]
+        j = 0
+        for s in range(2):
+            c = child[b, s]
+            for p in range(1 if c < 0 else 2):  # the lane's box: side h of binary node i
+                i, h = (b, s) if c < 0 else (c, p)
+                for a in range(6):
+                    rows[w, 8 * (a // 2) + 4 * (a % 2) + j] = cbox[i, 6 * h + a]
+                g = child[i, h]
+                if g >= 0:
+                    wlink[w, 24 + j] = wid[g]
+                    parent[wid[g]] = w
+                else:
+                    wlink[w, 28 + j] = link[i, 14 + h]
+                slot[i, h] = WIDE * w + j
+                j += 1
+    return parent, slot
+
+
+@nb.njit(cache=True, boundscheck=False)
+def wide_count(child):
+    """The number of wide nodes of the binary tree ``child`` (k, 2) (:func:`wide_rows`)."""
+    k = child.shape[0]
+    even = np.zeros(k, np.bool_)
+    even[0] = True
+    n = 0
+    for b in range(k):  # parents before children
+        if not even[b]:
+            continue
+        n += 1
+        for s in range(2):
+            c = child[b, s]
+            for t in range(2):
+                if c >= 0 and child[c, t] >= 0:
+                    even[child[c, t]] = True
+    return n
+
+
+@nb.njit(cache=True, inline="always")
+def to_lanes(i, slot, cbox, rows):
+    """Copy binary node ``i``'s two child boxes from its row of ``cbox`` (k, 16) into their
+    lanes of the wide rows ``rows`` (n, :data:`WIDE`) (``slot`` of :func:`wide_rows`; a
+    folded-away box is skipped)."""
+    for s in range(2):
+        at = slot[i, s]
+        if at < 0:
+            continue
+        w, j = at // WIDE, at % WIDE
+        for a in range(6):
+            rows[w, 8 * (a // 2) + 4 * (a % 2) + j] = cbox[i, 6 * s + a]

@@ -254,3 +254,5 @@ def test_the_refit_on_every_thread_equals_the_refit_on_one(monkeypatch):
     split = B.toward_light(bvh, Q, D, tmax)
     assert np.array_equal(one.cbox.view(np.int32), split.cbox.view(np.int32))
     assert not np.array_equal(one.cbox, bvh.cbox)
+    assert np.array_equal(one.wide.view(np.int32), split.wide.view(np.int32))  # the lanes too
+    assert not np.array_equal(one.wide, bvh.wide)
