@@ -1,5 +1,5 @@
-"""The kernels' hand-written LLVM code (explorer.shading.vmath's intrinsics) on CPUs without
-AVX-512.
+"""The kernels' hand-written LLVM code (explorer.shading.vmath's and traverse.enter4) on CPUs
+without AVX-512.
 
 The float64 lobe's lane packing (vmath.compress8 / expand8) emits LLVM's vector compress and
 masked expand intrinsics, which AVX-512 does in one instruction each and LLVM writes out
@@ -7,7 +7,8 @@ otherwise (its generic expansion of the register-form compress aborted the proce
 hence vmath.NATIVE_COMPRESS). This machine may have AVX-512, so the intrinsics are compiled here
 for portable x86-64 targets (numba's ``NUMBA_CPU_NAME`` / ``NUMBA_CPU_FEATURES``, in a
 subprocess with a cache directory of its own) and must give what they give on this host: the
-packing's lanes, the powers (pow32 / pow64: their bit tricks) and the ordered keys.
+packing's lanes, the powers (pow32 / pow64: their bit tricks), the ordered keys, and the shadow
+rays' four-box test (explorer.geometry.traverse.enter4).
 """
 
 from __future__ import annotations
@@ -61,9 +62,42 @@ p64, p32, back = powers_and_keys(x, y, x.astype(np.float32), y.astype(np.float32
 assert np.allclose(p64, x**y, rtol=1e-12, atol=1e-300)
 assert np.allclose(p32, x.astype(np.float32) ** y.astype(np.float32), rtol=1e-4, atol=1e-30)
 assert np.array_equal(back, x)
+
+# the shadow rays' four-box test (explorer.geometry.traverse.enter4): its bits, as a digest
+import hashlib
+from explorer.geometry import bvh as B, traverse as T
+
+@nb.njit
+def entered(wide, O, D, t1):
+    out = np.empty((wide.shape[0], O.shape[0]), np.int64)
+    for w in range(wide.shape[0]):
+        for r in range(O.shape[0]):
+            ox, oy, oz, _, _, _, ix, iy, iz = T.ray_of(O, D, r)
+            out[w, r] = T.enter4(wide, w, ox, oy, oz, ix, iy, iz, t1[r])
+    return out
+
+wide = B.aligned_rows(16, T.WIDE)
+lo = rng.uniform(-1, 1, (16, 24)).astype(np.float32)
+wide[:, :24] = np.where(np.arange(24) // 4 % 2 == 0, lo, lo + 0.5)  # x0 of 4, x1 of 4, ...
+O, D = rng.uniform(-1.5, 1.5, (2000, 3)), rng.normal(size=(2000, 3))
+D[::7, 0] = 0.0
+bits = entered(wide, O, D, rng.uniform(0.1, 3.0, 2000))
+assert 0 < bits.mean() < 15
 asm = next(iter(round_trip.inspect_asm().values()))
-print("ok", vmath.NATIVE_COMPRESS, "zmm" in asm)
+print("ok", vmath.NATIVE_COMPRESS, "zmm" in asm, hashlib.sha256(bits.tobytes()).hexdigest()[:16])
 """
+
+
+def _run(tmp_path, **target) -> list[str]:
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), **target)
+    if not target:
+        for name in ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
+            env.pop(name, None)
+    out = subprocess.run(
+        [sys.executable, "-c", ROUND_TRIP], env=env, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    return out.stdout.split()
 
 
 # (numba takes the host's features for a named CPU unless NUMBA_CPU_FEATURES says otherwise)
@@ -71,15 +105,8 @@ print("ok", vmath.NATIVE_COMPRESS, "zmm" in asm)
 def test_intrinsics_on_cpus_without_avx512(cpu, tmp_path):
     if os.uname().machine not in ("x86_64", "AMD64"):
         pytest.skip("x86-64 targets")
-    env = dict(
-        os.environ,
-        NUMBA_CPU_NAME=cpu,
-        NUMBA_CPU_FEATURES="-avx512f",
-        NUMBA_CACHE_DIR=str(tmp_path),
-    )
-    out = subprocess.run(
-        [sys.executable, "-c", ROUND_TRIP], env=env, capture_output=True, text=True, timeout=300
-    )
-    assert out.returncode == 0, out.stderr
+    got = _run(tmp_path / cpu, NUMBA_CPU_NAME=cpu, NUMBA_CPU_FEATURES="-avx512f")
     # compiled for the target asked for: the packing's portable form, no 512-bit registers
-    assert out.stdout.split() == ["ok", "False", "False"], out.stdout + out.stderr
+    assert got[:3] == ["ok", "False", "False"], got
+    # the four-box test enters the same boxes as on this host
+    assert got[3] == _run(tmp_path / "host")[3]
