@@ -8,6 +8,10 @@ or a leaf child) and one ray enters half as many nodes. A wide row keeps the fou
 boxes side by side (x0 of the four, x1 of the four, ...), and :func:`enter4` tests them in one
 vector operation: the same float64 arithmetic as :func:`slab`, lane by lane, so a ray enters a
 box in a wide row exactly when it enters that box in the binary tree.
+
+These functions are inlined into :mod:`explorer.geometry.bvh`'s and
+:mod:`explorer.geometry.occluders`' kernels, which numba's on-disk cache keys by their own files
+only: after an edit here, touch those two (or clear their cache), or they keep the old code.
 """
 
 from __future__ import annotations
