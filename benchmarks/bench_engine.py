@@ -89,16 +89,57 @@ def spot_lights(lights: int, rng) -> tuple:
     return tuple(out)
 
 
+def slab_sizes(scene, P, N, sizes, R) -> int:
+    """One-shot calls (and their geometry preparation alone) at each slab size: the sizes
+    take turns, ``R`` rounds, so drift spreads over all of them; prints the medians."""
+    n = len(P)
+    times: dict = {}
+    for _ in range(R):
+        for size in sizes:
+            shader_module.SLAB = size or n
+            for precision in ("float64", "float32"):
+
+                def prep(precision=precision):
+                    sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
+                    for _ in sh._slabs():
+                        pass
+
+                one = timed(lambda p=precision: explorer.shade(scene, P, N, precision=p), 3)[0]
+                times.setdefault((size, precision, "one-shot"), []).append(one)
+                times.setdefault((size, precision, "geometry"), []).append(timed(prep, 3)[0])
+    print(f"machine: {machine()}")
+    print(f"mesh: {n} vertices, {len(scene.lights)} point lights; medians of {R} rounds\n")
+    print("| slab (vertices) | one-shot float64 ms | geometry float64 ms "
+          "| one-shot float32 ms | geometry float32 ms |")  # fmt: skip
+    print("|---:|---:|---:|---:|---:|")
+    for size in sizes:
+        cells = [
+            f"{np.median(times[(size, p, what)]) * 1e3:.2f}"
+            for p in ("float64", "float32")
+            for what in ("one-shot", "geometry")
+        ]
+        print(f"| {size or n} | " + " | ".join(cells) + " |")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--lights", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=11)
+    ap.add_argument(
+        "--slabs",
+        default="",
+        help="only time one-shot calls with these slab sizes (comma-separated vertex counts, "
+        "multiples of kernels.BLOCK; 0: one slab of every vertex)",
+    )
     args = ap.parse_args(argv)
     n, L, R = args.vertices, args.lights, args.repeat
     rng = np.random.default_rng(0)
     P, N = sphere_points(n, rng)
     scene = scene_with(L, rng)
+    if args.slabs:
+        return slab_sizes(scene, P, N, [int(v) for v in args.slabs.split(",")], R)
     other = scene_with(L, np.random.default_rng(1)).lights
 
     rows = []
@@ -180,16 +221,17 @@ def main(argv=None) -> int:
     row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
     one_shot = timed(lambda: explorer.shade(scene, P, N), R)
     row("one-shot `shade()` float64 (the default), incl. preparing the geometry", *one_shot, n * L)
-    # what a one-shot call does before its pass: check the vertices, find the frame, prepare
-    # the geometry in the working precision and the chunk bounds for culling
+    # what a one-shot call does before and between its passes: check the vertices, find the
+    # frame, the plan, and slab by slab the geometry in the working precision and its chunk
+    # bounds (into the buffers the previous call left)
     geometry = {}
     for precision in ("float32", "float64"):
 
         def prep(precision=precision):
             sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
-            sh._compiled_geometry()  # (made by the constructor already when the kernels serve)
-            # as a one-shot call ends: its prepared geometry is the spare the next call takes
-            shader_module._GEOMETRY.give(sh._G)
+            sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
+            for _ in sh._slabs():
+                pass
 
         geometry[precision] = timed(prep, R)
         row(f"geometry preparation, {precision} (of a one-shot call)", *geometry[precision])

@@ -70,6 +70,10 @@ COMPILED_MODELS = ("blinn", "phong")
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
+#: vertices per slab of a one-shot pass (:meth:`Shader._slabs`; a multiple of BLOCK): its
+#: prepared geometry, 48 bytes a vertex in float64, stays in the cache between being written
+#: and being shaded (``benchmarks/bench_engine.py --slabs`` measures the choice)
+SLAB = 128 * 1024
 #: :func:`chunk_bounds` tests that share on every CULL_SAMPLE-th chunk before it finds them all
 CULL_SAMPLE = 16
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
@@ -118,9 +122,7 @@ def shade(
         faces=faces,
         tier=tier,
     )
-    colours = np.asarray(s.colors, dtype=np.float64)
-    _GEOMETRY.give(s._G)  # (the shader is dropped: its prepared geometry serves the next call)
-    return colours
+    return np.asarray(s.colors, dtype=np.float64)
 
 
 class Shader:
@@ -195,7 +197,11 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        geometry = prepared_geometry(P, N, self._T, self._k) if now else None
+        geometry = None
+        if now:  # a one-shot shader (keep=False) finds the frame alone: see _slabs
+            geometry = (
+                prepared_geometry(P, N, self._T, self._k) if self.keep else frame_of_positions(P)
+            )
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -219,8 +225,14 @@ class Shader:
 
     def _compiled_geometry(self, geometry=None) -> None:
         """The compiled tier's geometry (:func:`prepared_geometry`; ``geometry``: found already):
-        frame positions, unit normals (6, n) in the working precision, the chunk bounds."""
-        if self._G is None:
+        frame positions, unit normals (6, n) in the working precision, the chunk bounds. A
+        one-shot shader (keep=False) finds the frame alone (:func:`frame_of_positions`): each of
+        its passes prepares the geometry slab by slab (:meth:`_slabs`)."""
+        if not self.keep:
+            if self._centre is None:
+                self._centre, self._scale = geometry or frame_of_positions(self._P)
+                self.stats["geometry"] += 1
+        elif self._G is None:
             geometry = geometry or prepared_geometry(self._P, self._N, self._T, self._k)
             self._centre, self._scale, self._G, self._bounds, self._N = geometry
             self._scaled = True
@@ -469,49 +481,23 @@ class Shader:
             self._lobe_memory = (base, ws)
         else:
             base = ws = np.zeros((L, 0), T)
-        redo = self._redo  # every block writes its count, and its marks if it counts any
         vis = self._visibility(T)
-        shin = T(scene.material.shininess)
-        K.shade(
-            self._G,
+        inputs = (
             K.Lights(params, flags, view),
             opts,
-            K.Surface(mat, aconst, shin),
+            K.Surface(mat, aconst, T(scene.material.shininess)),
             self._k,
             K.Sums(A, D, S),
             K.Lobes(base, ws),
-            vis,
-            K.Marks(redo, self._redo_count),
-            self._out,
-            K.Culling(
-                self._bounds if self._plan.cull and self.cull else self._bounds[:, :0], self._culled
-            ),
         )
+        if self._G is not None:
+            self._pass(self._G, self._bounds, vis, inputs, 0, n)
+        else:  # a one-shot shader: slab by slab, each slab's geometry prepared as it comes
+            for s, e, G, bounds in self._slabs():
+                self._pass(G, bounds, vis, inputs, s, e)
         self.stats["pass"] += 1
-        self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
-        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
-            params64, _, view64 = self._params_for(np.float64)
-            self.stats["fixup_vertices"] += K.fixup(
-                K.Marks(redo, self._redo_count),
-                _readonly(self._P),
-                _readonly(self._normals()),
-                self._centre,
-                1.0 / self._scale,
-                K.Lights(params64, flags, view64),
-                opts,
-                K.Surface(
-                    material_vector(self._scene.material, np.float64),
-                    self._aconst,
-                    np.float64(scene.material.shininess),
-                ),
-                self._k64,
-                K.Sums(A, D, S),
-                K.Lobes(base, ws),
-                vis,
-                self._out,
-            )
         if keep:
             if do_amb:
                 self._A = A
@@ -524,6 +510,95 @@ class Shader:
                     self._ws = ws
                 self._spec_shininess = scene.material.shininess
 
+    def _pass(self, G, bounds, vis, inputs, s: int, e: int) -> None:
+        """The shading kernel over vertices ``s`` to ``e`` (+ the float64 redo of the float32
+        lanes it marks): ``G`` (6, e - s) their prepared geometry, ``bounds`` its chunk bounds,
+        ``vis`` (L, n) or (L, 0) the lights' visibility, ``inputs`` the kernel's lights, options,
+        surface, constants, sums and lobes (whole arrays; cut to the vertices here)."""
+        lights, opts, surface, k, sums, lobes = inputs
+        whole = (s, e) == (0, self.n)
+        b0, b1 = s // K.BLOCK, -(-e // K.BLOCK)  # (s is a multiple of BLOCK)
+
+        def rows(a):  # vertices s to e of an (n, ...) array, or an empty one
+            return a if whole or a.shape[0] == 0 else a[s:e]
+
+        if not whole:
+            sums = K.Sums(*(rows(x) for x in sums))
+            if lobes.base.shape[1]:  # (contiguous copies keep the kernel's argument types)
+                lobes = K.Lobes(*(np.ascontiguousarray(x[:, s:e]) for x in lobes))
+            if vis.shape[1]:
+                vis = np.ascontiguousarray(vis[:, s:e])
+        marks = K.Marks(rows(self._redo), self._redo_count[b0:b1])
+        out = rows(self._out)
+        culled = self._culled[b0:b1]
+        K.shade(
+            G,
+            lights,
+            opts,
+            surface,
+            k,
+            sums,
+            lobes,
+            vis,
+            marks,
+            out,
+            K.Culling(bounds if self._plan.cull and self.cull else bounds[:, :0], culled),
+        )
+        self.stats["culled"] += int(culled.sum())  # vertex-lights skipped
+        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
+            params64, flags, view64 = self._params_for(np.float64)
+            scene = self._scene
+            self.stats["fixup_vertices"] += K.fixup(
+                marks,
+                rows(_readonly(self._P)),
+                rows(_readonly(self._normals() if self._G is not None else self._N)),  # (tested)
+                self._centre,
+                1.0 / self._scale,
+                K.Lights(params64, flags, view64),
+                opts,
+                K.Surface(
+                    material_vector(scene.material, np.float64),
+                    self._aconst,
+                    np.float64(scene.material.shininess),
+                ),
+                self._k64,
+                sums,
+                lobes,
+                vis,
+                out,
+            )
+
+    def _slabs(self):
+        """The prepared geometry of a one-shot shader, slab by slab: yields (s, e, G, bounds)
+        for vertices s to e, :data:`SLAB` at a time (a multiple of BLOCK; the last one fewer), G
+        (6, e - s) in one reused buffer (a second one for the last slab: the kernels take
+        contiguous rows) and its chunk bounds (:func:`chunk_bounds`). Slab after slab stays in
+        the cache, and no full-size G is written (48 MB at 1M vertices in float64). Normals found
+        outside NORMAL_RANGE are scaled (all of them, once, as :func:`prepared_geometry` does);
+        a NaN or an infinite normal raises :func:`~explorer.geometry.frame.check_finite`'s error.
+        """
+        n, T = self.n, self._T
+        frame = (self._centre, 1.0 / self._scale, self._k)
+        P = _readonly(self._P)
+        size = min(n, SLAB)
+        buffers = [_GEOMETRY.take((6, size), T)]
+        try:
+            for s in range(0, max(n, 1), SLAB):
+                e = min(n, s + SLAB)
+                if e - s != size:  # the last, shorter slab
+                    buffers.append(_GEOMETRY.take((6, e - s), T))
+                G = buffers[-1]
+                if K.prepare(P[s:e], _readonly(self._N)[s:e], *frame, G):
+                    check_finite("normals", self._N)  # (NaN and inf are outside too)
+                    self._N = scale_normals(self._N)
+                    self._scaled = True
+                    K.prepare(P[s:e], _readonly(self._N)[s:e], *frame, G)
+                yield s, e, G, chunk_bounds(G)
+            self._scaled = True  # every normal was tested
+        finally:
+            for b in buffers:
+                _GEOMETRY.give(b)
+
 
 def _compiled_now(tier: str | None, model: str) -> bool:
     """Whether a shader prepares the compiled geometry with its vertices (and leaves their test
@@ -534,6 +609,18 @@ def _compiled_now(tier: str | None, model: str) -> bool:
     return tier == "compiled" or tiers.loaded()
 
 
+def frame_of_positions(P) -> tuple:
+    """(centre, scale) of the normalised frame of positions ``P`` (n, 3) (:func:`frame_of`),
+    their extent found in one compiled pass that tests them too: a NaN or an infinite value
+    raises the error of :func:`~explorer.geometry.frame.check_finite` naming the first one."""
+    if not len(P):
+        return frame_of(P)
+    lohi = K.extent(_readonly(P))  # (all NaN when some coordinate is not finite)
+    if np.isnan(lohi[0, 0]):
+        check_finite("positions", P)
+    return frame_from_extent(*lohi)
+
+
 def prepared_geometry(P, N, dtype, k) -> tuple:
     """The compiled tier's geometry of positions ``P`` and normals ``N`` (n, 3) in precision
     ``dtype`` (``k``: its constants): (centre, scale) of the normalised frame (:func:`frame_of`,
@@ -542,15 +629,8 @@ def prepared_geometry(P, N, dtype, k) -> tuple:
     NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would).
     These passes test the values too: a NaN or an infinite value raises the error of
     :func:`~explorer.geometry.frame.check_finite` naming the first such vertex."""
-    n = len(P)
-    if n:
-        lohi = K.extent(_readonly(P))  # (all NaN when some coordinate is not finite)
-        if np.isnan(lohi[0, 0]):
-            check_finite("positions", P)
-        centre, scale = frame_from_extent(*lohi)
-    else:
-        centre, scale = frame_of(P)
-    G = _GEOMETRY.take((6, n), dtype)
+    centre, scale = frame_of_positions(P)
+    G = np.empty((6, len(P)), dtype)
     frame = (centre, 1.0 / scale, k)
     if K.prepare(_readonly(P), _readonly(N), *frame, G):  # (NaN and inf are outside too)
         check_finite("normals", N)
@@ -655,26 +735,30 @@ def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.n
 
 
 class _Spare:
-    """One array of each dtype that a finished one-shot :func:`shade` left, for the next call
-    (its prepared geometry: 6n values, 48 MB at 1M vertices in float64, whose first touch costs
-    more page faults than preparing it costs work). Thread-safe: an array is taken by one shader,
-    which owns it from then on."""
+    """The few arrays finished one-shot passes left, for the next call: the slab buffers of
+    their prepared geometry (:meth:`Shader._slabs`: 6·SLAB values, 6 MB in float64, whose first
+    touch costs more page faults than preparing them costs work). Thread-safe: an array is taken
+    by one pass, which owns it until it gives it back."""
+
+    #: arrays kept at most (the latest given)
+    KEEP = 4
 
     def __init__(self):
         self._lock = threading.Lock()
-        self._spare: dict = {}
+        self._spare: list[np.ndarray] = []
 
     def take(self, shape: tuple, dtype) -> np.ndarray:
-        """The spare array of this shape and dtype, or a new one."""
+        """A spare array of this shape and dtype, or a new one."""
         with self._lock:
-            a = self._spare.pop(np.dtype(dtype), None)
-        return a if a is not None and a.shape == shape else np.empty(shape, dtype)
+            for i, a in enumerate(self._spare):
+                if a.shape == shape and a.dtype == dtype:
+                    return self._spare.pop(i)
+        return np.empty(shape, dtype)
 
     def give(self, a) -> None:
-        """Keep ``a`` (nothing else may use it any more) as the spare of its dtype; None: none."""
-        if a is not None:
-            with self._lock:
-                self._spare[a.dtype] = a
+        """Keep ``a`` (nothing else may use it any more) for a later :meth:`take`."""
+        with self._lock:
+            self._spare = [a, *self._spare[: self.KEEP - 1]]
 
 
 #: the spare prepared geometry of one-shot calls
