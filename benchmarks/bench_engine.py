@@ -35,7 +35,7 @@ from explorer.core.lights import PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
-from explorer.shading import shader as shader_module
+from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
@@ -96,7 +96,7 @@ def slab_sizes(scene, P, N, sizes, R) -> int:
     times: dict = {}
     for _ in range(R):
         for size in sizes:
-            shader_module.SLAB = size or n
+            prepared.SLAB = size or n
             for precision in ("float64", "float32"):
 
                 def prep(precision=precision):
@@ -131,7 +131,7 @@ def main(argv=None) -> int:
         "--slabs",
         default="",
         help="only time one-shot calls with these slab sizes (comma-separated vertex counts, "
-        "multiples of kernels.BLOCK; 0: one slab of every vertex)",
+        "multiples of kernels.BLOCK; 0: one slab of every vertex; see prepared.SLAB)",
     )
     args = ap.parse_args(argv)
     n, L, R = args.vertices, args.lights, args.repeat

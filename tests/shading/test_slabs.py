@@ -1,5 +1,5 @@
 """One-shot passes in slabs: a one-shot shader (``keep=False``, what :func:`explorer.shade`
-uses) prepares and shades its vertices :data:`explorer.shading.shader.SLAB` at a time, and gives
+uses) prepares and shades its vertices :data:`explorer.shading.prepared.SLAB` at a time, and gives
 the colours of one pass over every vertex, bit for bit, with the same compiled kernels."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import explorer
 from explorer.core.errors import ExplorerError
 from explorer.geometry import meshes as M
 from explorer.shading import kernels as K
-from explorer.shading import shader
+from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaPerformanceWarning")
@@ -36,7 +36,7 @@ SMALL = 2 * K.BLOCK
 
 def one_shot(scene, P, N, precision, slab, monkeypatch, **kw):
     """A one-shot shader's colours and stats with slabs of ``slab`` vertices."""
-    monkeypatch.setattr(shader, "SLAB", slab)
+    monkeypatch.setattr(prepared, "SLAB", slab)
     s = explorer.Shader(scene, P, N, precision=precision, keep=False, tier="compiled", **kw)
     return np.asarray(s.colors).copy(), s
 
@@ -128,7 +128,7 @@ def test_shadowed_slabs(monkeypatch):
 @pytest.mark.parametrize("which", ["positions", "normals"])
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_nan_or_inf_in_a_later_slab_raises_before_colours_are_returned(which, bad, monkeypatch):
-    monkeypatch.setattr(shader, "SLAB", SMALL)
+    monkeypatch.setattr(prepared, "SLAB", SMALL)
     n = 3 * SMALL + 7
     rng = np.random.default_rng(4)
     P, N = rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
