@@ -12,10 +12,22 @@ Prints the machine, then one row per case: median and best wall time over ``--re
 first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
 floor of a recolour (read positions and normals once, write colours once) is measured in the
 same run, on the same arrays, so "recolour / floor" is a like-for-like ratio; so are the rows
-"geometry preparation" (what a one-shot ``shade()`` does before its pass: check the vertices,
-find the frame, prepare the geometry in the working precision, the chunk bounds; the prepared
-geometry is then handed back as the call hands it back, so the next call reuses its memory, as
-repeated one-shot calls do) against it.
+"geometry preparation" (what a one-shot ``shade()`` does before and between its passes: check
+the vertices, find the frame, the plan, then slab by slab (``prepared.SLAB`` vertices) the
+geometry in the working precision and its chunk bounds, into the buffers the previous call
+handed back, as repeated one-shot calls do) against it.
+
+``--slabs 0,65536,131072,262144`` times only one-shot calls and their geometry preparation at
+each slab size (0: one slab of every vertex, as a kept ``Shader`` prepares it), the sizes taking
+turns. Last run (AMD EPYC, 2 cores, load 1.3, ``--repeat 7``; medians, ms; the VM moves these
+by 10 % from run to run):
+
+| slab | one-shot float64 | geometry float64 | one-shot float32 | geometry float32 |
+|---:|---:|---:|---:|---:|
+| 1,000,000 (whole) | 30.40 | 5.53 | 16.34 | 3.31 |
+| 65,536 | 28.10 | 3.49 | 17.79 | 3.61 |
+| 131,072 | 29.46 | 3.49 | 16.18 | 3.67 |
+| 262,144 | 27.84 | 3.79 | 15.57 | 3.30 |
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 
