@@ -74,7 +74,6 @@ import numba as nb
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils
 from numba.core.errors import NumbaIRAssumptionWarning, TypingError
 from numba.extending import intrinsic, overload
 
@@ -258,46 +257,6 @@ def _assume(typingctx, cond):
         return context.get_dummy_value()
 
     return types.none(cond), codegen
-
-
-def _prefetcher(write: int):
-    """An intrinsic ``f(a, i)`` asking the CPU to bring the cache line of ``a[i]`` (a 1-D array)
-    into its L2 cache, to read (``write`` 0) or to write (1): ``llvm.prefetch``, a hint that
-    never faults and changes no value."""
-
-    @intrinsic
-    def prefetch(typingctx, a, i):
-        if not (isinstance(a, types.Array) and a.ndim == 1 and isinstance(i, types.Integer)):
-            return None
-
-        def codegen(context, builder, sig, args):
-            arr = context.make_array(sig.args[0])(context, builder, value=args[0])
-            i8p, i32 = ir.IntType(8).as_pointer(), ir.IntType(32)
-            ptr = builder.bitcast(builder.gep(arr.data, [args[1]]), i8p)
-            fnty = ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32])
-            fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0")
-            # (rw, locality 2: the L2 cache, not L1, where the block's scratch rows are; data)
-            flags = [ir.Constant(i32, write), ir.Constant(i32, 2), ir.Constant(i32, 1)]
-            builder.call(fn, [ptr, *flags])
-            return context.get_dummy_value()
-
-        return types.none(a, types.intp), codegen
-
-    return prefetch
-
-
-_prefetch_read, _prefetch_write = _prefetcher(0), _prefetcher(1)
-
-
-@nb.njit(**_LEAF)
-def _ask_for(a, write):
-    """Prefetch every cache line of the 1-D array ``a`` (see :func:`_prefetcher`)."""
-    step = max(1, 64 // a.itemsize)
-    for i in range(0, a.shape[0], step):
-        if write:
-            _prefetch_write(a, i)
-        else:
-            _prefetch_read(a, i)
 
 
 @nb.njit(inline="always", **_LEAF)
@@ -1390,22 +1349,9 @@ def _task(
             fl = flags[li]
             back = not (do_amb and (fl & AMBIENT) != 0)
             _reach(bounds, c0, c1 - c0, params[li, :], fl, back, act[li, :])
-    store, compose = opts[O_STORE] != 0, opts[O_COMPOSE] != 0
     for b in range(b0, b1):
         s = b * BLOCK
         e = min(n, s + BLOCK)
-        if b + 1 < b1:  # the next block's rows, read and written, asked for while this one runs
-            # (each 4 KB row is a page of its own: the CPU's own prefetcher stops at pages, and a
-            # block's reads of G and its stores then waited on memory)
-            s1, e1 = e, min(n, e + BLOCK)
-            for r in range(6):
-                _ask_for(G[r, s1:e1], False)
-            if compose:
-                _ask_for(out[3 * s1 : 3 * e1], True)
-            if store:
-                _ask_for(A[3 * s1 : 3 * e1], True)
-                _ask_for(D[dw * s1 : dw * e1], True)
-                _ask_for(S[sw * s1 : sw * e1], True)
         _block(
             (G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e]),
             lights,
