@@ -17,9 +17,10 @@ from explorer.shading import kernels as K
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
 #: vertices per slab of a one-shot pass (:func:`slabs`; a multiple of BLOCK): its
-#: prepared geometry, 48 bytes a vertex in float64, stays in the cache between being written
-#: and being shaded (``benchmarks/bench_engine.py --slabs`` measures the choice)
-SLAB = 128 * 1024
+#: prepared geometry, 48 bytes a vertex in float64 (12 MB), stays in the cache between being
+#: written and being shaded; each slab costs three parallel regions, each of which waits for a
+#: thread another process holds (``benchmarks/bench_engine.py --slabs`` measures the choice)
+SLAB = 256 * 1024
 #: :func:`chunk_bounds` tests that share on every CULL_SAMPLE-th chunk before it finds them all
 CULL_SAMPLE = 16
 
