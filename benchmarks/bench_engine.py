@@ -12,10 +12,22 @@ Prints the machine, then one row per case: median and best wall time over ``--re
 first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
 floor of a recolour (read positions and normals once, write colours once) is measured in the
 same run, on the same arrays, so "recolour / floor" is a like-for-like ratio; so are the rows
-"geometry preparation" (what a one-shot ``shade()`` does before its pass: check the vertices,
-find the frame, prepare the geometry in the working precision, the chunk bounds; the prepared
-geometry is then handed back as the call hands it back, so the next call reuses its memory, as
-repeated one-shot calls do) against it.
+"geometry preparation" (what a one-shot ``shade()`` does before and between its passes: check
+the vertices, find the frame, the plan, then slab by slab (``prepared.SLAB`` vertices) the
+geometry in the working precision and its chunk bounds, into the buffers the previous call
+handed back, as repeated one-shot calls do) against it.
+
+``--slabs 0,65536,131072,262144`` times only one-shot calls and their geometry preparation at
+each slab size (0: one slab of every vertex, as a kept ``Shader`` prepares it), the sizes taking
+turns. Last run (AMD EPYC, 2 cores, load 1.3, ``--repeat 7``; medians, ms; the VM moves these
+by 10 % from run to run):
+
+| slab | one-shot float64 | geometry float64 | one-shot float32 | geometry float32 |
+|---:|---:|---:|---:|---:|
+| 1,000,000 (whole) | 30.40 | 5.53 | 16.34 | 3.31 |
+| 65,536 | 28.10 | 3.49 | 17.79 | 3.61 |
+| 131,072 | 29.46 | 3.49 | 16.18 | 3.67 |
+| 262,144 | 27.84 | 3.79 | 15.57 | 3.30 |
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 
@@ -35,7 +47,7 @@ from explorer.core.lights import PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
-from explorer.shading import shader as shader_module
+from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
@@ -89,16 +101,57 @@ def spot_lights(lights: int, rng) -> tuple:
     return tuple(out)
 
 
+def slab_sizes(scene, P, N, sizes, R) -> int:
+    """One-shot calls (and their geometry preparation alone) at each slab size: the sizes
+    take turns, ``R`` rounds, so drift spreads over all of them; prints the medians."""
+    n = len(P)
+    times: dict = {}
+    for _ in range(R):
+        for size in sizes:
+            prepared.SLAB = size or n
+            for precision in ("float64", "float32"):
+
+                def prep(precision=precision):
+                    sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
+                    for _ in sh._slabs():
+                        pass
+
+                one = timed(lambda p=precision: explorer.shade(scene, P, N, precision=p), 3)[0]
+                times.setdefault((size, precision, "one-shot"), []).append(one)
+                times.setdefault((size, precision, "geometry"), []).append(timed(prep, 3)[0])
+    print(f"machine: {machine()}")
+    print(f"mesh: {n} vertices, {len(scene.lights)} point lights; medians of {R} rounds\n")
+    print("| slab (vertices) | one-shot float64 ms | geometry float64 ms "
+          "| one-shot float32 ms | geometry float32 ms |")  # fmt: skip
+    print("|---:|---:|---:|---:|---:|")
+    for size in sizes:
+        cells = [
+            f"{np.median(times[(size, p, what)]) * 1e3:.2f}"
+            for p in ("float64", "float32")
+            for what in ("one-shot", "geometry")
+        ]
+        print(f"| {size or n} | " + " | ".join(cells) + " |")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--lights", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=11)
+    ap.add_argument(
+        "--slabs",
+        default="",
+        help="only time one-shot calls with these slab sizes (comma-separated vertex counts, "
+        "multiples of kernels.BLOCK; 0: one slab of every vertex; see prepared.SLAB)",
+    )
     args = ap.parse_args(argv)
     n, L, R = args.vertices, args.lights, args.repeat
     rng = np.random.default_rng(0)
     P, N = sphere_points(n, rng)
     scene = scene_with(L, rng)
+    if args.slabs:
+        return slab_sizes(scene, P, N, [int(v) for v in args.slabs.split(",")], R)
     other = scene_with(L, np.random.default_rng(1)).lights
 
     rows = []
@@ -180,16 +233,17 @@ def main(argv=None) -> int:
     row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
     one_shot = timed(lambda: explorer.shade(scene, P, N), R)
     row("one-shot `shade()` float64 (the default), incl. preparing the geometry", *one_shot, n * L)
-    # what a one-shot call does before its pass: check the vertices, find the frame, prepare
-    # the geometry in the working precision and the chunk bounds for culling
+    # what a one-shot call does before and between its passes: check the vertices, find the
+    # frame, the plan, and slab by slab the geometry in the working precision and its chunk
+    # bounds (into the buffers the previous call left)
     geometry = {}
     for precision in ("float32", "float64"):
 
         def prep(precision=precision):
             sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
-            sh._compiled_geometry()  # (made by the constructor already when the kernels serve)
-            # as a one-shot call ends: its prepared geometry is the spare the next call takes
-            shader_module._GEOMETRY.give(sh._G)
+            sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
+            for _ in sh._slabs():
+                pass
 
         geometry[precision] = timed(prep, R)
         row(f"geometry preparation, {precision} (of a one-shot call)", *geometry[precision])

@@ -83,6 +83,20 @@ one Newton step (loop1 about 5% faster, but a relative error of 3e-14 in the bas
 128 makes 4e-12 in the lobe: above the 1e-12 the float64 tests hold), a float32 division seeding
 pow's (m - 1)/(m + 1) (slower), 8 fewer polynomial terms in pow (loop2 -27%, far looser than the
 stated bound).
+
+k12 (632f8d3 -> k12: one-shot calls prepare and shade in slabs, ``prepared.SLAB``; the kernels
+unchanged), ``--precision float64``, wall:
+
+| case | run 1 (``--rounds 3``, load 0.9-1.2, VM slow) | run 2 (``--rounds 4``, load 1.3) |
+|---|---:|---:|
+| random points | 25.34 / 25.09 ms (1.01x) | 20.75 / 19.51 (1.06x: noise, same kernels) |
+| one-shot shade() | 28.85 / 26.97 (1.07x) | 23.26 / 22.61 (1.03x) |
+| geometry preparation of a one-shot call | 4.63 / 3.45 (1.34x) | 2.99 / 2.87 (1.04x) |
+
+(run 1 with 128k slabs, run 2 with 256k.) Tried and not kept: each task prefetching the next
+block's rows of G, sums and colours (``llvm.prefetch``): 0.99x on the full float64 pass
+(``--rounds 4``, idle), though the pass's fixed part is bound by reading G (with no light, 3.8 ms
+in float64 against 1.7 ms in float32, whose G is half as large).
 """
 
 from __future__ import annotations
@@ -139,8 +153,10 @@ for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):  # 
     t = time.perf_counter()  # geometry and chunk bounds; its geometry then the spare
     sh = explorer.Shader(scene, P, N, precision={precision!r}, keep=False)
     sh._compiled_geometry()
+    for _ in getattr(sh, "_slabs", lambda: ())():  # (slab by slab, the buffers handed back)
+        pass
     ts.append(time.perf_counter() - t)
-    if spare is not None:
+    if spare is not None and sh._G is not None:
         spare.give(sh._G)
     del sh
 print(min(ts[1:]) * 1e3 if ts else "nan", statistics.median(ts[1:]) * 1e3 if ts else "nan")

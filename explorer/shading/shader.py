@@ -35,7 +35,6 @@ A shader switches to the compiled tier at its next pass once the kernels are loa
 from __future__ import annotations
 
 import sys
-import threading
 from collections import Counter
 from collections.abc import Iterable, Mapping
 
@@ -48,10 +47,7 @@ from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
 from explorer.geometry.frame import (
     check_faces,
-    check_finite,
     check_vertices,
-    frame_from_extent,
-    frame_of,
     scale_normals,
     to_frame,
 )
@@ -60,6 +56,8 @@ from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
+from explorer.shading.prepared import geometry_of, slabs
+from explorer.shading.prepared import readonly as _readonly
 from explorer.shading.shadows import visibility_rows
 
 PRECISIONS = ("float64", "float32")
@@ -67,11 +65,6 @@ PRECISIONS = ("float64", "float32")
 TIERS = ("compiled", "numpy")
 #: the specular models the compiled kernels implement; the others run on the numpy tier
 COMPILED_MODELS = ("blinn", "phong")
-#: light culling is kept for a mesh where one chunk of vertices in this many or more has a
-#: normal cone narrower than 90° (only such chunks can ever be skipped)
-CULL_MIN_SHARE = 8
-#: :func:`chunk_bounds` tests that share on every CULL_SAMPLE-th chunk before it finds them all
-CULL_SAMPLE = 16
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
 #: (:func:`invalidated`)
@@ -118,9 +111,7 @@ def shade(
         faces=faces,
         tier=tier,
     )
-    colours = np.asarray(s.colors, dtype=np.float64)
-    _GEOMETRY.give(s._G)  # (the shader is dropped: its prepared geometry serves the next call)
-    return colours
+    return np.asarray(s.colors, dtype=np.float64)
 
 
 class Shader:
@@ -129,7 +120,11 @@ class Shader:
     positions, normals : (n, 3) float arrays (kept by reference for float64 re-evaluation; any
         normal outside NORMAL_RANGE is rescaled in a copy: see geometry.frame.scale_normals)
     precision : "float32" (default here: the interactive path) or "float64"
-    keep : keep the light sums for cheap updates (False: one-shot, less memory traffic)
+    keep : keep the light sums and the prepared geometry for cheap updates. False: one-shot
+        (what :func:`shade` uses): nothing per vertex is kept, each pass prepares the geometry
+        and shades it slab by slab (:data:`SLAB` vertices at a time, in the cache), less memory
+        and memory traffic; the constructor finds the frame (and NaN or infinite positions),
+        a pass finds NaN or infinite normals (the same error, before any colours)
     faces : (m, 3) int triangles for shadows (None: no shadows)
     force_all : the plan skips nothing (same colours; benchmark only)
     cull : skip a light for runs of vertices that provably get nothing from it (the plan's
@@ -171,7 +166,6 @@ class Shader:
         self._scene = load_scene(scene, materials_dirs=self._materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
-        self._lobe_memory = None  # (base, ws) arrays kept for reuse
         self._k64 = K.constants(np.float64)
         self.set_geometry(positions, normals, faces)
 
@@ -195,7 +189,7 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        geometry = prepared_geometry(P, N, self._T, self._k) if now else None
+        geometry = geometry_of(P, N, self._T, self._k, self.keep) if now else None
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -218,12 +212,12 @@ class Shader:
         self._lights_changed()
 
     def _compiled_geometry(self, geometry=None) -> None:
-        """The compiled tier's geometry (:func:`prepared_geometry`; ``geometry``: found already):
-        frame positions, unit normals (6, n) in the working precision, the chunk bounds."""
-        if self._G is None:
-            geometry = geometry or prepared_geometry(self._P, self._N, self._T, self._k)
-            self._centre, self._scale, self._G, self._bounds, self._N = geometry
-            self._scaled = True
+        """The compiled tier's geometry (:func:`~explorer.shading.prepared.geometry_of`;
+        ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_slabs`)."""
+        if self._centre is None:
+            geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, self.keep)
+            self._centre, self._scale, self._G, self._bounds, N = geometry
+            self._N, self._scaled = (self._N, False) if N is None else (N, True)
             self.stats["geometry"] += 1
 
     def _normals(self) -> np.ndarray:
@@ -435,7 +429,6 @@ class Shader:
         """One fused pass of the shading kernel over every vertex (+ float64 fix-ups)."""
         scene, T, n = self._scene, self._T, self.n
         params, flags, view = self._params_for(T)
-        L = len(params)
         keep = self.keep
         opts = pass_options(scene, self._plan, flat, (do_amb, do_dif, do_spec), T)
         opts[K.O_STORE] = keep
@@ -458,71 +451,69 @@ class Shader:
         A = cache(self._A, do_amb)
         D = cache(self._D, True, grey) if do_dif else D
         S = cache(self._S, do_spec, grey)
-        if opts[K.O_STORE_LOBE]:
-            # every row the lobe kernel reads (lights with specular) is written by this pass;
-            # the memory of the previous, now invalid, lobes is reused (no page faults)
-            old = self._lobe_memory
-            if old is not None and old[0].shape == (L, n):
-                base, ws = old
-            else:
-                base, ws = np.empty((L, n), T), np.empty((L, n), T)
-            self._lobe_memory = (base, ws)
-        else:
-            base = ws = np.zeros((L, 0), T)
-        redo = self._redo  # every block writes its count, and its marks if it counts any
+        base, ws = self._memory.lobe_rows((len(params), n if opts[K.O_STORE_LOBE] else 0), T)
         vis = self._visibility(T)
-        shin = T(scene.material.shininess)
-        K.shade(
-            self._G,
+        inputs = (
             K.Lights(params, flags, view),
             opts,
-            K.Surface(mat, aconst, shin),
+            K.Surface(mat, aconst, T(scene.material.shininess)),
             self._k,
             K.Sums(A, D, S),
             K.Lobes(base, ws),
-            vis,
-            K.Marks(redo, self._redo_count),
-            self._out,
-            K.Culling(
-                self._bounds if self._plan.cull and self.cull else self._bounds[:, :0], self._culled
-            ),
         )
+        if self._G is not None:
+            self._pass(self._G, self._bounds, vis, inputs, 0, n)
+        else:  # a one-shot shader: slab by slab, each slab's geometry prepared as it comes
+            for s, e, G, bounds, N in self._slabs():
+                self._N = N  # (scaled where a slab held a normal outside NORMAL_RANGE)
+                self._pass(G, bounds, vis, inputs, s, e)
+            self._scaled = True  # (every normal was tested)
         self.stats["pass"] += 1
-        self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
-        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
-            params64, _, view64 = self._params_for(np.float64)
-            self.stats["fixup_vertices"] += K.fixup(
-                K.Marks(redo, self._redo_count),
-                _readonly(self._P),
-                _readonly(self._normals()),
-                self._centre,
-                1.0 / self._scale,
-                K.Lights(params64, flags, view64),
-                opts,
-                K.Surface(
-                    material_vector(self._scene.material, np.float64),
-                    self._aconst,
-                    np.float64(scene.material.shininess),
-                ),
-                self._k64,
-                K.Sums(A, D, S),
-                K.Lobes(base, ws),
-                vis,
-                self._out,
-            )
-        if keep:
-            if do_amb:
-                self._A = A
-            if do_dif:
-                self._D = D
+        if keep:  # the sums recomputed now are the cached ones
+            self._A, self._D = A if do_amb else self._A, D if do_dif else self._D
             if do_spec:
-                self._S = S
+                self._S, self._spec_shininess = S, scene.material.shininess
                 if opts[K.O_STORE_LOBE]:
-                    self._base = base if not flat else None
-                    self._ws = ws
-                self._spec_shininess = scene.material.shininess
+                    self._base, self._ws = None if flat else base, ws
+
+    def _slabs(self):
+        """A one-shot shader's prepared geometry, slab by slab (:func:`slabs`)."""
+        return slabs(self._P, self._N, self._T, self._k, self._centre, self._scale)
+
+    def _pass(self, G, bounds, vis, inputs, s: int, e: int) -> None:
+        """The kernel over vertices ``s`` to ``e`` (+ the float64 redo of marked float32 lanes):
+        ``G`` (6, e - s) and ``bounds`` theirs; ``vis``, ``inputs`` (lights, options, surface,
+        constants, sums, lobes) for every vertex (cut to these here)."""
+        lights, opts, surface, k, sums, lobes = inputs
+        whole = (s, e) == (0, self.n)
+        b0, b1 = s // K.BLOCK, -(-e // K.BLOCK)  # (s is a multiple of BLOCK)
+
+        def rows(a):  # vertices s to e of an (n, ...) array, or an empty one
+            return a if whole or a.shape[0] == 0 else a[s:e]
+
+        if not whole:  # (one-shot: no sums, no lobes kept; contiguous rows keep the kernel's
+            # argument types)
+            sums = K.Sums(*(rows(x) for x in sums))
+            vis = np.ascontiguousarray(vis[:, s:e]) if vis.shape[1] else vis
+        marks = K.Marks(rows(self._redo), self._redo_count[b0:b1])
+        out = rows(self._out)
+        culled = self._culled[b0:b1]
+        cull = bounds if self._plan.cull and self.cull else bounds[:, :0]
+        args = (G, lights, opts, surface, k, sums, lobes, vis, marks, out)
+        K.shade(*args, K.Culling(cull, culled))
+        self.stats["culled"] += int(culled.sum())  # vertex-lights skipped
+        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
+            P, N = self._P, self._normals() if self._G is not None else self._N  # (N: tested)
+            params64, flags, view64 = self._params_for(np.float64)
+            m = self._scene.material
+            surface64 = K.Surface(material_vector(m, np.float64), self._aconst, m.shininess)
+            frame = (self._centre, 1.0 / self._scale)
+            fix = (*frame, K.Lights(params64, flags, view64), opts, surface64, self._k64)
+            self.stats["fixup_vertices"] += K.fixup(
+                marks, rows(_readonly(P)), rows(_readonly(N)), *fix, sums, lobes, vis, out
+            )
 
 
 def _compiled_now(tier: str | None, model: str) -> bool:
@@ -532,49 +523,6 @@ def _compiled_now(tier: str | None, model: str) -> bool:
     if tier == "numpy" or model not in COMPILED_MODELS:
         return False
     return tier == "compiled" or tiers.loaded()
-
-
-def prepared_geometry(P, N, dtype, k) -> tuple:
-    """The compiled tier's geometry of positions ``P`` and normals ``N`` (n, 3) in precision
-    ``dtype`` (``k``: its constants): (centre, scale) of the normalised frame (:func:`frame_of`,
-    the extent found in one compiled pass), ``G`` (6, n) (:func:`explorer.shading.kernels.prepare`),
-    the chunk bounds (:func:`chunk_bounds`) and the normals as prepared: ``N``, or scaled into
-    NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would).
-    These passes test the values too: a NaN or an infinite value raises the error of
-    :func:`~explorer.geometry.frame.check_finite` naming the first such vertex."""
-    n = len(P)
-    if n:
-        lohi = K.extent(_readonly(P))  # (all NaN when some coordinate is not finite)
-        if np.isnan(lohi[0, 0]):
-            check_finite("positions", P)
-        centre, scale = frame_from_extent(*lohi)
-    else:
-        centre, scale = frame_of(P)
-    G = _GEOMETRY.take((6, n), dtype)
-    frame = (centre, 1.0 / scale, k)
-    if K.prepare(_readonly(P), _readonly(N), *frame, G):  # (NaN and inf are outside too)
-        check_finite("normals", N)
-        N = scale_normals(N)
-        K.prepare(_readonly(P), _readonly(N), *frame, G)
-    return centre, scale, G, chunk_bounds(G), N
-
-
-def chunk_bounds(G: np.ndarray) -> np.ndarray:
-    """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
-    prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
-    read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
-    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests.
-    Every CULL_SAMPLE-th chunk is found first: when those already fall short, the rest are not
-    (on vertices in no particular order most of the bounds' cost)."""
-    b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
-    K.bounds(G, b, CULL_SAMPLE)
-    sample = b[K.B_COS, ::CULL_SAMPLE]
-    if np.count_nonzero(sample > 0) * CULL_MIN_SHARE < sample.size:
-        return _readonly(b[:, :0])
-    K.bounds(G, b, 1)
-    if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
-        b = b[:, :0]
-    return _readonly(b)
 
 
 def stored_terms(aconst, A, D, S, n: int, dtype) -> dict[str, np.ndarray]:
@@ -654,33 +602,6 @@ def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.n
     return opts
 
 
-class _Spare:
-    """One array of each dtype that a finished one-shot :func:`shade` left, for the next call
-    (its prepared geometry: 6n values, 48 MB at 1M vertices in float64, whose first touch costs
-    more page faults than preparing it costs work). Thread-safe: an array is taken by one shader,
-    which owns it from then on."""
-
-    def __init__(self):
-        self._lock = threading.Lock()
-        self._spare: dict = {}
-
-    def take(self, shape: tuple, dtype) -> np.ndarray:
-        """The spare array of this shape and dtype, or a new one."""
-        with self._lock:
-            a = self._spare.pop(np.dtype(dtype), None)
-        return a if a is not None and a.shape == shape else np.empty(shape, dtype)
-
-    def give(self, a) -> None:
-        """Keep ``a`` (nothing else may use it any more) as the spare of its dtype; None: none."""
-        if a is not None:
-            with self._lock:
-                self._spare[a.dtype] = a
-
-
-#: the spare prepared geometry of one-shot calls
-_GEOMETRY = _Spare()
-
-
 class _Memory:
     """Arrays reused instead of allocated: colour buffers, and the memory of invalidated sums.
 
@@ -691,6 +612,15 @@ class _Memory:
     def __init__(self):
         self.colours: list[np.ndarray] = []
         self.spares: list[np.ndarray] = []
+        self.lobes: tuple = ()
+
+    def lobe_rows(self, shape: tuple, dtype) -> tuple:
+        """(base, ws) rows of a lobe store, ``shape`` (L, n), or (L, 0): none stored; the memory
+        of the previous ones (now invalid: a pass that stores lobes writes every row the lobe
+        kernel reads) when it has that shape (no page faults)."""
+        if not self.lobes or self.lobes[0].shape != shape or self.lobes[0].dtype != dtype:
+            self.lobes = (np.empty(shape, dtype), np.empty(shape, dtype))
+        return self.lobes
 
     def retire(self, *sums) -> None:
         """Keep the memory of invalidated sums for the next pass (see :meth:`fresh`)."""
@@ -745,11 +675,3 @@ def _typed(name: str, value, types, wanted: str, not_types=()):
         shown = f"{value!r:.60}"
         raise ExplorerTypeError(f"{name} must be {wanted}, got {type(value).__name__} {shown}")
     return value
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    """A read-only view (the engine keeps the writable base private, so kernels get one
-    array type and compile once)."""
-    v = a.view()
-    v.flags.writeable = False
-    return v
