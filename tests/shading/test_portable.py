@@ -19,23 +19,16 @@ import sys
 
 import pytest
 
+TESTS = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
 # the round trip of tests/shading/test_vmath.py, with weights of every kind (0, -0, NaN,
 # subnormal, infinite), checked against numpy inside the subprocess
 ROUND_TRIP = """
+import sys
 import numba as nb, numpy as np
 from explorer.shading import vmath
-
-@nb.njit(error_model="numpy", boundscheck=False)
-def round_trip(src, w):
-    packed = np.full(src.shape[0], -1.0)
-    back = np.full(src.shape[0], -1.0)
-    nc = 0
-    for i in range(0, src.shape[0] - 7, 8):
-        nc += vmath.compress8(src, w, i, packed, nc)
-    k = 0
-    for i in range(0, src.shape[0] - 7, 8):
-        k += vmath.expand8(packed, k, w, i, back)
-    return packed, back, nc, k
+sys.path.insert(0, sys.argv[1])  # tests/: the round trip of test_vmath.py
+from helpers.lanes import round_trip
 
 rng = np.random.default_rng(7)
 kinds = [0.0, -0.0, np.nan, 5e-324, -5e-324, np.inf, -np.inf, 1.0]
@@ -94,7 +87,11 @@ def _run(tmp_path, **target) -> list[str]:
         for name in ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES"):
             env.pop(name, None)
     out = subprocess.run(
-        [sys.executable, "-c", ROUND_TRIP], env=env, capture_output=True, text=True, timeout=300
+        [sys.executable, "-c", ROUND_TRIP, TESTS],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert out.returncode == 0, out.stderr
     return out.stdout.split()

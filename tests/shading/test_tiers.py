@@ -212,17 +212,24 @@ COLD = textwrap.dedent(
 )
 
 
+def _empty_cache(tmp_path, path: str) -> tuple[dict, str]:
+    """The environment of a process in mode auto on an empty numba cache under ``tmp_path``,
+    and the path ``tiers.<path>()`` names there (its directory made)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    env[tiers.ENV] = "auto"
+    probe = f"from explorer.shading import tiers; print(tiers.{path}())"
+    out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
+                         text=True, check=True).stdout.strip()  # fmt: skip
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    return env, out
+
+
 @contextmanager
 def _cold_cache(tmp_path):
     """An empty numba cache in mode auto, with the background compile's lock held, as if one
     were running already: a background compile started meanwhile must see it and leave (it is
     waited for on exit), so no test compiles the kernels for minutes."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
-    env[tiers.ENV] = "auto"
-    probe = "from explorer.shading import tiers; print(tiers.lock_path())"
-    lock_file = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
-                               text=True, check=True).stdout.strip()  # fmt: skip
-    os.makedirs(os.path.dirname(lock_file), exist_ok=True)
+    env, lock_file = _empty_cache(tmp_path, "lock_path")
     log = os.path.join(os.path.dirname(lock_file), "explorer-warm.log")
     with open(lock_file, "a+") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -343,12 +350,7 @@ CRASH = textwrap.dedent(
 def test_a_background_compile_that_crashes_is_counted(tmp_path):
     # the compiler aborting the process (as LLVM's assertions do) or an exception: each run
     # counted, the exception's text kept for the next process to tell
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
-    env[tiers.ENV] = "auto"
-    probe = "from explorer.shading import tiers; print(tiers.attempt_path())"
-    path = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True,
-                          text=True, check=True).stdout.strip()  # fmt: skip
-    os.makedirs(os.path.dirname(path), exist_ok=True)
+    env, path = _empty_cache(tmp_path, "attempt_path")
     first = subprocess.run([sys.executable, "-c", CRASH, "abort"], env=env, capture_output=True)
     assert first.returncode != 0
     assert json.loads(_read(path)) == {"attempts": 1, "error": None}

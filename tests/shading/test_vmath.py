@@ -8,6 +8,7 @@ import mpmath
 import numba as nb
 import numpy as np
 import pytest
+from helpers.lanes import round_trip
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -119,20 +120,6 @@ def test_pow32_edge_values():
     assert vmath.pow32(np.float32(1e-30), np.float32(1e-6)) == pytest.approx(1e-30**1e-6, rel=1e-6)
 
 
-@nb.njit(error_model="numpy", boundscheck=False)
-def _round_trip(src, w):
-    # the float64 lobe's compaction (kernels._split_lobe): whole groups of 8 lanes
-    packed = np.full(src.shape[0], -1.0)
-    back = np.full(src.shape[0], -1.0)
-    nc = 0
-    for i in range(0, src.shape[0] - 7, 8):
-        nc += vmath.compress8(src, w, i, packed, nc)
-    k = 0
-    for i in range(0, src.shape[0] - 7, 8):
-        k += vmath.expand8(packed, k, w, i, back)
-    return packed, back, nc, k
-
-
 @settings(max_examples=100, deadline=None)
 @given(
     groups=st.integers(1, 6),
@@ -150,7 +137,7 @@ def test_compress8_and_expand8_pack_and_put_back_the_positive_lanes(groups, seed
         # zero of either sign, NaN, subnormal and infinite weights: kept only where w > 0
         "signs": rng.choice([0.0, -0.0, np.nan, 5e-324, -5e-324, np.inf, -np.inf, 1.0], n),
     }[kinds]
-    packed, back, nc, k = _round_trip(src, w)
+    packed, back, nc, k = round_trip(src, w)  # (tests/helpers/lanes.py)
     keep = w > 0
     assert nc == k == np.count_nonzero(keep)
     assert np.array_equal(packed[:nc], src[keep])  # in order, at the front
