@@ -115,7 +115,7 @@ def slabs(P, N, dtype, k, centre, scale):
 
 class _Spare:
     """The few arrays finished one-shot passes left, for the next call: the slab buffers of
-    their prepared geometry (:func:`slabs`: 6·SLAB values, 6 MB in float64, whose first
+    their prepared geometry (:func:`slabs`: 6·SLAB values, 12 MB in float64, whose first
     touch costs more page faults than preparing them costs work). Thread-safe: an array is taken
     by one pass, which owns it until it gives it back."""
 
