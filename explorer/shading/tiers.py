@@ -177,14 +177,7 @@ def _ready() -> bool:
             if why is None:
                 _start_background()
             else:
-                _state["failed"] = why
-                warnings.warn(
-                    f"the compiled engine could not be prepared on this machine: {why}; the "
-                    "numpy engine serves: the same colours, slower on large meshes (to try "
-                    f"again, remove {attempt_path()})",
-                    Notice,
-                    stacklevel=4,
-                )
+                _unavailable(f"{why}; to try again, remove {attempt_path()}", stacklevel=5)
         if _state["ready"] and _state["preload"]:
             _start_loading()
     return bool(_state["ready"])
@@ -282,11 +275,18 @@ def attempts() -> dict:
         return {"attempts": 0, "error": None}
 
 
-def record_attempt(error: str | None = None) -> None:
-    """Count one more background compile (``error``: None), or write the error the current one
-    ended with (the count stays)."""
-    info = attempts()
-    info = {"attempts": info["attempts"] + (error is None), "error": error or info["error"]}
+def record_attempt() -> None:
+    """Count one more background compile (it starts)."""
+    _write_attempts(attempts()["attempts"] + 1, None)
+
+
+def record_error(error: str) -> None:
+    """Write the error the current background compile ended with (the count stays)."""
+    _write_attempts(attempts()["attempts"], error)
+
+
+def _write_attempts(n: int, error: str | None) -> None:
+    info = {"attempts": n, "error": error}
     write_atomic(attempt_path(), json.dumps(info).encode(), overwrite=True)
 
 
@@ -346,15 +346,20 @@ def _start_background() -> None:
                 close_fds=True,
             )
     except OSError as exc:  # no writable cache directory, no interpreter to start
-        _state["failed"] = exc.strerror or str(exc)
-        warnings.warn(
-            f"the compiled engine cannot be prepared ({_state['failed']}); "
-            "the numpy engine serves: the same colours, slower on large meshes",
-            Notice,
-            stacklevel=3,
-        )
+        _unavailable(exc.strerror or str(exc), stacklevel=4)
         return
     warnings.warn(PREPARING, Notice, stacklevel=3)
+
+
+def _unavailable(why: str, stacklevel: int) -> None:
+    """The compiled engine cannot be prepared: the numpy tier serves on; tell the user once."""
+    _state["failed"] = why
+    warnings.warn(
+        f"the compiled engine cannot be prepared on this machine ({why}); the numpy engine "
+        "serves: the same colours, slower on large meshes",
+        Notice,
+        stacklevel=stacklevel,
+    )
 
 
 def _start_loading() -> None:

@@ -6,7 +6,8 @@ background on a machine whose cache lacks the kernels. It takes the lock
 with the compiled tier (every kind of pass the product makes, on small meshes, in both
 precisions: numba compiles each kernel signature once and writes it to its cache), then writes the
 ready marker. Progress and errors go to :func:`explorer.shading.tiers.log_path`; each run counts
-itself first (:func:`explorer.shading.tiers.record_attempt`), so that runs that end without the
+itself first (:func:`explorer.shading.tiers.record_attempt`; an error it raises:
+:func:`~explorer.shading.tiers.record_error`), so that runs that end without the
 marker (an error, a crash of the compiler) are not started again and again.
 
 :func:`load` runs the same passes in a process whose cache already holds them: numba loads each
@@ -172,7 +173,7 @@ def main() -> int:
         passes = exercise()
     except Exception as exc:  # noqa: BLE001 - written for the next process to tell the user
         traceback.print_exc(file=sys.stdout)
-        tiers.record_attempt(f"{type(exc).__name__}: {exc}")
+        tiers.record_error(f"{type(exc).__name__}: {exc}")
         return 1
     seconds = time.perf_counter() - t
     tiers.write_marker(seconds)

@@ -310,7 +310,7 @@ def test_after_failed_background_compiles_the_numpy_tier_serves_and_says_why(col
     assert tiers._state["started"]
     # two: no more; the first pass says why, once, and how to try again
     tiers.record_attempt()
-    tiers.record_attempt("RuntimeError: LLVM ERROR")
+    tiers.record_error("RuntimeError: LLVM ERROR")
     assert tiers.attempts() == {"attempts": 2, "error": "RuntimeError: LLVM ERROR"}
     tiers.set_mode("auto")
     tiers._state.update(started=False)
@@ -319,7 +319,7 @@ def test_after_failed_background_compiles_the_numpy_tier_serves_and_says_why(col
         assert not tiers.compiled(10**9)
     assert len(told) == 1
     said = str(told[0].message)
-    assert "could not be prepared" in said and "LLVM ERROR" in said
+    assert "cannot be prepared" in said and "LLVM ERROR" in said
     assert f"remove {tiers.attempt_path()}" in said
     assert not tiers._state["started"]  # none started
     assert "unavailable" in tiers.status() and "LLVM ERROR" in tiers.status()
