@@ -19,15 +19,19 @@ handed back, as repeated one-shot calls do) against it.
 
 ``--slabs 0,65536,131072,262144`` times only one-shot calls and their geometry preparation at
 each slab size (0: one slab of every vertex, as a kept ``Shader`` prepares it), the sizes taking
-turns. Last run (AMD EPYC, 2 cores, load 1.3, ``--repeat 7``; medians, ms; the VM moves these
-by 10 % from run to run):
+turns. Two runs on an idle machine (AMD EPYC, 2 cores, load 0.45-0.61, ``--slabs
+0,262144,65536 --repeat 15``; medians, ms, run 1 / run 2; the VM moves these by 10 % from run
+to run). The 256k slabs made the slowest one-shot float64 call in both runs (by 4-13 %), 64k
+the fastest, while the geometry rows are alike; the default stays 256k because beside a busy
+process each slab's three parallel regions can wait for a descheduled thread (15 calls beside a
+CPU-bound process: one slab 90 ms, 256k 115 ms, 128k 196 ms): worth measuring again.
 
 | slab | one-shot float64 | geometry float64 | one-shot float32 | geometry float32 |
 |---:|---:|---:|---:|---:|
-| 1,000,000 (whole) | 30.40 | 5.53 | 16.34 | 3.31 |
-| 65,536 | 28.10 | 3.49 | 17.79 | 3.61 |
-| 131,072 | 29.46 | 3.49 | 16.18 | 3.67 |
-| 262,144 | 27.84 | 3.79 | 15.57 | 3.30 |
+| 1,000,000 (whole) | 25.19 / 22.89 | 3.19 / 2.68 | 12.84 / 12.91 | 2.46 / 2.56 |
+| 262,144 | 26.17 / 25.16 | 2.32 / 2.28 | 13.69 / 13.08 | 2.15 / 2.30 |
+| 65,536 | 24.68 / 22.22 | 2.32 / 2.41 | 12.87 / 12.69 | 2.35 / 2.63 |
+
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 
