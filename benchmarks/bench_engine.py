@@ -11,26 +11,15 @@ only a mesh whose vertex order keeps neighbours together allows.
 Prints the machine, then one row per case: median and best wall time over ``--repeat`` runs (the
 first, compiling run is excluded), vertex-lights per second, and ratios. The memory-bandwidth
 floor of a recolour (read positions and normals once, write colours once) is measured in the
-same run, on the same arrays, so "recolour / floor" is a like-for-like ratio; so are the rows
-"geometry preparation" (what a one-shot ``shade()`` does before and between its passes: check
-the vertices, find the frame, the plan, then slab by slab (``prepared.SLAB`` vertices) the
-geometry in the working precision and its chunk bounds, into the buffers the previous call
-handed back, as repeated one-shot calls do) against it.
-
-``--slabs 0,65536,131072,262144`` times only one-shot calls and their geometry preparation at
-each slab size (0: one slab of every vertex, as a kept ``Shader`` prepares it), the sizes taking
-turns. Two runs on an idle machine (AMD EPYC, 2 cores, load 0.45-0.61, ``--slabs
-0,262144,65536 --repeat 15``; medians, ms, run 1 / run 2; the VM moves these by 10 % from run
-to run). The 256k slabs made the slowest one-shot float64 call in both runs (by 4-13 %), 64k
-the fastest, while the geometry rows are alike; the default stays 256k because beside a busy
-process each slab's three parallel regions can wait for a descheduled thread (15 calls beside a
-CPU-bound process: one slab 90 ms, 256k 115 ms, 128k 196 ms): worth measuring again.
-
-| slab | one-shot float64 | geometry float64 | one-shot float32 | geometry float32 |
-|---:|---:|---:|---:|---:|
-| 1,000,000 (whole) | 25.19 / 22.89 | 3.19 / 2.68 | 12.84 / 12.91 | 2.46 / 2.56 |
-| 262,144 | 26.17 / 25.16 | 2.32 / 2.28 | 13.69 / 13.08 | 2.15 / 2.30 |
-| 65,536 | 24.68 / 22.22 | 2.32 / 2.41 | 12.87 / 12.69 | 2.35 / 2.63 |
+same run, on the same arrays, so "recolour / floor" is a like-for-like ratio. "geometry
+preparation" is what a one-shot ``shade()`` does before its pass (:func:`one_shot_geometry`:
+check the vertices, find the frame and its extent, the plan, and the chunk bounds light
+culling would use); its pass then prepares each block of vertices as it shades it
+(``kernels.Vertices``), so that share is inside the one-shot rows, and the row "one-shot -
+full shading" gives what a one-shot call costs beyond a kept shader's pass over the same
+lights. The geometry rows and the floor are timed in turns, call after call, so the ratio
+between them sees the same machine (the floor moves by 2x between runs, with what of the
+arrays the cache still holds).
 
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
@@ -40,7 +29,9 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import statistics
 import sys
+import time
 
 import numba
 import numpy as np
@@ -51,7 +42,6 @@ from explorer.core.lights import PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
-from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
@@ -105,37 +95,35 @@ def spot_lights(lights: int, rng) -> tuple:
     return tuple(out)
 
 
-def slab_sizes(scene, P, N, sizes, R) -> int:
-    """One-shot calls (and their geometry preparation alone) at each slab size: the sizes
-    take turns, ``R`` rounds, so drift spreads over all of them; prints the medians."""
-    n = len(P)
-    times: dict = {}
+def one_shot_geometry(scene, P, N, precision: str) -> None:
+    """What a one-shot ``shade()`` does before its pass: the shader's checks, the frame (one
+    compiled pass over the positions, their finiteness test too), the plan, and the chunk bounds
+    for light culling (a sample first; every chunk when the sample says culling pays). Older
+    revisions (``benchmarks/bench_revisions.py``) prepared the geometry here too: slab by slab
+    (``_slabs``), or whole."""
+    sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
+    sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
+    if hasattr(sh, "_one_shot"):
+        from explorer.shading import prepared  # (here: older revisions have no such module)
+
+        src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale)
+        prepared.chunk_bounds(src, sh._k)
+    for _ in getattr(sh, "_slabs", lambda: ())():
+        pass
+
+
+def in_turns(fns: dict, R: int) -> dict:
+    """(median, best) seconds of each of ``fns`` (name -> function), timed in turns: one call
+    of each per round, ``R`` rounds after a warm-up round."""
+    for fn in fns.values():
+        fn()
+    ts: dict = {name: [] for name in fns}
     for _ in range(R):
-        for size in sizes:
-            prepared.SLAB = size or n
-            for precision in ("float64", "float32"):
-
-                def prep(precision=precision):
-                    sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
-                    for _ in sh._slabs():
-                        pass
-
-                one = timed(lambda p=precision: explorer.shade(scene, P, N, precision=p), 3)[0]
-                times.setdefault((size, precision, "one-shot"), []).append(one)
-                times.setdefault((size, precision, "geometry"), []).append(timed(prep, 3)[0])
-    print(f"machine: {machine()}")
-    print(f"mesh: {n} vertices, {len(scene.lights)} point lights; medians of {R} rounds\n")
-    print("| slab (vertices) | one-shot float64 ms | geometry float64 ms "
-          "| one-shot float32 ms | geometry float32 ms |")  # fmt: skip
-    print("|---:|---:|---:|---:|---:|")
-    for size in sizes:
-        cells = [
-            f"{np.median(times[(size, p, what)]) * 1e3:.2f}"
-            for p in ("float64", "float32")
-            for what in ("one-shot", "geometry")
-        ]
-        print(f"| {size or n} | " + " | ".join(cells) + " |")
-    return 0
+        for name, fn in fns.items():
+            t = time.perf_counter()
+            fn()
+            ts[name].append(time.perf_counter() - t)
+    return {name: (statistics.median(v), min(v)) for name, v in ts.items()}
 
 
 def main(argv=None) -> int:
@@ -143,22 +131,15 @@ def main(argv=None) -> int:
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--lights", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=11)
-    ap.add_argument(
-        "--slabs",
-        default="",
-        help="only time one-shot calls with these slab sizes (comma-separated vertex counts, "
-        "multiples of kernels.BLOCK; 0: one slab of every vertex; see prepared.SLAB)",
-    )
     args = ap.parse_args(argv)
     n, L, R = args.vertices, args.lights, args.repeat
     rng = np.random.default_rng(0)
     P, N = sphere_points(n, rng)
     scene = scene_with(L, rng)
-    if args.slabs:
-        return slab_sizes(scene, P, N, [int(v) for v in args.slabs.split(",")], R)
     other = scene_with(L, np.random.default_rng(1)).lights
 
     rows = []
+    full = {}  # median full shading per precision
 
     def row(name, med, best, work=None, note=""):
         rate = f"{work / med / 1e9:.2f}" if work else ""
@@ -182,8 +163,7 @@ def main(argv=None) -> int:
             n * L,
             "light change: every term recomputed",
         )
-        if precision == "float32":
-            full32 = med
+        full[precision] = med
 
     # the same lights on a mesh: a UV sphere with as many vertices, in the order it was made
     # (ring after ring), and the same vertices shuffled. In mesh order neighbours sit
@@ -233,24 +213,28 @@ def main(argv=None) -> int:
 
     row(f"full shading, float32 ({L} spot lights, Blinn, local viewer)", *timed(respot, R), n * L)
 
-    one_shot = timed(lambda: explorer.shade(scene, P, N, precision="float32"), R)
-    row("one-shot `shade()` float32, incl. preparing the geometry", *one_shot, n * L)
-    one_shot = timed(lambda: explorer.shade(scene, P, N), R)
-    row("one-shot `shade()` float64 (the default), incl. preparing the geometry", *one_shot, n * L)
-    # what a one-shot call does before and between its passes: check the vertices, find the
-    # frame, the plan, and slab by slab the geometry in the working precision and its chunk
-    # bounds (into the buffers the previous call left)
-    geometry = {}
+    one_shot = {}
     for precision in ("float32", "float64"):
-
-        def prep(precision=precision):
-            sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
-            sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
-            for _ in sh._slabs():
-                pass
-
-        geometry[precision] = timed(prep, R)
-        row(f"geometry preparation, {precision} (of a one-shot call)", *geometry[precision])
+        one_shot[precision] = timed(lambda p=precision: explorer.shade(scene, P, N, precision=p), R)
+        what = "float64 (the default)" if precision == "float64" else precision
+        row(f"one-shot `shade()` {what}, incl. preparing the geometry", *one_shot[precision], n * L)
+    # what a one-shot call does before its pass, in turns with the bandwidth floor (below)
+    out = np.empty((n, 3), np.float32)
+    turns = in_turns(
+        {
+            "stream": lambda: K.stream(P, N, out),
+            "add": lambda: np.add(P, N, out=out),
+            "float32": lambda: one_shot_geometry(scene, P, N, "float32"),
+            "float64": lambda: one_shot_geometry(scene, P, N, "float64"),
+        },
+        R,
+    )
+    geometry = {p: turns[p] for p in ("float32", "float64")}
+    for precision, (med, best) in geometry.items():
+        row(f"geometry preparation, {precision} (of a one-shot call, before its pass)", med, best)
+    for precision in ("float32", "float64"):
+        extra = one_shot[precision][0] - full[precision]
+        row(f"one-shot - full shading, {precision} (medians: beyond a kept pass)", extra, extra)
 
     # interactive updates, float32 Shader
     sh = explorer.Shader(scene, P, N, precision="float32")
@@ -281,9 +265,8 @@ def main(argv=None) -> int:
 
     row("viewer change (specular only)", *timed(review, R), n * L)
 
-    out = np.empty((n, 3), np.float32)
     # the floor: the faster of a compiled parallel pass and numpy's add over the same arrays
-    floor = min(timed(lambda: K.stream(P, N, out), R), timed(lambda: np.add(P, N, out=out), R))
+    floor = min(turns["stream"], turns["add"])
     row(
         "bandwidth floor: read P, N once + write colours once",
         *floor,
@@ -315,7 +298,10 @@ def main(argv=None) -> int:
             f"geometry preparation {precision} / bandwidth floor: {med / floor[0]:.2f}x (median), "
             f"{best / floor[1]:.2f}x (best)"
         )
-    print(f"full float32 shading vs plain numpy reference: {ref[0] * n / sub / full32:.1f}x faster")
+    print(
+        "full float32 shading vs plain numpy reference: "
+        f"{ref[0] * n / sub / full['float32']:.1f}x faster"
+    )
     print(
         f"UV sphere, mesh order vs shuffled (light culling): {shuffled32 / mesh32:.2f}x faster "
         f"({culled['mesh order']:.0%} of the vertex-lights skipped)"

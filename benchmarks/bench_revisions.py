@@ -146,19 +146,12 @@ for _ in range(11):
     t = time.perf_counter(); explorer.shade(scene, P, N, precision={precision!r})
     ts.append(time.perf_counter() - t)
 print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
-from explorer.shading import shader as shader_module
-spare = getattr(shader_module, "_GEOMETRY", None)  # (revisions before k10 keep no spare)
-ts = []  # geometry preparation of a one-shot call (bench_engine's row): the shader's checks,
-for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):  # frame, prepared
-    t = time.perf_counter()  # geometry and chunk bounds; its geometry then the spare
-    sh = explorer.Shader(scene, P, N, precision={precision!r}, keep=False)
-    sh._compiled_geometry()
-    for _ in getattr(sh, "_slabs", lambda: ())():  # (slab by slab, the buffers handed back)
-        pass
+from bench_engine import one_shot_geometry
+ts = []  # what a one-shot call does before its pass (bench_engine's geometry row)
+for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):
+    t = time.perf_counter()
+    one_shot_geometry(scene, P, N, {precision!r})
     ts.append(time.perf_counter() - t)
-    if spare is not None and sh._G is not None:
-        spare.give(sh._G)
-    del sh
 print(min(ts[1:]) * 1e3 if ts else "nan", statistics.median(ts[1:]) * 1e3 if ts else "nan")
 sh = explorer.Shader(scene, P, N, precision={precision!r})
 sh.colors

@@ -336,6 +336,58 @@ def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
     return outside
 
 
+class Vertices(NamedTuple):
+    """A pass's geometry as the caller holds it, prepared block by block as the pass reaches
+    it (:func:`prepare`'s arithmetic: the same values), so that no (6, n) G is written or read
+    (a one-shot pass). ``P``, ``N`` (n, 3) float32/float64 world positions and normals (one
+    dtype); ``centre`` (3,) float64 and ``inv_scale`` float64: the normalised frame."""
+
+    P: np.ndarray
+    N: np.ndarray
+    centre: np.ndarray
+    inv_scale: float
+
+
+def _vertex_count(src):  # pragma: no cover - replaced by the overload
+    raise NotImplementedError
+
+
+@overload(_vertex_count, jit_options=_LEAF)
+def _vertex_count_overload(src):
+    """How many vertices a pass's geometry holds: G (6, n) or :class:`Vertices`."""
+    if isinstance(src, types.Array):
+        return lambda src: src.shape[1]
+    return lambda src: src.P.shape[0]
+
+
+def _geometry(src, s, e, gb, k):  # pragma: no cover - replaced by the overload
+    raise NotImplementedError
+
+
+@overload(_geometry, jit_options=_LEAF)
+def _geometry_overload(src, s, e, gb, k):
+    """Vertices ``s`` to ``e`` of a pass's geometry as six (e - s,) T rows (px, py, pz, nx, ny,
+    nz; see :func:`prepare`) and 0, or 1 when some of their normals lie outside NORMAL_RANGE or
+    are not finite (as :func:`prepare` counts them). ``src``: G (6, n), whose rows are given as
+    they are, or :class:`Vertices`, prepared here into ``gb`` (6, >= e - s) T."""
+    if isinstance(src, types.Array):
+
+        def rows(src, s, e, gb, k):
+            return (src[0, s:e], src[1, s:e], src[2, s:e], src[3, s:e], src[4, s:e], src[5, s:e]), 0
+
+        return rows
+
+    def prepared(src, s, e, gb, k):
+        m = e - s
+        Pf, Nf = src.P.reshape(-1), src.N.reshape(-1)
+        frame = (src.centre, src.inv_scale)
+        _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
+        outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
+        return (gb[0, :m], gb[1, :m], gb[2, :m], gb[3, :m], gb[4, :m], gb[5, :m]), outside
+
+    return prepared
+
+
 #: squared lengths that put a normal's largest component inside NORMAL_RANGE (the fast test of
 #: explorer.geometry.frame.scale_normals: the largest lies between length/√3 and length)
 _NN_LO, _NN_HI = 3.0 * tol.NORMAL_RANGE[0] ** 2, tol.NORMAL_RANGE[1] ** 2
@@ -456,10 +508,11 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def bounds(G, out, step):
+def bounds(src, k, out, step):
     """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
 
-    G : (6, n) T prepared geometry (see :func:`prepare`)
+    src : the pass's geometry: G (6, n) T prepared (see :func:`prepare`), or :class:`Vertices`
+    (each chunk prepared here as :func:`prepare` would: the same bounds); k : constants(T)
     out : (N_BOUNDS, ceil(n / CHUNK)) float64: the bounding sphere of the chunk's positions
     (centre of its box, radius to the farthest vertex) and the cone of its normals (axis: their
     mean direction; half-angle: the widest normal from it), both widened by
@@ -468,34 +521,48 @@ def bounds(G, out, step):
     step : every chunk (1), or every ``step``-th one (columns 0, step, 2·step ...; the others
     are left as they were): a sample, to see whether culling can pay before finding them all
     """
-    for j in nb.prange((out.shape[1] + step - 1) // step):
-        _chunk_bounds(G, j * step, out)
+    nj = (out.shape[1] + step - 1) // step
+    ntasks = max(1, min(nj, TASKS))
+    for t in nb.prange(ntasks):
+        gb = np.empty((6, CHUNK), k.dtype)  # (a chunk of Vertices, prepared: once per task)
+        _bounds_run(src, k, out, step, t * nj // ntasks, (t + 1) * nj // ntasks, gb)
 
 
 @nb.njit(**_LEAF)
-def _chunk_bounds(G, c, out):
-    """Column ``c`` of :func:`bounds`' ``out``: chunk ``c`` of the prepared geometry ``G``."""
-    n = G.shape[1]
+def _bounds_run(src, k, out, step, j0, j1, gb):
+    """Columns j0·step, (j0 + 1)·step ... (j1 - 1)·step of :func:`bounds`' ``out``: the rows
+    :func:`_geometry` gives are views without reference counts, used here only."""
+    n = _vertex_count(src)
+    for j in range(j0, j1):
+        s = j * step * CHUNK
+        e = min(n, s + CHUNK)
+        g, _ = _geometry(src, s, e, gb, k)
+        _chunk_bounds(g, j * step, out)
+
+
+@nb.njit(**_LEAF)
+def _chunk_bounds(g, c, out):
+    """Column ``c`` of :func:`bounds`' ``out`` from the chunk's geometry ``g``: six (m,) rows,
+    m <= CHUNK (positions, unit normals; see :func:`prepare`)."""
+    gx, gy, gz, gnx, gny, gnz = g
     guard = tol.CULL_GUARD
-    s = c * CHUNK
-    e = min(n, s + CHUNK)
     # (scalars, not small arrays: an allocation per chunk cost more than the chunk)
     lx = ly = lz = np.inf
     hx = hy = hz = -np.inf
     ax = ay = az = 0.0
-    for i in range(s, e):
-        x, y, z = np.float64(G[0, i]), np.float64(G[1, i]), np.float64(G[2, i])
+    for i in range(gx.shape[0]):
+        x, y, z = np.float64(gx[i]), np.float64(gy[i]), np.float64(gz[i])
         lx, ly, lz = min(lx, x), min(ly, y), min(lz, z)
         hx, hy, hz = max(hx, x), max(hy, y), max(hz, z)
-        ax += np.float64(G[3, i])
-        ay += np.float64(G[4, i])
-        az += np.float64(G[5, i])
+        ax += np.float64(gnx[i])
+        ay += np.float64(gny[i])
+        az += np.float64(gnz[i])
     cx, cy, cz = 0.5 * (lx + hx), 0.5 * (ly + hy), 0.5 * (lz + hz)
     r2 = 0.0
-    for i in range(s, e):
-        x = np.float64(G[0, i]) - cx
-        y = np.float64(G[1, i]) - cy
-        z = np.float64(G[2, i]) - cz
+    for i in range(gx.shape[0]):
+        x = np.float64(gx[i]) - cx
+        y = np.float64(gy[i]) - cy
+        z = np.float64(gz[i]) - cz
         r2 = max(r2, x * x + y * y + z * z)
     r = np.sqrt(r2) * (1.0 + guard) + guard
     la = np.sqrt(ax * ax + ay * ay + az * az)
@@ -503,8 +570,8 @@ def _chunk_bounds(G, c, out):
     if la > 0.0:
         ax, ay, az = ax / la, ay / la, az / la
         ct = 1.0
-        for i in range(s, e):
-            nn = ax * G[3, i] + ay * G[4, i] + az * G[5, i]
+        for i in range(gx.shape[0]):
+            nn = ax * gnx[i] + ay * gny[i] + az * gnz[i]
             ct = min(ct, nn)  # an absent normal gives 0: never culled
         ct -= guard
     if ct <= 0.0:
@@ -1327,19 +1394,23 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
 
 @nb.njit(**_LEAF)
 def _task(
-    G, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, act, b0, b1, layout, cull
+    src, lights, opts, surface, k, sums, lobes, vis, marks, out, work, act, b0, b1, layout, cull
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
-    arrays here costs no atomic operations on their counts, which both threads would contend).
-    ``sums`` and ``out`` are flat (see :func:`_flat`); ``layout`` is (grey_only, dw, sw): the
-    pass keeps its sums in the grey rows alone (:func:`grey_pass`), and the widths of the D and
-    S sums (1: grey); ``cull`` : :class:`Culling`."""
+    arrays here costs no atomic operations on their counts, which both threads would contend);
+    returns how many of them hold a normal outside NORMAL_RANGE (:class:`Vertices` only; see
+    :func:`_geometry`). ``src``: the pass's geometry (see :func:`shade`); ``sums`` and ``out``
+    are flat (see :func:`_flat`); ``work``: the task's scratch and its (6, BLOCK) rows for a
+    block of Vertices; ``layout`` is (grey_only, dw, sw): the pass keeps its sums in the grey
+    rows alone (:func:`grey_pass`), and the widths of the D and S sums (1: grey); ``cull`` :
+    :class:`Culling`."""
+    scr, gb = work
     params, flags = lights.params, lights.flags
     A, D, S = sums
     redo, redo_count = marks
     bounds, culled = cull
     dw, sw = layout[1], layout[2]
-    n = G.shape[1]
+    n = _vertex_count(src)
     # light culling: which chunks of the task's blocks each light can reach, one vectorised
     # _reach per light (per block, its 16 chunks are fewer than one vector iteration); not
     # two-sided (N flips with V)
@@ -1351,11 +1422,14 @@ def _task(
             fl = flags[li]
             back = not (do_amb and (fl & AMBIENT) != 0)
             _reach(bounds, c0, c1 - c0, params[li, :], fl, back, act[li, :])
+    outside = 0
     for b in range(b0, b1):
         s = b * BLOCK
         e = min(n, s + BLOCK)
+        g, bad = _geometry(src, s, e, gb, k)
+        outside += bad
         _block(
-            (G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e]),
+            g,
             lights,
             opts,
             surface,
@@ -1370,6 +1444,7 @@ def _task(
             act[:, (b - b0) * CHUNKS : (b - b0 + 1) * CHUNKS] if cull_on else act[:, :0],
             culled[b : b + 1],
         )
+    return outside
 
 
 def _host_has_avx512() -> bool:
@@ -1442,29 +1517,40 @@ def wide_vectors(lanes: int = 16):
             llvm.set_option("", "-force-vector-interleave=0")
 
 
+def _kind(a):
+    """What of a kernel argument decides numba's signature, roughly: an array's dtype, number
+    of dimensions and writability, a tuple's members' kinds, else the type."""
+    if isinstance(a, np.ndarray):
+        return a.dtype, a.ndim, a.flags.writeable
+    if isinstance(a, tuple):
+        return tuple(_kind(x) for x in a)
+    return type(a)
+
+
 def _wide(kernel, dtype_arg: int, lanes: int = 0):
-    """Call ``kernel`` so that a signature it meets for the first time with float data of a
-    dtype (that of positional argument ``dtype_arg``) is compiled with 512-bit vectors
-    (:func:`wide_vectors` around such first calls, which compile or load from numba's cache);
-    later calls go straight to the kernel. ``lanes``: a fixed width instead (8: a kernel whose
-    arithmetic is float64 whatever its data)."""
+    """Call ``kernel`` so that a signature it meets for the first time (by the :func:`_kind` of
+    its arguments) with float data of a dtype (that of positional argument ``dtype_arg``) is
+    compiled with 512-bit vectors (:func:`wide_vectors` around such first calls, which compile
+    or load from numba's cache); later calls go straight to the kernel. ``lanes``: a fixed
+    width instead (8: a kernel whose arithmetic is float64 whatever its data)."""
     if not WIDE_VECTORS:
         return kernel
     seen: set = set()
 
     @functools.wraps(kernel.py_func)
     def call(*args):
-        dt = args[dtype_arg].dtype
-        if dt in seen:
+        key = _kind(args)
+        if key in seen:
             return kernel(*args)
+        dt = args[dtype_arg].dtype
         if dt not in (np.float32, np.float64):
-            seen.add(dt)
+            seen.add(key)
             return kernel(*args)
         with wide_vectors(lanes or 64 // dt.itemsize):
             try:
                 return kernel(*args)
             finally:
-                seen.add(dt)
+                seen.add(key)
 
     call.dispatcher = kernel  # the numba dispatcher itself (signatures, inspection)
     return call
@@ -1572,16 +1658,20 @@ class Culling(NamedTuple):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def shade(G, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
-    """Shade every vertex (see the module docstring).
+def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
+    """Shade every vertex (see the module docstring); returns how many blocks hold a normal
+    outside NORMAL_RANGE or not finite (only :class:`Vertices`, which the pass prepares: 0, or
+    scale the normals and shade again; see :func:`prepare`).
 
-    G : (6, n) T prepared geometry (see :func:`prepare`); lights : :class:`Lights`
+    src : the geometry: G (6, n) T prepared (see :func:`prepare`), or :class:`Vertices`, each
+    block prepared as the pass reaches it (a one-shot pass: no G written, and the pass reads
+    the caller's positions and normals instead of G's six rows); lights : :class:`Lights`
     opts : (N_OPTS,) int64; surface : :class:`Surface`; k : constants(T)
     sums : :class:`Sums` (read where not recomputed, written where stored); lobes :
     :class:`Lobes`; vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
     marks : :class:`Marks`; out : (n, 3) colours; culling : :class:`Culling`
     """
-    n = G.shape[1]
+    n = _vertex_count(src)
     nblocks = (n + BLOCK - 1) // BLOCK
     ntasks = _tasks(nblocks)
     D, S = sums.D, sums.S
@@ -1597,16 +1687,18 @@ def shade(G, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
             raise ValueError("grey (n, 1) sums need a grey pass (see grey_pass)")
     culls = culling.bounds.shape[1] > 0
     L = lights.params.shape[0]
+    outside = 0
     for t in nb.prange(ntasks):
         scr = _scratch(lights.params.dtype)  # once per task: no allocation per block
+        gb = np.empty((6, BLOCK), k.dtype)  # (a block of Vertices, prepared)
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
         r = _spread(np.int64(t), np.int64(ntasks)) if culls else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
         act = np.empty((L, (b1 - b0) * CHUNKS if culls else 0), np.int32)
         flat = Sums(Af, Df, Sf)
         layout = (grey_only, dw, sw)
-        _task(
-            G,
+        outside += _task(
+            src,
             lights,
             opts,
             surface,
@@ -1616,13 +1708,14 @@ def shade(G, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
             vis,
             marks,
             outf,
-            scr,
+            (scr, gb),
             act,
             b0,
             b1,
             layout,
             culling,
         )
+    return outside
 
 
 @nb.njit(**_OPTS)
@@ -1704,7 +1797,7 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         vm,
         none,
         om.reshape(-1),
-        _scratch(np.float64),
+        (_scratch(np.float64), np.empty((6, 0))),  # (G: no block to prepare)
         np.empty((L, 0), np.int32),
         0,
         nblocks,
@@ -1944,8 +2037,8 @@ def _add(p, q, o):
 # the number is the argument whose dtype picks the precision
 prepare = _wide(prepare, 5)
 extent = _wide(extent, 0)
-bounds = _wide(bounds, 0, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
-shade = _wide(shade, 0)
+bounds = _wide(bounds, 1, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
+shade = _wide(shade, 4)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)
 stream = _wide(stream, 2)

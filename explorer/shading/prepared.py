@@ -1,12 +1,11 @@
-"""The compiled tier's prepared geometry: the normalised frame, positions and unit normals as
-(6, n) rows in the working precision (:func:`explorer.shading.kernels.prepare`) and light
-culling's chunk bounds; for a one-shot pass, the same slab by slab (:func:`slabs`), so that no
-full-size copy is written.
+"""The compiled tier's geometry: the normalised frame; for a kept shader, positions and unit
+normals as (6, n) rows in the working precision (:func:`explorer.shading.kernels.prepare`); for a
+one-shot pass, the caller's vertices as they are (:func:`vertices`: the pass prepares each block
+as it reaches it, so that no full-size copy is written); and light culling's chunk bounds of
+either.
 """
 
 from __future__ import annotations
-
-import threading
 
 import numpy as np
 
@@ -16,11 +15,6 @@ from explorer.shading import kernels as K
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
 CULL_MIN_SHARE = 8
-#: vertices per slab of a one-shot pass (:func:`slabs`; a multiple of BLOCK): its
-#: prepared geometry, 48 bytes a vertex in float64 (12 MB), stays in the cache between being
-#: written and being shaded; each slab costs three parallel regions, each of which waits for a
-#: thread another process holds (``benchmarks/bench_engine.py --slabs`` measures the choice)
-SLAB = 256 * 1024
 #: :func:`chunk_bounds` tests that share on every CULL_SAMPLE-th chunk before it finds them all
 CULL_SAMPLE = 16
 
@@ -52,96 +46,43 @@ def prepared_geometry(P, N, dtype, k) -> tuple:
         check_finite("normals", N)
         N = scale_normals(N)
         K.prepare(readonly(P), readonly(N), *frame, G)
-    return centre, scale, G, chunk_bounds(G), N
+    return centre, scale, G, chunk_bounds(G, k), N
 
 
 def geometry_of(P, N, dtype, k, whole: bool = True) -> tuple:
     """(centre, scale, G, bounds, N): :func:`prepared_geometry`; ``whole`` False (a one-shot
-    shader, which prepares slabs as it shades: :func:`slabs`): the frame alone,
+    shader, whose pass prepares each block as it shades: :func:`vertices`): the frame alone,
     (centre, scale, None, None, None)."""
     if whole:
         return prepared_geometry(P, N, dtype, k)
     return (*frame_of_positions(P), None, None, None)
 
 
-def chunk_bounds(G: np.ndarray) -> np.ndarray:
-    """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of the
-    prepared geometry ``G`` (6, n), for light culling (see :func:`explorer.shading.kernels.bounds`),
-    read-only; (N_BOUNDS, 0) when fewer than one chunk in CULL_MIN_SHARE has a normal cone
-    narrower than 90° (shuffled vertices, say): too little could be culled to pay for the tests.
-    Every CULL_SAMPLE-th chunk is found first: when those already fall short, the rest are not
-    (on vertices in no particular order most of the bounds' cost)."""
-    b = np.empty((K.N_BOUNDS, -(-G.shape[1] // K.CHUNK)), np.float64)
-    K.bounds(G, b, CULL_SAMPLE)
+def vertices(P, N, centre, scale) -> K.Vertices:
+    """Positions ``P`` and normals ``N`` (n, 3) (one dtype) in the frame ``centre``, ``scale``
+    as a one-shot pass takes them (:class:`explorer.shading.kernels.Vertices`, read-only)."""
+    return K.Vertices(readonly(P), readonly(N), np.asarray(centre, np.float64), 1.0 / scale)
+
+
+def chunk_bounds(src, k) -> np.ndarray:
+    """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of a
+    pass's geometry ``src``: the prepared G (6, n), or :func:`vertices` (the same bounds; ``k``:
+    the working precision's constants), for light culling (see
+    :func:`explorer.shading.kernels.bounds`), read-only; (N_BOUNDS, 0) when fewer than one chunk
+    in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled vertices, say): too little
+    could be culled to pay for the tests. Every CULL_SAMPLE-th chunk is found first: when those
+    already fall short, the rest are not (on vertices in no particular order most of the
+    bounds' cost)."""
+    n = len(src.P) if isinstance(src, K.Vertices) else src.shape[1]
+    b = np.empty((K.N_BOUNDS, -(-n // K.CHUNK)), np.float64)
+    K.bounds(src, k, b, CULL_SAMPLE)
     sample = b[K.B_COS, ::CULL_SAMPLE]
     if np.count_nonzero(sample > 0) * CULL_MIN_SHARE < sample.size:
         return readonly(b[:, :0])
-    K.bounds(G, b, 1)
+    K.bounds(src, k, b, 1)
     if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
         b = b[:, :0]
     return readonly(b)
-
-
-def slabs(P, N, dtype, k, centre, scale):
-    """The prepared geometry of a one-shot pass, slab by slab: yields (s, e, G, bounds, N) for
-    vertices s to e, :data:`SLAB` at a time (a multiple of BLOCK; the last one fewer): G
-    (6, e - s) in precision ``dtype`` (``k``: its constants) in the frame ``centre``, ``scale``,
-    in one reused buffer (a second one for the last slab: the kernels take contiguous rows), its
-    chunk bounds (:func:`chunk_bounds`) and the normals ``N`` as prepared so far (scaled into
-    NORMAL_RANGE, all of them, once a slab held one outside it, as :func:`prepared_geometry`
-    does). Slab after slab stays in the cache, and no full-size G is written (48 MB at 1M
-    vertices in float64). A NaN or an infinite normal raises
-    :func:`~explorer.geometry.frame.check_finite`'s error naming the first one."""
-    n = len(P)
-    frame = (centre, 1.0 / scale, k)
-    P = readonly(P)
-    size = min(n, SLAB)
-    buffers = [SPARES.take((6, size), dtype)]
-    try:
-        for s in range(0, max(n, 1), SLAB):
-            e = min(n, s + SLAB)
-            if e - s != size:  # the last, shorter slab
-                buffers.append(SPARES.take((6, e - s), dtype))
-            G = buffers[-1]
-            if K.prepare(P[s:e], readonly(N)[s:e], *frame, G):  # (NaN and inf are outside too)
-                check_finite("normals", N)
-                N = scale_normals(N)
-                K.prepare(P[s:e], readonly(N)[s:e], *frame, G)
-            yield s, e, G, chunk_bounds(G), N
-    finally:
-        for b in buffers:
-            SPARES.give(b)
-
-
-class _Spare:
-    """The few arrays finished one-shot passes left, for the next call: the slab buffers of
-    their prepared geometry (:func:`slabs`: 6·SLAB values, 12 MB in float64, whose first
-    touch costs more page faults than preparing them costs work). Thread-safe: an array is taken
-    by one pass, which owns it until it gives it back."""
-
-    #: arrays kept at most (the latest given)
-    KEEP = 4
-
-    def __init__(self):
-        self._lock = threading.Lock()
-        self._spare: list[np.ndarray] = []
-
-    def take(self, shape: tuple, dtype) -> np.ndarray:
-        """A spare array of this shape and dtype, or a new one."""
-        with self._lock:
-            for i, a in enumerate(self._spare):
-                if a.shape == shape and a.dtype == dtype:
-                    return self._spare.pop(i)
-        return np.empty(shape, dtype)
-
-    def give(self, a) -> None:
-        """Keep ``a`` (nothing else may use it any more) for a later :meth:`take`."""
-        with self._lock:
-            self._spare = [a, *self._spare[: self.KEEP - 1]]
-
-
-#: the slab buffers one-shot passes left for the next
-SPARES = _Spare()
 
 
 def readonly(a: np.ndarray) -> np.ndarray:

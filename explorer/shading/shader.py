@@ -47,6 +47,7 @@ from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, check_materials_dirs, load_scene
 from explorer.geometry.frame import (
     check_faces,
+    check_finite,
     check_vertices,
     scale_normals,
     to_frame,
@@ -56,7 +57,7 @@ from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.prepared import geometry_of, slabs
+from explorer.shading.prepared import chunk_bounds, geometry_of, vertices
 from explorer.shading.prepared import readonly as _readonly
 from explorer.shading.shadows import visibility_rows
 
@@ -65,6 +66,8 @@ PRECISIONS = ("float64", "float32")
 TIERS = ("compiled", "numpy")
 #: the specular models the compiled kernels implement; the others run on the numpy tier
 COMPILED_MODELS = ("blinn", "phong")
+#: chunk bounds of a pass without light culling
+_NO_BOUNDS = _readonly(np.zeros((K.N_BOUNDS, 0)))
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
 #: (:func:`invalidated`)
@@ -121,10 +124,10 @@ class Shader:
         normal outside NORMAL_RANGE is rescaled in a copy: see geometry.frame.scale_normals)
     precision : "float32" (default here: the interactive path) or "float64"
     keep : keep the light sums and the prepared geometry for cheap updates. False: one-shot
-        (what :func:`shade` uses): nothing per vertex is kept, each pass prepares the geometry
-        and shades it slab by slab (:data:`SLAB` vertices at a time, in the cache), less memory
-        and memory traffic; the constructor finds the frame (and NaN or infinite positions),
-        a pass finds NaN or infinite normals (the same error, before any colours)
+        (what :func:`shade` uses): nothing per vertex is kept, each pass prepares every block of
+        vertices as it shades it (no prepared copy of the geometry: less memory and memory
+        traffic); the constructor finds the frame (and NaN or infinite positions), a pass finds
+        NaN or infinite normals (the same error, before any colours)
     faces : (m, 3) int triangles for shadows (None: no shadows)
     force_all : the plan skips nothing (same colours; benchmark only)
     cull : skip a light for runs of vertices that provably get nothing from it (the plan's
@@ -213,7 +216,7 @@ class Shader:
 
     def _compiled_geometry(self, geometry=None) -> None:
         """The compiled tier's geometry (:func:`~explorer.shading.prepared.geometry_of`;
-        ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_slabs`)."""
+        ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_one_shot`)."""
         if self._centre is None:
             geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, self.keep)
             self._centre, self._scale, self._G, self._bounds, N = geometry
@@ -462,12 +465,9 @@ class Shader:
             K.Lobes(base, ws),
         )
         if self._G is not None:
-            self._pass(self._G, self._bounds, vis, inputs, 0, n)
-        else:  # a one-shot shader: slab by slab, each slab's geometry prepared as it comes
-            for s, e, G, bounds, N in self._slabs():
-                self._N = N  # (scaled where a slab held a normal outside NORMAL_RANGE)
-                self._pass(G, bounds, vis, inputs, s, e)
-            self._scaled = True  # (every normal was tested)
+            self._pass(self._G, self._bounds, vis, inputs)
+        else:
+            self._one_shot(vis, inputs)
         self.stats["pass"] += 1
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
@@ -478,32 +478,34 @@ class Shader:
                 if opts[K.O_STORE_LOBE]:
                     self._base, self._ws = None if flat else base, ws
 
-    def _slabs(self):
-        """A one-shot shader's prepared geometry, slab by slab (:func:`slabs`)."""
-        return slabs(self._P, self._N, self._T, self._k, self._centre, self._scale)
+    def _one_shot(self, vis, inputs) -> None:
+        """A one-shot shader's pass: the kernel prepares each block of the caller's vertices as
+        it reaches it (:func:`~explorer.shading.prepared.vertices`: no prepared copy). Normals
+        outside NORMAL_RANGE, which that pass finds, are scaled into it and the pass runs
+        again; NaN or infinite ones raise check_finite's error naming the first, no colours."""
+        for scaled in (False, True):  # (scaled ones lie inside: the second pass is the last)
+            src = vertices(self._P, self._N, self._centre, self._scale)
+            bounds = chunk_bounds(src, self._k) if self._plan.cull and self.cull else _NO_BOUNDS
+            if not self._pass(src, bounds, vis, inputs) or scaled:
+                break
+            check_finite("normals", self._N)
+            self._N = scale_normals(self._N)
+        self._scaled = True  # (every normal was tested)
 
-    def _pass(self, G, bounds, vis, inputs, s: int, e: int) -> None:
-        """The kernel over vertices ``s`` to ``e`` (+ the float64 redo of marked float32 lanes):
-        ``G`` (6, e - s) and ``bounds`` theirs; ``vis``, ``inputs`` (lights, options, surface,
-        constants, sums, lobes) for every vertex (cut to these here)."""
+    def _pass(self, src, bounds, vis, inputs) -> int:
+        """The kernel over every vertex (+ the float64 redo of marked float32 lanes): ``src``
+        the geometry (the prepared G, or :func:`~explorer.shading.prepared.vertices`),
+        ``bounds`` its chunk bounds; ``vis``, ``inputs`` (lights, options, surface, constants,
+        sums, lobes). Returns how many blocks hold a normal outside NORMAL_RANGE (vertices
+        only): when some do, nothing more is done (the colours are not to be used)."""
         lights, opts, surface, k, sums, lobes = inputs
-        whole = (s, e) == (0, self.n)
-        b0, b1 = s // K.BLOCK, -(-e // K.BLOCK)  # (s is a multiple of BLOCK)
-
-        def rows(a):  # vertices s to e of an (n, ...) array, or an empty one
-            return a if whole or a.shape[0] == 0 else a[s:e]
-
-        if not whole:  # (one-shot: no sums, no lobes kept; contiguous rows keep the kernel's
-            # argument types)
-            sums = K.Sums(*(rows(x) for x in sums))
-            vis = np.ascontiguousarray(vis[:, s:e]) if vis.shape[1] else vis
-        marks = K.Marks(rows(self._redo), self._redo_count[b0:b1])
-        out = rows(self._out)
-        culled = self._culled[b0:b1]
+        marks = K.Marks(self._redo, self._redo_count)
         cull = bounds if self._plan.cull and self.cull else bounds[:, :0]
-        args = (G, lights, opts, surface, k, sums, lobes, vis, marks, out)
-        K.shade(*args, K.Culling(cull, culled))
-        self.stats["culled"] += int(culled.sum())  # vertex-lights skipped
+        args = (src, lights, opts, surface, k, sums, lobes, vis, marks, self._out)
+        outside = K.shade(*args, K.Culling(cull, self._culled))
+        if outside:
+            return outside
+        self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
             P, N = self._P, self._normals() if self._G is not None else self._N  # (N: tested)
             params64, flags, view64 = self._params_for(np.float64)
@@ -512,8 +514,9 @@ class Shader:
             frame = (self._centre, 1.0 / self._scale)
             fix = (*frame, K.Lights(params64, flags, view64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
-                marks, rows(_readonly(P)), rows(_readonly(N)), *fix, sums, lobes, vis, out
+                marks, _readonly(P), _readonly(N), *fix, sums, lobes, vis, self._out
             )
+        return 0
 
 
 def _compiled_now(tier: str | None, model: str) -> bool:

@@ -65,7 +65,7 @@ def test_bounds_hold_every_vertex_of_their_chunk(name):
     _ = sh.colors  # the compiled tier prepares its geometry at its first pass
     G = sh._G.astype(np.float64)
     b = np.empty((K.N_BOUNDS, -(-sh.n // K.CHUNK)))
-    K.bounds(sh._G, b, 1)
+    K.bounds(sh._G, sh._k, b, 1)
     chunk = np.arange(sh.n) // K.CHUNK
     d = np.linalg.norm(G[:3].T - b[[K.B_CX, K.B_CY, K.B_CZ]][:, chunk].T, axis=1)
     assert np.all(d <= b[K.B_R, chunk])
@@ -84,9 +84,9 @@ def test_bounds_can_be_sampled_every_kth_chunk():
     sh = explorer.Shader({"material": MATERIAL}, mesh.positions, mesh.normals)
     _ = sh.colors
     full = np.empty((K.N_BOUNDS, -(-sh.n // K.CHUNK)))
-    K.bounds(sh._G, full, 1)
+    K.bounds(sh._G, sh._k, full, 1)
     sampled = np.full_like(full, np.nan)
-    K.bounds(sh._G, sampled, 5)
+    K.bounds(sh._G, sh._k, sampled, 5)
     assert np.array_equal(sampled[:, ::5], full[:, ::5])
     keep = np.ones(full.shape[1], bool)
     keep[::5] = False
