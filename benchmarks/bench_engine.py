@@ -42,6 +42,7 @@ from explorer.core.lights import PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
 from explorer.shading import kernels as K
+from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
@@ -98,18 +99,11 @@ def spot_lights(lights: int, rng) -> tuple:
 def one_shot_geometry(scene, P, N, precision: str) -> None:
     """What a one-shot ``shade()`` does before its pass: the shader's checks, the frame (one
     compiled pass over the positions, their finiteness test too), the plan, and the chunk bounds
-    for light culling (a sample first; every chunk when the sample says culling pays). Older
-    revisions (``benchmarks/bench_revisions.py``) prepared the geometry here too: slab by slab
-    (``_slabs``), or whole."""
+    for light culling (a sample first; every chunk when the sample says culling pays)."""
     sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
     sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
-    if hasattr(sh, "_one_shot"):
-        from explorer.shading import prepared  # (here: older revisions have no such module)
-
-        src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale)
-        prepared.chunk_bounds(src, sh._k)
-    for _ in getattr(sh, "_slabs", lambda: ())():
-        pass
+    src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale)
+    prepared.chunk_bounds(src, sh._k)
 
 
 def in_turns(fns: dict, R: int) -> dict:

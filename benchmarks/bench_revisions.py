@@ -146,11 +146,16 @@ for _ in range(11):
     t = time.perf_counter(); explorer.shade(scene, P, N, precision={precision!r})
     ts.append(time.perf_counter() - t)
 print(min(ts[1:]) * 1e3, statistics.median(ts[1:]) * 1e3)
-from bench_engine import one_shot_geometry
-ts = []  # what a one-shot call does before its pass (bench_engine's geometry row)
-for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):
-    t = time.perf_counter()
-    one_shot_geometry(scene, P, N, {precision!r})
+ts = []  # what a one-shot call does before its pass (bench_engine's geometry row; older
+for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):  # revisions
+    t = time.perf_counter()  # prepared the geometry here too: slab by slab, or whole)
+    sh = explorer.Shader(scene, P, N, precision={precision!r}, keep=False)
+    sh._compiled_geometry()
+    if hasattr(sh, "_vertex_pass"):
+        from explorer.shading import prepared
+        prepared.chunk_bounds(prepared.vertices(sh._P, sh._N, sh._centre, sh._scale), sh._k)
+    for _ in getattr(sh, "_slabs", lambda: ())():
+        pass
     ts.append(time.perf_counter() - t)
 print(min(ts[1:]) * 1e3 if ts else "nan", statistics.median(ts[1:]) * 1e3 if ts else "nan")
 sh = explorer.Shader(scene, P, N, precision={precision!r})
