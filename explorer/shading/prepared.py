@@ -49,21 +49,11 @@ def prepared_geometry(P, N, dtype, k) -> tuple:
     return centre, scale, G, chunk_bounds(G, k), N
 
 
-def keeps_copy(P, dtype, keep: bool) -> bool:
-    """Whether a shader of positions ``P`` in precision ``dtype`` (``keep``: a kept shader) holds
-    a prepared copy G (6, n) for its passes: only a kept shader, and only when its vertices are
-    as wide as its precision. float32 vertices in float64 take 24 bytes a vertex to read and G
-    48, and a pass reads its geometry whole (1M vertices: more bytes than fit the cache), so
-    such a pass prepares each block of the vertices as it shades it (:func:`vertices`), as a
-    one-shot pass does: ``benchmarks/bench_engine.py`` measures both."""
-    return keep and P.dtype.itemsize >= np.dtype(dtype).itemsize
-
-
-def geometry_of(P, N, dtype, k, keep: bool = True) -> tuple:
-    """(centre, scale, G, bounds, N) of a shader (``keep``: a kept one): :func:`prepared_geometry`
-    where it keeps a prepared copy (:func:`keeps_copy`), else (its passes prepare each block as
-    they shade it: :func:`vertices`) the frame alone, (centre, scale, None, None, None)."""
-    if keeps_copy(P, dtype, keep):
+def geometry_of(P, N, dtype, k, whole: bool = True) -> tuple:
+    """(centre, scale, G, bounds, N): :func:`prepared_geometry`; ``whole`` False (a one-shot
+    shader, whose pass prepares each block as it shades: :func:`vertices`): the frame alone,
+    (centre, scale, None, None, None)."""
+    if whole:
         return prepared_geometry(P, N, dtype, k)
     return (*frame_of_positions(P), None, None, None)
 
@@ -74,7 +64,7 @@ def vertices(P, N, centre, scale) -> K.Vertices:
     return K.Vertices(readonly(P), readonly(N), np.asarray(centre, np.float64), 1.0 / scale)
 
 
-def chunk_bounds(src, k, wanted: bool = True) -> np.ndarray:
+def chunk_bounds(src, k) -> np.ndarray:
     """(N_BOUNDS, ceil(n / CHUNK)) float64 bounds of each chunk of consecutive vertices of a
     pass's geometry ``src``: the prepared G (6, n), or :func:`vertices` (the same bounds; ``k``:
     the working precision's constants), for light culling (see
@@ -82,10 +72,8 @@ def chunk_bounds(src, k, wanted: bool = True) -> np.ndarray:
     in CULL_MIN_SHARE has a normal cone narrower than 90° (shuffled vertices, say): too little
     could be culled to pay for the tests. Every CULL_SAMPLE-th chunk is found first: when those
     already fall short, the rest are not (on vertices in no particular order most of the
-    bounds' cost). ``wanted`` False (a pass that does not cull): (N_BOUNDS, 0) at once."""
+    bounds' cost)."""
     n = len(src.P) if isinstance(src, K.Vertices) else src.shape[1]
-    if not wanted:
-        return readonly(np.zeros((K.N_BOUNDS, 0)))
     b = np.empty((K.N_BOUNDS, -(-n // K.CHUNK)), np.float64)
     K.bounds(src, k, b, CULL_SAMPLE)
     sample = b[K.B_COS, ::CULL_SAMPLE]

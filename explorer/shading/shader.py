@@ -66,6 +66,8 @@ PRECISIONS = ("float64", "float32")
 TIERS = ("compiled", "numpy")
 #: the specular models the compiled kernels implement; the others run on the numpy tier
 COMPILED_MODELS = ("blinn", "phong")
+#: chunk bounds of a pass without light culling
+_NO_BOUNDS = _readonly(np.zeros((K.N_BOUNDS, 0)))
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
 #: (:func:`invalidated`)
@@ -214,7 +216,7 @@ class Shader:
 
     def _compiled_geometry(self, geometry=None) -> None:
         """The compiled tier's geometry (:func:`~explorer.shading.prepared.geometry_of`;
-        ``geometry``: found already); no copy kept: the frame alone (see :meth:`_vertex_pass`)."""
+        ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_one_shot`)."""
         if self._centre is None:
             geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, self.keep)
             self._centre, self._scale, self._G, self._bounds, N = geometry
@@ -465,7 +467,7 @@ class Shader:
         if self._G is not None:
             self._pass(self._G, self._bounds, vis, inputs)
         else:
-            self._vertex_pass(vis, inputs)
+            self._one_shot(vis, inputs)
         self.stats["pass"] += 1
         for name, do in (("ambient", do_amb), ("diffuse", do_dif), ("specular", do_spec)):
             self.stats[name] += int(bool(do))
@@ -476,32 +478,32 @@ class Shader:
                 if opts[K.O_STORE_LOBE]:
                     self._base, self._ws = None if flat else base, ws
 
-    def _vertex_pass(self, vis, inputs) -> None:
-        """A pass that prepares each block of the vertices as it shades it (see
-        :func:`~explorer.shading.prepared.keeps_copy`; a kept shader keeps the chunk bounds).
-        Normals outside NORMAL_RANGE, which it finds, are scaled into it and the pass runs
-        again; NaN or infinite ones raise check_finite's error naming the first."""
+    def _one_shot(self, vis, inputs) -> None:
+        """A one-shot shader's pass: the kernel prepares each block of the caller's vertices as
+        it reaches it (:func:`~explorer.shading.prepared.vertices`: no prepared copy). Normals
+        outside NORMAL_RANGE, which that pass finds, are scaled into it and the pass runs
+        again; NaN or infinite ones raise check_finite's error naming the first, no colours."""
         for scaled in (False, True):  # (scaled ones lie inside: the second pass is the last)
             src = vertices(self._P, self._N, self._centre, self._scale)
-            bounds = self._bounds
-            if bounds is None:  # (kept: for passes to come, which may cull)
-                bounds = chunk_bounds(src, self._k, self.keep or self._plan.cull and self.cull)
+            bounds = chunk_bounds(src, self._k) if self._plan.cull and self.cull else _NO_BOUNDS
             if not self._pass(src, bounds, vis, inputs) or scaled:
                 break
             check_finite("normals", self._N)
             self._N = scale_normals(self._N)
         self._scaled = True  # (every normal was tested)
-        self._bounds = bounds if self.keep else None
 
     def _pass(self, src, bounds, vis, inputs) -> int:
-        """The kernel over ``src`` (G, or :func:`~explorer.shading.prepared.vertices`) with its
-        chunk ``bounds``, ``vis`` and ``inputs`` (+ the float64 redo of marked float32 lanes).
-        Returns how many blocks hold a normal outside NORMAL_RANGE: if any, nothing more."""
+        """The kernel over every vertex (+ the float64 redo of marked float32 lanes): ``src``
+        the geometry (the prepared G, or :func:`~explorer.shading.prepared.vertices`),
+        ``bounds`` its chunk bounds; ``vis``, ``inputs`` (lights, options, surface, constants,
+        sums, lobes). Returns how many blocks hold a normal outside NORMAL_RANGE (vertices
+        only): when some do, nothing more is done (the colours are not to be used)."""
         lights, opts, surface, k, sums, lobes = inputs
         marks = K.Marks(self._redo, self._redo_count)
         cull = bounds if self._plan.cull and self.cull else bounds[:, :0]
         args = (src, lights, opts, surface, k, sums, lobes, vis, marks, self._out)
-        if outside := K.shade(*args, K.Culling(cull, self._culled)):
+        outside = K.shade(*args, K.Culling(cull, self._culled))
+        if outside:
             return outside
         self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64

@@ -11,8 +11,8 @@ import pytest
 import explorer
 from explorer.core.errors import ExplorerError
 from explorer.geometry import meshes as M
-from explorer.shading import kernels as K
 from explorer.shading import prepared
+from explorer.shading import kernels as K
 from explorer.shading.equation import equation_shade
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaPerformanceWarning")
@@ -73,13 +73,13 @@ def test_chunk_bounds_of_vertices_are_those_of_the_prepared_geometry(precision, 
     assert mesh.n_vertices % K.CHUNK  # a last, shorter chunk
     P, N = mesh.positions.astype(dtype), mesh.normals.astype(dtype)
     N[5] = 0.0  # an absent normal: its chunk is never culled
-    k = K.constants(np.dtype(precision).type)
-    centre, scale, G, _, _ = prepared.prepared_geometry(P, N, np.dtype(precision), k)
-    src = prepared.vertices(P, N, centre, scale)
+    s = explorer.Shader(SCENE, P, N, precision=precision, tier="compiled")
+    _ = s.colors
+    src = prepared.vertices(P, N, s._centre, s._scale)
     want = np.full((K.N_BOUNDS, -(-len(P) // K.CHUNK)), np.nan)
     got = want.copy()
-    K.bounds(G, k, want, step)
-    K.bounds(src, k, got, step)
+    K.bounds(s._G, s._k, want, step)
+    K.bounds(src, s._k, got, step)
     np.testing.assert_array_equal(got, want)
     assert np.isnan(got[:, 1]).all() == (step > 1) and not np.isnan(got[:, ::step]).any()
     assert got[K.B_COS, 0] == -1.0
@@ -170,30 +170,3 @@ def test_a_one_shot_shader_shades_again_after_a_change():
     want = equation_shade(explorer.load_scene(other), P, N)
     assert np.abs(again - want).max() <= 1e-12
     assert s.stats["pass"] == 2 and s.stats["geometry"] == 1
-
-
-def test_a_kept_float64_shader_of_float32_vertices_shades_them_as_they_are():
-    # float32 vertices take half the bytes of a prepared float64 copy: its passes prepare each
-    # block as they shade it, and give the colours of a shader holding that copy, change by change
-    mesh = M.sphere(96)
-    P, N = mesh.positions.astype(np.float32), mesh.normals.astype(np.float32)
-    vertices = explorer.Shader(SCENE, P, N, precision="float64", tier="compiled")
-    copy = explorer.Shader(SCENE, P.astype(np.float64), N.astype(np.float64), precision="float64")
-    assert not prepared.keeps_copy(P, np.float64, True)
-    assert prepared.keeps_copy(P, np.float32, True)
-    assert not prepared.keeps_copy(P, np.float32, False)
-    other = {**SCENE["lights"][0], "position": [-2, 1, 3]}
-    changes = [
-        lambda s: s.set_lights([other, *SCENE["lights"][1:]]),
-        lambda s: s.set_viewer({"eye": [2.0, 0.5, 3.0]}),
-        lambda s: s.set_material(s.scene.material.replace(shininess=90.0)),
-        lambda s: s.set_material(s.scene.material.replace(diffuse=(0.1, 0.9, 0.3))),
-    ]
-    for change in [lambda s: None, *changes]:
-        change(vertices)
-        change(copy)
-        np.testing.assert_array_equal(np.asarray(vertices.colors), np.asarray(copy.colors))
-        assert vertices.stats["culled"] == copy.stats["culled"]
-    assert vertices._G is None and copy._G is not None
-    assert vertices.stats["culled"] > 0 and vertices._bounds.shape[1] > 0  # kept, and culling
-    assert vertices.stats["geometry"] == 1
