@@ -139,9 +139,8 @@ def main(argv=None) -> int:
         rate = f"{work / med / 1e9:.2f}" if work else ""
         rows.append((name, med * 1e3, best * 1e3, rate, note))
 
-    # full shading after a light change (as in the explorer): the float32 vertices as they are
-    # (a float64 pass prepares each block of them as it shades it: half the bytes of a prepared
-    # float64 copy, see prepared.keeps_copy), and float64 vertices (the pass reads the copy)
+    # full shading after a light change (geometry prepared once, as in the explorer), of float32
+    # vertices and of float64 ones (the pass reads the same prepared copy G of either)
     P64, N64 = P.astype(np.float64), N.astype(np.float64)
     for precision, vertices in (
         ("float32", "float32"),

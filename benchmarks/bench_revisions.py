@@ -151,7 +151,7 @@ for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):  # 
     t = time.perf_counter()  # prepared the geometry here too: slab by slab, or whole)
     sh = explorer.Shader(scene, P, N, precision={precision!r}, keep=False)
     sh._compiled_geometry()
-    if hasattr(sh, "_vertex_pass"):
+    if hasattr(sh, "_one_shot"):
         from explorer.shading import prepared
         prepared.chunk_bounds(prepared.vertices(sh._P, sh._N, sh._centre, sh._scale), sh._k)
     for _ in getattr(sh, "_slabs", lambda: ())():

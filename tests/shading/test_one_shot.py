@@ -11,8 +11,8 @@ import pytest
 import explorer
 from explorer.core.errors import ExplorerError
 from explorer.geometry import meshes as M
-from explorer.shading import prepared
 from explorer.shading import kernels as K
+from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaPerformanceWarning")
