@@ -106,6 +106,71 @@ def one_shot_geometry(scene, P, N, precision: str) -> None:
     prepared.chunk_bounds(src, sh._k)
 
 
+def one_shot_flows(scene, P, N, R: int) -> int:
+    """``--flows``: a one-shot pass as the engine runs it (the kernel prepares each block of
+    the vertices as it shades it, ``kernels.Vertices``) against the flow it replaced (slabs of
+    256k vertices prepared into a reused buffer, each then shaded), the same kernels and
+    arguments in one process, in turns; both give the same colours (checked). Prints wall-clock
+    medians with every thread and CPU medians with one."""
+    import numba
+
+    for precision in ("float64", "float32"):
+        flows = _flows(scene, P, N, precision)
+        for threads in (numba.config.NUMBA_NUM_THREADS, 1):
+            numba.set_num_threads(threads)
+            clock = time.perf_counter if threads > 1 else time.process_time
+            ts: dict = {name: [] for name in flows}
+            for _ in range(R):
+                for name, fn in flows.items():
+                    t = clock()
+                    fn()
+                    ts[name].append(clock() - t)
+            v, sl = (statistics.median(ts[x]) * 1e3 for x in ("vertices", "slabs"))
+            what = f"wall, {threads} threads" if threads > 1 else "CPU, 1 thread"
+            print(f"{precision} one-shot pass ({what}): vertices {v:.2f} ms, slabs {sl:.2f} ms")
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    return 0
+
+
+def _flows(scene, P, N, precision: str) -> dict:
+    """The two one-shot flows of :func:`one_shot_flows` for ``precision``, as functions."""
+    slab, seen, real = 256 * 1024, {}, K.shade
+
+    def spy(*args):
+        seen["args"] = args
+        return real(*args)
+
+    K.shade = spy
+    try:
+        _ = explorer.Shader(scene, P, N, precision=precision, keep=False).colors
+    finally:
+        K.shade = real
+    src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling = seen["args"]
+    n = len(P)
+    bufs = {size: np.empty((6, size), precision) for size in (slab, n % slab)}
+    inputs = (lights, opts, surface, k, sums, lobes, vis)
+
+    def vertices():
+        b = prepared.chunk_bounds(src, k)
+        real(src, *inputs, marks, out, K.Culling(b, culling.culled))
+
+    def slabs():
+        for s in range(0, n, slab):
+            e = min(n, s + slab)
+            G = bufs[e - s]
+            K.prepare(src.P[s:e], src.N[s:e], src.centre, src.inv_scale, k, G)
+            b = prepared.chunk_bounds(G, k)
+            b0, b1 = s // K.BLOCK, -(-e // K.BLOCK)
+            m = K.Marks(marks.redo[s:e] if len(marks.redo) else marks.redo, marks.count[b0:b1])
+            real(G, *inputs, m, out[s:e], K.Culling(b, culling.culled[b0:b1]))
+
+    vertices()
+    first = out.copy()
+    slabs()
+    assert np.array_equal(first, out), "the two flows' colours differ"
+    return {"vertices": vertices, "slabs": slabs}
+
+
 def in_turns(fns: dict, R: int) -> dict:
     """(median, best) seconds of each of ``fns`` (name -> function), timed in turns: one call
     of each per round, ``R`` rounds after a warm-up round."""
@@ -125,11 +190,19 @@ def main(argv=None) -> int:
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--lights", type=int, default=8)
     ap.add_argument("--repeat", type=int, default=11)
+    ap.add_argument(
+        "--flows",
+        action="store_true",
+        help="only the one-shot pass over the vertices against slabs prepared first",
+    )
     args = ap.parse_args(argv)
     n, L, R = args.vertices, args.lights, args.repeat
     rng = np.random.default_rng(0)
     P, N = sphere_points(n, rng)  # float32, as GPU-bound meshes (glTF, PLY) mostly come
     scene = scene_with(L, rng)
+    if args.flows:
+        print(f"machine: {machine()}\nmesh: {n} vertices, {L} point lights; medians of {R}")
+        return one_shot_flows(scene, P, N, R)
     other = scene_with(L, np.random.default_rng(1)).lights
 
     rows = []
