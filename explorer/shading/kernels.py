@@ -1529,20 +1529,20 @@ def _kind(a):
 
 def _wide(kernel, dtype_arg: int, lanes: int = 0):
     """Call ``kernel`` so that a signature it meets for the first time (by the :func:`_kind` of
-    its arguments) with float data of a dtype (that of positional argument ``dtype_arg``) is
-    compiled with 512-bit vectors (:func:`wide_vectors` around such first calls, which compile
-    or load from numba's cache); later calls go straight to the kernel. ``lanes``: a fixed
-    width instead (8: a kernel whose arithmetic is float64 whatever its data)."""
+    its first argument, the data, and the dtype of positional argument ``dtype_arg``, float
+    data) is compiled with 512-bit vectors (:func:`wide_vectors` around such first calls, which
+    compile or load from numba's cache); later calls go straight to the kernel. ``lanes``: a
+    fixed width instead (8: a kernel whose arithmetic is float64 whatever its data)."""
     if not WIDE_VECTORS:
         return kernel
     seen: set = set()
 
     @functools.wraps(kernel.py_func)
     def call(*args):
-        key = _kind(args)
+        dt = args[dtype_arg].dtype
+        key = (_kind(args[0]), dt)
         if key in seen:
             return kernel(*args)
-        dt = args[dtype_arg].dtype
         if dt not in (np.float32, np.float64):
             seen.add(key)
             return kernel(*args)

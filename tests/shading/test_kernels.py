@@ -63,6 +63,40 @@ def test_wide_vectors_can_be_switched_off():
     assert out.stdout.strip() == "ok", out.stderr
 
 
+def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
+    # _wide compiles a call inside wide_vectors() the first time it meets a kind of data (the
+    # first argument's dtype, dimensions, writability; a record's members) with a float dtype:
+    # G (6, n) and kernels.Vertices of float32 or float64 vertices are separate signatures
+    import contextlib
+
+    widths = []
+
+    @contextlib.contextmanager
+    def wide(lanes=16):
+        widths.append(lanes)
+        yield
+
+    class Kernel:  # stands for a numba dispatcher
+        def py_func(self, *args):
+            return None
+
+        def __call__(self, *args):
+            return None
+
+    monkeypatch.setattr(K, "WIDE_VECTORS", True)
+    monkeypatch.setattr(K, "wide_vectors", wide)
+    call = K._wide(Kernel(), 1)
+    f32, f64 = K.constants(np.float32), K.constants(np.float64)
+    G32, P32, P64 = np.zeros((6, 4), np.float32), np.zeros((4, 3), np.float32), np.zeros((4, 3))
+    V32 = K.Vertices(P32, P32, np.zeros(3), 1.0)
+    V64 = K.Vertices(P64, P64, np.zeros(3), 1.0)
+    for data, k in [(G32, f32), (G32, f32), (V32, f32), (V64, f32), (V32, f64), (V32, f32)]:
+        call(data, k)
+    assert widths == [16, 16, 16, 8]  # G32, V32 and V64 in float32, V32 in float64: once each
+    call(np.zeros(3, np.int64), np.zeros(3, np.int64))  # no float data: no wide vectors
+    assert widths == [16, 16, 16, 8]
+
+
 def test_marked_reads_only_the_blocks_that_count_marks():
     # a block that counts no marks does not write them: what its part of the array holds is
     # stale and must not be read
