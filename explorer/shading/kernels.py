@@ -104,6 +104,12 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
 from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
+#: the scratch's row stride (elements): a block's rows lie ROW apart, not BLOCK. At BLOCK, a
+#: float64 row is 4 KB, the span of the L1 data cache's sets, so lane i of every row falls in
+#: one set: a light loop reading and writing 14 rows evicts its own lines (8 ways) and streams
+#: them from L2. 16 lanes more shift each row by 64 (float32) or 128 (float64) bytes, one or two
+#: sets (``benchmarks/bench_revisions.py --precision float64`` compares).
+ROW = BLOCK + 16
 
 # numba's pedantic IR check says a phi variable of the inlined power (vmath.pow64 inside the
 # packed float64 lobe loop) "is not in scope" when it compiles these kernels: a note about its
@@ -266,17 +272,17 @@ def _row_checked(scr, r, m):
     vector loop. For the inline light loops: rows at a known constant distance make LLVM refuse to
     interleave two vector iterations (it takes the distance as a limit), and interleaving is
     worth more there (0.93x without it, full pass at 1M)."""
-    return scr[r * BLOCK : r * BLOCK + m]
+    return scr[r * ROW : r * ROW + m]
 
 
 @nb.njit(inline="always", **_LEAF)
 def _row(scr, r, m):
-    """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie BLOCK
+    """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie ROW
     apart in one flat array, and LLVM is told the scratch holds row ``r`` whole: the slice is
     then the scratch's start plus a constant, not clamped at run time, so LLVM proves the rows
     of a loop disjoint (no run-time overlap checks: a loop that reads and writes many rows had
     too many to vectorise at all) and addresses them all from one register."""
-    _assume(scr.shape[0] >= (r + 1) * BLOCK)
+    _assume(scr.shape[0] >= (r + 1) * ROW)
     _assume(m <= BLOCK)
     _assume(m >= 0)
     return _row_checked(scr, r, m)
@@ -1273,7 +1279,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
                     e += 1
                 s0, s1 = c * CHUNK, min(m, e * CHUNK)
                 if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
-                    sub = scr[s0 : s0 + N_ROWS * BLOCK]
+                    sub = scr[s0 : s0 + N_ROWS * ROW]
                     v = vis[li, s0:s1]  # (an empty row when no light casts shadows)
                     _light_run(
                         sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
@@ -1477,10 +1483,10 @@ TASKS = 64
 
 @nb.njit(**_OPTS)
 def _scratch(dtype):
-    """A task's scratch: N_ROWS rows of BLOCK lanes, and one row more, so that the scratch seen
-    from any lane of a block on (``scr[s0 : s0 + N_ROWS * BLOCK]``, a run of chunks) still
-    holds N_ROWS whole rows."""
-    return np.empty((N_ROWS + 1) * BLOCK, dtype)
+    """A task's scratch: N_ROWS rows of BLOCK lanes, ROW apart, and one row more, so that the
+    scratch seen from any lane of a block on (``scr[s0 : s0 + N_ROWS * ROW]``, a run of chunks)
+    still holds N_ROWS whole rows."""
+    return np.empty((N_ROWS + 1) * ROW, dtype)
 
 
 @nb.njit(**_LEAF)
@@ -1748,7 +1754,7 @@ def lobe(base, ws, params, flags, shininess, k, S):
     ntasks = _tasks(nblocks)
     Sf = S.reshape(-1)
     for t in nb.prange(ntasks):
-        scr = np.empty(3 * BLOCK, params.dtype)
+        scr = np.empty(3 * ROW, params.dtype)
         _lobe_task(
             base,
             ws,
