@@ -97,6 +97,27 @@ unchanged), ``--precision float64``, wall:
 block's rows of G, sums and colours (``llvm.prefetch``): 0.99x on the full float64 pass
 (``--rounds 4``, idle), though the pass's fixed part is bound by reading G (with no light, 3.8 ms
 in float64 against 1.7 ms in float32, whose G is half as large).
+
+k13 (97356cc -> k13, ``--precision float64 --rounds 3``, wall, load 1.6-2.1): the float64 light
+loops keep base² in the base row, raised to n/2, and the inline point-light loop finds Blinn's
+base² as (N·u)²/|u|² with u = l + |l|·V (one square root and two divisions per vertex-light
+where there were two of each; ``kernels.lobe_power``); the scratch rows lie
+``kernels.ROW = BLOCK + 16`` apart.
+
+| case | 97356cc ms | k13 ms | ratio |
+|---|---:|---:|---:|
+| random points (best 17.66 / 16.42) | 18.94 | 16.90 | 1.12x |
+| UV sphere, mesh order | 12.54 | 11.79 | 1.06x |
+| one-shot shade() | 20.89 | 18.61 | 1.12x |
+| viewer change | 18.97 | 16.93 | 1.12x |
+
+The row stride alone (k13's square change alone, on 97356cc, -> k13; ``--precision float64
+--cpu``, beside a test run, load 2.6): random points 37.28 / 33.40 ms (1.12x; best 32.60 / 31.90), UV
+sphere 24.67 / 23.06 (1.07x). On a standalone copy of the loops (one thread, one block in
+cache, ns per vertex-light): at a 512-lane stride the L / base loop took 1.9-2.8 ns from one
+process to the next, at 528 1.9-2.3; the divisions and square roots there are worth 0.8 ns (1.1
+with multiplies in their place), and this square form takes 1.6 (an integer-seeded reciprocal
+square root with four Newton steps took 2.7, a float32-seeded one with two 2.3: not kept).
 """
 
 from __future__ import annotations

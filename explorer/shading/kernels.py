@@ -104,6 +104,12 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
 from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
+#: the scratch's row stride (elements): a block's rows lie ROW apart, not BLOCK. At BLOCK, a
+#: float64 row is 4 KB, the span of the L1 data cache's sets, so lane i of every row falls in
+#: one set: a light loop reading and writing 14 rows evicts its own lines (8 ways) and streams
+#: them from L2. 16 lanes more shift each row by 64 (float32) or 128 (float64) bytes, one or two
+#: sets (``benchmarks/bench_revisions.py --precision float64`` compares).
+ROW = BLOCK + 16
 
 # numba's pedantic IR check says a phi variable of the inlined power (vmath.pow64 inside the
 # packed float64 lobe loop) "is not in scope" when it compiles these kernels: a note about its
@@ -243,6 +249,20 @@ def _nil_overload(k):
     return lambda k: np.float64(0.0)
 
 
+def lobe_power(k):
+    """What the lobe's exponent is multiplied by, with the base row holding base^(1/that): in
+    float64 (the light loops that split, see the comment above :func:`_light`) the base row and
+    the stored lobe bases hold base², raised to n/2 (1/2); in float32 the base itself (1)."""
+    return 0.5 if k.dtype == np.float64 else 1.0
+
+
+@overload(lobe_power, jit_options=_LEAF)
+def _lobe_power_overload(k):
+    if k.dtype == types.float32:
+        return lambda k: np.float32(1.0)
+    return lambda k: np.float64(0.5)
+
+
 @intrinsic
 def _assume(typingctx, cond):
     """Tell LLVM ``cond`` holds (``llvm.assume``): no code, only facts for the optimiser."""
@@ -266,17 +286,17 @@ def _row_checked(scr, r, m):
     vector loop. For the inline light loops: rows at a known constant distance make LLVM refuse to
     interleave two vector iterations (it takes the distance as a limit), and interleaving is
     worth more there (0.93x without it, full pass at 1M)."""
-    return scr[r * BLOCK : r * BLOCK + m]
+    return scr[r * ROW : r * ROW + m]
 
 
 @nb.njit(inline="always", **_LEAF)
 def _row(scr, r, m):
-    """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie BLOCK
+    """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie ROW
     apart in one flat array, and LLVM is told the scratch holds row ``r`` whole: the slice is
     then the scratch's start plus a constant, not clamped at run time, so LLVM proves the rows
     of a loop disjoint (no run-time overlap checks: a loop that reads and writes many rows had
     too many to vectorise at all) and addresses them all from one register."""
-    _assume(scr.shape[0] >= (r + 1) * BLOCK)
+    _assume(scr.shape[0] >= (r + 1) * ROW)
     _assume(m <= BLOCK)
     _assume(m >= 0)
     return _row_checked(scr, r, m)
@@ -677,6 +697,10 @@ def _reach(bd, c0, nc, q, fl, back, act):
 # (``benchmarks/bench_revisions.py --precision float64`` compares); float32 keeps the lobe in the
 # one loop (its chain is shorter). That second loop (:func:`_split_lobe`) raises to the power
 # only the lanes with a lobe weight when many have none (the vertices facing away from the light).
+# The float64 loops that split write the base's square to the base row (see :func:`lobe_power`):
+# base^n = (base²)^(n/2), and Blinn's base² = (N·u)²/|u|² with u = l + |l|·V = |l|·(L + V) needs
+# neither 1/|L + V| (a square root and a division) nor 1/|l|; the inline loop then divides
+# twice and takes one square root per vertex-light, where it took two of each.
 
 SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
 LOBE_NONE = 4  # (after the LOBE_* modes above)
@@ -748,6 +772,8 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
     # float64: the lobe (base^n) in a second loop over the rows B and WS the first writes (see
     # the comment above)
     split = lobe_on and not track
+    # float64 inline Blinn: the base row's base² found without 1/|L + V| (see the comment above)
+    square = split and inline and mode == LOBE_BLINN
     # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
     # it interleaves them; the row-path loops read and write too many rows for such checks
     row = _row_checked if inline else _row
@@ -801,7 +827,8 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                     rcp = one / (r * att)
                     inv = att * rcp
                     w = r * rcp if atten else one
-                ndl = (a * x + b * yy + c * z) * inv  # N·L
+                nl = a * x + b * yy + c * z  # N·l
+                ndl = nl * inv  # N·L
                 margin = d2 * c_dist2
             else:
                 if const:  # directional: constant L, never attenuated
@@ -825,6 +852,16 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                         else:
                             ndv = a * ex + b * ey + c * ez
                             base = two * ndl * ndv - (lx * ex + ly * ey + lz * ez)
+                    elif square:  # Blinn, float64 inline: base² (see the comment above)
+                        # u = l + |l|·V (|l| = 1 at the light, where l = N); |L + V|² below
+                        # its epsilon is |u|² below it times |l|²
+                        ux = x + r * vx[i]
+                        uy = yy + r * vy[i]
+                        uz = z + r * vz[i]
+                        ndu = nl + r * NV[i]
+                        h2 = ux * ux + uy * uy + uz * uz
+                        ok = (h2 > h_eps2 * (r * r)) & (ndu > zero)
+                        base = ndu * ndu / (h2 if ok else one) if ok else zero
                     else:  # Blinn: N·normalize(L + V); 0 where L = -V
                         if inline:  # u = L + V; N·u = N·L + N·V (the block's row)
                             ux = x * inv + vx[i]
@@ -846,7 +883,8 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                         margin = min(margin, h2 * c_len2)
                     margin = min(margin, abs(base) * c_dot)
                     base = max(base, zero)
-                    B[i] = base  # kept for a lobe store (and the lobe loop below)
+                    # kept for a lobe store (and the lobe loop below): squared where it splits
+                    B[i] = base * base if split and not square else base
                     if not split:
                         lob = fpow(base, y)  # base^n
                 if not split:
@@ -854,8 +892,8 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                 WS[i] = ws
             if track and (spec or inline):
                 TRK[i] = min(TRK[i], margin)
-        if split:
-            _split_lobe(scr, m, y, sr, sg, sb, grey)
+        if split:  # (the base row holds base²: see lobe_power)
+            _split_lobe(scr, m, y * lobe_power(k), sr, sg, sb, grey)
 
     return impl
 
@@ -870,7 +908,8 @@ PACK_SHARE = 0.5 if NATIVE_COMPRESS else 0.0
 
 @nb.njit(**_LEAF)
 def _split_lobe(scr, m, y, sr, sg, sb, grey):
-    """The float64 light loops' lobe: S += ws·base^n·s_i from the rows R_BASE and R_WS.
+    """The float64 light loops' lobe: S += ws·base^n·s_i from the rows R_BASE and R_WS
+    (``y``: the exponent for what the base row holds, n/2 for base², see :func:`lobe_power`).
 
     A lane whose weight ws is 0 (facing away from the light, outside its cone, in shadow) adds
     0 whatever its power, and the power is most of the loop's work: when such lanes are at least
@@ -1340,7 +1379,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
                     e += 1
                 s0, s1 = c * CHUNK, min(m, e * CHUNK)
                 if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
-                    sub = scr[s0 : s0 + N_ROWS * BLOCK]
+                    sub = scr[s0 : s0 + N_ROWS * ROW]
                     v = vis[li, s0:s1]  # (an empty row when no light casts shadows)
                     _light_run(
                         sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
@@ -1563,10 +1602,10 @@ TASKS = 64
 
 @nb.njit(**_OPTS)
 def _scratch(dtype):
-    """A task's scratch: N_ROWS rows of BLOCK lanes, and one row more, so that the scratch seen
-    from any lane of a block on (``scr[s0 : s0 + N_ROWS * BLOCK]``, a run of chunks) still
-    holds N_ROWS whole rows."""
-    return np.empty((N_ROWS + 1) * BLOCK, dtype)
+    """A task's scratch: N_ROWS rows of BLOCK lanes, ROW apart, and one row more, so that the
+    scratch seen from any lane of a block on (``scr[s0 : s0 + N_ROWS * ROW]``, a run of chunks)
+    still holds N_ROWS whole rows."""
+    return np.empty((N_ROWS + 1) * ROW, dtype)
 
 
 @nb.njit(**_LEAF)
@@ -1815,7 +1854,7 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         for c in range(S.shape[1] if S.shape[0] else 0):
             S[i, c] = Sm[j, c]
         for li in range(L if lobes else 0):
-            base_out[li, i] = bm[li, j]
+            base_out[li, i] = np.sqrt(bm[li, j])  # (float64 rows hold base²: lobe_power)
             ws_out[li, i] = wm[li, j]
     return m
 
@@ -1833,7 +1872,8 @@ def _lobe_rows(base, ws, y, flat, cr, cg, cb, Sx, Sy, Sz):
 def lobe(base, ws, params, flags, shininess, k, S):
     """S = Σ_l ws_l·base_l^n·s_l from stored per-light bases (a shininess change).
 
-    base, ws : (L, n) T (base unused when shininess is 0); params : (L, N_PARAMS) T;
+    base, ws : (L, n) T (base unused when shininess is 0; in float64 it holds base², see
+    :func:`lobe_power`, as the pass that stored it wrote it); params : (L, N_PARAMS) T;
     flags : (L,) int32; S : (n, 3) T out
     """
     n = S.shape[0]
@@ -1841,7 +1881,7 @@ def lobe(base, ws, params, flags, shininess, k, S):
     ntasks = _tasks(nblocks)
     Sf = S.reshape(-1)
     for t in nb.prange(ntasks):
-        scr = np.empty(3 * BLOCK, params.dtype)
+        scr = np.empty(3 * ROW, params.dtype)
         _lobe_task(
             base,
             ws,
@@ -1874,7 +1914,7 @@ def _lobe_task(base, ws, params, flags, shininess, k, Sf, scr, b0, b1):
                 _lobe_rows(
                     base[li, s:e],
                     ws[li, s:e],
-                    shininess,
+                    shininess * lobe_power(k),
                     flat,
                     params[li, P_SPEC],
                     params[li, P_SPEC + 1],
