@@ -32,6 +32,19 @@ CPU-bound process: one slab 90 ms, 256k 115 ms, 128k 196 ms): worth measuring ag
 | 262,144 | 26.17 / 25.16 | 2.32 / 2.28 | 13.69 / 13.08 | 2.15 / 2.30 |
 | 65,536 | 24.68 / 22.22 | 2.32 / 2.41 | 12.87 / 12.69 | 2.35 / 2.63 |
 
+The float64 full-shading row (the issue's target: 0.4 G vertex-lights/s, <= 20 ms), four runs
+of this script at 97356cc and at k13 (the float64 lobe from base², see
+``benchmarks/bench_revisions.py``) taking turns, load 1.0-1.3 (medians, ms):
+
+| run | 97356cc float64 | k13 float64 | 97356cc one-shot float64 | k13 one-shot float64 |
+|---:|---:|---:|---:|---:|
+| 1 | 20.63 | 17.14 | 23.37 | 21.52 |
+| 2 | 19.36 | 19.88 | 21.89 | 18.59 |
+| 3 | 19.50 | 17.04 | 22.04 | 18.94 |
+| 4 | 20.61 | 16.97 | 23.73 | 18.15 |
+
+(float32 row in the same runs: 11.21 / 10.43, 10.14 / 10.97, 9.54 / 9.56, 8.70 / 8.87.)
+
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 
