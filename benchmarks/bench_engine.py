@@ -21,6 +21,19 @@ lights. The geometry rows and the floor are timed in turns, call after call, so 
 between them sees the same machine (the floor moves by 2x between runs, with what of the
 arrays the cache still holds).
 
+The float64 full-shading row (the issue's target: 0.4 G vertex-lights/s, <= 20 ms), four runs
+of this script at 97356cc and at k13 (the float64 lobe from base², see
+``benchmarks/bench_revisions.py``) taking turns, load 1.0-1.3 (medians, ms):
+
+| run | 97356cc float64 | k13 float64 | 97356cc one-shot float64 | k13 one-shot float64 |
+|---:|---:|---:|---:|---:|
+| 1 | 20.63 | 17.14 | 23.37 | 21.52 |
+| 2 | 19.36 | 19.88 | 21.89 | 18.59 |
+| 3 | 19.50 | 17.04 | 22.04 | 18.94 |
+| 4 | 20.61 | 16.97 | 23.73 | 18.15 |
+
+(float32 row in the same runs: 11.21 / 10.43, 10.14 / 10.97, 9.54 / 9.56, 8.70 / 8.87.)
+
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
 """
 

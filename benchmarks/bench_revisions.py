@@ -111,13 +111,16 @@ where there were two of each; ``kernels.lobe_power``); the scratch rows lie
 | one-shot shade() | 20.89 | 18.61 | 1.12x |
 | viewer change | 18.97 | 16.93 | 1.12x |
 
-The row stride alone (k13's square change alone, on 97356cc, -> k13; ``--precision float64
---cpu``, beside a test run, load 2.6): random points 37.28 / 33.40 ms (1.12x; best 32.60 / 31.90), UV
-sphere 24.67 / 23.06 (1.07x). On a standalone copy of the loops (one thread, one block in
-cache, ns per vertex-light): at a 512-lane stride the L / base loop took 1.9-2.8 ns from one
-process to the next, at 528 1.9-2.3; the divisions and square roots there are worth 0.8 ns (1.1
-with multiplies in their place), and this square form takes 1.6 (an integer-seeded reciprocal
-square root with four Newton steps took 2.7, a float32-seeded one with two 2.3: not kept).
+The row stride alone (k13's square change alone, on 97356cc, -> k13; ``--precision float64 --cpu``,
+beside a test run, load 2.6): random points 37.28 / 33.40 ms (1.12x; best 32.60 / 31.90), UV sphere
+24.67 / 23.06 (1.07x); again (k13 with the stride reverted -> k13, idle, load 0.6-1.0): 37.58 /
+34.06 (1.10x; best 33.65 / 32.73), UV sphere 24.82 / 23.27 (1.07x). In wall time, the stride before
+the square change (97356cc -> the stride alone, load 1.0-1.5) gave 18.47 / 19.85 ms (0.93x; best
+17.91 / 17.93): within this VM's drift. On a standalone copy of the loops (one thread, one block in
+cache, ns per vertex-light): at a 512-lane stride the L / base loop took 1.9-2.8 ns from one process
+to the next, at 528 1.9-2.3; the divisions and square roots there are worth 0.8 ns (1.1 with
+multiplies in their place), and this square form takes 1.6 (an integer-seeded reciprocal square root
+with four Newton steps took 2.7, a float32-seeded one with two 2.3: not kept).
 """
 
 from __future__ import annotations
