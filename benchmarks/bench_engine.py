@@ -2,9 +2,11 @@
 
     python benchmarks/bench_engine.py                # 1M vertices, 8 point lights
     python benchmarks/bench_engine.py --vertices 200000 --lights 4 --repeat 15
+    python benchmarks/bench_engine.py --flows        # the one-shot pass against slabs
 
-The full-shading rows run twice on random points (every vertex-light computed: the kernel's
-raw rate) and on a UV sphere mesh with as many vertices, in mesh order and shuffled: the
+The full-shading rows run on random points (every vertex-light computed: the kernel's raw
+rate; float32 vertices, and in float64 also float64 ones: the pass reads the same prepared
+copy of either) and on a UV sphere mesh with as many vertices, in mesh order and shuffled: the
 engine skips a light for runs of vertices that all face away from it (light culling), which
 only a mesh whose vertex order keeps neighbours together allows.
 
