@@ -380,6 +380,19 @@ def _vertex_count_overload(src):
     return lambda src: src.P.shape[0]
 
 
+def _lanes_to_prepare(src):  # pragma: no cover - replaced by the overload
+    raise NotImplementedError
+
+
+@overload(_lanes_to_prepare, jit_options=_LEAF)
+def _lanes_to_prepare_overload(src):
+    """The lanes of a task's buffer for a block of :class:`Vertices` (see :func:`_geometry`):
+    BLOCK, or 0 for G, whose rows the pass reads as they are."""
+    if isinstance(src, types.Array):
+        return lambda src: 0
+    return lambda src: BLOCK
+
+
 def _geometry(src, s, e, gb, k):  # pragma: no cover - replaced by the overload
     raise NotImplementedError
 
@@ -1729,7 +1742,7 @@ def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     outside = 0
     for t in nb.prange(ntasks):
         scr = _scratch(lights.params.dtype)  # once per task: no allocation per block
-        gb = np.empty((6, BLOCK), k.dtype)  # (a block of Vertices, prepared)
+        gb = np.empty((6, _lanes_to_prepare(src)), k.dtype)  # (a block of Vertices, prepared)
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
         r = _spread(np.int64(t), np.int64(ntasks)) if culls else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks

@@ -490,7 +490,6 @@ class Shader:
                 break
             check_finite("normals", self._N)
             self._N = scale_normals(self._N)
-        self._scaled = True  # (every normal was tested)
 
     def _pass(self, src, bounds, vis, inputs) -> int:
         """The kernel over every vertex (+ the float64 redo of marked float32 lanes): ``src``
@@ -505,9 +504,10 @@ class Shader:
         outside = K.shade(*args, K.Culling(cull, self._culled))
         if outside:
             return outside
+        self._scaled = True  # (every normal was tested: inside NORMAL_RANGE)
         self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
-            P, N = self._P, self._normals() if self._G is not None else self._N  # (N: tested)
+            P, N = self._P, self._N
             params64, flags, view64 = self._params_for(np.float64)
             m = self._scene.material
             surface64 = K.Surface(material_vector(m, np.float64), self._aconst, m.shininess)
