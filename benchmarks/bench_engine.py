@@ -134,13 +134,8 @@ def one_shot_flows(scene, P, N, R: int) -> int:
         for threads in (numba.config.NUMBA_NUM_THREADS, 1):
             numba.set_num_threads(threads)
             clock = time.perf_counter if threads > 1 else time.process_time
-            ts: dict = {name: [] for name in flows}
-            for _ in range(R):
-                for name, fn in flows.items():
-                    t = clock()
-                    fn()
-                    ts[name].append(clock() - t)
-            v, sl = (statistics.median(ts[x]) * 1e3 for x in ("vertices", "slabs"))
+            ts = in_turns(flows, R, clock)
+            v, sl = (ts[x][0] * 1e3 for x in ("vertices", "slabs"))
             what = f"wall, {threads} threads" if threads > 1 else "CPU, 1 thread"
             print(f"{precision} one-shot pass ({what}): vertices {v:.2f} ms, slabs {sl:.2f} ms")
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
@@ -186,17 +181,17 @@ def _flows(scene, P, N, precision: str) -> dict:
     return {"vertices": vertices, "slabs": slabs}
 
 
-def in_turns(fns: dict, R: int) -> dict:
-    """(median, best) seconds of each of ``fns`` (name -> function), timed in turns: one call
-    of each per round, ``R`` rounds after a warm-up round."""
+def in_turns(fns: dict, R: int, clock=time.perf_counter) -> dict:
+    """(median, best) seconds of each of ``fns`` (name -> function) by ``clock``, timed in
+    turns: one call of each per round, ``R`` rounds after a warm-up round."""
     for fn in fns.values():
         fn()
     ts: dict = {name: [] for name in fns}
     for _ in range(R):
         for name, fn in fns.items():
-            t = time.perf_counter()
+            t = clock()
             fn()
-            ts[name].append(time.perf_counter() - t)
+            ts[name].append(clock() - t)
     return {name: (statistics.median(v), min(v)) for name, v in ts.items()}
 
 
