@@ -14,6 +14,7 @@ from pathlib import Path
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
+from explorer.app.messages import open_log
 from explorer.app.session import last_session_path, load_session, save_session
 from explorer.app.start import add_mesh_materials, free_name, load_mesh_choice
 from explorer.core.atomic import write_atomic
@@ -152,6 +153,8 @@ class Commands:
         add(v, "toggle_difference", "&Difference view (d)", self.toggle_difference)
         add(v, "toggle_compare", "&Compare A | B (c)", self.toggle_compare)
         add(v, "swap_sides", "&Swap A and B (x)", self.swap_sides)
+        v.addSeparator()
+        add(v, "messages", "&Messages", lambda: open_log(self.messages), "Ctrl+M")
         h = bar.addMenu("&Help")
         add(h, "help", "&Keys and mouse", self.toggle_help, "F1")
         self.panel.material.save.clicked.connect(self._guard(self.save_preset_as, "save preset"))

@@ -98,7 +98,7 @@ class FileCommands:
         if notes:
             text += f" ({plural(len(notes), noun)})"
             self.tell(title, text, details="\n".join(notes))
-        self.show_status(text)
+        self.show_status(text, warning=bool(notes), details=notes, open_log_=False)
 
     def _ask_replace(self, path: Path) -> bool:
         """True when ``path`` may be written: it does not exist, or the user said yes."""
@@ -148,8 +148,8 @@ class FileCommands:
             for w in warnings:
                 log.warning("%s", w)
             self.show_status(f"{mesh.name}: its materials read with "
-                             f"{plural(len(warnings), 'warning')}: {warnings[0]}",
-                             msecs=STATUS_MS)  # fmt: skip
+                             f"{plural(len(warnings), 'warning')} (View ▸ Messages)",
+                             msecs=STATUS_MS, warning=True, details=warnings)  # fmt: skip
         return True
 
     def _with_mesh_materials(self, state: M.State, mesh: Mesh) -> tuple[M.State, list[str]]:

@@ -10,24 +10,34 @@ from explorer.app.panel import (
     MAX_INTENSITY,
     ColourButton,
     MaterialTab,
+    NumberField,
     ValueSlider,
     _form,
     _scroll,
+    guard_wheel,
 )
 from explorer.core.lights import LIGHT_TYPES, SPOT_EXPONENT_RANGE
 from explorer.core.material import MODELS
 
+#: the attenuation fields' range (the scene file takes any value >= 0, not all three zero)
+ATTENUATION_RANGE = (0.0, 100.0)
+
 
 def light_summary(i: int, light, state: M.State) -> str:
-    """One line of the light list: number, type and placement."""
+    """One line of the light list: number, type and placement, and the light it shares its
+    place with (a duplicate, until moved)."""
     az, el, d = state.placement(i)
     where = "from" if light.type == "directional" else "at"
     dist = "" if light.type == "directional" else f", {d / state.radius:.2f} r"
-    return f"{i + 1}: {light.type} {where} az {az:.0f}°, el {el:.0f}°{dist}"
+    j = M.same_place_as(state, i)
+    same = "" if j is None else f" (same place as {j + 1})"
+    return f"{i + 1}: {light.type} {where} az {az:.0f}°, el {el:.0f}°{dist}{same}"
 
 
 class LightsTab(QtWidgets.QWidget):
     """The scene's lights (add, duplicate, remove) and the selected light's controls."""
+
+    rejected = QtCore.Signal(str)
 
     def __init__(self, act, parent=None):
         super().__init__(parent)
@@ -51,21 +61,24 @@ class LightsTab(QtWidgets.QWidget):
         self.controls = QtWidgets.QWidget()
         form = _form(self.controls)
         form.setContentsMargins(0, 0, 0, 0)
-        row = QtWidgets.QHBoxLayout()
-        row.addWidget(QtWidgets.QLabel("type"))
+        row = QtWidgets.QGridLayout()  # type and colour on rows of their own: a narrow panel
+        label = QtWidgets.QLabel("type")
+        label.setMinimumWidth(64)
+        row.addWidget(label, 0, 0)
         self.type = QtWidgets.QComboBox()
         self.type.setObjectName("type")
         self.type.addItems(list(LIGHT_TYPES))
         self.type.activated.connect(
             lambda i: self.act(M.set_light_type, LIGHT_TYPES[i], label="light type")
         )
-        row.addWidget(self.type, 1)
-        row.addWidget(QtWidgets.QLabel("color"))
+        row.addWidget(self.type, 0, 1)
+        row.addWidget(QtWidgets.QLabel("color"), 1, 0)
         self.colour = ColourButton("color")
         self.colour.picked.connect(
             lambda rgb: self.act(M.set_light_colour, rgb, label="light color")
         )
-        row.addWidget(self.colour, 1)
+        row.addWidget(self.colour, 1, 1)
+        row.setColumnStretch(1, 1)
         form.addLayout(row)
         self.sliders = {
             "intensity": ValueSlider(
@@ -81,29 +94,31 @@ class LightsTab(QtWidgets.QWidget):
         self.sliders["distance"].setToolTip("distance from the mesh centre in mesh radii")
         for name, s in self.sliders.items():
             form.addWidget(s)
+            s.rejected.connect(self.rejected)
             s.edited.connect(lambda v, n=name: self._edited(n, v))
             s.released.connect(lambda: self.act(None))
         self.attenuation_box = QtWidgets.QWidget()
-        row = QtWidgets.QHBoxLayout(self.attenuation_box)
-        row.setContentsMargins(0, 0, 0, 0)
-        row.addWidget(QtWidgets.QLabel("attenuation"))
+        grid = QtWidgets.QGridLayout(self.attenuation_box)  # its title above its three fields
+        grid.setContentsMargins(0, 0, 0, 0)
+        grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 6)
         self.attenuation = []
-        for key in ("kc", "kl", "kq"):
-            f = QtWidgets.QDoubleSpinBox()
+        for k, key in enumerate(("kc", "kl", "kq")):
+            f = NumberField(key, *ATTENUATION_RANGE)
             f.setObjectName(f"attenuation_{key}")
-            f.setDecimals(3)
-            f.setRange(0.0, 100.0)
             f.setSingleStep(0.05)
-            f.setKeyboardTracking(False)
             f.setToolTip(f"{key} of 1 / (kc + kl·d + kq·d²), d in world units")
             f.valueChanged.connect(self._attenuation)
-            row.addWidget(f, 1)
+            f.rejected.connect(self.rejected)
+            grid.addWidget(QtWidgets.QLabel(key), 1, 2 * k)
+            grid.addWidget(f, 1, 2 * k + 1)
+            grid.setColumnStretch(2 * k + 1, 1)
             self.attenuation.append(f)
         form.addWidget(self.attenuation_box)
         self.cutoff = ValueSlider("cutoff", 0.0, 90.0, decimals=1, suffix="°")
         self.exponent = ValueSlider("exponent", *SPOT_EXPONENT_RANGE, decimals=1)
         for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
             form.addWidget(s)
+            s.rejected.connect(self.rejected)
             s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
             s.released.connect(lambda: self.act(None))
         box.addWidget(self.controls)
@@ -302,7 +317,13 @@ class ViewTab(QtWidgets.QWidget):
 
 
 class Panel(QtWidgets.QTabWidget):
-    """The three tabs. act : the window's action sender; choose_mesh(name) : the mesh chooser"""
+    """The three tabs. act : the window's action sender; choose_mesh(name) : the mesh chooser.
+
+    ``rejected(message)``: a typed value was refused (the field shows the state's again). The
+    panel is never narrower than its widest tab's least width (with the scroll bar), so no
+    control is cut at any window size; a wheel over a control it has not focused scrolls."""
+
+    rejected = QtCore.Signal(str)
 
     def __init__(self, act, choose_mesh, parent=None):
         super().__init__(parent)
@@ -310,10 +331,23 @@ class Panel(QtWidgets.QTabWidget):
         self.material = MaterialTab(act)
         self.lights = LightsTab(act)
         self.view = ViewTab(act, choose_mesh)
-        self.addTab(_scroll(self.material), "material")
-        self.addTab(_scroll(self.lights), "lights")
-        self.addTab(_scroll(self.view), "view")
-        self.setMinimumWidth(250)
+        self.areas = [_scroll(self.material), _scroll(self.lights), _scroll(self.view)]
+        for area, name in zip(self.areas, ("material", "lights", "view"), strict=True):
+            area.setObjectName(f"{name}_scroll")
+            self.addTab(area, name)
+        for s in self.material.sliders.values():
+            s.rejected.connect(self.rejected)
+        self.lights.rejected.connect(self.rejected)
+        self._wheel = [guard_wheel(t) for t in (self.material, self.lights, self.view)]
+        self.fit_width()
+
+    def fit_width(self) -> None:
+        """The least width that shows every tab's controls whole (the vertical scroll bar
+        included: the tabs scroll when the window is low)."""
+        bar = self.style().pixelMetric(QtWidgets.QStyle.PixelMetric.PM_ScrollBarExtent)
+        need = max(t.minimumSizeHint().width() for t in (self.material, self.lights, self.view))
+        frame = 2 * self.style().pixelMetric(QtWidgets.QStyle.PixelMetric.PM_DefaultFrameWidth)
+        self.setMinimumWidth(need + bar + frame + 4)
 
     def show_state(self, s: M.State, n_vertices: int) -> None:
         self.material.show_state(s)

@@ -491,14 +491,26 @@ def add_light(state: State) -> State:
 
 
 def duplicate_light(state: State) -> State:
-    """A copy of the selected light, turned :data:`NEW_LIGHT_TURN` degrees; it is selected."""
+    """An exact copy of the selected light (same type, colour, place and cone), selected, so
+    that the controls or its handle move it from there; the light list says which lights share
+    a place (:func:`same_place_as`)."""
     light = state.selected_light
     if light is None:
         raise ExplorerError("the scene has no light to duplicate")
-    az, el, d = state.placement()
-    copy = light.placed((az + NEW_LIGHT_TURN + 180.0) % 360.0 - 180.0, el, d, state.centre)
-    lights = state.scene.lights + (copy,)
+    lights = state.scene.lights + (light,)
     return _lights(state, lights, len(lights) - 1).replace(held_azimuth=None)
+
+
+def same_place_as(state: State, i: int) -> int | None:
+    """The first light before light ``i`` with the same type and placement (azimuth, elevation,
+    distance), or None: the light list says so, since such lights draw one
+    handle over the other."""
+    lights = state.scene.lights
+    here = lights[i].placement(state.centre)
+    for j in range(i):
+        if lights[j].type == lights[i].type and lights[j].placement(state.centre) == here:
+            return j
+    return None
 
 
 def remove_light(state: State) -> State:
@@ -508,6 +520,56 @@ def remove_light(state: State) -> State:
     lights = list(state.scene.lights)
     del lights[state.light]
     return _lights(state, lights, state.light).replace(held_azimuth=None)
+
+
+# -- typed values ------------------------------------------------------------------------------
+
+
+def parse_number(key: str, text: str, lo: float, hi: float) -> float:
+    """The number typed for ``key`` (a unit such as ``°`` or `` r`` after it is allowed), which
+    must lie within ``[lo, hi]``; anything else raises :class:`ExplorerError` naming the key
+    and the range, so the user is told instead of the value being clamped or dropped."""
+    t = text.strip().rstrip("°").removesuffix(" r").removesuffix("r").strip()
+    try:
+        v = float(t)
+    except ValueError:
+        v = None
+    if v is None or not math.isfinite(v) or not lo <= v <= hi:
+        raise ExplorerError(f"{key} must be a number within {lo:g} .. {hi:g}, got {text.strip()!r}")
+    return v
+
+
+def parse_colour(key: str, text: str) -> Vec3:
+    """A colour typed as ``r, g, b`` (each within 0 .. 1, commas or spaces between) or as hex
+    ``#rrggbb`` (``#rgb``, the ``#`` optional) -> (3,) floats in [0, 1]; anything else raises
+    :class:`ExplorerError` naming ``key`` and the forms taken."""
+    t = text.strip()
+    forms = "'r, g, b' with each within 0 .. 1, or '#rrggbb'"
+    h = t.removeprefix("#")
+    if (
+        len(h) in (3, 6)
+        and all(c in "0123456789abcdefABCDEF" for c in h)
+        and (t.startswith("#") or "," not in t and " " not in t and not _is_number(t))
+    ):
+        if len(h) == 3:
+            h = "".join(c * 2 for c in h)
+        return tuple(int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+    parts = [p for p in t.replace(",", " ").split() if p]
+    try:
+        rgb = tuple(float(p) for p in parts)
+    except ValueError:
+        rgb = ()
+    if len(rgb) != 3 or not all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in rgb):
+        raise ExplorerError(f"{key} must be {forms}, got {t!r}")
+    return rgb
+
+
+def _is_number(t: str) -> bool:
+    try:
+        float(t)
+    except ValueError:
+        return False
+    return True
 
 
 # -- mesh ----------------------------------------------------------------------------------------

@@ -12,10 +12,19 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
-from explorer.core.material import MODELS, RGB_KEYS
+from explorer.core.errors import ExplorerError
+from explorer.core.material import (
+    COEFFICIENT_RANGE,
+    MODELS,
+    OPACITY_RANGE,
+    RGB_KEYS,
+    SHININESS_RANGE,
+)
+from explorer.shading.display import to_bytes
 
 #: slider steps (QSlider is integral)
 STEPS = 1000
@@ -46,6 +55,106 @@ def rgb_text(rgb) -> str:
     return ", ".join(f"{c:.3f}" for c in rgb)
 
 
+def rgb_bytes(rgb) -> tuple[int, int, int]:
+    """The 8-bit colour the view draws for the value ``rgb`` (3,): each channel clamped to
+    [0, 1] and times 255, rounded as :func:`~explorer.shading.display.to_bytes` rounds the
+    engine's colours (no transfer function: the view shows the values as they are)."""
+    c = np.clip(np.asarray(rgb, dtype=np.float64).reshape(1, 3), 0.0, 1.0)
+    return tuple(int(v) for v in to_bytes(c)[0])
+
+
+def qcolour(rgb) -> QtGui.QColor:
+    """:func:`rgb_bytes` as a ``QColor`` (8-bit, exact)."""
+    return QtGui.QColor(*rgb_bytes(rgb))
+
+
+class NumberField(QtWidgets.QDoubleSpinBox):
+    """A number field for the state's key ``key`` that never changes a typed value behind the
+    user's back: any text may be typed, and on Enter (or leaving the field) a value outside
+    ``[lo, hi]``, or no number at all, is refused with ``rejected(message)`` (naming the key
+    and the range, :func:`explorer.app.model.parse_number`) and the field shows again the value
+    it held (the state's). A value inside the range is taken as QDoubleSpinBox takes it."""
+
+    rejected = QtCore.Signal(str)
+
+    def __init__(self, key: str, lo: float, hi: float, *, decimals: int = 3, suffix: str = "",
+                 parent=None):  # fmt: skip
+        super().__init__(parent)
+        self.key = key
+        self.setDecimals(decimals)
+        self.setRange(lo, hi)
+        self.setSuffix(suffix)
+        self.setKeyboardTracking(False)
+
+    def validate(self, text: str, pos: int):
+        """Every text may be typed (Qt's own check would drop the keys that leave the range,
+        turning 5000 into 500); :meth:`check` judges it when it is entered."""
+        body = text.removesuffix(self.suffix()).strip()
+        try:
+            float(body)
+        except ValueError:
+            return QtGui.QValidator.State.Intermediate, text, pos
+        return QtGui.QValidator.State.Acceptable, text, pos
+
+    def check(self) -> bool:
+        """True when the text is a value in range (or unchanged); else reject it (the signal)
+        and show the field's value again."""
+        text = self.lineEdit().text()
+        if text == self.textFromValue(self.value()) + self.suffix() or (
+            text == self.textFromValue(self.value())
+        ):
+            return True
+        try:
+            M.parse_number(self.key, text.removesuffix(self.suffix()), self.minimum(),
+                           self.maximum())  # fmt: skip
+        except ExplorerError as exc:
+            self.lineEdit().setText(self.textFromValue(self.value()) + self.suffix())
+            self.rejected.emit(str(exc))
+            return False
+        return True
+
+    def keyPressEvent(self, event: QtGui.QKeyEvent) -> None:  # noqa: N802 - Qt's name
+        if event.key() in (QtCore.Qt.Key.Key_Return, QtCore.Qt.Key.Key_Enter) and not self.check():
+            event.accept()
+            return
+        super().keyPressEvent(event)
+
+    def focusOutEvent(self, event: QtGui.QFocusEvent) -> None:  # noqa: N802 - Qt's name
+        self.check()
+        super().focusOutEvent(event)
+
+    def stepBy(self, steps: int) -> None:  # noqa: N802 - Qt's name
+        if self.check():
+            super().stepBy(steps)
+
+
+class WheelToScroll(QtCore.QObject):
+    """An event filter for the panel's sliders, number fields and choosers: a wheel turned over
+    one that does not have the keyboard focus scrolls the panel (the nearest scroll area)
+    instead of changing the value; once clicked (focused) the wheel changes it."""
+
+    def eventFilter(self, obj, event) -> bool:  # noqa: N802 - Qt's name
+        if event.type() != QtCore.QEvent.Type.Wheel or obj.hasFocus():
+            return False
+        area = obj.parentWidget()
+        while area is not None and not isinstance(area, QtWidgets.QScrollArea):
+            area = area.parentWidget()
+        if area is not None:
+            QtWidgets.QApplication.sendEvent(area.verticalScrollBar(), event)
+        return True
+
+
+def guard_wheel(root: QtWidgets.QWidget) -> WheelToScroll:
+    """Install :class:`WheelToScroll` on every slider, spin box and combo box under ``root``
+    (they take the focus by click or Tab, not by the wheel). Returns the filter (keep it)."""
+    f = WheelToScroll(root)
+    for kind in (QtWidgets.QAbstractSlider, QtWidgets.QAbstractSpinBox, QtWidgets.QComboBox):
+        for w in root.findChildren(kind):
+            w.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
+            w.installEventFilter(f)
+    return f
+
+
 class ValueSlider(QtWidgets.QWidget):
     """A labelled slider with a number field. ``edited(value)`` while the user drags or
     types; ``released()`` when a drag ends (one undo step).
@@ -56,6 +165,7 @@ class ValueSlider(QtWidgets.QWidget):
     edited = QtCore.Signal(float)
     pressed = QtCore.Signal()
     released = QtCore.Signal()
+    rejected = QtCore.Signal(str)
 
     def __init__(self, name: str, lo: float, hi: float, *, decimals: int = 3, log: bool = False,
                  field_range=None, suffix: str = "", parent=None):  # fmt: skip
@@ -68,15 +178,12 @@ class ValueSlider(QtWidgets.QWidget):
         self.slider.setObjectName(f"{name}_slider")
         self.slider.setRange(0, STEPS)
         self.slider.setMinimumWidth(60)
-        self.field = QtWidgets.QDoubleSpinBox()
-        self.field.setObjectName(f"{name}_field")
-        self.field.setDecimals(decimals)
         flo, fhi = field_range or (lo, hi)
-        self.field.setRange(flo, fhi)
+        self.field = NumberField(name, flo, fhi, decimals=decimals, suffix=suffix)
+        self.field.setObjectName(f"{name}_field")
         self.field.setSingleStep(10 ** -min(decimals, 2))
-        self.field.setKeyboardTracking(False)
-        self.field.setSuffix(suffix)
         self.field.setMinimumWidth(72)
+        self.field.rejected.connect(self.rejected)
         self.note = QtWidgets.QLabel("")  # a second line (the distance in world units)
         self.note.setVisible(False)
         grid = QtWidgets.QGridLayout(self)
@@ -130,35 +237,116 @@ class ValueSlider(QtWidgets.QWidget):
         return float(self.field.value())
 
 
-class ColourButton(QtWidgets.QPushButton):
-    """A button showing a colour and its RGB; a click opens a colour dialog (non-native, so
-    it can be driven in tests), and ``picked(rgb)`` carries the choice."""
+class ColourDialog(QtWidgets.QColorDialog):
+    """Qt's colour dialog (non-native, so it can be driven in tests) with a ``value`` field
+    that takes the colour typed as ``r, g, b`` (0 .. 1) or ``#rrggbb``
+    (:func:`explorer.app.model.parse_colour`); a typed value is kept exactly (Qt's colours hold
+    16 bits a channel). ``picked(rgb)`` carries the choice."""
 
     picked = QtCore.Signal(tuple)
+
+    def __init__(self, key: str, rgb, parent=None):
+        super().__init__(parent)
+        self.key = key
+        self.setObjectName(f"{key}_dialog")
+        self.setOption(QtWidgets.QColorDialog.ColorDialogOption.DontUseNativeDialog, True)
+        self.setWindowTitle(f"{key} colour")
+        self.typed: tuple | None = None
+        self.value = QtWidgets.QLineEdit(rgb_text(rgb))
+        self.value.setObjectName("colour_value")
+        self.value.setPlaceholderText("r, g, b (each 0 .. 1) or #rrggbb")
+        self.value.setToolTip(f"type the {key} as r, g, b (each 0 .. 1) or as #rrggbb, then Enter")
+        self.problem = QtWidgets.QLabel("")
+        self.problem.setObjectName("colour_problem")
+        self.problem.setWordWrap(True)
+        self.problem.setStyleSheet("color: #c0392b;")
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(QtWidgets.QLabel("value"))
+        row.addWidget(self.value, 1)
+        lay = self.layout()
+        lay.insertLayout(lay.count() - 1, row)
+        lay.insertWidget(lay.count() - 1, self.problem)
+        self.problem.setVisible(False)
+        self.setCurrentColor(qcolour(rgb))
+        self.value.returnPressed.connect(self.take_typed)
+        self.currentColorChanged.connect(self._shown)
+        self.colorSelected.connect(self._selected)
+
+    def take_typed(self) -> bool:
+        """Read the ``value`` field: the dialog shows that colour, or says what is wrong."""
+        try:
+            rgb = M.parse_colour(self.key, self.value.text())
+        except ExplorerError as exc:
+            self.problem.setText(str(exc))
+            self.problem.setVisible(True)
+            return False
+        self.problem.setVisible(False)
+        self.typed = rgb
+        with QtCore.QSignalBlocker(self):
+            self.setCurrentColor(qcolour(rgb))
+        self.value.setModified(False)
+        return True
+
+    def _shown(self, c: QtGui.QColor) -> None:  # picked with the mouse or Qt's own fields
+        self.typed = None
+        self.problem.setVisible(False)
+        self.value.setText(rgb_text((c.redF(), c.greenF(), c.blueF())))
+
+    def accept(self) -> None:
+        if self.value.isModified() and not self.take_typed():
+            return  # the typed value is wrong: said so, the dialog stays open
+        super().accept()
+
+    def _selected(self, c: QtGui.QColor) -> None:
+        rgb = self.typed if self.typed is not None and qcolour(self.typed) == c else None
+        self.picked.emit(rgb or (c.redF(), c.greenF(), c.blueF()))
+
+
+class ColourButton(QtWidgets.QPushButton):
+    """A button showing a colour value and its RGB; a click opens a :class:`ColourDialog`, and
+    ``picked(rgb)`` carries the choice. The swatch is painted here (no style sheet, which would
+    also colour the dialog, the button's child) in exactly the 8-bit colour the view draws for
+    the value (:func:`rgb_bytes`)."""
+
+    picked = QtCore.Signal(tuple)
+    #: the frame of the button around the swatch (pixels)
+    INSET = 3
 
     def __init__(self, name: str, parent=None):
         super().__init__(parent)
         self.setObjectName(name)
         self.name = name
         self.rgb = (0.0, 0.0, 0.0)
-        self.dialog: QtWidgets.QColorDialog | None = None
+        self.dialog: ColourDialog | None = None
         self.clicked.connect(self.open_dialog)
 
     def set_rgb(self, rgb) -> None:
         self.rgb = tuple(float(c) for c in rgb)
-        q = QtGui.QColor.fromRgbF(*(min(max(c, 0.0), 1.0) for c in self.rgb))
-        text = "#000" if q.lightnessF() > 0.5 else "#fff"
-        self.setStyleSheet(f"background-color: {q.name()}; color: {text}; padding: 3px;")
         self.setText(rgb_text(self.rgb))
-        self.setToolTip(f"{self.name}: {rgb_text(self.rgb)} (click to pick)")
+        self.setToolTip(f"{self.name}: {rgb_text(self.rgb)}, drawn as the 8-bit "
+                        f"{rgb_bytes(self.rgb)} as the view draws it (click to pick)")  # fmt: skip
+        self.update()
 
-    def open_dialog(self) -> QtWidgets.QColorDialog:
-        d = QtWidgets.QColorDialog(self)
-        d.setObjectName(f"{self.name}_dialog")
-        d.setOption(QtWidgets.QColorDialog.ColorDialogOption.DontUseNativeDialog, True)
-        d.setWindowTitle(f"{self.name} colour")
-        d.setCurrentColor(QtGui.QColor.fromRgbF(*(min(max(c, 0.0), 1.0) for c in self.rgb)))
-        d.colorSelected.connect(lambda c: self.picked.emit((c.redF(), c.greenF(), c.blueF())))
+    def swatch_rect(self) -> QtCore.QRect:
+        """Where the colour is painted (the button less its frame)."""
+        k = self.INSET
+        return self.rect().adjusted(k, k, -k, -k)
+
+    def paintEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        p = QtWidgets.QStylePainter(self)
+        opt = QtWidgets.QStyleOptionButton()
+        self.initStyleOption(opt)
+        opt.text = ""
+        p.drawControl(QtWidgets.QStyle.ControlElement.CE_PushButton, opt)
+        colour = qcolour(self.rgb)
+        p.fillRect(self.swatch_rect(), colour)
+        p.setPen(QtGui.QColor("#000") if colour.lightnessF() > 0.5 else QtGui.QColor("#fff"))
+        p.drawText(self.swatch_rect(), QtCore.Qt.AlignmentFlag.AlignCenter, self.text())
+        p.end()
+
+    def open_dialog(self) -> ColourDialog:
+        d = ColourDialog(self.name, self.rgb, self)
+        d.picked.connect(self.picked)
         d.finished.connect(lambda _: setattr(self, "dialog", None))
         self.dialog = d
         d.open()
@@ -176,7 +364,7 @@ def _scroll(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
     area = QtWidgets.QScrollArea()
     area.setWidget(widget)
     area.setWidgetResizable(True)
-    area.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    area.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAsNeeded)
     area.setFrameShape(QtWidgets.QFrame.Shape.NoFrame)
     return area
 
@@ -184,9 +372,9 @@ def _scroll(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
 def swatch(material, size: int = 18) -> QtGui.QIcon:
     """A small square of the material's diffuse colour with its specular colour in a corner."""
     pm = QtGui.QPixmap(size, size)
-    pm.fill(QtGui.QColor.fromRgbF(*(min(c, 1.0) for c in material.diffuse)))
+    pm.fill(qcolour(material.diffuse))
     p = QtGui.QPainter(pm)
-    spec = QtGui.QColor.fromRgbF(*(min(c, 1.0) for c in material.specular))
+    spec = qcolour(material.specular)
     p.fillRect(size // 2, 0, size - size // 2, size // 2, spec)
     p.end()
     return QtGui.QIcon(pm)
@@ -283,13 +471,13 @@ class MaterialTab(QtWidgets.QWidget):
         self.mesh_materials = MeshMaterialsBox(act)
         for w in (self.mesh_materials, self.preset_label, self.search, self.presets,
                   self.description):  # fmt: skip
-            box.addWidget(w)
+            box.addWidget(w, 1 if w is self.presets else 0)  # the list takes the spare height
         self.sliders = {
-            "ka": ValueSlider("ka", 0.0, 1.0),
-            "kd": ValueSlider("kd", 0.0, 1.0),
-            "ks": ValueSlider("ks", 0.0, 1.0),
-            "shininess": ValueSlider("shininess", 0.0, 1000.0, decimals=1, log=True),
-            "opacity": ValueSlider("opacity", 0.0, 1.0),
+            "ka": ValueSlider("ka", *COEFFICIENT_RANGE),
+            "kd": ValueSlider("kd", *COEFFICIENT_RANGE),
+            "ks": ValueSlider("ks", *COEFFICIENT_RANGE),
+            "shininess": ValueSlider("shininess", *SHININESS_RANGE, decimals=1, log=True),
+            "opacity": ValueSlider("opacity", *OPACITY_RANGE),
         }
         actions = {
             "ka": lambda v: (M.set_coefficient, "ka", v),
@@ -339,7 +527,6 @@ class MaterialTab(QtWidgets.QWidget):
         self.save = QtWidgets.QPushButton("Save preset as…")
         self.save.setObjectName("save_preset")
         box.addWidget(self.save)
-        box.addStretch(1)
         self.search.textChanged.connect(self._filter)
         self.presets.itemClicked.connect(self._chosen)
         self.presets.currentItemChanged.connect(self._describe)

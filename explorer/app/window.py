@@ -28,6 +28,7 @@ from explorer.app.compare import ComparePane, DifferencePane
 from explorer.app.difference import DifferenceWorker, HeatMap
 from explorer.app.filemenu import FileCommands
 from explorer.app.lightpanel import Panel
+from explorer.app.messages import MessageIndicator, MessageLog, open_log
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
 from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
@@ -105,7 +106,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self.views.setChildrenCollapsible(False)
         self.plotter = QtInteractor(self.views, multi_samples=0, auto_update=False)
         self.plotter.setObjectName("view")
-        self.plotter.setMinimumSize(200, 150)
+        self.plotter.setMinimumSize(120, 120)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.plotter.disable_anti_aliasing()
         self.plotter.set_background(BACKGROUND if background is None else background)
@@ -121,6 +122,10 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self.status_label = QtWidgets.QLabel("")
         self.status_label.setObjectName("status")
         self.statusBar().addPermanentWidget(self.status_label)
+        self.messages = MessageLog(self)
+        self.messages_indicator = MessageIndicator(self.messages)
+        self.statusBar().addPermanentWidget(self.messages_indicator)
+        self.panel.rejected.connect(self._guard(self.reject_input, "typed value"))
         self._watch_engine()
         self.view_aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)
         self._frame_on_show = state.camera is None  # framed again for the view's real shape
@@ -219,17 +224,41 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         else:
             text = f"{type(exc).__name__}: {exc}"
             log.error("%s failed", where, exc_info=exc)
-        first = text.splitlines()[0] if text else type(exc).__name__
+        lines = text.splitlines() or [type(exc).__name__]
         self.errors.append(f"{where}: {text}")
-        self.show_status(f"error ({where}): {first}", error=True)
+        self.show_status(f"error ({where}): {lines[0]}", error=True, details=lines[1:])
 
-    def show_status(self, text: str, *, msecs: int = MESSAGE_MS, error: bool = False) -> None:
-        """Show a short message on the status bar (errors stay until the next message). The
+    def reject_input(self, text: str) -> None:
+        """A typed value was refused (``text`` names the key and the range): said as an error,
+        and the panel shows the state again."""
+        self.errors.append(f"typed value: {text}")
+        self.show_status(f"error: {text}", error=True)
+        self._show_panel(self.store.state)
+
+    def show_status(self, text: str, *, msecs: int = MESSAGE_MS, error: bool = False,
+                    warning: bool = False, details=(), open_log_: bool = True) -> None:  # fmt: skip
+        """Show a short message on the status bar (errors stay until the next message) and add
+        it to the message log; the log opens when the message is an error or a warning that
+        the status bar cannot show whole, or comes with ``details`` (each a line of the log).
+        ``open_log_=False``: never opens it (the details are shown in a dialog already). The
         engine's "kernels are being prepared" line comes here too."""
         self.message = text
         bar = self.statusBar()
-        bar.setStyleSheet("color: #ff7766;" if error else "")
+        bar.setStyleSheet("color: #ff7766;" if error else "color: #e0a030;" if warning else "")
         bar.showMessage(text, 0 if error else int(msecs))
+        level = "error" if error else "warning" if warning else "info"
+        self.messages.add(level, text, details)
+        self.messages_indicator.refresh()
+        if open_log_ and level != "info" and (details or not self._fits_status_bar(text)):
+            open_log(self.messages)
+
+    def _fits_status_bar(self, text: str) -> bool:
+        """Whether ``text`` shows whole in the status bar's message area (the bar less its
+        permanent widgets)."""
+        bar = self.statusBar()
+        taken = sum(w.width() + 8 for w in (self.engine_label, self.status_label,
+                                            self.messages_indicator) if w.isVisible())  # fmt: skip
+        return bar.fontMetrics().horizontalAdvance(text) <= max(bar.width() - taken - 16, 0)
 
     def _watch_engine(self) -> None:
         """Load the compiled kernels in a thread as soon as numba's cache holds them (the numpy
@@ -266,6 +295,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
             return self.store.apply(action, *args, label=label, merge=merge)
         except ExplorerError as exc:
             self.report(exc, label or action.__name__)
+            self._show_panel(self.store.state)  # the control that sent it shows the state again
             return False
 
     def _on_change(self, old: M.State, new: M.State) -> None:

@@ -40,6 +40,26 @@ COMMANDS = {
 }
 
 
+#: the command run when none is given; its options (and a SCENE file) are taken without it
+DEFAULT_COMMAND = "gui"
+#: the top-level options (they do not mean the default command)
+TOP_OPTIONS = ("-h", "--help", "--version")
+
+
+def with_default_command(argv: list[str]) -> list[str]:
+    """``argv`` with :data:`DEFAULT_COMMAND` put first when no command is named: nothing at all,
+    a ``gui`` option (``phong-explorer --preset jade``) or an existing SCENE file. A word that
+    is neither a command nor a file is left for the parser to refuse (a mistyped command)."""
+    if not argv:
+        return [DEFAULT_COMMAND]
+    first = argv[0]
+    if first in COMMANDS or first in TOP_OPTIONS:
+        return list(argv)
+    if first.startswith("-") or os.path.isfile(first):
+        return [DEFAULT_COMMAND, *argv]
+    return list(argv)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The command's parser. Imports every subcommand's module (and with them numpy and the
     engine: about half a second), which this module itself does not, so that :func:`main`
@@ -47,6 +67,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="phong-explorer",
         description="Explore materials under the Phong / Blinn-Phong illumination model.",
+        epilog=f"Without a COMMAND, '{DEFAULT_COMMAND}' runs and takes its options and SCENE "
+        f"(phong-explorer --preset jade); 'phong-explorer {DEFAULT_COMMAND} --help' lists them.",
     )
     parser.add_argument("--version", action="version", version=f"phong-explorer {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -108,9 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:  # Ctrl-C while the engine loads: nothing was started
         print("error: interrupted (Ctrl-C)", file=sys.stderr)
         return INTERRUPTED_STATUS
-    args = parser.parse_args(argv)
-    if args.command is None:  # plain ``phong-explorer`` opens the window
-        args = parser.parse_args(["gui"])
+    args = parser.parse_args(with_default_command(sys.argv[1:] if argv is None else argv))
     try:
         with _sigterm_raises(enabled=args.command != "gui"):
             status = int(args._run(args) or 0)

@@ -11,8 +11,10 @@ import pytest
 
 from explorer.app.start import start_xvfb
 
+#: the private server's screen: room for the largest window size tested (1920x1080)
+SCREEN = (1920, 1200)
 #: modules whose tests open Qt windows in the test process
-QT_MODULES = ("test_window.py", "test_filemenu.py")
+QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py")
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -34,7 +36,7 @@ def xserver():
         pytest.skip("needs Xvfb for the Qt window (apt-get install -y xvfb)")
     pytest.importorskip("PySide6")
     pytest.importorskip("pyvistaqt")
-    _proc, display = start_xvfb()
+    _proc, display = start_xvfb(size=SCREEN)
     # left running: Qt keeps its connection to the end of the process, and a server gone
     # before that makes Xlib end the process with an I/O error; the server ends with the
     # process (PR_SET_PDEATHSIG)

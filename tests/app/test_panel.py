@@ -1,0 +1,335 @@
+"""The panel shows the truth (issue 30): colour swatches in the colour they hold, a colour
+dialog that is not painted in it and takes typed values, a wheel that scrolls the panel, every
+control reachable from 640x480 to 1920x1080, typed values refused out loud, controls that show
+the state after a refusal, and a message log that keeps every message whole. In-process under
+Xvfb (pytest-qt), reading the widgets' real pixels and geometry."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from explorer.app import model as M
+from explorer.core.material import COEFFICIENT_RANGE, SHININESS_RANGE
+from explorer.shading.display import to_bytes
+
+pytestmark = pytest.mark.usefixtures("xdisplay")
+ROOT = Path(__file__).resolve().parents[2]
+#: the sizes the window must lay itself out at (README: from 640x480 to full screen)
+SIZES = [(640, 480), (800, 500), (1100, 720), (1920, 1080)]
+TABS = ("material", "lights", "view")
+
+
+def rgb_bytes(rgb) -> tuple[int, int, int]:
+    """The 8-bit colour the view draws for ``rgb`` (the engine's rounding)."""
+    return tuple(int(v) for v in to_bytes([rgb])[0])
+
+
+def pixel(widget: QtWidgets.QWidget, point: QtCore.QPoint) -> tuple[int, int, int]:
+    """The colour ``widget`` paints at ``point`` (its own coordinates), from ``grab()``."""
+    image = widget.grab().toImage()
+    ratio = image.devicePixelRatio()
+    c = image.pixelColor(round(point.x() * ratio), round(point.y() * ratio))
+    return (c.red(), c.green(), c.blue())
+
+
+def swatch_pixels(button) -> set[tuple[int, int, int]]:
+    """The colours painted along the button's left and right quarters at mid height (away
+    from the text in the middle)."""
+    w, h = button.width(), button.height()
+    return {pixel(button, QtCore.QPoint(x, h // 2)) for x in (6, 8, w - 9, w - 7)}
+
+
+# -- 3. swatches -------------------------------------------------------------------------------
+@pytest.mark.parametrize("rgb", [(0.667, 0.0, 0.0), (0.2, 0.5, 0.9), (1.0, 1.0, 1.0)])
+def test_a_material_colour_button_is_painted_in_its_value(win, rgb):
+    win.act(M.set_colour, "diffuse", rgb)
+    button = win.panel.material.colours["diffuse"]
+    assert swatch_pixels(button) == {rgb_bytes(rgb)}
+    assert rgb_bytes((0.667, 0.0, 0.0)) == (170, 0, 0)  # round(255 v): no transfer function
+
+
+def test_a_light_colour_button_is_painted_in_its_value(win):
+    win.panel.setCurrentIndex(1)
+    win.act(M.set_light_colour, (0.0, 0.0, 1.0))
+    button = win.panel.lights.colour
+    assert swatch_pixels(button) == {(0, 0, 255)}
+    assert "(0, 0, 255)" in button.toolTip()
+
+
+# -- 4. the colour dialog ----------------------------------------------------------------------
+@pytest.mark.parametrize(("preset", "term"), [("jade", "diffuse"), ("jade", "emission")])
+def test_the_colour_dialog_is_not_filled_with_the_colour(win, qtbot, preset, term):
+    info = next(p for p in win.presets if p.name == preset)
+    win.act(M.apply_preset, info.name, info.material)
+    button = win.panel.material.colours[term]
+    qtbot.mouseClick(button, QtCore.Qt.MouseButton.LeftButton)
+    dialog = button.dialog
+    qtbot.waitExposed(dialog)
+    window_colour = QtWidgets.QApplication.palette().color(QtGui.QPalette.ColorRole.Window)
+    want = (window_colour.red(), window_colour.green(), window_colour.blue())
+    # the dialog's own background: its margins at the corners
+    for p in ((2, 2), (dialog.width() - 3, 2), (2, dialog.height() - 3),
+              (dialog.width() - 3, dialog.height() - 3)):  # fmt: skip
+        assert pixel(dialog, QtCore.QPoint(*p)) == want, p
+    assert button.styleSheet() == "" and dialog.styleSheet() == ""
+    dialog.reject()
+
+
+def test_the_colour_dialog_takes_typed_values(win, qtbot):
+    button = win.panel.material.colours["specular"]
+    for text, want in (("0.2, 0.4, 0.6", (0.2, 0.4, 0.6)), ("#ff8000", (1.0, 128 / 255, 0.0)),
+                       ("0.25 0.5 0.75", (0.25, 0.5, 0.75))):  # fmt: skip
+        qtbot.mouseClick(button, QtCore.Qt.MouseButton.LeftButton)
+        dialog = button.dialog
+        dialog.value.selectAll()
+        qtbot.keyClicks(dialog.value, text)
+        qtbot.keyClick(dialog.value, QtCore.Qt.Key.Key_Return)  # takes it, then OK
+        assert win.store.state.material.specular == want  # exactly what was typed
+        assert not dialog.isVisible()
+    before = win.store.state
+    qtbot.mouseClick(button, QtCore.Qt.MouseButton.LeftButton)
+    dialog = button.dialog
+    dialog.value.selectAll()
+    qtbot.keyClicks(dialog.value, "1.5, 0, 0")
+    dialog.accept()  # OK with a wrong value: said in the dialog, which stays open
+    assert dialog.isVisible() and win.store.state == before
+    assert "specular must be 'r, g, b' with each within 0 .. 1" in dialog.problem.text()
+    assert dialog.problem.isVisible()
+    dialog.reject()
+
+
+# -- 8. the wheel ------------------------------------------------------------------------------
+def wheel(widget: QtWidgets.QWidget, clicks: int) -> None:
+    """A real wheel event (``clicks`` notches, negative: toward the user) at the widget's
+    centre, through the application's event delivery (event filters included)."""
+    pos = QtCore.QPointF(widget.rect().center())
+    glob = QtCore.QPointF(widget.mapToGlobal(widget.rect().center()))
+    ev = QtGui.QWheelEvent(pos, glob, QtCore.QPoint(0, 0), QtCore.QPoint(0, 120 * clicks),
+                           QtCore.Qt.MouseButton.NoButton, QtCore.Qt.KeyboardModifier.NoModifier,
+                           QtCore.Qt.ScrollPhase.NoScrollPhase, False)  # fmt: skip
+    QtWidgets.QApplication.sendEvent(widget, ev)
+
+
+def test_the_wheel_over_a_slider_scrolls_the_panel(open_window, qtbot):
+    w = open_window()
+    w.resize(800, 500)
+    qtbot.waitUntil(lambda: w.panel.widget(0).verticalScrollBar().maximum() > 0)
+    bar = w.panel.widget(0).verticalScrollBar()
+    ks = w.panel.material.sliders["ks"]
+    for widget in (ks.slider, ks.field):
+        before, top = w.store.state, bar.value()
+        wheel(widget, -1)
+        assert w.store.state == before and not w.store.state.edited
+        assert bar.value() > top, "the panel did not scroll"
+    w.activateWindow()
+    qtbot.waitUntil(w.isActiveWindow)
+    ks.slider.setFocus()  # clicked into: then the wheel is the slider's
+    qtbot.waitUntil(ks.slider.hasFocus)
+    wheel(ks.slider, -1)
+    assert w.store.state.material.scalars()[2] != pytest.approx(
+        before.material.scalars()[2], abs=1e-9
+    )
+    assert not w.errors, w.errors
+
+
+# -- 9. layout at every size -------------------------------------------------------------------
+INTERACTIVE = (QtWidgets.QAbstractButton, QtWidgets.QAbstractSlider, QtWidgets.QAbstractSpinBox,
+               QtWidgets.QComboBox, QtWidgets.QLineEdit, QtWidgets.QAbstractItemView)  # fmt: skip
+
+
+def unreachable(window, area: QtWidgets.QScrollArea) -> list[str]:
+    """The visible interactive widgets of a tab that are cut: not whole inside the visible
+    viewport across, or below / above it with no vertical scroll bar to reach them."""
+    viewport = area.viewport()
+    vbar = area.verticalScrollBar()
+    content = area.widget()
+    bad = []
+    for w in content.findChildren(QtWidgets.QWidget):
+        if not isinstance(w, INTERACTIVE) or not w.isVisibleTo(content):
+            continue
+        if isinstance(w.parentWidget(), QtWidgets.QAbstractSpinBox | QtWidgets.QComboBox):
+            continue  # a spin box's own line edit
+        top_left = w.mapTo(viewport, QtCore.QPoint(0, 0))
+        r = QtCore.QRect(top_left, w.size())
+        across = r.left() >= 0 and r.right() < viewport.width()
+        y0 = w.mapTo(content, QtCore.QPoint(0, 0)).y()  # in the scrolled content
+        down = y0 >= 0 and y0 + w.height() <= vbar.maximum() + viewport.height()
+        inside = r.top() >= 0 and r.bottom() < viewport.height()
+        if not across or not (inside or (vbar.isVisible() and down)):
+            bad.append(f"{w.objectName() or type(w).__name__} at {r.getRect()} in viewport "
+                       f"{viewport.width()}x{viewport.height()}")  # fmt: skip
+    return bad
+
+
+def laid_out(qtbot, w, size):
+    w.resize(*size)
+    qtbot.waitUntil(lambda: (w.width(), w.height()) == size, timeout=5000)
+    QtWidgets.QApplication.processEvents()
+    w.render()
+    return w
+
+
+def check_window(w, size, tab: int) -> None:
+    w.panel.setCurrentIndex(tab)
+    QtWidgets.QApplication.processEvents()
+    assert (w.width(), w.height()) == size, "the window did not take the size"
+    panel = w.widget_box(w.panel)
+    assert panel[0] >= 0 and panel[0] + panel[2] <= w.width(), f"panel {panel} cut"
+    for view in (w.plotter, w.plotter_b):
+        if view is not None and view.isVisible():
+            x, y, vw, vh = w.widget_box(view)
+            assert vw >= 100 and vh >= 100 and x >= 0 and x + vw <= panel[0], (x, vw, panel)
+    area = w.panel.widget(tab)
+    assert not area.horizontalScrollBar().isVisible(), "a tab needs sideways scrolling"
+    bad = unreachable(w, area)
+    assert not bad, f"{TABS[tab]} at {size[0]}x{size[1]}: cut: {bad}"
+
+
+@pytest.mark.parametrize("size", SIZES, ids=[f"{a}x{b}" for a, b in SIZES])
+@pytest.mark.parametrize("tab", range(3), ids=TABS)
+def test_every_tab_is_whole_or_scrolls_at_every_size(open_window, qtbot, size, tab):
+    w = laid_out(qtbot, open_window(), size)
+    if tab == 1:  # the lights tab with everything a spot shows, and two lights
+        w.act(M.add_light)
+        w.act(M.set_light_type, "spot")
+    check_window(w, size, tab)
+    assert not w.errors, w.errors
+
+
+@pytest.mark.parametrize("size", SIZES, ids=[f"{a}x{b}" for a, b in SIZES])
+def test_the_compare_and_difference_views_fit_at_every_size(open_window, qtbot, size):
+    w = laid_out(qtbot, open_window(), size)
+    w.act(M.set_compare, True)
+    qtbot.waitUntil(lambda: w.plotter_b.isVisible() and w.plotter_b.width() > 50)
+    w.act(M.set_compare_difference, True)
+    for tab in range(3):
+        check_window(w, size, tab)
+    w.act(M.set_compare, False)
+    w.act(M.set_difference, True)
+    qtbot.waitUntil(lambda: w.heat.shown, timeout=60_000)
+    check_window(w, size, 2)
+    assert not w.errors, w.errors
+
+
+def test_the_preset_list_grows_with_the_window(open_window, qtbot):
+    w = laid_out(qtbot, open_window(), (1100, 720))
+    presets = w.panel.material.presets
+    row = presets.visualItemRect(presets.item(0)).height()
+    rows_small = presets.viewport().height() // row
+    laid_out(qtbot, w, (1920, 1080))
+    rows_big = presets.viewport().height() // row
+    assert rows_big >= min(presets.count(), rows_small + 10), (rows_small, rows_big)
+
+
+# -- 10. typed values --------------------------------------------------------------------------
+def type_into(qtbot, field, text: str) -> None:
+    field.setFocus()
+    field.lineEdit().selectAll()
+    qtbot.keyClicks(field.lineEdit(), text)
+    qtbot.keyClick(field.lineEdit(), QtCore.Qt.Key.Key_Return)
+
+
+@pytest.mark.parametrize(
+    ("key", "text", "lo", "hi"),
+    [("shininess", "5000", *SHININESS_RANGE), ("ka", "2.5", *COEFFICIENT_RANGE),
+     ("kd", "-1", *COEFFICIENT_RANGE), ("ks", "abc", *COEFFICIENT_RANGE)],
+)  # fmt: skip
+def test_a_typed_value_out_of_range_is_refused_out_loud(win, qtbot, key, text, lo, hi):
+    before = win.store.state
+    field = win.panel.material.sliders[key].field
+    shown = field.text()
+    type_into(qtbot, field, text)
+    assert win.store.state == before
+    assert field.text() == shown  # the state's value, not a clamped or truncated one
+    want = f"{key} must be a number within {lo:g} .. {hi:g}, got '{text}'"
+    assert want in win.message and win.statusBar().currentMessage() == win.message
+    assert any(want in m.text for m in win.messages.messages)
+    win.errors.clear()
+    type_into(qtbot, field, "0.5")  # a value in range is taken
+    assert win.store.state != before
+
+
+def test_a_typed_light_value_out_of_range_is_refused_out_loud(win, qtbot):
+    win.panel.setCurrentIndex(1)
+    before = win.store.state
+    type_into(qtbot, win.panel.lights.sliders["elevation"].field, "120")
+    assert win.store.state == before
+    assert "elevation must be a number within -90 .. 90, got '120'" in win.message
+    win.errors.clear()
+
+
+# -- 11. a control shows the state after a refusal ---------------------------------------------
+def test_a_refused_attenuation_leaves_no_stale_field(win, qtbot):
+    win.panel.setCurrentIndex(1)
+    win.act(M.set_light_field, "attenuation", (1.0, 0.5, 0.0))
+    kc, kl, _ = win.panel.lights.attenuation
+    type_into(qtbot, kc, "0")
+    assert win.store.state.selected_light.attenuation == (0.0, 0.5, 0.0)
+    type_into(qtbot, kl, "0")  # all zero: refused by the light
+    assert win.store.state.selected_light.attenuation == (0.0, 0.5, 0.0)
+    assert "all zero" in win.message
+    assert kl.value() == 0.5 and kl.text() == "0.500"
+    win.errors.clear()
+
+
+@pytest.mark.parametrize(
+    ("action", "control"),
+    [("set_light_field", lambda t: t.lights.exponent),
+     ("set_light_intensity", lambda t: t.lights.sliders["intensity"]),
+     ("place_light", lambda t: t.lights.sliders["azimuth"]),
+     ("set_coefficient", lambda t: t.material.sliders["kd"]),
+     ("set_shininess", lambda t: t.material.sliders["shininess"])],
+)  # fmt: skip
+def test_every_control_shows_the_state_after_a_refused_action(win, monkeypatch, action, control):
+    """The mechanism: whatever a control sent, a refusal re-reads the state into the panel
+    (here every action of the kind is made to refuse)."""
+    win.act(M.set_light_type, "spot")
+    before = win.store.state
+
+    def refuse(*_args):
+        raise M.ExplorerError(f"{action} refused")
+
+    monkeypatch.setattr(M, action, refuse)
+    c = control(win.panel)
+    shown = c.value()
+    c.field.setValue(shown / 2 + 0.3)  # a value in range the action then refuses
+    assert win.store.state == before and f"{action} refused" in win.message
+    assert c.value() == shown and c.slider.value() == c._to_step(shown)
+    win.errors.clear()
+
+
+# -- 12. the message log -----------------------------------------------------------------------
+def test_the_obj_warnings_are_whole_in_the_message_log(win, qtbot):
+    from explorer.app.start import add_mesh_materials
+
+    obj = ROOT / "docs" / "examples" / "teapot_parts.obj"
+    before = win.store.state
+    win.open_file(obj)
+    qtbot.waitUntil(win.messages.isVisible)  # the log opened by itself
+    text = win.messages.plain_text()
+    _, expected = add_mesh_materials(before, win.view.mesh)  # the reader's own warnings
+    assert len(expected) == 3, expected
+    for line in expected:
+        assert line in text, f"not whole in the log: {line}"
+    assert "warning" in win.messages_indicator.text()
+    win.messages.copy_all()
+    assert QtGui.QGuiApplication.clipboard().text() == text
+    win.messages.hide()
+    win.menu_actions["messages"].trigger()
+    assert win.messages.isVisible()
+
+
+# -- 13b. duplicate ----------------------------------------------------------------------------
+def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
+    win.panel.setCurrentIndex(1)
+    tab = win.panel.lights
+    tab.buttons["duplicate"].click()
+    lights = win.store.state.scene.lights
+    assert len(lights) == 2 and lights[1] == lights[0] and win.store.state.light == 1
+    assert tab.list.item(1).text().endswith("(same place as 1)")
+    assert "same place" not in tab.list.item(0).text()
+    tab.sliders["azimuth"].field.setValue(-100.0)  # moved: no longer said
+    assert "same place" not in tab.list.item(1).text()
