@@ -86,6 +86,9 @@ def test_light_actions(state):
     assert len(s.scene.lights) == 2 and s.light == 1
     s = M.duplicate_light(s)
     assert len(s.scene.lights) == 3 and s.light == 2
+    assert s.scene.lights[2] == s.scene.lights[1]  # an exact copy, said in the list
+    assert M.same_place_as(s, 2) == 1 and M.same_place_as(s, 1) is None
+    assert M.same_place_as(M.place_light(s, azimuth=-170.0), 2) is None
     s = M.remove_light(s)
     assert len(s.scene.lights) == 2 and s.light == 1
     s = M.select_light(s, 0)
@@ -197,12 +200,69 @@ def test_bad_sessions_name_file_and_key(tmp_path, text, words):
     assert "bad.yaml" in str(e.value) and words in str(e.value)
 
 
+@pytest.mark.parametrize(
+    ("text", "value"), [("0.5", 0.5), (" 1000 ", 1000.0), ("-90°", -90.0), ("2.5 r", 2.5)]
+)
+def test_parse_number_takes_values_in_range(text, value):
+    assert M.parse_number("key", text, -90.0, 1000.0) == value
+
+
+@pytest.mark.parametrize("text", ["5000", "-91", "abc", "", "nan", "inf"])
+def test_parse_number_names_the_key_and_range(text):
+    with pytest.raises(explorer.ExplorerError) as e:
+        M.parse_number("shininess", text, -90.0, 1000.0)
+    assert str(e.value) == f"shininess must be a number within -90 .. 1000, got {text.strip()!r}"
+
+
+@pytest.mark.parametrize(
+    ("text", "rgb"),
+    [("0.2, 0.4, 0.6", (0.2, 0.4, 0.6)), ("0 1 0.5", (0.0, 1.0, 0.5)),
+     ("#ff8000", (1.0, 128 / 255, 0.0)), ("#FFF", (1.0, 1.0, 1.0)), ("00ff00", (0.0, 1.0, 0.0))],
+)  # fmt: skip
+def test_parse_colour(text, rgb):
+    assert M.parse_colour("diffuse", text) == rgb
+
+
+@pytest.mark.parametrize("text", ["1.5, 0, 0", "0.2, 0.4", "red", "#12345", "-0.1 0 0", ""])
+def test_parse_colour_names_the_key_and_the_forms(text):
+    with pytest.raises(explorer.ExplorerError, match="^diffuse must be 'r, g, b' with each"):
+        M.parse_colour("diffuse", text)
+
+
 def test_no_display_reason():
     assert A.no_display_reason({}) == "no display (DISPLAY is not set)"
     forced = {"DISPLAY": ":0", "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow"}
     assert "off-screen" in A.no_display_reason(forced)
     assert "xcb" in A.no_display_reason({"DISPLAY": ":0", "QT_QPA_PLATFORM": "offscreen"})
     assert "cannot open" in A.no_display_reason({"DISPLAY": ":98765"})
+
+
+def test_no_command_means_gui_with_its_options(tmp_path):
+    from explorer.cli import with_default_command
+
+    assert with_default_command([]) == ["gui"]
+    assert with_default_command(["--preset", "jade"]) == ["gui", "--preset", "jade"]
+    scene = tmp_path / "s.yaml"
+    scene.write_text("material: ruby\n")
+    assert with_default_command([str(scene)]) == ["gui", str(scene)]
+    for kept in (["--help"], ["--version"], ["render", "--preset", "jade"], ["rendr"]):
+        assert with_default_command(kept) == kept  # a mistyped command stays refused
+    args = build_parser().parse_args(
+        with_default_command(["--preset", "jade", "--size", "640x480"])
+    )
+    assert args.command == "gui" and args.preset == "jade"
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    run = subprocess.run([sys.executable, "-m", "explorer.cli", "--preset", "jade"], env=env,
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 3 and "no display" in run.stderr, run.stderr  # gui's own exit
+    assert "invalid choice" not in run.stderr
+    run = subprocess.run([sys.executable, "-m", "explorer.cli", "--help"], env=env,
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    from explorer.cli import COMMANDS
+
+    listed = [line.split()[0] for line in run.stdout.splitlines() if line.startswith("    ")]
+    assert run.returncode == 0 and [c for c in listed if c in COMMANDS] == list(COMMANDS)
+    assert "Without a COMMAND, 'gui' runs" in " ".join(run.stdout.split())
 
 
 def _gui_args(*argv):
