@@ -98,9 +98,9 @@ class LightsTab(QtWidgets.QWidget):
             s.edited.connect(lambda v, n=name: self._edited(n, v))
             s.released.connect(lambda: self.act(None))
         self.attenuation_box = QtWidgets.QWidget()
-        grid = QtWidgets.QGridLayout(self.attenuation_box)  # its title above its three fields
+        grid = QtWidgets.QGridLayout(self.attenuation_box)  # a row a key: a narrow panel
         grid.setContentsMargins(0, 0, 0, 0)
-        grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 6)
+        grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 3)
         self.attenuation = []
         for k, key in enumerate(("kc", "kl", "kq")):
             f = NumberField(key, *ATTENUATION_RANGE)
@@ -109,10 +109,12 @@ class LightsTab(QtWidgets.QWidget):
             f.setToolTip(f"{key} of 1 / (kc + kl·d + kq·d²), d in world units")
             f.valueChanged.connect(self._attenuation)
             f.rejected.connect(self.rejected)
-            grid.addWidget(QtWidgets.QLabel(key), 1, 2 * k)
-            grid.addWidget(f, 1, 2 * k + 1)
-            grid.setColumnStretch(2 * k + 1, 1)
+            label = QtWidgets.QLabel(key)
+            label.setMinimumWidth(64)  # as the sliders' labels
+            grid.addWidget(label, 1 + k, 0)
+            grid.addWidget(f, 1 + k, 2)
             self.attenuation.append(f)
+        grid.setColumnStretch(1, 1)
         form.addWidget(self.attenuation_box)
         self.cutoff = ValueSlider("cutoff", 0.0, 90.0, decimals=1, suffix="°")
         self.exponent = ValueSlider("exponent", *SPOT_EXPONENT_RANGE, decimals=1)
