@@ -47,6 +47,8 @@ class LightsTab(QtWidgets.QWidget):
         self.list.setObjectName("lights")
         self.list.setMinimumHeight(60)
         self.list.setMaximumHeight(110)
+        self.list.setWordWrap(True)  # a long line (a duplicate's) wraps in a narrow panel
+        self.list.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         box.addWidget(self.list)
         row = QtWidgets.QHBoxLayout()
         self.buttons = {}
@@ -150,7 +152,9 @@ class LightsTab(QtWidgets.QWidget):
         with QtCore.QSignalBlocker(self.list):
             self.list.clear()
             for i, light in enumerate(lights):
-                self.list.addItem(light_summary(i, light, s))
+                text = light_summary(i, light, s)
+                self.list.addItem(text)
+                self.list.item(i).setToolTip(text)
             self.list.setCurrentRow(s.light if lights else -1)
         light = s.selected_light
         self.controls.setVisible(light is not None)

@@ -86,8 +86,8 @@ class MessageIndicator(QtWidgets.QToolButton):
 
     def refresh(self) -> None:
         e, w = self.log.count("error"), self.log.count("warning")
-        self.setText(f"messages: {e} error{'s' * (e != 1)}, {w} warning{'s' * (w != 1)}"
-                     if e or w else "messages")  # fmt: skip
+        parts = [f"{n} {noun}{'s' * (n != 1)}" for n, noun in ((e, "error"), (w, "warning")) if n]
+        self.setText(", ".join(parts) or "messages")
         self.setStyleSheet("color: #ff7766;" if e else "color: #e0a030;" if w else "")
         self.setToolTip("every message of this session, whole and copyable (View ▸ Messages)")
 

@@ -314,7 +314,7 @@ def test_the_obj_warnings_are_whole_in_the_message_log(win, qtbot):
     assert len(expected) == 3, expected
     for line in expected:
         assert line in text, f"not whole in the log: {line}"
-    assert "warning" in win.messages_indicator.text()
+    assert win.messages_indicator.text() == "1 warning"
     win.messages.copy_all()
     assert QtGui.QGuiApplication.clipboard().text() == text
     win.messages.hide()
