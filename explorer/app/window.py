@@ -28,7 +28,7 @@ from explorer.app.compare import ComparePane, DifferencePane
 from explorer.app.difference import DifferenceWorker, HeatMap
 from explorer.app.filemenu import FileCommands
 from explorer.app.lightpanel import Panel
-from explorer.app.messages import MessageIndicator, MessageLog, open_log
+from explorer.app.messages import Messages
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
 from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
@@ -55,11 +55,10 @@ log = logging.getLogger(__name__)
 PANEL_FRACTION = 0.34
 #: how often the status bar asks whether the compiled kernels are ready yet (ms)
 ENGINE_POLL_MS = 500
-#: how long a status message stays (ms); errors stay until the next message
-MESSAGE_MS = 6000
 
 
-class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
+class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messages,
+                     QtWidgets.QMainWindow):  # fmt: skip
     """The explorer window.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
@@ -122,10 +121,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self.status_label = QtWidgets.QLabel("")
         self.status_label.setObjectName("status")
         self.statusBar().addPermanentWidget(self.status_label)
-        self.messages = MessageLog(self)
-        self.messages_indicator = MessageIndicator(self.messages)
-        self.statusBar().addPermanentWidget(self.messages_indicator)
-        self.panel.rejected.connect(self._guard(self.reject_input, "typed value"))
+        self.build_messages()
         self._watch_engine()
         self.view_aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)
         self._frame_on_show = state.camera is None  # framed again for the view's real shape
@@ -227,38 +223,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         lines = text.splitlines() or [type(exc).__name__]
         self.errors.append(f"{where}: {text}")
         self.show_status(f"error ({where}): {lines[0]}", error=True, details=lines[1:])
-
-    def reject_input(self, text: str) -> None:
-        """A typed value was refused (``text`` names the key and the range): said as an error,
-        and the panel shows the state again."""
-        self.errors.append(f"typed value: {text}")
-        self.show_status(f"error: {text}", error=True)
-        self._show_panel(self.store.state)
-
-    def show_status(self, text: str, *, msecs: int = MESSAGE_MS, error: bool = False,
-                    warning: bool = False, details=(), open_log_: bool = True) -> None:  # fmt: skip
-        """Show a short message on the status bar (errors stay until the next message) and add
-        it to the message log; the log opens when the message is an error or a warning that
-        the status bar cannot show whole, or comes with ``details`` (each a line of the log).
-        ``open_log_=False``: never opens it (the details are shown in a dialog already). The
-        engine's "kernels are being prepared" line comes here too."""
-        self.message = text
-        bar = self.statusBar()
-        bar.setStyleSheet("color: #ff7766;" if error else "color: #e0a030;" if warning else "")
-        bar.showMessage(text, 0 if error else int(msecs))
-        level = "error" if error else "warning" if warning else "info"
-        self.messages.add(level, text, details)
-        self.messages_indicator.refresh()
-        if open_log_ and level != "info" and (details or not self._fits_status_bar(text)):
-            open_log(self.messages)
-
-    def _fits_status_bar(self, text: str) -> bool:
-        """Whether ``text`` shows whole in the status bar's message area (the bar less its
-        permanent widgets)."""
-        bar = self.statusBar()
-        taken = sum(w.width() + 8 for w in (self.engine_label, self.status_label,
-                                            self.messages_indicator) if w.isVisible())  # fmt: skip
-        return bar.fontMetrics().horizontalAdvance(text) <= max(bar.width() - taken - 16, 0)
 
     def _watch_engine(self) -> None:
         """Load the compiled kernels in a thread as soon as numba's cache holds them (the numpy
