@@ -46,6 +46,7 @@ from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
 from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import plain_blending
 from explorer.shading import tiers
 
 log = logging.getLogger(__name__)
@@ -108,6 +109,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self.plotter.setMinimumSize(200, 150)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.plotter.disable_anti_aliasing()
+        plain_blending(self.plotter.renderer)  # translucency drawn as the off-screen renders
         self.plotter.set_background(BACKGROUND if background is None else background)
         self.panel = Panel(self.act, self.choose_mesh)
         self.views.addWidget(self.plotter)
