@@ -32,13 +32,11 @@ from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
 from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
 from explorer.app.view import (
-    HANDLE_RADIUS,
     LOD_TARGET,
     LOD_VERTICES,
     SceneView,
     framed_camera,
     view_camera,
-    widen_to_show,
 )
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
@@ -94,6 +92,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self._t0: float | None = None
         self._in_frame = False
         self._holding_handle = False
+        self._grab = None
         self._requested = None
         self.meshes: dict[str, Mesh] = {state.mesh: mesh}
         self.mesh_choices = dict(MESH_CHOICES)
@@ -133,7 +132,9 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self.view = SceneView(self.plotter, mesh, state, lod_vertices=lod_vertices,
                               lod_target=lod_target)  # fmt: skip
         self.view.apply_camera(state.camera)
-        self.view.add_handle(self._guard(self._on_handle, "light handle"))
+        self.view.add_handles(self._guard(self._grab_handle, "light handle"),
+                              self._guard(self._drag_handle, "light handle"),
+                              self._guard(self._release_handle, "light handle"))  # fmt: skip
         self.heat = HeatMap(self.plotter.renderer)
         self.worker = DifferenceWorker(self.difference_ready.emit)
         self.difference_ready.connect(self._guard(self._on_difference, "difference view"))
@@ -163,18 +164,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         if style is not None:
             style.AddObserver("StartInteractionEvent", self._guard(self._begin_drag, "camera"))
             style.AddObserver("EndInteractionEvent", self._guard(self._end_drag, "camera"))
-        handle = self.view.handle
-
-        def grab(*_):
-            self._holding_handle = True
-            self._begin_drag()
-
-        def release(*_):
-            self._holding_handle = False
-            self._end_drag()
-
-        handle.AddObserver("StartInteractionEvent", self._guard(grab, "handle"))
-        handle.AddObserver("EndInteractionEvent", self._guard(release, "handle"))
         for s in self.panel.findChildren(ValueSlider):
             s.pressed.connect(self._guard(self._begin_drag, s.objectName()))
             s.released.connect(self._guard(self._end_drag_if_dragging, s.objectName()))
@@ -287,21 +276,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         self._update_difference()
         if not self._in_frame:
             self.render()
-        self._keep_handle_in_view(old, new)  # last: it may change the camera
-
-    def _keep_handle_in_view(self, old: M.State, new: M.State) -> None:
-        """A light moved from the panel or a key keeps its handle in view: the view is widened
-        (the camera's position, and so the viewer, stay)."""
-        if (new.selected_light is None or new.camera is None or self._holding_handle
-                or new.scene.lights == old.scene.lights):  # fmt: skip
-            return
-        w, h = self.plotter.window_size
-        if min(w, h) < 16:
-            return
-        pad = HANDLE_RADIUS * new.radius
-        cam = widen_to_show(new.camera, [M.handle_point(new)], w / h, pad=pad)
-        if cam != new.camera:
-            self.store.set_camera(cam)
 
     def _show_panel(self, state: M.State) -> None:
         self.panel.show_state(state, self.view.mesh.n_vertices)
@@ -370,7 +344,56 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         else:
             self.store.seal()
 
+    def _grab_handle(self, index: int) -> None:
+        """Light ``index``'s handle is pressed: its light is selected, and the drag starts
+        with the pointer's offset from the handle's centre (kept to the end, so the handle
+        does not jump) and the side of the mesh centre it is on (see :func:`M.point_on_ray`)."""
+        if index != self.store.state.light:
+            self.act(M.select_light, index, label="select light")
+        s = self.store.state
+        x, y = self.plotter.iren.interactor.GetEventPosition()
+        hx, hy, _ = self.view.handle_pixels()[index]
+        origin, direction = self._pointer_ray(hx, hy)
+        near = float((M.handle_point(s) - origin) @ direction) <= float(
+            (np.asarray(s.centre) - origin) @ direction)  # fmt: skip
+        self._grab = (hx - x, hy - y, near)
+        self._holding_handle = True
+        self._begin_drag()
+
+    def _drag_handle(self, index: int) -> None:
+        """Handle ``index`` dragged: the light goes where the pointer is (on the pointer's ray,
+        at the light's distance from the mesh centre), so the handle stays under the pointer
+        (VTK's sphere widget moves its sphere at the focal point's depth, not the handle's:
+        ahead of the pointer when the handle is nearer than the focal point)."""
+        s = self.store.state
+        if s.selected_light is None or index != s.light or self._grab is None:
+            return
+        dx, dy, near = self._grab
+        x, y = self.plotter.iren.interactor.GetEventPosition()
+        origin, direction = self._pointer_ray(x + dx, y + dy)
+        d = s.placement()[2]
+        self._on_handle(M.point_on_ray(origin, direction, s.centre, d, near))
+
+    def _release_handle(self, index: int) -> None:
+        self._grab = None
+        self._holding_handle = False
+        self._end_drag()
+
+    def _pointer_ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+        """The ray under display pixel ``(x, y)`` (origin bottom-left): its start on the near
+        clipping plane and its unit direction, each (3,)."""
+        ren = self.plotter.renderer
+        ends = []
+        for z in (0.0, 1.0):
+            ren.SetDisplayPoint(float(x), float(y), z)
+            ren.DisplayToWorld()
+            p = np.asarray(ren.GetWorldPoint(), np.float64)
+            ends.append(p[:3] / p[3])
+        u = ends[1] - ends[0]
+        return ends[0], u / max(float(np.linalg.norm(u)), 1e-300)
+
     def _on_handle(self, centre) -> None:
+        """Move the selected light to where its handle is put (``centre`` (3,), world)."""
         s = self.store.state
         if s.selected_light is None:
             return
