@@ -34,7 +34,10 @@ class ComparePane:
         plain_blending(pl.renderer)
         pl.set_background(self.plotter.renderer.GetBackground())
         self.views.addWidget(pl)
-        pl.renderer.SetActiveCamera(self.plotter.renderer.GetActiveCamera())  # linked cameras
+        # linked cameras: one vtkCamera, A's, which PyVista's ``camera`` names too (after
+        # SetActiveCamera alone it named B's own unused camera, and B's translucent triangles
+        # were sorted for that one)
+        pl.renderer.camera = self.plotter.renderer.camera
         pl.camera_set = True
         self.plotter_b = pl
         self.view_b = SceneView(pl, self.view.mesh, M.side_b(state),

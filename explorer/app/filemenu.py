@@ -301,6 +301,7 @@ class FileCommands:
         img = self.plotter.screenshot(return_img=True)[:, :, :3]
         pl_b = self.plotter_b
         if pl_b is not None and pl_b.isVisible():
+            pl_b.render_window.Render()  # drawn at its present size before it is read
             b = pl_b.screenshot(return_img=True)[:, :, :3]
             a_x = self.plotter.mapTo(self, QtCore.QPoint(0, 0)).x()
             gap = max(pl_b.mapTo(self, QtCore.QPoint(0, 0)).x() - a_x - img.shape[1], 0)

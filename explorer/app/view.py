@@ -450,9 +450,9 @@ class SceneView:
                 rings.append(np.column_stack([x + (r + RING_GAP) * np.cos(t),
                                               y + (r + RING_GAP) * np.sin(t)]))  # fmt: skip
         if self._ring is None:
-            self._ring = _overlay(self.plotter, RING_COLOR, 2.0)
-            self._markers = _overlay(self.plotter, (1.0, 1.0, 1.0), 1.0, filled=True)
-            self._marker_edges = _overlay(self.plotter, MARKER_OUTLINE, 2.0)
+            self._ring = _overlay(self.plotter, RING_COLOR, 2.0)[0]
+            self._markers = _overlay(self.plotter, (1.0, 1.0, 1.0), 1.0, filled=True)[0]
+            self._marker_edges = _overlay(self.plotter, MARKER_OUTLINE, 2.0)[0]
         _set_lines(self._ring, rings)
         colours = [light_colour(s.scene.lights[i])[0] for i in self.marker_triangles]
         _set_triangles(self._markers, list(self.marker_triangles.values()), colours)
@@ -517,7 +517,9 @@ class SceneView:
         import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
         from vtkmodules.vtkRenderingCore import vtkTextActor
 
-        self._lobe_polys = {"panel": _overlay(self.plotter, LOBE_PANEL_COLOR, 1.0, filled=True)}
+        panel, actor = _overlay(self.plotter, LOBE_PANEL_COLOR, 1.0, filled=True)
+        self._lobe_polys = {"panel": panel}
+        self.lobe_actors = [actor]  # everything the inset draws
         for key, color, width in (
             ("frame", LOBE_FRAME_COLOR, 1.0),
             ("diffuse", LOBE_DIFFUSE_COLOR, 1.0),
@@ -525,7 +527,8 @@ class SceneView:
             ("mirror", LOBE_MIRROR_COLOR, 1.5),
             ("lobe", LOBE_COLOR, 2.0),
         ):
-            self._lobe_polys[key] = _overlay(self.plotter, color, width)
+            self._lobe_polys[key], actor = _overlay(self.plotter, color, width)
+            self.lobe_actors.append(actor)
         self.lobe_caption = vtkTextActor()
         self._lobe_labels = {}
         for key, color in (("caption", LOBE_TEXT_COLOR), ("L", LOBE_INCIDENT_COLOR),
@@ -543,6 +546,7 @@ class SceneView:
                 prop.SetVerticalJustificationToTop()
             self.plotter.renderer.AddViewProp(t)
             self._lobe_labels[key] = t
+            self.lobe_actors.append(t)
         self._lobe_key = None
         self.lobe_box = None
         self._layout_lobe()
@@ -710,7 +714,7 @@ def _arrow_head(ray) -> list:
 
 def _overlay(plotter, color, width: float, *, filled: bool = False):
     """An empty 2D polydata drawn over the view in display pixels (lines, or filled triangles
-    coloured per cell when ``filled``); returns the polydata."""
+    coloured per cell when ``filled``); returns the polydata and its actor."""
     from vtkmodules.vtkCommonCore import vtkPoints
     from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
     from vtkmodules.vtkRenderingCore import vtkActor2D, vtkPolyDataMapper2D
@@ -730,7 +734,7 @@ def _overlay(plotter, color, width: float, *, filled: bool = False):
     actor.GetProperty().SetColor(*color)
     actor.GetProperty().SetLineWidth(width)
     plotter.renderer.AddViewProp(actor)
-    return poly
+    return poly, actor
 
 
 def _set_triangles(poly, triangles, colours) -> None:

@@ -12,7 +12,7 @@ import pytest
 from explorer.app.start import start_xvfb
 
 #: modules whose tests open Qt windows in the test process
-QT_MODULES = ("test_window.py", "test_filemenu.py")
+QT_MODULES = ("test_window.py", "test_filemenu.py", "test_window_view.py")
 
 
 def pytest_collection_modifyitems(session, config, items):
