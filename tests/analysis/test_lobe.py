@@ -10,10 +10,10 @@ import pytest
 
 from explorer.analysis import lobe
 from explorer.core.errors import ExplorerError
-from explorer.shading.equation import equation_terms
 from explorer.core.lights import DirectionalLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
+from explorer.shading.equation import equation_terms
 
 
 def test_blinn_at_normal_incidence_is_cos_of_half_the_view_angle():

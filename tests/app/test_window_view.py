@@ -61,7 +61,8 @@ def test_translucency_is_drawn_as_the_offscreen_render_in_every_pane(open_window
     want = offscreen_of(w.plotter, s)
     probe = w.view.probe_vertex()
     x, y = w.view.world_to_window(w.view.mesh.positions[probe])
-    assert np.abs(got[y, x].astype(int) - want[y, x].astype(int)).max() <= 3, (got[y, x], want[y, x])
+    probe_diff = np.abs(got[y, x].astype(int) - want[y, x].astype(int)).max()
+    assert probe_diff <= 3, (got[y, x], want[y, x])
     bg = (np.asarray(w.plotter.renderer.GetBackground()) * 255).round()
     x0, y0, bw, bh = w.view.lobe_box
     got[-(y0 + bh) :, : x0 + bw + 1] = want[-(y0 + bh) :, : x0 + bw + 1]  # the inset's place
@@ -108,7 +109,7 @@ def inset_pixels(w, state_changes) -> np.ndarray:
     for a in w.view.lobe_actors:
         a.SetVisibility(False)
     hidden = pixels(w.plotter)
-    for a, v in zip(w.view.lobe_actors, shown_before):
+    for a, v in zip(w.view.lobe_actors, shown_before, strict=True):
         a.SetVisibility(v)
     ys, xs = np.nonzero(np.abs(shown.astype(int) - hidden.astype(int)).max(axis=2) > 0)
     return np.column_stack([xs, ys])
@@ -231,11 +232,16 @@ def test_every_light_has_a_handle_and_clicking_one_selects_its_light(win):
         hue = patch.mean(axis=0)
         k = int(np.argmax(want))
         assert hue[k] > 60 and hue[k] > 2 * np.delete(hue, k).max(), (i, hue)
+
     # the selected light's handle is ringed in RING_COLOR, the other not
     def ring_pixels(i):
         x, y = w.view.world_to_window(M.handle_point(w.store.state, i))
-        r = w.view._pixel_radius(M.handle_point(w.store.state, i),
-                                 V.HANDLE_RADIUS * V.SELECTED_SCALE * s.radius) + V.RING_GAP
+        r = (
+            w.view._pixel_radius(
+                M.handle_point(w.store.state, i), V.HANDLE_RADIUS * V.SELECTED_SCALE * s.radius
+            )
+            + V.RING_GAP
+        )
         img = pixels(w.plotter)
         t = np.linspace(0, 2 * math.pi, 72, endpoint=False)
         xs, ys = (x + r * np.cos(t)).round().astype(int), (y - r * np.sin(t)).round().astype(int)
