@@ -69,7 +69,7 @@ MARKER_OUTLINE = (0.08, 0.08, 0.08)
 #: (pixels), its colours (the text's contrast on the panel is at least 4.5:1, tested)
 LOBE_MARGIN = 12
 LOBE_FRACTION = 0.3
-LOBE_SIDE = (110, 200)
+LOBE_SIDE = (130, 200)
 LOBE_PAD = 6
 LOBE_PANEL_COLOR = (0.12, 0.12, 0.13)
 LOBE_FRAME_COLOR = (0.45, 0.45, 0.48)
@@ -559,18 +559,8 @@ class SceneView:
         side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi, max(w - 2 * LOBE_MARGIN, 40)))
         if self.lobe_box is not None and self.lobe_box[2] == side:
             return
-        font = 13 if side >= 170 else 11
-        longest = max(lobe.MODEL_LABELS.values(), key=len)
+        font = self._lobe_font = 13 if side >= 170 else 11
         t = self.lobe_caption
-        while font > 8:
-            t.SetInput(f"{longest}\nlight below (180°), n = 1000")
-            t.GetTextProperty().SetFontSize(font)
-            extent = [0.0, 0.0]
-            t.GetSize(self.plotter.renderer, extent)
-            if extent[0] <= side - 2 * LOBE_PAD:
-                break
-            font -= 1
-        t.GetTextProperty().SetFontSize(font)
         text = 2 * (font + 4)
         plot_h = side // 2
         height = plot_h + 3 * LOBE_PAD + text
@@ -634,6 +624,21 @@ class SceneView:
             self.lobe_caption.SetInput(f"{label}\n{where}, n = {n:g}")
         for key, polylines in lines.items():
             _set_lines(self._lobe_polys[key], polylines)
+        self._fit_caption()
+
+    def _fit_caption(self) -> None:
+        """The caption's font: the inset's own size, smaller (down to 8 px) while the text is
+        wider than the panel."""
+        t = self.lobe_caption
+        font = self._lobe_font
+        while font > 8:
+            t.GetTextProperty().SetFontSize(font)
+            extent = [0.0, 0.0]
+            t.GetSize(self.plotter.renderer, extent)
+            if extent[0] <= self.lobe_box[2] - 2 * LOBE_PAD:
+                break
+            font -= 1
+        t.GetTextProperty().SetFontSize(font)
 
     # -- pixels ---------------------------------------------------------------------------------
     def world_to_window(self, point) -> list[int]:

@@ -419,6 +419,11 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
         handle = None
         if s.selected_light is not None:
             handle = in_window(self.view.world_to_window(M.handle_point(s)))
+        handles = [in_window(self.view.world_to_window(M.handle_point(s, i)))
+                   for i in range(len(s.scene.lights))]  # fmt: skip
+        _, h = self.plotter.window_size
+        arrows = {str(i): in_window([round(float(t[0, 0])), round(h - 1 - float(t[0, 1]))])
+                  for i, t in self.view.marker_triangles.items()}  # fmt: skip
         widgets = {
             w.objectName(): self.widget_box(w)
             for w in self.findChildren(QtWidgets.QWidget)
@@ -434,6 +439,8 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
             "dragging": self.view.dragging > 0,
             "lod": self.view.lod_active,
             "handle_px": handle,
+            "handles_px": handles,
+            "arrows_px": arrows,
             "glyph": self.view.glyph_kind,
             "probe": {"vertex": probe,
                       "px": in_window(self.view.world_to_window(self.view.mesh.positions[probe]))},
