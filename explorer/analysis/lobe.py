@@ -11,8 +11,9 @@ comes from ``-theta_i``, its mirror direction is ``+theta_i``, and a viewer at `
 
 each times the specular coefficient ``ks`` (three.js's: inside its Fresnel term), and 0 when
 the light is below the surface (``N·L <= 0``), as the engine shades it
-(:mod:`explorer.shading.equation`, per unit light colour; the material's ``fresnel`` and
-``energy_conserving`` weights are not drawn). The diffuse term ``kd·(N·L)`` does not depend on
+(:mod:`explorer.shading.equation`, per unit light colour), with the material's effects on it:
+Schlick's F of ``fresnel`` and the ``energy_conserving`` factor (:mod:`explorer.shading.effects`;
+three.js has both built in). The diffuse term ``kd·(N·L)`` does not depend on
 the view: a circle. Both are drawn at one scale, the larger of the two at radius 1, so their
 sizes compare.
 
@@ -29,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import ExplorerError
+from explorer.shading.effects.fresnel import schlick
 from explorer.shading.equation import threejs_fresnel
 
 #: samples spread uniformly over the half circle of view directions
@@ -91,10 +93,12 @@ def view_angles(model: str, n: float, theta_i: float) -> np.ndarray:
     return np.unique(np.concatenate([even, peak]))
 
 
-def specular_lobe(model: str, n: float, theta_i: float, theta_v, ks: float = 1.0) -> np.ndarray:
+def specular_lobe(model: str, n: float, theta_i: float, theta_v, ks: float = 1.0, *,
+                  fresnel: float | None = None, energy: float = 1.0) -> np.ndarray:  # fmt: skip
     """The specular term (per unit light) seen from ``theta_v`` (k,) radians with the light at
     incidence ``theta_i``: (k,) float64 (see the module's table). numpy's 0^0 = 1 makes an
-    n = 0 lobe 1 everywhere, as in the engine."""
+    n = 0 lobe 1 everywhere, as in the engine. ``fresnel``: Schlick's F0 weighting the term
+    (None: off), ``energy``: its constant factor (phong and blinn only)."""
     if model not in MODEL_LABELS:
         raise ExplorerError(f"model must be one of {tuple(MODEL_LABELS)}, got {model!r}")
     tv = np.asarray(theta_v, np.float64)
@@ -107,14 +111,17 @@ def specular_lobe(model: str, n: float, theta_i: float, theta_v, ks: float = 1.0
         base = np.cos(0.5 * (tv - theta_i))
     lobe = np.maximum(base, 0.0) ** float(n)
     if model != "threejs":
-        return ks * lobe
+        weight = 1.0 if fresnel is None else schlick(fresnel, np.cos(tv + theta_i))
+        return ks * energy * weight * lobe
     g = threejs_fresnel(np.cos(tv + theta_i))  # V·L: V at theta_v, L at -theta_i
     return ndl * (0.5 * n + 1.0) / 4.0 * lobe * (ks * (1.0 - g) + g)
 
 
-def lobe_plot(model: str, n: float, theta_i: float, kd: float, ks: float) -> LobePlot:
+def lobe_plot(model: str, n: float, theta_i: float, kd: float, ks: float, *,
+              fresnel: float | None = None, energy: float = 1.0) -> LobePlot:  # fmt: skip
     """The plot for a light at incidence ``theta_i`` (radians) on a material of diffuse and
-    specular coefficients ``kd``, ``ks`` and shininess ``n`` under ``model``."""
+    specular coefficients ``kd``, ``ks`` and shininess ``n`` under ``model`` (``fresnel``,
+    ``energy``: see :func:`specular_lobe`)."""
     incident = np.array([-math.sin(theta_i), math.cos(theta_i)])
     mirror = np.array([math.sin(theta_i), math.cos(theta_i)])
     ndl = math.cos(theta_i)
@@ -122,7 +129,7 @@ def lobe_plot(model: str, n: float, theta_i: float, kd: float, ks: float) -> Lob
         empty = np.empty((0, 2))
         return LobePlot(theta_i, incident, mirror, empty, empty, 1.0)
     tv = view_angles(model, n, theta_i)
-    spec = specular_lobe(model, n, theta_i, tv, ks)
+    spec = specular_lobe(model, n, theta_i, tv, ks, fresnel=fresnel, energy=energy)
     diffuse = max(float(kd), 0.0) * ndl
     scale = max(float(spec.max()), diffuse)
     scale = scale if scale > 0.0 and math.isfinite(scale) else 1.0

@@ -38,6 +38,7 @@ from explorer.render.camera import (
 )
 from explorer.render.vtk import add_unlit, cells, polydata
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
+from explorer.shading.effects.energy import specular_scale
 from explorer.shading.shader import Shader
 
 #: meshes with more vertices than this get a level of detail drawn while dragging
@@ -582,11 +583,15 @@ class SceneView:
         if getattr(self, "lobe_box", None) is None:
             return
         light = state.selected_light
-        m = state.shown_scene().material
+        scene = state.shown_scene()
+        m = scene.material
         _, kd, ks = m.scalars()
         theta = None if light is None else lobe_incidence(state)
-        model, n = state.scene.model, m.shininess
-        key = (model, n, kd, ks, None if theta is None else round(math.degrees(theta), 1))
+        model, n = scene.model, m.shininess
+        effects = {"fresnel": None if model == "threejs" else m.fresnel,
+                   "energy": specular_scale(scene)}  # fmt: skip
+        degrees = None if theta is None else round(math.degrees(theta), 1)
+        key = (model, n, kd, ks, tuple(effects.values()), degrees)
         if key == self._lobe_key:
             return
         self._lobe_key = key
@@ -602,7 +607,7 @@ class SceneView:
             for key in ("L", "R"):
                 self._lobe_labels[key].SetVisibility(False)
         else:
-            plot = lobe.lobe_plot(model, n, theta, kd, ks)
+            plot = lobe.lobe_plot(model, n, theta, kd, ks, **effects)
             ray_l = lobe.to_box([(0.0, 0.0), plot.incident], box)
             ray_r = lobe.to_box([(0.0, 0.0), plot.mirror], box)
             dashes = [lobe.to_box([t * plot.mirror, (t + 0.06) * plot.mirror], box)

@@ -13,6 +13,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import DirectionalLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
+from explorer.shading.effects.energy import energy_factor, specular_scale
 from explorer.shading.equation import equation_terms
 
 
@@ -50,13 +51,19 @@ def test_the_lobe_is_what_the_engine_shades(model):
     ti = math.radians(30.0)
     light = DirectionalLight(to_light=(-math.sin(ti), 0.0, math.cos(ti)), diffuse=(1, 1, 1),
                              specular=(1, 1, 1), ambient=(0, 0, 0))  # fmt: skip
-    m = Material(ambient=(0, 0, 0), diffuse=(0, 0, 0), specular=(0.7, 0.7, 0.7), shininess=20.0)
-    for tv in np.radians([-60.0, -10.0, 0.0, 20.0, 30.0, 45.0, 80.0]):
-        scene = Scene(material=m, lights=(light,), model=model,
-                      viewer=Viewer(to_viewer=(math.sin(tv), 0.0, math.cos(tv))))  # fmt: skip
-        t = equation_terms(scene, [[0.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]])
-        want = 0.7 * t["specular"][0, 0] + (t["specular_f90"][0, 0] if model == "threejs" else 0)
-        assert lobe.specular_lobe(model, 20.0, ti, [tv], ks=0.7)[0] == pytest.approx(want)
+    plain = Material(ambient=(0, 0, 0), diffuse=(0, 0, 0), specular=(0.7, 0.7, 0.7),
+                     shininess=20.0)  # fmt: skip
+    for m in (plain, plain.replace(fresnel=0.04, energy_conserving=True)):
+        scene = Scene(material=m, lights=(light,), model=model)
+        three = model == "threejs"
+        effects = {"fresnel": None if three else m.fresnel, "energy": specular_scale(scene)}
+        assert effects["energy"] == (1.0 if three or m is plain else energy_factor(model, 20.0))
+        for tv in np.radians([-60.0, -10.0, 0.0, 20.0, 30.0, 45.0, 80.0]):
+            scene = scene.replace(viewer=Viewer(to_viewer=(math.sin(tv), 0.0, math.cos(tv))))
+            t = equation_terms(scene, [[0.0, 0.0, 0.0]], [[0.0, 0.0, 1.0]])
+            want = 0.7 * t["specular"][0, 0] + (t["specular_f90"][0, 0] if three else 0)
+            got = lobe.specular_lobe(model, 20.0, ti, [tv], ks=0.7, **effects)[0]
+            assert got == pytest.approx(want)
 
 
 def test_a_sharp_lobe_is_sampled_where_it_is():
