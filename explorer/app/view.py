@@ -24,10 +24,11 @@ import math
 
 import numpy as np
 
-from explorer.analysis import lobe
 from explorer.analysis.comparison import heat_map
 from explorer.app.difference import VMAX
+from explorer.app.lobeinset import LobeInset
 from explorer.app.model import State, handle_point, light_colour
+from explorer.app.overlay import overlay, set_lines, set_triangles
 from explorer.geometry.meshes import Mesh, area_weighted_normals
 from explorer.render.camera import (
     Camera,
@@ -38,7 +39,6 @@ from explorer.render.camera import (
 )
 from explorer.render.vtk import add_unlit, cells, polydata
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
-from explorer.shading.effects.energy import specular_scale
 from explorer.shading.shader import Shader
 
 #: meshes with more vertices than this get a level of detail drawn while dragging
@@ -65,20 +65,6 @@ MAX_VIEW_ANGLE = 60.0
 MARKER_SIZE = 18
 MARKER_MARGIN = 6
 MARKER_OUTLINE = (0.08, 0.08, 0.08)
-#: the lobe inset (:mod:`explorer.analysis.lobe`): left and bottom margin in pixels, its width
-#: as a fraction of the view's smaller side held within LOBE_SIDE (pixels), its inner padding
-#: (pixels), its colours (the text's contrast on the panel is at least 4.5:1, tested)
-LOBE_MARGIN = 12
-LOBE_FRACTION = 0.3
-LOBE_SIDE = (130, 200)
-LOBE_PAD = 6
-LOBE_PANEL_COLOR = (0.12, 0.12, 0.13)
-LOBE_FRAME_COLOR = (0.45, 0.45, 0.48)
-LOBE_TEXT_COLOR = (0.93, 0.93, 0.93)
-LOBE_COLOR = (1.0, 0.85, 0.2)
-LOBE_DIFFUSE_COLOR = (0.62, 0.62, 0.68)
-LOBE_INCIDENT_COLOR = (1.0, 1.0, 1.0)
-LOBE_MIRROR_COLOR = (0.4, 0.8, 1.0)
 
 
 def widen_to_show(camera: Camera, points, aspect: float, *, pad: float = 0.0,
@@ -266,7 +252,7 @@ class SceneView:
         self._glyph = None
         self._glyph_kind = None
         self.set_mesh(mesh, state)
-        self._build_lobe()
+        self.lobe = LobeInset(plotter, state)
 
     # -- mesh --------------------------------------------------------------------------------
     @property
@@ -310,7 +296,8 @@ class SceneView:
                 d.actor.GetProperty().SetOpacity(state.material.opacity)
             self.active.upload()
         self._show_handle(state)
-        self._update_lobe(state)
+        if getattr(self, "lobe", None) is not None:
+            self.lobe.update(state)
 
     def before_frame(self, camera: Camera) -> None:
         """Before a frame: translucent triangles sorted back to front for the camera, the lobe
@@ -318,7 +305,7 @@ class SceneView:
         out of the view placed for the camera."""
         if self.state.material.opacity < 1.0:
             self.active.sort_for(camera)
-        self._layout_lobe()
+        self.lobe.layout(self.state)
         self._show_markers()
 
     def begin_drag(self) -> None:
@@ -343,6 +330,11 @@ class SceneView:
     def displayed_colors(self) -> np.ndarray:
         """(n, 3) uint8 colours VTK draws for the full mesh (a copy)."""
         return np.array(self.drawings[0].rgb)
+
+    @property
+    def lobe_caption(self):
+        """The lobe inset's caption (a ``vtkTextActor``)."""
+        return self.lobe.caption
 
     def set_caption(self, text: str) -> None:
         """A line at the top left of the view (which side of the compare view it is)."""
@@ -451,14 +443,14 @@ class SceneView:
                 rings.append(np.column_stack([x + (r + RING_GAP) * np.cos(t),
                                               y + (r + RING_GAP) * np.sin(t)]))  # fmt: skip
         if self._ring is None:
-            self._ring = _overlay(self.plotter, RING_COLOR, 2.0)[0]
-            self._markers = _overlay(self.plotter, (1.0, 1.0, 1.0), 1.0, filled=True)[0]
-            self._marker_edges = _overlay(self.plotter, MARKER_OUTLINE, 2.0)[0]
-        _set_lines(self._ring, rings)
+            self._ring = overlay(self.plotter, RING_COLOR, 2.0)[0]
+            self._markers = overlay(self.plotter, (1.0, 1.0, 1.0), 1.0, filled=True)[0]
+            self._marker_edges = overlay(self.plotter, MARKER_OUTLINE, 2.0)[0]
+        set_lines(self._ring, rings)
         colours = [light_colour(s.scene.lights[i])[0] for i in self.marker_triangles]
-        _set_triangles(self._markers, list(self.marker_triangles.values()), colours)
+        set_triangles(self._markers, list(self.marker_triangles.values()), colours)
         triangles = list(self.marker_triangles.values())
-        _set_lines(self._marker_edges, [np.vstack([t, t[:1]]) for t in triangles])
+        set_lines(self._marker_edges, [np.vstack([t, t[:1]]) for t in triangles])
 
     def _pixel_radius(self, point, radius: float) -> float:
         """How many pixels a sphere of ``radius`` at ``point`` spans (its projected radius)."""
@@ -511,140 +503,6 @@ class SceneView:
             return None
         return self._glyph_kind
 
-    # -- the lobe inset ---------------------------------------------------------------------
-    def _build_lobe(self) -> None:
-        """The inset's actors: a panel, its frame and surface line, the diffuse circle, the
-        incident and mirror directions, the lobe, and the text (drawn in this order)."""
-        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
-        from vtkmodules.vtkRenderingCore import vtkTextActor
-
-        panel, actor = _overlay(self.plotter, LOBE_PANEL_COLOR, 1.0, filled=True)
-        self._lobe_polys = {"panel": panel}
-        self.lobe_actors = [actor]  # everything the inset draws
-        for key, color, width in (
-            ("frame", LOBE_FRAME_COLOR, 1.0),
-            ("diffuse", LOBE_DIFFUSE_COLOR, 1.0),
-            ("incident", LOBE_INCIDENT_COLOR, 1.5),
-            ("mirror", LOBE_MIRROR_COLOR, 1.5),
-            ("lobe", LOBE_COLOR, 2.0),
-        ):
-            self._lobe_polys[key], actor = _overlay(self.plotter, color, width)
-            self.lobe_actors.append(actor)
-        self.lobe_caption = vtkTextActor()
-        self._lobe_labels = {}
-        for key, color in (("caption", LOBE_TEXT_COLOR), ("L", LOBE_INCIDENT_COLOR),
-                           ("R", LOBE_MIRROR_COLOR)):  # fmt: skip
-            t = self.lobe_caption if key == "caption" else vtkTextActor()
-            prop = t.GetTextProperty()
-            prop.SetColor(*color)
-            prop.SetFontFamilyToArial()
-            prop.ShadowOff()
-            if key != "caption":
-                t.SetInput(key)
-                prop.SetJustificationToCentered()
-                prop.SetVerticalJustificationToCentered()
-            else:
-                prop.SetVerticalJustificationToTop()
-            self.plotter.renderer.AddViewProp(t)
-            self._lobe_labels[key] = t
-            self.lobe_actors.append(t)
-        self._lobe_key = None
-        self.lobe_box = None
-        self._layout_lobe()
-
-    def _layout_lobe(self) -> None:
-        """Size the inset for the view: :data:`LOBE_FRACTION` of its smaller side, held within
-        :data:`LOBE_SIDE` and within the view; the caption's font the largest that fits."""
-        w, h = self.plotter.window_size
-        lo, hi = LOBE_SIDE
-        side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi, max(w - 2 * LOBE_MARGIN, 40)))
-        if self.lobe_box is not None and self.lobe_box[2] == side:
-            return
-        font = self._lobe_font = 13 if side >= 170 else 11
-        t = self.lobe_caption
-        text = 2 * (font + 4)
-        plot_h = side // 2
-        height = plot_h + 3 * LOBE_PAD + text
-        x0 = y0 = LOBE_MARGIN
-        self.lobe_box = (x0, y0, side, height)  # display pixels, origin bottom-left
-        self._plot_box = (x0 + LOBE_PAD, y0 + LOBE_PAD, side - 2 * LOBE_PAD, plot_h - LOBE_PAD)
-        t.SetPosition(x0 + LOBE_PAD, y0 + height - LOBE_PAD)
-        for key in ("L", "R"):
-            self._lobe_labels[key].GetTextProperty().SetFontSize(max(font - 1, 8))
-        corners = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + height), (x0, y0 + height)]
-        _set_triangles(self._lobe_polys["panel"], [corners[:3], [corners[0], *corners[2:]]],
-                       [LOBE_PANEL_COLOR] * 2)  # fmt: skip
-        self._lobe_key = None
-        self._update_lobe(self.state)
-
-    def _update_lobe(self, state: State) -> None:
-        """Redraw the plot for the state's selected light, model and material (only when one
-        of them changed)."""
-        if getattr(self, "lobe_box", None) is None:
-            return
-        light = state.selected_light
-        scene = state.shown_scene()
-        m = scene.material
-        _, kd, ks = m.scalars()
-        theta = None if light is None else lobe_incidence(state)
-        model, n = scene.model, m.shininess
-        effects = {"fresnel": None if model == "threejs" else m.fresnel,
-                   "energy": specular_scale(scene)}  # fmt: skip
-        degrees = None if theta is None else round(math.degrees(theta), 1)
-        key = (model, n, kd, ks, tuple(effects.values()), degrees)
-        if key == self._lobe_key:
-            return
-        self._lobe_key = key
-        box = self._plot_box
-        x, y, w, h = box
-        frame = [(x, y), (x + w, y), (x + w, y + h), (x, y + h), (x, y)]
-        ox = x + 0.5 * w
-        lines = {"frame": [frame, [(x, y), (x + w, y)], [(ox, y), (ox, y + 4)]]}
-        label = lobe.MODEL_LABELS[model]
-        if theta is None:
-            lines.update(diffuse=[], incident=[], mirror=[], lobe=[])
-            self.lobe_caption.SetInput(f"{label}\nno light, n = {n:g}")
-            for key in ("L", "R"):
-                self._lobe_labels[key].SetVisibility(False)
-        else:
-            plot = lobe.lobe_plot(model, n, theta, kd, ks, **effects)
-            ray_l = lobe.to_box([(0.0, 0.0), plot.incident], box)
-            ray_r = lobe.to_box([(0.0, 0.0), plot.mirror], box)
-            dashes = [lobe.to_box([t * plot.mirror, (t + 0.06) * plot.mirror], box)
-                      for t in np.arange(0.0, 1.0, 0.12)]  # fmt: skip
-            lines.update(
-                diffuse=[lobe.to_box(plot.diffuse, box)] if len(plot.diffuse) else [],
-                incident=[ray_l, _arrow_head(ray_l)] if plot.lit else [],
-                mirror=dashes if plot.lit else [],
-                lobe=[lobe.to_box(plot.lobe, box)] if len(plot.lobe) else [],
-            )
-            for key, end, shown, away in (("L", ray_l[1], plot.lit, -9.0),
-                                          ("R", ray_r[1], plot.lit, 9.0)):  # fmt: skip
-                lx = min(max(end[0] + away, x + 6), x + w - 6)
-                ly = min(max(end[1] - 4, y + 6), y + h - 6)
-                self._lobe_labels[key].SetPosition(lx, ly)
-                self._lobe_labels[key].SetVisibility(shown)
-            deg = math.degrees(theta)
-            where = f"incidence {deg:.0f}°" if plot.lit else f"light below ({deg:.0f}°)"
-            self.lobe_caption.SetInput(f"{label}\n{where}, n = {n:g}")
-        for key, polylines in lines.items():
-            _set_lines(self._lobe_polys[key], polylines)
-        self._fit_caption()
-
-    def _fit_caption(self) -> None:
-        """The caption's font: the inset's own size, smaller (down to 8 px) while the text is
-        wider than the panel."""
-        t = self.lobe_caption
-        font = self._lobe_font
-        while font > 8:
-            t.GetTextProperty().SetFontSize(font)
-            extent = [0.0, 0.0]
-            t.GetSize(self.plotter.renderer, extent)
-            if extent[0] <= self.lobe_box[2] - 2 * LOBE_PAD:
-                break
-            font -= 1
-        t.GetTextProperty().SetFontSize(font)
-
     # -- pixels ---------------------------------------------------------------------------------
     def world_to_window(self, point) -> list[int]:
         """Window pixel (origin top-left) of a world point."""
@@ -674,16 +532,6 @@ class SceneView:
         self.plotter.renderer.ResetCameraClippingRange()
 
 
-def lobe_incidence(state: State) -> float:
-    """theta_i (radians) of the selected light at the mesh's point that faces the viewer: the
-    angle between the directions from the mesh centre toward the viewer and toward the light's
-    handle (:func:`explorer.analysis.lobe.incidence`)."""
-    viewer = state.scene.viewer
-    centre = np.asarray(state.centre)
-    to_viewer = np.subtract(viewer.eye, centre) if viewer.local else viewer.to_viewer
-    return lobe.incidence(to_viewer, handle_point(state) - centre)
-
-
 def edge_marker(x: float, y: float, ahead: bool, width: int, height: int,
                 size: float = MARKER_SIZE, margin: float = MARKER_MARGIN):  # fmt: skip
     """The arrow that shows a handle out of the view: a (3, 2) triangle in display pixels
@@ -707,75 +555,3 @@ def edge_marker(x: float, y: float, ahead: bool, width: int, height: int,
     side = np.array([-u[1], u[0]])
     back = tip - size * u
     return np.array([tip, back + 0.45 * size * side, back - 0.45 * size * side])
-
-
-def _arrow_head(ray) -> list:
-    """Two short strokes at the start of ``ray`` ((2, 2) pixels from the origin out): an
-    arrow head pointing at the origin (the light's ray arrives there)."""
-    o, e = np.asarray(ray[0], float), np.asarray(ray[1], float)
-    length = float(np.hypot(*(e - o)))
-    if length < 1e-9:
-        return []
-    u = (e - o) / length
-    side = np.array([-u[1], u[0]])
-    a = o + 7.0 * u
-    return [a + 3.5 * side, o, a - 3.5 * side]
-
-
-def _overlay(plotter, color, width: float, *, filled: bool = False):
-    """An empty 2D polydata drawn over the view in display pixels (lines, or filled triangles
-    coloured per cell when ``filled``); returns the polydata and its actor."""
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-    from vtkmodules.vtkRenderingCore import vtkActor2D, vtkPolyDataMapper2D
-
-    poly = vtkPolyData()
-    poly.SetPoints(vtkPoints())
-    poly.SetLines(vtkCellArray())
-    mapper = vtkPolyDataMapper2D()
-    mapper.SetInputData(poly)
-    if filled:
-        mapper.SetScalarModeToUseCellData()
-        mapper.SetColorModeToDirectScalars()
-    else:
-        mapper.ScalarVisibilityOff()
-    actor = vtkActor2D()
-    actor.SetMapper(mapper)
-    actor.GetProperty().SetColor(*color)
-    actor.GetProperty().SetLineWidth(width)
-    plotter.renderer.AddViewProp(actor)
-    return poly, actor
-
-
-def _set_triangles(poly, triangles, colours) -> None:
-    """Filled triangles (each (3, 2) pixels), one colour (RGB in [0, 1]) each."""
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray
-
-    pts = vtkPoints()
-    polys = vtkCellArray()
-    for tri in triangles:
-        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in tri]
-        polys.InsertNextCell(len(ids), ids)
-    poly.SetPoints(pts)
-    poly.SetPolys(polys)
-    rgb = to_bytes(np.asarray(colours, np.float64).reshape(-1, 3))
-    arr = numpy_to_vtk(np.ascontiguousarray(rgb), deep=True)
-    arr.SetName("colors")
-    poly.GetCellData().SetScalars(arr)
-    poly.Modified()
-
-
-def _set_lines(poly, polylines) -> None:
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray
-
-    pts = vtkPoints()
-    lines = vtkCellArray()
-    for line in polylines:
-        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in line]
-        lines.InsertNextCell(len(ids), ids)
-    poly.SetPoints(pts)
-    poly.SetLines(lines)
-    poly.Modified()

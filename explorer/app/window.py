@@ -27,6 +27,7 @@ from explorer.app.commands import Commands
 from explorer.app.compare import ComparePane, DifferencePane
 from explorer.app.difference import DifferenceWorker, HeatMap
 from explorer.app.filemenu import FileCommands
+from explorer.app.handledrag import HandleDrag
 from explorer.app.lightpanel import Panel
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
@@ -57,7 +58,8 @@ ENGINE_POLL_MS = 500
 MESSAGE_MS = 6000
 
 
-class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidgets.QMainWindow):
+class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, HandleDrag,
+                     QtWidgets.QMainWindow):  # fmt: skip
     """The explorer window.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
@@ -343,63 +345,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, QtWidg
             self._end_drag()
         else:
             self.store.seal()
-
-    def _grab_handle(self, index: int) -> None:
-        """Light ``index``'s handle is pressed: its light is selected, and the drag starts
-        with the pointer's offset from the handle's centre (kept to the end, so the handle
-        does not jump) and the side of the mesh centre it is on (see :func:`M.point_on_ray`)."""
-        if index != self.store.state.light:
-            self.act(M.select_light, index, label="select light")
-        s = self.store.state
-        x, y = self.plotter.iren.interactor.GetEventPosition()
-        hx, hy, _ = self.view.handle_pixels()[index]
-        origin, direction = self._pointer_ray(hx, hy)
-        near = float((M.handle_point(s) - origin) @ direction) <= float(
-            (np.asarray(s.centre) - origin) @ direction)  # fmt: skip
-        self._grab = (hx - x, hy - y, near)
-        self._holding_handle = True
-        self._begin_drag()
-
-    def _drag_handle(self, index: int) -> None:
-        """Handle ``index`` dragged: the light goes where the pointer is (on the pointer's ray,
-        at the light's distance from the mesh centre), so the handle stays under the pointer
-        (VTK's sphere widget moves its sphere at the focal point's depth, not the handle's:
-        ahead of the pointer when the handle is nearer than the focal point)."""
-        s = self.store.state
-        if s.selected_light is None or index != s.light or self._grab is None:
-            return
-        dx, dy, near = self._grab
-        x, y = self.plotter.iren.interactor.GetEventPosition()
-        origin, direction = self._pointer_ray(x + dx, y + dy)
-        d = s.placement()[2]
-        self._on_handle(M.point_on_ray(origin, direction, s.centre, d, near))
-
-    def _release_handle(self, index: int) -> None:
-        self._grab = None
-        self._holding_handle = False
-        self._end_drag()
-
-    def _pointer_ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
-        """The ray under display pixel ``(x, y)`` (origin bottom-left): its start on the near
-        clipping plane and its unit direction, each (3,)."""
-        ren = self.plotter.renderer
-        ends = []
-        for z in (0.0, 1.0):
-            ren.SetDisplayPoint(float(x), float(y), z)
-            ren.DisplayToWorld()
-            p = np.asarray(ren.GetWorldPoint(), np.float64)
-            ends.append(p[:3] / p[3])
-        u = ends[1] - ends[0]
-        return ends[0], u / max(float(np.linalg.norm(u)), 1e-300)
-
-    def _on_handle(self, centre) -> None:
-        """Move the selected light to where its handle is put (``centre`` (3,), world)."""
-        s = self.store.state
-        if s.selected_light is None:
-            return
-        az, el, d = M.angles_from_point(s, centre)
-        if d > 0:
-            self.act(M.place_light, az, el, d, label="light handle", merge="handle")
 
     # -- reporting ------------------------------------------------------------------------------
     def widget_box(self, widget: QtWidgets.QWidget) -> list[int]:

@@ -12,6 +12,7 @@ import pytest
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.analysis import lobe
+from explorer.app import lobeinset as LI
 from explorer.app import model as M
 from explorer.app import view as V
 from explorer.render.images import read_png
@@ -64,7 +65,7 @@ def test_translucency_is_drawn_as_the_offscreen_render_in_every_pane(open_window
     probe_diff = np.abs(got[y, x].astype(int) - want[y, x].astype(int)).max()
     assert probe_diff <= 3, (got[y, x], want[y, x])
     bg = (np.asarray(w.plotter.renderer.GetBackground()) * 255).round()
-    x0, y0, bw, bh = w.view.lobe_box
+    x0, y0, bw, bh = w.view.lobe.box
     got[-(y0 + bh) :, : x0 + bw + 1] = want[-(y0 + bh) :, : x0 + bw + 1]  # the inset's place
     bad, worst = mesh_pixels_match(got, want, bg)
     assert bad < 0.005, f"{bad:.1%} of the mesh's pixels differ (up to {worst} levels)"
@@ -76,7 +77,7 @@ def test_translucency_is_drawn_as_the_offscreen_render_in_every_pane(open_window
     for pl, side in ((w.plotter, s), (w.plotter_b, M.side_b(w.store.state))):
         got, want = pixels(pl), offscreen_of(pl, side)
         view = w.view if pl is w.plotter else w.view_b
-        x0, y0, bw, bh = view.lobe_box
+        x0, y0, bw, bh = view.lobe.box
         got[-(y0 + bh) :, : x0 + bw + 1] = want[-(y0 + bh) :, : x0 + bw + 1]
         top = got.shape[0] // 10  # the pane's caption
         got[:top] = want[:top]
@@ -105,11 +106,11 @@ def inset_pixels(w, state_changes) -> np.ndarray:
     for change in state_changes:
         w.act(*change)
     shown = pixels(w.plotter)
-    shown_before = [a.GetVisibility() for a in w.view.lobe_actors]
-    for a in w.view.lobe_actors:
+    shown_before = [a.GetVisibility() for a in w.view.lobe.actors]
+    for a in w.view.lobe.actors:
         a.SetVisibility(False)
     hidden = pixels(w.plotter)
-    for a, v in zip(w.view.lobe_actors, shown_before, strict=True):
+    for a, v in zip(w.view.lobe.actors, shown_before, strict=True):
         a.SetVisibility(v)
     ys, xs = np.nonzero(np.abs(shown.astype(int) - hidden.astype(int)).max(axis=2) > 0)
     return np.column_stack([xs, ys])
@@ -122,7 +123,7 @@ def test_the_lobe_inset_draws_nothing_outside_its_frame(win, n, model):
     w.view.handles[0].Off()
     changed = inset_pixels(w, [(M.set_model, model), (M.set_shininess, n)])
     _, h = w.plotter.window_size
-    x0, y0, bw, bh = w.view.lobe_box  # display pixels, origin bottom-left
+    x0, y0, bw, bh = w.view.lobe.box  # display pixels, origin bottom-left
     assert len(changed) > 200  # the inset is drawn
     assert changed[:, 0].min() >= x0 and changed[:, 0].max() <= x0 + bw
     top = h - 1 - (y0 + bh)
@@ -136,7 +137,7 @@ def test_the_lobe_follows_the_light_and_its_text_reads(win):
     w.act(M.set_shininess, 30.0)
     pl = w.plotter
     w.render()
-    x0, y0, bw, bh = w.view.lobe_box
+    x0, y0, bw, bh = w.view.lobe.box
     _, h = pl.window_size
 
     def yellow_column():
@@ -144,12 +145,12 @@ def test_the_lobe_follows_the_light_and_its_text_reads(win):
         lobe_px = (img[..., 0] > 200) & (img[..., 1] > 160) & (img[..., 2] < 120)  # LOBE_COLOR
         return np.nonzero(lobe_px)[1].mean(), img
 
-    theta0 = math.degrees(V.lobe_incidence(w.store.state))
+    theta0 = math.degrees(LI.lobe_incidence(w.store.state))
     before, img = yellow_column()
     az, el, d = w.store.state.placement()
     # toward the viewer: the incidence falls, the lobe (at the mirror) leans back to the normal
     w.act(M.place_light, 0.0, 20.0, d)
-    theta1 = math.degrees(V.lobe_incidence(w.store.state))
+    theta1 = math.degrees(LI.lobe_incidence(w.store.state))
     after, _ = yellow_column()
     assert theta1 < theta0 - 10 and f"incidence {theta1:.0f}°" in w.view.lobe_caption.GetInput()
     assert after < before - 5  # the lobe's pixels moved left, toward the plot's middle
@@ -158,8 +159,8 @@ def test_the_lobe_follows_the_light_and_its_text_reads(win):
     caption = img[: bh // 3].reshape(-1, 3)
     brightest = caption[np.argmax(caption.sum(axis=1))] / 255.0
     assert lobe.contrast_ratio(brightest, panel) >= 4.5
-    for c in (V.LOBE_TEXT_COLOR, V.LOBE_INCIDENT_COLOR, V.LOBE_MIRROR_COLOR):
-        assert lobe.contrast_ratio(c, V.LOBE_PANEL_COLOR) >= 4.5
+    for c in (LI.LOBE_TEXT_COLOR, LI.LOBE_INCIDENT_COLOR, LI.LOBE_MIRROR_COLOR):
+        assert lobe.contrast_ratio(c, LI.LOBE_PANEL_COLOR) >= 4.5
 
 
 def mouse(w, kind, x, y, buttons):
