@@ -34,17 +34,24 @@ def overlay(plotter, color, width: float, *, filled: bool = False):
     return poly, actor
 
 
-def set_triangles(poly, triangles, colours) -> None:
-    """Filled triangles (each (3, 2) pixels), one colour (RGB in [0, 1]) each."""
-    from vtkmodules.util.numpy_support import numpy_to_vtk
+def _cells(shapes):
+    """vtkPoints and a vtkCellArray of ``shapes`` (each (k, 2) display pixels), one cell each."""
     from vtkmodules.vtkCommonCore import vtkPoints
     from vtkmodules.vtkCommonDataModel import vtkCellArray
 
     pts = vtkPoints()
-    polys = vtkCellArray()
-    for tri in triangles:
-        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in tri]
-        polys.InsertNextCell(len(ids), ids)
+    cells = vtkCellArray()
+    for shape in shapes:
+        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in shape]
+        cells.InsertNextCell(len(ids), ids)
+    return pts, cells
+
+
+def set_triangles(poly, triangles, colours) -> None:
+    """Filled triangles (each (3, 2) pixels), one colour (RGB in [0, 1]) each."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+
+    pts, polys = _cells(triangles)
     poly.SetPoints(pts)
     poly.SetPolys(polys)
     rgb = to_bytes(np.asarray(colours, np.float64).reshape(-1, 3))
@@ -55,14 +62,8 @@ def set_triangles(poly, triangles, colours) -> None:
 
 
 def set_lines(poly, polylines) -> None:
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray
-
-    pts = vtkPoints()
-    lines = vtkCellArray()
-    for line in polylines:
-        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in line]
-        lines.InsertNextCell(len(ids), ids)
+    """Polylines (each (k, 2) pixels) in the overlay's colour."""
+    pts, lines = _cells(polylines)
     poly.SetPoints(pts)
     poly.SetLines(lines)
     poly.Modified()
