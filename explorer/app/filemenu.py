@@ -305,7 +305,8 @@ class FileCommands:
             b = pl_b.screenshot(return_img=True)[:, :, :3]
             a_x = self.plotter.mapTo(self, QtCore.QPoint(0, 0)).x()
             gap = max(pl_b.mapTo(self, QtCore.QPoint(0, 0)).x() - a_x - img.shape[1], 0)
-            img = side_by_side(img, b, gap)
+            fill = self.views.palette().window().color().getRgb()[:3]  # the splitter's
+            img = side_by_side(img, b, gap, fill)
         return encode_png(np.ascontiguousarray(img))
 
     def picture_stem(self) -> str:
