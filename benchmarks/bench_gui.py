@@ -125,7 +125,7 @@ class Driven:
         state = AM.set_camera(state, framed_camera(state, mesh, SIZE[0] / SIZE[1]))
         self.store = AM.Store(state)
         self.view = SceneView(self.plotter, mesh, state, **kw)
-        self.view.add_handle(lambda *_: None)
+        self.view.add_handles(*(lambda *_: None,) * 3)
         self.view.apply_camera(state.camera)
         self.store.subscribe(lambda old, new: self.view.show_state(new))
 

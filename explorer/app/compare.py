@@ -16,6 +16,7 @@ from explorer.app import model as M
 from explorer.app.commands import ViewKeys
 from explorer.app.difference import PENDING, Job, advice_lines
 from explorer.app.view import SceneView, view_camera
+from explorer.render.vtk import plain_blending
 from explorer.shading.display import to_bytes
 
 
@@ -30,9 +31,13 @@ class ComparePane:
         pl.setObjectName("view_b")
         pl.setMinimumSize(120, 150)
         pl.disable_anti_aliasing()
+        plain_blending(pl.renderer)
         pl.set_background(self.plotter.renderer.GetBackground())
         self.views.addWidget(pl)
-        pl.renderer.SetActiveCamera(self.plotter.renderer.GetActiveCamera())  # linked cameras
+        # linked cameras: one vtkCamera, A's, which PyVista's ``camera`` names too (after
+        # SetActiveCamera alone it named B's own unused camera, and B's translucent triangles
+        # were sorted for that one)
+        pl.renderer.camera = self.plotter.renderer.camera
         pl.camera_set = True
         self.plotter_b = pl
         self.view_b = SceneView(pl, self.view.mesh, M.side_b(state),

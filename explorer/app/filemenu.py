@@ -30,7 +30,7 @@ from explorer.core.mtl import MtlError, format_mtl, mtl_import, preset_name
 from explorer.core.presets import user_dir
 from explorer.core.yamlio import dump_yaml
 from explorer.geometry.meshes import Mesh
-from explorer.render.images import encode_png
+from explorer.render.images import encode_png, side_by_side
 from explorer.render.turntable import TURNTABLE_SUFFIXES
 
 log = logging.getLogger(__name__)
@@ -294,10 +294,20 @@ class FileCommands:
 
     # -- pictures -----------------------------------------------------------------------------
     def view_png(self) -> bytes:
-        """The 3D view as it is drawn now, PNG-encoded."""
+        """The 3D view as it is drawn now, PNG-encoded: in the compare view both panes, side
+        by side as in the window (A left, B right, the gap between them in the splitter's
+        place)."""
         self.render()
-        img = self.plotter.screenshot(return_img=True)
-        return encode_png(np.ascontiguousarray(img[:, :, :3]))
+        img = self.plotter.screenshot(return_img=True)[:, :, :3]
+        pl_b = self.plotter_b
+        if pl_b is not None and pl_b.isVisible():
+            pl_b.render_window.Render()  # drawn at its present size before it is read
+            b = pl_b.screenshot(return_img=True)[:, :, :3]
+            a_x = self.plotter.mapTo(self, QtCore.QPoint(0, 0)).x()
+            gap = max(pl_b.mapTo(self, QtCore.QPoint(0, 0)).x() - a_x - img.shape[1], 0)
+            fill = self.views.palette().window().color().getRgb()[:3]  # the splitter's
+            img = side_by_side(img, b, gap, fill)
+        return encode_png(np.ascontiguousarray(img))
 
     def picture_stem(self) -> str:
         """``phong-explorer-<preset or mesh file>-<mesh>``, safe as a file name."""

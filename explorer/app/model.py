@@ -688,10 +688,27 @@ class Store:
         return set_camera(state, self.state.camera)
 
 
-def handle_point(state: State) -> np.ndarray:
-    """(3,) where the selected light's handle is drawn (world units)."""
-    az, el, d = state.placement()
+def handle_point(state: State, index: int | None = None) -> np.ndarray:
+    """(3,) where a light's handle is drawn (world units); default: the selected light's."""
+    az, el, d = state.placement(index)
     return np.asarray(state.centre) + d * direction_of(az, el)
+
+
+def point_on_ray(origin, direction, centre, distance: float, near: bool = True) -> np.ndarray:
+    """Where a handle dragged under the pointer goes: the point of the pointer's ray
+    ``origin + t·direction`` (each (3,), t >= 0) at ``distance`` from ``centre`` (3,), the
+    nearer of the two such points when ``near`` (else the farther); where the ray passes
+    farther than ``distance`` from the centre, its point nearest the centre (the two
+    intersections meet there, so a drag across the sphere's outline is continuous). The point
+    is always on the ray: the handle stays under the pointer. Returns (3,) float64."""
+    o = np.asarray(origin, np.float64)
+    u = np.asarray(direction, np.float64)
+    u = u / max(float(np.linalg.norm(u)), 1e-300)
+    t0 = float((np.asarray(centre, np.float64) - o) @ u)  # the ray's point nearest the centre
+    miss2 = float(np.sum((o + t0 * u - np.asarray(centre, np.float64)) ** 2))
+    half = math.sqrt(max(float(distance) ** 2 - miss2, 0.0))
+    t = t0 - half if near else t0 + half
+    return o + max(t, 0.0) * u
 
 
 def angles_from_point(state: State, point) -> tuple[float, float, float]:

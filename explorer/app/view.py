@@ -26,7 +26,9 @@ import numpy as np
 
 from explorer.analysis.comparison import heat_map
 from explorer.app.difference import VMAX
-from explorer.app.model import State, handle_point
+from explorer.app.lobeinset import LobeInset
+from explorer.app.model import State, handle_point, light_colour
+from explorer.app.overlay import overlay, set_lines, set_triangles
 from explorer.geometry.meshes import Mesh, area_weighted_normals
 from explorer.render.camera import (
     Camera,
@@ -45,35 +47,24 @@ LOD_VERTICES = 250_000
 LOD_TARGET = 60_000
 #: the fewest vertices a material group's part of the level of detail is clustered to
 LOD_GROUP_MIN = 64
-#: the light handle's radius, in mesh radii
+#: the light handles' radius, in mesh radii (the selected light's is SELECTED_SCALE times it)
 HANDLE_RADIUS = 0.07
-HANDLE_COLOR = (1.0, 0.85, 0.2)
-#: the handle's glyph (arrow for directional, cone for spot), in mesh radii
+SELECTED_SCALE = 1.3
+#: the ring that marks the selected light's handle: its colour and its gap (pixels) around it
+RING_COLOR = (1.0, 1.0, 1.0)
+RING_GAP = 4
+#: the selected handle's glyph (arrow for directional, cone for spot), in mesh radii
 GLYPH_LENGTH = 0.6
 GLYPH_COLOR = (1.0, 0.85, 0.2)
 #: a handle nearer than this (mesh radii) is kept in view when the camera is framed
 HANDLE_FRAMING = 5.5
 #: widest view angle (degrees) the framing may use to show the handle
 MAX_VIEW_ANGLE = 60.0
-#: the lobe inset: left and bottom margin in pixels, its side as a fraction of the view's
-#: smaller side held within LOBE_SIDE (pixels); colours; samples of the curve
-LOBE_MARGIN = 12
-LOBE_FRACTION = 0.2
-LOBE_SIDE = (60, 120)
-LOBE_COLOR = (1.0, 0.85, 0.2)
-LOBE_REFERENCE_COLOR = (0.55, 0.55, 0.6)
-LOBE_FRAME_COLOR = (0.35, 0.35, 0.38)
-LOBE_SAMPLES = 181
-
-
-def lobe_curve(n: float, samples: int = LOBE_SAMPLES) -> np.ndarray:
-    """The specular lobe ``r = cos^n(t)`` for -90° <= t <= 90° in polar coordinates around the
-    mirror direction (the x axis), as the lecture notes draw it: (samples, 2) float64 points
-    ``(r cos t, r sin t)``."""
-    t = np.linspace(-0.5 * math.pi, 0.5 * math.pi, int(samples))
-    c = np.clip(np.cos(t), 0.0, 1.0)
-    r = c ** float(n) if n > 0 else np.ones_like(c)
-    return np.column_stack([r * np.cos(t), r * np.sin(t)])
+#: a handle out of the view is shown by an arrow at the view's edge: its length (pixels), its
+#: distance from the edge (pixels), and the outline drawn around it (for contrast)
+MARKER_SIZE = 18
+MARKER_MARGIN = 6
+MARKER_OUTLINE = (0.08, 0.08, 0.08)
 
 
 def widen_to_show(camera: Camera, points, aspect: float, *, pad: float = 0.0,
@@ -254,12 +245,14 @@ class SceneView:
         self.drawings: list[MeshDrawing] = []
         self.dragging = 0
         self._lods: dict[str, Mesh] = {}
-        self._lobe_n = None
-        self.handle = None
+        self.handles: list = []
+        self._handle_calls = None
+        self._ring = None
+        self.marker_triangles: dict[int, np.ndarray] = {}
         self._glyph = None
         self._glyph_kind = None
         self.set_mesh(mesh, state)
-        self._build_lobe()
+        self.lobe = LobeInset(plotter, state)
 
     # -- mesh --------------------------------------------------------------------------------
     @property
@@ -303,14 +296,17 @@ class SceneView:
                 d.actor.GetProperty().SetOpacity(state.material.opacity)
             self.active.upload()
         self._show_handle(state)
-        self._update_lobe(state.material.shininess)
+        if getattr(self, "lobe", None) is not None:
+            self.lobe.update(state)
 
     def before_frame(self, camera: Camera) -> None:
         """Before a frame: translucent triangles sorted back to front for the camera, the lobe
-        inset sized for the view."""
+        inset sized for the view, the selected handle's ring and the arrows toward handles
+        out of the view placed for the camera."""
         if self.state.material.opacity < 1.0:
             self.active.sort_for(camera)
-        self._layout_lobe()
+        self.lobe.layout(self.state)
+        self._show_markers()
 
     def begin_drag(self) -> None:
         self.dragging += 1
@@ -335,6 +331,11 @@ class SceneView:
         """(n, 3) uint8 colours VTK draws for the full mesh (a copy)."""
         return np.array(self.drawings[0].rgb)
 
+    @property
+    def lobe_caption(self):
+        """The lobe inset's caption (a ``vtkTextActor``)."""
+        return self.lobe.caption
+
     def set_caption(self, text: str) -> None:
         """A line at the top left of the view (which side of the compare view it is)."""
         import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
@@ -358,31 +359,107 @@ class SceneView:
         d.rgb[:] = heat_map(np.asarray(levels)[None, :], vmax=VMAX)[0]
         d.vtk_colors.Modified()
 
-    # -- the handle ---------------------------------------------------------------------------
-    def add_handle(self, callback) -> None:
-        """The light's handle: a sphere widget calling ``callback(centre)`` while dragged."""
-        r = HANDLE_RADIUS * self.state.radius
-        self.handle = self.plotter.add_sphere_widget(
-            callback, center=tuple(handle_point(self.state)) if self.state.scene.lights
-            else (0.0, 0.0, 0.0), radius=r, theta_resolution=20, phi_resolution=12,
-            color=HANDLE_COLOR, selected_color=(1.0, 1.0, 1.0), test_callback=False,
-            interaction_event="always",
-        )  # fmt: skip
-        self.handle.ScaleOff()  # right-drag would resize it
+    # -- the handles ---------------------------------------------------------------------------
+    def add_handles(self, grab, move, release) -> None:
+        """Every light's handle: a sphere widget in the light's colour, the selected light's
+        larger and ringed. ``grab(i)``, ``move(i)`` and ``release(i)`` are called when light
+        ``i``'s handle is pressed, dragged and let go."""
+        self._handle_calls = (grab, move, release)
         self._show_handle(self.state)
 
+    @property
+    def handle(self):
+        """The selected light's sphere widget (None before :meth:`add_handles` or with no
+        light)."""
+        s = self.state
+        if s.selected_light is None or s.light >= len(self.handles):
+            return None
+        return self.handles[s.light]
+
+    def _new_handle(self, i: int):
+        grab, move, release = self._handle_calls
+        w = self.plotter.add_sphere_widget(
+            lambda *_: move(i), center=(0.0, 0.0, 0.0), radius=HANDLE_RADIUS * self.state.radius,
+            theta_resolution=20, phi_resolution=12, color=(1.0, 1.0, 1.0),
+            selected_color=(1.0, 1.0, 1.0), test_callback=False, interaction_event="always",
+        )  # fmt: skip
+        w.ScaleOff()  # right-drag would resize it
+        w.AddObserver("StartInteractionEvent", lambda *_: grab(i))
+        w.AddObserver("EndInteractionEvent", lambda *_: release(i))
+        return w
+
     def _show_handle(self, state: State) -> None:
-        if self.handle is None:
+        """Each light's handle where the light is, in the light's colour; the rest off."""
+        if self._handle_calls is None:
             return
-        light = state.selected_light
-        if light is None:
-            self.handle.Off()
-            self._set_glyph(None, state)
+        lights = state.scene.lights
+        while len(self.handles) < len(lights):
+            self.handles.append(self._new_handle(len(self.handles)))
+        for i, w in enumerate(self.handles):
+            if i >= len(lights):
+                w.Off()
+                continue
+            scale = SELECTED_SCALE if i == state.light else 1.0
+            w.SetRadius(HANDLE_RADIUS * state.radius * scale)
+            w.SetCenter(*handle_point(state, i))
+            w.GetSphereProperty().SetColor(*light_colour(lights[i])[0])
+            w.On()
+        self._set_glyph(state.selected_light, state)
+
+    def handle_pixels(self) -> list[tuple[float, float, bool]]:
+        """Each light's handle centre in the view's pixels (origin bottom-left, VTK's display
+        coordinates) and whether it is in front of the camera."""
+        s = self.state
+        return [self._display(handle_point(s, i)) for i in range(len(s.scene.lights))]
+
+    def _display(self, point) -> tuple[float, float, bool]:
+        ren = self.plotter.renderer
+        ren.SetWorldPoint(*point, 1.0)
+        ren.WorldToDisplay()
+        x, y, _ = ren.GetDisplayPoint()
+        cam = ren.GetActiveCamera()
+        pos, focal = np.asarray(cam.GetPosition()), np.asarray(cam.GetFocalPoint())
+        ahead = float((np.asarray(point) - pos) @ (focal - pos)) > 0.0
+        return x, y, ahead or bool(cam.GetParallelProjection())
+
+    def _show_markers(self) -> None:
+        """The ring around the selected light's handle, and an arrow at the view's edge for
+        every handle out of the view (:func:`edge_marker`)."""
+        if self._handle_calls is None:
             return
-        self.handle.SetRadius(HANDLE_RADIUS * state.radius)
-        self.handle.SetCenter(*handle_point(state))
-        self.handle.On()
-        self._set_glyph(light, state)
+        s = self.state
+        w, h = self.plotter.window_size
+        shown = self.handle_pixels()
+        self.marker_triangles = {}
+        rings = []
+        for i, (x, y, ahead) in enumerate(shown):
+            tri = edge_marker(x, y, ahead, w, h)
+            if tri is not None:
+                self.marker_triangles[i] = tri
+            elif i == s.light:
+                size = HANDLE_RADIUS * SELECTED_SCALE * s.radius
+                r = self._pixel_radius(handle_point(s, i), size)
+                t = np.linspace(0.0, 2.0 * math.pi, 49)
+                rings.append(np.column_stack([x + (r + RING_GAP) * np.cos(t),
+                                              y + (r + RING_GAP) * np.sin(t)]))  # fmt: skip
+        if self._ring is None:
+            self._ring = overlay(self.plotter, RING_COLOR, 2.0)[0]
+            self._markers = overlay(self.plotter, (1.0, 1.0, 1.0), 1.0, filled=True)[0]
+            self._marker_edges = overlay(self.plotter, MARKER_OUTLINE, 2.0)[0]
+        set_lines(self._ring, rings)
+        colours = [light_colour(s.scene.lights[i])[0] for i in self.marker_triangles]
+        set_triangles(self._markers, list(self.marker_triangles.values()), colours)
+        triangles = list(self.marker_triangles.values())
+        set_lines(self._marker_edges, [np.vstack([t, t[:1]]) for t in triangles])
+
+    def _pixel_radius(self, point, radius: float) -> float:
+        """How many pixels a sphere of ``radius`` at ``point`` spans (its projected radius)."""
+        cam = self.plotter.renderer.GetActiveCamera()
+        _, h = self.plotter.window_size
+        if cam.GetParallelProjection():
+            return radius * h / (2.0 * cam.GetParallelScale())
+        depth = float(np.linalg.norm(np.subtract(point, cam.GetPosition())))
+        return radius * h / (2.0 * depth * math.tan(math.radians(0.5 * cam.GetViewAngle())))
 
     def _set_glyph(self, light, state: State) -> None:
         """An arrow toward the mesh for a directional light, the spot's cone for a spot,
@@ -426,66 +503,6 @@ class SceneView:
             return None
         return self._glyph_kind
 
-    # -- the lobe inset ---------------------------------------------------------------------
-    def _build_lobe(self) -> None:
-        from vtkmodules.vtkCommonCore import vtkPoints
-        from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
-        from vtkmodules.vtkRenderingCore import vtkActor2D, vtkPolyDataMapper2D
-
-        self._lobe_polys = {}
-        for key, color, width in (
-            ("frame", LOBE_FRAME_COLOR, 1.0),
-            ("reference", LOBE_REFERENCE_COLOR, 1.0),
-            ("lobe", LOBE_COLOR, 2.0),
-        ):
-            poly = vtkPolyData()
-            poly.SetPoints(vtkPoints())
-            poly.SetLines(vtkCellArray())
-            mapper = vtkPolyDataMapper2D()
-            mapper.SetInputData(poly)
-            actor = vtkActor2D()
-            actor.SetMapper(mapper)
-            actor.GetProperty().SetColor(*color)
-            actor.GetProperty().SetLineWidth(width)
-            self.plotter.renderer.AddViewProp(actor)
-            self._lobe_polys[key] = poly
-        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
-        from vtkmodules.vtkRenderingCore import vtkTextActor
-
-        self.lobe_caption = vtkTextActor()
-        prop = self.lobe_caption.GetTextProperty()
-        prop.SetColor(*LOBE_REFERENCE_COLOR)
-        self.plotter.renderer.AddViewProp(self.lobe_caption)
-        self._lobe_n = None
-        self._lobe_side = None
-        self._layout_lobe()
-
-    def _layout_lobe(self) -> None:
-        """Size the inset for the view (:data:`LOBE_FRACTION` of its smaller side)."""
-        w, h = self.plotter.window_size
-        lo, hi = LOBE_SIDE
-        side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi))
-        if side == self._lobe_side:
-            return
-        self._lobe_side = side
-        x0 = y0 = LOBE_MARGIN
-        pad = 8
-        frame = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + side), (x0, y0 + side), (x0, y0)]
-        axes = [(x0 + pad, y0 + side / 2), (x0 + side - pad, y0 + side / 2)]
-        _set_lines(self._lobe_polys["frame"], [frame, axes])
-        _set_lines(self._lobe_polys["reference"], [_lobe_points(1.0, side)])
-        self.lobe_caption.SetPosition(x0, y0 + side + 4)
-        self.lobe_caption.GetTextProperty().SetFontSize(13 if side >= 100 else 11)
-        self._lobe_n = None
-        self._update_lobe(self.state.material.shininess)
-
-    def _update_lobe(self, n: float) -> None:
-        if n == self._lobe_n or not hasattr(self, "_lobe_polys"):
-            return
-        self._lobe_n = n
-        _set_lines(self._lobe_polys["lobe"], [_lobe_points(n, self._lobe_side)])
-        self.lobe_caption.SetInput(f"specular lobe cos^n, n = {n:g}")
-
     # -- pixels ---------------------------------------------------------------------------------
     def world_to_window(self, point) -> list[int]:
         """Window pixel (origin top-left) of a world point."""
@@ -515,23 +532,26 @@ class SceneView:
         self.plotter.renderer.ResetCameraClippingRange()
 
 
-def _lobe_points(n: float, side: int) -> np.ndarray:
-    x0 = y0 = LOBE_MARGIN
-    pad = 8
-    p = lobe_curve(n)
-    scale = side - 2 * pad
-    return np.column_stack([x0 + pad + p[:, 0] * scale, y0 + side / 2 + p[:, 1] * scale])
-
-
-def _set_lines(poly, polylines) -> None:
-    from vtkmodules.vtkCommonCore import vtkPoints
-    from vtkmodules.vtkCommonDataModel import vtkCellArray
-
-    pts = vtkPoints()
-    lines = vtkCellArray()
-    for line in polylines:
-        ids = [pts.InsertNextPoint(float(x), float(y), 0.0) for x, y in line]
-        lines.InsertNextCell(len(ids), ids)
-    poly.SetPoints(pts)
-    poly.SetLines(lines)
-    poly.Modified()
+def edge_marker(x: float, y: float, ahead: bool, width: int, height: int,
+                size: float = MARKER_SIZE, margin: float = MARKER_MARGIN):  # fmt: skip
+    """The arrow that shows a handle out of the view: a (3, 2) triangle in display pixels
+    (origin bottom-left) at the view's edge, its tip toward the handle's projection ``(x, y)``,
+    or None when the handle is in the view. ``ahead``: the handle is in front of the camera
+    (a point behind it projects mirrored through the view's centre, so the arrow points the
+    other way)."""
+    w, h = float(width), float(height)
+    if ahead and 0.0 <= x < w and 0.0 <= y < h:
+        return None
+    cx, cy = 0.5 * w, 0.5 * h
+    d = np.array([x - cx, y - cy]) * (1.0 if ahead else -1.0)
+    if not np.all(np.isfinite(d)) or float(np.hypot(*d)) < 1e-9:
+        d = np.array([0.0, 1.0])
+    u = d / float(np.hypot(*d))
+    reach = min(
+        (cx - margin) / abs(u[0]) if abs(u[0]) > 1e-12 else math.inf,
+        (cy - margin) / abs(u[1]) if abs(u[1]) > 1e-12 else math.inf,
+    )
+    tip = np.array([cx, cy]) + max(reach, 0.0) * u
+    side = np.array([-u[1], u[0]])
+    back = tip - size * u
+    return np.array([tip, back + 0.45 * size * side, back - 0.45 * size * side])

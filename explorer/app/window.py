@@ -27,19 +27,18 @@ from explorer.app.commands import Commands
 from explorer.app.compare import ComparePane, DifferencePane
 from explorer.app.difference import DifferenceWorker, HeatMap
 from explorer.app.filemenu import FileCommands
+from explorer.app.handledrag import HandleDrag
 from explorer.app.lightpanel import Panel
 from explorer.app.messages import Messages
 from explorer.app.panel import ValueSlider
 from explorer.app.session import session_mapping
 from explorer.app.start import MESH_CHOICES, TITLE, WINDOW_SIZE
 from explorer.app.view import (
-    HANDLE_RADIUS,
     LOD_TARGET,
     LOD_VERTICES,
     SceneView,
     framed_camera,
     view_camera,
-    widen_to_show,
 )
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
@@ -47,6 +46,7 @@ from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
 from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import plain_blending
 from explorer.shading import tiers
 
 log = logging.getLogger(__name__)
@@ -57,7 +57,7 @@ PANEL_FRACTION = 0.34
 ENGINE_POLL_MS = 500
 
 
-class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messages,
+class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, HandleDrag, Messages,
                      QtWidgets.QMainWindow):  # fmt: skip
     """The explorer window.
 
@@ -93,6 +93,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         self._t0: float | None = None
         self._in_frame = False
         self._holding_handle = False
+        self._grab = None
         self._requested = None
         self.meshes: dict[str, Mesh] = {state.mesh: mesh}
         self.mesh_choices = dict(MESH_CHOICES)
@@ -108,6 +109,7 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         self.plotter.setMinimumSize(120, 120)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.plotter.disable_anti_aliasing()
+        plain_blending(self.plotter.renderer)  # translucency drawn as the off-screen renders
         self.plotter.set_background(BACKGROUND if background is None else background)
         self.panel = Panel(self.act, self.choose_mesh)
         self.views.addWidget(self.plotter)
@@ -132,7 +134,9 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         self.view = SceneView(self.plotter, mesh, state, lod_vertices=lod_vertices,
                               lod_target=lod_target)  # fmt: skip
         self.view.apply_camera(state.camera)
-        self.view.add_handle(self._guard(self._on_handle, "light handle"))
+        self.view.add_handles(self._guard(self._grab_handle, "light handle"),
+                              self._guard(self._drag_handle, "light handle"),
+                              self._guard(self._release_handle, "light handle"))  # fmt: skip
         self.heat = HeatMap(self.plotter.renderer)
         self.worker = DifferenceWorker(self.difference_ready.emit)
         self.difference_ready.connect(self._guard(self._on_difference, "difference view"))
@@ -162,18 +166,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         if style is not None:
             style.AddObserver("StartInteractionEvent", self._guard(self._begin_drag, "camera"))
             style.AddObserver("EndInteractionEvent", self._guard(self._end_drag, "camera"))
-        handle = self.view.handle
-
-        def grab(*_):
-            self._holding_handle = True
-            self._begin_drag()
-
-        def release(*_):
-            self._holding_handle = False
-            self._end_drag()
-
-        handle.AddObserver("StartInteractionEvent", self._guard(grab, "handle"))
-        handle.AddObserver("EndInteractionEvent", self._guard(release, "handle"))
         for s in self.panel.findChildren(ValueSlider):
             s.pressed.connect(self._guard(self._begin_drag, s.objectName()))
             s.released.connect(self._guard(self._end_drag_if_dragging, s.objectName()))
@@ -279,21 +271,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         self._update_difference()
         if not self._in_frame:
             self.render()
-        self._keep_handle_in_view(old, new)  # last: it may change the camera
-
-    def _keep_handle_in_view(self, old: M.State, new: M.State) -> None:
-        """A light moved from the panel or a key keeps its handle in view: the view is widened
-        (the camera's position, and so the viewer, stay)."""
-        if (new.selected_light is None or new.camera is None or self._holding_handle
-                or new.scene.lights == old.scene.lights):  # fmt: skip
-            return
-        w, h = self.plotter.window_size
-        if min(w, h) < 16:
-            return
-        pad = HANDLE_RADIUS * new.radius
-        cam = widen_to_show(new.camera, [M.handle_point(new)], w / h, pad=pad)
-        if cam != new.camera:
-            self.store.set_camera(cam)
 
     def _show_panel(self, state: M.State) -> None:
         self.panel.show_state(state, self.view.mesh.n_vertices)
@@ -362,14 +339,6 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         else:
             self.store.seal()
 
-    def _on_handle(self, centre) -> None:
-        s = self.store.state
-        if s.selected_light is None:
-            return
-        az, el, d = M.angles_from_point(s, centre)
-        if d > 0:
-            self.act(M.place_light, az, el, d, label="light handle", merge="handle")
-
     # -- reporting ------------------------------------------------------------------------------
     def widget_box(self, widget: QtWidgets.QWidget) -> list[int]:
         """``[x, y, width, height]`` of a widget in the window's pixels (top-left origin)."""
@@ -388,6 +357,11 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
         handle = None
         if s.selected_light is not None:
             handle = in_window(self.view.world_to_window(M.handle_point(s)))
+        handles = [in_window(self.view.world_to_window(M.handle_point(s, i)))
+                   for i in range(len(s.scene.lights))]  # fmt: skip
+        _, h = self.plotter.window_size
+        arrows = {str(i): in_window([round(float(t[0, 0])), round(h - 1 - float(t[0, 1]))])
+                  for i, t in self.view.marker_triangles.items()}  # fmt: skip
         widgets = {
             w.objectName(): self.widget_box(w)
             for w in self.findChildren(QtWidgets.QWidget)
@@ -403,6 +377,8 @@ class ExplorerWindow(Commands, FileCommands, ComparePane, DifferencePane, Messag
             "dragging": self.view.dragging > 0,
             "lod": self.view.lod_active,
             "handle_px": handle,
+            "handles_px": handles,
+            "arrows_px": arrows,
             "glyph": self.view.glyph_kind,
             "probe": {"vertex": probe,
                       "px": in_window(self.view.world_to_window(self.view.mesh.positions[probe]))},

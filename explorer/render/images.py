@@ -96,3 +96,16 @@ def read_png(path) -> np.ndarray:
     arr = vtk_to_numpy(img.GetPointData().GetScalars())
     c = arr.shape[1] if arr.ndim == 2 else 1
     return np.ascontiguousarray(arr.reshape(h, w, c)[::-1]).astype(np.uint8)
+
+
+def side_by_side(left, right, gap: int = 0, fill=(0, 0, 0)) -> np.ndarray:
+    """Two pictures (h1, w1, 3) and (h2, w2, 3) uint8 in one, ``gap`` columns of ``fill``
+    between them, the shorter one padded at the bottom with ``fill``:
+    (max(h1, h2), w1 + gap + w2, 3) uint8."""
+    a, b = np.asarray(left, np.uint8), np.asarray(right, np.uint8)
+    h = max(a.shape[0], b.shape[0])
+    out = np.empty((h, a.shape[1] + int(gap) + b.shape[1], 3), np.uint8)
+    out[:] = np.asarray(fill, np.uint8)
+    out[: a.shape[0], : a.shape[1]] = a
+    out[: b.shape[0], a.shape[1] + int(gap) :] = b
+    return out

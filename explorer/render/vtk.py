@@ -63,10 +63,20 @@ def plotter(size: Sequence[int], background, *, off_screen: bool = True, title: 
         pl = pv.Plotter(window_size=[w, h], lighting=None, title=title)
     pl.render_window.SetMultiSamples(0)  # before the first render: no multisampling
     pl.disable_anti_aliasing()
-    pl.renderer.SetUseOIT(False)
-    pl.renderer.SetUseDepthPeeling(False)
+    plain_blending(pl.renderer)
     pl.set_background(background)
     return pl
+
+
+def plain_blending(renderer) -> None:
+    """Blend translucent triangles "over" what is drawn, in the order they are drawn (the
+    callers sort them back to front): VTK's weighted-average order-independent transparency
+    (on by default in every ``vtkOpenGLRenderer``) would average the front and back layers of a
+    closed mesh whatever its opacity, and its depth peeling orders layers wrongly on Mesa
+    llvmpipe. Every renderer that draws the engine's colours goes through here, the window's
+    panes too, so the window blends as the off-screen renders do."""
+    renderer.SetUseOIT(False)
+    renderer.SetUseDepthPeeling(False)
 
 
 def cells(faces) -> np.ndarray:

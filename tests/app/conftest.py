@@ -14,7 +14,7 @@ from explorer.app.start import start_xvfb
 #: the private server's screen: room for the largest window size tested (1920x1080)
 SCREEN = (1920, 1200)
 #: modules whose tests open Qt windows in the test process
-QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py")
+QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py", "test_window_view.py")
 
 
 def pytest_collection_modifyitems(session, config, items):

@@ -7,6 +7,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import explorer
@@ -344,3 +345,32 @@ def test_compare_actions(state):
     assert M.stop_compare(s).compare is None
     with pytest.raises(explorer.ExplorerError, match="compare view is off"):
         M.swap_compare(state)
+
+
+def test_a_dragged_handle_stays_on_the_pointers_ray():
+    """point_on_ray: on the ray, at the light's distance from the centre (near or far side),
+    and the ray's point nearest the centre where the ray passes outside that sphere."""
+    centre, d = np.array([1.0, 2.0, 3.0]), 2.0
+    o = centre + np.array([0.0, 0.0, 10.0])
+    u = np.array([0.6, 0.0, -0.8])  # passes 10 · 0.6 = 6 from the centre: a miss
+    p = M.point_on_ray(o, u, centre, d)
+    assert np.cross(p - o, u) == pytest.approx(np.zeros(3), abs=1e-12)  # on the ray
+    assert np.linalg.norm(p - centre) == pytest.approx(6.0)
+    assert (p - o) @ u == pytest.approx(10.0 * 0.8)  # the nearest point: t = (c - o)·u
+    u = np.array([0.1, 0.0, -1.0])
+    near, far = M.point_on_ray(o, u, centre, d), M.point_on_ray(o, u, centre, d, near=False)
+    for p in (near, far):
+        assert np.linalg.norm(p - centre) == pytest.approx(d)
+        assert np.linalg.norm(np.cross(p - o, u / np.linalg.norm(u))) == pytest.approx(0, abs=1e-12)
+    assert near[2] > centre[2] > far[2]
+    # straight at the centre: the sphere's pole facing the ray's start
+    assert M.point_on_ray(o, [0, 0, -1], centre, d) == pytest.approx(centre + [0, 0, d])
+
+
+def test_handle_point_of_each_light(state):
+    s = M.add_light(state)
+    for i in range(2):
+        az, el, d = s.placement(i)
+        assert np.linalg.norm(M.handle_point(s, i) - np.asarray(s.centre)) == pytest.approx(d)
+    assert M.handle_point(s) == pytest.approx(M.handle_point(s, s.light))
+    assert not np.allclose(M.handle_point(s, 0), M.handle_point(s, 1))

@@ -80,3 +80,18 @@ def test_dragging_draws_the_groups_level_of_detail_in_their_materials(tori):
         assert np.abs(full.rgb.astype(int) - want.astype(int)).max() <= 1
     finally:
         pl.close()
+
+
+def test_edge_marker_points_from_the_views_edge_to_a_handle_out_of_it():
+    from explorer.app.view import MARKER_MARGIN, MARKER_SIZE, edge_marker
+
+    assert edge_marker(50, 40, True, 200, 100) is None  # in the view: no arrow
+    tri = edge_marker(100, 400, True, 200, 100)  # straight above
+    assert tri[0] == pytest.approx([100, 100 - MARKER_MARGIN])  # the tip at the top edge
+    assert tri[1:, 1] == pytest.approx([100 - MARKER_MARGIN - MARKER_SIZE] * 2)
+    behind = edge_marker(100, 400, False, 200, 100)  # behind the camera: mirrored, downward
+    assert behind[0] == pytest.approx([100, MARKER_MARGIN])
+    tri = edge_marker(-1000, 50, True, 200, 100)  # far left
+    assert tri[0] == pytest.approx([MARKER_MARGIN, 50]) and (tri[:, 0] >= 0).all()
+    corner = edge_marker(1e6, 1e6, True, 200, 100)
+    assert 0 <= corner[0, 0] <= 200 and 0 <= corner[0, 1] <= 100

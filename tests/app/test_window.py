@@ -351,17 +351,6 @@ def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
     assert win.store.state.compare is not None and win.plotter_b.isVisible()
 
 
-def test_a_light_moved_from_the_panel_keeps_its_handle_in_view(win):
-    tab = win.panel.lights
-    tab.sliders["distance"].field.setValue(3.0)
-    tab.sliders["elevation"].field.setValue(90.0)  # straight up: above the framed view
-    win.render()
-    x, y = win.view.world_to_window(M.handle_point(win.store.state))
-    w, h = win.plotter.window_size
-    assert 0 <= x < w and 0 <= y < h
-    assert win.store.state.scene.viewer.eye == pytest.approx(win.store.state.camera.position)
-
-
 @pytest.mark.skipif(sys.version_info >= (3, 12), reason="None is immortal from Python 3.12")
 def test_qt_calls_keep_their_reference_to_none(qapp):
     """Each call of a Qt method that returns nothing must leave None's reference count as it

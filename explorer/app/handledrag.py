@@ -1,0 +1,73 @@
+"""Dragging the light handles with the mouse (a mix-in of
+:class:`explorer.app.window.ExplorerWindow`): a press on a handle selects its light, a drag keeps
+the handle under the pointer (:func:`explorer.app.model.point_on_ray`), whatever the camera's
+distance and zoom."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from explorer.app import model as M
+
+
+class HandleDrag:
+    """Needs the window's ``store``, ``plotter``, ``view``, ``act``, ``_begin_drag`` and
+    ``_end_drag``; :meth:`_grab_handle`, :meth:`_drag_handle` and :meth:`_release_handle` are
+    the handles' callbacks (:meth:`explorer.app.view.SceneView.add_handles`)."""
+
+    def _grab_handle(self, index: int) -> None:
+        """Light ``index``'s handle is pressed: its light is selected, and the drag starts
+        with the pointer's offset from the handle's centre (kept to the end, so the handle
+        does not jump) and the side of the mesh centre it is on (see :func:`M.point_on_ray`)."""
+        if index != self.store.state.light:
+            self.act(M.select_light, index, label="select light")
+        s = self.store.state
+        x, y = self.plotter.iren.interactor.GetEventPosition()
+        hx, hy, _ = self.view.handle_pixels()[index]
+        origin, direction = self._pointer_ray(hx, hy)
+        near = float((M.handle_point(s) - origin) @ direction) <= float(
+            (np.asarray(s.centre) - origin) @ direction)  # fmt: skip
+        self._grab = (hx - x, hy - y, near)
+        self._holding_handle = True
+        self._begin_drag()
+
+    def _drag_handle(self, index: int) -> None:
+        """Handle ``index`` dragged: the light goes where the pointer is (on the pointer's ray,
+        at the light's distance from the mesh centre), so the handle stays under the pointer
+        (VTK's sphere widget moves its sphere at the focal point's depth, not the handle's:
+        ahead of the pointer when the handle is nearer than the focal point)."""
+        s = self.store.state
+        if s.selected_light is None or index != s.light or self._grab is None:
+            return
+        dx, dy, near = self._grab
+        x, y = self.plotter.iren.interactor.GetEventPosition()
+        origin, direction = self._pointer_ray(x + dx, y + dy)
+        d = s.placement()[2]
+        self._on_handle(M.point_on_ray(origin, direction, s.centre, d, near))
+
+    def _release_handle(self, index: int) -> None:
+        self._grab = None
+        self._holding_handle = False
+        self._end_drag()
+
+    def _pointer_ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+        """The ray under display pixel ``(x, y)`` (origin bottom-left): its start on the near
+        clipping plane and its unit direction, each (3,)."""
+        ren = self.plotter.renderer
+        ends = []
+        for z in (0.0, 1.0):
+            ren.SetDisplayPoint(float(x), float(y), z)
+            ren.DisplayToWorld()
+            p = np.asarray(ren.GetWorldPoint(), np.float64)
+            ends.append(p[:3] / p[3])
+        u = ends[1] - ends[0]
+        return ends[0], u / max(float(np.linalg.norm(u)), 1e-300)
+
+    def _on_handle(self, centre) -> None:
+        """Move the selected light to where its handle is put (``centre`` (3,), world)."""
+        s = self.store.state
+        if s.selected_light is None:
+            return
+        az, el, d = M.angles_from_point(s, centre)
+        if d > 0:
+            self.act(M.place_light, az, el, d, label="light handle", merge="handle")
