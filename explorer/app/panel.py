@@ -10,12 +10,16 @@ scene's lights and the selected one's type, colour, placement, attenuation and c
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
+from explorer.app.scales import (
+    STEPS,
+    rgb_text,
+    shininess_to_step,
+    step_to_shininess,
+)
 from explorer.core.errors import ExplorerError
 from explorer.core.material import (
     COEFFICIENT_RANGE,
@@ -25,34 +29,6 @@ from explorer.core.material import (
     SHININESS_RANGE,
 )
 from explorer.shading.display import to_bytes
-
-#: slider steps (QSlider is integral)
-STEPS = 1000
-#: the shininess slider's log scale: step 0 is n = 0, steps 1..STEPS are 10**0 to 10**LOG_MAX
-LOG_MAX = 3.0
-#: the light intensity control's slider range (the number field takes more)
-INTENSITY_RANGE = (0.0, 2.0)
-MAX_INTENSITY = 1000.0
-
-
-def shininess_to_step(n: float) -> int:
-    """Slider step of exponent ``n`` (0 at the left end, then log10 n from 0 to 3)."""
-    if n <= 0.0:
-        return 0
-    t = min(max(math.log10(max(n, 1.0)) / LOG_MAX, 0.0), 1.0)
-    return 1 + round(t * (STEPS - 1))
-
-
-def step_to_shininess(step: int) -> float:
-    """Exponent of a shininess slider step, to 3 significant digits (step 0 is 0)."""
-    if step <= 0:
-        return 0.0
-    n = 10.0 ** (LOG_MAX * (min(step, STEPS) - 1) / (STEPS - 1))
-    return float(f"{n:.3g}")
-
-
-def rgb_text(rgb) -> str:
-    return ", ".join(f"{c:.3f}" for c in rgb)
 
 
 def rgb_bytes(rgb) -> tuple[int, int, int]:

@@ -107,14 +107,18 @@ def session_mapping(state: State) -> dict:
     return out
 
 
+def session_text(state: State, *, as_json: bool = False) -> str:
+    """``state`` as a session file's text: YAML with its header line, or JSON."""
+    data = session_mapping(state)
+    if as_json:
+        return json.dumps(data, indent=1)
+    return dump_yaml(data, header="phong-explorer session (phong-explorer gui --session FILE)")
+
+
 def save_session(path, state: State, *, overwrite: bool = False) -> Path:
     """Write ``state`` as a session file (YAML; ``.json`` names get JSON), atomically; an
     existing file is replaced only with ``overwrite``."""
-    data = session_mapping(state)
-    if os.fspath(path).lower().endswith(".json"):
-        text = json.dumps(data, indent=1)
-    else:
-        text = dump_yaml(data, header="phong-explorer session (phong-explorer gui --session FILE)")
+    text = session_text(state, as_json=os.fspath(path).lower().endswith(".json"))
     return write_atomic(path, text.encode("utf-8"), overwrite=overwrite, make_dirs=True)
 
 

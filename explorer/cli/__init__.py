@@ -36,6 +36,7 @@ COMMANDS = {
     "render": "render a scene off-screen to PNG, PLY, GLB, OBJ or a GIF/MP4 turntable",
     "sheet": "render every preset in one labelled grid",
     "gui": "open the interactive explorer window",
+    "web": "serve the interactive explorer to a browser (trame)",
     "bench": "measure what accuracy costs in time",
 }
 

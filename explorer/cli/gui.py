@@ -21,14 +21,11 @@ import math
 import os
 import sys
 
-from explorer.app import session as S
 from explorer.app import start as gui
-from explorer.app.model import DEFAULT_PLACEMENT
-from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
+from explorer.cli.explorerstart import start as shared_start
+from explorer.cli.explorerstart import start_state as shared_start_state
+from explorer.cli.options import add_scene_arguments, background_from_options
 from explorer.core.errors import ExplorerError
-from explorer.core.lights import PointLight
-from explorer.core.text import printable
-from explorer.geometry.meshes import get_mesh
 from explorer.render.images import parse_size
 
 
@@ -83,53 +80,17 @@ def check_options(args) -> None:
 
 
 def start(args):
-    """The explorer's start from the command line: ``(scene, mesh, preset name)``.
-
-    Without a SCENE file the start is :data:`explorer.app.start.DEFAULT_PRESET` on the teapot
-    under one point light placed at :data:`explorer.app.model.DEFAULT_PLACEMENT`, seen from a
-    local viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
-    (:data:`explorer.app.start.MESH_CHOICES`) unless ``--resolution`` is given.
-    """
+    """The explorer's start from the command line: see
+    :func:`explorer.cli.explorerstart.start` (the options are checked first)."""
     check_options(args)
-    if args.scene is None and args.preset is None:
-        args.preset = gui.DEFAULT_PRESET
-    args.mesh_default = gui.DEFAULT_MESH
-    placeholder = PointLight(position=(0.0, 0.0, 0.0), diffuse=(1.0, 1.0, 1.0))
-    scene, mesh = build_scene(args, default_light=placeholder)
-    spec = args.mesh if args.mesh is not None else (scene.mesh or gui.DEFAULT_MESH)
-    scene = scene.replace(mesh=spec)  # the state names the mesh shown
-    if args.resolution is None and spec in gui.MESH_CHOICES:
-        mesh = get_mesh(spec, gui.MESH_CHOICES[spec])
-    r = mesh.radius or 1.0
-    if scene.lights == (placeholder,):  # no scene lights and no --light-* option
-        az, el, d = DEFAULT_PLACEMENT
-        scene = scene.replace(lights=(PointLight().placed(az, el, d * r, mesh.centre),))
-    if args.scene is None and args.viewer_eye is None and args.viewer_to_viewer is None:
-        scene = scene.replace(viewer=gui.default_viewer(mesh))
-    preset = args.preset if isinstance(args.preset, str) else scene.material.name
-    return scene, mesh, preset
+    return shared_start(args)
 
 
 def start_state(args):
-    """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s; a mesh
-    file's own materials are shown unless ``--preset`` is given (as ``render`` does)."""
+    """``(state, mesh)``: see :func:`explorer.cli.explorerstart.start_state` (the options are
+    checked first)."""
     check_options(args)
-    dirs = tuple(args.materials_dirs)
-    if args.last:
-        path = S.last_session_path()
-        if not path.is_file():
-            raise ExplorerError(f"--last: no session kept yet ({path} does not exist)")
-        return S.load_session(path, materials_dirs=dirs)
-    if args.session is not None:
-        return S.load_session(args.session, materials_dirs=dirs)
-    own = not isinstance(args.preset, str)  # --preset overrides the mesh's own materials
-    scene, mesh, preset = start(args)
-    state = gui.first_state(scene, mesh, preset=preset, materials_dirs=dirs,
-                            resolution=args.resolution)  # fmt: skip
-    state, warnings = gui.add_mesh_materials(state, mesh, use=own)
-    for w in warnings:
-        print(f"warning: {printable(w)}", file=sys.stderr)
-    return state, mesh
+    return shared_start_state(args)
 
 
 def run(args) -> int:

@@ -1,0 +1,82 @@
+"""``phong-explorer web``: the explorer served to a browser (trame; the view rendered here).
+
+::
+
+    phong-explorer web                               # gold on the teapot, http://127.0.0.1:8080/
+    phong-explorer web --preset jade --mesh torus --port 9000 --open
+    phong-explorer web scene.yaml
+    phong-explorer web --session my.yaml             # a saved session, exactly
+
+It prints its URL and serves until Ctrl-C. It listens on 127.0.0.1 (this machine only) unless
+``--host`` says otherwise, and then warns that anyone who can reach the port can use it. One
+explorer per server: every tab shows and edits the same state. Needs the ``web`` extra
+(``pip install "phong-explorer[web]"``); without it the command says so in one line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import logging
+import sys
+
+from explorer.app import start as gui
+from explorer.cli.explorerstart import start_state
+from explorer.cli.options import add_scene_arguments, background_from_options
+from explorer.core.errors import ExplorerError
+
+#: the port served unless --port says otherwise
+DEFAULT_PORT = 8080
+#: what the web front end needs (the ``web`` extra)
+NEEDS = ("trame", "trame_vuetify", "trame_vtk")
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--preset", metavar="NAME",
+        help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
+    )  # fmt: skip
+    p.add_argument(
+        "--port", type=int, default=DEFAULT_PORT, metavar="N",
+        help="port to listen on (default %(default)s; 0: any free port)",
+    )  # fmt: skip
+    p.add_argument(
+        "--host", default=None, metavar="ADDR",
+        help="address to listen on (default 127.0.0.1: this machine only; any other address "
+        "lets whoever reaches the port use the explorer)",
+    )  # fmt: skip
+    p.add_argument("--open", action="store_true", help="open the page in the default browser")
+    p.add_argument(
+        "--session", metavar="FILE", default=None,
+        help="open a saved session (Save session, or the desktop's) exactly as it was",
+    )  # fmt: skip
+    add_scene_arguments(p, force=False, mesh_default=gui.DEFAULT_MESH)
+
+
+def missing() -> list[str]:
+    """The web extra's modules that are not installed."""
+    return [m for m in NEEDS if importlib.util.find_spec(m) is None]
+
+
+def run(args) -> int:
+    from explorer.app import web  # noqa: I001 - the server's module (VTK, trame) only here
+
+    if not 0 <= args.port <= 65535:
+        raise ExplorerError(f"--port must be 0 to 65535, got {args.port}")
+    lack = missing()
+    if lack:
+        raise ExplorerError(
+            f'the web explorer needs {", ".join(lack)}: pip install "phong-explorer[web]"'
+        )
+    if not logging.getLogger().handlers:
+        logging.basicConfig(
+            level=logging.WARNING, format="phong-explorer: %(levelname)s: %(message)s"
+        )
+    host = args.host or web.DEFAULT_HOST
+    if args.host is not None and host not in ("127.0.0.1", "localhost", "::1"):
+        print(web.OPEN_HOST_WARNING.format(host=host, port=args.port), file=sys.stderr)
+    state, mesh = start_state(args)
+    app = web.WebExplorer(state, mesh, materials_dirs=tuple(args.materials_dirs),
+                          background=background_from_options(args))  # fmt: skip
+    web.serve(app, port=args.port, host=host, open_browser=args.open)
+    return 0
