@@ -6,8 +6,6 @@ from PySide6 import QtCore, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.panel import (
-    INTENSITY_RANGE,
-    MAX_INTENSITY,
     ColourButton,
     MaterialTab,
     NumberField,
@@ -16,6 +14,7 @@ from explorer.app.panel import (
     _scroll,
     guard_wheel,
 )
+from explorer.app.scales import INTENSITY_RANGE, MAX_INTENSITY
 from explorer.core.lights import LIGHT_TYPES, SPOT_EXPONENT_RANGE
 from explorer.core.material import MODELS
 

@@ -10,12 +10,12 @@ scene's lights and the selected one's type, colour, placement, attenuation and c
 
 from __future__ import annotations
 
-import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.scales import (
     STEPS,
+    rgb_bytes,
     rgb_text,
     shininess_to_step,
     step_to_shininess,
@@ -28,15 +28,6 @@ from explorer.core.material import (
     RGB_KEYS,
     SHININESS_RANGE,
 )
-from explorer.shading.display import to_bytes
-
-
-def rgb_bytes(rgb) -> tuple[int, int, int]:
-    """The 8-bit colour the view draws for the value ``rgb`` (3,): each channel clamped to
-    [0, 1] and times 255, rounded as :func:`~explorer.shading.display.to_bytes` rounds the
-    engine's colours (no transfer function: the view shows the values as they are)."""
-    c = np.clip(np.asarray(rgb, dtype=np.float64).reshape(1, 3), 0.0, 1.0)
-    return tuple(int(v) for v in to_bytes(c)[0])
 
 
 def qcolour(rgb) -> QtGui.QColor:

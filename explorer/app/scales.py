@@ -5,6 +5,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
+from explorer.shading.display import to_bytes
+
 #: slider steps (QSlider is integral)
 STEPS = 1000
 #: the shininess slider's log scale: step 0 is n = 0, steps 1..STEPS are 10**0 to 10**LOG_MAX
@@ -33,3 +37,11 @@ def step_to_shininess(step: int) -> float:
 def rgb_text(rgb) -> str:
     """A colour as the fields show it: ``"r, g, b"`` to three decimals."""
     return ", ".join(f"{c:.3f}" for c in rgb)
+
+
+def rgb_bytes(rgb) -> tuple[int, int, int]:
+    """The 8-bit colour the view draws for the value ``rgb`` (3,): each channel clamped to
+    [0, 1] and times 255, rounded as :func:`~explorer.shading.display.to_bytes` rounds the
+    engine's colours (no transfer function: the view shows the values as they are)."""
+    c = np.clip(np.asarray(rgb, dtype=np.float64).reshape(1, 3), 0.0, 1.0)
+    return tuple(int(v) for v in to_bytes(c)[0])

@@ -1,17 +1,19 @@
-"""The explorer in the browser and in Jupyter: a trame server over the same
-:class:`~explorer.app.model.Store` and :class:`~explorer.app.view.SceneView` as the Qt window.
+"""The explorer in the browser and in Jupyter: a trame server that is the second front end of
+:class:`~explorer.app.controller.Controller` (the Qt window is the first), so both share every
+flow (open, save, export, difference, undo) and differ only in their widgets.
 
-The 3D view is rendered on the server (an off-screen PyVista plotter, trame's
-``VtkRemoteView``): the page receives pictures, so the engine's colours, the lobe inset, the
-light handles and the difference heat map are the desktop's pixels. Dragging in the view turns
-the server's camera, and the camera is the viewer (before each frame it goes into the state,
-as in the window). The panel is vuetify widgets, each named (``aria-label``) like the scene
-file's key it sets; every change is an action on the store, so undo / redo are the window's.
+The 3D view is rendered on the server (an off-screen PyVista plotter shown by trame's
+``VtkRemoteView``, drawn by :class:`~explorer.app.view.SceneView`): the page receives pictures,
+so the engine's colours, the lobe inset, the light handles and the difference heat map are the
+desktop's pixels. Dragging in the view turns the server's camera, and the camera is the viewer:
+before each frame it goes into the state (:meth:`Controller.camera_moved`). The panel is
+vuetify widgets (:mod:`explorer.app.webpanel`), each named (``aria-label``) like the scene
+file's key it sets.
 
-One explorer per server: every tab shows and edits the same state. Nothing from the page names
-a server path: uploads are read from a private temporary folder under fixed names, through the
-same readers (and their size caps) as files on disk; a session from the page may name only a
-built-in mesh.
+One explorer per server process: every tab shows and edits the same state. Nothing from the
+page names a server path (:mod:`explorer.app.webfiles`): uploads are written under fixed names
+into a private temporary folder and read by the same readers (and their size caps) as files on
+disk; downloads are written there first; presets go to the user's preset folder.
 
 trame, VTK and PyVista are imported inside the functions that need them (``import explorer``
 stays free of them).
@@ -23,26 +25,31 @@ import dataclasses
 import logging
 import tempfile
 import threading
-from pathlib import Path
+from collections.abc import Sequence
+
+import numpy as np
 
 from explorer.app import model as M
 from explorer.app import webpanel as P
-from explorer.app.session import load_session, session_mapping, session_text
+from explorer.app.controller import Controller, Ports
+from explorer.app.difference import PENDING, DifferenceWorker, HeatMap
+from explorer.app.handledrag import HandleDrag
+from explorer.app.session import session_mapping
 from explorer.app.start import (
     DEFAULT_MESH,
     DEFAULT_PRESET,
-    MESH_CHOICES,
     default_viewer,
     first_state,
     load_mesh_choice,
 )
-from explorer.app.view import SceneView, framed_camera, view_camera
+from explorer.app.view import SceneView, view_camera
+from explorer.app.webfiles import WebFiles
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
-from explorer.core.presets import find_preset, list_presets
+from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, load_scene
-from explorer.core.yamlio import MAX_BYTES, load_yaml
 from explorer.geometry.meshes import Mesh
+from explorer.render.images import encode_png
 from explorer.render.offscreen import BACKGROUND
 
 log = logging.getLogger(__name__)
@@ -56,87 +63,202 @@ OPEN_HOST_WARNING = (
     "warning: listening on {host}: anyone who can reach port {port} can use this explorer "
     "(and save presets into your preset folder)"
 )
+#: how many messages the page's message log keeps
+MESSAGE_LOG = 50
 
 
-class WebExplorer:
-    """One explorer served by trame.
+class WebExplorer(WebFiles, HandleDrag):
+    """One explorer served by trame: the controller's ports (dialogs, messages, view,
+    choices, progress) for a page.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
-    materials_dirs : extra preset directories; size : the view's first size (pixels)
-    name : the trame server's name (one server per name in a process)
+    materials_dirs : extra preset directories; preset_dir : where presets are saved (default:
+        the user's); size : the view's first size (pixels); name : the trame server's name
+        (one server per name in a process); background : RGB in [0, 1]
     """
 
-    def __init__(self, state: M.State, mesh: Mesh, *, materials_dirs=(), size=VIEW_SIZE,
-                 name: str = "phong-explorer", background=None):  # fmt: skip
+    def __init__(self, state: M.State, mesh: Mesh, *, materials_dirs=(), preset_dir=None,
+                 size=VIEW_SIZE, name: str = "phong-explorer", background=None):  # fmt: skip
         from trame.app import get_server
 
         from explorer.render.vtk import plotter  # VTK only once a server is made
 
-        self.materials_dirs = tuple(materials_dirs)
-        self.meshes: dict[str, Mesh] = {state.mesh: mesh}
-        self.errors: list[str] = []
         self.frames = 0
+        self.messages: list[dict] = []
+        self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
+        self.loop = None  # the server's event loop (the difference worker delivers into it)
         self.server = get_server(name, client_type="vue3")
         self.plotter = plotter(size, BACKGROUND if background is None else background)
-        self.plotter.iren.initialize() if self.plotter.iren is not None else None
-        aspect = size[0] / size[1]
-        if state.camera is None:
-            cam = dataclasses.replace(framed_camera(state, mesh, aspect), window_center=(0, 0))
-            state = M.set_camera(state, cam)
-        self.store = M.Store(state)
+        self.view = None
+        self.heat = HeatMap(self.plotter.renderer)
+        self.worker = DifferenceWorker(self._deliver)
+        self.controller = Controller(
+            state, mesh, Ports.of(self, worker=self.worker), materials_dirs=materials_dirs,
+            preset_dir=preset_dir, output_dir=self._uploads.name, last_session=None,
+        )  # fmt: skip
+        self.store = self.controller.store
+        state = self.store.state
         self.view = SceneView(self.plotter, mesh, state)
+        self._mesh_name = state.mesh
         self.view.apply_camera(state.camera)
-        self.presets = list_presets(self.materials_dirs)
-        self._pushing = False
-        self._in_frame = False
-        self.plotter.renderer.AddObserver("StartEvent", self._before_frame)
+        self._grab = None
+        self._holding_handle = False
+        self.view.add_handles(self._guard(self._grab_handle), self._guard(self._drag_handle),
+                              self._guard(self._release_handle))  # fmt: skip
+        self.plotter.renderer.AddObserver("StartEvent", self._guard(self._before_frame))
         self.plotter.render_window.AddObserver("EndEvent", self._after_frame)
-        self.store.subscribe(self._on_change)
         P.build(self)
+        self.server.controller.on_server_ready.add(self._ready)
+        self.controller.start()
         self._push(state)
 
-    # -- actions -----------------------------------------------------------------------------
+    # -- the controller's helpers for HandleDrag -------------------------------------------------
     def act(self, action, *args, label: str | None = None, merge=None) -> bool:
-        """Apply ``action(state, *args)`` as one undo step (``merge``: see
-        :meth:`~explorer.app.model.Store.commit`); an error is shown on the page."""
-        try:
-            return self.store.apply(action, *args, label=label, merge=merge)
-        except ExplorerError as exc:
-            self.report(exc, label or action.__name__)
-            self._push(self.store.state)  # the control that sent it shows the state again
-            return False
+        return self.controller.act(action, *args, label=label, merge=merge)
 
-    def report(self, exc: BaseException, where: str) -> None:
-        text = str(exc) if isinstance(exc, ExplorerError) else f"{type(exc).__name__}: {exc}"
-        self.errors.append(f"{where}: {text}")
-        log.error("%s: %s", where, text)
+    def _begin_drag(self, *_) -> None:
+        self.view.begin_drag()
+        self.controller.begin_drag()
+
+    def _end_drag(self, *_) -> None:
+        self.view.end_drag()
+        self.controller.end_drag()
+
+    def _guard(self, fn):
+        """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
+        logged, never lost."""
+
+        def call(*args, **kw):
+            try:
+                return fn(*args, **kw)
+            except Exception as exc:  # noqa: BLE001 - every error is shown, none is lost
+                self.controller.report(exc, getattr(fn, "__name__", "web"))
+                return None
+
+        return call
+
+    def _ready(self, **_) -> None:
+        import asyncio
+
+        self.loop = asyncio.get_event_loop()
+
+    # -- Dialogs ---------------------------------------------------------------------------------
+    def ask_text(self, title: str, label: str, default: str = "") -> str | None:
+        return self.answers.pop("text", None)
+
+    def ask_yes(self, question: str) -> bool:
+        """Yes only when the page said so beforehand (the "replace" switch); else the question
+        is said, and the answer is no."""
+        yes = bool(self.answers.get("yes", False))
+        if not yes:
+            self.show_message(f"{question} (no: turn on 'replace' to do so)", "warning")
+        return yes
+
+    def ask_path(self, title: str, *, save: bool = False, default: str = "",
+                 filter: str = "") -> str | None:  # fmt: skip
+        return None  # the page names no server path: every flow is given its file
+
+    def ask_number(self, title: str, label: str, default: int, lo: int, hi: int) -> int | None:
+        return default
+
+    def tell(self, title: str, text: str, *, details: str = "", error: bool = False) -> None:
+        self.show_message(f"{title}: {text}", "error" if error else "info",
+                          details.splitlines())  # fmt: skip
+
+    # -- Messages --------------------------------------------------------------------------------
+    def show_message(self, text: str, level: str = "info", details: Sequence[str] = (),
+                     msecs: int | None = None, open_log: bool = True) -> None:  # fmt: skip
+        self.messages = [*self.messages, {"text": text, "level": level,
+                                          "details": list(details)}][-MESSAGE_LOG:]  # fmt: skip
         with self.server.state as s:
-            s.message = f"error ({where}): {text.splitlines()[0] if text else ''}"
+            s.message = text
+            s.message_level = level
+            s.message_log = self.messages
 
-    def undo(self) -> None:
-        self.store.undo()
+    # -- Progress --------------------------------------------------------------------------------
+    def run_steps(self, title: str, total: int, step, cancelled, label, done) -> None:
+        """A long job, run to its end here (the page shows its messages)."""
+        while step():
+            pass
+        done()
 
-    def redo(self) -> None:
-        self.store.redo()
+    # -- Choices ---------------------------------------------------------------------------------
+    def show_presets(self, presets: list) -> None:
+        self.server.state.presets = [P.preset_item(p) for p in presets]
 
-    def seal(self) -> None:
-        self.store.seal()
+    def show_meshes(self, labels: dict[str, str]) -> None:
+        self.server.state.meshes = [{"title": t, "value": n} for n, t in labels.items()]
 
-    # -- the store to the page ---------------------------------------------------------------
-    def _on_change(self, old: M.State, new: M.State) -> None:
-        if new.mesh != old.mesh:
-            self.view.set_mesh(self.meshes[new.mesh], new)
+    def show_recent(self, paths: list[str]) -> None:
+        """The page keeps no recent files (it opens uploads only)."""
+
+    def show_history(self, undo: str | None, redo: str | None) -> None:
+        with self.server.state as s:
+            s.can_undo, s.can_redo = undo is not None, redo is not None
+            s.undo_label, s.redo_label = undo or "", redo or ""
+
+    # -- View ------------------------------------------------------------------------------------
+    def show(self, old: M.State | None, new: M.State) -> None:
+        """The view and the panel show ``new`` (``old`` None: everything afresh)."""
+        if self.view is None:
+            return
+        if new.mesh != self._mesh_name:
+            self.view.set_mesh(self.controller.meshes[new.mesh], new)
+            self._mesh_name = new.mesh
         else:
             self.view.show_state(new)
-        if new.camera is not None and not self._in_frame:
+        if new.camera is not None and not self.controller.in_frame:
             live = view_camera(self.plotter.camera, new.centre, new.radius)
             if live != new.camera:
                 self.view.apply_camera(new.camera)
-        if not self._in_frame:
+        if old is None or not self.controller.in_frame:
             self._push(new)
-            self.update_view()
 
+    def redraw(self) -> None:
+        """Send a new picture to every page."""
+        self.server.controller.view_update()
+
+    def size(self) -> tuple[int, int]:
+        w, h = self.plotter.window_size
+        return int(w), int(h)
+
+    def aspect(self) -> float:
+        w, h = self.size()
+        return w / max(h, 1)
+
+    def background(self) -> tuple[float, float, float]:
+        return tuple(self.plotter.renderer.GetBackground())
+
+    def colors(self) -> np.ndarray:
+        return self.view.drawings[0].colors()
+
+    def dragging(self) -> bool:
+        return self.view is not None and self.view.dragging > 0
+
+    def show_difference(self, result, *, on: bool) -> None:
+        if result is not None and result is not self.heat.result:
+            self.heat.set(result)
+        current = on and result is not None
+        self.heat.show(current)
+        if self.view is not None:
+            self.view.show_mesh(not current)
+        legend = "" if not on else (self.heat.legend() if current else PENDING)
+        self.server.state.legend = legend
+
+    def png(self) -> bytes:
+        return encode_png(self.plotter.screenshot(return_img=True)[:, :, :3])
+
+    # -- the worker's results ------------------------------------------------------------------
+    def _deliver(self, result) -> None:
+        """From the difference worker's thread: handed to the server's loop."""
+        if self.loop is not None:
+            self.loop.call_soon_threadsafe(self._guard(self._on_difference), result)
+
+    def _on_difference(self, result) -> None:
+        self.controller.on_difference(result)
+
+    # -- the store to the page -------------------------------------------------------------------
     def _push(self, state: M.State) -> None:
         """Every control's value from ``state`` (the change handlers ignore these)."""
         self._pushing = True
@@ -146,21 +268,13 @@ class WebExplorer:
         finally:
             self._pushing = False
 
-    def update_view(self) -> None:
-        """Send a new picture to every page."""
-        self.server.controller.view_update()
-
-    # -- frames ------------------------------------------------------------------------------
+    # -- frames ----------------------------------------------------------------------------------
     def _before_frame(self, *_) -> None:
         """The camera is the viewer: it goes into the state (no undo step) before each frame;
         translucent triangles are sorted, the inset and the handle ring laid out."""
         s = self.store.state
         cam = view_camera(self.plotter.camera, s.centre, s.radius)
-        self._in_frame = True
-        try:
-            self.store.set_camera(cam)
-        finally:
-            self._in_frame = False
+        self.controller.camera_moved(cam)
         self.view.before_frame(cam)
         self.plotter.renderer.ResetCameraClippingRange()
 
@@ -169,67 +283,27 @@ class WebExplorer:
 
     def report_state(self) -> dict:
         """What a test may read (plain JSON values): the frame count, the view's size, the
-        probe vertex and its pixel in the view (origin top-left), undo / redo."""
+        probe vertex and its pixel in the view (origin top-left), the session."""
         probe = self.view.probe_vertex()
         return {
             "frame": self.frames,
-            "size": list(self.plotter.window_size),
+            "size": list(self.size()),
             "probe": {"vertex": probe,
                       "px": self.view.world_to_window(self.view.mesh.positions[probe])},
+            "handles_px": [self.view.world_to_window(M.handle_point(self.store.state, i))
+                           for i in range(len(self.store.state.scene.lights))],
+            "placement": (list(self.store.state.placement())
+                          if self.store.state.selected_light is not None else None),
             "can_undo": self.store.can_undo,
             "can_redo": self.store.can_redo,
-            "errors": list(self.errors),
+            "errors": list(self.controller.errors),
             "n_vertices": self.view.mesh.n_vertices,
+            "difference": self.heat.state(),
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 
-    # -- files -------------------------------------------------------------------------------
-    def session_text(self) -> str:
-        """The present session as YAML (what the desktop's File > Save session writes)."""
-        return session_text(self.store.state)
-
-    def open_session_bytes(self, data: bytes) -> None:
-        """Open a session uploaded from the page: written under a fixed name in the private
-        upload folder and read by :func:`~explorer.app.session.load_session` (its caps and
-        checks); its mesh must be a built-in one (a page names no server path)."""
-        path = Path(self._uploads.name) / "session.yaml"
-        path.write_bytes(data)
-        doc = load_yaml(path, what="session")
-        name = doc.data.get("mesh") if isinstance(doc.data, dict) else None
-        if name not in MESH_CHOICES:
-            raise ExplorerError(
-                f"session: mesh {name!r}: a session opened from the page may name only a "
-                f"built-in mesh ({', '.join(MESH_CHOICES)})"
-            )
-        state, mesh = load_session(path, materials_dirs=self.materials_dirs)
-        self.meshes[state.mesh] = mesh
-        if state.camera is None:
-            w, h = self.plotter.window_size
-            state = M.set_camera(state, framed_camera(state, mesh, w / max(h, 1)))
-        self.store.commit(state, "open session")
-
-    def open_uploaded_session(self, upload: dict) -> None:
-        """A session file chosen in the page (trame's file dict: ``content`` bytes, ``size``);
-        refused above the YAML reader's cap before anything is written."""
-        data = upload.get("content") or b""
-        if isinstance(data, list):  # a large file arrives in chunks
-            data = b"".join(data)
-        if len(data) > MAX_BYTES:
-            raise ExplorerError(f"session: {upload.get('name', 'upload')!r} is too large: "
-                                f"{len(data)} bytes, the limit is {MAX_BYTES} bytes")  # fmt: skip
-        self.open_session_bytes(bytes(data))
-
-    def choose_mesh(self, name: str) -> None:
-        """Show built-in mesh ``name`` (the chooser offers only the built-in meshes and the
-        start's)."""
-        if name not in self.meshes:
-            if name not in MESH_CHOICES:
-                raise ExplorerError(f"mesh must be one of {', '.join(MESH_CHOICES)}, got {name!r}")
-            self.meshes[name] = load_mesh_choice(name)
-        mesh = self.meshes[name]
-        self.act(M.set_mesh, name, tuple(mesh.centre), float(mesh.radius or 1.0), label="mesh")
-
     def close(self) -> None:
+        self.worker.close()
         self._uploads.cleanup()
         self.plotter.close()
 
@@ -260,16 +334,25 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
                      show_connection_info=True)  # fmt: skip
 
 
+@dataclasses.dataclass
 class Shown:
     """An explorer served from a thread for a notebook: displayed inline as an ``<iframe>``;
-    :attr:`state` reads the explorer's present state back in Python."""
+    :attr:`state` reads the explorer's present state back in Python.
 
-    def __init__(self, app: WebExplorer, url: str, height: int):
-        self.app, self.url, self.height = app, url, int(height)
+    app : the :class:`WebExplorer`; url : its page; height : the cell's height (pixels)
+    """
+
+    app: WebExplorer
+    url: str
+    height: int = 720
 
     @property
     def state(self) -> M.State:
         return self.app.store.state
+
+    @property
+    def controller(self) -> Controller:
+        return self.app.controller
 
     def session(self) -> dict:
         """The present state as a session mapping (what Save session writes)."""
@@ -282,9 +365,10 @@ class Shown:
 
 def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
          port: int = 0, height: int = 720, materials_dirs=()) -> Shown:  # fmt: skip
-    """Serve an explorer on 127.0.0.1 from a background thread and return it for display in a
-    notebook cell. ``scene``: a :class:`~explorer.core.scene.Scene`, a scene file or None (the
-    explorer's start); ``preset`` overrides its material."""
+    """Serve an explorer on 127.0.0.1 from a background thread (its own event loop, so the
+    notebook's kernel stays free) and return it for display in a notebook cell. ``scene``: a
+    :class:`~explorer.core.scene.Scene`, a scene file or None (the explorer's start);
+    ``preset`` overrides its material; ``mesh`` a built-in mesh."""
     state, m = notebook_state(scene, preset=preset, mesh=mesh, materials_dirs=materials_dirs)
     ready = threading.Event()
     box: dict = {}
@@ -294,21 +378,29 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
 
         loop = asyncio.new_event_loop()
         asyncio.set_event_loop(loop)
-        app = WebExplorer(state, m, materials_dirs=materials_dirs,
-                          name=f"phong-explorer-{id(box)}")  # fmt: skip
-        box["app"] = app
-        app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task", open_browser=False,
-                         timeout=0, show_connection_info=False, disable_logging=True)  # fmt: skip
+        try:
+            app = WebExplorer(state, m, materials_dirs=materials_dirs,
+                              name=f"phong-explorer-{id(box)}")  # fmt: skip
+            box["app"] = app
+            app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task",
+                             open_browser=False, timeout=0, show_connection_info=False,
+                             disable_logging=True)  # fmt: skip
 
-        async def wait():
-            await app.server.ready
-            box["port"] = app.server.port
+            async def wait():
+                await app.server.ready
+                box["port"] = app.server.port
+                ready.set()
+
+            loop.create_task(wait())
+        except Exception as exc:  # noqa: BLE001 - handed to the caller's thread
+            box["error"] = exc
             ready.set()
-
-        loop.create_task(wait())
+            return
         loop.run_forever()
 
     threading.Thread(target=run, daemon=True, name="phong-explorer-web").start()
-    if not ready.wait(60):
-        raise ExplorerError("the explorer's web server did not start within 60 s")
+    if not ready.wait(120):
+        raise ExplorerError("the explorer's web server did not start within 120 s")
+    if "error" in box:
+        raise box["error"]
     return Shown(box["app"], f"http://{DEFAULT_HOST}:{box['port']}/", height)

@@ -150,9 +150,7 @@ def test_every_control_is_named_by_its_scene_key(server, browser):
     by_name(browser, "material tab").click()
 
 
-def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(
-    server, browser, mesh
-):
+def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(server, browser, mesh):
     rep = open_page(browser, server.url)
     assert rep["n_vertices"] == mesh.n_vertices and not rep["errors"]
     check_probe(browser, mesh)
@@ -169,3 +167,73 @@ def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(
     check_probe(browser, mesh)
     assert rep["can_redo"]
     assert not console_errors(browser)
+
+
+def test_a_light_added_a_session_downloaded_and_opened_again(server, browser, downloads, mesh):
+    rep = open_page(browser, server.url)
+    n = len(rep["session"]["scene"]["lights"])
+    by_name(browser, "lights tab").click()
+    by_name(browser, "add light").click()
+    rep = wait("a new light", lambda: (r := report(browser))
+               and len(r["session"]["scene"]["lights"]) == n + 1 and r)  # fmt: skip
+    assert rep["session"]["light"] == n + 1  # the new light is selected (1-based in the file)
+    type_value(browser, "azimuth", "-120")
+    rep = wait("the light to turn", lambda: (r := report(browser))
+               and abs(r["placement"][0] + 120) < 1e-6 and r)  # fmt: skip
+    saved = rep["session"]
+    for f in downloads.glob("*"):
+        f.unlink()
+    by_name(browser, "save session").click()
+    path = wait("the download", lambda: next(
+        (f for f in downloads.glob("*.yaml") if f.stat().st_size > 0), None))  # fmt: skip
+    time.sleep(0.2)
+    assert explorer.load_scene(saved["scene"]) == explorer.load_scene(
+        __import__("yaml").safe_load(path.read_text())["scene"])  # fmt: skip
+    by_name(browser, "material tab").click()
+    type_value(browser, "kd", "0.1")
+    wait("kd 0.1", lambda: abs(kd(report(browser)) - 0.1) < 1e-9)
+    by_name(browser, "open session").send_keys(str(path))
+    rep = wait("the session to open", lambda: (r := report(browser))
+               and abs(kd(r) - kd({"session": saved})) < 1e-9 and r)  # fmt: skip
+    assert explorer.load_scene(rep["session"]["scene"]) == explorer.load_scene(saved["scene"])
+    check_probe(browser, mesh)
+    assert not console_errors(browser)
+
+
+def test_ctrl_z_undoes_and_ctrl_shift_z_redoes(server, browser):
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.keys import Keys
+
+    open_page(browser, server.url)
+    type_value(browser, "ks", "0.2")
+    wait("ks 0.2", lambda: report(browser)["can_undo"])
+    start = report(browser)["session"]["scene"]["material"]
+    by_name(browser, "view").click()  # focus off the text field (there Ctrl+Z edits the text)
+    ActionChains(browser).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
+    wait("undo", lambda: report(browser)["session"]["scene"]["material"] != start)
+    (ActionChains(browser).key_down(Keys.CONTROL).key_down(Keys.SHIFT).send_keys("z")
+     .key_up(Keys.SHIFT).key_up(Keys.CONTROL).perform())  # fmt: skip
+    wait("redo", lambda: report(browser)["session"]["scene"]["material"] == start)
+
+
+def test_a_closed_tab_leaves_the_server_serving_a_new_tab(server, browser, downloads, mesh):
+    from conftest import new_browser
+
+    other = new_browser(downloads)
+    try:
+        open_page(other, server.url)
+        type_value(other, "kd", "0.45")
+        wait("kd 0.45 seen by the first tab too", lambda: abs(kd(report(browser)) - 0.45) < 1e-9)
+    finally:
+        other.quit()  # the tab and its socket go away
+    time.sleep(1.0)
+    assert server.proc.poll() is None, server.output()
+    fresh = new_browser(downloads)
+    try:
+        rep = open_page(fresh, server.url)
+        assert abs(kd(rep) - 0.45) < 1e-9  # one explorer per server: the same state
+        check_probe(fresh, mesh)
+        assert not console_errors(fresh)
+    finally:
+        fresh.quit()
+    assert "Traceback" not in server.output(), server.output()

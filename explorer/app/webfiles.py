@@ -1,0 +1,147 @@
+"""The web explorer's files (a mix-in of :class:`explorer.app.web.WebExplorer`): uploads and
+downloads, through the controller's flows.
+
+Nothing from the page names a server path. An upload is written into the explorer's private
+temporary folder under a name of its own (the page's file name reduced to its last part, with
+only letters, digits, ``.``, ``-`` and ``_``), after the same size cap as a file on disk
+(:data:`explorer.core.yamlio.MAX_BYTES` for sessions,
+:data:`~explorer.core.tolerances.MAX_MESH_FILE_BYTES` for meshes,
+:data:`~explorer.core.tolerances.MAX_MTL_FILE_BYTES` for material libraries), and then read by
+the same readers, with their checks. A session from the page may name only a built-in mesh,
+and an OBJ's ``mtllib`` only a library uploaded with it. A download is written there by the
+controller's flow (save session, export) and its bytes are sent to the page. Presets are saved
+into the user's preset folder only.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import re
+from pathlib import Path
+
+from explorer.app.start import MESH_CHOICES
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
+from explorer.core.yamlio import MAX_BYTES, load_yaml
+from explorer.geometry.meshes import MESH_SUFFIXES, obj_material_names
+
+#: what the page may download: kind -> (file suffix, MIME type)
+DOWNLOADS = {
+    "session": (".yaml", "text/yaml"),
+    "png": (".png", "image/png"),
+    "mtl": (".mtl", "text/plain"),
+    "json": (".json", "application/json"),
+    "x3d": (".x3d", "model/x3d+xml"),
+    "preset": (".yaml", "text/yaml"),
+}
+#: the characters an uploaded file's own name keeps (others become ``_``)
+UNSAFE = re.compile(r"[^A-Za-z0-9._-]")
+#: the longest uploaded file name kept (characters)
+MAX_UPLOAD_NAME = 100
+
+
+def upload_name(name: str) -> str:
+    """The name an uploaded file is kept under: the page's name's last part, made safe (never
+    empty, never ``.`` or ``..``)."""
+    base = UNSAFE.sub("_", re.split(r"[\\/]", str(name))[-1])[:MAX_UPLOAD_NAME].lstrip(".")
+    return base or "upload"
+
+
+def upload_bytes(upload) -> tuple[str, bytes]:
+    """``(name, content)`` of a trame file upload (a dict with ``name`` and ``content``, the
+    content whole or in chunks)."""
+    if not isinstance(upload, dict):
+        raise ExplorerError("upload: not a file")
+    data = upload.get("content") or b""
+    if isinstance(data, list):
+        data = b"".join(bytes(c) for c in data)
+    return str(upload.get("name") or "upload"), bytes(data)
+
+
+def check_size(name: str, data: bytes, limit: int, what: str) -> None:
+    if len(data) > limit:
+        raise ExplorerError(f"{what} '{upload_name(name)}' is too large: {len(data)} bytes, the "
+                            f"limit is {limit} bytes ({limit >> 20} MiB)")  # fmt: skip
+
+
+class WebFiles:
+    """Needs the explorer's ``controller`` and ``_uploads`` (a temporary directory)."""
+
+    _count = itertools.count(1)
+
+    def _fresh_folder(self, kind: str) -> Path:
+        folder = Path(self._uploads.name) / f"{kind}-{next(self._count)}"
+        folder.mkdir()
+        return folder
+
+    # -- downloads -------------------------------------------------------------------------------
+    def download(self, kind: str) -> dict:
+        """``{"name", "type", "content"}``: the session, the view (PNG) or the material
+        (.mtl, three.js JSON, X3D, preset YAML) as a file for the page to save."""
+        if kind not in DOWNLOADS:
+            raise ExplorerError(f"download must be one of {', '.join(DOWNLOADS)}, got {kind!r}")
+        suffix, mime = DOWNLOADS[kind]
+        c = self.controller
+        folder = self._fresh_folder("download")
+        if kind == "session":
+            path = c.save_session_as(folder / "session.yaml")
+        elif kind == "png":
+            path = c.export_render(folder / f"{c.picture_stem()}.png")
+        else:
+            path = c.export_material(folder / f"{c.material_name()}{suffix}")
+        if path is None:
+            raise ExplorerError(f"download {kind}: nothing was written")
+        data = Path(path).read_bytes()
+        return {"name": Path(path).name, "type": mime,
+                "content": data if kind == "png" else data.decode("utf-8")}  # fmt: skip
+
+    # -- uploads ---------------------------------------------------------------------------------
+    def open_uploaded_session(self, upload) -> None:
+        """A session file chosen in the page: capped, kept under a fixed name, its mesh checked
+        to be a built-in one, then opened by the controller."""
+        name, data = upload_bytes(upload)
+        check_size(name, data, MAX_BYTES, "session")
+        path = self._fresh_folder("session") / "session.yaml"
+        path.write_bytes(data)
+        doc = load_yaml(path, what="session")
+        mesh = doc.data.get("mesh") if isinstance(doc.data, dict) else None
+        if mesh not in MESH_CHOICES:
+            raise ExplorerError(
+                f"session '{upload_name(name)}': mesh {mesh!r}: a session opened from the page "
+                f"may name only a built-in mesh ({', '.join(MESH_CHOICES)})"
+            )
+        self.controller.open_session(path)
+
+    def open_uploaded_mesh(self, uploads) -> None:
+        """A mesh file (and, for an OBJ, the .mtl libraries it names) chosen in the page."""
+        files = [upload_bytes(u) for u in (uploads if isinstance(uploads, list) else [uploads])]
+        meshes = [(n, d) for n, d in files if n.lower().endswith(MESH_SUFFIXES)]
+        if len(meshes) != 1:
+            raise ExplorerError(f"upload one mesh file ({', '.join(MESH_SUFFIXES)}) with its "
+                                f".mtl files, got {len(meshes)} mesh files")  # fmt: skip
+        folder = self._fresh_folder("mesh")
+        for name, data in files:
+            is_mesh = name.lower().endswith(MESH_SUFFIXES)
+            limit = tol.MAX_MESH_FILE_BYTES if is_mesh else tol.MAX_MTL_FILE_BYTES
+            check_size(name, data, limit, "mesh file" if is_mesh else "material library")
+            (folder / upload_name(name)).write_bytes(data)
+        path = folder / upload_name(meshes[0][0])
+        if path.suffix.lower() == ".obj":
+            libraries, _ = obj_material_names(os.fspath(path))
+            for lib in libraries:
+                if Path(lib).resolve().parent != folder.resolve():
+                    raise ExplorerError(
+                        f"mesh file '{path.name}': mtllib {Path(lib).name!r} names a file "
+                        "outside the upload: upload the .mtl files beside the OBJ"
+                    )  # fmt: skip
+        self.controller.choose_mesh(os.fspath(path))
+
+    def save_preset(self, name: str, replace: bool = False) -> None:
+        """Save the material as preset ``name`` in the user's preset folder (``replace``: the
+        page's answer to "replace the file?" and "hide the preset of that name?")."""
+        self.answers = {"yes": bool(replace)}
+        try:
+            self.controller.save_preset_as(str(name))
+        finally:
+            self.answers = {}
