@@ -102,7 +102,8 @@ def test_import_explorer_loads_no_drawing_or_gui_toolkit():
     code = (
         "import sys, explorer; "
         "bad = sorted({m.split('.')[0] for m in sys.modules} & "
-        "{'vtk', 'vtkmodules', 'pyvista', 'pyvistaqt', 'PySide6', 'matplotlib'}); print(bad)"
+        "{'vtk', 'vtkmodules', 'pyvista', 'pyvistaqt', 'PySide6', 'matplotlib', 'trame', "
+        "'wslink'}); print(bad)"
     )
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)

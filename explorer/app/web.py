@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import os
 import tempfile
 import threading
 from collections.abc import Sequence
@@ -328,8 +329,16 @@ def notebook_state(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str
     return state, m
 
 
+def own_arguments() -> None:
+    """trame reads its own options from the command line (``--host``, ``--port``,
+    ``--timeout``...) unless ``TRAME_ARGS`` is set: it is set empty, so that only the
+    explorer's arguments, given to ``server.start``, count."""
+    os.environ["TRAME_ARGS"] = ""
+
+
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
     """Serve ``app`` until the process ends (prints ``App running at:`` and the URL)."""
+    own_arguments()
     app.server.start(port=port, host=host, open_browser=open_browser, timeout=0,
                      show_connection_info=True)  # fmt: skip
 
@@ -358,6 +367,24 @@ class Shown:
         """The present state as a session mapping (what Save session writes)."""
         return session_mapping(self.app.store.state)
 
+    def run(self, fn, *args, timeout: float = 60.0):
+        """``fn(*args)`` run in the server's thread (VTK draws there), and its result."""
+        import asyncio
+
+        async def call():
+            return fn(*args)
+
+        return asyncio.run_coroutine_threadsafe(call(), self.app.loop).result(timeout)
+
+    def set(self, key: str, value) -> None:
+        """Set control ``key`` (a scene-file key: ``kd``, ``shininess``, ``azimuth``...) as
+        the page's control does: one undo step; every open page shows it."""
+
+        def go():
+            self.app.controller.set_value(key, value, merge=False)
+
+        self.run(go)
+
     def _repr_html_(self) -> str:
         return (f'<iframe src="{self.url}" style="width:100%;height:{self.height}px;'
                 f'border:none" title="phong-explorer"></iframe>')  # fmt: skip
@@ -382,7 +409,8 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
             app = WebExplorer(state, m, materials_dirs=materials_dirs,
                               name=f"phong-explorer-{id(box)}")  # fmt: skip
             box["app"] = app
-            app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task",
+            own_arguments()
+            app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task", thread=True,
                              open_browser=False, timeout=0, show_connection_info=False,
                              disable_logging=True)  # fmt: skip
 

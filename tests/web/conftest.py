@@ -30,7 +30,7 @@ def free_port() -> int:
 class Server:
     """A ``phong-explorer web`` process: its URL, its output, whether it still runs."""
 
-    def __init__(self, args, log: Path, env=None):
+    def __init__(self, args, log: Path, env=None, host: str = "127.0.0.1"):
         self.port = free_port()
         self.log = log
         self._out = open(log, "w")  # noqa: SIM115 - closed in stop()
@@ -38,7 +38,7 @@ class Server:
             [sys.executable, "-m", "explorer.cli", "web", "--port", str(self.port), *args],
             stdout=self._out, stderr=subprocess.STDOUT, env=env,
         )  # fmt: skip
-        self.url = f"http://127.0.0.1:{self.port}/"
+        self.url = f"http://{host}:{self.port}/"
         end = time.monotonic() + START_TIMEOUT
         while self.url not in log.read_text(errors="replace"):
             if self.proc.poll() is not None or time.monotonic() > end:

@@ -139,12 +139,13 @@ def test_every_control_is_named_by_its_scene_key(server, browser):
     names = {e.get_attribute("aria-label")
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("preset", "ka", "kd", "ks", "shininess", "opacity", "ambient", "diffuse",
-                "specular", "emission", "model", "view", "undo", "redo", "save session"):  # fmt: skip
+                "specular", "emission", "model", "show_ambient", "show_diffuse",
+                "show_specular", "view", "undo", "redo", "save session"):  # fmt: skip
         assert key in names, f"{key!r} not among {sorted(n for n in names if n)}"
     by_name(browser, "lights tab").click()
     names = {e.get_attribute("aria-label")
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
-    for key in ("light", "type", "intensity", "azimuth", "elevation", "distance",
+    for key in ("light", "type", "color", "intensity", "azimuth", "elevation", "distance",
                 "attenuation", "add light", "duplicate light", "remove light"):  # fmt: skip
         assert key in names, key
     by_name(browser, "material tab").click()
@@ -237,3 +238,38 @@ def test_a_closed_tab_leaves_the_server_serving_a_new_tab(server, browser, downl
     finally:
         fresh.quit()
     assert "Traceback" not in server.output(), server.output()
+
+
+def listening_addresses(port: int) -> set[str]:
+    """The local addresses (IPv4, dotted) listening on ``port`` (/proc/net/tcp)."""
+    found = set()
+    for line in open("/proc/net/tcp").read().splitlines()[1:]:
+        local, state = line.split()[1], line.split()[3]
+        host, p = local.split(":")
+        if int(p, 16) == port and state == "0A":  # LISTEN
+            found.add(".".join(str(int(host[i:i + 2], 16)) for i in (6, 4, 2, 0)))
+    return found
+
+
+def test_it_listens_on_this_machine_only_and_says_so_otherwise(server, tmp_path):
+    from conftest import Server
+
+    assert listening_addresses(server.port) == {"127.0.0.1"}
+    assert "warning" not in server.output()
+    other = Server(["--host", "127.0.0.2", "--mesh", "cube"], tmp_path / "other.log",
+                   host="127.0.0.2")
+    try:
+        assert listening_addresses(other.port) == {"127.0.0.2"}
+        assert (f"warning: listening on 127.0.0.2: anyone who can reach port {other.port} can "
+                "use this explorer") in other.output()  # fmt: skip
+    finally:
+        other.stop()
+
+
+def test_the_command_refuses_a_bad_port_in_one_line(capsys):
+    from explorer.cli import COMMANDS, main
+
+    assert "web" in COMMANDS
+    assert main(["web", "--port", "70000"]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "error: --port must be 0 to 65535, got 70000"
