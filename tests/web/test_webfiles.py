@@ -79,8 +79,8 @@ def test_an_objs_mtllib_must_be_uploaded_with_it(files):
         with pytest.raises(ExplorerError, match="outside the upload"):
             files.open_uploaded_mesh({"name": "m.obj", "content": OBJ % lib})
     assert files.controller.calls == []
-    files.open_uploaded_mesh([{"name": "m.obj", "content": OBJ % b"m.mtl"},
-                              {"name": "../m.mtl", "content": b"newmtl red\nKd 1 0 0\n"}])  # fmt: skip
+    mtl = {"name": "../m.mtl", "content": b"newmtl red\nKd 1 0 0\n"}
+    files.open_uploaded_mesh([{"name": "m.obj", "content": OBJ % b"m.mtl"}, mtl])
     (call, path), = files.controller.calls
     assert call == "choose_mesh" and path.endswith("/m.obj")
     assert path.startswith(files._uploads.name)
