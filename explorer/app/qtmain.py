@@ -8,8 +8,8 @@ import sys
 
 from PySide6 import QtCore, QtWidgets
 
+from explorer.app.qt.window import ExplorerWindow
 from explorer.app.start import NoDisplayError
-from explorer.app.window import ExplorerWindow
 
 log = logging.getLogger(__name__)
 

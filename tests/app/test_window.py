@@ -182,7 +182,7 @@ def test_the_handle_moves_the_light_and_keeps_the_azimuth_at_the_pole(win):
     point = np.asarray(s.centre) + 2.0 * s.radius * np.array([0.0, 1.0, 0.0])  # straight up
     az = s.placement()[0]
     win.view.handle.SetCenter(*point)
-    win._on_handle(point)
+    win.handles._on_handle(point)
     az2, el, d = win.store.state.placement()
     assert (
         el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
@@ -260,7 +260,7 @@ def test_difference_view_from_the_worker(win, qtbot):
     win.panel.view.difference.click()
     qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
     r = win.heat.result
-    assert r.job.key == win._difference_key() and r.comparison.mask.sum() > 1000
+    assert r.job.key == win.controller.difference_key() and r.comparison.mask.sum() > 1000
     assert "RMSE" in win.panel.view.legend.text() and win.panel.view.advice.text()
     assert not win.view.drawings[0].actor.GetVisibility()  # the map stands in for the mesh
     win.panel.material.sliders["shininess"].field.setValue(300.0)

@@ -1,11 +1,12 @@
-"""The panel's ``lights`` and ``view`` tabs and the panel itself (see :mod:`explorer.app.panel`)."""
+"""The panel's ``lights`` and ``view`` tabs and the panel itself (see
+:mod:`explorer.app.qt.panel`)."""
 
 from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
 from explorer.app import model as M
-from explorer.app.panel import (
+from explorer.app.qt.panel import (
     INTENSITY_RANGE,
     MAX_INTENSITY,
     ColourButton,
