@@ -401,8 +401,13 @@ class FileFlows:
         if path is None:
             return None
         if frames is None:
-            frames = self.ports.dialogs.ask_number("Export turntable", "frames in a full turn:",
-                                                   DEFAULT_FRAMES, 2, tol.MAX_TURNTABLE_FRAMES)
+            frames = self.ports.dialogs.ask_number(
+                "Export turntable",
+                "frames in a full turn:",
+                DEFAULT_FRAMES,
+                2,
+                tol.MAX_TURNTABLE_FRAMES,
+            )
             if frames is None:
                 return None
         if not self._ask_replace(path):

@@ -7,8 +7,6 @@ from PySide6 import QtCore, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.qt.panel import (
-    INTENSITY_RANGE,
-    MAX_INTENSITY,
     ColourButton,
     MaterialTab,
     NumberField,
@@ -17,11 +15,9 @@ from explorer.app.qt.panel import (
     _scroll,
     guard_wheel,
 )
-from explorer.core.lights import LIGHT_TYPES, SPOT_EXPONENT_RANGE
+from explorer.core.controls import CONTROLS
+from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS
-
-#: the attenuation fields' range (the scene file takes any value >= 0, not all three zero)
-ATTENUATION_RANGE = (0.0, 100.0)
 
 
 def light_summary(i: int, light, state: M.State) -> str:
@@ -84,14 +80,7 @@ class LightsTab(QtWidgets.QWidget):
         row.setColumnStretch(1, 1)
         form.addLayout(row)
         self.sliders = {
-            "intensity": ValueSlider(
-                "intensity", *INTENSITY_RANGE, field_range=(0.0, MAX_INTENSITY)
-            ),  # fmt: skip
-            "azimuth": ValueSlider("azimuth", -180.0, 180.0, decimals=1, suffix="°"),
-            "elevation": ValueSlider("elevation", -90.0, 90.0, decimals=1, suffix="°"),
-            "distance": ValueSlider(
-                "distance", *M.DISTANCE_RANGE, decimals=2, suffix=" r", field_range=(0.01, 1e4)
-            ),  # fmt: skip
+            name: ValueSlider(name) for name in ("intensity", "azimuth", "elevation", "distance")
         }
         self.sliders["distance"].note.setVisible(True)
         self.sliders["distance"].setToolTip("distance from the mesh centre in mesh radii")
@@ -105,10 +94,11 @@ class LightsTab(QtWidgets.QWidget):
         grid.setContentsMargins(0, 0, 0, 0)
         grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 3)
         self.attenuation = []
+        att = CONTROLS["attenuation"]
         for k, key in enumerate(("kc", "kl", "kq")):
-            f = NumberField(key, *ATTENUATION_RANGE)
+            f = NumberField(key, *att.field_range, decimals=att.decimals)
             f.setObjectName(f"attenuation_{key}")
-            f.setSingleStep(0.05)
+            f.setSingleStep(att.field_step)
             f.setToolTip(f"{key} of 1 / (kc + kl·d + kq·d²), d in world units")
             f.valueChanged.connect(self._attenuation)
             f.rejected.connect(self.rejected)
@@ -119,8 +109,8 @@ class LightsTab(QtWidgets.QWidget):
             self.attenuation.append(f)
         grid.setColumnStretch(1, 1)
         form.addWidget(self.attenuation_box)
-        self.cutoff = ValueSlider("cutoff", 0.0, 90.0, decimals=1, suffix="°")
-        self.exponent = ValueSlider("exponent", *SPOT_EXPONENT_RANGE, decimals=1)
+        self.cutoff = ValueSlider("cutoff")
+        self.exponent = ValueSlider("exponent")
         for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
             form.addWidget(s)
             s.rejected.connect(self.rejected)

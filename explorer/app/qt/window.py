@@ -307,8 +307,11 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         _, h = self.plotter.window_size
         arrows = {str(i): in_window([round(float(t[0, 0])), round(h - 1 - float(t[0, 1]))])
                   for i, t in view.marker_triangles.items()}  # fmt: skip
-        widgets = {w.objectName(): self.widget_box(w) for w in self.findChildren(QtWidgets.QWidget)
-                   if w.objectName() and not w.objectName().startswith("qt_") and w.isVisible()}
+        widgets = {
+            w.objectName(): self.widget_box(w)
+            for w in self.findChildren(QtWidgets.QWidget)
+            if w.objectName() and not w.objectName().startswith("qt_") and w.isVisible()
+        }
         return {
             "frame": self.frames,
             "frame_ms": None if not np.isfinite(self.frame_ms) else self.frame_ms,
