@@ -271,6 +271,46 @@ def test_difference_view_from_the_worker(win, qtbot):
     assert not win.store.state.difference and win.view.drawings[0].actor.GetVisibility()
 
 
+def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot, monkeypatch):
+    """One kd step with the difference view on: one engine update, one upload, one frame, the
+    difference checked once and asked for once; a result for the state before is dropped."""
+    from explorer.app import view as V
+    from explorer.app.difference import run_job
+    from explorer.shading.shader import Shader
+
+    win.panel.view.difference.click()
+    qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
+    old = win.heat.result
+    counts: dict[str, int] = {}
+
+    def count(owner, name):
+        orig = getattr(owner, name)
+
+        def wrapped(*args, **kw):
+            counts[name] = counts.get(name, 0) + 1
+            return orig(*args, **kw)
+
+        monkeypatch.setattr(owner, name, wrapped)
+
+    count(Shader, "set_scene")
+    count(V.MeshDrawing, "upload")
+    count(type(win.controller), "update_difference")
+    jobs = []
+    monkeypatch.setattr(win.worker, "submit", jobs.append)
+    frames = win.frames
+    slider = win.panel.material.sliders["kd"].slider
+    slider.setValue(slider.value() - 37)
+    assert counts == {"set_scene": 1, "upload": 1, "update_difference": 1}
+    assert win.frames == frames + 1 and len(jobs) == 1
+    assert not win.heat.shown  # the live view until the new map comes
+    stale = run_job(old.job)
+    win.difference_ready.emit(stale)
+    assert win.heat.result is old and not win.heat.shown  # dropped, never shown
+    fresh = run_job(jobs[0])
+    win.difference_ready.emit(fresh)
+    assert win.heat.result is fresh and win.heat.shown
+
+
 def test_keys_of_the_view(win, qtbot):
     win.plotter.setFocus()
     qtbot.keyClick(win.plotter, "b")

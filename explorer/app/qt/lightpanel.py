@@ -88,9 +88,25 @@ class LightsTab(QtWidgets.QWidget):
             form.addWidget(s)
             s.rejected.connect(self.rejected)
             s.edited.connect(lambda v, n=name: self._edited(n, v))
-            s.released.connect(lambda: self.act(None))
+        form.addWidget(self._attenuation_fields())
+        self.cutoff = ValueSlider("cutoff")
+        self.exponent = ValueSlider("exponent")
+        for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
+            form.addWidget(s)
+            s.rejected.connect(self.rejected)
+            s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
+        box.addWidget(self.controls)
+        self.none = QtWidgets.QLabel("The scene has no lights: add one.")
+        box.addWidget(self.none)
+        box.addStretch(1)
+        self.list.currentRowChanged.connect(
+            lambda i: i >= 0 and self.act(M.select_light, i, label="select light")
+        )
+
+    def _attenuation_fields(self) -> QtWidgets.QWidget:
+        """The attenuation's three number fields, a row a key (a narrow panel)."""
         self.attenuation_box = QtWidgets.QWidget()
-        grid = QtWidgets.QGridLayout(self.attenuation_box)  # a row a key: a narrow panel
+        grid = QtWidgets.QGridLayout(self.attenuation_box)
         grid.setContentsMargins(0, 0, 0, 0)
         grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 3)
         self.attenuation = []
@@ -108,21 +124,7 @@ class LightsTab(QtWidgets.QWidget):
             grid.addWidget(f, 1 + k, 2)
             self.attenuation.append(f)
         grid.setColumnStretch(1, 1)
-        form.addWidget(self.attenuation_box)
-        self.cutoff = ValueSlider("cutoff")
-        self.exponent = ValueSlider("exponent")
-        for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
-            form.addWidget(s)
-            s.rejected.connect(self.rejected)
-            s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
-            s.released.connect(lambda: self.act(None))
-        box.addWidget(self.controls)
-        self.none = QtWidgets.QLabel("The scene has no lights: add one.")
-        box.addWidget(self.none)
-        box.addStretch(1)
-        self.list.currentRowChanged.connect(
-            lambda i: i >= 0 and self.act(M.select_light, i, label="select light")
-        )
+        return self.attenuation_box
 
     def _edited(self, name: str, v: float) -> None:
         if name == "intensity":

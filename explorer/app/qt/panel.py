@@ -454,7 +454,6 @@ class MaterialTab(QtWidgets.QWidget):
         for name, s in self.sliders.items():
             box.addWidget(s)
             s.edited.connect(lambda v, n=name: self.act(*actions[n](v), label=n, merge=n))
-            s.released.connect(lambda: self.act(None))
         colours = QtWidgets.QGridLayout()
         self.colours = {}
         for i, term in enumerate(RGB_KEYS):
