@@ -31,10 +31,10 @@ from collections.abc import Sequence
 import numpy as np
 
 from explorer.app import model as M
-from explorer.app import webpanel as P
+from explorer.app import webpage, webpanel
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import PENDING, DifferenceWorker, HeatMap
-from explorer.app.handledrag import HandleDrag
+from explorer.app.qt.handledrag import HandleDragger  # toolkit-free: shared with the window
 from explorer.app.session import session_mapping
 from explorer.app.start import (
     DEFAULT_MESH,
@@ -68,7 +68,7 @@ OPEN_HOST_WARNING = (
 MESSAGE_LOG = 50
 
 
-class WebExplorer(WebFiles, HandleDrag):
+class WebExplorer(WebFiles):
     """One explorer served by trame: the controller's ports (dialogs, messages, view,
     choices, progress) for a page.
 
@@ -85,6 +85,7 @@ class WebExplorer(WebFiles, HandleDrag):
         from explorer.render.vtk import plotter  # VTK only once a server is made
 
         self.frames = 0
+        self.pushing = False  # the server is setting the page's values (no user change)
         self.messages: list[dict] = []
         self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
@@ -103,30 +104,25 @@ class WebExplorer(WebFiles, HandleDrag):
         self.view = SceneView(self.plotter, mesh, state)
         self._mesh_name = state.mesh
         self.view.apply_camera(state.camera)
-        self._grab = None
-        self._holding_handle = False
-        self.view.add_handles(self._guard(self._grab_handle), self._guard(self._drag_handle),
-                              self._guard(self._release_handle))  # fmt: skip
-        self.plotter.renderer.AddObserver("StartEvent", self._guard(self._before_frame))
+        self.handles = HandleDragger(self)
+        self.plotter.renderer.AddObserver("StartEvent", self.guard(self._before_frame, "frame"))
         self.plotter.render_window.AddObserver("EndEvent", self._after_frame)
-        P.build(self)
+        webpanel.connect(self)
+        webpage.build(self)
         self.server.controller.on_server_ready.add(self._ready)
         self.controller.start()
         self._push(state)
 
-    # -- the controller's helpers for HandleDrag -------------------------------------------------
-    def act(self, action, *args, label: str | None = None, merge=None) -> bool:
-        return self.controller.act(action, *args, label=label, merge=merge)
-
-    def _begin_drag(self, *_) -> None:
+    # -- drags and errors (the handles' dragger calls these too) ----------------------------------
+    def begin_drag(self, *_) -> None:
         self.view.begin_drag()
         self.controller.begin_drag()
 
-    def _end_drag(self, *_) -> None:
+    def end_drag(self, *_) -> None:
         self.view.end_drag()
         self.controller.end_drag()
 
-    def _guard(self, fn):
+    def guard(self, fn, where: str):
         """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
         logged, never lost."""
 
@@ -134,10 +130,12 @@ class WebExplorer(WebFiles, HandleDrag):
             try:
                 return fn(*args, **kw)
             except Exception as exc:  # noqa: BLE001 - every error is shown, none is lost
-                self.controller.report(exc, getattr(fn, "__name__", "web"))
+                self.controller.report(exc, where)
                 return None
 
         return call
+
+    _guard = guard  # the name the handles' dragger calls
 
     def _ready(self, **_) -> None:
         import asyncio
@@ -186,7 +184,7 @@ class WebExplorer(WebFiles, HandleDrag):
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:
-        self.server.state.presets = [P.preset_item(p) for p in presets]
+        self.server.state.presets = [webpanel.preset_item(p) for p in presets]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
         self.server.state.meshes = [{"title": t, "value": n} for n, t in labels.items()]
@@ -254,7 +252,7 @@ class WebExplorer(WebFiles, HandleDrag):
     def _deliver(self, result) -> None:
         """From the difference worker's thread: handed to the server's loop."""
         if self.loop is not None:
-            self.loop.call_soon_threadsafe(self._guard(self._on_difference), result)
+            self.loop.call_soon_threadsafe(self.guard(self._on_difference, "difference"), result)
 
     def _on_difference(self, result) -> None:
         self.controller.on_difference(result)
@@ -262,12 +260,12 @@ class WebExplorer(WebFiles, HandleDrag):
     # -- the store to the page -------------------------------------------------------------------
     def _push(self, state: M.State) -> None:
         """Every control's value from ``state`` (the change handlers ignore these)."""
-        self._pushing = True
+        self.pushing = True
         try:
             with self.server.state as s:
-                s.update(P.values(self, state))
+                s.update(webpanel.values(state))
         finally:
-            self._pushing = False
+            self.pushing = False
 
     # -- frames ----------------------------------------------------------------------------------
     def _before_frame(self, *_) -> None:

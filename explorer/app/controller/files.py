@@ -16,6 +16,8 @@ from pathlib import Path
 from explorer.app import model as M
 from explorer.app.session import last_session_path, load_session, save_session
 from explorer.app.start import MESH_CHOICES, add_mesh_materials, free_name, load_mesh_choice
+from explorer.app.turntablejob import DEFAULT_FRAMES, TurntableJob, turntable_size
+from explorer.core import tolerances as tol
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.formats import EXPORT_SUFFIXES, convert
@@ -24,6 +26,7 @@ from explorer.core.presets import MAX_NAME_LENGTH, check_name, save_preset, user
 from explorer.core.scene import load_scene
 from explorer.core.yamlio import dump_yaml, load_yaml
 from explorer.geometry.meshes import MESH_SUFFIXES, Mesh
+from explorer.render.turntable import TURNTABLE_SUFFIXES
 
 log = logging.getLogger(__name__)
 
@@ -382,3 +385,57 @@ class FileFlows:
         write_atomic(path, self.ports.view.png())
         self.say(f"saved screenshot {path}")
         return path
+
+    def export_turntable(self, path=None, frames: int | None = None, size=None):
+        """A turntable of the present state (the camera and lights orbit the mesh) as a GIF or
+        MP4, made a frame at a time under the progress port, whose Cancel leaves no file.
+        ``size``: (width, height), default the view's. Returns the job (its ``stage`` says how
+        far it got; ``job.dialog`` the front end's progress handle), or None when the user gave
+        up at a question."""
+        if self.turntable is not None and self.turntable.stage in ("render", "encode"):
+            raise ExplorerError("a turntable is being made: wait for it, or cancel it")
+        s = self.store.state
+        path = self._output_path(path, "Export turntable",
+                                 f"{self.picture_stem()}-turntable.gif",
+                                 "GIF (*.gif);;MP4 (*.mp4)", TURNTABLE_SUFFIXES)  # fmt: skip
+        if path is None:
+            return None
+        if frames is None:
+            frames = self.ports.dialogs.ask_number(
+                "Export turntable",
+                "frames in a full turn:",
+                DEFAULT_FRAMES,
+                2,
+                tol.MAX_TURNTABLE_FRAMES,
+            )
+            if frames is None:
+                return None
+        if not self._ask_replace(path):
+            return None
+        size = turntable_size(*(size or self.ports.view.size()))
+        job = TurntableJob(s.shown_scene(), self.meshes[s.mesh], frames, size, path,
+                           groups=s.shown_groups(), camera=s.camera,
+                           background=tuple(self.ports.view.background()),
+                           overwrite=os.path.lexists(path))  # fmt: skip
+        self.turntable = job
+
+        def step():
+            try:
+                stage = job.step()
+            except Exception as exc:  # noqa: BLE001 - said, and the job ends
+                job.cancel()
+                self.report(exc, "turntable")
+                return None
+            if stage == "written":
+                self.say(f"wrote {path}: {frames} frames of {size[0]}x{size[1]}")
+                return None
+            return job.done, (f"Encoding {path.name}…" if stage == "encode" else None)
+
+        def cancel():
+            job.cancel()
+            self.say(f"turntable cancelled: {path} was not written")
+
+        job.dialog = self.ports.progress.run_steps(
+            "turntable", f"Drawing {frames} frames of {path.name}…", frames + 1, step, cancel
+        )
+        return job

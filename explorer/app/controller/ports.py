@@ -45,11 +45,12 @@ class Messages(Protocol):
 
 @runtime_checkable
 class Progress(Protocol):
-    """A long job shown with a progress bar and a Cancel: ``step()`` is called until it returns
-    False (from the front end's event loop, so frames keep coming); ``cancelled()`` when the
-    user cancels; ``label()`` and ``done()`` say how far it got."""
+    """A long job under a progress bar with a Cancel, stepped from the front end's event loop
+    (so frames keep coming): ``step()`` does one unit and returns ``(done, text)`` (``text``
+    None: the label stays) while there is more, None when finished; ``cancel()`` is called
+    when the user cancels. Returns the front end's handle of the progress display."""
 
-    def run_steps(self, title: str, total: int, step, cancelled, label, done) -> None: ...
+    def run_steps(self, title: str, text: str, total: int, step, cancel) -> object: ...
 
 
 @runtime_checkable

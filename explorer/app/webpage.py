@@ -1,0 +1,213 @@
+"""The web explorer's page: a vuetify layout of the panel (material, lights and view tabs), the
+toolbar (undo / redo, sessions, exports) and the view rendered on the server (trame's
+``VtkRemoteView``). Every control is named (``aria-label``) like the scene file's key it sets
+(``kd``, ``shininess``, ``azimuth``...; a slider ``<key> slider``, a term's switch
+``show_<term>``), so tests and screen readers find it. The state keys and their handlers are
+:mod:`explorer.app.webpanel`'s.
+
+trame is imported inside :func:`build` (``import explorer`` stays free of it).
+"""
+
+from __future__ import annotations
+
+from explorer.app import model as M
+from explorer.app.webpanel import LIGHT_NUMBERS, MATERIAL_NUMBERS
+from explorer.core.controls import STEPS
+from explorer.core.lights import LIGHT_TYPES
+from explorer.core.material import MODELS, RGB_KEYS
+from explorer.geometry.meshes import MESH_SUFFIXES
+
+#: the drawer's width (pixels)
+DRAWER_WIDTH = 380
+#: the export menu: download kind -> its entry
+EXPORTS = {
+    "png": "view as PNG",
+    "mtl": "material as .mtl",
+    "json": "material as three.js JSON",
+    "x3d": "material as X3D",
+    "preset": "material as preset YAML",
+}
+#: a click that asks the server for a file and saves it (the browser's download)
+DOWNLOAD_JS = ("trigger('download', ['{kind}']).then(f => f && utils.download(f.name, f.content, "
+               "f.type))")  # fmt: skip
+#: Ctrl+Z and Ctrl+Shift+Z (also Cmd on a Mac) undo and redo, except in a text field (where
+#: they edit the text)
+KEYS_JS = """
+document.addEventListener('keydown', (e) => {
+  if (!(e.ctrlKey || e.metaKey) || (e.key !== 'z' && e.key !== 'Z')) return;
+  const t = e.target;
+  if (t && t.tagName === 'INPUT' && t.type === 'text') return;
+  e.preventDefault();
+  window.trame.trigger(e.shiftKey ? 'redo' : 'undo');
+});
+"""
+
+
+def _number(v3, html, ctrl, key: str, label: str) -> None:
+    """A slider (:data:`~explorer.core.controls.STEPS` steps) and a number field for ``key`` in
+    one row, shown when the state has a value for it."""
+    with html.Div(classes="d-flex align-center", v_show=f"{key} !== null"):
+        v3.VSlider(
+            v_model=(f"{key}_step", 0), min=0, max=STEPS, step=1, label=label, hide_details=True,
+            density="compact", end=ctrl.seal, raw_attrs=[f'aria-label="{key} slider"'],
+            classes="flex-grow-1 mr-2",
+        )  # fmt: skip
+        v3.VTextField(
+            model_value=(key, 0), type="text", density="compact", hide_details=True,
+            variant="outlined", style="max-width: 92px",
+            change=(ctrl.on_field, f"['{key}', $event.target.value]"),
+            raw_attrs=[f'aria-label="{key}"'],
+        )  # fmt: skip
+
+
+def _colour(v3, ctrl, key: str, label: str) -> None:
+    """A colour field ``"r, g, b"`` for state key ``key``, named ``label`` (the scene file's
+    key)."""
+    v3.VTextField(
+        model_value=(key, ""), label=label, density="compact", hide_details=True,
+        variant="outlined", classes="my-1",
+        change=(ctrl.on_colour, f"['{key}', $event.target.value]"),
+        raw_attrs=[f'aria-label="{label}"'],
+    )  # fmt: skip
+
+
+def _material_tab(v3, html, ctrl) -> None:
+    """The preset, the numbers, the colours, the model and the terms."""
+    v3.VAutocomplete(
+        v_model=("preset", None), items=("presets", []), label="preset", item_props=True,
+        density="compact", hide_details=True, raw_attrs=['aria-label="preset"'],
+    )  # fmt: skip
+    for key in MATERIAL_NUMBERS:
+        _number(v3, html, ctrl, key, key)
+    for term in RGB_KEYS:
+        _colour(v3, ctrl, term, term)
+    v3.VSelect(v_model=("model", "blinn"), items=("models",), label="model",
+               density="compact", hide_details=True,
+               raw_attrs=['aria-label="model"'])  # fmt: skip
+    with html.Div(classes="d-flex"):
+        for term in M.TERMS:
+            v3.VCheckbox(v_model=(f"show_{term}", True), label=term,
+                         density="compact", hide_details=True,
+                         raw_attrs=[f'aria-label="show_{term}"'])  # fmt: skip
+
+
+def _lights_tab(v3, html, ctrl) -> None:
+    """The light list, add / duplicate / remove, and the selected light."""
+    v3.VSelect(v_model=("light", 0), items=("lights",), label="light",
+               density="compact", hide_details=True,
+               raw_attrs=['aria-label="light"'])  # fmt: skip
+    with html.Div(classes="d-flex my-1"):
+        for name in ("add", "duplicate", "remove"):
+            v3.VBtn(name, click=getattr(ctrl, f"{name}_light"), size="small",
+                    classes="mr-1", raw_attrs=[f'aria-label="{name} light"'])  # fmt: skip
+    v3.VSelect(v_model=("type", None), items=("light_types",), label="type",
+               density="compact", hide_details=True, v_show="type !== null",
+               raw_attrs=['aria-label="type"'])  # fmt: skip
+    _colour(v3, ctrl, "light_color", "color")
+    for key in LIGHT_NUMBERS:
+        _number(v3, html, ctrl, key, key)
+    v3.VTextField(
+        model_value=("attenuation", ""), label="attenuation (kc, kl, kq)",
+        density="compact", hide_details=True, variant="outlined",
+        v_show="attenuation !== null",
+        change=(ctrl.on_attenuation, "[$event.target.value]"),
+        raw_attrs=['aria-label="attenuation"'],
+    )  # fmt: skip
+
+
+def _view_tab(v3, html, ctrl) -> None:
+    """The mesh chooser and upload, the difference view and its legend."""
+    v3.VSelect(v_model=("mesh", None), items=("meshes",), label="mesh",
+               density="compact", hide_details=True,
+               raw_attrs=['aria-label="mesh"'])  # fmt: skip
+    v3.VFileInput(
+        v_model=("mesh_upload", None), label="upload a mesh (an OBJ with its .mtl files)",
+        multiple=True, density="compact", hide_details=True, classes="my-2",
+        accept=",".join(MESH_SUFFIXES) + ",.mtl", raw_attrs=['aria-label="upload mesh"'],
+    )  # fmt: skip
+    v3.VSwitch(v_model=("difference", False), label="difference from the exact lighting",
+               density="compact", hide_details=True, color="primary",
+               raw_attrs=['aria-label="difference"'])  # fmt: skip
+    html.Div("{{ legend }}", classes="text-caption", v_show="difference")
+    v3.VBtn("reset camera", click=ctrl.reset_camera, size="small", classes="my-2",
+            raw_attrs=['aria-label="reset camera"'])  # fmt: skip
+
+
+def _files(v3, ctrl) -> None:
+    """The toolbar's files: save and open a session, export the view and the material."""
+    v3.VBtn("save session", variant="text", raw_attrs=['aria-label="save session"'],
+            click=DOWNLOAD_JS.format(kind="session"))  # fmt: skip
+    v3.VFileInput(
+        v_model=("session_upload", None), label="open session", accept=".yaml,.yml,.json",
+        density="compact", hide_details=True, style="max-width: 200px", prepend_icon="",
+        raw_attrs=['aria-label="open session"'],
+    )  # fmt: skip
+    with v3.VMenu():
+        with v3.Template(v_slot_activator="{ props }"):
+            v3.VBtn("export", v_bind="props", variant="text", raw_attrs=['aria-label="export"'])
+        with v3.VList(density="compact"):
+            for kind, text in EXPORTS.items():
+                v3.VListItem(title=text, click=DOWNLOAD_JS.format(kind=kind),
+                             raw_attrs=[f'aria-label="export {kind}"'])  # fmt: skip
+
+
+def _save_preset(v3, html, ctrl) -> None:
+    """Save the material as a preset in the user's preset folder."""
+    with html.Div(classes="d-flex align-center my-1"):
+        v3.VTextField(v_model=("preset_name", ""), label="save as preset", density="compact",
+                      hide_details=True, variant="outlined", classes="mr-1",
+                      raw_attrs=['aria-label="preset name"'])  # fmt: skip
+        v3.VCheckbox(v_model=("preset_replace", False), label="replace", density="compact",
+                     hide_details=True, raw_attrs=['aria-label="replace preset"'])  # fmt: skip
+        v3.VBtn("save", click=ctrl.save_preset, size="small",
+                raw_attrs=['aria-label="save preset"'])  # fmt: skip
+
+
+def build(app) -> None:
+    """The page: the toolbar (undo / redo, files), the drawer (the panel) and the view."""
+    from trame.ui.vuetify3 import SinglePageWithDrawerLayout
+    from trame.widgets import client, html
+    from trame.widgets import vtk as vtkw
+    from trame.widgets import vuetify3 as v3
+
+    server = app.server
+    ctrl = server.controller
+    server.state.update(
+        models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
+        message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
+        session_upload=None, mesh_upload=None, can_undo=False, can_redo=False, undo_label="",
+        redo_label="",
+    )  # fmt: skip
+    with SinglePageWithDrawerLayout(server, full_height=True) as layout:
+        layout.title.set_text("phong-explorer")
+        layout.drawer.width = DRAWER_WIDTH
+        client.Script(KEYS_JS)
+        with layout.toolbar:
+            v3.VSpacer()
+            v3.VBtn("undo", click=ctrl.undo, disabled=("!can_undo",), variant="text",
+                    title=("'Undo ' + undo_label + ' (Ctrl+Z)'",),
+                    raw_attrs=['aria-label="undo"'])  # fmt: skip
+            v3.VBtn("redo", click=ctrl.redo, disabled=("!can_redo",), variant="text",
+                    title=("'Redo ' + redo_label + ' (Ctrl+Shift+Z)'",),
+                    raw_attrs=['aria-label="redo"'])  # fmt: skip
+            _files(v3, ctrl)
+        with layout.drawer:
+            with v3.VTabs(v_model="tab", density="compact", grow=True):
+                for t in ("material", "lights", "view"):
+                    v3.VTab(t, value=t, raw_attrs=[f'aria-label="{t} tab"'])
+            with v3.VWindow(v_model="tab"):
+                with v3.VWindowItem(value="material", classes="pa-2"):
+                    _material_tab(v3, html, ctrl)
+                    _save_preset(v3, html, ctrl)
+                with v3.VWindowItem(value="lights", classes="pa-2"):
+                    _lights_tab(v3, html, ctrl)
+                with v3.VWindowItem(value="view", classes="pa-2"):
+                    _view_tab(v3, html, ctrl)
+            html.Div("{{ message }}", classes=("'text-caption pa-2 ' + (message_level === "
+                     "'error' ? 'text-error' : '')",), raw_attrs=['role="status"'])  # fmt: skip
+        with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
+            view = vtkw.VtkRemoteView(app.plotter.render_window, interactive_ratio=1,
+                                      still_quality=100, interactive_quality=100,
+                                      raw_attrs=['aria-label="view"'])  # fmt: skip
+            ctrl.view_update = view.update
+    app.layout = layout
