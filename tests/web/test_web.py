@@ -247,7 +247,7 @@ def listening_addresses(port: int) -> set[str]:
         local, state = line.split()[1], line.split()[3]
         host, p = local.split(":")
         if int(p, 16) == port and state == "0A":  # LISTEN
-            found.add(".".join(str(int(host[i:i + 2], 16)) for i in (6, 4, 2, 0)))
+            found.add(".".join(str(int(host[i : i + 2], 16)) for i in (6, 4, 2, 0)))
     return found
 
 
@@ -256,8 +256,9 @@ def test_it_listens_on_this_machine_only_and_says_so_otherwise(server, tmp_path)
 
     assert listening_addresses(server.port) == {"127.0.0.1"}
     assert "warning" not in server.output()
-    other = Server(["--host", "127.0.0.2", "--mesh", "cube"], tmp_path / "other.log",
-                   host="127.0.0.2")
+    other = Server(
+        ["--host", "127.0.0.2", "--mesh", "cube"], tmp_path / "other.log", host="127.0.0.2"
+    )
     try:
         assert listening_addresses(other.port) == {"127.0.0.2"}
         assert (f"warning: listening on 127.0.0.2: anyone who can reach port {other.port} can "

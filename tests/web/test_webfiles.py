@@ -55,9 +55,10 @@ def test_a_session_from_the_page_may_name_only_a_built_in_mesh(files, tmp_path):
     with pytest.raises(ExplorerError, match="only a built-in mesh"):
         files.open_uploaded_session({"name": "s.yaml", "content": session(str(secret))})
     assert files.controller.calls == []
-    files.open_uploaded_session({"name": "../s.yaml", "content": [session("cube")[:9],
-                                                                   session("cube")[9:]]})
-    (call, path), = files.controller.calls
+    files.open_uploaded_session(
+        {"name": "../s.yaml", "content": [session("cube")[:9], session("cube")[9:]]}
+    )
+    ((call, path),) = files.controller.calls
     assert call == "open_session" and path.startswith(files._uploads.name)
 
 
@@ -81,7 +82,7 @@ def test_an_objs_mtllib_must_be_uploaded_with_it(files):
     assert files.controller.calls == []
     mtl = {"name": "../m.mtl", "content": b"newmtl red\nKd 1 0 0\n"}
     files.open_uploaded_mesh([{"name": "m.obj", "content": OBJ % b"m.mtl"}, mtl])
-    (call, path), = files.controller.calls
+    ((call, path),) = files.controller.calls
     assert call == "choose_mesh" and path.endswith("/m.obj")
     assert path.startswith(files._uploads.name)
 
