@@ -64,6 +64,11 @@ OPEN_HOST_WARNING = (
     "warning: listening on {host}: anyone who can reach port {port} can use this explorer "
     "(and save presets into your preset folder)"
 )
+#: VTK encodes each picture in a thread of its own, and trame sends a picture still being
+#: encoded half a second later: instead, every FOLLOW_S seconds the server asks for it again
+#: and sends it once it is done (FOLLOW_TRIES times at most; trame's own retry stays behind)
+FOLLOW_S = 0.004
+FOLLOW_TRIES = 1000
 #: how many messages the page's message log keeps
 MESSAGE_LOG = 50
 
@@ -90,6 +95,7 @@ class WebExplorer(WebFiles):
         self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
         self.loop = None  # the server's event loop (the difference worker delivers into it)
+        self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
         self.server = get_server(name, client_type="vue3")
         self.plotter = plotter(size, BACKGROUND if background is None else background)
         self.view = None
@@ -138,9 +144,14 @@ class WebExplorer(WebFiles):
     _guard = guard  # the name the handles' dragger calls
 
     def _ready(self, **_) -> None:
+        """The server runs: its loop is kept (the difference worker delivers into it), and
+        trame's image publisher (see :meth:`_follow_picture`)."""
         import asyncio
 
         self.loop = asyncio.get_event_loop()
+        for p in self.server.protocol.getLinkProtocols():
+            if hasattr(p, "push_render") and hasattr(p, "tracking_views"):
+                self._publisher = p
 
     # -- Dialogs ---------------------------------------------------------------------------------
     def ask_text(self, title: str, label: str, default: str = "") -> str | None:
@@ -216,7 +227,24 @@ class WebExplorer(WebFiles):
 
     def redraw(self) -> None:
         """Send a new picture to every page."""
+        pub = self._publisher
+        vid = None if pub is None else str(pub.get_global_id(self.plotter.render_window))
+        sent = None if vid is None else pub.tracking_views.get(vid, {}).get("mtime")
         self.server.controller.view_update()
+        if vid is not None and self.loop is not None:
+            self.loop.call_later(FOLLOW_S, self.guard(self._follow_picture, "view"), vid, sent,
+                                 FOLLOW_TRIES)  # fmt: skip
+
+    def _follow_picture(self, vid: str, sent, tries: int) -> None:
+        """Send the view's picture as soon as VTK has encoded it: until a picture newer than
+        ``sent`` (the publisher's time of the last one sent) has gone, look every
+        :data:`FOLLOW_S` seconds (``tries`` times at most)."""
+        pub = self._publisher
+        if pub.tracking_views.get(vid, {}).get("mtime") != sent or tries <= 0:
+            return  # sent (by trame itself, or below)
+        pub.push_render(vid)  # sends the picture if it is encoded by now
+        self.loop.call_later(FOLLOW_S, self.guard(self._follow_picture, "view"), vid, sent,
+                             tries - 1)  # fmt: skip
 
     def size(self) -> tuple[int, int]:
         w, h = self.plotter.window_size
