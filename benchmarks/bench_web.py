@@ -199,6 +199,7 @@ def main(argv=None) -> int:
     qt = qt_frames(teapot, args.repeat)
     after = load()
     pl = plotter(SIZE, (0.0, 0.0, 0.0))
+    pl.render()  # the renderer's name is known once it has drawn
     info = machine(pl)
     pl.close()
 

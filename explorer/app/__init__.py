@@ -1,4 +1,4 @@
-"""The desktop explorer.
+"""The explorer: its state, its flows and its two front ends (the desktop window, the web page).
 
 - :mod:`explorer.app.model`, :mod:`explorer.app.session`, :mod:`explorer.app.start`: the state,
   its actions and undo history, sessions, the start: plain Python that imports neither Qt, VTK
@@ -9,6 +9,10 @@
   difference and compare views) for any front end, through small ports; no GUI toolkit.
 - :mod:`explorer.app.qt` and :mod:`explorer.app.qtmain`: the Qt window (PySide6, pyvistaqt), a
   thin binding of the controller.
+- :mod:`explorer.app.web` (with :mod:`~explorer.app.webpage`, :mod:`~explorer.app.webpanel`,
+  :mod:`~explorer.app.webfiles`): the page in the browser and in Jupyter (trame, imported inside
+  functions), the controller's second front end; :mod:`explorer.app.colours`: colours as both
+  front ends' controls show them.
 
 May import everything below it (:mod:`explorer.core`, :mod:`explorer.geometry`,
 :mod:`explorer.shading`, :mod:`explorer.render`) and, of :mod:`explorer.analysis`, the

@@ -274,3 +274,41 @@ def test_the_command_refuses_a_bad_port_in_one_line(capsys):
     assert main(["web", "--port", "70000"]) == 2
     err = capsys.readouterr().err
     assert err.strip() == "error: --port must be 0 to 65535, got 70000"
+
+
+def test_the_difference_view_shows_its_heat_map(server, browser):
+    open_page(browser, server.url)
+    by_name(browser, "view tab").click()
+    before = picture_src(browser)
+    by_name(browser, "difference").click()
+    rep = wait("the heat map", lambda: (r := report(browser)) and r["difference"]["shown"] and r)
+    assert rep["session"]["difference"] is True and rep["difference"]["rmse"] is not None
+    wait("a new picture", lambda: picture_src(browser) not in (None, before))
+    by_name(browser, "difference").click()
+    wait("the view again", lambda: not report(browser)["difference"]["shown"])
+    by_name(browser, "material tab").click()
+    assert not console_errors(browser)
+
+
+@pytest.mark.parametrize(("kind", "suffix", "head"),
+                         [("png", ".png", b"\x89PNG"), ("mtl", ".mtl", b"# ")])  # fmt: skip
+def test_exports_are_downloads(server, browser, downloads, kind, suffix, head):
+    open_page(browser, server.url)
+    for f in downloads.glob("*"):
+        f.unlink()
+    from selenium.common.exceptions import WebDriverException
+
+    by_name(browser, "export").click()
+
+    def choose():  # the menu's entries take clicks once it has opened
+        try:
+            by_name(browser, f"export {kind}").click()
+            return True
+        except (WebDriverException, AssertionError):
+            return False
+
+    wait("the export menu", choose)
+    path = wait("the download", lambda: next(
+        (f for f in downloads.glob(f"*{suffix}") if f.stat().st_size > 0), None))  # fmt: skip
+    time.sleep(0.2)
+    assert path.read_bytes().startswith(head), path.read_bytes()[:40]
