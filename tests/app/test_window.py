@@ -272,8 +272,9 @@ def test_difference_view_from_the_worker(win, qtbot):
 
 
 def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot, monkeypatch):
-    """One kd step with the difference view on: one engine update, one upload, one frame, the
-    difference checked once and asked for once; a result for the state before is dropped."""
+    """One kd step with the difference view on: one engine update, one upload, one frame, one
+    seal, the difference checked once and asked for once; a result for the state before is
+    dropped."""
     from explorer.app import view as V
     from explorer.app.difference import run_job
     from explorer.shading.shader import Shader
@@ -295,12 +296,13 @@ def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot
     count(Shader, "set_scene")
     count(V.MeshDrawing, "upload")
     count(type(win.controller), "update_difference")
+    count(M.Store, "seal")  # a click step is a whole step: sealed once (not by panel and window)
     jobs = []
     monkeypatch.setattr(win.worker, "submit", jobs.append)
     frames = win.frames
     slider = win.panel.material.sliders["kd"].slider
     slider.setValue(slider.value() - 37)
-    assert counts == {"set_scene": 1, "upload": 1, "update_difference": 1}
+    assert counts == {"set_scene": 1, "upload": 1, "update_difference": 1, "seal": 1}
     assert win.frames == frames + 1 and len(jobs) == 1
     assert not win.heat.shown  # the live view until the new map comes
     stale = run_job(old.job)

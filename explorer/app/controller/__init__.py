@@ -10,6 +10,18 @@ How a front end uses it::
     c.release()               #   export_render, toggle_difference, toggle_compare, undo, ...
     c.store.state             # the state to draw; c.store.subscribe(fn) to hear of changes
 
+The intents (all on :class:`Controller`): ``set_value(key, value)`` and ``release()`` (a
+control of :data:`explorer.core.controls.CONTROLS`), ``act(action, *args, label=, merge=)`` (any
+model action), ``pick_preset``, ``next_preset`` / ``previous_preset``, ``choose_mesh``,
+``next_light`` / ``next_light_type``, ``toggle_model`` / ``toggle_term`` / ``toggle_difference``
+/ ``toggle_compare`` / ``swap_sides``, ``undo`` / ``redo`` / ``reset_all``, ``open_file`` /
+``open_session`` / ``open_recent``, ``save_session_as`` / ``save_preset_as`` /
+``keep_last_session``, ``import_materials``, ``export_material`` / ``export_render`` /
+``export_turntable`` / ``screenshot`` (each takes a path, or asks the dialogs port for one),
+the camera's ``camera_moved`` (before a frame), ``move_camera``, ``reset_camera``,
+``frame_start``, drags' ``begin_drag`` / ``end_drag``, the worker's ``on_difference(result)``,
+and ``reject_input(text)`` (a typed value the front end refused).
+
 The controller calls the model's actions (:mod:`explorer.app.model`), which make each change
 one undo step; then it gives the new state to the view port (one engine update, one upload),
 schedules the difference worker (once per change; a stale result is never shown) and asks for

@@ -175,9 +175,6 @@ class ExplorerWindow(QtWidgets.QMainWindow):
 
         return call
 
-    def report(self, exc: BaseException, where: str) -> None:
-        self.controller.report(exc, where)
-
     # -- ports: dialogs (replaceable by scripts and tests), messages, progress ------------------
     def ask_text(self, title: str, label: str, default: str = "") -> str | None:
         text, ok = QtWidgets.QInputDialog.getText(self, title, label, text=default)
