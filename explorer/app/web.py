@@ -96,6 +96,7 @@ class WebExplorer(WebFiles):
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
         self.loop = None  # the server's event loop (the difference worker delivers into it)
         self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
+        self._job = None  # the long job running (run_steps) and its cancel
         self.server = get_server(name, client_type="vue3")
         self.plotter = plotter(size, BACKGROUND if background is None else background)
         self.view = None
@@ -187,11 +188,43 @@ class WebExplorer(WebFiles):
             s.message_log = self.messages
 
     # -- Progress --------------------------------------------------------------------------------
-    def run_steps(self, title: str, total: int, step, cancelled, label, done) -> None:
-        """A long job, run to its end here (the page shows its messages)."""
-        while step():
-            pass
-        done()
+    def run_steps(self, title: str, text: str, total: int, step, cancel) -> object:
+        """A long job stepped from the server's loop (pictures keep coming), its progress in the
+        page (state ``progress``: title, text, done, total; the page's Cancel calls
+        ``cancel``). Returns the job's progress record."""
+        job = {"title": title, "text": text, "done": 0, "total": int(total), "running": True}
+        self._job = (job, cancel)
+        self._show_progress(job)
+
+        def go():
+            if not job["running"]:
+                return
+            out = step()
+            if out is None:
+                job["running"] = False
+                self._job = None
+            else:
+                job["done"], job["text"] = out[0], out[1] or job["text"]
+                self.loop.call_soon(self.guard(go, title))
+            self._show_progress(job)
+
+        self.loop.call_soon(self.guard(go, title))
+        return job
+
+    def cancel_job(self) -> None:
+        """The page's Cancel: the running job stops, and its flow says what was left."""
+        if self._job is not None:
+            job, cancel = self._job
+            job["running"] = False
+            self._job = None
+            cancel()
+            self._show_progress(job)
+
+    def _show_progress(self, job: dict) -> None:
+        path = getattr(self, "turntable_path", None)
+        with self.server.state as s:
+            s.progress = dict(job)
+            s.turntable_ready = not job["running"] and path is not None and path.is_file()
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:

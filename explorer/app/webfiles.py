@@ -79,6 +79,8 @@ class WebFiles:
     def download(self, kind: str) -> dict:
         """``{"name", "type", "content"}``: the session, the view (PNG) or the material
         (.mtl, three.js JSON, X3D, preset YAML) as a file for the page to save."""
+        if kind == "turntable":
+            return self.turntable_download()
         if kind not in DOWNLOADS:
             raise ExplorerError(f"download must be one of {', '.join(DOWNLOADS)}, got {kind!r}")
         suffix, mime = DOWNLOADS[kind]
@@ -95,6 +97,24 @@ class WebFiles:
         data = Path(path).read_bytes()
         return {"name": Path(path).name, "type": mime,
                 "content": data if kind == "png" else data.decode("utf-8")}  # fmt: skip
+
+    def start_turntable(self, suffix: str = ".gif") -> None:
+        """A turntable of the present state made in the background (the page shows its
+        progress and offers it as a download when it is written)."""
+        if suffix not in (".gif", ".mp4"):
+            raise ExplorerError(f"turntable: .gif or .mp4, got {suffix!r}")
+        c = self.controller
+        path = self._fresh_folder("turntable") / f"{c.picture_stem()}-turntable{suffix}"
+        self.turntable_path = path
+        c.export_turntable(path)
+
+    def turntable_download(self) -> dict:
+        """The turntable written last, as a file for the page to save."""
+        path = getattr(self, "turntable_path", None)
+        if path is None or not path.is_file():
+            raise ExplorerError("no turntable has been written yet")
+        mime = "image/gif" if path.suffix == ".gif" else "video/mp4"
+        return {"name": path.name, "type": mime, "content": path.read_bytes()}
 
     # -- uploads ---------------------------------------------------------------------------------
     def open_uploaded_session(self, upload) -> None:

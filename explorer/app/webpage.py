@@ -131,6 +131,23 @@ def _view_tab(v3, html, ctrl) -> None:
     html.Div("{{ legend }}", classes="text-caption", v_show="difference")
     v3.VBtn("reset camera", click=ctrl.reset_camera, size="small", classes="my-2",
             raw_attrs=['aria-label="reset camera"'])  # fmt: skip
+    _turntable(v3, html, ctrl)
+
+
+def _turntable(v3, html, ctrl) -> None:
+    """A turntable GIF made on the server under a progress bar (Cancel), then downloaded."""
+    v3.VBtn("make a turntable (GIF)", click=ctrl.turntable, size="small", classes="my-1",
+            disabled=("progress && progress.running",),
+            raw_attrs=['aria-label="turntable"'])  # fmt: skip
+    with html.Div(v_show="progress && progress.running", classes="my-1"):
+        html.Div("{{ progress && progress.text }}", classes="text-caption")
+        v3.VProgressLinear(model_value=("progress ? 100 * progress.done / progress.total : 0",),
+                           height=6, raw_attrs=['aria-label="progress"'])  # fmt: skip
+        v3.VBtn("cancel", click=ctrl.cancel_job, size="small", variant="text",
+                raw_attrs=['aria-label="cancel"'])  # fmt: skip
+    v3.VBtn("download the turntable", v_show="turntable_ready", size="small",
+            click=DOWNLOAD_JS.format(kind="turntable"),
+            raw_attrs=['aria-label="download turntable"'])  # fmt: skip
 
 
 def _files(v3, ctrl) -> None:
@@ -175,8 +192,8 @@ def build(app) -> None:
     server.state.update(
         models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
-        session_upload=None, mesh_upload=None, can_undo=False, can_redo=False, undo_label="",
-        redo_label="",
+        session_upload=None, mesh_upload=None, progress=None, turntable_ready=False,
+        can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")

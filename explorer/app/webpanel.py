@@ -190,6 +190,8 @@ def _choices(app) -> None:
         )
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
+    ctrl.turntable = app.guard(app.start_turntable, "turntable")
+    ctrl.cancel_job = app.guard(app.cancel_job, "cancel")
     ctrl.save_preset = app.guard(lambda: app.save_preset(
         state.preset_name or "", bool(state.preset_replace)), "save preset")  # fmt: skip
 

@@ -36,6 +36,21 @@ def by_name(driver, name: str):
     return found[0]
 
 
+def click(driver, name: str) -> None:
+    """Click the element named ``name`` once it takes clicks (a tab's or a menu's content is
+    shown after a transition)."""
+    from selenium.common.exceptions import WebDriverException
+
+    def go():
+        try:
+            by_name(driver, name).click()
+            return True
+        except (WebDriverException, AssertionError):
+            return False
+
+    wait(f"{name!r} to take a click", go)
+
+
 def report(driver) -> dict:
     """The server's report (frame count, view size, probe vertex and pixel, the session)."""
     return driver.execute_async_script(
@@ -75,10 +90,11 @@ def kd(rep: dict) -> float:
 
 
 def type_value(driver, name: str, text: str) -> None:
+    """Type ``text`` into field ``name`` and confirm it (Enter)."""
     from selenium.webdriver.common.keys import Keys
 
+    click(driver, name)
     field = by_name(driver, name)
-    field.click()
     field.send_keys(Keys.CONTROL, "a")
     field.send_keys(text, Keys.ENTER)
 
@@ -142,13 +158,13 @@ def test_every_control_is_named_by_its_scene_key(server, browser):
                 "specular", "emission", "model", "show_ambient", "show_diffuse",
                 "show_specular", "view", "undo", "redo", "save session"):  # fmt: skip
         assert key in names, f"{key!r} not among {sorted(n for n in names if n)}"
-    by_name(browser, "lights tab").click()
+    click(browser, "lights tab")
     names = {e.get_attribute("aria-label")
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("light", "type", "color", "intensity", "azimuth", "elevation", "distance",
                 "attenuation", "add light", "duplicate light", "remove light"):  # fmt: skip
         assert key in names, key
-    by_name(browser, "material tab").click()
+    click(browser, "material tab")
 
 
 def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(server, browser, mesh):
@@ -163,7 +179,7 @@ def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(serv
     rep = check_probe(browser, mesh)
     assert rep["can_undo"]
     assert by_name(browser, "kd").get_attribute("value") == "0.3"
-    by_name(browser, "undo").click()
+    click(browser, "undo")
     rep = wait("undo", lambda: (r := report(browser)) and abs(kd(r) - start) < 1e-9 and r)
     check_probe(browser, mesh)
     assert rep["can_redo"]
@@ -173,8 +189,8 @@ def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(serv
 def test_a_light_added_a_session_downloaded_and_opened_again(server, browser, downloads, mesh):
     rep = open_page(browser, server.url)
     n = len(rep["session"]["scene"]["lights"])
-    by_name(browser, "lights tab").click()
-    by_name(browser, "add light").click()
+    click(browser, "lights tab")
+    click(browser, "add light")
     rep = wait("a new light", lambda: (r := report(browser))
                and len(r["session"]["scene"]["lights"]) == n + 1 and r)  # fmt: skip
     assert rep["session"]["light"] == n + 1  # the new light is selected (1-based in the file)
@@ -184,13 +200,13 @@ def test_a_light_added_a_session_downloaded_and_opened_again(server, browser, do
     saved = rep["session"]
     for f in downloads.glob("*"):
         f.unlink()
-    by_name(browser, "save session").click()
+    click(browser, "save session")
     path = wait("the download", lambda: next(
         (f for f in downloads.glob("*.yaml") if f.stat().st_size > 0), None))  # fmt: skip
     time.sleep(0.2)
     assert explorer.load_scene(saved["scene"]) == explorer.load_scene(
         __import__("yaml").safe_load(path.read_text())["scene"])  # fmt: skip
-    by_name(browser, "material tab").click()
+    click(browser, "material tab")
     type_value(browser, "kd", "0.1")
     wait("kd 0.1", lambda: abs(kd(report(browser)) - 0.1) < 1e-9)
     by_name(browser, "open session").send_keys(str(path))
@@ -209,7 +225,7 @@ def test_ctrl_z_undoes_and_ctrl_shift_z_redoes(server, browser):
     type_value(browser, "ks", "0.2")
     wait("ks 0.2", lambda: report(browser)["can_undo"])
     start = report(browser)["session"]["scene"]["material"]
-    by_name(browser, "view").click()  # focus off the text field (there Ctrl+Z edits the text)
+    click(browser, "view")  # focus off the text field (there Ctrl+Z edits the text)
     ActionChains(browser).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
     wait("undo", lambda: report(browser)["session"]["scene"]["material"] != start)
     (ActionChains(browser).key_down(Keys.CONTROL).key_down(Keys.SHIFT).send_keys("z")
@@ -278,15 +294,15 @@ def test_the_command_refuses_a_bad_port_in_one_line(capsys):
 
 def test_the_difference_view_shows_its_heat_map(server, browser):
     open_page(browser, server.url)
-    by_name(browser, "view tab").click()
+    click(browser, "view tab")
     before = picture_src(browser)
-    by_name(browser, "difference").click()
+    click(browser, "difference")
     rep = wait("the heat map", lambda: (r := report(browser)) and r["difference"]["shown"] and r)
     assert rep["session"]["difference"] is True and rep["difference"]["rmse"] is not None
     wait("a new picture", lambda: picture_src(browser) not in (None, before))
     by_name(browser, "difference").click()
     wait("the view again", lambda: not report(browser)["difference"]["shown"])
-    by_name(browser, "material tab").click()
+    click(browser, "material tab")
     assert not console_errors(browser)
 
 
@@ -296,19 +312,25 @@ def test_exports_are_downloads(server, browser, downloads, kind, suffix, head):
     open_page(browser, server.url)
     for f in downloads.glob("*"):
         f.unlink()
-    from selenium.common.exceptions import WebDriverException
-
     by_name(browser, "export").click()
-
-    def choose():  # the menu's entries take clicks once it has opened
-        try:
-            by_name(browser, f"export {kind}").click()
-            return True
-        except (WebDriverException, AssertionError):
-            return False
-
-    wait("the export menu", choose)
+    click(browser, f"export {kind}")
     path = wait("the download", lambda: next(
         (f for f in downloads.glob(f"*{suffix}") if f.stat().st_size > 0), None))  # fmt: skip
     time.sleep(0.2)
     assert path.read_bytes().startswith(head), path.read_bytes()[:40]
+
+
+def test_a_turntable_is_made_under_a_progress_bar_and_downloaded(server, browser, downloads):
+    open_page(browser, server.url)
+    for f in downloads.glob("*"):
+        f.unlink()
+    click(browser, "view tab")
+    click(browser, "turntable")
+    wait("the turntable", lambda: by_name(browser, "download turntable").is_displayed(), 120)
+    click(browser, "download turntable")
+    path = wait("the download", lambda: next(
+        (f for f in downloads.glob("*.gif") if f.stat().st_size > 0), None))  # fmt: skip
+    time.sleep(0.3)
+    assert path.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
+    click(browser, "material tab")
+    assert not console_errors(browser)
