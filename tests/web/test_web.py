@@ -334,3 +334,47 @@ def test_a_turntable_is_made_under_a_progress_bar_and_downloaded(server, browser
     assert path.read_bytes()[:6] in (b"GIF89a", b"GIF87a")
     click(browser, "material tab")
     assert not console_errors(browser)
+
+
+def drag(driver, start, moves) -> None:
+    """Press at view pixel ``start`` (the server's picture, origin top-left), move by each
+    ``(dx, dy)`` of ``moves`` (CSS pixels) and release."""
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    img = driver.find_element(By.CSS_SELECTOR, '[aria-label="view"] img')
+    w, h = report(driver)["size"]
+    r = driver.execute_script("return arguments[0].getBoundingClientRect().toJSON()", img)
+    ox, oy = (
+        start[0] * r["width"] / w - r["width"] / 2,
+        start[1] * r["height"] / h - r["height"] / 2,
+    )
+    chain = ActionChains(driver).move_to_element_with_offset(img, round(ox), round(oy))
+    chain.click_and_hold()
+    for dx, dy in moves:
+        chain.move_by_offset(dx, dy)
+    chain.release().perform()
+
+
+def test_the_light_handle_is_dragged_in_the_view(server, browser, mesh):
+    rep = open_page(browser, server.url)
+    light = rep["session"]["light"] - 1
+    (hx, hy), before = rep["handles_px"][light], rep["placement"]
+    drag(browser, (hx, hy), [(-10, 6)] * 10)
+    rep = wait("the light to move", lambda: (r := report(browser)) and r["placement"] != before
+               and not r["errors"] and r)  # fmt: skip
+    x, y = rep["handles_px"][light]
+    assert abs(x - (hx - 100)) <= 3 and abs(y - (hy + 60)) <= 3  # it stayed under the pointer
+    check_probe(browser, mesh)
+    click(browser, "undo")
+    wait("undo", lambda: report(browser)["placement"] == pytest.approx(before))
+
+
+def test_dragging_the_view_turns_the_camera_and_the_highlights_follow(server, browser, mesh):
+    rep = open_page(browser, server.url)
+    w, h = rep["size"]
+    eye = rep["session"]["scene"]["viewer"]
+    drag(browser, (w // 2, h // 2 + 40), [(12, 0)] * 8)
+    rep = wait("the camera to turn", lambda: (r := report(browser))
+               and r["session"]["scene"]["viewer"] != eye and r)  # fmt: skip
+    check_probe(browser, mesh)  # the picture's colours are the engine's for the new viewer
