@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from common import uv_sphere  # benchmarks/common.py
+from common import publish, uv_sphere  # benchmarks/common.py
 
 import explorer
 from explorer.app import model as AM
@@ -406,10 +406,7 @@ def main(argv=None) -> int:
     qt_flag = " --qt" if qt is not None else ""
     lines += ["", f"Command: `python benchmarks/bench_gui.py --repeat {args.repeat}{qt_flag}`"]
     text = "\n".join(lines) + "\n"
-    print(text)
-    if not args.no_write:
-        DOCS.write_text(text)
-        print(f"wrote {DOCS}", file=sys.stderr)
+    publish(text, DOCS, write=not args.no_write)
     return 0
 
 

@@ -32,6 +32,7 @@ import urllib.request
 from pathlib import Path
 
 from bench_gui import load, machine, qt_frames  # this script's directory is on sys.path
+from common import publish
 
 from explorer.geometry import meshes as M
 from explorer.render.vtk import plotter
@@ -226,10 +227,7 @@ def main(argv=None) -> int:
         f"Command: `python benchmarks/bench_web.py --repeat {args.repeat} --starts {args.starts}`",
     ]  # fmt: skip
     text = "\n".join(lines) + "\n"
-    print(text)
-    if not args.no_write:
-        DOCS.write_text(text)
-        print(f"wrote {DOCS}", file=sys.stderr)
+    publish(text, DOCS, write=not args.no_write)
     return 0
 
 

@@ -10,7 +10,9 @@ from __future__ import annotations
 import os
 import platform
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -59,3 +61,11 @@ def timed(fn, repeat: int) -> tuple[float, float]:
         fn()
         ts.append(time.perf_counter() - t)
     return statistics.median(ts), min(ts)
+
+
+def publish(text: str, path: Path, write: bool = True) -> None:
+    """Print a benchmark's table and, unless ``write`` is False, write it to ``path``."""
+    print(text)
+    if write:
+        path.write_text(text)
+        print(f"wrote {path}", file=sys.stderr)

@@ -3,6 +3,7 @@ scene, mesh and preset their options name, or a saved session."""
 
 from __future__ import annotations
 
+import argparse
 import sys
 
 from explorer.app import session as S
@@ -13,6 +14,14 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
 from explorer.core.text import printable
 from explorer.geometry.meshes import get_mesh
+
+
+def add_preset_option(p: argparse.ArgumentParser) -> None:
+    """``--preset NAME``: the explorer's start preset."""
+    p.add_argument(
+        "--preset", metavar="NAME",
+        help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
+    )  # fmt: skip
 
 
 def start(args):

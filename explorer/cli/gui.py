@@ -22,6 +22,7 @@ import os
 import sys
 
 from explorer.app import start as gui
+from explorer.cli.explorerstart import add_preset_option
 from explorer.cli.explorerstart import start as shared_start
 from explorer.cli.explorerstart import start_state as shared_start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
@@ -30,10 +31,7 @@ from explorer.render.images import parse_size
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--preset", metavar="NAME",
-        help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
-    )  # fmt: skip
+    add_preset_option(p)
     p.add_argument(
         "--size", default="{}x{}".format(*gui.WINDOW_SIZE), metavar="WxH",
         help="window size in pixels (default %(default)s)",

@@ -21,7 +21,7 @@ import logging
 import sys
 
 from explorer.app import start as gui
-from explorer.cli.explorerstart import start_state
+from explorer.cli.explorerstart import add_preset_option, start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
 from explorer.core.errors import ExplorerError
 
@@ -32,10 +32,7 @@ NEEDS = ("trame", "trame_vuetify", "trame_vtk")
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--preset", metavar="NAME",
-        help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
-    )  # fmt: skip
+    add_preset_option(p)
     p.add_argument(
         "--port", type=int, default=DEFAULT_PORT, metavar="N",
         help="port to listen on (default %(default)s; 0: any free port)",
