@@ -10,9 +10,9 @@
 - :mod:`explorer.app.qt` and :mod:`explorer.app.qtmain`: the Qt window (PySide6, pyvistaqt), a
   thin binding of the controller.
 - :mod:`explorer.app.web` (with :mod:`~explorer.app.webpage`, :mod:`~explorer.app.webpanel`,
-  :mod:`~explorer.app.webfiles`): the page in the browser and in Jupyter (trame, imported inside
-  functions), the controller's second front end; :mod:`explorer.app.colours`: colours as both
-  front ends' controls show them.
+  :mod:`~explorer.app.webfiles`, :mod:`~explorer.app.webcompare`): the page in the browser and
+  in Jupyter (trame, imported inside functions), the controller's second front end;
+  :mod:`explorer.app.colours`: colours as both front ends' controls show them.
 
 May import everything below it (:mod:`explorer.core`, :mod:`explorer.geometry`,
 :mod:`explorer.shading`, :mod:`explorer.render`) and, of :mod:`explorer.analysis`, the

@@ -44,6 +44,7 @@ from explorer.app.start import (
     load_mesh_choice,
 )
 from explorer.app.view import SceneView, view_camera
+from explorer.app.webcompare import WebCompare
 from explorer.app.webfiles import WebFiles
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
@@ -109,6 +110,7 @@ class WebExplorer(WebFiles):
         self.store = self.controller.store
         state = self.store.state
         self.view = SceneView(self.plotter, mesh, state)
+        self.compare = WebCompare(self, size)
         self._mesh_name = state.mesh
         self.view.apply_camera(state.camera)
         self.handles = HandleDragger(self)
@@ -255,15 +257,21 @@ class WebExplorer(WebFiles):
             live = view_camera(self.plotter.camera, new.centre, new.radius)
             if live != new.camera:
                 self.view.apply_camera(new.camera)
+        self.compare.show(old, new)
         if old is None or not self.controller.in_frame:
             self._push(new)
 
     def redraw(self) -> None:
-        """Send a new picture to every page."""
+        """Send a new picture to every page (side B's follows side A's frame)."""
+        self._send(self.server.controller.view_update, self.plotter.render_window)
+
+    def _send(self, update, window) -> None:
+        """``update()`` (a remote view's push) and then :meth:`_follow_picture` for
+        ``window``'s picture."""
         pub = self._publisher
-        vid = None if pub is None else str(pub.get_global_id(self.plotter.render_window))
+        vid = None if pub is None else str(pub.get_global_id(window))
         sent = None if vid is None else pub.tracking_views.get(vid, {}).get("mtime")
-        self.server.controller.view_update()
+        update()
         if vid is not None and self.loop is not None:
             self.loop.call_later(FOLLOW_S, self.guard(self._follow_picture, "view"), vid, sent,
                                  FOLLOW_TRIES)  # fmt: skip
@@ -339,7 +347,12 @@ class WebExplorer(WebFiles):
         self.plotter.renderer.ResetCameraClippingRange()
 
     def _after_frame(self, *_) -> None:
+        """A frame of side A: counted; side B (the same camera) is sent after it."""
         self.frames += 1
+        if self.compare.shown and self.loop is not None:
+            b = self.compare.plotter.render_window
+            self.loop.call_soon(self.guard(self._send, "B"), self.server.controller.view_b_update,
+                                b)  # fmt: skip
 
     def report_state(self) -> dict:
         """What a test may read (plain JSON values): the frame count, the view's size, the
@@ -359,6 +372,7 @@ class WebExplorer(WebFiles):
             "errors": list(self.controller.errors),
             "n_vertices": self.view.mesh.n_vertices,
             "difference": self.heat.state(),
+            "compare": self.compare.probe() if self.compare.shown else None,
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 

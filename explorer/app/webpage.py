@@ -131,7 +131,27 @@ def _view_tab(v3, html, ctrl) -> None:
     html.Div("{{ legend }}", classes="text-caption", v_show="difference")
     v3.VBtn("reset camera", click=ctrl.reset_camera, size="small", classes="my-2",
             raw_attrs=['aria-label="reset camera"'])  # fmt: skip
+    _compare(v3, html, ctrl)
     _turntable(v3, html, ctrl)
+
+
+def _compare(v3, html, ctrl) -> None:
+    """Compare A | B: side B's preset and model, A − B, swap."""
+    v3.VSwitch(v_model=("compare_on", False), label="compare A | B", density="compact",
+               hide_details=True, color="primary", raw_attrs=['aria-label="compare"'])  # fmt: skip
+    with html.Div(v_show="compare_on", classes="ml-2"):
+        v3.VAutocomplete(v_model=("compare_preset", None), items=("presets", []),
+                         label="B preset", item_props=True, density="compact",
+                         hide_details=True, raw_attrs=['aria-label="compare_preset"'])  # fmt: skip
+        v3.VSelect(v_model=("compare_model", None), items=("models",), label="B model",
+                   density="compact", hide_details=True,
+                   raw_attrs=['aria-label="compare_model"'])  # fmt: skip
+        with html.Div(classes="d-flex align-center"):
+            v3.VCheckbox(v_model=("compare_difference", False), label="A − B",
+                         density="compact", hide_details=True,
+                         raw_attrs=['aria-label="compare_difference"'])  # fmt: skip
+            v3.VBtn("swap", click=ctrl.swap_sides, size="small",
+                    raw_attrs=['aria-label="swap"'])  # fmt: skip
 
 
 def _turntable(v3, html, ctrl) -> None:
@@ -193,6 +213,7 @@ def build(app) -> None:
         models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, progress=None, turntable_ready=False,
+        compare_on=False,
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
@@ -223,8 +244,18 @@ def build(app) -> None:
             html.Div("{{ message }}", classes=("'text-caption pa-2 ' + (message_level === "
                      "'error' ? 'text-error' : '')",), raw_attrs=['role="status"'])  # fmt: skip
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
-            view = vtkw.VtkRemoteView(app.plotter.render_window, interactive_ratio=1,
-                                      still_quality=100, interactive_quality=100,
-                                      raw_attrs=['aria-label="view"'])  # fmt: skip
+            with html.Div(classes="d-flex", style="width: 100%; height: 100%"):
+                with html.Div(style="flex: 1 1 0; height: 100%; position: relative"):
+                    view = vtkw.VtkRemoteView(app.plotter.render_window, interactive_ratio=1,
+                                              still_quality=100, interactive_quality=100,
+                                              raw_attrs=['aria-label="view"'])  # fmt: skip
+                with html.Div(v_if="compare_on", style="flex: 1 1 0; height: 100%; "
+                              "position: relative; margin-left: 4px"):  # fmt: skip
+                    view_b = vtkw.VtkRemoteView(
+                        app.compare.plotter.render_window, interactive_ratio=1,
+                        still_quality=100, interactive_quality=100,
+                        raw_attrs=['aria-label="view_b"'],
+                    )  # fmt: skip
             ctrl.view_update = view.update
+            ctrl.view_b_update = view_b.update
     app.layout = layout

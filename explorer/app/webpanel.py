@@ -87,7 +87,9 @@ def values(state: M.State) -> dict:
         light=state.light if lights else None, type=None if light is None else light.type,
         light_color=None if light is None else rgb_text(M.light_colour(light)[0]),
         attenuation=rgb_text(light.attenuation) if positional else None,
-        difference=state.difference,
+        difference=state.difference, compare_on=state.compare is not None,
+        compare_preset=state.compare_preset, compare_model=state.compare_model,
+        compare_difference=state.compare_difference,
     )  # fmt: skip
     return out
 
@@ -181,6 +183,7 @@ def _choices(app) -> None:
     user("mesh", lambda v, s: v != s.mesh, c.choose_mesh)
     user("difference", lambda v, s: bool(v) != s.difference,
          lambda v: c.act(M.set_difference, bool(v), label="difference"))  # fmt: skip
+    _compare(app, user)
     for name, action in (("add", M.add_light), ("duplicate", M.duplicate_light),
                          ("remove", M.remove_light)):  # fmt: skip
         setattr(
@@ -194,6 +197,28 @@ def _choices(app) -> None:
     ctrl.cancel_job = app.guard(app.cancel_job, "cancel")
     ctrl.save_preset = app.guard(lambda: app.save_preset(
         state.preset_name or "", bool(state.preset_replace)), "save preset")  # fmt: skip
+
+
+def _compare(app, user) -> None:
+    """The compare view's controls: on / off, side B's preset and model, A − B, swap."""
+    c = app.controller
+
+    def preset_b(name):
+        info = next((p for p in c.presets if p.name == name), None)
+        if info is None:
+            raise ExplorerError(f"no preset named '{name}'")
+        c.act(M.set_compare_preset, info.name, info.material, label=f"B {info.name}")
+
+    user("compare_on", lambda v, s: bool(v) != (s.compare is not None),
+         lambda v: c.act(M.set_compare, bool(v), label="compare"))  # fmt: skip
+    user("compare_preset", lambda v, s: s.compare is not None and v != s.compare_preset,
+         preset_b)  # fmt: skip
+    user("compare_model", lambda v, s: s.compare is not None and v != s.compare_model,
+         lambda v: c.act(M.set_compare_model, v, label="B model"))  # fmt: skip
+    user("compare_difference", lambda v, s: s.compare is not None
+         and bool(v) != s.compare_difference,
+         lambda v: c.act(M.set_compare_difference, bool(v), label="A − B"))  # fmt: skip
+    app.server.controller.swap_sides = app.guard(c.swap_sides, "swap A and B")
 
 
 def _files(app) -> None:

@@ -99,33 +99,46 @@ def type_value(driver, name: str, text: str) -> None:
     field.send_keys(text, Keys.ENTER)
 
 
-def view_pixels(driver) -> tuple[np.ndarray, dict]:
-    """The page's screenshot (h, w, 3) uint8 and the view picture's box in it."""
+def view_pixels(driver, view: str = "view") -> tuple[np.ndarray, dict]:
+    """The page's screenshot (h, w, 3) uint8 and the box of ``view``'s picture in it."""
     from PIL import Image
 
     img = Image.open(io.BytesIO(driver.get_screenshot_as_png())).convert("RGB")
     box = driver.execute_script(
-        "const r = document.querySelector('[aria-label=\"view\"] img').getBoundingClientRect();"
-        "return {x: r.left, y: r.top, w: r.width, h: r.height, dpr: window.devicePixelRatio};"
+        'const r = document.querySelector(`[aria-label="${arguments[0]}"] img`)'
+        ".getBoundingClientRect();"
+        "return {x: r.left, y: r.top, w: r.width, h: r.height, dpr: window.devicePixelRatio};",
+        view,
     )
     return np.asarray(img), box
 
 
-def check_probe(driver, mesh) -> dict:
+def side_b_scene(session: dict):
+    """Side B's scene of a reported session: B's material and model, the rest shared."""
+    b = session["compare"]
+    scene = explorer.load_scene(session["scene"])
+    return scene.replace(material=explorer.load_scene({"material": b["material"]}).material,
+                         model=b["model"])  # fmt: skip
+
+
+def check_probe(driver, mesh, view: str = "view") -> dict:
     """The view's pixel under the probe vertex shows the engine's colour there: within the
     colours of the triangles around it (Gouraud) and two 8-bit levels, computed here from the
-    reported scene. Polls report and pixels until they agree; returns the report."""
+    reported scene (side B's for ``view_b``). Polls report and pixels until they agree; returns
+    the report."""
     end = time.monotonic() + STEP_TIMEOUT
     while True:
         rep = report(driver)
-        scene = explorer.load_scene(rep["session"]["scene"])
+        side = rep if view == "view" else {**rep, **rep["compare"]}
+        scene = (explorer.load_scene(rep["session"]["scene"]) if view == "view"
+                 else side_b_scene(rep["session"]))  # fmt: skip
         colours = to_bytes(explorer.shade(scene, mesh.positions, mesh.normals)).astype(int)
-        i = rep["probe"]["vertex"]
+        i = side["vertex"] if view != "view" else rep["probe"]["vertex"]
         around = np.unique(mesh.faces[(mesh.faces == i).any(axis=1)])
         lo, hi = colours[around].min(axis=0) - 2, colours[around].max(axis=0) + 2
-        shot, box = view_pixels(driver)
-        w, h = rep["size"]
-        px, py = rep["probe"]["px"]
+        shot, box = view_pixels(driver, view)
+        w, h = side["size"]
+        px, py = side["px"] if view != "view" else rep["probe"]["px"]
         x = round((box["x"] + (px + 0.5) * box["w"] / w) * box["dpr"] - 0.5)
         y = round((box["y"] + (py + 0.5) * box["h"] / h) * box["dpr"] - 0.5)
         pixel = shot[y, x].astype(int)
@@ -378,3 +391,24 @@ def test_dragging_the_view_turns_the_camera_and_the_highlights_follow(server, br
     rep = wait("the camera to turn", lambda: (r := report(browser))
                and r["session"]["scene"]["viewer"] != eye and r)  # fmt: skip
     check_probe(browser, mesh)  # the picture's colours are the engine's for the new viewer
+
+
+def test_compare_a_b_shows_side_b_in_its_own_view(server, browser, mesh):
+    open_page(browser, server.url)
+    click(browser, "view tab")
+    click(browser, "compare")
+    rep = wait("side B", lambda: (r := report(browser)) and r["compare"] and r)
+    assert rep["session"]["compare"]["model"] != rep["session"]["scene"]["model"]
+    wait("side B's picture", lambda: browser.execute_script(
+        "const i = document.querySelector('[aria-label=\"view_b\"] img');"
+        "return i && i.complete && i.naturalWidth > 0;"))  # fmt: skip
+    check_probe(browser, mesh, "view_b")
+    check_probe(browser, mesh)
+    click(browser, "swap")
+    wait("the sides swapped", lambda: report(browser)["session"]["scene"]["model"]
+         == rep["session"]["compare"]["model"])  # fmt: skip
+    check_probe(browser, mesh, "view_b")
+    click(browser, "compare")
+    wait("side B gone", lambda: report(browser)["compare"] is None)
+    click(browser, "material tab")
+    assert not console_errors(browser)
