@@ -53,6 +53,7 @@ from explorer.core.scene import Scene, load_scene
 from explorer.geometry.meshes import Mesh
 from explorer.render.images import encode_png
 from explorer.render.offscreen import BACKGROUND
+from explorer.shading import tiers
 
 log = logging.getLogger(__name__)
 
@@ -118,6 +119,8 @@ class WebExplorer(WebFiles):
         self.plotter.render_window.AddObserver("EndEvent", self._after_frame)
         webpanel.connect(self)
         webpage.build(self)
+        tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
+        self.server.state.engine = tiers.status() or ""
         self.server.controller.on_server_ready.add(self._ready)
         self.controller.start()
         self._push(state)
@@ -262,7 +265,13 @@ class WebExplorer(WebFiles):
             self._push(new)
 
     def redraw(self) -> None:
-        """Send a new picture to every page (side B's follows side A's frame)."""
+        """Send a new picture to every page (side B's follows side A's frame). The compiled
+        kernels are looked for too (:func:`explorer.shading.tiers.preload`: the numpy tier
+        serves until they are loaded), and the page says which engine serves."""
+        tiers.preload()
+        engine = tiers.status() or ""
+        if engine != self.server.state.engine:
+            self.server.state.engine = engine
         self._send(self.server.controller.view_update, self.plotter.render_window)
 
     def _send(self, update, window) -> None:

@@ -241,6 +241,8 @@ def build(app) -> None:
                     _lights_tab(v3, html, ctrl)
                 with v3.VWindowItem(value="view", classes="pa-2"):
                     _view_tab(v3, html, ctrl)
+            html.Div("{{ engine }}", v_show="engine", classes="text-caption pa-2",
+                     raw_attrs=['aria-label="engine"'])  # fmt: skip
             html.Div("{{ message }}", classes=("'text-caption pa-2 ' + (message_level === "
                      "'error' ? 'text-error' : '')",), raw_attrs=['role="status"'])  # fmt: skip
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
