@@ -233,7 +233,9 @@ def build(app) -> None:
             with v3.VTabs(v_model="tab", density="compact", grow=True):
                 for t in ("material", "lights", "view"):
                     v3.VTab(t, value=t, raw_attrs=[f'aria-label="{t} tab"'])
-            with v3.VWindow(v_model="tab"):
+            # no sliding between the tabs: a control is where it is drawn (a click during the
+            # slide could land beside it)
+            with v3.VWindow(v_model="tab", transition=("false",), reverse_transition=("false",)):
                 with v3.VWindowItem(value="material", classes="pa-2"):
                     _material_tab(v3, html, ctrl)
                     _save_preset(v3, html, ctrl)
