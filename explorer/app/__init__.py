@@ -12,7 +12,8 @@
 - :mod:`explorer.app.web` (with :mod:`~explorer.app.webpage`, :mod:`~explorer.app.webpanel`,
   :mod:`~explorer.app.webfiles`, :mod:`~explorer.app.webcompare`): the page in the browser and
   in Jupyter (trame, imported inside functions), the controller's second front end;
-  :mod:`explorer.app.colours`: colours as both front ends' controls show them.
+  :mod:`explorer.app.colours`, :mod:`explorer.app.sides`: colours as both front ends' controls
+  show them, the compare view's side B.
 
 May import everything below it (:mod:`explorer.core`, :mod:`explorer.geometry`,
 :mod:`explorer.shading`, :mod:`explorer.render`) and, of :mod:`explorer.analysis`, the

@@ -1,16 +1,14 @@
 """The web page's A / B compare view: side B's view beside side A's, rendered on the server by a
 second off-screen plotter with the same camera (one ``vtkCamera`` for both), the same lights and
-mesh, and side B's material and model; or, as "A − B", the difference of the two sides' colours
-per vertex in the difference view's colours (as the desktop's :mod:`explorer.app.qt.compare`).
+mesh, and side B's material and model, or A − B (:func:`explorer.app.sides.show_side_b`, as the
+desktop's :mod:`explorer.app.qt.compare`).
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from explorer.app import model as M
+from explorer.app.sides import show_side_b
 from explorer.app.view import SceneView, view_camera
-from explorer.shading.display import to_bytes
 
 
 class WebCompare:
@@ -43,23 +41,9 @@ class WebCompare:
         if new.compare is None:
             app.view.set_caption("")
             return
-        b = M.side_b(new)
         if self.view is None:
-            self.view = SceneView(self.plotter, app.view.mesh, b)
-        elif self.view.mesh is not app.view.mesh:
-            self.view.set_mesh(app.view.mesh, b)
-        else:
-            self.view.show_state(b)
-        if new.compare_difference:
-            a = app.view.displayed_colors().astype(np.int16)
-            other = to_bytes(self.view.drawings[0].colors()).astype(np.int16)
-            self.view.paint_levels(np.abs(a - other).max(axis=1))
-        elif old is not None and old.compare_difference:
-            self.view.drawings[0].upload()
-        app.view.set_caption(f"A: {new.preset or 'scene material'} ({new.scene.model})")
-        self.view.set_caption("A − B (levels, as the difference view)" if new.compare_difference
-                              else f"B: {new.compare_preset or 'material'} "
-                              f"({new.compare_model})")  # fmt: skip
+            self.view = SceneView(self.plotter, app.view.mesh, M.side_b(new))
+        show_side_b(app.view, self.view, old, new)
 
     def probe(self) -> dict:
         """Side B's probe vertex and its pixel (origin top-left), its picture's size."""

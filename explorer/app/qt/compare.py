@@ -11,10 +11,10 @@ from PySide6 import QtCore
 
 from explorer.app import model as M
 from explorer.app.qt.menus import ViewKeys
+from explorer.app.sides import show_side_b
 from explorer.app.view import SceneView, view_camera
 from explorer.render.images import side_by_side
 from explorer.render.vtk import plain_blending
-from explorer.shading.display import to_bytes
 
 
 class CompareView:
@@ -85,21 +85,7 @@ class CompareView:
             return
         if w.view_b is None:
             self._make_side_b(new)
-        b = M.side_b(new)
-        if w.view_b.mesh is not w.view.mesh:
-            w.view_b.set_mesh(w.view.mesh, b)
-        else:
-            w.view_b.show_state(b)
-        if new.compare_difference:
-            a = w.view.displayed_colors().astype(np.int16)
-            other = to_bytes(w.view_b.drawings[0].colors()).astype(np.int16)
-            w.view_b.paint_levels(np.abs(a - other).max(axis=1))
-        elif old is not None and old.compare_difference:
-            w.view_b.drawings[0].upload()
-        w.view.set_caption(f"A: {new.preset or 'scene material'} ({new.scene.model})")
-        w.view_b.set_caption("A − B (levels, as the difference view)" if new.compare_difference
-                             else f"B: {new.compare_preset or 'material'} "
-                             f"({new.compare_model})")  # fmt: skip
+        show_side_b(w.view, w.view_b, old, new)
         if not w.plotter_b.isVisible():
             w.plotter_b.show()
             half = max(w.views.width() // 2, 1)
