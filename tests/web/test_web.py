@@ -380,11 +380,14 @@ def test_the_light_handle_is_dragged_in_the_view(server, browser, mesh):
     rep = open_page(browser, server.url)
     light = rep["session"]["light"] - 1
     (hx, hy), before = rep["handles_px"][light], rep["placement"]
-    drag(browser, (hx, hy), [(-10, 6)] * 10)
+    w, h = rep["size"]
+    sx, sy = (-1 if hx > w / 2 else 1), (1 if hy < h / 2 else -1)  # toward the middle
+    drag(browser, (hx, hy), [(10 * sx, 6 * sy)] * 10)
     rep = wait("the light to move", lambda: (r := report(browser)) and r["placement"] != before
                and not r["errors"] and r)  # fmt: skip
     x, y = rep["handles_px"][light]
-    assert abs(x - (hx - 100)) <= 3 and abs(y - (hy + 60)) <= 3  # it stayed under the pointer
+    # it stayed under the pointer
+    assert abs(x - (hx + 100 * sx)) <= 3 and abs(y - (hy + 60 * sy)) <= 3, (x, y, hx, hy)
     check_probe(browser, mesh)
     click(browser, "undo")
     wait("undo", lambda: report(browser)["placement"] == pytest.approx(before))
