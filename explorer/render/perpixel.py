@@ -44,7 +44,7 @@ from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
 from explorer.shading.shader import shade
-from explorer.shading.tiers import ray_engine
+from explorer.shading.tiers import ray_engine, ray_work
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -163,7 +163,10 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     P = np.asarray(mesh.positions, np.float64)
     F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
     scale = max(float(np.abs(P).max(initial=0.0)), 1.0)
-    engine = ray_engine()
+    with _bvh_lock:
+        kept = bool(_bvh_cache.get(mesh))
+    # the tier choice counts this cast's work: a large picture loads the compiled casts
+    engine = ray_engine(ray_work(0 if kept else len(F), len(O)))
     tree = mesh_bvh(mesh, cancelled=cancelled, engine=engine)
     best_t, best_tri, best_u, best_v = engine.nearest_hits(
         tree, O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled

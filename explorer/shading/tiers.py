@@ -89,6 +89,12 @@ MAX_ATTEMPTS = 2
 #: numba's cache (a load costs about what the numpy tier takes for this much work, so small
 #: one-shot jobs, like the quick start's render, never pay for it)
 LOAD_WORTH = 2_000_000
+#: the numpy tier's tree build, per triangle, and its shadow or pixel ray, per ray, in
+#: vertex-lights of its shading (each 160-250 ns on the reference machine: a build takes 2.4-3.7 µs
+#: a triangle, a shadow ray 4-7 µs: benchmarks/bench_rays.py's "numpy tier" rows), so
+#: that :func:`compiled` counts a pass's ray work with its shading (:func:`ray_work`)
+BUILD_WORK = 20
+RAY_WORK = 25
 
 _lock = threading.Lock()
 _state = {
@@ -183,11 +189,26 @@ def _ready() -> bool:
     return bool(_state["ready"])
 
 
-def ray_engine():
-    """The module that casts rays now: :mod:`explorer.geometry.bvh` (compiled) once the kernels
-    serve (:func:`loaded`), else :mod:`explorer.geometry.bvh_numpy` (the same answers, no
-    compile). Both have ``build_bvh``, ``any_hit`` and ``nearest_hits``."""
-    return bvh if loaded() else bvh_numpy
+def ray_work(triangles: int, rays: int) -> int:
+    """The ray work of building a tree over ``triangles`` (0: the tree is kept already) and
+    casting ``rays`` through it, in vertex-lights of the numpy tier (what :func:`compiled`
+    counts): the numpy tier builds a tree at :data:`BUILD_WORK` and casts a ray at
+    :data:`RAY_WORK` vertex-lights' time."""
+    return BUILD_WORK * int(triangles) + RAY_WORK * int(rays)
+
+
+def ray_engine(work: int = 0, tier: str | None = None):
+    """The module that casts rays: :mod:`explorer.geometry.bvh` (compiled) or
+    :mod:`explorer.geometry.bvh_numpy` (the same answers, no compile). Both have
+    ``build_bvh``, ``any_hit``, ``nearest_hits`` and ``surface_points``.
+
+    tier : "compiled" or "numpy" is obeyed; None: the compiled casts when :func:`compiled`
+    says so for ``work`` vertex-lights (:func:`ray_work`: so a large cast loads the kernels
+    from a warm cache at once), else numpy
+    """
+    if tier is not None:
+        return bvh if tier == "compiled" else bvh_numpy
+    return bvh if compiled(work) else bvh_numpy
 
 
 def status() -> str | None:

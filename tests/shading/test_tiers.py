@@ -360,3 +360,70 @@ def test_a_background_compile_that_crashes_is_counted(tmp_path):
         "attempts": 2,
         "error": "ZeroDivisionError: division by zero",
     }
+
+
+def _ray_engines(shader) -> set[str]:
+    """The ray engines that built the shader's shadow trees."""
+    from explorer.shading.shadows import GEOMETRY_KEY
+
+    return {k[1] for k in shader._vis_cache if isinstance(k, tuple) and k[:1] == (GEOMETRY_KEY,)}
+
+
+def test_an_explicit_tier_is_obeyed_for_rays(cold_tiers):
+    # issue 31 item 3: the rays followed the process's tier (tiers.loaded()), not the shader's:
+    # tier="compiled" cast on the numpy BVH in mode auto, tier="numpy" on the compiled one in
+    # mode compiled
+    mesh = torus(16)
+    cold_tiers.write_text("{}")  # a warm cache, but no work served: auto would stay on numpy
+    for tier, engine in (("compiled", "explorer.geometry.bvh"),
+                         ("numpy", "explorer.geometry.bvh_numpy")):  # fmt: skip
+        for mode in ("auto", "compiled", "numpy"):
+            tiers.set_mode(mode)
+            s = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces, tier=tier)
+            _ = s.colors
+            assert _ray_engines(s) == {engine}, (tier, mode)
+            assert s.stats["shadow_rays"] > 0
+    assert tiers.ray_engine(tier="numpy").__name__ == "explorer.geometry.bvh_numpy"
+    assert tiers.ray_engine(tier="compiled").__name__ == "explorer.geometry.bvh"
+
+
+def test_the_tier_choice_counts_ray_work(cold_tiers, monkeypatch):
+    # issue 31 item 3: a one-shot shadowed pass counted its shading (n·L vertex-lights) but
+    # not its tree and rays, so it built the numpy BVH although the warm cache would pay
+    cold_tiers.write_text("{}")  # the cache holds the kernels
+    mesh = teapot(8)
+    n = len(mesh.positions)
+    work = tiers.ray_work(len(mesh.faces), n)
+    assert work > 10 * n  # the rays cost more than the shading of one light
+    monkeypatch.setattr(tiers, "LOAD_WORTH", 2 * n)  # more than the shading alone
+    unshadowed = {**SHADOWED, "lights": [{"type": "point", "position": [1.5, 2.0, 1.0]}]}
+    plain = Shader(unshadowed, mesh.positions, mesh.normals, faces=mesh.faces, keep=False)
+    _ = plain.colors  # no shadows: n vertex-lights, under LOAD_WORTH
+    assert plain.stats["numpy"] == 1 and not tiers.loaded()
+    one = {**SHADOWED, "lights": SHADOWED["lights"][:1]}
+    s = Shader(one, mesh.positions, mesh.normals, faces=mesh.faces, keep=False)
+    _ = s.colors  # n vertex-lights and the ray work: the kernels load, rays and shading both
+    assert s.stats["pass"] == 1 and s.stats["numpy"] == 0 and tiers.loaded()
+    assert _ray_engines(s) == {"explorer.geometry.bvh"}
+    np.testing.assert_allclose(
+        s.colors, Shader(one, mesh.positions, mesh.normals, faces=mesh.faces, tier="numpy").colors,
+        atol=1 / 255,
+    )  # fmt: skip
+
+
+def test_a_per_pixel_cast_counts_its_rays(cold_tiers, monkeypatch):
+    # issue 31 item 3: render --per-pixel cast every pixel's ray on the numpy BVH until the
+    # process had shaded LOAD_WORTH vertex-lights (8192² pixels: 14.3 GiB, then a traceback)
+    from explorer.render import perpixel
+    from explorer.render.camera import camera_for
+
+    cold_tiers.write_text("{}")
+    mesh = teapot(6)
+    camera = camera_for(explorer.load_scene({}), mesh)
+    monkeypatch.setattr(tiers, "LOAD_WORTH", tiers.ray_work(0, 40 * 30 * 4))
+    perpixel.mesh_hits(camera, (40, 30), mesh)  # a few rays: the numpy casts
+    assert set(perpixel._bvh_cache[mesh]) == {"explorer.geometry.bvh_numpy"}
+    assert not tiers.loaded()
+    hits = perpixel.mesh_hits(camera, (160, 120), mesh)  # sixteen times the rays: compiled
+    assert tiers.loaded() and "explorer.geometry.bvh" in perpixel._bvh_cache[mesh]
+    assert hits.mask.any()
