@@ -360,8 +360,8 @@ class Shader:
         if not plan.shadows:
             return 0
         shadowed = [lp.shadows for lp in plan.lights]
-        tree, lights = pending_rays(self._vis_cache, scene.lights, shadowed,
-                                    two_sided=scene.two_sided, force_all=self.force_all)  # fmt: skip
+        cache, two, force = self._vis_cache, scene.two_sided, self.force_all
+        tree, lights = pending_rays(cache, scene.lights, shadowed, two_sided=two, force_all=force)
         return tiers.ray_work(len(self._faces) if tree else 0, lights * self.n)
 
     # -- the work ------------------------------------------------------------------------------

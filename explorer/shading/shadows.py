@@ -10,9 +10,10 @@ its vertex, or out through the far side of the body) never counts, so no bias or
 offsets are needed. An open sheet casts shadows from its front side only.
 
 Visibility is 1 (lit) or 0 (shadowed), kept as uint8 and only for the lights that cast
-shadows (one byte per vertex and shadowing light: :func:`visibility_rows`); the engine zeroes the
-light's diffuse and specular weight where it is 0 (ambient light is not shadowed, as in OpenGL practice). Between vertices the
-renderer interpolates colours, so a shadow edge is as sharp as the mesh is fine.
+shadows (one byte per vertex and shadowing light: :func:`visibility_rows`); the engine zeroes
+the light's diffuse and specular weight where it is 0 (ambient light is not shadowed, as in
+OpenGL practice). Between vertices the renderer interpolates colours, so a shadow edge is as
+sharp as the mesh is fine.
 
 Ray engine: :func:`explorer.geometry.bvh.any_hit` through a bounding-volume hierarchy of the
 mesh (:mod:`explorer.geometry.bvh`), built once per geometry. It runs the same Möller-Trumbore

@@ -13,12 +13,12 @@ import trimesh
 
 import explorer
 from explorer.cli import main
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
 from explorer.core.mtl import read_mtl
 from explorer.geometry import meshes as M
 from explorer.render.exports import UNLIT, glb_bytes, linear_colors
 from explorer.render.images import read_png
-from explorer.core import tolerances as tol
-from explorer.core.errors import ExplorerError
 from explorer.render.turntable import check_frames, check_turntable, orbit_scene
 from explorer.shading.display import group_vertex_colors, vertex_colors
 
@@ -260,7 +260,10 @@ def test_turntable_needs_are_checked_before_any_frame_renders(tmp_path, capsys, 
     assert "--size 121x120" in err and "even width and height" in err and "122x120" in err
     assert "Traceback" not in err and not out.exists()
     argv = ["render", "--turntable", "360", "--size", "8192x8192", "--out"]
-    for suffix, cap in ((".mp4", tol.MAX_TURNTABLE_PIXELS), (".gif", tol.MAX_TURNTABLE_HELD_PIXELS)):
+    for suffix, cap in (
+        (".mp4", tol.MAX_TURNTABLE_PIXELS),
+        (".gif", tol.MAX_TURNTABLE_HELD_PIXELS),
+    ):
         assert main([*argv, str(tmp_path / f"t{suffix}")]) == 2
         err = capsys.readouterr().err
         assert "--turntable 360 --size 8192x8192" in err and f"at most {cap:,}" in err, err
