@@ -107,10 +107,10 @@ DAMAGED = (
 #: one-shot jobs, like the quick start's render, never pay for it)
 LOAD_WORTH = 2_000_000
 #: the numpy tier's tree build, per triangle, and its shadow or pixel ray, per ray, in
-#: vertex-lights of its shading (each 160-250 ns on the reference machine: a build takes 2.4-3.7 µs
-#: a triangle, a shadow ray 4-7 µs: benchmarks/bench_rays.py's "numpy tier" rows), so
-#: that :func:`compiled` counts a pass's ray work with its shading (:func:`ray_work`)
-BUILD_WORK = 20
+#: vertex-lights of its shading, so that :func:`compiled` counts a pass's ray work with its
+#: shading (:func:`ray_work`): benchmarks/bench_rays.py --section numpy measured 7-23 and 24-30
+#: (a build 2.4-3.7 µs a triangle, a ray 4-10 µs, a vertex-light 160-425 ns, as loads varied)
+BUILD_WORK = 10
 RAY_WORK = 25
 
 _lock = threading.Lock()
