@@ -6,10 +6,10 @@ fields, :func:`camera_for` frames a mesh as the scene's viewer sees it, :func:`a
 :func:`project` give the ray through each pixel centre and where a point lands (the per-pixel
 reference and the tests use them).
 
-Scale: a camera is computed with scale-safe lengths (:func:`_length`), so a mesh of size 1e-300
-or 1e300 is framed as a unit one; the renderers hand VTK the mesh and the camera in the mesh's
-normalised frame (:func:`in_frame`, the same similarity for both: the same picture), so that
-VTK's float32 drawing never meets coordinates beyond its range. A mesh too large for its
+Scale: a camera is computed with scale-safe lengths (:func:`vector_length`), so a mesh of size
+1e-300 or 1e300 is framed as a unit one; the renderers hand VTK the mesh and the camera in the
+mesh's normalised frame (:func:`in_frame`, the same similarity for both: the same picture), so
+that VTK's float32 drawing never meets coordinates beyond its range. A mesh too large for its
 camera's coordinates (4 radii from the centre) to be finite float64 numbers is refused with an
 :class:`~explorer.core.errors.ExplorerError`.
 """
@@ -73,7 +73,7 @@ def _view_up(forward: np.ndarray) -> np.ndarray:
     return up / np.linalg.norm(up)
 
 
-def _length(v) -> float:
+def vector_length(v) -> float:
     """The length of a vector (3,), without overflow or underflow of its squares."""
     v = np.asarray(v, np.float64)
     with np.errstate(over="ignore", under="ignore"):
@@ -143,13 +143,13 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
     centre = np.asarray(mesh.centre, np.float64)
     radius = float(mesh.radius)
     if not radius > 0.0:  # a single point: any small sphere about it
-        radius = max(1e-12 * _length(centre), 1e-300)
+        radius = max(1e-12 * vector_length(centre), 1e-300)
     viewer = scene.viewer
     if viewer.eye is not None:
         eye = np.asarray(viewer.eye, np.float64)
         with np.errstate(over="ignore"):
             offset = centre - eye
-        dist = _length(offset)
+        dist = vector_length(offset)
         if not math.isfinite(dist):
             raise _too_large(mesh)
         if dist <= 1e-9 * radius:  # eye at the centre: look down -z as OpenGL does
@@ -236,7 +236,7 @@ def back_to_front(mesh: Mesh, camera: Camera) -> np.ndarray:
 def _basis(camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit forward, right and up vectors of a camera, as VTK builds its view transform."""
     forward = np.subtract(camera.focal_point, camera.position).astype(np.float64)
-    forward /= _length(forward)
+    forward /= vector_length(forward)
     right = np.cross(forward, np.asarray(camera.view_up, np.float64))
     norm = np.linalg.norm(right)
     if norm < 1e-12:

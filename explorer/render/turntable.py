@@ -29,7 +29,7 @@ from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.scene import Viewer
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import FRAME_MARGIN, Camera, camera_for
+from explorer.render.camera import FRAME_MARGIN, Camera, camera_for, vector_length
 from explorer.render.offscreen import BACKGROUND, OffscreenRenderer
 
 #: ``render --turntable --out`` suffixes
@@ -118,15 +118,17 @@ def orbit_camera(scene, mesh: Mesh, aspect: float) -> Camera:
     p = mesh.positions
     lo, hi = p.min(axis=0), p.max(axis=0)
     centre = np.array([0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])])
-    r_xz = float(np.sqrt(np.max((p[:, 0] - centre[0]) ** 2 + (p[:, 2] - centre[2]) ** 2)))
+    d = np.stack([p[:, 0] - centre[0], p[:, 2] - centre[2]], axis=1)
+    m = float(np.abs(d).max()) or 1.0  # scaled first: no overflow of the squares at 1e155
+    r_xz = m * float(np.sqrt(np.max(np.einsum("ij,ij->i", d / m, d / m))))
     half_y = 0.5 * float(hi[1] - lo[1])
     toward = np.subtract(cam.position, cam.focal_point)
-    toward = toward / np.linalg.norm(toward)
+    dist = vector_length(toward)  # (scale-safe: a mesh of size 1e155 too)
+    toward = toward / dist
     tilt = abs(float(toward[1]))  # sine of the viewer's elevation
     flat = math.sqrt(max(0.0, 1.0 - tilt * tilt))
     half_h = half_y * flat + r_xz * tilt
-    scale = max(half_h, r_xz / aspect, 1e-12) * FRAME_MARGIN
-    dist = float(np.linalg.norm(np.subtract(cam.position, cam.focal_point)))
+    scale = max(half_h, r_xz / aspect) * FRAME_MARGIN or cam.parallel_scale  # (a point: its own)
     return Camera(
         tuple(centre + toward * dist),
         tuple(centre),

@@ -54,6 +54,24 @@ def test_a_mesh_renders_alike_at_every_scale(viewer):
             assert different <= 0.02 * SIZE[0] * SIZE[1], (r, different)
 
 
+def test_a_turntable_frames_a_mesh_at_every_scale():
+    from explorer.render.turntable import iter_frames
+
+    unit = _scaled(1.0)
+    scene = explorer.load_scene({})
+    colors = explorer.shade(scene, unit.positions, unit.normals)
+    counts = {}
+    for r in (1.0, 1e-20, 1e155):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            frames = list(iter_frames(scene, _scaled(r), 2, lambda s: colors, SIZE))
+        counts[r] = [_mesh_pixels(f) for f in frames]
+    assert counts[1.0][0] > 0.3 * SIZE[0] * SIZE[1]
+    for r in (1e-20, 1e155):
+        pairs = zip(counts[r], counts[1.0], strict=True)
+        assert all(abs(a - b) <= 0.02 * SIZE[0] * SIZE[1] for a, b in pairs), counts
+
+
 def test_a_mesh_too_large_for_its_camera_is_refused():
     mesh = _scaled(1.5e308)
     with warnings.catch_warnings():
