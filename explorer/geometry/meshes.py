@@ -117,16 +117,11 @@ class Mesh:
 
     @property
     def radius(self) -> float:
-        """Radius of the smallest sphere about :attr:`centre` holding every vertex (computed in
-        the normalised frame: no overflow for coordinates near 1e308, no underflow at 1e-300)."""
-        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-            d = self.positions - self.centre
-            r = float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d))))
-            if np.isfinite(r) and (r > 0.0 or not d.any()):
-                return r
-            centre, scale = frame_of(self.positions)  # the squares overflowed or underflowed
-            d = self.positions / scale - centre / scale
-            return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))) * scale
+        """Radius of the smallest sphere about :attr:`centre` holding every vertex (in the
+        normalised frame: no overflow near 1e308, no underflow at 1e-300)."""
+        centre, scale = frame_of(self.positions)
+        d = self.positions / scale - centre / scale
+        return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))) * scale
 
     def face_normals(self) -> np.ndarray:
         """(m, 3) float64 unit normals of the triangles (zero for degenerate ones)."""
@@ -219,22 +214,11 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     return _unit_rows(acc)
 
 
-def _weld(
-    positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False,
-    relative: bool = False,
-):  # fmt: skip
+def _weld(positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False):
     """Merge vertices at the same position (and the same key); average their normals; drop
     triangles that become degenerate. keys : (n,) int group of each vertex or None.
-    decimals : positions equal when rounded to this many decimals; ``relative``: in the
-    normalised frame (:func:`frame_of`, coordinates in [-1, 1]), so that the tolerance scales
-    with the mesh (a file's mesh of size 1e-13 welds as one of size 1); else as they are (the
-    built-in meshes, of size 1)
     sources : also return (k,) the index of a source vertex of each new vertex."""
-    if relative:
-        centre, scale = frame_of(positions)
-        q = np.round((positions - centre) / scale, decimals)
-    else:
-        q = np.round(positions, decimals)
+    q = np.round(positions, decimals)
     q[q == 0] = 0.0  # -0.0 and 0.0 are the same place
     table = q if keys is None else np.column_stack([q, keys])
     _, first, inverse = np.unique(table, axis=0, return_index=True, return_inverse=True)
@@ -668,9 +652,10 @@ def load_mesh(path) -> Mesh:
         if missing.any():
             nrm[missing] = area_weighted_normals(pos, faces)[missing]
     else:
-        pos, _, faces, src = _weld(pos, np.zeros_like(pos), faces, keys, 12, sources=True,
-                                   relative=True)  # fmt: skip
-        keys = keys[src]
+        centre, scale = frame_of(pos)  # welded to 12 decimals of the mesh's frame: any scale
+        Q = pos / scale - centre / scale
+        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True)
+        pos, keys = pos[src], keys[src]
         nrm = area_weighted_normals(pos, faces)
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")

@@ -59,7 +59,7 @@ from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
 from explorer.shading.prepared import chunk_bounds, geometry_of, vertices
 from explorer.shading.prepared import readonly as _readonly
-from explorer.shading.shadows import pending_rays, visibility_rows
+from explorer.shading.shadows import pending_work, visibility_rows
 
 PRECISIONS = ("float64", "float32")
 #: the engine's tiers (see :mod:`explorer.shading.tiers`)
@@ -338,31 +338,15 @@ class Shader:
         return make_plan(scene, mesh=self._mesh_kind(scene), force_all=self.force_all)
 
     def _visibility(self) -> K.Shadows:
-        """The visibility rows of the lights the plan shadows (:class:`~.kernels.Shadows`:
-        uint8, one row per shadowing light, (1, 0) when none)."""
-        scene, plan = self._scene, self._plan
-        if not plan.shadows:
-            return K.Shadows(np.ones((1, 0), np.uint8), np.full(len(scene.lights), -1, np.int64))
-        shadowed = [lp.shadows for lp in plan.lights]
-        engine = tiers.ray_engine(tier=self.tier)  # (the pass's tier choice counted the rays)
-        rows, index, rays = visibility_rows(self._P, self._normals(), self._faces, scene.lights,
-                                            shadowed, two_sided=scene.two_sided,
-                                            force_all=self.force_all, cache=self._vis_cache,
-                                            cancelled=self.cancelled, engine=engine)  # fmt: skip
+        """The visibility rows of the lights the plan shadows (:class:`~.kernels.Shadows`)."""
+        scene, shadowed = self._scene, _shadowed(self._plan)
+        N = self._normals() if any(shadowed) else self._N  # (rays on the pass's tier: counted)
+        rows, index, rays = visibility_rows(self._P, N, self._faces, scene.lights, shadowed,
+                                            two_sided=scene.two_sided, force_all=self.force_all,
+                                            cache=self._vis_cache, cancelled=self.cancelled,
+                                            engine=tiers.ray_engine(tier=self.tier))  # fmt: skip
         self.stats["shadow_rays"] += rays
         return K.Shadows(rows, index)
-
-    def _ray_work(self) -> int:
-        """The ray work of the next pass's shadow rays on the numpy tier
-        (:func:`~explorer.shading.tiers.ray_work`): the tree if it is not kept, and a ray from
-        every vertex for each shadowing light whose row is not kept (an upper bound)."""
-        plan, scene = self._plan, self._scene
-        if not plan.shadows:
-            return 0
-        shadowed = [lp.shadows for lp in plan.lights]
-        cache, two, force = self._vis_cache, scene.two_sided, self.force_all
-        tree, lights = pending_rays(cache, scene.lights, shadowed, two_sided=two, force_all=force)
-        return tiers.ray_work(len(self._faces) if tree else 0, lights * self.n)
 
     # -- the work ------------------------------------------------------------------------------
     def _compiled_tier(self) -> bool:
@@ -370,11 +354,11 @@ class Shader:
         kernels = self._scene.model in COMPILED_MODELS  # threejs: the equation computes it
         if self.tier is not None:
             return kernels and self.tier == "compiled"
-        # the vertex-lights this pass would compute on the numpy tier: none when its sums are
-        # kept and only the material changed (a compose is not work the kernels would save),
-        # and its shadow rays' work (the tree, the rays): the shadow rays follow this choice
-        work = 0 if self._np is not None else self.n * max(1, len(self._scene.lights))
-        work += self._ray_work() if self._np is None else 0
+        # the numpy tier's vertex-lights of this pass with its shadow rays' work (at most; they
+        # follow this choice); none for a compose of kept sums (not work the kernels would save)
+        work = 0 if self._np is not None else self.n * max(1, len(self._scene.lights)) + (
+            pending_work(self._vis_cache, self._scene, _shadowed(self._plan), self.n,
+                         self._faces, force_all=self.force_all))  # fmt: skip
         return tiers.compiled(work) and kernels
 
     def _update(self, force=(False, False, False)):
@@ -533,6 +517,11 @@ class Shader:
                 marks, _readonly(P), _readonly(N), *fix, sums, lobes, vis, self._out
             )
         return 0
+
+
+def _shadowed(plan: Plan) -> list[bool]:
+    """Which lights the plan casts shadow rays for, one bool per light."""
+    return [bool(plan.shadows and lp.shadows) for lp in plan.lights]
 
 
 def _compiled_now(tier: str | None, model: str) -> bool:

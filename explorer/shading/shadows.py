@@ -37,7 +37,7 @@ import numpy as np
 
 from explorer.core import tolerances as tol
 from explorer.geometry.frame import frame_of
-from explorer.shading.tiers import ray_engine
+from explorer.shading.tiers import ray_engine, ray_work
 
 #: the key under which :func:`visibility_rows` keeps the geometry's frame and BVH in its cache
 #: (with the name of the ray engine that built it)
@@ -84,16 +84,18 @@ def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=N
     return vis
 
 
-def pending_rays(cache, lights, shadowed, *, two_sided, force_all) -> tuple[bool, int]:
-    """What :func:`visibility_rows` would cast now with this ``cache``: whether it builds a tree
-    (none kept, by any ray engine) and for how many lights it casts rays (their rows not kept)."""
-    tree = not any(isinstance(k, tuple) and k[:1] == (GEOMETRY_KEY,) for k in cache)
+def pending_work(cache, scene, shadowed, n: int, faces, *, force_all) -> int:
+    """The ray work (:func:`explorer.shading.tiers.ray_work`) :func:`visibility_rows` would do
+    now with this ``cache`` on the numpy tier, at most: a tree when none is kept (by any ray
+    engine) and a ray from each of the ``n`` vertices for every ``shadowed`` light of
+    ``scene`` whose row is not kept."""
     lights = sum(
         1
-        for light, on in zip(lights, shadowed, strict=True)
-        if on and (light.anchor, two_sided, force_all) not in cache
+        for light, on in zip(scene.lights, shadowed, strict=True)
+        if on and (light.anchor, scene.two_sided, force_all) not in cache
     )
-    return tree and lights > 0, lights
+    tree = lights and not any(isinstance(k, tuple) and k[:1] == (GEOMETRY_KEY,) for k in cache)
+    return ray_work(len(faces) if tree else 0, lights * n)
 
 
 def visibility_rows(
@@ -132,7 +134,9 @@ def visibility_rows(
     index = np.cumsum(np.asarray(shadowed, np.bool_), dtype=np.int64) - 1
     index[~np.asarray(shadowed, np.bool_)] = -1
     count = int(index.max(initial=-1)) + 1
-    vis = np.empty((count, n), np.uint8) if count else np.ones((1, 0), np.uint8)
+    if not count:  # no light casts shadows: nothing to keep
+        return np.ones((1, 0), np.uint8), index, 0
+    vis = np.empty((count, n), np.uint8)
     N = np.asarray(normals, np.float64)
     length = np.sqrt(np.einsum("ij,ij->i", N, N))
     unit = N / np.where(length > 0, length, 1.0)[:, None]
