@@ -80,7 +80,8 @@ DET_EPS = 1e-15
 SHADOW_NDL_MARGIN = 1e-6
 
 #: Per-pixel reference: a pixel's ray meeting a triangle at a parameter at most this times the
-#: scene's size (max(largest absolute coordinate, 1)) is ignored; the rays start at the camera,
+#: scene's size in the mesh's normalised frame (max(largest absolute coordinate of the rays'
+#: origins there, 1): the rays are cast in that frame) is ignored; the rays start at the camera,
 #: so this only drops hits at the camera itself. Any determinant other than 0 counts (both
 #: sides are seen, as VTK draws them).
 PIXEL_RAY_T_MIN = 1e-9

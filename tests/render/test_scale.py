@@ -72,6 +72,24 @@ def test_a_turntable_frames_a_mesh_at_every_scale():
         assert all(abs(a - b) <= 0.02 * SIZE[0] * SIZE[1] for a, b in pairs), counts
 
 
+def test_the_per_pixel_reference_sees_a_mesh_at_every_scale():
+    # the per-pixel reference cast its rays in world units: empty pictures at 1e-20 and 1e155
+    from explorer.render.perpixel import mesh_hits
+
+    scene = explorer.load_scene({})
+    masks = {}
+    for r in (1.0, 1e-20, 1e155, 1e300):
+        mesh = _scaled(r)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            hits = mesh_hits(camera_for(scene, mesh), SIZE, mesh)
+        masks[r] = hits.mask
+        assert np.isfinite(hits.positions).all() and np.isfinite(hits.normals).all()
+    assert masks[1.0].sum() > 0.3 * SIZE[0] * SIZE[1]
+    for r in (1e-20, 1e155, 1e300):
+        assert (masks[r] != masks[1.0]).sum() <= 0.02 * SIZE[0] * SIZE[1], r
+
+
 def test_a_mesh_too_large_for_its_camera_is_refused():
     mesh = _scaled(1.5e308)
     with warnings.catch_warnings():
