@@ -42,8 +42,9 @@ from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
     check_frames,
+    check_turntable,
     encode,
-    turntable_frames,
+    iter_frames,
 )
 from explorer.shading.display import group_vertex_colors, vertex_colors
 
@@ -83,6 +84,8 @@ def run(args) -> int:
     if turntable:
         check_frames(args.turntable)
     size = size_from_option(args.size, "--size")
+    if turntable:  # its format's needs and its total, before the mesh is read or a frame drawn
+        check_turntable(args.turntable, size, suffix)
     background = background_from_options(args)
     args.mesh_default = "sphere"
     scene, mesh = build_scene(args)
@@ -152,7 +155,7 @@ def run_obj(args, scene, mesh, materials) -> int:
 def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -> int:
     """``--turntable N``: N frames of the orbit into a GIF or MP4, with a progress bar."""
     bar = ProgressBar(sys.stderr, "turntable")
-    frames = turntable_frames(
+    frames = iter_frames(
         scene,
         mesh,
         args.turntable,
@@ -161,8 +164,9 @@ def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -
         background=background,
         progress=bar.update,
     )
+    data = encode(frames, suffix)  # each frame encoded as it renders
     bar.close()
-    write_atomic(args.out, encode(frames, suffix), overwrite=args.force)
+    write_atomic(args.out, data, overwrite=args.force)
     print(
         f"wrote {args.out}: {args.turntable} frames of {size[0]}x{size[1]} at {FPS} frames/s "
         f"({mesh.name}, {scene.model})"

@@ -80,7 +80,8 @@ DET_EPS = 1e-15
 SHADOW_NDL_MARGIN = 1e-6
 
 #: Per-pixel reference: a pixel's ray meeting a triangle at a parameter at most this times the
-#: scene's size (max(largest absolute coordinate, 1)) is ignored; the rays start at the camera,
+#: scene's size in the mesh's normalised frame (max(largest absolute coordinate of the rays'
+#: origins there, 1): the rays are cast in that frame) is ignored; the rays start at the camera,
 #: so this only drops hits at the camera itself. Any determinant other than 0 counts (both
 #: sides are seen, as VTK draws them).
 PIXEL_RAY_T_MIN = 1e-9
@@ -187,9 +188,17 @@ MAX_MESH_UNPACKED_BYTES = 256 << 20
 #: largest real ones (scenes of thousands of materials) are a few MiB, so anything larger is
 #: refused before it is read.
 MAX_MTL_FILE_BYTES = 16 << 20
-#: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
-#: full off-screen render held in memory until the animation is encoded.
+#: Most turntable frames one render writes: a full turn in 1-degree steps.
 MAX_TURNTABLE_FRAMES = 360
+#: Largest turntable, frames x width x height pixels, whose frames are held until the end: a
+#: GIF (its encoder keeps every frame, one byte per pixel once in its palette) and the window's
+#: turntable (it keeps the frames it renders, 3 bytes per pixel, to encode them in a thread).
+#: 2**29 pixels: 512 MiB palettised, 1.5 GiB as RGB; 360 frames of 1200 x 1200, 36 of 3800 x 3800.
+MAX_TURNTABLE_HELD_PIXELS = 1 << 29
+#: Largest MP4 turntable of ``render --turntable``, frames x width x height pixels: its frames
+#: are streamed to the encoder one at a time (memory: one frame), so this bounds the time only:
+#: 2**32 pixels, 360 frames of 3400 x 3400, several minutes (360 x 2048² took 117 s).
+MAX_TURNTABLE_PIXELS = 1 << 32
 #: Largest picture (width x height pixels) a render or a whole sheet may have: 8192 x 8192,
 #: 192 MiB as RGB bytes and several times that inside VTK while drawing. A sheet of large
 #: tiles is checked before anything is allocated (beyond it VTK aborts with std::bad_alloc).

@@ -117,9 +117,11 @@ class Mesh:
 
     @property
     def radius(self) -> float:
-        """Radius of the smallest sphere about :attr:`centre` holding every vertex."""
-        d = self.positions - self.centre
-        return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d))))
+        """Radius of the smallest sphere about :attr:`centre` holding every vertex (in the
+        normalised frame: no overflow near 1e308, no underflow at 1e-300)."""
+        centre, scale = frame_of(self.positions)
+        d = self.positions / scale - centre / scale
+        return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))) * scale
 
     def face_normals(self) -> np.ndarray:
         """(m, 3) float64 unit normals of the triangles (zero for degenerate ones)."""
@@ -650,8 +652,10 @@ def load_mesh(path) -> Mesh:
         if missing.any():
             nrm[missing] = area_weighted_normals(pos, faces)[missing]
     else:
-        pos, _, faces, src = _weld(pos, np.zeros_like(pos), faces, keys, 12, sources=True)
-        keys = keys[src]
+        centre, scale = frame_of(pos)  # welded to 12 decimals of the mesh's frame: any scale
+        Q = pos / scale - centre / scale
+        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True)
+        pos, keys = pos[src], keys[src]
         nrm = area_weighted_normals(pos, faces)
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")

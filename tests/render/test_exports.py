@@ -13,11 +13,13 @@ import trimesh
 
 import explorer
 from explorer.cli import main
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
 from explorer.core.mtl import read_mtl
 from explorer.geometry import meshes as M
 from explorer.render.exports import UNLIT, glb_bytes, linear_colors
 from explorer.render.images import read_png
-from explorer.render.turntable import check_frames, orbit_scene
+from explorer.render.turntable import check_frames, check_turntable, orbit_scene
 from explorer.shading.display import group_vertex_colors, vertex_colors
 
 # two unit squares side by side, each its own usemtl group; the shared edge (x = 1) is split
@@ -236,6 +238,77 @@ def test_turntable_options_are_checked(tmp_path, capsys):
     assert main(["render", "--turntable", "4", "--out", str(tmp_path / "a.png")]) == 2
     assert "must end in .gif or .mp4" in capsys.readouterr().err
     assert check_frames(36) == 36
+
+
+def _no_frame(monkeypatch):
+    """Make any off-screen frame render fail the test."""
+    from explorer.render import offscreen
+
+    def render(*args, **kw):
+        raise AssertionError("a frame was rendered")
+
+    monkeypatch.setattr(offscreen.OffscreenRenderer, "render", render)
+
+
+def test_turntable_needs_are_checked_before_any_frame_renders(tmp_path, capsys, monkeypatch):
+    # issue 31 item 5: an odd-sized MP4 rendered every frame before it was refused, and a
+    # turntable of 360 frames of 8192² asked 67.5 GiB (a traceback)
+    _no_frame(monkeypatch)
+    out = tmp_path / "t.mp4"
+    assert main(["render", "--turntable", "4", "--size", "121x120", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--size 121x120" in err and "even width and height" in err and "122x120" in err
+    assert "Traceback" not in err and not out.exists()
+    argv = ["render", "--turntable", "360", "--size", "8192x8192", "--out"]
+    for suffix, cap in (
+        (".mp4", tol.MAX_TURNTABLE_PIXELS),
+        (".gif", tol.MAX_TURNTABLE_HELD_PIXELS),
+    ):
+        assert main([*argv, str(tmp_path / f"t{suffix}")]) == 2
+        err = capsys.readouterr().err
+        assert "--turntable 360 --size 8192x8192" in err and f"at most {cap:,}" in err, err
+        assert "Traceback" not in err
+    # within the budget a GIF of these frames is refused, an MP4 accepted
+    assert check_turntable(360, (2048, 2048), ".mp4") == 360
+    with pytest.raises(ExplorerError, match="an .mp4 may have more"):
+        check_turntable(360, (2048, 2048), ".gif")
+    with pytest.raises(ExplorerError, match="held until the end"):
+        check_turntable(360, (2048, 2048), ".mp4", held=True)  # the window keeps its frames
+
+
+def _turntable_peak(tmp_path, monkeypatch, frames: int, size=(256, 256)) -> int:
+    """tracemalloc's peak over ``render --turntable frames`` into an MP4, the off-screen render
+    replaced by a fresh synthetic picture per frame (the encoder and the loop are real)."""
+    import tracemalloc
+
+    from explorer.render import offscreen
+
+    w, h = size
+
+    def render(self, scene, mesh, colors, camera=None):
+        frame = np.empty((h, w, 3), np.uint8)
+        frame[:] = np.asarray(colors[0] * 255, np.uint8)
+        return frame
+
+    monkeypatch.setattr(offscreen.OffscreenRenderer, "render", render)
+    out = tmp_path / f"t{frames}.mp4"
+    argv = ["render", "--mesh", "sphere", "--resolution", "6", "--size", f"{w}x{h}"]
+    tracemalloc.start()
+    try:
+        assert main([*argv, "--turntable", str(frames), "--out", str(out)]) == 0
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_turntable_streams_its_frames(tmp_path, monkeypatch):
+    # issue 31 item 5: every frame was held until the end (360 x 2048²: 12.3 GiB); an MP4's
+    # frames now go to the encoder as they render, so memory does not grow with their number
+    small = _turntable_peak(tmp_path, monkeypatch, 6)
+    large = _turntable_peak(tmp_path, monkeypatch, 30)
+    frame = 256 * 256 * 3
+    assert large < small + 4 * frame, (small, large)  # held frames: 24 more frames, 4.7 MB
+    assert iio.imread(tmp_path / "t30.mp4", index=None).shape[:3] == (30, 256, 256)
 
 
 def test_orbit_turns_viewer_and_lights_together():
