@@ -32,6 +32,7 @@ from pathlib import Path
 
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
+from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.material import (
     COEFFICIENT_RANGE,
     OPACITY_RANGE,
@@ -66,6 +67,9 @@ ILLUM_MEANING = {
 }
 #: OpenGL 1.x / 2.1's largest GL_SHININESS: a larger exponent is legal in MTL and here
 GL_MAX_SHININESS = 128.0
+#: a number as MTL writes it: ASCII decimal digits, an optional sign, point and exponent
+#: (``1``, ``-0.5``, ``.5``, ``1e-3``); not Python's ``1_0``, ``inf``, ``nan`` or other digits
+MTL_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _TEXTURE = re.compile(r"(map_\w+|bump|disp|decal|refl|norm)")
 
 
@@ -90,22 +94,15 @@ class MtlMaterial:
 
 
 def read_mtl(path) -> list[MtlMaterial]:
-    """The materials of an .mtl file (see :func:`parse_mtl`); a missing or unreadable file,
-    or one larger than ``MAX_MTL_FILE_BYTES``, raises an :class:`MtlError` naming it."""
+    """The materials of an .mtl file (see :func:`parse_mtl`); a missing file, one that is not a
+    regular file (a FIFO or device is refused without blocking) or one larger than
+    ``MAX_MTL_FILE_BYTES`` raises an :class:`MtlError` naming it
+    (:func:`explorer.core.files.read_checked`)."""
     shown = os.fspath(path)
     try:
-        size = os.path.getsize(shown)
-        if size > tol.MAX_MTL_FILE_BYTES:
-            raise MtlError(
-                f"{shown}: too large for a material library ({size} bytes, the limit is "
-                f"{tol.MAX_MTL_FILE_BYTES})"
-            )
-        with open(shown, "rb") as fh:
-            data = fh.read()
-    except IsADirectoryError:
-        raise MtlError(f"{shown}: is a directory, not an .mtl file") from None
-    except OSError as exc:
-        raise MtlError(f"{shown}: cannot be read: {exc.strerror or exc}") from None
+        data = read_checked(shown, cap=tol.MAX_MTL_FILE_BYTES, what="material library")
+    except UnreadableFile as exc:
+        raise MtlError(str(exc)) from None
     return parse_mtl(data, shown)
 
 
@@ -127,7 +124,7 @@ def parse_mtl(data: bytes | str, source: str = "<mtl>") -> list[MtlMaterial]:
                 raise MtlError(f"{where}: newmtl needs a material name")
             if current is not None:
                 out.append(current.build())
-            current = _Builder(" ".join(words[1:]), number, source)
+            current = _Builder(check_mtl_name(" ".join(words[1:]), where), number, source)
             continue
         if current is None:
             raise MtlError(
@@ -317,10 +314,11 @@ def _number(words: list[str], count: int | None, where: str, what: str) -> float
 
 
 def _float(word: str, where: str, what: str) -> float:
-    try:
-        value = float(word)
-    except ValueError:
-        raise MtlError(f"{where}: {what}: {word!r} is not a number") from None
+    if word.lstrip("+-").lower() in ("nan", "inf", "infinity"):
+        raise MtlError(f"{where}: {what}: {word!r} is not a finite number")
+    if not MTL_NUMBER.fullmatch(word):  # float() also takes '1_0' and non-ASCII digits
+        raise MtlError(f"{where}: {what}: {word!r} is not a number")
+    value = float(word)
     if not math.isfinite(value):
         raise MtlError(f"{where}: {what}: {word!r} is not a finite number")
     return value
@@ -361,6 +359,18 @@ def _illum(words: list[str], where: str) -> int:
 
 
 # -- names -----------------------------------------------------------------------------------
+def check_mtl_name(name: str, where: str) -> str:
+    """``name`` if a ``newmtl`` may have it: at most ``MAX_MTL_NAME_LENGTH`` characters (a
+    longer one would make a preset file that the preset reader refuses); else an
+    :class:`MtlError` at ``where``."""
+    if len(name) > tol.MAX_MTL_NAME_LENGTH:
+        raise MtlError(
+            f"{where}: newmtl name is {len(name)} characters long; the limit is "
+            f"{tol.MAX_MTL_NAME_LENGTH}"
+        )
+    return name
+
+
 def preset_name(name: str) -> str:
     """A preset name (lowercase letters, digits, ``_``) made from a material name: letters
     lowercased, runs of anything else one ``_``, at most ``MAX_NAME_LENGTH`` characters;

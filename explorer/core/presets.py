@@ -28,10 +28,11 @@ from platformdirs import user_config_dir
 
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Notice, ValidationError
+from explorer.core.files import file_kind
 from explorer.core.material import Material, parse_material
 from explorer.core.validate import Checker, suggest
 from explorer.core.version import __version__
-from explorer.core.yamlio import dump_yaml, file_kind, load_yaml
+from explorer.core.yamlio import dump_yaml, load_yaml
 
 #: Environment variable overriding the user's preset directory (used by the tests).
 ENV_VAR = "PHONG_EXPLORER_MATERIALS"

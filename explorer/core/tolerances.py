@@ -187,6 +187,13 @@ MAX_MESH_UNPACKED_BYTES = 256 << 20
 #: largest real ones (scenes of thousands of materials) are a few MiB, so anything larger is
 #: refused before it is read.
 MAX_MTL_FILE_BYTES = 16 << 20
+#: Longest ``newmtl`` name read (characters). An imported material keeps its name in its
+#: preset's description; a name of megabytes would make a preset file over the YAML reader's
+#: 1 MiB cap, so import would write what validate and render then refuse. Real names are a
+#: few dozen characters.
+MAX_MTL_NAME_LENGTH = 256
+#: How many ``mtllib`` libraries one OBJ may name: each is a file opened and read.
+MAX_MTL_LIBRARIES = 64
 #: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
 #: full off-screen render held in memory until the animation is encoded.
 MAX_TURNTABLE_FRAMES = 360
