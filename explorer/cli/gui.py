@@ -27,7 +27,7 @@ from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
-from explorer.core.text import printable
+from explorer.core.text import printable, say
 from explorer.geometry.meshes import get_mesh
 from explorer.render.images import parse_size
 
@@ -128,7 +128,7 @@ def start_state(args):
                             resolution=args.resolution)  # fmt: skip
     state, warnings = gui.add_mesh_materials(state, mesh, use=own)
     for w in warnings:
-        print(f"warning: {printable(w)}", file=sys.stderr)
+        say(f"warning: {printable(w)}", file=sys.stderr)
     return state, mesh
 
 
@@ -137,7 +137,7 @@ def run(args) -> int:
     check_options(args)
     reason = gui.no_display_reason()
     if reason:
-        print(gui.no_display_message(reason), file=sys.stderr)
+        say(gui.no_display_message(reason), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS
     if not logging.getLogger().handlers:
         logging.basicConfig(
@@ -157,5 +157,5 @@ def run(args) -> int:
             background=background_from_options(args), exit_after=args.exit_after,
         )  # fmt: skip
     except gui.NoDisplayError as exc:
-        print(gui.no_display_message(str(exc)), file=sys.stderr)
+        say(gui.no_display_message(str(exc)), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS

@@ -114,9 +114,7 @@ def read_text_checked(path, *, cap: int, what: str = "file") -> str:
         return raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
-        raise UnreadableFile(
-            os.fspath(path), what, f"line {line} is not UTF-8 text"
-        ) from None
+        raise UnreadableFile(os.fspath(path), what, f"line {line} is not UTF-8 text") from None
 
 
 def inside(folder, name: str) -> str | None:

@@ -77,6 +77,15 @@ class MtlError(ExplorerError):
     """An .mtl file the reader cannot take: the message is ``file:line: what is wrong``."""
 
 
+class MtlUnreadable(MtlError):
+    """An .mtl file that could not be opened or read at all (missing, not a regular file, too
+    large); ``reason`` says which (:class:`explorer.core.files.UnreadableFile`)."""
+
+    def __init__(self, exc: UnreadableFile):
+        self.reason = exc.reason
+        super().__init__(str(exc))
+
+
 @dataclass(frozen=True)
 class MtlMaterial:
     """One ``newmtl`` of a file.
@@ -102,7 +111,7 @@ def read_mtl(path) -> list[MtlMaterial]:
     try:
         data = read_checked(shown, cap=tol.MAX_MTL_FILE_BYTES, what="material library")
     except UnreadableFile as exc:
-        raise MtlError(str(exc)) from None
+        raise MtlUnreadable(exc) from None
     return parse_mtl(data, shown)
 
 
