@@ -39,7 +39,7 @@ from explorer.core.material import (
     SHININESS_RANGE,
     Material,
 )
-from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_preset
+from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_presets
 
 #: colour statement -> the material field it sets
 COLOUR_KEYS = {"ka": "ambient", "kd": "diffuse", "ks": "specular", "ke": "emission"}
@@ -421,17 +421,15 @@ class MtlImport:
         return [t for t in self.targets if t.exists()]
 
     def write(self, overwrite: bool) -> list[Path]:
-        """Write every preset (atomically; an existing file only with ``overwrite``)."""
+        """Write every preset, all or nothing (:func:`~explorer.core.presets.save_presets`:
+        an existing file is replaced only with ``overwrite``; a failure or an interrupt
+        leaves the directory as it was)."""
         origin = Path(self.source).name
-        return [
-            save_preset(
-                m.material.replace(description=f"imported from {origin}: {m.name}"),
-                name,
-                t.parent,
-                overwrite=overwrite,
-            )  # fmt: skip
-            for m, name, t in zip(self.found, self.names, self.targets, strict=True)
+        items = [
+            (m.material.replace(description=f"imported from {origin}: {m.name}"), name)
+            for m, name in zip(self.found, self.names, strict=True)
         ]
+        return save_presets(items, self.targets[0].parent if self.targets else None, overwrite)
 
 
 def mtl_import(path, directory) -> MtlImport:

@@ -562,13 +562,12 @@ def _unpacked_size(data: bytes, cap: int) -> int | None:
         if zipfile.is_zipfile(stream):
             with zipfile.ZipFile(stream) as archive:
                 return sum(info.file_size for info in archive.infolist())
-        opener = {b"BZh": bz2.BZ2File, b"\x1f\x8b\x08": gzip.GzipFile}.get(data[:3])
+        unpack = {b"BZh": bz2.BZ2File, b"\x1f\x8b\x08": lambda f: gzip.GzipFile(fileobj=f)}
+        opener = unpack.get(data[:3])
         if opener is None:
             return None
         total = 0
-        with opener(fileobj=io.BytesIO(data)) if opener is gzip.GzipFile else opener(
-            io.BytesIO(data)
-        ) as unpacking:
+        with opener(io.BytesIO(data)) as unpacking:
             while total <= cap:
                 chunk = unpacking.read(1 << 20)
                 if not chunk:
