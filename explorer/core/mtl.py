@@ -40,6 +40,7 @@ from explorer.core.material import (
     Material,
 )
 from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_presets
+from explorer.core.validate import format_number
 
 #: colour statement -> the material field it sets
 COLOUR_KEYS = {"ka": "ambient", "kd": "diffuse", "ks": "specular", "ke": "emission"}
@@ -357,7 +358,8 @@ def _colour(words: list[str], where: str) -> tuple[float, float, float]:
 def _check_range(value: float, bounds: tuple[float, float], where: str, what: str) -> None:
     lo, hi = bounds
     if not lo <= value <= hi:
-        raise MtlError(f"{where}: {what} must be in [{lo:g}, {hi:g}], got {value:g}")
+        shown = ", ".join(format_number(v) for v in (lo, hi))
+        raise MtlError(f"{where}: {what} must be in [{shown}], got {format_number(value)}")
 
 
 def _illum(words: list[str], where: str) -> int:

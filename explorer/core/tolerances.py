@@ -194,6 +194,10 @@ MAX_MTL_FILE_BYTES = 16 << 20
 MAX_MTL_NAME_LENGTH = 256
 #: How many ``mtllib`` libraries one OBJ may name: each is a file opened and read.
 MAX_MTL_LIBRARIES = 64
+#: Largest of the other files the product reads (bytes): the window's recent-files list, the
+#: accuracy table (about 400 KB), ``/proc/cpuinfo`` for a benchmark's machine line (a few KB
+#: per core). Read through the checked open, which never trusts a size (``/proc`` gives 0).
+MAX_DATA_FILE_BYTES = 16 << 20
 #: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
 #: full off-screen render held in memory until the animation is encoded.
 MAX_TURNTABLE_FRAMES = 360
