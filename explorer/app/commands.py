@@ -356,6 +356,7 @@ class Commands:
         self.remember_recent(path)
 
     def _open_scene(self, scene, path: str) -> None:
+        M.check_window_lights(len(scene.lights), path)
         s = self.store.state  # the scene's material covers the mesh (groups=None)
         new = s.replace(scene=scene.replace(mesh=s.mesh), preset=scene.material.name,
                         preset_material=None, light=0, held_azimuth=None,

@@ -198,6 +198,12 @@ MAX_MTL_LIBRARIES = 64
 #: accuracy table (about 400 KB), ``/proc/cpuinfo`` for a benchmark's machine line (a few KB
 #: per core). Read through the checked open, which never trusts a size (``/proc`` gives 0).
 MAX_DATA_FILE_BYTES = 16 << 20
+#: Most lights the window holds (a session, a scene opened in it, lights added there): eight
+#: times OpenGL's GL_MAX_LIGHTS. Each light is a row in the light panel and a handle in the
+#: view and is shaded every frame; a 20,000-light session took 40-50 s to open and to close
+#: (and was kept as a last session over the 1 MiB the reader takes). ``render`` and the
+#: library take more.
+MAX_WINDOW_LIGHTS = 64
 #: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
 #: full off-screen render held in memory until the animation is encoded.
 MAX_TURNTABLE_FRAMES = 360
