@@ -27,7 +27,6 @@ import bz2
 import gzip
 import io
 import os
-import re
 import warnings
 import zipfile
 from dataclasses import dataclass
@@ -36,11 +35,11 @@ import numpy as np
 
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError, Notice
-from explorer.core.files import UnreadableFile, inside, read_checked
-from explorer.core.text import printable
+from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
 from explorer.geometry.frame import check_faces, check_vertices, frame_of
+from explorer.geometry.sidefiles import CheckedResolver, library_names, obj_material_names
 
 #: resolution option of each built-in mesh: (default, lowest, highest); None = no option
 RESOLUTION: dict[str, tuple[int, int, int] | None] = {
@@ -588,7 +587,7 @@ def load_mesh(path) -> Mesh:
 
     The file is read once (:func:`read_mesh_file`) and trimesh parses those bytes; every
     other file trimesh would open (an OBJ's ``mtllib``, a glTF's buffers) is served by
-    :class:`_CheckedResolver`, so no library opens a file the checked open has not. An OBJ's
+    :class:`CheckedResolver`, so no library opens a file the checked open has not. An OBJ's
     ``mtllib`` libraries are resolved by :func:`obj_material_names` (inside the OBJ's folder,
     ``.mtl`` names only; the others are named in a :class:`Notice` and not opened).
 
@@ -611,7 +610,7 @@ def load_mesh(path) -> Mesh:
         for message in refused:
             warnings.warn(message, Notice, stacklevel=2)
     file_type = trimesh.util.split_extension(path, special=["tar.gz", "tar.bz2"]).lower()
-    resolver = _CheckedResolver(path, library_names(libraries) if ext == ".obj" else None)
+    resolver = CheckedResolver(path, library_names(libraries) if ext == ".obj" else None)
     try:
         loaded = trimesh.load(
             io.BytesIO(data), file_type=file_type, resolver=resolver, process=False
@@ -702,136 +701,6 @@ def _used(pos, faces) -> np.ndarray:
     used = np.zeros(len(pos), bool)
     used[faces.ravel()] = True
     return used
-
-
-#: an OBJ line naming material libraries or a material (at the start of a line)
-_MATERIAL_LINE = re.compile(rb"^[ \t]*(mtllib|usemtl)[ \t]+([^\r\n]*)", re.MULTILINE)
-#: a comment: ``#`` at the start of the text or after a blank (``a#b.mtl`` is a name)
-_COMMENT = re.compile(r"(?:^|\s)#.*$")
-
-
-def obj_material_names(path: str, data: bytes) -> tuple[tuple, tuple, tuple]:
-    """``(libraries, used, refused)`` of an OBJ's bytes ``data`` (read from ``path``).
-
-    libraries : the ``mtllib`` files the OBJ names that may be read, as paths in its folder
-        (at most ``MAX_MTL_LIBRARIES``); not yet opened
-    used : the names its ``usemtl`` lines give, in the order first met
-    refused : one sentence per library not read, each naming the library and why: outside the
-        OBJ's folder (``..``, an absolute path, a link out of it), not an ``.mtl`` name; these
-        are never opened, so nothing of their content is ever shown
-
-    An ``mtllib`` line holds one or more names; a name may hold blanks: the words are grouped
-    into names each ending in ``.mtl`` (as Blender reads them), so ``mtllib my model.mtl`` is
-    one file and ``mtllib a.mtl b.mtl`` two. ``#`` starts a comment at a line's start or after
-    a blank (``a#b.mtl`` is a name).
-    """
-    folder = os.path.dirname(path)
-    libraries: list[str] = []
-    used: list[str] = []
-    refused: list[str] = []
-    for match in _MATERIAL_LINE.finditer(data):
-        rest = _COMMENT.sub("", match.group(2).decode("utf-8", "replace")).strip()
-        if match.group(1) == b"usemtl":
-            if rest and rest not in used:
-                used.append(rest)
-            continue
-        for name in mtllib_names(rest):
-            where = f"mesh file '{path}': mtllib {printable(name)}"
-            lib = inside(folder, name) if name.lower().endswith(".mtl") else None
-            if not name.lower().endswith(".mtl"):
-                refused.append(f"{where}: not an .mtl file name; it is not read")
-            elif lib is None:
-                refused.append(
-                    f"{where}: outside the OBJ's folder; it is not read (put the library "
-                    "beside the OBJ)"
-                )
-            elif lib not in libraries:
-                if len(libraries) >= tol.MAX_MTL_LIBRARIES:
-                    refused.append(
-                        f"{where}: more than {tol.MAX_MTL_LIBRARIES} libraries; it is not read"
-                    )
-                    continue
-                libraries.append(lib)
-    return tuple(libraries), tuple(used), tuple(refused)
-
-
-def mtllib_names(rest: str) -> list[str]:
-    """The library names of an ``mtllib`` line's text after the keyword: words grouped into
-    names each ending in ``.mtl`` (case aside); words after the last such name form one more
-    name. ``"my model.mtl"`` -> ``["my model.mtl"]``; ``"a.mtl b.mtl"`` -> two names."""
-    names: list[str] = []
-    pending: list[str] = []
-    for word in rest.split():
-        pending.append(word)
-        if word.lower().endswith(".mtl"):
-            names.append(" ".join(pending))
-            pending = []
-    if pending:
-        names.append(" ".join(pending))
-    return names
-
-
-def library_names(libraries) -> tuple[str, ...]:
-    """Every material name the readable ``libraries`` define (read with the strict reader,
-    :func:`explorer.core.mtl.read_mtl`; a library it refuses adds none here, and
-    :func:`explorer.geometry.filematerials.group_materials` reports it)."""
-    from explorer.core.mtl import MtlError, read_mtl
-
-    names: list[str] = []
-    for lib in libraries:
-        try:
-            found = read_mtl(lib)
-        except MtlError:
-            continue
-        names.extend(m.name for m in found if m.name not in names)
-    return tuple(names)
-
-
-class _CheckedResolver:
-    """What trimesh gets to fetch the files a mesh file names, instead of opening them itself.
-
-    An OBJ (``materials`` given) is served a material library holding only ``newmtl`` lines of
-    ``materials``: trimesh needs the names to split faces by ``usemtl``; the colours are read
-    by :mod:`explorer.core.mtl`, and no texture is ever opened. Any other format (a glTF's
-    buffers and images) is served files inside the mesh file's folder, through
-    :func:`explorer.core.files.read_checked` with the mesh-file cap; anything else is
-    "not found" to trimesh.
-    """
-
-    def __init__(self, path: str, materials: tuple[str, ...] | None):
-        self.folder = os.path.dirname(path)
-        self.file_name = os.path.basename(path)
-        self.materials = materials
-
-    def get(self, name: str) -> bytes:
-        if self.materials is not None:
-            if not self.materials:
-                raise FileNotFoundError(name)
-            return "".join(f"newmtl {m}\n" for m in self.materials).encode("utf-8")
-        lib = inside(self.folder, str(name).strip())
-        if lib is None:
-            raise FileNotFoundError(name)
-        try:
-            return read_checked(lib, cap=tol.MAX_MESH_FILE_BYTES, what="file a mesh names")
-        except UnreadableFile as exc:
-            raise FileNotFoundError(str(exc)) from None
-
-    __getitem__ = get
-
-    def get_base(self) -> bytes:  # pragma: no cover - trimesh asks this of web resolvers only
-        raise FileNotFoundError(self.file_name)
-
-    def keys(self):
-        return iter(())
-
-    def __contains__(self, name) -> bool:
-        return False
-
-    def namespaced(self, namespace):
-        return _CheckedResolver(os.path.join(self.folder, namespace, "x"), self.materials)
-
-    def write(self, name, data):  # pragma: no cover - loading never writes
-        raise OSError("the mesh reader writes no files")
 
 
 def _say_unread_materials(shown: str, parts, libraries) -> None:

@@ -118,7 +118,7 @@ ALLOWED = {
     ("explorer/app/start.py", "fdopen"): "reads the pipe of the Xvfb it started (-displayfd)",
     ("explorer/analysis/report.py", "read_text"): "the package's own report template",
     ("explorer/geometry/meshes.py", "trimesh.load"): (
-        "parses bytes read by read_mesh_file, with _CheckedResolver for side files"
+        "parses bytes read by read_mesh_file, with sidefiles.CheckedResolver for side files"
     ),
     ("explorer/shading/tiers.py", "read_text"): (
         "the compile cache's attempt file: issue 31 item 9, owned by the w31rays branch"

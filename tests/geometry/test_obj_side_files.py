@@ -20,6 +20,7 @@ from explorer.core.material import Material
 from explorer.core.mtl import MtlError, parse_mtl, read_mtl
 from explorer.geometry import meshes as M
 from explorer.geometry.filematerials import group_materials
+from explorer.geometry.sidefiles import mtllib_names
 
 TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"
 RED = "newmtl red\nKd 1 0 0\n"
@@ -128,9 +129,9 @@ def test_a_library_beside_the_obj_is_read_once_by_the_product(tmp_path, no_trime
 
 
 def test_mtllib_names_group_words_into_mtl_names():
-    assert M.mtllib_names("my model.mtl") == ["my model.mtl"]
-    assert M.mtllib_names("a.mtl  b.MTL") == ["a.mtl", "b.MTL"]
-    assert M.mtllib_names("a.mtl notes") == ["a.mtl", "notes"]
+    assert mtllib_names("my model.mtl") == ["my model.mtl"]
+    assert mtllib_names("a.mtl  b.MTL") == ["a.mtl", "b.MTL"]
+    assert mtllib_names("a.mtl notes") == ["a.mtl", "notes"]
 
 
 @pytest.mark.parametrize("name", ["my model.obj", "a#b.obj", "tab\there.obj"])
