@@ -16,6 +16,7 @@ import re
 
 from explorer.core import tolerances as tol
 from explorer.core.files import UnreadableFile, inside, read_checked
+from explorer.core.mtl import MtlError, read_mtl
 from explorer.core.text import printable
 
 #: an OBJ line naming material libraries or a material (at the start of a line)
@@ -89,8 +90,6 @@ def library_names(libraries) -> tuple[str, ...]:
     """Every material name the readable ``libraries`` define (read with the strict reader,
     :func:`explorer.core.mtl.read_mtl`; a library it refuses adds none here, and
     :func:`explorer.geometry.filematerials.group_materials` reports it)."""
-    from explorer.core.mtl import MtlError, read_mtl
-
     names: list[str] = []
     for lib in libraries:
         try:
