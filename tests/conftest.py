@@ -115,3 +115,19 @@ def cold_tiers(monkeypatch, tmp_path):
         loader.join(timeout=600)
     tiers.set_mode(None)
     tiers._state.update(started=False, loading=None, failed=None, preload=False)
+
+
+@pytest.fixture
+def no_hang():
+    """A test that would block (a reader waiting on a FIFO) fails after 20 s instead of
+    stopping the suite (``pytestmark = pytest.mark.usefixtures("no_hang")``)."""
+    import signal
+
+    def hung(signum, frame):
+        raise AssertionError("blocked: still waiting after 20 s")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.alarm(20)
+    yield
+    signal.alarm(0)
+    signal.signal(signal.SIGALRM, previous)

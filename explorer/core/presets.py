@@ -273,15 +273,7 @@ def save_presets(items, directory=None, overwrite: bool = False) -> list[Path]:
     goes, a preset that exists (without ``overwrite``) or an interrupt leaves the directory as
     it was. Returns the files written, in order."""
     files = {preset_path(name, directory): preset_bytes(m, name) for m, name in items}
-    if files:
-        parent = next(iter(files)).parent
-        try:
-            parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise ExplorerError(
-                f"{parent}: cannot create directory: {exc.strerror or exc}"
-            ) from None
-    return write_all_atomic(files, overwrite=overwrite)
+    return write_all_atomic(files, overwrite=overwrite, make_dirs=True)
 
 
 def preset_path(name: str, directory=None) -> Path:

@@ -7,11 +7,10 @@ runs under an alarm that turns a hang into a failure."""
 from __future__ import annotations
 
 import ast
-import os
-import signal
 from pathlib import Path
 
 import pytest
+from helpers.files import KINDS, special_file
 
 from explorer.core import files as F
 from explorer.core import tolerances as tol
@@ -20,36 +19,9 @@ from explorer.core.errors import ExplorerError
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.fixture(autouse=True)
-def no_hang():
-    """A reader that blocks fails the test after 20 s instead of stopping the suite."""
-
-    def hung(signum, frame):
-        raise AssertionError("the reader blocked (still waiting after 20 s)")
-
-    previous = signal.signal(signal.SIGALRM, hung)
-    signal.alarm(20)
-    yield
-    signal.alarm(0)
-    signal.signal(signal.SIGALRM, previous)
+pytestmark = pytest.mark.usefixtures("no_hang")
 
 
-def special(tmp_path: Path, kind: str, name: str) -> Path:
-    """A file of ``kind`` named ``name`` in ``tmp_path``."""
-    path = tmp_path / name
-    if kind == "fifo":
-        os.mkfifo(path)
-    elif kind == "zero":
-        path.symlink_to("/dev/zero")
-    elif kind == "sparse":
-        with open(path, "wb") as fh:
-            fh.truncate(3 << 30)  # 3 GiB that take no disk
-    elif kind == "dir":
-        path.mkdir()
-    return path
-
-
-KINDS = ["fifo", "zero", "sparse", "dir"]
 #: what each kind is called in the messages
 SAID = {
     "fifo": "FIFO",
@@ -62,7 +34,7 @@ SAID = {
 # -- the helper --------------------------------------------------------------------------------
 @pytest.mark.parametrize("kind", KINDS)
 def test_read_checked_refuses_what_is_not_a_small_regular_file(tmp_path, kind):
-    path = special(tmp_path, kind, "x")
+    path = special_file(tmp_path, kind, "x")
     with pytest.raises(F.UnreadableFile) as info:
         F.read_checked(path, cap=1 << 20, what="scene")
     msg = str(info.value)
@@ -214,7 +186,7 @@ READERS = {
 @pytest.mark.parametrize("kind", KINDS)
 @pytest.mark.parametrize("name", sorted(READERS))
 def test_every_reader_refuses_special_and_huge_files_at_once(tmp_path, name, kind):
-    path = special(tmp_path, kind, f"x \x1b]0;t\x07 {name}")
+    path = special_file(tmp_path, kind, f"x \x1b]0;t\x07 {name}")
     with pytest.raises(ValueError) as info:
         READERS[name](path)
     msg = str(info.value)
@@ -231,17 +203,17 @@ def test_cli_readers_refuse_special_files(tmp_path, kind, capsys, monkeypatch):
     from explorer.cli import build_parser, main
     from explorer.cli.gui import start_state
 
-    mtl = special(tmp_path, kind, "f.mtl")
+    mtl = special_file(tmp_path, kind, "f.mtl")
     monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
     assert main(["presets", "import", str(mtl), "--into", str(tmp_path / "p")]) == 2
     assert main(["presets", "validate", str(mtl)]) == 1
-    mesh = special(tmp_path, kind, "m.obj")
+    mesh = special_file(tmp_path, kind, "m.obj")
     assert main(["render", "--mesh", str(mesh), "--out", str(tmp_path / "o.png")]) == 2
-    scene = special(tmp_path, kind, "s.yaml")
+    scene = special_file(tmp_path, kind, "s.yaml")
     assert main(["plan", str(scene)]) == 2
     out = capsys.readouterr()
     assert "Traceback" not in out.err and out.err.count("error:") == 3
-    last = special(tmp_path, kind, "last.yaml")
+    last = special_file(tmp_path, kind, "last.yaml")
     monkeypatch.setenv(S.LAST_SESSION_ENV, str(last))
     with pytest.raises(ExplorerError) as info:
         start_state(build_parser().parse_args(["gui", "--last"]))
@@ -254,7 +226,7 @@ def test_a_huge_recent_files_list_is_not_read(tmp_path):
     pytest.importorskip("PySide6")
     from explorer.app.filemenu import RECENT_NAME, FileCommands
 
-    special(tmp_path, "sparse", RECENT_NAME)
+    special_file(tmp_path, "sparse", RECENT_NAME)
 
     class Menu(FileCommands):
         def __init__(self):

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import os
 import re
-import signal
 import warnings
 from pathlib import Path
 
 import pytest
+from helpers.files import KINDS, special_file
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -26,16 +26,7 @@ TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"
 RED = "newmtl red\nKd 1 0 0\n"
 
 
-@pytest.fixture(autouse=True)
-def no_hang():
-    def hung(signum, frame):
-        raise AssertionError("a side file blocked the reader (still waiting after 20 s)")
-
-    previous = signal.signal(signal.SIGALRM, hung)
-    signal.alarm(20)
-    yield
-    signal.alarm(0)
-    signal.signal(signal.SIGALRM, previous)
+pytestmark = pytest.mark.usefixtures("no_hang")
 
 
 @pytest.fixture
@@ -65,21 +56,12 @@ def load(path):
     return mesh, notices, said, found
 
 
-@pytest.mark.parametrize("kind", ["fifo", "zero", "sparse", "dir"])
+@pytest.mark.parametrize("kind", KINDS)
 def test_an_mtllib_that_is_no_small_file_is_named_and_never_opened_blocking(
     tmp_path, kind, no_trimesh_files
 ):
     """Before: a FIFO hung ``render --mesh``; a sparse 3 GiB library cost 25 s and 6.1 GiB."""
-    lib = tmp_path / "red.mtl"
-    if kind == "fifo":
-        os.mkfifo(lib)
-    elif kind == "zero":
-        lib.symlink_to("/dev/zero")
-    elif kind == "sparse":
-        with open(lib, "wb") as fh:
-            fh.truncate(3 << 30)
-    else:
-        lib.mkdir()
+    special_file(tmp_path, kind, "red.mtl")
     mesh, notices, said, found = load(obj(tmp_path, "mtllib red.mtl\n"))
     assert mesh.n_faces == 1
     text = " ".join(notices + said)
