@@ -341,7 +341,7 @@ class Commands:
             if not path:
                 return
         path = os.fspath(path)
-        if not os.path.isfile(path):
+        if not os.path.lexists(path):  # anything else is read, or refused, by the checked open
             raise ExplorerError(f"{path}: no such file")
         if path.lower().endswith(MESH_SUFFIXES):
             if self.choose_mesh(os.path.abspath(path)):

@@ -236,3 +236,22 @@ def test_fuzzed_obj_with_side_files_loads_or_names_the_file(side_folder, libs, b
     except (ValueError, TypeError) as exc:
         assert isinstance(exc, ExplorerError)
         assert "fuzz.obj" in str(exc) or "good.mtl" in str(exc) or "a b.mtl" in str(exc)
+
+
+@pytest.mark.parametrize("kind", ["fifo", "zero", "outside"])
+def test_a_gltf_buffer_is_served_through_the_checked_open(tmp_path, kind, no_trimesh_files):
+    """A .gltf names its buffers: trimesh gets them only through the checked open, inside the
+    file's folder; a FIFO, a device or a buffer outside is a clean error naming the file."""
+    import trimesh
+
+    trimesh.creation.box().export(tmp_path / "b.gltf")
+    assert M.load_mesh(tmp_path / "b.gltf").n_faces == 12
+    buffer = tmp_path / "gltf_buffer_0.bin"
+    buffer.unlink()
+    if kind == "outside":
+        text = (tmp_path / "b.gltf").read_text()
+        (tmp_path / "b.gltf").write_text(text.replace('"gltf_buffer_0.bin"', '"../x.bin"'))
+    else:
+        special_file(tmp_path, kind, buffer.name)
+    with pytest.raises(ExplorerError, match="b.gltf"):
+        M.load_mesh(tmp_path / "b.gltf")
