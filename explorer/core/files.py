@@ -80,8 +80,9 @@ def read_checked(path, *, cap: int, what: str = "file") -> bytes:
     except PermissionError:
         raise UnreadableFile(name, what, "permission denied") from None
     except (OSError, ValueError) as exc:  # ValueError: a NUL in the name
-        if isinstance(exc, OSError) and os.path.isdir(name):
-            raise UnreadableFile(name, what, "it is a directory, not a file") from None
+        mode = _mode(name)
+        if mode is not None and not stat.S_ISREG(mode):  # a socket cannot be opened at all
+            raise UnreadableFile(name, what, f"it is {file_kind(mode)}, not a file") from None
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise UnreadableFile(name, what, reason) from None
     try:
@@ -104,6 +105,14 @@ def read_checked(path, *, cap: int, what: str = "file") -> bytes:
     if total > cap:  # it grew since fstat, or it is a file whose size says nothing (/proc)
         raise UnreadableFile(name, what, too_large(None, cap))
     return b"".join(chunks)
+
+
+def _mode(name: str) -> int | None:
+    """``st_mode`` of ``name`` (links followed), None if it cannot be had."""
+    try:
+        return os.stat(name).st_mode
+    except (OSError, ValueError):
+        return None
 
 
 def read_text_checked(path, *, cap: int, what: str = "file") -> str:

@@ -233,3 +233,13 @@ def test_a_huge_recent_files_list_is_not_read(tmp_path):
             self.last_session = str(tmp_path / "last.yaml")
 
     assert Menu().recent_files() == []
+
+
+def test_a_socket_is_named_as_a_socket(tmp_path):
+    import socket
+
+    path = tmp_path / "s.yaml"
+    with socket.socket(socket.AF_UNIX) as sock:
+        sock.bind(str(path))
+        with pytest.raises(F.UnreadableFile, match="it is a socket, not a file"):
+            F.read_checked(path, cap=10)
