@@ -26,6 +26,9 @@ import numpy as np
 from explorer.analysis.advice import MAIN_SIDE, TABLE_VERSION
 from explorer.analysis.comparison import compare, coverage
 from explorer.analysis.refine import refine_highlights
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
+from explorer.core.files import read_text_checked
 from explorer.core.lights import DirectionalLight
 from explorer.core.presets import builtin_dir, load_material_file
 from explorer.core.scene import Scene
@@ -151,23 +154,23 @@ class Progress:
 
 def _cpu_model() -> str:
     try:
-        with open("/proc/cpuinfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.lower().startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
+        text = read_text_checked("/proc/cpuinfo", cap=tol.MAX_DATA_FILE_BYTES)
+        for line in text.splitlines():
+            if line.lower().startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except ExplorerError:
         pass
     return platform.processor() or platform.machine() or "unknown"
 
 
 def _memory() -> str | None:
     try:
-        with open("/proc/meminfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("MemTotal:"):
-                    kb = int(line.split()[1])
-                    return f"{kb / 1024 / 1024:.1f} GiB"
-    except (OSError, ValueError, IndexError):
+        text = read_text_checked("/proc/meminfo", cap=tol.MAX_DATA_FILE_BYTES)
+        for line in text.splitlines():
+            if line.startswith("MemTotal:"):
+                kb = int(line.split()[1])
+                return f"{kb / 1024 / 1024:.1f} GiB"
+    except (ValueError, IndexError):  # ExplorerError is a ValueError
         pass
     return None
 

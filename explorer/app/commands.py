@@ -344,7 +344,7 @@ class Commands:
             if not path:
                 return
         path = os.fspath(path)
-        if not os.path.isfile(path):
+        if not os.path.lexists(path):  # anything else is read, or refused, by the checked open
             raise ExplorerError(f"{path}: no such file")
         if path.lower().endswith(MESH_SUFFIXES):
             if self.choose_mesh(os.path.abspath(path)):
@@ -359,6 +359,7 @@ class Commands:
         self.remember_recent(path)
 
     def _open_scene(self, scene, path: str) -> None:
+        M.check_window_lights(len(scene.lights), path)
         s = self.store.state  # the scene's material covers the mesh (groups=None)
         new = s.replace(scene=scene.replace(mesh=s.mesh), preset=scene.material.name,
                         preset_material=None, light=0, held_azimuth=None,

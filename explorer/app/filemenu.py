@@ -25,6 +25,7 @@ from explorer.app.turntablejob import DEFAULT_FRAMES, TurntableJob, turntable_si
 from explorer.core import tolerances as tol
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.files import read_text_checked
 from explorer.core.formats import EXPORT_SUFFIXES, convert
 from explorer.core.mtl import MtlError, format_mtl, mtl_import, preset_name
 from explorer.core.presets import user_dir
@@ -176,8 +177,9 @@ class FileCommands:
         if path is None or not path.is_file():
             return []
         try:
-            items = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+            text = read_text_checked(path, cap=tol.MAX_DATA_FILE_BYTES, what="recent files")
+            items = json.loads(text)
+        except ValueError as exc:  # UnreadableFile and JSON errors are ValueErrors
             log.warning("%s: cannot be read (%s); the recent files start afresh", path, exc)
             return []
         return [str(p) for p in items if isinstance(p, str)][:RECENT_MAX] if isinstance(

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
 from explorer.core.material import MODELS, RGB_KEYS, Material
@@ -366,7 +367,18 @@ def side_b(state: State) -> State:
 # -- light actions -------------------------------------------------------------------------------
 
 
+def check_window_lights(n: int, where: str = "the scene") -> None:
+    """Refuse more than ``MAX_WINDOW_LIGHTS`` lights in the window: an :class:`ExplorerError`
+    naming ``where``, the count and the cap."""
+    if n > tol.MAX_WINDOW_LIGHTS:
+        raise ExplorerError(
+            f"{where}: {n} lights; the window holds at most {tol.MAX_WINDOW_LIGHTS} "
+            "(MAX_WINDOW_LIGHTS; 'phong-explorer render' takes more)"
+        )
+
+
 def _lights(state: State, lights, selected: int | None = None) -> State:
+    check_window_lights(len(lights))
     sel = state.light if selected is None else selected
     sel = min(max(sel, 0), max(len(lights) - 1, 0))
     held = state.held_azimuth if sel == state.light else None

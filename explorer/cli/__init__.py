@@ -5,7 +5,7 @@ own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
 ``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
 User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
 block on stderr, exit status 2, no traceback; text a terminal would act on (from file names,
-keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`). SIGTERM (every
+keys, descriptions) is shown escaped (:func:`explorer.core.text.say`). SIGTERM (every
 command but ``gui``, whose window loop would hold it back) raises :class:`Terminated`, so that
 the writer's cleanup runs: the command stops with one ``error:`` line, exit status 143, and
 leaves no temporary file. Ctrl-C does the same with exit status 130: long ray work runs in
@@ -25,7 +25,7 @@ import warnings
 from contextlib import contextmanager
 
 from explorer.core.errors import Cancelled, ExplorerError, Notice
-from explorer.core.text import printable
+from explorer.core.text import say
 from explorer.core.version import __version__
 
 #: subcommand -> one-line help; each is the module ``explorer.cli.<name>``, with
@@ -87,7 +87,7 @@ def _show_notices() -> None:
 
     def show(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, Notice):
-            print(f"notice: {printable(message, keep=chr(10))}", file=sys.stderr)
+            say(f"notice: {message}", file=sys.stderr)
         else:
             original(message, category, filename, lineno, file, line)
 
@@ -137,7 +137,7 @@ def main(argv: list[str] | None = None) -> int:
             sys.stdout.flush()  # here, so a reader that went away is met below, not at exit
         return status
     except ExplorerError as exc:
-        print(f"error: {printable(exc, keep=chr(10))}", file=sys.stderr)
+        say(f"error: {exc}", file=sys.stderr)
         return 2
     except Terminated:
         print("error: terminated (SIGTERM); no unfinished file was left", file=sys.stderr)

@@ -27,7 +27,7 @@ from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import add_scene_arguments, background_from_options, build_scene
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
-from explorer.core.text import printable
+from explorer.core.text import printable, say
 from explorer.geometry.meshes import get_mesh
 from explorer.render.images import parse_size
 
@@ -76,10 +76,26 @@ def check_options(args) -> None:
     if t is not None and not (math.isfinite(t) and t > 0):
         raise ExplorerError(f"--exit-after must be a finite number of seconds > 0, got {t}")
     f = args.state_file
-    if f is not None and os.path.lexists(f) and not args.force:
-        raise ExplorerError(f"--state-file {f!r}: already exists; use --force to replace it")
+    if f is not None:
+        check_state_file(f, args.force)
     if args.session is not None and args.last:
         raise ExplorerError("--session and --last both name a session: give one")
+
+
+def check_state_file(f, force: bool) -> None:
+    """Refuse a ``--state-file`` the window could not write after every frame: a directory
+    (even with ``--force``), a file in a directory that does not exist, an existing file
+    without ``--force``. (Before, the window ran and logged one error per frame.)"""
+    shown = printable(repr(os.fspath(f)))
+    if os.path.isdir(f):
+        raise ExplorerError(f"--state-file {shown}: is a directory; give a file name")
+    parent = os.path.dirname(os.path.abspath(f))
+    if not os.path.isdir(parent):
+        raise ExplorerError(
+            f"--state-file {shown}: directory {printable(repr(parent))} does not exist"
+        )
+    if os.path.lexists(f) and not force:
+        raise ExplorerError(f"--state-file {shown}: already exists; use --force to replace it")
 
 
 def start(args):
@@ -117,7 +133,7 @@ def start_state(args):
     dirs = tuple(args.materials_dirs)
     if args.last:
         path = S.last_session_path()
-        if not path.is_file():
+        if not os.path.lexists(path):  # anything else is read, or refused, by the checked open
             raise ExplorerError(f"--last: no session kept yet ({path} does not exist)")
         return S.load_session(path, materials_dirs=dirs)
     if args.session is not None:
@@ -128,7 +144,7 @@ def start_state(args):
                             resolution=args.resolution)  # fmt: skip
     state, warnings = gui.add_mesh_materials(state, mesh, use=own)
     for w in warnings:
-        print(f"warning: {printable(w)}", file=sys.stderr)
+        say(f"warning: {printable(w)}", file=sys.stderr)
     return state, mesh
 
 
@@ -137,7 +153,7 @@ def run(args) -> int:
     check_options(args)
     reason = gui.no_display_reason()
     if reason:
-        print(gui.no_display_message(reason), file=sys.stderr)
+        say(gui.no_display_message(reason), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS
     if not logging.getLogger().handlers:
         logging.basicConfig(
@@ -157,5 +173,5 @@ def run(args) -> int:
             background=background_from_options(args), exit_after=args.exit_after,
         )  # fmt: skip
     except gui.NoDisplayError as exc:
-        print(gui.no_display_message(str(exc)), file=sys.stderr)
+        say(gui.no_display_message(str(exc)), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS

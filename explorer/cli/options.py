@@ -23,7 +23,7 @@ from explorer.core.material import MODELS
 from explorer.core.mtl import MtlError
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, load_scene
-from explorer.core.text import printable
+from explorer.core.text import printable, say
 from explorer.core.validate import Checker, notice
 from explorer.geometry.filematerials import group_materials
 from explorer.geometry.meshes import BUILTIN_MESHES, RESOLUTION, get_mesh
@@ -328,12 +328,12 @@ def mesh_materials(args, scene, mesh):
     except MtlError as exc:
         raise MtlError(f"{exc}: give --preset NAME to draw the mesh in one preset") from None
     for w in warnings:
-        print(f"warning: {printable(w)}", file=sys.stderr)
+        say(f"warning: {printable(w)}", file=sys.stderr)
     sizes = np.bincount(mesh.groups.of_vertex, minlength=len(materials))
     main = materials[int(np.argmax(sizes))]
     opacities = {m.opacity for m, size in zip(materials, sizes, strict=True) if size}
     if len(opacities) > 1:
-        print(
+        say(
             f"warning: {mesh.name}: its materials' opacities differ "
             f"({', '.join(f'{o:g}' for o in sorted(opacities))}); the whole mesh is drawn "
             f"with {main.opacity:g}",

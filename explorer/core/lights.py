@@ -48,6 +48,7 @@ from explorer.core.validate import (
     Checked,
     Checker,
     check_fields,
+    format_number,
     old_keywords,
 )
 
@@ -93,7 +94,7 @@ def _attenuation(checker: Checker, value, path):
 def _cutoff(checker: Checker, value, path):
     c = checker.number(value, path, 0.0, 180.0)
     if c is not None and 90.0 < c < 180.0:
-        checker.problem(path, f"must be in [0, 90] or exactly 180, got {c:g}")
+        checker.problem(path, f"must be in [0, 90] or exactly 180, got {format_number(c)}")
         return None
     return c
 

@@ -188,6 +188,23 @@ MAX_MESH_UNPACKED_BYTES = 256 << 20
 #: largest real ones (scenes of thousands of materials) are a few MiB, so anything larger is
 #: refused before it is read.
 MAX_MTL_FILE_BYTES = 16 << 20
+#: Longest ``newmtl`` name read (characters). An imported material keeps its name in its
+#: preset's description; a name of megabytes would make a preset file over the YAML reader's
+#: 1 MiB cap, so import would write what validate and render then refuse. Real names are a
+#: few dozen characters.
+MAX_MTL_NAME_LENGTH = 256
+#: How many ``mtllib`` libraries one OBJ may name: each is a file opened and read.
+MAX_MTL_LIBRARIES = 64
+#: Largest of the other files the product reads (bytes): the window's recent-files list, the
+#: accuracy table (about 400 KB), ``/proc/cpuinfo`` for a benchmark's machine line (a few KB
+#: per core). Read through the checked open, which never trusts a size (``/proc`` gives 0).
+MAX_DATA_FILE_BYTES = 16 << 20
+#: Most lights the window holds (a session, a scene opened in it, lights added there): eight
+#: times OpenGL's GL_MAX_LIGHTS. Each light is a row in the light panel and a handle in the
+#: view and is shaded every frame; a 20,000-light session took 40-50 s to open and to close
+#: (and was kept as a last session over the 1 MiB the reader takes). ``render`` and the
+#: library take more.
+MAX_WINDOW_LIGHTS = 64
 #: Most turntable frames one render writes: a full turn in 1-degree steps.
 MAX_TURNTABLE_FRAMES = 360
 #: Largest turntable, frames x width x height pixels, whose frames are held until the end: a

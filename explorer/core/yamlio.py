@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import os
 import re
-import stat
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
@@ -45,6 +44,7 @@ from numbers import Integral, Real
 import yaml
 
 from explorer.core.errors import Problem, ValidationError
+from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.validate import Checker, format_path, line_of
 
 #: Largest document accepted, in bytes (1 MiB: presets and scenes are a few hundred bytes).
@@ -165,50 +165,14 @@ def parse_yaml(
 
 
 def _read_bytes(name: str, what: str) -> bytes:
-    """The bytes of the regular file ``name``. It is opened without blocking (a FIFO would
-    wait for a writer forever) and refused unless it is a regular file (a FIFO, socket or
-    device is named as such), or when larger than :data:`MAX_BYTES`."""
+    """The bytes of the regular file ``name`` (:func:`explorer.core.files.read_checked`: a FIFO,
+    socket or device is refused without blocking, as is a file over :data:`MAX_BYTES`)."""
     try:
-        fd = os.open(name, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except FileNotFoundError:
-        _fail(name, None, f"cannot read {what}: no such file")
-    except IsADirectoryError:
-        _fail(name, None, f"cannot read {what}: it is a directory, not a file")
-    except PermissionError:
-        _fail(name, None, f"cannot read {what}: permission denied")
-    except OSError as exc:
-        if os.path.isdir(name):
-            _fail(name, None, f"cannot read {what}: it is a directory, not a file")
-        _fail(name, None, f"cannot read {what}: {exc.strerror or exc}")
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            _fail(name, None, f"cannot read {what}: it is {file_kind(st.st_mode)}, not a file")
-        if st.st_size > MAX_BYTES:
-            _fail(name, None, _too_big(st.st_size))
-    except BaseException:
-        os.close(fd)
-        raise
-    with os.fdopen(fd, "rb") as fh:
-        try:
-            raw = fh.read(MAX_BYTES + 1)
-        except OSError as exc:
-            _fail(name, None, f"cannot read {what}: {exc.strerror or exc}")
-        if len(raw) > MAX_BYTES:  # it grew since fstat
-            _fail(name, None, _too_big(len(raw)))
-        return raw
-
-
-def file_kind(mode: int) -> str:
-    """What a file that is not a regular file is, for messages ("a FIFO (named pipe)")."""
-    kinds = (
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISSOCK, "a socket"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISDIR, "a directory"),
-    )
-    return next((text for test, text in kinds if test(mode)), "not a regular file")
+        return read_checked(name, cap=MAX_BYTES, what=what)
+    except UnreadableFile as exc:
+        if exc.reason.startswith("too large"):
+            _fail(name, None, _too_big(exc.size))
+        _fail(name, None, f"cannot read {what}: {exc.reason}")
 
 
 def _decode(raw: bytes, file: str | None) -> str:

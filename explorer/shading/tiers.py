@@ -67,6 +67,7 @@ from pathlib import Path
 
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Notice
+from explorer.core.files import NO_SUCH_FILE, UnreadableFile, read_checked
 from explorer.geometry import bvh, bvh_numpy
 
 #: the environment variable that picks the mode
@@ -311,30 +312,16 @@ class _NotRegular(OSError):
 
 
 def read_small(path, limit: int = MAX_SMALL_FILE) -> bytes:
-    """The bytes of a small regular file, never blocking: opened with ``O_NONBLOCK`` (a FIFO
-    does not wait for a writer), checked to be a regular file of at most ``limit`` bytes
-    (else :class:`_NotRegular`, an OSError), read at most ``limit + 1`` bytes.
-    FileNotFoundError when there is none. (A local form of the checked open of
-    explorer.core; the marker and attempt files are read through it.)"""
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    """The bytes of a small regular file of the cache, never blocking, through the product's
+    one checked open (:func:`explorer.core.files.read_checked`: ``O_NONBLOCK``, a regular file
+    only, at most ``limit`` bytes read). FileNotFoundError when there is none (no marker yet is
+    the normal case); :class:`_NotRegular` (an OSError) for anything else it refuses."""
     try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise _NotRegular(f"{path}: not a regular file")
-        if st.st_size > limit:
-            raise _NotRegular(f"{path}: {st.st_size} bytes, more than {limit}")
-        chunks, total = [], 0
-        while total <= limit:
-            chunk = os.read(fd, limit + 1 - total)
-            if not chunk:
-                break
-            chunks.append(chunk)
-            total += len(chunk)
-        if total > limit:
-            raise _NotRegular(f"{path}: more than {limit} bytes")
-        return b"".join(chunks)
-    finally:
-        os.close(fd)
+        return read_checked(path, cap=limit, what="compile cache file")
+    except UnreadableFile as exc:
+        if exc.reason == NO_SUCH_FILE:
+            raise FileNotFoundError(os.fspath(path)) from None
+        raise _NotRegular(str(exc)) from None
 
 
 def _json(path) -> dict:

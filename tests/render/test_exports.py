@@ -347,3 +347,19 @@ def test_progress_bar_draws_on_a_terminal_only():
     text = term.getvalue()
     assert text.count("\r") == 4 and text.endswith("] 4/4\n")
     assert "\rturntable [" + "#" * 15 + "-" * 15 + "] 2/4" in text
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".ply", ".glb"])
+def test_an_export_larger_than_the_read_cap_is_written_with_a_warning(
+    tmp_path, monkeypatch, capsys, suffix
+):
+    """A 5M-vertex export (1.1 GB .obj, 320 MB .glb) is more than ``--mesh`` reads back: the
+    write says so, naming the cap (lowered here so that the file stays small)."""
+    from explorer.core import tolerances
+
+    monkeypatch.setattr(tolerances, "MAX_MESH_FILE_BYTES", 2048)
+    out = tmp_path / f"big{suffix}"
+    assert main(["render", "--mesh", "sphere", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert f"{out} is {out.stat().st_size} bytes, more than the 2048 bytes" in err
+    assert "MAX_MESH_FILE_BYTES" in err
