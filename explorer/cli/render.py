@@ -22,7 +22,6 @@ import sys
 from pathlib import Path
 
 from explorer.cli.options import (
-    ProgressBar,
     add_scene_arguments,
     background_from_options,
     build_scene,
@@ -34,6 +33,7 @@ from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
+from explorer.core.progress import Progress
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
@@ -151,7 +151,7 @@ def run_obj(args, scene, mesh, materials) -> int:
 
 def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -> int:
     """``--turntable N``: N frames of the orbit into a GIF or MP4, with a progress bar."""
-    bar = ProgressBar(sys.stderr, "turntable")
+    bar = Progress("turntable")
     frames = turntable_frames(
         scene,
         mesh,

@@ -253,24 +253,3 @@ def test_orbit_turns_viewer_and_lights_together():
     a = vertex_colors(scene, mesh)
     b = vertex_colors(s, mesh)
     assert np.abs(np.sort(a, axis=0) - np.sort(b, axis=0)).max() < 1e-9
-
-
-def test_progress_bar_draws_on_a_terminal_only():
-    import io
-
-    from explorer.cli.options import ProgressBar
-
-    class Terminal(io.StringIO):
-        def isatty(self):
-            return True
-
-    term, pipe = Terminal(), io.StringIO()
-    for stream in (term, pipe):
-        bar = ProgressBar(stream, "turntable")
-        for k in range(1, 5):
-            bar.update(k, 4)
-        bar.close()
-    assert pipe.getvalue() == ""
-    text = term.getvalue()
-    assert text.count("\r") == 4 and text.endswith("] 4/4\n")
-    assert "\rturntable [" + "#" * 15 + "-" * 15 + "] 2/4" in text

@@ -37,7 +37,7 @@ from explorer.core.tolerances import GOLDEN_COLOR_ABS_TOL
 from explorer.geometry import meshes as M
 from explorer.render.camera import FRAME_MARGIN, Camera, back_to_front, camera_for
 from explorer.render.exports import mesh_file_bytes
-from explorer.render.images import check_size, encode_png, parse_size, read_png
+from explorer.render.images import check_size, decode_png, encode_png, parse_size, read_png
 from explorer.render.offscreen import (
     BACKGROUND,
     LABEL_HEIGHT,
@@ -272,15 +272,70 @@ def test_parse_size():
         check_size((400.5, 300))
 
 
-def test_png_round_trip(tmp_path):
+def _vtk_png(img=None, path=None):
+    """VTK's PNG codec, the independent one the package's (Pillow's) is checked against:
+    ``img`` -> file bytes, or the file ``path`` -> (h, w, c) uint8."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
+
+    if img is not None:
+        h, w, c = img.shape
+        image = vtkImageData()
+        image.SetDimensions(w, h, 1)
+        arr = numpy_to_vtk(np.ascontiguousarray(img[::-1].reshape(-1, c)), deep=True)
+        image.GetPointData().SetScalars(arr)
+        writer = vtkPNGWriter()
+        writer.SetWriteToMemory(True)
+        writer.SetInputData(image)
+        writer.Write()
+        return bytes(memoryview(writer.GetResult()))
+    reader = vtkPNGReader()
+    reader.SetFileName(str(path))
+    reader.Update()
+    out = reader.GetOutput()
+    w, h, _ = out.GetDimensions()
+    return vtk_to_numpy(out.GetPointData().GetScalars()).reshape(h, w, -1)[::-1]
+
+
+def _chunks(data: bytes) -> list[bytes]:
+    names, at = [], 8
+    while at < len(data):
+        length = int.from_bytes(data[at : at + 4], "big")
+        names.append(data[at + 4 : at + 8])
+        at += 12 + length
+    return names
+
+
+def test_png_round_trip_and_vtk_agrees(tmp_path):
     rng = np.random.default_rng(1)
-    for c in (3, 4):
+    for c, colour_type in ((3, 2), (4, 6)):  # PNG colour types: RGB, RGBA
         img = rng.integers(0, 256, (7, 11, c), dtype=np.uint8)
+        data = encode_png(img)
         path = tmp_path / f"x{c}.png"
-        path.write_bytes(encode_png(img))
+        path.write_bytes(data)
         assert np.array_equal(read_png(path), img)
-    with pytest.raises(ExplorerError, match="PNG"):
+        # 8-bit, the colour type, nothing but the picture; VTK reads it the same and the
+        # codec reads VTK's file the same
+        assert data[24:26] == bytes([8, colour_type])
+        assert _chunks(data) == [b"IHDR", b"IDAT", b"IEND"]
+        assert np.array_equal(_vtk_png(path=path), img)
+        assert np.array_equal(decode_png(_vtk_png(img)), img)
+
+
+def test_png_reading_refuses_what_it_cannot_read(tmp_path):
+    with pytest.raises(ExplorerError, match="missing.png: not a readable PNG file"):
         read_png(tmp_path / "missing.png")
+    data = encode_png(np.zeros((4, 5, 3), np.uint8))
+    with pytest.raises(ExplorerError, match="half.png: not a readable PNG file"):
+        decode_png(data[: len(data) // 2], "half.png")
+    with pytest.raises(ExplorerError, match="x.gif: not a readable PNG file"):
+        decode_png(b"GIF89a" + bytes(40), "x.gif")
+    grey = np.arange(20, dtype=np.uint8).reshape(4, 5, 1)
+    assert np.array_equal(decode_png(_vtk_png(grey)), np.repeat(grey, 3, axis=2))
+    deep = _vtk_png(np.full((4, 5, 3), 40000, np.uint16))  # a 16-bit RGB file
+    with pytest.raises(ExplorerError, match="deep.png: a 16-bit PNG"):
+        decode_png(deep, "deep.png")
 
 
 def test_write_atomic(tmp_path):

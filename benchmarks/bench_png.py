@@ -1,0 +1,126 @@
+"""The PNG codec: VTK's writer and reader (the codec before issue 34) beside Pillow's (the one of
+explorer/render/images.py), on one window-sized frame.
+
+    python benchmarks/bench_png.py                     # 1100x720 (the window's size), 15 repeats
+    python benchmarks/bench_png.py --size 1920x1080 --repeat 31
+
+The frame is a real off-screen render (gold on the teapot, the sheet's background), so the
+compressor sees what it sees in use. Prints the median wall time of each (after one untimed
+call) in milliseconds and the file size; both decoders must give the frame back exactly (they
+read from a file in the page cache, as the tests and scripts do).
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import os
+import shutil
+import statistics
+import tempfile
+import time
+
+import common  # noqa: F401 - the compiled tier (benchmarks/common.py)
+import numpy as np
+
+
+def vtk_encode(img: np.ndarray) -> bytes:
+    """VTK's PNG writer (what explorer.render.images used before issue 34)."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkPNGWriter
+
+    h, w, c = img.shape
+    data = vtkImageData()
+    data.SetDimensions(w, h, 1)
+    arr = numpy_to_vtk(np.ascontiguousarray(img[::-1].reshape(-1, c)), deep=True)
+    arr.SetNumberOfComponents(c)
+    data.GetPointData().SetScalars(arr)
+    writer = vtkPNGWriter()
+    writer.SetWriteToMemory(True)
+    writer.SetInputData(data)
+    writer.Write()
+    return bytes(memoryview(writer.GetResult()))
+
+
+def vtk_decode(path: str) -> np.ndarray:
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOImage import vtkPNGReader
+
+    reader = vtkPNGReader()
+    reader.SetFileName(path)
+    reader.Update()
+    out = reader.GetOutput()
+    w, h, _ = out.GetDimensions()
+    arr = vtk_to_numpy(out.GetPointData().GetScalars())
+    return np.ascontiguousarray(arr.reshape(h, w, -1)[::-1])
+
+
+def pillow_decode(path: str) -> np.ndarray:
+    from explorer.render.images import read_png
+
+    return read_png(path)
+
+
+def frame(size: tuple[int, int]) -> np.ndarray:
+    from explorer.core.presets import find_preset
+    from explorer.core.scene import Scene
+    from explorer.geometry.meshes import get_mesh
+    from explorer.render.offscreen import render_image
+
+    scene = Scene(material=find_preset("gold"))
+    return render_image(scene, get_mesh("teapot", 24), size)
+
+
+def median_ms(fn, repeat: int) -> float:
+    fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return 1000.0 * statistics.median(times)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--size", default="1100x720", help="frame size WxH (default %(default)s)")
+    ap.add_argument("--repeat", type=int, default=15, help="timed calls each (default 15)")
+    args = ap.parse_args(argv)
+    from explorer.render.images import encode_png, parse_size
+
+    size = parse_size(args.size)
+    img = frame(size)
+    assert img.shape == (size[1], size[0], 3) and img.dtype == np.uint8
+    vtk_png, pil_png = vtk_encode(img), encode_png(img)
+    tmp = tempfile.mkdtemp(prefix="bench_png_")
+    files = {}
+    for name, data in (("VTK", vtk_png), ("Pillow", pil_png)):
+        files[name] = os.path.join(tmp, f"{name}.png")
+        with open(files[name], "wb") as fh:
+            fh.write(data)
+        for decode in (vtk_decode, pillow_decode):
+            assert np.array_equal(decode(files[name]), img), f"{name} file, {decode.__name__}"
+    from PIL import Image
+    from vtkmodules.vtkCommonCore import vtkVersion
+
+    with Image.open(io.BytesIO(pil_png)) as im:
+        kind = f"{im.mode}, {im.info.get('dpi', 'no dpi')}"
+    print(f"frame {size[0]}x{size[1]} RGB 8-bit (a teapot render); median of {args.repeat} calls")
+    print(f"VTK {vtkVersion.GetVTKVersion()}, Pillow {Image.__version__}; Pillow's file: {kind}")
+    print("| codec | encode ms | decode ms | file bytes |")
+    print("|---|---:|---:|---:|")
+    rows = (
+        ("VTK (vtkPNGWriter / Reader)", vtk_encode, vtk_decode, "VTK", vtk_png),
+        ("Pillow (explorer.render.images)", encode_png, pillow_decode, "Pillow", pil_png),
+    )
+    for name, enc, dec, key, data in rows:
+        e = median_ms(lambda enc=enc: enc(img), args.repeat)
+        d = median_ms(lambda dec=dec, key=key: dec(files[key]), args.repeat)
+        print(f"| {name} | {e:.1f} | {d:.1f} | {len(data):,} |")
+    shutil.rmtree(tmp)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
