@@ -17,43 +17,18 @@ import io
 import os
 import shutil
 import statistics
+import sys
 import tempfile
 import time
+from pathlib import Path
 
 import common  # noqa: F401 - the compiled tier (benchmarks/common.py)
 import numpy as np
 
-
-def vtk_encode(img: np.ndarray) -> bytes:
-    """VTK's PNG writer (what explorer.render.images used before issue 34)."""
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOImage import vtkPNGWriter
-
-    h, w, c = img.shape
-    data = vtkImageData()
-    data.SetDimensions(w, h, 1)
-    arr = numpy_to_vtk(np.ascontiguousarray(img[::-1].reshape(-1, c)), deep=True)
-    arr.SetNumberOfComponents(c)
-    data.GetPointData().SetScalars(arr)
-    writer = vtkPNGWriter()
-    writer.SetWriteToMemory(True)
-    writer.SetInputData(data)
-    writer.Write()
-    return bytes(memoryview(writer.GetResult()))
-
-
-def vtk_decode(path: str) -> np.ndarray:
-    from vtkmodules.util.numpy_support import vtk_to_numpy
-    from vtkmodules.vtkIOImage import vtkPNGReader
-
-    reader = vtkPNGReader()
-    reader.SetFileName(path)
-    reader.Update()
-    out = reader.GetOutput()
-    w, h, _ = out.GetDimensions()
-    arr = vtk_to_numpy(out.GetPointData().GetScalars())
-    return np.ascontiguousarray(arr.reshape(h, w, -1)[::-1])
+# VTK's codec, which the package used before, lives with the tests as their independent oracle
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from helpers.vtkpng import encode as vtk_encode  # noqa: E402
+from helpers.vtkpng import read as vtk_decode  # noqa: E402
 
 
 def pillow_decode(path: str) -> np.ndarray:

@@ -15,6 +15,7 @@ import tempfile
 import numpy as np
 import pytest
 import trimesh
+from helpers import vtkpng
 from helpers.imagecompare import (
     MAX_DIFFERENT_FRACTION,
     PIXEL_TOL,
@@ -272,32 +273,6 @@ def test_parse_size():
         check_size((400.5, 300))
 
 
-def _vtk_png(img=None, path=None):
-    """VTK's PNG codec, the independent one the package's (Pillow's) is checked against:
-    ``img`` -> file bytes, or the file ``path`` -> (h, w, c) uint8."""
-    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOImage import vtkPNGReader, vtkPNGWriter
-
-    if img is not None:
-        h, w, c = img.shape
-        image = vtkImageData()
-        image.SetDimensions(w, h, 1)
-        arr = numpy_to_vtk(np.ascontiguousarray(img[::-1].reshape(-1, c)), deep=True)
-        image.GetPointData().SetScalars(arr)
-        writer = vtkPNGWriter()
-        writer.SetWriteToMemory(True)
-        writer.SetInputData(image)
-        writer.Write()
-        return bytes(memoryview(writer.GetResult()))
-    reader = vtkPNGReader()
-    reader.SetFileName(str(path))
-    reader.Update()
-    out = reader.GetOutput()
-    w, h, _ = out.GetDimensions()
-    return vtk_to_numpy(out.GetPointData().GetScalars()).reshape(h, w, -1)[::-1]
-
-
 def _chunks(data: bytes) -> list[bytes]:
     names, at = [], 8
     while at < len(data):
@@ -319,8 +294,8 @@ def test_png_round_trip_and_vtk_agrees(tmp_path):
         # codec reads VTK's file the same
         assert data[24:26] == bytes([8, colour_type])
         assert _chunks(data) == [b"IHDR", b"IDAT", b"IEND"]
-        assert np.array_equal(_vtk_png(path=path), img)
-        assert np.array_equal(decode_png(_vtk_png(img)), img)
+        assert np.array_equal(vtkpng.read(path), img)
+        assert np.array_equal(decode_png(vtkpng.encode(img)), img)
 
 
 def test_png_reading_refuses_what_it_cannot_read(tmp_path):
@@ -332,8 +307,8 @@ def test_png_reading_refuses_what_it_cannot_read(tmp_path):
     with pytest.raises(ExplorerError, match="x.gif: not a readable PNG file"):
         decode_png(b"GIF89a" + bytes(40), "x.gif")
     grey = np.arange(20, dtype=np.uint8).reshape(4, 5, 1)
-    assert np.array_equal(decode_png(_vtk_png(grey)), np.repeat(grey, 3, axis=2))
-    deep = _vtk_png(np.full((4, 5, 3), 40000, np.uint16))  # a 16-bit RGB file
+    assert np.array_equal(decode_png(vtkpng.encode(grey)), np.repeat(grey, 3, axis=2))
+    deep = vtkpng.encode(np.full((4, 5, 3), 40000, np.uint16))  # a 16-bit RGB file
     with pytest.raises(ExplorerError, match="deep.png: a 16-bit PNG"):
         decode_png(deep, "deep.png")
 
