@@ -4,10 +4,10 @@ explorer/render/images.py), on one window-sized frame.
     python benchmarks/bench_png.py                     # 1100x720 (the window's size), 15 repeats
     python benchmarks/bench_png.py --size 1920x1080 --repeat 31
 
-The frame is a real off-screen render (gold on the teapot, the sheet's background), so the
-compressor sees what it sees in use. Prints the median wall time of each (after one untimed
-call) in milliseconds and the file size; both decoders must give the frame back exactly (they
-read from a file in the page cache, as the tests and scripts do).
+The frame is a real off-screen render (gold on the teapot, the default background), so the
+compressor sees what it sees in use. Prints the median wall time of each in milliseconds (the
+two codecs' calls alternate, so both see the same load; one untimed round first) and the file
+size; both decoders must give the frame back exactly (they read a file in the page cache).
 """
 
 from __future__ import annotations
@@ -47,14 +47,18 @@ def frame(size: tuple[int, int]) -> np.ndarray:
     return render_image(scene, get_mesh("teapot", 24), size)
 
 
-def median_ms(fn, repeat: int) -> float:
-    fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
+def medians_ms(fns, repeat: int) -> list[float]:
+    """Median wall time in ms of each of ``fns`` over ``repeat`` rounds, the calls of a round
+    one after the other (A B A B ...: both see the same load), after one untimed round."""
+    for fn in fns:
         fn()
-        times.append(time.perf_counter() - t0)
-    return 1000.0 * statistics.median(times)
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for fn, out in zip(fns, times, strict=True):
+            t0 = time.perf_counter()
+            fn()
+            out.append(time.perf_counter() - t0)
+    return [1000.0 * statistics.median(t) for t in times]
 
 
 def main(argv=None) -> int:
@@ -89,10 +93,11 @@ def main(argv=None) -> int:
         ("VTK (vtkPNGWriter / Reader)", vtk_encode, vtk_decode, "VTK", vtk_png),
         ("Pillow (explorer.render.images)", encode_png, pillow_decode, "Pillow", pil_png),
     )
-    for name, enc, dec, key, data in rows:
-        e = median_ms(lambda enc=enc: enc(img), args.repeat)
-        d = median_ms(lambda dec=dec, key=key: dec(files[key]), args.repeat)
+    enc = medians_ms([lambda f=r[1]: f(img) for r in rows], args.repeat)
+    dec = medians_ms([lambda f=r[2], k=r[3]: f(files[k]) for r in rows], args.repeat)
+    for (name, *_, data), e, d in zip(rows, enc, dec, strict=True):
         print(f"| {name} | {e:.1f} | {d:.1f} | {len(data):,} |")
+    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     shutil.rmtree(tmp)
     return 0
 
