@@ -59,8 +59,8 @@ def parse_size(text: str) -> tuple[int, int]:
 
 
 #: zlib level of the PNG files written (lossless at every level): 5, VTK's writer's, which the
-#: package used before; Pillow's default 6 took twice as long for files 4 % smaller on a
-#: 1100x720 render (benchmarks/bench_png.py)
+#: package used before; Pillow's default 6 took 1.6-1.9 times as long for files 4 % smaller on
+#: a 1100x720 render (benchmarks/bench_png.py)
 PNG_COMPRESS_LEVEL = 5
 
 
