@@ -555,7 +555,8 @@ def parse_colour(key: str, text: str) -> Vec3:
     ):
         if len(h) == 3:
             h = "".join(c * 2 for c in h)
-        return tuple(int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+        r, g, b = (int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+        return r, g, b
     parts = [p for p in t.replace(",", " ").split() if p]
     try:
         rgb = tuple(float(p) for p in parts)
