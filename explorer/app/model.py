@@ -237,7 +237,8 @@ def use_mesh_materials(state: State) -> State:
 
 def select_group(state: State, index: int) -> State:
     """Edit group ``index`` of the mesh's own materials (its material goes to the panel)."""
-    if state.groups is None:
+    mm = state.mesh_materials
+    if state.groups is None or mm is None:
         raise ExplorerError("the mesh's own materials are not shown: there is no group to edit")
     n = len(state.groups)
     if isinstance(index, bool) or not 0 <= int(index) < n:
@@ -245,7 +246,7 @@ def select_group(state: State, index: int) -> State:
     i = int(index)
     return state.replace(
         scene=state.scene.replace(material=state.groups[i]), group=i,
-        preset_material=state.mesh_materials.materials[i],
+        preset_material=mm.materials[i],
     )  # fmt: skip
 
 
@@ -288,7 +289,8 @@ def viewer_of_camera(camera: Camera) -> Viewer:
     an infinite viewer looking along the camera (parallel projection)."""
     if camera.parallel:
         return Viewer(to_viewer=tuple(np.subtract(camera.position, camera.focal_point)))
-    return Viewer(eye=tuple(float(c) for c in camera.position))
+    x, y, z = camera.position
+    return Viewer(eye=(float(x), float(y), float(z)))
 
 
 def set_camera(state: State, camera: Camera | None) -> State:
@@ -565,7 +567,8 @@ def parse_colour(key: str, text: str) -> Vec3:
     ):
         if len(h) == 3:
             h = "".join(c * 2 for c in h)
-        return tuple(int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+        r, g, b = (int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+        return r, g, b
     parts = [p for p in t.replace(",", " ").split() if p]
     try:
         rgb = tuple(float(p) for p in parts)

@@ -25,7 +25,7 @@ import warnings
 from contextlib import contextmanager
 
 from explorer.core.errors import Cancelled, ExplorerError, Notice
-from explorer.core.text import say
+from explorer.core.text import printable, say
 from explorer.core.version import __version__
 
 #: subcommand -> one-line help; each is the module ``explorer.cli.<name>``, with
@@ -80,18 +80,25 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _show_notices() -> None:
-    """Print every :class:`~explorer.core.errors.Notice` (a preset hiding another, an old key
-    name) as one ``notice: ...`` line on stderr, not as a Python warning."""
-    original = warnings.showwarning
+@contextmanager
+def _notices_as_lines():
+    """While a command runs, every :class:`~explorer.core.errors.Notice` (a preset hiding
+    another, an old key name) shown is one ``notice: ...`` line on stderr, not a Python
+    warning. Only the form changes (``warnings.formatwarning``), and only for the command's
+    time: the warning filters decide as ever, and a caller recording warnings
+    (``pytest.warns``, ``warnings.catch_warnings(record=True)``) receives them."""
+    original = warnings.formatwarning
 
-    def show(message, category, filename, lineno, file=None, line=None):
+    def form(message, category, filename, lineno, line=None):
         if issubclass(category, Notice):
-            say(f"notice: {message}", file=sys.stderr)
-        else:
-            original(message, category, filename, lineno, file, line)
+            return f"notice: {printable(message, keep=chr(10))}\n"
+        return original(message, category, filename, lineno, line)
 
-    warnings.showwarning = show
+    warnings.formatwarning = form
+    try:
+        yield
+    finally:
+        warnings.formatwarning = original
 
 
 #: exit status after SIGTERM (the shell's 128 + signal number)
@@ -124,7 +131,11 @@ def _sigterm_raises(enabled: bool = True):
 
 
 def main(argv: list[str] | None = None) -> int:
-    _show_notices()
+    with _notices_as_lines():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         parser = build_parser()
     except KeyboardInterrupt:  # Ctrl-C while the engine loads: nothing was started

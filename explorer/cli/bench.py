@@ -33,10 +33,11 @@ import os
 import sys
 from pathlib import Path
 
-from explorer.analysis.benchmark import BenchConfig, Progress, run_bench
+from explorer.analysis.benchmark import BenchConfig, run_bench
 from explorer.analysis.report import markdown, plot_png, table_bytes
 from explorer.core.atomic import write_all_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.progress import Progress
 from explorer.core.text import say
 
 #: bench -> one-line help
@@ -103,7 +104,7 @@ def run_accuracy(args) -> int:
             raise ExplorerError(f"--repeats must be at least 1, got {args.repeats}")
         config = dataclasses.replace(config, repeats=args.repeats)
     command = "phong-explorer bench accuracy" + (" --quick" if args.quick else "")
-    table = run_bench(config, progress=Progress())
+    table = run_bench(config, progress=Progress("accuracy"))
     table["command"] = command
     files = {paths["json"]: table_bytes(table)}
     png = plot_png(table)

@@ -10,7 +10,9 @@
 
 A SCENE file gives the start (material, lights, viewer, mesh); the options are the ``render``
 command's and override their part of it. The window needs a display: without one the command
-prints one line saying why and what to run instead, and exits with status 3.
+prints one line saying why and what to run instead, and exits with status 3; so it does when Qt's
+xcb platform lacks system libraries (:mod:`explorer.app.qtlibs`: the line names them and the apt
+command).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import math
 import os
 import sys
 
+from explorer.app import qtlibs
 from explorer.app import session as S
 from explorer.app import start as gui
 from explorer.app.model import DEFAULT_PLACEMENT
@@ -154,6 +157,10 @@ def run(args) -> int:
     reason = gui.no_display_reason()
     if reason:
         say(gui.no_display_message(reason), file=sys.stderr)
+        return gui.NO_DISPLAY_STATUS
+    missing = qtlibs.missing_libraries()  # before Qt is asked: it would abort (status 134)
+    if missing:
+        print(qtlibs.missing_message(missing), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS
     if not logging.getLogger().handlers:
         logging.basicConfig(

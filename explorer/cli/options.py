@@ -340,29 +340,3 @@ def mesh_materials(args, scene, mesh):
             file=sys.stderr,
         )
     return scene.replace(material=main), materials
-
-
-class ProgressBar:
-    """A one-line progress bar on a terminal (nothing when ``stream`` is not one)."""
-
-    WIDTH = 30
-
-    def __init__(self, stream, label: str):
-        self.stream, self.label = stream, label
-        isatty = getattr(stream, "isatty", None)
-        self.shown = bool(isatty and isatty())
-        self.drawn = False
-
-    def update(self, done: int, total: int) -> None:
-        if not self.shown:
-            return
-        filled = self.WIDTH * done // max(total, 1)
-        bar = "#" * filled + "-" * (self.WIDTH - filled)
-        self.stream.write(f"\r{self.label} [{bar}] {done}/{total}")
-        self.stream.flush()
-        self.drawn = True
-
-    def close(self) -> None:
-        if self.drawn:
-            self.stream.write("\n")
-            self.stream.flush()

@@ -23,7 +23,6 @@ import sys
 from pathlib import Path
 
 from explorer.cli.options import (
-    ProgressBar,
     add_scene_arguments,
     background_from_options,
     build_scene,
@@ -36,6 +35,7 @@ from explorer.core.atomic import write_all_atomic, write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
+from explorer.core.progress import Progress
 from explorer.core.text import say
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
@@ -178,7 +178,7 @@ def warn_if_unreadable(out, size: int) -> None:
 
 def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -> int:
     """``--turntable N``: N frames of the orbit into a GIF or MP4, with a progress bar."""
-    bar = ProgressBar(sys.stderr, "turntable")
+    bar = Progress("turntable")
     frames = iter_frames(
         scene,
         mesh,

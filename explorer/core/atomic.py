@@ -43,7 +43,7 @@ def sweep_stale_temps(directory, *, now: float | None = None) -> list[Path]:
     it cannot remove or a directory it cannot list."""
     now = time.time() if now is None else now
     uid = os.getuid() if hasattr(os, "getuid") else None
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(os.scandir(directory))
     except OSError:

@@ -161,8 +161,8 @@ def _decode(data: bytes | str, source: str) -> str:
         text = data
     else:
         if b"\0" in data:
-            line = data[: data.index(b"\0")].count(b"\n") + 1
-            raise MtlError(f"{source}:{line}: binary data (a NUL byte): not an .mtl text file")
+            at = data[: data.index(b"\0")].count(b"\n") + 1
+            raise MtlError(f"{source}:{at}: binary data (a NUL byte): not an .mtl text file")
         try:
             text = data.decode("utf-8-sig")
         except UnicodeDecodeError:
@@ -350,9 +350,8 @@ def _colour(words: list[str], where: str) -> tuple[float, float, float]:
     values = [_float(a, where, what) for a in args]
     for v in values:
         _check_range(v, COEFFICIENT_RANGE, where, what)
-    if len(values) == 1:
-        values = values * 3
-    return tuple(values)
+    r, g, b = values * 3 if len(values) == 1 else values
+    return r, g, b
 
 
 def _check_range(value: float, bounds: tuple[float, float], where: str, what: str) -> None:

@@ -67,7 +67,10 @@ class PresetInfo:
 # -- directories -----------------------------------------------------------------------------
 def builtin_dir() -> Path:
     """Directory of the built-in presets (inside the installed package)."""
-    return Path(os.fspath(resources.files("explorer.materials")))
+    root = resources.files("explorer.materials")
+    if not isinstance(root, os.PathLike):  # e.g. a zipped install: the presets are no files
+        raise TypeError(f"the built-in presets are not files on disk: {root!r}")
+    return Path(os.fspath(root))
 
 
 def user_dir() -> Path:
@@ -135,6 +138,7 @@ def load_material_file(path) -> Material:
         material = parse_material(doc.data, checker, ())
     if checker.problems:
         raise ValidationError(sorted(checker.problems, key=lambda p: p.line or 0))
+    assert material is not None  # parse_material records a problem whenever it gives None
     return material.replace(name=Path(os.fspath(path)).stem)
 
 

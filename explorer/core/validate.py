@@ -27,7 +27,7 @@ import math
 import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from numbers import Real
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -287,6 +287,8 @@ class Checked:
 
     KEYS: ClassVar[Mapping[str, Check]] = {}
     RENAMED: ClassVar[Mapping[str, tuple[str, str]]] = {}
+    #: every subclass is a dataclass (what ``dataclasses.fields`` needs; declared for checkers)
+    __dataclass_fields__: ClassVar[dict[str, dataclasses.Field[Any]]]
 
     def __post_init__(self):
         self._check(type(self).KEYS)

@@ -40,6 +40,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
+from typing import NoReturn
 
 import yaml
 
@@ -138,8 +139,7 @@ def parse_yaml(
         _fail(file, exc.line, exc.message)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else None
-        _fail(file, line, _syntax_message(exc, mark))
+        _fail(file, mark.line + 1 if mark is not None else None, _syntax_message(exc, mark))
     except yaml.reader.ReaderError as exc:
         line = text.count("\n", 0, exc.position) + 1
         _fail(file, line, _reader_message(exc))
@@ -202,7 +202,7 @@ def _too_big(size: int | None) -> str:
     return f"is too large: {got} bytes, the limit is {MAX_BYTES} bytes ({MAX_BYTES >> 20} MiB)"
 
 
-def _fail(file, line, message):
+def _fail(file: str | None, line: int | None, message: str) -> NoReturn:
     raise ValidationError([Problem(message, file, line)])
 
 

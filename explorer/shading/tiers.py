@@ -126,6 +126,9 @@ _state = {
     "checked": 0.0,  # when the marker was last looked for
     "failed": None,  # why the compiled engine is unavailable
 }
+#: the background compiles this process started, kept (a Popen dropped while its process runs
+#: warns, ResourceWarning); those that ended are reaped at the next start
+_children: list[subprocess.Popen] = []
 
 
 def mode() -> str:
@@ -528,8 +531,9 @@ def _start_background(told: str = PREPARING) -> None:
         directory = cache_dir()
         directory.mkdir(parents=True, exist_ok=True)
         env = dict(os.environ, **{ENV: "compiled"})
+        _children[:] = [p for p in _children if p.poll() is None]
         with open(log_path(), "ab") as log:
-            subprocess.Popen(
+            child = subprocess.Popen(
                 warm_command(),
                 stdin=subprocess.DEVNULL,
                 stdout=log,
@@ -539,6 +543,7 @@ def _start_background(told: str = PREPARING) -> None:
                 start_new_session=True,  # Ctrl-C in the terminal does not stop it
                 close_fds=True,
             )
+        _children.append(child)
     except OSError as exc:  # no writable cache directory, no interpreter to start
         _unavailable(exc.strerror or str(exc), stacklevel=4)
         return
