@@ -160,7 +160,7 @@ def run(args) -> int:
         return gui.NO_DISPLAY_STATUS
     missing = qtlibs.missing_libraries()  # before Qt is asked: it would abort (status 134)
     if missing:
-        print(qtlibs.missing_message(missing), file=sys.stderr)
+        say(qtlibs.missing_message(missing), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS
     if not logging.getLogger().handlers:
         logging.basicConfig(

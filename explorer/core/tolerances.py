@@ -220,3 +220,6 @@ MAX_TURNTABLE_PIXELS = 1 << 32
 #: 192 MiB as RGB bytes and several times that inside VTK while drawing. A sheet of large
 #: tiles is checked before anything is allocated (beyond it VTK aborts with std::bad_alloc).
 MAX_PICTURE_PIXELS = 8192 * 8192
+#: Largest PNG file read (bytes): the largest picture as RGBA without any compression, plus
+#: 1 MiB for its chunks' headers (a PNG of MAX_PICTURE_PIXELS is never larger).
+MAX_PNG_FILE_BYTES = 4 * MAX_PICTURE_PIXELS + (1 << 20)

@@ -10,7 +10,8 @@ import re
 import numpy as np
 
 from explorer.core.errors import ExplorerError
-from explorer.core.tolerances import MAX_PICTURE_PIXELS
+from explorer.core.files import read_checked
+from explorer.core.tolerances import MAX_PICTURE_PIXELS, MAX_PNG_FILE_BYTES
 
 #: default image size (width, height)
 DEFAULT_SIZE = (400, 400)
@@ -106,14 +107,10 @@ def decode_png(data: bytes, name: str = "PNG data") -> np.ndarray:
 
 
 def read_png(path) -> np.ndarray:
-    """An (h, w, 3|4) uint8 image from a PNG file (:func:`decode_png`)."""
+    """An (h, w, 3|4) uint8 image from a PNG file (:func:`decode_png`), read through the
+    checked open (a regular file of at most ``MAX_PNG_FILE_BYTES``)."""
     name = os.fspath(path)
-    try:
-        with open(name, "rb") as fh:
-            data = fh.read()
-    except OSError as exc:
-        raise ExplorerError(f"{name}: not a readable PNG file ({exc.strerror or exc})") from None
-    return decode_png(data, name)
+    return decode_png(read_checked(name, cap=MAX_PNG_FILE_BYTES, what="PNG file"), name)
 
 
 def side_by_side(left, right, gap: int = 0, fill=(0, 0, 0)) -> np.ndarray:

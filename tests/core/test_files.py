@@ -93,6 +93,7 @@ ALLOWED = {
         "parses bytes read by read_mesh_file, with sidefiles.CheckedResolver for side files"
     ),
     ("explorer/shading/tiers.py", "open"): "appends to the compile log (a write)",
+    ("explorer/render/images.py", "x.open"): "Pillow decodes PNG bytes already read (BytesIO)",
     ("explorer/shading/tiers.py", "os.open"): (
         "the compile lock, opened (O_NONBLOCK, O_NOFOLLOW) to flock it, after lstat set aside "
         "anything that is not a regular file"

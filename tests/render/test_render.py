@@ -299,8 +299,11 @@ def test_png_round_trip_and_vtk_agrees(tmp_path):
 
 
 def test_png_reading_refuses_what_it_cannot_read(tmp_path):
-    with pytest.raises(ExplorerError, match="missing.png: not a readable PNG file"):
+    with pytest.raises(ExplorerError, match="missing.png: cannot read PNG file: no such file"):
         read_png(tmp_path / "missing.png")
+    os.mkfifo(tmp_path / "fifo.png")  # through the checked open: refused at once, never waited on
+    with pytest.raises(ExplorerError, match="fifo.png: cannot read PNG file: it is a FIFO"):
+        read_png(tmp_path / "fifo.png")
     data = encode_png(np.zeros((4, 5, 3), np.uint8))
     with pytest.raises(ExplorerError, match="half.png: not a readable PNG file"):
         decode_png(data[: len(data) // 2], "half.png")
