@@ -283,8 +283,8 @@ def qt_frames(mesh, repeat: int) -> dict:
     server = None
     if not os.environ.get("DISPLAY"):
         server, os.environ["DISPLAY"] = start_xvfb()
+    from explorer.app.qt.window import ExplorerWindow
     from explorer.app.qtmain import application
-    from explorer.app.window import ExplorerWindow
 
     app = application()
     scene = scene_for(mesh, 1)

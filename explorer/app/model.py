@@ -22,6 +22,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from explorer.core import tolerances as tol
+from explorer.core.controls import DISTANCE_RANGE
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
 from explorer.core.material import MODELS, RGB_KEYS, Material
@@ -33,8 +34,6 @@ Vec3 = tuple[float, float, float]
 TERMS = ("ambient", "diffuse", "specular")
 #: where a new light's handle sits by default: azimuth, elevation (degrees), distance (radii)
 DEFAULT_PLACEMENT = (40.0, 35.0, 2.5)
-#: the light distance control's range, in mesh radii (a handle farther out leaves the view)
-DISTANCE_RANGE = (1.0, 5.0)
 #: a spot made in the window lights about this fraction of the mesh radius around its aim
 SPOT_SPREAD = 0.5
 #: the cone of a spot made in the window is held within these half-angles (degrees)

@@ -8,8 +8,8 @@ import sys
 
 from PySide6 import QtCore, QtWidgets
 
+from explorer.app.qt.window import ExplorerWindow
 from explorer.app.start import NoDisplayError
-from explorer.app.window import ExplorerWindow
 
 log = logging.getLogger(__name__)
 
@@ -26,7 +26,7 @@ def run_window(state, mesh, *, exit_after: float | None = None, last_session=Tru
                **options) -> int:  # fmt: skip
     """Open the window on ``state`` / ``mesh`` and run until it is closed (or for
     ``exit_after`` seconds); the session is kept for ``gui --last``. ``options`` go to
-    :class:`~explorer.app.window.ExplorerWindow`. Returns the exit status (0)."""
+    :class:`~explorer.app.qt.window.ExplorerWindow`. Returns the exit status (0)."""
     app = application()
     window = ExplorerWindow(state, mesh, last_session=last_session, **options)
     name = window.plotter.render_window.GetClassName()

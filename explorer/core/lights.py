@@ -60,6 +60,9 @@ NO_ATTENUATION: Vec3 = (1.0, 0.0, 0.0)
 #: Upper bound accepted for a light colour channel (HDR lights above 1 are allowed).
 MAX_LIGHT_VALUE = 1e6
 SPOT_EXPONENT_RANGE = (0.0, 128.0)
+#: a spot's cone half-angle (degrees); 180 (no cone) is taken too, nothing between
+SPOT_CUTOFF_RANGE = (0.0, 90.0)
+NO_CONE = 180.0
 
 
 # -- the checks of each key ------------------------------------------------------------------
@@ -92,9 +95,12 @@ def _attenuation(checker: Checker, value, path):
 
 
 def _cutoff(checker: Checker, value, path):
-    c = checker.number(value, path, 0.0, 180.0)
-    if c is not None and 90.0 < c < 180.0:
-        checker.problem(path, f"must be in [0, 90] or exactly 180, got {format_number(c)}")
+    lo, hi = SPOT_CUTOFF_RANGE
+    c = checker.number(value, path, lo, NO_CONE)
+    if c is not None and hi < c < NO_CONE:
+        checker.problem(
+            path, f"must be in [{lo:g}, {hi:g}] or exactly {NO_CONE:g}, got {format_number(c)}"
+        )
         return None
     return c
 

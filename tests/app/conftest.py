@@ -82,7 +82,7 @@ def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
     --resolution 3``), shown at 1000x700 and drawn once; presets are saved in
     ``tmp_path/presets``, screenshots and the ``--state-file`` go to ``tmp_path``, and the
     last session is kept in ``tmp_path/last.yaml``."""
-    from explorer.app.window import ExplorerWindow
+    from explorer.app.qt.window import ExplorerWindow
     from explorer.cli import build_parser
     from explorer.cli.gui import start_state
 

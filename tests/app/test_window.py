@@ -182,7 +182,7 @@ def test_the_handle_moves_the_light_and_keeps_the_azimuth_at_the_pole(win):
     point = np.asarray(s.centre) + 2.0 * s.radius * np.array([0.0, 1.0, 0.0])  # straight up
     az = s.placement()[0]
     win.view.handle.SetCenter(*point)
-    win._on_handle(point)
+    win.handles._on_handle(point)
     az2, el, d = win.store.state.placement()
     assert (
         el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
@@ -260,7 +260,7 @@ def test_difference_view_from_the_worker(win, qtbot):
     win.panel.view.difference.click()
     qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
     r = win.heat.result
-    assert r.job.key == win._difference_key() and r.comparison.mask.sum() > 1000
+    assert r.job.key == win.controller.difference_key() and r.comparison.mask.sum() > 1000
     assert "RMSE" in win.panel.view.legend.text() and win.panel.view.advice.text()
     assert not win.view.drawings[0].actor.GetVisibility()  # the map stands in for the mesh
     win.panel.material.sliders["shininess"].field.setValue(300.0)
@@ -269,6 +269,48 @@ def test_difference_view_from_the_worker(win, qtbot):
     assert win.heat.result.job.scene.material.shininess == 300.0
     qtbot.keyClick(win.plotter, "d")
     assert not win.store.state.difference and win.view.drawings[0].actor.GetVisibility()
+
+
+def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot, monkeypatch):
+    """One kd step with the difference view on: one engine update, one upload, one frame, one
+    seal, the difference checked once and asked for once; a result for the state before is
+    dropped."""
+    from explorer.app import view as V
+    from explorer.app.difference import run_job
+    from explorer.shading.shader import Shader
+
+    win.panel.view.difference.click()
+    qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
+    old = win.heat.result
+    counts: dict[str, int] = {}
+
+    def count(owner, name):
+        orig = getattr(owner, name)
+
+        def wrapped(*args, **kw):
+            counts[name] = counts.get(name, 0) + 1
+            return orig(*args, **kw)
+
+        monkeypatch.setattr(owner, name, wrapped)
+
+    count(Shader, "set_scene")
+    count(V.MeshDrawing, "upload")
+    count(type(win.controller), "update_difference")
+    count(M.Store, "seal")  # a click step is a whole step: sealed once (not by panel and window)
+    jobs = []
+    monkeypatch.setattr(win.worker, "submit", jobs.append)
+    frames = win.frames
+    slider = win.panel.material.sliders["kd"].slider
+    slider.setValue(slider.value() - 37)
+    assert counts == {"set_scene": 1, "upload": 1, "update_difference": 1, "seal": 1}
+    assert win.frames == frames + 1 and len(jobs) == 1
+    assert not win.heat.shown  # the live view until the new map comes
+    stale = run_job(old.job)
+    win.difference_ready.emit(stale)
+    assert win.heat.result is old and not win.heat.shown  # dropped, never shown
+    fresh = run_job(jobs[0])
+    win.difference_ready.emit(fresh)
+    assert win.heat.result is fresh and win.heat.shown
 
 
 def test_keys_of_the_view(win, qtbot):

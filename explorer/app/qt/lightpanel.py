@@ -1,13 +1,12 @@
-"""The panel's ``lights`` and ``view`` tabs and the panel itself (see :mod:`explorer.app.panel`)."""
+"""The panel's ``lights`` and ``view`` tabs and the panel itself (see
+:mod:`explorer.app.qt.panel`)."""
 
 from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
 from explorer.app import model as M
-from explorer.app.panel import (
-    INTENSITY_RANGE,
-    MAX_INTENSITY,
+from explorer.app.qt.panel import (
     ColourButton,
     MaterialTab,
     NumberField,
@@ -16,11 +15,9 @@ from explorer.app.panel import (
     _scroll,
     guard_wheel,
 )
-from explorer.core.lights import LIGHT_TYPES, SPOT_EXPONENT_RANGE
+from explorer.core.controls import CONTROLS
+from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS
-
-#: the attenuation fields' range (the scene file takes any value >= 0, not all three zero)
-ATTENUATION_RANGE = (0.0, 100.0)
 
 
 def light_summary(i: int, light, state: M.State) -> str:
@@ -83,14 +80,7 @@ class LightsTab(QtWidgets.QWidget):
         row.setColumnStretch(1, 1)
         form.addLayout(row)
         self.sliders = {
-            "intensity": ValueSlider(
-                "intensity", *INTENSITY_RANGE, field_range=(0.0, MAX_INTENSITY)
-            ),  # fmt: skip
-            "azimuth": ValueSlider("azimuth", -180.0, 180.0, decimals=1, suffix="°"),
-            "elevation": ValueSlider("elevation", -90.0, 90.0, decimals=1, suffix="°"),
-            "distance": ValueSlider(
-                "distance", *M.DISTANCE_RANGE, decimals=2, suffix=" r", field_range=(0.01, 1e4)
-            ),  # fmt: skip
+            name: ValueSlider(name) for name in ("intensity", "azimuth", "elevation", "distance")
         }
         self.sliders["distance"].note.setVisible(True)
         self.sliders["distance"].setToolTip("distance from the mesh centre in mesh radii")
@@ -98,16 +88,33 @@ class LightsTab(QtWidgets.QWidget):
             form.addWidget(s)
             s.rejected.connect(self.rejected)
             s.edited.connect(lambda v, n=name: self._edited(n, v))
-            s.released.connect(lambda: self.act(None))
+        form.addWidget(self._attenuation_fields())
+        self.cutoff = ValueSlider("cutoff")
+        self.exponent = ValueSlider("exponent")
+        for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
+            form.addWidget(s)
+            s.rejected.connect(self.rejected)
+            s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
+        box.addWidget(self.controls)
+        self.none = QtWidgets.QLabel("The scene has no lights: add one.")
+        box.addWidget(self.none)
+        box.addStretch(1)
+        self.list.currentRowChanged.connect(
+            lambda i: i >= 0 and self.act(M.select_light, i, label="select light")
+        )
+
+    def _attenuation_fields(self) -> QtWidgets.QWidget:
+        """The attenuation's three number fields, a row a key (a narrow panel)."""
         self.attenuation_box = QtWidgets.QWidget()
-        grid = QtWidgets.QGridLayout(self.attenuation_box)  # a row a key: a narrow panel
+        grid = QtWidgets.QGridLayout(self.attenuation_box)
         grid.setContentsMargins(0, 0, 0, 0)
         grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 3)
         self.attenuation = []
+        att = CONTROLS["attenuation"]
         for k, key in enumerate(("kc", "kl", "kq")):
-            f = NumberField(key, *ATTENUATION_RANGE)
+            f = NumberField(key, *att.field_range, decimals=att.decimals)
             f.setObjectName(f"attenuation_{key}")
-            f.setSingleStep(0.05)
+            f.setSingleStep(att.field_step)
             f.setToolTip(f"{key} of 1 / (kc + kl·d + kq·d²), d in world units")
             f.valueChanged.connect(self._attenuation)
             f.rejected.connect(self.rejected)
@@ -117,21 +124,7 @@ class LightsTab(QtWidgets.QWidget):
             grid.addWidget(f, 1 + k, 2)
             self.attenuation.append(f)
         grid.setColumnStretch(1, 1)
-        form.addWidget(self.attenuation_box)
-        self.cutoff = ValueSlider("cutoff", 0.0, 90.0, decimals=1, suffix="°")
-        self.exponent = ValueSlider("exponent", *SPOT_EXPONENT_RANGE, decimals=1)
-        for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
-            form.addWidget(s)
-            s.rejected.connect(self.rejected)
-            s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
-            s.released.connect(lambda: self.act(None))
-        box.addWidget(self.controls)
-        self.none = QtWidgets.QLabel("The scene has no lights: add one.")
-        box.addWidget(self.none)
-        box.addStretch(1)
-        self.list.currentRowChanged.connect(
-            lambda i: i >= 0 and self.act(M.select_light, i, label="select light")
-        )
+        return self.attenuation_box
 
     def _edited(self, name: str, v: float) -> None:
         if name == "intensity":

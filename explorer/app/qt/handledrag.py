@@ -1,5 +1,5 @@
-"""Dragging the light handles with the mouse (a mix-in of
-:class:`explorer.app.window.ExplorerWindow`): a press on a handle selects its light, a drag keeps
+"""Dragging the light handles with the mouse (in
+:class:`explorer.app.qt.window.ExplorerWindow`): a press on a handle selects its light, a drag keeps
 the handle under the pointer (:func:`explorer.app.model.point_on_ray`), whatever the camera's
 distance and zoom."""
 
@@ -10,10 +10,25 @@ import numpy as np
 from explorer.app import model as M
 
 
-class HandleDrag:
-    """Needs the window's ``store``, ``plotter``, ``view``, ``act``, ``_begin_drag`` and
-    ``_end_drag``; :meth:`_grab_handle`, :meth:`_drag_handle` and :meth:`_release_handle` are
-    the handles' callbacks (:meth:`explorer.app.view.SceneView.add_handles`)."""
+class HandleDragger:
+    """The handles of ``window`` (its ``controller``, ``plotter``, ``view``, ``begin_drag``,
+    ``end_drag`` and ``_guard``): :meth:`_grab_handle`, :meth:`_drag_handle` and
+    :meth:`_release_handle` are the handles' callbacks
+    (:meth:`explorer.app.view.SceneView.add_handles`)."""
+
+    def __init__(self, window):
+        self.window = w = window
+        self.store = w.controller.store
+        self.act = w.controller.act
+        self.plotter = w.plotter
+        self.view = w.view
+        self._grab = None
+        self._holding_handle = False
+        self._begin_drag, self._end_drag = w.begin_drag, w.end_drag
+        g = w._guard
+        w.view.add_handles(g(self._grab_handle, "light handle"),
+                           g(self._drag_handle, "light handle"),
+                           g(self._release_handle, "light handle"))  # fmt: skip
 
     def _grab_handle(self, index: int) -> None:
         """Light ``index``'s handle is pressed: its light is selected, and the drag starts

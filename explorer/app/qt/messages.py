@@ -103,47 +103,41 @@ def open_log(log: MessageLog) -> None:
     bar.setValue(bar.maximum())
 
 
-class Messages:
-    """The window's messages (a mix-in of :class:`explorer.app.window.ExplorerWindow`; needs
-    its ``statusBar()``, ``status_label``, ``panel``, ``store``, ``errors``, ``message``,
-    ``_guard`` and ``_show_panel``)."""
+class MessageBar:
+    """The window's status bar and message log: the state's summary (``status_label``), the
+    log (``messages``) and its indicator (``messages_indicator``), all set on ``window``,
+    whose ``message`` is the last message shown."""
 
-    def build_messages(self) -> None:
-        """The log, its indicator on the status bar, and the panel's refused values."""
-        self.messages = MessageLog(self)
-        self.messages_indicator = MessageIndicator(self.messages)
-        self.statusBar().addPermanentWidget(self.messages_indicator)
-        self.panel.rejected.connect(self._guard(self.reject_input, "typed value"))
+    def __init__(self, window):
+        self.window = w = window
+        w.status_label = QtWidgets.QLabel("")
+        w.status_label.setObjectName("status")
+        w.statusBar().addPermanentWidget(w.status_label)
+        w.messages = MessageLog(w)
+        w.messages_indicator = MessageIndicator(w.messages)
+        w.statusBar().addPermanentWidget(w.messages_indicator)
 
-    def reject_input(self, text: str) -> None:
-        """A typed value was refused (``text`` names the key and the range): said as an error,
-        and the panel shows the state again."""
-        self.errors.append(f"typed value: {text}")
-        self.show_status(f"error: {text}", error=True)
-        self._show_panel(self.store.state)
-
-    def show_status(self, text: str, *, msecs: int = MESSAGE_MS, error: bool = False,
-                    warning: bool = False, details=(), open_log_: bool = True) -> None:  # fmt: skip
+    def show(self, text: str, level: str = "info", details=(), msecs: int | None = None,
+             open_log_: bool = True) -> None:  # fmt: skip
         """Show a short message on the status bar (errors stay until the next message) and add
         it to the message log; the log opens when the message is an error or a warning that
         the status bar cannot show whole, or comes with ``details`` (each a line of the log).
-        ``open_log_=False``: never opens it (the details are shown in a dialog already). The
-        engine's "kernels are being prepared" line comes here too."""
-        self.message = text
-        bar = self.statusBar()
-        bar.setStyleSheet("color: #ff7766;" if error else "color: #e0a030;" if warning else "")
-        bar.showMessage(text, 0 if error else int(msecs))
-        level = "error" if error else "warning" if warning else "info"
-        self.messages.add(level, text, details)
-        self.messages_indicator.refresh()
+        ``open_log_=False``: never opens it (the details are shown in a dialog already)."""
+        w = self.window
+        w.message = text
+        bar = w.statusBar()
+        bar.setStyleSheet({"error": "color: #ff7766;", "warning": "color: #e0a030;"}.get(level, ""))
+        bar.showMessage(text, 0 if level == "error" else int(msecs or MESSAGE_MS))
+        w.messages.add(level, text, details)
+        w.messages_indicator.refresh()
         if open_log_ and level != "info" and (details or not self._fits_status_bar(text)):
-            open_log(self.messages)
+            open_log(w.messages)
 
     def _fits_status_bar(self, text: str) -> bool:
         """Whether ``text`` shows whole in the status bar's message area (the bar less its
         permanent widgets)."""
-        bar = self.statusBar()
-        widgets = (getattr(self, "engine_label", None), self.status_label,
-                   self.messages_indicator)  # fmt: skip
-        taken = sum(w.width() + 8 for w in widgets if w is not None and w.isVisible())
+        w = self.window
+        bar = w.statusBar()
+        widgets = (getattr(w, "engine_label", None), w.status_label, w.messages_indicator)
+        taken = sum(x.width() + 8 for x in widgets if x is not None and x.isVisible())
         return bar.fontMetrics().horizontalAdvance(text) <= max(bar.width() - taken - 16, 0)

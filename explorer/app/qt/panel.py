@@ -10,45 +10,14 @@ scene's lights and the selected one's type, colour, placement, attenuation and c
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
+from explorer.core.controls import CONTROLS, STEPS, Control, from_step, to_step
 from explorer.core.errors import ExplorerError
-from explorer.core.material import (
-    COEFFICIENT_RANGE,
-    MODELS,
-    OPACITY_RANGE,
-    RGB_KEYS,
-    SHININESS_RANGE,
-)
+from explorer.core.material import MODELS, RGB_KEYS
 from explorer.shading.display import to_bytes
-
-#: slider steps (QSlider is integral)
-STEPS = 1000
-#: the shininess slider's log scale: step 0 is n = 0, steps 1..STEPS are 10**0 to 10**LOG_MAX
-LOG_MAX = 3.0
-#: the light intensity control's slider range (the number field takes more)
-INTENSITY_RANGE = (0.0, 2.0)
-MAX_INTENSITY = 1000.0
-
-
-def shininess_to_step(n: float) -> int:
-    """Slider step of exponent ``n`` (0 at the left end, then log10 n from 0 to 3)."""
-    if n <= 0.0:
-        return 0
-    t = min(max(math.log10(max(n, 1.0)) / LOG_MAX, 0.0), 1.0)
-    return 1 + round(t * (STEPS - 1))
-
-
-def step_to_shininess(step: int) -> float:
-    """Exponent of a shininess slider step, to 3 significant digits (step 0 is 0)."""
-    if step <= 0:
-        return 0.0
-    n = 10.0 ** (LOG_MAX * (min(step, STEPS) - 1) / (STEPS - 1))
-    return float(f"{n:.3g}")
 
 
 def rgb_text(rgb) -> str:
@@ -159,7 +128,8 @@ class ValueSlider(QtWidgets.QWidget):
     """A labelled slider with a number field. ``edited(value)`` while the user drags or
     types; ``released()`` when a drag ends (one undo step).
 
-    lo, hi : the slider's range (the field may take ``field_range``); log : the shininess scale
+    name : a key of :data:`explorer.core.controls.CONTROLS`, whose entry gives the slider's
+    range, the field's range, decimals and unit, and the scale (log for the shininess)
     """
 
     edited = QtCore.Signal(float)
@@ -167,21 +137,21 @@ class ValueSlider(QtWidgets.QWidget):
     released = QtCore.Signal()
     rejected = QtCore.Signal(str)
 
-    def __init__(self, name: str, lo: float, hi: float, *, decimals: int = 3, log: bool = False,
-                 field_range=None, suffix: str = "", parent=None):  # fmt: skip
+    def __init__(self, name: str, parent=None):
         super().__init__(parent)
         self.setObjectName(name)
-        self.lo, self.hi, self.log = float(lo), float(hi), log
+        c: Control = CONTROLS[name]
+        self.control = c
+        self.lo, self.hi, self.log = c.lo, c.hi, c.scale == "log"
         self.label = QtWidgets.QLabel(name)
         self.label.setMinimumWidth(64)
         self.slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
         self.slider.setObjectName(f"{name}_slider")
         self.slider.setRange(0, STEPS)
         self.slider.setMinimumWidth(60)
-        flo, fhi = field_range or (lo, hi)
-        self.field = NumberField(name, flo, fhi, decimals=decimals, suffix=suffix)
+        self.field = NumberField(name, *c.field_range, decimals=c.decimals, suffix=c.unit)
         self.field.setObjectName(f"{name}_field")
-        self.field.setSingleStep(10 ** -min(decimals, 2))
+        self.field.setSingleStep(c.field_step)
         self.field.setMinimumWidth(72)
         self.field.rejected.connect(self.rejected)
         self.note = QtWidgets.QLabel("")  # a second line (the distance in world units)
@@ -199,15 +169,10 @@ class ValueSlider(QtWidgets.QWidget):
         self.field.valueChanged.connect(self._from_field)
 
     def _to_step(self, v: float) -> int:
-        if self.log:
-            return shininess_to_step(v)
-        t = (v - self.lo) / (self.hi - self.lo) if self.hi > self.lo else 0.0
-        return round(min(max(t, 0.0), 1.0) * STEPS)
+        return to_step(self.control, v, self.lo, self.hi)
 
     def _from_step(self, step: int) -> float:
-        if self.log:
-            return step_to_shininess(step)
-        return self.lo + (self.hi - self.lo) * step / STEPS
+        return from_step(self.control, step, self.lo, self.hi)
 
     def _from_slider(self, step: int) -> None:
         v = round(self._from_step(step), self.field.decimals())
@@ -228,9 +193,13 @@ class ValueSlider(QtWidgets.QWidget):
         self.field.setRange(min(self.field.minimum(), lo), max(self.field.maximum(), hi))
 
     def set_value(self, v: float) -> None:
-        """Show ``v`` (no signal)."""
+        """Show ``v`` (no signal; nothing done when it is shown already: the control a user
+        moves is not set back)."""
+        step = self._to_step(v)
+        if step == self.slider.value() and self.field.value() == round(v, self.field.decimals()):
+            return
         with QtCore.QSignalBlocker(self.slider), QtCore.QSignalBlocker(self.field):
-            self.slider.setValue(self._to_step(v))
+            self.slider.setValue(step)
             self.field.setValue(v)
 
     def value(self) -> float:
@@ -473,11 +442,7 @@ class MaterialTab(QtWidgets.QWidget):
                   self.description):  # fmt: skip
             box.addWidget(w, 1 if w is self.presets else 0)  # the list takes the spare height
         self.sliders = {
-            "ka": ValueSlider("ka", *COEFFICIENT_RANGE),
-            "kd": ValueSlider("kd", *COEFFICIENT_RANGE),
-            "ks": ValueSlider("ks", *COEFFICIENT_RANGE),
-            "shininess": ValueSlider("shininess", *SHININESS_RANGE, decimals=1, log=True),
-            "opacity": ValueSlider("opacity", *OPACITY_RANGE),
+            name: ValueSlider(name) for name in ("ka", "kd", "ks", "shininess", "opacity")
         }
         actions = {
             "ka": lambda v: (M.set_coefficient, "ka", v),
@@ -489,7 +454,6 @@ class MaterialTab(QtWidgets.QWidget):
         for name, s in self.sliders.items():
             box.addWidget(s)
             s.edited.connect(lambda v, n=name: self.act(*actions[n](v), label=n, merge=n))
-            s.released.connect(lambda: self.act(None))
         colours = QtWidgets.QGridLayout()
         self.colours = {}
         for i, term in enumerate(RGB_KEYS):

@@ -1,0 +1,75 @@
+"""The Qt window's progress displays: a long job stepped under a progress dialog (the
+controller's progress port, :func:`run_steps`), and the status bar's word on the compiled
+kernels (:class:`EngineStatus`)."""
+
+from __future__ import annotations
+
+from PySide6 import QtCore, QtWidgets
+
+from explorer.shading import tiers
+
+#: how often the job's timer takes a step (ms; 0: whenever the event loop is idle)
+STEP_MS = 0
+#: how often the status bar asks whether the compiled kernels are ready yet (ms)
+ENGINE_POLL_MS = 500
+
+
+def run_steps(parent, title: str, text: str, total: int, step, cancel):
+    """``step()`` called from the event loop under a window-modal progress dialog until it
+    returns None (see :class:`explorer.app.controller.ports.Progress`); the dialog's Cancel
+    calls ``cancel()``. Returns the dialog."""
+    dialog = QtWidgets.QProgressDialog(text, "Cancel", 0, total, parent)
+    dialog.setObjectName(f"{title}_progress")
+    dialog.setWindowTitle(f"phong-explorer: {title}")
+    dialog.setWindowModality(QtCore.Qt.WindowModality.WindowModal)
+    dialog.setMinimumDuration(0)
+    dialog.setAutoClose(False)
+    dialog.setAutoReset(False)
+    timer = QtCore.QTimer(dialog)
+
+    def tick() -> None:
+        if dialog.wasCanceled():
+            timer.stop()
+            dialog.close()
+            cancel()
+            return
+        out = step()
+        if out is None:
+            timer.stop()
+            dialog.setValue(total)
+            dialog.close()
+            return
+        done, label = out
+        dialog.setValue(done)
+        if label:
+            dialog.setLabelText(label)
+
+    timer.timeout.connect(tick)
+    timer.start(STEP_MS)
+    dialog.show()
+    return dialog
+
+
+class EngineStatus:
+    """Load the compiled kernels in a thread as soon as numba's cache holds them (the numpy
+    tier draws meanwhile; :func:`explorer.shading.tiers.preload`), and say so in the status bar
+    (``window.engine_label``) while it lasts."""
+
+    def __init__(self, window):
+        tiers.preload()
+        self.label = window.engine_label = QtWidgets.QLabel("")
+        self.label.setObjectName("engine")
+        self.label.setContentsMargins(0, 0, 16, 0)  # apart from the preset and model
+        window.statusBar().insertPermanentWidget(0, self.label)
+        self.timer = QtCore.QTimer(window)
+        self.timer.timeout.connect(self.show)
+        self.timer.start(ENGINE_POLL_MS)
+        self.show()
+
+    def show(self) -> None:
+        tiers.preload()  # looks for the ready marker (a stat at most every tiers.POLL seconds)
+        text = tiers.status() or ""
+        if text != self.label.text():
+            self.label.setText(text)
+        if not text and (tiers.loaded() or tiers.mode() != "auto"):
+            self.timer.stop()

@@ -1,0 +1,343 @@
+"""The explorer window: a Qt main window with the 3D view (pyvistaqt's ``QtInteractor``)
+beside the control panel (:mod:`explorer.app.qt.panel`), a thin binding of
+:class:`explorer.app.controller.Controller`.
+
+The window holds no state and no flow of its own: the controls send intents to the controller,
+which changes the store and tells the window (its ports: :class:`ExplorerWindow` implements the
+dialogs, messages, view, choices and progress ports) what to show. The camera is the viewer:
+before each frame the view's camera goes into the state (:meth:`Controller.camera_moved`, no
+undo step). The difference view is computed in a worker thread
+(:class:`~explorer.app.difference.DifferenceWorker`) whose results come back through a Qt
+signal to :meth:`Controller.on_difference`.
+
+Menus, shortcuts and keys are in :mod:`explorer.app.qt.menus`.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+from PySide6 import QtCore, QtGui, QtWidgets
+
+from explorer.app import model as M
+from explorer.app.controller import Controller, Ports
+from explorer.app.difference import DifferenceWorker, HeatMap
+from explorer.app.qt.compare import CompareView
+from explorer.app.qt.handledrag import HandleDragger
+from explorer.app.qt.lightpanel import Panel
+from explorer.app.qt.menus import Menus
+from explorer.app.qt.messages import MessageBar
+from explorer.app.qt.panel import ValueSlider
+from explorer.app.qt.progress import EngineStatus, run_steps
+from explorer.app.qt.viewport import QtView
+from explorer.app.session import session_mapping
+from explorer.app.start import TITLE, WINDOW_SIZE
+from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, view_camera
+from explorer.core.atomic import write_atomic
+from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import plain_blending
+
+#: the panel's share of the window's width at the start (the view takes the rest)
+PANEL_FRACTION = 0.34
+#: the controller's intents and data the window answers for (its menus, keys, scripts, tests)
+FORWARDED = frozenset({
+    "store", "act", "undo", "redo", "reset_all", "reset_camera", "toggle_difference",
+    "toggle_compare", "swap_sides", "toggle_model", "toggle_ambient", "toggle_diffuse",
+    "toggle_specular", "next_preset", "previous_preset", "next_light_type", "next_light",
+    "choose_mesh", "open_file", "open_session", "save_session_as", "save_preset_as",
+    "import_materials", "export_material", "export_render", "export_turntable", "screenshot",
+    "recent_files", "keep_last_session", "presets", "start_state", "meshes", "errors",
+    "output_dir", "session_path", "turntable", "reload_presets", "material_name",
+    "picture_stem",
+})  # fmt: skip
+
+
+class ExplorerWindow(QtWidgets.QMainWindow):
+    """The explorer window.
+
+    state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
+    materials_dirs, preset_dir, output_dir, last_session : see
+        :class:`~explorer.app.controller.Controller`; state_file : write the session and a
+        report as JSON after every frame
+    size : (width, height) of the window; lod_vertices, lod_target : see
+        :mod:`explorer.app.view`; background : RGB in [0, 1]
+    """
+
+    difference_ready = QtCore.Signal(object)
+
+    def __init__(self, state: M.State, mesh, *, materials_dirs=(), preset_dir=None,
+                 output_dir=None, state_file=None, last_session=None, size=WINDOW_SIZE,
+                 lod_vertices: int = LOD_VERTICES, lod_target: int = LOD_TARGET,
+                 background=None):  # fmt: skip
+        super().__init__()
+        self.setWindowTitle(TITLE)
+        self.state_file = Path(state_file) if state_file else None
+        self.message = ""
+        self.frames = 0
+        self.frame_ms = float("nan")
+        self._t0: float | None = None
+        w, h = (int(v) for v in size)
+        self.resize(w, h)
+        self._build_views(w, background)
+        self.view_aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)
+        self._frame_on_show = state.camera is None  # framed again for the view's real shape
+        self.worker = DifferenceWorker(self.difference_ready.emit)
+        ports = Ports.of(self, worker=self.worker, view=QtView(self))
+        self.controller = c = Controller(state, mesh, ports, materials_dirs=materials_dirs,
+                                         preset_dir=preset_dir, output_dir=output_dir,
+                                         last_session=last_session)  # fmt: skip
+        self.panel = Panel(c.act, c.choose_mesh)
+        self.splitter.addWidget(self.panel)
+        self.splitter.setSizes([round(w * (1 - PANEL_FRACTION)), round(w * PANEL_FRACTION)])
+        self.bar = MessageBar(self)
+        self.panel.rejected.connect(self._guard(c.reject_input, "typed value"))
+        self.engine = EngineStatus(self)
+        self.view = SceneView(self.plotter, mesh, c.state, lod_vertices=lod_vertices,
+                              lod_target=lod_target)  # fmt: skip
+        self.view.apply_camera(c.state.camera)
+        self.handles = HandleDragger(self)
+        self.heat = HeatMap(self.plotter.renderer)
+        self.difference_ready.connect(self._guard(c.on_difference, "difference view"))
+        self.compare = CompareView(self)
+        self._observe()
+        self.menus = Menus(self)
+        c.start()
+        self.compare.show(None, c.state)
+        c.ports.view.show_panel(c.state)
+
+    def __getattr__(self, name: str):
+        controller = self.__dict__.get("controller")
+        if name in FORWARDED and controller is not None:
+            return getattr(controller, name)
+        raise AttributeError(f"{type(self).__name__} has no attribute '{name}'")
+
+    # -- building ------------------------------------------------------------------------------
+    def _build_views(self, w: int, background) -> None:
+        from pyvistaqt import QtInteractor
+
+        self.splitter = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
+        self.views = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
+        self.views.setChildrenCollapsible(False)
+        self.plotter = QtInteractor(self.views, multi_samples=0, auto_update=False)
+        self.plotter.setObjectName("view")
+        self.plotter.setMinimumSize(120, 120)
+        self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
+        self.plotter.disable_anti_aliasing()
+        plain_blending(self.plotter.renderer)  # translucency drawn as the off-screen renders
+        self.plotter.set_background(BACKGROUND if background is None else background)
+        self.views.addWidget(self.plotter)
+        self.splitter.addWidget(self.views)
+        self.splitter.setStretchFactor(0, 1)
+        self.splitter.setStretchFactor(1, 0)
+        self.splitter.setChildrenCollapsible(False)
+        self.setCentralWidget(self.splitter)
+
+    def _observe(self) -> None:
+        pl = self.plotter
+        pl.renderer.AddObserver("StartEvent", self._guard(self._before_frame, "frame"))
+        pl.render_window.AddObserver("EndEvent", self._guard(self._after_frame, "frame"))
+        self.watch_camera(pl)
+        for s in self.panel.findChildren(ValueSlider):
+            s.pressed.connect(self._guard(self.begin_drag, s.objectName()))
+            s.released.connect(self._guard(self._end_drag_if_dragging, s.objectName()))
+
+    def watch_camera(self, pl) -> None:
+        """``pl``'s camera drags are drags (the level of detail, one undo step); VTK's and
+        PyVista's own keys (w wireframe, s surface, ...) would change the picture behind the
+        state's back: the window's keys are the only keys."""
+        iren = pl.iren.interactor
+        style = iren.GetInteractorStyle()
+        if style is not None:
+            style.AddObserver("StartInteractionEvent", self._guard(self.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self._guard(self.end_drag, "camera"))
+        for key in list(getattr(pl, "_key_press_event_callbacks", {})):
+            pl.clear_events_for_key(key)
+
+        def block(obj, _event):
+            obj.GetCommand(tag).SetAbortFlag(1)
+
+        tag = iren.AddObserver("CharEvent", block, 10.0)
+
+    # -- errors --------------------------------------------------------------------------------
+    def _guard(self, fn, where: str):
+        """``fn`` made safe for Qt's and VTK's callbacks: an error is said and logged, never
+        lost and never a traceback in the user's face."""
+
+        def call(*args):
+            try:
+                return fn(*args)
+            except Exception as exc:  # noqa: BLE001 - every error is shown, none is lost
+                self.controller.report(exc, where)
+                return None
+
+        return call
+
+    # -- ports: dialogs (replaceable by scripts and tests), messages, progress ------------------
+    def ask_text(self, title: str, label: str, default: str = "") -> str | None:
+        text, ok = QtWidgets.QInputDialog.getText(self, title, label, text=default)
+        return text.strip() if ok else None
+
+    def ask_yes(self, question: str) -> bool:
+        answer = QtWidgets.QMessageBox.question(self, "phong-explorer", question)
+        return answer == QtWidgets.QMessageBox.StandardButton.Yes
+
+    def ask_path(self, title: str, *, save: bool = False, default: str = "",
+                 filter: str = "") -> str | None:  # fmt: skip
+        """A file name from Qt's file dialog, or None. Saving, the dialog does not ask about
+        an existing file: the controller asks (:meth:`ask_yes`), whoever gave the name."""
+        if save:
+            path, _ = QtWidgets.QFileDialog.getSaveFileName(
+                self, title, default, filter,
+                options=QtWidgets.QFileDialog.Option.DontConfirmOverwrite,
+            )  # fmt: skip
+        else:
+            path, _ = QtWidgets.QFileDialog.getOpenFileName(self, title, default, filter)
+        return path or None
+
+    def ask_number(self, title: str, label: str, default: int, lo: int, hi: int) -> int | None:
+        value, ok = QtWidgets.QInputDialog.getInt(self, title, label, default, lo, hi)
+        return int(value) if ok else None
+
+    def tell(self, title: str, text: str, *, details: str = "", error: bool = False) -> None:
+        """A message box (``details`` behind its Show Details button)."""
+        box = QtWidgets.QMessageBox(self)
+        box.setIcon(QtWidgets.QMessageBox.Icon.Warning if error
+                    else QtWidgets.QMessageBox.Icon.Information)  # fmt: skip
+        box.setWindowTitle(f"phong-explorer: {title}")
+        box.setText(text)
+        if details:
+            box.setDetailedText(details)
+        box.exec()
+
+    def show_message(self, text, level="info", details=(), msecs=None, open_log=True) -> None:
+        self.bar.show(text, level, details, msecs, open_log)
+
+    def show_status(self, text: str, *, error: bool = False, warning: bool = False,
+                    details=(), **kw) -> None:  # fmt: skip
+        level = "error" if error else "warning" if warning else "info"
+        self.bar.show(text, level, details, kw.get("msecs"), kw.get("open_log_", True))
+
+    def run_steps(self, title, text, total, step, cancel):
+        return run_steps(self, title, text, total, step, cancel)
+
+    # -- ports: choices ------------------------------------------------------------------------
+    def show_presets(self, presets) -> None:
+        self.panel.material.set_presets(presets)
+        self.panel.view.set_presets(presets)
+
+    def show_meshes(self, labels) -> None:
+        self.panel.view.set_meshes(labels)
+
+    def show_recent(self, paths) -> None:
+        self.menus.show_recent(paths)
+
+    def show_history(self, undo, redo) -> None:
+        self.menus.show_history(undo, redo)
+
+    def render(self) -> None:
+        """Draw a frame now."""
+        if self._t0 is None:
+            self._t0 = time.perf_counter()
+        self.plotter.render_window.Render()
+
+    # -- frames and drags ----------------------------------------------------------------------
+    def _before_frame(self, *_) -> None:
+        """Renderer StartEvent: the camera is the viewer; translucent triangles sorted."""
+        if self._t0 is None:
+            self._t0 = time.perf_counter()
+        s = self.controller.state
+        cam = view_camera(self.plotter.camera, s.centre, s.radius)
+        self.controller.camera_moved(cam)
+        self.view.before_frame(cam)
+        self.plotter.renderer.ResetCameraClippingRange()
+
+    def _after_frame(self, *_) -> None:
+        """Render window EndEvent: count and time the frame, draw side B of the compare view
+        (same camera), then write the state file (after the frame, so a reader never races
+        the pixels)."""
+        self.frames += 1
+        self.compare.after_frame()
+        if self._t0 is not None:
+            self.frame_ms = 1000.0 * (time.perf_counter() - self._t0)
+            self._t0 = None
+        if self.state_file is not None:
+            data = {**session_mapping(self.controller.state), "window": self.report_state()}
+            write_atomic(self.state_file, json.dumps(data).encode(), overwrite=True)
+
+    def begin_drag(self, *_) -> None:
+        self.view.begin_drag()
+        self.controller.begin_drag()
+
+    def end_drag(self, *_) -> None:
+        self.view.end_drag()
+        self.controller.end_drag()
+
+    def _end_drag_if_dragging(self, *_) -> None:
+        if self.view.dragging:
+            self.end_drag()
+        else:
+            self.controller.release()
+
+    # -- reporting ------------------------------------------------------------------------------
+    def widget_box(self, widget: QtWidgets.QWidget) -> list[int]:
+        """``[x, y, width, height]`` of a widget in the window's pixels (top-left origin)."""
+        p = widget.mapTo(self, QtCore.QPoint(0, 0))
+        return [p.x(), p.y(), widget.width(), widget.height()]
+
+    def report_state(self) -> dict:
+        """What a test or a script may want to know beyond the session (plain JSON values)."""
+        s, store, view = self.controller.state, self.controller.store, self.view
+        probe = view.probe_vertex()
+        origin = self.widget_box(self.plotter)[:2]
+
+        def in_window(px):
+            return [px[0] + origin[0], px[1] + origin[1]]
+
+        handle = None
+        if s.selected_light is not None:
+            handle = in_window(view.world_to_window(M.handle_point(s)))
+        handles = [in_window(view.world_to_window(M.handle_point(s, i)))
+                   for i in range(len(s.scene.lights))]  # fmt: skip
+        _, h = self.plotter.window_size
+        arrows = {str(i): in_window([round(float(t[0, 0])), round(h - 1 - float(t[0, 1]))])
+                  for i, t in view.marker_triangles.items()}  # fmt: skip
+        widgets = {
+            w.objectName(): self.widget_box(w)
+            for w in self.findChildren(QtWidgets.QWidget)
+            if w.objectName() and not w.objectName().startswith("qt_") and w.isVisible()
+        }
+        return {
+            "frame": self.frames,
+            "frame_ms": None if not np.isfinite(self.frame_ms) else self.frame_ms,
+            "window_size": [self.width(), self.height()],
+            "view_box": self.widget_box(self.plotter),
+            "n_vertices": view.mesh.n_vertices, "edited": s.edited,
+            "dragging": view.dragging > 0, "lod": view.lod_active,
+            "handle_px": handle, "handles_px": handles, "arrows_px": arrows,
+            "glyph": view.glyph_kind,
+            "probe": {"vertex": probe,
+                      "px": in_window(view.world_to_window(view.mesh.positions[probe]))},
+            "difference": self.heat.state(), "widgets": widgets,
+            "can_undo": store.can_undo, "can_redo": store.can_redo,
+            "message": self.message, "errors": list(self.controller.errors),
+        }  # fmt: skip
+
+    def showEvent(self, event: QtGui.QShowEvent) -> None:  # noqa: N802 - Qt's name
+        super().showEvent(event)
+        if self._frame_on_show:
+            self._frame_on_show = False
+            w, h = self.plotter.width(), self.plotter.height()
+            if w > 1 and h > 1:
+                self.view_aspect = w / h
+                self.controller.frame_start()
+
+    def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802 - Qt's name
+        self.controller.keep_last_session()
+        if self.controller.turntable is not None:
+            self.controller.turntable.cancel()  # nothing written
+        self.worker.close()
+        self.plotter.close()
+        super().closeEvent(event)
