@@ -228,12 +228,11 @@ def test_cli_readers_refuse_special_files(tmp_path, kind, capsys, monkeypatch):
 def test_a_huge_recent_files_list_is_not_read(tmp_path):
     """The window's recent-files list through the checked open: a sparse 3 GiB file reads as
     no list (before, all of it was read)."""
-    pytest.importorskip("PySide6")
-    from explorer.app.filemenu import RECENT_NAME, FileCommands
+    from explorer.app.controller.files import RECENT_NAME, FileFlows
 
     special_file(tmp_path, "sparse", RECENT_NAME)
 
-    class Menu(FileCommands):
+    class Menu(FileFlows):
         def __init__(self):
             self.last_session = str(tmp_path / "last.yaml")
 
