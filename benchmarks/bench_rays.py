@@ -1,7 +1,7 @@
 """Rays through the BVH against the brute force, in one run: shadow rays, scaling, the engine's
 shadow update and the window's difference view.
 
-    python benchmarks/bench_rays.py [--repeat N] [--section shadows scaling engine view]
+    python benchmarks/bench_rays.py [--repeat N] [--section shadows scaling engine view numpy]
 
 Sections (all by default):
 
@@ -29,6 +29,13 @@ Sections (all by default):
   reference, two off-screen renders, difference, heat map), and its steps (pixel rays through
   the BVH, the reference's colours, the two renders, the comparison). Run with ``PYTHONPATH``
   on an older checkout, it times what that checkout has (a step it lacks is left out).
+- ``numpy``: the numpy tier's rays (:mod:`explorer.geometry.bvh_numpy`, what casts until the
+  compiled kernels serve): its tree build per triangle and its shadow rays per ray on the 100k
+  teapot, the numpy tier's shading per vertex-light (the three in vertex-lights are what
+  :func:`explorer.shading.tiers.ray_work` counts: ``BUILD_WORK``, ``RAY_WORK``), and the peak
+  memory of a cast (tracemalloc: nearest hits) through soups of crossing triangles, where
+  every ray enters every leaf, next to the bound
+  :func:`~explorer.geometry.bvh_numpy.pair_bound` states.
 Every figure is wall-clock: median and best of ``--repeat`` runs after a warm-up; the machine
 and its load average are printed with the tables. Compare rows of one run. One line gives the
 BVH cast's CPU time per ray instead (every thread's, over ``--repeat`` casts): on a VM whose
@@ -51,7 +58,7 @@ from common import cpu_name, load_average, timed  # benchmarks/common.py
 from explorer.core.scene import load_scene
 from explorer.geometry.meshes import get_mesh
 
-SECTIONS = ("shadows", "scaling", "engine", "view")
+SECTIONS = ("shadows", "scaling", "engine", "view", "numpy")
 #: the brute force's sample is sized to about this many ray-triangle tests
 BRUTE_TESTS = 3e8
 #: a small mesh's rays are repeated up to this many, so that a cast is not all overhead
@@ -364,6 +371,63 @@ def section_view(repeat: int) -> None:
         ref = PP.reference(scene, mesh, size, camera=cam)
         _ = ref.specular
         row("step: the difference of the pictures", lambda: C.compare(img, ref, cov))
+
+
+def _crossing_soup(m: int, seed: int = 0):
+    """``m`` large triangles with their corners on the unit sphere: every box of a tree over them
+    holds the centre, so a ray through it enters every leaf."""
+    c = np.random.default_rng(seed).normal(size=(m, 3, 3))
+    return c / np.linalg.norm(c, axis=2, keepdims=True)
+
+
+def section_numpy(repeat: int) -> None:
+    import tracemalloc
+
+    import explorer
+    from explorer.geometry import bvh_numpy as NB
+    from explorer.shading import tiers
+
+    mesh = get_mesh("teapot", 56)
+    O, D, tmax, tri = shadow_rays(mesh, LIGHT)
+    print(f"\n## The numpy tier's rays, {mesh.n_vertices:,}-vertex teapot, point light at "
+          f"{list(LIGHT)}\n")  # fmt: skip
+    bmed, _ = timed(lambda: NB.build_bvh(tri), max(1, repeat // 3))
+    tree = NB.build_bvh(tri)
+    cmed, _ = timed(lambda: NB.any_hit(tree, O, D, tmax), max(1, repeat // 3))
+    scene = load_scene({"lights": [{"type": "point", "position": list(LIGHT)}]})
+    smed, _ = timed(lambda: explorer.shade(scene, mesh.positions, mesh.normals, tier="numpy"),
+                    repeat)  # fmt: skip
+    vl = smed / mesh.n_vertices  # one light
+    build, ray = bmed / len(tri), cmed / len(O)
+    print("| numpy tier | median | in vertex-lights of its shading | tiers counts |")
+    print("|---|---:|---:|---:|")
+    print(f"| shading, per vertex-light | {vl * 1e9:.0f} ns | 1 | 1 |")
+    counts = (getattr(tiers, "BUILD_WORK", "-"), getattr(tiers, "RAY_WORK", "-"))
+    print(f"| tree build, per triangle ({len(tri):,}) | {build * 1e6:.2f} µs | "
+          f"{build / vl:.0f} | {counts[0]} |")  # fmt: skip
+    print(f"| shadow ray, per ray ({len(O):,}) | {ray * 1e6:.2f} µs | {ray / vl:.0f} | "
+          f"{counts[1]} |")  # fmt: skip
+    print(
+        "\nPeak memory of a numpy cast through crossing triangles (every ray enters every "
+        "leaf: nearest hits, no early end), 500 rays through the centre, tracemalloc:\n"
+    )
+    print("| triangles | (ray, triangle) pairs | nearest_hits s | peak MiB | stated bound MiB |")
+    print("|---:|---:|---:|---:|---:|")
+    rng = np.random.default_rng(1)
+    k = 500
+    O = rng.normal(size=(k, 3)) * 3.0
+    D = -O + rng.normal(scale=0.05, size=(k, 3))
+    for m in (2000, 8000, 32000):
+        tree = NB.build_bvh(_crossing_soup(m))
+        tracemalloc.start()
+        t = time.perf_counter()
+        NB.nearest_hits(tree, O, D, 1e-9)
+        seconds = time.perf_counter() - t
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        bound = NB.pair_bound(tree) / 2**20 if hasattr(NB, "pair_bound") else float("nan")
+        print(f"| {m:,} | {k * m:,} | {seconds:.2f} | {peak / 2**20:.1f} | {bound:.1f} |")
+        sys.stdout.flush()
 
 
 def main(argv=None) -> int:

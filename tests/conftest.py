@@ -115,3 +115,25 @@ def cold_tiers(monkeypatch, tmp_path):
         loader.join(timeout=600)
     tiers.set_mode(None)
     tiers._state.update(started=False, loading=None, failed=None, preload=False)
+
+
+@pytest.fixture
+def no_hang():
+    """A test that would block (a reader waiting on a FIFO) fails instead of stopping the suite
+    (``pytestmark = pytest.mark.usefixtures("no_hang")``): after 20 s, and every second after
+    that, the blocked call is interrupted with an exception; should the code under test swallow
+    it (trimesh catches BaseException around its side files), the test still fails at its end."""
+    import signal
+
+    fired = []
+
+    def hung(signum, frame):
+        fired.append(True)
+        raise AssertionError("blocked: still waiting after 20 s")
+
+    previous = signal.signal(signal.SIGALRM, hung)
+    signal.setitimer(signal.ITIMER_REAL, 20.0, 1.0)
+    yield
+    signal.setitimer(signal.ITIMER_REAL, 0.0)
+    signal.signal(signal.SIGALRM, previous)
+    assert not fired, "the test blocked for more than 20 s"

@@ -1,6 +1,8 @@
-"""The package data ships inside the wheel: build it, install it into a fresh environment outside
-the source tree, load every preset from there and write the accuracy report from the shipped table
-and template."""
+"""The package as an index and its users get it: build the sdist and, from it, the wheel (as
+``python -m build`` does); both carry the licence, ``py.typed``, the presets, the data and the
+report template, and the wheel's metadata the licence expression and classifiers of
+pyproject.toml. Then install the wheel into a fresh environment outside the source tree, load every
+preset from there and write the accuracy report from the shipped table and template."""
 
 from __future__ import annotations
 
@@ -10,8 +12,10 @@ import os
 import shutil
 import subprocess
 import sys
+import tarfile
 import venv
 import zipfile
+from email.parser import HeaderParser
 from pathlib import Path
 
 import pytest
@@ -46,10 +50,12 @@ sys.stdout.buffer.write(markdown(table, plot="accuracy.png", command=table["comm
 
 
 def _can_build_wheels() -> bool:
+    """The build-system requirement of pyproject.toml (setuptools>=77, for the PEP 639 licence
+    fields) and the ``build`` front end, installed: the test builds offline, without isolation."""
     import setuptools
 
     major, minor = (int(x) for x in setuptools.__version__.split(".")[:2])
-    return importlib.util.find_spec("wheel") is not None or (major, minor) >= (70, 1)
+    return (major, minor) >= (77, 0) and importlib.util.find_spec("build") is not None
 
 
 def _run(cmd, **kw):
@@ -60,7 +66,9 @@ def _run(cmd, **kw):
 
 @pytest.mark.slow
 @pytest.mark.skipif(
-    not _can_build_wheels(), reason="needs the 'wheel' package (or setuptools>=70.1)"
+    not _can_build_wheels(),
+    reason="needs setuptools>=77 (pyproject.toml's build requirement) and 'build' installed: "
+    "pip install -U setuptools build",
 )
 def test_presets_load_from_an_installed_wheel(tmp_path):
     # 1. build from a clean copy of the project (keeps build/ and *.egg-info out of the tree)
@@ -73,15 +81,18 @@ def test_presets_load_from_an_installed_wheel(tmp_path):
     for name in ("explorer", "materials"):
         shutil.copytree(ROOT / name, src / name, ignore=ignore)
     dist = tmp_path / "dist"
-    _run(
-        [sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "--no-build-isolation",
-         "--no-index", "-q", "-w", str(dist)],
-        cwd=tmp_path,
-    )  # fmt: skip
+    # the sdist, then the wheel from the unpacked sdist: what an index or `pip install` from a
+    # source archive sees
+    built = _run(
+        [sys.executable, "-m", "build", "--no-isolation", "-o", str(dist), str(src)], cwd=tmp_path
+    )
+    # no packaging warning from setuptools (a deprecated field, a data folder it would drop)
+    said = built.stdout + built.stderr
+    assert "WARNING" not in said and "Deprecat" not in said, said
+    (sdist,) = dist.glob("phong_explorer-*.tar.gz")
     (wheel,) = dist.glob("phong_explorer-*.whl")
-    names = zipfile.ZipFile(wheel).namelist()
-    assert "explorer/analysis/templates/accuracy.md" in names
-    assert "explorer/data/accuracy.json" in names
+    _check_sdist(sdist)
+    _check_wheel(wheel)
 
     # 2. a fresh environment (numpy & co. come from the system site-packages, no network)
     env_dir = tmp_path / "venv"
@@ -121,3 +132,53 @@ def test_presets_load_from_an_installed_wheel(tmp_path):
     report = subprocess.run([str(py), "-c", REPORT], cwd=work, env=env, capture_output=True)
     assert report.returncode == 0, report.stderr.decode()
     assert report.stdout == (ROOT / "docs" / "accuracy.md").read_bytes()
+
+
+PRESETS = sorted(p.name for p in (ROOT / "materials").glob("*.yaml"))
+SHIPPED = (
+    "explorer/py.typed",
+    "explorer/data/accuracy.json",
+    "explorer/analysis/templates/accuracy.md",
+)
+
+
+def _check_sdist(sdist: Path) -> None:
+    with tarfile.open(sdist) as tar:
+        names = tar.getnames()
+    (top,) = {n.split("/", 1)[0] for n in names}
+    inner = {n.split("/", 1)[1] for n in names if "/" in n}
+    for name in ("LICENSE", "README.md", "pyproject.toml", *SHIPPED):
+        assert name in inner, f"{name} missing from the sdist {sdist.name}: {sorted(inner)}"
+    assert sorted(n for n in inner if n.startswith("materials/") and n.endswith(".yaml")) == [
+        f"materials/{p}" for p in PRESETS
+    ]
+
+
+def _check_wheel(wheel: Path) -> None:
+    names = zipfile.ZipFile(wheel).namelist()
+    for name in SHIPPED:
+        assert name in names, f"{name} missing from the wheel {wheel.name}: {names}"
+    assert sorted(
+        n for n in names if n.startswith("explorer/materials/") and n.endswith(".yaml")
+    ) == [f"explorer/materials/{p}" for p in PRESETS]
+    # only the package and its metadata: no tests, benchmarks or docs
+    assert {n.split("/", 1)[0] for n in names} == {"explorer", _dist_info(names)}
+    info = _dist_info(names)
+    licence = zipfile.ZipFile(wheel).read(f"{info}/licenses/LICENSE")
+    assert licence == (ROOT / "LICENSE").read_bytes()
+    meta = HeaderParser().parsestr(zipfile.ZipFile(wheel).read(f"{info}/METADATA").decode())
+    assert meta["License-Expression"] == "MIT"
+    assert meta.get_all("License-File") == ["LICENSE"]
+    if sys.version_info < (3, 11):
+        return  # tomllib: the rest compares with pyproject.toml
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    assert meta["License-Expression"] == project["license"]
+    assert meta.get_all("Classifier") == project["classifiers"]
+    assert meta["Keywords"] == ",".join(project["keywords"])
+
+
+def _dist_info(names: list[str]) -> str:
+    (info,) = {n.split("/", 1)[0] for n in names if n.split("/", 1)[0].endswith(".dist-info")}
+    return info

@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 
 from explorer import data
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
+from explorer.core.files import read_text_checked
 from explorer.render.images import check_size
 
 #: the table's file name, in the package's data (:func:`data_path`) and in the bench's output
@@ -52,8 +54,9 @@ def load_table(path=None) -> dict:
                 f"{p}: no accuracy table; run 'phong-explorer bench accuracy' to measure one"
             )
         try:
-            table = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+            text = read_text_checked(p, cap=tol.MAX_DATA_FILE_BYTES, what="accuracy table")
+            table = json.loads(text)
+        except ValueError as exc:  # UnreadableFile, a ValueError, names the file itself
             raise ExplorerError(f"{p}: not a readable accuracy table: {exc}") from None
         if not isinstance(table, dict) or table.get("version") != TABLE_VERSION:
             raise ExplorerError(f"{p}: accuracy table of another version; measure it again")

@@ -15,7 +15,6 @@ from __future__ import annotations
 import os
 import platform
 import statistics
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -26,8 +25,12 @@ import numpy as np
 from explorer.analysis.advice import MAIN_SIDE, TABLE_VERSION
 from explorer.analysis.comparison import compare, coverage
 from explorer.analysis.refine import refine_highlights
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
+from explorer.core.files import read_text_checked
 from explorer.core.lights import DirectionalLight
 from explorer.core.presets import builtin_dir, load_material_file
+from explorer.core.progress import Progress
 from explorer.core.scene import Scene
 from explorer.core.version import __version__
 from explorer.geometry.meshes import get_mesh
@@ -101,7 +104,7 @@ def bench_material(preset: str, shininess: float | None = None):
     return m if shininess is None else m.replace(shininess=float(shininess))
 
 
-# -- timing, progress, machine ---------------------------------------------------------------------
+# -- timing, machine ---------------------------------------------------------------------
 
 
 def median_ms(fn: Callable[[], object], repeats: int) -> float:
@@ -116,58 +119,25 @@ def median_ms(fn: Callable[[], object], repeats: int) -> float:
     return 1000.0 * statistics.median(times)
 
 
-class Progress:
-    """A one-line progress bar on a terminal (stderr); silent when the stream is not a TTY."""
-
-    def __init__(self, total: int = 1, stream=None, width: int = 30, enabled: bool | None = None):
-        self.total = max(1, int(total))
-        self.done = 0
-        self.stream = sys.stderr if stream is None else stream
-        self.width = width
-        if enabled is None:
-            enabled = bool(getattr(self.stream, "isatty", lambda: False)())
-        self.enabled = enabled
-        self.t0 = time.perf_counter()
-
-    def step(self, label: str = "") -> None:
-        self.done += 1
-        if not self.enabled:
-            return
-        frac = min(1.0, self.done / self.total)
-        bar = "#" * int(round(frac * self.width))
-        elapsed = time.perf_counter() - self.t0
-        eta = elapsed / frac - elapsed if frac > 0 else 0.0
-        self.stream.write(
-            f"\r[{bar:<{self.width}}] {100 * frac:3.0f}%  {elapsed:5.0f}s  eta {eta:4.0f}s  "
-            f"{label[:40]:<40}"
-        )
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.enabled:
-            self.stream.write("\n")
-            self.stream.flush()
-
-
 def _cpu_model() -> str:
     try:
-        with open("/proc/cpuinfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.lower().startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
+        text = read_text_checked("/proc/cpuinfo", cap=tol.MAX_DATA_FILE_BYTES)
+        for line in text.splitlines():
+            if line.lower().startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except ExplorerError:
         pass
     return platform.processor() or platform.machine() or "unknown"
 
 
 def _memory() -> str | None:
     try:
-        with open("/proc/meminfo", encoding="utf-8") as fh:
-            for line in fh:
-                if line.startswith("MemTotal:"):
-                    kb = int(line.split()[1])
-                    return f"{kb / 1024 / 1024:.1f} GiB"
-    except (OSError, ValueError, IndexError):
+        text = read_text_checked("/proc/meminfo", cap=tol.MAX_DATA_FILE_BYTES)
+        for line in text.splitlines():
+            if line.startswith("MemTotal:"):
+                kb = int(line.split()[1])
+                return f"{kb / 1024 / 1024:.1f} GiB"
+    except (ValueError, IndexError):  # ExplorerError is a ValueError
         pass
     return None
 

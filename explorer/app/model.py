@@ -21,6 +21,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from explorer.core import tolerances as tol
 from explorer.core.controls import DISTANCE_RANGE
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
@@ -235,7 +236,8 @@ def use_mesh_materials(state: State) -> State:
 
 def select_group(state: State, index: int) -> State:
     """Edit group ``index`` of the mesh's own materials (its material goes to the panel)."""
-    if state.groups is None:
+    mm = state.mesh_materials
+    if state.groups is None or mm is None:
         raise ExplorerError("the mesh's own materials are not shown: there is no group to edit")
     n = len(state.groups)
     if isinstance(index, bool) or not 0 <= int(index) < n:
@@ -243,7 +245,7 @@ def select_group(state: State, index: int) -> State:
     i = int(index)
     return state.replace(
         scene=state.scene.replace(material=state.groups[i]), group=i,
-        preset_material=state.mesh_materials.materials[i],
+        preset_material=mm.materials[i],
     )  # fmt: skip
 
 
@@ -286,7 +288,8 @@ def viewer_of_camera(camera: Camera) -> Viewer:
     an infinite viewer looking along the camera (parallel projection)."""
     if camera.parallel:
         return Viewer(to_viewer=tuple(np.subtract(camera.position, camera.focal_point)))
-    return Viewer(eye=tuple(float(c) for c in camera.position))
+    x, y, z = camera.position
+    return Viewer(eye=(float(x), float(y), float(z)))
 
 
 def set_camera(state: State, camera: Camera | None) -> State:
@@ -365,7 +368,18 @@ def side_b(state: State) -> State:
 # -- light actions -------------------------------------------------------------------------------
 
 
+def check_window_lights(n: int, where: str = "the scene") -> None:
+    """Refuse more than ``MAX_WINDOW_LIGHTS`` lights in the window: an :class:`ExplorerError`
+    naming ``where``, the count and the cap."""
+    if n > tol.MAX_WINDOW_LIGHTS:
+        raise ExplorerError(
+            f"{where}: {n} lights; the window holds at most {tol.MAX_WINDOW_LIGHTS} "
+            "(MAX_WINDOW_LIGHTS; 'phong-explorer render' takes more)"
+        )
+
+
 def _lights(state: State, lights, selected: int | None = None) -> State:
+    check_window_lights(len(lights))
     sel = state.light if selected is None else selected
     sel = min(max(sel, 0), max(len(lights) - 1, 0))
     held = state.held_azimuth if sel == state.light else None
@@ -552,7 +566,8 @@ def parse_colour(key: str, text: str) -> Vec3:
     ):
         if len(h) == 3:
             h = "".join(c * 2 for c in h)
-        return tuple(int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+        r, g, b = (int(h[k : k + 2], 16) / 255.0 for k in (0, 2, 4))
+        return r, g, b
     parts = [p for p in t.replace(",", " ").split() if p]
     try:
         rgb = tuple(float(p) for p in parts)

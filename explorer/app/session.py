@@ -35,7 +35,7 @@ from pathlib import Path
 
 from platformdirs import user_config_dir
 
-from explorer.app.model import TERMS, State
+from explorer.app.model import TERMS, State, check_window_lights
 from explorer.app.start import add_mesh_materials, first_state, load_mesh_choice
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
@@ -151,10 +151,14 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
     groups = _groups(checker, m["groups"]) if m.get("groups") is not None else None
     checker.raise_if_any()
+    lights = m["scene"].get("lights") if isinstance(m["scene"], dict) else None
+    if isinstance(lights, list):  # counted before each light is parsed and checked
+        check_window_lights(len(lights), f"{os.fspath(path)}: scene")
     try:
         scene = load_scene(m["scene"], materials_dirs=materials_dirs)
     except ExplorerError as exc:
         raise ExplorerError(f"{os.fspath(path)}: scene: {exc}") from None
+    check_window_lights(len(scene.lights), f"{os.fspath(path)}: scene")
     mesh = load_mesh_choice(name, resolution)
     state = first_state(scene, mesh, name=name, preset=preset, materials_dirs=materials_dirs,
                         resolution=resolution)  # fmt: skip

@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 
-from explorer.app.model import MeshMaterials, State, with_mesh_materials
+from explorer.app.model import MeshMaterials, State, check_window_lights, with_mesh_materials
 from explorer.core.errors import ExplorerError
 from explorer.core.material import Material
 from explorer.core.presets import list_presets
@@ -73,6 +73,7 @@ def first_state(
     chooser, default the mesh's name; ``resolution`` its built-in resolution, None for the
     explorer's), under preset ``preset`` (marked clean when the library's
     preset of that name has this material)."""
+    check_window_lights(len(scene.lights))
     name = name or scene.mesh or mesh.name
     clean = None
     if preset is not None:

@@ -28,6 +28,7 @@ from explorer.render.offscreen import BACKGROUND, OffscreenRenderer
 from explorer.render.turntable import (
     TURNTABLE_SUFFIXES,
     check_frames,
+    check_turntable,
     encode,
     orbit_camera,
     orbit_scene,
@@ -82,6 +83,8 @@ class TurntableJob:
             raise ExplorerError(
                 f"{self.path}: a turntable is written as {' or '.join(TURNTABLE_SUFFIXES)}"
             )
+        # the frames are kept until they are encoded: the held budget, before any is drawn
+        check_turntable(frames, size, self.suffix, held=True)
         if not self.path.parent.is_dir():
             raise ExplorerError(f"{self.path}: the directory {self.path.parent} does not exist")
         if os.path.lexists(self.path) and not overwrite:

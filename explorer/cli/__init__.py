@@ -5,7 +5,7 @@ own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
 ``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
 User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
 block on stderr, exit status 2, no traceback; text a terminal would act on (from file names,
-keys, descriptions) is shown escaped (:func:`explorer.core.text.printable`). SIGTERM (every
+keys, descriptions) is shown escaped (:func:`explorer.core.text.say`). SIGTERM (every
 command but ``gui``, whose window loop would hold it back) raises :class:`Terminated`, so that
 the writer's cleanup runs: the command stops with one ``error:`` line, exit status 143, and
 leaves no temporary file. Ctrl-C does the same with exit status 130: long ray work runs in
@@ -25,7 +25,7 @@ import warnings
 from contextlib import contextmanager
 
 from explorer.core.errors import Cancelled, ExplorerError, Notice
-from explorer.core.text import printable
+from explorer.core.text import printable, say
 from explorer.core.version import __version__
 
 #: subcommand -> one-line help; each is the module ``explorer.cli.<name>``, with
@@ -81,18 +81,25 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _show_notices() -> None:
-    """Print every :class:`~explorer.core.errors.Notice` (a preset hiding another, an old key
-    name) as one ``notice: ...`` line on stderr, not as a Python warning."""
-    original = warnings.showwarning
+@contextmanager
+def _notices_as_lines():
+    """While a command runs, every :class:`~explorer.core.errors.Notice` (a preset hiding
+    another, an old key name) shown is one ``notice: ...`` line on stderr, not a Python
+    warning. Only the form changes (``warnings.formatwarning``), and only for the command's
+    time: the warning filters decide as ever, and a caller recording warnings
+    (``pytest.warns``, ``warnings.catch_warnings(record=True)``) receives them."""
+    original = warnings.formatwarning
 
-    def show(message, category, filename, lineno, file=None, line=None):
+    def form(message, category, filename, lineno, line=None):
         if issubclass(category, Notice):
-            print(f"notice: {printable(message, keep=chr(10))}", file=sys.stderr)
-        else:
-            original(message, category, filename, lineno, file, line)
+            return f"notice: {printable(message, keep=chr(10))}\n"
+        return original(message, category, filename, lineno, line)
 
-    warnings.showwarning = show
+    warnings.formatwarning = form
+    try:
+        yield
+    finally:
+        warnings.formatwarning = original
 
 
 #: exit status after SIGTERM (the shell's 128 + signal number)
@@ -125,7 +132,11 @@ def _sigterm_raises(enabled: bool = True):
 
 
 def main(argv: list[str] | None = None) -> int:
-    _show_notices()
+    with _notices_as_lines():
+        return _main(argv)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         parser = build_parser()
     except KeyboardInterrupt:  # Ctrl-C while the engine loads: nothing was started
@@ -138,7 +149,7 @@ def main(argv: list[str] | None = None) -> int:
             sys.stdout.flush()  # here, so a reader that went away is met below, not at exit
         return status
     except ExplorerError as exc:
-        print(f"error: {printable(exc, keep=chr(10))}", file=sys.stderr)
+        say(f"error: {exc}", file=sys.stderr)
         return 2
     except Terminated:
         print("error: terminated (SIGTERM); no unfinished file was left", file=sys.stderr)

@@ -33,10 +33,12 @@ import os
 import sys
 from pathlib import Path
 
-from explorer.analysis.benchmark import BenchConfig, Progress, run_bench
+from explorer.analysis.benchmark import BenchConfig, run_bench
 from explorer.analysis.report import markdown, plot_png, table_bytes
 from explorer.core.atomic import write_all_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.progress import Progress
+from explorer.core.text import say
 
 #: bench -> one-line help
 BENCHES = {"accuracy": "per-vertex shading against the per-pixel reference: error and time"}
@@ -102,7 +104,7 @@ def run_accuracy(args) -> int:
             raise ExplorerError(f"--repeats must be at least 1, got {args.repeats}")
         config = dataclasses.replace(config, repeats=args.repeats)
     command = "phong-explorer bench accuracy" + (" --quick" if args.quick else "")
-    table = run_bench(config, progress=Progress())
+    table = run_bench(config, progress=Progress("accuracy"))
     table["command"] = command
     files = {paths["json"]: table_bytes(table)}
     png = plot_png(table)
@@ -112,13 +114,13 @@ def run_accuracy(args) -> int:
     files[paths["md"]] = markdown(table, plot=rel, command=command).encode("utf-8")
     # all-or-nothing: a failure leaves none of the new files and the old ones as they were
     write_all_atomic(files, overwrite=args.force)
-    print(f"wrote {paths['json']}: {len(table['rows'])} rows")
+    say(f"wrote {paths['json']}: {len(table['rows'])} rows")
     if png is not None:
-        print(f"wrote {paths['png']}")
+        say(f"wrote {paths['png']}")
     else:
-        print(
+        say(
             "plot skipped: matplotlib is not installed (pip install 'phong-explorer[bench]')",
             file=sys.stderr,
         )
-    print(f"wrote {paths['md']}")
+    say(f"wrote {paths['md']}")
     return 0

@@ -4,6 +4,7 @@ scene, mesh and preset their options name, or a saved session."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from explorer.app import session as S
@@ -12,7 +13,7 @@ from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import build_scene
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
-from explorer.core.text import printable
+from explorer.core.text import printable, say
 from explorer.geometry.meshes import get_mesh
 
 
@@ -57,7 +58,7 @@ def start_state(args):
     dirs = tuple(args.materials_dirs)
     if getattr(args, "last", False):
         path = S.last_session_path()
-        if not path.is_file():
+        if not os.path.lexists(path):  # anything else is read, or refused, by the checked open
             raise ExplorerError(f"--last: no session kept yet ({path} does not exist)")
         return S.load_session(path, materials_dirs=dirs)
     if getattr(args, "session", None) is not None:
@@ -68,5 +69,5 @@ def start_state(args):
                             resolution=args.resolution)  # fmt: skip
     state, warnings = gui.add_mesh_materials(state, mesh, use=own)
     for w in warnings:
-        print(f"warning: {printable(w)}", file=sys.stderr)
+        say(f"warning: {printable(w)}", file=sys.stderr)
     return state, mesh

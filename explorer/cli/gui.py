@@ -10,7 +10,9 @@
 
 A SCENE file gives the start (material, lights, viewer, mesh); the options are the ``render``
 command's and override their part of it. The window needs a display: without one the command
-prints one line saying why and what to run instead, and exits with status 3.
+prints one line saying why and what to run instead, and exits with status 3; so it does when Qt's
+xcb platform lacks system libraries (:mod:`explorer.app.qtlibs`: the line names them and the apt
+command).
 """
 
 from __future__ import annotations
@@ -21,12 +23,14 @@ import math
 import os
 import sys
 
+from explorer.app import qtlibs
 from explorer.app import start as gui
 from explorer.cli.explorerstart import add_preset_option
 from explorer.cli.explorerstart import start as shared_start
 from explorer.cli.explorerstart import start_state as shared_start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
 from explorer.core.errors import ExplorerError
+from explorer.core.text import printable, say
 from explorer.render.images import parse_size
 
 
@@ -71,10 +75,26 @@ def check_options(args) -> None:
     if t is not None and not (math.isfinite(t) and t > 0):
         raise ExplorerError(f"--exit-after must be a finite number of seconds > 0, got {t}")
     f = args.state_file
-    if f is not None and os.path.lexists(f) and not args.force:
-        raise ExplorerError(f"--state-file {f!r}: already exists; use --force to replace it")
+    if f is not None:
+        check_state_file(f, args.force)
     if args.session is not None and args.last:
         raise ExplorerError("--session and --last both name a session: give one")
+
+
+def check_state_file(f, force: bool) -> None:
+    """Refuse a ``--state-file`` the window could not write after every frame: a directory
+    (even with ``--force``), a file in a directory that does not exist, an existing file
+    without ``--force``. (Before, the window ran and logged one error per frame.)"""
+    shown = printable(repr(os.fspath(f)))
+    if os.path.isdir(f):
+        raise ExplorerError(f"--state-file {shown}: is a directory; give a file name")
+    parent = os.path.dirname(os.path.abspath(f))
+    if not os.path.isdir(parent):
+        raise ExplorerError(
+            f"--state-file {shown}: directory {printable(repr(parent))} does not exist"
+        )
+    if os.path.lexists(f) and not force:
+        raise ExplorerError(f"--state-file {shown}: already exists; use --force to replace it")
 
 
 def start(args):
@@ -96,7 +116,11 @@ def run(args) -> int:
     check_options(args)
     reason = gui.no_display_reason()
     if reason:
-        print(gui.no_display_message(reason), file=sys.stderr)
+        say(gui.no_display_message(reason), file=sys.stderr)
+        return gui.NO_DISPLAY_STATUS
+    missing = qtlibs.missing_libraries()  # before Qt is asked: it would abort (status 134)
+    if missing:
+        say(qtlibs.missing_message(missing), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS
     if not logging.getLogger().handlers:
         logging.basicConfig(
@@ -116,5 +140,5 @@ def run(args) -> int:
             background=background_from_options(args), exit_after=args.exit_after,
         )  # fmt: skip
     except gui.NoDisplayError as exc:
-        print(gui.no_display_message(str(exc)), file=sys.stderr)
+        say(gui.no_display_message(str(exc)), file=sys.stderr)
         return gui.NO_DISPLAY_STATUS

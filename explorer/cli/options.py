@@ -23,7 +23,7 @@ from explorer.core.material import MODELS
 from explorer.core.mtl import MtlError
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, Viewer, load_scene
-from explorer.core.text import printable
+from explorer.core.text import printable, say
 from explorer.core.validate import Checker, notice
 from explorer.geometry.filematerials import group_materials
 from explorer.geometry.meshes import BUILTIN_MESHES, RESOLUTION, get_mesh
@@ -328,41 +328,15 @@ def mesh_materials(args, scene, mesh):
     except MtlError as exc:
         raise MtlError(f"{exc}: give --preset NAME to draw the mesh in one preset") from None
     for w in warnings:
-        print(f"warning: {printable(w)}", file=sys.stderr)
+        say(f"warning: {printable(w)}", file=sys.stderr)
     sizes = np.bincount(mesh.groups.of_vertex, minlength=len(materials))
     main = materials[int(np.argmax(sizes))]
     opacities = {m.opacity for m, size in zip(materials, sizes, strict=True) if size}
     if len(opacities) > 1:
-        print(
+        say(
             f"warning: {mesh.name}: its materials' opacities differ "
             f"({', '.join(f'{o:g}' for o in sorted(opacities))}); the whole mesh is drawn "
             f"with {main.opacity:g}",
             file=sys.stderr,
         )
     return scene.replace(material=main), materials
-
-
-class ProgressBar:
-    """A one-line progress bar on a terminal (nothing when ``stream`` is not one)."""
-
-    WIDTH = 30
-
-    def __init__(self, stream, label: str):
-        self.stream, self.label = stream, label
-        isatty = getattr(stream, "isatty", None)
-        self.shown = bool(isatty and isatty())
-        self.drawn = False
-
-    def update(self, done: int, total: int) -> None:
-        if not self.shown:
-            return
-        filled = self.WIDTH * done // max(total, 1)
-        bar = "#" * filled + "-" * (self.WIDTH - filled)
-        self.stream.write(f"\r{self.label} [{bar}] {done}/{total}")
-        self.stream.flush()
-        self.drawn = True
-
-    def close(self) -> None:
-        if self.drawn:
-            self.stream.write("\n")
-            self.stream.flush()

@@ -6,6 +6,7 @@ import argparse
 
 from explorer.cli.options import add_materials_dir_option
 from explorer.core.scene import load_scene
+from explorer.core.text import say
 from explorer.geometry.meshes import DEFAULT_MESH, get_mesh
 from explorer.shading.plan import make_plan
 
@@ -22,7 +23,7 @@ def run(args) -> int:
     if any(lt.shadows for lt in scene.lights):  # shadows depend on the mesh: look at it
         mesh = get_mesh(scene.mesh or DEFAULT_MESH)
         mesh_kind = "faces" if mesh.n_faces else None
-        print(f"mesh {mesh.name}: {mesh.n_faces} triangles")
+        say(f"mesh {mesh.name}: {mesh.n_faces} triangles")
     plan = make_plan(scene, mesh=mesh_kind)
     m = scene.material
     viewer = (
@@ -30,9 +31,9 @@ def run(args) -> int:
         if scene.viewer.local
         else (f"to_viewer {[round(c, 6) for c in scene.viewer.to_viewer]}")
     )
-    print(
+    say(
         f"scene {args.scene}: {len(scene.lights)} light(s), model {scene.model}, "
         f"shininess {m.shininess:g}, viewer {viewer}"
     )
-    print(plan.describe())
+    say(plan.describe())
     return 0

@@ -18,11 +18,11 @@ material; ``--preset`` draws the whole mesh in one preset instead. The scene opt
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from pathlib import Path
 
 from explorer.cli.options import (
-    ProgressBar,
     add_scene_arguments,
     background_from_options,
     build_scene,
@@ -30,10 +30,13 @@ from explorer.cli.options import (
     mesh_materials,
     size_from_option,
 )
-from explorer.core.atomic import write_atomic
+from explorer.core import tolerances as tol
+from explorer.core.atomic import write_all_atomic, write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
+from explorer.core.progress import Progress
+from explorer.core.text import say
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
@@ -42,8 +45,9 @@ from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
     check_frames,
+    check_turntable,
     encode,
-    turntable_frames,
+    iter_frames,
 )
 from explorer.shading.display import group_vertex_colors, vertex_colors
 
@@ -83,6 +87,8 @@ def run(args) -> int:
     if turntable:
         check_frames(args.turntable)
     size = size_from_option(args.size, "--size")
+    if turntable:  # its format's needs and its total, before the mesh is read or a frame drawn
+        check_turntable(args.turntable, size, suffix)
     background = background_from_options(args)
     args.mesh_default = "sphere"
     scene, mesh = build_scene(args)
@@ -90,7 +96,7 @@ def run(args) -> int:
     if scene.hdr is not None:
         for m in materials or (scene.material,):
             for w in energy_warnings(m):
-                print(f"warning: {w}", file=sys.stderr)
+                say(f"warning: {w}", file=sys.stderr)
     if args.per_pixel:
         if materials:
             raise ExplorerError(
@@ -115,8 +121,9 @@ def run(args) -> int:
             mesh, colors, suffix, scene.material.opacity, double_sided=scene.two_sided
         )
         what = f"{mesh.n_vertices} vertices with colours"
+        warn_if_unreadable(args.out, len(data))
     write_atomic(args.out, data, overwrite=args.force)
-    print(f"wrote {args.out}: {what} ({mesh.name}, {name}, {scene.model})")
+    say(f"wrote {args.out}: {what} ({mesh.name}, {name}, {scene.model})")
     return 0
 
 
@@ -128,31 +135,51 @@ def colors_of(scene, mesh, materials):
 
 
 def run_obj(args, scene, mesh, materials) -> int:
-    """``--out x.obj``: the mesh and ``x.mtl`` beside it; neither replaces a file without
-    ``--force`` (both are checked before either is written)."""
+    """``--out x.obj``: the mesh and ``x.mtl`` beside it (:func:`mtl_file_name`), written
+    together (:func:`~explorer.core.atomic.write_all_atomic`); neither replaces a file without
+    ``--force``."""
     out = Path(args.out)
-    mtl_path = out.with_suffix(".mtl")
-    if mtl_path.exists() and not args.force:
-        raise ExplorerError(f"{mtl_path}: already exists; use --force to replace it")
+    mtl_path = out.with_name(mtl_file_name(out))
     if materials:
         names = preset_names([n or "default" for n in mesh.groups.names])
         pairs = list(zip(names, materials, strict=True))
     else:
         pairs = [(preset_name(scene.material.name or "material"), scene.material)]
     obj, mtl = obj_files(mesh, pairs, mtl_path.name)
-    write_atomic(mtl_path, mtl, overwrite=args.force)
-    write_atomic(out, obj, overwrite=args.force)
-    print(
+    warn_if_unreadable(out, len(obj))
+    write_all_atomic({mtl_path: mtl, out: obj}, overwrite=args.force)
+    say(
         f"wrote {out} and {mtl_path}: {mesh.n_vertices} vertices, "
         f"{len(pairs)} material{'s' if len(pairs) != 1 else ''} ({mesh.name})"
     )
     return 0
 
 
+def mtl_file_name(out: Path) -> str:
+    """The name of the .mtl written beside the OBJ ``out``: its stem with every run of
+    characters other than letters, digits, ``.``, ``-`` and ``_`` made one ``_``, so that the
+    ``mtllib`` line reads back the same in every reader (a blank would split it in most, a
+    ``#`` would start a comment): ``my model.obj`` -> ``my_model.mtl``."""
+    stem = re.sub(r"[^\w.\-]+", "_", out.stem).strip("_") or "materials"
+    return f"{stem}.mtl"
+
+
+def warn_if_unreadable(out, size: int) -> None:
+    """A warning when a mesh file written is larger than the product reads back
+    (``MAX_MESH_FILE_BYTES``): it is still written."""
+    if size > tol.MAX_MESH_FILE_BYTES:
+        say(
+            f"warning: {out} is {size} bytes, more than the {tol.MAX_MESH_FILE_BYTES} bytes "
+            f"({tol.MAX_MESH_FILE_BYTES >> 20} MiB) phong-explorer reads as a mesh file "
+            "(MAX_MESH_FILE_BYTES); other tools can read it, --mesh cannot",
+            file=sys.stderr,
+        )
+
+
 def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -> int:
     """``--turntable N``: N frames of the orbit into a GIF or MP4, with a progress bar."""
-    bar = ProgressBar(sys.stderr, "turntable")
-    frames = turntable_frames(
+    bar = Progress("turntable")
+    frames = iter_frames(
         scene,
         mesh,
         args.turntable,
@@ -161,9 +188,10 @@ def run_turntable(args, scene, mesh, materials, size, background, suffix: str) -
         background=background,
         progress=bar.update,
     )
+    data = encode(frames, suffix)  # each frame encoded as it renders
     bar.close()
-    write_atomic(args.out, encode(frames, suffix), overwrite=args.force)
-    print(
+    write_atomic(args.out, data, overwrite=args.force)
+    say(
         f"wrote {args.out}: {args.turntable} frames of {size[0]}x{size[1]} at {FPS} frames/s "
         f"({mesh.name}, {scene.model})"
     )
@@ -175,7 +203,7 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
     if suffix != ".png":
         raise ExplorerError(f"--per-pixel draws a picture: give --out FILE.png, not {suffix}")
     if scene.material.opacity < 1.0:
-        print(
+        say(
             f"note: --per-pixel draws the nearest surface only (opacity "
             f"{scene.material.opacity:g} is not blended)",
             file=sys.stderr,
@@ -184,7 +212,7 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
     write_atomic(args.out, encode_png(ref.image(background)), overwrite=args.force)
     how = "exact sphere" if ref.hits.method == "sphere" else "ray cast"
     name = scene.material.name or "material"
-    print(
+    say(
         f"wrote {args.out}: {size[0]}x{size[1]} per-pixel picture ({mesh.name}, {how}, {name}, "
         f"{scene.model})"
     )

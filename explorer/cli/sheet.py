@@ -29,6 +29,7 @@ from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import DirectionalLight
 from explorer.core.presets import find_preset, list_presets
+from explorer.core.text import say
 from explorer.render.images import encode_png
 from explorer.render.offscreen import SHEET_LIGHT_DIRECTION, sheet
 
@@ -71,5 +72,5 @@ def run(args) -> int:
     write_atomic(args.out, encode_png(image), overwrite=args.force)
     h, w = image.shape[:2]
     under = f" under {', '.join(models)}" if models else ""
-    print(f"wrote {args.out}: {len(items)} presets{under} on {mesh.name}, {w}x{h}")
+    say(f"wrote {args.out}: {len(items)} presets{under} on {mesh.name}, {w}x{h}")
     return 0

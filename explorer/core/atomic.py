@@ -43,7 +43,7 @@ def sweep_stale_temps(directory, *, now: float | None = None) -> list[Path]:
     it cannot remove or a directory it cannot list."""
     now = time.time() if now is None else now
     uid = os.getuid() if hasattr(os, "getuid") else None
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(os.scandir(directory))
     except OSError:
@@ -87,12 +87,7 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
         raise exists_error(target)
     parent = target.parent
     if make_dirs:
-        try:
-            parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise ExplorerError(
-                f"{parent}: cannot create directory: {exc.strerror or exc}"
-            ) from None
+        _make_dirs(parent)
     elif not parent.is_dir():
         raise ExplorerError(f"{target}: directory {str(parent)!r} does not exist")
     _sweep_now_and_then(parent)
@@ -119,16 +114,31 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
     return target
 
 
-def write_all_atomic(files: Mapping, *, overwrite: bool = False) -> list[Path]:
+def _make_dirs(directory: Path) -> None:
+    """Create ``directory`` and its missing parents (an :class:`ExplorerError` naming it)."""
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ExplorerError(
+            f"{directory}: cannot create directory: {exc.strerror or exc}"
+        ) from None
+
+
+def write_all_atomic(
+    files: Mapping, *, overwrite: bool = False, make_dirs: bool = False
+) -> list[Path]:
     """Write several files all-or-nothing: ``files`` maps each path to its bytes.
 
     Every file is first written to a temporary beside its target; only when all of them are
     on disk are they renamed into place. If anything fails (a full disk, a target that
     appeared, an interrupt) no new file is left and the files that were there before are
-    back as they were. Returns the paths written, in the order given. Each target's directory
-    must exist; ``overwrite`` as for :func:`write_atomic`.
+    back as they were. Returns the paths written, in the order given. ``overwrite`` and
+    ``make_dirs`` as for :func:`write_atomic` (without it each target's directory must exist).
     """
     targets = [(Path(os.fspath(p)), data) for p, data in files.items()]
+    if make_dirs:
+        for parent in dict.fromkeys(t.parent for t, _ in targets):
+            _make_dirs(parent)
     for target, _ in targets:
         if target.is_dir():
             raise ExplorerError(f"{target}: is a directory; give a file name to write")

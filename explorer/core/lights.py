@@ -48,6 +48,7 @@ from explorer.core.validate import (
     Checked,
     Checker,
     check_fields,
+    format_number,
     old_keywords,
 )
 
@@ -97,7 +98,9 @@ def _cutoff(checker: Checker, value, path):
     lo, hi = SPOT_CUTOFF_RANGE
     c = checker.number(value, path, lo, NO_CONE)
     if c is not None and hi < c < NO_CONE:
-        checker.problem(path, f"must be in [{lo:g}, {hi:g}] or exactly {NO_CONE:g}, got {c:g}")
+        checker.problem(
+            path, f"must be in [{lo:g}, {hi:g}] or exactly {NO_CONE:g}, got {format_number(c)}"
+        )
         return None
     return c
 
@@ -243,8 +246,10 @@ class Light(Checked):
         """A light of this type with the colours of ``light`` (and its attenuation between
         positional types; a new spot gets the cone of ``LIKE_DEFAULTS``), at this type's default
         place: move it with :meth:`placed`."""
-        colours = dict(ambient=light.ambient, diffuse=light.diffuse, specular=light.specular)
-        return cls(**colours, **cls._kept_from(light), **cls.LIKE_DEFAULTS)
+        return cls(
+            ambient=light.ambient, diffuse=light.diffuse, specular=light.specular,
+            **cls._kept_from(light), **cls.LIKE_DEFAULTS,
+        )  # fmt: skip
 
     @classmethod
     def _kept_from(cls, light: Light) -> dict:
@@ -460,7 +465,9 @@ class PositionalLight(Light):
         if distance <= tol.FAR_LIGHT:
             return v, (min(kc, cap), kl, kq)
         denominator = kc + _times(kl, distance) + _times(_times(kq, distance), distance)
-        return tuple(tol.FAR_LIGHT * c for c in u), (min(denominator, cap), 0.0, 0.0)
+        ux, uy, uz = u
+        far = tol.FAR_LIGHT
+        return (far * ux, far * uy, far * uz), (min(denominator, cap), 0.0, 0.0)
 
     def toward(self, points, centre=None, scale=1.0) -> np.ndarray:
         if centre is None:  # the world: the light where it is
@@ -635,10 +642,10 @@ def _color_intensity(m: dict, checker: Checker, path: tuple):
                 path + (key,),
                 "cannot be combined with color/intensity (they set diffuse and specular)",
             )
-    color = (1.0, 1.0, 1.0)
+    color: RGB | None = (1.0, 1.0, 1.0)
     if "color" in m:
         color = checker.rgb(m["color"], path + ("color",), 0.0, MAX_LIGHT_VALUE)
-    k = 1.0
+    k: float | None = 1.0
     if "intensity" in m:
         k = checker.number(m["intensity"], path + ("intensity",), 0.0, MAX_LIGHT_VALUE)
     if color is None or k is None:

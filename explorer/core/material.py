@@ -229,7 +229,8 @@ def _hue(rgb: RGB) -> RGB | None:
     if m <= 0.0:
         return None
     # c / m is exactly 1.0 for the largest channel, so max(hue * k) == k exactly
-    return tuple(c / m for c in rgb)
+    r, g, b = rgb
+    return r / m, g / m, b / m
 
 
 def parse_material(value, checker: Checker, path: tuple = ()) -> Material | None:

@@ -32,13 +32,15 @@ from pathlib import Path
 
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
+from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.material import (
     COEFFICIENT_RANGE,
     OPACITY_RANGE,
     SHININESS_RANGE,
     Material,
 )
-from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_preset
+from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_presets
+from explorer.core.validate import format_number
 
 #: colour statement -> the material field it sets
 COLOUR_KEYS = {"ka": "ambient", "kd": "diffuse", "ks": "specular", "ke": "emission"}
@@ -66,11 +68,23 @@ ILLUM_MEANING = {
 }
 #: OpenGL 1.x / 2.1's largest GL_SHININESS: a larger exponent is legal in MTL and here
 GL_MAX_SHININESS = 128.0
+#: a number as MTL writes it: ASCII decimal digits, an optional sign, point and exponent
+#: (``1``, ``-0.5``, ``.5``, ``1e-3``); not Python's ``1_0``, ``inf``, ``nan`` or other digits
+MTL_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _TEXTURE = re.compile(r"(map_\w+|bump|disp|decal|refl|norm)")
 
 
 class MtlError(ExplorerError):
     """An .mtl file the reader cannot take: the message is ``file:line: what is wrong``."""
+
+
+class MtlUnreadable(MtlError):
+    """An .mtl file that could not be opened or read at all (missing, not a regular file, too
+    large); ``reason`` says which (:class:`explorer.core.files.UnreadableFile`)."""
+
+    def __init__(self, exc: UnreadableFile):
+        self.reason = exc.reason
+        super().__init__(str(exc))
 
 
 @dataclass(frozen=True)
@@ -90,22 +104,15 @@ class MtlMaterial:
 
 
 def read_mtl(path) -> list[MtlMaterial]:
-    """The materials of an .mtl file (see :func:`parse_mtl`); a missing or unreadable file,
-    or one larger than ``MAX_MTL_FILE_BYTES``, raises an :class:`MtlError` naming it."""
+    """The materials of an .mtl file (see :func:`parse_mtl`); a missing file, one that is not a
+    regular file (a FIFO or device is refused without blocking) or one larger than
+    ``MAX_MTL_FILE_BYTES`` raises an :class:`MtlError` naming it
+    (:func:`explorer.core.files.read_checked`)."""
     shown = os.fspath(path)
     try:
-        size = os.path.getsize(shown)
-        if size > tol.MAX_MTL_FILE_BYTES:
-            raise MtlError(
-                f"{shown}: too large for a material library ({size} bytes, the limit is "
-                f"{tol.MAX_MTL_FILE_BYTES})"
-            )
-        with open(shown, "rb") as fh:
-            data = fh.read()
-    except IsADirectoryError:
-        raise MtlError(f"{shown}: is a directory, not an .mtl file") from None
-    except OSError as exc:
-        raise MtlError(f"{shown}: cannot be read: {exc.strerror or exc}") from None
+        data = read_checked(shown, cap=tol.MAX_MTL_FILE_BYTES, what="material library")
+    except UnreadableFile as exc:
+        raise MtlUnreadable(exc) from None
     return parse_mtl(data, shown)
 
 
@@ -127,7 +134,7 @@ def parse_mtl(data: bytes | str, source: str = "<mtl>") -> list[MtlMaterial]:
                 raise MtlError(f"{where}: newmtl needs a material name")
             if current is not None:
                 out.append(current.build())
-            current = _Builder(" ".join(words[1:]), number, source)
+            current = _Builder(check_mtl_name(" ".join(words[1:]), where), number, source)
             continue
         if current is None:
             raise MtlError(
@@ -154,8 +161,8 @@ def _decode(data: bytes | str, source: str) -> str:
         text = data
     else:
         if b"\0" in data:
-            line = data[: data.index(b"\0")].count(b"\n") + 1
-            raise MtlError(f"{source}:{line}: binary data (a NUL byte): not an .mtl text file")
+            at = data[: data.index(b"\0")].count(b"\n") + 1
+            raise MtlError(f"{source}:{at}: binary data (a NUL byte): not an .mtl text file")
         try:
             text = data.decode("utf-8-sig")
         except UnicodeDecodeError:
@@ -317,10 +324,11 @@ def _number(words: list[str], count: int | None, where: str, what: str) -> float
 
 
 def _float(word: str, where: str, what: str) -> float:
-    try:
-        value = float(word)
-    except ValueError:
-        raise MtlError(f"{where}: {what}: {word!r} is not a number") from None
+    if word.lstrip("+-").lower() in ("nan", "inf", "infinity"):
+        raise MtlError(f"{where}: {what}: {word!r} is not a finite number")
+    if not MTL_NUMBER.fullmatch(word):  # float() also takes '1_0' and non-ASCII digits
+        raise MtlError(f"{where}: {what}: {word!r} is not a number")
+    value = float(word)
     if not math.isfinite(value):
         raise MtlError(f"{where}: {what}: {word!r} is not a finite number")
     return value
@@ -342,15 +350,15 @@ def _colour(words: list[str], where: str) -> tuple[float, float, float]:
     values = [_float(a, where, what) for a in args]
     for v in values:
         _check_range(v, COEFFICIENT_RANGE, where, what)
-    if len(values) == 1:
-        values = values * 3
-    return tuple(values)
+    r, g, b = values * 3 if len(values) == 1 else values
+    return r, g, b
 
 
 def _check_range(value: float, bounds: tuple[float, float], where: str, what: str) -> None:
     lo, hi = bounds
     if not lo <= value <= hi:
-        raise MtlError(f"{where}: {what} must be in [{lo:g}, {hi:g}], got {value:g}")
+        shown = ", ".join(format_number(v) for v in (lo, hi))
+        raise MtlError(f"{where}: {what} must be in [{shown}], got {format_number(value)}")
 
 
 def _illum(words: list[str], where: str) -> int:
@@ -361,6 +369,18 @@ def _illum(words: list[str], where: str) -> int:
 
 
 # -- names -----------------------------------------------------------------------------------
+def check_mtl_name(name: str, where: str) -> str:
+    """``name`` if a ``newmtl`` may have it: at most ``MAX_MTL_NAME_LENGTH`` characters (a
+    longer one would make a preset file that the preset reader refuses); else an
+    :class:`MtlError` at ``where``."""
+    if len(name) > tol.MAX_MTL_NAME_LENGTH:
+        raise MtlError(
+            f"{where}: newmtl name is {len(name)} characters long; the limit is "
+            f"{tol.MAX_MTL_NAME_LENGTH}"
+        )
+    return name
+
+
 def preset_name(name: str) -> str:
     """A preset name (lowercase letters, digits, ``_``) made from a material name: letters
     lowercased, runs of anything else one ``_``, at most ``MAX_NAME_LENGTH`` characters;
@@ -402,17 +422,15 @@ class MtlImport:
         return [t for t in self.targets if t.exists()]
 
     def write(self, overwrite: bool) -> list[Path]:
-        """Write every preset (atomically; an existing file only with ``overwrite``)."""
+        """Write every preset, all or nothing (:func:`~explorer.core.presets.save_presets`:
+        an existing file is replaced only with ``overwrite``; a failure or an interrupt
+        leaves the directory as it was)."""
         origin = Path(self.source).name
-        return [
-            save_preset(
-                m.material.replace(description=f"imported from {origin}: {m.name}"),
-                name,
-                t.parent,
-                overwrite=overwrite,
-            )  # fmt: skip
-            for m, name, t in zip(self.found, self.names, self.targets, strict=True)
+        items = [
+            (m.material.replace(description=f"imported from {origin}: {m.name}"), name)
+            for m, name in zip(self.found, self.names, strict=True)
         ]
+        return save_presets(items, self.targets[0].parent if self.targets else None, overwrite)
 
 
 def mtl_import(path, directory) -> MtlImport:

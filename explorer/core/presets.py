@@ -26,12 +26,13 @@ from pathlib import Path
 
 from platformdirs import user_config_dir
 
-from explorer.core.atomic import write_atomic
+from explorer.core.atomic import write_all_atomic, write_atomic
 from explorer.core.errors import ExplorerError, Notice, ValidationError
+from explorer.core.files import file_kind
 from explorer.core.material import Material, parse_material
 from explorer.core.validate import Checker, suggest
 from explorer.core.version import __version__
-from explorer.core.yamlio import dump_yaml, file_kind, load_yaml
+from explorer.core.yamlio import dump_yaml, load_yaml
 
 #: Environment variable overriding the user's preset directory (used by the tests).
 ENV_VAR = "PHONG_EXPLORER_MATERIALS"
@@ -66,7 +67,10 @@ class PresetInfo:
 # -- directories -----------------------------------------------------------------------------
 def builtin_dir() -> Path:
     """Directory of the built-in presets (inside the installed package)."""
-    return Path(os.fspath(resources.files("explorer.materials")))
+    root = resources.files("explorer.materials")
+    if not isinstance(root, os.PathLike):  # e.g. a zipped install: the presets are no files
+        raise TypeError(f"the built-in presets are not files on disk: {root!r}")
+    return Path(os.fspath(root))
 
 
 def user_dir() -> Path:
@@ -134,6 +138,7 @@ def load_material_file(path) -> Material:
         material = parse_material(doc.data, checker, ())
     if checker.problems:
         raise ValidationError(sorted(checker.problems, key=lambda p: p.line or 0))
+    assert material is not None  # parse_material records a problem whenever it gives None
     return material.replace(name=Path(os.fspath(path)).stem)
 
 
@@ -261,7 +266,28 @@ def save_preset(material: Material, name: str, directory=None, overwrite: bool =
     is only replaced with ``overwrite=True``. A material a file could not hold (a coefficient
     above 1, shininess above 1000) is refused before anything is written.
     """
+    data = preset_bytes(material, name)  # before touching the disk: bad data fails first
+    return write_atomic(preset_path(name, directory), data, overwrite=overwrite, make_dirs=True)
 
+
+def save_presets(items, directory=None, overwrite: bool = False) -> list[Path]:
+    """Write several presets all-or-nothing: ``items`` is ``[(material, name), ...]``. Every
+    file is checked and made first, then all are put in place together
+    (:func:`~explorer.core.atomic.write_all_atomic`): a problem, a directory where a file
+    goes, a preset that exists (without ``overwrite``) or an interrupt leaves the directory as
+    it was. Returns the files written, in order."""
+    files = {preset_path(name, directory): preset_bytes(m, name) for m, name in items}
+    return write_all_atomic(files, overwrite=overwrite, make_dirs=True)
+
+
+def preset_path(name: str, directory=None) -> Path:
+    """Where preset ``name`` is saved in ``directory`` (default :func:`user_dir`)."""
+    directory = user_dir() if directory is None else Path(os.fspath(directory)).expanduser()
+    return directory / f"{name}{SUFFIX}"
+
+
+def preset_bytes(material: Material, name: str) -> bytes:
+    """The preset file of ``material`` named ``name``, checked as :func:`save_preset` says."""
     check_name(name)
     if not isinstance(material, Material):
         raise ExplorerError(f"save_preset needs a Material, got {type(material).__name__}")
@@ -269,12 +295,8 @@ def save_preset(material: Material, name: str, directory=None, overwrite: bool =
     checker = Checker(f"preset '{name}'")
     parse_material(data, checker, ())
     checker.raise_if_any()
-    directory = user_dir() if directory is None else Path(os.fspath(directory)).expanduser()
     header = f"phong-explorer material preset '{name}' (saved by phong-explorer {__version__})"
-    text = dump_yaml(data, header=header)  # before touching the disk: bad data fails first
-    return write_atomic(
-        directory / f"{name}{SUFFIX}", text.encode("utf-8"), overwrite=overwrite, make_dirs=True
-    )
+    return dump_yaml(data, header=header).encode("utf-8")
 
 
 # -- notices ---------------------------------------------------------------------------------

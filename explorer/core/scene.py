@@ -96,6 +96,7 @@ class Viewer(Checked):
     def to_mapping(self) -> dict:
         if self.eye is not None:
             return {"eye": list(self.eye)}
+        assert self.to_viewer is not None  # _check: exactly one of the two is given
         return {"to_viewer": list(self.to_viewer)}
 
 
@@ -281,6 +282,7 @@ def _parse(data, checker: Checker, materials_dirs, base_dir) -> Scene:
     model defaults to the material's, a mesh path is relative to the file."""
     m = checker.mapping(data, (), "a mapping of scene keys")
     checker.raise_if_any()
+    assert m is not None  # mapping() records a problem whenever it gives None
     checker.keys(m, (), SCENE_KEYS)
     checks = dict(Scene.KEYS)
     if isinstance(m.get("material"), str):

@@ -9,6 +9,7 @@ else, accented letters included, is kept as it is.
 
 from __future__ import annotations
 
+import sys
 import unicodedata
 
 #: Unicode categories escaped: controls (C0, DEL, C1), format characters (bidi overrides,
@@ -36,3 +37,10 @@ def _escaped(c: str) -> str:
     if n < 0x10000:
         return f"\\u{n:04x}"
     return f"\\U{n:08x}"
+
+
+def say(text, *, file=None, keep: str = "\n") -> None:
+    """Print one message that holds user text (a file name, a mesh name, a preset's words):
+    the CLI's one printing path for such messages, so what a terminal would act on is shown
+    escaped (:func:`printable`; ``keep`` as there). ``file``: the stream (stdout if None)."""
+    print(printable(text, keep=keep), file=file if file is not None else sys.stdout)

@@ -80,7 +80,8 @@ DET_EPS = 1e-15
 SHADOW_NDL_MARGIN = 1e-6
 
 #: Per-pixel reference: a pixel's ray meeting a triangle at a parameter at most this times the
-#: scene's size (max(largest absolute coordinate, 1)) is ignored; the rays start at the camera,
+#: scene's size in the mesh's normalised frame (max(largest absolute coordinate of the rays'
+#: origins there, 1): the rays are cast in that frame) is ignored; the rays start at the camera,
 #: so this only drops hits at the camera itself. Any determinant other than 0 counts (both
 #: sides are seen, as VTK draws them).
 PIXEL_RAY_T_MIN = 1e-9
@@ -187,10 +188,38 @@ MAX_MESH_UNPACKED_BYTES = 256 << 20
 #: largest real ones (scenes of thousands of materials) are a few MiB, so anything larger is
 #: refused before it is read.
 MAX_MTL_FILE_BYTES = 16 << 20
-#: Most turntable frames one render writes: a full turn in 1-degree steps. Each frame is a
-#: full off-screen render held in memory until the animation is encoded.
+#: Longest ``newmtl`` name read (characters). An imported material keeps its name in its
+#: preset's description; a name of megabytes would make a preset file over the YAML reader's
+#: 1 MiB cap, so import would write what validate and render then refuse. Real names are a
+#: few dozen characters.
+MAX_MTL_NAME_LENGTH = 256
+#: How many ``mtllib`` libraries one OBJ may name: each is a file opened and read.
+MAX_MTL_LIBRARIES = 64
+#: Largest of the other files the product reads (bytes): the window's recent-files list, the
+#: accuracy table (about 400 KB), ``/proc/cpuinfo`` for a benchmark's machine line (a few KB
+#: per core). Read through the checked open, which never trusts a size (``/proc`` gives 0).
+MAX_DATA_FILE_BYTES = 16 << 20
+#: Most lights the window holds (a session, a scene opened in it, lights added there): eight
+#: times OpenGL's GL_MAX_LIGHTS. Each light is a row in the light panel and a handle in the
+#: view and is shaded every frame; a 20,000-light session took 40-50 s to open and to close
+#: (and was kept as a last session over the 1 MiB the reader takes). ``render`` and the
+#: library take more.
+MAX_WINDOW_LIGHTS = 64
+#: Most turntable frames one render writes: a full turn in 1-degree steps.
 MAX_TURNTABLE_FRAMES = 360
+#: Largest turntable, frames x width x height pixels, whose frames are held until the end: a
+#: GIF (its encoder keeps every frame, one byte per pixel once in its palette) and the window's
+#: turntable (it keeps the frames it renders, 3 bytes per pixel, to encode them in a thread).
+#: 2**29 pixels: 512 MiB palettised, 1.5 GiB as RGB; 360 frames of 1200 x 1200, 36 of 3800 x 3800.
+MAX_TURNTABLE_HELD_PIXELS = 1 << 29
+#: Largest MP4 turntable of ``render --turntable``, frames x width x height pixels: its frames
+#: are streamed to the encoder one at a time (memory: one frame), so this bounds the time only:
+#: 2**32 pixels, 360 frames of 3400 x 3400, several minutes (360 x 2048² took 117 s).
+MAX_TURNTABLE_PIXELS = 1 << 32
 #: Largest picture (width x height pixels) a render or a whole sheet may have: 8192 x 8192,
 #: 192 MiB as RGB bytes and several times that inside VTK while drawing. A sheet of large
 #: tiles is checked before anything is allocated (beyond it VTK aborts with std::bad_alloc).
 MAX_PICTURE_PIXELS = 8192 * 8192
+#: Largest PNG file read (bytes): the largest picture as RGBA without any compression, plus
+#: 1 MiB for its chunks' headers (a PNG of MAX_PICTURE_PIXELS is never larger).
+MAX_PNG_FILE_BYTES = 4 * MAX_PICTURE_PIXELS + (1 << 20)

@@ -27,7 +27,7 @@ import math
 import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from numbers import Real
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -64,9 +64,20 @@ def suggest(word: str, options: Iterable[str]) -> str:
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 
+def format_number(x: float) -> str:
+    """A number as range errors show it: short (``1``, ``0.5``, ``1e+06``) when that is the
+    number exactly, else every digit it needs (``179.0001``, not ``179``), so a refused value
+    never reads as an allowed one."""
+    x = float(x)
+    short = f"{x:g}"
+    if not math.isfinite(x) or (float(short) == x and len(short) <= len(repr(x))):
+        return short
+    return repr(x)
+
+
 def _fmt(x) -> str:
     if isinstance(x, float):
-        return f"{x:g}"
+        return format_number(x)
     return repr(x) if isinstance(x, str) else str(x)
 
 
@@ -276,6 +287,8 @@ class Checked:
 
     KEYS: ClassVar[Mapping[str, Check]] = {}
     RENAMED: ClassVar[Mapping[str, tuple[str, str]]] = {}
+    #: every subclass is a dataclass (what ``dataclasses.fields`` needs; declared for checkers)
+    __dataclass_fields__: ClassVar[dict[str, dataclasses.Field[Any]]]
 
     def __post_init__(self):
         self._check(type(self).KEYS)

@@ -37,14 +37,15 @@ from __future__ import annotations
 
 import os
 import re
-import stat
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from numbers import Integral, Real
+from typing import NoReturn
 
 import yaml
 
 from explorer.core.errors import Problem, ValidationError
+from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.validate import Checker, format_path, line_of
 
 #: Largest document accepted, in bytes (1 MiB: presets and scenes are a few hundred bytes).
@@ -138,8 +139,7 @@ def parse_yaml(
         _fail(file, exc.line, exc.message)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else None
-        _fail(file, line, _syntax_message(exc, mark))
+        _fail(file, mark.line + 1 if mark is not None else None, _syntax_message(exc, mark))
     except yaml.reader.ReaderError as exc:
         line = text.count("\n", 0, exc.position) + 1
         _fail(file, line, _reader_message(exc))
@@ -165,50 +165,14 @@ def parse_yaml(
 
 
 def _read_bytes(name: str, what: str) -> bytes:
-    """The bytes of the regular file ``name``. It is opened without blocking (a FIFO would
-    wait for a writer forever) and refused unless it is a regular file (a FIFO, socket or
-    device is named as such), or when larger than :data:`MAX_BYTES`."""
+    """The bytes of the regular file ``name`` (:func:`explorer.core.files.read_checked`: a FIFO,
+    socket or device is refused without blocking, as is a file over :data:`MAX_BYTES`)."""
     try:
-        fd = os.open(name, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except FileNotFoundError:
-        _fail(name, None, f"cannot read {what}: no such file")
-    except IsADirectoryError:
-        _fail(name, None, f"cannot read {what}: it is a directory, not a file")
-    except PermissionError:
-        _fail(name, None, f"cannot read {what}: permission denied")
-    except OSError as exc:
-        if os.path.isdir(name):
-            _fail(name, None, f"cannot read {what}: it is a directory, not a file")
-        _fail(name, None, f"cannot read {what}: {exc.strerror or exc}")
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            _fail(name, None, f"cannot read {what}: it is {file_kind(st.st_mode)}, not a file")
-        if st.st_size > MAX_BYTES:
-            _fail(name, None, _too_big(st.st_size))
-    except BaseException:
-        os.close(fd)
-        raise
-    with os.fdopen(fd, "rb") as fh:
-        try:
-            raw = fh.read(MAX_BYTES + 1)
-        except OSError as exc:
-            _fail(name, None, f"cannot read {what}: {exc.strerror or exc}")
-        if len(raw) > MAX_BYTES:  # it grew since fstat
-            _fail(name, None, _too_big(len(raw)))
-        return raw
-
-
-def file_kind(mode: int) -> str:
-    """What a file that is not a regular file is, for messages ("a FIFO (named pipe)")."""
-    kinds = (
-        (stat.S_ISFIFO, "a FIFO (named pipe)"),
-        (stat.S_ISSOCK, "a socket"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISDIR, "a directory"),
-    )
-    return next((text for test, text in kinds if test(mode)), "not a regular file")
+        return read_checked(name, cap=MAX_BYTES, what=what)
+    except UnreadableFile as exc:
+        if exc.reason.startswith("too large"):
+            _fail(name, None, _too_big(exc.size))
+        _fail(name, None, f"cannot read {what}: {exc.reason}")
 
 
 def _decode(raw: bytes, file: str | None) -> str:
@@ -238,7 +202,7 @@ def _too_big(size: int | None) -> str:
     return f"is too large: {got} bytes, the limit is {MAX_BYTES} bytes ({MAX_BYTES >> 20} MiB)"
 
 
-def _fail(file, line, message):
+def _fail(file: str | None, line: int | None, message: str) -> NoReturn:
     raise ValidationError([Problem(message, file, line)])
 
 

@@ -627,14 +627,17 @@ def any_hit(bvh: BVH, origins, directions, tmax, *, cancelled=None, refit=True) 
     return hit
 
 
-def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None) -> BVH:
+def toward_light(bvh: BVH, origins, directions, tmax, *, cancelled=None, split=None) -> BVH:
     """``bvh`` with its boxes refitted around the triangles that can block the rays, when the
     rays all end at one point or all run one way (:mod:`explorer.geometry.occluders`); else
     ``bvh`` itself. Casting the rays through either gives the same answers.
 
     origins, directions : (k, 3) float64 C-contiguous; tmax : (k,) float64
+    split : the refit's walk split among the threads REFIT_DEPTH levels down; None (default):
+        for a tree of REFIT_NODES nodes or more on more than one core (the background compile
+        takes both ways on a small tree: :mod:`explorer.shading.warm`)
     """
-    big = bvh.n_nodes >= REFIT_NODES and workers() > 1
+    big = bvh.n_nodes >= REFIT_NODES and workers() > 1 if split is None else bool(split)
     # a large tree's copy of the binary rows is made on another thread meanwhile
     copy = _get_pool().submit(copy_rows, bvh.cbox) if big else None
     end = occ.shared_end(origins, directions, tmax)

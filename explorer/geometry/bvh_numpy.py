@@ -12,8 +12,14 @@ hierarchy only decides which triangles are tested, and its boxes are padded
 
 The hierarchy is built level by level, every node of a level at once: each node's triangles are
 split at the median of their centres along the longest axis of the centres' bounds (one sort per
-level). The casts walk it breadth first: a frontier of (ray, node) pairs, each level's box tests
-and leaf tests done for every pair at once.
+level). The casts walk it with a frontier of (ray, node) pairs, worked in pieces of at most
+:data:`PAIRS` pairs, depth first: a piece's box tests and leaf tests are done for all its pairs at
+once, and its children (at most ``2·PAIRS`` pairs) go on a stack above what is left of the
+frontier. So a cast's memory beyond its rays (k per-ray values) and the tree is bounded whatever
+the triangles: the stack holds at most ``2·PAIRS`` pairs per level of the tree (its depth is
+``log2(m / LEAF) + 1``), and a piece's leaf tests at most ``LEAF·PAIRS`` (ray, triangle) pairs,
+about 48 float64 of temporaries each (:func:`pair_bound` gives the bound in bytes). A mesh whose
+triangles all cross (every ray enters every leaf) costs time, not memory.
 
 :func:`build_bvh`, :func:`any_hit`, :func:`nearest_hits` and :func:`surface_points` take the
 arguments of their compiled namesakes, so a caller picks either module
@@ -33,6 +39,14 @@ from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NO
 LEAF = 4
 #: the stand-in for 1/0 in the slab test (as the compiled casts)
 _BIG = 1e300
+#: (ray, node) pairs a step of the walk tests at once at most (see the module docstring)
+PAIRS = 16384
+#: bytes a (ray, triangle) pair of a leaf test holds at most: the pair (two int64) and about 48
+#: float64 of temporaries (the Möller-Trumbore test's, the selections of the hits; measured with
+#: tracemalloc at 300-350 bytes: tests/geometry/test_bvh_numpy.py)
+PAIR_BYTES = 16 + 48 * 8
+#: bytes a (ray, node) pair on the walk's stack holds (two int64)
+STACK_BYTES = 16
 
 
 @dataclass(frozen=True)
@@ -183,20 +197,41 @@ def _check(cancelled) -> None:
         raise Cancelled("ray cast cancelled")
 
 
+def depth(bvh: NumpyBVH) -> int:
+    """The number of levels of the tree (1 for a root that is a leaf)."""
+    m = len(bvh.tri)
+    return 1 + max(0, int(np.ceil(np.log2(max(m, 1) / LEAF))))
+
+
+def pair_bound(bvh: NumpyBVH) -> int:
+    """Bytes a cast through ``bvh`` holds at most beyond its rays and the tree: the walk's stack
+    (``2·PAIRS`` pairs per level) and one piece's leaf tests (``LEAF·PAIRS`` pairs); see the
+    module docstring. It grows with the log of the triangle count only."""
+    return (2 * depth(bvh) + 1) * PAIRS * STACK_BYTES + LEAF * PAIRS * PAIR_BYTES
+
+
 def _walk(bvh: NumpyBVH, O, inv, limit, cancelled):
-    """Walk the tree breadth first; yield each level's (ray, triangle) pairs at the leaves the
-    rays enter within [0, limit[ray]]. ``limit`` (k,) is read at every level: the caller lowers
-    it as hits are found (below 0: the ray is done)."""
-    rays, nodes = np.arange(len(O)), np.zeros(len(O), np.int64)
-    while len(rays):
+    """Walk the tree (see the module docstring); yield the (ray, triangle) pairs at the leaves
+    the rays enter within [0, limit[ray]], at most ``LEAF·PAIRS`` at a time. ``limit`` (k,) is
+    read at every step: the caller lowers it as hits are found (below 0: the ray is done)."""
+    stack = [(np.arange(len(O)), np.zeros(len(O), np.int64))]
+    while stack:
         _check(cancelled)
+        rays, nodes = stack.pop()
+        if len(rays) > PAIRS:  # a piece of it now, the rest (a view) later
+            stack.append((rays[PAIRS:], nodes[PAIRS:]))
+            rays, nodes = rays[:PAIRS], nodes[:PAIRS]
         enter = _slab(bvh.box[nodes], O[rays], inv[rays], limit[rays]) < np.inf
         rays, nodes = rays[enter], nodes[enter]
         leaf = bvh.child[nodes, 0] < 0
-        yield _leaf_pairs(bvh, rays[leaf], nodes[leaf])
+        if leaf.any():
+            yield _leaf_pairs(bvh, rays[leaf], nodes[leaf])
         rays, nodes = rays[~leaf], nodes[~leaf]
-        rays = np.concatenate([rays, rays])
-        nodes = np.concatenate([bvh.child[nodes, 0], bvh.child[nodes, 1]])
+        if len(rays):
+            stack.append(
+                (np.concatenate([rays, rays]),
+                 np.concatenate([bvh.child[nodes, 0], bvh.child[nodes, 1]]))
+            )  # fmt: skip
 
 
 def any_hit(bvh: NumpyBVH, origins, directions, tmax, *, cancelled=None) -> np.ndarray:

@@ -8,10 +8,8 @@ scene's material, with a warning.
 
 from __future__ import annotations
 
-import os
-
 from explorer.core.material import Material
-from explorer.core.mtl import read_mtl
+from explorer.core.mtl import MtlUnreadable, read_mtl
 from explorer.geometry.meshes import Mesh
 
 
@@ -19,8 +17,9 @@ def group_materials(mesh: Mesh, fallback: Material) -> tuple[tuple[Material, ...
     """``(materials, warnings)``: one material per name of ``mesh.groups`` (``fallback`` for a
     group no library defines) and what the reader warned of, one sentence each.
 
-    A library with a problem raises its :class:`~explorer.core.mtl.MtlError` (the file and
-    line).
+    A library that cannot be read (missing, not a regular file, too large) is a warning; one
+    that is read but has a problem raises its :class:`~explorer.core.mtl.MtlError` (the file
+    and line).
     """
     groups = mesh.groups
     if groups is None:
@@ -28,10 +27,11 @@ def group_materials(mesh: Mesh, fallback: Material) -> tuple[tuple[Material, ...
     found: dict[str, Material] = {}
     warnings: list[str] = []
     for lib in groups.libraries:
-        if not os.path.isfile(lib):
-            warnings.append(f"mtllib {lib}: no such file; its materials are not read")
+        try:
+            materials = read_mtl(lib)
+        except MtlUnreadable as exc:  # missing, a FIFO or device, too large: never blocks
+            warnings.append(f"mtllib {lib}: {exc.reason}; its materials are not read")
             continue
-        materials = read_mtl(lib)
         for m in materials:
             found.setdefault(m.name, m.material.replace(name=m.name))
             warnings.extend(m.warnings)

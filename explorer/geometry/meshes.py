@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import bz2
 import gzip
+import io
 import os
-import stat
 import warnings
 import zipfile
 from dataclasses import dataclass
@@ -35,9 +35,11 @@ import numpy as np
 
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError, Notice
+from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
 from explorer.geometry.frame import check_faces, check_vertices, frame_of
+from explorer.geometry.sidefiles import CheckedResolver, library_names, obj_material_names
 
 #: resolution option of each built-in mesh: (default, lowest, highest); None = no option
 RESOLUTION: dict[str, tuple[int, int, int] | None] = {
@@ -117,9 +119,11 @@ class Mesh:
 
     @property
     def radius(self) -> float:
-        """Radius of the smallest sphere about :attr:`centre` holding every vertex."""
-        d = self.positions - self.centre
-        return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d))))
+        """Radius of the smallest sphere about :attr:`centre` holding every vertex (in the
+        normalised frame: no overflow near 1e308, no underflow at 1e-300)."""
+        centre, scale = frame_of(self.positions)
+        d = self.positions / scale - centre / scale
+        return float(np.sqrt(np.max(np.einsum("ij,ij->i", d, d)))) * scale
 
     def face_normals(self) -> np.ndarray:
         """(m, 3) float64 unit normals of the triangles (zero for degenerate ones)."""
@@ -507,48 +511,66 @@ _BUILDERS = {
 # -- files ---------------------------------------------------------------------------------
 
 
-def check_mesh_file_size(path) -> None:
-    """Refuse, before anything is read or unpacked, a mesh file that is not a regular file
-    (a FIFO would block), is empty, is larger than ``MAX_MESH_FILE_BYTES``, or is an archive
-    unpacking to more than ``MAX_MESH_UNPACKED_BYTES`` (see
-    :mod:`explorer.core.tolerances`): an :class:`ExplorerError` naming the file and the cap."""
-    path = os.fspath(path)
-    mode = os.stat(path).st_mode
-    if not stat.S_ISREG(mode):
-        raise ExplorerError(f"mesh file '{path}' is not a regular file (a FIFO, socket or device)")
-    size = os.path.getsize(path)
-    if size == 0:
-        raise ExplorerError(f"mesh file '{path}' is empty")
-    if size > tol.MAX_MESH_FILE_BYTES:
-        raise ExplorerError(
-            f"mesh file '{path}' is too large: {size} bytes, the limit is "
-            f"{tol.MAX_MESH_FILE_BYTES} bytes ({tol.MAX_MESH_FILE_BYTES >> 20} MiB)"
-        )
-    unpacked = _unpacked_size(path, tol.MAX_MESH_UNPACKED_BYTES)
+def read_mesh_file(path) -> bytes:
+    """The bytes of a mesh file, read once through the checked open
+    (:func:`explorer.core.files.read_checked`): a file that does not exist, is a directory, a
+    FIFO, socket or device (never opened in a way that blocks), is empty, is larger than
+    ``MAX_MESH_FILE_BYTES``, or is an archive unpacking to more than
+    ``MAX_MESH_UNPACKED_BYTES`` (see :mod:`explorer.core.tolerances`) raises an
+    :class:`ExplorerError` naming the file and the cap."""
+    shown = os.fspath(path)
+    try:
+        data = read_checked(shown, cap=tol.MAX_MESH_FILE_BYTES, what="mesh file")
+    except UnreadableFile as exc:
+        raise ExplorerError(f"mesh file '{shown}' {_unreadable(exc)}") from None
+    if not data:
+        raise ExplorerError(f"mesh file '{shown}' is empty")
+    unpacked = _unpacked_size(data, tol.MAX_MESH_UNPACKED_BYTES)
     if unpacked is not None and unpacked > tol.MAX_MESH_UNPACKED_BYTES:
         raise ExplorerError(
-            f"mesh file '{path}' is an archive that unpacks to more than "
+            f"mesh file '{shown}' is an archive that unpacks to more than "
             f"{tol.MAX_MESH_UNPACKED_BYTES} bytes ({tol.MAX_MESH_UNPACKED_BYTES >> 20} MiB), "
             "the limit for a mesh; unpack it yourself if it is really meant"
         )
+    return data
 
 
-def _unpacked_size(path: str, cap: int) -> int | None:
-    """The size an archive unpacks to (zip: the declared sizes; bz2 / gzip: counted while
-    unpacking, stopping once past ``cap``); None for a file that is no archive."""
-    with open(path, "rb") as fh:
-        magic = fh.read(3)
+def _unreadable(exc: UnreadableFile) -> str:
+    """The end of a mesh-file message for what :func:`read_checked` refused."""
+    reason = exc.reason
+    if reason == "no such file":
+        return "does not exist"
+    if reason.startswith("it is a directory"):
+        return "is a directory, not a mesh file"
+    if reason == "permission denied":
+        return "cannot be read (permission denied)"
+    if reason.startswith("too large"):
+        size = f"{exc.size} bytes" if exc.size is not None else "more bytes than that"
+        return (
+            f"is too large: {size}, the limit is {tol.MAX_MESH_FILE_BYTES} bytes "
+            f"({tol.MAX_MESH_FILE_BYTES >> 20} MiB)"
+        )
+    if reason.startswith("it is a"):
+        return f"is not a regular file ({reason[6:].split(', not')[0]})"
+    return f"cannot be read: {reason}"
+
+
+def _unpacked_size(data: bytes, cap: int) -> int | None:
+    """The size an archive's bytes unpack to (zip: the declared sizes; bz2 / gzip: counted
+    while unpacking, stopping once past ``cap``); None for a file that is no archive."""
+    stream = io.BytesIO(data)
     try:
-        if zipfile.is_zipfile(path):
-            with zipfile.ZipFile(path) as archive:
+        if zipfile.is_zipfile(stream):
+            with zipfile.ZipFile(stream) as archive:
                 return sum(info.file_size for info in archive.infolist())
-        opener = {b"BZh": bz2.open, b"\x1f\x8b\x08": gzip.open}.get(magic)
+        unpack = {b"BZh": bz2.BZ2File, b"\x1f\x8b\x08": lambda f: gzip.GzipFile(fileobj=f)}
+        opener = unpack.get(data[:3])
         if opener is None:
             return None
         total = 0
-        with opener(path, "rb") as stream:
+        with opener(io.BytesIO(data)) as unpacking:
             while total <= cap:
-                chunk = stream.read(1 << 20)
+                chunk = unpacking.read(1 << 20)
                 if not chunk:
                     break
                 total += len(chunk)
@@ -565,27 +587,36 @@ def load_mesh(path) -> Mesh:
     (renormalised); a file without them gets vertices welded by position and smooth
     area-weighted normals. Vertices no triangle uses are dropped.
 
-    A missing, unreadable or empty file, one that is too large or unpacks to too much
-    (:func:`check_mesh_file_size`), or one holding no triangles (a point cloud, a
-    drawing), raises an :class:`ExplorerError` naming the file and the reason.
+    The file is read once (:func:`read_mesh_file`) and trimesh parses those bytes; every
+    other file trimesh would open (an OBJ's ``mtllib``, a glTF's buffers) is served by
+    :class:`CheckedResolver`, so no library opens a file the checked open has not. An OBJ's
+    ``mtllib`` libraries are resolved by :func:`obj_material_names` (inside the OBJ's folder,
+    ``.mtl`` names only; the others are named in a :class:`Notice` and not opened).
+
+    A missing, unreadable or empty file, one that is too large or unpacks to too much, or one
+    holding no triangles (a point cloud, a drawing), raises an :class:`ExplorerError` naming
+    the file and the reason.
     """
     path = os.fspath(path)
     shown = path
-    if not os.path.exists(path):
-        raise ExplorerError(f"mesh file '{shown}' does not exist")
-    if os.path.isdir(path):
-        raise ExplorerError(f"mesh file '{shown}' is a directory, not a mesh file")
-    if not os.access(path, os.R_OK):
-        raise ExplorerError(f"mesh file '{shown}' cannot be read (permission denied)")
-    check_mesh_file_size(path)
+    data = read_mesh_file(path)
     import logging
 
     import trimesh
 
     logging.getLogger("trimesh").setLevel(logging.ERROR)
     ext = os.path.splitext(path)[1].lower() or "(no suffix)"
+    libraries, used_names = (), ()
+    if ext == ".obj":
+        libraries, used_names, refused = obj_material_names(path, data)
+        for message in refused:
+            warnings.warn(message, Notice, stacklevel=2)
+    file_type = trimesh.util.split_extension(path, special=["tar.gz", "tar.bz2"]).lower()
+    resolver = CheckedResolver(path, library_names(libraries) if ext == ".obj" else None)
     try:
-        loaded = trimesh.load(path, process=False)
+        loaded = trimesh.load(
+            io.BytesIO(data), file_type=file_type, resolver=resolver, process=False
+        )
     except OSError as exc:
         raise ExplorerError(f"mesh file '{shown}' cannot be read: {exc.strerror or exc}") from exc
     except Exception as exc:  # noqa: BLE001 - every parser failure is the file's fault
@@ -606,7 +637,6 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(
             f"mesh file '{shown}' holds {reason}: a mesh needs triangles (or polygons)"
         )
-    libraries, used_names = obj_material_names(path) if ext == ".obj" else ((), ())
     _say_unread_materials(shown, parts, libraries)
     group_names: list[str] = []
     keys = []
@@ -650,8 +680,10 @@ def load_mesh(path) -> Mesh:
         if missing.any():
             nrm[missing] = area_weighted_normals(pos, faces)[missing]
     else:
-        pos, _, faces, src = _weld(pos, np.zeros_like(pos), faces, keys, 12, sources=True)
-        keys = keys[src]
+        centre, scale = frame_of(pos)  # welded to 12 decimals of the mesh's frame: any scale
+        Q = pos / scale - centre / scale
+        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True)
+        pos, keys = pos[src], keys[src]
         nrm = area_weighted_normals(pos, faces)
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")
@@ -673,30 +705,6 @@ def _used(pos, faces) -> np.ndarray:
     used = np.zeros(len(pos), bool)
     used[faces.ravel()] = True
     return used
-
-
-def obj_material_names(path: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    """``(libraries, used)``: the ``mtllib`` files an OBJ names, as paths next to it (a name
-    with blanks in it cannot be told from two names, as in every OBJ reader), and the names
-    its ``usemtl`` lines give, in the order first met."""
-    folder = os.path.dirname(path)
-    libraries: list[str] = []
-    used: list[str] = []
-    with open(path, "rb") as fh:
-        for raw in fh:
-            if raw[:6] not in (b"mtllib", b"usemtl"):
-                continue
-            words = raw[6:].decode("utf-8", "replace").split("#", 1)[0].split()
-            if raw[:6] == b"usemtl":
-                name = " ".join(words)
-                if name and name not in used:
-                    used.append(name)
-                continue
-            for word in words:
-                lib = os.path.join(folder, word)
-                if lib not in libraries:
-                    libraries.append(lib)
-    return tuple(libraries), tuple(used)
 
 
 def _say_unread_materials(shown: str, parts, libraries) -> None:

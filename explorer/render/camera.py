@@ -5,6 +5,13 @@ fields, :func:`camera_for` frames a mesh as the scene's viewer sees it, :func:`a
 :func:`camera_from_vtk` convert to and from a live ``vtkCamera``, and :func:`pixel_rays` /
 :func:`project` give the ray through each pixel centre and where a point lands (the per-pixel
 reference and the tests use them).
+
+Scale: a camera is computed with scale-safe lengths (:func:`vector_length`), so a mesh of size
+1e-300 or 1e300 is framed as a unit one; the renderers hand VTK the mesh and the camera in the
+mesh's normalised frame (:func:`in_frame`, the same similarity for both: the same picture), so
+that VTK's float32 drawing never meets coordinates beyond its range. A mesh too large for its
+camera's coordinates (4 radii from the centre) to be finite float64 numbers is refused with an
+:class:`~explorer.core.errors.ExplorerError`.
 """
 
 from __future__ import annotations
@@ -16,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import ExplorerError
+from explorer.geometry.frame import frame_of
 from explorer.geometry.meshes import Mesh
 
 Vec3 = tuple[float, float, float]
@@ -65,6 +73,55 @@ def _view_up(forward: np.ndarray) -> np.ndarray:
     return up / np.linalg.norm(up)
 
 
+def vector_length(v) -> float:
+    """The length of a vector (3,), without overflow or underflow of its squares."""
+    v = np.asarray(v, np.float64)
+    with np.errstate(over="ignore", under="ignore"):
+        n = float(np.linalg.norm(v))
+    if 1e-150 < n < 1e150:  # the squares neither overflowed nor underflowed
+        return n
+    m = float(np.max(np.abs(v)))
+    if m == 0.0 or not math.isfinite(m):
+        return m
+    u = v / m
+    return m * math.sqrt(float(u @ u))
+
+
+def in_frame(camera: Camera, centre, scale: float) -> Camera:
+    """``camera`` in the normalised frame ``(centre, scale)`` (:func:`explorer.geometry.frame.
+    frame_of`): points ``(p - centre) / scale``, lengths ``/ scale``, angles as they are. A
+    mesh in that frame seen by this camera gives the world camera's picture."""
+    c = np.asarray(centre, np.float64) / scale
+
+    def point(p):
+        return tuple(float(x) for x in np.asarray(p, np.float64) / scale - c)
+
+    near, far = camera.clipping_range
+    return Camera(point(camera.position), point(camera.focal_point), camera.view_up,
+                  camera.parallel, camera.parallel_scale / scale, camera.view_angle,
+                  (near / scale, far / scale), camera.window_center)  # fmt: skip
+
+
+def mesh_frame(mesh: Mesh) -> tuple[np.ndarray, float]:
+    """The frame the renderers hand VTK a mesh in (:func:`in_frame`)."""
+    return frame_of(np.asarray(mesh.positions, np.float64))
+
+
+def _finite(camera: Camera, mesh: Mesh) -> Camera:
+    """``camera``, when every field is a finite number; else the mesh is too large to frame."""
+    values = [*camera.position, *camera.focal_point, camera.parallel_scale, *camera.clipping_range]
+    if not all(math.isfinite(v) for v in values):
+        raise _too_large(mesh)
+    return camera
+
+
+def _too_large(mesh: Mesh) -> ExplorerError:
+    return ExplorerError(
+        f"mesh '{mesh.name}' is too large to frame (radius {mesh.radius:.3g}): its camera would "
+        "lie beyond the float64 range; scale it down (coordinates up to about 1e300 render)"
+    )
+
+
 def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -> Camera:
     """The camera that sees what the scene's viewer sees, framing the mesh.
 
@@ -84,12 +141,17 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
     """
     bottom = min(max(float(bottom), 0.0), 0.9)
     centre = np.asarray(mesh.centre, np.float64)
-    radius = max(float(mesh.radius), 1e-12)
+    radius = float(mesh.radius)
+    if not radius > 0.0:  # a single point: any small sphere about it
+        radius = max(1e-12 * vector_length(centre), 1e-300)
     viewer = scene.viewer
     if viewer.eye is not None:
         eye = np.asarray(viewer.eye, np.float64)
-        offset = centre - eye
-        dist = float(np.linalg.norm(offset))
+        with np.errstate(over="ignore"):
+            offset = centre - eye
+        dist = vector_length(offset)
+        if not math.isfinite(dist):
+            raise _too_large(mesh)
         if dist <= 1e-9 * radius:  # eye at the centre: look down -z as OpenGL does
             forward = np.array([0.0, 0.0, -1.0])
             focal = eye + forward * radius
@@ -105,7 +167,7 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
         shift = t * bottom / (1.0 - bottom) / t_v if bottom else 0.0
         near = max(dist - 1.5 * radius, 1e-3 * radius)
         far = dist + 1.5 * radius
-        return Camera(
+        camera = Camera(
             tuple(eye),
             tuple(focal),
             tuple(_view_up(forward)),
@@ -115,28 +177,31 @@ def camera_for(scene, mesh: Mesh, aspect: float = 1.0, *, bottom: float = 0.0) -
             (near, far),
             (0.0, -shift),
         )
+        return _finite(camera, mesh)
     toward = np.asarray(viewer.to_viewer, np.float64)
     toward = toward / np.linalg.norm(toward)
     forward = -toward
     up = _view_up(forward)
     right = np.cross(forward, up)
-    rel = mesh.positions - centre
-    u, v = rel @ right, rel @ up
-    uc, vc = 0.5 * (u.min() + u.max()), 0.5 * (v.min() + v.max())
-    hw = 0.5 * (u.max() - u.min()) * FRAME_MARGIN
-    hh = 0.5 * (v.max() - v.min()) * FRAME_MARGIN
-    scale = max(hh / (1.0 - bottom), hw / aspect, 1e-3 * radius)
-    focal = centre + right * uc + up * (vc - scale * bottom)
-    dist = 4.0 * radius
-    return Camera(
-        tuple(focal + toward * dist),
-        tuple(focal),
-        tuple(up),
-        True,
-        scale,
-        30.0,
-        (dist - 1.5 * radius, dist + 1.5 * radius),
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # too large: refused below
+        rel = mesh.positions - centre
+        u, v = rel @ right, rel @ up
+        uc, vc = 0.5 * (u.min() + u.max()), 0.5 * (v.min() + v.max())
+        hw = 0.5 * (u.max() - u.min()) * FRAME_MARGIN
+        hh = 0.5 * (v.max() - v.min()) * FRAME_MARGIN
+        scale = max(hh / (1.0 - bottom), hw / aspect, 1e-3 * radius)
+        focal = centre + right * uc + up * (vc - scale * bottom)
+        dist = 4.0 * radius
+        camera = Camera(
+            tuple(focal + toward * dist),
+            tuple(focal),
+            tuple(up),
+            True,
+            scale,
+            30.0,
+            (dist - 1.5 * radius, dist + 1.5 * radius),
+        )
+    return _finite(camera, mesh)
 
 
 def apply_camera(vtk_camera, cam: Camera) -> None:
@@ -155,7 +220,9 @@ def apply_camera(vtk_camera, cam: Camera) -> None:
 def back_to_front(mesh: Mesh, camera: Camera) -> np.ndarray:
     """Order of the triangles from the farthest to the nearest seen from the camera (by their
     centroids): (m,) int64, stable so ties keep the file order."""
-    centroids = mesh.positions[mesh.faces].mean(axis=1)
+    centre, scale = mesh_frame(mesh)  # in the frame: no overflow of the distances' squares
+    camera = in_frame(camera, centre, scale)
+    centroids = (mesh.positions / scale - centre / scale)[mesh.faces].mean(axis=1)
     if camera.parallel:
         depth = (centroids - np.asarray(camera.position)) @ camera.direction
     else:
@@ -169,7 +236,7 @@ def back_to_front(mesh: Mesh, camera: Camera) -> np.ndarray:
 def _basis(camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Unit forward, right and up vectors of a camera, as VTK builds its view transform."""
     forward = np.subtract(camera.focal_point, camera.position).astype(np.float64)
-    forward /= np.linalg.norm(forward)
+    forward /= vector_length(forward)
     right = np.cross(forward, np.asarray(camera.view_up, np.float64))
     norm = np.linalg.norm(right)
     if norm < 1e-12:

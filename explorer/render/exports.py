@@ -21,7 +21,7 @@ import numpy as np
 from explorer.core.errors import ExplorerError
 from explorer.core.mtl import format_mtl
 from explorer.core.version import __version__
-from explorer.geometry.meshes import Mesh
+from explorer.geometry.meshes import Mesh, has_area
 from explorer.shading.display import to_bytes
 from explorer.shading.effects.hdr import srgb_decode
 
@@ -48,6 +48,7 @@ def mesh_file_bytes(
         return glb_bytes(mesh, colors, opacity, double_sided=double_sided)
     if kind != "ply":
         raise ExplorerError(f"mesh export writes .ply or .glb, got {suffix!r}")
+    check_float32(mesh, ".ply")
     import trimesh
 
     tm = trimesh.Trimesh(
@@ -58,6 +59,34 @@ def mesh_file_bytes(
         process=False,
     )
     return tm.export(file_type="ply")
+
+
+def check_float32(mesh: Mesh, what: str) -> np.ndarray:
+    """The mesh's positions as float32, as a .glb and a .ply store them, when they keep the mesh:
+    finite (coordinates within ±3.4e38), an extent of at least float32's smallest normal number
+    (1.2e-38: below it the numbers keep fewer digits) and every triangle with an area in float64
+    keeping one; else an
+    :class:`ExplorerError` naming the format and the range, before anything is written.
+    (A mesh of that size renders: see explorer.render.camera.)"""
+    P = np.asarray(mesh.positions, np.float64)
+    with np.errstate(over="ignore", under="ignore"):
+        P32 = P.astype(np.float32)
+    if not np.isfinite(P32).all():
+        big = float(np.abs(P).max())
+        raise ExplorerError(
+            f"mesh '{mesh.name}' has coordinates up to {big:.3g}: a {what} file stores float32, "
+            f"at most {float(np.finfo(np.float32).max):.3g}; scale the mesh down to export it"
+        )
+    F = np.asarray(mesh.faces)
+    size = float(np.max(P.max(axis=0) - P.min(axis=0)))
+    tiny = float(np.finfo(np.float32).tiny)  # below it float32 loses precision
+    if 0.0 < size < tiny or has_area(P32.astype(np.float64), F).sum() < has_area(P, F).sum():
+        raise ExplorerError(
+            f"mesh '{mesh.name}' of size {size:.3g} is too small for a {what} file: it stores "
+            f"float32, whose numbers below {tiny:.3g} lose the mesh's shape; scale the mesh up "
+            "to export it"
+        )
+    return P32
 
 
 def linear_colors(colors) -> np.ndarray:
@@ -81,7 +110,7 @@ def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = 
     rgba[:, :3] = linear_colors(colors)
     rgba[:, 3] = float(opacity)
     arrays = [
-        (np.asarray(mesh.positions, np.float32), "VEC3", _FLOAT, _ARRAY_BUFFER),
+        (check_float32(mesh, ".glb"), "VEC3", _FLOAT, _ARRAY_BUFFER),
         (np.asarray(mesh.normals, np.float32), "VEC3", _FLOAT, _ARRAY_BUFFER),
         (rgba, "VEC4", _FLOAT, _ARRAY_BUFFER),
         (np.asarray(mesh.faces, np.uint32).ravel(), "SCALAR", _UINT, _ELEMENT_ARRAY_BUFFER),

@@ -20,7 +20,7 @@ import numpy as np
 
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import Camera
+from explorer.render.camera import Camera, mesh_frame
 from explorer.render.offscreen import OffscreenWindow
 from explorer.render.vtk import polydata, set_camera
 
@@ -54,7 +54,7 @@ class FaceIdRenderer(OffscreenWindow):
         super().__init__(size, (0.0, 0.0, 0.0))
 
     def _forget(self) -> None:
-        self._mesh = self._actor = None
+        self._mesh = self._actor = self._frame = None
 
     def render(self, mesh: Mesh, camera: Camera) -> np.ndarray:
         """(h, w) int64: the index of the triangle of ``mesh`` each pixel shows, -1 where none
@@ -63,12 +63,13 @@ class FaceIdRenderer(OffscreenWindow):
         if self._mesh is not mesh:
             if self._actor is not None:
                 pl.remove_actor(self._actor)
-            poly = polydata(mesh, normals=False)
+            self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
+            poly = polydata(mesh, normals=False, frame=self._frame)
             poly.cell_data["index"] = index_colors(mesh.n_faces)
             self._actor = pl.add_mesh(poly, scalars="index", rgb=True, lighting=False,
                                       preference="cell", show_scalar_bar=False,
                                       reset_camera=False)  # fmt: skip
             self._mesh = mesh
-        set_camera(pl, camera)
+        set_camera(pl, camera, self._frame)
         pl.render()
         return decode(pl.screenshot(return_img=True)[:, :, :3])

@@ -1,14 +1,17 @@
-"""Pictures as arrays and files: sizes, PNG encoding and decoding (VTK's codec)."""
+"""Pictures as arrays and files: sizes, and the one PNG codec (Pillow's) for every picture the
+package writes or reads."""
 
 from __future__ import annotations
 
+import io
 import os
 import re
 
 import numpy as np
 
 from explorer.core.errors import ExplorerError
-from explorer.core.tolerances import MAX_PICTURE_PIXELS
+from explorer.core.files import read_checked
+from explorer.core.tolerances import MAX_PICTURE_PIXELS, MAX_PNG_FILE_BYTES
 
 #: default image size (width, height)
 DEFAULT_SIZE = (400, 400)
@@ -56,46 +59,58 @@ def parse_size(text: str) -> tuple[int, int]:
     return check_size((int(m.group(1)), int(m.group(2))))
 
 
-def encode_png(image) -> bytes:
-    """PNG file contents of an (h, w, 3|4) uint8 image (VTK's PNG writer)."""
-    from vtkmodules.util.numpy_support import numpy_to_vtk
-    from vtkmodules.vtkCommonDataModel import vtkImageData
-    from vtkmodules.vtkIOImage import vtkPNGWriter
+#: zlib level of the PNG files written (lossless at every level): 5, VTK's writer's, which the
+#: package used before; Pillow's default 6 took 1.6-1.9 times as long for files 4 % smaller on
+#: a 1100x720 render (benchmarks/bench_png.py)
+PNG_COMPRESS_LEVEL = 5
 
+
+def _picture(image) -> np.ndarray:
     img = np.asarray(image)
     if img.dtype != np.uint8 or img.ndim != 3 or img.shape[2] not in (3, 4):
         raise ValueError(f"image must be (h, w, 3|4) uint8, got {img.shape} {img.dtype}")
-    h, w, c = img.shape
-    data = vtkImageData()
-    data.SetDimensions(w, h, 1)
-    flat = np.ascontiguousarray(img[::-1].reshape(-1, c))  # VTK rows go bottom-up
-    arr = numpy_to_vtk(flat, deep=True)
-    arr.SetNumberOfComponents(c)
-    data.GetPointData().SetScalars(arr)
-    writer = vtkPNGWriter()
-    writer.SetWriteToMemory(True)
-    writer.SetInputData(data)
-    writer.Write()
-    result = writer.GetResult()
-    return bytes(memoryview(result))
+    return np.ascontiguousarray(img)
+
+
+def encode_png(image) -> bytes:
+    """PNG file contents of an (h, w, 3|4) uint8 image: 8-bit RGB or RGBA, rows top to bottom,
+    no other chunks (Pillow's PNG writer; ``benchmarks/bench_png.py`` times it beside VTK's)."""
+    from PIL import Image
+
+    img = _picture(image)
+    buf = io.BytesIO()
+    Image.fromarray(img).save(buf, format="PNG", compress_level=PNG_COMPRESS_LEVEL)  # RGB(A)
+    return buf.getvalue()
+
+
+def decode_png(data: bytes, name: str = "PNG data") -> np.ndarray:
+    """An (h, w, 3|4) uint8 image from PNG file contents: RGB and RGBA as they are, grey and
+    palette pictures as RGB (RGBA when they have transparency). 16-bit pictures are refused
+    (an :class:`ExplorerError` naming ``name``), as is anything that is not a PNG."""
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with Image.open(io.BytesIO(data), formats=["PNG"]) as im:
+            depth = data[24]  # IHDR's bit depth (Pillow keeps 8 of 16-bit RGB's bits)
+            check_picture_pixels(*im.size, name)
+            if depth <= 8 and im.mode not in ("RGB", "RGBA"):
+                alpha = "A" in im.getbands() or "transparency" in im.info
+                im = im.convert("RGBA" if alpha else "RGB")
+            pixels = np.array(im, dtype=np.uint8) if depth <= 8 else None
+    except UnidentifiedImageError:
+        raise ExplorerError(f"{name}: not a readable PNG file (not PNG data)") from None
+    except (OSError, SyntaxError) as exc:  # Pillow's errors for damaged data
+        raise ExplorerError(f"{name}: not a readable PNG file ({exc})") from None
+    if pixels is None:
+        raise ExplorerError(f"{name}: a {depth}-bit PNG; only 8-bit pictures are read")
+    return pixels
 
 
 def read_png(path) -> np.ndarray:
-    """An (h, w, 3|4) uint8 image from a PNG file."""
-    from vtkmodules.util.numpy_support import vtk_to_numpy
-    from vtkmodules.vtkIOImage import vtkPNGReader
-
-    path = os.fspath(path)
-    reader = vtkPNGReader()
-    if not os.path.isfile(path) or not reader.CanReadFile(path):
-        raise ExplorerError(f"{path}: not a readable PNG file")
-    reader.SetFileName(path)
-    reader.Update()
-    img = reader.GetOutput()
-    w, h, _ = img.GetDimensions()
-    arr = vtk_to_numpy(img.GetPointData().GetScalars())
-    c = arr.shape[1] if arr.ndim == 2 else 1
-    return np.ascontiguousarray(arr.reshape(h, w, c)[::-1]).astype(np.uint8)
+    """An (h, w, 3|4) uint8 image from a PNG file (:func:`decode_png`), read through the
+    checked open (a regular file of at most ``MAX_PNG_FILE_BYTES``)."""
+    name = os.fspath(path)
+    return decode_png(read_checked(name, cap=MAX_PNG_FILE_BYTES, what="PNG file"), name)
 
 
 def side_by_side(left, right, gap: int = 0, fill=(0, 0, 0)) -> np.ndarray:

@@ -28,7 +28,7 @@ import numpy as np
 
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import Camera, Vec3, back_to_front, camera_for
+from explorer.render.camera import Camera, Vec3, back_to_front, camera_for, mesh_frame
 from explorer.render.images import DEFAULT_SIZE, check_picture_pixels, check_size
 from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import group_vertex_colors, to_bytes, vertex_colors
@@ -98,7 +98,7 @@ class OffscreenRenderer(OffscreenWindow):
         super().__init__(size, background)
 
     def _forget(self) -> None:
-        self._actor = self._mesh = self._poly = self._text = None
+        self._actor = self._mesh = self._poly = self._text = self._frame = None
         self._sorted = False
 
     def render(
@@ -136,7 +136,8 @@ class OffscreenRenderer(OffscreenWindow):
         if self._mesh is not mesh:
             if self._actor is not None:
                 pl.remove_actor(self._actor)
-            self._poly = polydata(mesh, rgb)
+            self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
+            self._poly = polydata(mesh, rgb, frame=self._frame)
             self._sorted = False
             self._actor = add_unlit(pl, self._poly)
             self._mesh = mesh
@@ -151,7 +152,7 @@ class OffscreenRenderer(OffscreenWindow):
             if label is not None:
                 band = 1.5 * self._text.GetTextProperty().GetFontSize() / h
             camera = camera_for(scene, mesh, w / h, bottom=band)
-        set_camera(pl, camera)
+        set_camera(pl, camera, self._frame)
         # translucent: draw the triangles back to front, so each blends over what is behind
         # it; opaque: file order (the depth test decides)
         order = back_to_front(mesh, camera) if opacity < 1.0 else None
@@ -161,7 +162,7 @@ class OffscreenRenderer(OffscreenWindow):
         extra = None
         if backdrop is not None:
             bmesh, bcolors = backdrop
-            extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors)))
+            extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors), frame=self._frame))
         try:
             pl.render()
             img = pl.screenshot(return_img=True)

@@ -39,12 +39,12 @@ import numpy as np
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import DET_EPS, PIXEL_RAY_T_MIN
 from explorer.geometry.bvh_numpy import surface_points
-from explorer.render.camera import camera_for, pixel_rays, project
+from explorer.render.camera import camera_for, mesh_frame, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
 from explorer.shading.shader import shade
-from explorer.shading.tiers import ray_engine
+from explorer.shading.tiers import ray_engine, ray_work
 
 #: names of built-in meshes that approximate the unit sphere (closed-form reference)
 SPHERE_MESHES = ("sphere", "icosphere")
@@ -103,8 +103,11 @@ _bvh_lock = threading.Lock()
 
 
 def mesh_bvh(mesh, *, cancelled=None, engine=None):
-    """The BVH of a mesh's triangles in world coordinates, built on first use and kept while
-    the mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only).
+    """The BVH of a mesh's triangles in the mesh's normalised frame
+    (:func:`~explorer.render.camera.mesh_frame`: ``(p - centre) / scale``, so that the ray
+    arithmetic neither overflows for a mesh of size 1e300 nor underflows at 1e-300), built on
+    first use and kept while the mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays
+    are read-only).
     cancelled : () -> bool, asked while the tree is built (:func:`~explorer.geometry.bvh.build_bvh`)
     engine : the ray engine that builds and casts (:func:`explorer.shading.tiers.ray_engine`,
         the default); each keeps its own tree
@@ -113,7 +116,8 @@ def mesh_bvh(mesh, *, cancelled=None, engine=None):
     with _bvh_lock:
         bvh = _bvh_cache.get(mesh, {}).get(engine.__name__)
     if bvh is None:
-        P = np.asarray(mesh.positions, np.float64)
+        centre, scale = mesh_frame(mesh)
+        P = np.asarray(mesh.positions, np.float64) / scale - centre / scale
         tri = P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)]
         bvh = engine.build_bvh(tri, cancelled=cancelled)
         with _bvh_lock:
@@ -160,14 +164,19 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     origins, dirs = pixel_rays(camera, (w, h), rect)
     O = np.ascontiguousarray(origins.reshape(-1, 3))
     D = np.ascontiguousarray(dirs.reshape(-1, 3))
-    P = np.asarray(mesh.positions, np.float64)
     F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
-    scale = max(float(np.abs(P).max(initial=0.0)), 1.0)
-    engine = ray_engine()
+    centre, scale = mesh_frame(mesh)  # the rays are cast in the tree's frame (unit directions)
+    Of = np.ascontiguousarray(O / scale - centre / scale)
+    reach = max(float(np.abs(Of).max(initial=0.0)), 1.0)
+    with _bvh_lock:
+        kept = bool(_bvh_cache.get(mesh))
+    # the tier choice counts this cast's work: a large picture loads the compiled casts
+    engine = ray_engine(ray_work(0 if kept else len(F), len(O)))
     tree = mesh_bvh(mesh, cancelled=cancelled, engine=engine)
     best_t, best_tri, best_u, best_v = engine.nearest_hits(
-        tree, O, D, PIXEL_RAY_T_MIN * scale, cancelled=cancelled
+        tree, Of, D, PIXEL_RAY_T_MIN * reach, cancelled=cancelled
     )
+    best_t = best_t * scale  # the distances in world units
     c0, c1, r0, r1 = rect
     Nv = np.asarray(mesh.normals, np.float64)
     hit, pos, n = engine.surface_points(O, D, best_t, best_tri, best_u, best_v, F, Nv)

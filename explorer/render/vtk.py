@@ -24,7 +24,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from explorer.geometry.meshes import Mesh
-from explorer.render.camera import Camera, apply_camera
+from explorer.render.camera import Camera, apply_camera, in_frame
 
 #: the environment variable that picks VTK's OpenGL window class
 WINDOW_ENV = "VTK_DEFAULT_OPENGL_WINDOW"
@@ -89,7 +89,9 @@ def cells(faces) -> np.ndarray:
     return np.hstack([np.full((len(faces), 1), 3, np.int64), faces]).ravel()
 
 
-def polydata(mesh: Mesh, colors=None, *, faces=None, float32: bool = False, normals: bool = True):
+def polydata(
+    mesh: Mesh, colors=None, *, faces=None, float32: bool = False, normals: bool = True, frame=None
+):
     """A ``pyvista.PolyData`` of the mesh's triangles.
 
     colors : (n, 3|4) uint8 point data named ``"colors"``, or None
@@ -97,13 +99,17 @@ def polydata(mesh: Mesh, colors=None, *, faces=None, float32: bool = False, norm
     float32 : float32 points (what the GPU draws) instead of a float64 copy
     normals : the vertex normals as the active point normals ``"Normals"`` (VTK's own lighting
         uses them; unlit colours do not)
+    frame : (centre (3,), scale): the points in that frame, ``(p - centre) / scale``
+        (:func:`explorer.render.camera.mesh_frame`; the camera goes there too: :func:`set_camera`)
     """
     import pyvista as pv
 
     dtype = np.float32 if float32 else np.float64
-    poly = pv.PolyData(
-        np.array(mesh.positions, dtype=dtype), cells(mesh.faces if faces is None else faces)
-    )
+    P = np.asarray(mesh.positions, np.float64)
+    if frame is not None:
+        centre, scale = frame
+        P = P / scale - np.asarray(centre, np.float64) / scale
+    poly = pv.PolyData(np.array(P, dtype=dtype), cells(mesh.faces if faces is None else faces))
     if normals:
         poly.point_data["Normals"] = np.array(mesh.normals)
         poly.point_data.active_normals_name = "Normals"
@@ -125,8 +131,9 @@ def add_unlit(plotter, poly):
     )
 
 
-def set_camera(plotter, camera: Camera) -> None:
+def set_camera(plotter, camera: Camera, frame=None) -> None:
     """Point the plotter's camera as ``camera`` (:func:`explorer.render.camera.apply_camera`)
-    and keep PyVista from resetting it at the first frame."""
+    and keep PyVista from resetting it at the first frame. frame : (centre, scale), the frame
+    the meshes were given in (:func:`polydata`): the camera goes there too."""
     plotter.camera_set = True
-    apply_camera(plotter.camera, camera)
+    apply_camera(plotter.camera, camera if frame is None else in_frame(camera, *frame))

@@ -58,9 +58,10 @@ def equation_terms(
     Schlick's F that does not depend on the specular colour).
     The specular sum uses the scene material's shininess and the scene's model.
     faces : (m, 3) int triangles for shadows, or None
-    visibility : (L, n) float, each light's shadow visibility already cast (the engine's numpy
-        tier passes the rows it keeps per light), instead of rays from ``faces``; (L, 0) or
-        None: none
+    visibility : a sequence of L rows, each light's shadow visibility already cast, (n,) 1 lit
+        and 0 shadowed (any numeric type), or None for a light that casts no shadows (the
+        engine's numpy tier passes the rows it keeps per light), instead of rays from
+        ``faces``; (L, n) works too; (L, 0) or None: none
     """
 
     P, N = check_vertices(positions, normals)
@@ -90,12 +91,13 @@ def equation_terms(
     specular = np.zeros((n, 3))
     threejs = scene.model == "threejs"
     f90 = np.zeros((n, 3)) if threejs else None
-    cast = visibility is not None and np.shape(visibility)[-1] > 0
+    rows = [None] * len(scene.lights) if visibility is None else list(visibility)
     for i, light in enumerate(scene.lights):
         L, _, w = light.incident(P, N, centre, scale)  # what arrives and from where
         dif_w, spec_w = _effect_weights(scene, light, Incident(world, faces, L, V), w)
-        if cast:  # shadows cast by the caller
-            dif_w, spec_w = dif_w * visibility[i], spec_w * visibility[i]
+        vis = rows[i]
+        if vis is not None and len(vis):  # shadows cast by the caller
+            dif_w, spec_w = dif_w * vis, spec_w * vis
 
         ndl = np.einsum("ij,ij->i", N, L)
         lit = ndl > 0.0  # f_i: specular only where N·L > 0

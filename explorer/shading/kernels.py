@@ -1071,10 +1071,12 @@ def _dir_rows(scr, m, q, one):
 
 @nb.njit(**_LEAF)
 def _shadow(scr, m, vis):
-    """w *= visibility (0 or 1 per vertex, from explorer.shading.shadows)."""
+    """w = 0 where the light is hidden: ``vis`` (m,) uint8, 1 lit, 0 shadowed (from
+    explorer.shading.shadows)."""
     W = _row(scr, R_W, m)
     for i in range(m):
-        W[i] = W[i] * vis[i]
+        if vis[i] == 0:
+            W[i] = 0.0
 
 
 @nb.njit(**_LEAF)
@@ -1258,7 +1260,7 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
 def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
     """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
     ``scr`` starts at the run's first lane, see _block): its pre-passes (rows L and the weight
-    w), then its light loop; ``vis`` : (m,) its visibility, or (0,)."""
+    w), then its light loop; ``vis`` : (m,) uint8 its visibility, or (0,)."""
     atten = (fl & ATTEN) != 0
     if inline:  # a plain point light (see _is_inline): no pre-pass
         code = _loop_code(SRC_INLINE, mode, l_spec, (fl & GREY) != 0)
@@ -1306,6 +1308,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
     A, D, S = sums
     base_out, ws_out = lobes
     redo, redo_count = marks
+    vrows, vindex = vis
     grey_only, dw, sw = layout
     m = gpx.shape[0]
     zero = k[K_ZERO]
@@ -1383,7 +1386,8 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
             for j in range(nc):
                 reach += act[li, j]
         if reach == nc:  # the whole block
-            _light_run(scr, m, fl, q, shininess, k, vis[li, :], l_amb, l_dif, l_spec, mode, inline)
+            v = vrows[max(vindex[li], 0), :]  # (read only by a light flagged SHADOW)
+            _light_run(scr, m, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline)
         else:  # runs of chunks it can reach; the others get nothing (a zero lobe weight)
             c = 0
             while c < nc:
@@ -1393,7 +1397,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
                 s0, s1 = c * CHUNK, min(m, e * CHUNK)
                 if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
                     sub = scr[s0 : s0 + N_ROWS * ROW]
-                    v = vis[li, s0:s1]  # (an empty row when no light casts shadows)
+                    v = vrows[max(vindex[li], 0), s0:s1]  # (empty when no light casts shadows)
                     _light_run(
                         sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
                     )
@@ -1488,7 +1492,7 @@ def _task(
             k,
             Sums(A[3 * s : 3 * e], D[dw * s : dw * e], S[sw * s : sw * e]),
             Lobes(lobes.base[:, s:e], lobes.ws[:, s:e]),
-            vis[:, s:e],
+            Shadows(vis.rows[:, s:e], vis.index),
             Marks(redo[s:e], redo_count[b : b + 1]),
             out[3 * s : 3 * e],
             scr,
@@ -1700,6 +1704,16 @@ class Marks(NamedTuple):
     count: np.ndarray
 
 
+class Shadows(NamedTuple):
+    """Shadow visibility, kept only for the lights that cast shadows: ``rows`` (S, n) uint8,
+    1 lit, 0 shadowed, one row per such light (at least one row: (1, 0) when none);
+    ``index`` (L,) int64, each light's row (-1: the light casts no shadows, its visibility is
+    never read: the kernel reads a row only for a light flagged SHADOW)."""
+
+    rows: np.ndarray
+    index: np.ndarray
+
+
 class Culling(NamedTuple):
     """Light culling: ``bounds`` (N_BOUNDS, ceil(n / CHUNK)) float64 chunk bounds (see
     :func:`bounds`), or (N_BOUNDS, 0): no culling; ``culled`` (nblocks,) int32 out: vertex-lights
@@ -1720,7 +1734,7 @@ def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     the caller's positions and normals instead of G's six rows); lights : :class:`Lights`
     opts : (N_OPTS,) int64; surface : :class:`Surface`; k : constants(T)
     sums : :class:`Sums` (read where not recomputed, written where stored); lobes :
-    :class:`Lobes`; vis : (L, n) T light visibility for lights flagged SHADOW (or (L, 0))
+    :class:`Lobes`; vis : :class:`Shadows`, the visibility of the lights flagged SHADOW
     marks : :class:`Marks`; out : (n, 3) colours; culling : :class:`Culling`
     """
     n = _vertex_count(src)
@@ -1831,10 +1845,11 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
     Am, Dm, Sm = _gather_sum(A, idx), _gather_sum(D, idx), _gather_sum(S, idx)
     lobes = m if base_out.shape[1] else 0
     bm, wm = np.zeros((L, lobes)), np.zeros((L, lobes))
-    vm = np.empty((L, m if vis.shape[1] else 0))
-    for li in range(vm.shape[0]):
+    rows = vis.rows
+    vm = np.empty((rows.shape[0], m if rows.shape[1] else 0), np.uint8)
+    for r in range(vm.shape[0]):
         for j in range(vm.shape[1]):
-            vm[li, j] = vis[li, idx[j]]
+            vm[r, j] = rows[r, idx[j]]
     om = np.empty((m, 3))
     none = Marks(np.zeros(0, np.bool_), np.zeros(0, np.int32))
     layout = (False, Dm.shape[1], Sm.shape[1])  # (the float64 pass keeps RGB sums)
@@ -1846,7 +1861,7 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         k,
         Sums(Am.reshape(-1), Dm.reshape(-1), Sm.reshape(-1)),
         Lobes(bm, wm),
-        vm,
+        Shadows(vm, vis.index),
         none,
         om.reshape(-1),
         (_scratch(np.float64), np.empty((6, 0))),  # (G: no block to prepare)

@@ -59,7 +59,7 @@ from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
 from explorer.shading.prepared import chunk_bounds, geometry_of, vertices
 from explorer.shading.prepared import readonly as _readonly
-from explorer.shading.shadows import visibility_rows
+from explorer.shading.shadows import pending_work, visibility_rows
 
 PRECISIONS = ("float64", "float32")
 #: the engine's tiers (see :mod:`explorer.shading.tiers`)
@@ -337,30 +337,29 @@ class Shader:
     def _make_plan(self, scene) -> Plan:
         return make_plan(scene, mesh=self._mesh_kind(scene), force_all=self.force_all)
 
-    def _visibility(self, dtype) -> np.ndarray:
-        """(L, n) visibility rows of the lights the plan shadows, or (L, 0) when none."""
-        scene, plan = self._scene, self._plan
-        if not plan.shadows:
-            return np.zeros((len(scene.lights), 0), dtype)
-        shadowed = [lp.shadows for lp in plan.lights]
-        vis, rays = visibility_rows(self._P, self._normals(), self._faces, scene.lights, shadowed,
-                                    two_sided=scene.two_sided, force_all=self.force_all,
-                                    cache=self._vis_cache, dtype=dtype,
-                                    cancelled=self.cancelled)  # fmt: skip
+    def _visibility(self) -> K.Shadows:
+        """The visibility rows of the lights the plan shadows (:class:`~.kernels.Shadows`)."""
+        scene, shadowed = self._scene, _shadowed(self._plan)
+        N = self._normals() if any(shadowed) else self._N  # (rays on the pass's tier: counted)
+        rows, index, rays = visibility_rows(self._P, N, self._faces, scene.lights, shadowed,
+                                            two_sided=scene.two_sided, force_all=self.force_all,
+                                            cache=self._vis_cache, cancelled=self.cancelled,
+                                            engine=tiers.ray_engine(tier=self.tier))  # fmt: skip
         self.stats["shadow_rays"] += rays
-        return vis
+        return K.Shadows(rows, index)
 
     # -- the work ------------------------------------------------------------------------------
     def _compiled_tier(self) -> bool:
         """Whether this pass runs on the compiled kernels (see :mod:`explorer.shading.tiers`)."""
-        if self._scene.model not in COMPILED_MODELS:  # threejs: the equation computes it
-            return False
+        kernels = self._scene.model in COMPILED_MODELS  # threejs: the equation computes it
         if self.tier is not None:
-            return self.tier == "compiled"
-        # the vertex-lights this pass would compute on the numpy tier: none when its sums are
-        # kept and only the material changed (a compose is not work the kernels would save)
-        work = 0 if self._np is not None else self.n * max(1, len(self._scene.lights))
-        return tiers.compiled(work)
+            return kernels and self.tier == "compiled"
+        # the numpy tier's vertex-lights of this pass with its shadow rays' work (at most; they
+        # follow this choice); none for a compose of kept sums (not work the kernels would save)
+        work = 0 if self._np is not None else self.n * max(1, len(self._scene.lights)) + (
+            pending_work(self._vis_cache, self._scene, _shadowed(self._plan), self.n,
+                         self._faces, force_all=self.force_all))  # fmt: skip
+        return tiers.compiled(work) and kernels
 
     def _update(self, force=(False, False, False)):
         if not self._compiled_tier():
@@ -407,7 +406,8 @@ class Shader:
         model or shininess change), composed with the material."""
         self._colors = None
         if self._np is None:
-            vis = self._visibility(np.float64)
+            rows, index = self._visibility()
+            vis = [rows[i] if i >= 0 else None for i in index]  # a row per light, or None
             self._np = equation_terms(self._scene, self._P, self._normals(), visibility=vis)
             self.stats["numpy"] += 1
         else:
@@ -455,7 +455,7 @@ class Shader:
         D = cache(self._D, True, grey) if do_dif else D
         S = cache(self._S, do_spec, grey)
         base, ws = self._memory.lobe_rows((len(params), n if opts[K.O_STORE_LOBE] else 0), T)
-        vis = self._visibility(T)
+        vis = self._visibility()
         inputs = (
             K.Lights(params, flags, view),
             opts,
@@ -517,6 +517,11 @@ class Shader:
                 marks, _readonly(P), _readonly(N), *fix, sums, lobes, vis, self._out
             )
         return 0
+
+
+def _shadowed(plan: Plan) -> list[bool]:
+    """Which lights the plan casts shadow rays for, one bool per light."""
+    return [bool(plan.shadows and lp.shadows) for lp in plan.lights]
 
 
 def _compiled_now(tier: str | None, model: str) -> bool:

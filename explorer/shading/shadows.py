@@ -9,9 +9,11 @@ the solid it bounds, and a ray leaving the surface it starts on (through the tri
 its vertex, or out through the far side of the body) never counts, so no bias or "shadow acne"
 offsets are needed. An open sheet casts shadows from its front side only.
 
-Visibility is 1 (lit) or 0 (shadowed); the engine multiplies it into the light's diffuse and
-specular weight (ambient light is not shadowed, as in OpenGL practice). Between vertices the
-renderer interpolates colours, so a shadow edge is as sharp as the mesh is fine.
+Visibility is 1 (lit) or 0 (shadowed), kept as uint8 and only for the lights that cast
+shadows (one byte per vertex and shadowing light: :func:`visibility_rows`); the engine zeroes
+the light's diffuse and specular weight where it is 0 (ambient light is not shadowed, as in
+OpenGL practice). Between vertices the renderer interpolates colours, so a shadow edge is as
+sharp as the mesh is fine.
 
 Ray engine: :func:`explorer.geometry.bvh.any_hit` through a bounding-volume hierarchy of the
 mesh (:mod:`explorer.geometry.bvh`), built once per geometry. It runs the same Möller-Trumbore
@@ -35,7 +37,7 @@ import numpy as np
 
 from explorer.core import tolerances as tol
 from explorer.geometry.frame import frame_of
-from explorer.shading.tiers import ray_engine
+from explorer.shading.tiers import ray_engine, ray_work
 
 #: the key under which :func:`visibility_rows` keeps the geometry's frame and BVH in its cache
 #: (with the name of the ray engine that built it)
@@ -61,7 +63,7 @@ def frame_bvh(positions, faces, engine=None, *, cancelled=None) -> tuple:
 
 
 def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=None):
-    """Visibility of ``light`` at each vertex: (n,) float64, 1 lit, 0 shadowed.
+    """Visibility of ``light`` at each vertex: (n,) uint8, 1 lit, 0 shadowed.
 
     positions : (n, 3) float; faces : (m, 3) int (counter-clockwise seen from the front)
     light : a light of :mod:`explorer.core.lights` (it gives the rays: :meth:`shadow_ray`)
@@ -71,15 +73,29 @@ def visibility(positions, faces, light, *, only=None, geometry=None, cancelled=N
         :class:`~explorer.core.errors.Cancelled`)
     """
     n = len(positions)
-    vis = np.ones(n)
+    vis = np.ones(n, np.uint8)
     idx = np.arange(n) if only is None else np.flatnonzero(only)
     if len(idx) == 0 or len(faces) == 0:
         return vis
     centre, scale, Q, bvh, engine = frame_bvh(positions, faces) if geometry is None else geometry
     D, tmax = light.shadow_ray(Q[idx], centre, scale)
     hit = engine.any_hit(bvh, Q[idx], D, tmax, cancelled=cancelled)
-    vis[idx[hit]] = 0.0
+    vis[idx[hit]] = 0
     return vis
+
+
+def pending_work(cache, scene, shadowed, n: int, faces, *, force_all) -> int:
+    """The ray work (:func:`explorer.shading.tiers.ray_work`) :func:`visibility_rows` would do
+    now with this ``cache`` on the numpy tier, at most: a tree when none is kept (by any ray
+    engine) and a ray from each of the ``n`` vertices for every ``shadowed`` light of
+    ``scene`` whose row is not kept."""
+    lights = sum(
+        1
+        for light, on in zip(scene.lights, shadowed, strict=True)
+        if on and (light.anchor, scene.two_sided, force_all) not in cache
+    )
+    tree = lights and not any(isinstance(k, tuple) and k[:1] == (GEOMETRY_KEY,) for k in cache)
+    return ray_work(len(faces) if tree else 0, lights * n)
 
 
 def visibility_rows(
@@ -92,10 +108,14 @@ def visibility_rows(
     two_sided,
     force_all,
     cache,
-    dtype=np.float64,
     cancelled=None,
+    engine=None,
 ):
-    """(L, n) ``dtype`` visibility rows, one per light (rows of lights not ``shadowed`` are 1).
+    """The visibility rows of the lights the plan casts rays for: (S, n) uint8, 1 lit, 0
+    shadowed, one row per ``shadowed`` light in order (at least one row: (1, 0) when none, as
+    :class:`explorer.shading.kernels.Shadows` takes them), and (L,) int64 each light's row (-1:
+    not shadowed). Memory: one byte per vertex and shadowing light (lights without shadows
+    take none).
 
     positions, normals : (n, 3) float; faces : (m, 3) int
     lights : the scene's lights; shadowed : (L,) bool, the lights the plan casts rays for
@@ -107,10 +127,16 @@ def visibility_rows(
         (same position or direction) reuses its row
     cancelled : () -> bool, asked while the BVH is built and between chunks of rays (True:
         raise :class:`~explorer.core.errors.Cancelled`; the rows finished so far stay cached)
-    Returns the rows and the number of rays cast."""
+    engine : the ray engine (default :func:`explorer.shading.tiers.ray_engine`)
+    Returns the rows, the index and the number of rays cast."""
     P = positions
     n = len(P)
-    vis = np.ones((len(lights), n), dtype)
+    index = np.cumsum(np.asarray(shadowed, np.bool_), dtype=np.int64) - 1
+    index[~np.asarray(shadowed, np.bool_)] = -1
+    count = int(index.max(initial=-1)) + 1
+    if not count:  # no light casts shadows: nothing to keep
+        return np.ones((1, 0), np.uint8), index, 0
+    vis = np.empty((count, n), np.uint8)
     N = np.asarray(normals, np.float64)
     length = np.sqrt(np.einsum("ij,ij->i", N, N))
     unit = N / np.where(length > 0, length, 1.0)[:, None]
@@ -126,7 +152,7 @@ def visibility_rows(
                 ndl = np.einsum("ij,ij->i", light.toward(P), unit)
                 # a margin: a ray more than needed is harmless, one fewer is not
                 only = length > 0 if two_sided else ndl > -tol.SHADOW_NDL_MARGIN
-            engine = ray_engine()
+            engine = ray_engine() if engine is None else engine
             geometry = (GEOMETRY_KEY, engine.__name__)
             if geometry not in cache:
                 cache[geometry] = frame_bvh(P, faces, engine, cancelled=cancelled)
@@ -134,5 +160,5 @@ def visibility_rows(
                            cancelled=cancelled)  # fmt: skip
             cache[key] = v
             rays += int(n if only is None else only.sum())
-        vis[i] = v
-    return vis, rays
+        vis[index[i]] = v
+    return vis, index, rays

@@ -34,6 +34,15 @@ on (the window) calls :func:`preload`: the kernels load in a thread as soon as t
 them (at start, or when the background compile finishes while the window is open) and the
 shaders switch at their next pass, so no pass waits on a load.
 
+A damaged cache is detected, set aside and rebuilt: the marker lists numba's cache files of
+every kernel (:func:`cache_files`: each index, each compiled overload and its size), and the first
+look for the marker checks them (a ``stat`` each): one missing, not a regular file, or of
+another size (truncated) makes the marker and the kernels' cache files move into a
+folder ``explorer-damaged-<time>`` beside them (:func:`set_aside`), with one notice, and the
+background compile starts again; an attempt file, a marker or a lock that is not a regular file,
+or an attempt file that is not a small count, is set aside the same way. The marker and the
+attempt file are read with :func:`read_small` (never blocks: a FIFO or a device is refused).
+
 The environment variable ``PHONG_EXPLORER_KERNELS`` picks the mode: ``auto``, ``compiled``
 (compile in this process when needed, as numba does by default: the tests and the benchmarks)
 or ``numpy`` (never compile). Colours are the engine's contract on either tier: float64 within
@@ -48,6 +57,7 @@ import importlib.util
 import json
 import os
 import platform
+import stat
 import subprocess
 import sys
 import threading
@@ -57,6 +67,7 @@ from pathlib import Path
 
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Notice
+from explorer.core.files import NO_SUCH_FILE, UnreadableFile, read_checked
 from explorer.geometry import bvh, bvh_numpy
 
 #: the environment variable that picks the mode
@@ -84,11 +95,24 @@ PREPARING = (
 
 #: background compiles that may end without the ready marker before no other is started
 MAX_ATTEMPTS = 2
+#: the largest marker or attempt file read (bytes): the marker lists every kernel's cache files
+MAX_SMALL_FILE = 1 << 20
+#: what the user is told, once, when a damaged cache was set aside
+DAMAGED = (
+    "the compiled engine's cache was damaged ({why}); it was set aside in {where} and is "
+    "rebuilt in the background; meanwhile the numpy engine serves"
+)
 
 #: vertex-lights a process serves on the numpy tier before it loads the compiled kernels from
 #: numba's cache (a load costs about what the numpy tier takes for this much work, so small
 #: one-shot jobs, like the quick start's render, never pay for it)
 LOAD_WORTH = 2_000_000
+#: the numpy tier's tree build, per triangle, and its shadow or pixel ray, per ray, in
+#: vertex-lights of its shading, so that :func:`compiled` counts a pass's ray work with its
+#: shading (:func:`ray_work`): benchmarks/bench_rays.py --section numpy measured 7-23 and 24-30
+#: (a build 2.4-3.7 µs a triangle, a ray 4-10 µs, a vertex-light 160-425 ns, as loads varied)
+BUILD_WORK = 10
+RAY_WORK = 25
 
 _lock = threading.Lock()
 _state = {
@@ -102,6 +126,9 @@ _state = {
     "checked": 0.0,  # when the marker was last looked for
     "failed": None,  # why the compiled engine is unavailable
 }
+#: the background compiles this process started, kept (a Popen dropped while its process runs
+#: warns, ResourceWarning); those that ended are reaped at the next start
+_children: list[subprocess.Popen] = []
 
 
 def mode() -> str:
@@ -171,11 +198,17 @@ def _ready() -> bool:
     if _state["ready"] is None or now - _state["checked"] >= POLL:
         first = _state["ready"] is None
         _state["checked"] = now
-        _state["ready"] = marker_path().exists()
+        _state["ready"] = os.path.lexists(marker_path())
+        told = PREPARING
+        if first and _state["ready"]:  # once per process: the cache it names is whole
+            why = damage()
+            if why is not None:
+                told = DAMAGED.format(why=why, where=set_aside(why))
+                _state["ready"] = False
         if first and not _state["ready"]:
             why = given_up()
             if why is None:
-                _start_background()
+                _start_background(told)
             else:
                 _unavailable(f"{why}; to try again, remove {attempt_path()}", stacklevel=5)
         if _state["ready"] and _state["preload"]:
@@ -183,11 +216,26 @@ def _ready() -> bool:
     return bool(_state["ready"])
 
 
-def ray_engine():
-    """The module that casts rays now: :mod:`explorer.geometry.bvh` (compiled) once the kernels
-    serve (:func:`loaded`), else :mod:`explorer.geometry.bvh_numpy` (the same answers, no
-    compile). Both have ``build_bvh``, ``any_hit`` and ``nearest_hits``."""
-    return bvh if loaded() else bvh_numpy
+def ray_work(triangles: int, rays: int) -> int:
+    """The ray work of building a tree over ``triangles`` (0: the tree is kept already) and
+    casting ``rays`` through it, in vertex-lights of the numpy tier (what :func:`compiled`
+    counts): the numpy tier builds a tree at :data:`BUILD_WORK` and casts a ray at
+    :data:`RAY_WORK` vertex-lights' time."""
+    return BUILD_WORK * int(triangles) + RAY_WORK * int(rays)
+
+
+def ray_engine(work: int = 0, tier: str | None = None):
+    """The module that casts rays: :mod:`explorer.geometry.bvh` (compiled) or
+    :mod:`explorer.geometry.bvh_numpy` (the same answers, no compile). Both have
+    ``build_bvh``, ``any_hit``, ``nearest_hits`` and ``surface_points``.
+
+    tier : "compiled" or "numpy" is obeyed; None: the compiled casts when :func:`compiled`
+    says so for ``work`` vertex-lights (:func:`ray_work`: so a large cast loads the kernels
+    from a warm cache at once), else numpy
+    """
+    if tier is not None:
+        return bvh if tier == "compiled" else bvh_numpy
+    return bvh if compiled(work) else bvh_numpy
 
 
 def status() -> str | None:
@@ -251,12 +299,152 @@ def log_path() -> Path:
 
 
 def write_marker(seconds: float) -> Path:
-    """Write the ready marker (after every kernel compiled), atomically; the attempts are
-    forgotten."""
-    info = {"seconds": round(seconds, 1), "written": time.strftime("%Y-%m-%d %H:%M:%S")}
+    """Write the ready marker (after every kernel compiled), atomically, with the cache files it
+    vouches for (:func:`cache_files`); the attempts are forgotten."""
+    info = {"seconds": round(seconds, 1), "written": time.strftime("%Y-%m-%d %H:%M:%S"),
+            "files": cache_files()}  # fmt: skip
     path = write_atomic(marker_path(), json.dumps(info).encode(), overwrite=True)
     attempt_path().unlink(missing_ok=True)
     return path
+
+
+# -- a damaged cache -----------------------------------------------------------------------------
+class _NotRegular(OSError):
+    """A small file of the cache that is not a regular file (a FIFO, a device, a directory), or
+    too large to be one."""
+
+
+def read_small(path, limit: int = MAX_SMALL_FILE) -> bytes:
+    """The bytes of a small regular file of the cache, never blocking, through the product's
+    one checked open (:func:`explorer.core.files.read_checked`: ``O_NONBLOCK``, a regular file
+    only, at most ``limit`` bytes read). FileNotFoundError when there is none (no marker yet is
+    the normal case); :class:`_NotRegular` (an OSError) for anything else it refuses."""
+    try:
+        return read_checked(path, cap=limit, what="compile cache file")
+    except UnreadableFile as exc:
+        if exc.reason == NO_SUCH_FILE:
+            raise FileNotFoundError(os.fspath(path)) from None
+        raise _NotRegular(str(exc)) from None
+
+
+def _json(path) -> dict:
+    """A small JSON object file (:func:`read_small`); ValueError when it is not one (numbers
+    such as Infinity and NaN refused)."""
+
+    def refuse(name):
+        raise ValueError(f"{name} is not a number JSON allows")
+
+    info = json.loads(read_small(path), parse_constant=refuse)
+    if not isinstance(info, dict):
+        raise ValueError("not a JSON object")
+    return info
+
+
+def cache_files() -> dict[str, int]:
+    """numba's cache files of every kernel the product calls, as they are now: each
+    dispatcher's index (``.nbi``) and compiled overloads (``.nbc``), path -> size in bytes."""
+    from explorer.shading import warm  # (warm imports this module)
+
+    found = {}
+    for d in warm.dispatchers().values():
+        impl = getattr(d._cache, "_cache_file", None)  # numba's IndexDataCacheFile
+        if impl is None:  # a function numba does not cache
+            continue
+        directory, index = impl._cache_path, impl._index_path
+        base = os.path.basename(index)[: -len(".nbi")]
+        try:
+            names = os.listdir(directory)
+        except OSError:
+            continue
+        for name in names:
+            if name == base + ".nbi" or (name.startswith(base + ".") and name.endswith(".nbc")):
+                path = os.path.join(directory, name)
+                try:
+                    found[path] = os.stat(path).st_size
+                except OSError:
+                    pass
+    return found
+
+
+def damage() -> str | None:
+    """Why the cache the marker vouches for is damaged, else None: the marker is not a small
+    JSON file, or one of the files it lists is missing, not a regular file, or of another size
+    (an index may grow: numba adds the overloads it compiles later; it never shrinks). A marker
+    of an older release (no list) is taken as it is."""
+    try:
+        files = _json(marker_path()).get("files", {})
+        if not isinstance(files, dict):
+            raise ValueError("its list of files is not an object")
+    except (OSError, ValueError) as exc:
+        return f"the ready marker {marker_path().name}: {exc}"
+    for path, size in files.items():
+        try:
+            st = os.stat(path)
+        except OSError:
+            return f"{path} is missing"
+        if not stat.S_ISREG(st.st_mode):
+            return f"{path} is not a regular file"
+        grows = path.endswith(".nbi")
+        if st.st_size < size or (st.st_size != size and not grows):
+            return f"{path} has {st.st_size} bytes, {size} when it was written"
+    return None
+
+
+def set_aside(why: str, paths=None) -> Path:
+    """Move the marker, the attempt file and the kernels' cache files (or ``paths``)
+    into a new folder ``explorer-damaged-<time>`` of the cache directory, with a note of
+    ``why``; returns the folder. What cannot be moved is removed (or left, if neither can be
+    done: numba then recompiles what it cannot read)."""
+    where = cache_dir() / time.strftime("explorer-damaged-%Y%m%d-%H%M%S")
+    n = 1
+    while os.path.lexists(where):
+        n += 1
+        where = where.with_name(f"{where.name.split('.')[0]}.{n}")
+    if paths is None:
+        paths = [marker_path(), attempt_path(), *_listed(), *cache_files()]
+    try:
+        where.mkdir(parents=True)
+        (where / "why.txt").write_text(why + "\n")
+    except OSError:
+        where = None
+    for path in dict.fromkeys(str(p) for p in paths):
+        if not os.path.lexists(path):
+            continue
+        try:
+            if where is None:
+                raise OSError
+            os.replace(path, where / f"{len(os.listdir(where)):03d}-{os.path.basename(path)}")
+        except OSError:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
+    return where if where is not None else cache_dir()
+
+
+def _listed() -> list[str]:
+    """The files the marker lists (none when it cannot be read)."""
+    try:
+        files = _json(marker_path()).get("files", {})
+        return list(files) if isinstance(files, dict) else []
+    except (OSError, ValueError):
+        return []
+
+
+def open_lock():
+    """The background compile's lock file, opened for locking (``a+``). A lock path that is not
+    a regular file (a directory, a FIFO, a dangling symlink...) is set aside and made anew;
+    OSError when it still cannot be opened."""
+    path = lock_path()
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        st = None
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        set_aside(f"{path} is not a regular file", [path])
+    fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_APPEND | getattr(os, "O_NONBLOCK", 0)
+                 | getattr(os, "O_NOFOLLOW", 0), 0o666)  # fmt: skip
+    return os.fdopen(fd, "a+")
 
 
 def attempt_path() -> Path:
@@ -267,12 +455,20 @@ def attempt_path() -> Path:
 
 def attempts() -> dict:
     """The attempt file's record; ``{"attempts": 0, "error": None}`` when there is none or it
-    cannot be read."""
+    cannot be read. One that is not a small JSON count (``Infinity``, a FIFO, a directory) is
+    set aside (:func:`set_aside`) and counts none."""
+    path = attempt_path()
     try:
-        info = json.loads(attempt_path().read_text())
-        return {"attempts": int(info["attempts"]), "error": info.get("error")}
-    except (OSError, ValueError, KeyError, TypeError):
-        return {"attempts": 0, "error": None}
+        info = _json(path)
+        n, error = info["attempts"], info.get("error")
+        if type(n) is not int or not 0 <= n <= 1000 or not isinstance(error, str | None):
+            raise ValueError(f"attempts {n!r}, error {error!r}")
+        return {"attempts": n, "error": error}
+    except FileNotFoundError:
+        pass
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        set_aside(f"{path}: {exc}", [path])
+    return {"attempts": 0, "error": None}
 
 
 def record_attempt() -> None:
@@ -297,7 +493,7 @@ def compile_running() -> bool:
     except ImportError:
         return False
     try:
-        lock = open(lock_path(), "a+")  # noqa: SIM115 - closed below
+        lock = open_lock()
     except OSError:  # no cache directory: nothing runs there
         return False
     with lock:
@@ -324,8 +520,9 @@ def warm_command() -> list[str]:
     return [sys.executable, "-m", "explorer.shading.warm"]
 
 
-def _start_background() -> None:
-    """Start the background compile (at most once per process) and tell the user once."""
+def _start_background(told: str = PREPARING) -> None:
+    """Start the background compile (at most once per process) and tell the user once
+    (``told``)."""
     with _lock:
         if _state["started"]:
             return
@@ -334,8 +531,9 @@ def _start_background() -> None:
         directory = cache_dir()
         directory.mkdir(parents=True, exist_ok=True)
         env = dict(os.environ, **{ENV: "compiled"})
+        _children[:] = [p for p in _children if p.poll() is None]
         with open(log_path(), "ab") as log:
-            subprocess.Popen(
+            child = subprocess.Popen(
                 warm_command(),
                 stdin=subprocess.DEVNULL,
                 stdout=log,
@@ -345,10 +543,11 @@ def _start_background() -> None:
                 start_new_session=True,  # Ctrl-C in the terminal does not stop it
                 close_fds=True,
             )
+        _children.append(child)
     except OSError as exc:  # no writable cache directory, no interpreter to start
         _unavailable(exc.strerror or str(exc), stacklevel=4)
         return
-    warnings.warn(PREPARING, Notice, stacklevel=3)
+    warnings.warn(told, Notice, stacklevel=3)
 
 
 def _unavailable(why: str, stacklevel: int) -> None:

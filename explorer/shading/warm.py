@@ -115,9 +115,24 @@ def _pixel_rays() -> None:
     bvh.surface_points(O, D, t, f, u, v, faces, np.asarray(mesh.normals, np.float64))
 
 
+def _refits() -> None:
+    """The shadow rays' per-light refit of the tree (:func:`explorer.geometry.bvh.toward_light`)
+    both ways: whole, and split among the threads (``occluders.refit_top``, ``refit`` and
+    ``refit_unions``: the product's way for trees of ``bvh.REFIT_NODES`` nodes and more on
+    several cores, which the small meshes of the exercise do not reach)."""
+    mesh = torus(12)
+    P = np.asarray(mesh.positions, np.float64)
+    tree = bvh.build_bvh(P[np.asarray(mesh.faces, np.int64).reshape(-1, 3)])
+    D = np.ascontiguousarray(np.array([2.0, 1.5, 3.0]) - P)  # toward a point light
+    tmax = np.ones(len(P))
+    for split in (True, False):
+        bvh.toward_light(tree, P, D, tmax, split=split)
+
+
 def exercise() -> int:
     """Run every kind of pass the product makes on the compiled tier; returns the passes."""
     _pixel_rays()
+    _refits()
     passes = 0
     for P, N, faces in _meshes():
         for scene in SCENES:
@@ -157,14 +172,20 @@ def main() -> int:
         fcntl = None
     if hasattr(os, "nice"):
         os.nice(10)  # the user's own work first
-    lock = open(tiers.lock_path(), "a+")  # noqa: SIM115 - held until the process ends
+    try:
+        lock = tiers.open_lock()  # held until the process ends
+    except OSError as exc:  # counted, so that no more are started when it cannot be opened
+        tiers.record_attempt()
+        tiers.record_error(f"cannot open the lock {tiers.lock_path()}: {exc}")
+        print(f"{time.strftime('%H:%M:%S')} cannot open the lock: {exc}", flush=True)
+        return 1
     try:
         if fcntl is not None:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         print(f"{time.strftime('%H:%M:%S')} another compile holds the lock: nothing to do")
         return 0
-    if tiers.marker_path().exists():
+    if tiers.marker_path().exists() and tiers.damage() is None:
         return 0
     print(f"{time.strftime('%H:%M:%S')} compiling the kernels (pid {os.getpid()})", flush=True)
     tiers.record_attempt()

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import io
 import json
 import subprocess
 import sys
@@ -18,22 +17,6 @@ from explorer.cli import bench as cli_bench
 from explorer.cli import main
 
 TABLE = load_table()
-
-
-def test_progress_bar_only_on_a_terminal():
-    class Tty(io.StringIO):
-        def isatty(self):
-            return True
-
-    tty, pipe = Tty(), io.StringIO()
-    for stream in (tty, pipe):
-        p = B.Progress(4, stream=stream)
-        for i in range(4):
-            p.step(f"item {i}")
-        p.close()
-    assert pipe.getvalue() == ""
-    out = tty.getvalue()
-    assert out.count("\r") == 4 and "100%" in out and "item 3" in out and out.endswith("\n")
 
 
 @pytest.mark.slow

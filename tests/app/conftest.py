@@ -13,6 +13,8 @@ from explorer.app.start import start_xvfb
 
 #: the private server's screen: room for the largest window size tested (1920x1080)
 SCREEN = (1920, 1200)
+#: the session's Xvfb servers (their Popen objects live as long as the process)
+_SERVERS: list = []
 #: modules whose tests open Qt windows in the test process
 QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py", "test_window_view.py")
 
@@ -36,10 +38,12 @@ def xserver():
         pytest.skip("needs Xvfb for the Qt window (apt-get install -y xvfb)")
     pytest.importorskip("PySide6")
     pytest.importorskip("pyvistaqt")
-    _proc, display = start_xvfb(size=SCREEN)
+    proc, display = start_xvfb(size=SCREEN)
     # left running: Qt keeps its connection to the end of the process, and a server gone
     # before that makes Xlib end the process with an I/O error; the server ends with the
-    # process (PR_SET_PDEATHSIG)
+    # process (PR_SET_PDEATHSIG). Its Popen is kept: one dropped while the server runs warns
+    # (ResourceWarning, an error in the suite)
+    _SERVERS.append(proc)
     return display
 
 

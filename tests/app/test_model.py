@@ -374,3 +374,57 @@ def test_handle_point_of_each_light(state):
         assert np.linalg.norm(M.handle_point(s, i) - np.asarray(s.centre)) == pytest.approx(d)
     assert M.handle_point(s) == pytest.approx(M.handle_point(s, s.light))
     assert not np.allclose(M.handle_point(s, 0), M.handle_point(s, 1))
+
+
+@pytest.mark.parametrize("kind", ["no directory", "a directory"])
+def test_a_state_file_that_cannot_be_written_is_refused_at_start(tmp_path, kind):
+    """``gui --state-file nodir/s.json`` (or a directory, even with --force) ran with an error
+    logged per frame and rc 0: refused before the display is looked for."""
+    from explorer.cli.gui import check_options
+
+    target = tmp_path / "nodir" / "s.json" if kind == "no directory" else tmp_path
+    with pytest.raises(explorer.ExplorerError, match="--state-file") as info:
+        check_options(_gui_args("--state-file", str(target), "--force"))
+    assert ("does not exist" if kind == "no directory" else "is a directory") in str(info.value)
+    check_options(_gui_args("--state-file", str(tmp_path / "s.json")))  # a new file is fine
+
+
+def test_the_window_holds_at_most_max_window_lights(tmp_path):
+    """A 20,000-light session took 40-50 s to open and close (and the session it kept was over
+    the reader's 1 MiB): a session, a scene or added lights beyond the cap are refused."""
+    from explorer.core import tolerances as tol
+
+    n = tol.MAX_WINDOW_LIGHTS
+    state, _ = start_state(_gui_args("--mesh", "cube"))
+    light = state.scene.lights[0]
+    full = state.replace(scene=state.scene.replace(lights=(light,) * n))
+    path = S.save_session(tmp_path / "full.yaml", full)
+    assert len(S.load_session(path)[0].scene.lights) == n
+    with pytest.raises(explorer.ExplorerError, match=rf"the window holds at most {n}"):
+        M.add_light(full)
+    over = full.replace(scene=full.scene.replace(lights=(light,) * (n + 1)))
+    text = path.read_text()
+    path.write_text(text.replace("lights:", "lights:\n  - {type: point, position: [1, 2, 3]}", 1))
+    with pytest.raises(explorer.ExplorerError, match=rf"full.yaml: scene: {n + 1} lights; the"):
+        S.load_session(path)
+    with pytest.raises(explorer.ExplorerError, match=rf"{n + 1} lights"):
+        A.first_state(over.scene, G.get_mesh("cube"))
+
+
+def test_range_errors_show_every_digit_needed(tmp_path):
+    """``view_angle 179.0001`` was refused as "got 179"."""
+    from explorer.core.validate import format_number
+
+    assert [format_number(x) for x in (179.0001, 179.0, 0.5, 1e6, 1e-320)] == [
+        "179.0001", "179", "0.5", "1e+06", "1e-320"]  # fmt: skip
+    state, _ = start_state(_gui_args("--mesh", "cube"))
+    state = state.replace(camera=camera_for(state.scene, G.get_mesh("cube")))
+    path = S.save_session(tmp_path / "s.yaml", state)
+    text = path.read_text()
+    import re
+
+    path.write_text(re.sub(r"view_angle: [0-9.e+-]+", "view_angle: 179.0001", text))
+    with pytest.raises(
+        explorer.ExplorerError, match=r"view_angle: must be in \(0, 179\], got 179.0001"
+    ):
+        S.load_session(path)

@@ -108,7 +108,9 @@ def test_more_bad_input():
         parse_mtl("newmtl a\nillum 2.5\n", "x")
     with pytest.raises(MtlError, match="newmtl needs a material name"):
         parse_mtl("newmtl\n", "x")
-    with pytest.raises(MtlError, match="does-not-exist.mtl: cannot be read"):
+    with pytest.raises(
+        MtlError, match="does-not-exist.mtl: cannot read material library: no such file"
+    ):
         read_mtl(DATA / "does-not-exist.mtl")
 
 

@@ -128,3 +128,58 @@ def test_a_cast_can_be_cancelled():
     with pytest.raises(Cancelled):
         NB.any_hit(NB.build_bvh(tri), np.zeros((10, 3)), np.ones((10, 3)) / 3**0.5, 5.0,
                    cancelled=lambda: True)  # fmt: skip
+
+
+def _crossing(m, seed):
+    """``m`` large triangles whose corners lie on the unit sphere: every one spans the centre's
+    neighbourhood, so every box of the tree holds the centre and every ray through it enters
+    every leaf (the adversarial case: rays × triangles pairs)."""
+    rng = np.random.default_rng(seed)
+    c = rng.normal(size=(m, 3, 3))
+    return c / np.linalg.norm(c, axis=2, keepdims=True)
+
+
+def _peak(fn) -> int:
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        fn()
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+@pytest.mark.parametrize("cast", ["any_hit", "nearest_hits"])
+def test_a_cast_through_crossing_triangles_is_memory_bounded(monkeypatch, cast):
+    # issue 31 item 3: the numpy tier's casts held every (ray, leaf) pair of a level at once,
+    # rays × triangles of them on a soup of crossing triangles (9.7 GiB for a 1.5 MB OBJ)
+    monkeypatch.setattr(NB, "PAIRS", 512, raising=False)  # a small piece: a small bound
+    rng = np.random.default_rng(5)
+    k = 400
+    O = rng.normal(size=(k, 3)) * 3.0
+    D = -O + rng.normal(scale=0.05, size=(k, 3))  # toward the centre, through the soup
+    peaks = {}
+    for m in (600, 2400):
+        tree = NB.build_bvh(_crossing(m, m))
+        if cast == "any_hit":
+            run = lambda t=tree: NB.any_hit(t, O, D, np.full(k, 1e9))  # noqa: E731
+        else:
+            run = lambda t=tree: NB.nearest_hits(t, O, D, 1e-9)  # noqa: E731
+        peaks[m] = _peak(run)
+        per_ray = 200 * k  # the rays' own arrays (O, D, inverses, answers, the root piece)
+        assert peaks[m] <= NB.pair_bound(tree) + per_ray, (m, peaks[m], NB.pair_bound(tree))
+    # four times the triangles (four times the pairs): the peak grows with the tree's depth only
+    assert peaks[2400] < 1.5 * peaks[600], peaks
+    # and the answers are still the compiled casts'
+    tree = NB.build_bvh(_crossing(600, 600))
+    compiled = B.build_bvh(_crossing(600, 600))
+    if cast == "any_hit":
+        got = NB.any_hit(tree, O, D, np.full(k, 1e9))
+        np.testing.assert_array_equal(got, B.any_hit(compiled, O, D, np.full(k, 1e9)))
+        assert got.any()
+    else:
+        t, f, _, _ = NB.nearest_hits(tree, O, D, 1e-9)
+        t2, f2, _, _ = B.nearest_hits(compiled, O, D, 1e-9)
+        np.testing.assert_array_equal(f, f2)
+        np.testing.assert_array_equal(t, t2)

@@ -1,9 +1,9 @@
 """Golden files of the tests: pictures and colour arrays. Every image tolerance is here.
 
 Goldens live in ``tests/golden/`` and its subfolders: ``<name>.png`` pictures
-(:func:`check_golden`) and ``<name>.npz`` arrays (:func:`check_golden_arrays`). They are read and
-written with Pillow and numpy, never with the PNG codec under test
-(:mod:`explorer.render.images`, which tests/render tests on its own).
+(:func:`check_golden`) and ``<name>.npz`` arrays (:func:`check_golden_arrays`). Pictures are read
+and written with the package's one PNG codec (:mod:`explorer.render.images`, Pillow's), which
+tests/render/test_render.py checks against an independent one (VTK's PNG reader and writer).
 
 A picture matches its golden when
 
@@ -46,9 +46,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from explorer.core.atomic import write_atomic
+from explorer.render.images import encode_png, read_png
 
 GOLDEN_DIR = Path(__file__).resolve().parent.parent / "golden"
 REGENERATE_ENV = "PHONG_EXPLORER_REGENERATE_GOLDENS"
@@ -126,20 +126,15 @@ def diff_image(actual, expected) -> np.ndarray:
 
 
 def read_picture(path) -> np.ndarray:
-    """A PNG read with Pillow: (h, w, 3) or (h, w, 4) uint8."""
-    with Image.open(path) as im:
-        if im.mode not in ("RGB", "RGBA"):
-            im = im.convert("RGBA" if "A" in im.getbands() else "RGB")
-        return np.array(im)
+    """A PNG read with the package's codec: (h, w, 3) or (h, w, 4) uint8."""
+    return read_png(path)
 
 
 def write_picture(path, image) -> None:
-    """Write an (h, w, 3|4) uint8 picture as PNG with Pillow (atomically, folders made)."""
+    """Write an (h, w, 3|4) uint8 picture as PNG (atomically, folders made)."""
     a = np.ascontiguousarray(image)
     _rgb(a)  # shape and type check
-    buf = io.BytesIO()
-    Image.fromarray(a).save(buf, format="PNG")
-    write_atomic(path, buf.getvalue(), overwrite=True, make_dirs=True)
+    write_atomic(path, encode_png(a), overwrite=True, make_dirs=True)
 
 
 def write_arrays(path, arrays: Mapping[str, np.ndarray]) -> None:

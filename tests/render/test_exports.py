@@ -3,6 +3,8 @@ OBJ meshes with their own materials (render and sheet), and turntables."""
 
 from __future__ import annotations
 
+import gc
+import warnings
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -13,11 +15,13 @@ import trimesh
 
 import explorer
 from explorer.cli import main
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
 from explorer.core.mtl import read_mtl
 from explorer.geometry import meshes as M
 from explorer.render.exports import UNLIT, glb_bytes, linear_colors
 from explorer.render.images import read_png
-from explorer.render.turntable import check_frames, orbit_scene
+from explorer.render.turntable import check_frames, check_turntable, orbit_scene
 from explorer.shading.display import group_vertex_colors, vertex_colors
 
 # two unit squares side by side, each its own usemtl group; the shared edge (x = 1) is split
@@ -215,13 +219,25 @@ def test_obj_export_writes_its_mtl_and_reads_back(two_groups, tmp_path):
 # -- turntables ------------------------------------------------------------------------------
 
 
+def read_frames(path) -> np.ndarray:
+    """Every frame of a GIF or MP4, (n, h, w, 3|4) uint8. imageio-ffmpeg's MP4 reader leaves its
+    ffmpeg pipes to the garbage collector (a ResourceWarning, an error in the suite; the writer,
+    which the package uses, closes them): that one warning is ignored here, and the collector
+    runs before the filter is restored."""
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "unclosed file <_io.Buffered", ResourceWarning)
+        frames = iio.imread(path, index=None)
+        gc.collect()
+    return frames
+
+
 @pytest.mark.parametrize("suffix", [".gif", ".mp4"])
 def test_turntable_writes_n_frames_and_never_overwrites(tmp_path, suffix):
     out = tmp_path / f"spin{suffix}"
     argv = ["render", "--preset", "gold", "--mesh", "teapot", "--resolution", "4"]
     argv += ["--size", "64x48", "--turntable", "6", "--out", str(out)]
     assert main(argv) == 0
-    frames = iio.imread(out, index=None)
+    frames = read_frames(out)
     assert frames.shape[:3] == (6, 48, 64)
     # the teapot turns: frames differ, and a half turn is not the first frame
     assert np.abs(frames[0].astype(int) - frames[3].astype(int)).max() > 50
@@ -236,6 +252,77 @@ def test_turntable_options_are_checked(tmp_path, capsys):
     assert main(["render", "--turntable", "4", "--out", str(tmp_path / "a.png")]) == 2
     assert "must end in .gif or .mp4" in capsys.readouterr().err
     assert check_frames(36) == 36
+
+
+def _no_frame(monkeypatch):
+    """Make any off-screen frame render fail the test."""
+    from explorer.render import offscreen
+
+    def render(*args, **kw):
+        raise AssertionError("a frame was rendered")
+
+    monkeypatch.setattr(offscreen.OffscreenRenderer, "render", render)
+
+
+def test_turntable_needs_are_checked_before_any_frame_renders(tmp_path, capsys, monkeypatch):
+    # issue 31 item 5: an odd-sized MP4 rendered every frame before it was refused, and a
+    # turntable of 360 frames of 8192² asked 67.5 GiB (a traceback)
+    _no_frame(monkeypatch)
+    out = tmp_path / "t.mp4"
+    assert main(["render", "--turntable", "4", "--size", "121x120", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--size 121x120" in err and "even width and height" in err and "122x120" in err
+    assert "Traceback" not in err and not out.exists()
+    argv = ["render", "--turntable", "360", "--size", "8192x8192", "--out"]
+    for suffix, cap in (
+        (".mp4", tol.MAX_TURNTABLE_PIXELS),
+        (".gif", tol.MAX_TURNTABLE_HELD_PIXELS),
+    ):
+        assert main([*argv, str(tmp_path / f"t{suffix}")]) == 2
+        err = capsys.readouterr().err
+        assert "--turntable 360 --size 8192x8192" in err and f"at most {cap:,}" in err, err
+        assert "Traceback" not in err
+    # within the budget a GIF of these frames is refused, an MP4 accepted
+    assert check_turntable(360, (2048, 2048), ".mp4") == 360
+    with pytest.raises(ExplorerError, match="an .mp4 may have more"):
+        check_turntable(360, (2048, 2048), ".gif")
+    with pytest.raises(ExplorerError, match="held until the end"):
+        check_turntable(360, (2048, 2048), ".mp4", held=True)  # the window keeps its frames
+
+
+def _turntable_peak(tmp_path, monkeypatch, frames: int, size=(256, 256)) -> int:
+    """tracemalloc's peak over ``render --turntable frames`` into an MP4, the off-screen render
+    replaced by a fresh synthetic picture per frame (the encoder and the loop are real)."""
+    import tracemalloc
+
+    from explorer.render import offscreen
+
+    w, h = size
+
+    def render(self, scene, mesh, colors, camera=None):
+        frame = np.empty((h, w, 3), np.uint8)
+        frame[:] = np.asarray(colors[0] * 255, np.uint8)
+        return frame
+
+    monkeypatch.setattr(offscreen.OffscreenRenderer, "render", render)
+    out = tmp_path / f"t{frames}.mp4"
+    argv = ["render", "--mesh", "sphere", "--resolution", "6", "--size", f"{w}x{h}"]
+    tracemalloc.start()
+    try:
+        assert main([*argv, "--turntable", str(frames), "--out", str(out)]) == 0
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_turntable_streams_its_frames(tmp_path, monkeypatch):
+    # issue 31 item 5: every frame was held until the end (360 x 2048²: 12.3 GiB); an MP4's
+    # frames now go to the encoder as they render, so memory does not grow with their number
+    small = _turntable_peak(tmp_path, monkeypatch, 6)
+    large = _turntable_peak(tmp_path, monkeypatch, 30)
+    frame = 256 * 256 * 3
+    assert large < small + 4 * frame, (small, large)  # held frames: 24 more frames, 4.7 MB
+    assert read_frames(tmp_path / "t30.mp4").shape[:3] == (30, 256, 256)
 
 
 def test_orbit_turns_viewer_and_lights_together():
@@ -255,22 +342,17 @@ def test_orbit_turns_viewer_and_lights_together():
     assert np.abs(np.sort(a, axis=0) - np.sort(b, axis=0)).max() < 1e-9
 
 
-def test_progress_bar_draws_on_a_terminal_only():
-    import io
+@pytest.mark.parametrize("suffix", [".obj", ".ply", ".glb"])
+def test_an_export_larger_than_the_read_cap_is_written_with_a_warning(
+    tmp_path, monkeypatch, capsys, suffix
+):
+    """A 5M-vertex export (1.1 GB .obj, 320 MB .glb) is more than ``--mesh`` reads back: the
+    write says so, naming the cap (lowered here so that the file stays small)."""
+    from explorer.core import tolerances
 
-    from explorer.cli.options import ProgressBar
-
-    class Terminal(io.StringIO):
-        def isatty(self):
-            return True
-
-    term, pipe = Terminal(), io.StringIO()
-    for stream in (term, pipe):
-        bar = ProgressBar(stream, "turntable")
-        for k in range(1, 5):
-            bar.update(k, 4)
-        bar.close()
-    assert pipe.getvalue() == ""
-    text = term.getvalue()
-    assert text.count("\r") == 4 and text.endswith("] 4/4\n")
-    assert "\rturntable [" + "#" * 15 + "-" * 15 + "] 2/4" in text
+    monkeypatch.setattr(tolerances, "MAX_MESH_FILE_BYTES", 2048)
+    out = tmp_path / f"big{suffix}"
+    assert main(["render", "--mesh", "sphere", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert f"{out} is {out.stat().st_size} bytes, more than the 2048 bytes" in err
+    assert "MAX_MESH_FILE_BYTES" in err

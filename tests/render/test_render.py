@@ -15,6 +15,7 @@ import tempfile
 import numpy as np
 import pytest
 import trimesh
+from helpers import vtkpng
 from helpers.imagecompare import (
     MAX_DIFFERENT_FRACTION,
     PIXEL_TOL,
@@ -29,7 +30,7 @@ import explorer
 from explorer.cli import main
 from explorer.core import presets
 from explorer.core.atomic import write_atomic
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import DeprecatedName, ExplorerError
 from explorer.core.lights import DirectionalLight
 from explorer.core.material import Material
 from explorer.core.scene import Viewer
@@ -37,7 +38,7 @@ from explorer.core.tolerances import GOLDEN_COLOR_ABS_TOL
 from explorer.geometry import meshes as M
 from explorer.render.camera import FRAME_MARGIN, Camera, back_to_front, camera_for
 from explorer.render.exports import mesh_file_bytes
-from explorer.render.images import check_size, encode_png, parse_size, read_png
+from explorer.render.images import check_size, decode_png, encode_png, parse_size, read_png
 from explorer.render.offscreen import (
     BACKGROUND,
     LABEL_HEIGHT,
@@ -272,15 +273,47 @@ def test_parse_size():
         check_size((400.5, 300))
 
 
-def test_png_round_trip(tmp_path):
+def _chunks(data: bytes) -> list[bytes]:
+    names, at = [], 8
+    while at < len(data):
+        length = int.from_bytes(data[at : at + 4], "big")
+        names.append(data[at + 4 : at + 8])
+        at += 12 + length
+    return names
+
+
+def test_png_round_trip_and_vtk_agrees(tmp_path):
     rng = np.random.default_rng(1)
-    for c in (3, 4):
+    for c, colour_type in ((3, 2), (4, 6)):  # PNG colour types: RGB, RGBA
         img = rng.integers(0, 256, (7, 11, c), dtype=np.uint8)
+        data = encode_png(img)
         path = tmp_path / f"x{c}.png"
-        path.write_bytes(encode_png(img))
+        path.write_bytes(data)
         assert np.array_equal(read_png(path), img)
-    with pytest.raises(ExplorerError, match="PNG"):
+        # 8-bit, the colour type, nothing but the picture; VTK reads it the same and the
+        # codec reads VTK's file the same
+        assert data[24:26] == bytes([8, colour_type])
+        assert _chunks(data) == [b"IHDR", b"IDAT", b"IEND"]
+        assert np.array_equal(vtkpng.read(path), img)
+        assert np.array_equal(decode_png(vtkpng.encode(img)), img)
+
+
+def test_png_reading_refuses_what_it_cannot_read(tmp_path):
+    with pytest.raises(ExplorerError, match="missing.png: cannot read PNG file: no such file"):
         read_png(tmp_path / "missing.png")
+    os.mkfifo(tmp_path / "fifo.png")  # through the checked open: refused at once, never waited on
+    with pytest.raises(ExplorerError, match="fifo.png: cannot read PNG file: it is a FIFO"):
+        read_png(tmp_path / "fifo.png")
+    data = encode_png(np.zeros((4, 5, 3), np.uint8))
+    with pytest.raises(ExplorerError, match="half.png: not a readable PNG file"):
+        decode_png(data[: len(data) // 2], "half.png")
+    with pytest.raises(ExplorerError, match="x.gif: not a readable PNG file"):
+        decode_png(b"GIF89a" + bytes(40), "x.gif")
+    grey = np.arange(20, dtype=np.uint8).reshape(4, 5, 1)
+    assert np.array_equal(decode_png(vtkpng.encode(grey)), np.repeat(grey, 3, axis=2))
+    deep = vtkpng.encode(np.full((4, 5, 3), 40000, np.uint16))  # a 16-bit RGB file
+    with pytest.raises(ExplorerError, match="deep.png: a 16-bit PNG"):
+        decode_png(deep, "deep.png")
 
 
 def test_write_atomic(tmp_path):
@@ -692,14 +725,15 @@ def test_cli_scene_file_and_overrides(tmp_path, capsys):
         (["--viewer-direction", "0", "1", "1"], ["--viewer-to-viewer", "0", "1", "1"]),
     ],
 )
-def test_cli_old_direction_flags_still_work_with_a_notice(tmp_path, capsys, old, new):
+def test_cli_old_direction_flags_still_work_with_a_notice(tmp_path, old, new):
+    """The old flag warns (a DeprecatedName notice, which the command prints as a ``notice:``
+    line: tests/shading/test_tiers.py checks that printing in a process of its own)."""
     base = ["render", "--mesh", "sphere", "--resolution", "16", "--size", "64x64", "--out"]
-    assert main([*base, str(tmp_path / "new.png"), *new]) == 0
-    assert "notice:" not in capsys.readouterr().err
-    assert main([*base, str(tmp_path / "old.png"), *old]) == 0
-    err = capsys.readouterr().err
+    assert main([*base, str(tmp_path / "new.png"), *new]) == 0  # no warning (they are errors)
     flag = new[-4]
-    assert f"notice: {old[-4]} is now {flag} (" in err and "the old name still works" in err
+    with pytest.warns(DeprecatedName, match=rf"^{old[-4]} is now {flag} \(") as notes:
+        assert main([*base, str(tmp_path / "old.png"), *old]) == 0
+    assert len(notes) == 1 and "the old name still works" in str(notes[0].message)
     assert np.array_equal(read_png(tmp_path / "old.png"), read_png(tmp_path / "new.png"))
 
 

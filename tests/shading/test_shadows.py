@@ -14,6 +14,7 @@ from explorer.core.scene import load_scene
 from explorer.geometry.frame import frame_of
 from explorer.geometry.meshes import get_mesh
 from explorer.geometry.rays import any_hit as brute_any_hit
+from explorer.shading.equation import equation_shade
 from explorer.shading.shadows import GEOMETRY_KEY, frame_bvh, visibility, visibility_rows
 
 LIGHTS = [
@@ -41,14 +42,77 @@ def test_shadowed_vertices_are_the_brute_force_ones(name, resolution):
     mesh = get_mesh(name, resolution)
     lights = load_scene({"lights": LIGHTS}).lights
     cache: dict = {}
-    rows, rays = visibility_rows(
+    rows, index, rays = visibility_rows(
         mesh.positions, mesh.normals, mesh.faces, lights, [True] * 3,
         two_sided=False, force_all=False, cache=cache,
     )  # fmt: skip
+    assert list(index) == [0, 1, 2] and rows.dtype == np.uint8
     expected = _brute_rows(mesh, lights)
     assert np.array_equal(rows, expected)
     assert ((expected == 0).sum(axis=1) > 0).all()  # every light shadows something
     assert (GEOMETRY_KEY, "explorer.geometry.bvh") in cache and rays > 0  # the compiled tier
+
+
+def _many_lights(count: int, shadowed: tuple[int, ...]) -> list[dict]:
+    """``count`` point lights around the mesh; those at ``shadowed`` cast shadows."""
+    angles = np.linspace(0.0, 2.0 * np.pi, count, endpoint=False)
+    return [{"type": "point", "position": [2.0 * np.cos(a), 1.5, 2.0 * np.sin(a)],
+             "diffuse": [0.6 / count ** 0.5] * 3, "specular": [0.3] * 3,
+             "shadows": i in shadowed} for i, a in enumerate(angles)]  # fmt: skip
+
+
+def test_visibility_is_kept_as_bytes_for_the_shadowing_lights_only():
+    # issue 31 item 4: visibility was (lights, vertices) float64 whatever cast shadows: one
+    # shadowed light among 1,000 on a 523k-vertex sphere took 4.7 GiB, 5,000 raised
+    mesh = get_mesh("torus", 24)
+    n = len(mesh.positions)
+    scene = {"lights": _many_lights(12, (3, 7)), "material": "gold"}
+    for tier in ("compiled", "numpy"):
+        s = explorer.Shader(scene, mesh.positions, mesh.normals, faces=mesh.faces, tier=tier)
+        rows, index = s._visibility()
+        assert rows.shape == (2, n) and rows.dtype == np.uint8
+        assert list(index) == [-1, -1, -1, 0, -1, -1, -1, 1, -1, -1, -1, -1]
+        assert set(np.unique(rows)) == {0, 1}  # both lights shadow some vertices
+
+    def peak(count: int) -> int:
+        import tracemalloc
+
+        lights = load_scene({"lights": _many_lights(count, (1,))}).lights
+        shadowed = [light.shadows for light in lights]
+        cache: dict = {}
+        visibility_rows(mesh.positions, mesh.normals, mesh.faces, lights, shadowed,
+                        two_sided=False, force_all=False, cache=cache)  # fmt: skip
+        cache = {k: v for k, v in cache.items() if k[0] == GEOMETRY_KEY}  # the tree kept
+        tracemalloc.start()
+        try:
+            rows, _, _ = visibility_rows(mesh.positions, mesh.normals, mesh.faces, lights,
+                                         shadowed, two_sided=False, force_all=False,
+                                         cache=cache)  # fmt: skip
+            assert rows.shape == (1, n)
+            return tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+
+    # 1,000 lights cost what 10 do beyond a few bytes a light (the old rows: 8 bytes a
+    # vertex-light, 990 x 8 x n = 4.6 MB more here)
+    assert peak(1000) - peak(10) < 64 * 1000
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_colours_with_some_lights_shadowed_are_the_equations(precision):
+    # the rows of the shadowing lights only, mapped to their lights: the equation's colours
+    mesh = get_mesh("torus", 24)
+    scene = {"lights": _many_lights(9, (0, 4, 5)), "material": "gold",
+             "viewer": {"eye": [0.0, 2.0, 3.0]}}  # fmt: skip
+    exact = equation_shade(load_scene(scene), mesh.positions, mesh.normals, faces=mesh.faces)
+    atol = 1e-5 if precision == "float64" else 1 / 255
+    for tier in ("compiled", "numpy"):
+        c = explorer.shade(scene, mesh.positions, mesh.normals, faces=mesh.faces,
+                           precision=precision, tier=tier)  # fmt: skip
+        np.testing.assert_allclose(c, exact, rtol=0, atol=atol)
+    plain = equation_shade(load_scene({**scene, "lights": _many_lights(9, ())}),
+                           mesh.positions, mesh.normals)  # fmt: skip
+    assert (exact < plain - 0.01).any()  # the shadows darken some vertices
 
 
 def test_a_shader_with_shadows_shades_as_the_brute_force_says():

@@ -297,6 +297,16 @@ def test_the_background_compile_covers_what_the_product_calls():
     s.set_lights([{"type": "spot", "position": [0, 3, 0], "aim": [0, -1, 0], "cutoff": 30}])
     s.set_viewer({"to_viewer": [0, 0, 1]})
     _ = s.colors
+    # a large tree's refit, split among the threads (occluders.refit_top, refit_unions: issue
+    # 31 item 9, they were compiled in-process on first use)
+    from explorer.geometry import bvh
+
+    saved = bvh.REFIT_NODES, bvh.workers
+    bvh.REFIT_NODES, bvh.workers = 0, lambda: 2
+    try:
+        explorer.shade(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces)
+    finally:
+        bvh.REFIT_NODES, bvh.workers = saved
     after = warm.signatures()
     new = {k: after[k] - before[k] for k in after if after[k] - before[k]}
     assert not new, f"kernel signatures the background compile does not make: {new}"
@@ -360,3 +370,177 @@ def test_a_background_compile_that_crashes_is_counted(tmp_path):
         "attempts": 2,
         "error": "ZeroDivisionError: division by zero",
     }
+
+
+def _ray_engines(shader) -> set[str]:
+    """The ray engines that built the shader's shadow trees."""
+    from explorer.shading.shadows import GEOMETRY_KEY
+
+    return {k[1] for k in shader._vis_cache if isinstance(k, tuple) and k[:1] == (GEOMETRY_KEY,)}
+
+
+def test_an_explicit_tier_is_obeyed_for_rays(cold_tiers):
+    # issue 31 item 3: the rays followed the process's tier (tiers.loaded()), not the shader's:
+    # tier="compiled" cast on the numpy BVH in mode auto, tier="numpy" on the compiled one in
+    # mode compiled
+    mesh = torus(16)
+    cold_tiers.write_text("{}")  # a warm cache, but no work served: auto would stay on numpy
+    for tier, engine in (("compiled", "explorer.geometry.bvh"),
+                         ("numpy", "explorer.geometry.bvh_numpy")):  # fmt: skip
+        for mode in ("auto", "compiled", "numpy"):
+            tiers.set_mode(mode)
+            s = Shader(SHADOWED, mesh.positions, mesh.normals, faces=mesh.faces, tier=tier)
+            _ = s.colors
+            assert _ray_engines(s) == {engine}, (tier, mode)
+            assert s.stats["shadow_rays"] > 0
+    assert tiers.ray_engine(tier="numpy").__name__ == "explorer.geometry.bvh_numpy"
+    assert tiers.ray_engine(tier="compiled").__name__ == "explorer.geometry.bvh"
+
+
+def test_the_tier_choice_counts_ray_work(cold_tiers, monkeypatch):
+    # issue 31 item 3: a one-shot shadowed pass counted its shading (n·L vertex-lights) but
+    # not its tree and rays, so it built the numpy BVH although the warm cache would pay
+    cold_tiers.write_text("{}")  # the cache holds the kernels
+    mesh = teapot(8)
+    n = len(mesh.positions)
+    work = tiers.ray_work(len(mesh.faces), n)
+    assert work > 10 * n  # the rays cost more than the shading of one light
+    monkeypatch.setattr(tiers, "LOAD_WORTH", 2 * n)  # more than the shading alone
+    unshadowed = {**SHADOWED, "lights": [{"type": "point", "position": [1.5, 2.0, 1.0]}]}
+    plain = Shader(unshadowed, mesh.positions, mesh.normals, faces=mesh.faces, keep=False)
+    _ = plain.colors  # no shadows: n vertex-lights, under LOAD_WORTH
+    assert plain.stats["numpy"] == 1 and not tiers.loaded()
+    one = {**SHADOWED, "lights": SHADOWED["lights"][:1]}
+    s = Shader(one, mesh.positions, mesh.normals, faces=mesh.faces, keep=False)
+    _ = s.colors  # n vertex-lights and the ray work: the kernels load, rays and shading both
+    assert s.stats["pass"] == 1 and s.stats["numpy"] == 0 and tiers.loaded()
+    assert _ray_engines(s) == {"explorer.geometry.bvh"}
+    np.testing.assert_allclose(
+        s.colors, Shader(one, mesh.positions, mesh.normals, faces=mesh.faces, tier="numpy").colors,
+        atol=1 / 255,
+    )  # fmt: skip
+
+
+def test_a_per_pixel_cast_counts_its_rays(cold_tiers, monkeypatch):
+    # issue 31 item 3: render --per-pixel cast every pixel's ray on the numpy BVH until the
+    # process had shaded LOAD_WORTH vertex-lights (8192² pixels: 14.3 GiB, then a traceback)
+    from explorer.render import perpixel
+    from explorer.render.camera import camera_for
+
+    cold_tiers.write_text("{}")
+    mesh = teapot(6)
+    camera = camera_for(explorer.load_scene({}), mesh)
+    monkeypatch.setattr(tiers, "LOAD_WORTH", tiers.ray_work(0, 40 * 30 * 4))
+    perpixel.mesh_hits(camera, (40, 30), mesh)  # a few rays: the numpy casts
+    assert set(perpixel._bvh_cache[mesh]) == {"explorer.geometry.bvh_numpy"}
+    assert not tiers.loaded()
+    hits = perpixel.mesh_hits(camera, (160, 120), mesh)  # sixteen times the rays: compiled
+    assert tiers.loaded() and "explorer.geometry.bvh" in perpixel._bvh_cache[mesh]
+    assert hits.mask.any()
+
+
+# -- a damaged cache (issue 31 item 9) -------------------------------------------------------------
+def _fake_cache(tmp_path, monkeypatch) -> dict:
+    """Two kernels' cache files (an index and a compiled overload each) standing for numba's, and
+    :func:`tiers.cache_files` listing them: a damaged cache simulated without compiling."""
+    files = {}
+    for name, size in (("kernels.shade-1.py311", 900), ("bvh.any_hit-2.py311", 400)):
+        for suffix, n in ((".nbi", 64), (".1.nbc", size)):
+            path = tmp_path / f"{name}{suffix}"
+            path.write_bytes(b"x" * n)
+            files[str(path)] = n
+    monkeypatch.setattr(
+        tiers, "cache_files", lambda: {p: os.path.getsize(p) for p in files if os.path.exists(p)}
+    )
+    return files
+
+
+@pytest.mark.parametrize("damage", ["truncated", "index removed", "marker a FIFO"])
+def test_a_damaged_cache_is_set_aside_with_one_notice_and_rebuilt(cold_tiers, monkeypatch, damage):
+    # a truncated .nbc with the marker kept died in an UnpicklingError traceback on every large
+    # render; an index removed made a 4-light render recompile for 55 s, silently
+    files = _fake_cache(cold_tiers.parent, monkeypatch)
+    tiers.write_marker(1.0)
+    nbc = next(p for p in files if p.endswith(".nbc"))
+    nbi = next(p for p in files if p.endswith(".nbi"))
+    if damage == "truncated":
+        os.truncate(nbc, 10)
+    elif damage == "index removed":
+        os.unlink(nbi)
+    else:
+        cold_tiers.unlink()
+        os.mkfifo(cold_tiers)
+    tiers.set_mode("auto")
+    with pytest.warns(explorer.core.errors.Notice) as told:
+        assert not tiers.compiled(10**9)  # the numpy tier serves
+        assert not tiers.compiled(10**9)
+    told = [w for w in told if issubclass(w.category, explorer.core.errors.Notice)]
+    assert len(told) == 1, [str(w.message) for w in told]
+    said = str(told[0].message)
+    assert "damaged" in said and "rebuilt in the background" in said, said
+    assert (nbc if damage == "truncated" else nbi if damage == "index removed" else
+            cold_tiers.name) in said  # fmt: skip
+    aside = list(cold_tiers.parent.glob("explorer-damaged-*"))
+    assert len(aside) == 1 and (aside[0] / "why.txt").exists()
+    assert not os.path.lexists(cold_tiers)  # the marker is gone
+    assert not any(os.path.exists(p) for p in files)  # the kernels' files set aside
+    assert tiers._state["started"]  # and the background compile rebuilds them
+
+
+def test_an_intact_cache_is_used_and_an_index_may_grow(cold_tiers, monkeypatch):
+    files = _fake_cache(cold_tiers.parent, monkeypatch)
+    tiers.write_marker(1.0)
+    nbi = next(p for p in files if p.endswith(".nbi"))
+    with open(nbi, "ab") as f:  # numba added an overload it compiled later
+        f.write(b"more")
+    tiers.set_mode("auto")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", explorer.core.errors.Notice)
+        assert tiers.compiled(10**9)
+    assert tiers.damage() is None and not list(cold_tiers.parent.glob("explorer-damaged-*"))
+
+
+def test_an_attempt_file_that_is_not_a_count_is_set_aside(cold_tiers):
+    # {"attempts": Infinity} gave an OverflowError traceback on every command
+    path = tiers.attempt_path()
+    for text in ('{"attempts": Infinity}', '{"attempts": 1e400}', '{"attempts": true}', "[1]",
+                 '{"attempts": 2, "error": 5}', "\xff\xfe"):  # fmt: skip
+        path.write_bytes(text.encode("utf-8", "surrogateescape"))
+        assert tiers.attempts() == {"attempts": 0, "error": None}
+        assert not path.exists()  # set aside
+    path.write_text('{"attempts": 1, "error": "boom"}')
+    assert tiers.attempts() == {"attempts": 1, "error": "boom"}
+
+
+def test_an_attempt_file_that_is_a_fifo_does_not_block(cold_tiers):
+    # a FIFO there hung every command
+    import threading
+
+    os.mkfifo(tiers.attempt_path())
+    result = {}
+    t = threading.Thread(target=lambda: result.update(a=tiers.attempts()), daemon=True)
+    t.start()
+    t.join(timeout=20)
+    assert result.get("a") == {"attempts": 0, "error": None}
+    assert not os.path.lexists(tiers.attempt_path())
+
+
+def test_a_lock_path_that_cannot_be_opened(cold_tiers, monkeypatch, capsys):
+    # a lock path that could not be opened made every command start a compile (which died
+    # before counting itself) and say "preparing ..." forever
+    tiers.lock_path().mkdir()  # a directory where the lock file goes: set aside, made anew
+    assert not tiers.compile_running()
+    assert tiers.lock_path().is_file()
+    # a lock that cannot be made at all: the compile counts itself and says why, so that after
+    # MAX_ATTEMPTS no more are started
+    blocker = cold_tiers.parent / "blocker"
+    blocker.write_text("")
+    monkeypatch.setattr(tiers, "lock_path", lambda: blocker / "explorer-warm.lock")
+    monkeypatch.setattr(os, "nice", lambda n: 0)
+    for n in (1, 2):
+        assert warm.main() == 1
+        info = tiers.attempts()
+        assert info["attempts"] == n and "cannot open the lock" in info["error"]
+    assert "cannot open the lock" in tiers.given_up()

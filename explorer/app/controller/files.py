@@ -20,6 +20,7 @@ from explorer.app.turntablejob import DEFAULT_FRAMES, TurntableJob, turntable_si
 from explorer.core import tolerances as tol
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
+from explorer.core.files import read_text_checked
 from explorer.core.formats import EXPORT_SUFFIXES, convert
 from explorer.core.mtl import MtlError, format_mtl, mtl_import, preset_name
 from explorer.core.presets import MAX_NAME_LENGTH, check_name, save_preset, user_dir
@@ -129,7 +130,7 @@ class FileFlows:
             if not path:
                 return
         path = os.fspath(path)
-        if not os.path.isfile(path):
+        if not os.path.lexists(path):  # anything else is read, or refused, by the checked open
             raise ExplorerError(f"{path}: no such file")
         if path.lower().endswith(MESH_SUFFIXES):
             if self.choose_mesh(os.path.abspath(path)):
@@ -143,6 +144,7 @@ class FileFlows:
         self.remember_recent(path)
 
     def _open_scene(self, scene, path: str) -> None:
+        M.check_window_lights(len(scene.lights), path)
         s = self.store.state  # the scene's material covers the mesh (groups=None)
         new = s.replace(scene=scene.replace(mesh=s.mesh), preset=scene.material.name,
                         preset_material=None, light=0, held_azimuth=None,
@@ -258,8 +260,9 @@ class FileFlows:
         if path is None or not path.is_file():
             return []
         try:
-            items = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+            text = read_text_checked(path, cap=tol.MAX_DATA_FILE_BYTES, what="recent files")
+            items = json.loads(text)
+        except ValueError as exc:  # UnreadableFile and JSON errors are ValueErrors
             log.warning("%s: cannot be read (%s); the recent files start afresh", path, exc)
             return []
         return [str(p) for p in items if isinstance(p, str)][:RECENT_MAX] if isinstance(
