@@ -23,6 +23,8 @@ from pathlib import Path
 from explorer.app.start import MESH_CHOICES
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
+from explorer.core.files import read_checked
+from explorer.core.tolerances import MAX_DOWNLOAD_BYTES
 from explorer.core.yamlio import MAX_BYTES, load_yaml
 from explorer.geometry.meshes import MESH_SUFFIXES, obj_material_names
 
@@ -94,7 +96,7 @@ class WebFiles:
             path = c.export_material(folder / f"{c.material_name()}{suffix}")
         if path is None:
             raise ExplorerError(f"download {kind}: nothing was written")
-        data = Path(path).read_bytes()
+        data = read_checked(path, cap=MAX_DOWNLOAD_BYTES, what=f"{kind} download")
         return {"name": Path(path).name, "type": mime,
                 "content": data if kind == "png" else data.decode("utf-8")}  # fmt: skip
 
@@ -114,7 +116,8 @@ class WebFiles:
         if path is None or not path.is_file():
             raise ExplorerError("no turntable has been written yet")
         mime = "image/gif" if path.suffix == ".gif" else "video/mp4"
-        return {"name": path.name, "type": mime, "content": path.read_bytes()}
+        data = read_checked(path, cap=MAX_DOWNLOAD_BYTES, what="turntable download")
+        return {"name": path.name, "type": mime, "content": data}
 
     # -- uploads ---------------------------------------------------------------------------------
     def open_uploaded_session(self, upload) -> None:
@@ -148,13 +151,14 @@ class WebFiles:
             (folder / upload_name(name)).write_bytes(data)
         path = folder / upload_name(meshes[0][0])
         if path.suffix.lower() == ".obj":
-            libraries, _ = obj_material_names(os.fspath(path))
-            for lib in libraries:
-                if Path(lib).resolve().parent != folder.resolve():
-                    raise ExplorerError(
-                        f"mesh file '{path.name}': mtllib {Path(lib).name!r} names a file "
-                        "outside the upload: upload the .mtl files beside the OBJ"
-                    )  # fmt: skip
+            # the readers' one policy (geometry.sidefiles) refuses a library outside the OBJ's
+            # folder, here the upload's: the page says so before anything is opened
+            _, _, refused = obj_material_names(os.fspath(path), meshes[0][1])
+            if refused:
+                raise ExplorerError(
+                    f"mesh file '{path.name}': {refused[0]}; a library outside the upload is "
+                    "never read: upload the .mtl files beside the OBJ"
+                )  # fmt: skip
         self.controller.choose_mesh(os.fspath(path))
 
     def save_preset(self, name: str, replace: bool = False) -> None:

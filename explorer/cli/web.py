@@ -24,6 +24,7 @@ from explorer.app import start as gui
 from explorer.cli.explorerstart import add_preset_option, start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
 from explorer.core.errors import ExplorerError
+from explorer.core.text import say
 
 #: the port served unless --port says otherwise
 DEFAULT_PORT = 8080
@@ -71,7 +72,7 @@ def run(args) -> int:
         )
     host = args.host or web.DEFAULT_HOST
     if args.host is not None and host not in ("127.0.0.1", "localhost", "::1"):
-        print(web.OPEN_HOST_WARNING.format(host=host, port=args.port), file=sys.stderr)
+        say(web.OPEN_HOST_WARNING.format(host=host, port=args.port), file=sys.stderr)
     state, mesh = start_state(args)
     app = web.WebExplorer(state, mesh, materials_dirs=tuple(args.materials_dirs),
                           background=background_from_options(args))  # fmt: skip

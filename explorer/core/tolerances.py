@@ -223,3 +223,7 @@ MAX_PICTURE_PIXELS = 8192 * 8192
 #: Largest PNG file read (bytes): the largest picture as RGBA without any compression, plus
 #: 1 MiB for its chunks' headers (a PNG of MAX_PICTURE_PIXELS is never larger).
 MAX_PNG_FILE_BYTES = 4 * MAX_PICTURE_PIXELS + (1 << 20)
+#: Largest file the web page downloads (bytes): files the product has just written into its
+#: private folder (a session, a material, a PNG, a turntable: a GIF of MAX_TURNTABLE_HELD_PIXELS
+#: is at most 512 MiB), read back through the checked open.
+MAX_DOWNLOAD_BYTES = 1 << 30
