@@ -218,6 +218,24 @@ def test_the_handle_stays_under_the_pointer(win, zoom, dolly):
     assert not w.view.dragging and w.store.can_undo
 
 
+def test_the_handle_ends_where_the_pointer_lets_go(win):
+    """A move the front end dropped (the web page's view drops moves while it is busy): the
+    release's position is the drag's last step, so the handle ends under the pointer."""
+    Type, left = QtCore.QEvent.Type, QtCore.Qt.MouseButton.LeftButton
+    w = win
+    w.render()
+    x, y = w.view.world_to_window(M.handle_point(w.store.state))
+    vw, vh = w.plotter.window_size
+    sx, sy = (-1 if x > vw / 2 else 1), (1 if y < vh / 2 else -1)
+    mouse(w, Type.MouseButtonPress, x, y, left)
+    mouse(w, Type.MouseMove, x + 20 * sx, y + 12 * sy, left)
+    end = (x + 60 * sx, y + 36 * sy)  # no move event reaches this point: only the release
+    mouse(w, Type.MouseButtonRelease, *end, QtCore.Qt.MouseButton.NoButton)
+    hx, hy = w.view.world_to_window(M.handle_point(w.store.state))
+    assert math.hypot(hx - end[0], hy - end[1]) <= 3.0, ((hx, hy), end)
+    assert not w.view.dragging
+
+
 def test_every_light_has_a_handle_and_clicking_one_selects_its_light(win):
     w = win
     w.act(M.add_light)  # selected: light 1

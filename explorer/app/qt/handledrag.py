@@ -37,12 +37,12 @@ class HandleDragger:
         if index != self.store.state.light:
             self.act(M.select_light, index, label="select light")
         s = self.store.state
-        x, y = self.plotter.iren.interactor.GetEventPosition()
+        x, y = self._pointer()
         hx, hy, _ = self.view.handle_pixels()[index]
         origin, direction = self._pointer_ray(hx, hy)
         near = float((M.handle_point(s) - origin) @ direction) <= float(
             (np.asarray(s.centre) - origin) @ direction)  # fmt: skip
-        self._grab = (hx - x, hy - y, near)
+        self._grab = (hx - x, hy - y, near, (x, y))  # the last pointer position handled
         self._holding_handle = True
         self._begin_drag()
 
@@ -54,16 +54,27 @@ class HandleDragger:
         s = self.store.state
         if s.selected_light is None or index != s.light or self._grab is None:
             return
-        dx, dy, near = self._grab
-        x, y = self.plotter.iren.interactor.GetEventPosition()
+        dx, dy, near, _ = self._grab
+        x, y = self._pointer()
+        self._grab = (dx, dy, near, (x, y))
         origin, direction = self._pointer_ray(x + dx, y + dy)
         d = s.placement()[2]
         self._on_handle(M.point_on_ray(origin, direction, s.centre, d, near))
 
     def _release_handle(self, index: int) -> None:
+        """The handle let go: the release's position is the drag's last step (a front end may
+        drop moves while the view is busy, as the web page's does: the handle still ends under
+        the pointer), then the drag ends."""
+        if self._grab is not None and self._pointer() != self._grab[3]:  # a click moves nothing
+            self._drag_handle(index)
         self._grab = None
         self._holding_handle = False
         self._end_drag()
+
+    def _pointer(self) -> tuple[int, int]:
+        """The pointer's display pixel of the event being handled (origin bottom-left)."""
+        x, y = self.plotter.iren.interactor.GetEventPosition()
+        return int(x), int(y)
 
     def _pointer_ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
         """The ray under display pixel ``(x, y)`` (origin bottom-left): its start on the near
