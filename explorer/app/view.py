@@ -299,6 +299,15 @@ class SceneView:
         if getattr(self, "lobe", None) is not None:
             self.lobe.update(state)
 
+    def frame_camera(self, state: State, camera_moved) -> None:
+        """Before a frame of either front end: the VTK camera read as the viewer's camera
+        (``camera_moved(camera)``: the controller puts it in the state, no undo step), then
+        :meth:`before_frame` for it, and VTK's clipping range set around what is drawn."""
+        cam = view_camera(self.plotter.camera, state.centre, state.radius)
+        camera_moved(cam)
+        self.before_frame(cam)
+        self.plotter.renderer.ResetCameraClippingRange()
+
     def before_frame(self, camera: Camera) -> None:
         """Before a frame: translucent triangles sorted back to front for the camera, the lobe
         inset sized for the view, the selected handle's ring and the arrows toward handles

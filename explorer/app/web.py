@@ -34,7 +34,7 @@ from explorer.app import model as M
 from explorer.app import webpage, webpanel
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import PENDING, DifferenceWorker, HeatMap
-from explorer.app.qt.handledrag import HandleDragger  # toolkit-free: shared with the window
+from explorer.app.handledrag import HandleDragger
 from explorer.app.session import session_mapping
 from explorer.app.start import (
     DEFAULT_MESH,
@@ -349,11 +349,7 @@ class WebExplorer(WebFiles):
     def _before_frame(self, *_) -> None:
         """The camera is the viewer: it goes into the state (no undo step) before each frame;
         translucent triangles are sorted, the inset and the handle ring laid out."""
-        s = self.store.state
-        cam = view_camera(self.plotter.camera, s.centre, s.radius)
-        self.controller.camera_moved(cam)
-        self.view.before_frame(cam)
-        self.plotter.renderer.ResetCameraClippingRange()
+        self.view.frame_camera(self.store.state, self.controller.camera_moved)
 
     def _after_frame(self, *_) -> None:
         """A frame of side A: counted; side B (the same camera) is sent after it."""

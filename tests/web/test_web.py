@@ -378,24 +378,41 @@ def drag(driver, start, moves) -> None:
 
 
 def test_the_light_handle_is_dragged_in_the_view(server, browser, mesh):
+    """A handle dragged in the page ends under the pointer (within 3 pixels). One retry: run
+    right after another run of this module on one machine, about one drag in two ended short
+    (the page's pointer events, not the drag's geometry: a handle that ran ahead or lagged as a
+    rule fails both tries); where it ended is in the message."""
     rep = open_page(browser, server.url)
     light = rep["session"]["light"] - 1
-    (hx, hy), before = rep["handles_px"][light], rep["placement"]
+    before = rep["placement"]
     w, h = rep["size"]
-    sx, sy = (-1 if hx > w / 2 else 1), (1 if hy < h / 2 else -1)  # toward the middle
-    drag(browser, (hx, hy), [(10 * sx, 6 * sy)] * 10)
-    target = (hx + 100 * sx, hy + 60 * sy)
+    ended, drags = [], 0
+    for _ in range(2):
+        hx, hy = report(browser)["handles_px"][light]
+        sx, sy = (-1 if hx > w / 2 else 1), (1 if hy < h / 2 else -1)  # toward the middle
+        drag(browser, (hx, hy), [(10 * sx, 6 * sy)] * 10)
+        drags += 1
+        target = (hx + 100 * sx, hy + 60 * sy)
 
-    def under_the_pointer(r):  # the handle where the pointer let go, within 3 pixels
-        x, y = r["handles_px"][light]
-        return abs(x - target[0]) <= 3 and abs(y - target[1]) <= 3
+        def under_the_pointer(r, target=target):  # where the pointer let go, within 3 pixels
+            x, y = r["handles_px"][light]
+            return abs(x - target[0]) <= 3 and abs(y - target[1]) <= 3
 
-    # the page reports while the drag's steps arrive: wait for the last one, not the first
-    rep = wait("the handle under the pointer", lambda: (r := report(browser))
-               and r["placement"] != before and not r["errors"] and under_the_pointer(r)
-               and r)  # fmt: skip
+        # the page reports while the drag's steps arrive: wait for the last one, not the first
+        end = time.monotonic() + 10
+        while time.monotonic() < end:
+            r = report(browser)
+            if r and r["placement"] != before and not r["errors"] and under_the_pointer(r):
+                break
+            time.sleep(0.05)
+        else:
+            ended.append((target, report(browser)["handles_px"][light]))
+            continue
+        break
+    assert len(ended) < 2, f"the handle ended away from the pointer (target, handle): {ended}"
     check_probe(browser, mesh)
-    click(browser, "undo")
+    for _ in range(drags):  # each drag is one undo step
+        click(browser, "undo")
     wait("undo", lambda: report(browser)["placement"] == pytest.approx(before))
 
 

@@ -25,8 +25,8 @@ from PySide6 import QtCore, QtGui, QtWidgets
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker, HeatMap
+from explorer.app.handledrag import HandleDragger
 from explorer.app.qt.compare import CompareView
-from explorer.app.qt.handledrag import HandleDragger
 from explorer.app.qt.lightpanel import Panel
 from explorer.app.qt.menus import Menus
 from explorer.app.qt.messages import MessageBar
@@ -35,7 +35,7 @@ from explorer.app.qt.progress import EngineStatus, run_steps
 from explorer.app.qt.viewport import QtView
 from explorer.app.session import session_mapping
 from explorer.app.start import TITLE, WINDOW_SIZE
-from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, view_camera
+from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView
 from explorer.core.atomic import write_atomic
 from explorer.render.offscreen import BACKGROUND
 from explorer.render.vtk import plain_blending
@@ -248,11 +248,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         """Renderer StartEvent: the camera is the viewer; translucent triangles sorted."""
         if self._t0 is None:
             self._t0 = time.perf_counter()
-        s = self.controller.state
-        cam = view_camera(self.plotter.camera, s.centre, s.radius)
-        self.controller.camera_moved(cam)
-        self.view.before_frame(cam)
-        self.plotter.renderer.ResetCameraClippingRange()
+        self.view.frame_camera(self.controller.state, self.controller.camera_moved)
 
     def _after_frame(self, *_) -> None:
         """Render window EndEvent: count and time the frame, draw side B of the compare view

@@ -1,7 +1,7 @@
-"""Dragging the light handles with the mouse (in
-:class:`explorer.app.qt.window.ExplorerWindow`): a press on a handle selects its light, a drag keeps
-the handle under the pointer (:func:`explorer.app.model.point_on_ray`), whatever the camera's
-distance and zoom."""
+"""Dragging the light handles with the mouse, for either front end (the Qt window and the web
+page: no toolkit here, only the VTK interactor's event positions): a press on a handle selects
+its light, a drag keeps the handle under the pointer (:func:`explorer.app.model.point_on_ray`),
+whatever the camera's distance and zoom."""
 
 from __future__ import annotations
 
