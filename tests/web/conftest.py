@@ -27,6 +27,15 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+#: the engine's tier in the servers these tests start. The suite runs in mode ``compiled``
+#: (tests/conftest.py), which compiles a missing kernel in the calling process: in a server that
+#: holds the interpreter for tens of seconds on a cold cache and freezes the page (CI's cold run
+#: timed out on the difference view). A user's server never compiles in-process (mode ``auto``:
+#: the numpy tier serves while the background compile runs, tests/web/test_web_cold.py), so the
+#: page tests' servers run the numpy tier: the same colours (the tiers' contract), no compile.
+SERVER_KERNELS = "numpy"
+
+
 class Server:
     """A ``phong-explorer web`` process: its URL, its output, whether it still runs."""
 
@@ -34,6 +43,7 @@ class Server:
         self.port = free_port()
         self.log = log
         self._out = open(log, "w")  # noqa: SIM115 - closed in stop()
+        env = dict(os.environ if env is None else env, PHONG_EXPLORER_KERNELS=SERVER_KERNELS)
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "explorer.cli", "web", "--port", str(self.port), *args],
             stdout=self._out, stderr=subprocess.STDOUT, env=env,
@@ -109,3 +119,35 @@ def browser(server, downloads):
     yield driver
     driver.quit()
     shutil.rmtree(downloads, ignore_errors=True)
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_makereport(item, call):
+    rep = yield
+    if rep.when == "call":
+        item.web_call_failed = rep.failed
+    return rep
+
+
+@pytest.fixture(autouse=True)
+def evidence_of_a_failure(request, tmp_path):
+    """A failed page test leaves the page's screenshot and the server's output beside the
+    test's temporary folder, and names them in the report: what the page showed when a wait
+    ran out is the first thing to look at."""
+    yield
+    if not getattr(request.node, "web_call_failed", False):
+        return
+    shot = tmp_path / "page.png"
+    for name in ("browser", "server"):
+        if name not in request.fixturenames:
+            continue
+        thing = request.getfixturevalue(name)
+        if name == "browser":
+            try:
+                thing.save_screenshot(str(shot))
+                print(f"the page at the failure: {shot}")
+            except Exception as exc:  # noqa: BLE001 - the browser may be what failed
+                print(f"no screenshot: {exc}")
+        else:
+            print("the server's output (last 40 lines):")
+            print("\n".join(thing.output().splitlines()[-40:]))
