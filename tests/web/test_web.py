@@ -40,14 +40,31 @@ def by_name(driver, name: str):
     return found[0]
 
 
+#: whether an element stands still: its box in two consecutive animation frames, the same and
+#: not empty (a tab's content slides in; a click aimed at a sliding button lands beside it, on
+#: a loaded machine: the cause of CI's "timed out waiting for the heat map")
+STILL_JS = """
+const e = arguments[0], done = arguments[arguments.length - 1];
+const a = e.getBoundingClientRect();
+requestAnimationFrame(() => requestAnimationFrame(() => {
+  const b = e.getBoundingClientRect();
+  done(b.width > 0 && b.height > 0 && a.left === b.left && a.top === b.top
+       && a.width === b.width && a.height === b.height);
+}));
+"""
+
+
 def click(driver, name: str) -> None:
-    """Click the element named ``name`` once it takes clicks (a tab's or a menu's content is
-    shown after a transition)."""
+    """Click the element named ``name`` once it stands still and takes clicks (a tab's or a
+    menu's content is shown after a transition)."""
     from selenium.common.exceptions import WebDriverException
 
     def go():
         try:
-            by_name(driver, name).click()
+            element = by_name(driver, name)
+            if not driver.execute_async_script(STILL_JS, element):
+                return False
+            element.click()
             return True
         except (WebDriverException, AssertionError):
             return False
@@ -321,7 +338,7 @@ def test_the_difference_view_shows_its_heat_map(server, browser):
     rep = wait("the heat map", lambda: (r := report(browser)) and r["difference"]["shown"] and r)
     assert rep["session"]["difference"] is True and rep["difference"]["rmse"] is not None
     wait("a new picture", lambda: picture_src(browser) not in (None, before))
-    by_name(browser, "difference").click()
+    click(browser, "difference")
     wait("the view again", lambda: not report(browser)["difference"]["shown"])
     click(browser, "material tab")
     assert not console_errors(browser)
@@ -333,7 +350,7 @@ def test_exports_are_downloads(server, browser, downloads, kind, suffix, head):
     open_page(browser, server.url)
     for f in downloads.glob("*"):
         f.unlink()
-    by_name(browser, "export").click()
+    click(browser, "export")
     click(browser, f"export {kind}")
     path = wait("the download", lambda: next(
         (f for f in downloads.glob(f"*{suffix}") if f.stat().st_size > 0), None))  # fmt: skip
