@@ -58,10 +58,14 @@ def machine(plotter) -> list[str]:
     import vtk
     from bench_engine import machine as engine_machine  # this script's directory is on sys.path
 
-    gl = "unknown"
-    for line in plotter.render_window.ReportCapabilities().splitlines():
+    from explorer.analysis.benchmark import machine_info
+
+    gl = ""
+    for line in (plotter.render_window.ReportCapabilities() or "").splitlines():
         if line.startswith("OpenGL renderer string:"):
             gl = line.split(":", 1)[1].strip()
+    # an EGL window that has not drawn yet reports nothing: ask a fresh off-screen context
+    gl = gl or machine_info(opengl=True).get("opengl", {}).get("renderer") or "unknown"
     return [
         engine_machine(),
         f"VTK {vtk.vtkVersion.GetVTKVersion()}, PyVista {pv.__version__}; OpenGL renderer: {gl}; "
