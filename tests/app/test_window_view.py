@@ -74,6 +74,8 @@ def test_translucency_is_drawn_as_the_offscreen_render_in_every_pane(open_window
     w.controller.act(M.set_compare_preset, "jade", w.controller.state.material)
     w.view_b.lobe_caption.SetVisibility(False)
     w.view.lobe_caption.SetVisibility(False)
+    for handle in w.view_b.handles:
+        handle.Off()  # pane B shows the shared lights' handles too
     for pl, side in ((w.plotter, s), (w.plotter_b, M.side_b(w.controller.state))):
         got, want = pixels(pl), offscreen_of(pl, side)
         view = w.view if pl is w.plotter else w.view_b
@@ -163,28 +165,30 @@ def test_the_lobe_follows_the_light_and_its_text_reads(win):
         assert lobe.contrast_ratio(c, LI.LOBE_PANEL_COLOR) >= 4.5
 
 
-def mouse(w, kind, x, y, buttons):
-    """A real Qt mouse event on the view at its pixel (x, y) (top-left origin)."""
+def mouse(w, kind, x, y, buttons, pane=None):
+    """A real Qt mouse event on the view (or ``pane``) at its pixel (x, y) (top-left origin)."""
     left = QtCore.Qt.MouseButton.LeftButton
     ev = QtGui.QMouseEvent(kind, QtCore.QPointF(x, y), QtCore.QPointF(x, y), left, buttons,
                            QtCore.Qt.KeyboardModifier.NoModifier)  # fmt: skip
-    QtWidgets.QApplication.sendEvent(w.plotter, ev)
+    QtWidgets.QApplication.sendEvent(w.plotter if pane is None else pane, ev)
 
 
-def drag_handle(w, index, steps):
-    """Press on light ``index``'s handle and move by ``steps`` (dx, dy) each; after each step
-    the distance (pixels) from the pointer to the handle's centre and the handle's pixel."""
+def drag_handle(w, index, steps, side_b=False):
+    """Press on light ``index``'s handle and move by ``steps`` (dx, dy) each, in the view (or
+    the compare view's pane B); after each step the distance (pixels) from the pointer to the
+    handle's centre and the handle's pixel."""
     Type, left = QtCore.QEvent.Type, QtCore.Qt.MouseButton.LeftButton
-    x, y = w.view.world_to_window(M.handle_point(w.controller.state, index))
-    mouse(w, Type.MouseButtonPress, x, y, left)
+    pl, view = (w.plotter_b, w.view_b) if side_b else (w.plotter, w.view)
+    x, y = view.world_to_window(M.handle_point(w.controller.state, index))
+    mouse(w, Type.MouseButtonPress, x, y, left, pl)
     out = []
     for dx, dy in steps:
         x, y = x + dx, y + dy
-        mouse(w, Type.MouseMove, x, y, left)
-        img = pixels(w.plotter)
-        hx, hy = w.view.world_to_window(M.handle_point(w.controller.state))
+        mouse(w, Type.MouseMove, x, y, left, pl)
+        img = pixels(pl)
+        hx, hy = view.world_to_window(M.handle_point(w.controller.state))
         out.append((math.hypot(hx - x, hy - y), img[y, x]))
-    mouse(w, Type.MouseButtonRelease, x, y, QtCore.Qt.MouseButton.NoButton)
+    mouse(w, Type.MouseButtonRelease, x, y, QtCore.Qt.MouseButton.NoButton, pl)
     return out
 
 
@@ -319,3 +323,127 @@ def test_the_screenshot_key_saves_both_compare_panes(win, qtbot):
     assert 0 <= gap <= 12 and saved.shape[0] == max(a.shape[0], b.shape[0])
     assert np.array_equal(saved[: a.shape[0], : a.shape[1]], a)
     assert np.array_equal(saved[: b.shape[0], a.shape[1] + gap :], b)
+
+
+def scaled_sphere_obj(path, r: float):
+    """An OBJ of the unit sphere (resolution 24) scaled by ``r``: what a user opens."""
+    from explorer.geometry.meshes import sphere
+
+    s = sphere(24)
+    lines = ["v {:.17g} {:.17g} {:.17g}".format(*p) for p in s.positions * r]
+    lines += ["vn {:.17g} {:.17g} {:.17g}".format(*n) for n in s.normals]
+    lines += [f"f {a}//{a} {b}//{b} {c}//{c}" for a, b, c in s.faces + 1]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def view_without_overlays(w) -> np.ndarray:
+    """The view's pixels with the handles, their ring and the lobe inset left out (the
+    off-screen render draws none of them)."""
+    for handle in w.view.handles:
+        handle.Off()
+    w.view.lobe_caption.SetVisibility(False)
+    got = pixels(w.plotter)
+    for handle in w.view.handles:
+        handle.On()
+    w.view.lobe_caption.SetVisibility(True)
+    return got
+
+
+@pytest.mark.parametrize("scale", [1e-20, 1e39, 1e300])
+def test_a_mesh_at_any_scale_is_framed_and_drawn_as_the_render(win, tmp_path, scale):
+    """A scaled OBJ opened as the user opens it (File > Open): framed as the unit one, drawn
+    as `render` draws it, the lobe plot the same, the handle under the pointer (a sphere
+    scaled by 1e-20 was a dot in an empty view, by 1e39 a spray of broken triangles)."""
+    w = win
+    w.controller.open_file(scaled_sphere_obj(tmp_path / "unit.obj", 1.0))
+    unit = view_without_overlays(w)
+    caption = w.view.lobe_caption.GetInput()
+    w.controller.open_file(scaled_sphere_obj(tmp_path / f"sphere_{scale:g}.obj", scale))
+    s = w.controller.state
+    assert s.radius == pytest.approx(scale) and not w.controller.errors
+    _MESHES[s.mesh] = w.view.mesh
+    got = view_without_overlays(w)
+    want = offscreen_of(w.plotter, s)
+    bg = (np.asarray(w.plotter.renderer.GetBackground()) * 255).round()
+    x0, y0, bw, bh = w.view.lobe.box
+    for img in (got, unit):
+        img[-(y0 + bh) :, : x0 + bw + 1] = want[-(y0 + bh) :, : x0 + bw + 1]  # the inset
+    covered = np.abs(got.astype(int) - bg).max(axis=2) > 2
+    assert covered.mean() > 0.1, f"the mesh covers {covered.mean():.1%} of the view"
+    bad, worst = mesh_pixels_match(got, want, bg)
+    assert bad < 0.005, f"{bad:.1%} of the mesh's pixels differ from the render (up to {worst})"
+    bad, worst = mesh_pixels_match(got, unit, bg)
+    assert bad < 0.01, f"{bad:.1%} differ from the unit sphere's view (up to {worst})"
+    assert w.view.lobe_caption.GetInput() == caption  # the same light, the same lobe
+    x, y = w.view.world_to_window(M.handle_point(s))
+    vw, vh = w.plotter.window_size
+    assert 20 < x < vw - 20 and 20 < y < vh - 20
+    trail = drag_handle(w, 0, [(-12, 10)] * 8)
+    worst = max(d for d, _ in trail)
+    assert worst <= 3.0, f"the handle ran {worst:.1f} px from the pointer: {trail}"
+    assert M.handle_point(w.controller.state)[1] < M.handle_point(s)[1]  # it moved down
+    assert not w.controller.errors, w.controller.errors
+
+
+def test_a_mesh_too_large_to_frame_is_refused_as_render_refuses_it(win, tmp_path):
+    from explorer.core.errors import ExplorerError
+    from explorer.core.scene import Scene
+    from explorer.geometry.meshes import load_mesh
+    from explorer.render.camera import camera_for
+
+    w = win
+    path = scaled_sphere_obj(tmp_path / "huge.obj", 1.5e308)
+    with pytest.raises(ExplorerError) as refused:  # `render`'s refusal
+        camera_for(Scene(), load_mesh(path))
+    before, shown = w.controller.state, pixels(w.plotter)
+    w.controller.open_file(path)
+    assert w.controller.errors == [f"mesh: {refused.value}"]
+    assert "too large to frame" in w.message
+    w.controller.errors.clear()
+    assert w.controller.state == before  # the view keeps the mesh it showed
+    assert np.array_equal(pixels(w.plotter), shown)
+
+
+def test_pane_b_shows_the_handles_and_a_drag_there_moves_the_light(win, qtbot):
+    """The lights are shared by both sides of the compare view: pane B draws every handle
+    (in the light's colour, the selected one ringed) and a drag there moves the light, the
+    handle under the pointer, as in pane A (pane B showed none)."""
+    w = win
+    w.panel.view.compare.click()
+    qtbot.waitUntil(lambda: w.plotter_b.width() > 100)
+    w.controller.act(M.add_light)
+    w.controller.act(M.set_light_colour, (0.0, 0.0, 1.0))
+    s = w.controller.state  # both lights between the camera and the mesh, in the narrow panes
+    cam = w.plotter.camera
+    toward = np.subtract(cam.GetPosition(), s.centre)
+    toward /= np.linalg.norm(toward)
+    up = np.asarray(cam.GetViewUp())
+    for i, side in ((1, -0.3), (0, 0.3)):
+        w.controller.act(M.select_light, i)
+        point = np.asarray(s.centre) + s.radius * (
+            1.6 * toward + 0.25 * up + side * np.cross(up, toward)
+        )
+        w.controller.act(M.place_light, *M.angles_from_point(w.controller.state, point))
+    w.render()
+    s = w.controller.state
+    assert len(w.view_b.handles) == 2
+    img = pixels(w.plotter_b)
+    vw, vh = w.plotter_b.window_size
+    for i in range(2):
+        x, y = w.view_b.world_to_window(M.handle_point(s, i))
+        colour = np.asarray(M.light_colour(s.scene.lights[i])[0]) * 255
+        assert np.abs(img[y, x].astype(int) - colour).max() < 110, (i, img[y, x], colour)
+    x, y = w.view_b.world_to_window(M.handle_point(s, 0))
+    assert 20 < x < vw - 20 and 20 < y < vh - 20
+    cam = s.camera
+    trail = drag_handle(w, 0, [(-10, 12)] * 8, side_b=True)
+    worst = max(d for d, _ in trail)
+    assert worst <= 3.0, f"the handle ran {worst:.1f} px from the pointer in pane B: {trail}"
+    moved = w.controller.state
+    assert moved.scene.lights[0] != s.scene.lights[0] and moved.camera == cam
+    assert moved.scene.lights[1] == s.scene.lights[1] and w.controller.store.can_undo
+    w.render()  # pane A's handle is where the light went
+    img_a = pixels(w.plotter)
+    ax, ay = w.view.world_to_window(M.handle_point(moved, 0))
+    assert np.abs(img_a[ay, ax].astype(int) - 255).max() < 110, img_a[ay, ax]
