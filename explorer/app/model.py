@@ -614,7 +614,8 @@ def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = 
     lights = [light.placed(az, el, d, centre) if d > 0 else light
               for light, (az, el, d) in zip(state.scene.lights, places, strict=True)]  # fmt: skip
     if eye is not None:
-        viewer = Viewer(eye=tuple(float(c) for c in eye))
+        x, y, z = (float(c) for c in eye)
+        viewer = Viewer(eye=(x, y, z))
     scene = state.scene.replace(lights=tuple(lights), mesh=spec or name, viewer=viewer)
     return state.replace(
         scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None,
