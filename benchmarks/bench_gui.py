@@ -307,7 +307,7 @@ def qt_frames(mesh, repeat: int) -> dict:
 
         out[name] = timed(step, repeat)
     # where a kd change's time goes: the panel's refresh, the engine and upload, the frame
-    state = win.store.state
+    state = win.controller.state
     out["panel refresh"] = timed(lambda i: win.panel.show_state(state, mesh.n_vertices), repeat)
     out["engine + upload"] = timed(
         lambda i: win.view.show_state(AM.set_coefficient(state, "kd", 0.3 + 0.4 * (i % 2))),

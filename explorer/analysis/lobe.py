@@ -159,7 +159,8 @@ def incidence(to_viewer, to_light) -> float:
     direction toward the viewer (its normal) and the direction toward the light, each (3,)."""
     n = np.asarray(to_viewer, np.float64)
     e = np.asarray(to_light, np.float64)
-    c = float(n @ e) / max(float(np.linalg.norm(n) * np.linalg.norm(e)), 1e-300)
+    ln, le = math.hypot(*n), math.hypot(*e)  # scale-safe lengths (no square overflows)
+    c = float((n / ln) @ (e / le)) if ln > 0.0 and le > 0.0 else 0.0
     return math.acos(min(max(c, -1.0), 1.0))
 
 

@@ -12,21 +12,22 @@ from explorer.app import model as M
 
 class HandleDragger:
     """The handles of ``window`` (its ``controller``, ``plotter``, ``view``, ``begin_drag``,
-    ``end_drag`` and ``_guard``): :meth:`_grab_handle`, :meth:`_drag_handle` and
-    :meth:`_release_handle` are the handles' callbacks
+    ``end_drag`` and ``_guard``), or of another pane of it (``plotter`` and ``view``: the
+    compare view's side B, which shows the same lights): :meth:`_grab_handle`,
+    :meth:`_drag_handle` and :meth:`_release_handle` are the handles' callbacks
     (:meth:`explorer.app.view.SceneView.add_handles`)."""
 
-    def __init__(self, window):
+    def __init__(self, window, plotter=None, view=None):
         self.window = w = window
         self.store = w.controller.store
         self.act = w.controller.act
-        self.plotter = w.plotter
-        self.view = w.view
+        self.plotter = w.plotter if plotter is None else plotter
+        self.view = w.view if view is None else view
         self._grab = None
         self._holding_handle = False
         self._begin_drag, self._end_drag = w.begin_drag, w.end_drag
         g = w._guard
-        w.view.add_handles(g(self._grab_handle, "light handle"),
+        self.view.add_handles(g(self._grab_handle, "light handle"),
                            g(self._drag_handle, "light handle"),
                            g(self._release_handle, "light handle"))  # fmt: skip
 
@@ -40,8 +41,9 @@ class HandleDragger:
         x, y = self._pointer()
         hx, hy, _ = self.view.handle_pixels()[index]
         origin, direction = self._pointer_ray(hx, hy)
-        near = float((M.handle_point(s) - origin) @ direction) <= float(
-            (np.asarray(s.centre) - origin) @ direction)  # fmt: skip
+        to_view = self.view.to_view
+        near = float((to_view(M.handle_point(s)) - origin) @ direction) <= float(
+            (to_view(s.centre) - origin) @ direction)  # fmt: skip
         self._grab = (hx - x, hy - y, near, (x, y))  # the last pointer position handled
         self._holding_handle = True
         self._begin_drag()
@@ -58,8 +60,9 @@ class HandleDragger:
         x, y = self._pointer()
         self._grab = (dx, dy, near, (x, y))
         origin, direction = self._pointer_ray(x + dx, y + dy)
-        d = s.placement()[2]
-        self._on_handle(M.point_on_ray(origin, direction, s.centre, d, near))
+        d = s.placement()[2] / self.view.frame[1]  # in the view's frame: any mesh scale
+        at = M.point_on_ray(origin, direction, self.view.to_view(s.centre), d, near)
+        self._on_handle(self.view.from_view(at))
 
     def _release_handle(self, index: int) -> None:
         """The handle let go: the release's position is the drag's last step (a front end may
@@ -78,7 +81,8 @@ class HandleDragger:
 
     def _pointer_ray(self, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
         """The ray under display pixel ``(x, y)`` (origin bottom-left): its start on the near
-        clipping plane and its unit direction, each (3,)."""
+        clipping plane and its unit direction, each (3,), in the coordinates VTK draws in
+        (the view's frame: :meth:`explorer.app.view.SceneView.to_view`)."""
         ren = self.plotter.renderer
         ends = []
         for z in (0.0, 1.0):

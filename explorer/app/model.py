@@ -16,6 +16,7 @@ camera where it is.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
@@ -27,7 +28,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import Scene, Viewer
-from explorer.render.camera import Camera
+from explorer.render.camera import Camera, too_large
 
 Vec3 = tuple[float, float, float]
 #: the terms that can be hidden (hiding ``ambient`` also hides the emission)
@@ -590,17 +591,32 @@ def _is_number(t: str) -> bool:
 
 
 def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = None) -> State:
-    """Show another mesh: each light keeps its place relative to the mesh, scaled to the new
-    mesh's size; the material shown is kept over the whole mesh (:func:`with_mesh_materials`
-    adds the new mesh's own). ``spec`` is the scene's ``mesh`` value (default: ``name``)."""
+    """Show another mesh: each light and a local viewer keep their places relative to the
+    mesh, scaled to the new mesh's size (so the camera frames a mesh of size 1e-20 or 1e300 as
+    it framed the last one); the material shown is kept over the whole mesh
+    (:func:`with_mesh_materials` adds the new mesh's own). ``spec`` is the scene's ``mesh``
+    value (default: ``name``)."""
     centre = tuple(float(c) for c in np.asarray(centre, dtype=np.float64))
     radius = float(radius) or 1.0
-    lights = []
-    for light in state.scene.lights:
-        az, el, d = light.placement(state.centre)
-        d = (d or 0.0) * radius / state.radius
-        lights.append(light.placed(az, el, d, centre) if d > 0 else light)
-    scene = state.scene.replace(lights=tuple(lights), mesh=spec or name)
+    # in radii first: no overflow from 1e-300 to 1e300
+    places = [light.placement(state.centre) for light in state.scene.lights]
+    places = [(az, el, (d or 0.0) / state.radius * radius) for az, el, d in places]
+    viewer = state.scene.viewer
+    far = max(abs(c) for c in centre)
+    ends = [far + d for _, _, d in places]
+    eye = None
+    if viewer.eye is not None:
+        with np.errstate(over="ignore", invalid="ignore"):  # too far: refused below
+            eye = np.subtract(viewer.eye, state.centre) / state.radius * radius + centre
+        ends.append(float(np.max(np.abs(eye))))
+    if not all(math.isfinite(e) for e in ends):
+        raise too_large(os.path.basename(name), radius)
+    lights = [light.placed(az, el, d, centre) if d > 0 else light
+              for light, (az, el, d) in zip(state.scene.lights, places, strict=True)]  # fmt: skip
+    if eye is not None:
+        x, y, z = (float(c) for c in eye)
+        viewer = Viewer(eye=(x, y, z))
+    scene = state.scene.replace(lights=tuple(lights), mesh=spec or name, viewer=viewer)
     return state.replace(
         scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None,
         mesh_materials=None, groups=None, group=0,

@@ -7,6 +7,13 @@ Every state goes the same way::
     state.shown_scene() -> Shader.set_scene (the engine recomputes only what changed)
                         -> uint8 colours written in place into the mesh's point data -> render
 
+Scale: VTK is handed the mesh, the handles, the glyph and the camera in the view's frame
+(:func:`view_frame`: the mesh's centre at the origin, lengths in units of the power of two
+nearest its radius), as the off-screen renderers do (:func:`explorer.render.camera.in_frame`),
+so that a mesh of size 1e-20 or 1e300 is drawn as a unit one (VTK draws in float32). Everything
+outside this module speaks world coordinates: :func:`view_camera` reads the camera back out of
+the frame, :meth:`SceneView.to_view` and :meth:`SceneView.from_view` convert points.
+
 The colours are drawn as RGB point scalars with VTK's lighting off, so VTK adds nothing to the
 engine's colours. Meshes above :data:`LOD_VERTICES` get a lighter level of detail (quadric
 clustering to about :data:`LOD_TARGET` vertices, shaded by its own Shader) drawn while something
@@ -36,6 +43,9 @@ from explorer.render.camera import (
     back_to_front,
     camera_for,
     camera_from_vtk,
+    in_frame,
+    mesh_frame,
+    out_of_frame,
 )
 from explorer.render.vtk import add_unlit, cells, polydata
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
@@ -93,14 +103,23 @@ def widen_to_show(camera: Camera, points, aspect: float, *, pad: float = 0.0,
     return replace(camera, view_angle=max(camera.view_angle, min(angle, MAX_VIEW_ANGLE)))
 
 
+def view_frame(centre, radius: float) -> tuple[np.ndarray, float]:
+    """The frame the view hands VTK its points and camera in, for a mesh of bounding-box
+    centre (3,) and radius: ``(centre, scale)``, ``scale`` the power of two nearest the radius
+    (exact to divide by; 1 for a radius that is 0 or not finite)."""
+    r = float(radius)
+    scale = 2.0 ** round(math.log2(r)) if 0.0 < r < math.inf else 1.0
+    return np.asarray(centre, np.float64), scale
+
+
 def view_camera(vtk_camera, centre, radius: float) -> Camera:
-    """The view's camera with a clipping range around the mesh (centre (3,), radius): what the
-    state records and the difference view compares (the window's own range follows what is
-    visible, and the mesh is hidden while the heat map shows)."""
+    """The view's camera in world coordinates (read out of :func:`view_frame`) with a clipping
+    range around the mesh (centre (3,), radius): what the state records and the difference
+    view compares (the window's own range follows what is visible, and the mesh is hidden
+    while the heat map shows)."""
     cam = camera_from_vtk(vtk_camera, window_center=(0.0, 0.0))
-    pos, focal = np.asarray(cam.position, float), np.asarray(cam.focal_point, float)
-    ahead = (focal - pos) / max(float(np.linalg.norm(focal - pos)), 1e-300)
-    d = float((np.asarray(centre) - pos) @ ahead)
+    cam = out_of_frame(cam, *view_frame(centre, radius))
+    d = float((np.asarray(centre) - np.asarray(cam.position, float)) @ cam.direction)
     r = 1.01 * radius
     return dataclasses.replace(cam, clipping_range=(max(d - r, 1e-3 * r), max(d + r, 2e-3 * r)))
 
@@ -149,7 +168,8 @@ def _clustered(mesh: Mesh, target: int) -> tuple[np.ndarray, np.ndarray]:
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkFiltersCore import vtkQuadricClustering
 
-    poly = polydata(mesh, float32=True, normals=False)
+    centre, scale = mesh_frame(mesh)  # clustered in the mesh's frame: float32 at any scale
+    poly = polydata(mesh, float32=True, normals=False, frame=(centre, scale))
 
     def cluster(divisions: int):
         q = vtkQuadricClustering()
@@ -170,16 +190,17 @@ def _clustered(mesh: Mesh, target: int) -> tuple[np.ndarray, np.ndarray]:
         step = 0.5 if count >= 0.8 * mesh.n_vertices else math.sqrt(target / count)
         d = max(4, int(round(d * step)))
         out = cluster(d)
-    pos = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64)
+    pos = vtk_to_numpy(out.GetPoints().GetData()).astype(np.float64) * scale + centre
     faces = vtk_to_numpy(out.GetPolys().GetConnectivityArray()).astype(np.int64).reshape(-1, 3)
     return pos, faces
 
 
 class MeshDrawing:
     """One drawn version of the mesh (the full mesh or its level of detail): its Shader, its
-    PolyData and actor, and the uint8 colour array VTK draws, written in place."""
+    PolyData (in ``frame``, :func:`view_frame`) and actor, and the uint8 colour array VTK
+    draws, written in place."""
 
-    def __init__(self, plotter, mesh: Mesh, scene):
+    def __init__(self, plotter, mesh: Mesh, scene, frame):
         from vtkmodules.util.numpy_support import vtk_to_numpy
 
         self.mesh = mesh
@@ -187,9 +208,8 @@ class MeshDrawing:
             scene, mesh.positions, mesh.normals, precision="float32",
             clamp=engine_clamps(scene), faces=mesh.faces,
         )  # fmt: skip
-        self.poly = polydata(
-            mesh, np.zeros((mesh.n_vertices, 3), np.uint8), float32=True, normals=False
-        )
+        self.poly = polydata(mesh, np.zeros((mesh.n_vertices, 3), np.uint8), float32=True,
+                             normals=False, frame=frame)  # fmt: skip
         self.actor = add_unlit(plotter, self.poly)
         self.vtk_colors = self.poly.GetPointData().GetArray("colors")
         self.rgb = vtk_to_numpy(self.vtk_colors)  # a view of VTK's memory
@@ -251,6 +271,7 @@ class SceneView:
         self.marker_triangles: dict[int, np.ndarray] = {}
         self._glyph = None
         self._glyph_kind = None
+        self._switching = False  # set while the drawings change meshes
         self.set_mesh(mesh, state)
         self.lobe = LobeInset(plotter, state)
 
@@ -268,18 +289,36 @@ class SceneView:
         return self.dragging > 0 and len(self.drawings) > 1
 
     def set_mesh(self, mesh: Mesh, state: State) -> None:
+        self._switching = True
+        try:
+            self._set_mesh(mesh, state)
+        finally:
+            self._switching = False
+
+    def _set_mesh(self, mesh: Mesh, state: State) -> None:
         for d in self.drawings:
-            self.plotter.remove_actor(d.actor)
+            self.plotter.remove_actor(d.actor, render=False)
         scene = state.shown_scene()
-        self.drawings = [MeshDrawing(self.plotter, mesh, scene)]
+        self.frame = view_frame(state.centre, state.radius)
+        self.drawings = [MeshDrawing(self.plotter, mesh, scene, self.frame)]
         if mesh.n_vertices > self.lod_vertices:
             if mesh.name not in self._lods:
                 self._lods = {mesh.name: lod_mesh(mesh, self.lod_target)}
-            lod = MeshDrawing(self.plotter, self._lods[mesh.name], scene)
+            lod = MeshDrawing(self.plotter, self._lods[mesh.name], scene, self.frame)
             lod.show(False)
             self.drawings.append(lod)
         self.state = None  # everything is shown afresh
         self.show_state(state)
+
+    def to_view(self, point) -> np.ndarray:
+        """A world point (3,) in the coordinates VTK draws in (:func:`view_frame`)."""
+        centre, scale = self.frame
+        return (np.asarray(point, np.float64) - centre) / scale
+
+    def from_view(self, point) -> np.ndarray:
+        """A point (3,) in VTK's coordinates as a world point (the inverse of :meth:`to_view`)."""
+        centre, scale = self.frame
+        return np.asarray(point, np.float64) * scale + centre
 
     # -- state -------------------------------------------------------------------------------
     def show_state(self, state: State) -> None:
@@ -302,7 +341,11 @@ class SceneView:
     def frame_camera(self, state: State, camera_moved) -> None:
         """Before a frame of either front end: the VTK camera read as the viewer's camera
         (``camera_moved(camera)``: the controller puts it in the state, no undo step), then
-        :meth:`before_frame` for it, and VTK's clipping range set around what is drawn."""
+        :meth:`before_frame` for it, and VTK's clipping range set around what is drawn. A frame
+        drawn while the view changes meshes (VTK draws when an actor comes) leaves the camera
+        alone: the state shows the new mesh, the drawings and camera the last one."""
+        if self._switching:
+            return
         cam = view_camera(self.plotter.camera, state.centre, state.radius)
         camera_moved(cam)
         self.before_frame(cam)
@@ -388,7 +431,7 @@ class SceneView:
     def _new_handle(self, i: int):
         grab, move, release = self._handle_calls
         w = self.plotter.add_sphere_widget(
-            lambda *_: move(i), center=(0.0, 0.0, 0.0), radius=HANDLE_RADIUS * self.state.radius,
+            lambda *_: move(i), center=(0.0, 0.0, 0.0), radius=HANDLE_RADIUS,
             theta_resolution=20, phi_resolution=12, color=(1.0, 1.0, 1.0),
             selected_color=(1.0, 1.0, 1.0), test_callback=False, interaction_event="always",
         )  # fmt: skip
@@ -409,8 +452,8 @@ class SceneView:
                 w.Off()
                 continue
             scale = SELECTED_SCALE if i == state.light else 1.0
-            w.SetRadius(HANDLE_RADIUS * state.radius * scale)
-            w.SetCenter(*handle_point(state, i))
+            w.SetRadius(HANDLE_RADIUS * state.radius * scale / self.frame[1])
+            w.SetCenter(*self.to_view(handle_point(state, i)))
             w.GetSphereProperty().SetColor(*light_colour(lights[i])[0])
             w.On()
         self._set_glyph(state.selected_light, state)
@@ -423,6 +466,7 @@ class SceneView:
 
     def _display(self, point) -> tuple[float, float, bool]:
         ren = self.plotter.renderer
+        point = self.to_view(point)
         ren.SetWorldPoint(*point, 1.0)
         ren.WorldToDisplay()
         x, y, _ = ren.GetDisplayPoint()
@@ -446,8 +490,8 @@ class SceneView:
             if tri is not None:
                 self.marker_triangles[i] = tri
             elif i == s.light:
-                size = HANDLE_RADIUS * SELECTED_SCALE * s.radius
-                r = self._pixel_radius(handle_point(s, i), size)
+                size = HANDLE_RADIUS * SELECTED_SCALE * s.radius / self.frame[1]
+                r = self._pixel_radius(self.to_view(handle_point(s, i)), size)
                 t = np.linspace(0.0, 2.0 * math.pi, 49)
                 rings.append(np.column_stack([x + (r + RING_GAP) * np.cos(t),
                                               y + (r + RING_GAP) * np.sin(t)]))  # fmt: skip
@@ -462,7 +506,8 @@ class SceneView:
         set_lines(self._marker_edges, [np.vstack([t, t[:1]]) for t in triangles])
 
     def _pixel_radius(self, point, radius: float) -> float:
-        """How many pixels a sphere of ``radius`` at ``point`` spans (its projected radius)."""
+        """How many pixels a sphere of ``radius`` at ``point`` (VTK's coordinates) spans (its
+        projected radius)."""
         cam = self.plotter.renderer.GetActiveCamera()
         _, h = self.plotter.window_size
         if cam.GetParallelProjection():
@@ -480,10 +525,10 @@ class SceneView:
             if self._glyph is not None:
                 self._glyph.SetVisibility(False)
             return
-        at = handle_point(state)
-        toward = np.asarray(state.centre) - at
+        at = self.to_view(handle_point(state))
+        toward = -at  # toward the mesh's centre, the view's origin
         toward /= max(float(np.linalg.norm(toward)), 1e-300)
-        length = GLYPH_LENGTH * state.radius
+        length = GLYPH_LENGTH * state.radius / self.frame[1]
         if kind == "directional":
             shape = pv.Arrow(start=at, direction=toward, scale=length, tip_length=0.3,
                              tip_radius=0.12, shaft_radius=0.04)  # fmt: skip
@@ -516,7 +561,7 @@ class SceneView:
     def world_to_window(self, point) -> list[int]:
         """Window pixel (origin top-left) of a world point."""
         ren = self.plotter.renderer
-        ren.SetWorldPoint(*point, 1.0)
+        ren.SetWorldPoint(*self.to_view(point), 1.0)
         ren.WorldToDisplay()
         x, y, _ = ren.GetDisplayPoint()
         _, h = self.plotter.window_size
@@ -530,14 +575,14 @@ class SceneView:
         if c.GetParallelProjection():
             v = np.subtract(c.GetPosition(), c.GetFocalPoint())[None, :]
         else:
-            v = np.asarray(c.GetPosition()) - mesh.positions
+            v = np.asarray(c.GetPosition()) - self.to_view(mesh.positions)
         v = v / np.linalg.norm(v, axis=1, keepdims=True)
         return int(np.argmax(np.einsum("ij,ij->i", mesh.normals, v)))
 
     def apply_camera(self, camera: Camera) -> None:
         """Point the plotter's camera (PyVista will not reset it at the first frame)."""
         self.plotter.camera_set = True
-        apply_camera(self.plotter.camera, camera)
+        apply_camera(self.plotter.camera, in_frame(camera, *self.frame))
         self.plotter.renderer.ResetCameraClippingRange()
 
 

@@ -170,7 +170,7 @@ def angles_of(v) -> tuple[float, float, float]:
     """``(azimuth, elevation, length)`` of a vector (degrees, degrees, its length); the zero
     vector gives (0, 0, 0)."""
     v = np.asarray(v, dtype=np.float64)
-    length = float(np.linalg.norm(v))
+    length = math.hypot(*v)  # scale-safe: no square overflows (1e300) or underflows (1e-200)
     if length == 0.0:
         return 0.0, 0.0, 0.0
     x, y, z = v / length

@@ -60,7 +60,7 @@ class Camera:
     def direction(self) -> np.ndarray:
         """(3,) unit vector from the camera toward the focal point."""
         d = np.subtract(self.focal_point, self.position)
-        return d / np.linalg.norm(d)
+        return d / vector_length(d)  # scale-safe: a camera 4e300 from its focal point too
 
 
 def _view_up(forward: np.ndarray) -> np.ndarray:
@@ -102,6 +102,20 @@ def in_frame(camera: Camera, centre, scale: float) -> Camera:
                   (near / scale, far / scale), camera.window_center)  # fmt: skip
 
 
+def out_of_frame(camera: Camera, centre, scale: float) -> Camera:
+    """The inverse of :func:`in_frame`: ``camera`` given in the frame ``(centre, scale)`` as
+    the world camera (points ``p * scale + centre``, lengths ``* scale``)."""
+    c = np.asarray(centre, np.float64)
+
+    def point(p):
+        return tuple(float(x) for x in np.asarray(p, np.float64) * scale + c)
+
+    near, far = camera.clipping_range
+    return Camera(point(camera.position), point(camera.focal_point), camera.view_up,
+                  camera.parallel, camera.parallel_scale * scale, camera.view_angle,
+                  (near * scale, far * scale), camera.window_center)  # fmt: skip
+
+
 def mesh_frame(mesh: Mesh) -> tuple[np.ndarray, float]:
     """The frame the renderers hand VTK a mesh in (:func:`in_frame`)."""
     return frame_of(np.asarray(mesh.positions, np.float64))
@@ -116,8 +130,14 @@ def _finite(camera: Camera, mesh: Mesh) -> Camera:
 
 
 def _too_large(mesh: Mesh) -> ExplorerError:
+    return too_large(mesh.name, mesh.radius)
+
+
+def too_large(name: str, radius: float) -> ExplorerError:
+    """The refusal of a mesh too large to frame (mesh ``name`` of ``radius``), the renderers'
+    and the explorer's (whose lights and viewer keep their places in mesh radii)."""
     return ExplorerError(
-        f"mesh '{mesh.name}' is too large to frame (radius {mesh.radius:.3g}): its camera would "
+        f"mesh '{name}' is too large to frame (radius {radius:.3g}): its camera would "
         "lie beyond the float64 range; scale it down (coordinates up to about 1e300 render)"
     )
 

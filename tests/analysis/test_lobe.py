@@ -106,3 +106,9 @@ def test_incidence_and_contrast():
     assert lobe.contrast_ratio((0.5, 0.5, 0.5), (0.5, 0.5, 0.5)) == pytest.approx(1.0)
     with pytest.raises(ExplorerError, match="model must be one of"):
         lobe.specular_lobe("cook", 1.0, 0.0, [0.0])
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1.0, 1e300])
+def test_the_incidence_is_the_same_at_every_scale(scale):
+    got = lobe.incidence((0.0, 0.0, 2.0 * scale), (scale, 0.0, scale))
+    assert got == pytest.approx(math.radians(45.0))

@@ -107,4 +107,4 @@ def win(open_window):
     """The default window; the test fails if any error was shown and not cleared."""
     w = open_window()
     yield w
-    assert not w.errors, w.errors
+    assert not w.controller.errors, w.controller.errors

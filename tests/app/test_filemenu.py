@@ -47,7 +47,7 @@ def answers(win, monkeypatch):
 
 def drawn_equals_groups(w):
     """The colours VTK draws equal each group's material run afresh in float64 (one level)."""
-    s = w.store.state
+    s = w.controller.state
     mesh = w.view.mesh
     want = to_bytes(group_vertex_colors(s.shown_scene(), mesh, s.shown_groups())).astype(int)
     diff = np.abs(w.view.displayed_colors().astype(int) - want)
@@ -65,7 +65,7 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     two = write_two_groups(tmp_path)
     answers["path"].append(str(two))
     win.menu_actions["open"].trigger()
-    s = win.store.state
+    s = win.controller.state
     assert s.mesh == str(two) and s.groups is not None and s.preset is None
     red, blue = group_rgb(win, "left_red"), group_rgb(win, "right_blue")
     assert red[0] > 100 > red[2] and blue[2] > 100 > blue[0]  # both group colours drawn
@@ -79,56 +79,61 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     # the controls edit the chosen group only
     i = s.mesh_materials.names.index("right_blue")
     box.group.activated.emit(i)
-    assert win.store.state.group == i and box.label.text().endswith("'right_blue'")
+    assert win.controller.state.group == i and box.label.text().endswith("'right_blue'")
     before = group_rgb(win, "left_red")
     win.panel.material.sliders["kd"].field.setValue(0.3)
-    assert max(win.store.state.groups[i].diffuse) == pytest.approx(0.3)
+    assert max(win.controller.state.groups[i].diffuse) == pytest.approx(0.3)
     assert np.array_equal(group_rgb(win, "left_red"), before)
     win.render()
     drawn_equals_groups(win)
     # the edited group's material saved as a preset: the groups stay
-    path = win.save_preset_as("my_blue")
-    assert load_material_file(path).diffuse == win.store.state.groups[i].diffuse
-    assert win.store.state.groups is not None and "my_blue" in {p.name for p in win.presets}
+    path = win.controller.save_preset_as("my_blue")
+    assert load_material_file(path).diffuse == win.controller.state.groups[i].diffuse
+    assert win.controller.state.groups is not None and "my_blue" in {
+        p.name for p in win.controller.presets
+    }
     # a preset covers the whole mesh; undo brings the groups back; so does the button
     tab = win.panel.material
     item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
     tab._chosen(item)
-    s = win.store.state
+    s = win.controller.state
     assert s.groups is None and s.preset == "jade" and box.use.isVisibleTo(win.panel)
     assert not box.group_row.isVisibleTo(win.panel)
     assert "preset 'jade' covers the whole mesh" in box.label.text()
     want = to_bytes(vertex_colors(s.shown_scene(), win.view.mesh)).astype(int)
     assert np.abs(win.view.displayed_colors().astype(int) - want).max() <= 1  # jade all over
-    win.undo()
-    assert win.store.state.groups is not None and max(win.store.state.groups[i].diffuse) == 0.3
-    win.redo()
+    win.controller.undo()
+    assert (
+        win.controller.state.groups is not None
+        and max(win.controller.state.groups[i].diffuse) == 0.3
+    )
+    win.controller.redo()
     qtbot.mouseClick(box.use, QtCore.Qt.MouseButton.LeftButton)
-    assert win.store.state.groups == win.store.state.mesh_materials.materials
+    assert win.controller.state.groups == win.controller.state.mesh_materials.materials
     # the difference view compares each group in its own material; editing a group that is
     # not the one drawn by the scene's material asks for a new map
-    win.toggle_difference()
+    win.controller.toggle_difference()
     qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
     job = win.heat.result.job
-    assert job.materials == win.store.state.shown_groups() and len(job.materials) == 2
+    assert job.materials == win.controller.state.shown_groups() and len(job.materials) == 2
     assert win.heat.result.comparison.mask.sum() > 1000
-    edited = win.store.state.group
-    win.act(M.select_group, 1 - edited, label="group")
+    edited = win.controller.state.group
+    win.controller.act(M.select_group, 1 - edited, label="group")
     win.panel.material.sliders["shininess"].field.setValue(7.0)
     assert not win.heat.shown  # stale: the live view until the new map comes
     qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
     assert win.heat.result.job.materials[1 - edited].shininess == 7.0
-    win.undo()
-    win.act(M.select_group, edited, label="group")
-    win.toggle_difference()
+    win.controller.undo()
+    win.controller.act(M.select_group, edited, label="group")
+    win.controller.toggle_difference()
     # the session keeps the mesh and its materials
     win.panel.material.sliders["shininess"].field.setValue(5.0)
-    saved = win.store.state
-    path = win.save_session_as(tmp_path / "grouped.yaml")
-    win.reset_all()
-    assert win.store.state.mesh == "icosphere"
-    win.open_file(path)
-    s = win.store.state
+    saved = win.controller.state
+    path = win.controller.save_session_as(tmp_path / "grouped.yaml")
+    win.controller.reset_all()
+    assert win.controller.state.mesh == "icosphere"
+    win.controller.open_file(path)
+    s = win.controller.state
     assert s.mesh == str(two) and s.groups == saved.groups and s.group == saved.group
     win.render()
     drawn_equals_groups(win)
@@ -139,7 +144,7 @@ def test_import_materials_adds_presets_asks_before_replacing_and_names_bad_lines
 ):
     answers["path"].append(f"{MTL_DATA}/several.mtl")
     win.menu_actions["import_materials"].trigger()
-    names = {p.name for p in win.presets}
+    names = {p.name for p in win.controller.presets}
     assert {"red_paint", "red_paint_2", "blue"} <= names  # in the list at once
     listed = {win.panel.material.presets.item(i).text()
               for i in range(win.panel.material.presets.count())}  # fmt: skip
@@ -149,7 +154,7 @@ def test_import_materials_adds_presets_asks_before_replacing_and_names_bad_lines
     text = blue.read_text()
     # again: asked, said no: nothing replaced
     answers["yes"].append(False)
-    assert win.import_materials(f"{MTL_DATA}/several.mtl") == []
+    assert win.controller.import_materials(f"{MTL_DATA}/several.mtl") == []
     assert answers["asked"][-1][0] == "yes" and "3 preset files" in answers["asked"][-1][1][0]
     assert blue.read_text() == text and "nothing imported" in win.message
     # a bad file: a dialog naming the file and line, nothing written
@@ -159,7 +164,7 @@ def test_import_materials_adds_presets_asks_before_replacing_and_names_bad_lines
     assert error and f"{MTL_DATA}/bad_number.mtl:" in said and "Nothing was imported" in said
     assert win.message.startswith("error")
     # warnings are shown
-    win.import_materials(f"{MTL_DATA}/blender.mtl")
+    win.controller.import_materials(f"{MTL_DATA}/blender.mtl")
     _, said, details, error = answers["told"][-1]
     assert not error and "warning" in said and "Ka 1 1 1" in details and "Ni" in details
 
@@ -172,24 +177,24 @@ def test_export_material_never_replaces_unasked(win, answers, tmp_path):
     win.menu_actions["export_material"].trigger()
     assert out.read_text() == "mine\n"  # asked, said no
     answers["yes"].append(True)
-    assert win.export_material(out) == out
+    assert win.controller.export_material(out) == out
     (m,) = read_mtl(out)
-    s = win.store.state
+    s = win.controller.state
     keys = ("ambient", "diffuse", "specular", "emission", "shininess", "opacity")
     assert m.name == "gold"
     assert [getattr(m.material, k) for k in keys] == [getattr(s.material, k) for k in keys]
     for suffix, word in ((".json", "MeshPhongMaterial"), (".x3d", "<Material")):
-        path = win.export_material(tmp_path / f"g{suffix}")
+        path = win.controller.export_material(tmp_path / f"g{suffix}")
         assert word in path.read_text()
     assert answers["told"] and "approximation" in answers["told"][-1][1]
-    back = load_material_file(win.export_material(tmp_path / "g.yaml"))
+    back = load_material_file(win.controller.export_material(tmp_path / "g.yaml"))
     assert [getattr(back, k) for k in keys] == [getattr(s.material, k) for k in keys]
     assert back.model == s.scene.model
     answers["path"].append(str(tmp_path / "bad.txt"))
     win.menu_actions["export_material"].trigger()
     assert "must end in .mtl, .json, .x3d, .yaml" in win.message
     assert not (tmp_path / "bad.txt").exists()
-    win.errors.clear()
+    win.controller.errors.clear()
 
 
 def test_export_material_of_a_grouped_mesh_writes_every_group(win, answers, tmp_path):
@@ -198,10 +203,10 @@ def test_export_material_of_a_grouped_mesh_writes_every_group(win, answers, tmp_
     two.write_text(text)
     mtl = tmp_path / "two_groups.mtl"
     mtl.write_text(mtl.read_text().replace("left_red", "Left_Red"))
-    win.open_file(two)
+    win.controller.open_file(two)
     win.panel.material.sliders["ks"].field.setValue(0.25)  # the edited group, as edited
-    s = win.store.state
-    path = win.export_material(tmp_path / "out.mtl")
+    s = win.controller.state
+    path = win.controller.export_material(tmp_path / "out.mtl")
     read = {m.name: m.material for m in read_mtl(path)}
     assert {n: m.diffuse for n, m in read.items()} == {"Left_Red": (1.0, 0.0, 0.0),
                                                       "right_blue": (0.0, 0.0, 1.0)}  # fmt: skip
@@ -209,10 +214,10 @@ def test_export_material_of_a_grouped_mesh_writes_every_group(win, answers, tmp_
     assert read[name].specular == s.groups[s.group].specular and max(read[name].specular) == 0.25
     # the exported library serves the OBJ: it reopens with the same materials
     (tmp_path / "two_groups.mtl").write_bytes(path.read_bytes())
-    win.meshes.clear()
-    win.choose_mesh("cube")
-    win.open_file(two)
-    assert [m.specular for m in win.store.state.groups] == [m.specular for m in s.groups]
+    win.controller.meshes.clear()
+    win.controller.choose_mesh("cube")
+    win.controller.open_file(two)
+    assert [m.specular for m in win.controller.state.groups] == [m.specular for m in s.groups]
 
 
 def test_export_view_png_asks_before_replacing(win, answers, tmp_path):
@@ -224,15 +229,15 @@ def test_export_view_png_asks_before_replacing(win, answers, tmp_path):
     assert picture.shape[:2] == (h, w)
     stamp = out.stat().st_mtime_ns
     answers["yes"].append(False)
-    assert win.export_render(out) is None and out.stat().st_mtime_ns == stamp
+    assert win.controller.export_render(out) is None and out.stat().st_mtime_ns == stamp
 
 
 def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp_path, qtbot):
     out = tmp_path / "spin.gif"
     answers["path"].append(str(out))
     answers["number"].append(3)
-    win.export_turntable(size=(48, 40))
-    job = win.turntable
+    win.controller.export_turntable(size=(48, 40))
+    job = win.controller.turntable
     assert job.dialog.isVisible()
     seen = []  # the event loop runs between the frames: the window keeps painting
     other = QtCore.QTimer()
@@ -246,10 +251,10 @@ def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp
     assert not (frames[0] == frames[1]).all()  # the lights and camera turned
     # asked before replacing: no
     answers["yes"].append(False)
-    assert win.export_turntable(out, 3, size=(48, 40)) is None
+    assert win.controller.export_turntable(out, 3, size=(48, 40)) is None
     # cancelled part way: no file, nothing left behind
     gone = tmp_path / "gone.mp4"
-    job = win.export_turntable(gone, 40, size=(48, 40))
+    job = win.controller.export_turntable(gone, 40, size=(48, 40))
     qtbot.waitUntil(lambda: job.done >= 2, timeout=WAIT_MS)
     job.dialog.cancel()
     qtbot.waitUntil(lambda: job.stage == "cancelled", timeout=WAIT_MS)
@@ -259,19 +264,19 @@ def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp
 
 def test_recent_files(win, answers, tmp_path):
     two = write_two_groups(tmp_path)
-    win.open_file(two)
-    win.save_session_as(tmp_path / "s.yaml")
-    recent = win.recent_files()
+    win.controller.open_file(two)
+    win.controller.save_session_as(tmp_path / "s.yaml")
+    recent = win.controller.recent_files()
     assert recent == [str(tmp_path / "s.yaml"), str(two)]
     actions = [a for a in win.recent_menu.actions() if a.objectName().startswith("recent_")]
     assert [a.objectName() for a in actions] == ["recent_1", "recent_2"]
-    win.act(M.apply_preset, "ruby", find_preset("ruby"))
+    win.controller.act(M.apply_preset, "ruby", find_preset("ruby"))
     actions[1].trigger()  # two.obj again: its own materials
-    assert win.store.state.mesh == str(two) and win.recent_files()[0] == str(two)
+    assert win.controller.state.mesh == str(two) and win.controller.recent_files()[0] == str(two)
     two.unlink()
     [a for a in win.recent_menu.actions() if a.objectName() == "recent_1"][0].trigger()
-    assert "no such file" in win.message and str(two) not in win.recent_files()
-    win.errors.clear()
+    assert "no such file" in win.message and str(two) not in win.controller.recent_files()
+    win.controller.errors.clear()
     assert S.last_session_path  # the list lives beside the last session
     assert (tmp_path / "recent-files.json").is_file()
 
@@ -279,25 +284,25 @@ def test_recent_files(win, answers, tmp_path):
 def test_an_obj_whose_mtl_is_bad_opens_in_the_present_material(win, tmp_path):
     two = write_two_groups(tmp_path)
     (tmp_path / "two_groups.mtl").write_text("newmtl left_red\nKd 1 zero 0\n")
-    before = win.store.state.material
-    win.open_file(two)
-    s = win.store.state
+    before = win.controller.state.material
+    win.controller.open_file(two)
+    s = win.controller.state
     assert s.mesh == str(two) and s.groups is None and s.material == before
     assert "two_groups.mtl:2" in win.message and win.message.startswith("error")
-    win.errors.clear()
+    win.controller.errors.clear()
 
 
 def test_compare_beside_the_mesh_materials(win, tmp_path, qtbot):
-    win.open_file(write_two_groups(tmp_path))
-    win.toggle_compare()
-    s = win.store.state
+    win.controller.open_file(write_two_groups(tmp_path))
+    win.controller.toggle_compare()
+    s = win.controller.state
     assert s.groups is not None and s.compare == s.material and win.plotter_b.isVisible()
     qtbot.waitUntil(lambda: win.plotter_b.width() > 100)
     mesh = win.view_b.mesh
     want = to_bytes(vertex_colors(M.side_b(s).shown_scene(), mesh)).astype(int)
     assert np.abs(win.view_b.displayed_colors().astype(int) - want).max() <= 1  # B: one material
     drawn_equals_groups(win)  # A: the groups
-    win.swap_sides()
-    assert win.store.state.groups is None
-    win.undo()
-    assert win.store.state.groups is not None
+    win.controller.swap_sides()
+    assert win.controller.state.groups is None
+    win.controller.undo()
+    assert win.controller.state.groups is not None

@@ -18,6 +18,7 @@ from explorer.cli import build_parser, main
 from explorer.cli.gui import start, start_state
 from explorer.core.lights import DirectionalLight, PointLight
 from explorer.core.presets import find_preset
+from explorer.core.scene import Viewer
 from explorer.geometry import meshes as G
 from explorer.render.camera import camera_for
 
@@ -428,3 +429,25 @@ def test_range_errors_show_every_digit_needed(tmp_path):
         explorer.ExplorerError, match=r"view_angle: must be in \(0, 179\], got 179.0001"
     ):
         S.load_session(path)
+
+
+@pytest.mark.parametrize("scale", [1e-20, 1e39, 1e300])
+def test_a_new_mesh_keeps_the_viewer_and_lights_in_mesh_radii(state, scale):
+    """The viewer (a local eye) and the lights keep their places in mesh radii, so a mesh of
+    size 1e-20 is framed as the last one was (the eye stayed 6.5 units from it: a dot)."""
+    s = state.replace(scene=state.scene.replace(viewer=Viewer(eye=(0.0, 2.0, 6.0))))
+    new = M.set_mesh(s, "big", (scale, 0.0, 0.0), scale)
+    eye = (np.asarray(new.scene.viewer.eye) - new.centre) / new.radius
+    assert eye == pytest.approx((np.asarray(s.scene.viewer.eye) - s.centre) / s.radius)
+    assert new.placement()[2] / new.radius == pytest.approx(s.placement()[2] / s.radius)
+    assert new.placement()[:2] == pytest.approx(s.placement()[:2])
+    cam = camera_for(new.scene, G.Mesh(G.sphere(8).positions * scale + (scale, 0, 0),
+                                      G.sphere(8).normals, G.sphere(8).faces))  # fmt: skip
+    assert cam.view_angle == pytest.approx(camera_for(s.scene, G.sphere(8)).view_angle)
+
+
+def test_a_mesh_too_large_for_its_lights_is_refused_as_render_refuses_it(state):
+    with pytest.raises(
+        explorer.core.errors.ExplorerError, match="'huge.obj' is too large to frame"
+    ):
+        M.set_mesh(state, "/models/huge.obj", (0.0, 0.0, 0.0), 1.5e308)

@@ -45,7 +45,7 @@ def swatch_pixels(button) -> set[tuple[int, int, int]]:
 # -- 3. swatches -------------------------------------------------------------------------------
 @pytest.mark.parametrize("rgb", [(0.667, 0.0, 0.0), (0.2, 0.5, 0.9), (1.0, 1.0, 1.0)])
 def test_a_material_colour_button_is_painted_in_its_value(win, rgb):
-    win.act(M.set_colour, "diffuse", rgb)
+    win.controller.act(M.set_colour, "diffuse", rgb)
     button = win.panel.material.colours["diffuse"]
     assert swatch_pixels(button) == {rgb_bytes(rgb)}
     assert rgb_bytes((0.667, 0.0, 0.0)) == (170, 0, 0)  # round(255 v): no transfer function
@@ -53,7 +53,7 @@ def test_a_material_colour_button_is_painted_in_its_value(win, rgb):
 
 def test_a_light_colour_button_is_painted_in_its_value(win):
     win.panel.setCurrentIndex(1)
-    win.act(M.set_light_colour, (0.0, 0.0, 1.0))
+    win.controller.act(M.set_light_colour, (0.0, 0.0, 1.0))
     button = win.panel.lights.colour
     assert swatch_pixels(button) == {(0, 0, 255)}
     assert "(0, 0, 255)" in button.toolTip()
@@ -62,8 +62,8 @@ def test_a_light_colour_button_is_painted_in_its_value(win):
 # -- 4. the colour dialog ----------------------------------------------------------------------
 @pytest.mark.parametrize(("preset", "term"), [("jade", "diffuse"), ("jade", "emission")])
 def test_the_colour_dialog_is_not_filled_with_the_colour(win, qtbot, preset, term):
-    info = next(p for p in win.presets if p.name == preset)
-    win.act(M.apply_preset, info.name, info.material)
+    info = next(p for p in win.controller.presets if p.name == preset)
+    win.controller.act(M.apply_preset, info.name, info.material)
     button = win.panel.material.colours[term]
     qtbot.mouseClick(button, QtCore.Qt.MouseButton.LeftButton)
     dialog = button.dialog
@@ -87,15 +87,15 @@ def test_the_colour_dialog_takes_typed_values(win, qtbot):
         dialog.value.selectAll()
         qtbot.keyClicks(dialog.value, text)
         qtbot.keyClick(dialog.value, QtCore.Qt.Key.Key_Return)  # takes it, then OK
-        assert win.store.state.material.specular == want  # exactly what was typed
+        assert win.controller.state.material.specular == want  # exactly what was typed
         assert not dialog.isVisible()
-    before = win.store.state
+    before = win.controller.state
     qtbot.mouseClick(button, QtCore.Qt.MouseButton.LeftButton)
     dialog = button.dialog
     dialog.value.selectAll()
     qtbot.keyClicks(dialog.value, "1.5, 0, 0")
     dialog.accept()  # OK with a wrong value: said in the dialog, which stays open
-    assert dialog.isVisible() and win.store.state == before
+    assert dialog.isVisible() and win.controller.state == before
     assert "specular must be 'r, g, b' with each within 0 .. 1" in dialog.problem.text()
     assert dialog.problem.isVisible()
     dialog.reject()
@@ -120,19 +120,19 @@ def test_the_wheel_over_a_slider_scrolls_the_panel(open_window, qtbot):
     bar = w.panel.widget(0).verticalScrollBar()
     ks = w.panel.material.sliders["ks"]
     for widget in (ks.slider, ks.field):
-        before, top = w.store.state, bar.value()
+        before, top = w.controller.state, bar.value()
         wheel(widget, -1)
-        assert w.store.state == before and not w.store.state.edited
+        assert w.controller.state == before and not w.controller.state.edited
         assert bar.value() > top, "the panel did not scroll"
     w.activateWindow()
     qtbot.waitUntil(w.isActiveWindow)
     ks.slider.setFocus()  # clicked into: then the wheel is the slider's
     qtbot.waitUntil(ks.slider.hasFocus)
     wheel(ks.slider, -1)
-    assert w.store.state.material.scalars()[2] != pytest.approx(
+    assert w.controller.state.material.scalars()[2] != pytest.approx(
         before.material.scalars()[2], abs=1e-9
     )
-    assert not w.errors, w.errors
+    assert not w.controller.errors, w.controller.errors
 
 
 # -- 9. layout at every size -------------------------------------------------------------------
@@ -193,25 +193,25 @@ def check_window(w, size, tab: int) -> None:
 def test_every_tab_is_whole_or_scrolls_at_every_size(open_window, qtbot, size, tab):
     w = laid_out(qtbot, open_window(), size)
     if tab == 1:  # the lights tab with everything a spot shows, and two lights
-        w.act(M.add_light)
-        w.act(M.set_light_type, "spot")
+        w.controller.act(M.add_light)
+        w.controller.act(M.set_light_type, "spot")
     check_window(w, size, tab)
-    assert not w.errors, w.errors
+    assert not w.controller.errors, w.controller.errors
 
 
 @pytest.mark.parametrize("size", SIZES, ids=[f"{a}x{b}" for a, b in SIZES])
 def test_the_compare_and_difference_views_fit_at_every_size(open_window, qtbot, size):
     w = laid_out(qtbot, open_window(), size)
-    w.act(M.set_compare, True)
+    w.controller.act(M.set_compare, True)
     qtbot.waitUntil(lambda: w.plotter_b.isVisible() and w.plotter_b.width() > 50)
-    w.act(M.set_compare_difference, True)
+    w.controller.act(M.set_compare_difference, True)
     for tab in range(3):
         check_window(w, size, tab)
-    w.act(M.set_compare, False)
-    w.act(M.set_difference, True)
+    w.controller.act(M.set_compare, False)
+    w.controller.act(M.set_difference, True)
     qtbot.waitUntil(lambda: w.heat.shown, timeout=60_000)
     check_window(w, size, 2)
-    assert not w.errors, w.errors
+    assert not w.controller.errors, w.controller.errors
 
 
 def test_the_preset_list_grows_with_the_window(open_window, qtbot):
@@ -238,41 +238,41 @@ def type_into(qtbot, field, text: str) -> None:
      ("kd", "-1", *COEFFICIENT_RANGE), ("ks", "abc", *COEFFICIENT_RANGE)],
 )  # fmt: skip
 def test_a_typed_value_out_of_range_is_refused_out_loud(win, qtbot, key, text, lo, hi):
-    before = win.store.state
+    before = win.controller.state
     field = win.panel.material.sliders[key].field
     shown = field.text()
     type_into(qtbot, field, text)
-    assert win.store.state == before
+    assert win.controller.state == before
     assert field.text() == shown  # the state's value, not a clamped or truncated one
     want = f"{key} must be a number within {lo:g} .. {hi:g}, got '{text}'"
     assert want in win.message and win.statusBar().currentMessage() == win.message
     assert any(want in m.text for m in win.messages.messages)
-    win.errors.clear()
+    win.controller.errors.clear()
     type_into(qtbot, field, "0.5")  # a value in range is taken
-    assert win.store.state != before
+    assert win.controller.state != before
 
 
 def test_a_typed_light_value_out_of_range_is_refused_out_loud(win, qtbot):
     win.panel.setCurrentIndex(1)
-    before = win.store.state
+    before = win.controller.state
     type_into(qtbot, win.panel.lights.sliders["elevation"].field, "120")
-    assert win.store.state == before
+    assert win.controller.state == before
     assert "elevation must be a number within -90 .. 90, got '120'" in win.message
-    win.errors.clear()
+    win.controller.errors.clear()
 
 
 # -- 11. a control shows the state after a refusal ---------------------------------------------
 def test_a_refused_attenuation_leaves_no_stale_field(win, qtbot):
     win.panel.setCurrentIndex(1)
-    win.act(M.set_light_field, "attenuation", (1.0, 0.5, 0.0))
+    win.controller.act(M.set_light_field, "attenuation", (1.0, 0.5, 0.0))
     kc, kl, _ = win.panel.lights.attenuation
     type_into(qtbot, kc, "0")
-    assert win.store.state.selected_light.attenuation == (0.0, 0.5, 0.0)
+    assert win.controller.state.selected_light.attenuation == (0.0, 0.5, 0.0)
     type_into(qtbot, kl, "0")  # all zero: refused by the light
-    assert win.store.state.selected_light.attenuation == (0.0, 0.5, 0.0)
+    assert win.controller.state.selected_light.attenuation == (0.0, 0.5, 0.0)
     assert "all zero" in win.message
     assert kl.value() == 0.5 and kl.text() == "0.500"
-    win.errors.clear()
+    win.controller.errors.clear()
 
 
 @pytest.mark.parametrize(
@@ -286,8 +286,8 @@ def test_a_refused_attenuation_leaves_no_stale_field(win, qtbot):
 def test_every_control_shows_the_state_after_a_refused_action(win, monkeypatch, action, control):
     """The mechanism: whatever a control sent, a refusal re-reads the state into the panel
     (here every action of the kind is made to refuse)."""
-    win.act(M.set_light_type, "spot")
-    before = win.store.state
+    win.controller.act(M.set_light_type, "spot")
+    before = win.controller.state
 
     def refuse(*_args):
         raise M.ExplorerError(f"{action} refused")
@@ -296,9 +296,9 @@ def test_every_control_shows_the_state_after_a_refused_action(win, monkeypatch, 
     c = control(win.panel)
     shown = c.value()
     c.field.setValue(shown / 2 + 0.3)  # a value in range the action then refuses
-    assert win.store.state == before and f"{action} refused" in win.message
+    assert win.controller.state == before and f"{action} refused" in win.message
     assert c.value() == shown and c.slider.value() == c._to_step(shown)
-    win.errors.clear()
+    win.controller.errors.clear()
 
 
 # -- 12. the message log -----------------------------------------------------------------------
@@ -306,8 +306,8 @@ def test_the_obj_warnings_are_whole_in_the_message_log(win, qtbot):
     from explorer.app.start import add_mesh_materials
 
     obj = ROOT / "docs" / "examples" / "teapot_parts.obj"
-    before = win.store.state
-    win.open_file(obj)
+    before = win.controller.state
+    win.controller.open_file(obj)
     qtbot.waitUntil(win.messages.isVisible)  # the log opened by itself
     text = win.messages.plain_text()
     _, expected = add_mesh_materials(before, win.view.mesh)  # the reader's own warnings
@@ -327,8 +327,8 @@ def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
     win.panel.setCurrentIndex(1)
     tab = win.panel.lights
     tab.buttons["duplicate"].click()
-    lights = win.store.state.scene.lights
-    assert len(lights) == 2 and lights[1] == lights[0] and win.store.state.light == 1
+    lights = win.controller.state.scene.lights
+    assert len(lights) == 2 and lights[1] == lights[0] and win.controller.state.light == 1
     assert tab.list.item(1).text().endswith("(same place as 1)")
     assert "same place" not in tab.list.item(0).text()
     tab.sliders["azimuth"].field.setValue(-100.0)  # moved: no longer said

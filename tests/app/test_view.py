@@ -95,3 +95,13 @@ def test_edge_marker_points_from_the_views_edge_to_a_handle_out_of_it():
     assert tri[0] == pytest.approx([MARKER_MARGIN, 50]) and (tri[:, 0] >= 0).all()
     corner = edge_marker(1e6, 1e6, True, 200, 100)
     assert 0 <= corner[0, 0] <= 200 and 0 <= corner[0, 1] <= 100
+
+
+@pytest.mark.parametrize("scale", [1e-30, 1e39])
+def test_level_of_detail_of_a_mesh_at_any_scale(scale):
+    """Clustered in the mesh's frame: float32 points of a mesh scaled by 1e39 were inf."""
+    unit = G.sphere(64)
+    mesh = G.Mesh(unit.positions * scale, unit.normals, unit.faces)
+    lod = lod_mesh(mesh, 1000)
+    assert np.isfinite(lod.positions).all() and 700 <= lod.n_vertices <= 1300
+    assert np.abs(np.linalg.norm(lod.positions / scale, axis=1) - 1.0).max() < 0.05

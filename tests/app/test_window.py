@@ -37,15 +37,15 @@ def test_the_window_draws_at_once_and_says_while_the_compiled_engine_is_prepared
     cold_tiers.write_text("{}")  # the background compile is done: load, then switch
     qtbot.waitUntil(lambda: w.engine_label.text() == "", timeout=WAIT_MS)
     assert tiers.loaded()
-    assert w.act(M.set_coefficient, "kd", 0.4)
+    assert w.controller.act(M.set_coefficient, "kd", 0.4)
     w.render()
     assert w.view.drawings[0].shader.stats["pass"] >= 1  # the compiled kernels drew this frame
     drawn_equals_engine(w)
-    assert not w.errors, w.errors
+    assert not w.controller.errors, w.controller.errors
 
 
 def drawn_equals_engine(w):
-    s = w.store.state
+    s = w.controller.state
     mesh = w.view.mesh
     want = to_bytes(explorer.shade(s.shown_scene(), mesh.positions, mesh.normals)).astype(int)
     diff = np.abs(w.view.displayed_colors().astype(int) - want)
@@ -63,20 +63,20 @@ def drawn_equals_engine(w):
     ],
 )
 def test_material_fields_and_sliders(win, name, value, read):
-    s0 = win.store.state
+    s0 = win.controller.state
     win.panel.material.sliders[name].field.setValue(value)
-    assert read(win.store.state) == pytest.approx(value)
-    assert win.store.state.edited and "(edited)" in win.panel.material.preset_label.text()
+    assert read(win.controller.state) == pytest.approx(value)
+    assert win.controller.state.edited and "(edited)" in win.panel.material.preset_label.text()
     win.render()
     drawn_equals_engine(win)
-    win.undo()
-    assert win.store.state == s0
+    win.controller.undo()
+    assert win.controller.state == s0
     drawn_equals_engine(win)
 
 
 def test_a_slider_drag_is_one_undo_step(win, qtbot):
     slider = win.panel.material.sliders["kd"].slider
-    before = win.store.state
+    before = win.controller.state
     slider.setSliderDown(True)
     win.panel.material.sliders["kd"].pressed.emit()
     for step in (700, 600, 500, 400):
@@ -85,22 +85,24 @@ def test_a_slider_drag_is_one_undo_step(win, qtbot):
     slider.setSliderDown(False)
     win.panel.material.sliders["kd"].released.emit()
     assert not win.view.dragging
-    assert win.store.state.material.scalars()[1] == pytest.approx(0.4)
-    win.undo()
-    assert win.store.state == before and not win.store.can_undo
-    win.redo()
-    assert win.store.state.material.scalars()[1] == pytest.approx(0.4)
+    assert win.controller.state.material.scalars()[1] == pytest.approx(0.4)
+    win.controller.undo()
+    assert win.controller.state == before and not win.controller.store.can_undo
+    win.controller.redo()
+    assert win.controller.state.material.scalars()[1] == pytest.approx(0.4)
 
 
 def test_shininess_slider_is_log_scale_with_zero_at_the_left(win):
     s = win.panel.material.sliders["shininess"]
     s.slider.setValue(0)
-    assert win.store.state.material.shininess == 0.0
+    assert win.controller.state.material.shininess == 0.0
     s.slider.setValue(s.slider.maximum())
-    assert win.store.state.material.shininess == 1000.0
+    assert win.controller.state.material.shininess == 1000.0
     s.slider.setValue(667)  # two thirds along: 10^2
-    assert win.store.state.material.shininess == pytest.approx(100.0, rel=0.01)
-    assert win.view.lobe_caption.GetInput().endswith(f"n = {win.store.state.material.shininess:g}")
+    assert win.controller.state.material.shininess == pytest.approx(100.0, rel=0.01)
+    assert win.view.lobe_caption.GetInput().endswith(
+        f"n = {win.controller.state.material.shininess:g}"
+    )
 
 
 def test_colour_buttons_through_the_dialog(win, qtbot):
@@ -111,7 +113,7 @@ def test_colour_buttons_through_the_dialog(win, qtbot):
         assert dialog is not None and dialog.isVisible()
         dialog.setCurrentColor(QtGui.QColor(255, 0, 51))
         dialog.accept()
-        assert getattr(win.store.state.material, term) == pytest.approx((1.0, 0.0, 0.2))
+        assert getattr(win.controller.state.material, term) == pytest.approx((1.0, 0.0, 0.2))
         assert button.text() == "1.000, 0.000, 0.200"
     win.render()
     drawn_equals_engine(win)
@@ -120,9 +122,9 @@ def test_colour_buttons_through_the_dialog(win, qtbot):
 def test_model_terms_and_presets(win, qtbot):
     tab = win.panel.material
     tab.model["phong"].click()
-    assert win.store.state.scene.model == "phong"
+    assert win.controller.state.scene.model == "phong"
     tab.terms["specular"].click()
-    assert win.store.state.hidden == {"specular"}
+    assert win.controller.state.hidden == {"specular"}
     win.render()
     drawn_equals_engine(win)
     tab.search.setText("green")
@@ -135,7 +137,7 @@ def test_model_terms_and_presets(win, qtbot):
     tab.presets.scrollToItem(item)
     qtbot.mouseClick(tab.presets.viewport(), QtCore.Qt.MouseButton.LeftButton,
                      pos=tab.presets.visualItemRect(item).center())  # fmt: skip
-    s = win.store.state
+    s = win.controller.state
     assert s.preset == "jade" and not s.edited and "jade" in tab.preset_label.text()
     assert tab.description.text() == s.material.description
     win.render()
@@ -145,32 +147,32 @@ def test_model_terms_and_presets(win, qtbot):
 def test_every_light_control(win):
     tab = win.panel.lights
     tab.buttons["add"].click()
-    assert len(win.store.state.scene.lights) == 2 and tab.list.count() == 2
+    assert len(win.controller.state.scene.lights) == 2 and tab.list.count() == 2
     tab.buttons["duplicate"].click()
     tab.buttons["remove"].click()
-    assert len(win.store.state.scene.lights) == 2
+    assert len(win.controller.state.scene.lights) == 2
     tab.list.setCurrentRow(0)
-    assert win.store.state.light == 0
+    assert win.controller.state.light == 0
     tab.sliders["azimuth"].field.setValue(-60.0)
     tab.sliders["elevation"].field.setValue(20.0)
     tab.sliders["distance"].field.setValue(3.0)
-    s = win.store.state
+    s = win.controller.state
     assert s.placement() == pytest.approx((-60.0, 20.0, 3.0 * s.radius))
     assert "world units" in tab.sliders["distance"].note.text()
     tab.sliders["intensity"].field.setValue(0.7)
-    assert M.light_colour(win.store.state.selected_light)[1] == pytest.approx(0.7)
+    assert M.light_colour(win.controller.state.selected_light)[1] == pytest.approx(0.7)
     tab.attenuation[1].setValue(0.2)
-    assert win.store.state.selected_light.attenuation[1] == pytest.approx(0.2)
+    assert win.controller.state.selected_light.attenuation[1] == pytest.approx(0.2)
     tab.type.activated.emit(2)  # spot
-    light = win.store.state.selected_light
+    light = win.controller.state.selected_light
     assert light.type == "spot" and tab.cutoff.isVisibleTo(tab)
     assert win.view.glyph_kind == "spot"
     tab.cutoff.field.setValue(12.0)
     tab.exponent.field.setValue(3.0)
-    light = win.store.state.selected_light
+    light = win.controller.state.selected_light
     assert (light.cutoff, light.exponent) == (12.0, 3.0)
     tab.colour.open_dialog().colorSelected.emit(QtGui.QColor(255, 128, 0))
-    assert M.light_colour(win.store.state.selected_light)[0][1] == pytest.approx(128 / 255)
+    assert M.light_colour(win.controller.state.selected_light)[0][1] == pytest.approx(128 / 255)
     tab.type.activated.emit(0)  # directional: an arrow, no attenuation
     assert win.view.glyph_kind == "directional" and not tab.attenuation_box.isVisibleTo(tab)
     win.render()
@@ -178,12 +180,12 @@ def test_every_light_control(win):
 
 
 def test_the_handle_moves_the_light_and_keeps_the_azimuth_at_the_pole(win):
-    s = win.store.state
+    s = win.controller.state
     point = np.asarray(s.centre) + 2.0 * s.radius * np.array([0.0, 1.0, 0.0])  # straight up
     az = s.placement()[0]
     win.view.handle.SetCenter(*point)
     win.handles._on_handle(point)
-    az2, el, d = win.store.state.placement()
+    az2, el, d = win.controller.state.placement()
     assert (
         el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
     )
@@ -196,17 +198,19 @@ def test_save_preset_as_asks_for_a_name_and_before_replacing(win, tmp_path, monk
     asked = []
     monkeypatch.setattr(win, "ask_yes", lambda q: asked.append(q) or False)
     win.panel.material.sliders["kd"].field.setValue(0.33)
-    path = win.save_preset_as()
+    path = win.controller.save_preset_as()
     assert path == tmp_path / "presets" / "my_gold.yaml" and path.exists()
-    s = win.store.state
+    s = win.controller.state
     assert s.preset == "my_gold" and not s.edited and "(edited)" not in (
         win.panel.material.preset_label.text())  # fmt: skip
     text = path.read_text()
-    assert win.save_preset_as("my_gold") is None and asked  # asked, said no: not replaced
+    assert (
+        win.controller.save_preset_as("my_gold") is None and asked
+    )  # asked, said no: not replaced
     assert path.read_text() == text
     win.menu_actions["save_preset"].trigger()  # "Bad Name": refused, shown, nothing written
     assert "not a valid preset name" in win.message
-    win.errors.clear()
+    win.controller.errors.clear()
 
 
 def test_sessions_save_and_reopen_exactly(win, qtbot, tmp_path, monkeypatch):
@@ -214,12 +218,12 @@ def test_sessions_save_and_reopen_exactly(win, qtbot, tmp_path, monkeypatch):
     win.panel.lights.buttons["add"].click()
     win.panel.material.terms["ambient"].click()
     monkeypatch.setattr(win, "ask_path", lambda *a, **k: str(tmp_path / "mine.yaml"))
-    path = win.save_session_as()
-    saved = win.store.state
-    win.reset_all()
-    assert win.store.state.scene != saved.scene
-    win.open_file(path)
-    s = win.store.state
+    path = win.controller.save_session_as()
+    saved = win.controller.state
+    win.controller.reset_all()
+    assert win.controller.state.scene != saved.scene
+    win.controller.open_file(path)
+    s = win.controller.state
     assert s.scene == saved.scene and s.hidden == saved.hidden and s.mesh == saved.mesh
     win.render()
     drawn_equals_engine(win)
@@ -233,26 +237,26 @@ def test_sessions_save_and_reopen_exactly(win, qtbot, tmp_path, monkeypatch):
 def test_open_mesh_files_and_errors_in_one_line(win, tmp_path):
     bad = tmp_path / "broken.obj"
     bad.write_text("v 0 0\n")
-    win._guard(win.open_file, "open")(str(bad))
-    assert win.errors and win.message.startswith("error (") and "\n" not in win.message
-    assert "broken.obj" in win.message and win.store.state.mesh == "icosphere"
-    win.errors.clear()
+    win._guard(win.controller.open_file, "open")(str(bad))
+    assert win.controller.errors and win.message.startswith("error (") and "\n" not in win.message
+    assert "broken.obj" in win.message and win.controller.state.mesh == "icosphere"
+    win.controller.errors.clear()
     win.panel.view.mesh.activated.emit(win.panel.view.mesh.findData("cube"))
-    assert win.store.state.mesh == "cube" and win.view.mesh.name == "cube"
-    win.undo()
-    assert win.store.state.mesh == "icosphere"
+    assert win.controller.state.mesh == "cube" and win.view.mesh.name == "cube"
+    win.controller.undo()
+    assert win.controller.state.mesh == "icosphere"
     scene = tmp_path / "scene.yaml"
     scene.write_text("material: ruby\nlights: [{type: directional, to_light: [0, 1, 0]}]\n")
-    win.open_file(scene)
-    s = win.store.state
+    win.controller.open_file(scene)
+    s = win.controller.state
     assert s.preset == "ruby" and s.material == explorer.load_scene(str(scene)).material
     assert [light.type for light in s.scene.lights] == ["directional"]
     win.render()
     drawn_equals_engine(win)
     stl = tmp_path / "box.stl"
     trimesh.creation.box().export(stl)
-    win.open_file(stl)
-    assert win.store.state.mesh == str(stl) and win.view.mesh.n_vertices > 0
+    win.controller.open_file(stl)
+    assert win.controller.state.mesh == str(stl) and win.view.mesh.n_vertices > 0
     assert win.panel.view.mesh.currentText() == "box.stl"
 
 
@@ -268,7 +272,7 @@ def test_difference_view_from_the_worker(win, qtbot):
     qtbot.waitUntil(lambda: win.heat.shown, timeout=WAIT_MS)
     assert win.heat.result.job.scene.material.shininess == 300.0
     qtbot.keyClick(win.plotter, "d")
-    assert not win.store.state.difference and win.view.drawings[0].actor.GetVisibility()
+    assert not win.controller.state.difference and win.view.drawings[0].actor.GetVisibility()
 
 
 def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot, monkeypatch):
@@ -316,26 +320,28 @@ def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot
 def test_keys_of_the_view(win, qtbot):
     win.plotter.setFocus()
     qtbot.keyClick(win.plotter, "b")
-    assert win.store.state.scene.model == "phong"
+    assert win.controller.state.scene.model == "phong"
     qtbot.keyClick(win.plotter, "3")
-    assert win.store.state.hidden == {"specular"}
+    assert win.controller.state.hidden == {"specular"}
     qtbot.keyClick(win.plotter, "n")
-    assert win.store.state.preset != A.DEFAULT_PRESET
+    assert win.controller.state.preset != A.DEFAULT_PRESET
     qtbot.keyClick(win.plotter, "l")
     assert "nothing to switch" in win.message  # one light: said so
-    before = win.store.state
+    before = win.controller.state
     for key in "wse":  # VTK's wireframe / surface / ...: switched off
         qtbot.keyClick(win.plotter, key)
-    assert win.store.state == before
+    assert win.controller.state == before
     assert win.view.drawings[0].actor.GetProperty().GetRepresentation() == 2  # surface
-    cam = win.store.state.camera
+    cam = win.controller.state.camera
     win.plotter.camera.Azimuth(30)
     win.render()
-    assert win.store.state.camera != cam  # the camera moved, and so the viewer
-    assert win.store.state.scene.viewer.eye == pytest.approx(win.store.state.camera.position)
+    assert win.controller.state.camera != cam  # the camera moved, and so the viewer
+    assert win.controller.state.scene.viewer.eye == pytest.approx(
+        win.controller.state.camera.position
+    )
     drawn_equals_engine(win)
     qtbot.keyClick(win.plotter, "r")
-    assert win.store.state.camera == cam and win.store.state.scene.model == "phong"
+    assert win.controller.state.camera == cam and win.controller.state.scene.model == "phong"
     path = None
     qtbot.keyClick(win.plotter, "i")
     path = win.message.split("saved screenshot ", 1)[1]
@@ -345,13 +351,26 @@ def test_keys_of_the_view(win, qtbot):
     assert win.help.isVisible() and "Ctrl+Z" in win.help.text()
 
 
+def test_the_window_binds_the_controller_explicitly(win, qtbot):
+    """The window forwards no name of the controller (issue 32: a plain binding): menus, keys,
+    scripts and tests say ``window.controller.X``; every key of the view runs its intent."""
+    own = set(dir(type(win))) | set(vars(win))
+    names = [n for n in dir(type(win.controller)) if not n.startswith("_") and n not in own]
+    assert names and [n for n in names if hasattr(win, n)] == []
+    win.plotter.setFocus()
+    for key in "cxct12dd":  # the view keys test_keys_of_the_view leaves out
+        qtbot.keyClick(win.plotter, key)
+    assert not win.controller.errors, win.controller.errors
+    assert win.controller.state.hidden == {"ambient", "diffuse"}
+
+
 def test_reset_all_can_be_undone(win):
     win.panel.material.sliders["kd"].field.setValue(0.1)
-    changed = win.store.state
-    win.reset_all()
-    assert win.store.state.scene == win.start_state.scene
-    win.undo()
-    assert win.store.state.scene == changed.scene
+    changed = win.controller.state
+    win.controller.reset_all()
+    assert win.controller.state.scene == win.controller.start_state.scene
+    win.controller.undo()
+    assert win.controller.state.scene == changed.scene
 
 
 def test_status_bar_takes_a_message(win):
@@ -361,7 +380,7 @@ def test_status_bar_takes_a_message(win):
 
 def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
     win.panel.view.compare.click()
-    s = win.store.state
+    s = win.controller.state
     assert s.compare == s.material and s.compare_model == "phong" and win.plotter_b.isVisible()
     qtbot.waitUntil(lambda: win.plotter_b.width() > 100)
     b = win.view_b
@@ -371,9 +390,9 @@ def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
     assert win.plotter_b.renderer.GetActiveCamera() is win.plotter.renderer.GetActiveCamera()
     i = win.panel.view.compare_preset.findText("jade")
     win.panel.view.compare_preset.activated.emit(i)
-    assert win.store.state.compare_preset == "jade"
+    assert win.controller.state.compare_preset == "jade"
     win.panel.view.swap.click()
-    s = win.store.state
+    s = win.controller.state
     assert s.preset == "jade" and s.compare_preset == A.DEFAULT_PRESET
     win.render()
     drawn_equals_engine(win)
@@ -384,13 +403,13 @@ def test_compare_view_two_panes_linked_cameras_swap_and_difference(win, qtbot):
     from explorer.analysis.comparison import heat_map
 
     assert np.array_equal(win.view_b.displayed_colors(), heat_map(levels[None, :], vmax=16)[0])
-    path = S.save_session(win.output_dir / "ab.yaml", win.store.state)
+    path = S.save_session(win.controller.output_dir / "ab.yaml", win.controller.state)
     back, _ = S.load_session(path)
     assert back.compare == s.compare and back.compare_difference
     qtbot.keyClick(win.plotter, "c")
-    assert win.store.state.compare is None and not win.plotter_b.isVisible()
-    win.undo()
-    assert win.store.state.compare is not None and win.plotter_b.isVisible()
+    assert win.controller.state.compare is None and not win.plotter_b.isVisible()
+    win.controller.undo()
+    assert win.controller.state.compare is not None and win.plotter_b.isVisible()
 
 
 @pytest.mark.skipif(sys.version_info >= (3, 12), reason="None is immortal from Python 3.12")

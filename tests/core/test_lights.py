@@ -16,6 +16,7 @@ from explorer.core.lights import (
     DirectionalLight,
     PointLight,
     SpotLight,
+    angles_of,
     direction_of,
 )
 from explorer.core.presets import PresetNotice
@@ -290,3 +291,9 @@ def test_tiny_light_direction_on_the_command_line_is_not_a_traceback():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecatedName)
             assert light_from_options(args).to_light == (1.0, 0.0, 0.0)
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1.0, 1e300])
+def test_angles_of_a_vector_at_every_scale(scale):
+    az, el, length = angles_of((0.0, 3.0 * scale, 4.0 * scale))
+    assert (az, length / scale) == pytest.approx((0.0, 5.0)) and el == pytest.approx(36.8699, 1e-5)

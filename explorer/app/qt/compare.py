@@ -1,5 +1,6 @@
 """The A / B compare view of the Qt window: side B's pane beside the 3D view, with the same
-camera (one ``vtkCamera`` for both), the same lights and mesh, and side B's material and model;
+camera (one ``vtkCamera`` for both), the same lights (their handles drawn and dragged in both
+panes) and mesh, and side B's material and model;
 or, as "A − B", the difference of the two sides' colours per vertex, largest channel in 1/255
 levels, in the difference view's colours (interpolated across each triangle, like the colours).
 """
@@ -10,6 +11,7 @@ import numpy as np
 from PySide6 import QtCore
 
 from explorer.app import model as M
+from explorer.app.handledrag import HandleDragger
 from explorer.app.qt.menus import ViewKeys
 from explorer.app.sides import show_side_b
 from explorer.app.view import SceneView, view_camera
@@ -48,6 +50,7 @@ class CompareView:
                              lod_target=w.view.lod_target)  # fmt: skip
         pl.installEventFilter(ViewKeys(w))
         w.watch_camera(pl)
+        self.handles = HandleDragger(w, pl, w.view_b)  # the lights are shared: B's move them too
 
         def draw_a(*_):  # B's camera is A's: a frame of B draws A too (and A records it)
             if not self._syncing:

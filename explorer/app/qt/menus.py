@@ -11,7 +11,8 @@ from PySide6 import QtCore, QtGui, QtWidgets
 from explorer.app.qt.messages import open_log
 from explorer.core.material import MODELS
 
-#: keys of the 3D view (active while it has the keyboard focus): key -> (what, method name)
+#: keys of the 3D view (active while it has the keyboard focus): key -> (what, method name);
+#: the methods are the controller's intents, but for the help (the menus') and quit (the window's)
 VIEW_KEYS = {
     "h": ("show / hide this help", "toggle_help"),
     "r": ("reset the camera (the material and lights stay)", "reset_camera"),
@@ -72,8 +73,8 @@ class ViewKeys(QtCore.QObject):
         if kind == QtCore.QEvent.Type.KeyPress and event.text() in VIEW_KEYS:
             key = event.text()
             w, method = self.window, VIEW_KEYS[key][1]
-            target = getattr(w.menus, method, None) or getattr(w, method)
-            w._guard(target, f"key {key}")()
+            target = {"toggle_help": w.menus.toggle_help, "close": w.close}.get(method)
+            w._guard(target or getattr(w.controller, method), f"key {key}")()
         return True
 
 

@@ -42,17 +42,6 @@ from explorer.render.vtk import plain_blending
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
-#: the controller's intents and data the window answers for (its menus, keys, scripts, tests)
-FORWARDED = frozenset({
-    "store", "act", "undo", "redo", "reset_all", "reset_camera", "toggle_difference",
-    "toggle_compare", "swap_sides", "toggle_model", "toggle_ambient", "toggle_diffuse",
-    "toggle_specular", "next_preset", "previous_preset", "next_light_type", "next_light",
-    "choose_mesh", "open_file", "open_session", "save_session_as", "save_preset_as",
-    "import_materials", "export_material", "export_render", "export_turntable", "screenshot",
-    "recent_files", "keep_last_session", "presets", "start_state", "meshes", "errors",
-    "output_dir", "session_path", "turntable", "reload_presets", "material_name",
-    "picture_stem",
-})  # fmt: skip
 
 
 class ExplorerWindow(QtWidgets.QMainWindow):
@@ -107,12 +96,6 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         c.start()
         self.compare.show(None, c.state)
         c.ports.view.show_panel(c.state)
-
-    def __getattr__(self, name: str):
-        controller = self.__dict__.get("controller")
-        if name in FORWARDED and controller is not None:
-            return getattr(controller, name)
-        raise AttributeError(f"{type(self).__name__} has no attribute '{name}'")
 
     # -- building ------------------------------------------------------------------------------
     def _build_views(self, w: int, background) -> None:

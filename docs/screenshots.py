@@ -1,0 +1,156 @@
+"""The docs' pictures of the explorer window (docs/gui*.png), taken from the real window on a
+private Xvfb server: the window at (0, 0) on an empty screen, grabbed from the screen (so an
+open menu is in the picture too).
+
+    python docs/screenshots.py                 # every picture, into docs/
+    python docs/screenshots.py --only gui_compare --out-dir /tmp/shots
+
+Needs Xvfb and ImageMagick's ``import`` (the packages the window tests need). The user's
+presets, recent files and last session are not read or written (a temporary folder stands in
+for them). Look at every picture before committing it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+#: the window's size in the pictures (the default pictures)
+SIZE = (1100, 720)
+#: the longest wait (seconds) for the compiled engine or the difference view
+WAIT_S = 300.0
+
+
+def settle(app, seconds: float = 0.4) -> None:
+    """Let Qt lay out and draw for ``seconds``."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        app.processEvents()
+        time.sleep(0.02)
+
+
+def wait_for(app, what: str, ready) -> None:
+    end = time.monotonic() + WAIT_S
+    while not ready():
+        if time.monotonic() > end:
+            raise SystemExit(f"screenshots: gave up waiting for {what}")
+        settle(app, 0.1)
+
+
+def open_window(app, tmp: Path, argv=(), size=SIZE):
+    """The window of ``phong-explorer gui ARGV`` at ``size``, at the screen's top left, drawn
+    on the compiled engine."""
+    from explorer.app.qt.window import ExplorerWindow
+    from explorer.cli import build_parser
+    from explorer.cli.gui import start_state
+
+    state, mesh = start_state(build_parser().parse_args(["gui", *argv]))
+    w = ExplorerWindow(state, mesh, output_dir=tmp, last_session=tmp / "last.yaml", size=size)
+    w.move(0, 0)
+    w.show()
+    settle(app)
+    wait_for(app, "the compiled engine", lambda: w.engine_label.text() == "")
+    w.render()
+    settle(app)
+    return w
+
+
+def grab(display: str, path: Path, size, crop=None) -> None:
+    """The screen's top-left ``size`` (or ``crop`` = (w, h, x, y)) as a PNG."""
+    w, h, x, y = crop or (*size, 0, 0)
+    subprocess.run(["import", "-display", display, "-window", "root", "-crop",
+                    f"{w}x{h}+{x}+{y}", "+repage", str(path)], check=True)  # fmt: skip
+
+
+def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
+    """Set up the window for picture ``name`` and grab it into ``out/name.png``."""
+    from explorer.app import model as M
+
+    size, argv, crop = SIZE, (), None
+    if name == "gui_800x500":
+        size = (800, 500)
+    elif name == "gui_640x480":
+        size = (640, 480)
+    elif name == "gui_translucent":
+        argv = ("--preset", "jade")
+    w = open_window(app, tmp, argv, size)
+    c = w.controller
+    if name == "gui_640x480":
+        w.panel.setCurrentIndex(1)  # the lights tab
+    elif name in ("gui_lobe_phong", "gui_lobe_blinn"):
+        c.act(M.set_model, name.rsplit("_", 1)[1])
+        x, y, vw, vh = w.widget_box(w.plotter)
+        crop = (540, 428, x, y + vh - 428)  # the view's lower left: the mesh and the lobe plot
+    elif name == "gui_compare":
+        w.panel.setCurrentIndex(2)
+        w.panel.view.compare.click()
+        c.act(M.set_compare_model, "phong")
+        c.act(M.place_light, 12.0, 30.0)  # the handle in both narrow panes
+    elif name == "gui_difference":
+        w.panel.setCurrentIndex(2)
+        c.toggle_difference()
+        wait_for(app, "the difference view", lambda: w.heat.shown)
+    elif name == "gui_file_menu":
+        w.close()
+        w = open_window(app, tmp, ("--mesh", str(HERE / "examples" / "teapot_parts.obj")))
+        w.controller.keep_recent(["/home/user/models/teapot_parts.obj",
+                                  "/home/user/sessions/glazes.yaml"])  # fmt: skip
+        file_menu = w.menuBar().actions()[0]
+        w.menuBar().setActiveAction(file_menu)
+        settle(app)
+        menu = file_menu.menu()
+        menu.setActiveAction(w.recent_menu.menuAction())
+        settle(app, 1.0)  # the submenu opens on its own after a hover delay
+        if not w.recent_menu.isVisible():
+            item = menu.actionGeometry(w.recent_menu.menuAction())
+            w.recent_menu.popup(menu.mapToGlobal(item.topRight()))
+    w.render()
+    settle(app, 0.8)
+    grab(display, out / f"{name}.png", size, crop)
+    w.close()
+    settle(app)
+
+
+NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "gui_difference",
+         "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent")  # fmt: skip
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out-dir", type=Path, default=HERE, help="where the PNGs go (docs/)")
+    ap.add_argument("--only", action="append", choices=NAMES, help="this picture (repeatable)")
+    args = ap.parse_args(argv)
+    for tool in ("Xvfb", "import"):
+        if shutil.which(tool) is None:
+            raise SystemExit(f"screenshots: needs {tool} (apt-get install xvfb imagemagick)")
+    from explorer.app.start import start_xvfb
+
+    server, display = start_xvfb(size=(1400, 900))
+    tmp = Path(tempfile.mkdtemp(prefix="phong-shots-"))
+    os.environ.update(DISPLAY=display, QT_QPA_PLATFORM="xcb",
+                      PHONG_EXPLORER_MATERIALS=str(tmp / "presets"))  # fmt: skip
+    os.environ.pop("VTK_DEFAULT_OPENGL_WINDOW", None)
+    from explorer.app.qtmain import application
+
+    app = application()
+    try:
+        args.out_dir.mkdir(parents=True, exist_ok=True)
+        for name in args.only or NAMES:
+            shoot(name, app, display, tmp, args.out_dir)
+            print(f"wrote {args.out_dir / name}.png")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+        server.terminate()
+        server.wait()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
