@@ -45,8 +45,9 @@ document.addEventListener('keydown', (e) => {
 
 def _number(v3, html, ctrl, key: str, label: str) -> None:
     """A slider (:data:`~explorer.core.controls.STEPS` steps) and a number field for ``key`` in
-    one row, shown when the state has a value for it."""
-    with html.Div(classes="d-flex align-center", v_show=f"{key} !== null"):
+    one row, shown when the state has a value for it (``v_show`` on a wrapper: Vuetify's
+    ``d-flex`` is ``display: flex !important``, which would override v-show's ``display: none``)."""
+    with html.Div(v_show=f"{key} != null"), html.Div(classes="d-flex align-center"):
         v3.VSlider(
             v_model=(f"{key}_step", 0), min=0, max=STEPS, step=1, label=label, hide_details=True,
             density="compact", end=ctrl.seal, raw_attrs=[f'aria-label="{key} slider"'],
@@ -220,6 +221,8 @@ def build(app) -> None:
         layout.title.set_text("phong-explorer")
         layout.drawer.width = DRAWER_WIDTH
         client.Script(KEYS_JS)
+        # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window
+        client.Style("html { overflow-y: auto; }")
         with layout.toolbar:
             v3.VSpacer()
             v3.VBtn("undo", click=ctrl.undo, disabled=("!can_undo",), variant="text",

@@ -72,6 +72,39 @@ def click(driver, name: str) -> None:
     wait(f"{name!r} to take a click", go)
 
 
+def choose(driver, name: str, text: str) -> None:
+    """Open select ``name`` (a click on its field: its input is covered by the value shown)
+    and click the item of its list that reads ``text``, each once it stands still."""
+    from selenium.common.exceptions import WebDriverException
+    from selenium.webdriver.common.by import By
+
+    def still_click(element) -> bool:
+        if not driver.execute_async_script(STILL_JS, element):
+            return False
+        element.click()
+        return True
+
+    def open_list():
+        try:
+            field = driver.execute_script(
+                "return arguments[0].closest('.v-field')", by_name(driver, name)
+            )
+            return field is not None and still_click(field)
+        except (WebDriverException, AssertionError):
+            return False
+
+    def pick():
+        try:
+            items = [e for e in driver.find_elements(By.CSS_SELECTOR, ".v-overlay .v-list-item")
+                     if e.is_displayed() and e.text.strip() == text]  # fmt: skip
+            return bool(items) and still_click(items[0])
+        except WebDriverException:
+            return False
+
+    wait(f"{name!r} to open", open_list)
+    wait(f"{text!r} in {name!r} to take a click", pick)
+
+
 def report(driver) -> dict:
     """The server's report (frame count, view size, probe vertex and pixel, the session)."""
     return driver.execute_async_script(
@@ -462,3 +495,27 @@ def test_compare_a_b_shows_side_b_in_its_own_view(server, browser, mesh):
     wait("side B gone", lambda: report(browser)["compare"] is None)
     click(browser, "material tab")
     assert not console_errors(browser)
+
+
+def test_a_light_shows_only_the_controls_its_type_has_and_the_page_no_scrollbar(server, browser):
+    """A point light has no cone: its cutoff and exponent rows are not drawn (as the desktop
+    hides them); a spot light's are. The page fits its window with no scrollbar drawn."""
+    rep = open_page(browser, server.url)
+    assert browser.execute_script(
+        "return document.documentElement.clientWidth === window.innerWidth"
+    )
+    click(browser, "lights tab")
+    light = rep["session"]["scene"]["lights"][rep["session"]["light"] - 1]
+    assert light.get("type", "point") == "point"
+    wait("the lights tab", lambda: by_name(browser, "distance").is_displayed())
+    for key in ("cutoff", "exponent"):
+        assert not by_name(browser, key).is_displayed()
+        assert not by_name(browser, f"{key} slider").is_displayed()
+    choose(browser, "type", "spot")
+    wait("a spot light", lambda: report(browser)["session"]["scene"]["lights"][
+        rep["session"]["light"] - 1].get("type") == "spot")  # fmt: skip
+    wait("the cone's rows", lambda: by_name(browser, "cutoff").is_displayed()
+         and by_name(browser, "exponent").is_displayed())  # fmt: skip
+    click(browser, "undo")
+    wait("a point light again", lambda: not by_name(browser, "cutoff").is_displayed())
+    click(browser, "material tab")
