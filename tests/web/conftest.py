@@ -44,6 +44,8 @@ class Server:
         self.log = log
         self._out = open(log, "w")  # noqa: SIM115 - closed in stop()
         env = dict(os.environ if env is None else env, PHONG_EXPLORER_KERNELS=SERVER_KERNELS)
+        # the server keeps its session when it stops (web --last): never in the user's folder
+        env.setdefault("PHONG_EXPLORER_LAST_SESSION", str(log.with_suffix(".last.yaml")))
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "explorer.cli", "web", "--port", str(self.port), *args],
             stdout=self._out, stderr=subprocess.STDOUT, env=env,
