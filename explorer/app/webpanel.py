@@ -254,7 +254,7 @@ def _files(app) -> None:
             c.report(exc, f"download {kind}")
             return None
 
-    def on_upload(name, opener):
+    def on_upload(name, opener, where=None):
         def changed(**kw):
             upload = kw.get(name)
             if not upload:
@@ -262,7 +262,7 @@ def _files(app) -> None:
             try:
                 opener(upload)
             except ExplorerError as exc:
-                c.report(exc, name.replace("_", " "))
+                c.report(exc, where or name.replace("_", " "))
             finally:
                 state[name] = None
 
@@ -270,7 +270,7 @@ def _files(app) -> None:
 
     on_upload("session_upload", app.open_uploaded_session)
     on_upload("mesh_upload", app.open_uploaded_mesh)
-    on_upload("mtl_upload", app.import_uploaded_materials)
+    on_upload("mtl_upload", app.import_uploaded_materials, "import materials")
 
 
 def connect(app) -> None:
