@@ -36,6 +36,9 @@ PICKER_HINT = ("pick a colour: the picker is 8-bit (#rrggbb, steps of 1/255); th
 #: the colour swatch beside a colour field (its background is the value's 8-bit colour)
 SWATCH_STYLE = ("width: 36px; height: 36px; flex: none; border: 1px solid #757575; "
                 "border-radius: 4px;")  # fmt: skip
+#: the status line: at most three lines of the last message (the log has it whole)
+MESSAGE_STYLE = ("display: -webkit-box; -webkit-line-clamp: 3; -webkit-box-orient: vertical; "
+                 "overflow: hidden; white-space: pre-line")  # fmt: skip
 #: a click that asks the server for a file and saves it (the browser's download)
 DOWNLOAD_JS = ("trigger('download', ['{kind}']).then(f => f && utils.download(f.name, f.content, "
                "f.type))")  # fmt: skip
@@ -316,10 +319,14 @@ def build(app) -> None:
                     _lights_tab(v3, html, ctrl)
                 with v3.VWindowItem(value="view", classes="pa-2"):
                     _view_tab(v3, html, ctrl)
-            html.Div("{{ engine }}", v_show="engine", classes="text-caption pa-2",
-                     raw_attrs=['aria-label="engine"'])  # fmt: skip
-            html.Div("{{ message }}", classes=("'text-caption pa-2 ' + (message_level === "
-                     "'error' ? 'text-error' : '')",), raw_attrs=['role="status"'])  # fmt: skip
+            # the engine and the last message stay at the drawer's foot (the panel above
+            # scrolls when it is taller than the window)
+            with v3.Template(v_slot_append=True):
+                html.Div("{{ engine }}", v_show="engine", classes="text-caption px-2",
+                         raw_attrs=['aria-label="engine"'])  # fmt: skip
+                html.Div("{{ message }}", classes=("'text-caption px-2 pb-1 ' + (message_level "
+                         "=== 'error' ? 'text-error' : '')",), style=MESSAGE_STYLE,
+                         raw_attrs=['role="status"'])  # fmt: skip
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
             with html.Div(classes="d-flex", style="width: 100%; height: 100%"):
                 with html.Div(style="flex: 1 1 0; height: 100%; position: relative"):
