@@ -255,7 +255,7 @@ def test_ctrl_z_undoes_and_ctrl_shift_z_redoes(server, browser):
 
 
 def test_a_closed_tab_leaves_the_server_serving_a_new_tab(server, browser, downloads, mesh):
-    from conftest import new_browser
+    from webserver import new_browser
 
     other = new_browser(downloads)
     try:
@@ -289,7 +289,7 @@ def listening_addresses(port: int) -> set[str]:
 
 
 def test_it_listens_on_this_machine_only_and_says_so_otherwise(server, tmp_path):
-    from conftest import Server
+    from webserver import Server
 
     assert listening_addresses(server.port) == {"127.0.0.1"}
     assert "warning" not in server.output()

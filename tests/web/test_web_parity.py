@@ -277,7 +277,7 @@ def test_a_colour_picked_sets_the_value_and_the_swatch_shows_it(server, browser)
 
 
 def test_web_last_reopens_the_session_kept_when_the_server_stopped(tmp_path, downloads):
-    from conftest import Server, need_browser, new_browser
+    from webserver import Server, need_browser, new_browser
 
     need_browser()
     env = dict(os.environ, PHONG_EXPLORER_MATERIALS=str(tmp_path / "presets"),
