@@ -235,6 +235,7 @@ class WebExplorer(WebFiles):
         with self.server.state as s:
             s.progress = dict(job)
             s.turntable_ready = not job["running"] and path is not None and path.is_file()
+            s.turntable_made = getattr(self, "turntable_made", "") if s.turntable_ready else ""
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:

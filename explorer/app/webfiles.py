@@ -127,8 +127,14 @@ class WebFiles:
             raise ExplorerError(f"frames: a whole number of frames, got {frames!r}")
         c = self.controller
         path = self._fresh_folder("turntable") / f"{c.picture_stem()}-turntable{suffix}"
+        before = getattr(self, "turntable_path", None), getattr(self, "turntable_made", "")
         self.turntable_path = path
-        c.export_turntable(path, frames=int(n))
+        self.turntable_made = f"{int(n)} frames, {suffix[1:].upper()}"
+        try:
+            c.export_turntable(path, frames=int(n))
+        except BaseException:
+            self.turntable_path, self.turntable_made = before  # the one made before stays
+            raise
 
     def turntable_download(self) -> dict:
         """The turntable written last, as a file for the page to save."""

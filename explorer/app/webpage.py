@@ -206,7 +206,8 @@ def _turntable(v3, html, ctrl) -> None:
                            height=6, raw_attrs=['aria-label="progress"'])  # fmt: skip
         v3.VBtn("cancel", click=ctrl.cancel_job, size="small", variant="text",
                 raw_attrs=['aria-label="cancel"'])  # fmt: skip
-    v3.VBtn("download the turntable", v_show="turntable_ready", size="small",
+    v3.VBtn("download the turntable ({{ turntable_made }})", v_show="turntable_ready",
+            size="small",
             click=DOWNLOAD_JS.format(kind="turntable"),
             raw_attrs=['aria-label="download turntable"'])  # fmt: skip
 
@@ -286,7 +287,7 @@ def build(app) -> None:
         models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
-        turntable_ready=False, show_messages=False,
+        turntable_ready=False, turntable_made="", show_messages=False,
         turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
         compare_on=False,
         can_undo=False, can_redo=False, undo_label="", redo_label="",
