@@ -177,13 +177,21 @@ def test_every_control_is_named_by_its_scene_key(server, browser):
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("preset", "ka", "kd", "ks", "shininess", "opacity", "ambient", "diffuse",
                 "specular", "emission", "model", "show_ambient", "show_diffuse",
-                "show_specular", "view", "undo", "redo", "save session"):  # fmt: skip
+                "show_specular", "view", "undo", "redo", "save session", "messages",
+                "import materials", "ambient picker", "diffuse picker", "specular picker",
+                "emission picker"):  # fmt: skip
         assert key in names, f"{key!r} not among {sorted(n for n in names if n)}"
     click(browser, "lights tab")
     names = {e.get_attribute("aria-label")
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("light", "type", "color", "intensity", "azimuth", "elevation", "distance",
-                "attenuation", "add light", "duplicate light", "remove light"):  # fmt: skip
+                "attenuation", "add light", "duplicate light", "remove light",
+                "color picker"):  # fmt: skip
+        assert key in names, key
+    click(browser, "view tab")
+    names = {e.get_attribute("aria-label")
+             for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
+    for key in ("turntable frames", "turntable format", "turntable"):
         assert key in names, key
     click(browser, "material tab")
 
