@@ -287,11 +287,12 @@ def build(app) -> None:
         models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
-        turntable_ready=False, turntable_made="", show_messages=False,
+        turntable_ready=False, turntable_made="",
         turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
         compare_on=False,
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
+    server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
         layout.drawer.width = DRAWER_WIDTH
