@@ -27,6 +27,7 @@ import socket
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 import urllib.request
 from pathlib import Path
@@ -77,13 +78,15 @@ def free_port() -> int:
 
 def browser():
     sys.path.insert(0, str(ROOT / "tests" / "web"))
-    from conftest import new_browser  # the tests' headless Chromium
+    from webserver import new_browser  # the tests' headless Chromium
 
     return new_browser(Path(os.environ.get("TMPDIR", "/tmp")))
 
 
 def start_server(port: int, log) -> subprocess.Popen:
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    # the server keeps its session when it stops (web --last): not over the user's own
+    last = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-last-session.yaml"
+    env = dict(os.environ, PYTHONPATH=str(ROOT), PHONG_EXPLORER_LAST_SESSION=str(last))
     return subprocess.Popen(
         [sys.executable, "-m", "explorer.cli", "web", "--mesh", "teapot", "--resolution", "56",
          "--port", str(port)],

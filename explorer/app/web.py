@@ -26,6 +26,7 @@ import logging
 import os
 import tempfile
 import threading
+import time
 from collections.abc import Sequence
 
 import numpy as np
@@ -82,11 +83,14 @@ class WebExplorer(WebFiles):
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
     materials_dirs : extra preset directories; preset_dir : where presets are saved (default:
         the user's); size : the view's first size (pixels); name : the trame server's name
-        (one server per name in a process); background : RGB in [0, 1]
+        (one server per name in a process); background : RGB in [0, 1]; last_session : where
+        :func:`serve` keeps the session when the server stops (True: the desktop's file,
+        ``--last`` reopens it; None: nowhere)
     """
 
     def __init__(self, state: M.State, mesh: Mesh, *, materials_dirs=(), preset_dir=None,
-                 size=VIEW_SIZE, name: str = "phong-explorer", background=None):  # fmt: skip
+                 size=VIEW_SIZE, name: str = "phong-explorer", background=None,
+                 last_session=None):  # fmt: skip
         from trame.app import get_server
 
         from explorer.render.vtk import plotter  # VTK only once a server is made
@@ -106,7 +110,7 @@ class WebExplorer(WebFiles):
         self.worker = DifferenceWorker(self._deliver)
         self.controller = Controller(
             state, mesh, Ports.of(self, worker=self.worker), materials_dirs=materials_dirs,
-            preset_dir=preset_dir, output_dir=self._uploads.name, last_session=None,
+            preset_dir=preset_dir, output_dir=self._uploads.name, last_session=last_session,
         )  # fmt: skip
         self.store = self.controller.store
         state = self.store.state
@@ -185,8 +189,9 @@ class WebExplorer(WebFiles):
     # -- Messages --------------------------------------------------------------------------------
     def show_message(self, text: str, level: str = "info", details: Sequence[str] = (),
                      msecs: int | None = None, open_log: bool = True) -> None:  # fmt: skip
-        self.messages = [*self.messages, {"text": text, "level": level,
-                                          "details": list(details)}][-MESSAGE_LOG:]  # fmt: skip
+        text, details = self.page_text(text), [self.page_text(d) for d in details]
+        entry = {"text": text, "level": level, "details": details, "at": time.strftime("%H:%M:%S")}
+        self.messages = [*self.messages, entry][-MESSAGE_LOG:]
         with self.server.state as s:
             s.message = text
             s.message_level = level
@@ -230,6 +235,7 @@ class WebExplorer(WebFiles):
         with self.server.state as s:
             s.progress = dict(job)
             s.turntable_ready = not job["running"] and path is not None and path.is_file()
+            s.turntable_made = getattr(self, "turntable_made", "") if s.turntable_ready else ""
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:
@@ -414,11 +420,26 @@ def own_arguments() -> None:
     os.environ["TRAME_ARGS"] = ""
 
 
+def _stop(signum, frame):
+    """SIGTERM ends the server as Ctrl-C does (the session is kept on the way out)."""
+    raise KeyboardInterrupt
+
+
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
-    """Serve ``app`` until the process ends (prints ``App running at:`` and the URL)."""
+    """Serve ``app`` until the process ends (prints ``App running at:`` and the URL). When the
+    server stops (Ctrl-C, SIGTERM) the session is kept as the desktop keeps it when its window
+    closes (:meth:`Controller.keep_last_session`; ``--last`` reopens it)."""
+    import signal
+
     own_arguments()
-    app.server.start(port=port, host=host, open_browser=open_browser, timeout=0,
-                     show_connection_info=True)  # fmt: skip
+    signal.signal(signal.SIGTERM, _stop)
+    try:
+        app.server.start(port=port, host=host, open_browser=open_browser, timeout=0,
+                         show_connection_info=True)  # fmt: skip
+    except KeyboardInterrupt:
+        pass
+    finally:
+        app.controller.keep_last_session()
 
 
 @dataclasses.dataclass

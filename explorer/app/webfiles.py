@@ -15,12 +15,15 @@ into the user's preset folder only.
 
 from __future__ import annotations
 
+import importlib.util
 import itertools
 import os
 import re
 from pathlib import Path
 
+from explorer.app.model import parse_number
 from explorer.app.start import MESH_CHOICES
+from explorer.app.turntablejob import DEFAULT_FRAMES
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.files import read_checked
@@ -41,6 +44,12 @@ DOWNLOADS = {
 UNSAFE = re.compile(r"[^A-Za-z0-9._-]")
 #: the longest uploaded file name kept (characters)
 MAX_UPLOAD_NAME = 100
+
+
+def turntable_formats() -> tuple[str, ...]:
+    """The turntable formats the server can write: a GIF always, an MP4 when imageio-ffmpeg
+    (its bundled ffmpeg) is installed, as ``render --turntable`` needs it."""
+    return (".gif", ".mp4") if importlib.util.find_spec("imageio_ffmpeg") else (".gif",)
 
 
 def upload_name(name: str) -> str:
@@ -77,6 +86,11 @@ class WebFiles:
         folder.mkdir()
         return folder
 
+    def page_text(self, text: str) -> str:
+        """``text`` with the server's private folder taken out of its paths: the page names an
+        upload or a download by its own name (``bad.mtl:3: ...``), never a server path."""
+        return re.sub(re.escape(self._uploads.name) + r"/[^/\s]+/", "", str(text))
+
     # -- downloads -------------------------------------------------------------------------------
     def download(self, kind: str) -> dict:
         """``{"name", "type", "content"}``: the session, the view (PNG) or the material
@@ -100,15 +114,27 @@ class WebFiles:
         return {"name": Path(path).name, "type": mime,
                 "content": data if kind == "png" else data.decode("utf-8")}  # fmt: skip
 
-    def start_turntable(self, suffix: str = ".gif") -> None:
-        """A turntable of the present state made in the background (the page shows its
-        progress and offers it as a download when it is written)."""
-        if suffix not in (".gif", ".mp4"):
-            raise ExplorerError(f"turntable: .gif or .mp4, got {suffix!r}")
+    def start_turntable(self, suffix: str = ".gif", frames=DEFAULT_FRAMES) -> None:
+        """A turntable of the present state, ``frames`` pictures in a full turn (a whole
+        number, or its text, from 2 to :data:`~explorer.core.tolerances.MAX_TURNTABLE_FRAMES`),
+        written as ``suffix`` (one of :func:`turntable_formats`), made in the background (the
+        page shows its progress and offers it as a download when it is written)."""
+        if suffix not in turntable_formats():
+            raise ExplorerError(f"turntable: the format must be one of "
+                                f"{', '.join(turntable_formats())}, got {suffix!r}")  # fmt: skip
+        n = parse_number("frames", str(frames), 2, tol.MAX_TURNTABLE_FRAMES)
+        if n != int(n):
+            raise ExplorerError(f"frames: a whole number of frames, got {frames!r}")
         c = self.controller
         path = self._fresh_folder("turntable") / f"{c.picture_stem()}-turntable{suffix}"
+        before = getattr(self, "turntable_path", None), getattr(self, "turntable_made", "")
         self.turntable_path = path
-        c.export_turntable(path)
+        self.turntable_made = f"{int(n)} frames, {suffix[1:].upper()}"
+        try:
+            c.export_turntable(path, frames=int(n))
+        except BaseException:
+            self.turntable_path, self.turntable_made = before  # the one made before stays
+            raise
 
     def turntable_download(self) -> dict:
         """The turntable written last, as a file for the page to save."""
@@ -160,6 +186,27 @@ class WebFiles:
                     "never read: upload the .mtl files beside the OBJ"
                 )  # fmt: skip
         self.controller.choose_mesh(os.fspath(path))
+
+    def import_uploaded_materials(self, upload) -> None:
+        """An .mtl file chosen in the page: capped as a file on disk
+        (:data:`~explorer.core.tolerances.MAX_MTL_FILE_BYTES`), kept under its own safe name,
+        then imported by the controller (:meth:`Controller.import_materials`: its materials
+        as presets in the user's preset folder, read by the same reader and checks). Preset
+        files that exist are replaced only when the page's "replace" switch is on."""
+        uploads = upload if isinstance(upload, list) else [upload]
+        if len(uploads) != 1:
+            raise ExplorerError(f"import materials: upload one .mtl file, got {len(uploads)}")
+        name, data = upload_bytes(uploads[0])
+        if not name.lower().endswith(".mtl"):
+            raise ExplorerError(f"import materials: '{upload_name(name)}' is not an .mtl file")
+        check_size(name, data, tol.MAX_MTL_FILE_BYTES, "material library")
+        path = self._fresh_folder("mtl") / upload_name(name)
+        path.write_bytes(data)
+        self.answers = {"yes": bool(self.server.state.preset_replace)}
+        try:
+            self.controller.import_materials(path)
+        finally:
+            self.answers = {}
 
     def save_preset(self, name: str, replace: bool = False) -> None:
         """Save the material as preset ``name`` in the user's preset folder (``replace``: the

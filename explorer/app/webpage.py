@@ -11,10 +11,13 @@ trame is imported inside :func:`build` (``import explorer`` stays free of it).
 from __future__ import annotations
 
 from explorer.app import model as M
+from explorer.app.turntablejob import DEFAULT_FRAMES
+from explorer.app.webfiles import turntable_formats
 from explorer.app.webpanel import LIGHT_NUMBERS, MATERIAL_NUMBERS
 from explorer.core.controls import STEPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS
+from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
 from explorer.geometry.meshes import MESH_SUFFIXES
 
 #: the drawer's width (pixels)
@@ -27,6 +30,15 @@ EXPORTS = {
     "x3d": "material as X3D",
     "preset": "material as preset YAML",
 }
+#: the colour pickers' hint (their tooltip, and a line under the picker)
+PICKER_HINT = ("pick a colour: the picker is 8-bit (#rrggbb, steps of 1/255); the r, g, b "
+               "field keeps the exact value")  # fmt: skip
+#: the colour swatch beside a colour field (its background is the value's 8-bit colour)
+SWATCH_STYLE = ("width: 36px; height: 36px; flex: none; border: 1px solid #757575; "
+                "border-radius: 4px;")  # fmt: skip
+#: the status line: at most three lines of the last message (the log has it whole)
+MESSAGE_STYLE = ("display: -webkit-box; -webkit-line-clamp: 3; -webkit-box-orient: vertical; "
+                 "overflow: hidden; white-space: pre-line")  # fmt: skip
 #: a click that asks the server for a file and saves it (the browser's download)
 DOWNLOAD_JS = ("trigger('download', ['{kind}']).then(f => f && utils.download(f.name, f.content, "
                "f.type))")  # fmt: skip
@@ -61,15 +73,31 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
         )  # fmt: skip
 
 
-def _colour(v3, ctrl, key: str, label: str) -> None:
+def _colour(v3, html, ctrl, key: str, label: str) -> None:
     """A colour field ``"r, g, b"`` for state key ``key``, named ``label`` (the scene file's
-    key)."""
-    v3.VTextField(
-        model_value=(key, ""), label=label, density="compact", hide_details=True,
-        variant="outlined", classes="my-1",
-        change=(ctrl.on_colour, f"['{key}', $event.target.value]"),
-        raw_attrs=[f'aria-label="{label}"'],
-    )  # fmt: skip
+    key), and beside it a swatch of the value (state ``<key>_hex``) that opens an 8-bit
+    colour picker (``<label> picker``)."""
+    with html.Div(classes="d-flex align-center my-1"):
+        v3.VTextField(
+            model_value=(key, ""), label=label, density="compact", hide_details=True,
+            variant="outlined", classes="flex-grow-1",
+            change=(ctrl.on_colour, f"['{key}', $event.target.value]"),
+            raw_attrs=[f'aria-label="{label}"'],
+        )  # fmt: skip
+        with v3.VMenu(close_on_content_click=False, location="end", update_modelValue=ctrl.seal):
+            with v3.Template(v_slot_activator="{ props }"):
+                html.Button(
+                    v_bind="props", v_show=f"{key}_hex", title=PICKER_HINT, classes="ml-2",
+                    style=(f"'{SWATCH_STYLE} background: ' + {key}_hex",),
+                    raw_attrs=[f'aria-label="{label} picker"'],
+                )  # fmt: skip
+            with v3.VCard(raw_attrs=[f'aria-label="{label} picker dialog"']):
+                v3.VColorPicker(
+                    model_value=(f"{key}_hex", "#000000"), modes=("['hex']",), mode="hex",
+                    update_modelValue=(ctrl.on_pick, f"['{key}', $event]"),
+                    raw_attrs=[f'aria-label="{label} picker colours"'],
+                )  # fmt: skip
+                html.Div(PICKER_HINT, classes="text-caption pa-2", style="max-width: 300px")
 
 
 def _material_tab(v3, html, ctrl) -> None:
@@ -81,7 +109,7 @@ def _material_tab(v3, html, ctrl) -> None:
     for key in MATERIAL_NUMBERS:
         _number(v3, html, ctrl, key, key)
     for term in RGB_KEYS:
-        _colour(v3, ctrl, term, term)
+        _colour(v3, html, ctrl, term, term)
     v3.VSelect(v_model=("model", "blinn"), items=("models",), label="model",
                density="compact", hide_details=True,
                raw_attrs=['aria-label="model"'])  # fmt: skip
@@ -104,7 +132,7 @@ def _lights_tab(v3, html, ctrl) -> None:
     v3.VSelect(v_model=("type", None), items=("light_types",), label="type",
                density="compact", hide_details=True, v_show="type !== null",
                raw_attrs=['aria-label="type"'])  # fmt: skip
-    _colour(v3, ctrl, "light_color", "color")
+    _colour(v3, html, ctrl, "light_color", "color")
     for key in LIGHT_NUMBERS:
         _number(v3, html, ctrl, key, key)
     v3.VTextField(
@@ -156,8 +184,21 @@ def _compare(v3, html, ctrl) -> None:
 
 
 def _turntable(v3, html, ctrl) -> None:
-    """A turntable GIF made on the server under a progress bar (Cancel), then downloaded."""
-    v3.VBtn("make a turntable (GIF)", click=ctrl.turntable, size="small", classes="my-1",
+    """A turntable (its frames in a full turn and its format chosen first) made on the server
+    under a progress bar (Cancel), then downloaded."""
+    with html.Div(classes="d-flex align-center mt-2"):
+        v3.VTextField(
+            v_model=("turntable_frames", DEFAULT_FRAMES), label="frames in a full turn",
+            type="number", min=2, max=MAX_TURNTABLE_FRAMES, density="compact",
+            hide_details=True, variant="outlined", classes="mr-2",
+            raw_attrs=['aria-label="turntable frames"'],
+        )  # fmt: skip
+        v3.VSelect(v_model=("turntable_format", ".gif"), items=("turntable_formats",),
+                   label="format", density="compact", hide_details=True,
+                   raw_attrs=['aria-label="turntable format"'])  # fmt: skip
+    html.Div("MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg)", classes="text-caption",
+             v_show="turntable_formats.length < 2")  # fmt: skip
+    v3.VBtn("make a turntable", click=ctrl.turntable, size="small", classes="my-1",
             disabled=("progress && progress.running",),
             raw_attrs=['aria-label="turntable"'])  # fmt: skip
     with html.Div(v_show="progress && progress.running", classes="my-1"):
@@ -166,7 +207,8 @@ def _turntable(v3, html, ctrl) -> None:
                            height=6, raw_attrs=['aria-label="progress"'])  # fmt: skip
         v3.VBtn("cancel", click=ctrl.cancel_job, size="small", variant="text",
                 raw_attrs=['aria-label="cancel"'])  # fmt: skip
-    v3.VBtn("download the turntable", v_show="turntable_ready", size="small",
+    v3.VBtn("download the turntable ({{ turntable_made }})", v_show="turntable_ready",
+            size="small",
             click=DOWNLOAD_JS.format(kind="turntable"),
             raw_attrs=['aria-label="download turntable"'])  # fmt: skip
 
@@ -199,6 +241,38 @@ def _save_preset(v3, html, ctrl) -> None:
                      hide_details=True, raw_attrs=['aria-label="replace preset"'])  # fmt: skip
         v3.VBtn("save", click=ctrl.save_preset, size="small",
                 raw_attrs=['aria-label="save preset"'])  # fmt: skip
+    v3.VFileInput(
+        v_model=("mtl_upload", None), label="import materials (.mtl) as presets", accept=".mtl",
+        density="compact", hide_details=True, classes="my-2",
+        raw_attrs=['aria-label="import materials"'],
+    )  # fmt: skip
+
+
+def _message_log(v3, html) -> None:
+    """The toolbar's "messages" button and the message log it opens: every message of the
+    session (state ``message_log``: time, level, text and details), oldest first."""
+    v3.VBtn("messages", click="show_messages = true", variant="text",
+            title="every message of the session (the desktop's View > Messages)",
+            raw_attrs=['aria-label="messages"'])  # fmt: skip
+    with v3.VDialog(v_model=("show_messages", False), max_width=720, scrollable=True):
+        with v3.VCard(raw_attrs=['aria-label="message log"', 'role="log"']):
+            v3.VCardTitle("messages")
+            with v3.VCardText(style="max-height: 60vh"):
+                html.Div("no messages yet", v_show="!message_log.length",
+                         classes="text-caption")  # fmt: skip
+                with html.Div(v_for="(m, i) in message_log", key="i", classes="mb-1",
+                              raw_attrs=['aria-label="message"']):  # fmt: skip
+                    html.Div("{{ m.at }} {{ m.level }}: {{ m.text }}",
+                             classes=("m.level === 'error' ? 'text-error' : m.level === "
+                                      "'warning' ? 'text-warning' : ''",),
+                             style="white-space: pre-wrap")  # fmt: skip
+                    html.Div("{{ d }}", v_for="(d, j) in m.details", key="j",
+                             classes="text-caption ml-4",
+                             style="white-space: pre-wrap")  # fmt: skip
+            with v3.VCardActions():
+                v3.VSpacer()
+                v3.VBtn("close", click="show_messages = false",
+                        raw_attrs=['aria-label="close messages"'])  # fmt: skip
 
 
 def build(app) -> None:
@@ -213,10 +287,13 @@ def build(app) -> None:
     server.state.update(
         models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
-        session_upload=None, mesh_upload=None, progress=None, turntable_ready=False,
+        session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
+        turntable_ready=False, turntable_made="",
+        turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
         compare_on=False,
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
+    server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
         layout.drawer.width = DRAWER_WIDTH
@@ -232,6 +309,7 @@ def build(app) -> None:
                     title=("'Redo ' + redo_label + ' (Ctrl+Shift+Z)'",),
                     raw_attrs=['aria-label="redo"'])  # fmt: skip
             _files(v3, ctrl)
+            _message_log(v3, html)
         with layout.drawer:
             with v3.VTabs(v_model="tab", density="compact", grow=True):
                 for t in ("material", "lights", "view"):
@@ -246,10 +324,14 @@ def build(app) -> None:
                     _lights_tab(v3, html, ctrl)
                 with v3.VWindowItem(value="view", classes="pa-2"):
                     _view_tab(v3, html, ctrl)
-            html.Div("{{ engine }}", v_show="engine", classes="text-caption pa-2",
-                     raw_attrs=['aria-label="engine"'])  # fmt: skip
-            html.Div("{{ message }}", classes=("'text-caption pa-2 ' + (message_level === "
-                     "'error' ? 'text-error' : '')",), raw_attrs=['role="status"'])  # fmt: skip
+            # the engine and the last message stay at the drawer's foot (the panel above
+            # scrolls when it is taller than the window)
+            with v3.Template(v_slot_append=True):
+                html.Div("{{ engine }}", v_show="engine", classes="text-caption px-2",
+                         raw_attrs=['aria-label="engine"'])  # fmt: skip
+                html.Div("{{ message }}", classes=("'text-caption px-2 pb-1 ' + (message_level "
+                         "=== 'error' ? 'text-error' : '')",), style=MESSAGE_STYLE,
+                         raw_attrs=['role="status"'])  # fmt: skip
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
             with html.Div(classes="d-flex", style="width: 100%; height: 100%"):
                 with html.Div(style="flex: 1 1 0; height: 100%; position: relative"):

@@ -16,7 +16,7 @@ from __future__ import annotations
 from urllib.parse import quote
 
 from explorer.app import model as M
-from explorer.app.colours import rgb_bytes, rgb_text
+from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
 from explorer.core.controls import CONTROLS, from_step, to_step
 from explorer.core.errors import ExplorerError
 from explorer.core.material import RGB_KEYS
@@ -77,6 +77,7 @@ def values(state: M.State) -> dict:
         out[f"{k}_step"] = None if v is None else to_step(CONTROLS[k], v, *slider_range(state, k))
     m = state.material
     out.update({term: rgb_text(getattr(m, term)) for term in RGB_KEYS})
+    out.update({f"{term}_hex": rgb_hex(getattr(m, term)) for term in RGB_KEYS})
     out.update({f"show_{t}": t not in state.hidden for t in M.TERMS})
     lights = state.scene.lights
     light = state.selected_light
@@ -86,6 +87,7 @@ def values(state: M.State) -> dict:
         lights=[{"title": f"{i + 1}: {lt.type}", "value": i} for i, lt in enumerate(lights)],
         light=state.light if lights else None, type=None if light is None else light.type,
         light_color=None if light is None else rgb_text(M.light_colour(light)[0]),
+        light_color_hex=None if light is None else rgb_hex(M.light_colour(light)[0]),
         attenuation=rgb_text(light.attenuation) if positional else None,
         difference=state.difference, compare_on=state.compare is not None,
         compare_preset=state.compare_preset, compare_model=state.compare_model,
@@ -131,12 +133,25 @@ def _numbers(app) -> None:
                lambda v: v != number_values(app.store.state)[key]
                and c.set_value(key, v, merge=False))  # fmt: skip
 
-    def on_colour(key, text):
+    def colour_sender(key, merge):
+        """``send(rgb)``: colour ``key`` set (a run of ``merge`` steps is one undo step)."""
         if key == "light_color":
-            send = lambda rgb: c.act(M.set_light_colour, rgb, label="light color")  # noqa: E731
-        else:
-            send = lambda rgb: c.set_value(key, rgb, merge=False)  # noqa: E731
-        _typed(app, lambda: M.parse_colour(key, str(text)), send)
+            return lambda rgb: c.act(M.set_light_colour, rgb, label="light color",
+                                     merge=key if merge else None)  # fmt: skip
+        return lambda rgb: c.set_value(key, rgb, merge=merge)
+
+    def on_colour(key, text):
+        _typed(app, lambda: M.parse_colour(key, str(text)), colour_sender(key, False))
+
+    def on_pick(key, text):
+        """A colour picked (8-bit ``#rrggbb``): set when it is not the 8-bit colour the state
+        shows already; a run of picks while the picker is open is one undo step (sealed when
+        it closes)."""
+        if app.pushing or not text:
+            return
+        send = colour_sender(key, True)
+        _typed(app, lambda: parse_hex(key, str(text)), lambda rgb: rgb_hex(rgb)
+               != values(app.store.state)[f"{key}_hex"] and send(rgb))  # fmt: skip
 
     def on_attenuation(text):
         lo, hi = CONTROLS["attenuation"].field_range
@@ -151,6 +166,7 @@ def _numbers(app) -> None:
 
     ctrl.on_field = app.guard(on_field, "field")
     ctrl.on_colour = app.guard(on_colour, "colour")
+    ctrl.on_pick = app.guard(on_pick, "colour picker")
     ctrl.on_attenuation = app.guard(on_attenuation, "attenuation")
     ctrl.seal = app.guard(c.release, "slider")
 
@@ -193,7 +209,8 @@ def _choices(app) -> None:
         )
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
-    ctrl.turntable = app.guard(app.start_turntable, "turntable")
+    ctrl.turntable = app.guard(lambda: app.start_turntable(
+        str(state.turntable_format), state.turntable_frames), "turntable")  # fmt: skip
     ctrl.cancel_job = app.guard(app.cancel_job, "cancel")
     ctrl.save_preset = app.guard(lambda: app.save_preset(
         state.preset_name or "", bool(state.preset_replace)), "save preset")  # fmt: skip
@@ -237,7 +254,7 @@ def _files(app) -> None:
             c.report(exc, f"download {kind}")
             return None
 
-    def on_upload(name, opener):
+    def on_upload(name, opener, where=None):
         def changed(**kw):
             upload = kw.get(name)
             if not upload:
@@ -245,7 +262,7 @@ def _files(app) -> None:
             try:
                 opener(upload)
             except ExplorerError as exc:
-                c.report(exc, name.replace("_", " "))
+                c.report(exc, where or name.replace("_", " "))
             finally:
                 state[name] = None
 
@@ -253,6 +270,7 @@ def _files(app) -> None:
 
     on_upload("session_upload", app.open_uploaded_session)
     on_upload("mesh_upload", app.open_uploaded_mesh)
+    on_upload("mtl_upload", app.import_uploaded_materials, "import materials")
 
 
 def connect(app) -> None:

@@ -6,11 +6,14 @@
     phong-explorer web --preset jade --mesh torus --port 9000 --open
     phong-explorer web scene.yaml
     phong-explorer web --session my.yaml             # a saved session, exactly
+    phong-explorer web --last                        # the session kept when it last stopped
 
-It prints its URL and serves until Ctrl-C. It listens on 127.0.0.1 (this machine only) unless
-``--host`` says otherwise, and then warns that anyone who can reach the port can use it. One
-explorer per server: every tab shows and edits the same state. Needs the ``web`` extra
-(``pip install "phong-explorer[web]"``); without it the command says so in one line.
+It prints its URL and serves until Ctrl-C (or SIGTERM); then it keeps the session where the
+desktop's window keeps it on closing, and ``--last`` (either command's) reopens it. It
+listens on 127.0.0.1 (this machine only) unless ``--host`` says otherwise, and then warns that
+anyone who can reach the port can use it. One explorer per server: every tab shows and edits
+the same state. Needs the ``web`` extra (``pip install "phong-explorer[web]"``); without it the
+command says so in one line.
 """
 
 from __future__ import annotations
@@ -48,6 +51,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--session", metavar="FILE", default=None,
         help="open a saved session (Save session, or the desktop's) exactly as it was",
     )  # fmt: skip
+    p.add_argument(
+        "--last", action="store_true",
+        help="reopen the session kept when the explorer (this server, or the desktop's "
+        "window) last closed",
+    )  # fmt: skip
     add_scene_arguments(p, force=False, mesh_default=gui.DEFAULT_MESH)
 
 
@@ -61,6 +69,8 @@ def run(args) -> int:
 
     if not 0 <= args.port <= 65535:
         raise ExplorerError(f"--port must be 0 to 65535, got {args.port}")
+    if args.session is not None and args.last:
+        raise ExplorerError("--session and --last both name a session: give one")
     lack = missing()
     if lack:
         raise ExplorerError(
@@ -75,6 +85,6 @@ def run(args) -> int:
         say(web.OPEN_HOST_WARNING.format(host=host, port=args.port), file=sys.stderr)
     state, mesh = start_state(args)
     app = web.WebExplorer(state, mesh, materials_dirs=tuple(args.materials_dirs),
-                          background=background_from_options(args))  # fmt: skip
+                          background=background_from_options(args), last_session=True)  # fmt: skip
     web.serve(app, port=args.port, host=host, open_browser=args.open)
     return 0

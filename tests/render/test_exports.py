@@ -3,15 +3,13 @@ OBJ meshes with their own materials (render and sheet), and turntables."""
 
 from __future__ import annotations
 
-import gc
-import warnings
 from pathlib import Path
 
-import imageio.v3 as iio
 import numpy as np
 import pygltflib
 import pytest
 import trimesh
+from helpers.frames import read_frames
 
 import explorer
 from explorer.cli import main
@@ -217,18 +215,6 @@ def test_obj_export_writes_its_mtl_and_reads_back(two_groups, tmp_path):
 
 
 # -- turntables ------------------------------------------------------------------------------
-
-
-def read_frames(path) -> np.ndarray:
-    """Every frame of a GIF or MP4, (n, h, w, 3|4) uint8. imageio-ffmpeg's MP4 reader leaves its
-    ffmpeg pipes to the garbage collector (a ResourceWarning, an error in the suite; the writer,
-    which the package uses, closes them): that one warning is ignored here, and the collector
-    runs before the filter is restored."""
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", "unclosed file <_io.Buffered", ResourceWarning)
-        frames = iio.imread(path, index=None)
-        gc.collect()
-    return frames
 
 
 @pytest.mark.parametrize("suffix", [".gif", ".mp4"])

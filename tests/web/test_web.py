@@ -227,13 +227,21 @@ def test_every_control_is_named_by_its_scene_key(server, browser):
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("preset", "ka", "kd", "ks", "shininess", "opacity", "ambient", "diffuse",
                 "specular", "emission", "model", "show_ambient", "show_diffuse",
-                "show_specular", "view", "undo", "redo", "save session"):  # fmt: skip
+                "show_specular", "view", "undo", "redo", "save session", "messages",
+                "import materials", "ambient picker", "diffuse picker", "specular picker",
+                "emission picker"):  # fmt: skip
         assert key in names, f"{key!r} not among {sorted(n for n in names if n)}"
     click(browser, "lights tab")
     names = {e.get_attribute("aria-label")
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("light", "type", "color", "intensity", "azimuth", "elevation", "distance",
-                "attenuation", "add light", "duplicate light", "remove light"):  # fmt: skip
+                "attenuation", "add light", "duplicate light", "remove light",
+                "color picker"):  # fmt: skip
+        assert key in names, key
+    click(browser, "view tab")
+    names = {e.get_attribute("aria-label")
+             for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
+    for key in ("turntable frames", "turntable format", "turntable"):
         assert key in names, key
     click(browser, "material tab")
 
@@ -305,7 +313,7 @@ def test_ctrl_z_undoes_and_ctrl_shift_z_redoes(server, browser):
 
 
 def test_a_closed_tab_leaves_the_server_serving_a_new_tab(server, browser, downloads, mesh):
-    from conftest import new_browser
+    from webserver import new_browser
 
     other = new_browser(downloads)
     try:
@@ -339,7 +347,7 @@ def listening_addresses(port: int) -> set[str]:
 
 
 def test_it_listens_on_this_machine_only_and_says_so_otherwise(server, tmp_path):
-    from conftest import Server
+    from webserver import Server
 
     assert listening_addresses(server.port) == {"127.0.0.1"}
     assert "warning" not in server.output()

@@ -13,8 +13,8 @@ pytestmark = pytest.mark.web
 
 
 def test_a_cold_cache_serves_the_numpy_tier_then_the_compiled_one(cold_tiers, tmp_path):
-    from conftest import need_browser, new_browser
     from test_web import by_name, check_probe, open_page, report, type_value, wait
+    from webserver import need_browser, new_browser
 
     from explorer.app import web
     from explorer.shading import tiers

@@ -5,10 +5,12 @@ names only a built-in mesh, and an OBJ's ``mtllib`` only a library uploaded with
 from __future__ import annotations
 
 import tempfile
+from types import SimpleNamespace
 
 import pytest
 
-from explorer.app.webfiles import WebFiles, upload_name
+from explorer.app.colours import parse_hex, rgb_hex
+from explorer.app.webfiles import WebFiles, turntable_formats, upload_name
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.yamlio import MAX_BYTES
@@ -26,11 +28,22 @@ class Controller:
     def choose_mesh(self, path):
         self.calls.append(("choose_mesh", str(path)))
 
+    def import_materials(self, path):
+        self.calls.append(("import_materials", str(path), self.answers()))
+
+    def export_turntable(self, path, frames):
+        self.calls.append(("export_turntable", str(path), frames))
+
+    def picture_stem(self):
+        return "stem"
+
 
 @pytest.fixture
 def files():
     f = WebFiles()
     f.controller = Controller()
+    f.controller.answers = lambda: dict(f.answers)
+    f.server = SimpleNamespace(state=SimpleNamespace(preset_replace=False))
     f._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-test-")
     yield f
     f._uploads.cleanup()
@@ -90,3 +103,40 @@ def test_an_objs_mtllib_must_be_uploaded_with_it(files):
 def test_one_mesh_file_per_upload(files):
     with pytest.raises(ExplorerError, match="upload one mesh file"):
         files.open_uploaded_mesh([{"name": "m.mtl", "content": b"newmtl red\n"}])
+
+
+def test_an_uploaded_mtl_is_capped_kept_under_its_own_name_and_imported(files):
+    with pytest.raises(ExplorerError, match="'x.obj' is not an .mtl file"):
+        files.import_uploaded_materials({"name": "x.obj", "content": b"v 0 0 0\n"})
+    big = b"#" * (tol.MAX_MTL_FILE_BYTES + 1)
+    with pytest.raises(ExplorerError, match="material library 'm.mtl' is too large"):
+        files.import_uploaded_materials({"name": "m.mtl", "content": big})
+    assert files.controller.calls == []
+    files.server.state.preset_replace = True  # the page's "replace": the answer to "replace?"
+    files.import_uploaded_materials({"name": "../../evil.mtl", "content": b"newmtl a\n"})
+    ((call, path, answers),) = files.controller.calls
+    assert call == "import_materials" and path.endswith("/evil.mtl") and answers == {"yes": True}
+    assert path.startswith(files._uploads.name) and files.answers == {}
+    assert files.page_text(f"{path}:2: Kd: bad") == "evil.mtl:2: Kd: bad"
+
+
+def test_the_turntable_takes_the_frames_and_a_format_the_server_can_write(files):
+    files.start_turntable(".gif", "12")
+    ((call, path, frames),) = files.controller.calls
+    assert path.endswith("stem-turntable.gif") and frames == 12
+    for bad in ("1", "361", "2.5", "many"):
+        with pytest.raises(ExplorerError, match="frames"):
+            files.start_turntable(".gif", bad)
+    with pytest.raises(ExplorerError, match="the format must be one of"):
+        files.start_turntable(".avi", 12)
+    assert ".gif" in turntable_formats() and len(files.controller.calls) == 1
+
+
+def test_a_picked_colour_is_8_bit_both_ways():
+    assert parse_hex("diffuse", "#336699") == (0.2, 0.4, 0.6)
+    assert parse_hex("diffuse", "#FF8000FF") == (1.0, 128 / 255, 0.0)  # the alpha dropped
+    assert parse_hex("diffuse", "#fff") == (1.0, 1.0, 1.0)
+    assert rgb_hex((0.2, 0.4, 0.6)) == "#336699" and rgb_hex((0.5, 2.0, -1.0)) == "#80ff00"
+    for bad in ("", "#12345", "#gg0000", "red"):
+        with pytest.raises(ExplorerError, match="diffuse: a picked colour is #rrggbb"):
+            parse_hex("diffuse", bad)
