@@ -47,7 +47,7 @@ from explorer.app.start import (
 from explorer.app.view import SceneView, view_camera
 from explorer.app.webcompare import WebCompare
 from explorer.app.webfiles import WebFiles
-from explorer.core.errors import ExplorerError
+from explorer.core.errors import ExplorerError, ExplorerTypeError
 from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, load_scene
@@ -74,6 +74,14 @@ FOLLOW_S = 0.004
 FOLLOW_TRIES = 1000
 #: how many messages the page's message log keeps
 MESSAGE_LOG = 50
+#: the environment variable that sends :func:`show`'s page through jupyter-server-proxy: the
+#: Jupyter server's base URL (``/`` for a Jupyter server at the root of its host,
+#: ``/user/NAME/`` under JupyterHub)
+JUPYTER_PROXY_ENV = "PHONG_EXPLORER_JUPYTER_PROXY"
+#: the variable JupyterHub sets in a user's server (its base URL): the page goes through the proxy
+JUPYTERHUB_PREFIX_ENV = "JUPYTERHUB_SERVICE_PREFIX"
+#: the values of :data:`JUPYTER_PROXY_ENV` that keep the direct address (even under JupyterHub)
+PROXY_OFF = ("0", "off", "false", "no")
 
 
 class WebExplorer(WebFiles):
@@ -485,16 +493,77 @@ class Shown:
         self.run(go)
 
     def _repr_html_(self) -> str:
-        return (f'<iframe src="{self.url}" style="width:100%;height:{self.height}px;'
+        import html
+
+        return (f'<iframe src="{html.escape(self.url)}" style="width:100%;height:{self.height}px;'
                 f'border:none" title="phong-explorer"></iframe>')  # fmt: skip
 
 
+def proxy_prefix(proxy: bool | str | None, environ=None) -> str | None:
+    """The Jupyter base URL through which :func:`show`'s page goes (jupyter-server-proxy's
+    ``<base>proxy/<port>/``), or None for the direct address.
+
+    ``proxy``: a base URL (``"/user/ana/"``, ``"https://hub.example.org/user/ana/"``), True
+    (the environment's base URL, else ``/``), False (direct), None (the environment decides:
+    :data:`JUPYTER_PROXY_ENV` when set (:data:`PROXY_OFF`: direct), else JupyterHub's
+    :data:`JUPYTERHUB_PREFIX_ENV`, else direct). The result ends with ``/``; a base URL that
+    is neither a path from ``/`` nor an http(s) URL is an :class:`ExplorerError` naming where
+    it came from."""
+    env = os.environ if environ is None else environ
+    if proxy is False:
+        return None
+    if isinstance(proxy, str):
+        return _base_url(proxy.strip(), "proxy")
+    if proxy is not None and proxy is not True:
+        raise ExplorerTypeError(f"proxy must be a Jupyter base URL, True, False or None, "
+                                f"got {type(proxy).__name__}")  # fmt: skip
+    own = env.get(JUPYTER_PROXY_ENV, "").strip()
+    hub = env.get(JUPYTERHUB_PREFIX_ENV, "").strip()
+    if own.lower() in PROXY_OFF:
+        if proxy is None:
+            return None
+        own = ""  # proxy=True asks for it all the same
+    if own:
+        return _base_url(own, JUPYTER_PROXY_ENV)
+    if hub:
+        return _base_url(hub, JUPYTERHUB_PREFIX_ENV)
+    return "/" if proxy else None
+
+
+def _base_url(base: str, where: str) -> str:
+    """``base`` (a path or an http(s) URL) checked, ending with ``/``."""
+    from urllib.parse import urlsplit
+
+    parts = urlsplit(base)
+    url = parts.scheme in ("http", "https") and parts.netloc
+    path = base.startswith("/") and not base.startswith("//")  # "//host" names another host
+    if not (path or url) or any(c in base for c in " \t\n\"'<>?#\\"):
+        raise ExplorerError(f"{where}: a Jupyter base URL is a path from / (such as "
+                            f"/user/NAME/) or an http(s) URL, got {base!r}")  # fmt: skip
+    return base if base.endswith("/") else base + "/"
+
+
+def page_url(port: int, prefix: str | None) -> str:
+    """The address of the page served on ``port``: direct (``http://127.0.0.1:PORT/``) or,
+    under Jupyter base URL ``prefix``, jupyter-server-proxy's ``<prefix>proxy/<port>/`` (the
+    page's assets are relative and its websocket is ``<page's folder>/ws``: both go through
+    the proxy)."""
+    if prefix is None:
+        return f"http://{DEFAULT_HOST}:{port}/"
+    return f"{prefix}proxy/{int(port)}/"
+
+
 def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
-         port: int = 0, height: int = 720, materials_dirs=()) -> Shown:  # fmt: skip
+         port: int = 0, height: int = 720, materials_dirs=(),
+         proxy: bool | str | None = None) -> Shown:  # fmt: skip
     """Serve an explorer on 127.0.0.1 from a background thread (its own event loop, so the
     notebook's kernel stays free) and return it for display in a notebook cell. ``scene``: a
     :class:`~explorer.core.scene.Scene`, a scene file or None (the explorer's start);
-    ``preset`` overrides its material; ``mesh`` a built-in mesh."""
+    ``preset`` overrides its material; ``mesh`` a built-in mesh. ``proxy``: whether the cell's
+    page goes through jupyter-server-proxy (a remote Jupyter, JupyterHub), and under which
+    Jupyter base URL (:func:`proxy_prefix`; by default, under JupyterHub or when
+    ``$PHONG_EXPLORER_JUPYTER_PROXY`` is set)."""
+    prefix = proxy_prefix(proxy)
     state, m = notebook_state(scene, preset=preset, mesh=mesh, materials_dirs=materials_dirs)
     ready = threading.Event()
     box: dict = {}
@@ -530,4 +599,4 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
         raise ExplorerError("the explorer's web server did not start within 120 s")
     if "error" in box:
         raise box["error"]
-    return Shown(box["app"], f"http://{DEFAULT_HOST}:{box['port']}/", height)
+    return Shown(box["app"], page_url(box["port"], prefix), height)
