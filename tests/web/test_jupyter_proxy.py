@@ -12,6 +12,7 @@ JupyterHub sets it."""
 from __future__ import annotations
 
 import asyncio
+import importlib.util
 import os
 import re
 import subprocess
@@ -80,12 +81,13 @@ def test_the_page_url_is_direct_or_under_the_proxy():
 # -- through a real proxy, in a real browser --------------------------------------------------
 class PrefixProxy:
     """An aiohttp reverse proxy in a thread: ``<hub>proxy/<port>/<rest>`` (HTTP and
-    websocket) to ``127.0.0.1:<port>/<rest>``, as jupyter-server-proxy; ``<hub>notebook``
-    serves ``html`` (the cell's output). ``sockets`` counts the websockets it carried."""
+    websocket) to ``127.0.0.1:<port>/<rest>``, as jupyter-server-proxy; :attr:`blank`, a page
+    of the proxy's origin (where the test writes the cell's output)."""
 
-    def __init__(self, hub: str, html: str):
+    def __init__(self, hub: str, tmp):
         self.port = free_port()
-        self.hub, self.html, self.sockets, self.paths = hub, html, 0, []
+        self.hub = hub
+        self.blank = f"http://127.0.0.1:{self.port}{hub}notebook"
         self.loop = asyncio.new_event_loop()
         started = threading.Event()
         self.thread = threading.Thread(target=self._run, args=(started,), daemon=True)
@@ -108,8 +110,7 @@ class PrefixProxy:
     async def _notebook(self, request):
         from aiohttp import web as aw
 
-        return aw.Response(text=f'<!doctype html><html><head><link rel="icon" href="data:,"></head>'
-                                f"<body>{self.html}</body></html>",
+        return aw.Response(text="<!doctype html><html><body></body></html>",
                            content_type="text/html")  # fmt: skip
 
     async def _forward(self, request):
@@ -118,7 +119,6 @@ class PrefixProxy:
 
         target = f"127.0.0.1:{request.match_info['port']}/{request.match_info['rest']}"
         query = f"?{request.query_string}" if request.query_string else ""
-        self.paths.append(request.path)
         if request.headers.get("Upgrade", "").lower() == "websocket":
             return await self._socket(request, f"ws://{target}{query}")
         hop = {"host", "connection", "upgrade", "transfer-encoding", "content-length",
@@ -138,7 +138,6 @@ class PrefixProxy:
 
         page = aw.WebSocketResponse(max_msg_size=0)
         await page.prepare(request)
-        self.sockets += 1
         async with aiohttp.ClientSession() as s, s.ws_connect(url, max_msg_size=0) as server:
 
             async def pump(src, dst):
@@ -159,6 +158,89 @@ class PrefixProxy:
         self.loop.call_soon_threadsafe(self.loop.stop)
         self.thread.join(30)
         self.loop.close()
+
+
+class JupyterProxy:
+    """``jupyter server`` under base URL ``hub`` with jupyter-server-proxy (as a JupyterHub
+    user's server; no token: the browser would hold the hub's login cookie), its files and
+    settings in ``tmp``; :attr:`blank`, an empty page of its origin (a page of Jupyter's own
+    forbids frames: an HTTP server of the test's, through the proxy)."""
+
+    def __init__(self, hub: str, tmp):
+        from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+        class Blank(BaseHTTPRequestHandler):
+            def do_GET(self):
+                body = b"<!doctype html><html><body></body></html>"
+                self.send_response(200)
+                self.send_header("Content-Type", "text/html")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                self.wfile.write(body)
+
+            def log_message(self, *args):
+                pass
+
+        self.page = ThreadingHTTPServer(("127.0.0.1", 0), Blank)
+        threading.Thread(target=self.page.serve_forever, daemon=True).start()
+        self.port = free_port()
+        self.blank = f"http://127.0.0.1:{self.port}{hub}proxy/{self.page.server_port}/"
+        env = dict(os.environ, **{f"JUPYTER_{k}_DIR": str(tmp / k.lower())
+                                  for k in ("RUNTIME", "CONFIG", "DATA")})  # fmt: skip
+        self.log = tmp / "jupyter.log"
+        with open(self.log, "w") as out:
+            self.proc = subprocess.Popen([
+                sys.executable, "-m", "jupyter_server", "--no-browser", "--allow-root",
+                f"--ServerApp.port={self.port}", "--ServerApp.port_retries=0",
+                "--ServerApp.ip=127.0.0.1", f"--ServerApp.base_url={hub}",
+                "--IdentityProvider.token=", f"--ServerApp.root_dir={tmp}",
+                '--ServerApp.jpserver_extensions={"jupyter_server_proxy": True}',
+            ], stdout=out, stderr=subprocess.STDOUT, env=env)  # fmt: skip
+        end = time.monotonic() + START_TIMEOUT
+        while not self._up():
+            if self.proc.poll() is not None or time.monotonic() > end:
+                self.stop()
+                pytest.fail("jupyter server did not start:\n" + self.log.read_text())
+            time.sleep(0.1)
+
+    def _up(self) -> bool:
+        import urllib.request
+
+        try:
+            with urllib.request.urlopen(self.blank, timeout=5) as r:
+                return r.status == 200
+        except OSError:
+            return False
+
+    def stop(self) -> None:
+        self.page.shutdown()
+        self.page.server_close()
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(30)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait()
+
+
+def jupyter_proxy(hub: str, tmp) -> JupyterProxy:
+    if importlib.util.find_spec("jupyter_server_proxy") is None:
+        pytest.skip("jupyter-server-proxy is not installed (the test extra)")
+    return JupyterProxy(hub, tmp)
+
+
+#: the page's websockets, recorded in every document of the tab (the cell's iframe too)
+RECORD_SOCKETS = """
+const Native = window.WebSocket;
+window.__sockets = [];
+window.WebSocket = function (url, ...rest) {
+  window.__sockets.push(String(url));
+  return new Native(url, ...rest);
+};
+window.WebSocket.prototype = Native.prototype;
+Object.assign(window.WebSocket, {CONNECTING: 0, OPEN: 1, CLOSING: 2, CLOSED: 3});
+"""
 
 
 @pytest.fixture(scope="module")
@@ -192,35 +274,50 @@ def kernel(tmp_path_factory):
 
 
 @pytest.mark.web
-def test_the_cell_shows_the_explorer_through_a_prefix_proxy(kernel, tmp_path):
+@pytest.mark.parametrize("make_proxy", [jupyter_proxy, PrefixProxy],
+                         ids=["jupyter-server-proxy", "aiohttp"])  # fmt: skip
+def test_the_cell_shows_the_explorer_through_a_prefix_proxy(kernel, make_proxy, tmp_path):
+    """The cell's HTML written into a page of the proxy's origin (as Jupyter shows a cell's
+    output): its iframe loads the explorer through the proxy, every resource and the websocket
+    under ``/user/ana/proxy/<port>/``; the picture comes, and kd typed in the page changes
+    the state and the picture."""
     from test_web import KNOWN_CONSOLE_ERRORS, by_name, kd, picture_src, report, type_value, wait
 
     src = re.search(r'<iframe src="([^"]+)"', kernel).group(1)
     assert re.fullmatch(r"/user/ana/proxy/\d+/", src), src  # JupyterHub: through the proxy
-    proxy = PrefixProxy(HUB, kernel)
+    proxy = make_proxy(HUB, tmp_path)
     driver = new_browser(tmp_path)
     try:
-        driver.get(f"http://127.0.0.1:{proxy.port}{HUB}notebook")
+        driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": RECORD_SOCKETS})
+        driver.get(proxy.blank)
+        driver.execute_script("document.open(); document.write(arguments[0]); document.close()",
+                              f"<!doctype html><html><body>{kernel}</body></html>")  # fmt: skip
         driver.switch_to.frame(driver.find_element("css selector", "iframe"))
-        # the iframe's address resolved against the notebook's origin (trame answers with
+        page = f"http://127.0.0.1:{proxy.port}{src}"
+        # the iframe's address resolved against the notebook's origin (trame answers / with
         # its index.html)
-        at = driver.execute_script("return location.href")
-        assert at.startswith(f"http://127.0.0.1:{proxy.port}{src}"), at
+        wait("the iframe's page", lambda: driver.execute_script("return location.href")
+             .startswith(page))  # fmt: skip
         first = wait("the first picture through the proxy", lambda: picture_src(driver))
-        assert proxy.sockets >= 1  # the page's websocket went through the proxy
-        assert f"{src}ws" in proxy.paths
-        before = report(driver)
-        assert abs(kd(before) - 0.3) > 0.05
-        type_value(driver, "kd", "0.3")
-        wait("kd 0.3 in the state", lambda: abs(kd(report(driver)) - 0.3) < 1e-9)
+        sockets = driver.execute_script("return window.__sockets")
+        assert sockets == [f"ws://127.0.0.1:{proxy.port}{src}ws"], sockets
+        loaded = driver.execute_script(
+            "return performance.getEntriesByType('resource').map(e => e.name)"
+        )
+        assert loaded and all(u.startswith(page) for u in loaded), loaded
+        now = kd(report(driver))  # the kernel serves each proxy in turn: a value it has not
+        target = max(("0.3", "0.6"), key=lambda v: abs(float(v) - now))
+        type_value(driver, "kd", target)
+        wait(f"kd {target} in the state", lambda: abs(kd(report(driver)) - float(target)) < 1e-9)
         wait("a new picture", lambda: picture_src(driver) not in (None, first))
-        assert by_name(driver, "kd").get_attribute("value") == "0.3"
+        assert by_name(driver, "kd").get_attribute("value") == target
+        known = (*KNOWN_CONSOLE_ERRORS, f"{proxy.port}/favicon.ico")  # the notebook's icon
         errors = [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"
-                  and not any(k in e["message"] for k in KNOWN_CONSOLE_ERRORS)]  # fmt: skip
+                  and not any(k in e["message"] for k in known)]  # fmt: skip
         assert not errors, errors
     except BaseException:
         driver.save_screenshot(str(tmp_path / "page.png"))
-        print(f"the page: {tmp_path / 'page.png'}; proxied: {proxy.paths[-20:]}")
+        print(f"the page: {tmp_path / 'page.png'}")
         raise
     finally:
         driver.quit()
