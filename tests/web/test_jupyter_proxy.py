@@ -21,7 +21,14 @@ import threading
 import time
 
 import pytest
-from webserver import SERVER_KERNELS, START_TIMEOUT, free_port, need_browser, new_browser
+from webserver import (
+    SERVER_KERNELS,
+    START_TIMEOUT,
+    end_process,
+    free_port,
+    need_browser,
+    new_browser,
+)
 
 from explorer.app import web
 from explorer.core.errors import ExplorerError, ExplorerTypeError
@@ -215,13 +222,7 @@ class JupyterProxy:
     def stop(self) -> None:
         self.page.shutdown()
         self.page.server_close()
-        if self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(30)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        end_process(self.proc, 30)
 
 
 def jupyter_proxy(hub: str, tmp) -> JupyterProxy:
@@ -259,18 +260,13 @@ def kernel(tmp_path_factory):
     end = time.monotonic() + START_TIMEOUT
     while not (html := re.search(r"^HTML (.*)$", log.read_text(errors="replace"), re.M)):
         if proc.poll() is not None or time.monotonic() > end:
-            proc.kill()
-            proc.wait()
+            end_process(proc)
             proc.stdin.close()
             pytest.fail("show() did not display:\n" + log.read_text(errors="replace"))
         time.sleep(0.1)
     yield html.group(1)
     proc.stdin.close()
-    try:
-        proc.wait(30)  # the kernel's stdin closed: it ends
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        proc.wait()
+    end_process(proc, 30)
 
 
 @pytest.mark.web
