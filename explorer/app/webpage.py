@@ -100,8 +100,27 @@ def _colour(v3, html, ctrl, key: str, label: str) -> None:
                 html.Div(PICKER_HINT, classes="text-caption pa-2", style="max-width: 300px")
 
 
+def _mesh_materials(v3, html, ctrl) -> None:
+    """A mesh file's own materials (shown when the mesh brings some): what is drawn, the group
+    the controls edit, or a button that draws the file's materials again."""
+    with html.Div(v_show="mesh_materials", classes="mb-2 pa-2 border rounded"):
+        html.Div("{{ mesh_materials }}", classes="text-body-2 mb-1",
+                 raw_attrs=['aria-label="mesh_materials"'])  # fmt: skip
+        v3.VSelect(v_model=("group", None), items=("groups", []), label="group",
+                   item_props=True, density="compact", hide_details=True,
+                   v_show="group != null",
+                   title="the group of the mesh whose material the controls below edit",
+                   raw_attrs=['aria-label="group"'])  # fmt: skip
+        v3.VBtn("use the mesh's materials", click=ctrl.use_mesh_materials, size="small",
+                v_show="group == null",
+                title="draw each group in the material its file gives (undoable)",
+                raw_attrs=['aria-label="use_mesh_materials"'])  # fmt: skip
+
+
 def _material_tab(v3, html, ctrl) -> None:
-    """The preset, the numbers, the colours, the model and the terms."""
+    """The mesh's own materials, the preset, the numbers, the colours, the model and the
+    terms."""
+    _mesh_materials(v3, html, ctrl)
     v3.VAutocomplete(
         v_model=("preset", None), items=("presets", []), label="preset", item_props=True,
         density="compact", hide_details=True, raw_attrs=['aria-label="preset"'],

@@ -53,11 +53,9 @@ def number_values(state: M.State) -> dict:
             for k, v in out.items()}  # fmt: skip
 
 
-def preset_item(info) -> dict:
-    """A preset as the searchable list shows it: its name, its description and the desktop's
-    swatch (the diffuse colour with the specular colour in the top right quarter), as an SVG
-    data URL."""
-    m = info.material
+def swatch_url(m) -> str:
+    """The desktop's swatch of material ``m`` (the diffuse colour with the specular colour in
+    the top right quarter) as an SVG data URL."""
 
     def css(rgb):
         return "rgb({},{},{})".format(*rgb_bytes(rgb))
@@ -65,8 +63,34 @@ def preset_item(info) -> dict:
     svg = ("<svg xmlns='http://www.w3.org/2000/svg' width='18' height='18'>"
            f"<rect width='18' height='18' fill='{css(m.diffuse)}'/>"
            f"<rect x='9' width='9' height='9' fill='{css(m.specular)}'/></svg>")  # fmt: skip
+    return "data:image/svg+xml;utf8," + quote(svg)
+
+
+def preset_item(info) -> dict:
+    """A preset as the searchable list shows it: its name, its description and its swatch."""
+    m = info.material
     return {"title": info.name, "value": info.name, "subtitle": m.description or "",
-            "prependAvatar": "data:image/svg+xml;utf8," + quote(svg)}  # fmt: skip
+            "prependAvatar": swatch_url(m)}  # fmt: skip
+
+
+def mesh_materials_values(state: M.State) -> dict:
+    """What the page says of a mesh file's own materials (as the desktop's box): the line
+    (``mesh_materials``: empty when the mesh brings none), the groups with their swatches and
+    the one the controls edit (``groups``, ``group``: None while a preset covers the mesh)."""
+    mm = state.mesh_materials
+    if mm is None:
+        return {"mesh_materials": "", "groups": [], "group": None}
+    k = len(mm.names)
+    if state.groups is None:
+        cover = f"preset {state.preset!r}" if state.preset else "one material"
+        line = (f"{mm.source} brings {k} material{'s' * (k != 1)} of its own; {cover} covers "
+                "the whole mesh instead")  # fmt: skip
+        return {"mesh_materials": line, "groups": [], "group": None}
+    line = (f"{mm.source} brings its own materials, one per group ({k}); the controls below "
+            f"edit group {mm.label(state.group)}")  # fmt: skip
+    groups = [{"title": mm.names[i] or "(no usemtl)", "value": i, "prependAvatar": swatch_url(m)}
+              for i, m in enumerate(state.groups)]  # fmt: skip
+    return {"mesh_materials": line, "groups": groups, "group": state.group}
 
 
 def values(state: M.State) -> dict:
@@ -93,6 +117,7 @@ def values(state: M.State) -> dict:
         compare_preset=state.compare_preset, compare_model=state.compare_model,
         compare_difference=state.compare_difference,
     )  # fmt: skip
+    out.update(mesh_materials_values(state))
     return out
 
 
@@ -192,6 +217,11 @@ def _choices(app) -> None:
         user(f"show_{term}", lambda v, s, t=term: bool(v) != (t not in s.hidden),
              lambda v, t=term: c.act(M.set_term, t, bool(v), label=f"{t} term"))  # fmt: skip
     user("preset", lambda v, s: v != s.preset, c.pick_preset)
+    user("group", lambda v, s: s.groups is not None and int(v) != s.group,
+         lambda v: c.act(M.select_group, int(v), label="group"))  # fmt: skip
+    ctrl.use_mesh_materials = app.guard(
+        lambda: c.act(M.use_mesh_materials, label="mesh materials"), "mesh materials"
+    )
     user("light", lambda v, s: int(v) != s.light,
          lambda v: c.act(M.select_light, int(v), label="select light"))  # fmt: skip
     user("type", lambda v, s: s.selected_light is not None and v != s.selected_light.type,

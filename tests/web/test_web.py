@@ -93,10 +93,14 @@ def choose(driver, name: str, text: str) -> None:
         except (WebDriverException, AssertionError):
             return False
 
+    def title(item) -> str:  # an item with a subtitle reads both: its title is the name
+        found = item.find_elements(By.CSS_SELECTOR, ".v-list-item-title")
+        return found[0].text.strip() if found else ""
+
     def pick():
         try:
             items = [e for e in driver.find_elements(By.CSS_SELECTOR, ".v-overlay .v-list-item")
-                     if e.is_displayed() and e.text.strip() == text]  # fmt: skip
+                     if e.is_displayed() and text in (e.text.strip(), title(e))]  # fmt: skip
             return bool(items) and still_click(items[0])
         except WebDriverException:
             return False

@@ -49,6 +49,14 @@ def by_name_role(driver, role: str):
     return driver.find_element(By.CSS_SELECTOR, f'[role="{role}"]')
 
 
+def drawn(driver, name: str) -> bool:
+    """Whether control ``name`` is drawn (a select's own input is transparent: its field is
+    what shows)."""
+    element = by_name(driver, name)
+    return driver.execute_script("return arguments[0].closest('.v-input')", element) \
+        .is_displayed() if element.tag_name == "input" else element.is_displayed()  # fmt: skip
+
+
 def user_presets(server) -> Path:
     return server.log.parent / "presets"
 
@@ -322,3 +330,44 @@ def test_web_refuses_session_and_last_together(capsys, tmp_path):
     assert main(["web", "--session", str(tmp_path / "s.yaml"), "--last"]) == 2
     assert capsys.readouterr().err.strip() == (
         "error: --session and --last both name a session: give one")  # fmt: skip
+
+
+def test_a_mesh_files_own_materials_are_chosen_by_group_and_drawn_again(tmp_path, downloads):
+    """An OBJ with its .mtl: the page says the file brings its own materials, the group
+    chooser lists them, the controls edit the chosen group (its kd in the field), a preset
+    covers the mesh and the button draws the file's materials again (as the desktop's box)."""
+    from test_web import choose
+    from webserver import Server, need_browser, new_browser
+
+    need_browser()
+    obj = Path(__file__).resolve().parents[2] / "docs" / "examples" / "teapot_parts.obj"
+    env = dict(os.environ, PHONG_EXPLORER_MATERIALS=str(tmp_path / "presets"),
+               PHONG_EXPLORER_LAST_SESSION=str(tmp_path / "last.yaml"))  # fmt: skip
+    srv = Server(["--mesh", str(obj)], tmp_path / "parts.log", env=env)
+    driver = new_browser(downloads)
+    try:
+        open_page(driver, srv.url)
+        wait("the mesh's materials", lambda: drawn(driver, "group"))
+        line = by_name(driver, "mesh_materials").text
+        assert "teapot_parts.obj brings its own materials, one per group (3)" in line, line
+        assert "edit group 'Porcelain'" in line, line
+        assert by_name(driver, "kd").get_attribute("value") == "0.92"
+        assert not by_name(driver, "use_mesh_materials").is_displayed()
+        choose(driver, "group", "Cobalt_Glaze")
+        wait("the cobalt group's kd", lambda: by_name(driver, "kd").get_attribute("value")
+             == "0.62")  # fmt: skip
+        assert "edit group 'Cobalt_Glaze'" in by_name(driver, "mesh_materials").text
+        assert report(driver)["session"]["groups"]["group"] == 2
+        choose(driver, "preset", "bronze")
+        wait("the button that draws them again",
+             lambda: by_name(driver, "use_mesh_materials").is_displayed())  # fmt: skip
+        assert "preset 'bronze' covers the whole mesh" in by_name(driver, "mesh_materials").text
+        assert not drawn(driver, "group")
+        click(driver, "use_mesh_materials")
+        wait("the groups again", lambda: drawn(driver, "group"))
+        assert report(driver)["session"]["groups"] is not None
+        assert not console_errors(driver)
+        assert "Traceback" not in srv.output()
+    finally:
+        driver.quit()
+        srv.stop()
