@@ -41,8 +41,10 @@ def by_name(driver, name: str):
 
 
 #: whether an element stands still: its box in two consecutive animation frames, the same and
-#: not empty (a tab's content slides in; a click aimed at a sliding button lands beside it, on
-#: a loaded machine: the cause of CI's "timed out waiting for the heat map")
+#: not empty. A click aimed at a control while the page still lays it out can land beside it:
+#: on a loaded machine a click on "add light" was not taken and the screenshot showed
+#: "remove" hovered instead (the likely cause of CI's "timed out waiting for the heat map"; the
+#: tab contents themselves do not slide: the panel's v-window has no transition)
 STILL_JS = """
 const e = arguments[0], done = arguments[arguments.length - 1];
 const a = e.getBoundingClientRect();
