@@ -93,12 +93,13 @@ class WebExplorer(WebFiles):
         the user's); size : the view's first size (pixels); name : the trame server's name
         (one server per name in a process); background : RGB in [0, 1]; last_session : where
         :func:`serve` keeps the session when the server stops (True: the desktop's file,
-        ``--last`` reopens it; None: nowhere)
+        ``--last`` reopens it; None: nowhere); start_warnings : the warnings of the start
+        mesh's materials (printed at the start; the page's message log lists them too)
     """
 
     def __init__(self, state: M.State, mesh: Mesh, *, materials_dirs=(), preset_dir=None,
                  size=VIEW_SIZE, name: str = "phong-explorer", background=None,
-                 last_session=None):  # fmt: skip
+                 last_session=None, start_warnings=()):  # fmt: skip
         from trame.app import get_server
 
         from explorer.render.vtk import plotter  # VTK only once a server is made
@@ -135,6 +136,7 @@ class WebExplorer(WebFiles):
         self.server.state.engine = tiers.status() or ""
         self.server.controller.on_server_ready.add(self._ready)
         self.controller.start()
+        self.controller.say_mesh_warnings(mesh.name, start_warnings, logged=True)
         self._push(state)
 
     # -- drags and errors (the handles' dragger calls these too) ----------------------------------

@@ -52,9 +52,11 @@ def start(args):
     return scene, mesh, preset
 
 
-def start_state(args):
+def start_state(args, warnings: list | None = None):
     """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s; a mesh
-    file's own materials are shown unless ``--preset`` is given (as ``render`` does)."""
+    file's own materials are shown unless ``--preset`` is given (as ``render`` does). The
+    warnings of the mesh's materials are printed, and appended to ``warnings`` when given (the
+    front end shows them in its message log too)."""
     dirs = tuple(args.materials_dirs)
     if getattr(args, "last", False):
         path = S.last_session_path()
@@ -67,7 +69,9 @@ def start_state(args):
     scene, mesh, preset = start(args)
     state = gui.first_state(scene, mesh, preset=preset, materials_dirs=dirs,
                             resolution=args.resolution)  # fmt: skip
-    state, warnings = gui.add_mesh_materials(state, mesh, use=own)
-    for w in warnings:
+    state, found = gui.add_mesh_materials(state, mesh, use=own)
+    for w in found:
         say(f"warning: {printable(w)}", file=sys.stderr)
+    if warnings is not None:
+        warnings.extend(found)
     return state, mesh

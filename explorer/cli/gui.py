@@ -104,11 +104,11 @@ def start(args):
     return shared_start(args)
 
 
-def start_state(args):
+def start_state(args, warnings: list | None = None):
     """``(state, mesh)``: see :func:`explorer.cli.explorerstart.start_state` (the options are
     checked first)."""
     check_options(args)
-    return shared_start_state(args)
+    return shared_start_state(args, warnings)
 
 
 def run(args) -> int:
@@ -129,7 +129,8 @@ def run(args) -> int:
     size = parse_size(args.size)
     if args.screenshot_dir is not None and not os.path.isdir(args.screenshot_dir):
         raise ExplorerError(f"--screenshot-dir: {args.screenshot_dir!r} is not a directory")
-    state, mesh = start_state(args)
+    warnings: list[str] = []
+    state, mesh = start_state(args, warnings)
     # Qt is loaded only when a window opens (every other command starts without it)
     from explorer.app.qtmain import run_window
 
@@ -138,6 +139,7 @@ def run(args) -> int:
             state, mesh, materials_dirs=tuple(args.materials_dirs), size=size,
             state_file=args.state_file, output_dir=args.screenshot_dir,
             background=background_from_options(args), exit_after=args.exit_after,
+            start_warnings=tuple(warnings),
         )  # fmt: skip
     except gui.NoDisplayError as exc:
         say(gui.no_display_message(str(exc)), file=sys.stderr)

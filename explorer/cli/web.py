@@ -83,8 +83,10 @@ def run(args) -> int:
     host = args.host or web.DEFAULT_HOST
     if args.host is not None and host not in ("127.0.0.1", "localhost", "::1"):
         say(web.OPEN_HOST_WARNING.format(host=host, port=args.port), file=sys.stderr)
-    state, mesh = start_state(args)
+    warnings: list[str] = []
+    state, mesh = start_state(args, warnings)
     app = web.WebExplorer(state, mesh, materials_dirs=tuple(args.materials_dirs),
-                          background=background_from_options(args), last_session=True)  # fmt: skip
+                          background=background_from_options(args), last_session=True,
+                          start_warnings=tuple(warnings))  # fmt: skip
     web.serve(app, port=args.port, host=host, open_browser=args.open)
     return 0

@@ -90,9 +90,11 @@ def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
 
     def make(*argv):
         argv = argv or ("--mesh", "icosphere", "--resolution", "3")
-        state, mesh = start_state(build_parser().parse_args(["gui", *argv]))
+        warnings: list[str] = []  # as `gui` starts it: the start mesh's warnings in the log
+        state, mesh = start_state(build_parser().parse_args(["gui", *argv]), warnings)
         w = ExplorerWindow(state, mesh, output_dir=tmp_path, state_file=tmp_path / "state.json",
-                           last_session=tmp_path / "last.yaml", size=(1000, 700))  # fmt: skip
+                           last_session=tmp_path / "last.yaml", size=(1000, 700),
+                           start_warnings=tuple(warnings))  # fmt: skip
         qtbot.addWidget(w)
         w.show()
         qtbot.waitExposed(w)

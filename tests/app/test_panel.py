@@ -322,6 +322,27 @@ def test_the_obj_warnings_are_whole_in_the_message_log(win, qtbot):
     assert win.messages.isVisible()
 
 
+def test_the_start_meshs_warnings_are_in_the_message_log(open_window, qtbot):
+    """`gui --mesh teapot_parts.obj`: the warnings its .mtl's reader printed at the start are
+    in the message log as well (whole), not only in the terminal."""
+    from explorer.app.start import add_mesh_materials
+
+    obj = ROOT / "docs" / "examples" / "teapot_parts.obj"
+    from explorer.cli import build_parser
+    from explorer.cli.gui import start_state
+
+    found: list[str] = []
+    start_state(build_parser().parse_args(["gui", "--mesh", str(obj)]), found)
+    assert len(found) == 3, found
+    win = open_window("--mesh", str(obj))
+    qtbot.waitUntil(lambda: win.messages_indicator.text() == "1 warning")
+    text = win.messages.plain_text()
+    _, expected = add_mesh_materials(win.controller.state, win.view.mesh)
+    for line in expected:
+        assert line in text, f"not whole in the log: {line}"
+    assert found == expected
+
+
 # -- 13b. duplicate ----------------------------------------------------------------------------
 def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
     win.panel.setCurrentIndex(1)

@@ -353,6 +353,12 @@ def test_a_mesh_files_own_materials_are_chosen_by_group_and_drawn_again(tmp_path
         assert "edit group 'Porcelain'" in line, line
         assert by_name(driver, "kd").get_attribute("value") == "0.92"
         assert not by_name(driver, "use_mesh_materials").is_displayed()
+        click(driver, "messages")  # the warnings printed at the start are in the page's log
+        lines = wait("the start's warnings", lambda: (got := log_lines(driver))
+                     and sum(t.count("teapot_parts.mtl:") for t in got) == 3 and got)  # fmt: skip
+        assert any("Ns 180 is above OpenGL's largest GL_SHININESS (128)" in t for t in lines)
+        click(driver, "close messages")
+        wait("the log closed", lambda: not shown(driver, "message log"))
         choose(driver, "group", "Cobalt_Glaze")
         wait("the cobalt group's kd", lambda: by_name(driver, "kd").get_attribute("value")
              == "0.62")  # fmt: skip

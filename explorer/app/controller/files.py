@@ -115,12 +115,20 @@ class FileFlows:
         except ExplorerError as exc:
             self.report(exc, "mesh")
             return False
-        if warnings:
+        self.say_mesh_warnings(mesh.name, warnings)
+        return True
+
+    def say_mesh_warnings(self, mesh_name: str, warnings, *, logged: bool = False) -> None:
+        """The warnings of a mesh file's materials (its .mtl read), one message whose log lines
+        are the warnings, whole: when the mesh is chosen, and for the mesh the explorer
+        started with (``logged``: already printed where the explorer was started)."""
+        if not warnings:
+            return
+        if not logged:
             for w in warnings:
                 log.warning("%s", w)
-            self.say(f"{mesh.name}: its materials read with {plural(len(warnings), 'warning')}"
-                     " (View ▸ Messages)", "warning", warnings, STATUS_MS)  # fmt: skip
-        return True
+        self.say(f"{mesh_name}: its materials read with {plural(len(warnings), 'warning')}"
+                 " (details in the message log)", "warning", list(warnings), STATUS_MS)  # fmt: skip
 
     # -- open -------------------------------------------------------------------------------
     def open_file(self, path=None) -> None:

@@ -52,7 +52,8 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         :class:`~explorer.app.controller.Controller`; state_file : write the session and a
         report as JSON after every frame
     size : (width, height) of the window; lod_vertices, lod_target : see
-        :mod:`explorer.app.view`; background : RGB in [0, 1]
+        :mod:`explorer.app.view`; background : RGB in [0, 1]; start_warnings : the warnings
+        of the start mesh's materials (printed at the start; the message log lists them too)
     """
 
     difference_ready = QtCore.Signal(object)
@@ -60,7 +61,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
     def __init__(self, state: M.State, mesh, *, materials_dirs=(), preset_dir=None,
                  output_dir=None, state_file=None, last_session=None, size=WINDOW_SIZE,
                  lod_vertices: int = LOD_VERTICES, lod_target: int = LOD_TARGET,
-                 background=None):  # fmt: skip
+                 background=None, start_warnings=()):  # fmt: skip
         super().__init__()
         self.setWindowTitle(TITLE)
         self.state_file = Path(state_file) if state_file else None
@@ -94,6 +95,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self._observe()
         self.menus = Menus(self)
         c.start()
+        c.say_mesh_warnings(mesh.name, start_warnings, logged=True)  # printed at the start too
         self.compare.show(None, c.state)
         c.ports.view.show_panel(c.state)
 
