@@ -66,6 +66,22 @@ class MeshMaterials:
         return f"'{name}'" if name else "(no usemtl)"
 
 
+def mesh_materials_line(state: State, source=str) -> str:
+    """What a front end says of the mesh file's own materials: whether they are drawn (and
+    which group the controls edit) or what covers the mesh instead ("" when it brings none).
+    ``source`` formats the file's name (the Qt label makes it bold, HTML-escaped)."""
+    mm = state.mesh_materials
+    if mm is None:
+        return ""
+    k, name = len(mm.names), source(mm.source)
+    if state.groups is not None:
+        return (f"{name} brings its own materials, one per group ({k}); the controls below "
+                f"edit group {mm.label(state.group)}")  # fmt: skip
+    cover = f"preset {state.preset!r}" if state.preset else "one material"
+    return (f"{name} brings {k} material{'s' * (k != 1)} of its own; {cover} covers the whole "
+            "mesh instead")  # fmt: skip
+
+
 @dataclass(frozen=True)
 class State:
     """Everything the explorer shows.

@@ -77,17 +77,10 @@ def mesh_materials_values(state: M.State) -> dict:
     """What the page says of a mesh file's own materials (as the desktop's box): the line
     (``mesh_materials``: empty when the mesh brings none), the groups with their swatches and
     the one the controls edit (``groups``, ``group``: None while a preset covers the mesh)."""
+    line = M.mesh_materials_line(state)
     mm = state.mesh_materials
-    if mm is None:
-        return {"mesh_materials": "", "groups": [], "group": None}
-    k = len(mm.names)
-    if state.groups is None:
-        cover = f"preset {state.preset!r}" if state.preset else "one material"
-        line = (f"{mm.source} brings {k} material{'s' * (k != 1)} of its own; {cover} covers "
-                "the whole mesh instead")  # fmt: skip
+    if mm is None or state.groups is None:
         return {"mesh_materials": line, "groups": [], "group": None}
-    line = (f"{mm.source} brings its own materials, one per group ({k}); the controls below "
-            f"edit group {mm.label(state.group)}")  # fmt: skip
     groups = [{"title": mm.names[i] or "(no usemtl)", "value": i, "prependAvatar": swatch_url(m)}
               for i, m in enumerate(state.groups)]  # fmt: skip
     return {"mesh_materials": line, "groups": groups, "group": state.group}

@@ -10,6 +10,8 @@ scene's lights and the selected one's type, colour, placement, attenuation and c
 
 from __future__ import annotations
 
+import html
+
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
@@ -375,23 +377,12 @@ class MeshMaterialsBox(QtWidgets.QFrame):
         self.setVisible(mm is not None)
         if mm is None:
             return
-        k = len(mm.names)
         own = s.groups is not None
         key = (mm, s.groups, s.group, s.preset)
         if key == self._shown:
             return
         self._shown = key
-        if own:
-            self.label.setText(
-                f"<b>{mm.source}</b> brings its own materials, one per group ({k}); the "
-                f"controls below edit group {mm.label(s.group)}"
-            )
-        else:
-            self.label.setText(
-                f"<b>{mm.source}</b> brings {k} material{'s' * (k != 1)} of its own; "
-                f"{'preset ' + repr(s.preset) if s.preset else 'one material'} covers the "
-                "whole mesh instead"
-            )
+        self.label.setText(M.mesh_materials_line(s, lambda name: f"<b>{html.escape(name)}</b>"))
         if own:
             with QtCore.QSignalBlocker(self.group):
                 self.group.clear()
