@@ -314,3 +314,31 @@ def test_the_controller_runs_without_any_gui_toolkit(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device link", "folder"])
+def test_the_last_session_never_replaces_what_is_not_a_kept_session(ctl, tmp_path, kind, caplog):
+    """Anything but a regular file at the last-session path (a FIFO, a link to a device, a
+    folder) is left as it is when the explorer closes, with a warning; a kept session is
+    replaced."""
+    import logging
+
+    path = tmp_path / "special.yaml"
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "device link":
+        path.symlink_to("/dev/null")
+    else:
+        path.mkdir()
+    before = os.lstat(path)
+    ctl.last_session = path
+    with caplog.at_level(logging.WARNING):
+        ctl.keep_last_session()
+    after = os.lstat(path)
+    assert (after.st_mode, after.st_ino) == (before.st_mode, before.st_ino)
+    assert "could not keep the last session" in caplog.text
+    kept = tmp_path / "kept.yaml"
+    kept.write_text("old")
+    ctl.last_session = kept
+    ctl.keep_last_session()
+    assert "scene" in kept.read_text()

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import stat
 from pathlib import Path
 
 from explorer.app import model as M
@@ -198,12 +199,17 @@ class FileFlows:
         return written
 
     def keep_last_session(self) -> None:
-        """Write the session to the last-session file (``gui --last`` reopens it)."""
+        """Write the session to the last-session file (``gui --last`` reopens it). The file
+        kept before is replaced; anything else at that path (a FIFO, a device, a link, a
+        folder: not a session this explorer kept) is left as it is, and the warning says so."""
         if self.last_session is None:
             return
         try:
             path = Path(self.last_session) if self.last_session is not True else None
-            save_session(path or last_session_path(), self.store.state, overwrite=True)
+            path = path or last_session_path()
+            if os.path.lexists(path) and not stat.S_ISREG(os.lstat(path).st_mode):
+                raise ExplorerError(f"{path}: is not a regular file; left as it is")
+            save_session(path, self.store.state, overwrite=True)
         except ExplorerError as exc:
             log.warning("could not keep the last session: %s", exc)
 
