@@ -51,8 +51,10 @@ def open_window(app, tmp: Path, argv=(), size=SIZE):
     from explorer.cli import build_parser
     from explorer.cli.gui import start_state
 
-    state, mesh = start_state(build_parser().parse_args(["gui", *argv]))
-    w = ExplorerWindow(state, mesh, output_dir=tmp, last_session=tmp / "last.yaml", size=size)
+    warnings: list[str] = []  # as `gui` starts: the start mesh's warnings in the message log
+    state, mesh = start_state(build_parser().parse_args(["gui", *argv]), warnings)
+    w = ExplorerWindow(state, mesh, output_dir=tmp, last_session=tmp / "last.yaml", size=size,
+                       start_warnings=tuple(warnings))  # fmt: skip
     w.move(0, 0)
     w.show()
     settle(app)
