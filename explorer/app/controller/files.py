@@ -120,9 +120,8 @@ class FileFlows:
         return True
 
     def say_mesh_warnings(self, mesh_name: str, warnings, *, logged: bool = False) -> None:
-        """The warnings of a mesh file's materials (its .mtl read), one message whose log lines
-        are the warnings, whole: when the mesh is chosen, and for the mesh the explorer
-        started with (``logged``: already printed where the explorer was started)."""
+        """A mesh file's material warnings as one message, each whole in the log (``logged``:
+        printed already, as for the mesh the explorer started with)."""
         if not warnings:
             return
         if not logged:
@@ -199,9 +198,8 @@ class FileFlows:
         return written
 
     def keep_last_session(self) -> None:
-        """Write the session to the last-session file (``gui --last`` reopens it). The file
-        kept before is replaced; anything else at that path (a FIFO, a device, a link, a
-        folder: not a session this explorer kept) is left as it is, and the warning says so."""
+        """Write the session to the last-session file (``--last`` reopens it), replacing only
+        a regular file: a FIFO, link, device or folder there is left as it is, with a warning."""
         if self.last_session is None:
             return
         try:
