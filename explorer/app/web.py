@@ -32,7 +32,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from explorer.app import model as M
-from explorer.app import webpage, webpanel
+from explorer.app import webguard, webpage, webpanel
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import PENDING, DifferenceWorker, HeatMap
 from explorer.app.handledrag import HandleDragger
@@ -65,7 +65,8 @@ DEFAULT_HOST = "127.0.0.1"
 #: the warning printed when the server listens beyond this machine
 OPEN_HOST_WARNING = (
     "warning: listening on {host}: anyone who can reach port {port} can use this explorer "
-    "(and save presets into your preset folder)"
+    "(and save presets into your preset folder) once they have the address printed below: "
+    "its token is the only key, share it with care"
 )
 #: VTK encodes each picture in a thread of its own, and trame sends a picture still being
 #: encoded half a second later: instead, every FOLLOW_S seconds the server asks for it again
@@ -113,6 +114,9 @@ class WebExplorer(WebFiles):
         self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
         self._job = None  # the long job running (run_steps) and its cancel
         self.server = get_server(name, client_type="vue3")
+        self.token = webguard.new_token()  # the page's key: in the URL the user is given only
+        self.hosts = webguard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
+        webguard.install(self.server, self.token, lambda: self.hosts)
         self.plotter = plotter(size, BACKGROUND if background is None else background)
         self.view = None
         self.heat = HeatMap(self.plotter.renderer)
@@ -436,20 +440,39 @@ def _stop(signum, frame):
 
 
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
-    """Serve ``app`` until the process ends (prints ``App running at:`` and the URL). When the
-    server stops (Ctrl-C, SIGTERM) the session is kept as the desktop keeps it when its window
-    closes (:meth:`Controller.keep_last_session`; ``--last`` reopens it)."""
+    """Serve ``app`` until the process ends (prints ``App running at:`` and the URL with the
+    page's token, the only place the token is written; ``open_browser``: opens it). A request
+    whose Host is not one of ``host``'s names (:func:`~explorer.app.webguard.listening_names`)
+    is refused. When the server stops (Ctrl-C, SIGTERM) the session is kept as the desktop
+    keeps it when its window closes (:meth:`Controller.keep_last_session`; ``--last`` reopens
+    it)."""
     import signal
 
     own_arguments()
     signal.signal(signal.SIGTERM, _stop)
+    app.hosts = webguard.listening_names(host)
+
+    def ready(**_):
+        url = webguard.page_url(served_url(host, app.server.port), app.token)
+        print(f"\nApp running at:\n - Local:   {url}\n", flush=True)
+        if open_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+
+    app.server.controller.on_server_ready.add(ready)
     try:
-        app.server.start(port=port, host=host, open_browser=open_browser, timeout=0,
-                         show_connection_info=True)  # fmt: skip
+        app.server.start(port=port, host=host, open_browser=False, timeout=0,
+                         show_connection_info=False)  # fmt: skip
     except KeyboardInterrupt:
         pass
     finally:
         app.controller.keep_last_session()
+
+
+def served_url(host: str, port: int) -> str:
+    """The page's address on a server listening on ``host`` (an IPv6 address in brackets)."""
+    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
 
 
 @dataclasses.dataclass
@@ -545,14 +568,13 @@ def _base_url(base: str, where: str) -> str:
     return base if base.endswith("/") else base + "/"
 
 
-def page_url(port: int, prefix: str | None) -> str:
+def page_url(port: int, prefix: str | None, token: str = "") -> str:
     """The address of the page served on ``port``: direct (``http://127.0.0.1:PORT/``) or,
     under Jupyter base URL ``prefix``, jupyter-server-proxy's ``<prefix>proxy/<port>/`` (the
     page's assets are relative and its websocket is ``<page's folder>/ws``: both go through
-    the proxy)."""
-    if prefix is None:
-        return f"http://{DEFAULT_HOST}:{port}/"
-    return f"{prefix}proxy/{int(port)}/"
+    the proxy); with the page's ``token`` when given (``?secret=TOKEN``)."""
+    base = f"http://{DEFAULT_HOST}:{port}/" if prefix is None else f"{prefix}proxy/{int(port)}/"
+    return webguard.page_url(base, token) if token else base
 
 
 def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
@@ -579,6 +601,8 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
             app = WebExplorer(state, m, materials_dirs=materials_dirs,
                               name=f"phong-explorer-{id(box)}")  # fmt: skip
             box["app"] = app
+            # behind jupyter-server-proxy the Host is the Jupyter server's (checked there)
+            app.hosts = None if prefix is not None else app.hosts
             own_arguments()
             app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task", thread=True,
                              open_browser=False, timeout=0, show_connection_info=False,
@@ -601,4 +625,4 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
         raise ExplorerError("the explorer's web server did not start within 120 s")
     if "error" in box:
         raise box["error"]
-    return Shown(box["app"], page_url(box["port"], prefix), height)
+    return Shown(box["app"], page_url(box["port"], prefix, box["app"].token), height)

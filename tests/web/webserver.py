@@ -6,6 +6,7 @@ folders): a ``phong-explorer web`` process, as a user starts it, and a headless 
 from __future__ import annotations
 
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -37,7 +38,8 @@ SERVER_KERNELS = "numpy"
 
 
 class Server:
-    """A ``phong-explorer web`` process: its URL, its output, whether it still runs."""
+    """A ``phong-explorer web`` process: its URL (the address it printed, with its token:
+    ``url``; without it: ``base``, and ``token``), its output, whether it still runs."""
 
     def __init__(self, args, log: Path, env=None, host: str = "127.0.0.1"):
         self.port = free_port()
@@ -50,13 +52,16 @@ class Server:
             [sys.executable, "-m", "explorer.cli", "web", "--port", str(self.port), *args],
             stdout=self._out, stderr=subprocess.STDOUT, env=env,
         )  # fmt: skip
-        self.url = f"http://{host}:{self.port}/"
+        self.base = f"http://{host}:{self.port}/"
+        printed = re.compile(re.escape(self.base) + r"\?secret=([A-Za-z0-9_-]+)")
         end = time.monotonic() + START_TIMEOUT
-        while self.url not in log.read_text(errors="replace"):
+        while not (found := printed.search(log.read_text(errors="replace"))):
             if self.proc.poll() is not None or time.monotonic() > end:
                 self.stop()
                 pytest.fail(f"the server did not start:\n{log.read_text(errors='replace')}")
             time.sleep(0.1)
+        self.token = found.group(1)
+        self.url = found.group(0)
 
     def output(self) -> str:
         return self.log.read_text(errors="replace")
@@ -101,3 +106,80 @@ def new_browser(downloads: Path):
     })  # fmt: skip
     service = webdriver.ChromeService(executable_path=CHROMEDRIVER)
     return webdriver.Chrome(options=opts, service=service)
+
+
+#: the origin of the page a server serves (what a browser sends with the page's websocket)
+def page_origin(server: Server) -> str:
+    return server.base.rstrip("/")
+
+
+class WsClient:
+    """A raw wslink client (what trame's page does, in Python): ``call`` sends one RPC and
+    returns its reply (``{"result": ...}`` or ``{"error": ...}``)."""
+
+    def __init__(self, ws, hello: dict):
+        self.ws, self.hello, self._n = ws, hello, 0
+
+    def call(self, method: str, args=(), timeout: float = 30) -> dict:
+        self._n += 1
+        return _rpc(self.ws, f"rpc:{self.hello.get('result', {}).get('clientID', 'c0')}:"
+                    f"{self._n}", method, list(args), timeout)  # fmt: skip
+
+    def close(self) -> None:
+        self.ws.close()
+
+
+def _frames(message: dict) -> list[bytes]:
+    import msgpack
+    from wslink.chunking import generate_chunks
+
+    return list(generate_chunks(msgpack.packb(message), 0))
+
+
+def _rpc(ws, rid: str, method: str, args: list, timeout: float) -> dict:
+    """Send RPC ``method`` (id ``rid``) and return the reply with that id (other messages,
+    the state's publications, are skipped)."""
+    import msgpack
+    from wslink.chunking import UnChunker
+
+    for frame in _frames({"wslink": "1.0", "id": rid, "method": method, "args": args,
+                          "kwargs": {}}):  # fmt: skip
+        ws.send_binary(frame)
+    unchunk = UnChunker()
+    unchunk.set_max_message_size(1 << 30)
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        ws.settimeout(max(end - time.monotonic(), 0.1))
+        msg = unchunk.process_chunk(ws.recv())
+        if msg is not None:
+            msg = msg if isinstance(msg, dict) else msgpack.unpackb(msg)
+            if msg.get("id") == rid:
+                return msg
+    raise TimeoutError(f"no reply to {method} within {timeout} s")
+
+
+def ws_connect(
+    server: Server,
+    *,
+    origin: str | None = "page",
+    token: str | None = "server",
+    host: str | None = None,
+) -> WsClient:
+    """A raw websocket to ``server``'s ``/ws`` that says hello as trame's page does, and its
+    client (``.hello``: the server's answer). ``origin``: the Origin header (``"page"``: the
+    page's own, None: none); ``token``: the secret said in the hello (``"server"``: the
+    server's own; trame's page without one says wslink's default ``"wslink-secret"``);
+    ``host``: the Host header (None: the server's address). A refused upgrade raises
+    ``websocket.WebSocketBadStatusException`` (its ``status_code``)."""
+    import websocket
+
+    origin = page_origin(server) if origin == "page" else origin
+    kw = {"suppress_origin": origin is None}
+    if origin is not None:
+        kw["origin"] = origin
+    if host is not None:
+        kw["host"] = host
+    ws = websocket.create_connection(f"ws://127.0.0.1:{server.port}/ws", timeout=30, **kw)
+    secret = server.token if token == "server" else token
+    hello = _rpc(ws, "system:c0:0", "wslink.hello", [{"secret": secret}], 30)
+    return WsClient(ws, hello)
