@@ -23,6 +23,9 @@ from explorer.core.material import RGB_KEYS
 
 MATERIAL_NUMBERS = ("ka", "kd", "ks", "shininess", "opacity")
 LIGHT_NUMBERS = ("intensity", "azimuth", "elevation", "distance", "cutoff", "exponent")
+#: what the page is told when its ``mesh`` is not one of the chooser's (the same words for a
+#: missing file, an existing one or anything else: nothing is loaded, no path is named)
+MESH_REFUSED = "mesh: choose one of the listed meshes, or upload a mesh file"
 
 
 def slider_range(state: M.State, key: str) -> tuple[float, float]:
@@ -219,7 +222,16 @@ def _choices(app) -> None:
          lambda v: c.act(M.select_light, int(v), label="select light"))  # fmt: skip
     user("type", lambda v, s: s.selected_light is not None and v != s.selected_light.type,
          lambda v: c.act(M.set_light_type, v, label="light type"))  # fmt: skip
-    user("mesh", lambda v, s: v != s.mesh, c.choose_mesh)
+
+    def choose_mesh(name):
+        """A mesh of the chooser's list only (a built-in, the start's, an upload): any other
+        value (a path sent over the socket) is refused in the same words, naming nothing."""
+        if name in c.mesh_choices:
+            c.choose_mesh(name)
+        else:
+            c.reject_input(MESH_REFUSED)
+
+    user("mesh", lambda v, s: v != s.mesh, choose_mesh)
     user("difference", lambda v, s: bool(v) != s.difference,
          lambda v: c.act(M.set_difference, bool(v), label="difference"))  # fmt: skip
     _compare(app, user)

@@ -115,15 +115,17 @@ def page_origin(server: Server) -> str:
 
 class WsClient:
     """A raw wslink client (what trame's page does, in Python): ``call`` sends one RPC and
-    returns its reply (``{"result": ...}`` or ``{"error": ...}``)."""
+    returns its reply (``{"result": ...}`` or ``{"error": ...}``); ``seen`` keeps every other
+    message received meanwhile (the server's publications: the state other tabs changed)."""
 
     def __init__(self, ws, hello: dict):
         self.ws, self.hello, self._n = ws, hello, 0
+        self.seen: list[dict] = []
 
     def call(self, method: str, args=(), timeout: float = 30) -> dict:
         self._n += 1
         return _rpc(self.ws, f"rpc:{self.hello.get('result', {}).get('clientID', 'c0')}:"
-                    f"{self._n}", method, list(args), timeout)  # fmt: skip
+                    f"{self._n}", method, list(args), timeout, self.seen)  # fmt: skip
 
     def close(self) -> None:
         self.ws.close()
@@ -136,9 +138,9 @@ def _frames(message: dict) -> list[bytes]:
     return list(generate_chunks(msgpack.packb(message), 0))
 
 
-def _rpc(ws, rid: str, method: str, args: list, timeout: float) -> dict:
+def _rpc(ws, rid: str, method: str, args: list, timeout: float, seen=None) -> dict:
     """Send RPC ``method`` (id ``rid``) and return the reply with that id (other messages,
-    the state's publications, are skipped)."""
+    the state's publications, go to list ``seen``)."""
     import msgpack
     from wslink.chunking import UnChunker
 
@@ -155,6 +157,8 @@ def _rpc(ws, rid: str, method: str, args: list, timeout: float) -> dict:
             msg = msg if isinstance(msg, dict) else msgpack.unpackb(msg)
             if msg.get("id") == rid:
                 return msg
+            if seen is not None:
+                seen.append(msg)
     raise TimeoutError(f"no reply to {method} within {timeout} s")
 
 
