@@ -330,3 +330,25 @@ def test_the_real_page_hides_its_token_and_survives_a_reload(server, browser):
     wait("the picture after a reload", lambda: picture_src(browser))
     assert report(browser)["session"]["mesh"] == "sphere"
     assert server.token not in browser.current_url
+
+
+def test_open_opens_the_address_with_its_token(tmp_path):
+    """``--open`` hands the browser the printed address, token included (trame's own opener
+    gave the address without it: a page that could not connect). ``$BROWSER`` is the
+    browser Python's ``webbrowser`` runs: here a script that writes down what it was given."""
+    import os
+    import sys
+
+    from webserver import Server, need_browser
+
+    need_browser()
+    got = tmp_path / "opened.txt"
+    script = f"import sys; open({str(got)!r}, 'w').write(sys.argv[1])"
+    env = dict(os.environ, BROWSER=f'{sys.executable} -c "{script}" %s')
+    srv = Server(["--mesh", "cube", "--open"], tmp_path / "server.log", env=env)
+    try:
+        wait("the browser to be opened", lambda: got.is_file() and got.read_text())
+        assert got.read_text() == srv.url
+        assert got.read_text().endswith(f"/?secret={srv.token}")
+    finally:
+        srv.stop()
