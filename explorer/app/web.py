@@ -40,6 +40,7 @@ from explorer.app.session import session_mapping
 from explorer.app.start import (
     DEFAULT_MESH,
     DEFAULT_PRESET,
+    MESH_CHOICES,
     default_viewer,
     first_state,
     load_mesh_choice,
@@ -117,6 +118,7 @@ class WebExplorer(WebFiles):
         self.token = webguard.new_token()  # the page's key: in the URL the user is given only
         self.hosts = webguard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
         webguard.install(self.server, self.token, lambda: self.hosts)
+        self.mesh_values = webguard.MeshValues(MESH_CHOICES)  # the chooser names no path
         self.plotter = plotter(size, BACKGROUND if background is None else background)
         self.view = None
         self.heat = HeatMap(self.plotter.renderer)
@@ -256,7 +258,8 @@ class WebExplorer(WebFiles):
         self.server.state.presets = [webpanel.preset_item(p) for p in presets]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
-        self.server.state.meshes = [{"title": t, "value": n} for n, t in labels.items()]
+        self.server.state.meshes = [{"title": t, "value": self.mesh_values.page(n)}
+                                    for n, t in labels.items()]  # fmt: skip
 
     def show_recent(self, paths: list[str]) -> None:
         """The page keeps no recent files (it opens uploads only)."""
@@ -361,7 +364,7 @@ class WebExplorer(WebFiles):
         self.pushing = True
         try:
             with self.server.state as s:
-                s.update(webpanel.values(state))
+                s.update({**webpanel.values(state), "mesh": self.mesh_values.page(state.mesh)})
         finally:
             self.pushing = False
 

@@ -34,6 +34,7 @@ import logging
 import math
 import secrets
 from collections.abc import Iterable, Mapping
+from pathlib import PurePath
 from urllib.parse import urlsplit
 
 from explorer.app.model import TERMS
@@ -233,6 +234,33 @@ def admit(changes, table: Mapping[str, str] = CLIENT_KEYS) -> tuple[list, list[s
             continue
         kept.append(change)
     return kept, dropped
+
+
+class MeshValues:
+    """The mesh chooser's values on the page, which never name a server path: a built-in
+    mesh's own name, a file's ``file N: NAME`` (its order of arrival and its file name); and
+    back: :meth:`name` gives the chooser name only for a value the page was given."""
+
+    def __init__(self, builtins: Iterable[str]):
+        self._builtins = frozenset(builtins)
+        self._page: dict[str, str] = {}  # chooser name -> page value
+        self._names: dict[str, str] = {}  # page value -> chooser name
+
+    def page(self, name: str) -> str:
+        """The page's value of chooser name ``name`` (a built-in name, or a file's path)."""
+        if name in self._builtins:
+            return name
+        if name not in self._page:
+            value = f"file {len(self._page) + 1}: {PurePath(name).name}"
+            self._page[name], self._names[value] = value, name
+        return self._page[name]
+
+    def name(self, value) -> str | None:
+        """The chooser name of page value ``value``; None when the page was never given it
+        (a path sent over the socket, anything else)."""
+        if isinstance(value, str) and value in self._builtins:
+            return value
+        return self._names.get(value) if isinstance(value, str) else None
 
 
 # -- the hooks into trame, wslink and aiohttp -------------------------------------------------

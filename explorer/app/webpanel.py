@@ -223,15 +223,17 @@ def _choices(app) -> None:
     user("type", lambda v, s: s.selected_light is not None and v != s.selected_light.type,
          lambda v: c.act(M.set_light_type, v, label="light type"))  # fmt: skip
 
-    def choose_mesh(name):
-        """A mesh of the chooser's list only (a built-in, the start's, an upload): any other
-        value (a path sent over the socket) is refused in the same words, naming nothing."""
+    def choose_mesh(value):
+        """A mesh of the chooser's list only (a built-in, the start's, an upload: values the
+        page was given, :class:`~explorer.app.webguard.MeshValues`): any other value (a path
+        sent over the socket) is refused in the same words, naming nothing."""
+        name = app.mesh_values.name(value)
         if name in c.mesh_choices:
             c.choose_mesh(name)
         else:
             c.reject_input(MESH_REFUSED)
 
-    user("mesh", lambda v, s: v != s.mesh, choose_mesh)
+    user("mesh", lambda v, s: v != app.mesh_values.page(s.mesh), choose_mesh)
     user("difference", lambda v, s: bool(v) != s.difference,
          lambda v: c.act(M.set_difference, bool(v), label="difference"))  # fmt: skip
     _compare(app, user)

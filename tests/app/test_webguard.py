@@ -144,3 +144,16 @@ def test_admit_keeps_the_controls_changes_and_drops_the_rest_with_a_line_each():
 def test_a_long_unknown_key_is_cut_in_the_log_line():
     _, dropped = G.admit([{"key": "k" * 10_000, "value": 1}])
     assert len(dropped[0]) < 200
+
+
+def test_the_mesh_chooser_names_no_path_and_takes_back_only_its_own_values():
+    names = G.MeshValues(("sphere", "teapot"))
+    assert names.page("sphere") == "sphere" and names.name("sphere") == "sphere"
+    first = names.page("/tmp/phong-explorer-web-x/mesh-1/parts.obj")
+    second = names.page("/home/ana/models/parts.obj")
+    assert (first, second) == ("file 1: parts.obj", "file 2: parts.obj")
+    assert names.page("/tmp/phong-explorer-web-x/mesh-1/parts.obj") == first  # stable
+    assert names.name(first) == "/tmp/phong-explorer-web-x/mesh-1/parts.obj"
+    assert names.name(second) == "/home/ana/models/parts.obj"
+    for other in ("/etc/passwd", "~/.bashrc", "file 3: parts.obj", "parts.obj", None, 1, ["x"]):
+        assert names.name(other) is None

@@ -178,6 +178,33 @@ def test_a_mesh_that_is_a_path_is_refused_alike_and_nothing_is_loaded(server, tm
     assert str(real) not in server.output() and "passwd" not in server.output()
 
 
+def test_an_uploaded_mesh_is_chosen_by_a_value_that_names_no_path(server):
+    """The chooser's values never name a server path: an upload (sent as the page's file
+    field sends it) is listed as ``file N: NAME``, chosen again by that value, and its path
+    refused."""
+    obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n"
+    client = ws_connect(server)
+    try:
+        upload = [{"name": "tetra.obj", "size": len(obj), "type": "", "content": obj}]
+        client.call("trame.state.update", [[{"key": "mesh_upload", "value": upload}]])
+        path = server_report(client)["session"]["mesh"]
+        assert path.endswith("/tetra.obj")  # the server's own name for it
+        state = state_of(client)
+        value = state["mesh"]
+        assert value.startswith("file ") and value.endswith(": tetra.obj"), value
+        assert all("/" not in m["value"] for m in state["meshes"]), state["meshes"]
+        client.call("trame.state.update", [[{"key": "mesh", "value": "sphere"}]])
+        assert server_report(client)["session"]["mesh"] == "sphere"
+        client.call("trame.state.update", [[{"key": "mesh", "value": path}]])
+        assert state_of(client)["message"] == f"error: {MESH_REFUSED}"
+        assert server_report(client)["session"]["mesh"] == "sphere"
+        client.call("trame.state.update", [[{"key": "mesh", "value": value}]])
+        assert server_report(client)["session"]["mesh"] == path
+        client.call("trame.state.update", [[{"key": "mesh", "value": "sphere"}]])
+    finally:
+        client.close()
+
+
 # -- what a client may set --------------------------------------------------------------------
 def test_a_client_sets_only_the_controls_keys_with_their_types(server):
     """A server-owned key (the page's Vue template, the message log), an unknown key and a
