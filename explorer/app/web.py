@@ -10,6 +10,8 @@ before each frame it goes into the state (:meth:`Controller.camera_moved`). The 
 vuetify widgets (:mod:`explorer.app.webpanel`), each named (``aria-label``) like the scene
 file's key it sets.
 
+Only the address the server prints (with its token) opens the page, a websocket only from the
+page's own origin, and a page sets only its controls' keys: :mod:`explorer.app.webguard`.
 One explorer per server process: every tab shows and edits the same state. Nothing from the
 page names a server path (:mod:`explorer.app.webfiles`): uploads are written under fixed names
 into a private temporary folder and read by the same readers (and their size caps) as files on

@@ -24,6 +24,8 @@ As Jupyter does it:
   :func:`admit` sorts a client's changes): a server-owned key (``trame__template_main``, the
   page's Vue template; the message log; the preset list) or a value of the wrong type is
   dropped before it reaches the state or any other tab, and logged.
+- **The page names no server path**: the mesh chooser's values are :class:`MeshValues`, and
+  the page's ``mesh`` is taken back only as one of them.
 """
 
 from __future__ import annotations
