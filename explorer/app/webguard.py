@@ -265,6 +265,22 @@ class MeshValues:
         return self._names.get(value) if isinstance(value, str) else None
 
 
+class Redact(logging.Filter):
+    """Takes ``token`` out of every record of the logger it filters (aiohttp's access log
+    writes each request line, the page's address with its token among them, when a program
+    turns its INFO level on)."""
+
+    def __init__(self, token: str):
+        super().__init__()
+        self.token = token
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        text = record.getMessage()
+        if self.token in text:
+            record.msg, record.args = text.replace(self.token, "<token>"), ()
+        return True
+
+
 # -- the hooks into trame, wslink and aiohttp -------------------------------------------------
 def install(server, token: str, hosts) -> None:
     """The rules above on trame ``server`` (before it starts): wslink's secret is ``token``;
@@ -272,6 +288,7 @@ def install(server, token: str, hosts) -> None:
     None for any, :func:`host_ok`), a websocket's Origin and the page's token
     (:func:`page_verdict`); a client's ``trame.state.update`` goes through :func:`admit`."""
     server.cli.set_defaults(authKey=token)  # wslink's secret (trame's --authKey)
+    logging.getLogger("aiohttp.access").addFilter(Redact(token))
 
     def bind(web_server) -> None:
         web_server.app.middlewares.append(_middleware(token, hosts))

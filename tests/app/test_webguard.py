@@ -157,3 +157,16 @@ def test_the_mesh_chooser_names_no_path_and_takes_back_only_its_own_values():
     assert names.name(second) == "/home/ana/models/parts.obj"
     for other in ("/etc/passwd", "~/.bashrc", "file 3: parts.obj", "parts.obj", None, 1, ["x"]):
         assert names.name(other) is None
+
+
+def test_the_access_log_never_writes_the_token():
+    import logging
+
+    line = '127.0.0.1 "GET /?secret=%s HTTP/1.1" 302'
+    record = logging.LogRecord("aiohttp.access", logging.INFO, __file__, 1, line, (TOKEN,), None)
+    assert G.Redact(TOKEN).filter(record)
+    assert TOKEN not in record.getMessage()
+    assert record.getMessage() == '127.0.0.1 "GET /?secret=<token> HTTP/1.1" 302'
+    other = logging.LogRecord("aiohttp.access", logging.INFO, __file__, 1, "GET /%s", ("a",),
+                              None)  # fmt: skip
+    assert G.Redact(TOKEN).filter(other) and other.getMessage() == "GET /a"

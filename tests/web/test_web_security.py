@@ -379,3 +379,26 @@ def test_open_opens_the_address_with_its_token(tmp_path):
         assert got.read_text().endswith(f"/?secret={srv.token}")
     finally:
         srv.stop()
+
+
+def test_the_access_log_at_info_level_never_writes_the_token(tmp_path):
+    """A program that turns logging's INFO level on gets aiohttp's access log, a line per
+    request with its address: the token is taken out of it (here the server's Python is
+    started with a ``sitecustomize`` that does ``logging.basicConfig(level=INFO)``)."""
+    import os
+
+    from webserver import Server, need_browser
+
+    need_browser()
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text("import logging\nlogging.basicConfig(level=20)\n")
+    path = os.pathsep.join(p for p in (str(site), os.environ.get("PYTHONPATH")) if p)
+    srv = Server(["--mesh", "cube"], tmp_path / "server.log", env=dict(os.environ, PYTHONPATH=path))
+    try:
+        assert get(srv.url)[0] == 302  # to index.html, with the token
+        assert get(f"{srv.base}index.html?secret={srv.token}")[0] == 200
+        wait("the access log's line", lambda: "GET /index.html?secret=<token>" in srv.output())
+        assert srv.output().count(srv.token) == 1  # the printed address only
+    finally:
+        srv.stop()
