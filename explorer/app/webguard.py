@@ -200,9 +200,10 @@ def key_table(rows: Iterable[tuple[str, str]]) -> dict[str, str]:
 
 
 #: every state key the page's controls set (their ``v_model``), with its kind: the sliders'
-#: steps, the selects, switches and check boxes, the text fields that are state, the uploads
-#: and the tab. The number fields, colour fields and pickers, buttons and downloads are not
-#: state: they call the server's handlers, which parse what they are given.
+#: steps, the selects, switches and check boxes, the text fields that are state, the uploads,
+#: the tab and the drawer. The number fields, colour fields and pickers, buttons and downloads
+#: are not state: they call the server's handlers, which parse what they are given.
+#: tests/web/test_web_security.py checks it against the page's template (every ``v-model``).
 CLIENT_KEYS: Mapping[str, str] = key_table([
     *((f"{k}_step", "number") for k in (*MATERIAL_NUMBERS, *LIGHT_NUMBERS)),
     *((f"show_{t}", "bool") for t in TERMS),
@@ -212,7 +213,7 @@ CLIENT_KEYS: Mapping[str, str] = key_table([
     ("compare_difference", "bool"), ("turntable_frames", "text or number"),
     ("turntable_format", "text"), ("preset_name", "text"), ("preset_replace", "bool"),
     ("session_upload", "upload"), ("mesh_upload", "upload"), ("mtl_upload", "upload"),
-    ("tab", "text"),
+    ("tab", "text"), ("main_drawer", "bool"),  # the layout's drawer (its toolbar button)
 ])  # fmt: skip
 
 

@@ -402,3 +402,22 @@ def test_the_access_log_at_info_level_never_writes_the_token(tmp_path):
         assert srv.output().count(srv.token) == 1  # the printed address only
     finally:
         srv.stop()
+
+
+def test_every_key_a_control_of_the_page_sets_is_in_the_client_table(server):
+    """The page's template (what trame's client renders) names each key a control sets
+    (``v-model``): every one is in the client-key table (a control added without its row
+    would be dropped by the server), and the table holds no key the page does not set but
+    the uploads and the fields' keys that are in it by design (none)."""
+    import re
+
+    client = ws_connect(server)
+    try:
+        template = state_of(client)["trame__template_main"]
+    finally:
+        client.close()
+    models = set(re.findall(r'v-model(?::\w+)?="([^"]+)"', template))
+    assert {"kd_step", "preset", "mesh", "tab", "mesh_upload"} <= models, models
+    client_only = {"show_messages"}  # the message log's dialog: kept in each tab, never sent
+    assert models - client_only <= set(webguard.CLIENT_KEYS), models - set(webguard.CLIENT_KEYS)
+    assert set(webguard.CLIENT_KEYS) <= models, set(webguard.CLIENT_KEYS) - models
