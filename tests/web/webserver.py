@@ -108,8 +108,8 @@ def new_browser(downloads: Path):
     return webdriver.Chrome(options=opts, service=service)
 
 
-#: the origin of the page a server serves (what a browser sends with the page's websocket)
 def page_origin(server: Server) -> str:
+    """The origin of the page ``server`` serves (what a browser sends with its websocket)."""
     return server.base.rstrip("/")
 
 
@@ -118,14 +118,15 @@ class WsClient:
     returns its reply (``{"result": ...}`` or ``{"error": ...}``); ``seen`` keeps every other
     message received meanwhile (the server's publications: the state other tabs changed)."""
 
-    def __init__(self, ws, hello: dict):
-        self.ws, self.hello, self._n = ws, hello, 0
+    def __init__(self, ws, unchunk, secret: str | None):
+        self.ws, self._unchunk, self._n = ws, unchunk, 0
         self.seen: list[dict] = []
+        self.hello = _rpc(self, "system:c0:0", "wslink.hello", [{"secret": secret}], 30)
 
     def call(self, method: str, args=(), timeout: float = 30) -> dict:
         self._n += 1
-        return _rpc(self.ws, f"rpc:{self.hello.get('result', {}).get('clientID', 'c0')}:"
-                    f"{self._n}", method, list(args), timeout, self.seen)  # fmt: skip
+        rid = f"rpc:{self.hello.get('result', {}).get('clientID', 'c0')}:{self._n}"
+        return _rpc(self, rid, method, list(args), timeout)
 
     def close(self) -> None:
         self.ws.close()
@@ -138,27 +139,23 @@ def _frames(message: dict) -> list[bytes]:
     return list(generate_chunks(msgpack.packb(message), 0))
 
 
-def _rpc(ws, rid: str, method: str, args: list, timeout: float, seen=None) -> dict:
+def _rpc(client: WsClient, rid: str, method: str, args: list, timeout: float) -> dict:
     """Send RPC ``method`` (id ``rid``) and return the reply with that id (other messages,
-    the state's publications, go to list ``seen``)."""
+    the state's publications, go to ``client.seen``)."""
     import msgpack
-    from wslink.chunking import UnChunker
 
     for frame in _frames({"wslink": "1.0", "id": rid, "method": method, "args": args,
                           "kwargs": {}}):  # fmt: skip
-        ws.send_binary(frame)
-    unchunk = UnChunker()
-    unchunk.set_max_message_size(1 << 30)
+        client.ws.send_binary(frame)
     end = time.monotonic() + timeout
     while time.monotonic() < end:
-        ws.settimeout(max(end - time.monotonic(), 0.1))
-        msg = unchunk.process_chunk(ws.recv())
+        client.ws.settimeout(max(end - time.monotonic(), 0.1))
+        msg = client._unchunk.process_chunk(client.ws.recv())
         if msg is not None:
             msg = msg if isinstance(msg, dict) else msgpack.unpackb(msg)
             if msg.get("id") == rid:
                 return msg
-            if seen is not None:
-                seen.append(msg)
+            client.seen.append(msg)
     raise TimeoutError(f"no reply to {method} within {timeout} s")
 
 
@@ -176,6 +173,7 @@ def ws_connect(
     ``host``: the Host header (None: the server's address). A refused upgrade raises
     ``websocket.WebSocketBadStatusException`` (its ``status_code``)."""
     import websocket
+    from wslink.chunking import UnChunker
 
     origin = page_origin(server) if origin == "page" else origin
     kw = {"suppress_origin": origin is None}
@@ -183,7 +181,8 @@ def ws_connect(
         kw["origin"] = origin
     if host is not None:
         kw["host"] = host
-    ws = websocket.create_connection(f"ws://127.0.0.1:{server.port}/ws", timeout=30, **kw)
-    secret = server.token if token == "server" else token
-    hello = _rpc(ws, "system:c0:0", "wslink.hello", [{"secret": secret}], 30)
-    return WsClient(ws, hello)
+    url = server.base.replace("http://", "ws://", 1) + "ws"
+    ws = websocket.create_connection(url, timeout=30, **kw)
+    unchunk = UnChunker()
+    unchunk.set_max_message_size(1 << 30)
+    return WsClient(ws, unchunk, server.token if token == "server" else token)
