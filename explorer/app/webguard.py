@@ -35,6 +35,7 @@ import ipaddress
 import logging
 import math
 import secrets
+import socket
 from collections.abc import Iterable, Mapping
 from pathlib import PurePath
 from urllib.parse import urlsplit
@@ -55,6 +56,8 @@ PAGE_PATHS = ("/", "/index.html")
 WS_PATH = "/ws"
 #: the names of this machine's loopback addresses a Host may give
 LOOPBACK_NAMES = ("localhost",)
+#: the addresses that listen on every address of the machine (``--host 0.0.0.0``)
+WILDCARDS = ("0.0.0.0", "::", "")
 #: the longest text a client may set in a state key (characters): a preset name, a choice
 MAX_CLIENT_TEXT = 4096
 #: the refusal of a page asked for without the token (one line, no path, no token)
@@ -109,11 +112,16 @@ def _is_ip(name: str) -> bool:
     return True
 
 
-def listening_names(host: str) -> frozenset[str]:
+def listening_names(host: str, machine: str | None = None) -> frozenset[str]:
     """The host names a request to a server listening on ``host`` may give: the loopback
-    names, and ``host`` itself when it is a name (an IP address is allowed anyway)."""
+    names, ``host`` itself when it is a name (an IP address is allowed anyway), and for a
+    wildcard address (:data:`WILDCARDS`: every address of the machine) the machine's name
+    (``machine``; default :func:`socket.gethostname`)."""
     name = host.strip("[]").lower()
-    return frozenset((*LOOPBACK_NAMES, *(() if _is_ip(name) or not name else (name,))))
+    names = {*LOOPBACK_NAMES, *(() if _is_ip(name) or not name else (name,))}
+    if name in WILDCARDS:
+        names.add((machine if machine is not None else socket.gethostname()).lower())
+    return frozenset(n for n in names if n)
 
 
 def host_ok(host: str | None, names: Iterable[str] | None, port: int) -> bool:

@@ -47,7 +47,9 @@ def test_a_host_naming_another_site_or_port_is_refused(host):
 def test_the_listening_names_are_the_loopback_names_and_a_named_host():
     assert G.listening_names("127.0.0.1") == {"localhost"}
     assert G.listening_names("::1") == {"localhost"}
-    assert G.listening_names("0.0.0.0") == {"localhost"}
+    assert G.listening_names("0.0.0.0", machine="Box") == {"localhost", "box"}
+    assert G.listening_names("::", machine="box") == {"localhost", "box"}
+    assert G.host_ok("box:9000", G.listening_names("0.0.0.0", machine="box"), 9000)
     assert G.listening_names("Explorer.Lan") == {"localhost", "explorer.lan"}
     assert G.host_ok("explorer.lan:9000", G.listening_names("explorer.lan"), 9000)
     assert not G.host_ok("explorer.lan:9000", G.listening_names("127.0.0.1"), 9000)
