@@ -1,6 +1,6 @@
 """Who may use the web explorer, and what a page may set: the admission rules of
-:mod:`explorer.app.web` as plain functions and one table (no trame, no aiohttp here; the
-server's hooks call them).
+:mod:`explorer.app.web` as plain functions and one table, and the thin hooks that put them
+into trame, wslink and aiohttp (:func:`install`; aiohttp is imported inside them only).
 
 As Jupyter does it:
 
