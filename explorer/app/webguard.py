@@ -313,7 +313,7 @@ def install(server, token: str, hosts) -> None:
 def _refuse(text: str, request, why: str):
     from aiohttp import web
 
-    log.warning("refused %s %s: %s", request.method, request.path, why)
+    log.warning("refused %s %r: %s", request.method, request.path, why)  # %r: a path's \n too
     return web.Response(status=403, text=text + "\n")
 
 
