@@ -113,6 +113,9 @@ def test_a_host_naming_another_site_is_refused(server):
     assert "<html" not in body
     assert refused_upgrade(server, host=evil, origin=f"http://{evil}") == 403
     assert f"Host {evil!r} is not this server's" in server.output()
+    # the refusal's log line quotes the path: a newline in it forges no line of its own
+    assert get(server.base + "x%0Aforged%20line", {"Host": evil})[0] == 403
+    assert "\nforged line" not in server.output() and "'/x\\nforged line'" in server.output()
     for own in (f"localhost:{server.port}", f"127.0.0.1:{server.port}"):
         assert get(server.url, {"Host": own})[0] in (200, 302)
 
