@@ -40,7 +40,7 @@ import numpy as np
 from explorer.core import tolerances as tol
 from explorer.core.lights import unit_rows
 from explorer.core.scene import Scene
-from explorer.geometry.frame import check_vertices, frame_of, to_frame
+from explorer.geometry.frame import check_vertices, frame_of
 from explorer.shading.effects import EFFECTS, Incident
 
 #: three.js's F_Schlick: g = 2^((A·c + B)·c) for c = V·H, Epic's fit of (1 - c)^5 (bsdfs.glsl.js)
@@ -77,7 +77,7 @@ def equation_terms(
 
     # viewer direction V per vertex (toward the viewer)
     if scene.viewer.local:
-        eye = to_frame(scene.viewer.eye, centre, scale)
+        eye = np.asarray(scene.viewer.framed(centre, scale))  # (the far-viewer policy)
         V, _ = unit_rows(eye - P, tol.POINT_EPS, N)  # eye at the vertex: look along N
     else:
         V = np.broadcast_to(np.asarray(scene.viewer.to_viewer, dtype=np.float64), (n, 3))

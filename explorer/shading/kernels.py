@@ -505,9 +505,10 @@ def _extent_run(Pf, out):
 
 
 @nb.njit(**_LEAF)
-def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
-    """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
-    one, eps2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS]
+def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, trk, k):
+    """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex (a lane
+    near the eye is marked, as one near a light: "at the vertex" is decided in float64)."""
+    one, eps2, c_dist2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS], k[K_MARGIN_DIST2]
     for i in range(px.shape[0]):
         x = ex - px[i]
         y = ey - py[i]
@@ -519,6 +520,7 @@ def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
         vx[i] = a if at else x * inv
         vy[i] = b if at else y * inv
         vz[i] = c if at else z * inv
+        trk[i] = min(trk[i], d2 * c_dist2)
 
 
 @nb.njit(**_LEAF)
@@ -828,9 +830,9 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                     inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (marked)
                     d = d2 * inv
                     w = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
-                else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = |l|
+                else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = 0
                     at = d2 < p_eps2
-                    d = np.sqrt(d2)
+                    d = zero if at else np.sqrt(d2)
                     r = one if at else d
                     x = a if at else x
                     yy = b if at else yy
@@ -1011,7 +1013,7 @@ def _to_light(scr, m, q, k, atten):
             d2 = x * x + y * y + z * z
             at = d2 < eps2
             inv = one / np.sqrt(one if at else d2)
-            d = np.sqrt(d2) if at else d2 * inv
+            d = k[K_ZERO] if at else d2 * inv  # at the light: distance 0 (POINT_EPS)
             a, b, c = nx[i], ny[i], nz[i]
             Lx[i] = a if at else x * inv
             Ly[i] = b if at else y * inv
@@ -1343,7 +1345,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
         used_grey = True
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
         if opts[O_LOCAL]:
-            _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
+            _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, trk, k)
         else:
             _fill(vx, view[0])
             _fill(vy, view[1])
