@@ -36,6 +36,14 @@ POINT_EPS = 1e-12
 #: length of L + V the engine takes N·H = 0 (no highlight; with shininess 0, 0**0 = 1 applies).
 HALFWAY_EPS2 = 1e-24
 
+#: A specular lobe base (R·V or N·H) below this is 0 on both tiers: the square root of float64's
+#: smallest normal number. The float64 kernels raise base² to n/2, and a smaller base's square
+#: is subnormal (imprecise) or 0, which left a base of 1e-200 with shininess 0.001 dark where
+#: the numpy tier gave 0.63. Such a base is rounding noise (dot products of unit vectors are
+#: exact to about 1e-16; float32 and OpenGL hold it as 0 anyway), and it matters only for a
+#: shininess far below 1 (for n >= 1, base**n < 1e-154).
+LOBE_BASE_MIN = 1.4916681462400413e-154
+
 #: Floor of the attenuation denominator kc + kl·d + kq·d². All-zero attenuation is rejected when
 #: a scene is loaded; with kc = 0 a light exactly at a vertex would divide by zero, so the
 #: attenuation factor is capped at 1 / ATTENUATION_FLOOR (and colours stay finite).

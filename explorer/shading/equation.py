@@ -109,7 +109,8 @@ def equation_terms(
             h2 = np.einsum("ij,ij->i", H, H)
             ok = h2 > tol.HALFWAY_EPS2  # H undefined for L = -V: N·H taken as 0
             base = np.where(ok, np.einsum("ij,ij->i", N, H) / np.sqrt(np.where(ok, h2, 1.0)), 0.0)
-        lobe = np.maximum(base, 0.0) ** shininess  # numpy: 0.0 ** 0.0 == 1.0
+        base = np.where(base >= tol.LOBE_BASE_MIN, base, 0.0)  # noise below it: 0
+        lobe = base**shininess  # numpy: 0.0 ** 0.0 == 1.0
         s_i = np.asarray(light.specular)
 
         ambient += w[:, None] * np.asarray(light.ambient)  # a_i (attenuated)

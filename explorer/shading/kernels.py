@@ -792,6 +792,8 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
     # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
     # it interleaves them; the row-path loops read and write too many rows for such checks
     row = _row_checked if inline else _row
+    # float64's smallest normal number, LOBE_BASE_MIN² (compared with base² where it splits)
+    tiny2 = float(np.finfo(np.float64).tiny)
 
     def impl(scr, m, q, y, k, atten, l_dif, code):
         # rows as separate 1-D arrays: lets the compiler vectorise
@@ -898,8 +900,10 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                         margin = min(margin, h2 * c_len2)
                     margin = min(margin, abs(base) * c_dot)
                     base = max(base, zero)
-                    # kept for a lobe store (and the lobe loop below): squared where it splits
-                    B[i] = base * base if split and not square else base
+                    # kept for a lobe store (and the lobe loop below): squared where it splits,
+                    # 0 below float64's smallest normal number (tolerances.LOBE_BASE_MIN)
+                    b2 = base * base if split and not square else base
+                    B[i] = (b2 if b2 >= tiny2 else zero) if split else b2
                     if not split:
                         lob = fpow(base, y)  # base^n
                 if not split:

@@ -125,14 +125,34 @@ def test_a_far_viewer_of_a_tiny_mesh_sees_what_an_infinite_one_does(model, preci
 
 
 @pytest.mark.parametrize("model", ("blinn", "phong"))
-def test_an_eye_on_a_vertex_is_decided_in_float64(model):
-    """An eye on a vertex: V = N there (POINT_EPS). float32 positions put it 1e-7 away, a
-    direction of noise: such lanes are redone in float64, as lanes near a light are."""
+@pytest.mark.parametrize("offset", [0.0, 1e-8])
+def test_an_eye_near_a_vertex_is_decided_in_float64(model, offset):
+    """An eye on a vertex (V = N there, POINT_EPS) or 1e-8 from it: float32 positions are
+    accurate to about 1e-7, so eye - P is a direction of noise there. Such lanes are redone in
+    float64, as lanes near a light are (AMBIGUOUS_DIST); they were not."""
     P, N = sphere()
     for j in range(0, 200, 7):
+        eye = (P[j] + offset * np.array([1.0, -2.0, 0.5])).tolist()
         s = lit(model, 20.0, {"type": "directional", "to_light": [0, 1, 0.2]},
-                viewer={"eye": P[j].tolist()}, two_sided=True)  # fmt: skip
+                viewer={"eye": eye}, two_sided=True)  # fmt: skip
         assert_one_engine(s, P, N, "float32")
+
+
+@pytest.mark.parametrize("precision", PRECISIONS)
+@pytest.mark.parametrize("shininess", [1e-3, 0.01, 0.5])
+@pytest.mark.parametrize("base", [1e-200, 1e-160, 1e-150])
+def test_a_lobe_base_of_noise_is_0_on_both_tiers(precision, shininess, base):
+    """Phong with R·V = ``base`` (N = z, V = x, L toward (-base, 0, 1)): a base below
+    LOBE_BASE_MIN (1.5e-154) is 0 on both tiers. The float64 kernels raise base² to n/2 and the
+    square of 1e-200 is 0: the numpy tier gave 0.63 for shininess 0.001, the kernels 0."""
+    P, N = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0.0, 0, 1]] * 3)
+    s = lit("phong", shininess, {"type": "directional", "to_light": [-base, 0, 1]},
+            viewer={"to_viewer": [1, 0, 0]}, ambient=[0, 0, 0])  # fmt: skip
+    s["material"].update(ambient=[0, 0, 0], diffuse=[0, 0, 0])
+    a, b = tiers(s, P, N, precision)
+    want = base**shininess if base >= tol.LOBE_BASE_MIN else 0.0
+    np.testing.assert_allclose(a[:, 0], want, rtol=1e-6, atol=1e-7)
+    np.testing.assert_allclose(b, a, rtol=0, atol=LIMIT[precision])
 
 
 # -- the fuzz: hard input, both tiers ---------------------------------------------------------
@@ -196,6 +216,8 @@ def hard_cases(draw):
     with np.errstate(over="ignore", under="ignore"):
         size = np.float64(10.0) ** power
         P = P * size + shift * size
+    N = N * draw(st.sampled_from([1.0, 1e-300, 1e300]))  # tiny and huge normals
+    N[draw(st.integers(0, len(N) - 1))] = 0.0  # and one absent
     centre = 0.5 * P.min(axis=0) + 0.5 * P.max(axis=0)
     size = float(np.abs(P - centre).max()) or 1e-300
     viewer = draw(st.sampled_from(["infinite", "near", "far", "vertex"]))
