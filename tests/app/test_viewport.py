@@ -9,17 +9,13 @@ import dataclasses
 
 import numpy as np
 import pytest
-from test_controller import FakeFront, FakeWorker
+from test_controller import icosphere_controller
 
 from explorer.app import model as M
-from explorer.app import start as A
-from explorer.app.controller import Controller, Ports
 from explorer.app.controller import ports as P
 from explorer.app.difference import PENDING, run_job
 from explorer.app.sides import SideB
 from explorer.app.viewport import PlotterView, controls_changed
-from explorer.cli import build_parser
-from explorer.cli.gui import start
 from explorer.geometry import meshes as G
 from explorer.render.images import decode_png
 from explorer.render.vtk import plotter
@@ -89,14 +85,10 @@ def mesh():
 @pytest.fixture
 def port(mesh, tmp_path, monkeypatch):
     """A PlotterView attached to a controller on the icosphere, with side B in a fake pane."""
-    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
-    scene, _, preset = start(build_parser().parse_args(["gui", "--mesh", "icosphere"]))
-    state = A.first_state(scene, mesh, name="icosphere", preset=preset, resolution=3)
     pictures, pane = FakePictures(), FakePane()
     view = PlotterView(plotter(SIZE, (0.1, 0.1, 0.1)), pictures)
     pictures.view = view
-    c = Controller(state, mesh, Ports.of(FakeFront(), worker=FakeWorker(), view=view),
-                   output_dir=tmp_path, last_session=None)  # fmt: skip
+    c = icosphere_controller(mesh, view, tmp_path, monkeypatch, 3)
     view.attach(c, mesh, side_b=SideB(view, pane), lod_vertices=100, lod_target=60)
     c.start()
     view.show_start(c.state)
