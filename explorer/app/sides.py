@@ -71,8 +71,12 @@ class SideB:
         self.pane.made(pl, self.view)
 
     def _before_frame(self, *_) -> None:
+        """Before a frame of side B: its triangles sorted and its inset laid out for the shared
+        camera, whose clipping range is set around what B draws (A's frame set it around
+        what A draws: no mesh while A shows the heat map)."""
         s = self.main.controller.state
         self.view.before_frame(view_camera(self.plotter.camera, s.centre, s.radius))
+        self.plotter.renderer.ResetCameraClippingRange()
 
     def show(self, old: M.State | None, new: M.State) -> None:
         """Side B made, shown, hidden, and given side B's state (or A − B)."""

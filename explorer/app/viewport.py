@@ -120,6 +120,14 @@ class PlotterView:
         self.view.end_drag()
         self.controller.end_drag()
 
+    def let_go(self, *_) -> None:
+        """A control let go: the drag it began ends, or (a click, a key: no drag) its steps so
+        far are one undo step."""
+        if self.dragging():
+            self.end_drag()
+        else:
+            self.controller.release()
+
     # -- the View port ---------------------------------------------------------------------------
     def show(self, old: M.State | None, new: M.State) -> None:
         """One change drawn: the mesh (switched, or one engine update and one upload), side B,

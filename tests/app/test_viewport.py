@@ -214,3 +214,35 @@ def test_only_a_camera_move_leaves_the_controls_alone(port):
     moved = M.set_camera(s, dataclasses.replace(s.camera, view_angle=s.camera.view_angle + 5))
     assert not controls_changed(s, moved)
     assert controls_changed(s, M.set_model(s, "phong"))
+
+
+def test_letting_go_ends_the_drag_or_seals_the_steps(port):
+    c = port.controller
+    port.begin_drag()  # a slider pressed
+    c.set_value("kd", 0.2)
+    c.set_value("kd", 0.25)
+    port.let_go()
+    assert not port.dragging() and c.store.undo_label() == "kd"
+    c.set_value("kd", 0.3)  # a new step: the drag's were sealed at its end
+    c.undo()
+    assert c.state.material.scalars()[1] == pytest.approx(0.25)
+    c.set_value("ks", 0.4)  # a click (no drag): the release seals
+    port.let_go()
+    c.set_value("ks", 0.5)
+    c.undo()
+    assert c.state.material.scalars()[2] == pytest.approx(0.4)
+
+
+def test_side_b_draws_its_mesh_while_side_a_shows_the_heat_map(port):
+    """The two sides share one camera: side A's clipping range, set around what A draws, left
+    out the mesh while A showed the heat map instead, and side B drew no mesh."""
+    c, b = port.controller, port.side_b
+    c.act(M.set_compare, True)
+    port.redraw()
+    before = b.plotter.screenshot(return_img=True)[:, :, :3].copy()
+    c.toggle_difference()
+    c.on_difference(run_job(c.ports.worker.jobs[-1]))
+    assert port.heat.shown
+    port.redraw()
+    b.plotter.render_window.Render()
+    assert np.array_equal(b.plotter.screenshot(return_img=True)[:, :, :3], before)

@@ -120,8 +120,8 @@ class ExplorerWindow(QtWidgets.QMainWindow):
     def _observe(self) -> None:
         self.watch_camera(self.plotter)
         for s in self.panel.findChildren(ValueSlider):
-            s.pressed.connect(self._guard(self.begin_drag, s.objectName()))
-            s.released.connect(self._guard(self._end_drag_if_dragging, s.objectName()))
+            s.pressed.connect(self._guard(self.viewport.begin_drag, s.objectName()))
+            s.released.connect(self._guard(self.viewport.let_go, s.objectName()))
 
     def watch_camera(self, pl) -> None:
         """``pl``'s camera drags are drags (the level of detail, one undo step); VTK's and
@@ -130,8 +130,9 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         iren = pl.iren.interactor
         style = iren.GetInteractorStyle()
         if style is not None:
-            style.AddObserver("StartInteractionEvent", self._guard(self.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self._guard(self.end_drag, "camera"))
+            vp = self.viewport
+            style.AddObserver("StartInteractionEvent", self._guard(vp.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self._guard(vp.end_drag, "camera"))
         for key in list(getattr(pl, "_key_press_event_callbacks", {})):
             pl.clear_events_for_key(key)
 
@@ -210,19 +211,6 @@ class ExplorerWindow(QtWidgets.QMainWindow):
     def render(self) -> None:
         """Draw a frame now."""
         self.viewport.redraw()
-
-    # -- drags -----------------------------------------------------------------------------------
-    def begin_drag(self, *_) -> None:
-        self.viewport.begin_drag()
-
-    def end_drag(self, *_) -> None:
-        self.viewport.end_drag()
-
-    def _end_drag_if_dragging(self, *_) -> None:
-        if self.view.dragging:
-            self.end_drag()
-        else:
-            self.controller.release()
 
     # -- reporting ------------------------------------------------------------------------------
     def widget_box(self, widget: QtWidgets.QWidget) -> list[int]:
