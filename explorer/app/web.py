@@ -3,7 +3,8 @@
 flow (open, save, export, difference, undo) and differ only in their widgets.
 
 The 3D view is rendered on the server (an off-screen PyVista plotter shown by trame's
-``VtkRemoteView``, drawn by :class:`~explorer.app.view.SceneView`): the page receives pictures,
+``VtkRemoteView``, drawn by the desktop's view port, :class:`~explorer.app.viewport.PlotterView`,
+whose pictures :class:`WebExplorer` pushes to the page): the page receives pictures,
 so the engine's colours, the lobe inset, the light handles and the difference heat map are the
 desktop's pixels. Dragging in the view turns the server's camera, and the camera is the viewer:
 before each frame it goes into the state (:meth:`Controller.camera_moved`). The panel is
@@ -82,8 +83,8 @@ PROXY_OFF = ("0", "off", "false", "no")
 
 
 class WebExplorer(WebFiles):
-    """One explorer served by trame: the controller's ports (dialogs, messages, view,
-    choices, progress) for a page.
+    """One explorer served by trame: the controller's ports (dialogs, messages, choices,
+    progress; the view is :attr:`viewport`, whose pictures this sends) for a page.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
     materials_dirs : extra preset directories; preset_dir : where presets are saved (default:

@@ -4,9 +4,11 @@ beside the control panel (:mod:`explorer.app.qt.panel`), a thin binding of
 
 The window holds no state and no flow of its own: the controls send intents to the controller,
 which changes the store and tells the window (its ports: :class:`ExplorerWindow` implements the
-dialogs, messages, view, choices and progress ports) what to show. The camera is the viewer:
-before each frame the view's camera goes into the state (:meth:`Controller.camera_moved`, no
-undo step). The difference view is computed in a worker thread
+dialogs, messages, choices and progress ports; the view port is the
+:class:`~explorer.app.viewport.PlotterView` both front ends share, over the window's
+``QtInteractor``, drawing through :class:`~explorer.app.qt.viewport.QtPictures`) what to
+show. The camera is the viewer: before each frame the view's camera goes into the state
+(:meth:`Controller.camera_moved`, no undo step). The difference view is computed in a worker thread
 (:class:`~explorer.app.difference.DifferenceWorker`) whose results come back through a Qt
 signal to :meth:`Controller.on_difference`.
 
