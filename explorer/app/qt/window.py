@@ -83,13 +83,9 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.panel.rejected.connect(self._guard(c.reject_input, "typed value"))
         self.engine = EngineStatus(self)
         self.compare = CompareView(self)
-        self.view = self.viewport.attach(
-            c,
-            mesh,
-            side_b=SideB(self.viewport, self.compare),
-            lod_vertices=lod_vertices,
-            lod_target=lod_target,
-        )
+        side_b = SideB(self.viewport, self.compare)
+        self.view = self.viewport.attach(c, mesh, side_b=side_b, lod_vertices=lod_vertices,
+                                         lod_target=lod_target)  # fmt: skip
         self.heat = self.viewport.heat
         self.difference_ready.connect(self._guard(c.on_difference, "difference view"))
         self._observe()
