@@ -457,7 +457,7 @@ def set_light_type(state: State, kind: str) -> State:
         return state
     az, el, d = state.placement()
     new = light.as_type(kind).placed(az, el, d, state.centre)
-    if kind == "spot":
+    if "cutoff" in new.CONTROL_KEYS:  # a cone: one that lights part of the mesh
         new = new.replace(cutoff=spot_cutoff(d, state.radius))
     return _with_selected(state, new).replace(held_azimuth=az)
 
@@ -494,12 +494,17 @@ def set_light_intensity(state: State, k: float) -> State:
     return _with_selected(state, light.replace(diffuse=rgb, specular=rgb))
 
 
+#: the selected light's fields :func:`set_light_field` sets as given (when the light's
+#: ``CONTROL_KEYS`` have them)
+LIGHT_FIELDS = ("attenuation", "cutoff", "exponent", "shadows")
+
+
 def set_light_field(state: State, name: str, value) -> State:
-    """``attenuation`` (point and spot), ``cutoff`` or ``exponent`` (spot) of the selected
-    light; the light checks the value."""
+    """``attenuation``, ``cutoff``, ``exponent`` or ``shadows`` of the selected light, when the
+    light has that control (its ``CONTROL_KEYS``: attenuation on a positional light, the cone
+    on a spot); the light checks the value."""
     light = state.selected_light
-    allowed = {"attenuation": ("point", "spot"), "cutoff": ("spot",), "exponent": ("spot",)}
-    if light is None or name not in allowed or light.type not in allowed[name]:
+    if light is None or name not in LIGHT_FIELDS or name not in light.CONTROL_KEYS:
         kind = "no light" if light is None else f"a {light.type} light"
         raise ExplorerError(f"{name!r} cannot be set on {kind}")
     if name == "attenuation":
