@@ -50,8 +50,10 @@ class Row:
     value(state) : the value shown (an optional number's None: off)
     edit(state, value) : ``(action, args)``, the model action that sets ``value``
     visible(state) : whether the row is shown
-    label : the undo step's name (default: the key)
-    choices : a choice's values; inline : draw them side by side (else a list to open)
+    label : the undo step's name (default: the key); text : the words beside the control
+        (default: the key)
+    choices : a choice's values, or a triple's parts; inline : draw a choice's values side by
+        side (else a list to open)
     optional : a number that may be off (None): the value it takes when turned on; the row
         is drawn with a ``<key>_on`` toggle before the number
     tip : what the control does (a tooltip)
@@ -68,6 +70,7 @@ class Row:
     visible: Callable[[M.State], bool] = _always
     group: str = ""
     label: str = ""
+    text: str = ""
     choices: tuple[str, ...] = ()
     inline: bool = False
     optional: float | None = None
@@ -83,6 +86,10 @@ class Row:
     @property
     def undo_label(self) -> str:
         return self.label or self.key
+
+    @property
+    def caption(self) -> str:
+        return self.text or self.key
 
     def shown(self, state: M.State):
         """The value when the row is shown, else None (the page hides a row whose value is
@@ -117,7 +124,7 @@ def _material_rows() -> list[Row]:
                     lambda s, v: (M.set_model, (v,)), choices=MODELS, inline=True))  # fmt: skip
     rows += [Row(f"show_{t}", "material", "toggle", lambda s, t=t: t not in s.hidden,
                  lambda s, v, t=t: (M.set_term, (t, bool(v))), group="terms",
-                 label=f"{t} term", tip=f"draw the {t} term (the material is unchanged)")
+                 label=f"{t} term", text=t, tip=f"draw the {t} term (the material is unchanged)")
              for t in M.TERMS]  # fmt: skip
     rows += [
         Row("fresnel", "material", "number", lambda s: s.material.fresnel,
@@ -187,7 +194,7 @@ def _light_rows() -> list[Row]:
             tip="distance from the mesh centre in mesh radii", note=_distance_note,
             slider=_distance_slider),
         Row("attenuation", "lights", "triple", light("attenuation"), field("attenuation"),
-            tip="1 / (kc + kl·d + kq·d²), d in world units"),
+            choices=("kc", "kl", "kq"), tip="1 / (kc + kl·d + kq·d²)"),
         Row("cutoff", "lights", "number", lambda s: min(float(s.selected_light.cutoff), 90.0),
             field("cutoff")),
         Row("exponent", "lights", "number", lambda s: float(s.selected_light.exponent),
