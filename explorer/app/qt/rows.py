@@ -121,9 +121,7 @@ class RowWidgets(QtCore.QObject):
         if not r.inline:
             combo = _named(QtWidgets.QComboBox(), r.key, r.tip)
             combo.addItems(list(r.choices))
-            combo.activated.connect(
-                lambda i, k=r.key, c=r.choices: self.send(k, c[i], merge=False)
-            )
+            combo.activated.connect(lambda i, k=r.key, c=r.choices: self.send(k, c[i], merge=False))
             return combo
         box = _named(QtWidgets.QWidget(), r.key, r.tip)
         row = QtWidgets.QHBoxLayout(box)
