@@ -57,7 +57,8 @@ class LightsTab(QtWidgets.QWidget):
         self.rows = RowWidgets(panelmodel.rows("lights"), form, send, self)
         self.rows.rejected.connect(self.rejected)
         self.sliders = self.rows.sliders
-        self.colour = self.rows.widgets["color"]
+        self.type, self.colour = self.rows.widgets["type"], self.rows.widgets["color"]
+        self.attenuation_box = self.rows.widgets["attenuation"]
         self.attenuation = self.rows.fields["attenuation"]
         self.cutoff, self.exponent = self.sliders["cutoff"], self.sliders["exponent"]
         box.addWidget(self.controls)
