@@ -127,6 +127,10 @@ def test_no_front_end_module_names_a_light_type():
     modules hold no light-type rule."""
     files = [*ROOT.glob("explorer/app/qt/*.py"), *ROOT.glob("explorer/app/web*.py")]
     pattern = re.compile(r"""["'](directional|point|spot)["']|\.type\s*(==(?!=)|!=(?!=)|in\b)""")
-    found = [f"{f.name}:{i}" for f in files
-             for i, line in enumerate(f.read_text().splitlines(), 1) if pattern.search(line)]  # fmt: skip
+    found = [
+        f"{f.name}:{i}"
+        for f in files
+        for i, line in enumerate(f.read_text().splitlines(), 1)
+        if pattern.search(line)
+    ]
     assert not found, found
