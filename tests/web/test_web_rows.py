@@ -18,7 +18,7 @@ def shown(driver, name: str) -> bool:
     """An element named ``name`` is laid out on the page (none of its ancestors hidden: a
     select's own input is transparent, so Selenium's ``is_displayed`` does not serve)."""
     return driver.execute_script(
-        "return [...document.querySelectorAll(`[aria-label=\"${arguments[0]}\"]`)]"
+        'return [...document.querySelectorAll(`[aria-label="${arguments[0]}"]`)]'
         ".some(e => e.getClientRects().length > 0);",
         name,
     )
