@@ -263,23 +263,20 @@ def names(r: Row) -> tuple[str, ...]:
     return (r.key, f"{r.key}_on") if r.kind == "number" and r.optional is not None else (r.key,)
 
 
-def client_keys() -> dict[str, type]:
-    """The page's state keys the rows let a client set, with their types (against a client
-    that sends anything: :mod:`explorer.app.webpanel` names them so): a number's value
-    (``float``; typed text is ``str``) and its slider step (``<key>_step``, ``int``), a
-    colour's ``r, g, b`` text and its ``<key>_hex``, a choice's value, a toggle's ``bool``,
-    a triple's ``kc, kl, kq`` text, an optional number's ``<key>_on``."""
-    out: dict[str, type] = {}
+def client_keys() -> dict[str, str]:
+    """The page's state keys the rows let a client set (their ``v_model``), with their kind
+    as the web guard names kinds (``number``, ``bool``, ``text``): a number's slider step
+    ``<key>_step`` and an optional number's switch ``<key>_on``, a choice's value, a toggle's.
+    A number's, a colour's and a triple's typed text and a colour's picks are not state: they
+    call the page's handlers, which parse what they are given."""
+    out: dict[str, str] = {}
     for r in ROWS:
         if r.kind == "number":
-            out[f"{r.key}_step"] = int
+            out[f"{r.key}_step"] = "number"
             if r.optional is not None:
-                out[f"{r.key}_on"] = bool
-        elif r.kind == "colour":
-            out[r.key] = str
-            out[f"{r.key}_hex"] = str
-        elif r.kind in ("choice", "triple"):
-            out[r.key] = str
+                out[f"{r.key}_on"] = "bool"
+        elif r.kind == "choice":
+            out[r.key] = "text"
         elif r.kind == "toggle":
-            out[r.key] = bool
+            out[r.key] = "bool"
     return out

@@ -112,14 +112,17 @@ def test_the_optional_fresnel_turns_off_with_none_and_the_hdr_rows_follow_the_di
     assert on.state.material.fresnel is None
 
 
-def test_client_keys_name_every_rows_state_keys_with_their_types():
+def test_client_keys_name_every_state_key_a_row_lets_the_page_set_with_its_kind():
     keys = P.client_keys()
     for r in P.ROWS:
         if r.kind == "number":
-            assert keys[f"{r.key}_step"] is int
-        else:
-            assert r.key in keys
-    assert keys["fresnel_on"] is bool and keys["shadows"] is bool and keys["color_hex"] is str
+            assert keys[f"{r.key}_step"] == "number"
+        elif r.kind in ("choice", "toggle"):
+            assert keys[r.key] == ("text" if r.kind == "choice" else "bool")
+        else:  # typed text and picks go to the page's handlers, not the state
+            assert r.key not in keys
+    assert keys["fresnel_on"] == "bool" and keys["tone_map"] == "text"
+    assert keys["show_specular"] == keys["shadows"] == keys["hdr"] == "bool"
 
 
 def test_no_front_end_module_names_a_light_type():
