@@ -1,6 +1,6 @@
 """The actions that switch the engine's effects from the explorer's panel (docs/effects.md):
-the material's Fresnel and energy-conserving specular, the scene's two-sided lighting and HDR
-display (exposure, tone map). A light's shadows are a light field
+the material's Fresnel and energy-conserving specular, the scene's two-sided lighting, HDR
+display (exposure, tone map) and local viewer. A light's shadows are a light field
 (:func:`explorer.app.model.set_light_field`); translucency is the material's opacity
 (:func:`explorer.app.model.set_opacity`). Each is a pure action of the
 :mod:`explorer.app.model` kind (one undo step; the scene keeps the value, so a session saves it).
@@ -8,7 +8,7 @@ display (exposure, tone map). A light's shadows are a light field
 
 from __future__ import annotations
 
-from explorer.app.model import State
+from explorer.app.model import State, set_camera
 from explorer.app.model import _material as with_material
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import HDR, HDR_KEYS
@@ -52,3 +52,10 @@ def set_hdr_field(state: State, name: str, value) -> State:
     if name not in HDR_KEYS:
         raise ExplorerError(f"hdr key must be one of {HDR_KEYS}, got {name!r}")
     return state.replace(scene=state.scene.replace(hdr=hdr.replace(**{name: value})))
+
+
+def set_local_viewer(state: State, on: bool) -> State:
+    """The viewer at the camera (on) or infinitely far along its view (off); the scene's
+    viewer follows the camera at once."""
+    new = state.replace(local_viewer=bool(on))
+    return set_camera(new, new.camera) if new.camera is not None else new

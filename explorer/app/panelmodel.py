@@ -214,6 +214,10 @@ def _view_rows() -> list[Row]:
         Row("two_sided", "view", "toggle", lambda s: s.scene.two_sided,
             lambda s, v: (E.set_scene_field, ("two_sided", bool(v))),
             tip="light back faces too, with the normal turned (-N)"),
+        Row("local_viewer", "view", "toggle", lambda s: s.local_viewer,
+            lambda s, v: (E.set_local_viewer, (bool(v),)),
+            tip="the viewer at the camera (highlights move across a flat face); off: "
+                "infinitely far along the view (OpenGL's default)"),
         Row("hdr", "view", "toggle", _hdr_on, lambda s, v: (E.set_hdr, (bool(v),)),
             tip="unclamped colours shown with an exposure and a tone map, then sRGB"),
         Row("exposure", "view", "number", lambda s: s.scene.hdr.exposure,
@@ -231,7 +235,7 @@ ROWS: tuple[Row, ...] = (*_material_rows(), *_light_rows(), *_view_rows())
 BY_KEY: dict[str, Row] = {r.key: r for r in ROWS}
 #: the effects of docs/effects.md as rows (translucency is ``opacity``)
 EFFECT_KEYS = ("shadows", "fresnel", "energy_conserving", "hdr", "exposure", "tone_map",
-               "opacity", "two_sided")  # fmt: skip
+               "opacity", "two_sided", "local_viewer")  # fmt: skip
 
 
 def rows(tab: str) -> tuple[Row, ...]:

@@ -391,6 +391,7 @@ EFFECTS = {
     "fresnel": ("material", lambda rows: rows.sliders["fresnel"].field.setValue(0.6)),
     "energy_conserving": ("material", lambda rows: rows.widgets["energy_conserving"].click()),
     "two_sided": ("view", lambda rows: rows.widgets["two_sided"].click()),
+    "local_viewer": ("view", lambda rows: rows.widgets["local_viewer"].click()),
     "hdr": ("view", lambda rows: rows.widgets["hdr"].click()),
     "exposure": ("view", lambda rows: rows.sliders["exposure"].field.setValue(1.5)),
     "tone_map": ("view", lambda rows: rows.widgets["tone_map"].activated.emit(2)),

@@ -29,7 +29,7 @@ SAMPLES = {
     "type": "point", "color": (1.0, 0.5, 0.0), "intensity": 0.7, "azimuth": -60.0,
     "elevation": 20.0, "distance": 3.0, "attenuation": (1.0, 0.2, 0.0), "cutoff": 12.0,
     "exponent": 3.0, "shadows": True, "two_sided": True, "hdr": False, "exposure": 1.5,
-    "tone_map": "aces",
+    "tone_map": "aces", "local_viewer": False,
 }  # fmt: skip
 
 

@@ -69,7 +69,7 @@ def test_an_effect_row_changes_the_picture_and_undo_restores_it(server, browser,
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
 
 
-def test_a_lights_shadows_and_two_sided_lighting_reach_the_session(server, browser):
+def test_a_lights_shadows_two_sided_lighting_and_the_viewer_reach_the_session(server, browser):
     rep = open_page(browser, server.url)
     click(browser, "lights tab")
     wait("the lights tab", lambda: shown(browser, "shadows"))
@@ -80,6 +80,9 @@ def test_a_lights_shadows_and_two_sided_lighting_reach_the_session(server, brows
     wait("the view tab", lambda: shown(browser, "two_sided"))
     click(browser, "two_sided")
     wait("two-sided", lambda: report(browser)["session"]["scene"]["two_sided"] is True)
-    click(browser, "undo")
-    click(browser, "undo")
+    click(browser, "local_viewer")
+    wait("an infinite viewer", lambda: (s := report(browser)["session"])["local_viewer"] is False
+         and "to_viewer" in s["scene"]["viewer"])  # fmt: skip
+    for _ in range(3):
+        click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
