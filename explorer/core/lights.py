@@ -253,12 +253,12 @@ class Light(Checked):
 
     @classmethod
     def like(cls, light: Light) -> Light:
-        """A light of this type with the colours of ``light`` (and its attenuation between
-        positional types; a new spot gets the cone of ``LIKE_DEFAULTS``), at this type's default
-        place: move it with :meth:`placed`."""
+        """A light of this type with the colours and the shadows of ``light`` (and its
+        attenuation between positional types; a new spot gets the cone of ``LIKE_DEFAULTS``),
+        at this type's default place: move it with :meth:`placed`."""
         return cls(
             ambient=light.ambient, diffuse=light.diffuse, specular=light.specular,
-            **cls._kept_from(light), **cls.LIKE_DEFAULTS,
+            shadows=light.shadows, **cls._kept_from(light), **cls.LIKE_DEFAULTS,
         )  # fmt: skip
 
     @classmethod
