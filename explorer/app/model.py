@@ -108,6 +108,9 @@ class State:
         one material (:attr:`material`: a preset, the scene's) covers the whole mesh
     group : the group the panel edits: while :attr:`groups` is shown, :attr:`material` is
         ``groups[group]`` (every material action edits that group)
+    local_viewer : the engine's viewer is at the camera (a local viewer, OpenGL's
+        ``GL_LIGHT_MODEL_LOCAL_VIEWER``); off: infinitely far along the camera's view (OpenGL's
+        default; a parallel camera's viewer is always so)
     """
 
     scene: Scene
@@ -130,6 +133,7 @@ class State:
     mesh_materials: MeshMaterials | None = None
     groups: tuple[Material, ...] | None = None
     group: int = 0
+    local_viewer: bool = True
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)
@@ -300,10 +304,10 @@ def set_difference(state: State, on: bool) -> State:
     return state.replace(difference=bool(on))
 
 
-def viewer_of_camera(camera: Camera) -> Viewer:
+def viewer_of_camera(camera: Camera, local: bool = True) -> Viewer:
     """The engine's viewer seen by a camera: a local viewer at the position (perspective), or
-    an infinite viewer looking along the camera (parallel projection)."""
-    if camera.parallel:
+    an infinite viewer looking along the camera (parallel projection, or ``local`` off)."""
+    if camera.parallel or not local:
         return Viewer(to_viewer=tuple(np.subtract(camera.position, camera.focal_point)))
     x, y, z = camera.position
     return Viewer(eye=(float(x), float(y), float(z)))
@@ -313,7 +317,7 @@ def set_camera(state: State, camera: Camera | None) -> State:
     """The view's camera, which is the viewer: the scene's viewer follows it."""
     if camera is None:
         return state.replace(camera=None)
-    viewer = viewer_of_camera(camera)
+    viewer = viewer_of_camera(camera, state.local_viewer)
     scene = state.scene if viewer == state.scene.viewer else state.scene.replace(viewer=viewer)
     return state.replace(camera=camera, scene=scene)
 
@@ -457,7 +461,7 @@ def set_light_type(state: State, kind: str) -> State:
         return state
     az, el, d = state.placement()
     new = light.as_type(kind).placed(az, el, d, state.centre)
-    if kind == "spot":
+    if "cutoff" in new.CONTROL_KEYS:  # a cone: one that lights part of the mesh
         new = new.replace(cutoff=spot_cutoff(d, state.radius))
     return _with_selected(state, new).replace(held_azimuth=az)
 
@@ -494,12 +498,17 @@ def set_light_intensity(state: State, k: float) -> State:
     return _with_selected(state, light.replace(diffuse=rgb, specular=rgb))
 
 
+#: the selected light's fields :func:`set_light_field` sets as given (when the light's
+#: ``CONTROL_KEYS`` have them)
+LIGHT_FIELDS = ("attenuation", "cutoff", "exponent", "shadows")
+
+
 def set_light_field(state: State, name: str, value) -> State:
-    """``attenuation`` (point and spot), ``cutoff`` or ``exponent`` (spot) of the selected
-    light; the light checks the value."""
+    """``attenuation``, ``cutoff``, ``exponent`` or ``shadows`` of the selected light, when the
+    light has that control (its ``CONTROL_KEYS``: attenuation on a positional light, the cone
+    on a spot); the light checks the value."""
     light = state.selected_light
-    allowed = {"attenuation": ("point", "spot"), "cutoff": ("spot",), "exponent": ("spot",)}
-    if light is None or name not in allowed or light.type not in allowed[name]:
+    if light is None or name not in LIGHT_FIELDS or name not in light.CONTROL_KEYS:
         kind = "no light" if light is None else f"a {light.type} light"
         raise ExplorerError(f"{name!r} cannot be set on {kind}")
     if name == "attenuation":
@@ -618,6 +627,8 @@ def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = 
     places = [light.placement(state.centre) for light in state.scene.lights]
     places = [(az, el, (d or 0.0) / state.radius * radius) for az, el, d in places]
     viewer = state.scene.viewer
+    if not state.local_viewer and state.camera is not None and not state.camera.parallel:
+        viewer = viewer_of_camera(state.camera)  # framed from the camera's place, not along it
     far = max(abs(c) for c in centre)
     ends = [far + d for _, _, d in places]
     eye = None

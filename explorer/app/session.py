@@ -13,6 +13,8 @@ A session file is YAML (or JSON, which YAML reads too)::
     camera: {position: [..], focal_point: [..], view_up: [..], parallel: false,
              parallel_scale: 1.0, view_angle: 30.0}
     difference: false
+    local_viewer: true         # optional: the viewer at the camera (false: infinitely far
+                               # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
                                # the A / B compare view's side B
     groups: {group: 1, materials: [{...}, ...]}   # optional: the mesh file's own materials
@@ -49,7 +51,7 @@ from explorer.render.camera import Camera
 FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
-    "camera", "difference", "compare", "groups", "window",
+    "camera", "difference", "compare", "groups", "window", "local_viewer",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -89,6 +91,7 @@ def session_mapping(state: State) -> dict:
         "light": state.light + 1,
         "handle_distance": float(state.handle_distance),
         "difference": bool(state.difference),
+        "local_viewer": bool(state.local_viewer),
     }
     if state.camera is not None:
         out["camera"] = camera_mapping(state.camera)
@@ -147,6 +150,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     handle = checker.number(m.get("handle_distance", 2.5), ("handle_distance",), 0.0, 1e6,
                             lo_open=True)  # fmt: skip
     difference = checker.boolean(m.get("difference", False), ("difference",))
+    local_viewer = checker.boolean(m.get("local_viewer", True), ("local_viewer",))
     camera = _camera(checker, m["camera"]) if "camera" in m else None
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
     groups = _groups(checker, m["groups"]) if m.get("groups") is not None else None
@@ -180,6 +184,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         handle_distance=handle,
         camera=camera,
         difference=bool(difference),
+        local_viewer=bool(local_viewer),
         **compare,
     )
     return state, mesh

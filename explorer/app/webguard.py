@@ -40,8 +40,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import PurePath
 from urllib.parse import urlsplit
 
-from explorer.app.model import TERMS
-from explorer.app.webpanel import LIGHT_NUMBERS, MATERIAL_NUMBERS
+from explorer.app import panelmodel
 
 log = logging.getLogger(__name__)
 
@@ -207,16 +206,16 @@ def key_table(rows: Iterable[tuple[str, str]]) -> dict[str, str]:
     return table
 
 
-#: every state key the page's controls set (their ``v_model``), with its kind: the sliders'
-#: steps, the selects, switches and check boxes, the text fields that are state, the uploads,
-#: the tab and the drawer. The number fields, colour fields and pickers, buttons and downloads
-#: are not state: they call the server's handlers, which parse what they are given.
+#: every state key the page's controls set (their ``v_model``), with its kind: the panel
+#: model's rows (:func:`explorer.app.panelmodel.client_keys`: the sliders' steps, the choices
+#: and toggles), then the page's own selects, switches and text fields that are state, the
+#: uploads, the tab and the drawer. The number fields, colour fields and pickers, buttons and
+#: downloads are not state: they call the server's handlers, which parse what they are given.
 #: tests/web/test_web_security.py checks it against the page's template (every ``v-model``).
 CLIENT_KEYS: Mapping[str, str] = key_table([
-    *((f"{k}_step", "number") for k in (*MATERIAL_NUMBERS, *LIGHT_NUMBERS)),
-    *((f"show_{t}", "bool") for t in TERMS),
-    ("preset", "text"), ("model", "text"), ("group", "index"), ("light", "index"),
-    ("type", "text"), ("mesh", "text"), ("difference", "bool"),
+    *panelmodel.client_keys().items(),
+    ("preset", "text"), ("group", "index"), ("light", "index"),
+    ("mesh", "text"), ("difference", "bool"),
     ("compare_on", "bool"), ("compare_preset", "text"), ("compare_model", "text"),
     ("compare_difference", "bool"), ("turntable_frames", "text or number"),
     ("turntable_format", "text"), ("preset_name", "text"), ("preset_replace", "bool"),

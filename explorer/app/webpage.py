@@ -10,13 +10,11 @@ trame is imported inside :func:`build` (``import explorer`` stays free of it).
 
 from __future__ import annotations
 
-from explorer.app import model as M
+from explorer.app import panelmodel
 from explorer.app.turntablejob import DEFAULT_FRAMES
 from explorer.app.webfiles import turntable_formats
-from explorer.app.webpanel import LIGHT_NUMBERS, MATERIAL_NUMBERS
 from explorer.core.controls import STEPS
-from explorer.core.lights import LIGHT_TYPES
-from explorer.core.material import MODELS, RGB_KEYS
+from explorer.core.material import MODELS
 from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
 from explorer.geometry.meshes import MESH_SUFFIXES
 
@@ -76,8 +74,8 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
 def _colour(v3, html, ctrl, key: str, label: str) -> None:
     """A colour field ``"r, g, b"`` for state key ``key``, named ``label`` (the scene file's
     key), and beside it a swatch of the value (state ``<key>_hex``) that opens an 8-bit
-    colour picker (``<label> picker``)."""
-    with html.Div(classes="d-flex align-center my-1"):
+    colour picker (``<label> picker``); hidden while ``key`` is null (no light to colour)."""
+    with html.Div(v_show=f"{key} != null"), html.Div(classes="d-flex align-center my-1"):
         v3.VTextField(
             model_value=(key, ""), label=label, density="compact", hide_details=True,
             variant="outlined", classes="flex-grow-1",
@@ -98,6 +96,57 @@ def _colour(v3, html, ctrl, key: str, label: str) -> None:
                     raw_attrs=[f'aria-label="{label} picker colours"'],
                 )  # fmt: skip
                 html.Div(PICKER_HINT, classes="text-caption pa-2", style="max-width: 300px")
+
+
+def _choice(v3, r) -> None:
+    v3.VSelect(v_model=(r.key, None), items=(repr(list(r.choices)),), label=r.caption,
+               density="compact", hide_details=True, v_show=f"{r.key} != null", title=r.tip,
+               raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+
+
+def _toggle(v3, r) -> None:
+    v3.VCheckbox(v_model=(r.key, False), label=r.caption, density="compact", hide_details=True,
+                 v_show=f"{r.key} != null", title=r.tip,
+                 raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+
+
+def _triple(v3, ctrl, r) -> None:
+    v3.VTextField(
+        model_value=(r.key, ""), label=f"{r.key} ({', '.join(r.choices)})", density="compact",
+        hide_details=True, variant="outlined", v_show=f"{r.key} != null", title=r.tip,
+        change=(ctrl.on_triple, f"['{r.key}', $event.target.value]"),
+        raw_attrs=[f'aria-label="{r.key}"'],
+    )  # fmt: skip
+
+
+def _rows(v3, html, ctrl, tab: str) -> None:
+    """The rows of ``tab`` (:mod:`explorer.app.panelmodel`), one factory per kind; a group of
+    toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
+    key is null (the row is not shown)."""
+    line, group = None, None
+    for r in panelmodel.rows(tab):
+        if r.kind == "toggle" and r.group:
+            if r.group != group:
+                line = html.Div(classes="d-flex")
+                group = r.group
+            with line:
+                _toggle(v3, r)
+            continue
+        group = None
+        if r.kind == "number":
+            if r.optional is not None:
+                v3.VCheckbox(v_model=(f"{r.key}_on", False), label=r.caption, density="compact",
+                             hide_details=True, v_show=f"{r.key}_on != null", title=r.tip,
+                             raw_attrs=[f'aria-label="{r.key}_on"'])  # fmt: skip
+            _number(v3, html, ctrl, r.key, r.caption)
+        elif r.kind == "colour":
+            _colour(v3, html, ctrl, r.key, r.key)
+        elif r.kind == "choice":
+            _choice(v3, r)
+        elif r.kind == "toggle":
+            _toggle(v3, r)
+        else:
+            _triple(v3, ctrl, r)
 
 
 def _mesh_materials(v3, html, ctrl) -> None:
@@ -125,18 +174,7 @@ def _material_tab(v3, html, ctrl) -> None:
         v_model=("preset", None), items=("presets", []), label="preset", item_props=True,
         density="compact", hide_details=True, raw_attrs=['aria-label="preset"'],
     )  # fmt: skip
-    for key in MATERIAL_NUMBERS:
-        _number(v3, html, ctrl, key, key)
-    for term in RGB_KEYS:
-        _colour(v3, html, ctrl, term, term)
-    v3.VSelect(v_model=("model", "blinn"), items=("models",), label="model",
-               density="compact", hide_details=True,
-               raw_attrs=['aria-label="model"'])  # fmt: skip
-    with html.Div(classes="d-flex"):
-        for term in M.TERMS:
-            v3.VCheckbox(v_model=(f"show_{term}", True), label=term,
-                         density="compact", hide_details=True,
-                         raw_attrs=[f'aria-label="show_{term}"'])  # fmt: skip
+    _rows(v3, html, ctrl, "material")
 
 
 def _lights_tab(v3, html, ctrl) -> None:
@@ -148,19 +186,7 @@ def _lights_tab(v3, html, ctrl) -> None:
         for name in ("add", "duplicate", "remove"):
             v3.VBtn(name, click=getattr(ctrl, f"{name}_light"), size="small",
                     classes="mr-1", raw_attrs=[f'aria-label="{name} light"'])  # fmt: skip
-    v3.VSelect(v_model=("type", None), items=("light_types",), label="type",
-               density="compact", hide_details=True, v_show="type !== null",
-               raw_attrs=['aria-label="type"'])  # fmt: skip
-    _colour(v3, html, ctrl, "light_color", "color")
-    for key in LIGHT_NUMBERS:
-        _number(v3, html, ctrl, key, key)
-    v3.VTextField(
-        model_value=("attenuation", ""), label="attenuation (kc, kl, kq)",
-        density="compact", hide_details=True, variant="outlined",
-        v_show="attenuation !== null",
-        change=(ctrl.on_attenuation, "[$event.target.value]"),
-        raw_attrs=['aria-label="attenuation"'],
-    )  # fmt: skip
+    _rows(v3, html, ctrl, "lights")
 
 
 def _view_tab(v3, html, ctrl) -> None:
@@ -180,6 +206,7 @@ def _view_tab(v3, html, ctrl) -> None:
     v3.VBtn("reset camera", click=ctrl.reset_camera, size="small", classes="my-2",
             raw_attrs=['aria-label="reset camera"'])  # fmt: skip
     _compare(v3, html, ctrl)
+    _rows(v3, html, ctrl, "view")
     _turntable(v3, html, ctrl)
 
 
@@ -304,7 +331,7 @@ def build(app) -> None:
     server = app.server
     ctrl = server.controller
     server.state.update(
-        models=list(MODELS), light_types=list(LIGHT_TYPES), message="", message_level="info",
+        models=list(MODELS), message="", message_level="info",
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         turntable_ready=False, turntable_made="",

@@ -3,12 +3,16 @@
 into one of the controller's intents (:func:`connect`). The layout is
 :mod:`explorer.app.webpage`.
 
-Every number of :data:`explorer.core.controls.CONTROLS` has a slider of
-:data:`~explorer.core.controls.STEPS` steps (state key ``<key>_step``; log-scaled for the
-shininess, as the desktop's) and a field (state key ``<key>``): a slider drag is one undo step
-(sealed when it ends), a value typed into a field and confirmed (Enter, or leaving the field)
-is one step, parsed as the desktop's fields parse it (:func:`explorer.app.model.parse_number`).
-A change the server pushed itself, or one equal to what the state shows, is no change.
+The rows of :mod:`explorer.app.panelmodel` are handled by kind, none by name: a row's state key
+is its key, None while the row is hidden (a spot's cutoff for a point light). A number has a
+slider of :data:`~explorer.core.controls.STEPS` steps (state key ``<key>_step``; log-scaled for
+the shininess, as the desktop's) and a field (state key ``<key>``): a slider drag is one undo
+step (sealed when it ends), a value typed into a field and confirmed (Enter, or leaving the
+field) is one step, parsed as the desktop's fields parse it
+(:func:`explorer.app.model.parse_number`). An optional number has its switch ``<key>_on``; a
+colour its ``r, g, b`` text and its 8-bit ``<key>_hex``; a choice, a toggle and a triple their
+value. Every edit is :meth:`Controller.set_value`. A change the server pushed itself, or one
+equal to what the state shows, is no change.
 """
 
 from __future__ import annotations
@@ -16,44 +20,27 @@ from __future__ import annotations
 from urllib.parse import quote
 
 from explorer.app import model as M
+from explorer.app import panelmodel
 from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
-from explorer.core.controls import CONTROLS, from_step, to_step
+from explorer.core.controls import from_step, to_step
 from explorer.core.errors import ExplorerError
-from explorer.core.material import RGB_KEYS
 
-MATERIAL_NUMBERS = ("ka", "kd", "ks", "shininess", "opacity")
-LIGHT_NUMBERS = ("intensity", "azimuth", "elevation", "distance", "cutoff", "exponent")
+#: the number rows (a slider and a field each)
+NUMBERS = tuple(r for r in panelmodel.ROWS if r.kind == "number")
 #: what the page is told when its ``mesh`` is not one of the chooser's (the same words for a
 #: missing file, an existing one or anything else: nothing is loaded, no path is named)
 MESH_REFUSED = "mesh: choose one of the listed meshes, or upload a mesh file"
 
 
-def slider_range(state: M.State, key: str) -> tuple[float, float]:
-    """The slider's range of control ``key``: the table's, but the distance's widened to hold
-    the light's own (mesh radii, :meth:`State.distance_range`)."""
-    if key == "distance":
-        lo, hi = state.distance_range()
-        return lo / state.radius, hi / state.radius
-    c = CONTROLS[key]
-    return c.lo, c.hi
-
-
 def number_values(state: M.State) -> dict:
-    """Every number control's value in ``state``, rounded to its decimals (None for a light
-    control with no light, or one the selected light's type has not)."""
-    ka, kd, ks = state.material.scalars()
-    out = {"ka": ka, "kd": kd, "ks": ks, "shininess": state.material.shininess,
-           "opacity": state.material.opacity}  # fmt: skip
-    out.update(dict.fromkeys(LIGHT_NUMBERS))
-    light = state.selected_light
-    if light is not None:
-        az, el, d = state.placement()
-        out.update(intensity=M.light_colour(light)[1], azimuth=az, elevation=el,
-                   distance=d / state.radius)  # fmt: skip
-        if light.type == "spot":
-            out.update(cutoff=min(float(light.cutoff), 90.0), exponent=float(light.exponent))
-    return {k: None if v is None else round(float(v), CONTROLS[k].decimals)
-            for k, v in out.items()}  # fmt: skip
+    """Every number row's value in ``state``, rounded to its decimals (None for a row not
+    shown: a light control with no light, or one the selected light has not; an optional
+    number that is off)."""
+    out = {}
+    for r in NUMBERS:
+        v = r.shown(state)
+        out[r.key] = None if v is None else round(float(v), r.control.decimals)
+    return out
 
 
 def swatch_url(m) -> str:
@@ -89,26 +76,34 @@ def mesh_materials_values(state: M.State) -> dict:
     return {"mesh_materials": line, "groups": groups, "group": state.group}
 
 
+def row_values(state: M.State) -> dict:
+    """Every row's state keys (see the module docstring), from ``state``."""
+    out = number_values(state)
+    for r in panelmodel.ROWS:
+        v = r.shown(state)
+        if r.kind == "number":
+            out[f"{r.key}_step"] = None if v is None else to_step(
+                r.control, out[r.key], *r.slider_range(state))  # fmt: skip
+            if r.optional is not None:
+                out[f"{r.key}_on"] = (v is not None) if r.visible(state) else None
+        elif r.kind == "colour":
+            out[r.key] = None if v is None else rgb_text(v)
+            out[f"{r.key}_hex"] = None if v is None else rgb_hex(v)
+        elif r.kind == "triple":
+            out[r.key] = None if v is None else rgb_text(v)
+        else:
+            out[r.key] = v
+    return out
+
+
 def values(state: M.State) -> dict:
     """Every trame state key the panel shows, from ``state``."""
-    out = number_values(state)
-    for k in (*MATERIAL_NUMBERS, *LIGHT_NUMBERS):
-        v = out[k]
-        out[f"{k}_step"] = None if v is None else to_step(CONTROLS[k], v, *slider_range(state, k))
-    m = state.material
-    out.update({term: rgb_text(getattr(m, term)) for term in RGB_KEYS})
-    out.update({f"{term}_hex": rgb_hex(getattr(m, term)) for term in RGB_KEYS})
-    out.update({f"show_{t}": t not in state.hidden for t in M.TERMS})
+    out = row_values(state)
     lights = state.scene.lights
-    light = state.selected_light
-    positional = light is not None and light.type in ("point", "spot")
     out.update(
-        model=state.scene.model, preset=state.preset, edited=state.edited, mesh=state.mesh,
+        preset=state.preset, edited=state.edited, mesh=state.mesh,
         lights=[{"title": f"{i + 1}: {lt.type}", "value": i} for i, lt in enumerate(lights)],
-        light=state.light if lights else None, type=None if light is None else light.type,
-        light_color=None if light is None else rgb_text(M.light_colour(light)[0]),
-        light_color_hex=None if light is None else rgb_hex(M.light_colour(light)[0]),
-        attenuation=rgb_text(light.attenuation) if positional else None,
+        light=state.light if lights else None,
         difference=state.difference, compare_on=state.compare is not None,
         compare_preset=state.compare_preset, compare_model=state.compare_model,
         compare_difference=state.compare_difference,
@@ -129,40 +124,34 @@ def _typed(app, parse, send) -> None:
 
 
 def _numbers(app) -> None:
-    """The sliders' and the number fields' handlers."""
+    """The sliders', the number fields', the colours' and the triples' handlers (every row of
+    those kinds)."""
     state, ctrl, c = app.server.state, app.server.controller, app.controller
 
-    def on_slider(key):
+    def on_slider(r):
         def changed(**kw):
-            step = kw.get(f"{key}_step")
+            step = kw.get(f"{r.key}_step")
             s = app.store.state
-            shown = values(s)[f"{key}_step"]
+            shown = values(s)[f"{r.key}_step"]
             if app.pushing or step is None or shown is None or int(step) == shown:
                 return  # the server's own value
-            v = round(from_step(CONTROLS[key], int(step), *slider_range(s, key)),
-                      CONTROLS[key].decimals)  # fmt: skip
-            c.set_value(key, v)
+            v = round(from_step(r.control, int(step), *r.slider_range(s)), r.control.decimals)
+            c.set_value(r.key, v)
 
-        return app.guard(changed, key)
+        return app.guard(changed, r.key)
 
-    for key in (*MATERIAL_NUMBERS, *LIGHT_NUMBERS):
-        state.change(f"{key}_step")(on_slider(key))
+    for r in NUMBERS:
+        state.change(f"{r.key}_step")(on_slider(r))
 
     def on_field(key, text):
-        lo, hi = CONTROLS[key].field_range
+        lo, hi = panelmodel.row(key).control.field_range
         _typed(app, lambda: M.parse_number(key, str(text), lo, hi),
                lambda v: v != number_values(app.store.state)[key]
                and c.set_value(key, v, merge=False))  # fmt: skip
 
-    def colour_sender(key, merge):
-        """``send(rgb)``: colour ``key`` set (a run of ``merge`` steps is one undo step)."""
-        if key == "light_color":
-            return lambda rgb: c.act(M.set_light_colour, rgb, label="light color",
-                                     merge=key if merge else None)  # fmt: skip
-        return lambda rgb: c.set_value(key, rgb, merge=merge)
-
     def on_colour(key, text):
-        _typed(app, lambda: M.parse_colour(key, str(text)), colour_sender(key, False))
+        _typed(app, lambda: M.parse_colour(key, str(text)),
+               lambda rgb: c.set_value(key, rgb, merge=False))  # fmt: skip
 
     def on_pick(key, text):
         """A colour picked (8-bit ``#rrggbb``): set when it is not the 8-bit colour the state
@@ -170,26 +159,41 @@ def _numbers(app) -> None:
         it closes)."""
         if app.pushing or not text:
             return
-        send = colour_sender(key, True)
         _typed(app, lambda: parse_hex(key, str(text)), lambda rgb: rgb_hex(rgb)
-               != values(app.store.state)[f"{key}_hex"] and send(rgb))  # fmt: skip
+               != values(app.store.state)[f"{key}_hex"] and c.set_value(key, rgb))  # fmt: skip
 
-    def on_attenuation(text):
-        lo, hi = CONTROLS["attenuation"].field_range
+    def on_triple(key, text):
+        r = panelmodel.row(key)
+        lo, hi = r.control.field_range
 
         def parse():
-            parts = [M.parse_number("attenuation", t, lo, hi) for t in str(text).split(",")]
-            if len(parts) != 3:
-                raise ExplorerError(f"attenuation: give three numbers kc, kl, kq, got {text!r}")
+            parts = [M.parse_number(key, t, lo, hi) for t in str(text).split(",")]
+            if len(parts) != len(r.choices):
+                raise ExplorerError(f"{key}: give {len(r.choices)} numbers "
+                                    f"{', '.join(r.choices)}, got {text!r}")  # fmt: skip
             return tuple(parts)
 
-        _typed(app, parse, lambda v: c.set_value("attenuation", v, merge=False))
+        _typed(app, parse, lambda v: c.set_value(key, v, merge=False))
 
     ctrl.on_field = app.guard(on_field, "field")
     ctrl.on_colour = app.guard(on_colour, "colour")
     ctrl.on_pick = app.guard(on_pick, "colour picker")
-    ctrl.on_attenuation = app.guard(on_attenuation, "attenuation")
+    ctrl.on_triple = app.guard(on_triple, "triple")
     ctrl.seal = app.guard(c.release, "slider")
+
+
+def _rows(app, user) -> None:
+    """The choices', the toggles' and the optional numbers' switches' handlers: each
+    ``set_value`` of its row, when the page's value is not the state's."""
+    c = app.controller
+    for r in panelmodel.ROWS:
+        if r.kind in ("choice", "toggle"):
+            user(r.key, lambda v, s, r=r: r.visible(s) and v != r.value(s),
+                 lambda v, r=r: c.set_value(r.key, v, merge=False))  # fmt: skip
+        elif r.optional is not None:
+            user(f"{r.key}_on", lambda v, s, r=r: r.visible(s) and bool(v) != (
+                r.value(s) is not None), lambda v, r=r: c.set_value(
+                r.key, r.optional if v else None, merge=False))  # fmt: skip
 
 
 def _choices(app) -> None:
@@ -207,11 +211,7 @@ def _choices(app) -> None:
 
         state.change(name)(app.guard(changed, name))
 
-    user("model", lambda v, s: v != s.scene.model,
-         lambda v: c.act(M.set_model, v, label="model"))  # fmt: skip
-    for term in M.TERMS:
-        user(f"show_{term}", lambda v, s, t=term: bool(v) != (t not in s.hidden),
-             lambda v, t=term: c.act(M.set_term, t, bool(v), label=f"{t} term"))  # fmt: skip
+    _rows(app, user)
     user("preset", lambda v, s: v != s.preset, c.pick_preset)
     user("group", lambda v, s: s.groups is not None and int(v) != s.group,
          lambda v: c.act(M.select_group, int(v), label="group"))  # fmt: skip
@@ -220,8 +220,6 @@ def _choices(app) -> None:
     )
     user("light", lambda v, s: int(v) != s.light,
          lambda v: c.act(M.select_light, int(v), label="select light"))  # fmt: skip
-    user("type", lambda v, s: s.selected_light is not None and v != s.selected_light.type,
-         lambda v: c.act(M.set_light_type, v, label="light type"))  # fmt: skip
 
     def choose_mesh(value):
         """A mesh of the chooser's list only (a built-in, the start's, an upload: values the

@@ -13,8 +13,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from explorer.core.hdr import EXPOSURE_RANGE
 from explorer.core.lights import SPOT_CUTOFF_RANGE, SPOT_EXPONENT_RANGE
-from explorer.core.material import COEFFICIENT_RANGE, OPACITY_RANGE, SHININESS_RANGE
+from explorer.core.material import (
+    COEFFICIENT_RANGE,
+    FRESNEL_RANGE,
+    OPACITY_RANGE,
+    SHININESS_RANGE,
+)
 
 #: slider steps over a control's range (sliders are integral)
 STEPS = 1000
@@ -31,6 +37,9 @@ DISTANCE_FIELD = (0.01, 1e4)
 MAX_INTENSITY = 1000.0
 #: the attenuation fields' range (a scene file takes any value >= 0, not all three zero)
 ATTENUATION_RANGE = (0.0, 100.0)
+#: the exposure slider's range in stops (x 1/16 to x 16); a typed value may take the file's
+#: whole range, :data:`explorer.core.hdr.EXPOSURE_RANGE`
+EXPOSURE_SLIDER = (-4.0, 4.0)
 
 
 @dataclass(frozen=True)
@@ -62,7 +71,7 @@ def _controls(*items: Control) -> dict[str, Control]:
     return {c.key: c for c in items}
 
 
-#: every control of the material and the selected light, by key
+#: every number control of the material, the selected light and the scene, by key
 CONTROLS: dict[str, Control] = _controls(
     Control("ka", *COEFFICIENT_RANGE),
     Control("kd", *COEFFICIENT_RANGE),
@@ -76,6 +85,8 @@ CONTROLS: dict[str, Control] = _controls(
     Control("cutoff", *SPOT_CUTOFF_RANGE, decimals=1, unit="°"),
     Control("exponent", *SPOT_EXPONENT_RANGE, decimals=1),
     Control("attenuation", *ATTENUATION_RANGE, step=0.05),
+    Control("fresnel", *FRESNEL_RANGE),
+    Control("exposure", *EXPOSURE_SLIDER, decimals=2, unit=" EV", field=EXPOSURE_RANGE),
 )
 
 

@@ -26,7 +26,10 @@ shader, the reference equation, shadows, the window) asks the light and never it
 - :meth:`Light.incident`: the reference's "what arrives and from where" (L, distance, weight);
 - :meth:`Light.shadow_ray`: the ray from a vertex toward the light;
 - :meth:`Light.placement`, :meth:`Light.placed`, :meth:`Light.as_type`: its handle in the
-  window.
+  window;
+- ``CONTROL_KEYS``, ``AT_INFINITY``: the explorer's controls it has (a spot's cone, a
+  positional light's attenuation) and whether it is at infinity: the panel's rows
+  (:mod:`explorer.app.panelmodel`) ask these, so no front end knows a light type.
 
 The old key ``direction`` (``to_light`` or ``aim``) still loads, with a
 :class:`~explorer.core.errors.DeprecatedName` notice.
@@ -221,6 +224,13 @@ class Light(Checked):
     FILE_KEYS: ClassVar[tuple[str, ...]] = ()
     #: fields a light made by :meth:`like` gets (a new spot's cone, say)
     LIKE_DEFAULTS: ClassVar[dict] = {}
+    #: the explorer's controls this type has (its panel rows, :mod:`explorer.app.panelmodel`,
+    #: in the order they are drawn): a front end asks the light, never its type
+    CONTROL_KEYS: ClassVar[tuple[str, ...]] = (
+        "type", "color", "intensity", "azimuth", "elevation", "distance", "shadows",
+    )  # fmt: skip
+    #: the light is at infinity (only its direction counts; its handle's distance is a choice)
+    AT_INFINITY: ClassVar[bool] = False
 
     def _settle(self) -> None:
         """Store direction fields unit length (after the checks)."""
@@ -243,12 +253,12 @@ class Light(Checked):
 
     @classmethod
     def like(cls, light: Light) -> Light:
-        """A light of this type with the colours of ``light`` (and its attenuation between
-        positional types; a new spot gets the cone of ``LIKE_DEFAULTS``), at this type's default
-        place: move it with :meth:`placed`."""
+        """A light of this type with the colours and the shadows of ``light`` (and its
+        attenuation between positional types; a new spot gets the cone of ``LIKE_DEFAULTS``),
+        at this type's default place: move it with :meth:`placed`."""
         return cls(
             ambient=light.ambient, diffuse=light.diffuse, specular=light.specular,
-            **cls._kept_from(light), **cls.LIKE_DEFAULTS,
+            shadows=light.shadows, **cls._kept_from(light), **cls.LIKE_DEFAULTS,
         )  # fmt: skip
 
     @classmethod
@@ -357,6 +367,7 @@ class DirectionalLight(Light):
     KEYS: ClassVar[dict[str, Check]] = {**Light.KEYS, "to_light": _direction}
     RENAMED: ClassVar[dict] = {"direction": ("to_light", "the direction toward the light")}
     FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + ("to_light",)
+    AT_INFINITY: ClassVar[bool] = True
 
     def _settle(self) -> None:
         object.__setattr__(self, "to_light", unit_vector(self.to_light))
@@ -416,6 +427,7 @@ class PositionalLight(Light):
         "position": _point,
         "attenuation": _attenuation,
     }
+    CONTROL_KEYS: ClassVar[tuple[str, ...]] = Light.CONTROL_KEYS + ("attenuation",)
 
     def _own_mapping(self) -> dict:
         out: dict = {"position": list(self.position)}
@@ -544,6 +556,7 @@ class SpotLight(PositionalLight):
     )
     #: the cone of a spot made from another light (:meth:`like`)
     LIKE_DEFAULTS: ClassVar[dict] = {"cutoff": 25.0, "exponent": 10.0}
+    CONTROL_KEYS: ClassVar[tuple[str, ...]] = PositionalLight.CONTROL_KEYS + ("cutoff", "exponent")
 
     def _settle(self) -> None:
         object.__setattr__(self, "aim", unit_vector(self.aim))

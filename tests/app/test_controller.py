@@ -177,6 +177,20 @@ def test_a_slider_run_is_one_step_and_one_update_each(ctl):
     assert kd(ctl) == pytest.approx(0.5)
 
 
+def test_the_viewer_made_infinite_keeps_the_cameras_perspective_when_the_mesh_is_framed(ctl):
+    """local_viewer off: the engine's viewer is infinitely far along the view, but a mesh
+    framed anew keeps the perspective camera (the infinite viewer alone would frame it with a
+    parallel one), and turning it on puts the viewer back at the camera."""
+    assert not ctl.state.camera.parallel and ctl.state.scene.viewer.local
+    assert ctl.set_value("local_viewer", False, merge=False)
+    assert ctl.state.scene.viewer.to_viewer is not None and not ctl.state.camera.parallel
+    assert ctl.choose_mesh("cube")
+    assert not ctl.state.camera.parallel and not ctl.state.scene.viewer.local
+    ctl.undo()
+    ctl.undo()
+    assert ctl.state.local_viewer and ctl.state.scene.viewer.local
+
+
 def test_a_refused_value_is_said_and_the_controls_show_the_state(ctl):
     assert not ctl.set_value("kd", 7.0)
     assert ctl.errors and "kd" in ctl.errors[-1]

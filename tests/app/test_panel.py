@@ -354,3 +354,73 @@ def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
     assert "same place" not in tab.list.item(0).text()
     tab.sliders["azimuth"].field.setValue(-100.0)  # moved: no longer said
     assert "same place" not in tab.list.item(1).text()
+
+
+# -- issue 38: the panel model's rows ----------------------------------------------------------
+def every_row_shown(c) -> None:
+    """A spot light, the HDR display and Fresnel on: every row of the panel model is shown."""
+    from explorer.app import panelmodel as P
+
+    c.act(M.set_light_type, "spot", label="light type")
+    assert c.set_value("hdr", True, merge=False)
+    assert c.set_value("fresnel", P.row("fresnel").optional, merge=False)
+
+
+def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
+    """Each row of :mod:`explorer.app.panelmodel` is a widget of its tab whose object name and
+    accessible name are the row's (the page's test reads the same names in the DOM)."""
+    from explorer.app import panelmodel as P
+
+    every_row_shown(win.controller)
+    for r in P.ROWS:
+        tab = getattr(win.panel, r.tab)
+        for name in P.names(r):
+            found = tab.findChildren(QtWidgets.QWidget, name)
+            assert len(found) == 1, (r.key, name, found)
+            assert found[0].accessibleName() == name and found[0].isVisibleTo(tab), name
+    win.controller.undo()  # fresnel off: its number hidden, its switch shown and unchecked
+    rows = win.panel.material.rows
+    assert not rows.sliders["fresnel"].isVisibleTo(win.panel.material)
+    assert not rows.switches["fresnel"].isChecked()
+
+
+#: each effect row worked through its widget: (tab, the click or the value)
+EFFECTS = {
+    "shadows": ("lights", lambda rows: rows.widgets["shadows"].click()),
+    "fresnel_on": ("material", lambda rows: rows.switches["fresnel"].click()),
+    "fresnel": ("material", lambda rows: rows.sliders["fresnel"].field.setValue(0.6)),
+    "energy_conserving": ("material", lambda rows: rows.widgets["energy_conserving"].click()),
+    "two_sided": ("view", lambda rows: rows.widgets["two_sided"].click()),
+    "local_viewer": ("view", lambda rows: rows.widgets["local_viewer"].click()),
+    "hdr": ("view", lambda rows: rows.widgets["hdr"].click()),
+    "exposure": ("view", lambda rows: rows.sliders["exposure"].field.setValue(1.5)),
+    "tone_map": ("view", lambda rows: rows.widgets["tone_map"].activated.emit(2)),
+}
+
+
+@pytest.mark.parametrize("effect", list(EFFECTS))
+def test_each_effect_row_changes_the_picture_and_undo_restores_it(open_window, effect):
+    """Through its widget, each effect changes the colours the view draws (shadows and
+    two-sided lighting change the vertices the light does not reach, so those two are read
+    from the drawn colours; the others from the view's pixels too), as one undo step."""
+    import numpy as np
+
+    w = open_window("--mesh", "teapot", "--resolution", "8", "--preset", "gold")
+    c = w.controller
+    if effect in ("fresnel", "exposure", "tone_map"):  # their switch first
+        c.set_value("fresnel" if effect == "fresnel" else "hdr",
+                    0.04 if effect == "fresnel" else True, merge=False)  # fmt: skip
+    w.render()
+    colours = w.view.displayed_colors()
+    shot = np.asarray(w.plotter.screenshot(return_img=True)[:, :, :3]).copy()
+    tab, work = EFFECTS[effect]
+    work(getattr(w.panel, tab).rows)
+    w.render()
+    assert c.store.undo_label() == effect.removesuffix("_on")
+    assert (w.view.displayed_colors() != colours).any(), effect
+    if effect not in ("shadows", "two_sided"):
+        assert (np.asarray(w.plotter.screenshot(return_img=True)[:, :, :3]) != shot).any()
+    c.undo()
+    w.render()
+    assert (w.view.displayed_colors() == colours).all()
+    assert not c.errors, c.errors

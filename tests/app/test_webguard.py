@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 from explorer.app import webguard as G
-from explorer.app.webpanel import LIGHT_NUMBERS, MATERIAL_NUMBERS
+from explorer.app.webpanel import NUMBERS
 
 TOKEN = G.new_token()
 
@@ -99,7 +99,7 @@ def test_the_page_needs_the_token_or_its_cookie():
 
 
 def test_the_client_keys_are_the_page_controls_keys():
-    for k in (*MATERIAL_NUMBERS, *LIGHT_NUMBERS):
+    for k in (r.key for r in NUMBERS):
         assert G.CLIENT_KEYS[f"{k}_step"] == "number"
         assert k not in G.CLIENT_KEYS  # the fields call the server's parser, never set state
     for server_owned in ("trame__template_main", "message_log", "presets", "meshes",

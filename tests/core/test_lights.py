@@ -297,3 +297,12 @@ def test_tiny_light_direction_on_the_command_line_is_not_a_traceback():
 def test_angles_of_a_vector_at_every_scale(scale):
     az, el, length = angles_of((0.0, 3.0 * scale, 4.0 * scale))
     assert (az, length / scale) == pytest.approx((0.0, 5.0)) and el == pytest.approx(36.8699, 1e-5)
+
+
+def test_as_type_keeps_the_lights_shadows():
+    """A shadowing light turned into another type (the panel's ``type`` row) still casts
+    shadows: the panel's ``shadows`` row does not switch off behind the user's back."""
+    p = PointLight(shadows=True)
+    for kind in ("spot", "directional", "point"):
+        p = p.as_type(kind)
+        assert p.type == kind and p.shadows

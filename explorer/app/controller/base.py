@@ -8,6 +8,7 @@ import logging
 from pathlib import Path
 
 from explorer.app import model as M
+from explorer.app import panelmodel
 from explorer.app.controller.files import FileFlows
 from explorer.app.controller.ports import Ports
 from explorer.app.difference import Job
@@ -24,30 +25,6 @@ log = logging.getLogger(__name__)
 MIN_DIFFERENCE_SIZE = 16
 #: the three light types, in the order "next light type" steps through
 LIGHT_TYPES = ("directional", "point", "spot")
-
-
-def _value_action(state: M.State, key: str, value):
-    """The model action and its arguments that set control ``key`` to ``value``
-    (:data:`explorer.core.controls.CONTROLS` names the keys; ``distance`` in mesh radii)."""
-    if key in ("ka", "kd", "ks"):
-        return M.set_coefficient, (key, value)
-    if key == "shininess":
-        return M.set_shininess, (value,)
-    if key == "opacity":
-        return M.set_opacity, (value,)
-    if key in M.RGB_KEYS:
-        return M.set_colour, (key, value)
-    if key == "intensity":
-        return M.set_light_intensity, (value,)
-    if key == "azimuth":
-        return M.place_light, (value, None)
-    if key == "elevation":
-        return M.place_light, (None, value)
-    if key == "distance":
-        return M.place_light, (None, None, value * state.radius)
-    if key in ("cutoff", "exponent", "attenuation"):
-        return M.set_light_field, (key, value)
-    raise ExplorerError(f"no control named '{key}'")
 
 
 class Controller(FileFlows):
@@ -143,11 +120,13 @@ class Controller(FileFlows):
             return False
 
     def set_value(self, key: str, value, *, merge: bool = True) -> bool:
-        """Set control ``key`` (a name of :data:`explorer.core.controls.CONTROLS`, or an RGB
-        key with an (r, g, b) value); a run of steps of one control is one undo step until
-        :meth:`release`."""
-        action, args = _value_action(self.store.state, key, value)
-        return self.act(action, *args, label=key, merge=key if merge else None)
+        """Set control ``key`` (a row of :mod:`explorer.app.panelmodel`: a number, a colour's
+        (r, g, b), a choice, a toggle, the attenuation's triple; ``distance`` in mesh radii);
+        a run of steps of one control is one undo step until :meth:`release`. A key the state
+        does not show (a spot's cutoff on a point light) is refused by its action and said; an
+        unknown key raises :class:`ExplorerError`."""
+        action, args, label = panelmodel.edit(self.store.state, key, value)
+        return self.act(action, *args, label=label, merge=key if merge else None)
 
     def release(self) -> None:
         """A control was let go: the steps so far are one undo step."""

@@ -1,31 +1,25 @@
-"""The panel's ``lights`` and ``view`` tabs and the panel itself (see
-:mod:`explorer.app.qt.panel`)."""
+"""The panel's three tabs and the panel itself (the widgets are :mod:`explorer.app.qt.panel`'s).
+Each tab draws its rows of :mod:`explorer.app.panelmodel` (:class:`~explorer.app.qt.rows.
+RowWidgets`) among the controls that are not rows: the preset list, the light list, the mesh
+chooser, the difference and compare views."""
 
 from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
 from explorer.app import model as M
-from explorer.app.qt.panel import (
-    ColourButton,
-    MaterialTab,
-    NumberField,
-    ValueSlider,
-    _form,
-    _scroll,
-    guard_wheel,
-)
-from explorer.core.controls import CONTROLS
-from explorer.core.lights import LIGHT_TYPES
-from explorer.core.material import MODELS
+from explorer.app import panelmodel
+from explorer.app.qt.panel import MeshMaterialsBox, _form, _scroll, guard_wheel, swatch
+from explorer.app.qt.rows import RowWidgets
+from explorer.core.material import MODELS, RGB_KEYS
 
 
 def light_summary(i: int, light, state: M.State) -> str:
     """One line of the light list: number, type and placement, and the light it shares its
     place with (a duplicate, until moved)."""
     az, el, d = state.placement(i)
-    where = "from" if light.type == "directional" else "at"
-    dist = "" if light.type == "directional" else f", {d / state.radius:.2f} r"
+    where = "from" if light.AT_INFINITY else "at"
+    dist = "" if light.AT_INFINITY else f", {d / state.radius:.2f} r"
     j = M.same_place_as(state, i)
     same = "" if j is None else f" (same place as {j + 1})"
     return f"{i + 1}: {light.type} {where} az {az:.0f}°, el {el:.0f}°{dist}{same}"
@@ -36,7 +30,7 @@ class LightsTab(QtWidgets.QWidget):
 
     rejected = QtCore.Signal(str)
 
-    def __init__(self, act, parent=None):
+    def __init__(self, act, send, parent=None):
         super().__init__(parent)
         self.act = act
         box = _form(self)
@@ -60,41 +54,13 @@ class LightsTab(QtWidgets.QWidget):
         self.controls = QtWidgets.QWidget()
         form = _form(self.controls)
         form.setContentsMargins(0, 0, 0, 0)
-        row = QtWidgets.QGridLayout()  # type and colour on rows of their own: a narrow panel
-        label = QtWidgets.QLabel("type")
-        label.setMinimumWidth(64)
-        row.addWidget(label, 0, 0)
-        self.type = QtWidgets.QComboBox()
-        self.type.setObjectName("type")
-        self.type.addItems(list(LIGHT_TYPES))
-        self.type.activated.connect(
-            lambda i: self.act(M.set_light_type, LIGHT_TYPES[i], label="light type")
-        )
-        row.addWidget(self.type, 0, 1)
-        row.addWidget(QtWidgets.QLabel("color"), 1, 0)
-        self.colour = ColourButton("color")
-        self.colour.picked.connect(
-            lambda rgb: self.act(M.set_light_colour, rgb, label="light color")
-        )
-        row.addWidget(self.colour, 1, 1)
-        row.setColumnStretch(1, 1)
-        form.addLayout(row)
-        self.sliders = {
-            name: ValueSlider(name) for name in ("intensity", "azimuth", "elevation", "distance")
-        }
-        self.sliders["distance"].note.setVisible(True)
-        self.sliders["distance"].setToolTip("distance from the mesh centre in mesh radii")
-        for name, s in self.sliders.items():
-            form.addWidget(s)
-            s.rejected.connect(self.rejected)
-            s.edited.connect(lambda v, n=name: self._edited(n, v))
-        form.addWidget(self._attenuation_fields())
-        self.cutoff = ValueSlider("cutoff")
-        self.exponent = ValueSlider("exponent")
-        for name, s in (("cutoff", self.cutoff), ("exponent", self.exponent)):
-            form.addWidget(s)
-            s.rejected.connect(self.rejected)
-            s.edited.connect(lambda v, n=name: self.act(M.set_light_field, n, v, label=n, merge=n))
+        self.rows = RowWidgets(panelmodel.rows("lights"), form, send, self)
+        self.rows.rejected.connect(self.rejected)
+        self.sliders = self.rows.sliders
+        self.type, self.colour = self.rows.widgets["type"], self.rows.widgets["color"]
+        self.attenuation_box = self.rows.widgets["attenuation"]
+        self.attenuation = self.rows.fields["attenuation"]
+        self.cutoff, self.exponent = self.sliders["cutoff"], self.sliders["exponent"]
         box.addWidget(self.controls)
         self.none = QtWidgets.QLabel("The scene has no lights: add one.")
         box.addWidget(self.none)
@@ -103,44 +69,7 @@ class LightsTab(QtWidgets.QWidget):
             lambda i: i >= 0 and self.act(M.select_light, i, label="select light")
         )
 
-    def _attenuation_fields(self) -> QtWidgets.QWidget:
-        """The attenuation's three number fields, a row a key (a narrow panel)."""
-        self.attenuation_box = QtWidgets.QWidget()
-        grid = QtWidgets.QGridLayout(self.attenuation_box)
-        grid.setContentsMargins(0, 0, 0, 0)
-        grid.addWidget(QtWidgets.QLabel("attenuation  1 / (kc + kl·d + kq·d²)"), 0, 0, 1, 3)
-        self.attenuation = []
-        att = CONTROLS["attenuation"]
-        for k, key in enumerate(("kc", "kl", "kq")):
-            f = NumberField(key, *att.field_range, decimals=att.decimals)
-            f.setObjectName(f"attenuation_{key}")
-            f.setSingleStep(att.field_step)
-            f.setToolTip(f"{key} of 1 / (kc + kl·d + kq·d²), d in world units")
-            f.valueChanged.connect(self._attenuation)
-            f.rejected.connect(self.rejected)
-            label = QtWidgets.QLabel(key)
-            label.setMinimumWidth(64)  # as the sliders' labels
-            grid.addWidget(label, 1 + k, 0)
-            grid.addWidget(f, 1 + k, 2)
-            self.attenuation.append(f)
-        grid.setColumnStretch(1, 1)
-        return self.attenuation_box
-
-    def _edited(self, name: str, v: float) -> None:
-        if name == "intensity":
-            self.act(M.set_light_intensity, v, label=name, merge=name)
-        elif name == "distance":
-            self.act(M.place_light, None, None, v * self._radius, label=name, merge=name)
-        else:
-            self.act(M.place_light, *((v, None) if name == "azimuth" else (None, v)),
-                     label=name, merge=name)  # fmt: skip
-
-    def _attenuation(self, _v=None) -> None:
-        value = tuple(f.value() for f in self.attenuation)
-        self.act(M.set_light_field, "attenuation", value, label="attenuation")
-
     def show_state(self, s: M.State) -> None:
-        self._radius = s.radius
         lights = s.scene.lights
         with QtCore.QSignalBlocker(self.list):
             self.list.clear()
@@ -156,38 +85,99 @@ class LightsTab(QtWidgets.QWidget):
         self.buttons["duplicate"].setEnabled(light is not None)
         if light is None:
             return
-        with QtCore.QSignalBlocker(self.type):
-            self.type.setCurrentIndex(LIGHT_TYPES.index(light.type))
-        hue, k = M.light_colour(light)
-        self.colour.set_rgb(hue)
-        az, el, d = s.placement()
-        lo, hi = s.distance_range()
-        dist = self.sliders["distance"]
-        dist.set_range(lo / s.radius, hi / s.radius)
-        for name, v in (("intensity", k), ("azimuth", az), ("elevation", el),
-                        ("distance", d / s.radius)):  # fmt: skip
-            self.sliders[name].set_value(v)
-        far = " (places the handle: a directional light is at infinity)"
-        dist.note.setText(f"= {d:.3g} world units" + (far if light.type == "directional" else ""))
-        dist.note.setWordWrap(True)
-        positional = light.type in ("point", "spot")
-        self.attenuation_box.setVisible(positional)
-        if positional:
-            for f, v in zip(self.attenuation, light.attenuation, strict=True):
-                with QtCore.QSignalBlocker(f):
-                    f.setValue(v)
-        spot = light.type == "spot"
-        self.cutoff.setVisible(spot)
-        self.exponent.setVisible(spot)
-        if spot:
-            self.cutoff.set_value(min(light.cutoff, 90.0))
-            self.exponent.set_value(light.exponent)
+        self.rows.show_state(s)
+
+
+class MaterialTab(QtWidgets.QWidget):
+    """Presets (searchable, with descriptions and swatches), then the material tab's rows
+    (:mod:`explorer.app.panelmodel`: coefficients, colours, model, terms, the material's
+    effects) and the save button."""
+
+    def __init__(self, act, send, parent=None):
+        super().__init__(parent)
+        self.act = act
+        box = _form(self)
+        self.search = QtWidgets.QLineEdit()
+        self.search.setObjectName("preset_search")
+        self.search.setPlaceholderText("search presets")
+        self.search.setClearButtonEnabled(True)
+        self.presets = QtWidgets.QListWidget()
+        self.presets.setObjectName("presets")
+        self.presets.setMinimumHeight(90)
+        self.presets.setIconSize(QtCore.QSize(18, 18))
+        self.description = QtWidgets.QLabel("")
+        self.description.setObjectName("preset_description")
+        self.description.setWordWrap(True)
+        self.preset_label = QtWidgets.QLabel("")
+        self.preset_label.setObjectName("preset")
+        self.preset_label.setWordWrap(True)
+        self.mesh_materials = MeshMaterialsBox(act)
+        for w in (self.mesh_materials, self.preset_label, self.search, self.presets,
+                  self.description):  # fmt: skip
+            box.addWidget(w, 1 if w is self.presets else 0)  # the list takes the spare height
+        self.rows = RowWidgets(panelmodel.rows("material"), box, send, self)
+        self.sliders = self.rows.sliders
+        self.colours = {t: self.rows.widgets[t] for t in RGB_KEYS}
+        self.model = self.rows.radios["model"]
+        self.terms = {t: self.rows.widgets[f"show_{t}"] for t in M.TERMS}
+        self.save = QtWidgets.QPushButton("Save preset as…")
+        self.save.setObjectName("save_preset")
+        box.addWidget(self.save)
+        self.search.textChanged.connect(self._filter)
+        self.presets.itemClicked.connect(self._chosen)
+        self.presets.currentItemChanged.connect(self._describe)
+        self._infos = {}
+
+    def set_presets(self, infos) -> None:
+        """The preset list (``explorer.core.presets.PresetInfo`` items)."""
+        self._infos = {p.name: p for p in infos}
+        with QtCore.QSignalBlocker(self.presets):
+            self.presets.clear()
+            for p in infos:
+                item = QtWidgets.QListWidgetItem(swatch(p.material), p.name)
+                item.setToolTip(p.material.description or p.name)
+                self.presets.addItem(item)
+        self._filter(self.search.text())
+
+    def _filter(self, text: str) -> None:
+        t = text.strip().lower()
+        for i in range(self.presets.count()):
+            item = self.presets.item(i)
+            info = self._infos.get(item.text())
+            hay = item.text() + " " + (info.material.description if info else "")
+            item.setHidden(bool(t) and t not in hay.lower())
+
+    def _chosen(self, item) -> None:
+        info = self._infos.get(item.text())
+        if info is not None:
+            self.act(M.apply_preset, info.name, info.material, label=f"preset {info.name}")
+
+    def _describe(self, item, _previous=None) -> None:
+        info = self._infos.get(item.text()) if item is not None else None
+        self.description.setText(info.material.description if info else "")
+
+    def show_state(self, s: M.State) -> None:
+        self.rows.show_state(s)
+        self.mesh_materials.show_state(s)
+        edited = " (edited)" if s.edited else ""
+        if s.groups is not None:
+            label = s.mesh_materials.label(s.group)
+            self.preset_label.setText(f"material: <b>{label}</b> of the mesh{edited}")
+        else:
+            name = s.preset or "(scene material)"
+            self.preset_label.setText(f"preset: <b>{name}</b>{edited}")
+        with QtCore.QSignalBlocker(self.presets):
+            found = self.presets.findItems(s.preset or "", QtCore.Qt.MatchFlag.MatchExactly)
+            self.presets.setCurrentItem(found[0] if found and s.preset else None)
+            if found and s.preset:
+                self.presets.scrollToItem(found[0])
+        self._describe(found[0] if found and s.preset else None)
 
 
 class ViewTab(QtWidgets.QWidget):
     """The mesh chooser and the difference view (toggle, legend, advice)."""
 
-    def __init__(self, act, choose_mesh, parent=None):
+    def __init__(self, act, choose_mesh, send, parent=None):
         super().__init__(parent)
         self.act = act
         box = _form(self)
@@ -222,6 +212,7 @@ class ViewTab(QtWidgets.QWidget):
         box.addWidget(self.legend)
         box.addWidget(self.advice)
         self._build_compare(box)
+        self.rows = RowWidgets(panelmodel.rows("view"), box, send, self)
         box.addStretch(1)
 
     def _build_compare(self, box) -> None:
@@ -292,6 +283,7 @@ class ViewTab(QtWidgets.QWidget):
                 self.mesh.addItem(label, name)
 
     def show_state(self, s: M.State, n_vertices: int) -> None:
+        self.rows.show_state(s)
         with QtCore.QSignalBlocker(self.mesh):
             self.mesh.setCurrentIndex(max(self.mesh.findData(s.mesh), 0))
         self.mesh_info.setText(f"{s.mesh}: {n_vertices:,} vertices")
@@ -324,19 +316,18 @@ class Panel(QtWidgets.QTabWidget):
 
     rejected = QtCore.Signal(str)
 
-    def __init__(self, act, choose_mesh, parent=None):
+    def __init__(self, act, choose_mesh, send, parent=None):
         super().__init__(parent)
         self.setObjectName("panel")
-        self.material = MaterialTab(act)
-        self.lights = LightsTab(act)
-        self.view = ViewTab(act, choose_mesh)
+        self.material = MaterialTab(act, send)
+        self.lights = LightsTab(act, send)
+        self.view = ViewTab(act, choose_mesh, send)
         self.areas = [_scroll(self.material), _scroll(self.lights), _scroll(self.view)]
         for area, name in zip(self.areas, ("material", "lights", "view"), strict=True):
             area.setObjectName(f"{name}_scroll")
             self.addTab(area, name)
-        for s in self.material.sliders.values():
-            s.rejected.connect(self.rejected)
-        self.lights.rejected.connect(self.rejected)
+        for tab in (self.material, self.lights, self.view):
+            tab.rows.rejected.connect(self.rejected)
         self._wheel = [guard_wheel(t) for t in (self.material, self.lights, self.view)]
         self.fit_width()
 

@@ -1,11 +1,16 @@
-"""The explorer's control panel: Qt widgets that show a :class:`~explorer.app.model.State` and
-send actions. Nothing of the model lives here: every widget is set from the state
-(:meth:`Panel.show_state`, signals blocked) and every user change goes to the window's
-``act(action, *args, label=..., merge=...)``.
+"""The explorer's control panel's widgets: Qt widgets that show a value of a
+:class:`~explorer.app.model.State` and signal a user's change (the number field, the slider
+with its field, the colour button and dialog, the mesh's own materials). Nothing of the model
+lives here: every widget is set from the state (signals blocked), and a user's change goes to
+the controller (``set_value`` for a row of :mod:`explorer.app.panelmodel`, drawn by
+:mod:`explorer.app.qt.rows`; the window's ``act(action, *args, label=..., merge=...)`` for the
+rest).
 
-Three tabs: ``material`` (preset list, coefficients, colours, model and terms), ``lights`` (the
-scene's lights and the selected one's type, colour, placement, attenuation and cone) and
-``view`` (mesh, difference view). Each widget is named like the scene file's key it sets.
+Three tabs (:mod:`explorer.app.qt.lightpanel`): ``material`` (preset list, coefficients,
+colours, model, terms, the material's effects), ``lights`` (the scene's lights and the selected
+one's rows: type, colour, placement, attenuation, cone, shadows) and ``view`` (mesh, difference
+and compare views, the scene's effects). Each widget is named like the scene file's key it
+sets.
 """
 
 from __future__ import annotations
@@ -18,7 +23,6 @@ from explorer.app import model as M
 from explorer.app.colours import rgb_bytes, rgb_text
 from explorer.core.controls import CONTROLS, STEPS, Control, from_step, to_step
 from explorer.core.errors import ExplorerError
-from explorer.core.material import MODELS, RGB_KEYS
 
 
 def qcolour(rgb) -> QtGui.QColor:
@@ -391,142 +395,3 @@ class MeshMaterialsBox(QtWidgets.QFrame):
                 self.group.setCurrentIndex(s.group)
         self.group_row.setVisible(own)
         self.use.setVisible(not own)
-
-
-class MaterialTab(QtWidgets.QWidget):
-    """Presets (searchable, with descriptions and swatches), coefficients, colours, model and
-    terms."""
-
-    def __init__(self, act, parent=None):
-        super().__init__(parent)
-        self.act = act
-        box = _form(self)
-        self.search = QtWidgets.QLineEdit()
-        self.search.setObjectName("preset_search")
-        self.search.setPlaceholderText("search presets")
-        self.search.setClearButtonEnabled(True)
-        self.presets = QtWidgets.QListWidget()
-        self.presets.setObjectName("presets")
-        self.presets.setMinimumHeight(90)
-        self.presets.setIconSize(QtCore.QSize(18, 18))
-        self.description = QtWidgets.QLabel("")
-        self.description.setObjectName("preset_description")
-        self.description.setWordWrap(True)
-        self.preset_label = QtWidgets.QLabel("")
-        self.preset_label.setObjectName("preset")
-        self.preset_label.setWordWrap(True)
-        self.mesh_materials = MeshMaterialsBox(act)
-        for w in (self.mesh_materials, self.preset_label, self.search, self.presets,
-                  self.description):  # fmt: skip
-            box.addWidget(w, 1 if w is self.presets else 0)  # the list takes the spare height
-        self.sliders = {
-            name: ValueSlider(name) for name in ("ka", "kd", "ks", "shininess", "opacity")
-        }
-        actions = {
-            "ka": lambda v: (M.set_coefficient, "ka", v),
-            "kd": lambda v: (M.set_coefficient, "kd", v),
-            "ks": lambda v: (M.set_coefficient, "ks", v),
-            "shininess": lambda v: (M.set_shininess, v),
-            "opacity": lambda v: (M.set_opacity, v),
-        }
-        for name, s in self.sliders.items():
-            box.addWidget(s)
-            s.edited.connect(lambda v, n=name: self.act(*actions[n](v), label=n, merge=n))
-        colours = QtWidgets.QGridLayout()
-        self.colours = {}
-        for i, term in enumerate(RGB_KEYS):
-            b = ColourButton(term)
-            b.picked.connect(lambda rgb, t=term: self.act(M.set_colour, t, rgb, label=t))
-            colours.addWidget(QtWidgets.QLabel(term), i, 0)
-            colours.addWidget(b, i, 1)
-            self.colours[term] = b
-        colours.setColumnStretch(1, 1)
-        box.addLayout(colours)
-        row = QtWidgets.QHBoxLayout()
-        self.model = {}
-        group = QtWidgets.QButtonGroup(self)
-        row.addWidget(QtWidgets.QLabel("model"))
-        for name in MODELS:
-            r = QtWidgets.QRadioButton(name)
-            r.setObjectName(name)
-            group.addButton(r)
-            r.toggled.connect(lambda on, n=name: on and self.act(M.set_model, n, label="model"))
-            row.addWidget(r)
-            self.model[name] = r
-        row.addStretch(1)
-        box.addLayout(row)
-        row = QtWidgets.QHBoxLayout()
-        self.terms = {}
-        for term in M.TERMS:
-            c = QtWidgets.QCheckBox(term)
-            c.setObjectName(f"show_{term}")
-            c.setToolTip(f"draw the {term} term (the material is unchanged)")
-            c.toggled.connect(lambda on, t=term: self.act(M.set_term, t, on, label=f"{t} term"))
-            row.addWidget(c)
-            self.terms[term] = c
-        row.addStretch(1)
-        box.addLayout(row)
-        self.save = QtWidgets.QPushButton("Save preset as…")
-        self.save.setObjectName("save_preset")
-        box.addWidget(self.save)
-        self.search.textChanged.connect(self._filter)
-        self.presets.itemClicked.connect(self._chosen)
-        self.presets.currentItemChanged.connect(self._describe)
-        self._infos = {}
-
-    def set_presets(self, infos) -> None:
-        """The preset list (``explorer.core.presets.PresetInfo`` items)."""
-        self._infos = {p.name: p for p in infos}
-        with QtCore.QSignalBlocker(self.presets):
-            self.presets.clear()
-            for p in infos:
-                item = QtWidgets.QListWidgetItem(swatch(p.material), p.name)
-                item.setToolTip(p.material.description or p.name)
-                self.presets.addItem(item)
-        self._filter(self.search.text())
-
-    def _filter(self, text: str) -> None:
-        t = text.strip().lower()
-        for i in range(self.presets.count()):
-            item = self.presets.item(i)
-            info = self._infos.get(item.text())
-            hay = item.text() + " " + (info.material.description if info else "")
-            item.setHidden(bool(t) and t not in hay.lower())
-
-    def _chosen(self, item) -> None:
-        info = self._infos.get(item.text())
-        if info is not None:
-            self.act(M.apply_preset, info.name, info.material, label=f"preset {info.name}")
-
-    def _describe(self, item, _previous=None) -> None:
-        info = self._infos.get(item.text()) if item is not None else None
-        self.description.setText(info.material.description if info else "")
-
-    def show_state(self, s: M.State) -> None:
-        m = s.material
-        ka, kd, ks = m.scalars()
-        for name, v in (("ka", ka), ("kd", kd), ("ks", ks), ("shininess", m.shininess),
-                        ("opacity", m.opacity)):  # fmt: skip
-            self.sliders[name].set_value(v)
-        for term, b in self.colours.items():
-            b.set_rgb(getattr(m, term))
-        for name, r in self.model.items():
-            with QtCore.QSignalBlocker(r):
-                r.setChecked(s.scene.model == name)
-        for term, c in self.terms.items():
-            with QtCore.QSignalBlocker(c):
-                c.setChecked(term not in s.hidden)
-        self.mesh_materials.show_state(s)
-        edited = " (edited)" if s.edited else ""
-        if s.groups is not None:
-            label = s.mesh_materials.label(s.group)
-            self.preset_label.setText(f"material: <b>{label}</b> of the mesh{edited}")
-        else:
-            name = s.preset or "(scene material)"
-            self.preset_label.setText(f"preset: <b>{name}</b>{edited}")
-        with QtCore.QSignalBlocker(self.presets):
-            found = self.presets.findItems(s.preset or "", QtCore.Qt.MatchFlag.MatchExactly)
-            self.presets.setCurrentItem(found[0] if found and s.preset else None)
-            if found and s.preset:
-                self.presets.scrollToItem(found[0])
-        self._describe(found[0] if found and s.preset else None)

@@ -76,7 +76,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.controller = c = Controller(state, mesh, ports, materials_dirs=materials_dirs,
                                          preset_dir=preset_dir, output_dir=output_dir,
                                          last_session=last_session)  # fmt: skip
-        self.panel = Panel(c.act, c.choose_mesh)
+        self.panel = Panel(c.act, c.choose_mesh, c.set_value)
         self.splitter.addWidget(self.panel)
         self.splitter.setSizes([round(w * (1 - PANEL_FRACTION)), round(w * PANEL_FRACTION)])
         self.bar = MessageBar(self)

@@ -1,0 +1,215 @@
+"""The panel's rows drawn in Qt: one widget factory per kind of
+:class:`~explorer.app.panelmodel.Row` (number, colour, choice, toggle, triple). Nothing here
+knows a control: :class:`RowWidgets` builds the widgets of any rows, shows a state in them
+(:meth:`RowWidgets.show_state`: each row's ``visible`` and ``value``, signals blocked) and sends
+every edit as ``set_value(key, value, merge=...)`` (the controller's one dialect).
+
+Every row's widget (or the box of one drawn as several widgets) is named like its key, as
+object name and accessible name; a row's label is its key (a term's toggle its term).
+"""
+
+from __future__ import annotations
+
+from PySide6 import QtCore, QtWidgets
+
+from explorer.app.panelmodel import Row
+from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider
+
+#: a label's least width (pixels): the labels of a tab line up with the sliders' own
+LABEL_WIDTH = 64
+
+
+def _label(text: str) -> QtWidgets.QLabel:
+    label = QtWidgets.QLabel(text)
+    label.setMinimumWidth(LABEL_WIDTH)
+    return label
+
+
+def _named(widget: QtWidgets.QWidget, name: str, tip: str = "") -> QtWidgets.QWidget:
+    widget.setObjectName(name)
+    widget.setAccessibleName(name)
+    if tip:
+        widget.setToolTip(tip)
+    return widget
+
+
+class RowWidgets(QtCore.QObject):
+    """The widgets of ``rows`` added to ``box`` (a ``QVBoxLayout``) in order; rows of one
+    ``group`` share a grid (colours) or a line (toggles, in a group of their own).
+
+    send(key, value, merge=...) : the edit (``Controller.set_value``)
+    ``rejected(message)``: a typed value was refused; ``widgets[key]``: each row's widget
+    (a :class:`ValueSlider`, :class:`ColourButton`, ``QComboBox``, ``QCheckBox``, or the box
+    of radio buttons / three fields), ``parts[key]``: every widget the row shows or hides.
+    """
+
+    rejected = QtCore.Signal(str)
+
+    def __init__(self, rows, box: QtWidgets.QVBoxLayout, send, parent=None):
+        super().__init__(parent)
+        self.rows = tuple(rows)
+        self.send = send
+        self.widgets: dict[str, QtWidgets.QWidget] = {}
+        self.parts: dict[str, list[QtWidgets.QWidget]] = {}
+        self.switches: dict[str, QtWidgets.QCheckBox] = {}  # an optional number's on / off
+        self.radios: dict[str, dict[str, QtWidgets.QRadioButton]] = {}
+        self.fields: dict[str, list[NumberField]] = {}  # a triple's three fields
+        self.sliders: dict[str, ValueSlider] = {}  # a number's slider and field
+        grids: dict[str, QtWidgets.QGridLayout] = {}
+        lines: dict[str, QtWidgets.QHBoxLayout] = {}
+        for r in self.rows:
+            if r.kind == "toggle" and r.group:
+                if r.group not in lines:
+                    lines[r.group] = QtWidgets.QHBoxLayout()
+                    box.addLayout(lines[r.group])
+                self._add(r, self._toggle(r), lines[r.group])
+            elif r.kind in ("colour", "choice") and not r.inline:
+                key = r.group or r.key
+                if key not in grids:
+                    grids[key] = QtWidgets.QGridLayout()
+                    grids[key].setColumnStretch(1, 1)
+                    box.addLayout(grids[key])
+                grid = grids[key]
+                label, widget = _label(r.key), getattr(self, f"_{r.kind}")(r)
+                n = grid.rowCount()
+                grid.addWidget(label, n, 0)
+                grid.addWidget(widget, n, 1)
+                self.widgets[r.key] = widget
+                self.parts[r.key] = [label, widget]
+            else:
+                self._add(r, getattr(self, f"_{r.kind}")(r), box)
+        for line in lines.values():
+            line.addStretch(1)
+
+    def _add(self, r: Row, widget: QtWidgets.QWidget, layout) -> None:
+        layout.addWidget(widget)
+        self.widgets[r.key] = widget
+        self.parts[r.key] = [widget]
+
+    # -- one factory per kind ----------------------------------------------------------------
+    def _number(self, r: Row) -> QtWidgets.QWidget:
+        s = ValueSlider(r.key)
+        s.setAccessibleName(r.key)
+        if r.tip:
+            s.setToolTip(r.tip)
+        s.note.setVisible(r.note is not None)
+        s.note.setWordWrap(True)
+        s.rejected.connect(self.rejected)
+        s.edited.connect(lambda v, k=r.key: self.send(k, v, merge=True))
+        self.sliders[r.key] = s
+        if r.optional is None:
+            return s
+        box = QtWidgets.QWidget()
+        lay = QtWidgets.QVBoxLayout(box)
+        lay.setContentsMargins(0, 0, 0, 0)
+        switch = _named(QtWidgets.QCheckBox(r.key), f"{r.key}_on", r.tip)
+        switch.toggled.connect(
+            lambda on, k=r.key, v=r.optional: self.send(k, v if on else None, merge=False)
+        )
+        lay.addWidget(switch)
+        lay.addWidget(s)
+        self.switches[r.key] = switch
+        return box
+
+    def _colour(self, r: Row) -> QtWidgets.QWidget:
+        b = ColourButton(r.key)
+        b.setAccessibleName(r.key)
+        b.picked.connect(lambda rgb, k=r.key: self.send(k, rgb, merge=False))
+        return b
+
+    def _choice(self, r: Row) -> QtWidgets.QWidget:
+        if not r.inline:
+            combo = _named(QtWidgets.QComboBox(), r.key, r.tip)
+            combo.addItems(list(r.choices))
+            combo.activated.connect(lambda i, k=r.key, c=r.choices: self.send(k, c[i], merge=False))
+            return combo
+        box = _named(QtWidgets.QWidget(), r.key, r.tip)
+        row = QtWidgets.QHBoxLayout(box)
+        row.setContentsMargins(0, 0, 0, 0)
+        row.addWidget(QtWidgets.QLabel(r.key))
+        group = QtWidgets.QButtonGroup(box)
+        self.radios[r.key] = {}
+        for name in r.choices:
+            b = QtWidgets.QRadioButton(name)
+            b.setObjectName(name)
+            group.addButton(b)
+            b.toggled.connect(lambda on, k=r.key, n=name: on and self.send(k, n, merge=False))
+            row.addWidget(b)
+            self.radios[r.key][name] = b
+        row.addStretch(1)
+        return box
+
+    def _toggle(self, r: Row) -> QtWidgets.QWidget:
+        c = _named(QtWidgets.QCheckBox(r.caption), r.key, r.tip)
+        c.toggled.connect(lambda on, k=r.key: self.send(k, on, merge=False))
+        return c
+
+    def _triple(self, r: Row) -> QtWidgets.QWidget:
+        """Three number fields (the attenuation's kc, kl, kq), a row a part (a narrow panel),
+        under a line saying what they are (the row's tip)."""
+        box = _named(QtWidgets.QWidget(), r.key)
+        grid = QtWidgets.QGridLayout(box)
+        grid.setContentsMargins(0, 0, 0, 0)
+        grid.addWidget(QtWidgets.QLabel(f"{r.key}  {r.tip}"), 0, 0, 1, 3)
+        c = r.control
+        self.fields[r.key] = []
+        for k, part in enumerate(r.choices):
+            f = NumberField(part, *c.field_range, decimals=c.decimals)
+            f.setObjectName(f"{r.key}_{part}")
+            f.setSingleStep(c.field_step)
+            f.setToolTip(f"{part} of {r.tip}")
+            f.valueChanged.connect(lambda _v, key=r.key: self._send_triple(key))
+            f.rejected.connect(self.rejected)
+            grid.addWidget(_label(part), 1 + k, 0)
+            grid.addWidget(f, 1 + k, 2)
+            self.fields[r.key].append(f)
+        grid.setColumnStretch(1, 1)
+        return box
+
+    def _send_triple(self, key: str) -> None:
+        self.send(key, tuple(f.value() for f in self.fields[key]), merge=False)
+
+    # -- showing a state ---------------------------------------------------------------------
+    def show_state(self, s) -> None:
+        """Each row shown or hidden (``visible``) and set to its value (no signal sent)."""
+        for r in self.rows:
+            on = r.visible(s)
+            for w in self.parts[r.key]:
+                w.setVisible(on)
+            if on:
+                getattr(self, f"_show_{r.kind}")(r, self.widgets[r.key], r.value(s), s)
+
+    def _show_number(self, r: Row, w, v, s) -> None:
+        if r.optional is not None:
+            with QtCore.QSignalBlocker(self.switches[r.key]):
+                self.switches[r.key].setChecked(v is not None)
+            w = self.sliders[r.key]
+            w.setVisible(v is not None)
+            if v is None:
+                return
+        if r.slider is not None:
+            w.set_range(*r.slider(s))
+        w.set_value(v)
+        if r.note is not None:
+            w.note.setText(r.note(s))
+
+    def _show_colour(self, r: Row, w, v, s) -> None:
+        w.set_rgb(v)
+
+    def _show_choice(self, r: Row, w, v, s) -> None:
+        if not r.inline:
+            with QtCore.QSignalBlocker(w):
+                w.setCurrentIndex(r.choices.index(v))
+            return
+        for name, b in self.radios[r.key].items():
+            with QtCore.QSignalBlocker(b):
+                b.setChecked(v == name)
+
+    def _show_toggle(self, r: Row, w, v, s) -> None:
+        with QtCore.QSignalBlocker(w):
+            w.setChecked(bool(v))
+
+    def _show_triple(self, r: Row, w, v, s) -> None:
+        for f, x in zip(self.fields[r.key], v, strict=True):
+            with QtCore.QSignalBlocker(f):
+                f.setValue(x)

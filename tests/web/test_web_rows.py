@@ -1,0 +1,88 @@
+"""The panel model's rows on the page (issue 38), in a real browser: every row of
+:mod:`explorer.app.panelmodel` is in the DOM of its tab under the name the window gives it
+(tests/app/test_panel.py reads the same names from the Qt widgets), and the effect rows, drawn
+with no code of their own, change the picture, are undone, and reach the session. This module's
+server is its own (the effects it turns on stay out of the other modules' pictures)."""
+
+from __future__ import annotations
+
+import pytest
+from test_web import choose, click, open_page, picture_src, report, wait
+
+from explorer.app import panelmodel as P
+
+pytestmark = pytest.mark.web
+
+
+def shown(driver, name: str) -> bool:
+    """An element named ``name`` is laid out on the page (none of its ancestors hidden: a
+    select's own input is transparent, so Selenium's ``is_displayed`` does not serve)."""
+    return driver.execute_script(
+        'return [...document.querySelectorAll(`[aria-label="${arguments[0]}"]`)]'
+        ".some(e => e.getClientRects().length > 0);",
+        name,
+    )
+
+
+def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, browser):
+    rep = open_page(browser, server.url)
+    click(browser, "lights tab")
+    wait("the lights tab", lambda: shown(browser, "type"))
+    choose(browser, "type", "spot")
+    wait("a spot light", lambda: shown(browser, "cutoff"))
+    click(browser, "view tab")
+    wait("the view tab", lambda: shown(browser, "hdr"))
+    click(browser, "hdr")
+    wait("the HDR display's rows", lambda: shown(browser, "exposure"))
+    click(browser, "material tab")
+    wait("the material tab", lambda: shown(browser, "fresnel_on"))
+    click(browser, "fresnel_on")
+    wait("fresnel's number", lambda: shown(browser, "fresnel"))
+    for tab in P.TABS:
+        click(browser, f"{tab} tab")
+        wait(f"the {tab} tab", lambda t=tab: shown(browser, P.rows(t)[0].key))
+        for r in P.rows(tab):
+            for name in P.names(r):
+                assert shown(browser, name), (tab, name)
+    for _ in range(3):  # fresnel, hdr, the spot: back to the start
+        click(browser, "undo")
+    wait("the start again", lambda: report(browser)["session"] == rep["session"])
+
+
+@pytest.mark.parametrize(
+    ("tab", "name", "check"),
+    [
+        ("material", "energy_conserving", lambda s: s["scene"]["material"]["energy_conserving"]),
+        ("material", "fresnel_on", lambda s: s["scene"]["material"]["fresnel"] == 0.04),
+        ("view", "hdr", lambda s: s["scene"]["hdr"]["tone_map"] == "reinhard"),
+    ],
+)
+def test_an_effect_row_changes_the_picture_and_undo_restores_it(server, browser, tab, name, check):
+    rep = open_page(browser, server.url)
+    click(browser, f"{tab} tab")
+    wait(f"the {tab} tab", lambda: shown(browser, name))
+    before = picture_src(browser)
+    click(browser, name)
+    wait(f"{name} in the session", lambda: check(report(browser)["session"]))
+    wait("a new picture", lambda: picture_src(browser) not in (None, before))
+    click(browser, "undo")
+    wait("the start again", lambda: report(browser)["session"] == rep["session"])
+
+
+def test_a_lights_shadows_two_sided_lighting_and_the_viewer_reach_the_session(server, browser):
+    rep = open_page(browser, server.url)
+    click(browser, "lights tab")
+    wait("the lights tab", lambda: shown(browser, "shadows"))
+    click(browser, "shadows")
+    wait("shadows on", lambda: (s := report(browser)["session"])["scene"]["lights"][
+        s["light"] - 1].get("shadows") is True)  # fmt: skip
+    click(browser, "view tab")
+    wait("the view tab", lambda: shown(browser, "two_sided"))
+    click(browser, "two_sided")
+    wait("two-sided", lambda: report(browser)["session"]["scene"]["two_sided"] is True)
+    click(browser, "local_viewer")
+    wait("an infinite viewer", lambda: (s := report(browser)["session"])["local_viewer"] is False
+         and "to_viewer" in s["scene"]["viewer"])  # fmt: skip
+    for _ in range(3):
+        click(browser, "undo")
+    wait("the start again", lambda: report(browser)["session"] == rep["session"])
