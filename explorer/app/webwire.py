@@ -302,8 +302,10 @@ class WireHandler(AioHttpWsHandler):
             return
         rpcid, method = rpc["id"], rpc["method"]
         args, kwargs = rpc.get("args", []), rpc.get("kwargs", {})
-        if not isinstance(args, list) or not isinstance(kwargs, dict) or not all(
-            isinstance(k, str) for k in kwargs
+        if (
+            not isinstance(args, list)
+            or not isinstance(kwargs, dict)
+            or not all(isinstance(k, str) for k in kwargs)
         ):
             await self.sendWrappedError(rpcid, EXCEPTION_ERROR, "args must be a list and "
                                         "kwargs a mapping", client_id=client_id)  # fmt: skip
