@@ -297,3 +297,40 @@ def test_fuzzed_messages_leave_the_server_serving(fuzz_server, seed):
     assert fuzz_server.proc.poll() is None
     out = fuzz_server.output()
     assert "Traceback" not in out, out[-3000:]
+
+
+def shown_preset(driver) -> str:
+    """The preset the page's preset field shows (its selection's text)."""
+    from test_web import by_name
+
+    return driver.execute_script(
+        "const f = arguments[0].closest('.v-field');"
+        "const s = f && f.querySelector('.v-autocomplete__selection');"
+        "return s ? s.textContent.trim() : '';", by_name(driver, "preset"))  # fmt: skip
+
+
+def test_two_pages_in_chromium_show_the_servers_preset(server, tmp_path):
+    """Two tabs in headless Chromium: B picks a preset, A picks another and B speaks at once
+    (a call of its own), and B's preset field shows A's pick, the server's, three times out
+    of three. (B calls once, not on a timer: trame's page holds its own state changes while
+    a call of its is in flight, and sends them only with its next change.)"""
+    from test_web import choose, open_page, report, wait
+    from webserver import need_browser, new_browser
+
+    need_browser()
+    a, b = new_browser(tmp_path), new_browser(tmp_path)
+    try:
+        open_page(a, server.url)
+        open_page(b, server.url)
+        for b_pick, a_pick in (("emerald", "bronze"), ("jade", "pearl"), ("ruby", "gold")):
+            choose(b, "preset", b_pick)
+            wait(f"{b_pick} in A", lambda p=b_pick: shown_preset(a) == p)
+            choose(a, "preset", a_pick)
+            b.execute_script("window.trame.trigger('report')")
+            wait(f"{a_pick} on the server", lambda p=a_pick: report(a)["session"]["preset"] == p)
+            wait(f"{a_pick} in B", lambda p=a_pick: shown_preset(b) == p, timeout=ANSWER_S)
+    finally:
+        a.save_screenshot(str(tmp_path / "a.png"))
+        b.save_screenshot(str(tmp_path / "b.png"))
+        a.quit()
+        b.quit()
