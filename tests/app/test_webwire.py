@@ -232,3 +232,16 @@ def test_a_change_goes_once_to_each_tab_but_its_sender_decided_when_published():
     h.publish("topic", 2, client_id="c")
     assert {c: len(q) for c, q in queued.items()} == {"a": 1, "b": 2, "c": 3}
     assert queued["b"][0] is queued["c"][0]  # one copy of the frames for every tab
+
+
+# -- the page's values (explorer/app/webpanel.page_value) -----------------------------------------
+@pytest.mark.parametrize(("value", "like"), [({"x": 1}, 0), ("1", 0), (True, 0), (1, True),
+                                             (float("nan"), None), ([1], None)])  # fmt: skip
+def test_a_page_value_of_the_wrong_kind_is_one_line_naming_the_key(value, like):
+    from explorer.app.webpanel import page_value
+    from explorer.core.errors import ExplorerError
+
+    with pytest.raises(ExplorerError, match=r"^light: the page sent .*, not a value of light$"):
+        page_value("light", int, value, like=like)
+    assert page_value("light", int, 2, like=0) == 2
+    assert page_value("light", int, 2.0, like=1) == 2
