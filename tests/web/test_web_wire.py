@@ -87,8 +87,8 @@ def test_a_claimed_size_allocates_nothing(server):
             big = await connect(s, server.port)
             for mid in (1, 2):
                 await big.ws.send_bytes(struct.pack("<III", mid, 0, 1 << 30))
-            await asyncio.sleep(1.0)
-            assert big.ws.closed or big.ws.close_code is not None or not big._reader.done()
+            await asyncio.wait_for(big._reader, ANSWER_S)  # the server cut it off
+            assert not small._reader.done()  # a claim under the cap is no offence
             return await server_state(s, server.port, "preset")
 
     assert run(go()) is not None
@@ -312,11 +312,12 @@ def shown_preset(driver) -> str:
         "return s ? s.textContent.trim() : '';", by_name(driver, "preset"))  # fmt: skip
 
 
+@pytest.mark.slow
 def test_two_pages_in_chromium_show_the_servers_preset(server, tmp_path):
     """Two tabs in headless Chromium: B picks a preset, A picks another and B speaks at once
-    (a call of its own), and B's preset field shows A's pick, the server's, three times out
-    of three. (B calls once, not on a timer: trame's page holds its own state changes while
-    a call of its is in flight, and sends them only with its next change.)"""
+    (a call of its own), and B's preset field shows A's pick, the server's, both times. (B
+    calls once, not on a timer: trame's page holds its own state changes while a call of its
+    is in flight, and sends them only with its next change.)"""
     from test_web import choose, open_page, report, wait
     from webserver import need_browser, new_browser
 
@@ -325,7 +326,7 @@ def test_two_pages_in_chromium_show_the_servers_preset(server, tmp_path):
     try:
         open_page(a, server.url)
         open_page(b, server.url)
-        for b_pick, a_pick in (("emerald", "bronze"), ("jade", "pearl"), ("ruby", "gold")):
+        for b_pick, a_pick in (("emerald", "bronze"), ("jade", "pearl")):
             choose(b, "preset", b_pick)
             wait(f"{b_pick} in A", lambda p=b_pick: shown_preset(a) == p)
             choose(a, "preset", a_pick)
