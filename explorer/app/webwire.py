@@ -33,8 +33,9 @@ used here, so an upgrade that moves them fails loudly); what each part corrects 
   exception raised by a call with its traceback (and sent the traceback to the tab);
   ``onMessage`` let a malformed message (not a mapping, an id that is not text) raise out of
   the connection's loop, and ``onClose`` raised ``KeyError`` for a connection whose handshake
-  failed (aiohttp printed both). Here each is one line (:data:`log`), and the tab's answer
-  names the error without the server's code.
+  failed (aiohttp printed both). Here a failed call is one line (:data:`log`) and the tab's
+  answer names the error without the server's code; a tab that sends a message that is not a
+  wslink call (or text, which wslink's page never sends) is dropped, with one line.
 
 :func:`bind` applies it when trame makes the server (``on_server_bind``): the handler object
 wslink made becomes a :class:`WireHandler`.
@@ -288,7 +289,7 @@ class WireHandler(AioHttpWsHandler):
         if whole is None:
             return
         if not _well_formed(whole):
-            log.warning("web: a tab's message was ignored: not a wslink call")
+            self._drop(client_id, "a message that is not a wslink call")
             return
         with self.network_monitor:
             await self.onCompleteMessage(whole, client_id)
