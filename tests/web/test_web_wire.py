@@ -191,6 +191,23 @@ def test_a_tab_that_spoke_last_converges(server):
         assert b_shows == [server_has]
 
 
+def test_no_tab_stops_the_server(server):
+    """wslink's ``application.exit`` and ``application.exit.later`` are refused: the server
+    serves every tab still (before, any tab's call stopped it)."""
+
+    async def go():
+        async with aiohttp.ClientSession() as s:
+            tab = await connect(s, server.port)
+            replies = [await tab.call("application.exit.later", [0]),
+                       await tab.call("application.exit")]  # fmt: skip
+            await asyncio.sleep(1.0)
+            return replies, await server_state(s, server.port, "preset")
+
+    replies, preset = run(go())
+    assert [r["error"]["message"] for r in replies] == ["Unregistered method called"] * 2
+    assert preset is not None and server.proc.poll() is None
+
+
 #: the methods the fuzz calls: trame's own, the view's, and names nobody serves
 FUZZ_METHODS = ["trame.state.update", "trame.state.get", "trame.trigger", "trame.force.push",
                 "trame.lifecycle.update", "trame.error.client", "viewport.image.push",
