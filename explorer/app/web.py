@@ -33,7 +33,7 @@ import time
 from collections.abc import Sequence
 
 from explorer.app import model as M
-from explorer.app import webguard, webpage, webpanel
+from explorer.app import webguard, webpage, webpanel, webwire
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker
 from explorer.app.session import session_mapping
@@ -138,6 +138,7 @@ class WebExplorer(WebFiles):
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
         self.server.state.engine = tiers.status() or ""
         self.server.controller.on_server_ready.add(self._ready)
+        self.server.controller.on_server_bind.add(webwire.bind)  # the wire's limits (issue 37)
         self.controller.start()
         self.controller.say_mesh_warnings(mesh.name, start_warnings, logged=True)
         self.viewport.show_start(state)
