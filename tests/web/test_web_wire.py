@@ -284,7 +284,6 @@ def test_fuzzed_messages_leave_the_server_serving(fuzz_server, seed):
     sizes, from tabs that are reconnected when dropped. Then a well-formed tab is served (its
     preset pick reaches the server) and the server's output holds no traceback."""
     rng = random.Random(seed)
-    port = fuzz_server.port
 
     async def go():
         async with aiohttp.ClientSession() as s:
