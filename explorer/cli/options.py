@@ -16,6 +16,7 @@ import sys
 
 import numpy as np
 
+from explorer.core.atomic import UnwritableFile, check_target
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
@@ -297,12 +298,11 @@ def check_out(path: str, suffixes: tuple[str, ...], force: bool) -> str:
     suffix = os.path.splitext(path)[1].lower()
     if suffix not in suffixes:
         raise ExplorerError(f"--out {path!r}: the file name must end in {' or '.join(suffixes)}")
-    if os.path.isdir(path):
-        raise ExplorerError(f"--out {path!r}: is a directory; give a file name")
-    parent = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(parent):
-        raise ExplorerError(f"--out {path!r}: directory {parent!r} does not exist")
-    if os.path.exists(path) and not force:
+    try:  # what no --force replaces: a folder, a FIFO, a device; a name too long...
+        check_target(os.path.abspath(path), overwrite=True)
+    except UnwritableFile as exc:
+        raise ExplorerError(f"--out {path!r}: {exc.reason}") from None
+    if os.path.lexists(path) and not force:
         raise ExplorerError(f"--out {path!r}: already exists; use --force to replace it")
     return suffix
 
