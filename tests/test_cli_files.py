@@ -14,9 +14,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers.files import permissions_hold
 
 from explorer.cli import main
-from tests.helpers.files import permissions_hold
 
 LONG = "x" * 300  # over the 255 bytes a name may have on every usual file system
 

@@ -11,6 +11,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 import urllib.request
 from urllib.parse import urlsplit
 
@@ -108,3 +109,47 @@ def test_shown_stop_closes_the_port_and_ends_the_thread():
         assert urlsplit(again.url).port == port
     finally:
         again.stop()
+
+
+def test_web_with_its_config_folder_locked_starts_serves_and_stops(tmp_path):
+    """The user's config folder (the last session, the recent files, the presets) that cannot
+    be searched: the recent files' ``PermissionError`` ended the start in a traceback, and so
+    did keeping the session at the stop. Now the server serves, and its stop says in one
+    warning that the session could not be kept."""
+    pytest.importorskip("trame")
+    from helpers.files import permissions_hold
+    from webserver import end_process, free_port
+
+    prefix = permissions_hold()
+    if prefix is None:
+        pytest.skip("no way to run a command that folder permissions hold for")
+    config = tmp_path / "config"
+    (config / "phong-explorer").mkdir(parents=True)
+    config.chmod(0)
+    port = free_port()
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), XDG_CONFIG_HOME=str(config),
+               MPLCONFIGDIR=str(tmp_path), PHONG_EXPLORER_KERNELS="numpy")  # fmt: skip
+    env.pop("PHONG_EXPLORER_LAST_SESSION", None)
+    env.pop("PHONG_EXPLORER_MATERIALS", None)
+    log = tmp_path / "web.log"
+    with open(log, "w") as out:
+        proc = subprocess.Popen(
+            [*prefix, sys.executable, "-m", "explorer.cli", "web", "--mesh", "sphere", "--port",
+             str(port)], stdout=out, stderr=subprocess.STDOUT, env=env,
+        )  # fmt: skip
+        try:
+            url = f"http://127.0.0.1:{port}/"
+            for _ in range(1200):  # at most two minutes
+                if url in log.read_text() or proc.poll() is not None:
+                    break
+                time.sleep(0.1)
+            assert proc.poll() is None, log.read_text()
+            with urllib.request.urlopen(url, timeout=60) as page:
+                assert page.status == 200
+        finally:
+            end_process(proc, wait=60)
+            config.chmod(0o755)
+    said = log.read_text()
+    assert proc.returncode == 0, said
+    assert "Traceback" not in said and "error:" not in said, said
+    assert said.count("could not keep the last session") == 1, said
