@@ -83,24 +83,31 @@ def test_show_on_a_taken_port_is_one_error(monkeypatch, when):
 
     if when != "before the start":
         monkeypatch.setattr(web, "check_listen", lambda host, port: None)
+    before = _servers()
     with _taken() as other:
         port = other.getsockname()[1]
         with pytest.raises(ExplorerError, match=f"cannot listen on 127.0.0.1 port {port}: "):
             web.show(mesh="sphere", port=port)
-    assert not [t for t in threading.enumerate() if t.name == "phong-explorer-web"]
+    assert _servers() == before  # no server thread left behind
+
+
+def _servers() -> set:
+    """The threads :func:`show` started that still run (other tests' included)."""
+    return {t for t in threading.enumerate() if t.name == "phong-explorer-web" and t.is_alive()}
 
 
 def test_shown_stop_closes_the_port_and_ends_the_thread():
     pytest.importorskip("trame")
     from explorer.app import web
 
+    before = _servers()
     shown = web.show(mesh="sphere")
     port = urlsplit(shown.url).port
     with urllib.request.urlopen(shown.url, timeout=60) as page:
         assert page.status == 200
+    assert _servers() == before | {shown.thread}
     shown.stop()
-    assert not shown.thread.is_alive()
-    assert not [t for t in threading.enumerate() if t.name == "phong-explorer-web"]
+    assert not shown.thread.is_alive() and _servers() == before
     with pytest.raises(ConnectionRefusedError):
         socket.create_connection(("127.0.0.1", port), timeout=10).close()
     shown.stop()  # a stopped one: nothing happens
