@@ -129,8 +129,8 @@ def locked(tmp_path):
 
 def test_a_locked_folder_is_one_line_per_command(tmp_path, locked):
     """One subprocess per kind of path: the output of render (--force over a file there), an
-    import into it, the last session in it (``--last`` reads it), the user's preset folder in
-    it (left out with a notice: the rest works)."""
+    import into it, the last session in it (``--last`` reads it), a ``--materials-dir`` in it,
+    the user's preset folder in it (left out with a notice: the rest works)."""
     folder, prefix = locked
     res = _run(["render", "--mesh", "sphere", "--size", "32x32", "--force",
                 "--out", str(folder / "sub" / "keep.png")], prefix=prefix)  # fmt: skip
@@ -144,6 +144,10 @@ def test_a_locked_folder_is_one_line_per_command(tmp_path, locked):
                env={"PHONG_EXPLORER_LAST_SESSION": str(folder / "last.yaml")})  # fmt: skip
     assert res.returncode == 2
     _one_error_line(res.stderr, "--last", "last.yaml", "Permission denied")
+    res = _run(["render", "--mesh", "sphere", "--size", "32x32", "--materials-dir",
+                str(folder / "sub"), "--out", str(tmp_path / "x.png")], prefix=prefix)  # fmt: skip
+    assert res.returncode == 2  # (it said the folder "is not a directory")
+    _one_error_line(res.stderr, "--materials-dir", "cannot read it: Permission denied")
     res = _run(["presets", "list"], prefix=prefix, env={"XDG_CONFIG_HOME": str(folder)})
     assert res.returncode == 0 and "gold" in res.stdout
     assert res.stderr.startswith("notice: cannot read the user's preset directory"), res.stderr

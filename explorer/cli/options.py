@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import stat
 import sys
 
 import numpy as np
@@ -249,7 +250,14 @@ def build_scene(args, *, default_light=None):
     command-line options applied. Returns (scene, mesh)."""
     materials_dirs = tuple(args.materials_dirs)
     for d in materials_dirs:
-        if not os.path.isdir(d):
+        try:
+            is_dir = stat.S_ISDIR(os.stat(d).st_mode)
+        except FileNotFoundError:
+            raise ExplorerError(f"--materials-dir: {d!r} does not exist") from None
+        except (OSError, ValueError) as exc:  # a folder on the way locked, a name too long
+            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+            raise ExplorerError(f"--materials-dir: {d!r}: cannot read it: {reason}") from None
+        if not is_dir:
             raise ExplorerError(f"--materials-dir: {d!r} is not a directory")
     scene = load_scene(args.scene, materials_dirs=materials_dirs) if args.scene else None
     if scene is None:
