@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from explorer.core.atomic import write_atomic
+from explorer.core.atomic import check_target, write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
@@ -85,8 +85,7 @@ class TurntableJob:
             )
         # the frames are kept until they are encoded: the held budget, before any is drawn
         check_turntable(frames, size, self.suffix, held=True)
-        if not self.path.parent.is_dir():
-            raise ExplorerError(f"{self.path}: the directory {self.path.parent} does not exist")
+        check_target(self.path, overwrite=True)  # a folder, a FIFO, a name too long...
         if os.path.lexists(self.path) and not overwrite:
             raise ExplorerError(f"{self.path}: already exists (not replaced)")
         self.scene, self.mesh, self.groups, self.camera = scene, mesh, groups, camera

@@ -369,15 +369,47 @@ def _stop(signum, frame):
     raise KeyboardInterrupt
 
 
+def check_listen(host: str, port: int) -> None:
+    """Refuse at once, in one :class:`ExplorerError`, an address the server could not listen
+    on: a port taken by another server, an address not of this machine (``EADDRNOTAVAIL``), a
+    host name that does not resolve. Port 0 (any free one) is never taken. The server's own
+    bind can still fail (a port taken in between): :func:`serve` and :func:`show` say that
+    as this does (:func:`cannot_listen`)."""
+    import socket
+
+    try:
+        found = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+        for family, kind, proto, _, address in found:
+            with socket.socket(family, kind, proto) as s:
+                s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as aiohttp binds
+                s.bind(address)
+    except OSError as exc:
+        raise cannot_listen(host, port, exc) from None
+
+
+def cannot_listen(host: str, port: int, exc: OSError) -> ExplorerError:
+    """The one line for an address the server cannot listen on."""
+    import errno
+
+    reason = exc.strerror or str(exc)
+    if exc.errno == errno.EADDRINUSE:
+        reason += " (another server has it: choose another port, or 0 for any free one)"
+    elif exc.errno == errno.EADDRNOTAVAIL:
+        reason += " (not an address of this machine)"
+    return ExplorerError(f"cannot listen on {host} port {port}: {reason}")
+
+
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
     """Serve ``app`` until the process ends (prints ``App running at:`` and the URL with the
     page's token, the only place the token is written; ``open_browser``: opens it). A request
     whose Host is not one of ``host``'s names (:func:`~explorer.app.webguard.listening_names`)
     is refused. When the server stops (Ctrl-C, SIGTERM) the session is kept as the desktop
     keeps it when its window closes (:meth:`Controller.keep_last_session`; ``--last`` reopens
-    it)."""
+    it), but only if it served: an address it cannot listen on (:func:`check_listen`) is one
+    :class:`ExplorerError`, and the session kept before stays."""
     import signal
 
+    check_listen(host, port)
     own_arguments()
     signal.signal(signal.SIGTERM, _stop)
     app.hosts = webguard.listening_names(host)
@@ -396,8 +428,13 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
                          show_connection_info=False)  # fmt: skip
     except KeyboardInterrupt:
         pass
+    except OSError as exc:
+        if app.loop is None:  # never served: the bind failed after the check
+            raise cannot_listen(host, port, exc) from None
+        raise
     finally:
-        app.controller.keep_last_session()
+        if app.loop is not None:  # set once the server listens (WebExplorer._ready)
+            app.controller.keep_last_session()
 
 
 def served_url(host: str, port: int) -> str:
@@ -411,11 +448,30 @@ class Shown:
     :attr:`state` reads the explorer's present state back in Python.
 
     app : the :class:`WebExplorer`; url : its page; height : the cell's height (pixels)
+
+    :meth:`stop` ends it: the port closes and the server's thread ends (a new :func:`show`
+    may then take the same port).
     """
 
     app: WebExplorer
     url: str
     height: int = 720
+    thread: threading.Thread | None = dataclasses.field(default=None, repr=False)
+
+    def stop(self, timeout: float = 30.0) -> None:
+        """Stop the server: it stops listening (the port is free again), its open pages lose
+        it, its thread ends and the explorer's resources (the view, the temporary folder of
+        uploads) are released. Stopping a stopped one does nothing."""
+        import asyncio
+
+        if self.thread is None or not self.thread.is_alive():
+            return
+        loop = self.app.loop
+        try:
+            asyncio.run_coroutine_threadsafe(self.app.server.stop(), loop).result(timeout)
+        finally:
+            loop.call_soon_threadsafe(loop.stop)
+            self.thread.join(timeout)
 
     @property
     def state(self) -> M.State:
@@ -486,13 +542,16 @@ def proxy_prefix(proxy: bool | str | None, environ=None) -> str | None:
 
 
 def _base_url(base: str, where: str) -> str:
-    """``base`` (a path or an http(s) URL) checked, ending with ``/``."""
+    """``base`` (a path or an http(s) URL) checked, ending with ``/``: no space, quote, ``<``,
+    ``>``, ``?``, ``#``, backslash, nor any character that is not printable (a control
+    character such as ``\\r``, ``\\0`` or ``\\v`` would go into the cell's ``<iframe src>``)."""
     from urllib.parse import urlsplit
 
     parts = urlsplit(base)
     url = parts.scheme in ("http", "https") and parts.netloc
     path = base.startswith("/") and not base.startswith("//")  # "//host" names another host
-    if not (path or url) or any(c in base for c in " \t\n\"'<>?#\\"):
+    bad = any(c in " \"'<>?#\\" or not c.isprintable() for c in base)  # \r, \0, \v, \u2028
+    if not (path or url) or bad:
         raise ExplorerError(f"{where}: a Jupyter base URL is a path from / (such as "
                             f"/user/NAME/) or an http(s) URL, got {base!r}")  # fmt: skip
     return base if base.endswith("/") else base + "/"
@@ -518,6 +577,7 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
     Jupyter base URL (:func:`proxy_prefix`; by default, under JupyterHub or when
     ``$PHONG_EXPLORER_JUPYTER_PROXY`` is set)."""
     prefix = proxy_prefix(proxy)
+    check_listen(DEFAULT_HOST, port)
     state, m = notebook_state(scene, preset=preset, mesh=mesh, materials_dirs=materials_dirs)
     ready = threading.Event()
     box: dict = {}
@@ -539,8 +599,12 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
                              disable_logging=True)  # fmt: skip
 
             async def wait():
-                await app.server.ready
-                box["port"] = app.server.port
+                try:
+                    await app.server.ready
+                    box["port"] = app.server.port
+                except OSError as exc:  # the bind failed after check_listen
+                    box["error"] = cannot_listen(DEFAULT_HOST, port, exc)
+                    loop.stop()
                 ready.set()
 
             loop.create_task(wait())
@@ -548,11 +612,18 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
             box["error"] = exc
             ready.set()
             return
-        loop.run_forever()
+        try:
+            loop.run_forever()
+        finally:  # Shown.stop(), or a failed start: the explorer's resources go with it
+            if "app" in box:
+                box["app"].close()
+            loop.close()
 
-    threading.Thread(target=run, daemon=True, name="phong-explorer-web").start()
+    thread = threading.Thread(target=run, daemon=True, name="phong-explorer-web")
+    thread.start()
     if not ready.wait(120):
         raise ExplorerError("the explorer's web server did not start within 120 s")
     if "error" in box:
+        thread.join(30)  # its loop stopped: the explorer closes with it
         raise box["error"]
-    return Shown(box["app"], page_url(box["port"], prefix, box["app"].token), height)
+    return Shown(box["app"], page_url(box["port"], prefix, box["app"].token), height, thread)

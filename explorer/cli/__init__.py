@@ -4,13 +4,15 @@ May import every other part of the package; nothing imports it. Each subcommand 
 own module (``explorer.cli.<name>``) exposing ``add_arguments(parser)`` and
 ``run(args) -> int``; VTK and trimesh load only when a command draws or reads a mesh file.
 User mistakes raise :class:`~explorer.core.errors.ExplorerError`: printed as one ``error: ...``
-block on stderr, exit status 2, no traceback; text a terminal would act on (from file names,
-keys, descriptions) is shown escaped (:func:`explorer.core.text.say`). SIGTERM (every
-command but ``gui``, whose window loop would hold it back) raises :class:`Terminated`, so that
-the writer's cleanup runs: the command stops with one ``error:`` line, exit status 143, and
-leaves no temporary file. Ctrl-C does the same with exit status 130: long ray work runs in
-chunks (:mod:`explorer.geometry.bvh`) and stops at the end of the current one, well within a
-second, with one ``error: interrupted ...`` line.
+block on stderr, exit status 2, no traceback (so is an ``OSError`` naming a file that no
+check turned into one: a folder that cannot be searched, a name too long); text a terminal
+would act on (from file names, keys, descriptions) is shown escaped
+(:func:`explorer.core.text.say`). SIGTERM (every command but ``gui``, whose window loop would
+hold it back) raises :class:`Terminated`, so that the writer's cleanup runs: the command
+stops with one ``error:`` line, exit status 143, and leaves no temporary file. Ctrl-C does
+the same with exit status 130: long ray work runs in chunks (:mod:`explorer.geometry.bvh`)
+and stops at the end of the current one, well within a second, with one ``error:
+interrupted ...`` line.
 """
 
 from __future__ import annotations
@@ -161,3 +163,8 @@ def _main(argv: list[str] | None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # so the interpreter's final flush cannot fail
         return 141
+    except OSError as exc:  # a file the system refused that no check named: still one line
+        if exc.filename is None:
+            raise
+        say(f"error: {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
+        return 2

@@ -60,8 +60,13 @@ def start_state(args, warnings: list | None = None):
     dirs = tuple(args.materials_dirs)
     if getattr(args, "last", False):
         path = S.last_session_path()
-        if not os.path.lexists(path):  # anything else is read, or refused, by the checked open
-            raise ExplorerError(f"--last: no session kept yet ({path} does not exist)")
+        try:  # what is there is read, or refused, by the checked open
+            os.lstat(path)
+        except FileNotFoundError:
+            raise ExplorerError(f"--last: no session kept yet ({path} does not exist)") from None
+        except (OSError, ValueError) as exc:  # its folder cannot be searched, a name too long
+            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            raise ExplorerError(f"--last: cannot read the last session {path}: {reason}") from None
         return S.load_session(path, materials_dirs=dirs)
     if getattr(args, "session", None) is not None:
         return S.load_session(args.session, materials_dirs=dirs)

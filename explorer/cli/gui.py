@@ -29,6 +29,7 @@ from explorer.cli.explorerstart import add_preset_option
 from explorer.cli.explorerstart import start as shared_start
 from explorer.cli.explorerstart import start_state as shared_start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
+from explorer.core.atomic import UnwritableFile, check_target
 from explorer.core.errors import ExplorerError
 from explorer.core.text import printable, say
 from explorer.render.images import parse_size
@@ -86,13 +87,10 @@ def check_state_file(f, force: bool) -> None:
     (even with ``--force``), a file in a directory that does not exist, an existing file
     without ``--force``. (Before, the window ran and logged one error per frame.)"""
     shown = printable(repr(os.fspath(f)))
-    if os.path.isdir(f):
-        raise ExplorerError(f"--state-file {shown}: is a directory; give a file name")
-    parent = os.path.dirname(os.path.abspath(f))
-    if not os.path.isdir(parent):
-        raise ExplorerError(
-            f"--state-file {shown}: directory {printable(repr(parent))} does not exist"
-        )
+    try:  # what no --force replaces: a folder, a FIFO, a device; a name too long...
+        check_target(os.path.abspath(f), overwrite=True)
+    except UnwritableFile as exc:
+        raise ExplorerError(f"--state-file {shown}: {printable(exc.reason)}") from None
     if os.path.lexists(f) and not force:
         raise ExplorerError(f"--state-file {shown}: already exists; use --force to replace it")
 

@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import argparse
 import os
+import stat
 import sys
 
 import numpy as np
 
+from explorer.core.atomic import UnwritableFile, check_target
 from explorer.core.errors import ExplorerError, Problem, ValidationError
 from explorer.core.hdr import HDR, TONE_MAPS
 from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
@@ -248,7 +250,14 @@ def build_scene(args, *, default_light=None):
     command-line options applied. Returns (scene, mesh)."""
     materials_dirs = tuple(args.materials_dirs)
     for d in materials_dirs:
-        if not os.path.isdir(d):
+        try:
+            is_dir = stat.S_ISDIR(os.stat(d).st_mode)
+        except FileNotFoundError:
+            raise ExplorerError(f"--materials-dir: {d!r} does not exist") from None
+        except (OSError, ValueError) as exc:  # a folder on the way locked, a name too long
+            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+            raise ExplorerError(f"--materials-dir: {d!r}: cannot read it: {reason}") from None
+        if not is_dir:
             raise ExplorerError(f"--materials-dir: {d!r} is not a directory")
     scene = load_scene(args.scene, materials_dirs=materials_dirs) if args.scene else None
     if scene is None:
@@ -297,12 +306,11 @@ def check_out(path: str, suffixes: tuple[str, ...], force: bool) -> str:
     suffix = os.path.splitext(path)[1].lower()
     if suffix not in suffixes:
         raise ExplorerError(f"--out {path!r}: the file name must end in {' or '.join(suffixes)}")
-    if os.path.isdir(path):
-        raise ExplorerError(f"--out {path!r}: is a directory; give a file name")
-    parent = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(parent):
-        raise ExplorerError(f"--out {path!r}: directory {parent!r} does not exist")
-    if os.path.exists(path) and not force:
+    try:  # what no --force replaces: a folder, a FIFO, a device; a name too long...
+        check_target(os.path.abspath(path), overwrite=True)
+    except UnwritableFile as exc:
+        raise ExplorerError(f"--out {path!r}: {exc.reason}") from None
+    if os.path.lexists(path) and not force:
         raise ExplorerError(f"--out {path!r}: already exists; use --force to replace it")
     return suffix
 

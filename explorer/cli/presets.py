@@ -257,8 +257,15 @@ def validate(paths, out=None, err=None) -> int:
     problems: list[Problem] = []
     for p in paths:
         path = Path(p)
-        if path.is_dir():
-            found = sorted(f for f in path.iterdir() if f.suffix == SUFFIX and f.is_file())
+        try:  # the loader says why a file cannot be read; here: a folder on the way that
+            # cannot be searched, a folder that cannot be listed, a name too long
+            found = None
+            if path.is_dir():
+                found = sorted(f for f in path.iterdir() if f.suffix == SUFFIX and f.is_file())
+        except OSError as exc:
+            problems.append(Problem(f"cannot read: {exc.strerror or exc}", str(path)))
+            continue
+        if found is not None:
             if not found:
                 problems.append(Problem(f"no *{SUFFIX} files in this directory", str(path)))
             files.extend(found)
@@ -276,7 +283,7 @@ def validate(paths, out=None, err=None) -> int:
             problems.extend(exc.problems)
         except ExplorerError as exc:  # pragma: no cover - the loader raises ValidationError
             problems.append(Problem(str(exc), str(path)))
-        if path.suffix == SUFFIX and path.exists() and not is_valid_name(path.stem):
+        if path.suffix == SUFFIX and os.path.exists(path) and not is_valid_name(path.stem):
             problems.append(
                 Problem(
                     f"the file name {path.stem!r} is not a valid preset name (lowercase letters, "

@@ -84,6 +84,7 @@ def run(args) -> int:
     host = args.host or web.DEFAULT_HOST
     if args.host is not None and host not in ("127.0.0.1", "localhost", "::1"):
         say(web.OPEN_HOST_WARNING.format(host=host, port=args.port), file=sys.stderr)
+    web.check_listen(host, args.port)  # a taken port said at once, before the explorer loads
     warnings: list[str] = []
     state, mesh = start_state(args, warnings)
     app = web.WebExplorer(state, mesh, materials_dirs=tuple(args.materials_dirs),

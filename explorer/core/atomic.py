@@ -10,6 +10,13 @@ so that this cleanup runs); a temporary file that survived anyway (``kill -9``, 
 by a later write into the same directory once it is older than :data:`STALE_TEMP_AGE` (a process
 lists a directory for this at most once per that age). :func:`write_all_atomic` writes several files
 all-or-nothing.
+
+What is refused before anything is written (:func:`check_target`, also called by the commands'
+early checks): a name the file system cannot take (too long), a folder that cannot be searched
+or does not exist, a directory at the path, an existing file without ``overwrite`` and, even
+with it, anything but a regular file (a FIFO, a device, a socket: ``--force`` replaces a file,
+never a pipe a reader waits on). Every refusal and every failure is one
+:class:`~explorer.core.errors.ExplorerError` naming the path; no ``OSError`` leaves this module.
 """
 
 from __future__ import annotations
@@ -23,6 +30,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from explorer.core.errors import ExplorerError
+from explorer.core.files import file_kind
 
 #: A temporary file of this module's naming older than this (seconds) is a leftover of a killed
 #: run: the next write into its directory removes it. A live write keeps touching its file and
@@ -81,15 +89,10 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
     Every failure is an :class:`ExplorerError` naming the path; the temporary file is removed.
     """
     target = Path(os.fspath(path))
-    if target.is_dir():
-        raise ExplorerError(f"{target}: is a directory; give a file name to write")
-    if target.exists() and not overwrite:
-        raise exists_error(target)
     parent = target.parent
     if make_dirs:
         _make_dirs(parent)
-    elif not parent.is_dir():
-        raise ExplorerError(f"{target}: directory {str(parent)!r} does not exist")
+    check_target(target, overwrite=overwrite)
     _sweep_now_and_then(parent)
     tmp = None
     try:
@@ -112,6 +115,63 @@ def write_atomic(path, data: bytes, *, overwrite: bool = False, make_dirs: bool 
             except OSError:
                 pass
     return target
+
+
+class UnwritableFile(ExplorerError):
+    """A path :func:`check_target` refuses: ``path`` as given, ``reason`` the phrase after it
+    (``"is a FIFO (named pipe), not a regular file; ..."``); the message is
+    ``"<path>: <reason>"``."""
+
+    def __init__(self, path, reason: str):
+        self.path, self.reason = os.fspath(path), reason
+        super().__init__(f"{self.path}: {reason}")
+
+
+def check_target(path, *, overwrite: bool, make_dirs: bool = False) -> Path:
+    """Refuse ``path`` as a file to write, before anything is written (see the module's
+    docstring for what is refused); returns it as a :class:`~pathlib.Path`. Each refusal but an
+    existing file's (:func:`exists_error`) is one :class:`UnwritableFile` naming the path; the
+    ``OSError`` of a name too long or of a folder that cannot be searched is said in its words
+    (``File name too long``). ``make_dirs``: a folder that does not exist yet is no refusal
+    (the writer makes it). The path is checked, not held: a FIFO made between this check
+    and the rename would still be replaced."""
+    target = Path(os.fspath(path))
+    parent = target.parent
+    try:
+        st = os.lstat(target)
+    except FileNotFoundError:
+        st = None
+    except OSError as exc:  # ENAMETOOLONG, EACCES (a folder on the way cannot be searched)
+        raise _cannot_write(target, exc) from None
+    except ValueError:  # a NUL in the name
+        raise UnwritableFile(target, "cannot write: the name holds a NUL character") from None
+    if st is None:
+        try:
+            if not stat.S_ISDIR(os.stat(parent).st_mode):
+                raise UnwritableFile(target, f"{str(parent)!r} is not a directory")
+        except FileNotFoundError:
+            if make_dirs:  # the writer makes it
+                return target
+            raise UnwritableFile(target, f"directory {str(parent)!r} does not exist") from None
+        except OSError as exc:
+            raise _cannot_write(target, exc) from None
+        return target
+    try:
+        mode = os.stat(target).st_mode if stat.S_ISLNK(st.st_mode) else st.st_mode
+    except OSError:  # a dangling link: replaced as a file would be
+        mode = stat.S_IFREG
+    if stat.S_ISDIR(mode):
+        raise UnwritableFile(target, "is a directory; give a file name to write")
+    if not overwrite:
+        raise exists_error(target)
+    if not stat.S_ISREG(mode):
+        raise UnwritableFile(target, f"is {file_kind(mode)}, not a regular file; not replacing "
+                             "it (overwrite / --force replace only a file)")  # fmt: skip
+    return target
+
+
+def _cannot_write(target: Path, exc: OSError) -> UnwritableFile:
+    return UnwritableFile(target, f"cannot write: {exc.strerror or exc}")
 
 
 def _make_dirs(directory: Path) -> None:
@@ -140,12 +200,7 @@ def write_all_atomic(
         for parent in dict.fromkeys(t.parent for t, _ in targets):
             _make_dirs(parent)
     for target, _ in targets:
-        if target.is_dir():
-            raise ExplorerError(f"{target}: is a directory; give a file name to write")
-        if target.exists() and not overwrite:
-            raise exists_error(target)
-        if not target.parent.is_dir():
-            raise ExplorerError(f"{target}: directory {str(target.parent)!r} does not exist")
+        check_target(target, overwrite=overwrite)
     for parent in {t.parent for t, _ in targets}:
         _sweep_now_and_then(parent)
     temps: dict[Path, str] = {}  # target -> its new contents, not yet in place
@@ -203,7 +258,10 @@ def _backup(target: Path) -> str:
 
 def _new_temp(target: Path) -> str:
     """A new empty temporary file beside ``target`` (named like :data:`TEMP_NAME`)."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    # the name's first 200 characters: a temporary name is 14 longer, and a target of up to
+    # 255 (most file systems' limit) must still be writable
+    prefix = f".{target.name[:200]}."
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=target.parent)
     os.close(fd)
     return tmp
 

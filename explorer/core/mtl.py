@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from explorer.core import tolerances as tol
+from explorer.core.atomic import check_target
 from explorer.core.errors import ExplorerError
 from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.material import (
@@ -418,8 +419,14 @@ class MtlImport:
 
     @property
     def existing(self) -> list[Path]:
-        """The targets that exist already (replaced only when asked)."""
-        return [t for t in self.targets if t.exists()]
+        """The targets that exist already (replaced only when asked). A target that could
+        not be written (its folder locked, its name too long, a FIFO there) is an
+        :class:`~explorer.core.atomic.UnwritableFile` here, before anything is written."""
+        return [
+            t
+            for t in self.targets
+            if check_target(t, overwrite=True, make_dirs=True) and os.path.lexists(t)
+        ]
 
     def write(self, overwrite: bool) -> list[Path]:
         """Write every preset, all or nothing (:func:`~explorer.core.presets.save_presets`:

@@ -84,19 +84,33 @@ def user_dir() -> Path:
 def search_dirs(materials_dirs: Iterable = ()) -> list[tuple[Path, str]]:
     """``[(directory, source), ...]`` in precedence order (first wins).
 
-    A ``--materials-dir`` directory that does not exist is an error (it was asked for); a missing
-    user directory is simply skipped.
+    A ``--materials-dir`` directory that does not exist or cannot be read is an error (it was
+    asked for); a missing user directory is simply skipped, one that cannot be searched (its
+    folder locked, its name too long) is skipped with a notice.
     """
     dirs: list[tuple[Path, str]] = []
     for d in materials_dirs or ():
         path = Path(os.fspath(d)).expanduser()
-        if not path.is_dir():
-            why = "is not a directory" if path.exists() else "does not exist"
-            raise ExplorerError(f"materials directory {path} {why}")
+        try:
+            is_dir = stat.S_ISDIR(os.stat(path).st_mode)
+        except FileNotFoundError:
+            raise ExplorerError(f"materials directory {path} does not exist") from None
+        except (OSError, ValueError) as exc:  # a folder on the way not searchable, too long
+            reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            raise ExplorerError(f"materials directory {path}: cannot read it: {reason}") from None
+        if not is_dir:
+            raise ExplorerError(f"materials directory {path} is not a directory")
         dirs.append((path, "extra"))
     user = user_dir()
-    if user.is_dir():
-        dirs.append((user, "user"))
+    try:
+        if stat.S_ISDIR(os.stat(user).st_mode):
+            dirs.append((user, "user"))
+    except FileNotFoundError:
+        pass
+    except (OSError, ValueError) as exc:  # not searchable, a name too long: said, left out
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        _notice(None, f"cannot read the user's preset directory {user}: {reason}; its "
+                      "presets are left out")  # fmt: skip
     dirs.append((builtin_dir(), "builtin"))
     # the same directory twice (e.g. --materials-dir pointing at the user dir) counts once
     seen: set = set()
@@ -207,16 +221,16 @@ def locate_preset(name: str, materials_dirs: Iterable = ()) -> tuple[Path, str, 
     """``(file, source, hidden file or None)`` of preset ``name``, without loading it."""
     _check_lookup_name(name)
     dirs = search_dirs(materials_dirs)
-    hits = [(d / f"{name}{SUFFIX}", s) for d, s in dirs if (d / f"{name}{SUFFIX}").is_file()]
+    modes = [(d / f"{name}{SUFFIX}", s, _mode(d / f"{name}{SUFFIX}")) for d, s in dirs]
+    hits = [(path, s) for path, s, mode in modes if mode is not None and stat.S_ISREG(mode)]
     if not hits:
-        for d, _ in dirs:  # the name is there, but not as a file: say what it is
-            path = d / f"{name}{SUFFIX}"
-            if path.exists() and not path.is_file():
-                kind = "a directory" if path.is_dir() else "not a regular file"
+        for path, _, mode in modes:  # the name is there, but not as a file: say what it is
+            if mode is not None and not stat.S_ISREG(mode):
+                kind = "a directory" if stat.S_ISDIR(mode) else "not a regular file"
                 raise ExplorerError(
                     f"material preset {name!r}: {path} is {kind}, not a preset file"
                 )
-        known = sorted(n for n, files in _scan(dirs, []).items() if files[0][0].is_file())
+        known = sorted(n for n, files in _scan(dirs, []).items() if _is_file(files[0][0]))
         hint = suggest(name.lower(), known) or suggest(name, known)
         where = "; ".join(f"{d} ({s})" for d, s in dirs)
         raise ExplorerError(
@@ -306,6 +320,20 @@ _NOTICED: set[str] = set()
 def _hidden_message(name, path, source, hidden) -> str:
     label = {"extra": "--materials-dir", "user": "user", "builtin": "built-in"}.get(source, source)
     return f"preset '{name}': using {path} ({label}), which hides {hidden[0]}"
+
+
+def _is_file(path: Path) -> bool:
+    mode = _mode(path)
+    return mode is not None and stat.S_ISREG(mode)
+
+
+def _mode(path: Path) -> int | None:
+    """``st_mode`` of ``path`` (links followed), None when it cannot be had: nothing there, or
+    a directory that cannot be searched (its listing says so in a notice)."""
+    try:
+        return os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None
 
 
 def _notice(notices: list | None, message: str) -> None:

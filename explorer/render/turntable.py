@@ -222,4 +222,31 @@ def _mp4(frames: Iterator[np.ndarray], fps: float) -> bytes:
         if writer is None:
             raise ExplorerError("a turntable needs at least one frame")
         with open(path, "rb") as f:
-            return f.read()
+            data = f.read()
+    if not mp4_complete(data):  # imageio-ffmpeg does not look at ffmpeg's exit status
+        raise ExplorerError(
+            "the MP4 encoder (ffmpeg) did not finish the file (a full disk, or a file size "
+            "limit?); nothing was written"
+        )
+    return data
+
+
+def mp4_complete(data: bytes) -> bool:
+    """Whether ``data`` is a whole MP4 file as ffmpeg finishes it: top-level boxes (a 4-byte
+    big-endian size, a 4-byte type; size 1: a 64-bit size follows) that end exactly at the
+    end of the data, among them ``ftyp``, ``mdat`` and ``moov`` (the index ffmpeg writes
+    last: a file cut short by a full disk or a size limit lacks it, and does not play)."""
+    seen, at = set(), 0
+    while at < len(data):
+        if at + 8 > len(data):
+            return False
+        size, kind = int.from_bytes(data[at : at + 4], "big"), data[at + 4 : at + 8]
+        if size == 1:
+            if at + 16 > len(data):
+                return False
+            size = int.from_bytes(data[at + 8 : at + 16], "big")
+        if size < 8 or at + size > len(data):  # size 0 (to the end) is not what ffmpeg writes
+            return False
+        seen.add(kind)
+        at += size
+    return {b"ftyp", b"mdat", b"moov"} <= seen

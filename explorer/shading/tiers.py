@@ -125,6 +125,8 @@ _state = {
     "loading": None,  # the loader thread, once started
     "checked": 0.0,  # when the marker was last looked for
     "failed": None,  # why the compiled engine is unavailable
+    "guarded": False,  # numba's cache reads of the kernels are guarded (guard_cache)
+    "told_damaged": False,  # a kernel's unreadable cache files were set aside and said
 }
 #: the background compiles this process started, kept (a Popen dropped while its process runs
 #: warns, ResourceWarning); those that ended are reaped at the next start
@@ -161,20 +163,21 @@ def compiled(work: int = 0) -> bool:
     user once) or the loader thread; never waits for either."""
     m = mode()
     if m != "auto":
-        return m == "compiled"
+        return m == "compiled" and guard_cache()
     if _state["loaded"]:
-        return True
+        return guard_cache()
     if not _ready() or _state["loading"] is not None:
         return False
     _state["numpy_work"] += int(work)
     if _state["numpy_work"] >= LOAD_WORTH:
         _state["loaded"] = True
-    return _state["loaded"]
+    return _state["loaded"] and guard_cache()
 
 
 def loaded() -> bool:
-    """Whether the compiled kernels serve in this process now (no side effects)."""
-    return mode() == "compiled" or (mode() == "auto" and _state["loaded"])
+    """Whether the compiled kernels serve in this process now (no side effects but
+    :func:`guard_cache`, once)."""
+    return (mode() == "compiled" or (mode() == "auto" and _state["loaded"])) and guard_cache()
 
 
 def preload() -> None:
@@ -234,7 +237,7 @@ def ray_engine(work: int = 0, tier: str | None = None):
     from a warm cache at once), else numpy
     """
     if tier is not None:
-        return bvh if tier == "compiled" else bvh_numpy
+        return bvh if tier == "compiled" and guard_cache() else bvh_numpy
     return bvh if compiled(work) else bvh_numpy
 
 
@@ -350,20 +353,26 @@ def cache_files() -> dict[str, int]:
         impl = getattr(d._cache, "_cache_file", None)  # numba's IndexDataCacheFile
         if impl is None:  # a function numba does not cache
             continue
-        directory, index = impl._cache_path, impl._index_path
-        base = os.path.basename(index)[: -len(".nbi")]
-        try:
-            names = os.listdir(directory)
-        except OSError:
-            continue
-        for name in names:
-            if name == base + ".nbi" or (name.startswith(base + ".") and name.endswith(".nbc")):
-                path = os.path.join(directory, name)
-                try:
-                    found[path] = os.stat(path).st_size
-                except OSError:
-                    pass
+        for path in _files_of(impl):
+            try:
+                found[path] = os.stat(path).st_size
+            except OSError:
+                pass
     return found
+
+
+def _files_of(impl) -> list[str]:
+    """The cache files of one function (``impl``: numba's ``IndexDataCacheFile``): its index
+    (``.nbi``) and compiled overloads (``.nbc``) as they are now."""
+    base = os.path.basename(impl._index_path)[: -len(".nbi")]
+    try:
+        names = os.listdir(impl._cache_path)
+    except OSError:
+        return []
+    ours = [
+        n for n in names if n == base + ".nbi" or (n.startswith(base + ".") and n.endswith(".nbc"))
+    ]
+    return [os.path.join(impl._cache_path, n) for n in ours]
 
 
 def damage() -> str | None:
@@ -420,6 +429,54 @@ def set_aside(why: str, paths=None) -> Path:
             except OSError:
                 pass
     return where if where is not None else cache_dir()
+
+
+#: what the user is told, once, when numba could not read a kernel's cache files
+UNREADABLE = (
+    "the compiled engine's cache was damaged (numba could not read {name}'s cache files: "
+    "{error}); they were set aside in {where} and it is compiled again"
+)
+
+
+def guard_cache() -> bool:
+    """Make numba's cache read of every kernel the product calls treat a file it cannot read
+    (an index or a compiled overload cut short or garbled: pickle's ``UnpicklingError``,
+    ``EOFError``...) as a miss: that kernel's cache files and the ready marker are set aside
+    (:func:`set_aside`), the user is told once (:data:`UNREADABLE`, a
+    :class:`~explorer.core.errors.Notice`), and numba compiles the kernel again and caches it
+    anew. Installed once per process, before the compiled tier first serves (the compiled
+    mode, the loader thread, the background compile); returns True."""
+    if _state["guarded"]:
+        return True
+    from explorer.shading import warm  # (warm imports this module)
+
+    with _lock:
+        if not _state["guarded"]:
+            for name, d in warm.dispatchers().items():
+                if getattr(d._cache, "_cache_file", None) is not None:  # a cached function
+                    d._cache.load_overload = _guarded_load(name, d._cache)
+            _state["guarded"] = True
+    return True
+
+
+def _guarded_load(name: str, cache):
+    """``cache.load_overload`` (numba's ``Cache``) with an unreadable file taken as a miss."""
+    load = cache.load_overload
+
+    def load_overload(sig, target_context):
+        try:
+            return load(sig, target_context)
+        except Exception as exc:  # noqa: BLE001 - any failure to read the cache: compile anew
+            error = f"{type(exc).__name__}: {exc}"
+            where = set_aside(f"numba could not read {name}'s cache: {error}",
+                              [marker_path(), *_files_of(cache._cache_file)])  # fmt: skip
+            if not _state["told_damaged"]:
+                _state["told_damaged"] = True
+                told = UNREADABLE.format(name=name, error=error, where=where)
+                warnings.warn(told, Notice, stacklevel=2)
+            return None
+
+    return load_overload
 
 
 def _listed() -> list[str]:

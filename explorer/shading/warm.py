@@ -131,6 +131,7 @@ def _refits() -> None:
 
 def exercise() -> int:
     """Run every kind of pass the product makes on the compiled tier; returns the passes."""
+    tiers.guard_cache()  # a cache file numba cannot read is set aside and compiled anew
     _pixel_rays()
     _refits()
     passes = 0

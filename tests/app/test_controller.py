@@ -362,3 +362,16 @@ def test_the_last_session_never_replaces_what_is_not_a_kept_session(ctl, tmp_pat
     ctl.last_session = kept
     ctl.keep_last_session()
     assert "scene" in kept.read_text()
+
+
+def test_a_last_session_path_the_system_refuses_is_a_warning_on_stop(ctl, tmp_path, caplog):
+    """A last-session name too long for the file system (``OSError`` 36) raised out of the
+    window's close and the web server's stop; it is one warning, and nothing is written."""
+    import logging
+
+    ctl.last_session = tmp_path / ("x" * 300 + ".yaml")
+    with caplog.at_level(logging.WARNING):
+        ctl.keep_last_session()
+    assert "could not keep the last session" in caplog.text
+    assert "File name too long" in caplog.text
+    assert list(tmp_path.iterdir()) == []

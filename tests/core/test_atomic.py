@@ -88,3 +88,40 @@ def test_write_all_atomic_refuses_before_writing_anything(tmp_path):
     with pytest.raises(ExplorerError, match="does not exist"):
         atomic.write_all_atomic({tmp_path / "a": b"1", tmp_path / "no" / "b": b"2"})
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device", "dangling link"])
+def test_overwrite_replaces_a_regular_file_only(tmp_path, kind):
+    """``overwrite`` (``--force``) put a regular file in the place of a FIFO a reader waits on,
+    or of the link to a device; a dangling link is replaced as a file would be."""
+    target = tmp_path / "out.yaml"
+    if kind == "fifo":
+        os.mkfifo(target)
+    elif kind == "device":
+        target.symlink_to(os.devnull)
+    else:
+        target.symlink_to(tmp_path / "gone")
+    if kind == "dangling link":
+        write_atomic(target, b"new", overwrite=True)
+        assert not target.is_symlink() and target.read_bytes() == b"new"
+        return
+    with pytest.raises(atomic.UnwritableFile, match="not a regular file") as info:
+        write_atomic(target, b"new", overwrite=True)
+    assert info.value.path == str(target)
+    with pytest.raises(ExplorerError, match="not a regular file"):
+        atomic.write_all_atomic({tmp_path / "other": b"1", target: b"2"}, overwrite=True)
+    assert os.path.lexists(target) and not os.path.isfile(target)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.yaml"]
+
+
+def test_a_name_the_file_system_refuses_is_an_explorer_error(tmp_path):
+    """A name over 255 bytes raised ``OSError`` 36 out of the checks before writing; one of
+    255 is written (its temporary, 14 characters longer, is named from a shorter part)."""
+    with pytest.raises(ExplorerError, match="File name too long"):
+        write_atomic(tmp_path / ("x" * 300), b"data")
+    with pytest.raises(ExplorerError, match="File name too long"):
+        atomic.write_all_atomic({tmp_path / ("x" * 300): b"data"}, overwrite=True)
+    assert list(tmp_path.iterdir()) == []
+    name = "y" * 255
+    assert write_atomic(tmp_path / name, b"data").read_bytes() == b"data"
+    assert [p.name for p in tmp_path.iterdir()] == [name]

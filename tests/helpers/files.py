@@ -23,3 +23,27 @@ def special_file(tmp_path: Path, kind: str, name: str) -> Path:
     elif kind == "dir":
         path.mkdir()
     return path
+
+
+#: root's capabilities that let it past a folder's permissions (``chmod 000`` means nothing to it)
+_OVERRIDES = "-dac_override,-dac_read_search"
+
+
+def permissions_hold() -> list[str] | None:
+    """A command prefix under which a folder's permissions hold for the command run after it:
+    none for a user, and for root ``setpriv`` without the capabilities that override them
+    (the files stay root's, so the test still owns them); None where neither works (a test
+    then skips)."""
+    if not hasattr(os, "geteuid"):
+        return None
+    if os.geteuid() != 0:
+        return []
+    import shutil
+    import subprocess
+
+    setpriv = shutil.which("setpriv")
+    if setpriv is None:
+        return None
+    prefix = [setpriv, f"--bounding-set={_OVERRIDES}", "--"]
+    probe = subprocess.run([*prefix, "true"], capture_output=True, timeout=30)
+    return prefix if probe.returncode == 0 else None

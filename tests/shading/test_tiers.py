@@ -487,6 +487,83 @@ def test_a_damaged_cache_is_set_aside_with_one_notice_and_rebuilt(cold_tiers, mo
     assert tiers._state["started"]  # and the background compile rebuilds them
 
 
+#: a process on a numba cache of its own: the display's byte rounding (a kernel that compiles
+#: in seconds) run on the compiled tier, its bytes printed
+_ROUND = textwrap.dedent(
+    """
+    import numpy as np
+    from explorer.shading import display
+    print(display.to_bytes(np.linspace(-0.1, 1.1, 12).reshape(4, 3)).ravel().tolist())
+    """
+)
+#: the background compile (``warm.main``) whose exercise is the byte rounding alone (the whole
+#: exercise compiles for minutes)
+_WARM = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from explorer.shading import display, warm
+    def rounding():
+        out = np.empty(12, np.uint8)
+        display._round_bytes(np.linspace(-0.1, 1.1, 12), out)
+    warm._pixel_rays, warm._refits, warm._meshes = rounding, lambda: None, lambda: iter(())
+    sys.exit(warm.main())
+    """
+)
+
+
+def _round_bytes_files(tmp_path) -> tuple[dict, list[str]]:
+    """A numba cache under ``tmp_path`` holding the byte rounding (compiled there, in a few
+    seconds), the environment that uses it, and its cache files (index first)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), **{tiers.ENV: "compiled"})
+    run = subprocess.run([sys.executable, "-c", _ROUND], env=env, capture_output=True,
+                         text=True, timeout=600)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    files = sorted(str(p) for p in (tmp_path / "numba").rglob("display._round_bytes-*.nb?"))
+    assert [f[-4:] for f in files] == [".nbc", ".nbi"], files
+    return env, files[::-1]
+
+
+def test_a_cache_file_numba_cannot_read_is_set_aside_and_compiled_again(tmp_path):
+    """A truncated index or compiled overload (a full disk, a killed writer) with no marker to
+    vouch for it ended the compiled mode in pickle's ``UnpicklingError`` traceback: now it is
+    set aside with one notice, the kernel is compiled again, and the next run reads the new
+    files without a word."""
+    env, (nbi, nbc) = _round_bytes_files(tmp_path)
+    want = np.rint(np.clip(np.linspace(-0.1, 1.1, 12) * 255.0, 0.0, 255.0)).tolist()
+    for damaged in (nbi, nbc):
+        os.truncate(damaged, 20)
+        for again in (False, True):
+            run = subprocess.run([sys.executable, "-c", _ROUND], env=env, capture_output=True,
+                                 text=True, timeout=600)  # fmt: skip
+            assert run.returncode == 0, run.stderr
+            assert json.loads(run.stdout.strip().splitlines()[-1]) == want
+            if again:
+                assert run.stderr == "", run.stderr
+                continue
+            assert "Traceback" not in run.stderr
+            assert run.stderr.count("numba could not read") == 1, run.stderr
+            assert "_round_bytes" in run.stderr and "set aside in" in run.stderr
+            assert os.path.getsize(damaged) > 20  # written anew
+    aside = list((tmp_path / "numba").rglob("explorer-damaged-*"))
+    assert len(aside) == 2 and all((a / "why.txt").exists() for a in aside)
+
+
+def test_the_background_compile_sets_an_unreadable_cache_file_aside(tmp_path):
+    """The background compile met the same ``UnpicklingError``, counted a failed attempt, and
+    after two no compiled engine was ever prepared: now it sets the file aside, compiles and
+    writes the ready marker."""
+    env, (nbi, _) = _round_bytes_files(tmp_path)
+    os.truncate(nbi, 20)
+    env[tiers.ENV] = "auto"
+    run = subprocess.run([sys.executable, "-c", _WARM], env=env, capture_output=True,
+                         text=True, timeout=600)  # fmt: skip
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "numba could not read" in run.stderr and "Traceback" not in run.stdout
+    assert list((tmp_path / "numba").rglob("explorer-ready-*.json"))  # the marker
+    assert os.path.getsize(nbi) > 20
+
+
 def test_an_intact_cache_is_used_and_an_index_may_grow(cold_tiers, monkeypatch):
     files = _fake_cache(cold_tiers.parent, monkeypatch)
     tiers.write_marker(1.0)

@@ -78,6 +78,18 @@ def test_a_bad_base_url_is_refused_naming_where_it_came_from(bad):
         web.proxy_prefix(8888, {})
 
 
+@pytest.mark.parametrize("control", ["\r", "\0", "\v", "\x1b", "\x85", "\u2028"])
+@pytest.mark.parametrize("form", ["/user/a{}b/", "https://hub.example.org/a{}b/"])
+def test_a_base_url_with_a_control_character_is_refused(control, form):
+    """A control character inside the base URL went into the cell's ``<iframe src>`` (issue 37
+    §3); it is refused from either source, and the message shows it escaped."""
+    bad = form.format(control)
+    for proxy, environ, where in ((bad, {}, "proxy"), (None, {OWN: bad}, OWN)):
+        with pytest.raises(ExplorerError, match=f"^{where}: a Jupyter base URL") as info:
+            web.proxy_prefix(proxy, environ)
+        assert control not in str(info.value)
+
+
 def test_the_page_url_is_direct_or_under_the_proxy():
     assert web.page_url(8123, None) == "http://127.0.0.1:8123/"
     assert web.page_url(8123, "/user/ana/") == "/user/ana/proxy/8123/"

@@ -41,3 +41,4 @@ def test_a_cold_cache_serves_the_numpy_tier_then_the_compiled_one(cold_tiers, tm
         check_probe(driver, mesh)
     finally:
         driver.quit()
+        shown.stop()

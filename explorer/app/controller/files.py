@@ -269,7 +269,7 @@ class FileFlows:
     def recent_files(self) -> list[str]:
         """The files opened last, newest first (a list that cannot be read is empty)."""
         path = self.recent_file()
-        if path is None or not path.is_file():
+        if path is None or not os.path.isfile(path):  # (False for a folder not searchable)
             return []
         try:
             text = read_text_checked(path, cap=tol.MAX_DATA_FILE_BYTES, what="recent files")
