@@ -98,7 +98,7 @@ class Viewer(Checked):
         """The eye in the normalised frame ``centre`` (3,), ``scale``: ``(eye - centre) / scale``,
         or, farther than :data:`~explorer.core.tolerances.FAR_VIEWER` (the far-viewer policy, both
         tiers), that distance along its direction (computed without overflow: an eye at 1e8 from
-        a mesh of size 1e-300 would be at 1e308, beyond float32 and inf in ``eye - P``)."""
+        a mesh of size 1e-300 would be at 1e308, beyond float32; ``eye - P`` of infinite length)."""
         assert self.eye is not None, "an infinite viewer has no eye"
         v, u, distance = span(self.eye, centre, scale)
         if distance <= tol.FAR_VIEWER:

@@ -74,8 +74,8 @@ FAR_LIGHT = 1e12
 #: centre (normalised units) is put at exactly this distance along its direction
 #: (:meth:`explorer.core.scene.Viewer.framed`), on both tiers. V then varies across the mesh by
 #: less than 2e-12 from the true directions. Without it an eye at 1e8 seen from a mesh of size
-#: 1e-300 was at 1e308 in the frame: inf in float32 (wrong highlights, 0.9 off the numpy tier)
-#: and inf - P in float64 (NaN colours).
+#: 1e-300 was at 1e308 in the frame: inf in float32 (wrong highlights, 0.9 off the numpy tier),
+#: and in float64 eye - P of infinite length, V taken as 0 (0.5 off the far viewer it is).
 FAR_VIEWER = FAR_LIGHT
 
 #: The smallest specular exponent the kernels receive for a positive shininess: twice the

@@ -509,9 +509,7 @@ class Shader:
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
             P, N = self._P, self._N
             params64, flags, view64 = self._params_for(np.float64)
-            m = self._scene.material
-            n64 = kernel_shininess(m.shininess, np.float64)
-            surface64 = K.Surface(material_vector(m, np.float64), self._aconst, n64)
+            surface64 = kernel_surface(self._scene.material, self._aconst, np.float64)
             frame = (self._centre, 1.0 / self._scale)
             fix = (*frame, K.Lights(params64, flags, view64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
@@ -603,6 +601,13 @@ def kernel_shininess(shininess: float, dtype):
     if shininess <= 0.0:
         return t(shininess)
     return max(t(shininess), t(tol.MIN_KERNEL_SHININESS[np.dtype(dtype).name]))
+
+
+def kernel_surface(material: Material, aconst, dtype) -> K.Surface:
+    """The kernels' :class:`~explorer.shading.kernels.Surface` of ``material`` in ``dtype``
+    (the float64 redo of a float32 pass), with the scene's constant ambient ``aconst``."""
+    shininess = kernel_shininess(material.shininess, dtype)
+    return K.Surface(material_vector(material, dtype), aconst, shininess)
 
 
 def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.ndarray:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.scenes import vertices
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
 from explorer.core import tolerances as tol
@@ -240,10 +240,14 @@ def hard_cases(draw):
     return scene, P, N
 
 
+@seed(37)
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=hard_cases(), precision=st.sampled_from(PRECISIONS))
 def test_the_tiers_agree_on_hard_input(case, precision):
-    """Seeded (the suite's hypothesis database and derandomised profile decide the examples):
-    whatever the input, the two tiers give finite colours within the documented tolerance."""
+    """Seeded and bounded (60 examples; ``HYPOTHESIS_PROFILE=thorough`` does not change them:
+    the settings here are the test's own): whatever the input, the two tiers give finite
+    colours within the documented tolerance. Before the fixes it found the tiers 228 levels
+    apart (an eye far from a tiny mesh, float32) and 251-255 (a light on a vertex, kl 1e30 or
+    1e300)."""
     scene, P, N = case
     assert_one_engine(scene, P, N, precision)
