@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import socket
 import statistics
 import subprocess
@@ -94,17 +95,22 @@ def start_server(port: int, log) -> subprocess.Popen:
     )  # fmt: skip
 
 
-def wait_url(url: str, timeout: float = 120.0) -> None:
+def wait_url(port: int, log: Path, timeout: float = 120.0) -> str:
+    """The page's address the server on ``port`` printed into ``log`` (with its token), once
+    it answers."""
+    printed = re.compile(rf"http://127\.0\.0\.1:{port}/\?secret=[A-Za-z0-9_-]+")
     end = time.monotonic() + timeout
     while True:
+        found = printed.search(log.read_text(errors="replace"))
         try:
-            with urllib.request.urlopen(url, timeout=2) as r:
-                if r.status == 200:
-                    return
+            if found:
+                with urllib.request.urlopen(found.group(0), timeout=2) as r:
+                    if r.status == 200:
+                        return found.group(0)
         except OSError:
             pass
         if time.monotonic() > end:
-            raise RuntimeError(f"{url} did not answer within {timeout} s")
+            raise RuntimeError(f"port {port} did not answer within {timeout} s")
         time.sleep(0.02)
 
 
@@ -124,12 +130,12 @@ def ready_times(driver, starts: int) -> dict:
     url_s, picture_s = [], []
     for _ in range(starts):
         port = free_port()
-        url = f"http://127.0.0.1:{port}/"
-        with open(os.devnull, "w") as log:
+        path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
+        with open(path, "w") as log:
             t0 = time.perf_counter()
             proc = start_server(port, log)
             try:
-                wait_url(url)
+                url = wait_url(port, path)
                 url_s.append(time.perf_counter() - t0)
                 driver.get(url)
                 wait_picture(driver)
@@ -137,6 +143,7 @@ def ready_times(driver, starts: int) -> dict:
             finally:
                 proc.terminate()
                 proc.wait(10)
+        path.unlink()
         driver.get("about:blank")
     return {"url": statistics.median(url_s), "picture": statistics.median(picture_s)}
 
@@ -187,15 +194,15 @@ def main(argv=None) -> int:
     try:
         ready = ready_times(driver, args.starts)
         port = free_port()
-        with open(os.devnull, "w") as log:
+        path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
+        with open(path, "w") as log:
             proc = start_server(port, log)
             try:
-                url = f"http://127.0.0.1:{port}/"
-                wait_url(url)
-                web = latency(driver, url, args.repeat)
+                web = latency(driver, wait_url(port, path), args.repeat)
             finally:
                 proc.terminate()
                 proc.wait(10)
+        path.unlink()
         version = driver.capabilities.get("browserVersion", "?")
     finally:
         driver.quit()

@@ -11,9 +11,10 @@ from explorer.app import model as M
 
 
 class HandleDragger:
-    """The handles of ``window`` (its ``controller``, ``plotter``, ``view``, ``begin_drag``,
-    ``end_drag`` and ``_guard``), or of another pane of it (``plotter`` and ``view``: the
-    compare view's side B, which shows the same lights): :meth:`_grab_handle`,
+    """The handles of ``window`` (an :class:`explorer.app.viewport.PlotterView`: its
+    ``controller``, ``plotter``, ``view``, ``begin_drag``, ``end_drag`` and ``guard``), or of
+    another pane of it (``plotter`` and ``view``: the compare view's side B, which shows the
+    same lights): :meth:`_grab_handle`,
     :meth:`_drag_handle` and :meth:`_release_handle` are the handles' callbacks
     (:meth:`explorer.app.view.SceneView.add_handles`)."""
 
@@ -26,7 +27,7 @@ class HandleDragger:
         self._grab = None
         self._holding_handle = False
         self._begin_drag, self._end_drag = w.begin_drag, w.end_drag
-        g = w._guard
+        g = w.guard
         self.view.add_handles(g(self._grab_handle, "light handle"),
                            g(self._drag_handle, "light handle"),
                            g(self._release_handle, "light handle"))  # fmt: skip

@@ -1,14 +1,109 @@
-"""The compare view's side B, for both front ends (no toolkit): side B's
-:class:`~explorer.app.view.SceneView` given side B's state, or "A − B" (the difference of the two
-sides' colours per vertex, largest channel in 1/255 levels, in the difference view's colours),
-and both sides' captions."""
+"""The compare view's side B, for both front ends (no toolkit): :class:`SideB`, side B's pane
+beside side A's :class:`~explorer.app.viewport.PlotterView`, with the same camera (one
+``vtkCamera`` for both), lights and mesh, and side B's material and model, or "A − B" (the
+difference of the two sides' colours per vertex, largest channel in 1/255 levels, in the
+difference view's colours), and both sides' captions. The front end's :class:`Pane` makes
+side B's plotter and shows it (Qt: a second ``QtInteractor`` beside the view; the page: a
+second off-screen plotter in its own remote view)."""
 
 from __future__ import annotations
+
+from typing import Protocol
 
 import numpy as np
 
 from explorer.app import model as M
+from explorer.app.handledrag import HandleDragger
+from explorer.app.view import SceneView, view_camera
 from explorer.shading.display import to_bytes
+
+
+class Pane(Protocol):
+    """What a front end gives :class:`SideB`: ``handles`` whether side B draws the light
+    handles (dragged there too); ``make_plotter()`` side B's plotter (called once, when side B
+    is first shown); ``made(plotter, view)`` once side B's scene is drawn in it;
+    ``show_pane(visible)``; ``follow()`` after each frame of side A while side B is shown (side
+    B's picture follows); ``beside(img)`` side A's picture (h, w, 3) with side B's beside it as
+    the front end shows them."""
+
+    handles: bool
+
+    def make_plotter(self): ...
+
+    def made(self, plotter, view: SceneView) -> None: ...
+
+    def show_pane(self, visible: bool) -> None: ...
+
+    def follow(self) -> None: ...
+
+    def beside(self, img: np.ndarray) -> np.ndarray: ...
+
+
+class SideB:
+    """Side B beside ``main`` (side A's :class:`~explorer.app.viewport.PlotterView`), in the
+    front end's ``pane``: :attr:`plotter` and :attr:`view` (its SceneView) are made when side
+    B is first shown."""
+
+    def __init__(self, main, pane: Pane):
+        self.main = main
+        self.pane = pane
+        self.plotter = None
+        self.view: SceneView | None = None
+
+    @property
+    def shown(self) -> bool:
+        return self.view is not None and self.main.controller.state.compare is not None
+
+    def _make(self, state: M.State) -> None:
+        main = self.main
+        pl = self.plotter = self.pane.make_plotter()
+        # linked cameras: one vtkCamera, A's, which PyVista's ``camera`` names too (after
+        # SetActiveCamera alone it named B's own unused camera, and B's translucent triangles
+        # were sorted for that one)
+        pl.renderer.camera = main.plotter.renderer.camera
+        pl.camera_set = True
+        a = main.view
+        self.view = SceneView(pl, a.mesh, M.side_b(state), lod_vertices=a.lod_vertices,
+                              lod_target=a.lod_target)  # fmt: skip
+        if self.pane.handles:  # the lights are shared: B's handles move them too
+            self.handles = HandleDragger(main, pl, self.view)
+        pl.renderer.AddObserver("StartEvent", main.guard(self._before_frame, "compare"))
+        self.pane.made(pl, self.view)
+
+    def _before_frame(self, *_) -> None:
+        """Before a frame of side B: its triangles sorted and its inset laid out for the shared
+        camera, whose clipping range is set around what B draws (A's frame set it around
+        what A draws: no mesh while A shows the heat map)."""
+        s = self.main.controller.state
+        self.view.before_frame(view_camera(self.plotter.camera, s.centre, s.radius))
+        self.plotter.renderer.ResetCameraClippingRange()
+
+    def show(self, old: M.State | None, new: M.State) -> None:
+        """Side B made, shown, hidden, and given side B's state (or A − B)."""
+        if new.compare is None:
+            if self.view is not None:
+                self.pane.show_pane(False)
+            self.main.view.set_caption("")
+            return
+        if self.view is None:
+            self._make(new)
+        show_side_b(self.main.view, self.view, old, new)
+        self.pane.show_pane(True)
+
+    def after_frame(self) -> None:
+        """After a frame of side A: side B's picture follows (the same camera)."""
+        if self.shown:
+            self.pane.follow()
+
+    def beside(self, img: np.ndarray) -> np.ndarray:
+        """``img`` (h, w, 3), side A's pixels, with side B's beside it while side B is shown."""
+        return self.pane.beside(img) if self.shown else img
+
+    def probe(self) -> dict:
+        """Side B's probe vertex and its pixel (origin top-left), its picture's size."""
+        i = self.view.probe_vertex()
+        return {"vertex": i, "px": self.view.world_to_window(self.view.mesh.positions[i]),
+                "size": list(self.plotter.window_size)}  # fmt: skip
 
 
 def show_side_b(view_a, view_b, old: M.State | None, new: M.State) -> None:

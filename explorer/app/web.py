@@ -3,13 +3,16 @@
 flow (open, save, export, difference, undo) and differ only in their widgets.
 
 The 3D view is rendered on the server (an off-screen PyVista plotter shown by trame's
-``VtkRemoteView``, drawn by :class:`~explorer.app.view.SceneView`): the page receives pictures,
+``VtkRemoteView``, drawn by the desktop's view port, :class:`~explorer.app.viewport.PlotterView`,
+whose pictures :class:`WebExplorer` pushes to the page): the page receives pictures,
 so the engine's colours, the lobe inset, the light handles and the difference heat map are the
 desktop's pixels. Dragging in the view turns the server's camera, and the camera is the viewer:
 before each frame it goes into the state (:meth:`Controller.camera_moved`). The panel is
 vuetify widgets (:mod:`explorer.app.webpanel`), each named (``aria-label``) like the scene
 file's key it sets.
 
+Only the address the server prints (with its token) opens the page, a websocket only from the
+page's own origin, and a page sets only its controls' keys: :mod:`explorer.app.webguard`.
 One explorer per server process: every tab shows and edits the same state. Nothing from the
 page names a server path (:mod:`explorer.app.webfiles`): uploads are written under fixed names
 into a private temporary folder and read by the same readers (and their size caps) as files on
@@ -29,22 +32,21 @@ import threading
 import time
 from collections.abc import Sequence
 
-import numpy as np
-
 from explorer.app import model as M
-from explorer.app import webpage, webpanel
+from explorer.app import webguard, webpage, webpanel, webwire
 from explorer.app.controller import Controller, Ports
-from explorer.app.difference import PENDING, DifferenceWorker, HeatMap
-from explorer.app.handledrag import HandleDragger
+from explorer.app.difference import DifferenceWorker
 from explorer.app.session import session_mapping
+from explorer.app.sides import SideB
 from explorer.app.start import (
     DEFAULT_MESH,
     DEFAULT_PRESET,
+    MESH_CHOICES,
     default_viewer,
     first_state,
     load_mesh_choice,
 )
-from explorer.app.view import SceneView, view_camera
+from explorer.app.viewport import PlotterView
 from explorer.app.webcompare import WebCompare
 from explorer.app.webfiles import WebFiles
 from explorer.core.errors import ExplorerError, ExplorerTypeError
@@ -52,7 +54,6 @@ from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, load_scene
 from explorer.geometry.meshes import Mesh
-from explorer.render.images import encode_png
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading import tiers
 
@@ -65,7 +66,8 @@ DEFAULT_HOST = "127.0.0.1"
 #: the warning printed when the server listens beyond this machine
 OPEN_HOST_WARNING = (
     "warning: listening on {host}: anyone who can reach port {port} can use this explorer "
-    "(and save presets into your preset folder)"
+    "(and save presets into your preset folder) once they have the address printed below: "
+    "its token is the only key, share it with care"
 )
 #: VTK encodes each picture in a thread of its own, and trame sends a picture still being
 #: encoded half a second later: instead, every FOLLOW_S seconds the server asks for it again
@@ -85,8 +87,8 @@ PROXY_OFF = ("0", "off", "false", "no")
 
 
 class WebExplorer(WebFiles):
-    """One explorer served by trame: the controller's ports (dialogs, messages, view,
-    choices, progress) for a page.
+    """One explorer served by trame: the controller's ports (dialogs, messages, choices,
+    progress; the view is :attr:`viewport`, whose pictures this sends) for a page.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names)
     materials_dirs : extra preset directories; preset_dir : where presets are saved (default:
@@ -104,7 +106,6 @@ class WebExplorer(WebFiles):
 
         from explorer.render.vtk import plotter  # VTK only once a server is made
 
-        self.frames = 0
         self.pushing = False  # the server is setting the page's values (no user change)
         self.messages: list[dict] = []
         self.answers: dict = {}  # the page's answers to the controller's next questions
@@ -113,55 +114,39 @@ class WebExplorer(WebFiles):
         self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
         self._job = None  # the long job running (run_steps) and its cancel
         self.server = get_server(name, client_type="vue3")
+        self.token = webguard.new_token()  # the page's key: in the URL the user is given only
+        self.hosts = webguard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
+        webguard.install(self.server, self.token, lambda: self.hosts)
+        self.mesh_values = webguard.MeshValues(MESH_CHOICES)  # the chooser names no path
         self.plotter = plotter(size, BACKGROUND if background is None else background)
-        self.view = None
-        self.heat = HeatMap(self.plotter.renderer)
+        self.viewport = PlotterView(self.plotter, self)  # the page's pictures: see send()
+        self.heat = self.viewport.heat
         self.worker = DifferenceWorker(self._deliver)
         self.controller = Controller(
-            state, mesh, Ports.of(self, worker=self.worker), materials_dirs=materials_dirs,
-            preset_dir=preset_dir, output_dir=self._uploads.name, last_session=last_session,
+            state, mesh, Ports.of(self, worker=self.worker, view=self.viewport),
+            materials_dirs=materials_dirs, preset_dir=preset_dir, output_dir=self._uploads.name,
+            last_session=last_session,
         )  # fmt: skip
         self.store = self.controller.store
         state = self.store.state
-        self.view = SceneView(self.plotter, mesh, state)
         self.compare = WebCompare(self, size)
-        self._mesh_name = state.mesh
-        self.view.apply_camera(state.camera)
-        self.handles = HandleDragger(self)
-        self.plotter.renderer.AddObserver("StartEvent", self.guard(self._before_frame, "frame"))
-        self.plotter.render_window.AddObserver("EndEvent", self._after_frame)
+        self.view = self.viewport.attach(
+            self.controller, mesh, side_b=SideB(self.viewport, self.compare)
+        )
         webpanel.connect(self)
         webpage.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
         self.server.state.engine = tiers.status() or ""
         self.server.controller.on_server_ready.add(self._ready)
+        self.server.controller.on_server_bind.add(webwire.bind)  # the wire's limits (issue 37)
         self.controller.start()
         self.controller.say_mesh_warnings(mesh.name, start_warnings, logged=True)
-        self._push(state)
-
-    # -- drags and errors (the handles' dragger calls these too) ----------------------------------
-    def begin_drag(self, *_) -> None:
-        self.view.begin_drag()
-        self.controller.begin_drag()
-
-    def end_drag(self, *_) -> None:
-        self.view.end_drag()
-        self.controller.end_drag()
+        self.viewport.show_start(state)
 
     def guard(self, fn, where: str):
         """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
-        logged, never lost."""
-
-        def call(*args, **kw):
-            try:
-                return fn(*args, **kw)
-            except Exception as exc:  # noqa: BLE001 - every error is shown, none is lost
-                self.controller.report(exc, where)
-                return None
-
-        return call
-
-    _guard = guard  # the name the handles' dragger calls
+        logged, never lost (:meth:`PlotterView.guard`)."""
+        return self.viewport.guard(fn, where)
 
     def _ready(self, **_) -> None:
         """The server runs: its loop is kept (the difference worker delivers into it), and
@@ -252,7 +237,8 @@ class WebExplorer(WebFiles):
         self.server.state.presets = [webpanel.preset_item(p) for p in presets]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
-        self.server.state.meshes = [{"title": t, "value": n} for n, t in labels.items()]
+        self.server.state.meshes = [{"title": t, "value": self.mesh_values.page(n)}
+                                    for n, t in labels.items()]  # fmt: skip
 
     def show_recent(self, paths: list[str]) -> None:
         """The page keeps no recent files (it opens uploads only)."""
@@ -262,25 +248,8 @@ class WebExplorer(WebFiles):
             s.can_undo, s.can_redo = undo is not None, redo is not None
             s.undo_label, s.redo_label = undo or "", redo or ""
 
-    # -- View ------------------------------------------------------------------------------------
-    def show(self, old: M.State | None, new: M.State) -> None:
-        """The view and the panel show ``new`` (``old`` None: everything afresh)."""
-        if self.view is None:
-            return
-        if new.mesh != self._mesh_name:
-            self.view.set_mesh(self.controller.meshes[new.mesh], new)
-            self._mesh_name = new.mesh
-        else:
-            self.view.show_state(new)
-        if new.camera is not None and not self.controller.in_frame:
-            live = view_camera(self.plotter.camera, new.centre, new.radius)
-            if live != new.camera:
-                self.view.apply_camera(new.camera)
-        self.compare.show(old, new)
-        if old is None or not self.controller.in_frame:
-            self._push(new)
-
-    def redraw(self) -> None:
+    # -- the view port's pictures (explorer.app.viewport.Pictures) --------------------------------
+    def send(self) -> None:
         """Send a new picture to every page (side B's follows side A's frame). The compiled
         kernels are looked for too (:func:`explorer.shading.tiers.preload`: the numpy tier
         serves until they are loaded), and the page says which engine serves."""
@@ -289,6 +258,15 @@ class WebExplorer(WebFiles):
         if engine != self.server.state.engine:
             self.server.state.engine = engine
         self._send(self.server.controller.view_update, self.plotter.render_window)
+
+    def show_controls(self, state: M.State) -> None:
+        self._push(state)
+
+    def show_legend(self, legend: str, advice: str) -> None:
+        self.server.state.legend = legend
+
+    def after_frame(self) -> None:
+        """Nothing of the page's own after a frame (side B's picture follows: WebCompare)."""
 
     def _send(self, update, window) -> None:
         """``update()`` (a remote view's push) and then :meth:`_follow_picture` for
@@ -312,36 +290,6 @@ class WebExplorer(WebFiles):
         self.loop.call_later(FOLLOW_S, self.guard(self._follow_picture, "view"), vid, sent,
                              tries - 1)  # fmt: skip
 
-    def size(self) -> tuple[int, int]:
-        w, h = self.plotter.window_size
-        return int(w), int(h)
-
-    def aspect(self) -> float:
-        w, h = self.size()
-        return w / max(h, 1)
-
-    def background(self) -> tuple[float, float, float]:
-        return tuple(self.plotter.renderer.GetBackground())
-
-    def colors(self) -> np.ndarray:
-        return self.view.drawings[0].colors()
-
-    def dragging(self) -> bool:
-        return self.view is not None and self.view.dragging > 0
-
-    def show_difference(self, result, *, on: bool) -> None:
-        if result is not None and result is not self.heat.result:
-            self.heat.set(result)
-        current = on and result is not None
-        self.heat.show(current)
-        if self.view is not None:
-            self.view.show_mesh(not current)
-        legend = "" if not on else (self.heat.legend() if current else PENDING)
-        self.server.state.legend = legend
-
-    def png(self) -> bytes:
-        return encode_png(self.plotter.screenshot(return_img=True)[:, :, :3])
-
     # -- the worker's results ------------------------------------------------------------------
     def _deliver(self, result) -> None:
         """From the difference worker's thread: handed to the server's loop."""
@@ -357,31 +305,17 @@ class WebExplorer(WebFiles):
         self.pushing = True
         try:
             with self.server.state as s:
-                s.update(webpanel.values(state))
+                s.update({**webpanel.values(state), "mesh": self.mesh_values.page(state.mesh)})
         finally:
             self.pushing = False
-
-    # -- frames ----------------------------------------------------------------------------------
-    def _before_frame(self, *_) -> None:
-        """The camera is the viewer: it goes into the state (no undo step) before each frame;
-        translucent triangles are sorted, the inset and the handle ring laid out."""
-        self.view.frame_camera(self.store.state, self.controller.camera_moved)
-
-    def _after_frame(self, *_) -> None:
-        """A frame of side A: counted; side B (the same camera) is sent after it."""
-        self.frames += 1
-        if self.compare.shown and self.loop is not None:
-            b = self.compare.plotter.render_window
-            self.loop.call_soon(self.guard(self._send, "B"), self.server.controller.view_b_update,
-                                b)  # fmt: skip
 
     def report_state(self) -> dict:
         """What a test may read (plain JSON values): the frame count, the view's size, the
         probe vertex and its pixel in the view (origin top-left), the session."""
         probe = self.view.probe_vertex()
         return {
-            "frame": self.frames,
-            "size": list(self.size()),
+            "frame": self.viewport.frames,
+            "size": list(self.viewport.size()),
             "probe": {"vertex": probe,
                       "px": self.view.world_to_window(self.view.mesh.positions[probe])},
             "handles_px": [self.view.world_to_window(M.handle_point(self.store.state, i))
@@ -393,7 +327,7 @@ class WebExplorer(WebFiles):
             "errors": list(self.controller.errors),
             "n_vertices": self.view.mesh.n_vertices,
             "difference": self.heat.state(),
-            "compare": self.compare.probe() if self.compare.shown else None,
+            "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 
@@ -436,20 +370,39 @@ def _stop(signum, frame):
 
 
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
-    """Serve ``app`` until the process ends (prints ``App running at:`` and the URL). When the
-    server stops (Ctrl-C, SIGTERM) the session is kept as the desktop keeps it when its window
-    closes (:meth:`Controller.keep_last_session`; ``--last`` reopens it)."""
+    """Serve ``app`` until the process ends (prints ``App running at:`` and the URL with the
+    page's token, the only place the token is written; ``open_browser``: opens it). A request
+    whose Host is not one of ``host``'s names (:func:`~explorer.app.webguard.listening_names`)
+    is refused. When the server stops (Ctrl-C, SIGTERM) the session is kept as the desktop
+    keeps it when its window closes (:meth:`Controller.keep_last_session`; ``--last`` reopens
+    it)."""
     import signal
 
     own_arguments()
     signal.signal(signal.SIGTERM, _stop)
+    app.hosts = webguard.listening_names(host)
+
+    def ready(**_):
+        url = webguard.page_url(served_url(host, app.server.port), app.token)
+        print(f"\nApp running at:\n - Local:   {url}\n", flush=True)
+        if open_browser:
+            import webbrowser
+
+            webbrowser.open(url)
+
+    app.server.controller.on_server_ready.add(ready)
     try:
-        app.server.start(port=port, host=host, open_browser=open_browser, timeout=0,
-                         show_connection_info=True)  # fmt: skip
+        app.server.start(port=port, host=host, open_browser=False, timeout=0,
+                         show_connection_info=False)  # fmt: skip
     except KeyboardInterrupt:
         pass
     finally:
         app.controller.keep_last_session()
+
+
+def served_url(host: str, port: int) -> str:
+    """The page's address on a server listening on ``host`` (an IPv6 address in brackets)."""
+    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
 
 
 @dataclasses.dataclass
@@ -545,14 +498,13 @@ def _base_url(base: str, where: str) -> str:
     return base if base.endswith("/") else base + "/"
 
 
-def page_url(port: int, prefix: str | None) -> str:
+def page_url(port: int, prefix: str | None, token: str = "") -> str:
     """The address of the page served on ``port``: direct (``http://127.0.0.1:PORT/``) or,
     under Jupyter base URL ``prefix``, jupyter-server-proxy's ``<prefix>proxy/<port>/`` (the
     page's assets are relative and its websocket is ``<page's folder>/ws``: both go through
-    the proxy)."""
-    if prefix is None:
-        return f"http://{DEFAULT_HOST}:{port}/"
-    return f"{prefix}proxy/{int(port)}/"
+    the proxy); with the page's ``token`` when given (``?secret=TOKEN``)."""
+    base = f"http://{DEFAULT_HOST}:{port}/" if prefix is None else f"{prefix}proxy/{int(port)}/"
+    return webguard.page_url(base, token) if token else base
 
 
 def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
@@ -579,6 +531,8 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
             app = WebExplorer(state, m, materials_dirs=materials_dirs,
                               name=f"phong-explorer-{id(box)}")  # fmt: skip
             box["app"] = app
+            # behind jupyter-server-proxy the Host is the Jupyter server's (checked there)
+            app.hosts = None if prefix is not None else app.hosts
             own_arguments()
             app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task", thread=True,
                              open_browser=False, timeout=0, show_connection_info=False,
@@ -601,4 +555,4 @@ def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT
         raise ExplorerError("the explorer's web server did not start within 120 s")
     if "error" in box:
         raise box["error"]
-    return Shown(box["app"], page_url(box["port"], prefix), height)
+    return Shown(box["app"], page_url(box["port"], prefix, box["app"].token), height)

@@ -59,20 +59,40 @@ def upload_name(name: str) -> str:
     return base or "upload"
 
 
-def upload_bytes(upload) -> tuple[str, bytes]:
-    """``(name, content)`` of a trame file upload (a dict with ``name`` and ``content``, the
-    content whole or in chunks)."""
+#: what an upload's content may be: bytes (the page's file), or a list of them (its chunks)
+BYTES = (bytes, bytearray, memoryview)
+
+
+def upload_name_of(upload) -> str:
+    """The page's own name of a trame file upload (a dict with ``name`` and ``content``)."""
     if not isinstance(upload, dict):
         raise ExplorerError("upload: not a file")
+    name = upload.get("name") or "upload"
+    if not isinstance(name, str):
+        raise ExplorerError(f"upload: its name must be text, got {type(name).__name__}")
+    return name
+
+
+def upload_bytes(upload, limit: int, what: str) -> tuple[str, bytes]:
+    """``(name, content)`` of a trame file upload (a dict with ``name`` and ``content``, the
+    content bytes, whole or a list of chunks), its size checked against ``limit`` (bytes;
+    ``what`` names the file in the message) before anything is joined or copied. Content
+    that is not bytes is refused (``bytes(n)`` of a number would make n zero bytes)."""
+    name = upload_name_of(upload)
     data = upload.get("content") or b""
-    if isinstance(data, list):
-        data = b"".join(bytes(c) for c in data)
-    return str(upload.get("name") or "upload"), bytes(data)
+    parts = data if isinstance(data, list) else [data]
+    bad = next((p for p in parts if not isinstance(p, BYTES)), None)
+    if bad is not None:
+        raise ExplorerError(f"{what} '{upload_name(name)}': the content must be bytes, got "
+                            f"{type(bad).__name__}")  # fmt: skip
+    check_size(name, sum(memoryview(p).nbytes for p in parts), limit, what)
+    return name, b"".join(parts)
 
 
-def check_size(name: str, data: bytes, limit: int, what: str) -> None:
-    if len(data) > limit:
-        raise ExplorerError(f"{what} '{upload_name(name)}' is too large: {len(data)} bytes, the "
+def check_size(name: str, size: int, limit: int, what: str) -> None:
+    """``size`` (bytes) within ``limit``, else one line naming the file and the limit."""
+    if size > limit:
+        raise ExplorerError(f"{what} '{upload_name(name)}' is too large: {size} bytes, the "
                             f"limit is {limit} bytes ({limit >> 20} MiB)")  # fmt: skip
 
 
@@ -149,8 +169,7 @@ class WebFiles:
     def open_uploaded_session(self, upload) -> None:
         """A session file chosen in the page: capped, kept under a fixed name, its mesh checked
         to be a built-in one, then opened by the controller."""
-        name, data = upload_bytes(upload)
-        check_size(name, data, MAX_BYTES, "session")
+        name, data = upload_bytes(upload, MAX_BYTES, "session")
         path = self._fresh_folder("session") / "session.yaml"
         path.write_bytes(data)
         doc = load_yaml(path, what="session")
@@ -162,18 +181,23 @@ class WebFiles:
             )
         self.controller.open_session(path)
 
+    @staticmethod
+    def _upload_limit(name: str) -> tuple[int, str]:
+        """The cap of an upload named ``name`` in a mesh's upload, and what it is called."""
+        if name.lower().endswith(MESH_SUFFIXES):
+            return tol.MAX_MESH_FILE_BYTES, "mesh file"
+        return tol.MAX_MTL_FILE_BYTES, "material library"
+
     def open_uploaded_mesh(self, uploads) -> None:
         """A mesh file (and, for an OBJ, the .mtl libraries it names) chosen in the page."""
-        files = [upload_bytes(u) for u in (uploads if isinstance(uploads, list) else [uploads])]
+        files = [upload_bytes(u, *self._upload_limit(upload_name_of(u)))
+                 for u in (uploads if isinstance(uploads, list) else [uploads])]  # fmt: skip
         meshes = [(n, d) for n, d in files if n.lower().endswith(MESH_SUFFIXES)]
         if len(meshes) != 1:
             raise ExplorerError(f"upload one mesh file ({', '.join(MESH_SUFFIXES)}) with its "
                                 f".mtl files, got {len(meshes)} mesh files")  # fmt: skip
         folder = self._fresh_folder("mesh")
         for name, data in files:
-            is_mesh = name.lower().endswith(MESH_SUFFIXES)
-            limit = tol.MAX_MESH_FILE_BYTES if is_mesh else tol.MAX_MTL_FILE_BYTES
-            check_size(name, data, limit, "mesh file" if is_mesh else "material library")
             (folder / upload_name(name)).write_bytes(data)
         path = folder / upload_name(meshes[0][0])
         if path.suffix.lower() == ".obj":
@@ -196,10 +220,10 @@ class WebFiles:
         uploads = upload if isinstance(upload, list) else [upload]
         if len(uploads) != 1:
             raise ExplorerError(f"import materials: upload one .mtl file, got {len(uploads)}")
-        name, data = upload_bytes(uploads[0])
+        name = upload_name_of(uploads[0])
         if not name.lower().endswith(".mtl"):
             raise ExplorerError(f"import materials: '{upload_name(name)}' is not an .mtl file")
-        check_size(name, data, tol.MAX_MTL_FILE_BYTES, "material library")
+        name, data = upload_bytes(uploads[0], tol.MAX_MTL_FILE_BYTES, "material library")
         path = self._fresh_folder("mtl") / upload_name(name)
         path.write_bytes(data)
         self.answers = {"yes": bool(self.server.state.preset_replace)}

@@ -27,6 +27,9 @@ from explorer.core.errors import ExplorerError
 
 #: the number rows (a slider and a field each)
 NUMBERS = tuple(r for r in panelmodel.ROWS if r.kind == "number")
+#: what the page is told when its ``mesh`` is not one of the chooser's (the same words for a
+#: missing file, an existing one or anything else: nothing is loaded, no path is named)
+MESH_REFUSED = "mesh: choose one of the listed meshes, or upload a mesh file"
 
 
 def number_values(state: M.State) -> dict:
@@ -110,6 +113,30 @@ def values(state: M.State) -> dict:
     return out
 
 
+def _kind(value) -> type:
+    """The kind of a state value the page sends back: bool, int, float (an int is one too),
+    text, or another type."""
+    if isinstance(value, bool):
+        return bool
+    return float if isinstance(value, int | float) else type(value)
+
+
+def page_value(name: str, read, value, like=None):
+    """``read(value)``: a value the page sent for state key ``name``, read by its handler. A
+    value of another kind than ``like`` (the server's own value of the key, when it has one)
+    or that ``read`` cannot take (text where a number goes, NaN, a list: no page of ours
+    sends one) is one line naming the key, not a traceback (issue 37)."""
+    shown = repr(value)
+    shown = shown if len(shown) <= 40 else shown[:37] + "..."
+    problem = ExplorerError(f"{name}: the page sent {shown}, not a value of {name}")
+    if like is not None and _kind(value) is not _kind(like):
+        raise problem
+    try:
+        return read(value)
+    except (TypeError, ValueError, ArithmeticError):
+        raise problem from None
+
+
 def _typed(app, parse, send) -> None:
     """A value typed into a field: parsed (``parse()``) and sent (``send(value)``) as one undo
     step; a refused value is said, and the field shows the state's again."""
@@ -131,9 +158,12 @@ def _numbers(app) -> None:
             step = kw.get(f"{r.key}_step")
             s = app.store.state
             shown = values(s)[f"{r.key}_step"]
-            if app.pushing or step is None or shown is None or int(step) == shown:
+            if app.pushing or step is None or shown is None:
                 return  # the server's own value
-            v = round(from_step(r.control, int(step), *r.slider_range(s)), r.control.decimals)
+            step = page_value(f"{r.key}_step", int, step)
+            if step == shown:
+                return
+            v = round(from_step(r.control, step, *r.slider_range(s)), r.control.decimals)
             c.set_value(r.key, v)
 
         return app.guard(changed, r.key)
@@ -218,7 +248,10 @@ def _choices(app) -> None:
 
         def changed(**kw):
             v = kw.get(name)
-            if not app.pushing and v is not None and check(v, app.store.state):
+            if app.pushing or v is None:
+                return
+            s = app.store.state
+            if page_value(name, lambda x: check(x, s), v, like=values(s).get(name)):
                 act(v)
 
         state.change(name)(app.guard(changed, name))
@@ -232,7 +265,18 @@ def _choices(app) -> None:
     )
     user("light", lambda v, s: int(v) != s.light,
          lambda v: c.act(M.select_light, int(v), label="select light"))  # fmt: skip
-    user("mesh", lambda v, s: v != s.mesh, c.choose_mesh)
+
+    def choose_mesh(value):
+        """A mesh of the chooser's list only (a built-in, the start's, an upload: values the
+        page was given, :class:`~explorer.app.webguard.MeshValues`): any other value (a path
+        sent over the socket) is refused in the same words, naming nothing."""
+        name = app.mesh_values.name(value)
+        if name in c.mesh_choices:
+            c.choose_mesh(name)
+        else:
+            c.reject_input(MESH_REFUSED)
+
+    user("mesh", lambda v, s: v != app.mesh_values.page(s.mesh), choose_mesh)
     user("difference", lambda v, s: bool(v) != s.difference,
          lambda v: c.act(M.set_difference, bool(v), label="difference"))  # fmt: skip
     _compare(app, user)

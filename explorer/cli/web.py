@@ -2,18 +2,19 @@
 
 ::
 
-    phong-explorer web                               # gold on the teapot, http://127.0.0.1:8080/
+    phong-explorer web                               # gold on the teapot, http://127.0.0.1:8080/?secret=
     phong-explorer web --preset jade --mesh torus --port 9000 --open
     phong-explorer web scene.yaml
     phong-explorer web --session my.yaml             # a saved session, exactly
     phong-explorer web --last                        # the session kept when it last stopped
 
-It prints its URL and serves until Ctrl-C (or SIGTERM); then it keeps the session where the
-desktop's window keeps it on closing, and ``--last`` (either command's) reopens it. It
-listens on 127.0.0.1 (this machine only) unless ``--host`` says otherwise, and then warns that
-anyone who can reach the port can use it. One explorer per server: every tab shows and edits
-the same state. Needs the ``web`` extra (``pip install "phong-explorer[web]"``); without it the
-command says so in one line.
+It prints its URL, with the page's token (only that address opens the page:
+:mod:`explorer.app.webguard`), and serves until Ctrl-C (or SIGTERM); then it keeps the session
+where the desktop's window keeps it on closing, and ``--last`` (either command's) reopens it.
+It listens on 127.0.0.1 (this machine only) unless ``--host`` says otherwise, and then warns
+that anyone who can reach the port and has that address can use it. One explorer per server:
+every tab shows and edits the same state. Needs the ``web`` extra (``pip install
+"phong-explorer[web]"``); without it the command says so in one line.
 """
 
 from __future__ import annotations

@@ -134,7 +134,7 @@ def unit_rows(v: np.ndarray, eps: float, fallback) -> tuple[np.ndarray, np.ndarr
     return unit, length
 
 
-def _span(point, centre, scale: float) -> tuple[Vec3, Vec3, float]:
+def span(point, centre, scale: float) -> tuple[Vec3, Vec3, float]:
     """``v = (point - centre) / scale`` (3,) (components inf where they overflow), its
     direction as a unit vector (3,) and its length (inf when that overflows), with no overflow
     or underflow on the way to the direction: halves first (``point - centre`` could overflow
@@ -479,7 +479,7 @@ class PositionalLight(Light):
         cap = tol.ATTENUATION_CAP
         kc, kl, kq = self.attenuation
         kl, kq = min(kl * scale, cap), min(kq * scale * scale, cap)
-        v, u, distance = _span(self.position, (0.0,) * 3 if centre is None else centre, scale)
+        v, u, distance = span(self.position, (0.0,) * 3 if centre is None else centre, scale)
         if distance <= tol.FAR_LIGHT:
             return v, (min(kc, cap), kl, kq)
         denominator = kc + _times(kl, distance) + _times(_times(kq, distance), distance)
@@ -500,7 +500,8 @@ class PositionalLight(Light):
     def _attenuated(self, P, N, centre, scale):
         position, (kc, kl, kq) = self.framed(centre, scale)
         L, d = unit_rows(np.asarray(position) - P, tol.POINT_EPS, N)
-        att = 1.0 / np.maximum(kc + (kl + kq * d) * d, tol.ATTENUATION_FLOOR)
+        at = np.where(d > tol.POINT_EPS, d, 0.0)  # at the light: distance 0 (POINT_EPS)
+        att = 1.0 / np.maximum(kc + (kl + kq * at) * at, tol.ATTENUATION_FLOOR)
         return L, d * scale, att  # world distances (up to FAR_LIGHT·scale)
 
     def placement(self, centre):

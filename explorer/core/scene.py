@@ -33,9 +33,10 @@ from dataclasses import dataclass, field
 from functools import partial
 from typing import ClassVar
 
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError, ExplorerTypeError
 from explorer.core.hdr import HDR, parse_hdr
-from explorer.core.lights import DirectionalLight, parse_light, unit_vector
+from explorer.core.lights import DirectionalLight, parse_light, span, unit_vector
 from explorer.core.material import MODELS, Material, parse_material
 from explorer.core.presets import find_preset
 from explorer.core.validate import Check, Checked, Checker, check_fields, old_keywords
@@ -92,6 +93,17 @@ class Viewer(Checked):
     @property
     def local(self) -> bool:
         return self.eye is not None
+
+    def framed(self, centre, scale: float) -> tuple[float, float, float]:
+        """The eye in the normalised frame ``centre`` (3,), ``scale``: ``(eye - centre) / scale``,
+        or, farther than :data:`~explorer.core.tolerances.FAR_VIEWER` (the far-viewer policy, both
+        tiers), that distance along its direction (computed without overflow: an eye at 1e8 from
+        a mesh of size 1e-300 would be at 1e308, beyond float32 and inf in ``eye - P``)."""
+        assert self.eye is not None, "an infinite viewer has no eye"
+        v, u, distance = span(self.eye, centre, scale)
+        if distance <= tol.FAR_VIEWER:
+            return v
+        return tuple(tol.FAR_VIEWER * c for c in u)
 
     def to_mapping(self) -> dict:
         if self.eye is not None:

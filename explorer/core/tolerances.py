@@ -25,12 +25,24 @@ NORMAL_RANGE = (1e-6, 1e6)
 
 #: A light (or the eye) closer to a vertex than this (in normalised units) is "at" the vertex:
 #: the direction to it is undefined, so the engine uses the vertex normal (fully facing).
-#: The distance used for attenuation is still the true distance.
+#: Its distance is 0 too, so a light at a vertex is attenuated by 1 / max(kc, floor) on both
+#: tiers. (The true distance there is the rounding of the frame, about 1e-16, and differs
+#: between the numpy tier, which divides by the scale, and the kernels, which multiply by its
+#: reciprocal: times a coefficient of 1e30 that noise made the weight 1e-14 on one tier and 1e6
+#: on the other, a light on a vertex lighting it fully or not at all.)
 POINT_EPS = 1e-12
 
 #: Blinn's halfway vector H = normalize(L + V) is undefined when L = -V. Below this squared
 #: length of L + V the engine takes N·H = 0 (no highlight; with shininess 0, 0**0 = 1 applies).
 HALFWAY_EPS2 = 1e-24
+
+#: A specular lobe base (R·V or N·H) below this is 0 on both tiers: the square root of float64's
+#: smallest normal number. The float64 kernels raise base² to n/2, and a smaller base's square
+#: is subnormal (imprecise) or 0, which left a base of 1e-200 with shininess 0.001 dark where
+#: the numpy tier gave 0.63. Such a base is rounding noise (dot products of unit vectors are
+#: exact to about 1e-16; float32 and OpenGL hold it as 0 anyway), and it matters only for a
+#: shininess far below 1 (for n >= 1, base**n < 1e-154).
+LOBE_BASE_MIN = 1.4916681462400413e-154
 
 #: Floor of the attenuation denominator kc + kl·d + kq·d². All-zero attenuation is rejected when
 #: a scene is loaded; with kc = 0 a light exactly at a vertex would divide by zero, so the
@@ -57,6 +69,22 @@ ATTENUATION_CAP = 1e30
 #: light at 4e154 (float64) or 1e19 (float32) gave d² = inf and NaN colours, and one at 1e200
 #: lit nothing.
 FAR_LIGHT = 1e12
+
+#: Far-viewer policy, as :data:`FAR_LIGHT` for lights: an eye farther than this from the mesh's
+#: centre (normalised units) is put at exactly this distance along its direction
+#: (:meth:`explorer.core.scene.Viewer.framed`), on both tiers. V then varies across the mesh by
+#: less than 2e-12 from the true directions. Without it an eye at 1e8 seen from a mesh of size
+#: 1e-300 was at 1e308 in the frame: inf in float32 (wrong highlights, 0.9 off the numpy tier)
+#: and inf - P in float64 (NaN colours).
+FAR_VIEWER = FAR_LIGHT
+
+#: The smallest specular exponent the kernels receive for a positive shininess: twice the
+#: smallest subnormal number of the pass's precision (float64 1e-323, float32 2.8e-45). The
+#: float64 kernels raise base² to n/2, and half of 5e-324 rounds to 0 (and float32 holds no
+#: 5e-324 at all): 0**0 = 1 then lit a vertex whose lobe base is 0 (R·V <= 0), where OpenGL's
+#: 0**n = 0 for n > 0 leaves it dark. Any exponent this small gives base**n = 1 for base > 0
+#: and 0 for base 0, as the given one does (:func:`explorer.shading.shader.kernel_shininess`).
+MIN_KERNEL_SHININESS = {"float64": 2 * 5e-324, "float32": 2 * 1.401298464324817e-45}
 
 #: Smallest scale of the normalised frame (explorer.geometry.frame.frame_of): float64's smallest
 #: normal number. A mesh whose extent is subnormal (below 2.2e-308) would otherwise get a scale

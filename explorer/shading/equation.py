@@ -40,7 +40,7 @@ import numpy as np
 from explorer.core import tolerances as tol
 from explorer.core.lights import unit_rows
 from explorer.core.scene import Scene
-from explorer.geometry.frame import check_vertices, frame_of, to_frame
+from explorer.geometry.frame import check_vertices, frame_of
 from explorer.shading.effects import EFFECTS, Incident
 
 #: three.js's F_Schlick: g = 2^((A·c + B)·c) for c = V·H, Epic's fit of (1 - c)^5 (bsdfs.glsl.js)
@@ -77,7 +77,7 @@ def equation_terms(
 
     # viewer direction V per vertex (toward the viewer)
     if scene.viewer.local:
-        eye = to_frame(scene.viewer.eye, centre, scale)
+        eye = np.asarray(scene.viewer.framed(centre, scale))  # (the far-viewer policy)
         V, _ = unit_rows(eye - P, tol.POINT_EPS, N)  # eye at the vertex: look along N
     else:
         V = np.broadcast_to(np.asarray(scene.viewer.to_viewer, dtype=np.float64), (n, 3))
@@ -109,7 +109,8 @@ def equation_terms(
             h2 = np.einsum("ij,ij->i", H, H)
             ok = h2 > tol.HALFWAY_EPS2  # H undefined for L = -V: N·H taken as 0
             base = np.where(ok, np.einsum("ij,ij->i", N, H) / np.sqrt(np.where(ok, h2, 1.0)), 0.0)
-        lobe = np.maximum(base, 0.0) ** shininess  # numpy: 0.0 ** 0.0 == 1.0
+        base = np.where(base >= tol.LOBE_BASE_MIN, base, 0.0)  # noise below it: 0
+        lobe = base**shininess  # numpy: 0.0 ** 0.0 == 1.0
         s_i = np.asarray(light.specular)
 
         ambient += w[:, None] * np.asarray(light.ambient)  # a_i (attenuated)

@@ -505,9 +505,10 @@ def _extent_run(Pf, out):
 
 
 @nb.njit(**_LEAF)
-def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
-    """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex."""
-    one, eps2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS]
+def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, trk, k):
+    """V = normalize(eye - P) for a local viewer; V = N where the eye is at the vertex (a lane
+    near the eye is marked, as one near a light: "at the vertex" is decided in float64)."""
+    one, eps2, c_dist2 = unit(k), k[K_POINT_EPS] * k[K_POINT_EPS], k[K_MARGIN_DIST2]
     for i in range(px.shape[0]):
         x = ex - px[i]
         y = ey - py[i]
@@ -519,6 +520,7 @@ def _view(px, py, pz, nx, ny, nz, ex, ey, ez, vx, vy, vz, k):
         vx[i] = a if at else x * inv
         vy[i] = b if at else y * inv
         vz[i] = c if at else z * inv
+        trk[i] = min(trk[i], d2 * c_dist2)
 
 
 @nb.njit(**_LEAF)
@@ -790,6 +792,8 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
     # inline loops take rows LLVM checks for overlap at run time (see _row_checked), so that
     # it interleaves them; the row-path loops read and write too many rows for such checks
     row = _row_checked if inline else _row
+    # float64's smallest normal number, LOBE_BASE_MIN² (compared with base² where it splits)
+    tiny2 = float(np.finfo(np.float64).tiny)
 
     def impl(scr, m, q, y, k, atten, l_dif, code):
         # rows as separate 1-D arrays: lets the compiler vectorise
@@ -828,9 +832,9 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                     inv = one / np.sqrt(max(d2, p_eps2))  # finite even at the light (marked)
                     d = d2 * inv
                     w = one / max(kc + (kl + kq * d) * d, floor)  # 1 / (kc + kl·d + kq·d²)
-                else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = |l|
+                else:  # the policy: at the light, L = N (l = N, |l| taken as 1), d = 0
                     at = d2 < p_eps2
-                    d = np.sqrt(d2)
+                    d = zero if at else np.sqrt(d2)
                     r = one if at else d
                     x = a if at else x
                     yy = b if at else yy
@@ -896,8 +900,10 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
                         margin = min(margin, h2 * c_len2)
                     margin = min(margin, abs(base) * c_dot)
                     base = max(base, zero)
-                    # kept for a lobe store (and the lobe loop below): squared where it splits
-                    B[i] = base * base if split and not square else base
+                    # kept for a lobe store (and the lobe loop below): squared where it splits,
+                    # 0 below float64's smallest normal number (tolerances.LOBE_BASE_MIN)
+                    b2 = base * base if split and not square else base
+                    B[i] = (b2 if b2 >= tiny2 else zero) if split else b2
                     if not split:
                         lob = fpow(base, y)  # base^n
                 if not split:
@@ -1011,7 +1017,7 @@ def _to_light(scr, m, q, k, atten):
             d2 = x * x + y * y + z * z
             at = d2 < eps2
             inv = one / np.sqrt(one if at else d2)
-            d = np.sqrt(d2) if at else d2 * inv
+            d = k[K_ZERO] if at else d2 * inv  # at the light: distance 0 (POINT_EPS)
             a, b, c = nx[i], ny[i], nz[i]
             Lx[i] = a if at else x * inv
             Ly[i] = b if at else y * inv
@@ -1343,7 +1349,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
         used_grey = True
     if two_sided or (do_spec and (not flat or opts[O_VIEW] != 0)):  # V toward the viewer
         if opts[O_LOCAL]:
-            _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, k)
+            _view(px, py, pz, nx, ny, nz, view[0], view[1], view[2], vx, vy, vz, trk, k)
         else:
             _fill(vx, view[0])
             _fill(vy, view[1])

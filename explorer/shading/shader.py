@@ -41,6 +41,7 @@ from collections.abc import Iterable, Mapping
 import numpy as np
 
 from explorer.core import lightrow as R
+from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError, ExplorerTypeError
 from explorer.core.material import MODELS, Material
 from explorer.core.presets import find_preset
@@ -50,7 +51,6 @@ from explorer.geometry.frame import (
     check_finite,
     check_vertices,
     scale_normals,
-    to_frame,
 )
 from explorer.shading import kernels as K
 from explorer.shading import tiers
@@ -384,7 +384,7 @@ class Shader:
             params, flags, _ = self._params_for(T)
             S = self._memory.fresh((self.n, 3), self._T)
             base = self._base if self._base is not None else self._ws
-            K.lobe(base, self._ws, params, flags, T(shininess), self._k, S)
+            K.lobe(base, self._ws, params, flags, kernel_shininess(shininess, T), self._k, S)
             self._S = S
             self._spec_shininess = shininess
             self.stats["lobe"] += 1
@@ -459,7 +459,7 @@ class Shader:
         inputs = (
             K.Lights(params, flags, view),
             opts,
-            K.Surface(mat, aconst, T(scene.material.shininess)),
+            K.Surface(mat, aconst, kernel_shininess(scene.material.shininess, T)),
             self._k,
             K.Sums(A, D, S),
             K.Lobes(base, ws),
@@ -510,7 +510,8 @@ class Shader:
             P, N = self._P, self._N
             params64, flags, view64 = self._params_for(np.float64)
             m = self._scene.material
-            surface64 = K.Surface(material_vector(m, np.float64), self._aconst, m.shininess)
+            n64 = kernel_shininess(m.shininess, np.float64)
+            surface64 = K.Surface(material_vector(m, np.float64), self._aconst, n64)
             frame = (self._centre, 1.0 / self._scale)
             fix = (*frame, K.Lights(params64, flags, view64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
@@ -571,7 +572,7 @@ def light_params(scene: Scene, plan: Plan, centre, scale) -> tuple:
     packs its own: :meth:`explorer.core.lights.Light.kernel_row`, then each effect adds its
     slots and flags), and the view (3,): the eye, or V for an infinite viewer."""
     if scene.viewer.local:
-        view = to_frame(scene.viewer.eye, centre, scale)
+        view = np.asarray(scene.viewer.framed(centre, scale))  # (the far-viewer policy)
     else:
         view = np.asarray(scene.viewer.to_viewer, dtype=np.float64)
     constant_h = scene.model == "blinn" and not scene.viewer.local and not plan.force_all
@@ -591,6 +592,17 @@ def light_params(scene: Scene, plan: Plan, centre, scale) -> tuple:
         flags.append(f)
     params = np.array(rows, dtype=np.float64).reshape(len(rows), R.N_PARAMS)
     return params, np.array(flags, np.int32), view
+
+
+def kernel_shininess(shininess: float, dtype):
+    """The specular exponent the kernels receive in ``dtype`` (float32 or float64): the
+    shininess, but at least :data:`~explorer.core.tolerances.MIN_KERNEL_SHININESS` when it is
+    positive (so that a lobe base of 0 stays 0**n = 0, as on the numpy tier: the float64 kernels
+    halve the exponent, and a float32 subnormal may round to 0); 0 stays 0 (0**0 = 1)."""
+    t = np.dtype(dtype).type
+    if shininess <= 0.0:
+        return t(shininess)
+    return max(t(shininess), t(tol.MIN_KERNEL_SHININESS[np.dtype(dtype).name]))
 
 
 def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.ndarray:

@@ -131,14 +131,20 @@ def mesh():
     return G.get_mesh("icosphere", 2)
 
 
-@pytest.fixture
-def ctl(mesh, tmp_path, monkeypatch):
+def icosphere_controller(mesh, view, tmp_path, monkeypatch, resolution: int) -> Controller:
+    """A controller on ``mesh`` (the icosphere of ``resolution``) in the gui's start, with fake
+    ports but ``view`` (not started); presets saved under ``tmp_path``."""
     monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
     scene, _, preset = start(build_parser().parse_args(["gui", "--mesh", "icosphere"]))
-    state = A.first_state(scene, mesh, name="icosphere", preset=preset, resolution=2)
-    front, view, worker = FakeFront(), FakeView(mesh.n_vertices), FakeWorker()
-    c = Controller(state, mesh, Ports.of(front, worker=worker, view=view), output_dir=tmp_path,
-                   last_session=tmp_path / "last.yaml")  # fmt: skip
+    state = A.first_state(scene, mesh, name="icosphere", preset=preset, resolution=resolution)
+    return Controller(state, mesh, Ports.of(FakeFront(), worker=FakeWorker(), view=view),
+                      output_dir=tmp_path, last_session=tmp_path / "last.yaml")  # fmt: skip
+
+
+@pytest.fixture
+def ctl(mesh, tmp_path, monkeypatch):
+    c = icosphere_controller(mesh, FakeView(mesh.n_vertices), tmp_path, monkeypatch, 2)
+    front, view, worker = c.ports.dialogs, c.ports.view, c.ports.worker
     c.start()
     c.front, c.view, c.worker = front, view, worker
     return c

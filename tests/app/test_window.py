@@ -184,7 +184,7 @@ def test_the_handle_moves_the_light_and_keeps_the_azimuth_at_the_pole(win):
     point = np.asarray(s.centre) + 2.0 * s.radius * np.array([0.0, 1.0, 0.0])  # straight up
     az = s.placement()[0]
     win.view.handle.SetCenter(*point)
-    win.handles._on_handle(point)
+    win.viewport.handles._on_handle(point)
     az2, el, d = win.controller.state.placement()
     assert (
         el == pytest.approx(90.0) and az2 == pytest.approx(az) and d == pytest.approx(2 * s.radius)
@@ -303,11 +303,11 @@ def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot
     count(M.Store, "seal")  # a click step is a whole step: sealed once (not by panel and window)
     jobs = []
     monkeypatch.setattr(win.worker, "submit", jobs.append)
-    frames = win.frames
+    frames = win.viewport.frames
     slider = win.panel.material.sliders["kd"].slider
     slider.setValue(slider.value() - 37)
     assert counts == {"set_scene": 1, "upload": 1, "update_difference": 1, "seal": 1}
-    assert win.frames == frames + 1 and len(jobs) == 1
+    assert win.viewport.frames == frames + 1 and len(jobs) == 1
     assert not win.heat.shown  # the live view until the new map comes
     stale = run_job(old.job)
     win.difference_ready.emit(stale)

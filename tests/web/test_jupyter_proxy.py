@@ -81,15 +81,18 @@ def test_a_bad_base_url_is_refused_naming_where_it_came_from(bad):
 def test_the_page_url_is_direct_or_under_the_proxy():
     assert web.page_url(8123, None) == "http://127.0.0.1:8123/"
     assert web.page_url(8123, "/user/ana/") == "/user/ana/proxy/8123/"
-    shown = web.Shown(app=None, url=web.page_url(8123, "/user/a&b/"), height=500)
-    assert 'src="/user/a&amp;b/proxy/8123/"' in shown._repr_html_()
+    assert web.page_url(8123, None, "T0k-_") == "http://127.0.0.1:8123/?secret=T0k-_"
+    assert web.page_url(8123, "/user/ana/", "T0k") == "/user/ana/proxy/8123/?secret=T0k"
+    shown = web.Shown(app=None, url=web.page_url(8123, "/user/a&b/", "T0k"), height=500)
+    assert 'src="/user/a&amp;b/proxy/8123/?secret=T0k"' in shown._repr_html_()
 
 
 # -- through a real proxy, in a real browser --------------------------------------------------
 class PrefixProxy:
     """An aiohttp reverse proxy in a thread: ``<hub>proxy/<port>/<rest>`` (HTTP and
-    websocket) to ``127.0.0.1:<port>/<rest>``, as jupyter-server-proxy; :attr:`blank`, a page
-    of the proxy's origin (where the test writes the cell's output)."""
+    websocket) to ``127.0.0.1:<port>/<rest>``, as jupyter-server-proxy (which passes the
+    browser's headers on, Host and Origin too); :attr:`blank`, a page of the proxy's origin
+    (where the test writes the cell's output)."""
 
     def __init__(self, hub: str, tmp):
         self.port = free_port()
@@ -128,7 +131,7 @@ class PrefixProxy:
         query = f"?{request.query_string}" if request.query_string else ""
         if request.headers.get("Upgrade", "").lower() == "websocket":
             return await self._socket(request, f"ws://{target}{query}")
-        hop = {"host", "connection", "upgrade", "transfer-encoding", "content-length",
+        hop = {"connection", "upgrade", "transfer-encoding", "content-length",
                "content-encoding", "keep-alive"}  # fmt: skip
         headers = {k: v for k, v in request.headers.items() if k.lower() not in hop}
         async with aiohttp.ClientSession(auto_decompress=True) as s, s.request(
@@ -145,7 +148,11 @@ class PrefixProxy:
 
         page = aw.WebSocketResponse(max_msg_size=0)
         await page.prepare(request)
-        async with aiohttp.ClientSession() as s, s.ws_connect(url, max_msg_size=0) as server:
+        passed = {k: v for k, v in request.headers.items() if k.lower() in ("host", "origin")}
+        async with (
+            aiohttp.ClientSession() as s,
+            s.ws_connect(url, max_msg_size=0, headers=passed) as server,
+        ):
 
             async def pump(src, dst):
                 async for msg in src:
@@ -280,7 +287,9 @@ def test_the_cell_shows_the_explorer_through_a_prefix_proxy(kernel, make_proxy, 
     from test_web import KNOWN_CONSOLE_ERRORS, by_name, kd, picture_src, report, type_value, wait
 
     src = re.search(r'<iframe src="([^"]+)"', kernel).group(1)
-    assert re.fullmatch(r"/user/ana/proxy/\d+/", src), src  # JupyterHub: through the proxy
+    # JupyterHub: through the proxy, with the page's token
+    assert re.fullmatch(r"/user/ana/proxy/\d+/\?secret=[A-Za-z0-9_-]+", src), src
+    src = src.split("?")[0]
     proxy = make_proxy(HUB, tmp_path)
     driver = new_browser(tmp_path)
     try:

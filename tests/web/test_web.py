@@ -364,6 +364,9 @@ def test_it_listens_on_this_machine_only_and_says_so_otherwise(server, tmp_path)
         assert listening_addresses(other.port) == {"127.0.0.2"}
         assert (f"warning: listening on 127.0.0.2: anyone who can reach port {other.port} can "
                 "use this explorer") in other.output()  # fmt: skip
+        # beyond loopback the token is kept, and the warning says it is the only key
+        assert other.url == f"http://127.0.0.2:{other.port}/?secret={other.token}"
+        assert "its token is the only key" in other.output()
     finally:
         other.stop()
 

@@ -5,6 +5,7 @@ names only a built-in mesh, and an OBJ's ``mtllib`` only a library uploaded with
 from __future__ import annotations
 
 import tempfile
+import tracemalloc
 from types import SimpleNamespace
 
 import pytest
@@ -83,6 +84,37 @@ def test_uploads_meet_the_caps_of_files_on_disk(files):
         files.open_uploaded_mesh([{"name": "m.obj", "content": b"v 0 0 0\n"},
                                   {"name": "m.mtl", "content": big}])  # fmt: skip
     assert files.controller.calls == []
+
+
+@pytest.mark.parametrize("content", [[900_000_000], 900_000_000, [b"v 0 0 0\n", 10**9], "v 0 0 0",
+                                     {"a": 1}])  # fmt: skip
+def test_an_uploads_content_must_be_bytes(files, content):
+    """Numbers as content are refused before anything is allocated (``bytes(n)`` of a number
+    made n zero bytes: a 30-byte message took 0.9 GB), and so is text or a mapping."""
+    tracemalloc.start()
+    try:
+        for opener in (files.open_uploaded_mesh, files.open_uploaded_session):
+            with pytest.raises(ExplorerError, match="the content must be bytes, got"):
+                opener({"name": "m.obj", "content": content})
+        with pytest.raises(ExplorerError, match="the content must be bytes, got"):
+            files.import_uploaded_materials({"name": "m.mtl", "content": content})
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1 << 20
+    assert files.controller.calls == []
+
+
+def test_an_uploads_size_is_checked_before_its_chunks_are_joined(files):
+    chunks = [b"#" * (1 << 20)] * (tol.MAX_MTL_FILE_BYTES // (1 << 20) + 1)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ExplorerError, match="material library 'm.mtl' is too large"):
+            files.import_uploaded_materials({"name": "m.mtl", "content": chunks})
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1 << 20
 
 
 OBJ = b"mtllib %s\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"

@@ -4,9 +4,11 @@ beside the control panel (:mod:`explorer.app.qt.panel`), a thin binding of
 
 The window holds no state and no flow of its own: the controls send intents to the controller,
 which changes the store and tells the window (its ports: :class:`ExplorerWindow` implements the
-dialogs, messages, view, choices and progress ports) what to show. The camera is the viewer:
-before each frame the view's camera goes into the state (:meth:`Controller.camera_moved`, no
-undo step). The difference view is computed in a worker thread
+dialogs, messages, choices and progress ports; the view port is the
+:class:`~explorer.app.viewport.PlotterView` both front ends share, over the window's
+``QtInteractor``, drawing through :class:`~explorer.app.qt.viewport.QtPictures`) what to
+show. The camera is the viewer: before each frame the view's camera goes into the state
+(:meth:`Controller.camera_moved`, no undo step). The difference view is computed in a worker thread
 (:class:`~explorer.app.difference.DifferenceWorker`) whose results come back through a Qt
 signal to :meth:`Controller.on_difference`.
 
@@ -15,8 +17,6 @@ Menus, shortcuts and keys are in :mod:`explorer.app.qt.menus`.
 
 from __future__ import annotations
 
-import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -24,19 +24,18 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
-from explorer.app.difference import DifferenceWorker, HeatMap
-from explorer.app.handledrag import HandleDragger
+from explorer.app.difference import DifferenceWorker
 from explorer.app.qt.compare import CompareView
 from explorer.app.qt.lightpanel import Panel
 from explorer.app.qt.menus import Menus
 from explorer.app.qt.messages import MessageBar
 from explorer.app.qt.panel import ValueSlider
 from explorer.app.qt.progress import EngineStatus, run_steps
-from explorer.app.qt.viewport import QtView
-from explorer.app.session import session_mapping
+from explorer.app.qt.viewport import QtPictures
+from explorer.app.sides import SideB
 from explorer.app.start import TITLE, WINDOW_SIZE
-from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView
-from explorer.core.atomic import write_atomic
+from explorer.app.view import LOD_TARGET, LOD_VERTICES
+from explorer.app.viewport import PlotterView
 from explorer.render.offscreen import BACKGROUND
 from explorer.render.vtk import plain_blending
 
@@ -66,16 +65,14 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.setWindowTitle(TITLE)
         self.state_file = Path(state_file) if state_file else None
         self.message = ""
-        self.frames = 0
-        self.frame_ms = float("nan")
-        self._t0: float | None = None
         w, h = (int(v) for v in size)
         self.resize(w, h)
         self._build_views(w, background)
-        self.view_aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)
+        aspect = max(w * (1 - PANEL_FRACTION), 1.0) / max(h - 60, 1.0)  # until it is shown
+        self.viewport = PlotterView(self.plotter, QtPictures(self), fixed_aspect=aspect)
         self._frame_on_show = state.camera is None  # framed again for the view's real shape
         self.worker = DifferenceWorker(self.difference_ready.emit)
-        ports = Ports.of(self, worker=self.worker, view=QtView(self))
+        ports = Ports.of(self, worker=self.worker, view=self.viewport)
         self.controller = c = Controller(state, mesh, ports, materials_dirs=materials_dirs,
                                          preset_dir=preset_dir, output_dir=output_dir,
                                          last_session=last_session)  # fmt: skip
@@ -85,19 +82,17 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.bar = MessageBar(self)
         self.panel.rejected.connect(self._guard(c.reject_input, "typed value"))
         self.engine = EngineStatus(self)
-        self.view = SceneView(self.plotter, mesh, c.state, lod_vertices=lod_vertices,
-                              lod_target=lod_target)  # fmt: skip
-        self.view.apply_camera(c.state.camera)
-        self.handles = HandleDragger(self)
-        self.heat = HeatMap(self.plotter.renderer)
-        self.difference_ready.connect(self._guard(c.on_difference, "difference view"))
         self.compare = CompareView(self)
+        side_b = SideB(self.viewport, self.compare)
+        self.view = self.viewport.attach(c, mesh, side_b=side_b, lod_vertices=lod_vertices,
+                                         lod_target=lod_target)  # fmt: skip
+        self.heat = self.viewport.heat
+        self.difference_ready.connect(self._guard(c.on_difference, "difference view"))
         self._observe()
         self.menus = Menus(self)
         c.start()
         c.say_mesh_warnings(mesh.name, start_warnings, logged=True)  # printed at the start too
-        self.compare.show(None, c.state)
-        c.ports.view.show_panel(c.state)
+        self.viewport.show_start(c.state)
 
     # -- building ------------------------------------------------------------------------------
     def _build_views(self, w: int, background) -> None:
@@ -121,13 +116,10 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.setCentralWidget(self.splitter)
 
     def _observe(self) -> None:
-        pl = self.plotter
-        pl.renderer.AddObserver("StartEvent", self._guard(self._before_frame, "frame"))
-        pl.render_window.AddObserver("EndEvent", self._guard(self._after_frame, "frame"))
-        self.watch_camera(pl)
+        self.watch_camera(self.plotter)
         for s in self.panel.findChildren(ValueSlider):
-            s.pressed.connect(self._guard(self.begin_drag, s.objectName()))
-            s.released.connect(self._guard(self._end_drag_if_dragging, s.objectName()))
+            s.pressed.connect(self._guard(self.viewport.begin_drag, s.objectName()))
+            s.released.connect(self._guard(self.viewport.let_go, s.objectName()))
 
     def watch_camera(self, pl) -> None:
         """``pl``'s camera drags are drags (the level of detail, one undo step); VTK's and
@@ -136,8 +128,9 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         iren = pl.iren.interactor
         style = iren.GetInteractorStyle()
         if style is not None:
-            style.AddObserver("StartInteractionEvent", self._guard(self.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self._guard(self.end_drag, "camera"))
+            vp = self.viewport
+            style.AddObserver("StartInteractionEvent", self._guard(vp.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self._guard(vp.end_drag, "camera"))
         for key in list(getattr(pl, "_key_press_event_callbacks", {})):
             pl.clear_events_for_key(key)
 
@@ -148,17 +141,8 @@ class ExplorerWindow(QtWidgets.QMainWindow):
 
     # -- errors --------------------------------------------------------------------------------
     def _guard(self, fn, where: str):
-        """``fn`` made safe for Qt's and VTK's callbacks: an error is said and logged, never
-        lost and never a traceback in the user's face."""
-
-        def call(*args):
-            try:
-                return fn(*args)
-            except Exception as exc:  # noqa: BLE001 - every error is shown, none is lost
-                self.controller.report(exc, where)
-                return None
-
-        return call
+        """``fn`` made safe for Qt's and VTK's callbacks (:meth:`PlotterView.guard`)."""
+        return self.viewport.guard(fn, where)
 
     # -- ports: dialogs (replaceable by scripts and tests), messages, progress ------------------
     def ask_text(self, title: str, label: str, default: str = "") -> str | None:
@@ -224,43 +208,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
 
     def render(self) -> None:
         """Draw a frame now."""
-        if self._t0 is None:
-            self._t0 = time.perf_counter()
-        self.plotter.render_window.Render()
-
-    # -- frames and drags ----------------------------------------------------------------------
-    def _before_frame(self, *_) -> None:
-        """Renderer StartEvent: the camera is the viewer; translucent triangles sorted."""
-        if self._t0 is None:
-            self._t0 = time.perf_counter()
-        self.view.frame_camera(self.controller.state, self.controller.camera_moved)
-
-    def _after_frame(self, *_) -> None:
-        """Render window EndEvent: count and time the frame, draw side B of the compare view
-        (same camera), then write the state file (after the frame, so a reader never races
-        the pixels)."""
-        self.frames += 1
-        self.compare.after_frame()
-        if self._t0 is not None:
-            self.frame_ms = 1000.0 * (time.perf_counter() - self._t0)
-            self._t0 = None
-        if self.state_file is not None:
-            data = {**session_mapping(self.controller.state), "window": self.report_state()}
-            write_atomic(self.state_file, json.dumps(data).encode(), overwrite=True)
-
-    def begin_drag(self, *_) -> None:
-        self.view.begin_drag()
-        self.controller.begin_drag()
-
-    def end_drag(self, *_) -> None:
-        self.view.end_drag()
-        self.controller.end_drag()
-
-    def _end_drag_if_dragging(self, *_) -> None:
-        if self.view.dragging:
-            self.end_drag()
-        else:
-            self.controller.release()
+        self.viewport.redraw()
 
     # -- reporting ------------------------------------------------------------------------------
     def widget_box(self, widget: QtWidgets.QWidget) -> list[int]:
@@ -290,9 +238,10 @@ class ExplorerWindow(QtWidgets.QMainWindow):
             for w in self.findChildren(QtWidgets.QWidget)
             if w.objectName() and not w.objectName().startswith("qt_") and w.isVisible()
         }
+        frame_ms = self.viewport.frame_ms
         return {
-            "frame": self.frames,
-            "frame_ms": None if not np.isfinite(self.frame_ms) else self.frame_ms,
+            "frame": self.viewport.frames,
+            "frame_ms": None if not np.isfinite(frame_ms) else frame_ms,
             "window_size": [self.width(), self.height()],
             "view_box": self.widget_box(self.plotter),
             "n_vertices": view.mesh.n_vertices, "edited": s.edited,
@@ -312,7 +261,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
             self._frame_on_show = False
             w, h = self.plotter.width(), self.plotter.height()
             if w > 1 and h > 1:
-                self.view_aspect = w / h
+                self.viewport.fixed_aspect = w / h
                 self.controller.frame_start()
 
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802 - Qt's name
