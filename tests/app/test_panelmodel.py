@@ -154,7 +154,7 @@ def test_no_front_end_module_names_a_light_type():
     """Which controls a light has is the light's (its CONTROL_KEYS): the Qt panel and the web
     modules hold no light-type rule."""
     files = [*ROOT.glob("explorer/app/qt/*.py"), *ROOT.glob("explorer/app/web*.py")]
-    pattern = re.compile(r"""["'](directional|point|spot)["']|\.type\s*(==(?!=)|!=(?!=)|in\b)""")
+    pattern = re.compile(r"""["'](directional|point|spot)["']|\.type\s*(==|!=|in)\s*[("']""")
     found = [
         f"{f.name}:{i}"
         for f in files
