@@ -108,34 +108,84 @@ def _material_rows() -> list[Row]:
     def scalar(i):
         return lambda s: s.material.scalars()[i]
 
-    rows = [Row(k, "material", "number", scalar(i), lambda s, v, k=k: (M.set_coefficient, (k, v)))
-            for i, k in enumerate(("ka", "kd", "ks"))]  # fmt: skip
+    rows = [
+        Row(k, "material", "number", scalar(i), lambda s, v, k=k: (M.set_coefficient, (k, v)))
+        for i, k in enumerate(("ka", "kd", "ks"))
+    ]
     rows += [
-        Row("shininess", "material", "number", lambda s: s.material.shininess,
-            lambda s, v: (M.set_shininess, (v,))),
-        Row("opacity", "material", "number", lambda s: s.material.opacity,
+        Row(
+            "shininess",
+            "material",
+            "number",
+            lambda s: s.material.shininess,
+            lambda s, v: (M.set_shininess, (v,)),
+        ),
+        Row(
+            "opacity",
+            "material",
+            "number",
+            lambda s: s.material.opacity,
             lambda s, v: (M.set_opacity, (v,)),
-            tip="below 1 the mesh is translucent: drawn back to front"),
-    ]  # fmt: skip
-    rows += [Row(t, "material", "colour", lambda s, t=t: getattr(s.material, t),
-                 lambda s, v, t=t: (M.set_colour, (t, v)), group="colours")
-             for t in RGB_KEYS]  # fmt: skip
-    rows.append(Row("model", "material", "choice", lambda s: s.scene.model,
-                    lambda s, v: (M.set_model, (v,)), choices=MODELS, inline=True))  # fmt: skip
-    rows += [Row(f"show_{t}", "material", "toggle", lambda s, t=t: t not in s.hidden,
-                 lambda s, v, t=t: (M.set_term, (t, bool(v))), group="terms",
-                 label=f"{t} term", text=t, tip=f"draw the {t} term (the material is unchanged)")
-             for t in M.TERMS]  # fmt: skip
+            tip="below 1 the mesh is translucent: drawn back to front",
+        ),
+    ]
     rows += [
-        Row("fresnel", "material", "number", lambda s: s.material.fresnel,
-            lambda s, v: (E.set_material_field, ("fresnel", v)), optional=0.04,
+        Row(
+            t,
+            "material",
+            "colour",
+            lambda s, t=t: getattr(s.material, t),
+            lambda s, v, t=t: (M.set_colour, (t, v)),
+            group="colours",
+        )
+        for t in RGB_KEYS
+    ]
+    rows.append(
+        Row(
+            "model",
+            "material",
+            "choice",
+            lambda s: s.scene.model,
+            lambda s, v: (M.set_model, (v,)),
+            choices=MODELS,
+            inline=True,
+        )
+    )
+    rows += [
+        Row(
+            f"show_{t}",
+            "material",
+            "toggle",
+            lambda s, t=t: t not in s.hidden,
+            lambda s, v, t=t: (M.set_term, (t, bool(v))),
+            group="terms",
+            label=f"{t} term",
+            text=t,
+            tip=f"draw the {t} term (the material is unchanged)",
+        )
+        for t in M.TERMS
+    ]
+    rows += [
+        Row(
+            "fresnel",
+            "material",
+            "number",
+            lambda s: s.material.fresnel,
+            lambda s, v: (E.set_material_field, ("fresnel", v)),
+            optional=0.04,
             tip="Schlick's Fresnel on the specular term: F0 at normal incidence, toward 1 at "
-                "grazing angles"),
-        Row("energy_conserving", "material", "toggle", lambda s: s.material.energy_conserving,
+            "grazing angles",
+        ),
+        Row(
+            "energy_conserving",
+            "material",
+            "toggle",
+            lambda s: s.material.energy_conserving,
             lambda s, v: (E.set_material_field, ("energy_conserving", bool(v))),
             tip="normalise the specular lobe: a higher shininess narrows the highlight and "
-                "raises its peak"),
-    ]  # fmt: skip
+            "raises its peak",
+        ),
+    ]
     return rows
 
 
@@ -181,27 +231,76 @@ def _light_rows() -> list[Row]:
         return lambda s, v: (M.set_light_field, (name, v))
 
     rows = [
-        Row("type", "lights", "choice", lambda s: s.selected_light.type,
-            lambda s, v: (M.set_light_type, (v,)), choices=LIGHT_TYPES, group="light",
-            label="light type"),
-        Row("color", "lights", "colour", lambda s: M.light_colour(s.selected_light)[0],
-            lambda s, v: (M.set_light_colour, (v,)), group="light", label="light color"),
-        Row("intensity", "lights", "number", lambda s: M.light_colour(s.selected_light)[1],
-            lambda s, v: (M.set_light_intensity, (v,))),
+        Row(
+            "type",
+            "lights",
+            "choice",
+            lambda s: s.selected_light.type,
+            lambda s, v: (M.set_light_type, (v,)),
+            choices=LIGHT_TYPES,
+            group="light",
+            label="light type",
+        ),
+        Row(
+            "color",
+            "lights",
+            "colour",
+            lambda s: M.light_colour(s.selected_light)[0],
+            lambda s, v: (M.set_light_colour, (v,)),
+            group="light",
+            label="light color",
+        ),
+        Row(
+            "intensity",
+            "lights",
+            "number",
+            lambda s: M.light_colour(s.selected_light)[1],
+            lambda s, v: (M.set_light_intensity, (v,)),
+        ),
         Row("azimuth", "lights", "number", _placement(0), _place(0)),
         Row("elevation", "lights", "number", _placement(1), _place(1)),
-        Row("distance", "lights", "number", _placement(2, True), _place(2),
-            tip="distance from the mesh centre in mesh radii", note=_distance_note,
-            slider=_distance_slider),
-        Row("attenuation", "lights", "triple", light("attenuation"), field("attenuation"),
-            choices=("kc", "kl", "kq"), tip="1 / (kc + kl·d + kq·d²)"),
-        Row("cutoff", "lights", "number", lambda s: min(float(s.selected_light.cutoff), 90.0),
-            field("cutoff")),
-        Row("exponent", "lights", "number", lambda s: float(s.selected_light.exponent),
-            field("exponent")),
-        Row("shadows", "lights", "toggle", light("shadows"), field("shadows"),
-            tip="the light casts hard shadows on the mesh (rays through its BVH)"),
-    ]  # fmt: skip
+        Row(
+            "distance",
+            "lights",
+            "number",
+            _placement(2, True),
+            _place(2),
+            tip="distance from the mesh centre in mesh radii",
+            note=_distance_note,
+            slider=_distance_slider,
+        ),
+        Row(
+            "attenuation",
+            "lights",
+            "triple",
+            light("attenuation"),
+            field("attenuation"),
+            choices=("kc", "kl", "kq"),
+            tip="1 / (kc + kl·d + kq·d²)",
+        ),
+        Row(
+            "cutoff",
+            "lights",
+            "number",
+            lambda s: min(float(s.selected_light.cutoff), 90.0),
+            field("cutoff"),
+        ),
+        Row(
+            "exponent",
+            "lights",
+            "number",
+            lambda s: float(s.selected_light.exponent),
+            field("exponent"),
+        ),
+        Row(
+            "shadows",
+            "lights",
+            "toggle",
+            light("shadows"),
+            field("shadows"),
+            tip="the light casts hard shadows on the mesh (rays through its BVH)",
+        ),
+    ]
     return [replace(r, visible=_has(r.key)) for r in rows]
 
 
@@ -211,22 +310,50 @@ def _hdr_on(s: M.State) -> bool:
 
 def _view_rows() -> list[Row]:
     return [
-        Row("two_sided", "view", "toggle", lambda s: s.scene.two_sided,
+        Row(
+            "two_sided",
+            "view",
+            "toggle",
+            lambda s: s.scene.two_sided,
             lambda s, v: (E.set_scene_field, ("two_sided", bool(v))),
-            tip="light back faces too, with the normal turned (-N)"),
-        Row("local_viewer", "view", "toggle", lambda s: s.local_viewer,
+            tip="light back faces too, with the normal turned (-N)",
+        ),
+        Row(
+            "local_viewer",
+            "view",
+            "toggle",
+            lambda s: s.local_viewer,
             lambda s, v: (E.set_local_viewer, (bool(v),)),
             tip="the viewer at the camera (highlights move across a flat face); off: "
-                "infinitely far along the view (OpenGL's default)"),
-        Row("hdr", "view", "toggle", _hdr_on, lambda s, v: (E.set_hdr, (bool(v),)),
-            tip="unclamped colours shown with an exposure and a tone map, then sRGB"),
-        Row("exposure", "view", "number", lambda s: s.scene.hdr.exposure,
-            lambda s, v: (E.set_hdr_field, ("exposure", v)), visible=_hdr_on,
-            tip="stops: each doubles the light"),
-        Row("tone_map", "view", "choice", lambda s: s.scene.hdr.tone_map,
-            lambda s, v: (E.set_hdr_field, ("tone_map", v)), visible=_hdr_on,
-            choices=TONE_MAPS),
-    ]  # fmt: skip
+            "infinitely far along the view (OpenGL's default)",
+        ),
+        Row(
+            "hdr",
+            "view",
+            "toggle",
+            _hdr_on,
+            lambda s, v: (E.set_hdr, (bool(v),)),
+            tip="unclamped colours shown with an exposure and a tone map, then sRGB",
+        ),
+        Row(
+            "exposure",
+            "view",
+            "number",
+            lambda s: s.scene.hdr.exposure,
+            lambda s, v: (E.set_hdr_field, ("exposure", v)),
+            visible=_hdr_on,
+            tip="stops: each doubles the light",
+        ),
+        Row(
+            "tone_map",
+            "view",
+            "choice",
+            lambda s: s.scene.hdr.tone_map,
+            lambda s, v: (E.set_hdr_field, ("tone_map", v)),
+            visible=_hdr_on,
+            choices=TONE_MAPS,
+        ),
+    ]
 
 
 #: every row, in the order each tab draws them
@@ -234,8 +361,17 @@ ROWS: tuple[Row, ...] = (*_material_rows(), *_light_rows(), *_view_rows())
 #: the rows by key
 BY_KEY: dict[str, Row] = {r.key: r for r in ROWS}
 #: the effects of docs/effects.md as rows (translucency is ``opacity``)
-EFFECT_KEYS = ("shadows", "fresnel", "energy_conserving", "hdr", "exposure", "tone_map",
-               "opacity", "two_sided", "local_viewer")  # fmt: skip
+EFFECT_KEYS = (
+    "shadows",
+    "fresnel",
+    "energy_conserving",
+    "hdr",
+    "exposure",
+    "tone_map",
+    "opacity",
+    "two_sided",
+    "local_viewer",
+)
 
 
 def rows(tab: str) -> tuple[Row, ...]:

@@ -99,15 +99,28 @@ def _colour(v3, html, ctrl, key: str, label: str) -> None:
 
 
 def _choice(v3, r) -> None:
-    v3.VSelect(v_model=(r.key, None), items=(repr(list(r.choices)),), label=r.caption,
-               density="compact", hide_details=True, v_show=f"{r.key} != null", title=r.tip,
-               raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+    v3.VSelect(
+        v_model=(r.key, None),
+        items=(repr(list(r.choices)),),
+        label=r.caption,
+        density="compact",
+        hide_details=True,
+        v_show=f"{r.key} != null",
+        title=r.tip,
+        raw_attrs=[f'aria-label="{r.key}"'],
+    )
 
 
 def _toggle(v3, r) -> None:
-    v3.VCheckbox(v_model=(r.key, False), label=r.caption, density="compact", hide_details=True,
-                 v_show=f"{r.key} != null", title=r.tip,
-                 raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+    v3.VCheckbox(
+        v_model=(r.key, False),
+        label=r.caption,
+        density="compact",
+        hide_details=True,
+        v_show=f"{r.key} != null",
+        title=r.tip,
+        raw_attrs=[f'aria-label="{r.key}"'],
+    )
 
 
 def _triple(v3, ctrl, r) -> None:
@@ -135,9 +148,15 @@ def _rows(v3, html, ctrl, tab: str) -> None:
         group = None
         if r.kind == "number":
             if r.optional is not None:
-                v3.VCheckbox(v_model=(f"{r.key}_on", False), label=r.caption, density="compact",
-                             hide_details=True, v_show=f"{r.key}_on != null", title=r.tip,
-                             raw_attrs=[f'aria-label="{r.key}_on"'])  # fmt: skip
+                v3.VCheckbox(
+                    v_model=(f"{r.key}_on", False),
+                    label=r.caption,
+                    density="compact",
+                    hide_details=True,
+                    v_show=f"{r.key}_on != null",
+                    title=r.tip,
+                    raw_attrs=[f'aria-label="{r.key}_on"'],
+                )
             _number(v3, html, ctrl, r.key, r.caption)
         elif r.kind == "colour":
             _colour(v3, html, ctrl, r.key, r.key)

@@ -82,8 +82,9 @@ def row_values(state: M.State) -> dict:
     for r in panelmodel.ROWS:
         v = r.shown(state)
         if r.kind == "number":
-            out[f"{r.key}_step"] = None if v is None else to_step(
-                r.control, out[r.key], *r.slider_range(state))  # fmt: skip
+            out[f"{r.key}_step"] = (
+                None if v is None else to_step(r.control, out[r.key], *r.slider_range(state))
+            )
             if r.optional is not None:
                 out[f"{r.key}_on"] = (v is not None) if r.visible(state) else None
         elif r.kind == "colour":
@@ -177,8 +178,11 @@ def _numbers(app) -> None:
                and c.set_value(key, v, merge=False))  # fmt: skip
 
     def on_colour(key, text):
-        _typed(app, lambda: M.parse_colour(key, str(text)),
-               lambda rgb: c.set_value(key, rgb, merge=False))  # fmt: skip
+        _typed(
+            app,
+            lambda: M.parse_colour(key, str(text)),
+            lambda rgb: c.set_value(key, rgb, merge=False),
+        )
 
     def on_pick(key, text):
         """A colour picked (8-bit ``#rrggbb``): set when it is not the 8-bit colour the state
@@ -186,8 +190,13 @@ def _numbers(app) -> None:
         it closes)."""
         if app.pushing or not text:
             return
-        _typed(app, lambda: parse_hex(key, str(text)), lambda rgb: rgb_hex(rgb)
-               != values(app.store.state)[f"{key}_hex"] and c.set_value(key, rgb))  # fmt: skip
+        _typed(
+            app,
+            lambda: parse_hex(key, str(text)),
+            lambda rgb: (
+                rgb_hex(rgb) != values(app.store.state)[f"{key}_hex"] and c.set_value(key, rgb)
+            ),
+        )
 
     def on_triple(key, text):
         r = panelmodel.row(key)
@@ -196,8 +205,9 @@ def _numbers(app) -> None:
         def parse():
             parts = [M.parse_number(key, t, lo, hi) for t in str(text).split(",")]
             if len(parts) != len(r.choices):
-                raise ExplorerError(f"{key}: give {len(r.choices)} numbers "
-                                    f"{', '.join(r.choices)}, got {text!r}")  # fmt: skip
+                raise ExplorerError(
+                    f"{key}: give {len(r.choices)} numbers {', '.join(r.choices)}, got {text!r}"
+                )
             return tuple(parts)
 
         _typed(app, parse, lambda v: c.set_value(key, v, merge=False))
@@ -215,12 +225,17 @@ def _rows(app, user) -> None:
     c = app.controller
     for r in panelmodel.ROWS:
         if r.kind in ("choice", "toggle"):
-            user(r.key, lambda v, s, r=r: r.visible(s) and v != r.value(s),
-                 lambda v, r=r: c.set_value(r.key, v, merge=False))  # fmt: skip
+            user(
+                r.key,
+                lambda v, s, r=r: r.visible(s) and v != r.value(s),
+                lambda v, r=r: c.set_value(r.key, v, merge=False),
+            )
         elif r.optional is not None:
-            user(f"{r.key}_on", lambda v, s, r=r: r.visible(s) and bool(v) != (
-                r.value(s) is not None), lambda v, r=r: c.set_value(
-                r.key, r.optional if v else None, merge=False))  # fmt: skip
+            user(
+                f"{r.key}_on",
+                lambda v, s, r=r: r.visible(s) and bool(v) != (r.value(s) is not None),
+                lambda v, r=r: c.set_value(r.key, r.optional if v else None, merge=False),
+            )
 
 
 def _choices(app) -> None:

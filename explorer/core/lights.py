@@ -227,8 +227,14 @@ class Light(Checked):
     #: the explorer's controls this type has (its panel rows, :mod:`explorer.app.panelmodel`,
     #: in the order they are drawn): a front end asks the light, never its type
     CONTROL_KEYS: ClassVar[tuple[str, ...]] = (
-        "type", "color", "intensity", "azimuth", "elevation", "distance", "shadows",
-    )  # fmt: skip
+        "type",
+        "color",
+        "intensity",
+        "azimuth",
+        "elevation",
+        "distance",
+        "shadows",
+    )
     #: the light is at infinity (only its direction counts; its handle's distance is a choice)
     AT_INFINITY: ClassVar[bool] = False
 

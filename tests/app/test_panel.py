@@ -408,8 +408,11 @@ def test_each_effect_row_changes_the_picture_and_undo_restores_it(open_window, e
     w = open_window("--mesh", "teapot", "--resolution", "8", "--preset", "gold")
     c = w.controller
     if effect in ("fresnel", "exposure", "tone_map"):  # their switch first
-        c.set_value("fresnel" if effect == "fresnel" else "hdr",
-                    0.04 if effect == "fresnel" else True, merge=False)  # fmt: skip
+        c.set_value(
+            "fresnel" if effect == "fresnel" else "hdr",
+            0.04 if effect == "fresnel" else True,
+            merge=False,
+        )
     w.render()
     colours = w.view.displayed_colors()
     shot = np.asarray(w.plotter.screenshot(return_img=True)[:, :, :3]).copy()

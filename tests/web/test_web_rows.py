@@ -74,15 +74,25 @@ def test_a_lights_shadows_two_sided_lighting_and_the_viewer_reach_the_session(se
     click(browser, "lights tab")
     wait("the lights tab", lambda: shown(browser, "shadows"))
     click(browser, "shadows")
-    wait("shadows on", lambda: (s := report(browser)["session"])["scene"]["lights"][
-        s["light"] - 1].get("shadows") is True)  # fmt: skip
+    wait(
+        "shadows on",
+        lambda: (
+            (s := report(browser)["session"])["scene"]["lights"][s["light"] - 1].get("shadows")
+            is True
+        ),
+    )
     click(browser, "view tab")
     wait("the view tab", lambda: shown(browser, "two_sided"))
     click(browser, "two_sided")
     wait("two-sided", lambda: report(browser)["session"]["scene"]["two_sided"] is True)
     click(browser, "local_viewer")
-    wait("an infinite viewer", lambda: (s := report(browser)["session"])["local_viewer"] is False
-         and "to_viewer" in s["scene"]["viewer"])  # fmt: skip
+    wait(
+        "an infinite viewer",
+        lambda: (
+            (s := report(browser)["session"])["local_viewer"] is False
+            and "to_viewer" in s["scene"]["viewer"]
+        ),
+    )
     for _ in range(3):
         click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])

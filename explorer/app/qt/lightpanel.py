@@ -112,8 +112,13 @@ class MaterialTab(QtWidgets.QWidget):
         self.preset_label.setObjectName("preset")
         self.preset_label.setWordWrap(True)
         self.mesh_materials = MeshMaterialsBox(act)
-        for w in (self.mesh_materials, self.preset_label, self.search, self.presets,
-                  self.description):  # fmt: skip
+        for w in (
+            self.mesh_materials,
+            self.preset_label,
+            self.search,
+            self.presets,
+            self.description,
+        ):
             box.addWidget(w, 1 if w is self.presets else 0)  # the list takes the spare height
         self.rows = RowWidgets(panelmodel.rows("material"), box, send, self)
         self.sliders = self.rows.sliders
