@@ -7,6 +7,7 @@ waited 120 s and raised something else; the object ``show()`` returned could not
 from __future__ import annotations
 
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -145,12 +146,13 @@ def test_web_with_its_config_folder_locked_starts_serves_and_stops(tmp_path):
              str(port)], stdout=out, stderr=subprocess.STDOUT, env=env,
         )  # fmt: skip
         try:
-            url = f"http://127.0.0.1:{port}/"
+            printed = re.compile(re.escape(f"http://127.0.0.1:{port}/") + r"\?secret=\S+")
             for _ in range(1200):  # at most two minutes
-                if url in log.read_text() or proc.poll() is not None:
+                if printed.search(log.read_text()) or proc.poll() is not None:
                     break
                 time.sleep(0.1)
             assert proc.poll() is None, log.read_text()
+            url = printed.search(log.read_text()).group(0)  # the page's address with its token
             with urllib.request.urlopen(url, timeout=60) as page:
                 assert page.status == 200
         finally:
