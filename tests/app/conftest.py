@@ -16,7 +16,8 @@ SCREEN = (1920, 1200)
 #: the session's Xvfb servers (their Popen objects live as long as the process)
 _SERVERS: list = []
 #: modules whose tests open Qt windows in the test process
-QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py", "test_window_view.py")
+QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py", "test_window_view.py",
+              "test_intents.py")  # fmt: skip
 
 
 def pytest_collection_modifyitems(session, config, items):
