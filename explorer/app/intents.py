@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 
+from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS
 
 #: the keys a page never receives (the browser's own, see the module's docstring), as
@@ -192,7 +193,7 @@ def run(intent_id: str, controller, front: dict[str, Callable[[], object]]):
     an intent that cannot run now (:attr:`Intent.enabled`) does nothing and returns False."""
     intent = BY_ID.get(intent_id)
     if intent is None:
-        raise ValueError(f"no intent named '{intent_id}'")
+        raise ExplorerError(f"no intent named '{intent_id}'")
     if not intent.can_run(controller):
         return False
     if intent.run.startswith("front:"):

@@ -31,8 +31,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from explorer.app import intents, webpage, webpanel
 from explorer.app import model as M
-from explorer.app import webpage, webpanel
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import PENDING, DifferenceWorker, HeatMap
 from explorer.app.handledrag import HandleDragger
@@ -261,6 +261,7 @@ class WebExplorer(WebFiles):
         with self.server.state as s:
             s.can_undo, s.can_redo = undo is not None, redo is not None
             s.undo_label, s.redo_label = undo or "", redo or ""
+            s.intents_enabled = intents.enabled(self.controller)
 
     # -- View ------------------------------------------------------------------------------------
     def show(self, old: M.State | None, new: M.State) -> None:
