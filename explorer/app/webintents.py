@@ -49,7 +49,8 @@ KEYS_JS = """
     const look = () => {
       let el = document.querySelector(`[aria-label="${label}"]`);
       if (el && !['INPUT', 'BUTTON'].includes(el.tagName)) el = el.querySelector('input') || el;
-      if (el) then(el); else if (tries++ < 50) setTimeout(look, 20);
+      if (el && el.getClientRects().length) then(el);  // laid out: its tab is shown
+      else if (tries++ < 50) setTimeout(look, 20);
     };
     look();
   };

@@ -5,6 +5,8 @@ text, not a shortcut."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 from test_web import by_name, click, console_errors, drag, open_page, report, wait
@@ -126,3 +128,27 @@ def test_a_menu_entry_runs_its_intent_and_the_page_refuses_a_desktop_one(server,
     assert said == "ran"  # the trigger answers, but quit does not run: the page says why
     wait("the refusal", lambda: any("no intent named 'quit'" in e
                                     for e in report(browser)["errors"]))  # fmt: skip
+
+
+def test_the_browsers_own_intents_a_download_a_tab_and_a_field(server, browser, downloads):
+    """The intents the page runs in the browser: Ctrl+Shift+E downloads the view's PNG,
+    Ctrl+Shift+S shows the material tab with the preset's name field taking the keyboard, Ctrl+E
+    opens the export menu."""
+    open_page(browser, server.url)
+    for f in downloads.glob("*"):
+        f.unlink()
+    click(browser, "view tab")
+    click(browser, "view")
+    press(browser, "e", "CONTROL", "SHIFT")
+    path = wait("the download", lambda: next(
+        (f for f in downloads.glob("*.png") if f.stat().st_size > 0), None))  # fmt: skip
+    time.sleep(0.2)
+    assert path.read_bytes().startswith(b"\x89PNG")
+    press(browser, "s", "CONTROL", "SHIFT")
+    wait("the preset name field", lambda: browser.execute_script(
+        "return document.activeElement.getAttribute('aria-label')") == "preset name")  # fmt: skip
+    click(browser, "view")
+    press(browser, "e", "CONTROL")
+    wait("the export menu", lambda: shown(browser, "export png"))
+    press(browser, "ESCAPE")
+    assert not report(browser)["errors"] and not console_errors(browser)
