@@ -30,9 +30,21 @@ from explorer.core.material import MODELS
 #: the keys a page never receives (the browser's own, see the module's docstring), as
 #: :func:`key_name` writes them
 BROWSER_KEYS = frozenset(
-    {"ctrl+n", "ctrl+shift+n", "ctrl+t", "ctrl+shift+t", "ctrl+w", "ctrl+shift+w", "ctrl+tab",
-     "ctrl+shift+tab", "ctrl+pgup", "ctrl+pgdown", "ctrl+f4", "ctrl+shift+q"}
-)  # fmt: skip
+    {
+        "ctrl+n",
+        "ctrl+shift+n",
+        "ctrl+t",
+        "ctrl+shift+t",
+        "ctrl+w",
+        "ctrl+shift+w",
+        "ctrl+tab",
+        "ctrl+shift+tab",
+        "ctrl+pgup",
+        "ctrl+pgdown",
+        "ctrl+f4",
+        "ctrl+shift+q",
+    }
+)
 #: the menus, in the menu bar's order
 MENUS = ("File", "Edit", "View", "Help")
 #: a front end's own callbacks (``run="front:NAME"``): what each must provide
@@ -49,7 +61,8 @@ class Intent:
         there (groups are separated, in order); keys : the window's shortcuts (Qt's key
         sequences, the first one shown); view_key : the 3D view's key (a plain character, while
         the view has the keyboard); help : what the help says of it (default: the title);
-        run : the controller method it calls, or ``front:NAME`` (:data:`FRONT`);
+        run : the controller method it calls (``files.NAME``: of its file flows,
+        :class:`~explorer.app.controller.files.FileFlows`), or ``front:NAME`` (:data:`FRONT`);
         enabled : ``enabled(controller)``, whether it can run now (None: always);
         page : how the page runs it (``server``: the controller's method through a trigger;
         ``download:KIND``, ``click:LABEL[@TAB]``, ``focus:LABEL[@TAB]``, ``toggle:STATE``: in
@@ -105,23 +118,23 @@ def _redo(c) -> bool:
 I = Intent  # short: the table below reads as a table
 #: every intent, in the menus' order
 INTENTS: tuple[Intent, ...] = (
-    I("open", "&Open mesh, scene or session…", "open_file", "File", 0, ("Ctrl+O",),
+    I("open", "&Open mesh, scene or session…", "files.open_file", "File", 0, ("Ctrl+O",),
       help="open a mesh, scene or session", page="click:open session"),
-    I("import_materials", "&Import materials (.mtl)…", "import_materials", "File", 1,
+    I("import_materials", "&Import materials (.mtl)…", "files.import_materials", "File", 1,
       ("Ctrl+I",), help="import materials (.mtl) as presets",
       page="click:import materials@material"),
-    I("export_material", "&Export material…", "export_material", "File", 1, ("Ctrl+E",),
+    I("export_material", "&Export material…", "files.export_material", "File", 1, ("Ctrl+E",),
       help="export the material", page="click:export"),
-    I("export_render", "Export &view as PNG…", "export_render", "File", 1, ("Ctrl+Shift+E",),
+    I("export_render", "Export &view as PNG…", "files.export_render", "File", 1, ("Ctrl+Shift+E",),
       help="export the view (PNG)", page="download:png"),
-    I("export_turntable", "Export &turntable (GIF, MP4)…", "export_turntable", "File", 1,
+    I("export_turntable", "Export &turntable (GIF, MP4)…", "files.export_turntable", "File", 1,
       ("Ctrl+T",), help="export a turntable (GIF, MP4)",
       page="click:turntable@view", page_keys=("Alt+T",)),
-    I("save_session", "&Save session…", "save_session_as", "File", 2, ("Ctrl+S",),
+    I("save_session", "&Save session…", "files.save_session_as", "File", 2, ("Ctrl+S",),
       help="save the session", page="download:session"),
-    I("save_preset", "Save &preset as…", "save_preset_as", "File", 2, ("Ctrl+Shift+S",),
+    I("save_preset", "Save &preset as…", "files.save_preset_as", "File", 2, ("Ctrl+Shift+S",),
       help="save the material as a preset", page="focus:preset name@material"),
-    I("screenshot", "Save screens&hot", "screenshot", "File", 2, view_key="i",
+    I("screenshot", "Save screens&hot", "files.screenshot", "File", 2, view_key="i",
       help="save a screenshot of the view (never over a file)", page="download:png"),
     I("quit", "&Quit", "front:quit", "File", 3, ("Ctrl+Q",), view_key="q",
       help="quit (the session is kept for 'gui --last')", page=None),
@@ -198,7 +211,10 @@ def run(intent_id: str, controller, front: dict[str, Callable[[], object]]):
         return False
     if intent.run.startswith("front:"):
         return front[intent.run.removeprefix("front:")]()
-    return getattr(controller, intent.run)()
+    target = controller
+    for name in intent.run.split("."):  # files.NAME: a method of the controller's file flows
+        target = getattr(target, name)
+    return target()
 
 
 def help_lines(*, page: bool = False) -> list[str]:

@@ -136,7 +136,7 @@ class WebExplorer(WebFiles):
         self.server.state.engine = tiers.status() or ""
         self.server.controller.on_server_ready.add(self._ready)
         self.controller.start()
-        self.controller.say_mesh_warnings(mesh.name, start_warnings, logged=True)
+        self.controller.files.say_mesh_warnings(mesh.name, start_warnings, logged=True)
         self._push(state)
 
     # -- drags and errors (the handles' dragger calls these too) ----------------------------------
@@ -450,7 +450,7 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
     except KeyboardInterrupt:
         pass
     finally:
-        app.controller.keep_last_session()
+        app.controller.files.keep_last_session()
 
 
 @dataclasses.dataclass

@@ -81,8 +81,11 @@ KEYS_JS = """
 
 def page_intents() -> dict[str, dict]:
     """The intents the page has: id -> {run: how the page runs it, keys: its keys there}."""
-    return {i.id: {"run": i.page, "keys": [X.key_name(k) for k in i.web_keys()]}
-            for i in X.INTENTS if i.page}  # fmt: skip
+    return {
+        i.id: {"run": i.page, "keys": [X.key_name(k) for k in i.web_keys()]}
+        for i in X.INTENTS
+        if i.page
+    }
 
 
 def keys_js() -> str:
@@ -99,8 +102,14 @@ def menus(v3) -> None:
             continue
         with v3.VMenu():
             with v3.Template(v_slot_activator="{ props }"):
-                v3.VBtn(name, v_bind="props", variant="text", classes="px-2",
-                        style="min-width: 0", raw_attrs=[f'aria-label="menu {name}"'])  # fmt: skip
+                v3.VBtn(
+                    name,
+                    v_bind="props",
+                    variant="text",
+                    classes="px-2",
+                    style="min-width: 0",
+                    raw_attrs=[f'aria-label="menu {name}"'],
+                )
             with v3.VList(density="compact", raw_attrs=[f'aria-label="menu {name} entries"']):
                 for n, group in enumerate(groups):
                     if n:
@@ -108,11 +117,12 @@ def menus(v3) -> None:
                     for i in group:
                         keys = " / ".join(i.web_keys())
                         v3.VListItem(
-                            title=i.label, subtitle=keys or None,
+                            title=i.label,
+                            subtitle=keys or None,
                             click=f"window.phongIntent('{i.id}')",
                             disabled=(f"intents_enabled['{i.id}'] === false",),
                             raw_attrs=[f'aria-label="intent {i.id}"'],
-                        )  # fmt: skip
+                        )
 
 
 def help_dialog(v3, html) -> None:
@@ -122,12 +132,14 @@ def help_dialog(v3, html) -> None:
         with v3.VCard(raw_attrs=['aria-label="help"']):
             v3.VCardTitle(X.BY_ID["help"].label)
             with v3.VCardText(style="max-height: 70vh"):
-                html.Pre("\n".join(X.help_lines(page=True)), style="white-space: pre-wrap",
-                         raw_attrs=['aria-label="help text"'])  # fmt: skip
+                html.Pre(
+                    "\n".join(X.help_lines(page=True)),
+                    style="white-space: pre-wrap",
+                    raw_attrs=['aria-label="help text"'],
+                )
             with v3.VCardActions():
                 v3.VSpacer()
-                v3.VBtn("close", click="show_help = false",
-                        raw_attrs=['aria-label="close help"'])  # fmt: skip
+                v3.VBtn("close", click="show_help = false", raw_attrs=['aria-label="close help"'])
 
 
 def connect(app) -> None:

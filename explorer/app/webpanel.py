@@ -219,7 +219,7 @@ def _choices(app) -> None:
          lambda v: c.act(M.select_light, int(v), label="select light"))  # fmt: skip
     user("type", lambda v, s: s.selected_light is not None and v != s.selected_light.type,
          lambda v: c.act(M.set_light_type, v, label="light type"))  # fmt: skip
-    user("mesh", lambda v, s: v != s.mesh, c.choose_mesh)
+    user("mesh", lambda v, s: v != s.mesh, c.files.choose_mesh)
     user("difference", lambda v, s: bool(v) != s.difference,
          lambda v: c.act(M.set_difference, bool(v), label="difference"))  # fmt: skip
     _compare(app, user)

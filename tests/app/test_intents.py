@@ -8,6 +8,7 @@ import pytest
 
 from explorer.app import intents as X
 from explorer.app.controller import Controller
+from explorer.app.controller.files import FileFlows
 
 
 def test_the_registry_names_real_callbacks_unique_ids_and_keys():
@@ -16,7 +17,9 @@ def test_the_registry_names_real_callbacks_unique_ids_and_keys():
         if i.run.startswith("front:"):
             assert i.run.removeprefix("front:") in X.FRONT, i.id
         else:
-            assert callable(getattr(Controller, i.run, None)), f"{i.id}: no Controller.{i.run}"
+            owner, _, name = i.run.rpartition(".")
+            cls = {"": Controller, "files": FileFlows}[owner]
+            assert callable(getattr(cls, name, None)), f"{i.id}: no Controller.{i.run}"
         assert i.menu in (None, *X.MENUS), i.id
         assert i.menu or i.view_key or i.keys, f"{i.id}: neither in a menu nor on a key"
     desktop = [X.key_name(k) for i in X.INTENTS for k in i.all_keys()]
@@ -88,7 +91,9 @@ def test_the_window_shortcuts_fire_their_intents(win, qtbot, monkeypatch):
     ran = []
     for i in X.INTENTS:
         if not i.run.startswith("front:"):
-            monkeypatch.setattr(c, i.run, lambda n=i.id: ran.append(n))
+            owner, _, name = i.run.rpartition(".")
+            target = c.files if owner else c
+            monkeypatch.setattr(target, name, lambda n=i.id: ran.append(n))
     for name in X.FRONT:
         monkeypatch.setitem(win.menus.front, name, lambda n=name: ran.append(n))
     active(win, qtbot)
@@ -96,8 +101,9 @@ def test_the_window_shortcuts_fire_their_intents(win, qtbot, monkeypatch):
         for key in i.keys:
             seq = QtGui.QKeySequence(key)[0]
             qtbot.keyClick(win.plotter, seq.key(), seq.keyboardModifiers())
-            assert ran[-1:] == [i.run.removeprefix("front:")
-                                if i.run.startswith("front:") else i.id], key  # fmt: skip
+            assert ran[-1:] == [
+                i.run.removeprefix("front:") if i.run.startswith("front:") else i.id
+            ], key
             ran.clear()
     qtbot.keyClick(win.plotter, "r")  # a view key: the same registry
     assert ran == ["reset_camera"]

@@ -126,8 +126,9 @@ def test_a_menu_entry_runs_its_intent_and_the_page_refuses_a_desktop_one(server,
         "window.trame.trigger('intent', ['quit']).then(() => done('ran'), e => done(String(e)));"
     )
     assert said == "ran"  # the trigger answers, but quit does not run: the page says why
-    wait("the refusal", lambda: any("no intent named 'quit'" in e
-                                    for e in report(browser)["errors"]))  # fmt: skip
+    wait(
+        "the refusal", lambda: any("no intent named 'quit'" in e for e in report(browser)["errors"])
+    )
 
 
 def test_the_browsers_own_intents_a_download_a_tab_and_a_field(server, browser, downloads):
@@ -140,13 +141,20 @@ def test_the_browsers_own_intents_a_download_a_tab_and_a_field(server, browser, 
     click(browser, "view tab")
     click(browser, "view")
     press(browser, "e", "CONTROL", "SHIFT")
-    path = wait("the download", lambda: next(
-        (f for f in downloads.glob("*.png") if f.stat().st_size > 0), None))  # fmt: skip
+    path = wait(
+        "the download",
+        lambda: next((f for f in downloads.glob("*.png") if f.stat().st_size > 0), None),
+    )
     time.sleep(0.2)
     assert path.read_bytes().startswith(b"\x89PNG")
     press(browser, "s", "CONTROL", "SHIFT")
-    wait("the preset name field", lambda: browser.execute_script(
-        "return document.activeElement.getAttribute('aria-label')") == "preset name")  # fmt: skip
+    wait(
+        "the preset name field",
+        lambda: (
+            browser.execute_script("return document.activeElement.getAttribute('aria-label')")
+            == "preset name"
+        ),
+    )
     click(browser, "view")
     press(browser, "e", "CONTROL")
     wait("the export menu", lambda: shown(browser, "export png"))

@@ -56,8 +56,11 @@ class Menus:
         self.window = w = window
         c = w.controller
         #: the window's own callbacks of the registry's ``front:NAME`` intents
-        self.front = {"quit": w.close, "help": self.toggle_help,
-                      "messages": lambda: open_log(w.messages)}  # fmt: skip
+        self.front = {
+            "quit": w.close,
+            "help": self.toggle_help,
+            "messages": lambda: open_log(w.messages),
+        }
         bar = w.menuBar()
         self.actions = w.menu_actions = {}
         for name in MENUS:
@@ -70,7 +73,7 @@ class Menus:
                 if intent.id == "open":  # the recent files follow File > Open
                     self.recent = w.recent_menu = menu.addMenu("Open &recent")
                     self.recent.setObjectName("recent")
-        w.panel.material.save.clicked.connect(w._guard(c.save_preset_as, "save preset"))
+        w.panel.material.save.clicked.connect(w._guard(c.files.save_preset_as, "save preset"))
         self._view_keys = ViewKeys(w)
         w.plotter.installEventFilter(self._view_keys)
         w.help = None
@@ -111,13 +114,15 @@ class Menus:
         for i, path in enumerate(items):
             a = menu.addAction(f"&{i + 1} {Path(path).name}   ({Path(path).parent})")
             a.setObjectName(f"recent_{i + 1}")
-            a.triggered.connect(self.window._guard(lambda _=False, p=path: c.open_recent(p),
-                                                   "open recent"))  # fmt: skip
+            a.triggered.connect(
+                self.window._guard(lambda _=False, p=path: c.files.open_recent(p), "open recent")
+            )
         if items:
             menu.addSeparator()
             clear = menu.addAction("&Clear the list")
-            clear.triggered.connect(self.window._guard(lambda _=False: c.keep_recent([]),
-                                                       "recent"))  # fmt: skip
+            clear.triggered.connect(
+                self.window._guard(lambda _=False: c.files.keep_recent([]), "recent")
+            )
         menu.setEnabled(bool(items))
 
     def toggle_help(self) -> None:
