@@ -439,7 +439,7 @@ def _stop(signum, frame):
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
     """Serve ``app`` until the process ends (prints ``App running at:`` and the URL). When the
     server stops (Ctrl-C, SIGTERM) the session is kept as the desktop keeps it when its window
-    closes (:meth:`Controller.keep_last_session`; ``--last`` reopens it)."""
+    closes (:meth:`FileFlows.keep_last_session`; ``--last`` reopens it)."""
     import signal
 
     own_arguments()

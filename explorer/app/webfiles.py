@@ -190,7 +190,7 @@ class WebFiles:
     def import_uploaded_materials(self, upload) -> None:
         """An .mtl file chosen in the page: capped as a file on disk
         (:data:`~explorer.core.tolerances.MAX_MTL_FILE_BYTES`), kept under its own safe name,
-        then imported by the controller (:meth:`Controller.import_materials`: its materials
+        then imported by the controller (:meth:`FileFlows.import_materials`: its materials
         as presets in the user's preset folder, read by the same reader and checks). Preset
         files that exist are replaced only when the page's "replace" switch is on."""
         uploads = upload if isinstance(upload, list) else [upload]
