@@ -67,7 +67,8 @@ class Intent:
         page : how the page runs it (``server``: the controller's method through a trigger;
         ``download:KIND``, ``click:LABEL[@TAB]``, ``focus:LABEL[@TAB]``, ``toggle:STATE``: in
         the browser; None: not on the page); page_keys : the page's keys where the browser
-        keeps the desktop's (None: the desktop's keys and view key)
+        keeps the desktop's (None: the desktop's keys and view key); page_help : what the
+        page's help says of it where the page does it otherwise (default: :attr:`what`)
     """
 
     id: str
@@ -81,6 +82,7 @@ class Intent:
     enabled: Callable[[object], bool] | None = None
     page: str | None = "server"
     page_keys: tuple[str, ...] | None = None
+    page_help: str = ""
 
     @property
     def label(self) -> str:
@@ -91,6 +93,11 @@ class Intent:
     def what(self) -> str:
         """What the help says the intent does."""
         return self.help or self.label[:1].lower() + self.label[1:]
+
+    @property
+    def page_what(self) -> str:
+        """What the page's help says the intent does."""
+        return self.page_help or self.what
 
     def all_keys(self) -> tuple[str, ...]:
         """The desktop's keys: the view key (if any) after the window's shortcuts."""
@@ -119,23 +126,29 @@ I = Intent  # short: the table below reads as a table
 #: every intent, in the menus' order
 INTENTS: tuple[Intent, ...] = (
     I("open", "&Open mesh, scene or session…", "files.open_file", "File", 0, ("Ctrl+O",),
-      help="open a mesh, scene or session", page="click:open session"),
+      help="open a mesh, scene or session", page="click:open session",
+      page_help="open a session (a mesh: the view tab's upload)"),
     I("import_materials", "&Import materials (.mtl)…", "files.import_materials", "File", 1,
       ("Ctrl+I",), help="import materials (.mtl) as presets",
       page="click:import materials@material"),
     I("export_material", "&Export material…", "files.export_material", "File", 1, ("Ctrl+E",),
-      help="export the material", page="click:export"),
+      help="export the material", page="click:export",
+      page_help="the export menu (downloads)"),
     I("export_render", "Export &view as PNG…", "files.export_render", "File", 1, ("Ctrl+Shift+E",),
-      help="export the view (PNG)", page="download:png"),
+      help="export the view (PNG)", page="download:png",
+      page_help="download the view (PNG)"),
     I("export_turntable", "Export &turntable (GIF, MP4)…", "files.export_turntable", "File", 1,
       ("Ctrl+T",), help="export a turntable (GIF, MP4)",
-      page="click:turntable@view", page_keys=("Alt+T",)),
+      page="click:turntable@view", page_keys=("Alt+T",),
+      page_help="make a turntable (the view tab)"),
     I("save_session", "&Save session…", "files.save_session_as", "File", 2, ("Ctrl+S",),
-      help="save the session", page="download:session"),
+      help="save the session", page="download:session", page_help="download the session"),
     I("save_preset", "Save &preset as…", "files.save_preset_as", "File", 2, ("Ctrl+Shift+S",),
-      help="save the material as a preset", page="focus:preset name@material"),
+      help="save the material as a preset", page="focus:preset name@material",
+      page_help="save the material as a preset (its name field)"),
     I("screenshot", "Save screens&hot", "files.screenshot", "File", 2, view_key="i",
-      help="save a screenshot of the view (never over a file)", page="download:png"),
+      help="save a screenshot of the view (never over a file)", page="download:png",
+      page_help="download the view (PNG)"),
     I("quit", "&Quit", "front:quit", "File", 3, ("Ctrl+Q",), view_key="q",
       help="quit (the session is kept for 'gui --last')", page=None),
     I("undo", "&Undo", "undo", "Edit", 0, ("Ctrl+Z",), enabled=_undo),
@@ -222,7 +235,7 @@ def help_lines(*, page: bool = False) -> list[str]:
     window's shortcuts), or the page's (``page``: the keys the page has)."""
     if page:
         lines = ["Keys (not while typing in a field):"]
-        lines += [f"  {' / '.join(i.web_keys())}   {i.what}" for i in INTENTS if i.web_keys()]
+        lines += [f"  {' / '.join(i.web_keys())}   {i.page_what}" for i in INTENTS if i.web_keys()]
     else:
         lines = ["Keys in the 3D view (VTK's own keys are switched off):"]
         lines += [f"  {i.view_key}   {i.what}" for i in INTENTS if i.view_key]

@@ -79,8 +79,8 @@ def test_f1_opens_the_help_and_it_lists_every_key_of_the_page(server, browser):
         said |= {(k, what) for k in keys.split(" / ")}
     for i in X.INTENTS:
         for key in i.web_keys():
-            assert (key, i.what) in said, (key, i.id)
-    assert ("Ctrl+T", X.BY_ID["export_turntable"].what) not in said  # the browser's new tab
+            assert (key, i.page_what) in said, (key, i.id)
+    assert ("Ctrl+T", X.BY_ID["export_turntable"].page_what) not in said  # the browser's tab
     click(browser, "close help")
 
 
