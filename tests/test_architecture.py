@@ -46,7 +46,7 @@ EXEMPT_FUNCTIONS_IN = {"shading/kernels.py", "geometry/rays.py"}
 #: Python files (537 before issue 38): a count that may only go down (a table laid out by hand
 #: is fine; a line kept long to pass a size gate is not). Lower it when you remove some; never
 #: raise it
-MAX_FMT_SKIP = 534
+MAX_FMT_SKIP = 532
 
 
 def _modules():
