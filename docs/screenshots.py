@@ -102,8 +102,8 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     elif name == "gui_file_menu":
         w.close()
         w = open_window(app, tmp, ("--mesh", str(HERE / "examples" / "teapot_parts.obj")))
-        w.controller.keep_recent(["/home/user/models/teapot_parts.obj",
-                                  "/home/user/sessions/glazes.yaml"])  # fmt: skip
+        w.controller.files.keep_recent(["/home/user/models/teapot_parts.obj",
+                                        "/home/user/sessions/glazes.yaml"])  # fmt: skip
         file_menu = w.menuBar().actions()[0]
         w.menuBar().setActiveAction(file_menu)
         settle(app)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -14,10 +15,18 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "explorer"
 
-#: size limits of docs/architecture.md: lines per module, per class, per function, and
-#: positional parameters per function
+#: size limits of docs/architecture.md, a ratchet: a limit moves only with its reason written
+#: here. A module of more than 800 lines holds more than one idea (split it by idea, not by
+#: line count)
 MAX_MODULE_LINES = 800
+#: a class is counted with its in-package bases (a mix-in defined in explorer/ is part of the
+#: class it is mixed into: cutting a class into mix-ins does not make it smaller), in lines and
+#: in methods: more than 400 lines or 40 methods is more than one job (compose collaborators,
+#: as the controller holds its file flows)
 MAX_CLASS_LINES = 400
+MAX_CLASS_METHODS = 40
+#: a function of more than 120 lines does more than one step; more than 10 positional
+#: parameters cannot be called without counting (keywords say what each is)
 MAX_FUNCTION_LINES = 120
 MAX_POSITIONAL = 10
 #: functions of the explorer (explorer/app) are shorter still: flows in the controller, the
@@ -25,9 +34,19 @@ MAX_POSITIONAL = 10
 MAX_APP_FUNCTION_LINES = 80
 #: the compiled kernels are excepted until their own issue reworks them (the light loop)
 EXEMPT_MODULES = {"shading/kernels.py"}
-EXEMPT_CLASSES: set[str] = set()
+#: classes excepted from the class limits, each with its reason
+EXEMPT_CLASSES: dict[str, str] = {
+    "app/web.py:WebExplorer": "458 lines and 45 methods with its mix-in WebFiles (uploads and "
+    "downloads); WebFiles becomes a collaborator when the web modules move into a package, "
+    "after issue 37's server work (which edits both) is merged",
+}
 #: numba kernels take their arrays positionally (no keyword arguments in nopython code)
 EXEMPT_FUNCTIONS_IN = {"shading/kernels.py", "geometry/rays.py"}
+#: lines that ruff's formatter is told to skip (ending in ``fmt: skip``) in the repository's
+#: Python files (537 before issue 38): a count that may only go down (a table laid out by hand
+#: is fine; a line kept long to pass a size gate is not). Lower it when you remove some; never
+#: raise it
+MAX_FMT_SKIP = 532
 
 
 def _modules():
@@ -52,8 +71,50 @@ def test_import_contracts_hold():
     assert r.returncode == 0, r.stdout + r.stderr
 
 
+def _classes() -> dict[str, list[tuple[str, ast.ClassDef]]]:
+    """Every class of the package by name: [(module, node)]."""
+    found: dict[str, list[tuple[str, ast.ClassDef]]] = {}
+    for rel, text in _modules():
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ClassDef):
+                found.setdefault(node.name, []).append((rel, node))
+    return found
+
+
+def class_family(node: ast.ClassDef, classes) -> list[ast.ClassDef]:
+    """``node`` and its bases defined in the package (recursively, each once): what the class
+    is made of. A base is the package's when its name names exactly one class of the package."""
+    family: list[ast.ClassDef] = []
+    todo = [node]
+    while todo:
+        n = todo.pop(0)
+        if any(n is f for f in family):
+            continue
+        family.append(n)
+        for b in n.bases:
+            name = b.id if isinstance(b, ast.Name) else getattr(b, "attr", None)
+            if name in classes and len(classes[name]) == 1:
+                todo.append(classes[name][0][1])
+    return family
+
+
+def class_size(node: ast.ClassDef, classes) -> tuple[int, int]:
+    """(lines, methods) of a class with its in-package bases (a method overridden counts
+    once)."""
+    family = class_family(node, classes)
+    lines = sum(n.end_lineno - n.lineno + 1 for n in family)
+    methods = {
+        m.name
+        for n in family
+        for m in n.body
+        if isinstance(m, (ast.FunctionDef, ast.AsyncFunctionDef))
+    }
+    return lines, len(methods)
+
+
 def test_sizes_stay_within_the_limits():
     too_big = []
+    classes = _classes()
     for rel, text in _modules():
         lines = len(text.splitlines())
         if lines > MAX_MODULE_LINES and rel not in EXEMPT_MODULES:
@@ -61,8 +122,13 @@ def test_sizes_stay_within_the_limits():
         for node in ast.walk(ast.parse(text)):
             span = getattr(node, "end_lineno", 0) - getattr(node, "lineno", 0) + 1
             if isinstance(node, ast.ClassDef):
-                if span > MAX_CLASS_LINES and f"{rel}:{node.name}" not in EXEMPT_CLASSES:
-                    too_big.append(f"class {rel}:{node.name}: {span} lines")
+                if f"{rel}:{node.name}" in EXEMPT_CLASSES:
+                    continue
+                n_lines, n_methods = class_size(node, classes)
+                if n_lines > MAX_CLASS_LINES:
+                    too_big.append(f"class {rel}:{node.name}: {n_lines} lines with its mix-ins")
+                if n_methods > MAX_CLASS_METHODS:
+                    too_big.append(f"class {rel}:{node.name}: {n_methods} methods")
             elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 if rel in EXEMPT_FUNCTIONS_IN or rel in EXEMPT_MODULES:
                     continue
@@ -73,6 +139,31 @@ def test_sizes_stay_within_the_limits():
                 if n > MAX_POSITIONAL:
                     too_big.append(f"function {rel}:{node.name}: {n} positional parameters")
     assert not too_big, "\n".join(too_big)
+
+
+def test_a_mix_in_counts_with_its_class():
+    """The class gate reads a class with its in-package bases: a class cut into two halves
+    is as big as before."""
+    tree = ast.parse(
+        "class Half:\n    def a(self): pass\n    def b(self): pass\n"
+        "class Whole(Half, object):\n    def b(self): pass\n    def c(self): pass\n"
+    )
+    classes = {n.name: [("x.py", n)] for n in tree.body}
+    whole = classes["Whole"][0][1]
+    assert [n.name for n in class_family(whole, classes)] == ["Whole", "Half"]
+    assert class_size(whole, classes) == (6, 3)
+
+
+def test_fmt_skip_does_not_grow():
+    """Lines ending in ``# fmt: skip`` in the repository's Python files: at most
+    :data:`MAX_FMT_SKIP`."""
+    skip = re.compile(r"#\s*fmt:\s*skip\s*$", re.M)
+    count = sum(
+        len(skip.findall(path.read_text(encoding="utf-8")))
+        for top in ("explorer", "tests", "benchmarks", "docs")
+        for path in (ROOT / top).rglob("*.py")
+    )
+    assert count <= MAX_FMT_SKIP, f"{count} lines skip the formatter (at most {MAX_FMT_SKIP})"
 
 
 def test_app_functions_stay_within_80_lines():

@@ -32,8 +32,8 @@ import threading
 import time
 from collections.abc import Sequence
 
+from explorer.app import intents, webguard, webpage, webpanel, webwire
 from explorer.app import model as M
-from explorer.app import webguard, webpage, webpanel, webwire
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker
 from explorer.app.session import session_mapping
@@ -140,7 +140,7 @@ class WebExplorer(WebFiles):
         self.server.controller.on_server_ready.add(self._ready)
         self.server.controller.on_server_bind.add(webwire.bind)  # the wire's limits (issue 37)
         self.controller.start()
-        self.controller.say_mesh_warnings(mesh.name, start_warnings, logged=True)
+        self.controller.files.say_mesh_warnings(mesh.name, start_warnings, logged=True)
         self.viewport.show_start(state)
 
     def guard(self, fn, where: str):
@@ -247,6 +247,7 @@ class WebExplorer(WebFiles):
         with self.server.state as s:
             s.can_undo, s.can_redo = undo is not None, redo is not None
             s.undo_label, s.redo_label = undo or "", redo or ""
+            s.intents_enabled = intents.enabled(self.controller)
 
     # -- the view port's pictures (explorer.app.viewport.Pictures) --------------------------------
     def send(self) -> None:
@@ -404,7 +405,7 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
     page's token, the only place the token is written; ``open_browser``: opens it). A request
     whose Host is not one of ``host``'s names (:func:`~explorer.app.webguard.listening_names`)
     is refused. When the server stops (Ctrl-C, SIGTERM) the session is kept as the desktop
-    keeps it when its window closes (:meth:`Controller.keep_last_session`; ``--last`` reopens
+    keeps it when its window closes (:meth:`FileFlows.keep_last_session`; ``--last`` reopens
     it), but only if it served: an address it cannot listen on (:func:`check_listen`) is one
     :class:`ExplorerError`, and the session kept before stays."""
     import signal
@@ -434,7 +435,7 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
         raise
     finally:
         if app.loop is not None:  # set once the server listens (WebExplorer._ready)
-            app.controller.keep_last_session()
+            app.controller.files.keep_last_session()
 
 
 def served_url(host: str, port: int) -> str:

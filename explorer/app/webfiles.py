@@ -123,11 +123,11 @@ class WebFiles:
         c = self.controller
         folder = self._fresh_folder("download")
         if kind == "session":
-            path = c.save_session_as(folder / "session.yaml")
+            path = c.files.save_session_as(folder / "session.yaml")
         elif kind == "png":
-            path = c.export_render(folder / f"{c.picture_stem()}.png")
+            path = c.files.export_render(folder / f"{c.files.picture_stem()}.png")
         else:
-            path = c.export_material(folder / f"{c.material_name()}{suffix}")
+            path = c.files.export_material(folder / f"{c.files.material_name()}{suffix}")
         if path is None:
             raise ExplorerError(f"download {kind}: nothing was written")
         data = read_checked(path, cap=MAX_DOWNLOAD_BYTES, what=f"{kind} download")
@@ -146,12 +146,12 @@ class WebFiles:
         if n != int(n):
             raise ExplorerError(f"frames: a whole number of frames, got {frames!r}")
         c = self.controller
-        path = self._fresh_folder("turntable") / f"{c.picture_stem()}-turntable{suffix}"
+        path = self._fresh_folder("turntable") / f"{c.files.picture_stem()}-turntable{suffix}"
         before = getattr(self, "turntable_path", None), getattr(self, "turntable_made", "")
         self.turntable_path = path
         self.turntable_made = f"{int(n)} frames, {suffix[1:].upper()}"
         try:
-            c.export_turntable(path, frames=int(n))
+            c.files.export_turntable(path, frames=int(n))
         except BaseException:
             self.turntable_path, self.turntable_made = before  # the one made before stays
             raise
@@ -179,7 +179,7 @@ class WebFiles:
                 f"session '{upload_name(name)}': mesh {mesh!r}: a session opened from the page "
                 f"may name only a built-in mesh ({', '.join(MESH_CHOICES)})"
             )
-        self.controller.open_session(path)
+        self.controller.files.open_session(path)
 
     @staticmethod
     def _upload_limit(name: str) -> tuple[int, str]:
@@ -209,12 +209,12 @@ class WebFiles:
                     f"mesh file '{path.name}': {refused[0]}; a library outside the upload is "
                     "never read: upload the .mtl files beside the OBJ"
                 )  # fmt: skip
-        self.controller.choose_mesh(os.fspath(path))
+        self.controller.files.choose_mesh(os.fspath(path))
 
     def import_uploaded_materials(self, upload) -> None:
         """An .mtl file chosen in the page: capped as a file on disk
         (:data:`~explorer.core.tolerances.MAX_MTL_FILE_BYTES`), kept under its own safe name,
-        then imported by the controller (:meth:`Controller.import_materials`: its materials
+        then imported by the controller (:meth:`FileFlows.import_materials`: its materials
         as presets in the user's preset folder, read by the same reader and checks). Preset
         files that exist are replaced only when the page's "replace" switch is on."""
         uploads = upload if isinstance(upload, list) else [upload]
@@ -228,7 +228,7 @@ class WebFiles:
         path.write_bytes(data)
         self.answers = {"yes": bool(self.server.state.preset_replace)}
         try:
-            self.controller.import_materials(path)
+            self.controller.files.import_materials(path)
         finally:
             self.answers = {}
 
@@ -237,6 +237,6 @@ class WebFiles:
         page's answer to "replace the file?" and "hide the preset of that name?")."""
         self.answers = {"yes": bool(replace)}
         try:
-            self.controller.save_preset_as(str(name))
+            self.controller.files.save_preset_as(str(name))
         finally:
             self.answers = {}

@@ -10,7 +10,7 @@ trame is imported inside :func:`build` (``import explorer`` stays free of it).
 
 from __future__ import annotations
 
-from explorer.app import panelmodel
+from explorer.app import panelmodel, webintents
 from explorer.app.turntablejob import DEFAULT_FRAMES
 from explorer.app.webfiles import turntable_formats
 from explorer.core.controls import STEPS
@@ -40,17 +40,6 @@ MESSAGE_STYLE = ("display: -webkit-box; -webkit-line-clamp: 3; -webkit-box-orien
 #: a click that asks the server for a file and saves it (the browser's download)
 DOWNLOAD_JS = ("trigger('download', ['{kind}']).then(f => f && utils.download(f.name, f.content, "
                "f.type))")  # fmt: skip
-#: Ctrl+Z and Ctrl+Shift+Z (also Cmd on a Mac) undo and redo, except in a text field (where
-#: they edit the text)
-KEYS_JS = """
-document.addEventListener('keydown', (e) => {
-  if (!(e.ctrlKey || e.metaKey) || (e.key !== 'z' && e.key !== 'Z')) return;
-  const t = e.target;
-  if (t && t.tagName === 'INPUT' && t.type === 'text') return;
-  e.preventDefault();
-  window.trame.trigger(e.shiftKey ? 'redo' : 'undo');
-});
-"""
 
 
 def _number(v3, html, ctrl, key: str, label: str) -> None:
@@ -341,7 +330,8 @@ def _message_log(v3, html) -> None:
 
 
 def build(app) -> None:
-    """The page: the toolbar (undo / redo, files), the drawer (the panel) and the view."""
+    """The page: the toolbar (the registry's menus, undo / redo, files), the drawer (the
+    panel) and the view; the registry's keys (:mod:`explorer.app.webintents`)."""
     from trame.ui.vuetify3 import SinglePageWithDrawerLayout
     from trame.widgets import client, html
     from trame.widgets import vtk as vtkw
@@ -359,13 +349,15 @@ def build(app) -> None:
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
     server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
+    webintents.connect(app)
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
         layout.drawer.width = DRAWER_WIDTH
-        client.Script(KEYS_JS)
+        client.Script(webintents.keys_js())  # the registry's keys (the desktop's)
         # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window
         client.Style("html { overflow-y: auto; }")
         with layout.toolbar:
+            webintents.menus(v3)
             v3.VSpacer()
             v3.VBtn("undo", click=ctrl.undo, disabled=("!can_undo",), variant="text",
                     title=("'Undo ' + undo_label + ' (Ctrl+Z)'",),
@@ -375,6 +367,7 @@ def build(app) -> None:
                     raw_attrs=['aria-label="redo"'])  # fmt: skip
             _files(v3, ctrl)
             _message_log(v3, html)
+            webintents.help_dialog(v3, html)
         with layout.drawer:
             with v3.VTabs(v_model="tab", density="compact", grow=True):
                 for t in ("material", "lights", "view"):

@@ -272,7 +272,7 @@ def _choices(app) -> None:
         sent over the socket) is refused in the same words, naming nothing."""
         name = app.mesh_values.name(value)
         if name in c.mesh_choices:
-            c.choose_mesh(name)
+            c.files.choose_mesh(name)
         else:
             c.reject_input(MESH_REFUSED)
 

@@ -16,7 +16,13 @@ SCREEN = (1920, 1200)
 #: the session's Xvfb servers (their Popen objects live as long as the process)
 _SERVERS: list = []
 #: modules whose tests open Qt windows in the test process
-QT_MODULES = ("test_window.py", "test_filemenu.py", "test_panel.py", "test_window_view.py")
+QT_MODULES = (
+    "test_window.py",
+    "test_filemenu.py",
+    "test_panel.py",
+    "test_window_view.py",
+    "test_intents.py",
+)
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -92,9 +98,15 @@ def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
         argv = argv or ("--mesh", "icosphere", "--resolution", "3")
         warnings: list[str] = []  # as `gui` starts it: the start mesh's warnings in the log
         state, mesh = start_state(build_parser().parse_args(["gui", *argv]), warnings)
-        w = ExplorerWindow(state, mesh, output_dir=tmp_path, state_file=tmp_path / "state.json",
-                           last_session=tmp_path / "last.yaml", size=(1000, 700),
-                           start_warnings=tuple(warnings))  # fmt: skip
+        w = ExplorerWindow(
+            state,
+            mesh,
+            output_dir=tmp_path,
+            state_file=tmp_path / "state.json",
+            last_session=tmp_path / "last.yaml",
+            size=(1000, 700),
+            start_warnings=tuple(warnings),
+        )
         qtbot.addWidget(w)
         w.show()
         qtbot.waitExposed(w)

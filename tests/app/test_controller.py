@@ -184,7 +184,7 @@ def test_the_viewer_made_infinite_keeps_the_cameras_perspective_when_the_mesh_is
     assert not ctl.state.camera.parallel and ctl.state.scene.viewer.local
     assert ctl.set_value("local_viewer", False, merge=False)
     assert ctl.state.scene.viewer.to_viewer is not None and not ctl.state.camera.parallel
-    assert ctl.choose_mesh("cube")
+    assert ctl.files.choose_mesh("cube")
     assert not ctl.state.camera.parallel and not ctl.state.scene.viewer.local
     ctl.undo()
     ctl.undo()
@@ -204,11 +204,11 @@ def test_open_save_and_undo_across_flows(ctl, tmp_path):
     ctl.set_value("kd", 0.3)
     ctl.release()
     path = tmp_path / "s.yaml"
-    assert ctl.save_session_as(path) == path and path.is_file()
+    assert ctl.files.save_session_as(path) == path and path.is_file()
     assert ctl.front.recent == [str(path)]
     ctl.set_value("kd", 0.7)
     ctl.release()
-    ctl.open_file(path)
+    ctl.files.open_file(path)
     assert kd(ctl) == pytest.approx(0.3) and ctl.session_path == path
     assert any("opened session" in t for _, t in ctl.front.messages)
     ctl.undo()
@@ -218,18 +218,18 @@ def test_open_save_and_undo_across_flows(ctl, tmp_path):
     # saving over a file asks first: no leaves it as it was
     stamp = path.stat().st_mtime_ns
     ctl.front.answers["yes"].append(False)
-    assert ctl.save_session_as(path) is None and path.stat().st_mtime_ns == stamp
+    assert ctl.files.save_session_as(path) is None and path.stat().st_mtime_ns == stamp
     # a name from the dialog; giving up writes nothing
     ctl.front.answers["path"].append(None)
-    assert ctl.save_session_as() is None
+    assert ctl.files.save_session_as() is None
     with pytest.raises(ExplorerError, match="no such file"):
-        ctl.open_file(tmp_path / "missing.yaml")
+        ctl.files.open_file(tmp_path / "missing.yaml")
 
 
 def test_open_a_mesh_file_and_a_preset(ctl, tmp_path):
     obj = tmp_path / "tri.obj"
     obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n")
-    ctl.open_file(obj)
+    ctl.files.open_file(obj)
     assert ctl.state.mesh == str(obj) and str(obj) in ctl.front.meshes
     assert ctl.view.shown[-1][1].mesh == str(obj)
     name = next(p.name for p in ctl.presets if p.name != ctl.state.preset)
@@ -243,17 +243,17 @@ def test_open_a_mesh_file_and_a_preset(ctl, tmp_path):
 def test_save_preset_and_export(ctl, tmp_path):
     ctl.set_value("kd", 0.25)
     ctl.front.answers["text"].append("mine")
-    written = ctl.save_preset_as()
+    written = ctl.files.save_preset_as()
     assert written.name == "mine.yaml" and ctl.state.preset == "mine" and not ctl.state.edited
-    out = ctl.export_material(tmp_path / "m.mtl")
+    out = ctl.files.export_material(tmp_path / "m.mtl")
     assert out.is_file() and "Kd" in out.read_text()
-    png = ctl.export_render(tmp_path / "v.png")
+    png = ctl.files.export_render(tmp_path / "v.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     ctl.front.answers["yes"].append(False)  # asked before replacing: no
-    assert ctl.export_render(tmp_path / "v.png") is None
+    assert ctl.files.export_render(tmp_path / "v.png") is None
     with pytest.raises(ExplorerError, match="must end in"):
-        ctl.export_render(tmp_path / "v.jpg")
-    shot = ctl.screenshot()
+        ctl.files.export_render(tmp_path / "v.jpg")
+    shot = ctl.files.screenshot()
     assert shot.parent == tmp_path and shot.suffix == ".png"
 
 
@@ -318,7 +318,7 @@ def test_compare_swap_and_undo(ctl):
 
 def test_turntable_through_the_progress_port(ctl, tmp_path):
     out = tmp_path / "spin.gif"
-    job = ctl.export_turntable(out, 2, size=(24, 20))
+    job = ctl.files.export_turntable(out, 2, size=(24, 20))
     assert job.stage == "written" and out.is_file() and job.dialog == "handle"
     assert "wrote" in ctl.front.messages[-1][1]
 
@@ -353,14 +353,14 @@ def test_the_last_session_never_replaces_what_is_not_a_kept_session(ctl, tmp_pat
     before = os.lstat(path)
     ctl.last_session = path
     with caplog.at_level(logging.WARNING):
-        ctl.keep_last_session()
+        ctl.files.keep_last_session()
     after = os.lstat(path)
     assert (after.st_mode, after.st_ino) == (before.st_mode, before.st_ino)
     assert "could not keep the last session" in caplog.text
     kept = tmp_path / "kept.yaml"
     kept.write_text("old")
     ctl.last_session = kept
-    ctl.keep_last_session()
+    ctl.files.keep_last_session()
     assert "scene" in kept.read_text()
 
 
@@ -371,7 +371,7 @@ def test_a_last_session_path_the_system_refuses_is_a_warning_on_stop(ctl, tmp_pa
 
     ctl.last_session = tmp_path / ("x" * 300 + ".yaml")
     with caplog.at_level(logging.WARNING):
-        ctl.keep_last_session()
+        ctl.files.keep_last_session()
     assert "could not keep the last session" in caplog.text
     assert "File name too long" in caplog.text
     assert list(tmp_path.iterdir()) == []

@@ -87,7 +87,7 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     win.render()
     drawn_equals_groups(win)
     # the edited group's material saved as a preset: the groups stay
-    path = win.controller.save_preset_as("my_blue")
+    path = win.controller.files.save_preset_as("my_blue")
     assert load_material_file(path).diffuse == win.controller.state.groups[i].diffuse
     assert win.controller.state.groups is not None and "my_blue" in {
         p.name for p in win.controller.presets
@@ -129,10 +129,10 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     # the session keeps the mesh and its materials
     win.panel.material.sliders["shininess"].field.setValue(5.0)
     saved = win.controller.state
-    path = win.controller.save_session_as(tmp_path / "grouped.yaml")
+    path = win.controller.files.save_session_as(tmp_path / "grouped.yaml")
     win.controller.reset_all()
     assert win.controller.state.mesh == "icosphere"
-    win.controller.open_file(path)
+    win.controller.files.open_file(path)
     s = win.controller.state
     assert s.mesh == str(two) and s.groups == saved.groups and s.group == saved.group
     win.render()
@@ -154,7 +154,7 @@ def test_import_materials_adds_presets_asks_before_replacing_and_names_bad_lines
     text = blue.read_text()
     # again: asked, said no: nothing replaced
     answers["yes"].append(False)
-    assert win.controller.import_materials(f"{MTL_DATA}/several.mtl") == []
+    assert win.controller.files.import_materials(f"{MTL_DATA}/several.mtl") == []
     assert answers["asked"][-1][0] == "yes" and "3 preset files" in answers["asked"][-1][1][0]
     assert blue.read_text() == text and "nothing imported" in win.message
     # a bad file: a dialog naming the file and line, nothing written
@@ -164,7 +164,7 @@ def test_import_materials_adds_presets_asks_before_replacing_and_names_bad_lines
     assert error and f"{MTL_DATA}/bad_number.mtl:" in said and "Nothing was imported" in said
     assert win.message.startswith("error")
     # warnings are shown
-    win.controller.import_materials(f"{MTL_DATA}/blender.mtl")
+    win.controller.files.import_materials(f"{MTL_DATA}/blender.mtl")
     _, said, details, error = answers["told"][-1]
     assert not error and "warning" in said and "Ka 1 1 1" in details and "Ni" in details
 
@@ -177,17 +177,17 @@ def test_export_material_never_replaces_unasked(win, answers, tmp_path):
     win.menu_actions["export_material"].trigger()
     assert out.read_text() == "mine\n"  # asked, said no
     answers["yes"].append(True)
-    assert win.controller.export_material(out) == out
+    assert win.controller.files.export_material(out) == out
     (m,) = read_mtl(out)
     s = win.controller.state
     keys = ("ambient", "diffuse", "specular", "emission", "shininess", "opacity")
     assert m.name == "gold"
     assert [getattr(m.material, k) for k in keys] == [getattr(s.material, k) for k in keys]
     for suffix, word in ((".json", "MeshPhongMaterial"), (".x3d", "<Material")):
-        path = win.controller.export_material(tmp_path / f"g{suffix}")
+        path = win.controller.files.export_material(tmp_path / f"g{suffix}")
         assert word in path.read_text()
     assert answers["told"] and "approximation" in answers["told"][-1][1]
-    back = load_material_file(win.controller.export_material(tmp_path / "g.yaml"))
+    back = load_material_file(win.controller.files.export_material(tmp_path / "g.yaml"))
     assert [getattr(back, k) for k in keys] == [getattr(s.material, k) for k in keys]
     assert back.model == s.scene.model
     answers["path"].append(str(tmp_path / "bad.txt"))
@@ -203,10 +203,10 @@ def test_export_material_of_a_grouped_mesh_writes_every_group(win, answers, tmp_
     two.write_text(text)
     mtl = tmp_path / "two_groups.mtl"
     mtl.write_text(mtl.read_text().replace("left_red", "Left_Red"))
-    win.controller.open_file(two)
+    win.controller.files.open_file(two)
     win.panel.material.sliders["ks"].field.setValue(0.25)  # the edited group, as edited
     s = win.controller.state
-    path = win.controller.export_material(tmp_path / "out.mtl")
+    path = win.controller.files.export_material(tmp_path / "out.mtl")
     read = {m.name: m.material for m in read_mtl(path)}
     assert {n: m.diffuse for n, m in read.items()} == {"Left_Red": (1.0, 0.0, 0.0),
                                                       "right_blue": (0.0, 0.0, 1.0)}  # fmt: skip
@@ -215,8 +215,8 @@ def test_export_material_of_a_grouped_mesh_writes_every_group(win, answers, tmp_
     # the exported library serves the OBJ: it reopens with the same materials
     (tmp_path / "two_groups.mtl").write_bytes(path.read_bytes())
     win.controller.meshes.clear()
-    win.controller.choose_mesh("cube")
-    win.controller.open_file(two)
+    win.controller.files.choose_mesh("cube")
+    win.controller.files.open_file(two)
     assert [m.specular for m in win.controller.state.groups] == [m.specular for m in s.groups]
 
 
@@ -229,14 +229,14 @@ def test_export_view_png_asks_before_replacing(win, answers, tmp_path):
     assert picture.shape[:2] == (h, w)
     stamp = out.stat().st_mtime_ns
     answers["yes"].append(False)
-    assert win.controller.export_render(out) is None and out.stat().st_mtime_ns == stamp
+    assert win.controller.files.export_render(out) is None and out.stat().st_mtime_ns == stamp
 
 
 def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp_path, qtbot):
     out = tmp_path / "spin.gif"
     answers["path"].append(str(out))
     answers["number"].append(3)
-    win.controller.export_turntable(size=(48, 40))
+    win.controller.files.export_turntable(size=(48, 40))
     job = win.controller.turntable
     assert job.dialog.isVisible()
     seen = []  # the event loop runs between the frames: the window keeps painting
@@ -251,10 +251,10 @@ def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp
     assert not (frames[0] == frames[1]).all()  # the lights and camera turned
     # asked before replacing: no
     answers["yes"].append(False)
-    assert win.controller.export_turntable(out, 3, size=(48, 40)) is None
+    assert win.controller.files.export_turntable(out, 3, size=(48, 40)) is None
     # cancelled part way: no file, nothing left behind
     gone = tmp_path / "gone.mp4"
-    job = win.controller.export_turntable(gone, 40, size=(48, 40))
+    job = win.controller.files.export_turntable(gone, 40, size=(48, 40))
     qtbot.waitUntil(lambda: job.done >= 2, timeout=WAIT_MS)
     job.dialog.cancel()
     qtbot.waitUntil(lambda: job.stage == "cancelled", timeout=WAIT_MS)
@@ -264,18 +264,19 @@ def test_turntable_writes_the_frames_and_cancel_leaves_no_file(win, answers, tmp
 
 def test_recent_files(win, answers, tmp_path):
     two = write_two_groups(tmp_path)
-    win.controller.open_file(two)
-    win.controller.save_session_as(tmp_path / "s.yaml")
-    recent = win.controller.recent_files()
+    win.controller.files.open_file(two)
+    win.controller.files.save_session_as(tmp_path / "s.yaml")
+    recent = win.controller.files.recent_files()
     assert recent == [str(tmp_path / "s.yaml"), str(two)]
     actions = [a for a in win.recent_menu.actions() if a.objectName().startswith("recent_")]
     assert [a.objectName() for a in actions] == ["recent_1", "recent_2"]
     win.controller.act(M.apply_preset, "ruby", find_preset("ruby"))
     actions[1].trigger()  # two.obj again: its own materials
-    assert win.controller.state.mesh == str(two) and win.controller.recent_files()[0] == str(two)
+    assert win.controller.state.mesh == str(two)
+    assert win.controller.files.recent_files()[0] == str(two)
     two.unlink()
     [a for a in win.recent_menu.actions() if a.objectName() == "recent_1"][0].trigger()
-    assert "no such file" in win.message and str(two) not in win.controller.recent_files()
+    assert "no such file" in win.message and str(two) not in win.controller.files.recent_files()
     win.controller.errors.clear()
     assert S.last_session_path  # the list lives beside the last session
     assert (tmp_path / "recent-files.json").is_file()
@@ -285,7 +286,7 @@ def test_an_obj_whose_mtl_is_bad_opens_in_the_present_material(win, tmp_path):
     two = write_two_groups(tmp_path)
     (tmp_path / "two_groups.mtl").write_text("newmtl left_red\nKd 1 zero 0\n")
     before = win.controller.state.material
-    win.controller.open_file(two)
+    win.controller.files.open_file(two)
     s = win.controller.state
     assert s.mesh == str(two) and s.groups is None and s.material == before
     assert "two_groups.mtl:2" in win.message and win.message.startswith("error")
@@ -293,7 +294,7 @@ def test_an_obj_whose_mtl_is_bad_opens_in_the_present_material(win, tmp_path):
 
 
 def test_compare_beside_the_mesh_materials(win, tmp_path, qtbot):
-    win.controller.open_file(write_two_groups(tmp_path))
+    win.controller.files.open_file(write_two_groups(tmp_path))
     win.controller.toggle_compare()
     s = win.controller.state
     assert s.groups is not None and s.compare == s.material and win.plotter_b.isVisible()

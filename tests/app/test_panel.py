@@ -307,7 +307,7 @@ def test_the_obj_warnings_are_whole_in_the_message_log(win, qtbot):
 
     obj = ROOT / "docs" / "examples" / "teapot_parts.obj"
     before = win.controller.state
-    win.controller.open_file(obj)
+    win.controller.files.open_file(obj)
     qtbot.waitUntil(win.messages.isVisible)  # the log opened by itself
     text = win.messages.plain_text()
     _, expected = add_mesh_materials(before, win.view.mesh)  # the reader's own warnings

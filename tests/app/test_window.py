@@ -198,14 +198,14 @@ def test_save_preset_as_asks_for_a_name_and_before_replacing(win, tmp_path, monk
     asked = []
     monkeypatch.setattr(win, "ask_yes", lambda q: asked.append(q) or False)
     win.panel.material.sliders["kd"].field.setValue(0.33)
-    path = win.controller.save_preset_as()
+    path = win.controller.files.save_preset_as()
     assert path == tmp_path / "presets" / "my_gold.yaml" and path.exists()
     s = win.controller.state
     assert s.preset == "my_gold" and not s.edited and "(edited)" not in (
         win.panel.material.preset_label.text())  # fmt: skip
     text = path.read_text()
     assert (
-        win.controller.save_preset_as("my_gold") is None and asked
+        win.controller.files.save_preset_as("my_gold") is None and asked
     )  # asked, said no: not replaced
     assert path.read_text() == text
     win.menu_actions["save_preset"].trigger()  # "Bad Name": refused, shown, nothing written
@@ -218,11 +218,11 @@ def test_sessions_save_and_reopen_exactly(win, qtbot, tmp_path, monkeypatch):
     win.panel.lights.buttons["add"].click()
     win.panel.material.terms["ambient"].click()
     monkeypatch.setattr(win, "ask_path", lambda *a, **k: str(tmp_path / "mine.yaml"))
-    path = win.controller.save_session_as()
+    path = win.controller.files.save_session_as()
     saved = win.controller.state
     win.controller.reset_all()
     assert win.controller.state.scene != saved.scene
-    win.controller.open_file(path)
+    win.controller.files.open_file(path)
     s = win.controller.state
     assert s.scene == saved.scene and s.hidden == saved.hidden and s.mesh == saved.mesh
     win.render()
@@ -237,7 +237,7 @@ def test_sessions_save_and_reopen_exactly(win, qtbot, tmp_path, monkeypatch):
 def test_open_mesh_files_and_errors_in_one_line(win, tmp_path):
     bad = tmp_path / "broken.obj"
     bad.write_text("v 0 0\n")
-    win._guard(win.controller.open_file, "open")(str(bad))
+    win._guard(win.controller.files.open_file, "open")(str(bad))
     assert win.controller.errors and win.message.startswith("error (") and "\n" not in win.message
     assert "broken.obj" in win.message and win.controller.state.mesh == "icosphere"
     win.controller.errors.clear()
@@ -247,7 +247,7 @@ def test_open_mesh_files_and_errors_in_one_line(win, tmp_path):
     assert win.controller.state.mesh == "icosphere"
     scene = tmp_path / "scene.yaml"
     scene.write_text("material: ruby\nlights: [{type: directional, to_light: [0, 1, 0]}]\n")
-    win.controller.open_file(scene)
+    win.controller.files.open_file(scene)
     s = win.controller.state
     assert s.preset == "ruby" and s.material == explorer.load_scene(str(scene)).material
     assert [light.type for light in s.scene.lights] == ["directional"]
@@ -255,7 +255,7 @@ def test_open_mesh_files_and_errors_in_one_line(win, tmp_path):
     drawn_equals_engine(win)
     stl = tmp_path / "box.stl"
     trimesh.creation.box().export(stl)
-    win.controller.open_file(stl)
+    win.controller.files.open_file(stl)
     assert win.controller.state.mesh == str(stl) and win.view.mesh.n_vertices > 0
     assert win.panel.view.mesh.currentText() == "box.stl"
 

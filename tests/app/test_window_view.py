@@ -356,10 +356,10 @@ def test_a_mesh_at_any_scale_is_framed_and_drawn_as_the_render(win, tmp_path, sc
     as `render` draws it, the lobe plot the same, the handle under the pointer (a sphere
     scaled by 1e-20 was a dot in an empty view, by 1e39 a spray of broken triangles)."""
     w = win
-    w.controller.open_file(scaled_sphere_obj(tmp_path / "unit.obj", 1.0))
+    w.controller.files.open_file(scaled_sphere_obj(tmp_path / "unit.obj", 1.0))
     unit = view_without_overlays(w)
     caption = w.view.lobe_caption.GetInput()
-    w.controller.open_file(scaled_sphere_obj(tmp_path / f"sphere_{scale:g}.obj", scale))
+    w.controller.files.open_file(scaled_sphere_obj(tmp_path / f"sphere_{scale:g}.obj", scale))
     s = w.controller.state
     assert s.radius == pytest.approx(scale) and not w.controller.errors
     _MESHES[s.mesh] = w.view.mesh
@@ -397,7 +397,7 @@ def test_a_mesh_too_large_to_frame_is_refused_as_render_refuses_it(win, tmp_path
     with pytest.raises(ExplorerError) as refused:  # `render`'s refusal
         camera_for(Scene(), load_mesh(path))
     before, shown = w.controller.state, pixels(w.plotter)
-    w.controller.open_file(path)
+    w.controller.files.open_file(path)
     assert w.controller.errors == [f"mesh: {refused.value}"]
     assert "too large to frame" in w.message
     w.controller.errors.clear()

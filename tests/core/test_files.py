@@ -228,15 +228,10 @@ def test_cli_readers_refuse_special_files(tmp_path, kind, capsys, monkeypatch):
 def test_a_huge_recent_files_list_is_not_read(tmp_path):
     """The window's recent-files list through the checked open: a sparse 3 GiB file reads as
     no list (before, all of it was read)."""
-    from explorer.app.controller.files import RECENT_NAME, FileFlows
+    from explorer.app.controller.files import RECENT_NAME, read_recent, recent_path
 
     special_file(tmp_path, "sparse", RECENT_NAME)
-
-    class Menu(FileFlows):
-        def __init__(self):
-            self.last_session = str(tmp_path / "last.yaml")
-
-    assert Menu().recent_files() == []
+    assert read_recent(recent_path(str(tmp_path / "last.yaml"))) == []
 
 
 def test_a_socket_is_named_as_a_socket(tmp_path):

@@ -17,8 +17,8 @@ from explorer.core.errors import ExplorerError
 from explorer.core.yamlio import MAX_BYTES
 
 
-class Controller:
-    """Records the flows the uploads end in."""
+class Flows:
+    """Records the flows the uploads end in (the controller's ``files``)."""
 
     def __init__(self):
         self.calls = []
@@ -42,8 +42,8 @@ class Controller:
 @pytest.fixture
 def files():
     f = WebFiles()
-    f.controller = Controller()
-    f.controller.answers = lambda: dict(f.answers)
+    f.controller = SimpleNamespace(files=Flows())
+    f.controller.files.answers = lambda: dict(f.answers)
     f.server = SimpleNamespace(state=SimpleNamespace(preset_replace=False))
     f._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-test-")
     yield f
@@ -68,11 +68,11 @@ def test_a_session_from_the_page_may_name_only_a_built_in_mesh(files, tmp_path):
     secret.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     with pytest.raises(ExplorerError, match="only a built-in mesh"):
         files.open_uploaded_session({"name": "s.yaml", "content": session(str(secret))})
-    assert files.controller.calls == []
+    assert files.controller.files.calls == []
     files.open_uploaded_session(
         {"name": "../s.yaml", "content": [session("cube")[:9], session("cube")[9:]]}
     )
-    ((call, path),) = files.controller.calls
+    ((call, path),) = files.controller.files.calls
     assert call == "open_session" and path.startswith(files._uploads.name)
 
 
@@ -83,7 +83,7 @@ def test_uploads_meet_the_caps_of_files_on_disk(files):
     with pytest.raises(ExplorerError, match="material library 'm.mtl' is too large"):
         files.open_uploaded_mesh([{"name": "m.obj", "content": b"v 0 0 0\n"},
                                   {"name": "m.mtl", "content": big}])  # fmt: skip
-    assert files.controller.calls == []
+    assert files.controller.files.calls == []
 
 
 @pytest.mark.parametrize("content", [[900_000_000], 900_000_000, [b"v 0 0 0\n", 10**9], "v 0 0 0",
@@ -124,10 +124,10 @@ def test_an_objs_mtllib_must_be_uploaded_with_it(files):
     for lib in (b"../outside.mtl", b"/etc/passwd"):
         with pytest.raises(ExplorerError, match="outside the upload"):
             files.open_uploaded_mesh({"name": "m.obj", "content": OBJ % lib})
-    assert files.controller.calls == []
+    assert files.controller.files.calls == []
     mtl = {"name": "../m.mtl", "content": b"newmtl red\nKd 1 0 0\n"}
     files.open_uploaded_mesh([{"name": "m.obj", "content": OBJ % b"m.mtl"}, mtl])
-    ((call, path),) = files.controller.calls
+    ((call, path),) = files.controller.files.calls
     assert call == "choose_mesh" and path.endswith("/m.obj")
     assert path.startswith(files._uploads.name)
 
@@ -143,10 +143,10 @@ def test_an_uploaded_mtl_is_capped_kept_under_its_own_name_and_imported(files):
     big = b"#" * (tol.MAX_MTL_FILE_BYTES + 1)
     with pytest.raises(ExplorerError, match="material library 'm.mtl' is too large"):
         files.import_uploaded_materials({"name": "m.mtl", "content": big})
-    assert files.controller.calls == []
+    assert files.controller.files.calls == []
     files.server.state.preset_replace = True  # the page's "replace": the answer to "replace?"
     files.import_uploaded_materials({"name": "../../evil.mtl", "content": b"newmtl a\n"})
-    ((call, path, answers),) = files.controller.calls
+    ((call, path, answers),) = files.controller.files.calls
     assert call == "import_materials" and path.endswith("/evil.mtl") and answers == {"yes": True}
     assert path.startswith(files._uploads.name) and files.answers == {}
     assert files.page_text(f"{path}:2: Kd: bad") == "evil.mtl:2: Kd: bad"
@@ -154,14 +154,14 @@ def test_an_uploaded_mtl_is_capped_kept_under_its_own_name_and_imported(files):
 
 def test_the_turntable_takes_the_frames_and_a_format_the_server_can_write(files):
     files.start_turntable(".gif", "12")
-    ((call, path, frames),) = files.controller.calls
+    ((call, path, frames),) = files.controller.files.calls
     assert path.endswith("stem-turntable.gif") and frames == 12
     for bad in ("1", "361", "2.5", "many"):
         with pytest.raises(ExplorerError, match="frames"):
             files.start_turntable(".gif", bad)
     with pytest.raises(ExplorerError, match="the format must be one of"):
         files.start_turntable(".avi", 12)
-    assert ".gif" in turntable_formats() and len(files.controller.calls) == 1
+    assert ".gif" in turntable_formats() and len(files.controller.files.calls) == 1
 
 
 def test_a_picked_colour_is_8_bit_both_ways():

@@ -27,7 +27,7 @@ MIN_DIFFERENCE_SIZE = 16
 LIGHT_TYPES = ("directional", "point", "spot")
 
 
-class Controller(FileFlows):
+class Controller:
     """Every flow of the explorer, for any front end.
 
     state, mesh : the start (``mesh`` is the mesh ``state.mesh`` names; a state without a
@@ -61,14 +61,16 @@ class Controller(FileFlows):
         self._requested = None  # the key of the difference job asked for last
         self._size = None  # the view's size at the last difference check
         self._in_frame = False
+        #: the file flows (open, save, import, export, screenshots, meshes), a collaborator
+        self.files = FileFlows(self)
 
     def start(self) -> None:
         """Observe the store, show the lists, schedule the difference (call once, after the
         front end's view exists)."""
         self.store.subscribe(self._on_change)
         self.reload_presets()
-        self.show_meshes()
-        self.ports.choices.show_recent(self.recent_files())
+        self.files.show_meshes()
+        self.ports.choices.show_recent(self.files.recent_files())
         self._show_history()
         self.update_difference()
 

@@ -1,4 +1,5 @@
-"""The controller's file flows (a mix-in of :class:`explorer.app.controller.Controller`): open a
+"""The controller's file flows (a collaborator :class:`explorer.app.controller.Controller` holds as
+``files``): open a
 mesh, scene or session (and the recent ones), import materials from an .mtl file, export the
 material and the view, save the session and presets, screenshots.
 
@@ -55,17 +56,46 @@ def plural(n: int, noun: str) -> str:
     return f"{n} {noun}{'s' * (n != 1)}"
 
 
+def recent_path(last_session) -> Path | None:
+    """Where the recent-files list is kept: beside the last session (``last_session``: the
+    controller's; none when no session is kept)."""
+    if last_session is None:
+        return None
+    last = last_session_path() if last_session is True else Path(last_session)
+    return last.with_name(RECENT_NAME)
+
+
+def read_recent(path: Path | None) -> list[str]:
+    """The files opened last, newest first, from the list at ``path`` (a list that cannot be
+    read is empty)."""
+    if path is None or not os.path.isfile(path):  # (False for a folder not searchable)
+        return []
+    try:
+        text = read_text_checked(path, cap=tol.MAX_DATA_FILE_BYTES, what="recent files")
+        items = json.loads(text)
+    except ValueError as exc:  # UnreadableFile and JSON errors are ValueErrors
+        log.warning("%s: cannot be read (%s); the recent files start afresh", path, exc)
+        return []
+    return [str(p) for p in items if isinstance(p, str)][:RECENT_MAX] if isinstance(
+        items, list) else []  # fmt: skip
+
+
 class FileFlows:
-    """Needs the controller's ``store``, ``ports``, ``say``, ``report``, ``framed``,
-    ``reload_presets``, ``meshes``, ``mesh_choices`` and its directories."""
+    """The controller's file flows, a collaborator it holds (``controller.files``): they use
+    the controller's ``store``, ``ports``, ``say``, ``report``, ``act``, ``framed``,
+    ``reload_presets``, ``presets``, ``meshes``, ``mesh_choices``, its directories, its session
+    and last-session files and the turntable running."""
+
+    def __init__(self, controller):
+        self.c = controller
 
     # -- questions --------------------------------------------------------------------------
     def _output_path(self, path, title: str, default: str, filter: str, suffixes) -> Path | None:
         """``path``, or the one the user gives (None: given up), checked to end in one of
         ``suffixes``; ``default`` is a name in the output directory."""
         if path is None:
-            path = self.ports.dialogs.ask_path(title, save=True, default=str(
-                self.output_dir / default), filter=filter)  # fmt: skip
+            path = self.c.ports.dialogs.ask_path(title, save=True, default=str(
+                self.c.output_dir / default), filter=filter)  # fmt: skip
             if not path:
                 return None
         path = Path(path)
@@ -75,7 +105,7 @@ class FileFlows:
 
     def _ask_replace(self, path: Path) -> bool:
         """True when ``path`` may be written: it does not exist, or the user said yes."""
-        return not os.path.lexists(path) or self.ports.dialogs.ask_yes(
+        return not os.path.lexists(path) or self.c.ports.dialogs.ask_yes(
             f"Replace the file {path}?")  # fmt: skip
 
     def _say_done(self, title: str, text: str, notes, noun: str) -> None:
@@ -85,56 +115,57 @@ class FileFlows:
             log.warning("%s", note)
         if notes:
             text += f" ({plural(len(notes), noun)})"
-            self.ports.dialogs.tell(title, text, details="\n".join(notes))
-        self.say(text, "warning" if notes else "info", notes, open_log=False)
+            self.c.ports.dialogs.tell(title, text, details="\n".join(notes))
+        self.c.say(text, "warning" if notes else "info", notes, open_log=False)
 
     # -- meshes -----------------------------------------------------------------------------
     def show_meshes(self) -> None:
-        labels = {n: (Path(n).name if n not in MESH_CHOICES else n) for n in self.mesh_choices}
-        self.ports.choices.show_meshes(labels)
+        labels = {n: (Path(n).name if n not in MESH_CHOICES else n) for n in self.c.mesh_choices}
+        self.c.ports.choices.show_meshes(labels)
 
     def _known_mesh(self, name: str, mesh: Mesh) -> None:
-        self.meshes[name] = mesh
-        if name not in self.mesh_choices:
-            self.mesh_choices[name] = None
+        self.c.meshes[name] = mesh
+        if name not in self.c.mesh_choices:
+            self.c.mesh_choices[name] = None
             self.show_meshes()
 
     def choose_mesh(self, name: str) -> bool:
         """Show mesh ``name`` (a chooser name): loaded once, the camera framed anew, with the
         materials its file brings. Returns False (the error said) when it cannot."""
         try:
-            mesh = self.meshes.get(name) or load_mesh_choice(name, self.mesh_choices.get(name))
+            mesh = self.c.meshes.get(name) or load_mesh_choice(name, self.c.mesh_choices.get(name))
             self._known_mesh(name, mesh)
-            state = M.set_mesh(self.store.state, name, mesh.centre, mesh.radius)
-            state = M.set_camera(state, self.framed(state, mesh))
+            state = M.set_mesh(self.c.store.state, name, mesh.centre, mesh.radius)
+            state = M.set_camera(state, self.c.framed(state, mesh))
             try:
                 state, warnings = add_mesh_materials(state, mesh)
             except MtlError as exc:  # the mesh is drawn in the present material
-                self.report(exc, "mesh materials")
+                self.c.report(exc, "mesh materials")
                 warnings = []
-            self.store.commit(state, f"mesh {Path(name).name}")
+            self.c.store.commit(state, f"mesh {Path(name).name}")
         except ExplorerError as exc:
-            self.report(exc, "mesh")
+            self.c.report(exc, "mesh")
             return False
         self.say_mesh_warnings(mesh.name, warnings)
         return True
 
     def say_mesh_warnings(self, mesh_name: str, warnings, *, logged: bool = False) -> None:
-        """A mesh file's material warnings as one message, each whole in the log (``logged``:
-        printed already, as for the mesh the explorer started with)."""
+        """The warnings of a mesh file's materials (its .mtl read), one message whose log lines
+        are the warnings, whole: when the mesh is chosen, and for the mesh the explorer
+        started with (``logged``: already printed where the explorer was started)."""
         if not warnings:
             return
         if not logged:
             for w in warnings:
                 log.warning("%s", w)
-        self.say(f"{mesh_name}: its materials read with {plural(len(warnings), 'warning')}"
-                 " (details in the message log)", "warning", list(warnings), STATUS_MS)  # fmt: skip
+        text = f"{mesh_name}: its materials read with {plural(len(warnings), 'warning')}"
+        self.c.say(text + " (details in the message log)", "warning", list(warnings), STATUS_MS)
 
     # -- open -------------------------------------------------------------------------------
     def open_file(self, path=None) -> None:
         """Open a mesh file, a scene file or a session (File > Open)."""
         if path is None:
-            path = self.ports.dialogs.ask_path("Open mesh, scene or session", filter=OPEN_FILTER)
+            path = self.c.ports.dialogs.ask_path("Open mesh, scene or session", filter=OPEN_FILTER)
             if not path:
                 return
         path = os.fspath(path)
@@ -148,12 +179,12 @@ class FileFlows:
         if isinstance(doc.data, dict) and "session" in doc.data:
             self.open_session(path)
         else:
-            self._open_scene(load_scene(path, materials_dirs=self.materials_dirs), path)
+            self._open_scene(load_scene(path, materials_dirs=self.c.materials_dirs), path)
         self.remember_recent(path)
 
     def _open_scene(self, scene, path: str) -> None:
         M.check_window_lights(len(scene.lights), path)
-        s = self.store.state  # the scene's material covers the mesh (groups=None)
+        s = self.c.store.state  # the scene's material covers the mesh (groups=None)
         new = s.replace(scene=scene.replace(mesh=s.mesh), preset=scene.material.name,
                         preset_material=None, light=0, held_azimuth=None,
                         groups=None)  # fmt: skip
@@ -165,57 +196,59 @@ class FileFlows:
             try:
                 new, _ = add_mesh_materials(new, mesh, use=False)
             except MtlError as exc:
-                self.report(exc, "mesh materials")
-        new = M.set_camera(new, self.framed(new, self.meshes[new.mesh]))
-        self.store.commit(new, f"open {Path(path).name}")
-        self.say(f"opened scene {path}")
+                self.c.report(exc, "mesh materials")
+        new = M.set_camera(new, self.c.framed(new, self.c.meshes[new.mesh]))
+        self.c.store.commit(new, f"open {Path(path).name}")
+        self.c.say(f"opened scene {path}")
 
     def open_session(self, path) -> None:
-        state, mesh = load_session(path, materials_dirs=self.materials_dirs)
+        state, mesh = load_session(path, materials_dirs=self.c.materials_dirs)
         self._known_mesh(state.mesh, mesh)
         if state.camera is None:
-            state = M.set_camera(state, self.framed(state, mesh))
-        self.store.commit(state, f"open {Path(path).name}")
-        self.session_path = Path(path)
-        self.say(f"opened session {path}")
+            state = M.set_camera(state, self.c.framed(state, mesh))
+        self.c.store.commit(state, f"open {Path(path).name}")
+        self.c.session_path = Path(path)
+        self.c.say(f"opened session {path}")
 
     # -- sessions and presets ---------------------------------------------------------------
     def save_session_as(self, path=None) -> Path | None:
         if path is None:
-            default = str(self.session_path or Path.cwd() / "session.yaml")
-            path = self.ports.dialogs.ask_path("Save session", save=True, default=default,
-                                               filter="sessions (*.yaml *.yml *.json)")  # fmt: skip
+            default = str(self.c.session_path or Path.cwd() / "session.yaml")
+            path = self.c.ports.dialogs.ask_path(
+                "Save session", save=True, default=default, filter="sessions (*.yaml *.yml *.json)"
+            )
             if not path:
                 return None
         path = Path(path)
         overwrite = path.exists()
-        if overwrite and not self.ports.dialogs.ask_yes(f"Replace the session file {path}?"):
+        if overwrite and not self.c.ports.dialogs.ask_yes(f"Replace the session file {path}?"):
             return None
-        written = save_session(path, self.store.state, overwrite=overwrite)
-        self.session_path = written
+        written = save_session(path, self.c.store.state, overwrite=overwrite)
+        self.c.session_path = written
         self.remember_recent(written)
-        self.say(f"saved session {written}")
+        self.c.say(f"saved session {written}")
         return written
 
     def keep_last_session(self) -> None:
-        """Write the session to the last-session file (``--last`` reopens it), replacing only
-        a regular file: a FIFO, link, device or folder there is left as it is, with a warning."""
-        if self.last_session is None:
+        """Write the session to the last-session file (``gui --last`` reopens it). The file
+        kept before is replaced; anything else at that path (a FIFO, a device, a link, a
+        folder: not a session this explorer kept) is left as it is, and the warning says so."""
+        if self.c.last_session is None:
             return
         try:
-            path = Path(self.last_session) if self.last_session is not True else None
+            path = Path(self.c.last_session) if self.c.last_session is not True else None
             path = path or last_session_path()
             if os.path.lexists(path) and not stat.S_ISREG(os.lstat(path).st_mode):
                 raise ExplorerError(f"{path}: is not a regular file; left as it is")
-            save_session(path, self.store.state, overwrite=True)
+            save_session(path, self.c.store.state, overwrite=True)
         except ExplorerError as exc:
             log.warning("could not keep the last session: %s", exc)
 
     def _preset_name(self, name, stem: str, taken: set) -> str | None:
         """The name to save a preset under: ``name``, or the one the user gives (checked)."""
-        s = self.store.state
+        s = self.c.store.state
         if name is None:
-            name = self.ports.dialogs.ask_text(
+            name = self.c.ports.dialogs.ask_text(
                 "Save preset as", "preset name (lowercase letters, digits, _):",
                 free_name(stem, taken) if s.edited else (s.preset or stem),
             )  # fmt: skip
@@ -229,16 +262,16 @@ class FileFlows:
         checks it, asks before replacing a file or hiding another preset. The preset is then
         shown clean; while the mesh shows its own materials the edited group's is saved, and
         the groups stay."""
-        s = self.store.state
+        s = self.c.store.state
         stem = (s.preset or self.material_name())[: MAX_NAME_LENGTH - 8]
-        taken = {p.name for p in self.presets}
+        taken = {p.name for p in self.c.presets}
         name = self._preset_name(name, stem, taken)
         if name is None:
             return None
-        directory = Path(self.preset_dir) if self.preset_dir else user_dir()
+        directory = Path(self.c.preset_dir) if self.c.preset_dir else user_dir()
         path = directory / f"{name}.yaml"
         overwrite = path.exists()
-        ask = self.ports.dialogs.ask_yes
+        ask = self.c.ports.dialogs.ask_yes
         if overwrite and not ask(f"Replace the preset file {path}?"):
             return None
         if (
@@ -250,35 +283,17 @@ class FileFlows:
         material = s.material.replace(model=s.scene.model, description=s.material.description
                                       or f"{stem} as edited in phong-explorer")  # fmt: skip
         written = save_preset(material, name, directory, overwrite=overwrite)
-        self.reload_presets()
-        info = next((p for p in self.presets if p.name == name), None)
+        self.c.reload_presets()
+        info = next((p for p in self.c.presets if p.name == name), None)
         if info is not None and s.groups is None:
-            self.act(M.apply_preset, name, info.material, label=f"save preset {name}")
-        self.say(f"saved preset '{name}' to {written}")
+            self.c.act(M.apply_preset, name, info.material, label=f"save preset {name}")
+        self.c.say(f"saved preset '{name}' to {written}")
         return written
 
     # -- recent files -----------------------------------------------------------------------
-    def recent_file(self) -> Path | None:
-        """Where the recent-files list is kept: beside the last session (none when no session
-        is kept)."""
-        if self.last_session is None:
-            return None
-        last = last_session_path() if self.last_session is True else Path(self.last_session)
-        return last.with_name(RECENT_NAME)
-
     def recent_files(self) -> list[str]:
-        """The files opened last, newest first (a list that cannot be read is empty)."""
-        path = self.recent_file()
-        if path is None or not os.path.isfile(path):  # (False for a folder not searchable)
-            return []
-        try:
-            text = read_text_checked(path, cap=tol.MAX_DATA_FILE_BYTES, what="recent files")
-            items = json.loads(text)
-        except ValueError as exc:  # UnreadableFile and JSON errors are ValueErrors
-            log.warning("%s: cannot be read (%s); the recent files start afresh", path, exc)
-            return []
-        return [str(p) for p in items if isinstance(p, str)][:RECENT_MAX] if isinstance(
-            items, list) else []  # fmt: skip
+        """The files opened last, newest first (:func:`read_recent`)."""
+        return read_recent(recent_path(self.c.last_session))
 
     def remember_recent(self, path) -> None:
         """Put ``path`` first in the recent files."""
@@ -287,14 +302,14 @@ class FileFlows:
         self.keep_recent(items[:RECENT_MAX])
 
     def keep_recent(self, items: list[str]) -> None:
-        where = self.recent_file()
+        where = recent_path(self.c.last_session)
         if where is not None:
             try:
                 text = json.dumps(items, indent=1).encode("utf-8")
                 write_atomic(where, text, overwrite=True, make_dirs=True)
             except (OSError, ExplorerError) as exc:
                 log.warning("could not keep the recent files: %s", exc)
-        self.ports.choices.show_recent(items)
+        self.c.ports.choices.show_recent(items)
 
     def open_recent(self, path: str) -> None:
         if not os.path.isfile(path):
@@ -308,17 +323,17 @@ class FileFlows:
         ``presets import``): asks before replacing preset files (all or nothing); a file the
         reader cannot take is named with its line in a dialog, and nothing is written; the
         reader's warnings are shown. Returns the preset files written."""
-        dialogs = self.ports.dialogs
+        dialogs = self.c.ports.dialogs
         if path is None:
             path = dialogs.ask_path("Import materials", filter="material libraries (*.mtl);;"
                                     "all files (*)")  # fmt: skip
             if not path:
                 return []
-        directory = Path(self.preset_dir) if self.preset_dir else user_dir()
+        directory = Path(self.c.preset_dir) if self.c.preset_dir else user_dir()
         try:
             job = mtl_import(path, directory)
         except MtlError as exc:
-            self.say(f"error (import materials): {exc}", "error")
+            self.c.say(f"error (import materials): {exc}", "error")
             dialogs.tell("Import materials", f"{exc}\n\nNothing was imported.", error=True)
             return []
         existing = job.existing
@@ -326,11 +341,11 @@ class FileFlows:
             f"{plural(len(existing), 'preset file')} of {Path(path).name} "
             f"exist already:\n" + "\n".join(str(t) for t in existing) + "\n\nReplace them?"
         ):
-            self.say(f"nothing imported from {path}: the preset files exist")
+            self.c.say(f"nothing imported from {path}: the preset files exist")
             return []
         written = job.write(overwrite=bool(existing))
         warnings = [w for m in job.found for w in m.warnings]
-        self.reload_presets()
+        self.c.reload_presets()
         text = (f"imported {plural(len(written), 'preset')} from {Path(path).name} into "
                 f"{directory}: " + ", ".join(job.names))  # fmt: skip
         self._say_done("Import materials", text, warnings, "warning")
@@ -338,7 +353,7 @@ class FileFlows:
 
     def material_name(self) -> str:
         """A file or preset name for the material shown: the preset's, or the edited group's."""
-        s = self.store.state
+        s = self.c.store.state
         if s.groups is not None:
             return preset_name(s.mesh_materials.names[s.group] or "material")
         return preset_name(s.preset or s.material.name or "material")
@@ -348,7 +363,7 @@ class FileFlows:
         ``.json`` (three.js), ``.x3d``, ``.yaml`` (a preset file). While the mesh shows its own
         materials, an ``.mtl`` holds every group's (a library for the OBJ); the other formats
         hold the edited group's. The approximations a format makes are shown."""
-        s = self.store.state
+        s = self.c.store.state
         name = self.material_name()
         path = self._output_path(path, "Export material", f"{name}.mtl", MATERIAL_FILTER,
                                  tuple(MATERIAL_SUFFIXES))  # fmt: skip
@@ -377,7 +392,7 @@ class FileFlows:
     # -- pictures ---------------------------------------------------------------------------
     def picture_stem(self) -> str:
         """``phong-explorer-<preset or mesh file>-<mesh>``, safe as a file name."""
-        s = self.store.state
+        s = self.c.store.state
         what = s.preset or (s.mesh_materials.source if s.groups is not None else "material")
         stem = f"phong-explorer-{Path(what).stem}-{Path(s.mesh).stem}"
         return "".join(ch if ch.isalnum() or ch in "-_" else "_" for ch in stem)
@@ -388,17 +403,17 @@ class FileFlows:
                                  "PNG pictures (*.png)", (".png",))  # fmt: skip
         if path is None or not self._ask_replace(path):
             return None
-        written = write_atomic(path, self.ports.view.png(), overwrite=os.path.lexists(path))
-        self.say(f"exported the view to {written}")
+        written = write_atomic(path, self.c.ports.view.png(), overwrite=os.path.lexists(path))
+        self.c.say(f"exported the view to {written}")
         return written
 
     def screenshot(self) -> Path:
         """Save the view as a PNG in the output directory (a new file every time)."""
         stem = self.picture_stem()
-        taken = {p.stem for p in self.output_dir.glob(f"{stem}_*.png")}
-        path = self.output_dir / f"{free_name(stem, taken)}.png"
-        write_atomic(path, self.ports.view.png())
-        self.say(f"saved screenshot {path}")
+        taken = {p.stem for p in self.c.output_dir.glob(f"{stem}_*.png")}
+        path = self.c.output_dir / f"{free_name(stem, taken)}.png"
+        write_atomic(path, self.c.ports.view.png())
+        self.c.say(f"saved screenshot {path}")
         return path
 
     def export_turntable(self, path=None, frames: int | None = None, size=None):
@@ -407,16 +422,16 @@ class FileFlows:
         ``size``: (width, height), default the view's. Returns the job (its ``stage`` says how
         far it got; ``job.dialog`` the front end's progress handle), or None when the user gave
         up at a question."""
-        if self.turntable is not None and self.turntable.stage in ("render", "encode"):
+        if self.c.turntable is not None and self.c.turntable.stage in ("render", "encode"):
             raise ExplorerError("a turntable is being made: wait for it, or cancel it")
-        s = self.store.state
+        s = self.c.store.state
         path = self._output_path(path, "Export turntable",
                                  f"{self.picture_stem()}-turntable.gif",
                                  "GIF (*.gif);;MP4 (*.mp4)", TURNTABLE_SUFFIXES)  # fmt: skip
         if path is None:
             return None
         if frames is None:
-            frames = self.ports.dialogs.ask_number(
+            frames = self.c.ports.dialogs.ask_number(
                 "Export turntable",
                 "frames in a full turn:",
                 DEFAULT_FRAMES,
@@ -427,30 +442,30 @@ class FileFlows:
                 return None
         if not self._ask_replace(path):
             return None
-        size = turntable_size(*(size or self.ports.view.size()))
-        job = TurntableJob(s.shown_scene(), self.meshes[s.mesh], frames, size, path,
+        size = turntable_size(*(size or self.c.ports.view.size()))
+        job = TurntableJob(s.shown_scene(), self.c.meshes[s.mesh], frames, size, path,
                            groups=s.shown_groups(), camera=s.camera,
-                           background=tuple(self.ports.view.background()),
+                           background=tuple(self.c.ports.view.background()),
                            overwrite=os.path.lexists(path))  # fmt: skip
-        self.turntable = job
+        self.c.turntable = job
 
         def step():
             try:
                 stage = job.step()
             except Exception as exc:  # noqa: BLE001 - said, and the job ends
                 job.cancel()
-                self.report(exc, "turntable")
+                self.c.report(exc, "turntable")
                 return None
             if stage == "written":
-                self.say(f"wrote {path}: {frames} frames of {size[0]}x{size[1]}")
+                self.c.say(f"wrote {path}: {frames} frames of {size[0]}x{size[1]}")
                 return None
             return job.done, (f"Encoding {path.name}…" if stage == "encode" else None)
 
         def cancel():
             job.cancel()
-            self.say(f"turntable cancelled: {path} was not written")
+            self.c.say(f"turntable cancelled: {path} was not written")
 
-        job.dialog = self.ports.progress.run_steps(
+        job.dialog = self.c.ports.progress.run_steps(
             "turntable", f"Drawing {frames} frames of {path.name}…", frames + 1, step, cancel
         )
         return job

@@ -1,6 +1,8 @@
-"""The explorer window's menus, shortcuts and the 3D view's keys (in
-:class:`explorer.app.qt.window.ExplorerWindow`): each entry sends an intent to the window's
-:class:`~explorer.app.controller.Controller`."""
+"""The explorer window's menus, shortcuts, the 3D view's keys and the help (in
+:class:`explorer.app.qt.window.ExplorerWindow`), all built from the intent registry
+(:data:`explorer.app.intents.INTENTS`): each entry and key runs an intent, a method of the
+window's :class:`~explorer.app.controller.Controller` or one of the window's own (quit, the
+help, the message log)."""
 
 from __future__ import annotations
 
@@ -8,54 +10,22 @@ from pathlib import Path
 
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from explorer.app import intents as intents_
+from explorer.app.intents import BY_ID, INTENTS, MENUS
 from explorer.app.qt.messages import open_log
-from explorer.core.material import MODELS
 
-#: keys of the 3D view (active while it has the keyboard focus): key -> (what, method name);
-#: the methods are the controller's intents, but for the help (the menus') and quit (the window's)
-VIEW_KEYS = {
-    "h": ("show / hide this help", "toggle_help"),
-    "r": ("reset the camera (the material and lights stay)", "reset_camera"),
-    "q": ("quit (the session is kept for 'gui --last')", "close"),
-    "d": ("show / hide the per-pixel difference", "toggle_difference"),
-    "b": (f"next specular model ({' / '.join(MODELS)})", "toggle_model"),
-    "1": ("show / hide the ambient term", "toggle_ambient"),
-    "2": ("show / hide the diffuse term", "toggle_diffuse"),
-    "3": ("show / hide the specular term", "toggle_specular"),
-    "n": ("next preset", "next_preset"),
-    "p": ("previous preset", "previous_preset"),
-    "t": ("next light type (directional / point / spot)", "next_light_type"),
-    "l": ("control the next light", "next_light"),
-    "i": ("save a screenshot of the view (never over a file)", "screenshot"),
-    "c": ("compare A | B on / off (two panes, linked cameras)", "toggle_compare"),
-    "x": ("swap A and B", "swap_sides"),
-}
-#: mouse controls of the view, for the help
-MOUSE = (
-    ("drag the yellow sphere", "move the light (the lights tab follows)"),
-    ("left drag", "rotate the camera; the camera is the viewer, so highlights move"),
-    ("right drag / wheel", "zoom"),
-    ("middle drag / shift + left drag", "pan"),
-)
+#: keys of the 3D view (active while it has the keyboard focus): key -> intent id (from the
+#: registry, :data:`explorer.app.intents.INTENTS`)
+VIEW_KEYS = {i.view_key: i.id for i in INTENTS if i.view_key}
 
 
 def help_text() -> str:
-    """Every key and mouse control, one per line."""
-    lines = ["Keys in the 3D view (VTK's own keys are switched off):"]
-    lines += [f"  {key}   {what}" for key, (what, _) in VIEW_KEYS.items()]
-    lines += ["", "Window shortcuts:", "  Ctrl+Z / Ctrl+Shift+Z   undo / redo",
-              "  Ctrl+O   open a mesh, scene or session",
-              "  Ctrl+I / Ctrl+E   import materials (.mtl) / export the material",
-              "  Ctrl+Shift+E / Ctrl+T   export the view (PNG) / a turntable (GIF, MP4)",
-              "  Ctrl+S   save the session",
-              "  Ctrl+Shift+S   save the material as a preset", "  Ctrl+Q   quit",
-              "  F1   this help", "", "Mouse in the 3D view:"]  # fmt: skip
-    lines += [f"  {how}: {what}" for how, what in MOUSE]
-    return "\n".join(lines)
+    """Every key and mouse control, one per line (from the registry)."""
+    return "\n".join(intents_.help_lines())
 
 
 class ViewKeys(QtCore.QObject):
-    """The 3D view's keys: :data:`VIEW_KEYS` run their commands; every other plain key is
+    """The 3D view's keys: :data:`VIEW_KEYS` run their intents; every other plain key is
     kept from VTK and PyVista, whose own keys (w wireframe, s surface, 3 stereo, ...) would
     change the picture behind the state's back. Keys with Ctrl or Alt go on to the menus."""
 
@@ -72,75 +42,71 @@ class ViewKeys(QtCore.QObject):
             return False
         if kind == QtCore.QEvent.Type.KeyPress and event.text() in VIEW_KEYS:
             key = event.text()
-            w, method = self.window, VIEW_KEYS[key][1]
-            target = {"toggle_help": w.menus.toggle_help, "close": w.close}.get(method)
-            w._guard(target or getattr(w.controller, method), f"key {key}")()
+            self.window._guard(self.window.menus.run, f"key {key}")(VIEW_KEYS[key])
         return True
 
 
 class Menus:
     """The menu bar of ``window`` (sets ``window.menu_actions``, ``window.recent_menu`` and
-    ``window.help``), the 3D view's keys, the Save button of the material tab; the
+    ``window.help``) and the 3D view's keys, both from the intent registry
+    (:data:`explorer.app.intents.INTENTS`), and the Save button of the material tab; the
     controller's choices port shows undo / redo and the recent files here."""
 
     def __init__(self, window):
         self.window = w = window
         c = w.controller
+        #: the window's own callbacks of the registry's ``front:NAME`` intents
+        self.front = {
+            "quit": w.close,
+            "help": self.toggle_help,
+            "messages": lambda: open_log(w.messages),
+        }
         bar = w.menuBar()
         self.actions = w.menu_actions = {}
-        f = bar.addMenu("&File")
-        add = self.add_action
-        add(f, "open", "&Open mesh, scene or session…", c.open_file, "Ctrl+O")
-        self.recent = w.recent_menu = f.addMenu("Open &recent")
-        self.recent.setObjectName("recent")
-        f.addSeparator()
-        add(f, "import_materials", "&Import materials (.mtl)…", c.import_materials, "Ctrl+I")
-        add(f, "export_material", "&Export material…", c.export_material, "Ctrl+E")
-        add(f, "export_render", "Export &view as PNG…", c.export_render, "Ctrl+Shift+E")
-        add(f, "export_turntable", "Export &turntable (GIF, MP4)…", c.export_turntable, "Ctrl+T")
-        f.addSeparator()
-        add(f, "save_session", "&Save session…", c.save_session_as, "Ctrl+S")
-        add(f, "save_preset", "Save &preset as…", c.save_preset_as, "Ctrl+Shift+S")
-        add(f, "screenshot", "Save screens&hot", c.screenshot)
-        f.addSeparator()
-        add(f, "quit", "&Quit", w.close, "Ctrl+Q")
-        e = bar.addMenu("&Edit")
-        add(e, "undo", "&Undo", c.undo, "Ctrl+Z")
-        add(e, "redo", "&Redo", c.redo, "Ctrl+Shift+Z|Ctrl+Y")
-        e.addSeparator()
-        add(e, "reset_all", "Reset &all (undoable)", c.reset_all)
-        v = bar.addMenu("&View")
-        add(v, "reset_camera", "Reset &camera (r)", c.reset_camera)
-        add(v, "toggle_difference", "&Difference view (d)", c.toggle_difference)
-        add(v, "toggle_compare", "&Compare A | B (c)", c.toggle_compare)
-        add(v, "swap_sides", "&Swap A and B (x)", c.swap_sides)
-        v.addSeparator()
-        add(v, "messages", "&Messages", lambda: open_log(w.messages), "Ctrl+M")
-        h = bar.addMenu("&Help")
-        add(h, "help", "&Keys and mouse", self.toggle_help, "F1")
-        w.panel.material.save.clicked.connect(w._guard(c.save_preset_as, "save preset"))
+        for name in MENUS:
+            menu = bar.addMenu(f"&{name}")
+            for n, group in enumerate(intents_.menu(name)):
+                if n:
+                    menu.addSeparator()
+                for intent in group:
+                    self.add_action(menu, intent)
+                if intent.id == "open":  # the recent files follow File > Open
+                    self.recent = w.recent_menu = menu.addMenu("Open &recent")
+                    self.recent.setObjectName("recent")
+        w.panel.material.save.clicked.connect(w._guard(c.files.save_preset_as, "save preset"))
         self._view_keys = ViewKeys(w)
         w.plotter.installEventFilter(self._view_keys)
         w.help = None
 
-    def add_action(self, menu, name: str, text: str, slot, shortcut: str | None = None):
-        """A menu entry named ``name`` (``menu_actions[name]``) running ``slot()`` with its
-        errors shown; ``shortcut``: key sequences separated by ``|``."""
-        a = QtGui.QAction(text, self.window)
-        a.setObjectName(name)
-        if shortcut:
-            a.setShortcuts([QtGui.QKeySequence(s) for s in shortcut.split("|")])
-        a.triggered.connect(self.window._guard(lambda _=False: slot(), name))
+    def run(self, intent_id: str):
+        """Run intent ``intent_id`` (:func:`explorer.app.intents.run`)."""
+        return intents_.run(intent_id, self.window.controller, self.front)
+
+    def add_action(self, menu, intent) -> QtGui.QAction:
+        """The menu entry of ``intent`` (``menu_actions[intent.id]``): its title (and view
+        key), its shortcuts, running the intent with its errors shown."""
+        key = f" ({intent.view_key})" if intent.view_key and not intent.keys else ""
+        a = QtGui.QAction(intent.title + key, self.window)
+        a.setObjectName(intent.id)
+        a.setShortcuts([QtGui.QKeySequence(s) for s in intent.keys])
+        a.triggered.connect(self.window._guard(lambda _=False: self.run(intent.id), intent.id))
         menu.addAction(a)
-        self.actions[name] = a
+        self.actions[intent.id] = a
         return a
 
+    def refresh(self) -> None:
+        """Each entry enabled when its intent can run now."""
+        for name, on in intents_.enabled(self.window.controller).items():
+            if name in self.actions:
+                self.actions[name].setEnabled(on)
+
     def show_history(self, undo: str | None, redo: str | None) -> None:
-        """Undo and redo enabled when there is something to undo or redo, named after it."""
+        """Undo and redo named after what they undo or redo; every entry enabled when its
+        intent can run (undo and redo: when there is something to undo or redo)."""
         for name, label in (("undo", undo), ("redo", redo)):
-            a = self.actions[name]
-            a.setEnabled(label is not None)
-            a.setText(f"&{name.title()} {label}" if label else f"&{name.title()}")
+            title = BY_ID[name].title
+            self.actions[name].setText(f"{title} {label}" if label else title)
+        self.refresh()
 
     def show_recent(self, items: list[str]) -> None:
         menu, c = self.recent, self.window.controller
@@ -148,13 +114,15 @@ class Menus:
         for i, path in enumerate(items):
             a = menu.addAction(f"&{i + 1} {Path(path).name}   ({Path(path).parent})")
             a.setObjectName(f"recent_{i + 1}")
-            a.triggered.connect(self.window._guard(lambda _=False, p=path: c.open_recent(p),
-                                                   "open recent"))  # fmt: skip
+            a.triggered.connect(
+                self.window._guard(lambda _=False, p=path: c.files.open_recent(p), "open recent")
+            )
         if items:
             menu.addSeparator()
             clear = menu.addAction("&Clear the list")
-            clear.triggered.connect(self.window._guard(lambda _=False: c.keep_recent([]),
-                                                       "recent"))  # fmt: skip
+            clear.triggered.connect(
+                self.window._guard(lambda _=False: c.files.keep_recent([]), "recent")
+            )
         menu.setEnabled(bool(items))
 
     def toggle_help(self) -> None:

@@ -76,7 +76,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.controller = c = Controller(state, mesh, ports, materials_dirs=materials_dirs,
                                          preset_dir=preset_dir, output_dir=output_dir,
                                          last_session=last_session)  # fmt: skip
-        self.panel = Panel(c.act, c.choose_mesh, c.set_value)
+        self.panel = Panel(c.act, c.files.choose_mesh, c.set_value)
         self.splitter.addWidget(self.panel)
         self.splitter.setSizes([round(w * (1 - PANEL_FRACTION)), round(w * PANEL_FRACTION)])
         self.bar = MessageBar(self)
@@ -91,7 +91,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self._observe()
         self.menus = Menus(self)
         c.start()
-        c.say_mesh_warnings(mesh.name, start_warnings, logged=True)  # printed at the start too
+        c.files.say_mesh_warnings(mesh.name, start_warnings, logged=True)  # printed at start too
         self.viewport.show_start(c.state)
 
     # -- building ------------------------------------------------------------------------------
@@ -265,7 +265,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
                 self.controller.frame_start()
 
     def closeEvent(self, event: QtGui.QCloseEvent) -> None:  # noqa: N802 - Qt's name
-        self.controller.keep_last_session()
+        self.controller.files.keep_last_session()
         if self.controller.turntable is not None:
             self.controller.turntable.cancel()  # nothing written
         self.worker.close()
