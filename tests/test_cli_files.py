@@ -48,8 +48,14 @@ def _writers(tmp_path, out: str) -> dict[str, list[str]]:
     }
 
 
-WRITERS = ["render png", "render obj", "render turntable", "sheet", "presets export",
-           "presets import"]  # fmt: skip
+WRITERS = [
+    "render png",
+    "render obj",
+    "render turntable",
+    "sheet",
+    "presets export",
+    "presets import",
+]
 
 
 @pytest.mark.parametrize("command", WRITERS)
@@ -104,9 +110,14 @@ def _run(argv, *, prefix=(), env=None, limit=None, cwd=None):
             resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
     return subprocess.run(
-        [*prefix, sys.executable, "-m", "explorer.cli", *argv], capture_output=True, text=True,
-        env=full_env, timeout=240, preexec_fn=limited, cwd=cwd,
-    )  # fmt: skip
+        [*prefix, sys.executable, "-m", "explorer.cli", *argv],
+        capture_output=True,
+        text=True,
+        env=full_env,
+        timeout=240,
+        preexec_fn=limited,
+        cwd=cwd,
+    )
 
 
 @pytest.fixture
@@ -132,20 +143,47 @@ def test_a_locked_folder_is_one_line_per_command(tmp_path, locked):
     import into it, the last session in it (``--last`` reads it), a ``--materials-dir`` in it,
     the user's preset folder in it (left out with a notice: the rest works)."""
     folder, prefix = locked
-    res = _run(["render", "--mesh", "sphere", "--size", "32x32", "--force",
-                "--out", str(folder / "sub" / "keep.png")], prefix=prefix)  # fmt: skip
+    res = _run(
+        [
+            "render",
+            "--mesh",
+            "sphere",
+            "--size",
+            "32x32",
+            "--force",
+            "--out",
+            str(folder / "sub" / "keep.png"),
+        ],
+        prefix=prefix,
+    )
     assert res.returncode == 2
     _one_error_line(res.stderr, "keep.png", "Permission denied")
-    res = _run(["presets", "import", str(_mtl(tmp_path)), "--into", str(folder / "sub")],
-               prefix=prefix)  # fmt: skip
+    res = _run(
+        ["presets", "import", str(_mtl(tmp_path)), "--into", str(folder / "sub")], prefix=prefix
+    )
     assert res.returncode == 2
     _one_error_line(res.stderr, "a.yaml", "Permission denied")
-    res = _run(["web", "--last", "--port", "1"], prefix=prefix,
-               env={"PHONG_EXPLORER_LAST_SESSION": str(folder / "last.yaml")})  # fmt: skip
+    res = _run(
+        ["web", "--last", "--port", "1"],
+        prefix=prefix,
+        env={"PHONG_EXPLORER_LAST_SESSION": str(folder / "last.yaml")},
+    )
     assert res.returncode == 2
     _one_error_line(res.stderr, "--last", "last.yaml", "Permission denied")
-    res = _run(["render", "--mesh", "sphere", "--size", "32x32", "--materials-dir",
-                str(folder / "sub"), "--out", str(tmp_path / "x.png")], prefix=prefix)  # fmt: skip
+    res = _run(
+        [
+            "render",
+            "--mesh",
+            "sphere",
+            "--size",
+            "32x32",
+            "--materials-dir",
+            str(folder / "sub"),
+            "--out",
+            str(tmp_path / "x.png"),
+        ],
+        prefix=prefix,
+    )
     assert res.returncode == 2  # (it said the folder "is not a directory")
     _one_error_line(res.stderr, "--materials-dir", "cannot read it: Permission denied")
     res = _run(["presets", "list"], prefix=prefix, env={"XDG_CONFIG_HOME": str(folder)})

@@ -165,7 +165,12 @@ def _material_rows() -> list[Row]:
         )
         for t in M.TERMS
     ]
-    rows += [
+    return rows
+
+
+def _material_effect_rows() -> list[Row]:
+    """The material's effects beyond OpenGL 2.1 (docs/effects.md), after its own rows."""
+    return [
         Row(
             "fresnel",
             "material",
@@ -186,7 +191,6 @@ def _material_rows() -> list[Row]:
             "raises its peak",
         ),
     ]
-    return rows
 
 
 def _has(key: str) -> Callable[[M.State], bool]:
@@ -357,7 +361,12 @@ def _view_rows() -> list[Row]:
 
 
 #: every row, in the order each tab draws them
-ROWS: tuple[Row, ...] = (*_material_rows(), *_light_rows(), *_view_rows())
+ROWS: tuple[Row, ...] = (
+    *_material_rows(),
+    *_material_effect_rows(),
+    *_light_rows(),
+    *_view_rows(),
+)
 #: the rows by key
 BY_KEY: dict[str, Row] = {r.key: r for r in ROWS}
 #: the effects of docs/effects.md as rows (translucency is ``opacity``)

@@ -47,8 +47,10 @@ def controls_changed(old: M.State, new: M.State) -> bool:
     """Whether the controls show something new from ``old`` to ``new``: anything but the camera
     (and the viewer, which is the camera) changed, or the preset's material was replaced."""
     viewer = old.scene.replace(viewer=new.scene.viewer)
-    return (old.replace(camera=None, scene=viewer) != new.replace(camera=None)
-            or new.preset_material is not old.preset_material)  # fmt: skip
+    return (
+        old.replace(camera=None, scene=viewer) != new.replace(camera=None)
+        or new.preset_material is not old.preset_material
+    )
 
 
 class PlotterView:
@@ -71,15 +73,23 @@ class PlotterView:
         self._t0: float | None = None
         self._mesh: str | None = None
 
-    def attach(self, controller, mesh, *, side_b=None, lod_vertices: int = LOD_VERTICES,
-               lod_target: int = LOD_TARGET) -> SceneView:  # fmt: skip
+    def attach(
+        self,
+        controller,
+        mesh,
+        *,
+        side_b=None,
+        lod_vertices: int = LOD_VERTICES,
+        lod_target: int = LOD_TARGET,
+    ) -> SceneView:
         """Draw ``controller``'s state (``mesh`` the mesh it names) with its camera, the light
         handles (dragged as :meth:`begin_drag` / :meth:`end_drag` say), side B ``side_b`` (an
         :class:`~explorer.app.sides.SideB`), and watch the frames. Returns the scene drawn."""
         self.controller = controller
         state = controller.state
-        self.view = SceneView(self.plotter, mesh, state, lod_vertices=lod_vertices,
-                              lod_target=lod_target)  # fmt: skip
+        self.view = SceneView(
+            self.plotter, mesh, state, lod_vertices=lod_vertices, lod_target=lod_target
+        )
         self._mesh = state.mesh
         self.view.apply_camera(state.camera)
         self.handles = HandleDragger(self)

@@ -60,8 +60,10 @@ WILDCARDS = ("0.0.0.0", "::", "")
 #: the longest text a client may set in a state key (characters): a preset name, a choice
 MAX_CLIENT_TEXT = 4096
 #: the refusal of a page asked for without the token (one line, no path, no token)
-NO_TOKEN = ("phong-explorer: this page needs its token: open the address the server printed "
-            "(http://HOST:PORT/?secret=...)")  # fmt: skip
+NO_TOKEN = (
+    "phong-explorer: this page needs its token: open the address the server printed "
+    "(http://HOST:PORT/?secret=...)"
+)
 #: the refusal of a request whose Host names another site
 BAD_HOST = "phong-explorer: this server does not answer to that host name"
 #: the refusal of a websocket opened by a page of another origin
@@ -212,16 +214,29 @@ def key_table(rows: Iterable[tuple[str, str]]) -> dict[str, str]:
 #: uploads, the tab and the drawer. The number fields, colour fields and pickers, buttons and
 #: downloads are not state: they call the server's handlers, which parse what they are given.
 #: tests/web/test_web_security.py checks it against the page's template (every ``v-model``).
-CLIENT_KEYS: Mapping[str, str] = key_table([
-    *panelmodel.client_keys().items(),
-    ("preset", "text"), ("group", "index"), ("light", "index"),
-    ("mesh", "text"), ("difference", "bool"),
-    ("compare_on", "bool"), ("compare_preset", "text"), ("compare_model", "text"),
-    ("compare_difference", "bool"), ("turntable_frames", "text or number"),
-    ("turntable_format", "text"), ("preset_name", "text"), ("preset_replace", "bool"),
-    ("session_upload", "upload"), ("mesh_upload", "upload"), ("mtl_upload", "upload"),
-    ("tab", "text"), ("main_drawer", "bool"),  # the layout's drawer (its toolbar button)
-])  # fmt: skip
+CLIENT_KEYS: Mapping[str, str] = key_table(
+    [
+        *panelmodel.client_keys().items(),
+        ("preset", "text"),
+        ("group", "index"),
+        ("light", "index"),
+        ("mesh", "text"),
+        ("difference", "bool"),
+        ("compare_on", "bool"),
+        ("compare_preset", "text"),
+        ("compare_model", "text"),
+        ("compare_difference", "bool"),
+        ("turntable_frames", "text or number"),
+        ("turntable_format", "text"),
+        ("preset_name", "text"),
+        ("preset_replace", "bool"),
+        ("session_upload", "upload"),
+        ("mesh_upload", "upload"),
+        ("mtl_upload", "upload"),
+        ("tab", "text"),
+        ("main_drawer", "bool"),  # the layout's drawer (its toolbar button)
+    ]
+)
 
 
 def admit(changes, table: Mapping[str, str] = CLIENT_KEYS) -> tuple[list, list[str]]:
@@ -332,8 +347,12 @@ def _middleware(token: str, hosts):
             if not origin_ok(origin, host):
                 return _refuse(BAD_ORIGIN, request, f"Origin {origin!r} is not the page's")
             return await handler(request)
-        verdict = page_verdict(request.path, request.query.get(TOKEN_PARAM),
-                               request.cookies.get(cookie_name(port)), token)  # fmt: skip
+        verdict = page_verdict(
+            request.path,
+            request.query.get(TOKEN_PARAM),
+            request.cookies.get(cookie_name(port)),
+            token,
+        )
         if verdict == "refuse":
             return _refuse(NO_TOKEN, request, "no token")
         if verdict == "redirect":

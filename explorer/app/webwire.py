@@ -122,8 +122,9 @@ class BoundedUnChunker:
         mid, offset, total = _decode_header(chunk[:HEADER_LENGTH])
         content = memoryview(chunk)[HEADER_LENGTH:]
         if not 0 < total <= self.max_message_size:
-            raise WireError(f"a message of {_size(total)}: the limit is "
-                            f"{_size(self.max_message_size)}")  # fmt: skip
+            raise WireError(
+                f"a message of {_size(total)}: the limit is {_size(self.max_message_size)}"
+            )
         if mid not in self.pending:
             if len(self.pending) >= MAX_PENDING_MESSAGES:
                 raise WireError(f"more than {MAX_PENDING_MESSAGES} messages under way")
@@ -131,8 +132,10 @@ class BoundedUnChunker:
         claimed, part = self.pending[mid]
         if claimed != total or offset != len(part) or len(part) + len(content) > total:
             del self.pending[mid]
-            raise WireError(f"a chunk at {offset} of {total} bytes, after {len(part)} of "
-                            f"{claimed}: wslink's chunks come in order")  # fmt: skip
+            raise WireError(
+                f"a chunk at {offset} of {total} bytes, after {len(part)} of "
+                f"{claimed}: wslink's chunks come in order"
+            )
         if self._budget() + len(content) > MAX_PENDING_BYTES:
             del self.pending[mid]
             raise WireError(f"the messages under way pass {_size(MAX_PENDING_BYTES)}")
@@ -165,8 +168,7 @@ class Outbox:
             return False
         n = sum(len(f) for f in frames)
         if self.bytes + n > self.cap:
-            self.drop(f"{_size(self.bytes + n)} waiting to be sent, more than "
-                      f"{_size(self.cap)}")  # fmt: skip
+            self.drop(f"{_size(self.bytes + n)} waiting to be sent, more than {_size(self.cap)}")
             return False
         self.frames.extend(frames)
         self.bytes += n
@@ -216,8 +218,9 @@ def abort(ws) -> None:
 def _well_formed(rpc) -> bool:
     """A wslink call or notification: a mapping whose ``id`` (when there is one) and
     ``method`` are text (``WslinkHandler.onCompleteMessage`` indexes and splits them)."""
-    return isinstance(rpc, dict) and ("id" not in rpc or (
-        isinstance(rpc["id"], str) and isinstance(rpc.get("method"), str)))  # fmt: skip
+    return isinstance(rpc, dict) and (
+        "id" not in rpc or (isinstance(rpc["id"], str) and isinstance(rpc.get("method"), str))
+    )
 
 
 #: a connection never made (:meth:`WireHandler.onClose`)
@@ -251,15 +254,17 @@ class WireHandler(AioHttpWsHandler):
                 link.onClose(client_id)
 
     def _pending_bytes(self) -> int:
-        return sum(u.pending_bytes() for u in self.unchunkers.values()
-                   if isinstance(u, BoundedUnChunker))  # fmt: skip
+        return sum(
+            u.pending_bytes() for u in self.unchunkers.values() if isinstance(u, BoundedUnChunker)
+        )
 
     def _outbox(self, client_id) -> Outbox | None:
         box = self.outboxes.get(client_id)
         ws = self.connections.get(client_id)
         if box is None and ws is not None and not ws.closed:
-            box = self.outboxes[client_id] = Outbox(ws, lambda why, quiet: self._drop(
-                client_id, why, quiet))  # fmt: skip
+            box = self.outboxes[client_id] = Outbox(
+                ws, lambda why, quiet: self._drop(client_id, why, quiet)
+            )
         return box
 
     def _drop(self, client_id, why: str, quiet: bool = False) -> None:
@@ -308,19 +313,27 @@ class WireHandler(AioHttpWsHandler):
             or not isinstance(kwargs, dict)
             or not all(isinstance(k, str) for k in kwargs)
         ):
-            await self.sendWrappedError(rpcid, EXCEPTION_ERROR, "args must be a list and "
-                                        "kwargs a mapping", client_id=client_id)  # fmt: skip
+            await self.sendWrappedError(
+                rpcid,
+                EXCEPTION_ERROR,
+                "args must be a list and kwargs a mapping",
+                client_id=client_id,
+            )
             return
         if await self.handleSystemMessage(rpcid, method, args, client_id):
             return
         if not self.isClientAuthenticated(client_id):
-            await self.sendWrappedError(rpcid, AUTHENTICATION_ERROR,
-                                        "Unauthorized: Skip message processing",
-                                        client_id=client_id)  # fmt: skip
+            await self.sendWrappedError(
+                rpcid,
+                AUTHENTICATION_ERROR,
+                "Unauthorized: Skip message processing",
+                client_id=client_id,
+            )
             return
         if method not in self.functionMap or method in REFUSED_METHODS:
-            await self.sendWrappedError(rpcid, METHOD_NOT_FOUND, "Unregistered method called",
-                                        method, client_id=client_id)  # fmt: skip
+            await self.sendWrappedError(
+                rpcid, METHOD_NOT_FOUND, "Unregistered method called", method, client_id=client_id
+            )
             return
         obj, func = self.functionMap[method]
         try:
@@ -331,9 +344,13 @@ class WireHandler(AioHttpWsHandler):
         except Exception as exc:  # noqa: BLE001 - any call's failure is the tab's answer
             text = f"{type(exc).__name__}: {exc}"[:300]
             log.warning("web: call %s failed: %s", method[:80], text)
-            await self.sendWrappedError(rpcid, EXCEPTION_ERROR, "Exception raised",
-                                        {"method": method, "exception": text},
-                                        client_id=client_id)  # fmt: skip
+            await self.sendWrappedError(
+                rpcid,
+                EXCEPTION_ERROR,
+                "Exception raised",
+                {"method": method, "exception": text},
+                client_id=client_id,
+            )
             return
         ws = self.connections.get(client_id)
         if ws is not None and not ws.closed:
@@ -361,12 +378,14 @@ class WireHandler(AioHttpWsHandler):
             log.warning("web: a message was not sent: %s", f"{type(exc).__name__}: {exc}"[:200])
             return None
 
-    async def sendWrappedMessage(self, rpcid, content, method="", client_id=None,
-                                 skip_last_active_client=False):  # fmt: skip
+    async def sendWrappedMessage(
+        self, rpcid, content, method="", client_id=None, skip_last_active_client=False
+    ):
         packed = self._pack({"wslink": "1.0", "id": rpcid, "result": content})
         if packed is None:
-            await self.sendWrappedError(rpcid, -32002, "Method result cannot be serialized",
-                                        method, client_id=client_id)  # fmt: skip
+            await self.sendWrappedError(
+                rpcid, -32002, "Method result cannot be serialized", method, client_id=client_id
+            )
             return
         self._queue(packed, self._targets(client_id, skip_last_active_client))
 
@@ -376,8 +395,9 @@ class WireHandler(AioHttpWsHandler):
             error["data"] = data
         packed = self._pack({"wslink": "1.0", "id": rpcid, "error": error})
         if packed is None:
-            packed = msgpack.packb({"wslink": "1.0", "id": rpcid,
-                                    "error": {"code": code, "message": message}})  # fmt: skip
+            packed = msgpack.packb(
+                {"wslink": "1.0", "id": rpcid, "error": {"code": code, "message": message}}
+            )
         self._queue(packed, [client_id] if client_id else list(self.connections))
 
     def publish(self, topic, data, client_id=None, skip_last_active_client=False):
@@ -387,8 +407,9 @@ class WireHandler(AioHttpWsHandler):
         targets = self._targets(client_id, skip_last_active_client)
         if not targets:
             return
-        packed = self._pack({"wslink": "1.0", "id": f"publish:{topic}:{self.publish_count}",
-                             "result": data})  # fmt: skip
+        packed = self._pack(
+            {"wslink": "1.0", "id": f"publish:{topic}:{self.publish_count}", "result": data}
+        )
         if packed is not None:
             self._queue(packed, targets)
 

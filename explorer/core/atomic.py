@@ -165,8 +165,11 @@ def check_target(path, *, overwrite: bool, make_dirs: bool = False) -> Path:
     if not overwrite:
         raise exists_error(target)
     if not stat.S_ISREG(mode):
-        raise UnwritableFile(target, f"is {file_kind(mode)}, not a regular file; not replacing "
-                             "it (overwrite / --force replace only a file)")  # fmt: skip
+        raise UnwritableFile(
+            target,
+            f"is {file_kind(mode)}, not a regular file; not replacing "
+            "it (overwrite / --force replace only a file)",
+        )
     return target
 
 

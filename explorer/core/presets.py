@@ -109,8 +109,10 @@ def search_dirs(materials_dirs: Iterable = ()) -> list[tuple[Path, str]]:
         pass
     except (OSError, ValueError) as exc:  # not searchable, a name too long: said, left out
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        _notice(None, f"cannot read the user's preset directory {user}: {reason}; its "
-                      "presets are left out")  # fmt: skip
+        _notice(
+            None,
+            f"cannot read the user's preset directory {user}: {reason}; its presets are left out",
+        )
     dirs.append((builtin_dir(), "builtin"))
     # the same directory twice (e.g. --materials-dir pointing at the user dir) counts once
     seen: set = set()

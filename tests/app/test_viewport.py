@@ -174,8 +174,10 @@ def test_the_difference_shows_the_heat_map_in_place_of_the_mesh(port):
 def test_a_mesh_switch_draws_the_new_mesh(port):
     c = port.controller
     c.files.choose_mesh("torus")
-    assert port.view.mesh is c.meshes["torus"] and port.colors().shape[0] == c.meshes[
-        "torus"].n_vertices  # fmt: skip
+    assert (
+        port.view.mesh is c.meshes["torus"]
+        and port.colors().shape[0] == c.meshes["torus"].n_vertices
+    )
 
 
 def test_side_b_is_made_once_follows_each_frame_and_hides(port):

@@ -22,23 +22,45 @@ def test_a_token_is_random_long_and_url_safe():
     assert G.page_url("http://127.0.0.1:8080/", "abc") == "http://127.0.0.1:8080/?secret=abc"
 
 
-@pytest.mark.parametrize("given", [None, "", "wslink-secret", TOKEN[:-1], TOKEN + "x", 12,
-                                   [TOKEN], TOKEN.swapcase()])  # fmt: skip
+@pytest.mark.parametrize(
+    "given", [None, "", "wslink-secret", TOKEN[:-1], TOKEN + "x", 12, [TOKEN], TOKEN.swapcase()]
+)
 def test_only_the_token_itself_is_the_token(given):
     assert G.token_ok(TOKEN, TOKEN)
     assert not G.token_ok(given, TOKEN)
 
 
-@pytest.mark.parametrize("host", ["127.0.0.1:8080", "localhost:8080", "LOCALHOST:8080",
-                                  "[::1]:8080", "127.0.0.1", "10.1.2.3:8080"])  # fmt: skip
+@pytest.mark.parametrize(
+    "host",
+    [
+        "127.0.0.1:8080",
+        "localhost:8080",
+        "LOCALHOST:8080",
+        "[::1]:8080",
+        "127.0.0.1",
+        "10.1.2.3:8080",
+    ],
+)
 def test_a_host_naming_this_server_is_allowed(host):
     assert G.host_ok(host, G.listening_names("127.0.0.1"), 8080)
 
 
-@pytest.mark.parametrize("host", ["evil.example:8080", "evil.example", "127.0.0.1:8081",
-                                  "localhost.evil.example:8080", "", None, "a b:8080",
-                                  "user@127.0.0.1:8080", "127.0.0.1:8080/x", "[::1:8080",
-                                  "127.0.0.1:99999"])  # fmt: skip
+@pytest.mark.parametrize(
+    "host",
+    [
+        "evil.example:8080",
+        "evil.example",
+        "127.0.0.1:8081",
+        "localhost.evil.example:8080",
+        "",
+        None,
+        "a b:8080",
+        "user@127.0.0.1:8080",
+        "127.0.0.1:8080/x",
+        "[::1:8080",
+        "127.0.0.1:99999",
+    ],
+)
 def test_a_host_naming_another_site_or_port_is_refused(host):
     """DNS rebinding: a name that resolves to this machine is still another site's name."""
     assert not G.host_ok(host, G.listening_names("127.0.0.1"), 8080)
@@ -56,30 +78,36 @@ def test_the_listening_names_are_the_loopback_names_and_a_named_host():
     assert G.host_ok("anything.example", None, 9000)  # behind a proxy that checks it
 
 
-@pytest.mark.parametrize(("origin", "host"), [
-    ("http://127.0.0.1:8080", "127.0.0.1:8080"),
-    ("http://localhost:8080", "localhost:8080"),
-    ("https://hub.example.org", "hub.example.org"),
-    ("https://hub.example.org:443", "hub.example.org"),
-    ("http://hub.example.org", "hub.example.org:80"),
-    ("http://[::1]:8080", "[::1]:8080"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("origin", "host"),
+    [
+        ("http://127.0.0.1:8080", "127.0.0.1:8080"),
+        ("http://localhost:8080", "localhost:8080"),
+        ("https://hub.example.org", "hub.example.org"),
+        ("https://hub.example.org:443", "hub.example.org"),
+        ("http://hub.example.org", "hub.example.org:80"),
+        ("http://[::1]:8080", "[::1]:8080"),
+    ],
+)
 def test_the_pages_own_origin_is_allowed(origin, host):
     assert G.origin_ok(origin, host)
 
 
-@pytest.mark.parametrize(("origin", "host"), [
-    (None, "127.0.0.1:8080"),  # no Origin: not a browser's page
-    ("", "127.0.0.1:8080"),
-    ("null", "127.0.0.1:8080"),  # a sandboxed frame or a file: page
-    ("http://127.0.0.1:9999", "127.0.0.1:8080"),  # another port of this machine
-    ("http://evil.example", "127.0.0.1:8080"),
-    ("http://localhost:8080", "127.0.0.1:8080"),  # another name is another origin
-    ("https://127.0.0.1:8080/x", "127.0.0.1:8080"),
-    ("file://", "127.0.0.1:8080"),
-    ("http://127.0.0.1:8080", None),
-    ("https://hub.example.org", "hub.example.org:80"),
-])  # fmt: skip
+@pytest.mark.parametrize(
+    ("origin", "host"),
+    [
+        (None, "127.0.0.1:8080"),  # no Origin: not a browser's page
+        ("", "127.0.0.1:8080"),
+        ("null", "127.0.0.1:8080"),  # a sandboxed frame or a file: page
+        ("http://127.0.0.1:9999", "127.0.0.1:8080"),  # another port of this machine
+        ("http://evil.example", "127.0.0.1:8080"),
+        ("http://localhost:8080", "127.0.0.1:8080"),  # another name is another origin
+        ("https://127.0.0.1:8080/x", "127.0.0.1:8080"),
+        ("file://", "127.0.0.1:8080"),
+        ("http://127.0.0.1:8080", None),
+        ("https://hub.example.org", "hub.example.org:80"),
+    ],
+)
 def test_another_origin_is_refused(origin, host):
     assert not G.origin_ok(origin, host)
 
@@ -102,8 +130,17 @@ def test_the_client_keys_are_the_page_controls_keys():
     for k in (r.key for r in NUMBERS):
         assert G.CLIENT_KEYS[f"{k}_step"] == "number"
         assert k not in G.CLIENT_KEYS  # the fields call the server's parser, never set state
-    for server_owned in ("trame__template_main", "message_log", "presets", "meshes",
-                         "engine", "can_undo", "legend", "progress", "message"):  # fmt: skip
+    for server_owned in (
+        "trame__template_main",
+        "message_log",
+        "presets",
+        "meshes",
+        "engine",
+        "can_undo",
+        "legend",
+        "progress",
+        "message",
+    ):
         assert server_owned not in G.CLIENT_KEYS
     assert G.CLIENT_KEYS["mesh_upload"] == "upload"
 
@@ -169,6 +206,5 @@ def test_the_access_log_never_writes_the_token():
     assert G.Redact(TOKEN).filter(record)
     assert TOKEN not in record.getMessage()
     assert record.getMessage() == '127.0.0.1 "GET /?secret=<token> HTTP/1.1" 302'
-    other = logging.LogRecord("aiohttp.access", logging.INFO, __file__, 1, "GET /%s", ("a",),
-                              None)  # fmt: skip
+    other = logging.LogRecord("aiohttp.access", logging.INFO, __file__, 1, "GET /%s", ("a",), None)
     assert G.Redact(TOKEN).filter(other) and other.getMessage() == "GET /a"

@@ -45,15 +45,28 @@ def test_the_private_api_relied_on_is_there():
     assert chunking.HEADER_LENGTH == 12
     assert chunking._decode_header(struct.pack("<III", 1, 2, 3)) == (1, 2, 3)
     handler = backend.AioHttpWsHandler
-    for name in ("onConnect", "onClose", "onMessage", "onCompleteMessage", "handleSystemMessage",
-                 "sendWrappedMessage", "sendWrappedError", "publish", "isClientAuthenticated",
-                 "getServerProtocol"):  # fmt: skip
+    for name in (
+        "onConnect",
+        "onClose",
+        "onMessage",
+        "onCompleteMessage",
+        "handleSystemMessage",
+        "sendWrappedMessage",
+        "sendWrappedError",
+        "publish",
+        "isClientAuthenticated",
+        "getServerProtocol",
+    ):
         assert callable(getattr(handler, name)), name
     src = inspect.getsource(protocol.WslinkHandler)
-    for text in ("self.unchunkers[client_id] = UnChunker()", "self.connections = {}",
-                 "self.functionMap[uri] = (protocolObject, proc)", "set_max_message_size",
-                 "self.web_app.last_active_client_id = client_id",
-                 "protocolObject.init(\n                    self.publish,"):  # fmt: skip
+    for text in (
+        "self.unchunkers[client_id] = UnChunker()",
+        "self.connections = {}",
+        "self.functionMap[uri] = (protocolObject, proc)",
+        "set_max_message_size",
+        "self.web_app.last_active_client_id = client_id",
+        "protocolObject.init(\n                    self.publish,",
+    ):
         assert text in src, text
     src = inspect.getsource(backend.AioHttpWsHandler.handleWsRequest)
     assert "self.connections[client_id] = current_ws" in src
@@ -199,8 +212,9 @@ def test_an_outbox_over_its_cap_drops_the_tab():
         box.close()
         return dropped
 
-    assert asyncio.run(go()) == ["12 bytes (0.0 MiB) waiting to be sent, more than 10 bytes "
-                                 "(0.0 MiB)"]  # fmt: skip
+    assert asyncio.run(go()) == [
+        "12 bytes (0.0 MiB) waiting to be sent, more than 10 bytes (0.0 MiB)"
+    ]
 
 
 # -- publish ----------------------------------------------------------------------------------
@@ -235,8 +249,10 @@ def test_a_change_goes_once_to_each_tab_but_its_sender_decided_when_published():
 
 
 # -- the page's values (explorer/app/webpanel.page_value) -----------------------------------------
-@pytest.mark.parametrize(("value", "like"), [({"x": 1}, 0), ("1", 0), (True, 0), (1, True),
-                                             (float("nan"), None), ([1], None)])  # fmt: skip
+@pytest.mark.parametrize(
+    ("value", "like"),
+    [({"x": 1}, 0), ("1", 0), (True, 0), (1, True), (float("nan"), None), ([1], None)],
+)
 def test_a_page_value_of_the_wrong_kind_is_one_line_naming_the_key(value, like):
     from explorer.app.webpanel import page_value
     from explorer.core.errors import ExplorerError

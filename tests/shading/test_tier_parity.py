@@ -48,12 +48,16 @@ def assert_one_engine(scene: dict, P, N, precision: str) -> None:
 def lit(model: str, shininess: float, *lights, viewer=None, **extra) -> dict:
     return {
         "model": model,
-        "material": {"ambient": [0.1] * 3, "diffuse": [0.5, 0.4, 0.3], "specular": [1, 1, 1],
-                     "shininess": shininess},
+        "material": {
+            "ambient": [0.1] * 3,
+            "diffuse": [0.5, 0.4, 0.3],
+            "specular": [1, 1, 1],
+            "shininess": shininess,
+        },
         "viewer": viewer or {"to_viewer": [0, 0, 1]},
         "lights": list(lights),
         **extra,
-    }  # fmt: skip
+    }
 
 
 def sphere():
@@ -83,8 +87,13 @@ def test_a_tiny_shininess_after_a_drag_leaves_a_zero_lobe_dark(precision):
     """The same through a shininess drag (the stored lobe bases, kernels.lobe)."""
     P, N = sphere()
     s = lit("phong", 20.0, {"type": "directional", "to_light": [0, 1, 0.2]})
-    want = Shader({**s, "material": {**s["material"], "shininess": 5e-324}}, P, N,
-                  precision=precision, tier="numpy").colors  # fmt: skip
+    want = Shader(
+        {**s, "material": {**s["material"], "shininess": 5e-324}},
+        P,
+        N,
+        precision=precision,
+        tier="numpy",
+    ).colors
     sh = Shader(s, P, N, precision=precision, tier="compiled")
     for n in (10.0, 5e-324):
         sh.set_material({**s["material"], "shininess": n})
@@ -133,8 +142,13 @@ def test_an_eye_near_a_vertex_is_decided_in_float64(model, offset):
     P, N = sphere()
     for j in range(0, 200, 7):
         eye = (P[j] + offset * np.array([1.0, -2.0, 0.5])).tolist()
-        s = lit(model, 20.0, {"type": "directional", "to_light": [0, 1, 0.2]},
-                viewer={"eye": eye}, two_sided=True)  # fmt: skip
+        s = lit(
+            model,
+            20.0,
+            {"type": "directional", "to_light": [0, 1, 0.2]},
+            viewer={"eye": eye},
+            two_sided=True,
+        )
         assert_one_engine(s, P, N, "float32")
 
 
@@ -146,8 +160,13 @@ def test_a_lobe_base_of_noise_is_0_on_both_tiers(precision, shininess, base):
     LOBE_BASE_MIN (1.5e-154) is 0 on both tiers. The float64 kernels raise base² to n/2 and the
     square of 1e-200 is 0: the numpy tier gave 0.63 for shininess 0.001, the kernels 0."""
     P, N = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0.0, 0, 1]] * 3)
-    s = lit("phong", shininess, {"type": "directional", "to_light": [-base, 0, 1]},
-            viewer={"to_viewer": [1, 0, 0]}, ambient=[0, 0, 0])  # fmt: skip
+    s = lit(
+        "phong",
+        shininess,
+        {"type": "directional", "to_light": [-base, 0, 1]},
+        viewer={"to_viewer": [1, 0, 0]},
+        ambient=[0, 0, 0],
+    )
     s["material"].update(ambient=[0, 0, 0], diffuse=[0, 0, 0])
     a, b = tiers(s, P, N, precision)
     want = base**shininess if base >= tol.LOBE_BASE_MIN else 0.0
@@ -230,13 +249,18 @@ def hard_cases(draw):
         view = {"eye": away(P, centre, size, draw(unit3), ep)}
     scene = {
         "model": draw(st.sampled_from(MODELS)),
-        "material": {"ambient": draw(rgb), "diffuse": draw(rgb), "specular": draw(rgb),
-                     "emission": [0.0] * 3, "shininess": draw(st.sampled_from(SHININESS))},
+        "material": {
+            "ambient": draw(rgb),
+            "diffuse": draw(rgb),
+            "specular": draw(rgb),
+            "emission": [0.0] * 3,
+            "shininess": draw(st.sampled_from(SHININESS)),
+        },
         "ambient": [0.05] * 3,
         "two_sided": draw(st.booleans()),
         "viewer": view,
         "lights": draw(st.lists(hard_lights(P, centre, size), min_size=1, max_size=3)),
-    }  # fmt: skip
+    }
     return scene, P, N
 
 

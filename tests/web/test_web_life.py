@@ -37,15 +37,29 @@ def test_web_that_cannot_listen_is_one_line_and_keeps_the_last_session(tmp_path,
     pytest.importorskip("trame")
     last = tmp_path / "last.yaml"
     last.write_text(KEPT)
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path),
-               PHONG_EXPLORER_LAST_SESSION=str(last))  # fmt: skip
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join(sys.path), PHONG_EXPLORER_LAST_SESSION=str(last)
+    )
     with _taken() as other:
         port = other.getsockname()[1]
         host = ["--host", "192.0.2.1"] if where != "taken port" else []  # TEST-NET-1
         res = subprocess.run(
-            [sys.executable, "-m", "explorer.cli", "web", "--mesh", "sphere", *host, "--port",
-             str(port)], env=env, capture_output=True, text=True, timeout=240,
-        )  # fmt: skip
+            [
+                sys.executable,
+                "-m",
+                "explorer.cli",
+                "web",
+                "--mesh",
+                "sphere",
+                *host,
+                "--port",
+                str(port),
+            ],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=240,
+        )
     assert res.returncode == 2, res.stderr
     lines = [ln for ln in res.stderr.splitlines() if not ln.startswith("warning: listening on")]
     assert len(lines) == 1 and lines[0].startswith("error: cannot listen on"), res.stderr
@@ -135,16 +149,33 @@ def test_web_with_its_config_folder_locked_starts_serves_and_stops(tmp_path):
     (config / "phong-explorer").mkdir(parents=True)
     config.chmod(0)
     port = free_port()
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path), XDG_CONFIG_HOME=str(config),
-               MPLCONFIGDIR=str(tmp_path), PHONG_EXPLORER_KERNELS="numpy")  # fmt: skip
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join(sys.path),
+        XDG_CONFIG_HOME=str(config),
+        MPLCONFIGDIR=str(tmp_path),
+        PHONG_EXPLORER_KERNELS="numpy",
+    )
     env.pop("PHONG_EXPLORER_LAST_SESSION", None)
     env.pop("PHONG_EXPLORER_MATERIALS", None)
     log = tmp_path / "web.log"
     with open(log, "w") as out:
         proc = subprocess.Popen(
-            [*prefix, sys.executable, "-m", "explorer.cli", "web", "--mesh", "sphere", "--port",
-             str(port)], stdout=out, stderr=subprocess.STDOUT, env=env,
-        )  # fmt: skip
+            [
+                *prefix,
+                sys.executable,
+                "-m",
+                "explorer.cli",
+                "web",
+                "--mesh",
+                "sphere",
+                "--port",
+                str(port),
+            ],
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            env=env,
+        )
         try:
             printed = re.compile(re.escape(f"http://127.0.0.1:{port}/") + r"\?secret=\S+")
             for _ in range(1200):  # at most two minutes

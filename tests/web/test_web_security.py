@@ -83,8 +83,9 @@ def test_a_websocket_without_the_token_gets_no_session(server, secret):
     assert server.token not in server.output().replace(server.url, "")
 
 
-@pytest.mark.parametrize("origin", [None, "http://127.0.0.1:1", "http://evil.example",
-                                    "http://localhost:{port}", "null"])  # fmt: skip
+@pytest.mark.parametrize(
+    "origin", [None, "http://127.0.0.1:1", "http://evil.example", "http://localhost:{port}", "null"]
+)
 def test_a_websocket_from_another_origin_is_refused_even_with_the_token(server, origin):
     """A page of another site, or of another port of this machine (another name for this
     server is another origin too), cannot open the page's websocket: refused at the upgrade,
@@ -159,8 +160,13 @@ def test_a_mesh_that_is_a_path_is_refused_alike_and_nothing_is_loaded(server, tm
     try:
         before = server_report(client)
         said = set()
-        for value in ("/etc/passwd", "~/.bashrc", str(real), str(tmp_path / "missing.obj"),
-                      "../../etc/hosts"):  # fmt: skip
+        for value in (
+            "/etc/passwd",
+            "~/.bashrc",
+            str(real),
+            str(tmp_path / "missing.obj"),
+            "../../etc/hosts",
+        ):
             reply = client.call("trame.state.update", [[{"key": "mesh", "value": value}]])
             assert "error" not in reply, reply
             state = state_of(client)
@@ -218,31 +224,42 @@ def test_a_client_sets_only_the_controls_keys_with_their_types(server):
     try:
         template = state_of(other)["trame__template_main"]
         log = [{"text": "forged", "level": "info", "details": [], "at": "00:00:00"}]
-        reply = attacker.call("trame.state.update", [[
-            {"key": "trame__template_main", "value": XSS},
-            {"key": "message_log", "value": log},
-            {"key": "no_such_key", "value": 1},
-            {"key": "show_ambient", "value": "yes"},
-            {"key": "light", "value": -3},
-        ]])  # fmt: skip
+        reply = attacker.call(
+            "trame.state.update",
+            [
+                [
+                    {"key": "trame__template_main", "value": XSS},
+                    {"key": "message_log", "value": log},
+                    {"key": "no_such_key", "value": 1},
+                    {"key": "show_ambient", "value": "yes"},
+                    {"key": "light", "value": -3},
+                ]
+            ],
+        )
         assert "error" not in reply, reply
         state = state_of(other)  # the publications to this tab came before this reply
         assert state["trame__template_main"] == template
         assert all(m.get("text") != "forged" for m in state["message_log"])
         assert "no_such_key" not in state
         assert state["show_ambient"] is True and state["light"] == 0
-        sent = [k for m in other.seen if str(m.get("id", "")).startswith("publish:")
-                for k in (m.get("result") or {})]  # fmt: skip
+        sent = [
+            k
+            for m in other.seen
+            if str(m.get("id", "")).startswith("publish:")
+            for k in (m.get("result") or {})
+        ]
         assert not {"trame__template_main", "message_log", "no_such_key"} & set(sent), sent
     finally:
         attacker.close()
         other.close()
     out = server.output()
-    for line in ("'trame__template_main': not a key the page's controls set",
-                 "'message_log': not a key the page's controls set",
-                 "'no_such_key': not a key the page's controls set",
-                 "'show_ambient': must be bool, got str",
-                 "'light': must be index, got int"):  # fmt: skip
+    for line in (
+        "'trame__template_main': not a key the page's controls set",
+        "'message_log': not a key the page's controls set",
+        "'no_such_key': not a key the page's controls set",
+        "'show_ambient': must be bool, got str",
+        "'light': must be index, got int",
+    ):
         assert f"a page's change was dropped: {line}" in out
     assert "onerror" not in out
 
@@ -256,8 +273,9 @@ def test_an_injected_template_never_reaches_an_open_page(server, browser):
         return browser.execute_script("return window.__xss")
 
     def shows_kd(value):
-        found = browser.execute_script("return [...document.querySelectorAll("
-                                       "'[aria-label=\"kd\"]')].map(e => e.value)")  # fmt: skip
+        found = browser.execute_script(
+            "return [...document.querySelectorAll('[aria-label=\"kd\"]')].map(e => e.value)"
+        )
         return bool(found) and float(found[0]) == value
 
     open_page(browser, server.url)
@@ -266,10 +284,15 @@ def test_an_injected_template_never_reaches_an_open_page(server, browser):
         step = 200 if state_of(client)["kd_step"] != 200 else 300
         c = CONTROLS["kd"]
         want = round(from_step(c, step, c.lo, c.hi), c.decimals)
-        client.call("trame.state.update", [[
-            {"key": "trame__template_main", "value": XSS},
-            {"key": "kd_step", "value": step},
-        ]])  # fmt: skip
+        client.call(
+            "trame.state.update",
+            [
+                [
+                    {"key": "trame__template_main", "value": XSS},
+                    {"key": "kd_step", "value": step},
+                ]
+            ],
+        )
         wait("the other client's changes", lambda: xss() or shows_kd(want))
     finally:
         client.close()
@@ -313,12 +336,22 @@ def test_a_page_of_another_port_cannot_hijack_the_session(server, browser):
     127.0.0.1 opens the explorer's websocket with wslink's default secret and asks for the
     state. The socket never opens (the title says so); the real page, with its token, still
     gets its session."""
-    hello = frames({"wslink": "1.0", "id": "system:c0:0", "method": "wslink.hello",
-                    "args": [{"secret": "wslink-secret"}], "kwargs": {}})  # fmt: skip
-    ask = frames({"wslink": "1.0", "id": "rpc:c0:1", "method": "trame.state.get",
-                  "args": [], "kwargs": {}})  # fmt: skip
-    page = (f"<!doctype html><html><head><title>-</title></head><body><script>"
-            f"{ATTACK_JS % (hello, ask, server.port)}</script></body></html>").encode()  # fmt: skip
+    hello = frames(
+        {
+            "wslink": "1.0",
+            "id": "system:c0:0",
+            "method": "wslink.hello",
+            "args": [{"secret": "wslink-secret"}],
+            "kwargs": {},
+        }
+    )
+    ask = frames(
+        {"wslink": "1.0", "id": "rpc:c0:1", "method": "trame.state.get", "args": [], "kwargs": {}}
+    )
+    page = (
+        f"<!doctype html><html><head><title>-</title></head><body><script>"
+        f"{ATTACK_JS % (hello, ask, server.port)}</script></body></html>"
+    ).encode()
 
     class Attacker(BaseHTTPRequestHandler):
         def do_GET(self):
@@ -335,8 +368,9 @@ def test_a_page_of_another_port_cannot_hijack_the_session(server, browser):
     threading.Thread(target=site.serve_forever, daemon=True).start()
     try:
         browser.get(f"http://127.0.0.1:{site.server_port}/")
-        title = wait("the attack to end", lambda: browser.title not in ("-", "trying")
-                     and browser.title)  # fmt: skip
+        title = wait(
+            "the attack to end", lambda: browser.title not in ("-", "trying") and browser.title
+        )
         time.sleep(0.5)  # a late reply would turn the title into "read ..."
         assert browser.title == title == "closed 1006", title
         said = [e["message"] for e in browser.get_log("browser")]  # read: the log is emptied

@@ -198,8 +198,10 @@ def test_no_tab_stops_the_server(server):
     async def go():
         async with aiohttp.ClientSession() as s:
             tab = await connect(s, server)
-            replies = [await tab.call("application.exit.later", [0]),
-                       await tab.call("application.exit")]  # fmt: skip
+            replies = [
+                await tab.call("application.exit.later", [0]),
+                await tab.call("application.exit"),
+            ]
             await asyncio.sleep(1.0)
             return replies, await server_state(s, server, "preset")
 
@@ -209,16 +211,53 @@ def test_no_tab_stops_the_server(server):
 
 
 #: the methods the fuzz calls: trame's own, the view's, and names nobody serves
-FUZZ_METHODS = ["trame.state.update", "trame.state.get", "trame.trigger", "trame.force.push",
-                "trame.lifecycle.update", "trame.error.client", "viewport.image.push",
-                "viewport.image.push.observer.add", "viewport.mouse.interaction", "no.such",
-                "wslink.hello", ""]  # fmt: skip
+FUZZ_METHODS = [
+    "trame.state.update",
+    "trame.state.get",
+    "trame.trigger",
+    "trame.force.push",
+    "trame.lifecycle.update",
+    "trame.error.client",
+    "viewport.image.push",
+    "viewport.image.push.observer.add",
+    "viewport.mouse.interaction",
+    "no.such",
+    "wslink.hello",
+    "",
+]
 #: the state keys the fuzz sets: the page's own (panel values, uploads) and others
-FUZZ_KEYS = ["kd", "ka", "shininess", "diffuse", "preset", "model", "light", "type", "mesh",
-             "kd_step", "shininess_step", "intensity_step", "compare_preset", "compare_model",
-             "compare_difference", "show_ambient", "diffuse_hex", "light_color", "turntable_format",
-             "difference", "compare_on", "group", "attenuation", "session_upload",
-             "mesh_upload", "mtl_upload", "preset_name", "turntable_frames", "x", ""]  # fmt: skip
+FUZZ_KEYS = [
+    "kd",
+    "ka",
+    "shininess",
+    "diffuse",
+    "preset",
+    "model",
+    "light",
+    "type",
+    "mesh",
+    "kd_step",
+    "shininess_step",
+    "intensity_step",
+    "compare_preset",
+    "compare_model",
+    "compare_difference",
+    "show_ambient",
+    "diffuse_hex",
+    "light_color",
+    "turntable_format",
+    "difference",
+    "compare_on",
+    "group",
+    "attenuation",
+    "session_upload",
+    "mesh_upload",
+    "mtl_upload",
+    "preset_name",
+    "turntable_frames",
+    "x",
+    "",
+]
 
 
 def fuzz_value(rng: random.Random, depth: int = 0):
@@ -229,8 +268,17 @@ def fuzz_value(rng: random.Random, depth: int = 0):
     if kind == "float":
         return rng.choice([0.5, -1e308, 1e308, float("nan"), float("inf"), 1e-320])
     if kind == "str":
-        return rng.choice(["", "jade", "sphere", "0.1, 0.2", "../../etc/passwd", "\x00\x1b[2J",
-                           "é" * rng.randint(1, 50)])  # fmt: skip
+        return rng.choice(
+            [
+                "",
+                "jade",
+                "sphere",
+                "0.1, 0.2",
+                "../../etc/passwd",
+                "\x00\x1b[2J",
+                "é" * rng.randint(1, 50),
+            ]
+        )
     if kind == "bytes":
         return rng.randbytes(rng.randint(0, 64))
     if kind == "bool":
@@ -238,8 +286,10 @@ def fuzz_value(rng: random.Random, depth: int = 0):
     if kind == "list":
         return [fuzz_value(rng, depth + 1) for _ in range(rng.randint(0, 4))]
     if kind == "dict":
-        return {rng.choice(["name", "content", "key", "value", "x"]): fuzz_value(rng, depth + 1)
-                for _ in range(rng.randint(0, 3))}  # fmt: skip
+        return {
+            rng.choice(["name", "content", "key", "value", "x"]): fuzz_value(rng, depth + 1)
+            for _ in range(rng.randint(0, 3))
+        }
     if kind == "big":
         return rng.choice(["x" * 200_000, [1] * 50_000, {"content": [2**40]}])
     return None
@@ -256,13 +306,21 @@ def fuzz_frame(rng: random.Random) -> bytes:
         return struct.pack("<III", mid, off % 64, size) + rng.randbytes(rng.randint(0, 16))
     method = rng.choice(FUZZ_METHODS)
     if method == "trame.state.update" and rng.random() < 0.7:
-        args = [[{"key": rng.choice(FUZZ_KEYS), "value": fuzz_value(rng)}
-                 for _ in range(rng.randint(1, 3))]]  # fmt: skip
+        args = [
+            [
+                {"key": rng.choice(FUZZ_KEYS), "value": fuzz_value(rng)}
+                for _ in range(rng.randint(1, 3))
+            ]
+        ]
     else:
         args = [fuzz_value(rng) for _ in range(rng.randint(0, 3))]
-    message = {"wslink": "1.0", "id": rng.choice([f"rpc:c0:{rng.randint(0, 99)}", 5, None]),
-               "method": method, "args": args if rng.random() < 0.9 else fuzz_value(rng),
-               "kwargs": {} if rng.random() < 0.9 else fuzz_value(rng)}  # fmt: skip
+    message = {
+        "wslink": "1.0",
+        "id": rng.choice([f"rpc:c0:{rng.randint(0, 99)}", 5, None]),
+        "method": method,
+        "args": args if rng.random() < 0.9 else fuzz_value(rng),
+        "kwargs": {} if rng.random() < 0.9 else fuzz_value(rng),
+    }
     if rng.random() < 0.1:
         message = fuzz_value(rng)
     body = msgpack.packb(message)
@@ -325,7 +383,9 @@ def shown_preset(driver) -> str:
     return driver.execute_script(
         "const f = arguments[0].closest('.v-field');"
         "const s = f && f.querySelector('.v-autocomplete__selection');"
-        "return s ? s.textContent.trim() : '';", by_name(driver, "preset"))  # fmt: skip
+        "return s ? s.textContent.trim() : '';",
+        by_name(driver, "preset"),
+    )
 
 
 @pytest.mark.slow

@@ -21,8 +21,12 @@ async def connect(session: aiohttp.ClientSession, server, *, hello: bool = True)
     ``token``), introduced as trame's page introduces itself (the page's ``Origin``, wslink's
     hello with the server's token as its secret)."""
     port = server.port
-    ws = await session.ws_connect(f"ws://127.0.0.1:{port}/ws", max_msg_size=0, compress=0,
-                                  headers={"Origin": f"http://127.0.0.1:{port}"})  # fmt: skip
+    ws = await session.ws_connect(
+        f"ws://127.0.0.1:{port}/ws",
+        max_msg_size=0,
+        compress=0,
+        headers={"Origin": f"http://127.0.0.1:{port}"},
+    )
     tab = Tab(ws)
     if hello:
         reply = await tab.call("wslink.hello", [{"secret": server.token}], system=True)
@@ -51,8 +55,9 @@ class Tab:
         rpcid = f"{'system' if system else 'rpc'}:c0:{next(self._ids)}"
         fut = asyncio.get_running_loop().create_future()
         self._waiting[rpcid] = fut
-        await self.send({"wslink": "1.0", "id": rpcid, "method": method, "args": list(args),
-                         "kwargs": {}})  # fmt: skip
+        await self.send(
+            {"wslink": "1.0", "id": rpcid, "method": method, "args": list(args), "kwargs": {}}
+        )
         return await asyncio.wait_for(fut, timeout)
 
     async def set_state(self, **values) -> dict:
@@ -62,9 +67,13 @@ class Tab:
 
     def state_updates(self, key: str) -> list:
         """The values of ``key`` in the server's state messages received, in order."""
-        return [m["result"][key] for m in self.received
-                if str(m.get("id", "")).startswith("publish:trame.state.topic")
-                and isinstance(m.get("result"), dict) and key in m["result"]]  # fmt: skip
+        return [
+            m["result"][key]
+            for m in self.received
+            if str(m.get("id", "")).startswith("publish:trame.state.topic")
+            and isinstance(m.get("result"), dict)
+            and key in m["result"]
+        ]
 
     async def _read(self) -> None:
         async for msg in self.ws:
