@@ -43,6 +43,7 @@ import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
 from explorer.geometry.traverse import (

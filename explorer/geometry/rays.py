@@ -26,6 +26,7 @@ import numba as nb
 import numpy as np
 
 from explorer.core.tolerances import DET_EPS, RAY_T_EPS
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 
 
 @nb.njit(inline="always")

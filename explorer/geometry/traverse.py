@@ -10,8 +10,8 @@ vector operation: the same float64 arithmetic as :func:`slab`, lane by lane, so 
 box in a wide row exactly when it enters that box in the binary tree.
 
 These functions are inlined into :mod:`explorer.geometry.bvh`'s and
-:mod:`explorer.geometry.occluders`' kernels, which numba's on-disk cache keys by their own files
-only: after an edit here, touch those two (or clear their cache), or they keep the old code.
+:mod:`explorer.geometry.occluders`' kernels: an edit here recompiles those (numba's cache of the
+kernel files is keyed on every source they import, :mod:`explorer.geometry.kernelcache`).
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from numba import types
 from numba.cpython.unsafe.numbers import trailing_zeros
 from numba.extending import intrinsic
 
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.geometry.rays import ray_triangle_row
 
 #: the traversal stack; the BVH builder's depth limit plus 64 levels holds any mesh that fits

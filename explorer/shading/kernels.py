@@ -45,8 +45,8 @@ it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and 
 the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
 :mod:`explorer.shading.equation`). Every loop is compiled with the entry point that first meets
 a precision (``shade``; ``fixup`` for the float64 redo of a float32 pass), and numba caches
-the result on disk (``cache=True``: per source file and machine; an edit to this module, or to
-:mod:`explorer.shading.vmath` followed by touching this file, recompiles). What that costs is
+the result on disk (``cache=True``: per machine, keyed on this file's and :mod:`.vmath`'s
+contents, :mod:`explorer.geometry.kernelcache`; an edit to either recompiles). What that costs is
 measured by ``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of
 the loops a scene does not use (its docstring keeps the last table, with the machine).
 
@@ -101,6 +101,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
