@@ -109,10 +109,10 @@ def next_node(stack, sp, ca, cb, ta, tb):
 def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
     """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in the leaf whose first
     triangle and count are ``packed`` (:data:`LEAF_BITS`, as the node rows hold them)."""
-    ox, oy, oz, dx, dy, dz = ray
+    o, d = ray[:3], ray[3:]
     first = np.int64(packed) >> LEAF_BITS
     for j in range(first, first + (np.int64(packed) & ((1 << LEAF_BITS) - 1))):
-        t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
+        t, _, _ = ray_triangle_row(tri, j, o, d, det_eps, True)
         if t > t_eps and t < tm:
             return True
     return False

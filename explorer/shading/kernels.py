@@ -357,14 +357,25 @@ def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
     return outside
 
 
-class Vertices(NamedTuple):
-    """A pass's geometry as the caller holds it, prepared block by block as the pass reaches
-    it (:func:`prepare`'s arithmetic: the same values), so that no (6, n) G is written or read
-    (a one-shot pass). ``P``, ``N`` (n, 3) float32/float64 world positions and normals (one
-    dtype); ``centre`` (3,) float64 and ``inv_scale`` float64: the normalised frame."""
+class Source(NamedTuple):
+    """A pass's geometry (``src``): ``G`` (6, n) T, the prepared rows (see :func:`prepare`),
+    read as they are; or G (6, 0) and the caller's vertices, prepared block by block as the
+    pass reaches them (:func:`prepare`'s arithmetic: the same values), so that no (6, n) G is
+    written or read (a one-shot pass): ``P``, ``N`` (n, 3) float64 world positions and normals,
+    or ``P32``, ``N32`` (n, 3) float32 (the other pair (0, 3)), read-only; ``centre`` (3,)
+    float64 and ``inv_scale`` float64: the normalised frame
+    (:func:`explorer.shading.prepared.vertices`, :func:`~explorer.shading.prepared.rows`).
 
+    One record type per precision whatever the path and the caller's dtype, so that
+    :func:`shade`, :func:`bounds` and what they call compile once per precision: each signature
+    of ``shade`` links every light loop and optimises it again (the cold compile took 6
+    signatures where it now takes 2; ``benchmarks/bench_compile.py --warm``)."""
+
+    G: np.ndarray
     P: np.ndarray
     N: np.ndarray
+    P32: np.ndarray
+    N32: np.ndarray
     centre: np.ndarray
     inv_scale: float
 
@@ -375,10 +386,10 @@ def _vertex_count(src):  # pragma: no cover - replaced by the overload
 
 @overload(_vertex_count, jit_options=_LEAF)
 def _vertex_count_overload(src):
-    """How many vertices a pass's geometry holds: G (6, n) or :class:`Vertices`."""
+    """How many vertices a pass's geometry holds: G (6, n) or a :class:`Source`."""
     if isinstance(src, types.Array):
         return lambda src: src.shape[1]
-    return lambda src: src.P.shape[0]
+    return lambda src: src.G.shape[1] + src.P.shape[0] + src.P32.shape[0]  # (two are empty)
 
 
 def _lanes_to_prepare(src):  # pragma: no cover - replaced by the overload
@@ -387,11 +398,11 @@ def _lanes_to_prepare(src):  # pragma: no cover - replaced by the overload
 
 @overload(_lanes_to_prepare, jit_options=_LEAF)
 def _lanes_to_prepare_overload(src):
-    """The lanes of a task's buffer for a block of :class:`Vertices` (see :func:`_geometry`):
+    """The lanes of a task's buffer for a block of vertices to prepare (see :func:`_geometry`):
     BLOCK, or 0 for G, whose rows the pass reads as they are."""
     if isinstance(src, types.Array):
         return lambda src: 0
-    return lambda src: BLOCK
+    return lambda src: 0 if src.G.shape[1] else BLOCK
 
 
 def _geometry(src, s, e, gb, k):  # pragma: no cover - replaced by the overload
@@ -402,8 +413,8 @@ def _geometry(src, s, e, gb, k):  # pragma: no cover - replaced by the overload
 def _geometry_overload(src, s, e, gb, k):
     """Vertices ``s`` to ``e`` of a pass's geometry as six (e - s,) T rows (px, py, pz, nx, ny,
     nz; see :func:`prepare`) and 0, or 1 when some of their normals lie outside NORMAL_RANGE or
-    are not finite (as :func:`prepare` counts them). ``src``: G (6, n), whose rows are given as
-    they are, or :class:`Vertices`, prepared here into ``gb`` (6, >= e - s) T."""
+    are not finite (as :func:`prepare` counts them). ``src``: G (6, n), or a :class:`Source`:
+    its G's rows as they are, or its vertices prepared here into ``gb`` (6, >= e - s) T."""
     if isinstance(src, types.Array):
 
         def rows(src, s, e, gb, k):
@@ -412,11 +423,19 @@ def _geometry_overload(src, s, e, gb, k):
         return rows
 
     def prepared(src, s, e, gb, k):
+        G = src.G
+        if G.shape[1]:
+            return (G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e]), 0
         m = e - s
-        Pf, Nf = src.P.reshape(-1), src.N.reshape(-1)
         frame = (src.centre, src.inv_scale)
-        _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
-        outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
+        if src.P.shape[0]:  # float64 vertices
+            Pf, Nf = src.P.reshape(-1), src.N.reshape(-1)
+            _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
+            outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
+        else:  # float32 vertices
+            Pf, Nf = src.P32.reshape(-1), src.N32.reshape(-1)
+            _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
+            outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
         return (gb[0, :m], gb[1, :m], gb[2, :m], gb[3, :m], gb[4, :m], gb[5, :m]), outside
 
     return prepared
@@ -545,8 +564,9 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 def bounds(src, k, out, step):
     """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
 
-    src : the pass's geometry: G (6, n) T prepared (see :func:`prepare`), or :class:`Vertices`
-    (each chunk prepared here as :func:`prepare` would: the same bounds); k : constants(T)
+    src : the pass's geometry: G (6, n) T prepared (see :func:`prepare`), or a
+    :class:`Source` (of vertices: each chunk prepared here as :func:`prepare` would: the same
+    bounds); k : constants(T)
     out : (N_BOUNDS, ceil(n / CHUNK)) float64: the bounding sphere of the chunk's positions
     (centre of its box, radius to the farthest vertex) and the cone of its normals (axis: their
     mean direction; half-angle: the widest normal from it), both widened by
@@ -558,7 +578,7 @@ def bounds(src, k, out, step):
     nj = (out.shape[1] + step - 1) // step
     ntasks = max(1, min(nj, TASKS))
     for t in nb.prange(ntasks):
-        gb = np.empty((6, CHUNK), k.dtype)  # (a chunk of Vertices, prepared: once per task)
+        gb = np.empty((6, CHUNK), k.dtype)  # (a chunk of vertices, prepared: once per task)
         _bounds_run(src, k, out, step, t * nj // ntasks, (t + 1) * nj // ntasks, gb)
 
 
@@ -1455,10 +1475,10 @@ def _task(
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
     arrays here costs no atomic operations on their counts, which both threads would contend);
-    returns how many of them hold a normal outside NORMAL_RANGE (:class:`Vertices` only; see
+    returns how many of them hold a normal outside NORMAL_RANGE (vertices to prepare only; see
     :func:`_geometry`). ``src``: the pass's geometry (see :func:`shade`); ``sums`` and ``out``
     are flat (see :func:`_flat`); ``work``: the task's scratch and its (6, BLOCK) rows for a
-    block of Vertices; ``layout`` is (grey_only, dw, sw): the pass keeps its sums in the grey
+    block of vertices; ``layout`` is (grey_only, dw, sw): the pass keeps its sums in the grey
     rows alone (:func:`grey_pass`), and the widths of the D and S sums (1: grey); ``cull`` :
     :class:`Culling`."""
     scr, gb = work
@@ -1727,12 +1747,13 @@ class Culling(NamedTuple):
 @nb.njit(parallel=True, **_OPTS)
 def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     """Shade every vertex (see the module docstring); returns how many blocks hold a normal
-    outside NORMAL_RANGE or not finite (only :class:`Vertices`, which the pass prepares: 0, or
-    scale the normals and shade again; see :func:`prepare`).
+    outside NORMAL_RANGE or not finite (only vertices the pass prepares: 0, or scale the
+    normals and shade again; see :func:`prepare`).
 
-    src : the geometry: G (6, n) T prepared (see :func:`prepare`), or :class:`Vertices`, each
-    block prepared as the pass reaches it (a one-shot pass: no G written, and the pass reads
-    the caller's positions and normals instead of G's six rows); lights : :class:`Lights`
+    src : the geometry, a :class:`Source`: G (6, n) T prepared (see :func:`prepare`), or
+    vertices, each block prepared as the pass reaches it (a one-shot pass: no G written, and the
+    pass reads the caller's positions and normals instead of G's six rows); lights :
+    :class:`Lights`
     opts : (N_OPTS,) int64; surface : :class:`Surface`; k : constants(T)
     sums : :class:`Sums` (read where not recomputed, written where stored); lobes :
     :class:`Lobes`; vis : :class:`Shadows`, the visibility of the lights flagged SHADOW
@@ -1757,7 +1778,7 @@ def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     outside = 0
     for t in nb.prange(ntasks):
         scr = _scratch(lights.params.dtype)  # once per task: no allocation per block
-        gb = np.empty((6, _lanes_to_prepare(src)), k.dtype)  # (a block of Vertices, prepared)
+        gb = np.empty((6, _lanes_to_prepare(src)), k.dtype)  # (a block of vertices, prepared)
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
         r = _spread(np.int64(t), np.int64(ntasks)) if culls else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
