@@ -1834,17 +1834,22 @@ def _gather_sum(X, idx):
 
 
 @nb.njit(**_OPTS)
-def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes, vis, out):
+def fixup(marks, src, lights, opts, surface, k, sums, lobes, vis, out, no_bounds):
     """Redo the lanes a float32 pass marked in float64, where the policies hold exactly, and
     write the results over the float32 ones; returns how many lanes.
 
     marks : the pass's :class:`Marks` (see :func:`marked`)
-    P, N : (n, 3) world positions and normals; centre, inv_scale : the frame (:func:`prepare`)
+    src : the pass's vertices as a float64 pass takes them (a :class:`Source` of float64 type:
+    (n, 3) world positions and normals, float64 or float32, and the frame; no prepared rows)
     lights, surface, k : the pass's inputs in float64 (:class:`Lights`, :class:`Surface`,
     constants); opts : the pass's (ambiguity tracking is switched off here)
     sums, lobes, vis, out : the pass's float32 arrays, written at the marked lanes
+    no_bounds : (N_BOUNDS, 0) float64, read-only (as a pass's bounds are): no culling
     (one compiled call: gathering, shading and scattering ~150 lanes from Python cost about as
-    much as a light at 1M vertices)
+    much as a light at 1M vertices). The lanes are shaded through the float64 pass's own
+    compiled code: every argument of its :func:`_task` has the type a float64 pass gives
+    (hence ``src``, ``no_bounds`` and the run-time False and 0 below: a literal types the call
+    anew), so that the light loops are not linked and optimised again for a third chain.
     """
     redo, redo_count = marks
     A, D, S = sums
@@ -1855,13 +1860,15 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         return 0
     L = lights.params.shape[0]
     Pm, Nm = np.empty((m, 3)), np.empty((m, 3))
+    wide = src.P.shape[0] > 0  # float64 vertices, else float32
     for j in range(m):
         for c in range(3):
-            Pm[j, c] = P[idx[j], c]
-            Nm[j, c] = N[idx[j], c]
+            Pm[j, c] = src.P[idx[j], c] if wide else src.P32[idx[j], c]
+            Nm[j, c] = src.N[idx[j], c] if wide else src.N32[idx[j], c]
     nblocks = (m + BLOCK - 1) // BLOCK
     G = np.empty((6, m))
-    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks)
+    frame = (src.centre, src.inv_scale)
+    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), *frame, k, G, 0, nblocks)
     o = opts.copy()
     o[O_TRACK] = 0
     Am, Dm, Sm = _gather_sum(A, idx), _gather_sum(D, idx), _gather_sum(S, idx)
@@ -1874,9 +1881,10 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
             vm[r, j] = rows[r, idx[j]]
     om = np.empty((m, 3))
     none = Marks(np.zeros(0, np.bool_), np.zeros(0, np.int32))
-    layout = (False, Dm.shape[1], Sm.shape[1])  # (the float64 pass keeps RGB sums)
+    rgb = m < 0  # False: the float64 pass keeps RGB sums (a run-time bool, see above)
+    layout = (rgb, Dm.shape[1], Sm.shape[1])
     _task(
-        G,
+        Source(G, src.P, src.N, src.P32, src.N32, src.centre, src.inv_scale),  # (G's rows)
         lights,
         o,
         surface,
@@ -1888,10 +1896,10 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         om.reshape(-1),
         (_scratch(np.float64), np.empty((6, 0))),  # (G: no block to prepare)
         np.empty((L, 0), np.int32),
-        0,
+        np.int64(0),
         nblocks,
         layout,
-        Culling(np.zeros((N_BOUNDS, 0)), np.zeros(nblocks, np.int32)),  # (lanes not in chunks)
+        Culling(no_bounds, np.zeros(nblocks, np.int32)),  # (lanes not in chunks)
     )
     for j in range(m):
         i = idx[j]
@@ -2131,4 +2139,5 @@ bounds = _wide(bounds, 1, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-
 shade = _wide(shade, 4)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)
+fixup = _wide(fixup, 5, lanes=8)  # (float64: it shares the float64 pass's compiled code)
 stream = _wide(stream, 2)

@@ -70,7 +70,7 @@ def vertices(P, N, centre, scale, dtype) -> K.Source:
         N if wide else _NONE[np.float64],
         _NONE[np.float32] if wide else P,
         _NONE[np.float32] if wide else N,
-        np.asarray(centre, np.float64),
+        np.array(centre, np.float64),  # (a writable copy: one record type, see rows)
         1.0 / scale,
     )
 

@@ -507,14 +507,13 @@ class Shader:
         self._scaled = True  # (every normal was tested: inside NORMAL_RANGE)
         self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
-            P, N = self._P, self._N
+            src64 = vertices(self._P, self._N, self._centre, self._scale, np.float64)
             params64, flags, view64 = self._params_for(np.float64)
             m = self._scene.material
             surface64 = K.Surface(material_vector(m, np.float64), self._aconst, m.shininess)
-            frame = (self._centre, 1.0 / self._scale)
-            fix = (*frame, K.Lights(params64, flags, view64), opts, surface64, self._k64)
+            fix = (K.Lights(params64, flags, view64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
-                marks, _readonly(P), _readonly(N), *fix, sums, lobes, vis, self._out
+                marks, src64, *fix, sums, lobes, vis, self._out, _NO_BOUNDS
             )
         return 0
 
