@@ -53,6 +53,32 @@ session total 70.2 s at 952533b, 71.9 s after; shade 54.8 / 56.7 s.
 
 7552fa3 had 34 hand-listed variants (16 inline ones in float32 only); the light loops are the
 18 of ``LIGHT_LOOPS`` in both precisions.
+
+``--warm`` before and after issue 38 (one ``kernels.Source`` per precision, ``fixup`` through the
+float64 pass's code; CPU seconds, each run beside other jobs, load 10-15 on the 2 cores, so a
+figure moves by 10% or so; ``None.impl`` is the light loop's dispatch, ``_light_loop``):
+
+| function | baf99d4 signatures | CPU s | after: signatures | CPU s |
+|---|---:|---:|---:|---:|
+| shading.kernels.shade | 6 | 56.4 | 2 | 20.6 |
+| shading.kernels._light_overload.impl | 36 | 43.9 | 36 | 53.9 |
+| shading.kernels._block | 3 | 25.1 | 2 | 19.7 |
+| shading.kernels._task | 7 | 18.1 | 2 | 5.5 |
+| shading.kernels._compose_block_overload.impl | 36 | 8.1 | 36 | 8.3 |
+| shading.kernels.fixup | 2 | 6.7 | 1 | 4.4 |
+| shading.kernels._split_lobe | 2 | 4.7 | 2 | 4.4 |
+| shading.kernels.bounds | 6 | 4.6 | 2 | 2.7 |
+| shading.kernels.compose | 2 | 4.3 | 2 | 5.0 |
+| shading.kernels._reach | 3 | 3.5 | 2 | 2.7 |
+| shading.kernels.prepare | 4 | 2.9 | 4 | 3.4 |
+| None.impl | 2 | 2.6 | 2 | 2.9 |
+| (the 101 others) | 298 | 45.4 | 286 | 57.2 |
+| **the whole compile** (``/usr/bin/time``, user + system) | 407 | 238.7 | 379 | 204.5 |
+
+The light loops' float64 variants cost more after: they are compiled with 512-bit vectors
+whatever compiles them first (``fixup`` used to, with LLVM's 256-bit choice). What is left is
+spread thin: 36 light loops of 1-2 s each, two ``_block`` of 10 s, and some 300 small
+functions of a fraction of a second each (numba's typing and lowering, LLVM, a cache file).
 """
 
 from __future__ import annotations
