@@ -2,6 +2,7 @@
 
     python benchmarks/bench_compile.py                  # this tree
     python benchmarks/bench_compile.py --rev cb71986    # another revision (git archive), too
+    python benchmarks/bench_compile.py --warm           # the background compile, by function
 
 Each case runs in a child process with an empty ``NUMBA_CACHE_DIR`` (nothing loaded from disk),
 which drives a small :class:`explorer.Shader` through what a session does (geometry, a full
@@ -17,6 +18,14 @@ the child, or the old dispatch tables replaced at revisions that had them): its 
 from "shade" is what the literal-dispatched variants cost to compile.
 
 Wall-clock seconds on a shared machine: the load average is printed with the table.
+
+``--warm`` measures the whole background compile instead (``python -m explorer.shading.warm``'s
+:func:`~explorer.shading.warm.exercise`, every kernel signature the product calls, in a child
+with an empty ``NUMBA_CACHE_DIR``) in CPU seconds (user + system: the compile is
+single-threaded, so its CPU time is what it takes on an idle core whatever the load), and each
+specialisation's own share: numba's ``numba:compile`` events, a function's time less that of
+the functions it compiles on the way (each kernel x signature; the light loop's variants, the
+compose variants...), summed by function with the count of signatures.
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; two runs, each child compiling alone
 but beside other engineers' jobs: load average 3.4 to 8.0 during the 7552fa3 run, 1.2 to 1.6
@@ -44,6 +53,32 @@ session total 70.2 s at 952533b, 71.9 s after; shade 54.8 / 56.7 s.
 
 7552fa3 had 34 hand-listed variants (16 inline ones in float32 only); the light loops are the
 18 of ``LIGHT_LOOPS`` in both precisions.
+
+``--warm`` before and after issue 38 (one ``kernels.Source`` per precision, ``fixup`` through the
+float64 pass's code; CPU seconds, each run beside other jobs, load 10-15 on the 2 cores, so a
+figure moves by 10% or so; ``None.impl`` is the light loop's dispatch, ``_light_loop``):
+
+| function | baf99d4 signatures | CPU s | after: signatures | CPU s |
+|---|---:|---:|---:|---:|
+| shading.kernels.shade | 6 | 56.4 | 2 | 20.6 |
+| shading.kernels._light_overload.impl | 36 | 43.9 | 36 | 53.9 |
+| shading.kernels._block | 3 | 25.1 | 2 | 19.7 |
+| shading.kernels._task | 7 | 18.1 | 2 | 5.5 |
+| shading.kernels._compose_block_overload.impl | 36 | 8.1 | 36 | 8.3 |
+| shading.kernels.fixup | 2 | 6.7 | 1 | 4.4 |
+| shading.kernels._split_lobe | 2 | 4.7 | 2 | 4.4 |
+| shading.kernels.bounds | 6 | 4.6 | 2 | 2.7 |
+| shading.kernels.compose | 2 | 4.3 | 2 | 5.0 |
+| shading.kernels._reach | 3 | 3.5 | 2 | 2.7 |
+| shading.kernels.prepare | 4 | 2.9 | 4 | 3.4 |
+| None.impl | 2 | 2.6 | 2 | 2.9 |
+| (the 101 others) | 298 | 45.4 | 286 | 57.2 |
+| **the whole compile** (``/usr/bin/time``, user + system) | 407 | 238.7 | 379 | 204.5 |
+
+The light loops' float64 variants cost more after: they are compiled with 512-bit vectors
+whatever compiles them first (``fixup`` used to, with LLVM's 256-bit choice). What is left is
+spread thin: 36 light loops of 1-2 s each, two ``_block`` of 10 s, and some 300 small
+functions of a fraction of a second each (numba's typing and lowering, LLVM, a cache file).
 """
 
 from __future__ import annotations
@@ -116,6 +151,58 @@ display.to_bytes(np.asarray(sh.colors, np.float64))
 print(json.dumps({{"import": import_s, **times}}))
 """
 
+#: the background compile, timed by specialisation (run in a child, like CHILD)
+WARM = r"""
+import json, sys, time
+from numba.core import event
+stack, rows = [], []
+class Listener(event.Listener):
+    def on_start(self, ev):
+        stack.append([time.process_time(), 0.0])
+    def on_end(self, ev):
+        t0, inner = stack.pop()
+        total = time.process_time() - t0
+        if stack:
+            stack[-1][1] += total
+        f = ev.data["dispatcher"].py_func
+        rows.append((f"{{f.__module__}}.{{f.__qualname__}}", total - inner))
+t = time.process_time()
+with event.install_listener("numba:compile", Listener()):
+    import explorer
+    assert explorer.__file__.startswith({root!r}), explorer.__file__
+    from explorer.shading import warm
+    warm.exercise()
+print(json.dumps({{"cpu": time.process_time() - t, "rows": rows}}))
+"""
+
+
+def warm_table(root: Path, label: str, top: int = 25) -> list[str]:
+    """The background compile's CPU seconds at ``root``, by function (see the docstring)."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, PYTHONPATH=str(root), NUMBA_CACHE_DIR=cache)
+        env["PHONG_EXPLORER_KERNELS"] = "compiled"
+        out = subprocess.run([sys.executable, "-c", WARM.format(root=str(root))], cwd=root,
+                             env=env, capture_output=True, text=True)  # fmt: skip
+    if out.returncode != 0:
+        sys.exit(f"{root}: the child failed:\n{out.stderr[-3000:]}")
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    by: dict[str, list] = {}
+    for name, s in res["rows"]:
+        name = name.replace("explorer.", "").replace("<locals>.", "")
+        by.setdefault(name, [0, 0.0])
+        by[name][0] += 1
+        by[name][1] += s
+    lines = [f"\n{label}: {res['cpu']:.1f} CPU s in all\n", "| function | signatures | CPU s |"]
+    lines.append("|---|---:|---:|")
+    ranked = sorted(by.items(), key=lambda kv: -kv[1][1])
+    for name, (n, s) in ranked[:top]:
+        lines.append(f"| {name} | {n} | {s:.1f} |")
+    rest = ranked[top:]
+    lines.append(f"| (the {len(rest)} others) | {sum(n for _, (n, _) in rest)} | "
+                 f"{sum(s for _, (_, s) in rest):.1f} |")  # fmt: skip
+    return lines
+
+
 ENTRIES = ("extent", "prepare", "bounds", "shade", "fixup", "compose", "lobe", "_round_bytes")
 
 
@@ -157,6 +244,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rev", action="append", default=[], help="also measure a git revision")
     ap.add_argument("--skip-tree", action="store_true", help="measure the revisions only")
     ap.add_argument("--precision", choices=("float32", "float64"), help="this one only")
+    ap.add_argument("--warm", action="store_true", help="the background compile, by function")
     args = ap.parse_args(argv)
     sys.path[:0] = [str(ROOT), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
@@ -171,9 +259,15 @@ def main(argv=None) -> int:
                 ["git", "-C", str(ROOT), "archive", rev], check=True, capture_output=True
             ).stdout
             subprocess.run(["tar", "-x", "-C", str(root)], input=arc, check=True)
-            out += measure(root, f"revision {rev}", dtypes)
+            out += (
+                warm_table(root, f"revision {rev}")
+                if args.warm
+                else measure(root, f"revision {rev}", dtypes)
+            )
         if not args.skip_tree:
-            out += measure(ROOT, "this tree", dtypes)
+            out += (
+                warm_table(ROOT, "this tree") if args.warm else measure(ROOT, "this tree", dtypes)
+            )
     out.append(f"\nload average after: {os.getloadavg()[0]:.2f}")
     print("\n".join(out))
     return 0

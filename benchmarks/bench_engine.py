@@ -16,8 +16,8 @@ floor of a recolour (read positions and normals once, write colours once) is mea
 same run, on the same arrays, so "recolour / floor" is a like-for-like ratio. "geometry
 preparation" is what a one-shot ``shade()`` does before its pass (:func:`one_shot_geometry`:
 check the vertices, find the frame and its extent, the plan, and the chunk bounds light
-culling would use); its pass then prepares each block of vertices as it shades it
-(``kernels.Vertices``), so that share is inside the one-shot rows, and the row "one-shot -
+culling would use); its pass then prepares each block of vertices as it shades it (a
+``kernels.Source`` of vertices), so that share is inside the one-shot rows, and the row "one-shot -
 full shading" gives what a one-shot call costs beyond a kept shader's pass over the same
 lights. The geometry rows and the floor are timed in turns, call after call, so the ratio
 between them sees the same machine (the floor moves by 2x between runs, with what of the
@@ -117,13 +117,13 @@ def one_shot_geometry(scene, P, N, precision: str) -> None:
     for light culling (a sample first; every chunk when the sample says culling pays)."""
     sh = explorer.Shader(scene, P, N, precision=precision, keep=False)
     sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
-    src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale)
+    src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale, sh._k.dtype)
     prepared.chunk_bounds(src, sh._k)
 
 
 def one_shot_flows(scene, P, N, R: int) -> int:
     """``--flows``: a one-shot pass as the engine runs it (the kernel prepares each block of
-    the vertices as it shades it, ``kernels.Vertices``) against the flow it replaced (slabs of
+    the vertices as it shades it, a ``kernels.Source``) against the flow it replaced (slabs of
     256k vertices prepared into a reused buffer, each then shaded), the same kernels and
     arguments in one process, in turns; both give the same colours (checked). Prints wall-clock
     medians with every thread and CPU medians with one."""
@@ -168,11 +168,12 @@ def _flows(scene, P, N, precision: str) -> dict:
         for s in range(0, n, slab):
             e = min(n, s + slab)
             G = bufs[e - s]
-            K.prepare(src.P[s:e], src.N[s:e], src.centre, src.inv_scale, k, G)
-            b = prepared.chunk_bounds(G, k)
+            P_, N_ = (src.P, src.N) if len(src.P) else (src.P32, src.N32)
+            K.prepare(P_[s:e], N_[s:e], src.centre, src.inv_scale, k, G)
+            b = prepared.chunk_bounds(prepared.rows(G), k)
             b0, b1 = s // K.BLOCK, -(-e // K.BLOCK)
             m = K.Marks(marks.redo[s:e] if len(marks.redo) else marks.redo, marks.count[b0:b1])
-            real(G, *inputs, m, out[s:e], K.Culling(b, culling.culled[b0:b1]))
+            real(prepared.rows(G), *inputs, m, out[s:e], K.Culling(b, culling.culled[b0:b1]))
 
     vertices()
     first = out.copy()

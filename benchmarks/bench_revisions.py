@@ -177,7 +177,10 @@ for _ in range(12 if hasattr(explorer.Shader, "_compiled_geometry") else 0):  # 
     sh._compiled_geometry()
     if hasattr(sh, "_one_shot"):
         from explorer.shading import prepared
-        prepared.chunk_bounds(prepared.vertices(sh._P, sh._N, sh._centre, sh._scale), sh._k)
+        import inspect  # (a Source per precision since w38: vertices takes the dtype)
+        more = [sh._k.dtype] if "dtype" in inspect.signature(prepared.vertices).parameters else []
+        src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale, *more)
+        prepared.chunk_bounds(src, sh._k)
     for _ in getattr(sh, "_slabs", lambda: ())():
         pass
     ts.append(time.perf_counter() - t)

@@ -43,6 +43,7 @@ import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import BVH_BOX_PAD, DET_EPS, RAY_T_EPS, SURFACE_NORMAL_MIN
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.geometry import occluders as occ
 from explorer.geometry.rays import pack_triangles, ray_triangle_row
 from explorer.geometry.traverse import (
@@ -461,11 +462,11 @@ def _any_hit_chunk(r0, r1, rays, tree, parent, eps, out):
 def _leaf_nearest(leaf, q, tri, order, ray, t_min, best):
     """Leaf ``q``'s hits of the ray ``(ox, oy, oz, dx, dy, dz)`` against best = (t, triangle,
     u, v, leaf): the nearer hit beyond ``t_min``, at equal ``t`` the lower triangle index."""
-    ox, oy, oz, dx, dy, dz = ray
+    o, d = ray[:3], ray[3:]
     bt, bf, bu, bv, bq = best
     first = leaf[q, 0]
     for j in range(first, first + leaf[q, 1]):
-        t, u, v = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, 0.0, False)
+        t, u, v = ray_triangle_row(tri, j, o, d, 0.0, False)
         if t > t_min and (t < bt or (t == bt and t < math.inf and (bf < 0 or order[j] < bf))):
             bt, bf, bu, bv, bq = t, order[j], u, v, q
     return bt, bf, bu, bv, bq

@@ -44,6 +44,7 @@ import numba as nb
 import numpy as np
 
 from explorer.core.tolerances import CONE_ROUND, CONE_SLACK, CONE_WIDEN, OCCLUDER_MARGIN
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.geometry.traverse import to_lanes
 
 #: the rays share an end when their ends ``O + tmax·D`` lie within this times (1 + |end|) of the

@@ -26,18 +26,25 @@ import numba as nb
 import numpy as np
 
 from explorer.core.tolerances import DET_EPS, RAY_T_EPS
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 
 
 @nb.njit(inline="always")
-def ray_triangle(ox, oy, oz, dx, dy, dz, ax, ay, az, px, py, pz, qx, qy, qz, det_min, front_only):
+def ray_triangle(o, d, a, p, q, det_min, front_only):
     """Möller-Trumbore: ray origin ``o``, direction ``d``; triangle corner ``a``, edges ``p``
-    (= e1) and ``q`` (= e2), all as scalars.
+    (= e1) and ``q`` (= e2), each a tuple (x, y, z) of floats (inlined: the tuples cost
+    nothing).
 
     front_only : True: only ``det >= det_min`` counts (the front side); False: any
         ``det != 0`` (both sides, ``det_min`` unused)
     Returns (t, u, v): the ray parameter and barycentric coordinates of the hit, or
     ``t = inf`` for a miss (no bound ``t < tmax`` accepts it).
     """
+    ox, oy, oz = o
+    dx, dy, dz = d
+    ax, ay, az = a
+    px, py, pz = p
+    qx, qy, qz = q
     # p = d × e2, det = e1 · p
     pv0 = dy * qz - dz * qy
     pv1 = dz * qx - dx * qz
@@ -89,15 +96,12 @@ def pack_triangles(triangles) -> np.ndarray:
 
 
 @nb.njit(inline="always")
-def ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_min, front_only):
-    """:func:`ray_triangle` against row ``j`` of :func:`pack_triangles`' rows ``tri``."""
-    return ray_triangle(
-        ox, oy, oz, dx, dy, dz,
-        tri[j, 0], tri[j, 1], tri[j, 2],
-        tri[j, 3], tri[j, 4], tri[j, 5],
-        tri[j, 6], tri[j, 7], tri[j, 8],
-        det_min, front_only,
-    )  # fmt: skip
+def ray_triangle_row(tri, j, o, d, det_min, front_only):
+    """:func:`ray_triangle` of the ray ``o``, ``d`` (tuples) against row ``j`` of
+    :func:`pack_triangles`' rows ``tri``."""
+    a = (tri[j, 0], tri[j, 1], tri[j, 2])
+    p = (tri[j, 3], tri[j, 4], tri[j, 5])
+    return ray_triangle(o, d, a, p, (tri[j, 6], tri[j, 7], tri[j, 8]), det_min, front_only)
 
 
 # -- any hit: shadow rays --------------------------------------------------------------------
@@ -109,11 +113,11 @@ def _any_hit(O, D, tmax, tri, t_eps, det_eps, out):
     (t_eps, tmax - t_eps); each ray stops at its first hit."""
     m = tri.shape[0]
     for r in nb.prange(O.shape[0]):
-        ox, oy, oz = O[r, 0], O[r, 1], O[r, 2]
-        dx, dy, dz = D[r, 0], D[r, 1], D[r, 2]
+        o = (O[r, 0], O[r, 1], O[r, 2])
+        d = (D[r, 0], D[r, 1], D[r, 2])
         tm = tmax[r] - t_eps
         for j in range(m):
-            t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
+            t, _, _ = ray_triangle_row(tri, j, o, d, det_eps, True)
             if t > t_eps and t < tm:
                 out[r] = True
                 break

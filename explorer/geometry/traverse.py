@@ -10,8 +10,8 @@ vector operation: the same float64 arithmetic as :func:`slab`, lane by lane, so 
 box in a wide row exactly when it enters that box in the binary tree.
 
 These functions are inlined into :mod:`explorer.geometry.bvh`'s and
-:mod:`explorer.geometry.occluders`' kernels, which numba's on-disk cache keys by their own files
-only: after an edit here, touch those two (or clear their cache), or they keep the old code.
+:mod:`explorer.geometry.occluders`' kernels: an edit here recompiles those (numba's cache of the
+kernel files is keyed on every source they import, :mod:`explorer.geometry.kernelcache`).
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from numba import types
 from numba.cpython.unsafe.numbers import trailing_zeros
 from numba.extending import intrinsic
 
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.geometry.rays import ray_triangle_row
 
 #: the traversal stack; the BVH builder's depth limit plus 64 levels holds any mesh that fits
@@ -108,10 +109,10 @@ def next_node(stack, sp, ca, cb, ta, tb):
 def leaf_any(packed, tri, ray, t_eps, tm, det_eps):
     """Whether the ray ``(ox, oy, oz, dx, dy, dz)`` meets a front side in the leaf whose first
     triangle and count are ``packed`` (:data:`LEAF_BITS`, as the node rows hold them)."""
-    ox, oy, oz, dx, dy, dz = ray
+    o, d = ray[:3], ray[3:]
     first = np.int64(packed) >> LEAF_BITS
     for j in range(first, first + (np.int64(packed) & ((1 << LEAF_BITS) - 1))):
-        t, _, _ = ray_triangle_row(tri, j, ox, oy, oz, dx, dy, dz, det_eps, True)
+        t, _, _ = ray_triangle_row(tri, j, o, d, det_eps, True)
         if t > t_eps and t < tm:
             return True
     return False

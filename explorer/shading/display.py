@@ -22,6 +22,7 @@ import numba as nb
 import numpy as np
 
 from explorer.core.errors import ExplorerError
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.geometry.meshes import Mesh
 from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS

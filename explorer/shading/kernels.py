@@ -45,8 +45,8 @@ it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and 
 the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
 :mod:`explorer.shading.equation`). Every loop is compiled with the entry point that first meets
 a precision (``shade``; ``fixup`` for the float64 redo of a float32 pass), and numba caches
-the result on disk (``cache=True``: per source file and machine; an edit to this module, or to
-:mod:`explorer.shading.vmath` followed by touching this file, recompiles). What that costs is
+the result on disk (``cache=True``: per machine, keyed on this file's and :mod:`.vmath`'s
+contents, :mod:`explorer.geometry.kernelcache`; an edit to either recompiles). What that costs is
 measured by ``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of
 the loops a scene does not use (its docstring keeps the last table, with the machine).
 
@@ -101,6 +101,7 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT,
     SPOT_EXP,
 )
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
@@ -356,14 +357,25 @@ def _prepare_blocks(Pf, Nf, centre, inv_scale, k, G, b0, b1):
     return outside
 
 
-class Vertices(NamedTuple):
-    """A pass's geometry as the caller holds it, prepared block by block as the pass reaches
-    it (:func:`prepare`'s arithmetic: the same values), so that no (6, n) G is written or read
-    (a one-shot pass). ``P``, ``N`` (n, 3) float32/float64 world positions and normals (one
-    dtype); ``centre`` (3,) float64 and ``inv_scale`` float64: the normalised frame."""
+class Source(NamedTuple):
+    """A pass's geometry (``src``): ``G`` (6, n) T, the prepared rows (see :func:`prepare`),
+    read as they are; or G (6, 0) and the caller's vertices, prepared block by block as the
+    pass reaches them (:func:`prepare`'s arithmetic: the same values), so that no (6, n) G is
+    written or read (a one-shot pass): ``P``, ``N`` (n, 3) float64 world positions and normals,
+    or ``P32``, ``N32`` (n, 3) float32 (the other pair (0, 3)), read-only; ``centre`` (3,)
+    float64 and ``inv_scale`` float64: the normalised frame
+    (:func:`explorer.shading.prepared.vertices`, :func:`~explorer.shading.prepared.rows`).
 
+    One record type per precision whatever the path and the caller's dtype, so that
+    :func:`shade`, :func:`bounds` and what they call compile once per precision: each signature
+    of ``shade`` links every light loop and optimises it again (the cold compile took 6
+    signatures where it now takes 2; ``benchmarks/bench_compile.py --warm``)."""
+
+    G: np.ndarray
     P: np.ndarray
     N: np.ndarray
+    P32: np.ndarray
+    N32: np.ndarray
     centre: np.ndarray
     inv_scale: float
 
@@ -374,10 +386,10 @@ def _vertex_count(src):  # pragma: no cover - replaced by the overload
 
 @overload(_vertex_count, jit_options=_LEAF)
 def _vertex_count_overload(src):
-    """How many vertices a pass's geometry holds: G (6, n) or :class:`Vertices`."""
+    """How many vertices a pass's geometry holds: G (6, n) or a :class:`Source`."""
     if isinstance(src, types.Array):
         return lambda src: src.shape[1]
-    return lambda src: src.P.shape[0]
+    return lambda src: src.G.shape[1] + src.P.shape[0] + src.P32.shape[0]  # (two are empty)
 
 
 def _lanes_to_prepare(src):  # pragma: no cover - replaced by the overload
@@ -386,11 +398,11 @@ def _lanes_to_prepare(src):  # pragma: no cover - replaced by the overload
 
 @overload(_lanes_to_prepare, jit_options=_LEAF)
 def _lanes_to_prepare_overload(src):
-    """The lanes of a task's buffer for a block of :class:`Vertices` (see :func:`_geometry`):
+    """The lanes of a task's buffer for a block of vertices to prepare (see :func:`_geometry`):
     BLOCK, or 0 for G, whose rows the pass reads as they are."""
     if isinstance(src, types.Array):
         return lambda src: 0
-    return lambda src: BLOCK
+    return lambda src: 0 if src.G.shape[1] else BLOCK
 
 
 def _geometry(src, s, e, gb, k):  # pragma: no cover - replaced by the overload
@@ -401,8 +413,8 @@ def _geometry(src, s, e, gb, k):  # pragma: no cover - replaced by the overload
 def _geometry_overload(src, s, e, gb, k):
     """Vertices ``s`` to ``e`` of a pass's geometry as six (e - s,) T rows (px, py, pz, nx, ny,
     nz; see :func:`prepare`) and 0, or 1 when some of their normals lie outside NORMAL_RANGE or
-    are not finite (as :func:`prepare` counts them). ``src``: G (6, n), whose rows are given as
-    they are, or :class:`Vertices`, prepared here into ``gb`` (6, >= e - s) T."""
+    are not finite (as :func:`prepare` counts them). ``src``: G (6, n), or a :class:`Source`:
+    its G's rows as they are, or its vertices prepared here into ``gb`` (6, >= e - s) T."""
     if isinstance(src, types.Array):
 
         def rows(src, s, e, gb, k):
@@ -411,11 +423,19 @@ def _geometry_overload(src, s, e, gb, k):
         return rows
 
     def prepared(src, s, e, gb, k):
+        G = src.G
+        if G.shape[1]:
+            return (G[0, s:e], G[1, s:e], G[2, s:e], G[3, s:e], G[4, s:e], G[5, s:e]), 0
         m = e - s
-        Pf, Nf = src.P.reshape(-1), src.N.reshape(-1)
         frame = (src.centre, src.inv_scale)
-        _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
-        outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
+        if src.P.shape[0]:  # float64 vertices
+            Pf, Nf = src.P.reshape(-1), src.N.reshape(-1)
+            _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
+            outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
+        else:  # float32 vertices
+            Pf, Nf = src.P32.reshape(-1), src.N32.reshape(-1)
+            _load_positions(Pf[3 * s : 3 * e], *frame, gb[0, :m], gb[1, :m], gb[2, :m])
+            outside = _load_normals(Nf[3 * s : 3 * e], gb[3, :m], gb[4, :m], gb[5, :m], k)
         return (gb[0, :m], gb[1, :m], gb[2, :m], gb[3, :m], gb[4, :m], gb[5, :m]), outside
 
     return prepared
@@ -546,8 +566,9 @@ def _two_sided(nx, ny, nz, vx, vy, vz, trk, k):
 def bounds(src, k, out, step):
     """What light culling knows of each chunk of :data:`CHUNK` consecutive vertices.
 
-    src : the pass's geometry: G (6, n) T prepared (see :func:`prepare`), or :class:`Vertices`
-    (each chunk prepared here as :func:`prepare` would: the same bounds); k : constants(T)
+    src : the pass's geometry: G (6, n) T prepared (see :func:`prepare`), or a
+    :class:`Source` (of vertices: each chunk prepared here as :func:`prepare` would: the same
+    bounds); k : constants(T)
     out : (N_BOUNDS, ceil(n / CHUNK)) float64: the bounding sphere of the chunk's positions
     (centre of its box, radius to the farthest vertex) and the cone of its normals (axis: their
     mean direction; half-angle: the widest normal from it), both widened by
@@ -559,7 +580,7 @@ def bounds(src, k, out, step):
     nj = (out.shape[1] + step - 1) // step
     ntasks = max(1, min(nj, TASKS))
     for t in nb.prange(ntasks):
-        gb = np.empty((6, CHUNK), k.dtype)  # (a chunk of Vertices, prepared: once per task)
+        gb = np.empty((6, CHUNK), k.dtype)  # (a chunk of vertices, prepared: once per task)
         _bounds_run(src, k, out, step, t * nj // ntasks, (t + 1) * nj // ntasks, gb)
 
 
@@ -1460,10 +1481,10 @@ def _task(
 ):
     """Blocks b0 to b1 - 1 of a pass (compiled without reference counting: slicing the shared
     arrays here costs no atomic operations on their counts, which both threads would contend);
-    returns how many of them hold a normal outside NORMAL_RANGE (:class:`Vertices` only; see
+    returns how many of them hold a normal outside NORMAL_RANGE (vertices to prepare only; see
     :func:`_geometry`). ``src``: the pass's geometry (see :func:`shade`); ``sums`` and ``out``
     are flat (see :func:`_flat`); ``work``: the task's scratch and its (6, BLOCK) rows for a
-    block of Vertices; ``layout`` is (grey_only, dw, sw): the pass keeps its sums in the grey
+    block of vertices; ``layout`` is (grey_only, dw, sw): the pass keeps its sums in the grey
     rows alone (:func:`grey_pass`), and the widths of the D and S sums (1: grey); ``cull`` :
     :class:`Culling`."""
     scr, gb = work
@@ -1732,12 +1753,13 @@ class Culling(NamedTuple):
 @nb.njit(parallel=True, **_OPTS)
 def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     """Shade every vertex (see the module docstring); returns how many blocks hold a normal
-    outside NORMAL_RANGE or not finite (only :class:`Vertices`, which the pass prepares: 0, or
-    scale the normals and shade again; see :func:`prepare`).
+    outside NORMAL_RANGE or not finite (only vertices the pass prepares: 0, or scale the
+    normals and shade again; see :func:`prepare`).
 
-    src : the geometry: G (6, n) T prepared (see :func:`prepare`), or :class:`Vertices`, each
-    block prepared as the pass reaches it (a one-shot pass: no G written, and the pass reads
-    the caller's positions and normals instead of G's six rows); lights : :class:`Lights`
+    src : the geometry, a :class:`Source`: G (6, n) T prepared (see :func:`prepare`), or
+    vertices, each block prepared as the pass reaches it (a one-shot pass: no G written, and the
+    pass reads the caller's positions and normals instead of G's six rows); lights :
+    :class:`Lights`
     opts : (N_OPTS,) int64; surface : :class:`Surface`; k : constants(T)
     sums : :class:`Sums` (read where not recomputed, written where stored); lobes :
     :class:`Lobes`; vis : :class:`Shadows`, the visibility of the lights flagged SHADOW
@@ -1762,7 +1784,7 @@ def shade(src, lights, opts, surface, k, sums, lobes, vis, marks, out, culling):
     outside = 0
     for t in nb.prange(ntasks):
         scr = _scratch(lights.params.dtype)  # once per task: no allocation per block
-        gb = np.empty((6, _lanes_to_prepare(src)), k.dtype)  # (a block of Vertices, prepared)
+        gb = np.empty((6, _lanes_to_prepare(src)), k.dtype)  # (a block of vertices, prepared)
         # (dealt across the mesh only when culling: contiguous halves stream faster, 1.04x)
         r = _spread(np.int64(t), np.int64(ntasks)) if culls else np.int64(t)
         b0, b1 = r * nblocks // ntasks, (r + 1) * nblocks // ntasks
@@ -1818,17 +1840,22 @@ def _gather_sum(X, idx):
 
 
 @nb.njit(**_OPTS)
-def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes, vis, out):
+def fixup(marks, src, lights, opts, surface, k, sums, lobes, vis, out, no_bounds):
     """Redo the lanes a float32 pass marked in float64, where the policies hold exactly, and
     write the results over the float32 ones; returns how many lanes.
 
     marks : the pass's :class:`Marks` (see :func:`marked`)
-    P, N : (n, 3) world positions and normals; centre, inv_scale : the frame (:func:`prepare`)
+    src : the pass's vertices as a float64 pass takes them (a :class:`Source` of float64 type:
+    (n, 3) world positions and normals, float64 or float32, and the frame; no prepared rows)
     lights, surface, k : the pass's inputs in float64 (:class:`Lights`, :class:`Surface`,
     constants); opts : the pass's (ambiguity tracking is switched off here)
     sums, lobes, vis, out : the pass's float32 arrays, written at the marked lanes
+    no_bounds : (N_BOUNDS, 0) float64, read-only (as a pass's bounds are): no culling
     (one compiled call: gathering, shading and scattering ~150 lanes from Python cost about as
-    much as a light at 1M vertices)
+    much as a light at 1M vertices). The lanes are shaded through the float64 pass's own
+    compiled code: every argument of its :func:`_task` has the type a float64 pass gives
+    (hence ``src``, ``no_bounds`` and the run-time False and 0 below: a literal types the call
+    anew), so that the light loops are not linked and optimised again for a third chain.
     """
     redo, redo_count = marks
     A, D, S = sums
@@ -1839,13 +1866,15 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         return 0
     L = lights.params.shape[0]
     Pm, Nm = np.empty((m, 3)), np.empty((m, 3))
+    wide = src.P.shape[0] > 0  # float64 vertices, else float32
     for j in range(m):
         for c in range(3):
-            Pm[j, c] = P[idx[j], c]
-            Nm[j, c] = N[idx[j], c]
+            Pm[j, c] = src.P[idx[j], c] if wide else src.P32[idx[j], c]
+            Nm[j, c] = src.N[idx[j], c] if wide else src.N32[idx[j], c]
     nblocks = (m + BLOCK - 1) // BLOCK
     G = np.empty((6, m))
-    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), centre, inv_scale, k, G, 0, nblocks)
+    frame = (src.centre, src.inv_scale)
+    _prepare_blocks(Pm.reshape(-1), Nm.reshape(-1), *frame, k, G, 0, nblocks)
     o = opts.copy()
     o[O_TRACK] = 0
     Am, Dm, Sm = _gather_sum(A, idx), _gather_sum(D, idx), _gather_sum(S, idx)
@@ -1858,9 +1887,10 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
             vm[r, j] = rows[r, idx[j]]
     om = np.empty((m, 3))
     none = Marks(np.zeros(0, np.bool_), np.zeros(0, np.int32))
-    layout = (False, Dm.shape[1], Sm.shape[1])  # (the float64 pass keeps RGB sums)
+    rgb = m < 0  # False: the float64 pass keeps RGB sums (a run-time bool, see above)
+    layout = (rgb, Dm.shape[1], Sm.shape[1])
     _task(
-        G,
+        Source(G, src.P, src.N, src.P32, src.N32, src.centre, src.inv_scale),  # (G's rows)
         lights,
         o,
         surface,
@@ -1872,10 +1902,10 @@ def fixup(marks, P, N, centre, inv_scale, lights, opts, surface, k, sums, lobes,
         om.reshape(-1),
         (_scratch(np.float64), np.empty((6, 0))),  # (G: no block to prepare)
         np.empty((L, 0), np.int32),
-        0,
+        np.int64(0),
         nblocks,
         layout,
-        Culling(np.zeros((N_BOUNDS, 0)), np.zeros(nblocks, np.int32)),  # (lanes not in chunks)
+        Culling(no_bounds, np.zeros(nblocks, np.int32)),  # (lanes not in chunks)
     )
     for j in range(m):
         i = idx[j]
@@ -2115,4 +2145,5 @@ bounds = _wide(bounds, 1, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-
 shade = _wide(shade, 4)
 lobe = _wide(lobe, 2)
 compose = _wide(compose, 7)
+fixup = _wide(fixup, 5, lanes=8)  # (float64: it shares the float64 pass's compiled code)
 stream = _wide(stream, 2)

@@ -46,7 +46,7 @@ def prepared_geometry(P, N, dtype, k) -> tuple:
         check_finite("normals", N)
         N = scale_normals(N)
         K.prepare(readonly(P), readonly(N), *frame, G)
-    return centre, scale, G, chunk_bounds(G, k), N
+    return centre, scale, G, chunk_bounds(rows(G), k), N
 
 
 def geometry_of(P, N, dtype, k, whole: bool = True) -> tuple:
@@ -58,10 +58,28 @@ def geometry_of(P, N, dtype, k, whole: bool = True) -> tuple:
     return (*frame_of_positions(P), None, None, None)
 
 
-def vertices(P, N, centre, scale) -> K.Vertices:
-    """Positions ``P`` and normals ``N`` (n, 3) (one dtype) in the frame ``centre``, ``scale``
-    as a one-shot pass takes them (:class:`explorer.shading.kernels.Vertices`, read-only)."""
-    return K.Vertices(readonly(P), readonly(N), np.asarray(centre, np.float64), 1.0 / scale)
+def vertices(P, N, centre, scale, dtype) -> K.Source:
+    """Positions ``P`` and normals ``N`` (n, 3) (one dtype, float32 or float64) in the frame
+    ``centre``, ``scale`` as a one-shot pass in precision ``dtype`` takes them
+    (:class:`explorer.shading.kernels.Source`, read-only; no prepared rows)."""
+    P, N = readonly(P), readonly(N)
+    wide = P.dtype == np.float64
+    return K.Source(
+        np.empty((6, 0), dtype),
+        P if wide else _NONE[np.float64],
+        N if wide else _NONE[np.float64],
+        _NONE[np.float32] if wide else P,
+        _NONE[np.float32] if wide else N,
+        np.array(centre, np.float64),  # (a writable copy: one record type, see rows)
+        1.0 / scale,
+    )
+
+
+def rows(G) -> K.Source:
+    """The prepared rows ``G`` (6, n) (:func:`prepared_geometry`) as a pass takes them
+    (:class:`explorer.shading.kernels.Source`; the same record type as :func:`vertices`)."""
+    none64, none32 = _NONE[np.float64], _NONE[np.float32]
+    return K.Source(G, none64, none64, none32, none32, np.zeros(3), 1.0)
 
 
 def chunk_bounds(src, k) -> np.ndarray:
@@ -73,7 +91,7 @@ def chunk_bounds(src, k) -> np.ndarray:
     could be culled to pay for the tests. Every CULL_SAMPLE-th chunk is found first: when those
     already fall short, the rest are not (on vertices in no particular order most of the
     bounds' cost)."""
-    n = len(src.P) if isinstance(src, K.Vertices) else src.shape[1]
+    n = src.G.shape[1] + len(src.P) + len(src.P32)  # (two of them are empty)
     b = np.empty((K.N_BOUNDS, -(-n // K.CHUNK)), np.float64)
     K.bounds(src, k, b, CULL_SAMPLE)
     sample = b[K.B_COS, ::CULL_SAMPLE]
@@ -91,3 +109,7 @@ def readonly(a: np.ndarray) -> np.ndarray:
     v = a.view()
     v.flags.writeable = False
     return v
+
+
+#: the absent vertices of a :class:`~explorer.shading.kernels.Source`, by dtype: (0, 3) read-only
+_NONE = {t: readonly(np.empty((0, 3), t)) for t in (np.float64, np.float32)}

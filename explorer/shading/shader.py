@@ -57,7 +57,7 @@ from explorer.shading import tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.prepared import chunk_bounds, geometry_of, vertices
+from explorer.shading.prepared import chunk_bounds, geometry_of, rows, vertices
 from explorer.shading.prepared import readonly as _readonly
 from explorer.shading.shadows import pending_work, visibility_rows
 
@@ -465,7 +465,7 @@ class Shader:
             K.Lobes(base, ws),
         )
         if self._G is not None:
-            self._pass(self._G, self._bounds, vis, inputs)
+            self._pass(rows(self._G), self._bounds, vis, inputs)
         else:
             self._one_shot(vis, inputs)
         self.stats["pass"] += 1
@@ -484,7 +484,7 @@ class Shader:
         outside NORMAL_RANGE, which that pass finds, are scaled into it and the pass runs
         again; NaN or infinite ones raise check_finite's error naming the first, no colours."""
         for scaled in (False, True):  # (scaled ones lie inside: the second pass is the last)
-            src = vertices(self._P, self._N, self._centre, self._scale)
+            src = vertices(self._P, self._N, self._centre, self._scale, self._k.dtype)
             bounds = chunk_bounds(src, self._k) if self._plan.cull and self.cull else _NO_BOUNDS
             if not self._pass(src, bounds, vis, inputs) or scaled:
                 break
@@ -507,13 +507,12 @@ class Shader:
         self._scaled = True  # (every normal was tested: inside NORMAL_RANGE)
         self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
         if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
-            P, N = self._P, self._N
+            src64 = vertices(self._P, self._N, self._centre, self._scale, np.float64)
             params64, flags, view64 = self._params_for(np.float64)
             surface64 = kernel_surface(self._scene.material, self._aconst, np.float64)
-            frame = (self._centre, 1.0 / self._scale)
-            fix = (*frame, K.Lights(params64, flags, view64), opts, surface64, self._k64)
+            fix = (K.Lights(params64, flags, view64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
-                marks, _readonly(P), _readonly(N), *fix, sums, lobes, vis, self._out
+                marks, src64, *fix, sums, lobes, vis, self._out, _NO_BOUNDS
             )
         return 0
 

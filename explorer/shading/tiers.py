@@ -15,7 +15,7 @@ install that first compile takes minutes. So the engine has two tiers:
 Mode ``auto`` (the default) uses the compiled tier when numba's cache holds every kernel the
 product calls: :mod:`explorer.shading.warm` compiles them all and then writes a *ready marker*
 into numba's cache directory, named by everything that invalidates numba's cache (the kernel
-sources' size and modification time, numba's and Python's versions, the CPU and the code
+sources' contents, numba's and Python's versions, the CPU and the code
 generation options). Until the marker is there, passes run on the numpy tier, and the first one
 starts ``python -m explorer.shading.warm`` in the background (detached: it outlives the command
 that started it; a lock keeps one at a time per cache directory) and says so once, as a
@@ -53,7 +53,6 @@ and rounds to the pass's precision).
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import os
 import platform
@@ -68,21 +67,13 @@ from pathlib import Path
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError, Notice
 from explorer.core.files import NO_SUCH_FILE, UnreadableFile, read_checked
-from explorer.geometry import bvh, bvh_numpy
+from explorer.geometry import bvh, bvh_numpy, kernelcache
 
 #: the environment variable that picks the mode
 ENV = "PHONG_EXPLORER_KERNELS"
 MODES = ("auto", "compiled", "numpy")
-#: modules whose numba functions the product calls (their sources name the marker)
-SOURCES = (
-    "explorer.shading.kernels",
-    "explorer.shading.vmath",
-    "explorer.shading.display",
-    "explorer.geometry.rays",
-    "explorer.geometry.traverse",
-    "explorer.geometry.occluders",
-    "explorer.geometry.bvh",
-)
+#: modules whose numba functions the product calls
+SOURCES = kernelcache.KERNEL_MODULES
 #: environment variables that change what numba compiles (so they name the marker too)
 CODEGEN_ENV = ("NUMBA_CPU_NAME", "NUMBA_CPU_FEATURES", "NUMBA_OPT", "PHONG_EXPLORER_WIDE_VECTORS")
 #: seconds between two looks for the marker while the numpy tier serves (a stat per look)
@@ -266,17 +257,15 @@ def cache_dir() -> Path:
 
 
 def marker_key() -> str:
-    """What names the ready marker: a hash of the kernel sources' stamps (as numba's own cache
-    index keys them), the versions and the code generation target."""
+    """What names the ready marker: a hash of the kernel sources' contents (the hash numba's
+    cache index keys them by, :func:`explorer.geometry.kernelcache.sources_hash`), the versions
+    and the code generation target."""
     import llvmlite
     import llvmlite.binding as llvm
     import numba
 
     parts = [numba.__version__, llvmlite.__version__, sys.version, platform.machine()]
-    for name in SOURCES:
-        origin = importlib.util.find_spec(name).origin
-        st = os.stat(origin)
-        parts.append(f"{origin}:{st.st_mtime_ns}:{st.st_size}")
+    parts.append(kernelcache.sources_hash())
     try:
         parts.append(llvm.get_host_cpu_name())
         parts.append(llvm.get_host_cpu_features().flatten())

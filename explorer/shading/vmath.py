@@ -35,8 +35,8 @@ there (:data:`explorer.shading.kernels.PACK_SHARE`).
 a smallest or largest value found on the keys is a reduction LLVM vectorises without
 fast-math's no-NaN promise, which the kernels never make.
 
-numba's on-disk cache checks only the file of the function it compiled: after an edit here,
-touch :mod:`explorer.shading.kernels` (or clear its cache), or the kernels keep the old code.
+An edit here recompiles the kernels that inline these functions, and only those: numba's cache
+of the kernel files is keyed on every source they import (:mod:`explorer.geometry.kernelcache`).
 """
 
 from __future__ import annotations
@@ -48,6 +48,8 @@ from numba import types
 from numba.core import cgutils, config
 from numba.core.codegen import get_host_cpu_features
 from numba.extending import intrinsic, overload
+
+from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
 
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
 _LEAF = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True, _nrt=False)

@@ -18,8 +18,8 @@ TRI = np.array([[[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]]])
 def _test(o, d, tri, det_min, front_only):
     a, p, q = tri[0], tri[1] - tri[0], tri[2] - tri[0]
     return ray_triangle(
-        o[0], o[1], o[2], d[0], d[1], d[2],
-        a[0], a[1], a[2], p[0], p[1], p[2], q[0], q[1], q[2],
+        (o[0], o[1], o[2]), (d[0], d[1], d[2]),
+        (a[0], a[1], a[2]), (p[0], p[1], p[2]), (q[0], q[1], q[2]),
         det_min, front_only,
     )  # fmt: skip
 

@@ -17,9 +17,8 @@ def _nearest(O, D, tri, t_min):
     bv = np.zeros(k)
     for r in range(k):
         for f in range(tri.shape[0]):
-            t, u, v = ray_triangle_row(
-                tri, f, O[r, 0], O[r, 1], O[r, 2], D[r, 0], D[r, 1], D[r, 2], 0.0, False
-            )
+            o, d = (O[r, 0], O[r, 1], O[r, 2]), (D[r, 0], D[r, 1], D[r, 2])
+            t, u, v = ray_triangle_row(tri, f, o, d, 0.0, False)
             if t > t_min and t < bt[r]:
                 bt[r], bf[r], bu[r], bv[r] = t, f, u, v
     return bt, bf, bu, bv

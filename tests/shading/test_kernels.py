@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from explorer.shading import kernels as K
+from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 
@@ -66,7 +67,8 @@ def test_wide_vectors_can_be_switched_off():
 def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
     # _wide compiles a call inside wide_vectors() the first time it meets a kind of data (the
     # first argument's dtype, dimensions, writability; a record's members) with a float dtype:
-    # G (6, n) and kernels.Vertices of float32 or float64 vertices are separate signatures
+    # G (6, n) and a kernels.Source are separate signatures, and a Source of the prepared rows
+    # or of float32 or float64 vertices is one (per precision)
     import contextlib
 
     widths = []
@@ -88,13 +90,14 @@ def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
     call = K._wide(Kernel(), 1)
     f32, f64 = K.constants(np.float32), K.constants(np.float64)
     G32, P32, P64 = np.zeros((6, 4), np.float32), np.zeros((4, 3), np.float32), np.zeros((4, 3))
-    V32 = K.Vertices(P32, P32, np.zeros(3), 1.0)
-    V64 = K.Vertices(P64, P64, np.zeros(3), 1.0)
-    for data, k in [(G32, f32), (G32, f32), (V32, f32), (V64, f32), (V32, f64), (V32, f32)]:
+    R32 = prepared.rows(G32)
+    V32, V64 = (prepared.vertices(P, P, np.zeros(3), 1.0, np.float32) for P in (P32, P64))
+    V32d = prepared.vertices(P32, P32, np.zeros(3), 1.0, np.float64)
+    for data, k in [(G32, f32), (G32, f32), (R32, f32), (V32, f32), (V64, f32), (V32d, f64)]:
         call(data, k)
-    assert widths == [16, 16, 16, 8]  # G32, V32 and V64 in float32, V32 in float64: once each
+    assert widths == [16, 16, 8]  # G32, then the Sources in float32, then in float64: once each
     call(np.zeros(3, np.int64), np.zeros(3, np.int64))  # no float data: no wide vectors
-    assert widths == [16, 16, 16, 8]
+    assert widths == [16, 16, 8]
 
 
 def test_marked_reads_only_the_blocks_that_count_marks():

@@ -75,10 +75,10 @@ def test_chunk_bounds_of_vertices_are_those_of_the_prepared_geometry(precision, 
     N[5] = 0.0  # an absent normal: its chunk is never culled
     s = explorer.Shader(SCENE, P, N, precision=precision, tier="compiled")
     _ = s.colors
-    src = prepared.vertices(P, N, s._centre, s._scale)
+    src = prepared.vertices(P, N, s._centre, s._scale, s._k.dtype)
     want = np.full((K.N_BOUNDS, -(-len(P) // K.CHUNK)), np.nan)
     got = want.copy()
-    K.bounds(s._G, s._k, want, step)
+    K.bounds(prepared.rows(s._G), s._k, want, step)
     K.bounds(src, s._k, got, step)
     np.testing.assert_array_equal(got, want)
     assert np.isnan(got[:, 1]).all() == (step > 1) and not np.isnan(got[:, ::step]).any()

@@ -312,6 +312,17 @@ def test_the_background_compile_covers_what_the_product_calls():
     assert not new, f"kernel signatures the background compile does not make: {new}"
 
 
+def test_the_shading_pass_compiles_once_per_precision():
+    # each signature of shade links every light loop and optimises it again (the largest part
+    # of the cold compile, benchmarks/bench_compile.py --warm): the prepared rows and the
+    # caller's float32 or float64 vertices are one kernels.Source per precision
+    warm.exercise()
+    found = warm.signatures()
+    for name in ("shade", "bounds"):
+        sigs = found[f"explorer.shading.kernels.{name}"]
+        assert len(sigs) == 2, (name, sigs)  # float32 and float64
+
+
 def test_after_failed_background_compiles_the_numpy_tier_serves_and_says_why(cold_tiers):
     # one compile that ended without the marker: another is started
     tiers.record_attempt()
