@@ -9,8 +9,8 @@
   difference and compare views) for any front end, through small ports; no GUI toolkit.
 - :mod:`explorer.app.qt` and :mod:`explorer.app.qtmain`: the Qt window (PySide6, pyvistaqt), a
   thin binding of the controller.
-- :mod:`explorer.app.web` (with :mod:`~explorer.app.webpage`, :mod:`~explorer.app.webpanel`,
-  :mod:`~explorer.app.webfiles`, :mod:`~explorer.app.webcompare`): the page in the browser and
+- :mod:`explorer.app.web` (with :mod:`~explorer.app.web.page`, :mod:`~explorer.app.web.panel`,
+  :mod:`~explorer.app.web.files`, :mod:`~explorer.app.web.compare`): the page in the browser and
   in Jupyter (trame, imported inside functions), the controller's second front end;
   :mod:`explorer.app.colours`, :mod:`explorer.app.sides`: colours as both front ends' controls
   show them, the compare view's side B.

@@ -1,7 +1,7 @@
 """Every intent of the explorer declared once: its id, title, menu, keys, enablement and what
 it runs. The Qt window's menus, its shortcuts, the 3D view's keys and the help
 (:mod:`explorer.app.qt.menus`), and the page's menus, keyboard shortcuts and help
-(:mod:`explorer.app.webintents`) are all built from :data:`INTENTS`.
+(:mod:`explorer.app.web.intents`) are all built from :data:`INTENTS`.
 
 The shape is that of napari's app-model ``Action`` (id, title, menus, key bindings,
 enablement, callback), in a few lines of our own and without its context expressions: an

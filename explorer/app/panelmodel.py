@@ -1,6 +1,6 @@
 """The panel model: every control of the explorer's panel declared once, as a :class:`Row`,
 and drawn by both front ends (the Qt panel, :mod:`explorer.app.qt.rows`; the web page,
-:mod:`explorer.app.webpage` and :mod:`explorer.app.webpanel`). Toolkit-free.
+:mod:`explorer.app.web.page` and :mod:`explorer.app.web.panel`). Toolkit-free.
 
 A row says what a control is, never how a toolkit draws it:
 

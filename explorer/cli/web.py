@@ -9,7 +9,7 @@
     phong-explorer web --last                        # the session kept when it last stopped
 
 It prints its URL, with the page's token (only that address opens the page:
-:mod:`explorer.app.webguard`), and serves until Ctrl-C (or SIGTERM); then it keeps the session
+:mod:`explorer.app.web.guard`), and serves until Ctrl-C (or SIGTERM); then it keeps the session
 where the desktop's window keeps it on closing, and ``--last`` (either command's) reopens it.
 It listens on 127.0.0.1 (this machine only) unless ``--host`` says otherwise, and then warns
 that anyone who can reach the port and has that address can use it. One explorer per server:

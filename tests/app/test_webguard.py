@@ -1,4 +1,4 @@
-"""The web explorer's admission rules (:mod:`explorer.app.webguard`), without a server: the
+"""The web explorer's admission rules (:mod:`explorer.app.web.guard`), without a server: the
 token, the Host and Origin checks, the page's verdict, and the table of what a client may set.
 The server's hooks are tested on a real ``phong-explorer web`` in
 tests/web/test_web_security.py."""
@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import pytest
 
-from explorer.app import webguard as G
-from explorer.app.webpanel import NUMBERS
+from explorer.app.web import guard as G
+from explorer.app.web.panel import NUMBERS
 
 TOKEN = G.new_token()
 

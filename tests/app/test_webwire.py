@@ -1,4 +1,4 @@
-"""explorer/app/webwire.py without a server: the bounded un-chunker, a tab's outbox, the
+"""explorer/app/web/wire.py without a server: the bounded un-chunker, a tab's outbox, the
 publish that decides its tabs when called, and the private wslink / trame-server / aiohttp
 names the module relies on (an upgrade that moves them fails here, loudly)."""
 
@@ -16,7 +16,7 @@ msgpack = pytest.importorskip("msgpack")
 
 from wslink.chunking import generate_chunks  # noqa: E402
 
-from explorer.app import webwire as W  # noqa: E402
+from explorer.app.web import wire as W  # noqa: E402
 
 
 def frames(message, size=64, mid=None):
@@ -248,13 +248,13 @@ def test_a_change_goes_once_to_each_tab_but_its_sender_decided_when_published():
     assert queued["b"][0] is queued["c"][0]  # one copy of the frames for every tab
 
 
-# -- the page's values (explorer/app/webpanel.page_value) -----------------------------------------
+# -- the page's values (explorer/app/web/panel.page_value) -----------------------------------------
 @pytest.mark.parametrize(
     ("value", "like"),
     [({"x": 1}, 0), ("1", 0), (True, 0), (1, True), (float("nan"), None), ([1], None)],
 )
 def test_a_page_value_of_the_wrong_kind_is_one_line_naming_the_key(value, like):
-    from explorer.app.webpanel import page_value
+    from explorer.app.web.panel import page_value
     from explorer.core.errors import ExplorerError
 
     with pytest.raises(ExplorerError, match=r"^light: the page sent .*, not a value of light$"):

@@ -20,8 +20,8 @@ import websocket
 from test_web import by_name, open_page, picture_src, report, wait
 from webserver import page_origin, ws_connect
 
-from explorer.app import webguard
-from explorer.app.webpanel import MESH_REFUSED
+from explorer.app.web import guard as webguard
+from explorer.app.web.panel import MESH_REFUSED
 from explorer.core.controls import CONTROLS, from_step
 
 pytestmark = pytest.mark.web

@@ -1,4 +1,4 @@
-"""The page's websocket against its clients (issue 37 §2; explorer/app/webwire.py): raw wslink
+"""The page's websocket against its clients (issue 37 §2; explorer/app/web/wire.py): raw wslink
 clients (tests/web/wireclient.py) against a real ``phong-explorer web`` process. A claimed size
 allocates nothing, nor does an upload whose content is numbers; a tab that stops reading
 freezes no other tab; each change reaches each other tab once, including a tab that spoke

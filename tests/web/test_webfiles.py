@@ -1,4 +1,4 @@
-"""What the page may send the server (explorer.app.webfiles): a file name never becomes a
+"""What the page may send the server (explorer.app.web.files): a file name never becomes a
 server path, an upload meets the same size caps as a file on disk, a session from the page
 names only a built-in mesh, and an OBJ's ``mtllib`` only a library uploaded with it."""
 
@@ -11,7 +11,7 @@ from types import SimpleNamespace
 import pytest
 
 from explorer.app.colours import parse_hex, rgb_hex
-from explorer.app.webfiles import WebFiles, turntable_formats, upload_name
+from explorer.app.web.files import WebFiles, turntable_formats, upload_name
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.yamlio import MAX_BYTES
@@ -102,7 +102,7 @@ def test_an_uploads_content_must_be_bytes(files, content):
     finally:
         tracemalloc.stop()
     assert peak < 1 << 20
-    assert files.controller.calls == []
+    assert files.controller.files.calls == []
 
 
 def test_an_uploads_size_is_checked_before_its_chunks_are_joined(files):

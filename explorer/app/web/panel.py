@@ -1,7 +1,7 @@
 """The web page's controls and the state: what every trame state key shows for a
 :class:`~explorer.app.model.State` (:func:`values`), and the handlers that turn a user's change
 into one of the controller's intents (:func:`connect`). The layout is
-:mod:`explorer.app.webpage`.
+:mod:`explorer.app.web.page`.
 
 The rows of :mod:`explorer.app.panelmodel` are handled by kind, none by name: a row's state key
 is its key, None while the row is hidden (a spot's cutoff for a point light). A number has a
@@ -268,7 +268,7 @@ def _choices(app) -> None:
 
     def choose_mesh(value):
         """A mesh of the chooser's list only (a built-in, the start's, an upload: values the
-        page was given, :class:`~explorer.app.webguard.MeshValues`): any other value (a path
+        page was given, :class:`~explorer.app.web.guard.MeshValues`): any other value (a path
         sent over the socket) is refused in the same words, naming nothing."""
         name = app.mesh_values.name(value)
         if name in c.mesh_choices:

@@ -3,16 +3,17 @@ toolbar (undo / redo, sessions, exports) and the view rendered on the server (tr
 ``VtkRemoteView``). Every control is named (``aria-label``) like the scene file's key it sets
 (``kd``, ``shininess``, ``azimuth``...; a slider ``<key> slider``, a term's switch
 ``show_<term>``), so tests and screen readers find it. The state keys and their handlers are
-:mod:`explorer.app.webpanel`'s.
+:mod:`explorer.app.web.panel`'s.
 
 trame is imported inside :func:`build` (``import explorer`` stays free of it).
 """
 
 from __future__ import annotations
 
-from explorer.app import panelmodel, webintents
+from explorer.app import panelmodel
 from explorer.app.turntablejob import DEFAULT_FRAMES
-from explorer.app.webfiles import turntable_formats
+from explorer.app.web import intents as webintents
+from explorer.app.web.files import turntable_formats
 from explorer.core.controls import STEPS
 from explorer.core.material import MODELS
 from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
@@ -331,7 +332,7 @@ def _message_log(v3, html) -> None:
 
 def build(app) -> None:
     """The page: the toolbar (the registry's menus, undo / redo, files), the drawer (the
-    panel) and the view; the registry's keys (:mod:`explorer.app.webintents`)."""
+    panel) and the view; the registry's keys (:mod:`explorer.app.web.intents`)."""
     from trame.ui.vuetify3 import SinglePageWithDrawerLayout
     from trame.widgets import client, html
     from trame.widgets import vtk as vtkw

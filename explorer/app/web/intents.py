@@ -9,7 +9,7 @@ keyboard (there the keys edit the text). An intent runs on the server (the trigg
 which runs only the intents the page runs there) or in the browser (a download, a click on a
 file field, the message log, the help).
 
-trame is imported by the caller (:func:`explorer.app.webpage.build`); this module needs none.
+trame is imported by the caller (:func:`explorer.app.web.page.build`); this module needs none.
 """
 
 from __future__ import annotations

@@ -8,13 +8,13 @@ whose pictures :class:`WebExplorer` pushes to the page): the page receives pictu
 so the engine's colours, the lobe inset, the light handles and the difference heat map are the
 desktop's pixels. Dragging in the view turns the server's camera, and the camera is the viewer:
 before each frame it goes into the state (:meth:`Controller.camera_moved`). The panel is
-vuetify widgets (:mod:`explorer.app.webpanel`), each named (``aria-label``) like the scene
+vuetify widgets (:mod:`explorer.app.web.panel`), each named (``aria-label``) like the scene
 file's key it sets.
 
 Only the address the server prints (with its token) opens the page, a websocket only from the
-page's own origin, and a page sets only its controls' keys: :mod:`explorer.app.webguard`.
+page's own origin, and a page sets only its controls' keys: :mod:`explorer.app.web.guard`.
 One explorer per server process: every tab shows and edits the same state. Nothing from the
-page names a server path (:mod:`explorer.app.webfiles`): uploads are written under fixed names
+page names a server path (:mod:`explorer.app.web.files`): uploads are written under fixed names
 into a private temporary folder and read by the same readers (and their size caps) as files on
 disk; downloads are written there first; presets go to the user's preset folder.
 
@@ -24,35 +24,26 @@ stays free of them).
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import os
 import tempfile
-import threading
 import time
 from collections.abc import Sequence
 
-from explorer.app import intents, webguard, webpage, webpanel, webwire
+from explorer.app import intents
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker
 from explorer.app.session import session_mapping
 from explorer.app.sides import SideB
 from explorer.app.start import (
-    DEFAULT_MESH,
-    DEFAULT_PRESET,
     MESH_CHOICES,
-    default_viewer,
-    first_state,
-    load_mesh_choice,
 )
 from explorer.app.viewport import PlotterView
-from explorer.app.webcompare import WebCompare
-from explorer.app.webfiles import WebFiles
-from explorer.core.errors import ExplorerError, ExplorerTypeError
-from explorer.core.lights import PointLight
-from explorer.core.presets import find_preset
-from explorer.core.scene import Scene, load_scene
+from explorer.app.web import guard, page, panel, wire
+from explorer.app.web.compare import WebCompare
+from explorer.app.web.files import WebFiles
+from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading import tiers
@@ -76,14 +67,6 @@ FOLLOW_S = 0.004
 FOLLOW_TRIES = 1000
 #: how many messages the page's message log keeps
 MESSAGE_LOG = 50
-#: the environment variable that sends :func:`show`'s page through jupyter-server-proxy: the
-#: Jupyter server's base URL (``/`` for a Jupyter server at the root of its host,
-#: ``/user/NAME/`` under JupyterHub)
-JUPYTER_PROXY_ENV = "PHONG_EXPLORER_JUPYTER_PROXY"
-#: the variable JupyterHub sets in a user's server (its base URL): the page goes through the proxy
-JUPYTERHUB_PREFIX_ENV = "JUPYTERHUB_SERVICE_PREFIX"
-#: the values of :data:`JUPYTER_PROXY_ENV` that keep the direct address (even under JupyterHub)
-PROXY_OFF = ("0", "off", "false", "no")
 
 
 class WebExplorer(WebFiles):
@@ -114,10 +97,10 @@ class WebExplorer(WebFiles):
         self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
         self._job = None  # the long job running (run_steps) and its cancel
         self.server = get_server(name, client_type="vue3")
-        self.token = webguard.new_token()  # the page's key: in the URL the user is given only
-        self.hosts = webguard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
-        webguard.install(self.server, self.token, lambda: self.hosts)
-        self.mesh_values = webguard.MeshValues(MESH_CHOICES)  # the chooser names no path
+        self.token = guard.new_token()  # the page's key: in the URL the user is given only
+        self.hosts = guard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
+        guard.install(self.server, self.token, lambda: self.hosts)
+        self.mesh_values = guard.MeshValues(MESH_CHOICES)  # the chooser names no path
         self.plotter = plotter(size, BACKGROUND if background is None else background)
         self.viewport = PlotterView(self.plotter, self)  # the page's pictures: see send()
         self.heat = self.viewport.heat
@@ -133,12 +116,12 @@ class WebExplorer(WebFiles):
         self.view = self.viewport.attach(
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
-        webpanel.connect(self)
-        webpage.build(self)
+        panel.connect(self)
+        page.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
         self.server.state.engine = tiers.status() or ""
         self.server.controller.on_server_ready.add(self._ready)
-        self.server.controller.on_server_bind.add(webwire.bind)  # the wire's limits (issue 37)
+        self.server.controller.on_server_bind.add(wire.bind)  # the wire's limits (issue 37)
         self.controller.start()
         self.controller.files.say_mesh_warnings(mesh.name, start_warnings, logged=True)
         self.viewport.show_start(state)
@@ -234,7 +217,7 @@ class WebExplorer(WebFiles):
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:
-        self.server.state.presets = [webpanel.preset_item(p) for p in presets]
+        self.server.state.presets = [panel.preset_item(p) for p in presets]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
         self.server.state.meshes = [{"title": t, "value": self.mesh_values.page(n)}
@@ -306,7 +289,7 @@ class WebExplorer(WebFiles):
         self.pushing = True
         try:
             with self.server.state as s:
-                s.update({**webpanel.values(state), "mesh": self.mesh_values.page(state.mesh)})
+                s.update({**panel.values(state), "mesh": self.mesh_values.page(state.mesh)})
         finally:
             self.pushing = False
 
@@ -336,26 +319,6 @@ class WebExplorer(WebFiles):
         self.worker.close()
         self._uploads.cleanup()
         self.plotter.close()
-
-
-def notebook_state(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
-                   materials_dirs=()) -> tuple[M.State, Mesh]:  # fmt: skip
-    """``(state, mesh)`` for :func:`show`: ``scene`` (a Scene, a scene file or a mapping; None:
-    one point light at :data:`~explorer.app.model.DEFAULT_PLACEMENT` seen from the explorer's
-    start camera) on built-in mesh ``mesh``, in preset ``preset`` (None: the scene's
-    material)."""
-    m = load_mesh_choice(mesh)
-    if scene is None:
-        az, el, d = M.DEFAULT_PLACEMENT
-        light = PointLight().placed(az, el, d * (m.radius or 1.0), m.centre)
-        scene = Scene(lights=(light,), viewer=default_viewer(m))
-    else:
-        scene = load_scene(scene, materials_dirs=materials_dirs)
-    if preset is not None:
-        scene = scene.replace(material=find_preset(preset, materials_dirs))
-    scene = scene.replace(mesh=mesh)
-    state = first_state(scene, m, name=mesh, preset=preset, materials_dirs=materials_dirs)
-    return state, m
 
 
 def own_arguments() -> None:
@@ -403,7 +366,7 @@ def cannot_listen(host: str, port: int, exc: OSError) -> ExplorerError:
 def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_browser=False):
     """Serve ``app`` until the process ends (prints ``App running at:`` and the URL with the
     page's token, the only place the token is written; ``open_browser``: opens it). A request
-    whose Host is not one of ``host``'s names (:func:`~explorer.app.webguard.listening_names`)
+    whose Host is not one of ``host``'s names (:func:`~explorer.app.guard.listening_names`)
     is refused. When the server stops (Ctrl-C, SIGTERM) the session is kept as the desktop
     keeps it when its window closes (:meth:`FileFlows.keep_last_session`; ``--last`` reopens
     it), but only if it served: an address it cannot listen on (:func:`check_listen`) is one
@@ -413,10 +376,10 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
     check_listen(host, port)
     own_arguments()
     signal.signal(signal.SIGTERM, _stop)
-    app.hosts = webguard.listening_names(host)
+    app.hosts = guard.listening_names(host)
 
     def ready(**_):
-        url = webguard.page_url(served_url(host, app.server.port), app.token)
+        url = guard.page_url(served_url(host, app.server.port), app.token)
         print(f"\nApp running at:\n - Local:   {url}\n", flush=True)
         if open_browser:
             import webbrowser
@@ -441,190 +404,3 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
 def served_url(host: str, port: int) -> str:
     """The page's address on a server listening on ``host`` (an IPv6 address in brackets)."""
     return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
-
-
-@dataclasses.dataclass
-class Shown:
-    """An explorer served from a thread for a notebook: displayed inline as an ``<iframe>``;
-    :attr:`state` reads the explorer's present state back in Python.
-
-    app : the :class:`WebExplorer`; url : its page; height : the cell's height (pixels)
-
-    :meth:`stop` ends it: the port closes and the server's thread ends (a new :func:`show`
-    may then take the same port).
-    """
-
-    app: WebExplorer
-    url: str
-    height: int = 720
-    thread: threading.Thread | None = dataclasses.field(default=None, repr=False)
-
-    def stop(self, timeout: float = 30.0) -> None:
-        """Stop the server: it stops listening (the port is free again), its open pages lose
-        it, its thread ends and the explorer's resources (the view, the temporary folder of
-        uploads) are released. Stopping a stopped one does nothing."""
-        import asyncio
-
-        if self.thread is None or not self.thread.is_alive():
-            return
-        loop = self.app.loop
-        try:
-            asyncio.run_coroutine_threadsafe(self.app.server.stop(), loop).result(timeout)
-        finally:
-            loop.call_soon_threadsafe(loop.stop)
-            self.thread.join(timeout)
-
-    @property
-    def state(self) -> M.State:
-        return self.app.store.state
-
-    @property
-    def controller(self) -> Controller:
-        return self.app.controller
-
-    def session(self) -> dict:
-        """The present state as a session mapping (what Save session writes)."""
-        return session_mapping(self.app.store.state)
-
-    def run(self, fn, *args, timeout: float = 60.0):
-        """``fn(*args)`` run in the server's thread (VTK draws there), and its result."""
-        import asyncio
-
-        async def call():
-            return fn(*args)
-
-        return asyncio.run_coroutine_threadsafe(call(), self.app.loop).result(timeout)
-
-    def set(self, key: str, value) -> None:
-        """Set control ``key`` (a scene-file key: ``kd``, ``shininess``, ``azimuth``...) as
-        the page's control does: one undo step; every open page shows it."""
-
-        def go():
-            self.app.controller.set_value(key, value, merge=False)
-
-        self.run(go)
-
-    def _repr_html_(self) -> str:
-        import html
-
-        return (f'<iframe src="{html.escape(self.url)}" style="width:100%;height:{self.height}px;'
-                f'border:none" title="phong-explorer"></iframe>')  # fmt: skip
-
-
-def proxy_prefix(proxy: bool | str | None, environ=None) -> str | None:
-    """The Jupyter base URL through which :func:`show`'s page goes (jupyter-server-proxy's
-    ``<base>proxy/<port>/``), or None for the direct address.
-
-    ``proxy``: a base URL (``"/user/ana/"``, ``"https://hub.example.org/user/ana/"``), True
-    (the environment's base URL, else ``/``), False (direct), None (the environment decides:
-    :data:`JUPYTER_PROXY_ENV` when set (:data:`PROXY_OFF`: direct), else JupyterHub's
-    :data:`JUPYTERHUB_PREFIX_ENV`, else direct). The result ends with ``/``; a base URL that
-    is neither a path from ``/`` nor an http(s) URL is an :class:`ExplorerError` naming where
-    it came from."""
-    env = os.environ if environ is None else environ
-    if proxy is False:
-        return None
-    if isinstance(proxy, str):
-        return _base_url(proxy.strip(), "proxy")
-    if proxy is not None and proxy is not True:
-        raise ExplorerTypeError(f"proxy must be a Jupyter base URL, True, False or None, "
-                                f"got {type(proxy).__name__}")  # fmt: skip
-    own = env.get(JUPYTER_PROXY_ENV, "").strip()
-    hub = env.get(JUPYTERHUB_PREFIX_ENV, "").strip()
-    if own.lower() in PROXY_OFF:
-        if proxy is None:
-            return None
-        own = ""  # proxy=True asks for it all the same
-    if own:
-        return _base_url(own, JUPYTER_PROXY_ENV)
-    if hub:
-        return _base_url(hub, JUPYTERHUB_PREFIX_ENV)
-    return "/" if proxy else None
-
-
-def _base_url(base: str, where: str) -> str:
-    """``base`` (a path or an http(s) URL) checked, ending with ``/``: no space, quote, ``<``,
-    ``>``, ``?``, ``#``, backslash, nor any character that is not printable (a control
-    character such as ``\\r``, ``\\0`` or ``\\v`` would go into the cell's ``<iframe src>``)."""
-    from urllib.parse import urlsplit
-
-    parts = urlsplit(base)
-    url = parts.scheme in ("http", "https") and parts.netloc
-    path = base.startswith("/") and not base.startswith("//")  # "//host" names another host
-    bad = any(c in " \"'<>?#\\" or not c.isprintable() for c in base)  # \r, \0, \v, \u2028
-    if not (path or url) or bad:
-        raise ExplorerError(f"{where}: a Jupyter base URL is a path from / (such as "
-                            f"/user/NAME/) or an http(s) URL, got {base!r}")  # fmt: skip
-    return base if base.endswith("/") else base + "/"
-
-
-def page_url(port: int, prefix: str | None, token: str = "") -> str:
-    """The address of the page served on ``port``: direct (``http://127.0.0.1:PORT/``) or,
-    under Jupyter base URL ``prefix``, jupyter-server-proxy's ``<prefix>proxy/<port>/`` (the
-    page's assets are relative and its websocket is ``<page's folder>/ws``: both go through
-    the proxy); with the page's ``token`` when given (``?secret=TOKEN``)."""
-    base = f"http://{DEFAULT_HOST}:{port}/" if prefix is None else f"{prefix}proxy/{int(port)}/"
-    return webguard.page_url(base, token) if token else base
-
-
-def show(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
-         port: int = 0, height: int = 720, materials_dirs=(),
-         proxy: bool | str | None = None) -> Shown:  # fmt: skip
-    """Serve an explorer on 127.0.0.1 from a background thread (its own event loop, so the
-    notebook's kernel stays free) and return it for display in a notebook cell. ``scene``: a
-    :class:`~explorer.core.scene.Scene`, a scene file or None (the explorer's start);
-    ``preset`` overrides its material; ``mesh`` a built-in mesh. ``proxy``: whether the cell's
-    page goes through jupyter-server-proxy (a remote Jupyter, JupyterHub), and under which
-    Jupyter base URL (:func:`proxy_prefix`; by default, under JupyterHub or when
-    ``$PHONG_EXPLORER_JUPYTER_PROXY`` is set)."""
-    prefix = proxy_prefix(proxy)
-    check_listen(DEFAULT_HOST, port)
-    state, m = notebook_state(scene, preset=preset, mesh=mesh, materials_dirs=materials_dirs)
-    ready = threading.Event()
-    box: dict = {}
-
-    def run():
-        import asyncio
-
-        loop = asyncio.new_event_loop()
-        asyncio.set_event_loop(loop)
-        try:
-            app = WebExplorer(state, m, materials_dirs=materials_dirs,
-                              name=f"phong-explorer-{id(box)}")  # fmt: skip
-            box["app"] = app
-            # behind jupyter-server-proxy the Host is the Jupyter server's (checked there)
-            app.hosts = None if prefix is not None else app.hosts
-            own_arguments()
-            app.server.start(port=port, host=DEFAULT_HOST, exec_mode="task", thread=True,
-                             open_browser=False, timeout=0, show_connection_info=False,
-                             disable_logging=True)  # fmt: skip
-
-            async def wait():
-                try:
-                    await app.server.ready
-                    box["port"] = app.server.port
-                except OSError as exc:  # the bind failed after check_listen
-                    box["error"] = cannot_listen(DEFAULT_HOST, port, exc)
-                    loop.stop()
-                ready.set()
-
-            loop.create_task(wait())
-        except Exception as exc:  # noqa: BLE001 - handed to the caller's thread
-            box["error"] = exc
-            ready.set()
-            return
-        try:
-            loop.run_forever()
-        finally:  # Shown.stop(), or a failed start: the explorer's resources go with it
-            if "app" in box:
-                box["app"].close()
-            loop.close()
-
-    thread = threading.Thread(target=run, daemon=True, name="phong-explorer-web")
-    thread.start()
-    if not ready.wait(120):
-        raise ExplorerError("the explorer's web server did not start within 120 s")
-    if "error" in box:
-        thread.join(30)  # its loop stopped: the explorer closes with it
-        raise box["error"]
-    return Shown(box["app"], page_url(box["port"], prefix, box["app"].token), height, thread)
