@@ -30,7 +30,7 @@ def pytest_collection_modifyitems(session, config, items):
     off-screen pictures of translucent meshes no longer match between a reused and a fresh
     window (tests/render/test_render.py::test_reused_window_matches_fresh_one), so the other
     tests run before any Qt window is made."""
-    qt = [i for i in items if i.path.name in QT_MODULES and i.path.parent.name == "app"]
+    qt = [i for i in items if i.path.name in QT_MODULES and i.path.parent.name == "qt"]
     if qt:
         rest = [i for i in items if i not in set(qt)]
         items[:] = rest + qt

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.files import write_two_groups
 
 from explorer.app import model as M
 from explorer.app import session as S
@@ -16,20 +17,9 @@ from explorer.cli.gui import start_state
 from explorer.core.errors import ExplorerError
 from explorer.core.presets import find_preset
 
+
 #: two unit squares side by side, each its own usemtl group (red on the left, blue on the
 #: right), and their .mtl
-TWO_GROUPS = Path(__file__).parent.parent / "data" / "obj" / "two_groups.obj"
-
-
-def write_two_groups(directory: Path) -> Path:
-    """A copy of :data:`TWO_GROUPS` and its .mtl in ``directory``, as ``two.obj``."""
-    mtl = TWO_GROUPS.with_suffix(".mtl")
-    (directory / mtl.name).write_bytes(mtl.read_bytes())
-    path = directory / "two.obj"
-    path.write_bytes(TWO_GROUPS.read_bytes())
-    return path
-
-
 @pytest.fixture
 def two(tmp_path) -> Path:
     return write_two_groups(tmp_path)

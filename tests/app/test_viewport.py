@@ -9,7 +9,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from test_controller import icosphere_controller
+from helpers.controllers import icosphere_controller
 
 from explorer.app import model as M
 from explorer.app.controller import ports as P

@@ -47,3 +47,16 @@ def permissions_hold() -> list[str] | None:
     prefix = [setpriv, f"--bounding-set={_OVERRIDES}", "--"]
     probe = subprocess.run([*prefix, "true"], capture_output=True, timeout=30)
     return prefix if probe.returncode == 0 else None
+
+
+#: an OBJ of two usemtl groups with its .mtl (tests/data/obj)
+TWO_GROUPS = Path(__file__).resolve().parents[1] / "data" / "obj" / "two_groups.obj"
+
+
+def write_two_groups(directory: Path) -> Path:
+    """A copy of :data:`TWO_GROUPS` and its .mtl in ``directory``, as ``two.obj``."""
+    mtl = TWO_GROUPS.with_suffix(".mtl")
+    (directory / mtl.name).write_bytes(mtl.read_bytes())
+    path = directory / "two.obj"
+    path.write_bytes(TWO_GROUPS.read_bytes())
+    return path

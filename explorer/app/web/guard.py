@@ -213,7 +213,7 @@ def key_table(rows: Iterable[tuple[str, str]]) -> dict[str, str]:
 #: and toggles), then the page's own selects, switches and text fields that are state, the
 #: uploads, the tab and the drawer. The number fields, colour fields and pickers, buttons and
 #: downloads are not state: they call the server's handlers, which parse what they are given.
-#: tests/web/test_web_security.py checks it against the page's template (every ``v-model``).
+#: tests/app/web/test_web_security.py checks it against the page's template (every ``v-model``).
 CLIENT_KEYS: Mapping[str, str] = key_table(
     [
         *panelmodel.client_keys().items(),

@@ -5,7 +5,7 @@ freeze every other tab, or miss (or receive many times) another tab's change.
 trame serves the page over wslink's aiohttp backend: one :class:`AioHttpWsHandler` per server
 reads each tab's frames (wslink's chunks: a 12-byte header, id, offset and the message's whole
 size, then the content), answers its calls and publishes state changes to every tab. Checked
-on wslink 2.6.0 and trame-server 4.1.0 (``tests/app/test_webwire.py`` pins the private names
+on wslink 2.6.0 and trame-server 4.1.0 (``tests/app/web/test_webwire.py`` pins the private names
 used here, so an upgrade that moves them fails loudly); what each part corrects upstream:
 
 - **Claims are not allocations.** ``wslink.chunking.UnChunker.process_chunk`` allocates the

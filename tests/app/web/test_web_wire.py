@@ -1,5 +1,5 @@
 """The page's websocket against its clients (issue 37 §2; explorer/app/web/wire.py): raw wslink
-clients (tests/web/wireclient.py) against a real ``phong-explorer web`` process. A claimed size
+clients (tests/app/web/wireclient.py) against a real ``phong-explorer web`` process. A claimed size
 allocates nothing, nor does an upload whose content is numbers; a tab that stops reading
 freezes no other tab; each change reaches each other tab once, including a tab that spoke
 last; and a seeded fuzz of frames, calls and state updates leaves the server serving, with no

@@ -9,8 +9,8 @@ from __future__ import annotations
 import imageio.v3 as iio
 import numpy as np
 import pytest
+from helpers.files import write_two_groups
 from PySide6 import QtCore
-from test_mesh_materials import write_two_groups
 
 from explorer.app import model as M
 from explorer.app import session as S

@@ -16,7 +16,7 @@ from explorer.core.material import COEFFICIENT_RANGE, SHININESS_RANGE
 from explorer.shading.display import to_bytes
 
 pytestmark = pytest.mark.usefixtures("xdisplay")
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 #: the sizes the window must lay itself out at (README: from 640x480 to full screen)
 SIZES = [(640, 480), (800, 500), (1100, 720), (1920, 1080)]
 TABS = ("material", "lights", "view")

@@ -1,6 +1,6 @@
 """The panel model's rows on the page (issue 38), in a real browser: every row of
 :mod:`explorer.app.panelmodel` is in the DOM of its tab under the name the window gives it
-(tests/app/test_panel.py reads the same names from the Qt widgets), and the effect rows, drawn
+(tests/app/qt/test_panel.py reads the same names from the Qt widgets), and the effect rows, drawn
 with no code of their own, change the picture, are undone, and reach the session. This module's
 server is its own (the effects it turns on stay out of the other modules' pictures)."""
 

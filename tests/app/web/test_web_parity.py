@@ -340,7 +340,7 @@ def test_a_mesh_files_own_materials_are_chosen_by_group_and_drawn_again(tmp_path
     from webserver import Server, need_browser, new_browser
 
     need_browser()
-    obj = Path(__file__).resolve().parents[2] / "docs" / "examples" / "teapot_parts.obj"
+    obj = Path(__file__).resolve().parents[3] / "docs" / "examples" / "teapot_parts.obj"
     env = dict(os.environ, PHONG_EXPLORER_MATERIALS=str(tmp_path / "presets"),
                PHONG_EXPLORER_LAST_SESSION=str(tmp_path / "last.yaml"))  # fmt: skip
     srv = Server(["--mesh", str(obj)], tmp_path / "parts.log", env=env)

@@ -1,4 +1,4 @@
-"""A raw wslink client for the wire tests (tests/web/test_web_wire.py): what trame's page says
+"""A raw wslink client for the wire tests (tests/app/web/test_web_wire.py): what trame's page says
 over its websocket, frame by frame, without a browser. The connect step is :func:`connect`
 alone (the page's ``Origin`` header and wslink's hello with its secret), so a change in how a
 tab must introduce itself is a change here only."""

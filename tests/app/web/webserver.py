@@ -1,5 +1,5 @@
 """The web tests' server and browser (a module of its own name: ``from conftest import``
-would find whichever conftest came first on the path when tests/web runs with other test
+would find whichever conftest came first on the path when tests/app/web runs with other test
 folders): a ``phong-explorer web`` process, as a user starts it, and a headless Chromium
 (Debian's ``chromium`` and ``chromium-driver``, driven by Selenium)."""
 
@@ -32,7 +32,7 @@ def free_port() -> int:
 #: (tests/conftest.py), which compiles a missing kernel in the calling process: in a server that
 #: holds the interpreter for tens of seconds on a cold cache and freezes the page (CI's cold run
 #: timed out on the difference view). A user's server never compiles in-process (mode ``auto``:
-#: the numpy tier serves while the background compile runs, tests/web/test_web_cold.py), so the
+#: the numpy tier serves while the background compile runs, tests/app/web/test_web_cold.py), so the
 #: page tests' servers run the numpy tier: the same colours (the tiers' contract), no compile.
 SERVER_KERNELS = "numpy"
 

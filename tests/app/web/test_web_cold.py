@@ -1,6 +1,6 @@
 """On a cold compile cache the page draws at once with the numpy tier (the same colours) and
 says so; once the background compile is done the compiled kernels serve (as the desktop's
-window does: tests/app/test_window.py). The explorer is served in this process
+window does: tests/app/qt/test_window.py). The explorer is served in this process
 (``explorer.app.web.show``), so that the engine's tiers can be made cold."""
 
 from __future__ import annotations

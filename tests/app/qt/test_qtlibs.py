@@ -114,5 +114,5 @@ def test_gui_says_what_is_missing_in_one_line_and_exits_3(xdisplay):
 def test_readme_shows_the_line_as_printed():
     from pathlib import Path
 
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text(encoding="utf-8")
+    readme = (Path(__file__).resolve().parents[3] / "README.md").read_text(encoding="utf-8")
     assert Q.missing_message(["libxcb-cursor.so.0", "libxcb-icccm.so.4"]) in readme

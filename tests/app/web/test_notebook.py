@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 pytestmark = pytest.mark.web
-NOTEBOOK = Path(__file__).resolve().parents[2] / "docs" / "examples" / "explorer.ipynb"
+NOTEBOOK = Path(__file__).resolve().parents[3] / "docs" / "examples" / "explorer.ipynb"
 
 
 def test_the_notebook_is_kept_without_outputs():

@@ -1,7 +1,7 @@
 """The web explorer's admission rules (:mod:`explorer.app.web.guard`), without a server: the
 token, the Host and Origin checks, the page's verdict, and the table of what a client may set.
 The server's hooks are tested on a real ``phong-explorer web`` in
-tests/web/test_web_security.py."""
+tests/app/web/test_web_security.py."""
 
 from __future__ import annotations
 
