@@ -103,7 +103,8 @@ class Viewer(Checked):
         v, u, distance = span(self.eye, centre, scale)
         if distance <= tol.FAR_VIEWER:
             return v
-        return tuple(tol.FAR_VIEWER * c for c in u)
+        x, y, z = u
+        return (tol.FAR_VIEWER * x, tol.FAR_VIEWER * y, tol.FAR_VIEWER * z)
 
     def to_mapping(self) -> dict:
         if self.eye is not None:
