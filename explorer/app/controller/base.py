@@ -15,6 +15,7 @@ from explorer.app.difference import Job
 from explorer.app.start import MESH_CHOICES
 from explorer.app.view import framed_camera
 from explorer.core.errors import ExplorerError
+from explorer.core.lights import LIGHT_TYPES
 from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
@@ -23,8 +24,6 @@ log = logging.getLogger(__name__)
 
 #: a view smaller than this (either side, pixels) is not laid out yet: no difference asked
 MIN_DIFFERENCE_SIZE = 16
-#: the three light types, in the order "next light type" steps through
-LIGHT_TYPES = ("directional", "point", "spot")
 
 
 class Controller:
