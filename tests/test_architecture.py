@@ -35,13 +35,7 @@ MAX_APP_FUNCTION_LINES = 80
 #: the compiled kernels are excepted until their own issue reworks them (the light loop)
 EXEMPT_MODULES = {"shading/kernels.py"}
 #: classes excepted from the class limits, each with its reason
-EXEMPT_CLASSES: dict[str, str] = {
-    "app/web/server.py:WebExplorer": (
-        "458 lines and 45 methods with its mix-in WebFiles (uploads and downloads); the web "
-        "modules are a package now (explorer/app/web), and WebFiles is to become a "
-        "collaborator the explorer holds, as the controller holds its file flows"
-    ),
-}
+EXEMPT_CLASSES: dict[str, str] = {}
 #: numba kernels take their arrays positionally (no keyword arguments in nopython code)
 EXEMPT_FUNCTIONS_IN = {"shading/kernels.py", "geometry/rays.py"}
 #: lines that ruff's formatter is told to skip (ending in ``fmt: skip``) in the repository's

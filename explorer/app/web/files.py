@@ -97,19 +97,31 @@ def check_size(name: str, size: int, limit: int, what: str) -> None:
 
 
 class WebFiles:
-    """Needs the explorer's ``controller`` and ``_uploads`` (a temporary directory)."""
+    """The page's uploads and downloads: a collaborator the web explorer holds (``app.files``),
+    as the controller holds its file flows.
+
+    app : the explorer (its ``controller``, its trame ``server`` and its ``answers`` to the
+        controller's next questions); folder : the server's private temporary folder (uploads
+        and downloads are written there first, under names of their own)
+    """
 
     _count = itertools.count(1)
 
+    def __init__(self, app, folder: str) -> None:
+        self.app = app
+        self.folder = folder
+        self.turntable_path: Path | None = None  # the turntable written last
+        self.turntable_made = ""  # what it is ("36 frames, GIF")
+
     def _fresh_folder(self, kind: str) -> Path:
-        folder = Path(self._uploads.name) / f"{kind}-{next(self._count)}"
+        folder = Path(self.folder) / f"{kind}-{next(self._count)}"
         folder.mkdir()
         return folder
 
     def page_text(self, text: str) -> str:
         """``text`` with the server's private folder taken out of its paths: the page names an
         upload or a download by its own name (``bad.mtl:3: ...``), never a server path."""
-        return re.sub(re.escape(self._uploads.name) + r"/[^/\s]+/", "", str(text))
+        return re.sub(re.escape(self.folder) + r"/[^/\s]+/", "", str(text))
 
     # -- downloads -------------------------------------------------------------------------------
     def download(self, kind: str) -> dict:
@@ -120,7 +132,7 @@ class WebFiles:
         if kind not in DOWNLOADS:
             raise ExplorerError(f"download must be one of {', '.join(DOWNLOADS)}, got {kind!r}")
         suffix, mime = DOWNLOADS[kind]
-        c = self.controller
+        c = self.app.controller
         folder = self._fresh_folder("download")
         if kind == "session":
             path = c.files.save_session_as(folder / "session.yaml")
@@ -145,9 +157,9 @@ class WebFiles:
         n = parse_number("frames", str(frames), 2, tol.MAX_TURNTABLE_FRAMES)
         if n != int(n):
             raise ExplorerError(f"frames: a whole number of frames, got {frames!r}")
-        c = self.controller
+        c = self.app.controller
         path = self._fresh_folder("turntable") / f"{c.files.picture_stem()}-turntable{suffix}"
-        before = getattr(self, "turntable_path", None), getattr(self, "turntable_made", "")
+        before = self.turntable_path, self.turntable_made
         self.turntable_path = path
         self.turntable_made = f"{int(n)} frames, {suffix[1:].upper()}"
         try:
@@ -158,7 +170,7 @@ class WebFiles:
 
     def turntable_download(self) -> dict:
         """The turntable written last, as a file for the page to save."""
-        path = getattr(self, "turntable_path", None)
+        path = self.turntable_path
         if path is None or not path.is_file():
             raise ExplorerError("no turntable has been written yet")
         mime = "image/gif" if path.suffix == ".gif" else "video/mp4"
@@ -179,7 +191,7 @@ class WebFiles:
                 f"session '{upload_name(name)}': mesh {mesh!r}: a session opened from the page "
                 f"may name only a built-in mesh ({', '.join(MESH_CHOICES)})"
             )
-        self.controller.files.open_session(path)
+        self.app.controller.files.open_session(path)
 
     @staticmethod
     def _upload_limit(name: str) -> tuple[int, str]:
@@ -209,7 +221,7 @@ class WebFiles:
                     f"mesh file '{path.name}': {refused[0]}; a library outside the upload is "
                     "never read: upload the .mtl files beside the OBJ"
                 )  # fmt: skip
-        self.controller.files.choose_mesh(os.fspath(path))
+        self.app.controller.files.choose_mesh(os.fspath(path))
 
     def import_uploaded_materials(self, upload) -> None:
         """An .mtl file chosen in the page: capped as a file on disk
@@ -226,17 +238,17 @@ class WebFiles:
         name, data = upload_bytes(uploads[0], tol.MAX_MTL_FILE_BYTES, "material library")
         path = self._fresh_folder("mtl") / upload_name(name)
         path.write_bytes(data)
-        self.answers = {"yes": bool(self.server.state.preset_replace)}
+        self.app.answers = {"yes": bool(self.app.server.state.preset_replace)}
         try:
-            self.controller.files.import_materials(path)
+            self.app.controller.files.import_materials(path)
         finally:
-            self.answers = {}
+            self.app.answers = {}
 
     def save_preset(self, name: str, replace: bool = False) -> None:
         """Save the material as preset ``name`` in the user's preset folder (``replace``: the
         page's answer to "replace the file?" and "hide the preset of that name?")."""
-        self.answers = {"yes": bool(replace)}
+        self.app.answers = {"yes": bool(replace)}
         try:
-            self.controller.files.save_preset_as(str(name))
+            self.app.controller.files.save_preset_as(str(name))
         finally:
-            self.answers = {}
+            self.app.answers = {}

@@ -289,10 +289,10 @@ def _choices(app) -> None:
         )
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
-    ctrl.turntable = app.guard(lambda: app.start_turntable(
+    ctrl.turntable = app.guard(lambda: app.files.start_turntable(
         str(state.turntable_format), state.turntable_frames), "turntable")  # fmt: skip
     ctrl.cancel_job = app.guard(app.cancel_job, "cancel")
-    ctrl.save_preset = app.guard(lambda: app.save_preset(
+    ctrl.save_preset = app.guard(lambda: app.files.save_preset(
         state.preset_name or "", bool(state.preset_replace)), "save preset")  # fmt: skip
 
 
@@ -329,7 +329,7 @@ def _files(app) -> None:
     @ctrl.trigger("download")
     def download(kind):
         try:
-            return app.download(kind)
+            return app.files.download(kind)
         except ExplorerError as exc:
             c.report(exc, f"download {kind}")
             return None
@@ -348,9 +348,9 @@ def _files(app) -> None:
 
         state.change(name)(app.guard(changed, name))
 
-    on_upload("session_upload", app.open_uploaded_session)
-    on_upload("mesh_upload", app.open_uploaded_mesh)
-    on_upload("mtl_upload", app.import_uploaded_materials, "import materials")
+    on_upload("session_upload", app.files.open_uploaded_session)
+    on_upload("mesh_upload", app.files.open_uploaded_mesh)
+    on_upload("mtl_upload", app.files.import_uploaded_materials, "import materials")
 
 
 def connect(app) -> None:

@@ -69,7 +69,7 @@ FOLLOW_TRIES = 1000
 MESSAGE_LOG = 50
 
 
-class WebExplorer(WebFiles):
+class WebExplorer:
     """One explorer served by trame: the controller's ports (dialogs, messages, choices,
     progress; the view is :attr:`viewport`, whose pictures this sends) for a page.
 
@@ -93,6 +93,7 @@ class WebExplorer(WebFiles):
         self.messages: list[dict] = []
         self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
+        self.files = WebFiles(self, self._uploads.name)  # the uploads and downloads
         self.loop = None  # the server's event loop (the difference worker delivers into it)
         self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
         self._job = None  # the long job running (run_steps) and its cancel
@@ -167,7 +168,8 @@ class WebExplorer(WebFiles):
     # -- Messages --------------------------------------------------------------------------------
     def show_message(self, text: str, level: str = "info", details: Sequence[str] = (),
                      msecs: int | None = None, open_log: bool = True) -> None:  # fmt: skip
-        text, details = self.page_text(text), [self.page_text(d) for d in details]
+        page_text = self.files.page_text
+        text, details = page_text(text), [page_text(d) for d in details]
         entry = {"text": text, "level": level, "details": details, "at": time.strftime("%H:%M:%S")}
         self.messages = [*self.messages, entry][-MESSAGE_LOG:]
         with self.server.state as s:
@@ -209,11 +211,11 @@ class WebExplorer(WebFiles):
             self._show_progress(job)
 
     def _show_progress(self, job: dict) -> None:
-        path = getattr(self, "turntable_path", None)
+        path = self.files.turntable_path
         with self.server.state as s:
             s.progress = dict(job)
             s.turntable_ready = not job["running"] and path is not None and path.is_file()
-            s.turntable_made = getattr(self, "turntable_made", "") if s.turntable_ready else ""
+            s.turntable_made = self.files.turntable_made if s.turntable_ready else ""
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:

@@ -41,13 +41,17 @@ class Flows:
 
 @pytest.fixture
 def files():
-    f = WebFiles()
-    f.controller = SimpleNamespace(files=Flows())
-    f.controller.files.answers = lambda: dict(f.answers)
-    f.server = SimpleNamespace(state=SimpleNamespace(preset_replace=False))
-    f._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-test-")
+    app = SimpleNamespace(
+        controller=SimpleNamespace(files=Flows()),
+        answers={},
+        server=SimpleNamespace(state=SimpleNamespace(preset_replace=False)),
+    )
+    app.controller.files.answers = lambda: dict(app.answers)
+    folder = tempfile.TemporaryDirectory(prefix="phong-explorer-web-test-")
+    f = WebFiles(app, folder.name)
+    f.controller = app.controller  # what the tests read back
     yield f
-    f._uploads.cleanup()
+    folder.cleanup()
 
 
 @pytest.mark.parametrize(
@@ -73,7 +77,7 @@ def test_a_session_from_the_page_may_name_only_a_built_in_mesh(files, tmp_path):
         {"name": "../s.yaml", "content": [session("cube")[:9], session("cube")[9:]]}
     )
     ((call, path),) = files.controller.files.calls
-    assert call == "open_session" and path.startswith(files._uploads.name)
+    assert call == "open_session" and path.startswith(files.folder)
 
 
 def test_uploads_meet_the_caps_of_files_on_disk(files):
@@ -129,7 +133,7 @@ def test_an_objs_mtllib_must_be_uploaded_with_it(files):
     files.open_uploaded_mesh([{"name": "m.obj", "content": OBJ % b"m.mtl"}, mtl])
     ((call, path),) = files.controller.files.calls
     assert call == "choose_mesh" and path.endswith("/m.obj")
-    assert path.startswith(files._uploads.name)
+    assert path.startswith(files.folder)
 
 
 def test_one_mesh_file_per_upload(files):
@@ -144,11 +148,11 @@ def test_an_uploaded_mtl_is_capped_kept_under_its_own_name_and_imported(files):
     with pytest.raises(ExplorerError, match="material library 'm.mtl' is too large"):
         files.import_uploaded_materials({"name": "m.mtl", "content": big})
     assert files.controller.files.calls == []
-    files.server.state.preset_replace = True  # the page's "replace": the answer to "replace?"
+    files.app.server.state.preset_replace = True  # the page's "replace": the answer to "replace?"
     files.import_uploaded_materials({"name": "../../evil.mtl", "content": b"newmtl a\n"})
     ((call, path, answers),) = files.controller.files.calls
     assert call == "import_materials" and path.endswith("/evil.mtl") and answers == {"yes": True}
-    assert path.startswith(files._uploads.name) and files.answers == {}
+    assert path.startswith(files.folder) and files.app.answers == {}
     assert files.page_text(f"{path}:2: Kd: bad") == "evil.mtl:2: Kd: bad"
 
 
