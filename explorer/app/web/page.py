@@ -88,37 +88,36 @@ def _colour(v3, html, ctrl, key: str, label: str) -> None:
                 html.Div(PICKER_HINT, classes="text-caption pa-2", style="max-width: 300px")
 
 
+def _shown_as(key: str, tip: str) -> dict:
+    """What every row's widget has: compact, named (``aria-label``) by its state key, hidden
+    while that key is null (the row is not shown), its tip as a tooltip."""
+    return dict(
+        density="compact",
+        hide_details=True,
+        v_show=f"{key} != null",
+        title=tip,
+        raw_attrs=[f'aria-label="{key}"'],
+    )
+
+
 def _choice(v3, r) -> None:
     v3.VSelect(
         v_model=(r.key, None),
         items=(repr(list(r.choices)),),
         label=r.caption,
-        density="compact",
-        hide_details=True,
-        v_show=f"{r.key} != null",
-        title=r.tip,
-        raw_attrs=[f'aria-label="{r.key}"'],
+        **_shown_as(r.key, r.tip),
     )
 
 
-def _toggle(v3, r) -> None:
-    v3.VCheckbox(
-        v_model=(r.key, False),
-        label=r.caption,
-        density="compact",
-        hide_details=True,
-        v_show=f"{r.key} != null",
-        title=r.tip,
-        raw_attrs=[f'aria-label="{r.key}"'],
-    )
+def _checkbox(v3, key: str, label: str, tip: str) -> None:
+    """A toggle row's box, or an optional number's ``<key>_on`` switch."""
+    v3.VCheckbox(v_model=(key, False), label=label, **_shown_as(key, tip))
 
 
 def _triple(v3, ctrl, r) -> None:
     v3.VTextField(
-        model_value=(r.key, ""), label=f"{r.key} ({', '.join(r.choices)})", density="compact",
-        hide_details=True, variant="outlined", v_show=f"{r.key} != null", title=r.tip,
-        change=(ctrl.on_triple, f"['{r.key}', $event.target.value]"),
-        raw_attrs=[f'aria-label="{r.key}"'],
+        model_value=(r.key, ""), label=f"{r.key} ({', '.join(r.choices)})", variant="outlined",
+        change=(ctrl.on_triple, f"['{r.key}', $event.target.value]"), **_shown_as(r.key, r.tip),
     )  # fmt: skip
 
 
@@ -133,27 +132,19 @@ def _rows(v3, html, ctrl, tab: str) -> None:
                 line = html.Div(classes="d-flex")
                 group = r.group
             with line:
-                _toggle(v3, r)
+                _checkbox(v3, r.key, r.caption, r.tip)
             continue
         group = None
         if r.kind == "number":
             if r.optional is not None:
-                v3.VCheckbox(
-                    v_model=(f"{r.key}_on", False),
-                    label=r.caption,
-                    density="compact",
-                    hide_details=True,
-                    v_show=f"{r.key}_on != null",
-                    title=r.tip,
-                    raw_attrs=[f'aria-label="{r.key}_on"'],
-                )
+                _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
             _number(v3, html, ctrl, r.key, r.caption)
         elif r.kind == "colour":
             _colour(v3, html, ctrl, r.key, r.key)
         elif r.kind == "choice":
             _choice(v3, r)
         elif r.kind == "toggle":
-            _toggle(v3, r)
+            _checkbox(v3, r.key, r.caption, r.tip)
         else:
             _triple(v3, ctrl, r)
 

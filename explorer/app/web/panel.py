@@ -76,15 +76,22 @@ def mesh_materials_values(state: M.State) -> dict:
     return {"mesh_materials": line, "groups": groups, "group": state.group}
 
 
+def slider_step(r: panelmodel.Row, state: M.State) -> int | None:
+    """Number row ``r``'s slider step in ``state`` (None while the row is not shown): its value
+    rounded to its decimals, as its field shows it."""
+    v = r.shown(state)
+    if v is None:
+        return None
+    return to_step(r.control, round(float(v), r.control.decimals), *r.slider_range(state))
+
+
 def row_values(state: M.State) -> dict:
     """Every row's state keys (see the module docstring), from ``state``."""
     out = number_values(state)
     for r in panelmodel.ROWS:
         v = r.shown(state)
         if r.kind == "number":
-            out[f"{r.key}_step"] = (
-                None if v is None else to_step(r.control, out[r.key], *r.slider_range(state))
-            )
+            out[f"{r.key}_step"] = slider_step(r, state)
             if r.optional is not None:
                 out[f"{r.key}_on"] = (v is not None) if r.visible(state) else None
         elif r.kind == "colour":
@@ -157,7 +164,7 @@ def _numbers(app) -> None:
         def changed(**kw):
             step = kw.get(f"{r.key}_step")
             s = app.store.state
-            shown = values(s)[f"{r.key}_step"]
+            shown = slider_step(r, s)  # this row's step only (every slider event comes here)
             if app.pushing or step is None or shown is None:
                 return  # the server's own value
             step = page_value(f"{r.key}_step", int, step)
