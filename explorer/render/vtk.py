@@ -120,7 +120,10 @@ def polydata(
 
 def add_unlit(plotter, poly):
     """Draw ``poly`` in its ``"colors"`` point data as they are (VTK's lighting off), without
-    moving the camera. Returns the actor."""
+    moving the camera and without drawing a frame now (PyVista's default renders one: in the
+    window that frame ran the explorer's frame observers in the middle of a mesh switch, which
+    switched side B's mesh a second time and left a stale copy drawn over the live one).
+    Returns the actor."""
     return plotter.add_mesh(
         poly,
         scalars="colors",
@@ -128,6 +131,7 @@ def add_unlit(plotter, poly):
         lighting=False,
         show_scalar_bar=False,
         reset_camera=False,
+        render=False,
     )
 
 

@@ -447,3 +447,29 @@ def test_pane_b_shows_the_handles_and_a_drag_there_moves_the_light(win, qtbot):
     img_a = pixels(w.plotter)
     ax, ay = w.view.world_to_window(M.handle_point(moved, 0))
     assert np.abs(img_a[ay, ax].astype(int) - 255).max() < 110, img_a[ay, ax]
+
+
+@pytest.mark.parametrize("mesh", ["torus", "teapot"])
+def test_compare_pane_b_follows_the_lights_after_a_mesh_change(win, qtbot, mesh):
+    """Compare on, then another mesh (the mesh chooser): side B still follows a light change,
+    drawn as the off-screen render of side B's state (pane B had a second, stale copy of the
+    mesh drawn over the live one: its body stayed lit at intensity 1 while A's went dark)."""
+    w = win
+    w.panel.view.compare.click()
+    qtbot.waitUntil(lambda: w.plotter_b.width() > 100)
+    assert w.controller.files.choose_mesh(mesh)
+    w.controller.act(M.set_light_intensity, 0.3)
+    w.render()
+    s = w.controller.state
+    _MESHES[s.mesh] = w.view.mesh
+    vb, pl = w.view_b, w.plotter_b
+    for handle in vb.handles:
+        handle.Off()
+    vb.lobe_caption.SetVisibility(False)
+    got = pixels(pl)
+    want = offscreen_of(pl, M.side_b(s))
+    bad, worst = mesh_pixels_match(got, want, np.asarray(pl.renderer.GetBackground()) * 255)
+    assert bad < 0.01 and worst < 60, (bad, worst)
+    meshes = [a for a in pl.renderer.actors.values() if a.IsA("vtkActor")]
+    drawn = [a for a in meshes if a.GetMapper().GetInput().GetNumberOfPoints() >= 1000]
+    assert len(drawn) == len(vb.drawings)  # one actor per drawing, none left behind
