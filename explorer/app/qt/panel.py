@@ -20,7 +20,7 @@ import html
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
-from explorer.app.colours import rgb_bytes, rgb_text
+from explorer.app.colours import rgb_bytes, rgb_text, text_on
 from explorer.core.controls import CONTROLS, STEPS, Control, from_step, to_step
 from explorer.core.errors import ExplorerError
 
@@ -302,7 +302,7 @@ class ColourButton(QtWidgets.QPushButton):
         p.drawControl(QtWidgets.QStyle.ControlElement.CE_PushButton, opt)
         colour = qcolour(self.rgb)
         p.fillRect(self.swatch_rect(), colour)
-        p.setPen(QtGui.QColor("#000") if colour.lightnessF() > 0.5 else QtGui.QColor("#fff"))
+        p.setPen(QtGui.QColor(text_on(self.rgb)))  # the text colour of higher contrast
         p.drawText(self.swatch_rect(), QtCore.Qt.AlignmentFlag.AlignCenter, self.text())
         p.end()
 

@@ -8,10 +8,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
+from explorer.app.colours import contrast_ratio, relative_luminance, text_on
 from explorer.core.material import COEFFICIENT_RANGE, SHININESS_RANGE
 from explorer.shading.display import to_bytes
 
@@ -57,6 +59,40 @@ def test_a_light_colour_button_is_painted_in_its_value(win):
     button = win.panel.lights.colour
     assert swatch_pixels(button) == {(0, 0, 255)}
     assert "(0, 0, 255)" in button.toolTip()
+
+
+@pytest.mark.parametrize(
+    "rgb", [(0.0, 0.0, 1.0), (1.0, 0.0, 0.0), (1.0, 1.0, 0.0), (0.5, 0.5, 0.5), (0.0, 0.4, 0.0)]
+)
+def test_a_colour_buttons_text_is_written_in_the_colour_of_higher_contrast(win, rgb):
+    """The RGB text on a swatch, read from the painted pixels: the text's pixels (those that
+    are not the swatch's colour) are the light or dark side that contrasts more with the
+    swatch (WCAG 2; black was written on pure blue, 2.4:1)."""
+    win.controller.act(M.set_colour, "diffuse", rgb)
+    button = win.panel.material.colours["diffuse"]
+    image = button.grab().toImage()
+    r = button.swatch_rect()
+    swatch = rgb_bytes(rgb)
+    ratio = image.devicePixelRatio()
+    text = [(c.red(), c.green(), c.blue()) for c in (
+        image.pixelColor(round(x * ratio), round(y * ratio))
+        for x in range(r.left() + 2, r.right() - 1) for y in range(r.top() + 2, r.bottom() - 1))
+        if (c.red(), c.green(), c.blue()) != swatch]  # fmt: skip
+    assert len(text) > 20  # the text is drawn
+    darker = sum(sum(t) < sum(swatch) for t in text) > len(text) / 2
+    white_wins = contrast_ratio(relative_luminance(rgb), 1.0) > contrast_ratio(
+        relative_luminance(rgb), 0.0
+    )
+    assert darker != white_wins, (rgb, len(text))
+
+
+def test_the_text_colour_rule_keeps_at_least_4_5_to_1():
+    for v in np.linspace(0.0, 1.0, 256):
+        for rgb in ((v, v, v), (0.0, 0.0, v), (v, 0.0, 0.0), (0.0, v, 0.0)):
+            y = relative_luminance(rgb)
+            t = 1.0 if text_on(rgb) == "#ffffff" else 0.0
+            assert contrast_ratio(y, t) >= 4.5, rgb
+    assert text_on((0.0, 0.0, 1.0)) == "#ffffff" and text_on((1.0, 1.0, 0.0)) == "#000000"
 
 
 # -- 4. the colour dialog ----------------------------------------------------------------------
