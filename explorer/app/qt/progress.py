@@ -12,6 +12,9 @@ from explorer.shading import tiers
 STEP_MS = 0
 #: how often the status bar asks whether the compiled kernels are ready yet (ms)
 ENGINE_POLL_MS = 500
+#: the widest the engine's word may be in the status bar (average characters); longer text is
+#: elided there and said whole in its tooltip (it took 400 pixels of a 1000-pixel window)
+ENGINE_CHARS = 30
 
 
 def run_steps(parent, title: str, text: str, total: int, step, cancel):
@@ -69,7 +72,10 @@ class EngineStatus:
     def show(self) -> None:
         tiers.preload()  # looks for the ready marker (a stat at most every tiers.POLL seconds)
         text = tiers.status() or ""
-        if text != self.label.text():
-            self.label.setText(text)
+        if text != self.label.toolTip():
+            metrics = self.label.fontMetrics()
+            width = metrics.averageCharWidth() * ENGINE_CHARS
+            self.label.setText(metrics.elidedText(text, QtCore.Qt.TextElideMode.ElideRight, width))
+            self.label.setToolTip(text)
         if not text and (tiers.loaded() or tiers.mode() != "auto"):
             self.timer.stop()

@@ -28,7 +28,10 @@ def test_the_window_draws_at_once_and_says_while_the_compiled_engine_is_prepared
 ):
     with pytest.warns(explorer.core.errors.Notice, match="preparing the compiled engine"):
         w = open_window()
-    assert "preparing the compiled engine" in w.engine_label.text()
+    label = w.engine_label
+    assert "preparing the compiled engine" in label.toolTip()  # whole in the tooltip
+    assert label.text().startswith("numpy engine")  # the start of it in the status bar
+    assert label.width() <= 0.3 * w.width()  # it took 400 px of the 1000 px window
     drawn_equals_engine(w)
     assert (
         w.view.drawings[0].shader.stats["numpy"] >= 1
