@@ -241,6 +241,12 @@ def apply_preset(state: State, name: str, material: Material) -> State:
     return state.replace(scene=scene, preset=name, preset_material=material, groups=None)
 
 
+def material_title(state: State) -> str:
+    """What the captions call the material shown: the preset's name, else the material's own
+    (an OBJ's ``newmtl`` name, kept when another mesh is chosen), else ``"scene material"``."""
+    return state.preset or state.scene.material.name or "scene material"
+
+
 def use_mesh_materials(state: State) -> State:
     """Show the mesh's own materials as its file has them, each group its own; the panel
     edits the group it edited last (at first the largest)."""

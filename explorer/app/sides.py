@@ -120,7 +120,7 @@ def show_side_b(view_a, view_b, old: M.State | None, new: M.State) -> None:
         view_b.paint_levels(np.abs(a - other).max(axis=1))
     elif old is not None and old.compare_difference:
         view_b.drawings[0].upload()
-    view_a.set_caption(f"A: {new.preset or 'scene material'} ({new.scene.model})")
+    view_a.set_caption(f"A: {M.material_title(new)} ({new.scene.model})")
     view_b.set_caption("A − B (levels, as the difference view)" if new.compare_difference
                        else f"B: {new.compare_preset or 'material'} "
                        f"({new.compare_model})")  # fmt: skip

@@ -168,9 +168,10 @@ class MaterialTab(QtWidgets.QWidget):
         if s.groups is not None:
             label = s.mesh_materials.label(s.group)
             self.preset_label.setText(f"material: <b>{label}</b> of the mesh{edited}")
+        elif s.preset:
+            self.preset_label.setText(f"preset: <b>{s.preset}</b>{edited}")
         else:
-            name = s.preset or "(scene material)"
-            self.preset_label.setText(f"preset: <b>{name}</b>{edited}")
+            self.preset_label.setText(f"material: <b>{M.material_title(s)}</b>{edited}")
         with QtCore.QSignalBlocker(self.presets):
             found = self.presets.findItems(s.preset or "", QtCore.Qt.MatchFlag.MatchExactly)
             self.presets.setCurrentItem(found[0] if found and s.preset else None)

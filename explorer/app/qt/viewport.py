@@ -27,7 +27,7 @@ class QtPictures:
         """The controls and the status bar's summary show ``state``."""
         w = self.w
         w.panel.show_state(state, w.view.mesh.n_vertices)
-        what = state.preset or "(scene material)"
+        what = M.material_title(state)
         if state.groups is not None:
             what = f"{state.mesh_materials.source}'s materials"
         parts = [what, state.scene.model]

@@ -463,3 +463,25 @@ def test_each_effect_row_changes_the_picture_and_undo_restores_it(open_window, e
     w.render()
     assert (w.view.displayed_colors() == colours).all()
     assert not c.errors, c.errors
+
+
+def test_a_meshs_own_material_kept_on_another_mesh_is_called_by_its_name(win, qtbot):
+    """Open an OBJ with its own materials, then choose a built-in mesh: the material kept
+    over the new mesh is called by its .mtl name in the panel, the status bar and the compare
+    caption (they said "scene material", which it is not)."""
+    win.controller.files.open_file(ROOT / "docs" / "examples" / "teapot_parts.obj")
+    name = win.controller.state.scene.material.name
+    assert name in ("Porcelain", "Cobalt_Glaze", "Gold_Trim")
+    assert win.controller.files.choose_mesh("sphere")
+    assert win.controller.state.groups is None and win.controller.state.preset is None
+    win.panel.view.compare.click()
+    qtbot.waitUntil(lambda: win.plotter_b.width() > 100)
+    texts = [
+        win.panel.material.preset_label.text(),
+        win.status_label.text(),
+        win.view.caption.GetInput(),
+    ]
+    for text in texts:
+        assert name in text and "scene material" not in text, texts
+    assert win.panel.material.preset_label.text().startswith("material: ")  # not a preset
+    win.controller.errors.clear()  # (the .mtl's warnings)
