@@ -128,11 +128,20 @@ class Shown:
 
         self.run(go)
 
+    def __repr__(self) -> str:
+        """What a console prints for it (outside a notebook): where its page is."""
+        return f"<phong-explorer page at {self.url} (.stop() ends it)>"
+
     def _repr_html_(self) -> str:
+        """The page in an ``<iframe>``, and below it its address as a link that opens it in a
+        browser tab of its own (the frame may be too small, or blocked)."""
         import html
 
-        return (f'<iframe src="{html.escape(self.url)}" style="width:100%;height:{self.height}px;'
-                f'border:none" title="phong-explorer"></iframe>')  # fmt: skip
+        url = html.escape(self.url)
+        return (f'<iframe src="{url}" style="width:100%;height:{self.height}px;'
+                f'border:none" title="phong-explorer"></iframe>'
+                f'<div style="font-size:small">phong-explorer: <a href="{url}" target="_blank" '
+                f'rel="noopener">{url}</a> (a tab of its own)</div>')  # fmt: skip
 
 
 def proxy_prefix(proxy: bool | str | None, environ=None) -> str | None:

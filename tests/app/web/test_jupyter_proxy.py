@@ -97,6 +97,11 @@ def test_the_page_url_is_direct_or_under_the_proxy():
     assert web.page_url(8123, "/user/ana/", "T0k") == "/user/ana/proxy/8123/?secret=T0k"
     shown = web.Shown(app=None, url=web.page_url(8123, "/user/a&b/", "T0k"), height=500)
     assert 'src="/user/a&amp;b/proxy/8123/?secret=T0k"' in shown._repr_html_()
+    # the address is said too: a link under the frame, and what a console prints
+    assert 'href="/user/a&amp;b/proxy/8123/?secret=T0k" target="_blank"' in shown._repr_html_()
+    assert (
+        repr(shown) == "<phong-explorer page at /user/a&b/proxy/8123/?secret=T0k (.stop() ends it)>"
+    )
 
 
 # -- through a real proxy, in a real browser --------------------------------------------------
