@@ -259,6 +259,18 @@ def _turntable(v3, html, ctrl) -> None:
             raw_attrs=['aria-label="download turntable"'])  # fmt: skip
 
 
+def _footer(layout, v3, html) -> None:
+    """The page's foot: trame's busy indicator and the explorer's name and version (trame's
+    own foot advertises trame and Kitware and lists the server's package versions)."""
+    from explorer.core.version import __version__
+
+    layout.footer.clear()
+    with layout.footer:
+        busy = ("!!trame__busy",)
+        v3.VProgressCircular(indeterminate=busy, size=16, width=3, classes="mr-2")
+        html.Span(f"phong-explorer {__version__}", classes="text-caption text-grey")
+
+
 def _files(v3, ctrl) -> None:
     """The toolbar's files: save and open a session, export the view and the material."""
     v3.VBtn("save session", variant="text", raw_attrs=['aria-label="save session"'],
@@ -344,6 +356,7 @@ def build(app) -> None:
     webintents.connect(app)
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
+        _footer(layout, v3, html)
         layout.drawer.width = DRAWER_WIDTH
         client.Script(webintents.keys_js())  # the registry's keys (the desktop's)
         # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window

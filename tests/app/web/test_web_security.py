@@ -264,6 +264,21 @@ def test_a_client_sets_only_the_controls_keys_with_their_types(server):
     assert "onerror" not in out
 
 
+def test_the_pages_foot_is_the_explorers_not_an_advert(server):
+    """The template the page is served: its foot names the explorer and its version, not
+    trame's "Powered by trame" and Kitware links, nor the server's package versions."""
+    from explorer.core.version import __version__
+
+    client = ws_connect(server)
+    try:
+        template = state_of(client)["trame__template_main"]
+    finally:
+        client.close()
+    assert f"phong-explorer {__version__}" in template
+    for advert in ("Powered by trame", "kitware", "trame_vuetify", "mdi-help-circle"):
+        assert advert.lower() not in template.lower(), advert
+
+
 def test_an_injected_template_never_reaches_an_open_page(server, browser):
     """The XSS: another client sets the page's Vue template to an image whose error handler
     runs; the open page keeps its panel, and the handler never runs (a change the other client
