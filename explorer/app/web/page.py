@@ -17,6 +17,7 @@ from explorer.app.web.files import turntable_formats
 from explorer.core.controls import STEPS
 from explorer.core.material import MODELS
 from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
+from explorer.core.version import __version__
 from explorer.geometry.meshes import MESH_SUFFIXES
 
 #: the drawer's width (pixels)
@@ -262,7 +263,6 @@ def _turntable(v3, html, ctrl) -> None:
 def _footer(layout, v3, html) -> None:
     """The page's foot: trame's busy indicator and the explorer's name and version (trame's
     own foot advertises trame and Kitware and lists the server's package versions)."""
-    from explorer.core.version import __version__
 
     layout.footer.clear()
     with layout.footer:
