@@ -27,6 +27,7 @@ from explorer.app.turntablejob import DEFAULT_FRAMES
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.files import read_checked
+from explorer.core.presets import user_dir
 from explorer.core.tolerances import MAX_DOWNLOAD_BYTES
 from explorer.core.yamlio import MAX_BYTES, load_yaml
 from explorer.geometry.meshes import MESH_SUFFIXES, obj_material_names
@@ -119,9 +120,12 @@ class WebFiles:
         return folder
 
     def page_text(self, text: str) -> str:
-        """``text`` with the server's private folder taken out of its paths: the page names an
-        upload or a download by its own name (``bad.mtl:3: ...``), never a server path."""
-        return re.sub(re.escape(self.folder) + r"/[^/\s]+/", "", str(text))
+        """``text`` with the server's folders taken out of its paths: the page names an
+        upload or a download by its own name (``bad.mtl:3: ...``) and a saved preset by
+        ``presets/NAME.yaml`` (the user's preset folder, :func:`~explorer.core.presets.user_dir`),
+        never a server path."""
+        text = re.sub(re.escape(self.folder) + r"/[^/\s]+/", "", str(text))
+        return text.replace(f"{user_dir()}{os.sep}", "presets/")
 
     # -- downloads -------------------------------------------------------------------------------
     def download(self, kind: str) -> dict:

@@ -156,6 +156,15 @@ def test_an_uploaded_mtl_is_capped_kept_under_its_own_name_and_imported(files):
     assert files.page_text(f"{path}:2: Kd: bad") == "evil.mtl:2: Kd: bad"
 
 
+def test_a_saved_presets_message_names_no_server_folder(files, tmp_path, monkeypatch):
+    """The controller says where a preset was saved (the window shows the path); the page
+    says ``presets/NAME.yaml``, not the server's folder."""
+    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "mine"))
+    said = f"saved preset 'jade 2' to {tmp_path / 'mine' / 'jade_2.yaml'}"
+    assert files.page_text(said) == "saved preset 'jade 2' to presets/jade_2.yaml"
+    assert str(tmp_path) not in files.page_text(said)
+
+
 def test_the_turntable_takes_the_frames_and_a_format_the_server_can_write(files):
     files.start_turntable(".gif", "12")
     ((call, path, frames),) = files.controller.files.calls
