@@ -43,6 +43,14 @@ class Messages(Protocol):
                      msecs: int | None = None, open_log: bool = True) -> None: ...  # fmt: skip
 
 
+def log_head(at: str, level: str, text: str) -> str:
+    """A message's first line in either front end's message log: ``"HH:MM:SS level: text"``,
+    the level left out where the text starts with it already (the controller's errors read
+    ``error (kd): ...``; the log said ``error: error (kd): ...``)."""
+    said = text.startswith(level) and text[len(level) : len(level) + 1] in (":", " ")
+    return f"{at} {text}" if said else f"{at} {level}: {text}"
+
+
 @runtime_checkable
 class Progress(Protocol):
     """A long job under a progress bar with a Cancel, stepped from the front end's event loop

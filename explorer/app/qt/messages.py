@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from explorer.app.controller.ports import log_head
+
 #: how long a status message stays (ms); errors stay until the next message
 MESSAGE_MS = 6000
 #: the levels of a message, in the order of their weight
@@ -27,7 +29,7 @@ class Message:
     at: str = ""
 
     def lines(self) -> list[str]:
-        head = f"{self.at} {self.level}: {self.text}"
+        head = log_head(self.at, self.level, self.text)
         return [head, *(f"    {d}" for d in self.details)]
 
 

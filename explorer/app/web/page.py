@@ -320,7 +320,7 @@ def _message_log(v3, html) -> None:
                          classes="text-caption")  # fmt: skip
                 with html.Div(v_for="(m, i) in message_log", key="i", classes="mb-1",
                               raw_attrs=['aria-label="message"']):  # fmt: skip
-                    html.Div("{{ m.at }} {{ m.level }}: {{ m.text }}",
+                    html.Div("{{ m.head }}",
                              classes=("m.level === 'error' ? 'text-error' : m.level === "
                                       "'warning' ? 'text-warning' : ''",),
                              style="white-space: pre-wrap")  # fmt: skip

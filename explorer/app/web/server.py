@@ -33,6 +33,7 @@ from collections.abc import Sequence
 from explorer.app import intents
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
+from explorer.app.controller.ports import log_head
 from explorer.app.difference import DifferenceWorker
 from explorer.app.session import session_mapping
 from explorer.app.sides import SideB
@@ -170,7 +171,9 @@ class WebExplorer:
                      msecs: int | None = None, open_log: bool = True) -> None:  # fmt: skip
         page_text = self.files.page_text
         text, details = page_text(text), [page_text(d) for d in details]
-        entry = {"text": text, "level": level, "details": details, "at": time.strftime("%H:%M:%S")}
+        at = time.strftime("%H:%M:%S")
+        head = log_head(at, level, text)
+        entry = {"text": text, "level": level, "details": details, "at": at, "head": head}
         self.messages = [*self.messages, entry][-MESSAGE_LOG:]
         with self.server.state as s:
             s.message = text

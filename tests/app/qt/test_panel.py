@@ -294,6 +294,10 @@ def test_a_typed_light_value_out_of_range_is_refused_out_loud(win, qtbot):
     type_into(qtbot, win.panel.lights.sliders["elevation"].field, "120")
     assert win.controller.state == before
     assert "elevation must be a number within -90 .. 90, got '120'" in win.message
+    # the log says "error" once: "HH:MM:SS error: elevation ..." (it said "error: error: ...")
+    line = win.messages.plain_text().splitlines()[-1]
+    assert line.endswith("error: elevation must be a number within -90 .. 90, got '120'"), line
+    assert "error: error" not in win.messages.plain_text()
     win.controller.errors.clear()
 
 

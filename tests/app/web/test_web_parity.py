@@ -125,6 +125,7 @@ def test_the_message_log_lists_the_sessions_messages(server, browser):
                  and any(refused in t for t in got) and got)  # fmt: skip
     browser.save_screenshot(str(server.log.parent / "messages.png"))
     assert all(t[:8].count(":") == 2 for t in lines), lines  # each with its time, HH:MM:SS
+    assert not any("error: error" in t for t in lines), lines  # the level said once
     click(browser, "close messages")
     wait("the log closed", lambda: not shown(browser, "message log"))
 
