@@ -46,6 +46,7 @@ class Controller:
         self.last_session = last_session
         self.session_path: Path | None = None
         self.errors: list[str] = []
+        self._error_shown = False  # the last message said is an error (the next edit clears it)
         self.presets: list = []
         self.turntable = None
         self.meshes: dict[str, Mesh] = {state.mesh: mesh}
@@ -84,6 +85,9 @@ class Controller:
 
     # -- messages ---------------------------------------------------------------------------
     def say(self, text: str, level: str = "info", details=(), msecs=None, open_log=True):
+        """Say ``text`` (see :class:`~explorer.app.controller.ports.Messages`; ``""`` takes
+        the message shown away and logs nothing)."""
+        self._error_shown = False
         self.ports.messages.show_message(text, level, tuple(details), msecs, open_log)
 
     def report(self, exc: BaseException, where: str) -> None:
@@ -98,11 +102,13 @@ class Controller:
         lines = text.splitlines() or [type(exc).__name__]
         self.errors.append(f"{where}: {text}")
         self.say(f"error ({where}): {lines[0]}", "error", lines[1:])
+        self._error_shown = True
 
     def reject_input(self, text: str) -> None:
         """A typed value was refused (``text`` names the key and the range)."""
         self.errors.append(f"typed value: {text}")
         self.say(f"error: {text}", "error")
+        self._error_shown = True
         self.ports.view.show(None, self.store.state)
 
     # -- changes ----------------------------------------------------------------------------
@@ -114,11 +120,15 @@ class Controller:
             self.store.seal()
             return False
         try:
-            return self.store.apply(action, *args, label=label, merge=merge)
+            changed = self.store.apply(action, *args, label=label, merge=merge)
         except ExplorerError as exc:
             self.report(exc, label or action.__name__)
             self.ports.view.show(None, self.store.state)  # the sending control shows the state
             return False
+        if changed and self._error_shown:  # an edit that worked takes the last error away
+            self._error_shown = False
+            self.say("", "info", open_log=False)
+        return changed
 
     def set_value(self, key: str, value, *, merge: bool = True) -> bool:
         """Set control ``key`` (a row of :mod:`explorer.app.panelmodel`: a number, a colour's

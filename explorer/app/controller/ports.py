@@ -37,7 +37,8 @@ class Messages(Protocol):
     """A short message for the user, kept in the session's message log: ``level`` one of
     ``info``, ``warning``, ``error``; ``details`` each a line of the log; ``msecs`` how long the
     status line shows it (None: the front end's default); ``open_log`` False: the details are
-    shown elsewhere already (a dialog)."""
+    shown elsewhere already (a dialog). An empty ``text`` takes the message shown away (an
+    error, after an edit that worked) and adds nothing to the log."""
 
     def show_message(self, text: str, level: str = "info", details: Sequence[str] = (),
                      msecs: int | None = None, open_log: bool = True) -> None: ...  # fmt: skip

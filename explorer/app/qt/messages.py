@@ -130,6 +130,8 @@ class MessageBar:
         bar = w.statusBar()
         bar.setStyleSheet({"error": "color: #ff7766;", "warning": "color: #e0a030;"}.get(level, ""))
         bar.showMessage(text, 0 if level == "error" else int(msecs or MESSAGE_MS))
+        if not text:  # the message shown taken away: nothing to log
+            return
         w.messages.add(level, text, details)
         w.messages_indicator.refresh()
         if open_log_ and level != "info" and (details or not self._fits_status_bar(text)):

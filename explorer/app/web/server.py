@@ -174,7 +174,8 @@ class WebExplorer:
         at = time.strftime("%H:%M:%S")
         head = log_head(at, level, text)
         entry = {"text": text, "level": level, "details": details, "at": at, "head": head}
-        self.messages = [*self.messages, entry][-MESSAGE_LOG:]
+        if text:  # (empty: the message shown taken away, nothing logged)
+            self.messages = [*self.messages, entry][-MESSAGE_LOG:]
         with self.server.state as s:
             s.message = text
             s.message_level = level

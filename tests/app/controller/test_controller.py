@@ -83,6 +83,19 @@ def test_a_refused_value_is_said_and_the_controls_show_the_state(ctl):
         ctl.set_value("glossiness", 1.0)
 
 
+def test_an_edit_that_works_takes_the_last_error_away(ctl):
+    """A refused value is said until an edit works: then the message goes (an empty message,
+    which the front ends show as none and do not log); later edits say nothing more."""
+    assert not ctl.set_value("kd", 7.0)
+    assert ctl.front.messages[-1][0] == "error"
+    assert ctl.set_value("kd", 0.4)
+    assert ctl.front.messages[-1] == ("info", "")
+    n = len(ctl.front.messages)
+    assert ctl.set_value("kd", 0.5)
+    assert len(ctl.front.messages) == n  # nothing more to take away
+    ctl.errors.clear()
+
+
 def test_open_save_and_undo_across_flows(ctl, tmp_path):
     ctl.set_value("kd", 0.3)
     ctl.release()

@@ -284,8 +284,11 @@ def test_a_typed_value_out_of_range_is_refused_out_loud(win, qtbot, key, text, l
     assert want in win.message and win.statusBar().currentMessage() == win.message
     assert any(want in m.text for m in win.messages.messages)
     win.controller.errors.clear()
+    logged = len(win.messages.messages)
     type_into(qtbot, field, "0.5")  # a value in range is taken
     assert win.controller.state != before
+    # and the error goes from the status bar (it stayed through later edits); nothing logged
+    assert win.statusBar().currentMessage() == "" and len(win.messages.messages) == logged
 
 
 def test_a_typed_light_value_out_of_range_is_refused_out_loud(win, qtbot):

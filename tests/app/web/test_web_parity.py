@@ -128,6 +128,8 @@ def test_the_message_log_lists_the_sessions_messages(server, browser):
     assert not any("error: error" in t for t in lines), lines  # the level said once
     click(browser, "close messages")
     wait("the log closed", lambda: not shown(browser, "message log"))
+    type_value(browser, "kd", "0.5")  # an edit that works takes the error away
+    wait("the error gone", lambda: "kd must be" not in status(browser))
 
 
 def log_lines(driver) -> list[str] | None:
