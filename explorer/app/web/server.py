@@ -222,12 +222,16 @@ class WebExplorer:
             s.turntable_made = self.files.turntable_made if s.turntable_ready else ""
 
     # -- Choices ---------------------------------------------------------------------------------
+    # (a value set on trame's state waits for the next flush: ``with state`` flushes it, so a
+    # change from a worker's callback reaches the pages now, not at the user's next action)
     def show_presets(self, presets: list) -> None:
-        self.server.state.presets = [panel.preset_item(p) for p in presets]
+        with self.server.state as s:
+            s.presets = [panel.preset_item(p) for p in presets]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
-        self.server.state.meshes = [{"title": t, "value": self.mesh_values.page(n)}
-                                    for n, t in labels.items()]  # fmt: skip
+        with self.server.state as s:
+            s.meshes = [{"title": t, "value": self.mesh_values.page(n)}
+                        for n, t in labels.items()]  # fmt: skip
 
     def show_recent(self, paths: list[str]) -> None:
         """The page keeps no recent files (it opens uploads only)."""
@@ -246,14 +250,19 @@ class WebExplorer:
         tiers.preload()
         engine = tiers.status() or ""
         if engine != self.server.state.engine:
-            self.server.state.engine = engine
+            with self.server.state as s:
+                s.engine = engine
         self._send(self.server.controller.view_update, self.plotter.render_window)
 
     def show_controls(self, state: M.State) -> None:
         self._push(state)
 
     def show_legend(self, legend: str, advice: str) -> None:
-        self.server.state.legend = legend
+        """The difference's legend, on every page now (it comes from the difference worker's
+        callback, between two of the user's actions: set without a flush, it waited for the
+        next one, and the page said "computing the map" over the finished heat map)."""
+        with self.server.state as s:
+            s.legend = legend
 
     def after_frame(self) -> None:
         """Nothing of the page's own after a frame (side B's picture follows: WebCompare)."""

@@ -380,6 +380,13 @@ def test_the_command_refuses_a_bad_port_in_one_line(capsys):
     assert err.strip() == "error: --port must be 0 to 65535, got 70000"
 
 
+def page_text(driver) -> str:
+    """The text the page shows (its body's, as a person reads it)."""
+    from selenium.webdriver.common.by import By
+
+    return driver.find_element(By.TAG_NAME, "body").text
+
+
 def test_the_difference_view_shows_its_heat_map(server, browser):
     open_page(browser, server.url)
     click(browser, "view tab")
@@ -388,6 +395,11 @@ def test_the_difference_view_shows_its_heat_map(server, browser):
     rep = wait("the heat map", lambda: (r := report(browser)) and r["difference"]["shown"] and r)
     assert rep["session"]["difference"] is True and rep["difference"]["rmse"] is not None
     wait("a new picture", lambda: picture_src(browser) not in (None, before))
+    # the legend the page shows says the map's figures, with no other action (it stayed on
+    # "computing the map for this view" over the heat map, 2 times of 3)
+    rmse = f"RMSE {rep['difference']['rmse']:.2f}"
+    wait("the legend's RMSE", lambda: rmse in page_text(browser), timeout=10)
+    assert "computing the map" not in page_text(browser)
     click(browser, "difference")
     wait("the view again", lambda: not report(browser)["difference"]["shown"])
     click(browser, "material tab")
