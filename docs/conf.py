@@ -72,8 +72,9 @@ sphinx_gallery_conf = {
     "show_memory": False,
     "write_computation_times": False,  # its page loads DataTables from a CDN: none offline
     "abort_on_example_error": True,
-    "within_subsection_order": "FileNameSortKey",
+    "within_subsection_order": "gallery_pictures.GalleryOrder",
     "first_notebook_cell": None,
+    "capture_repr": (),  # no "Out:" for a block's last value (write_atomic's path)
     "min_reported_time": 10**9,  # no timing lines: they change from build to build
 }
 

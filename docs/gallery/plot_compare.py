@@ -13,6 +13,7 @@ import numpy as np
 import explorer
 from explorer.analysis.comparison import channel_max, heat_map
 from explorer.core.atomic import write_atomic
+from explorer.core.presets import find_preset
 from explorer.geometry.meshes import get_mesh
 from explorer.render.images import encode_png, side_by_side
 from explorer.render.offscreen import OffscreenRenderer
@@ -35,14 +36,14 @@ def compare(a, b, labels):
     return side_by_side(pair, heat_map(diff), gap=2, fill=GAP)
 
 
-gold = scene.replace(material=explorer.load_scene({"material": "gold"}).material)
-brass = scene.replace(material=explorer.load_scene({"material": "brass"}).material)
-write_atomic("compare_materials.png", encode_png(compare(gold, brass, ("gold", "brass"))),
-             overwrite=True)  # fmt: skip
+gold = scene.replace(material=find_preset("gold"))
+brass = scene.replace(material=find_preset("brass"))
+picture = compare(gold, brass, ("gold", "brass"))
+write_atomic("compare_materials.png", encode_png(picture), overwrite=True)
 
 # %%
 # One material under two models: Phong's lobe is wider at the same shininess.
 
 phong = gold.replace(model="phong")
-write_atomic("compare_models.png", encode_png(compare(gold, phong, ("blinn", "phong"))),
-             overwrite=True)  # fmt: skip
+picture = compare(gold, phong, ("blinn", "phong"))
+write_atomic("compare_models.png", encode_png(picture), overwrite=True)
