@@ -102,3 +102,18 @@ def test_preset_page_holds_every_builtin_preset_in_three_forms():
         assert path.read_text(encoding="utf-8").rstrip() in page  # the YAML as it is
         assert f"newmtl {name}\n" in page  # the .mtl form
     assert page.count('"type": "MeshPhongMaterial"') == len(names)  # the three.js form
+
+
+def test_every_page_is_in_the_site():
+    """Each docs/*.md page is in a toctree of docs/index.md (the build refuses a page in none;
+    this says so in seconds, before the build, and names the line to add)."""
+    index = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    listed = set()
+    for block in re.findall(r"```\{toctree\}\n(.*?)```", index, re.S):
+        listed |= {line.strip() for line in block.splitlines() if line.strip()[:1].isalnum()}
+    pages = {p.stem for p in (ROOT / "docs").glob("*.md")} - {"index"}
+    assert not pages - listed, (
+        f"pages in no toctree of docs/index.md: {sorted(pages - listed)}; add each to the "
+        "'User guide' or 'Reference' toctree there"
+    )
+    assert not {name for name in listed - pages if "/" not in name}, listed - pages
