@@ -22,7 +22,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 #: the libraries Qt's xcb platform needs that a minimal Debian lacks, with their Debian
-#: packages (README.md's list and .ci/run's apt line)
+#: packages (docs/dependencies.md's list and .ci/run's apt line)
 XCB_LIBRARIES: dict[str, str] = {
     "libxcb-cursor.so.0": "libxcb-cursor0",
     "libxcb-icccm.so.4": "libxcb-icccm4",
