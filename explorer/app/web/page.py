@@ -353,6 +353,8 @@ def build(app) -> None:
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
     server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
+    # the panel's tab and the drawer are each page's own: another page's choice moves neither
+    server.state.client_only("tab", "main_drawer")
     webintents.connect(app)
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")

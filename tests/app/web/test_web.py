@@ -380,6 +380,44 @@ def test_the_command_refuses_a_bad_port_in_one_line(capsys):
     assert err.strip() == "error: --port must be 0 to 65535, got 70000"
 
 
+def selected_tab(driver) -> str | None:
+    """The name of the panel's tab shown selected (``"lights tab"``), or None."""
+    return driver.execute_script(
+        "const t = [...document.querySelectorAll('[role=tab][aria-selected=true]')];"
+        "return t.length === 1 ? t[0].getAttribute('aria-label') : null;"
+    )
+
+
+def test_each_page_keeps_its_own_tab_and_drawer(server, browser):
+    """The panel's tab is each page's own (the explorer's state is shared; the drawer is
+    client-only alike): a page opened later starts on the material tab whatever another page
+    chose, and one page's choice does not move another's (issue 42: a new page opened on the
+    tab someone else chose)."""
+    open_page(browser, server.url)
+    first = browser.current_window_handle
+    click(browser, "lights tab")
+    wait("the lights tab", lambda: selected_tab(browser) == "lights tab")
+    browser.switch_to.new_window("tab")
+    try:
+        open_page(browser, server.url)
+        assert selected_tab(browser) == "material tab"
+        type_value(browser, "kd", "0.3")  # (a shared change: it reaches both pages)
+        click(browser, "view tab")
+        wait("the view tab", lambda: selected_tab(browser) == "view tab")
+        browser.switch_to.window(first)
+        wait("the shared change", lambda: kd(report(browser)) == pytest.approx(0.3))
+        assert selected_tab(browser) == "lights tab"
+    finally:
+        if browser.current_window_handle != first:
+            browser.close()
+        else:
+            for h in browser.window_handles:
+                if h != first:
+                    browser.switch_to.window(h)
+                    browser.close()
+        browser.switch_to.window(first)
+
+
 def page_text(driver) -> str:
     """The text the page shows (its body's, as a person reads it)."""
     from selenium.webdriver.common.by import By
