@@ -344,7 +344,7 @@ def build(app) -> None:
     server = app.server
     ctrl = server.controller
     server.state.update(
-        models=list(MODELS), message="", message_level="info",
+        models=list(MODELS), message="", message_level="info", message_seq=0, seen_seq=0,
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         turntable_ready=False, turntable_made="",
@@ -355,12 +355,16 @@ def build(app) -> None:
     server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
     # the panel's tab and the drawer are each page's own: another page's choice moves neither
     server.state.client_only("tab", "main_drawer")
+    # a page shows the messages said after it opened, not the last one said to another page
+    # (``seen_seq``: the message count when this page mounted, kept in the page)
+    server.state.client_only("seen_seq")
     webintents.connect(app)
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
         _footer(layout, v3, html)
         layout.drawer.width = DRAWER_WIDTH
         client.Script(webintents.keys_js())  # the registry's keys (the desktop's)
+        client.ClientTriggers(mounted="seen_seq = message_seq")
         # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window
         client.Style("html { overflow-y: auto; }")
         with layout.toolbar:
@@ -396,6 +400,7 @@ def build(app) -> None:
                          raw_attrs=['aria-label="engine"'])  # fmt: skip
                 html.Div("{{ message }}", classes=("'text-caption px-2 pb-1 ' + (message_level "
                          "=== 'error' ? 'text-error' : '')",), style=MESSAGE_STYLE,
+                         v_show="message_seq > seen_seq",
                          raw_attrs=['role="status"'])  # fmt: skip
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
             with html.Div(classes="d-flex", style="width: 100%; height: 100%"):

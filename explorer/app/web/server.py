@@ -92,6 +92,7 @@ class WebExplorer:
 
         self.pushing = False  # the server is setting the page's values (no user change)
         self.messages: list[dict] = []
+        self.message_seq = 0  # messages said so far (a page shows those after it opened)
         self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
         self.files = WebFiles(self, self._uploads.name)  # the uploads and downloads
@@ -176,9 +177,11 @@ class WebExplorer:
         entry = {"text": text, "level": level, "details": details, "at": at, "head": head}
         if text:  # (empty: the message shown taken away, nothing logged)
             self.messages = [*self.messages, entry][-MESSAGE_LOG:]
+        self.message_seq += 1
         with self.server.state as s:
             s.message = text
             s.message_level = level
+            s.message_seq = self.message_seq
             s.message_log = self.messages
 
     # -- Progress --------------------------------------------------------------------------------

@@ -380,6 +380,13 @@ def test_the_command_refuses_a_bad_port_in_one_line(capsys):
     assert err.strip() == "error: --port must be 0 to 65535, got 70000"
 
 
+def status_text(driver) -> str:
+    """The page's status line as shown ("" while it is hidden)."""
+    from selenium.webdriver.common.by import By
+
+    return driver.find_element(By.CSS_SELECTOR, '[role="status"]').text
+
+
 def selected_tab(driver) -> str | None:
     """The name of the panel's tab shown selected (``"lights tab"``), or None."""
     return driver.execute_script(
@@ -389,18 +396,22 @@ def selected_tab(driver) -> str | None:
 
 
 def test_each_page_keeps_its_own_tab_and_drawer(server, browser):
-    """The panel's tab is each page's own (the explorer's state is shared; the drawer is
-    client-only alike): a page opened later starts on the material tab whatever another page
-    chose, and one page's choice does not move another's (issue 42: a new page opened on the
-    tab someone else chose)."""
+    """The panel's tab and the status line are each page's own (the explorer's state is
+    shared; the drawer is client-only alike): a page opened later starts on the material tab
+    whatever another page chose, without the message another page was shown last, and one
+    page's choice does not move another's (issue 42: a new page opened on the tab someone
+    else chose and showed their last message)."""
     open_page(browser, server.url)
     first = browser.current_window_handle
+    type_value(browser, "kd", "7")  # refused: said in this page
+    wait("the refusal", lambda: "kd must be" in status_text(browser))
     click(browser, "lights tab")
     wait("the lights tab", lambda: selected_tab(browser) == "lights tab")
     browser.switch_to.new_window("tab")
     try:
         open_page(browser, server.url)
         assert selected_tab(browser) == "material tab"
+        assert status_text(browser) == ""  # the other page's last message is not shown here
         type_value(browser, "kd", "0.3")  # (a shared change: it reaches both pages)
         click(browser, "view tab")
         wait("the view tab", lambda: selected_tab(browser) == "view tab")
