@@ -13,10 +13,10 @@ A :class:`LivePixels` draws the per-pixel picture of one mesh for any scene, cam
   light pass, a shininess change reruns only the specular (then only the lobe), a light change
   reruns what it invalidates, exactly as the per-vertex shader does (counted:
   :attr:`LivePixels.light_passes`, and the shader's own ``stats``).
-- **the display** (:func:`explorer.shading.display.shown`, :func:`~explorer.shading.display.to_bytes`):
-  the same path as every picture of the project, so the bytes are those of
-  ``phong-explorer render --per-pixel`` (which draws through this class) for that mesh, camera
-  and size.
+- **the display** (:func:`explorer.shading.display.shown`, then
+  :func:`~explorer.shading.display.to_bytes`): the same path as every picture of the project,
+  so the bytes are those of ``phong-explorer render --per-pixel`` (which draws through this
+  class) for that mesh, camera and size.
 
 Shadows: a light that casts them is traced by the engine's own shadow rays over the mesh's
 triangles, as :func:`explorer.render.perpixel.point_colors` does: the shader's points are then
