@@ -77,6 +77,14 @@ class GBuffer:
     size: tuple[int, int]
     hits: Hits
 
+    @property
+    def pixels(self) -> np.ndarray:
+        """(k,) int64 the covered pixels' indices in the picture's row-major order (made on
+        first use): pixel i of the hits is ``rgb.reshape(-1, 3)[pixels[i]]``."""
+        if "_pixels" not in self.__dict__:
+            object.__setattr__(self, "_pixels", np.flatnonzero(self.hits.mask))
+        return self.__dict__["_pixels"]
+
 
 class LivePixels:
     """Per-pixel pictures of one mesh, cached for interaction (see the module docstring).
@@ -102,6 +110,7 @@ class LivePixels:
         self._shader: Shader | None = None
         self._shader_key = None  # (G-buffer, with the mesh's vertices, clamped)
         self._retired: Counter = Counter()  # the stats of shaders replaced
+        self._bg_key, self._bg = None, None  # the background picture kept (_background)
 
     # -- life --------------------------------------------------------------------------------
     def __enter__(self):
@@ -174,19 +183,28 @@ class LivePixels:
         _check(cancelled)
         g, made = self.gbuffer(camera, size)
         _check(cancelled)
-        h = g.hits
         colors = self._colors(scene, g, materials, cancelled)
-        w_, h_ = g.size
-        bg = BACKGROUND if background is None else background
-        rgb = np.empty((h_, w_, 3), np.uint8)
-        rgb[:] = to_bytes(np.asarray(bg, np.float64)[None, :])[0]
+        rgb = self._background(g.size, BACKGROUND if background is None else background)
         if len(colors):
-            rgb[h.mask] = to_bytes(shown(colors, scene))
-        return PixelFrame(rgb, h.mask, time.perf_counter() - t0, made)
+            # the engine's clamped colours are the display's (shown: the same array); a display
+            # effect reads float64, as display_colors gives it the engine's colours
+            c = colors if engine_clamps(scene) else np.asarray(colors, np.float64)
+            rgb.reshape(-1, 3)[g.pixels] = to_bytes(shown(c, scene))
+        return PixelFrame(rgb, g.hits.mask, time.perf_counter() - t0, made)
+
+    def _background(self, size: tuple[int, int], background) -> np.ndarray:
+        """A new (h, w, 3) uint8 picture of the background colour (copied from a kept one)."""
+        key = (size, tuple(float(c) for c in background))
+        if self._bg_key != key:
+            w, h = size
+            self._bg = np.empty((h, w, 3), np.uint8)
+            self._bg[:] = to_bytes(np.asarray(key[1], np.float64)[None, :])[0]
+            self._bg_key = key
+        return self._bg.copy()
 
     def _colors(self, scene, g: GBuffer, materials, cancelled) -> np.ndarray:
-        """The engine's colours (k, 3) float64 of the G-buffer's pixels (clamped or not, as
-        :func:`~explorer.shading.display.display_colors` has them)."""
+        """The engine's colours (k, 3) of the G-buffer's pixels in the working precision
+        (clamped or not, as :func:`~explorer.shading.display.display_colors` has them)."""
         h, mesh = g.hits, self.mesh
         k = len(h.positions)
         if k == 0:
@@ -217,7 +235,7 @@ class LivePixels:
             c = self._shader.colors
         else:
             c = grouped_colors(self._shader, self._group_rows(g, materials, first), materials)
-        return np.asarray(c[first:], np.float64)
+        return c[first:]
 
     def _group_rows(self, g: GBuffer, materials, first: int) -> list[np.ndarray]:
         """The shader's rows of each group's pixels (offset by ``first``, the mesh's vertices
