@@ -37,10 +37,12 @@ from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
 from explorer.core.progress import Progress
 from explorer.core.text import say
+from explorer.render.camera import camera_for
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
+from explorer.render.live import LivePixels
 from explorer.render.offscreen import render_image
-from explorer.render.perpixel import reference
+from explorer.render.perpixel import METHODS, reference
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -50,6 +52,11 @@ from explorer.render.turntable import (
     iter_frames,
 )
 from explorer.shading.display import group_vertex_colors, vertex_colors
+
+#: what ``--per-pixel-method`` chooses from: the rasteriser's triangles
+#: (:class:`explorer.render.live.LivePixels`, the live view's picture), then the per-pixel
+#: reference's methods (:func:`explorer.render.perpixel.hits`)
+PER_PIXEL_METHODS = ("raster", *METHODS)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -70,8 +77,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--per-pixel", action="store_true",
-        help="light every pixel instead of every vertex (exact sphere for the built-in spheres, "
-        "else ray casting with interpolated normals): the accuracy reference; .png only",
+        help="light every pixel instead of every vertex: the engine at the surface point each "
+        "pixel shows, with the interpolated normal (the live per-pixel view's picture); .png only",
+    )  # fmt: skip
+    p.add_argument(
+        "--per-pixel-method", choices=PER_PIXEL_METHODS, default=None,
+        help="what --per-pixel lights: raster (default) the triangles VTK draws at each pixel, "
+        "as the live view; raycast the nearest triangle along each pixel's ray; sphere the exact "
+        "sphere (built-in spheres: the accuracy reference); auto sphere for those, else raycast",
     )  # fmt: skip
     add_scene_arguments(p, mesh_default="sphere")
 
@@ -97,6 +110,8 @@ def run(args) -> int:
         for m in materials or (scene.material,):
             for w in energy_warnings(m):
                 say(f"warning: {w}", file=sys.stderr)
+    if args.per_pixel_method is not None and not args.per_pixel:
+        raise ExplorerError("--per-pixel-method chooses what --per-pixel lights: give --per-pixel")
     if args.per_pixel:
         if materials:
             raise ExplorerError(
@@ -208,9 +223,17 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
             f"{scene.material.opacity:g} is not blended)",
             file=sys.stderr,
         )
-    ref = reference(scene, mesh, size)
-    write_atomic(args.out, encode_png(ref.image(background)), overwrite=args.force)
-    how = "exact sphere" if ref.hits.method == "sphere" else "ray cast"
+    method = args.per_pixel_method or "raster"
+    if method == "raster":
+        with LivePixels(mesh) as live:
+            image = live.frame(scene, camera_for(scene, mesh, size[0] / size[1]), size,
+                               background=background).rgb  # fmt: skip
+        how = "rasterised"
+    else:
+        ref = reference(scene, mesh, size, method=method)
+        image = ref.image(background)
+        how = "exact sphere" if ref.hits.method == "sphere" else "ray cast"
+    write_atomic(args.out, encode_png(image), overwrite=args.force)
     name = scene.material.name or "material"
     say(
         f"wrote {args.out}: {size[0]}x{size[1]} per-pixel picture ({mesh.name}, {how}, {name}, "
