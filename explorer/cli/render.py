@@ -81,11 +81,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "pixel shows, with the interpolated normal (the live per-pixel view's picture); .png only",
     )  # fmt: skip
     p.add_argument(
-        "--per-pixel-method", choices=PER_PIXEL_METHODS, default=None,
+        "--per-pixel-method",
+        choices=PER_PIXEL_METHODS,
+        default=None,
         help="what --per-pixel lights: raster (default) the triangles VTK draws at each pixel, "
         "as the live view; raycast the nearest triangle along each pixel's ray; sphere the exact "
         "sphere (built-in spheres: the accuracy reference); auto sphere for those, else raycast",
-    )  # fmt: skip
+    )
     add_scene_arguments(p, mesh_default="sphere")
 
 
@@ -226,8 +228,8 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
     method = args.per_pixel_method or "raster"
     if method == "raster":
         with LivePixels(mesh) as live:
-            image = live.frame(scene, camera_for(scene, mesh, size[0] / size[1]), size,
-                               background=background).rgb  # fmt: skip
+            camera = camera_for(scene, mesh, size[0] / size[1])
+            image = live.frame(scene, camera, size, background=background).rgb
         how = "rasterised"
     else:
         ref = reference(scene, mesh, size, method=method)

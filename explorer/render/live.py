@@ -168,8 +168,16 @@ class LivePixels:
         self.gbuffers += 1
         return g, True
 
-    def frame(self, scene, camera: Camera, size: Sequence[int], *, materials=None,
-              cancelled=None, background=None) -> PixelFrame:  # fmt: skip
+    def frame(
+        self,
+        scene,
+        camera: Camera,
+        size: Sequence[int],
+        *,
+        materials=None,
+        cancelled=None,
+        background=None,
+    ) -> PixelFrame:
         """The per-pixel picture of ``scene`` on the mesh through ``camera`` at ``size`` (w, h).
 
         materials : one Material per group of ``mesh.groups`` (a mesh file's own), or None:
@@ -223,8 +231,8 @@ class LivePixels:
         else:
             P, N, faces, first = h.positions, h.normals, None, 0
         if self._shader is None:
-            self._shader = Shader(scene, P, N, precision=self.precision, clamp=clamp,
-                                  faces=faces, cancelled=cancelled)  # fmt: skip
+            kw = {"precision": self.precision, "clamp": clamp, "faces": faces}
+            self._shader = Shader(scene, P, N, cancelled=cancelled, **kw)
         else:
             self._shader.cancelled = cancelled
             self._shader.set_scene(scene)

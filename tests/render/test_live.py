@@ -62,9 +62,9 @@ def test_a_live_frame_after_changes_is_the_render_per_pixel_picture(tmp_path, te
         live.frame(scene.replace(model="phong"), cam, SIZE)
         got = live.frame(scene, cam, SIZE)
     out = tmp_path / "pp.png"
-    argv = ["render", "--per-pixel", "--preset", "chrome", "--mesh", "teapot", "--resolution",
-            "6", "--viewer-eye", "2", "1.5", "3", "--light-position", "1.5", "2", "2",
-            "--size", "120x90", "--out", str(out)]  # fmt: skip
+    argv = "render --per-pixel --preset chrome --mesh teapot --resolution 6 --viewer-eye 2 1.5 3"
+    argv = [*argv.split(), "--light-position", "1.5", "2", "2", "--size", "120x90"]
+    argv += ["--out", str(out)]
     assert main(argv) == 0
     assert np.array_equal(read_png(out), got.rgb)
     assert got.mask.sum() > 1500
@@ -209,8 +209,8 @@ def test_every_effect_and_light_type_is_the_engine_at_each_pixel(teapot, case):
     :func:`~explorer.render.perpixel.reference_of`) at that pixel's surface point, for each
     light type, model and effect; a shadowing light darkens some pixels (the rays are cast)."""
     kw = dict(_cases()[case])
-    scene = _scene(kw.pop("viewer", None), kw.pop("material", CHROME), kw.pop("lights", LIGHTS),
-                   **kw)  # fmt: skip
+    viewer, material = kw.pop("viewer", None), kw.pop("material", CHROME)
+    scene = _scene(viewer, material, kw.pop("lights", LIGHTS), **kw)
     cam = camera_for(scene, teapot, SIZE[0] / SIZE[1])
     with LivePixels(teapot) as live:
         got = live.frame(scene, cam, SIZE)
@@ -218,8 +218,8 @@ def test_every_effect_and_light_type_is_the_engine_at_each_pixel(teapot, case):
     want = reference_of(scene, teapot, hits).image()
     levels = _levels(got.rgb, want)
     assert levels.max() <= 1 and np.mean(levels[got.mask] == 0) > 0.99
-    assert np.array_equal(got.mask, hits.mask) and np.array_equal(got.rgb[~got.mask],
-                                                                   want[~got.mask])  # fmt: skip
+    assert np.array_equal(got.mask, hits.mask)
+    assert np.array_equal(got.rgb[~got.mask], want[~got.mask])
     if case == "shadows":
         unshadowed = tuple(lt.replace(shadows=False) for lt in scene.lights)
         lit = reference_of(scene.replace(lights=unshadowed), teapot, hits).image()

@@ -348,15 +348,15 @@ def test_render_per_pixel_command(tmp_path, capsys):
     # an existing file is kept without --force
     assert main(["render", "--per-pixel", "--out", str(out)]) == 2
     assert "already exists" in capsys.readouterr().err
-    assert main(["render", "--per-pixel", "--per-pixel-method", "raycast", "--mesh", "torus",
-                 "--resolution", "12", "--size", "40x40", "--out", str(out),
-                 "--force"]) == 0  # fmt: skip
+    torus = "--mesh torus --resolution 12 --size 40x40".split()
+    argv = ["render", "--per-pixel", "--per-pixel-method", "raycast", *torus, "--out", str(out)]
+    assert main([*argv, "--force"]) == 0
     assert "ray cast" in capsys.readouterr().out
     # what the method chooses needs --per-pixel; the exact sphere needs a sphere
     assert main(["render", "--per-pixel-method", "sphere", "--out", str(out), "--force"]) == 2
     assert "give --per-pixel" in capsys.readouterr().err
-    assert main(["render", "--per-pixel", "--per-pixel-method", "sphere", "--mesh", "torus",
-                 "--out", str(out), "--force"]) == 2  # fmt: skip
+    argv = ["render", "--per-pixel", "--per-pixel-method", "sphere", "--mesh", "torus"]
+    assert main([*argv, "--out", str(out), "--force"]) == 2
     assert "not a built-in unit sphere" in capsys.readouterr().err
     assert main(["render", "--per-pixel", "--out", str(tmp_path / "x.ply")]) == 2
     assert "--per-pixel draws a picture" in capsys.readouterr().err
