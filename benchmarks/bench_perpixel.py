@@ -1,0 +1,217 @@
+"""Per-pixel benchmark (issue 39): a slider change and a camera change drawn per pixel
+(:class:`explorer.render.live.LivePixels`) beside the same change drawn per vertex, in one run.
+
+    python benchmarks/bench_perpixel.py           # prints the table, writes docs/perpixel_bench.md
+    python benchmarks/bench_perpixel.py --repeat 9 --no-write
+
+800x600 off-screen, anti-aliasing and multisampling off, the 100,578-vertex teapot (tessellation
+56) under 1 and 8 white point lights, gold, the local viewer of ``bench_gui`` (its scene), float32
+(the interactive precision) on both paths:
+
+- ``per vertex``: the engine's cached update of the mesh's vertices (kd: compose; shininess: the
+  lobe; azimuth: every light sum), the uint8 colour upload into VTK and the frame (VTK draws the
+  mesh, colours interpolated): ``bench_gui``'s bare-window path;
+- ``per pixel``: the same change through ``LivePixels.frame`` (the covered pixels' cached sums
+  recomposed, the display, the picture's bytes), the picture uploaded as the window's background
+  texture (an image layer: one texel per pixel) and the frame;
+- a camera change (3° about the mesh, the local viewer moving with the camera): per vertex every
+  specular sum and the frame; per pixel a new G-buffer (VTK's face-id picture, then the surface
+  points) and every light sum of the pixels, with where that time goes.
+
+Each row: median and best (ms) over ``--repeat`` frames after two warm-up ones; the per-pixel
+rows carry the ratio to the per-vertex row of the same change. A frame ends when VTK's
+``Render()`` returns and ``WaitForCompletion()`` says the GPU (Mesa llvmpipe here) is done. Wall
+times vary with load: the load average before and after is printed with the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+from bench_gui import SIZE, finish, load, machine, scene_for, timed  # (this script's directory)
+from common import publish  # benchmarks/common.py (the compiled tier)
+
+import explorer
+from explorer.geometry import meshes as M
+from explorer.render.camera import camera_for
+from explorer.render.live import LivePixels
+from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import add_unlit, plotter, polydata, set_camera
+from explorer.shading.display import to_bytes
+
+DOCS = Path(__file__).resolve().parent.parent / "docs" / "perpixel_bench.md"
+
+#: slider -> the scene of its i-th frame (two values, alternating)
+SLIDERS = {
+    "kd slider (compose)": lambda s, i: s.replace(
+        material=s.material.with_scalars(kd=0.3 + 0.4 * (i % 2))
+    ),
+    "shininess slider (lobe)": lambda s, i: s.replace(
+        material=s.material.replace(shininess=16.0 + 48.0 * (i % 2))
+    ),
+    "azimuth slider (all light sums)": lambda s, i: s.replace(
+        lights=tuple(lt.replace(position=_turned(lt.position, 10.0 * (i % 2))) for lt in s.lights)
+    ),
+}
+
+
+def _turned(p, degrees: float) -> tuple:
+    """``p`` turned by ``degrees`` about the vertical axis through the origin."""
+    a = np.radians(degrees)
+    x, y, z = p
+    return (x * np.cos(a) + z * np.sin(a), y, -x * np.sin(a) + z * np.cos(a))
+
+
+def _orbit(scene, mesh, i: int):
+    """The scene and camera of the i-th camera frame: the eye 3° to one side or the other."""
+    eye = np.asarray(scene.viewer.eye) - mesh.centre
+    eye = mesh.centre + np.asarray(_turned(eye, 3.0 if i % 2 else -3.0))
+    moved = scene.replace(viewer=scene.viewer.replace(eye=tuple(eye)))
+    return moved, camera_for(moved, mesh, SIZE[0] / SIZE[1])
+
+
+class VertexPath:
+    """Per vertex: the engine's cached update, the uint8 upload, VTK's frame of the mesh."""
+
+    def __init__(self, mesh, scene):
+        self.mesh = mesh
+        self.shader = explorer.Shader(scene, mesh.positions, mesh.normals, precision="float32")
+        self.pl = plotter(SIZE, BACKGROUND)
+        poly = polydata(mesh, to_bytes(self.shader.colors), float32=True, normals=False)
+        add_unlit(self.pl, poly)
+        set_camera(self.pl, camera_for(scene, mesh, SIZE[0] / SIZE[1]))
+        self.arr = poly.GetPointData().GetArray("colors")
+        from vtkmodules.util.numpy_support import vtk_to_numpy
+
+        self.rgb = vtk_to_numpy(self.arr)
+
+    def draw(self, scene, camera=None) -> None:
+        self.shader.set_scene(scene)
+        if camera is not None:
+            set_camera(self.pl, camera)
+        to_bytes(self.shader.colors, out=self.rgb)
+        self.arr.Modified()
+        self.pl.render_window.Render()
+        finish(self.pl)
+
+    def close(self) -> None:
+        self.pl.close()
+
+
+class PixelPath:
+    """Per pixel: ``LivePixels.frame``, the picture as the window's background texture (one
+    texel per pixel), VTK's frame."""
+
+    def __init__(self, mesh):
+        from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+        from vtkmodules.vtkCommonDataModel import vtkImageData
+        from vtkmodules.vtkRenderingCore import vtkTexture
+
+        self.mesh = mesh
+        self.live = LivePixels(mesh, precision="float32")
+        self.pl = plotter(SIZE, BACKGROUND)
+        w, h = SIZE
+        data = vtkImageData()
+        data.SetDimensions(w, h, 1)
+        self.arr = numpy_to_vtk(np.zeros((w * h, 3), np.uint8), deep=True)
+        data.GetPointData().SetScalars(self.arr)
+        self.texels = vtk_to_numpy(self.arr).reshape(h, w, 3)
+        tex = vtkTexture()
+        tex.SetInputData(data)
+        tex.InterpolateOff()
+        self.pl.renderer.SetBackgroundTexture(tex)
+        self.pl.renderer.SetTexturedBackground(True)
+        self.data = data
+
+    def draw(self, scene, camera) -> float:
+        """One frame; returns its G-buffer's share (ms; 0 when none was made)."""
+        t = time.perf_counter()
+        made = self.live.gbuffer(camera, SIZE)[1]
+        gbuffer = 1000.0 * (time.perf_counter() - t) if made else 0.0
+        frame = self.live.frame(scene, camera, SIZE)
+        self.texels[:] = frame.rgb[::-1]  # VTK's rows start at the bottom
+        self.arr.Modified()
+        self.data.Modified()
+        self.pl.render_window.Render()
+        finish(self.pl)
+        return gbuffer
+
+    def close(self) -> None:
+        self.live.close()
+        self.pl.close()
+
+
+def run(mesh, count: int, repeat: int) -> list[tuple]:
+    """Rows (change, path, (median, best) ms, ratio to per vertex or None) for ``count``
+    lights."""
+    scene = scene_for(mesh, count)
+    camera = camera_for(scene, mesh, SIZE[0] / SIZE[1])
+    vertex, pixel = VertexPath(mesh, scene), PixelPath(mesh)
+    rows = []
+    try:
+        for name, change in SLIDERS.items():
+            v = timed(lambda i, c=change: vertex.draw(c(scene, i)), repeat)
+            p = timed(lambda i, c=change: pixel.draw(c(scene, i), camera), repeat)
+            rows += [(name, "per vertex", v, None), (name, "per pixel", p, p[0] / v[0])]
+        orbit = [_orbit(scene, mesh, i) for i in (0, 1)]  # (made before: not timed)
+        v = timed(lambda i: vertex.draw(*orbit[i % 2]), repeat)
+        shares = []
+        p = timed(lambda i: shares.append(pixel.draw(*orbit[i % 2])), repeat)
+        g = sorted(shares[-repeat:])
+        rows.append(("camera change", "per vertex", v, None))
+        rows.append(("camera change", "per pixel", p, p[0] / v[0]))
+        rows.append(("camera change", "of it: the G-buffer", (g[len(g) // 2], g[0]), None))
+        rows.append(("pixels covered", int(pixel.live.gbuffer(camera, SIZE)[0].hits.mask.sum())))
+        rows.append(("machine", machine(vertex.pl)))
+    finally:
+        vertex.close()
+        pixel.close()
+    return rows
+
+
+def table(mesh, results: dict, before: str, after: str, repeat: int) -> str:
+    machine_lines = next(r[1] for rows in results.values() for r in rows if r[0] == "machine")
+    out = ["# Per-pixel benchmark", "", "Machine:", ""]
+    out += [f"- {line}" for line in machine_lines]
+    out += [f"- load average before / after: {before} / {after}", ""]
+    for count, rows in results.items():
+        covered = next(r[1] for r in rows if r[0] == "pixels covered")
+        out += [
+            f"{mesh.n_vertices:,}-vertex teapot, {count} point light{'s' if count > 1 else ''}, "
+            f"{SIZE[0]}x{SIZE[1]} ({covered:,} pixels covered); median (best) ms over {repeat} "
+            "frames:",
+            "",
+            "| change | path | ms | / per vertex | frames/s |",
+            "|---|---|---:|---:|---:|",
+        ]
+        for r in rows:
+            if len(r) != 4:
+                continue
+            name, path, (med, best), ratio = r
+            ratio_s = "" if ratio is None else f"{ratio:.2f}"
+            fps = "" if path.startswith("of it") else f"{1000.0 / med:.0f}"
+            out.append(f"| {name} | {path} | {med:.1f} ({best:.1f}) | {ratio_s} | {fps} |")
+        out.append("")
+    out.append(f"Command: `python benchmarks/bench_perpixel.py --repeat {repeat}`")
+    return "\n".join(out) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeat", type=int, default=15, help="timed frames per row (15)")
+    ap.add_argument("--lights", type=int, nargs="+", default=[1, 8])
+    ap.add_argument("--no-write", action="store_true", help="do not write the docs page")
+    args = ap.parse_args(argv)
+    before = load()
+    mesh = M.teapot(56)
+    results = {n: run(mesh, n, args.repeat) for n in args.lights}
+    text = table(mesh, results, before, load(), args.repeat)
+    publish(text, DOCS, write=not args.no_write)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
