@@ -70,7 +70,8 @@ class GBuffer:
 
     camera, size : what it was made for
     hits : :class:`~explorer.render.perpixel.Hits` (method "raster"): the mask, and per covered
-        pixel (row-major order) the triangle, float64 position and unit normal
+        pixel (row-major order) the triangle, its float64 barycentrics ``(u, v)``, the float64
+        position and unit normal
     """
 
     camera: Camera

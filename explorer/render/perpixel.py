@@ -65,6 +65,8 @@ class Hits:
     method : "sphere" (closed form), "raycast" (triangles, interpolated normals) or "raster"
         (:func:`raster_hits`)
     triangles : (k,) int64 the triangle of the mesh each hit lies on (None for the closed form)
+    barycentrics : (k, 2) float64 ``(u, v)`` of each hit on its triangle (corner weights
+        ``1-u-v, u, v``), for method "raster"; None otherwise
     """
 
     mask: np.ndarray
@@ -72,6 +74,7 @@ class Hits:
     normals: np.ndarray
     method: str
     triangles: np.ndarray | None = None
+    barycentrics: np.ndarray | None = None
 
 
 def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0) -> Hits:
@@ -227,7 +230,8 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
     flat = np.flatnonzero(seen >= 0)
     if flat.size == 0:
         none = np.zeros((0, 3))
-        return Hits(np.zeros((h, w), bool), none, none, "raster", np.zeros(0, np.int64))
+        empty = (np.zeros(0, np.int64), np.zeros((0, 2)))
+        return Hits(np.zeros((h, w), bool), none, none, "raster", *empty)
     rows, cols = np.divmod(flat, w)
     r0, c0 = int(rows[0]), int(cols.min())
     origins, dirs = pixel_rays(camera, (w, h), (c0, int(cols.max()), r0, int(rows[-1])))
@@ -253,11 +257,12 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
     length = np.sqrt(N[:, 0] * N[:, 0] + N[:, 1] * N[:, 1] + N[:, 2] * N[:, 2])[:, None]
     N = np.divide(N, length, out=np.zeros_like(N), where=length > SURFACE_NORMAL_MIN)
     pos = (O + t * D).T.copy()
+    uv = np.stack([u, v], axis=1)
     if not ok.all():  # (rays along their triangle's plane: misses)
-        flat, f, pos, N = flat[ok], f[ok], pos[ok], N[ok]
+        flat, f, pos, N, uv = flat[ok], f[ok], pos[ok], N[ok], uv[ok]
     mask = np.zeros(h * w, bool)
     mask[flat] = True
-    return Hits(mask.reshape(h, w), pos, N, "raster", f)
+    return Hits(mask.reshape(h, w), pos, N, "raster", f, uv)
 
 
 def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:

@@ -267,3 +267,29 @@ def test_the_background_is_where_nothing_is_covered(teapot):
     assert np.array_equal(grey.rgb[~grey.mask][0], to_bytes(np.array([BACKGROUND]))[0])
     assert (red.rgb[~red.mask] == [255, 0, 0]).all()
     assert np.array_equal(grey.rgb[grey.mask], red.rgb[red.mask])
+
+
+def test_the_gbuffer_holds_each_pixels_triangle_and_float64_barycentrics(teapot):
+    """The corners' weights (1-u-v, u, v) of each covered pixel give back its position and its
+    normal (before normalising) on its own triangle; one G-buffer per camera and size."""
+    scene = _scene(Viewer(eye=(2.0, 1.5, 3.0)))
+    cam = camera_for(scene, teapot, SIZE[0] / SIZE[1])
+    with LivePixels(teapot) as live:
+        g, made = live.gbuffer(cam, SIZE)
+        assert made and live.gbuffer(cam, SIZE) == (g, False) and live.gbuffers == 1
+    h = g.hits
+    u, v = h.barycentrics.T
+    assert h.barycentrics.dtype == np.float64 and len(u) == h.mask.sum() > 1500
+    corners = teapot.faces[h.triangles]
+    weights = np.stack([1.0 - u - v, u, v], axis=1)[:, :, None]
+    P = (weights * teapot.positions[corners]).sum(axis=1)
+    N = (weights * teapot.normals[corners]).sum(axis=1)
+    assert np.abs(P - h.positions).max() < 1e-12
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    assert np.abs(N - h.normals).max() < 1e-12
+    # inside the triangle but for pixel centres on an edge, which the rasteriser (float32) may
+    # give to either neighbour
+    inside = (u > -1e-6) & (v > -1e-6) & (u + v < 1 + 1e-6)
+    assert inside.mean() > 0.99 and weights.min() > -0.01
+    rows, cols = np.nonzero(h.mask)
+    assert np.array_equal(g.pixels, rows * SIZE[0] + cols)
