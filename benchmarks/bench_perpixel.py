@@ -27,11 +27,12 @@ times vary with load: the load average before and after is printed with the tabl
 from __future__ import annotations
 
 import argparse
+import statistics
 import time
 from pathlib import Path
 
 import numpy as np
-from bench_gui import SIZE, finish, load, machine, scene_for, timed  # (this script's directory)
+from bench_gui import SIZE, finish, load, machine, scene_for  # (this script's directory)
 from common import publish  # benchmarks/common.py (the compiled tier)
 
 import explorer
@@ -144,56 +145,82 @@ class PixelPath:
         self.pl.close()
 
 
-def run(mesh, count: int, repeat: int) -> list[tuple]:
-    """Rows (change, path, (median, best) ms, ratio to per vertex or None) for ``count``
-    lights."""
+def paired(vertex_step, pixel_step, repeat: int, warm: int = 2) -> tuple[dict, dict]:
+    """Both paths' frames alternated (vertex, pixel, vertex, ...: a change in the machine's
+    load falls on both): for each, the median and best wall ms and the median CPU ms of this
+    process (every thread: numba's and llvmpipe's) over ``repeat`` frames after ``warm``."""
+    out = ({"wall": [], "cpu": []}, {"wall": [], "cpu": []})
+    for i in range(warm + repeat):
+        for times, step in zip(out, (vertex_step, pixel_step), strict=True):
+            t, c = time.perf_counter(), time.process_time()
+            step(i)
+            wall, cpu = 1000.0 * (time.perf_counter() - t), 1000.0 * (time.process_time() - c)
+            if i >= warm:
+                times["wall"].append(wall)
+                times["cpu"].append(cpu)
+    return tuple(
+        {"ms": (statistics.median(x["wall"]), min(x["wall"])), "cpu": statistics.median(x["cpu"])}
+        for x in out
+    )
+
+
+def run(mesh, count: int, repeat: int) -> dict:
+    """Rows (change, path, times, ratio of median wall and CPU ms to per vertex, or None) for
+    ``count`` lights, the pixels covered and the machine lines."""
     scene = scene_for(mesh, count)
     camera = camera_for(scene, mesh, SIZE[0] / SIZE[1])
     vertex, pixel = VertexPath(mesh, scene), PixelPath(mesh)
     rows = []
+
+    def add(name, v, p):
+        ratio = (p["ms"][0] / v["ms"][0], p["cpu"] / v["cpu"])
+        rows.extend([(name, "per vertex", v, None), (name, "per pixel", p, ratio)])
+
     try:
         for name, change in SLIDERS.items():
-            v = timed(lambda i, c=change: vertex.draw(c(scene, i)), repeat)
-            p = timed(lambda i, c=change: pixel.draw(c(scene, i), camera), repeat)
-            rows += [(name, "per vertex", v, None), (name, "per pixel", p, p[0] / v[0])]
+            v, p = paired(
+                lambda i, c=change: vertex.draw(c(scene, i)),
+                lambda i, c=change: pixel.draw(c(scene, i), camera),
+                repeat,
+            )
+            add(name, v, p)
         orbit = [_orbit(scene, mesh, i) for i in (0, 1)]  # (made before: not timed)
-        v = timed(lambda i: vertex.draw(*orbit[i % 2]), repeat)
         shares = []
-        p = timed(lambda i: shares.append(pixel.draw(*orbit[i % 2])), repeat)
+        v, p = paired(
+            lambda i: vertex.draw(*orbit[i % 2]),
+            lambda i: shares.append(pixel.draw(*orbit[i % 2])),
+            repeat,
+        )
+        add("camera change", v, p)
         g = sorted(shares[-repeat:])
-        rows.append(("camera change", "per vertex", v, None))
-        rows.append(("camera change", "per pixel", p, p[0] / v[0]))
-        rows.append(("camera change", "of it: the G-buffer", (g[len(g) // 2], g[0]), None))
-        rows.append(("pixels covered", int(pixel.live.gbuffer(camera, SIZE)[0].hits.mask.sum())))
-        rows.append(("machine", machine(vertex.pl)))
+        rows.append(("camera change", "of it: the G-buffer", {"ms": (g[len(g) // 2], g[0])}, None))
+        covered = int(pixel.live.gbuffer(camera, SIZE)[0].hits.mask.sum())
+        return {"rows": rows, "covered": covered, "machine": machine(vertex.pl)}
     finally:
         vertex.close()
         pixel.close()
-    return rows
 
 
 def table(mesh, results: dict, before: str, after: str, repeat: int) -> str:
-    machine_lines = next(r[1] for rows in results.values() for r in rows if r[0] == "machine")
+    first = next(iter(results.values()))
     out = ["# Per-pixel benchmark", "", "Machine:", ""]
-    out += [f"- {line}" for line in machine_lines]
+    out += [f"- {line}" for line in first["machine"]]
     out += [f"- load average before / after: {before} / {after}", ""]
-    for count, rows in results.items():
-        covered = next(r[1] for r in rows if r[0] == "pixels covered")
+    for count, res in results.items():
         out += [
             f"{mesh.n_vertices:,}-vertex teapot, {count} point light{'s' if count > 1 else ''}, "
-            f"{SIZE[0]}x{SIZE[1]} ({covered:,} pixels covered); median (best) ms over {repeat} "
-            "frames:",
+            f"{SIZE[0]}x{SIZE[1]} ({res['covered']:,} pixels covered); wall ms median (best) and "
+            f"CPU ms (median) over {repeat} frames, the two paths alternated:",
             "",
-            "| change | path | ms | / per vertex | frames/s |",
-            "|---|---|---:|---:|---:|",
+            "| change | path | wall ms | CPU ms | / per vertex (wall, CPU) | frames/s |",
+            "|---|---|---:|---:|---:|---:|",
         ]
-        for r in rows:
-            if len(r) != 4:
-                continue
-            name, path, (med, best), ratio = r
-            ratio_s = "" if ratio is None else f"{ratio:.2f}"
+        for name, path, t, ratio in res["rows"]:
+            med, best = t["ms"]
+            cpu = f"{t['cpu']:.1f}" if "cpu" in t else ""
+            ratio_s = "" if ratio is None else f"{ratio[0]:.2f}, {ratio[1]:.2f}"
             fps = "" if path.startswith("of it") else f"{1000.0 / med:.0f}"
-            out.append(f"| {name} | {path} | {med:.1f} ({best:.1f}) | {ratio_s} | {fps} |")
+            out.append(f"| {name} | {path} | {med:.1f} ({best:.1f}) | {cpu} | {ratio_s} | {fps} |")
         out.append("")
     out.append(f"Command: `python benchmarks/bench_perpixel.py --repeat {repeat}`")
     return "\n".join(out) + "\n"
