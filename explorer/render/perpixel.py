@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
-from explorer.core.tolerances import DET_EPS, PIXEL_RAY_T_MIN, SURFACE_NORMAL_MIN
+from explorer.core.tolerances import DET_EPS, PIXEL_RAY_T_MIN
 from explorer.render.camera import camera_for, mesh_frame, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
@@ -190,19 +190,17 @@ _corner_cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def triangle_corners(mesh) -> np.ndarray:
-    """(18, m) float64 rows of the mesh's triangles, what :func:`raster_hits` reads of each:
-    the first corner ``a`` (rows 0-2), the edges ``e1 = b - a`` (3-5) and ``e2 = c - a``
-    (6-8), the corners' normals ``n0, n1, n2`` (9-17); made on first use and kept while the
-    mesh lives (a :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only)."""
+    """(9, m) float64 rows of the mesh's triangles, what :func:`raster_hits` reads of each: the
+    first corner ``a`` (rows 0-2) and the edges ``e1 = b - a`` (3-5) and ``e2 = c - a`` (6-8);
+    made on first use and kept while the mesh lives (a
+    :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only)."""
     with _bvh_lock:
         table = _corner_cache.get(mesh)
     if table is None:
         F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
         P = np.asarray(mesh.positions, np.float64)
-        Nv = np.asarray(mesh.normals, np.float64)
         a = P[F[:, 0]]
-        parts = (a, P[F[:, 1]] - a, P[F[:, 2]] - a, Nv[F[:, 0]], Nv[F[:, 1]], Nv[F[:, 2]])
-        table = np.ascontiguousarray(np.hstack(parts).T)
+        table = np.ascontiguousarray(np.hstack((a, P[F[:, 1]] - a, P[F[:, 2]] - a)).T)
         table.flags.writeable = False
         with _bvh_lock:
             _corner_cache[mesh] = table
@@ -217,11 +215,12 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
 
     faces_seen : (h, w) int triangle index per pixel, -1 where none
         (:class:`explorer.render.faceids.FaceIdRenderer`, same camera and size)
-    A pixel whose ray runs within DET_EPS of its triangle's plane counts as a miss. The point is
-    ``O + t·D``, the normal ``(1-u-v)·n0 + u·n1 + v·n2`` normalised (zero stays zero), as
-    :func:`~explorer.geometry.bvh_numpy.surface_points` has them; the arithmetic runs on one
-    component at a time over the covered pixels (each triangle's corners gathered once from
-    :func:`triangle_corners`). Returns :class:`Hits` (method "raster").
+    A pixel whose ray runs within DET_EPS of its triangle's plane counts as a miss. The
+    arithmetic runs on one component at a time over the covered pixels (each triangle's corner
+    and edges gathered from :func:`triangle_corners`); the point ``O + t·D`` and the normal
+    ``(1-u-v)·n0 + u·n1 + v·n2`` normalised (zero stays zero) are the ray engine's
+    ``surface_points``, as for the ray caster (:func:`mesh_hits`). Returns :class:`Hits`
+    (method "raster").
     """
     w, h = (int(v) for v in size)
     seen = np.asarray(faces_seen)
@@ -232,37 +231,28 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
         none = np.zeros((0, 3))
         empty = (np.zeros(0, np.int64), np.zeros((0, 2)))
         return Hits(np.zeros((h, w), bool), none, none, "raster", *empty)
-    rows, cols = np.divmod(flat, w)
-    r0, c0 = int(rows[0]), int(cols.min())
-    origins, dirs = pixel_rays(camera, (w, h), (c0, int(cols.max()), r0, int(rows[-1])))
-    pick = (rows - r0) * origins.shape[1] + (cols - c0)
-    O = origins.reshape(-1, 3)[pick].T  # (3, k) rows: one component each
-    D = dirs.reshape(-1, 3)[pick].T
+    O, D = pixel_rays(camera, (w, h), pixels=np.divmod(flat, w))  # (k, 3) each
     f = seen.reshape(-1)[flat].astype(np.int64)
-    a0, a1, a2, e10, e11, e12, e20, e21, e22, *n = np.take(triangle_corners(mesh), f, axis=1)
-    d0, d1, d2 = D
+    a0, a1, a2, e10, e11, e12, e20, e21, e22 = np.take(triangle_corners(mesh), f, axis=1)
+    d0, d1, d2 = D.T  # (one component at a time)
     p0, p1, p2 = d1 * e22 - d2 * e21, d2 * e20 - d0 * e22, d0 * e21 - d1 * e20  # D x e2
     det = e10 * p0 + e11 * p1 + e12 * p2
     ok = np.abs(det) > DET_EPS
     inv = 1.0 / np.where(ok, det, 1.0)
-    s0, s1, s2 = O[0] - a0, O[1] - a1, O[2] - a2
+    s0, s1, s2 = O[:, 0] - a0, O[:, 1] - a1, O[:, 2] - a2
     q0, q1, q2 = s1 * e12 - s2 * e11, s2 * e10 - s0 * e12, s0 * e11 - s1 * e10  # s x e1
     u = (s0 * p0 + s1 * p1 + s2 * p2) * inv
     v = (d0 * q0 + d1 * q1 + d2 * q2) * inv
     t = (e20 * q0 + e21 * q1 + e22 * q2) * inv
-    wa = 1.0 - u - v
-    N = np.empty((len(f), 3))
-    for i in range(3):
-        N[:, i] = wa * n[i] + u * n[3 + i] + v * n[6 + i]
-    length = np.sqrt(N[:, 0] * N[:, 0] + N[:, 1] * N[:, 1] + N[:, 2] * N[:, 2])[:, None]
-    N = np.divide(N, length, out=np.zeros_like(N), where=length > SURFACE_NORMAL_MIN)
-    pos = (O + t * D).T.copy()
-    uv = np.stack([u, v], axis=1)
-    if not ok.all():  # (rays along their triangle's plane: misses)
-        flat, f, pos, N, uv = flat[ok], f[ok], pos[ok], N[ok], uv[ok]
+    tri = np.where(ok, f, -1)  # (rays along their triangle's plane: misses)
+    F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
+    Nv = np.asarray(mesh.normals, np.float64)
+    engine = ray_engine(ray_work(0, len(f)))  # (the compiled points once the kernels load)
+    hit, pos, n = engine.surface_points(O, D, t, tri, u, v, F, Nv)
     mask = np.zeros(h * w, bool)
-    mask[flat] = True
-    return Hits(mask.reshape(h, w), pos, N, "raster", f, uv)
+    mask[flat[hit]] = True
+    uv = np.stack([u[hit], v[hit]], axis=1)
+    return Hits(mask.reshape(h, w), pos, n, "raster", f[hit], uv)
 
 
 def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:

@@ -428,6 +428,9 @@ def test_pixel_rays_of_a_rectangle_are_those_of_the_whole_picture(index):
     origins, dirs = pixel_rays(cam, size)
     o, d = pixel_rays(cam, size, (5, 20, 3, 11))
     assert np.array_equal(o, origins[3:12, 5:21]) and np.array_equal(d, dirs[3:12, 5:21])
+    rows, cols = np.array([0, 3, 3, 22, 11]), np.array([0, 5, 36, 36, 20])  # (any pixels)
+    o, d = pixel_rays(cam, size, pixels=(rows, cols))
+    assert np.array_equal(o, origins[rows, cols]) and np.array_equal(d, dirs[rows, cols])
 
 
 # -- the rasteriser's triangles ----------------------------------------------------------------
