@@ -27,6 +27,7 @@ times vary with load: the load average before and after is printed with the tabl
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import time
 from pathlib import Path
@@ -222,12 +223,12 @@ def table(mesh, results: dict, before: str, after: str, repeat: int) -> str:
             fps = "" if path.startswith("of it") else f"{1000.0 / med:.0f}"
             out.append(f"| {name} | {path} | {med:.1f} ({best:.1f}) | {cpu} | {ratio_s} | {fps} |")
         out.append("")
-    out += summary(results)
+    out += summary(results, before)
     out += ["", f"Command: `python benchmarks/bench_perpixel.py --repeat {repeat}`"]
     return "\n".join(out) + "\n"
 
 
-def summary(results: dict) -> list[str]:
+def summary(results: dict, before: str = "") -> list[str]:
     """What the tables say against issue 39's targets (a slider per pixel within 1.3x the
     per-vertex frame; a camera change at 20 frames/s or more), and what was measured."""
     rows = [r for res in results.values() for r in res["rows"]]
@@ -237,6 +238,15 @@ def summary(results: dict) -> list[str]:
         for n, res in results.items()
     }
     lines = ["## What it says", ""]
+    first = float(before.split()[0]) if before and before != "n/a" else 0.0
+    cores = os.cpu_count() or 1
+    if first > cores:
+        lines.append(
+            f"- Measured under load (load average {first:.1f} on {cores} cores: other work ran): "
+            "wall times are then several times the work (a frame waits for a core), so the CPU "
+            "columns and the ratios of the alternated paths are the figures to compare; "
+            "frames/s are this run's, not the machine's."
+        )
     lines.append(
         f"- A slider change per pixel takes {min(r[0] for r in sliders):.2f}x to "
         f"{max(r[0] for r in sliders):.2f}x the per-vertex frame's wall time "
