@@ -128,18 +128,21 @@ class PixelPath:
         self.pl.renderer.SetTexturedBackground(True)
         self.data = data
 
-    def draw(self, scene, camera) -> float:
-        """One frame; returns its G-buffer's share (ms; 0 when none was made)."""
-        t = time.perf_counter()
-        made = self.live.gbuffer(camera, SIZE)[1]
-        gbuffer = 1000.0 * (time.perf_counter() - t) if made else 0.0
+    def draw(self, scene, camera) -> tuple[float, float, float]:
+        """One frame; returns the CPU ms of its parts: the G-buffer (0 when none was made), the
+        shading and display (``LivePixels.frame``), the upload and the frame."""
+        c0 = time.process_time()
+        self.live.gbuffer(camera, SIZE)
+        c1 = time.process_time()
         frame = self.live.frame(scene, camera, SIZE)
+        c2 = time.process_time()
         self.texels[:] = frame.rgb[::-1]  # VTK's rows start at the bottom
         self.arr.Modified()
         self.data.Modified()
         self.pl.render_window.Render()
         finish(self.pl)
-        return gbuffer
+        c3 = time.process_time()
+        return tuple(1000.0 * x for x in (c1 - c0, c2 - c1, c3 - c2))
 
     def close(self) -> None:
         self.live.close()
@@ -193,8 +196,10 @@ def run(mesh, count: int, repeat: int) -> dict:
             repeat,
         )
         add("camera change", v, p)
-        g = sorted(shares[-repeat:])
-        rows.append(("camera change", "of it: the G-buffer", {"ms": (g[len(g) // 2], g[0])}, None))
+        parts = ("the G-buffer", "shading + display", "upload + frame")
+        for k, part in enumerate(parts):
+            cpu = statistics.median(x[k] for x in shares[-repeat:])
+            rows.append(("camera change", f"of it: {part}", {"cpu": cpu}, None))
         covered = int(pixel.live.gbuffer(camera, SIZE)[0].hits.mask.sum())
         return {"rows": rows, "covered": covered, "machine": machine(vertex.pl)}
     finally:
@@ -204,7 +209,22 @@ def run(mesh, count: int, repeat: int) -> dict:
 
 def table(mesh, results: dict, before: str, after: str, repeat: int) -> str:
     first = next(iter(results.values()))
-    out = ["# Per-pixel benchmark", "", "Machine:", ""]
+    out = ["# Per-pixel benchmark", ""]
+    out += [
+        "A change drawn per pixel (`explorer.render.live.LivePixels`, float32) beside the same "
+        "change drawn per vertex, in one run, off-screen (what is timed: "
+        "`benchmarks/bench_perpixel.py`):",
+        "",
+        "- per vertex: the engine's cached update of the vertices, the colour upload, VTK's "
+        "frame of the mesh (colours interpolated);",
+        "- per pixel: `LivePixels.frame` (a camera change: a new G-buffer, VTK's picture of "
+        "triangle indices then the surface points, and every light sum of the pixels; a slider: "
+        "the cached sums recomposed, or the lobe, or the sums of the lights), the picture "
+        "uploaded as the window's background texture, VTK's frame.",
+        "",
+        "Machine:",
+        "",
+    ]
     out += [f"- {line}" for line in first["machine"]]
     out += [f"- load average before / after: {before} / {after}", ""]
     for count, res in results.items():
@@ -217,11 +237,11 @@ def table(mesh, results: dict, before: str, after: str, repeat: int) -> str:
             "|---|---|---:|---:|---:|---:|",
         ]
         for name, path, t, ratio in res["rows"]:
-            med, best = t["ms"]
-            cpu = f"{t['cpu']:.1f}" if "cpu" in t else ""
+            wall, fps = "", ""
+            if "ms" in t:
+                wall, fps = f"{t['ms'][0]:.1f} ({t['ms'][1]:.1f})", f"{1000.0 / t['ms'][0]:.0f}"
             ratio_s = "" if ratio is None else f"{ratio[0]:.2f}, {ratio[1]:.2f}"
-            fps = "" if path.startswith("of it") else f"{1000.0 / med:.0f}"
-            out.append(f"| {name} | {path} | {med:.1f} ({best:.1f}) | {cpu} | {ratio_s} | {fps} |")
+            out.append(f"| {name} | {path} | {wall} | {t['cpu']:.1f} | {ratio_s} | {fps} |")
         out.append("")
     out += summary(results, before)
     out += ["", f"Command: `python benchmarks/bench_perpixel.py --repeat {repeat}`"]
@@ -255,14 +275,20 @@ def summary(results: dict, before: str = "") -> list[str]:
         "cheaper to draw than the 100k-vertex mesh."
     )
     for n, c in camera.items():
-        pp, g = c["per pixel"], c["of it: the G-buffer"]
+        pp, vv = c["per pixel"], c["per vertex"]
+        share = {}
+        for k, t in c.items():
+            if k.startswith("of it: "):
+                share[k[len("of it: ") :]] = 100.0 * t["cpu"] / pp["cpu"]
         lines.append(
             f"- A camera change per pixel, {n} light{'s' if n > 1 else ''}: "
             f"{1000.0 / pp['ms'][0]:.0f} frames/s ({1000.0 / pp['ms'][1]:.0f} at best; target: "
-            f"20 or more), {pp['ms'][0] / c['per vertex']['ms'][0]:.2f}x the per-vertex frame; "
-            f"the G-buffer is {100.0 * g['ms'][0] / pp['ms'][0]:.0f}% of it (VTK's picture of "
-            "triangle indices, as costly as a per-vertex frame of the mesh, then the surface "
-            "points in numpy), the rest the pixels' light sums and the frame."
+            f"20 or more), {pp['ms'][0] / vv['ms'][0]:.2f}x the per-vertex frame's wall time, "
+            f"{pp['cpu'] / vv['cpu']:.2f}x its CPU time. Of the CPU time: the G-buffer "
+            f"{share['the G-buffer']:.0f}% (VTK's picture of triangle indices, the work of a "
+            "per-vertex frame of the mesh, then the surface points), the pixels' light sums and "
+            f"display {share['shading + display']:.0f}%, the upload and frame "
+            f"{share['upload + frame']:.0f}%."
         )
     lines.append(
         "- The per-pixel picture is drawn here as an image layer (the renderer's background "
