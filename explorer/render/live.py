@@ -98,6 +98,10 @@ class LivePixels:
     per-pixel shader: a pass that computes light sums, not a compose or a lobe); :attr:`stats`
     has the shader's passes by kind. Call :meth:`close` (or use as a context manager) to close
     the face-id window.
+
+    One thread at a time: a front end that draws frames in a worker keeps its LivePixels
+    there (its face-id window is an OpenGL context of its own). Each pixel shows the nearest
+    surface: a translucent material is not blended (as ``render --per-pixel``).
     """
 
     def __init__(self, mesh, *, precision: str = "float64"):
