@@ -112,8 +112,6 @@ def run(args) -> int:
         for m in materials or (scene.material,):
             for w in energy_warnings(m):
                 say(f"warning: {w}", file=sys.stderr)
-    if args.per_pixel_method is not None and not args.per_pixel:
-        raise ExplorerError("--per-pixel-method chooses what --per-pixel lights: give --per-pixel")
     if args.per_pixel:
         if materials:
             raise ExplorerError(
@@ -121,6 +119,8 @@ def run(args) -> int:
                 "materials"
             )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
+    if args.per_pixel_method is not None:  # (a picture per vertex: nothing for it to choose)
+        raise ExplorerError("--per-pixel-method chooses what --per-pixel lights: give --per-pixel")
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
