@@ -40,9 +40,10 @@ from explorer.core.text import say
 from explorer.render.camera import camera_for
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
+from explorer.render.live import METHODS as PER_PIXEL_METHODS
 from explorer.render.live import LivePixels
 from explorer.render.offscreen import render_image
-from explorer.render.perpixel import METHODS, reference
+from explorer.render.perpixel import reference
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -52,11 +53,6 @@ from explorer.render.turntable import (
     iter_frames,
 )
 from explorer.shading.display import group_vertex_colors, vertex_colors
-
-#: what ``--per-pixel-method`` chooses from: the rasteriser's triangles
-#: (:class:`explorer.render.live.LivePixels`, the live view's picture), then the per-pixel
-#: reference's methods (:func:`explorer.render.perpixel.hits`)
-PER_PIXEL_METHODS = ("raster", *METHODS)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -76,11 +72,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--size", default="400x400", metavar="WxH", help="picture size in pixels (default 400x400)"
     )
     p.add_argument(
-        "--per-pixel", action="store_true",
-        help="light every pixel instead of every vertex: the engine at the surface point each "
-        "pixel shows, with the interpolated normal (the live per-pixel view's picture); .png only",
-    )  # fmt: skip
-    p.add_argument(
         "--per-pixel-method",
         choices=PER_PIXEL_METHODS,
         default=None,
@@ -88,6 +79,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "as the live view; raycast the nearest triangle along each pixel's ray; sphere the exact "
         "sphere (built-in spheres: the accuracy reference); auto sphere for those, else raycast",
     )
+    p.add_argument(
+        "--per-pixel", action="store_true",
+        help="light every pixel instead of every vertex: the engine at the surface point each "
+        "pixel shows, with the interpolated normal (the live per-pixel view's picture); .png only",
+    )  # fmt: skip
     add_scene_arguments(p, mesh_default="sphere")
 
 
@@ -119,11 +115,11 @@ def run(args) -> int:
                 "materials"
             )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
-    if args.per_pixel_method is not None:  # (a picture per vertex: nothing for it to choose)
-        raise ExplorerError("--per-pixel-method chooses what --per-pixel lights: give --per-pixel")
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
+    if args.per_pixel_method is not None:  # (a picture per vertex: nothing for it to choose)
+        raise ExplorerError("--per-pixel-method chooses what --per-pixel lights: give --per-pixel")
     if turntable:
         return run_turntable(args, scene, mesh, materials, size, background, suffix)
     colors = colors_of(scene, mesh, materials)

@@ -41,11 +41,17 @@ from explorer.core.errors import Cancelled, ExplorerError
 from explorer.render.camera import Camera
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
+from explorer.render.perpixel import METHODS as PERPIXEL_METHODS
 from explorer.render.perpixel import Hits, raster_hits
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import PRECISIONS, Shader
 
-__all__ = ["GBuffer", "LivePixels", "PixelFrame"]
+__all__ = ["METHODS", "GBuffer", "LivePixels", "PixelFrame"]
+
+#: where a per-pixel picture's surface points come from (``render --per-pixel-method``):
+#: "raster", the rasteriser's triangles (:class:`LivePixels`, the live view's picture), then
+#: the per-pixel reference's methods (:func:`explorer.render.perpixel.hits`)
+METHODS = ("raster", *PERPIXEL_METHODS)
 
 
 @dataclass(frozen=True)
