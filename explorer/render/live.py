@@ -235,20 +235,23 @@ class LivePixels:
             if self._shader is not None:
                 self._retired.update(self._shader.stats)
             self._shader = None
-        if shadows:
+        first = mesh.n_vertices if shadows else 0
+
+        def geometry():  # the points shaded (after the mesh's vertices when they cast shadows)
+            if not shadows:
+                return h.positions, h.normals, None
             P = np.vstack([mesh.positions, h.positions])
-            N = np.vstack([mesh.normals, h.normals])
-            faces, first = mesh.faces, mesh.n_vertices
-        else:
-            P, N, faces, first = h.positions, h.normals, None, 0
+            return P, np.vstack([mesh.normals, h.normals]), mesh.faces
+
         if self._shader is None:
+            P, N, faces = geometry()
             kw = {"precision": self.precision, "clamp": clamp, "faces": faces}
             self._shader = Shader(scene, P, N, cancelled=cancelled, **kw)
         else:
             self._shader.cancelled = cancelled
             self._shader.set_scene(scene)
             if self._shader_key[0] is not g:
-                self._shader.set_geometry(P, N, faces)
+                self._shader.set_geometry(*geometry())
         self._shader_key = key
         if materials is None:
             c = self._shader.colors

@@ -293,3 +293,24 @@ def test_the_gbuffer_holds_each_pixels_triangle_and_float64_barycentrics(teapot)
     assert inside.mean() > 0.99 and weights.min() > -0.01
     rows, cols = np.nonzero(h.mask)
     assert np.array_equal(g.pixels, rows * SIZE[0] + cols)
+
+
+def test_shadows_are_cast_once_per_gbuffer(teapot):
+    """A shadowing light: the pixels' shadow rays are cast with the light sums; a material
+    change reuses both (no rays, no light pass), a camera change casts them again, and each
+    frame is the one-shot engine's."""
+    shadowing = PointLight(position=(-1.5, 2.5, 0.5), shadows=True)
+    scene = _scene(lights=(shadowing,))
+    cam = camera_for(scene, teapot, SIZE[0] / SIZE[1])
+    moved = camera_for(_scene(Viewer(to_viewer=(-1, 1, 2))), teapot, SIZE[0] / SIZE[1])
+    with LivePixels(teapot) as live:
+        live.frame(scene, cam, SIZE)
+        rays, passes = live.stats["shadow_rays"], live.light_passes
+        assert rays > 0 and passes == 1
+        kd = scene.replace(material=CHROME.replace(diffuse=(0.6, 0.2, 0.1)))
+        got = live.frame(kd, cam, SIZE)
+        assert (live.stats["shadow_rays"], live.light_passes) == (rays, passes)
+        assert _levels(got.rgb, reference_of(kd, teapot, live._gbuffer.hits).image()).max() <= 1
+        got = live.frame(kd, moved, SIZE)
+        assert live.stats["shadow_rays"] > rays and live.light_passes == passes + 1
+        assert _levels(got.rgb, reference_of(kd, teapot, live._gbuffer.hits).image()).max() <= 1
