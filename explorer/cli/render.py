@@ -39,6 +39,7 @@ from explorer.core.progress import Progress
 from explorer.core.text import say
 from explorer.render.camera import camera_for
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
+from explorer.render.faceids import MAX_FACES
 from explorer.render.images import encode_png
 from explorer.render.live import METHODS as PER_PIXEL_METHODS
 from explorer.render.live import LivePixels
@@ -222,6 +223,12 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
             file=sys.stderr,
         )
     method = args.per_pixel_method or "raster"
+    if method == "raster" and mesh.n_faces > MAX_FACES:
+        raise ExplorerError(
+            f"--per-pixel: mesh {mesh.name!r} has {mesh.n_faces:,} triangles, more than a "
+            f"picture of triangle indices tells apart ({MAX_FACES:,}); give --per-pixel-method "
+            "raycast"
+        )
     if method == "raster":
         with LivePixels(mesh) as live:
             camera = camera_for(scene, mesh, size[0] / size[1])

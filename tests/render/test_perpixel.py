@@ -358,6 +358,19 @@ def test_render_per_pixel_command(tmp_path, capsys):
     argv = ["render", "--per-pixel", "--per-pixel-method", "sphere", "--mesh", "torus"]
     assert main([*argv, "--out", str(out), "--force"]) == 2
     assert "not a built-in unit sphere" in capsys.readouterr().err
+
+
+def test_render_per_pixel_names_the_method_for_more_triangles_than_the_index_picture(
+    tmp_path, capsys, monkeypatch
+):
+    import explorer.cli.render as R
+
+    monkeypatch.setattr(R, "MAX_FACES", 100)  # (the 24-bit picture's limit, made small)
+    out = tmp_path / "pp.png"
+    assert main(["render", "--per-pixel", "--mesh", "torus", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "more than a picture of triangle indices" in err
+    assert "--per-pixel-method raycast" in err and not out.exists()
     assert main(["render", "--per-pixel", "--out", str(tmp_path / "x.ply")]) == 2
     assert "--per-pixel draws a picture" in capsys.readouterr().err
     assert not (tmp_path / "x.ply").exists()
