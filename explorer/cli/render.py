@@ -37,12 +37,11 @@ from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
 from explorer.core.progress import Progress
 from explorer.core.text import say
-from explorer.render.camera import camera_for
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.faceids import MAX_FACES
 from explorer.render.images import encode_png
 from explorer.render.live import METHODS as PER_PIXEL_METHODS
-from explorer.render.live import LivePixels
+from explorer.render.live import picture
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
 from explorer.render.turntable import (
@@ -230,9 +229,7 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
             "raycast"
         )
     if method == "raster":
-        with LivePixels(mesh) as live:
-            camera = camera_for(scene, mesh, size[0] / size[1])
-            image = live.frame(scene, camera, size, background=background).rgb
+        image = picture(scene, mesh, size, background=background).rgb
         how = "rasterised"
     else:
         ref = reference(scene, mesh, size, method=method)

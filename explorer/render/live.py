@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
-from explorer.render.camera import Camera
+from explorer.render.camera import Camera, camera_for
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.render.perpixel import METHODS as PERPIXEL_METHODS
@@ -46,7 +46,7 @@ from explorer.render.perpixel import Hits, raster_hits
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import PRECISIONS, Shader
 
-__all__ = ["METHODS", "GBuffer", "LivePixels", "PixelFrame"]
+__all__ = ["METHODS", "GBuffer", "LivePixels", "PixelFrame", "picture"]
 
 #: where a per-pixel picture's surface points come from (``render --per-pixel-method``):
 #: "raster", the rasteriser's triangles (:class:`LivePixels`, the live view's picture), then
@@ -271,6 +271,21 @@ class LivePixels:
         of_hit = groups.of_vertex[np.asarray(mesh.faces, np.int64)[g.hits.triangles, 0]]
         every = np.arange(len(of_hit)) + first
         return [every[of_hit == i] for i in range(len(groups.names))]
+
+
+def picture(
+    scene, mesh, size: Sequence[int], *, camera=None, background=None, precision: str = "float64"
+) -> PixelFrame:
+    """``render --per-pixel``'s picture: one frame of a new :class:`LivePixels` of ``mesh``
+    (its face-id window closed after).
+
+    camera : default :func:`explorer.render.camera.camera_for` (scene, mesh, w / h), the camera
+        of a per-vertex render of the same scene
+    """
+    w, h = check_size(size)
+    camera = camera_for(scene, mesh, w / h) if camera is None else camera
+    with LivePixels(mesh, precision=precision) as live:
+        return live.frame(scene, camera, (w, h), background=background)
 
 
 def _check(cancelled) -> None:
