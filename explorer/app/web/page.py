@@ -20,8 +20,43 @@ from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
 from explorer.core.version import __version__
 from explorer.geometry.meshes import MESH_SUFFIXES
 
-#: the drawer's width (pixels)
+#: the drawer's width on a wide page (pixels)
 DRAWER_WIDTH = 380
+#: the drawer's width (pixels) by the page's width: (narrower than, drawer) in order, else
+#: DRAWER_WIDTH; at 640 pixels a 380-pixel drawer left the view 260 pixels
+DRAWER_WIDTHS = ((800, 270), (1100, 320))
+#: the page's own rules for small windows: the toolbar scrolls sideways rather than squeezing
+#: its title to a letter, the title goes below 1100 pixels (the tab's title says it), and the
+#: toolbar's buttons and the panel's tabs are narrower below 900
+PAGE_CSS = """
+html { overflow-y: auto; }
+.v-app-bar .v-toolbar__content { overflow-x: auto; overflow-y: hidden; scrollbar-width: thin; }
+.v-app-bar .v-toolbar__content > * { flex-shrink: 0; }
+.v-app-bar .v-file-input { min-width: 150px; }
+@media (max-width: 1099px) { .v-app-bar .v-toolbar-title { display: none; } }
+@media (max-width: 899px) {
+  .v-app-bar .v-btn, .v-tab.v-btn { padding: 0 6px; min-width: 0; }
+}
+"""
+#: the page's width as a client-only key (``page_w``), on load and on every resize
+PAGE_WIDTH_JS = """
+(() => {
+  const set = () => window.trame.state.set('page_w', window.innerWidth);
+  window.addEventListener('resize', () => window.trame && set());
+  const first = setInterval(() => { if (window.trame && window.trame.state) {
+    clearInterval(first); set(); } }, 20);
+})();
+"""
+
+
+def drawer_width_js() -> str:
+    """The drawer's width as a Vue expression of ``page_w`` (:data:`DRAWER_WIDTHS`)."""
+    expr = str(DRAWER_WIDTH)
+    for below, width in reversed(DRAWER_WIDTHS):
+        expr = f"page_w < {below} ? {width} : ({expr})"
+    return expr
+
+
 #: the export menu: download kind -> its entry
 EXPORTS = {
     "png": "view as PNG",
@@ -345,6 +380,7 @@ def build(app) -> None:
     ctrl = server.controller
     server.state.update(
         models=list(MODELS), message="", message_level="info", message_seq=0, seen_seq=0,
+        page_w=1280,
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         turntable_ready=False, turntable_made="",
@@ -354,7 +390,7 @@ def build(app) -> None:
     )  # fmt: skip
     server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
     # the panel's tab and the drawer are each page's own: another page's choice moves neither
-    server.state.client_only("tab", "main_drawer")
+    server.state.client_only("tab", "main_drawer", "page_w")
     # a page shows the messages said after it opened, not the last one said to another page
     # (``seen_seq``: the message count when this page mounted, kept in the page)
     server.state.client_only("seen_seq")
@@ -362,11 +398,12 @@ def build(app) -> None:
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
         _footer(layout, v3, html)
-        layout.drawer.width = DRAWER_WIDTH
+        layout.drawer.width = (drawer_width_js(),)
         client.Script(webintents.keys_js())  # the registry's keys (the desktop's)
         client.ClientTriggers(mounted="seen_seq = message_seq")
         # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window
-        client.Style("html { overflow-y: auto; }")
+        client.Style(PAGE_CSS)
+        client.Script(PAGE_WIDTH_JS)
         with layout.toolbar:
             webintents.menus(v3)
             v3.VSpacer()
