@@ -368,6 +368,28 @@ def _message_log(v3, html) -> None:
                         raw_attrs=['aria-label="close messages"'])  # fmt: skip
 
 
+def _page_state(state) -> None:
+    """The page's own keys, their first values, and which of them each page keeps to itself
+    (trame's client-only keys: never sent to the server, so never to another page)."""
+    state.update(
+        models=list(MODELS), message="", message_level="info", message_seq=0, seen_seq=0,
+        page_w=1280,
+        message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
+        session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
+        turntable_ready=False, turntable_made="",
+        turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
+        compare_on=False,
+        can_undo=False, can_redo=False, undo_label="", redo_label="",
+    )  # fmt: skip
+    state.client_only("show_messages")  # the log opens in the tab that asks, alone
+    # the panel's tab, the drawer and the page's width are each page's own: another page's
+    # choice moves none of them
+    state.client_only("tab", "main_drawer", "page_w")
+    # a page shows the messages said after it opened, not the last one said to another page
+    # (``seen_seq``: the message count when this page mounted, kept in the page)
+    state.client_only("seen_seq")
+
+
 def build(app) -> None:
     """The page: the toolbar (the registry's menus, undo / redo, files), the drawer (the
     panel) and the view; the registry's keys (:mod:`explorer.app.web.intents`)."""
@@ -378,22 +400,7 @@ def build(app) -> None:
 
     server = app.server
     ctrl = server.controller
-    server.state.update(
-        models=list(MODELS), message="", message_level="info", message_seq=0, seen_seq=0,
-        page_w=1280,
-        message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
-        session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
-        turntable_ready=False, turntable_made="",
-        turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
-        compare_on=False,
-        can_undo=False, can_redo=False, undo_label="", redo_label="",
-    )  # fmt: skip
-    server.state.client_only("show_messages")  # the log opens in the tab that asks, alone
-    # the panel's tab and the drawer are each page's own: another page's choice moves neither
-    server.state.client_only("tab", "main_drawer", "page_w")
-    # a page shows the messages said after it opened, not the last one said to another page
-    # (``seen_seq``: the message count when this page mounted, kept in the page)
-    server.state.client_only("seen_seq")
+    _page_state(server.state)
     webintents.connect(app)
     with SinglePageWithDrawerLayout(server, full_height=True) as layout:
         layout.title.set_text("phong-explorer")
