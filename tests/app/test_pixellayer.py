@@ -1,0 +1,162 @@
+"""The per-pixel view (explorer.app.pixellayer) in the view port both front ends share, on an
+off-screen plotter: the pixels read from the plotter equal the engine's per-pixel picture
+(explorer.render.perpixel.reference, what ``render --per-pixel`` writes) for the view's camera
+and size; a cube's highlight per pixel that per vertex misses; the drag fallback."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.controllers import FakeFront, FakeWorker
+
+from explorer.app import start as A
+from explorer.app.controller import Controller
+from explorer.app.controller.ports import Ports
+from explorer.app.pixellayer import fill_edges
+from explorer.app.view import HANDLE_RADIUS, RING_GAP, SELECTED_SCALE, handle_point
+from explorer.app.viewport import PlotterView
+from explorer.cli import build_parser
+from explorer.cli.explorerstart import start
+from explorer.render.perpixel import reference
+from explorer.render.vtk import plotter
+
+SIZE = (320, 240)
+BACKGROUND = (0.1, 0.1, 0.1)
+
+
+class Pictures:
+    """The front end's part: a picture is a frame drawn now."""
+
+    def __init__(self):
+        self.view = None
+
+    def send(self):
+        self.view.plotter.render_window.Render()
+
+    def show_controls(self, state):
+        pass
+
+    def show_legend(self, legend, advice):
+        pass
+
+    def after_frame(self):
+        pass
+
+
+def make_port(mesh_name, tmp_path, monkeypatch, *args):
+    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
+    parsed = build_parser().parse_args(["gui", "--mesh", mesh_name, *args])
+    scene, mesh, preset = start(parsed)
+    state = A.first_state(scene, mesh, name=mesh_name, preset=preset)
+    pictures = Pictures()
+    view = PlotterView(plotter(SIZE, BACKGROUND), pictures)
+    pictures.view = view
+    ports = Ports.of(FakeFront(), worker=FakeWorker(), view=view)
+    c = Controller(state, mesh, ports, output_dir=tmp_path, last_session=tmp_path / "last.yaml")
+    view.attach(c, mesh)
+    c.start()
+    view.show_start(c.state)
+    view.redraw()
+    return view
+
+
+@pytest.fixture
+def torus(tmp_path, monkeypatch):
+    view = make_port("torus", tmp_path, monkeypatch, "--preset", "jade")
+    yield view
+    view.plotter.close()
+
+
+def picture(view) -> np.ndarray:
+    view.plotter.render_window.Render()
+    return view.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+
+
+def handle_disks(view) -> np.ndarray:
+    """(h, w) bool: the pixels of every light handle and the selected one's ring."""
+    w, h = SIZE
+    yy, xx = np.mgrid[0:h, 0:w]
+    out = np.zeros((h, w), bool)
+    s = view.view.state
+    for i, (x, y, _ahead) in enumerate(view.view.handle_pixels()):
+        size = HANDLE_RADIUS * SELECTED_SCALE * s.radius / view.view.frame[1]
+        r = view.view._pixel_radius(view.view.to_view(handle_point(s, i)), size)
+        out |= np.hypot(xx - x, (h - 1 - yy) - y) <= r + RING_GAP + 3
+    return out
+
+
+def overlays(view) -> np.ndarray:
+    """(h, w) bool: what the view draws over the mesh (the light handles, the selected one's
+    ring, the lobe inset's panel), grown by 2 pixels."""
+    w, h = SIZE
+    out = handle_disks(view)
+    x0, y0, bw, bh = view.view.lobe.box  # display pixels, origin bottom-left
+    out[max(h - (y0 + bh) - 2, 0) : h - y0 + 2, max(x0 - 2, 0) : x0 + bw + 2] = True
+    return out
+
+
+def interior(mask: np.ndarray) -> np.ndarray:
+    """The covered pixels whose 8 neighbours are covered too (the rest: the silhouette)."""
+    m = np.pad(mask, 1)
+    h, w = mask.shape
+    out = mask.copy()
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            out &= m[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
+    return out
+
+
+def against_reference(view):
+    """The view's pixels and the engine's per-pixel picture for its state, camera and size
+    (explorer.render.perpixel.reference, what ``render --per-pixel`` writes): the largest
+    difference over the interior pixels, the silhouette pixels off by more than 1 and their
+    count, over the pixels the overlays leave free."""
+    s = view.controller.state
+    img = picture(view)
+    ref = reference(s.shown_scene(), view.view.mesh, SIZE, camera=s.camera)
+    d = np.abs(img - ref.image(BACKGROUND).astype(int)).max(axis=2)
+    free = ~overlays(view)
+    inner = interior(ref.mask) & free
+    edge = ref.mask & ~interior(ref.mask) & free
+    return int(d[inner].max()), int((d[edge] > 1).sum()), int(edge.sum()), ref
+
+
+def test_per_pixel_mode_draws_the_engines_per_pixel_picture(torus):
+    c = torus.controller
+    before = picture(torus)
+    c.set_value("shading", "per-pixel")
+    assert c.state.scene.shading == "per-pixel" and torus.pixels.shown
+    worst, off, edge, ref = against_reference(torus)
+    assert ref.mask.sum() > 5000 and edge > 200
+    assert worst <= 1  # every interior pixel within 1 level of the engine's per-pixel picture
+    assert off <= 0.05 * edge  # silhouette pixels: where two rasterisations may disagree
+    # the per-vertex picture differs from it (else the test could not fail)
+    d = np.abs(before - ref.image(BACKGROUND).astype(int)).max(axis=2)
+    assert d[interior(ref.mask) & ~overlays(torus)].max() > 4
+    c.undo()  # one undo step: the per-vertex view again
+    assert c.state.scene.shading == "per-vertex" and not torus.pixels.shown
+    assert np.array_equal(picture(torus), before)
+
+
+def test_a_material_change_makes_no_gbuffer_and_a_camera_change_one(torus):
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    live = torus.pixels._live
+    made = live.gbuffers
+    c.set_value("kd", 0.3, merge=False)
+    assert live.gbuffers == made and torus.pixels.last is not None
+    assert against_reference(torus)[0] <= 1
+    torus.plotter.camera.Azimuth(30.0)
+    torus.plotter.render_window.Render()
+    assert live.gbuffers == made + 1
+    assert against_reference(torus)[0] <= 1  # the new camera's picture
+
+
+def test_fill_edges_takes_a_covered_neighbours_colour():
+    rgb = np.zeros((3, 4, 3), np.uint8)
+    mask = np.zeros((3, 4), bool)
+    rgb[1, 1] = (9, 8, 7)
+    mask[1, 1] = True
+    out = fill_edges(rgb.copy(), mask)
+    assert (out[0:3, 0:3] == (9, 8, 7)).all()  # the 8 neighbours
+    assert (out[:, 3] == 0).all()  # two pixels away: left as it was
