@@ -256,6 +256,16 @@ INTENTS: tuple[Intent, ...] = (
     ),
     I("swap_sides", "&Swap A and B", "swap_sides", "View", 0, view_key="x"),
     I(
+        "gouraud_vs_per_pixel",
+        "&Gouraud vs per-pixel",
+        "gouraud_vs_per_pixel",
+        "View",
+        0,
+        view_key="g",
+        help="compare A | B with A lit per vertex (Gouraud) and B per pixel: each one's time "
+        "and the error, live",
+    ),
+    I(
         "messages",
         "&Messages",
         "front:messages",

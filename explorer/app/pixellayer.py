@@ -71,7 +71,8 @@ class PixelLayer:
     :meth:`update` before each frame in per-pixel mode, drawn by the full mesh's actor.
 
     frames : per-pixel pictures made; ms : the last one's time (LivePixels' frame, the edge
-    fill and the texture's upload); last : the last :class:`~explorer.render.live.PixelFrame`;
+    fill and the texture's upload); last : the last :class:`~explorer.render.live.PixelFrame`,
+    made for ``camera`` and ``size``; rgb : that picture as drawn (silhouette filled);
     vertex_ms : the last frame's time without the per-pixel picture (the per-vertex frame);
     fallback : this drag draws per vertex (the camera moves and per pixel costs too much)
     """
@@ -82,12 +83,12 @@ class PixelLayer:
         self.frames = 0
         self.ms = float("nan")
         self.last = None
+        self.camera = self.size = self.rgb = None
         self.shown = False
         self.vertex_ms = float("nan")
         self.fallback = False
         self._t0: float | None = None
         self._made_ms = 0.0
-        self.overlay: np.ndarray | None = None  # (h, w, 3) drawn instead (a heat map), or None
         self._live = None
         self._mesh = None
         self._key = None
@@ -116,6 +117,10 @@ class PixelLayer:
             self.vertex_ms = 1000.0 * (time.perf_counter() - self._t0) - self._made_ms
             self._t0 = None
 
+    def set_aside(self, seconds: float) -> None:
+        """Leave ``seconds`` of other work done in this frame out of :attr:`vertex_ms`."""
+        self._made_ms += 1000.0 * seconds
+
     def too_slow(self) -> bool:
         """A per-pixel picture costs more than :data:`FALLBACK_RATIO` per-vertex frames."""
         return self.ms > FALLBACK_RATIO * max(self.vertex_ms, 0.0)
@@ -143,12 +148,11 @@ class PixelLayer:
             frame = self._live_for(mesh).frame(scene, camera, (w, h), materials=groups)
             rgb = fill_edges(np.array(frame.rgb), frame.mask)
             self.last, self._key = frame, key
-            self._upload(rgb)
+            self.camera, self.size, self.rgb = camera, (w, h), rgb
+            self.draw(rgb)
             self.frames += 1
             self.ms = 1000.0 * (time.perf_counter() - t0)
             made = True
-        elif self.overlay is not None:
-            self._upload(self.overlay)
         self._show(True)
         return made
 
@@ -160,18 +164,19 @@ class PixelLayer:
         self._live.set_mesh(mesh)
         return self._live
 
-    def picture(self) -> np.ndarray | None:
-        """The last per-pixel picture (h, w, 3) uint8, top row first, or None."""
-        return None if self.last is None else np.asarray(self.last.rgb)
+    @property
+    def live(self):
+        """The :class:`~explorer.render.live.LivePixels` of the pictures (None before one)."""
+        return self._live
 
     # -- drawing -------------------------------------------------------------------------------
-    def _upload(self, rgb: np.ndarray) -> None:
-        """``rgb`` (h, w, 3), top row first, into the texture (VTK's rows run bottom up)."""
+    def draw(self, rgb: np.ndarray) -> None:
+        """Draw ``rgb`` (h, w, 3) uint8, top row first, on the mesh (the texture; VTK's rows
+        run bottom up): the picture, or the compare view's heat map in its place."""
         h, w = rgb.shape[:2]
         if self._texels is None or self._texels.shape[:2] != (h, w):
             self._make_texture(w, h)
-        src = self.overlay if self.overlay is not None and self.overlay.shape == rgb.shape else rgb
-        self._texels[:] = src[::-1]
+        self._texels[:] = rgb[::-1]
         self._image.GetPointData().GetScalars().Modified()
         self._image.Modified()
 

@@ -217,9 +217,14 @@ class PlotterView:
     # -- frames ----------------------------------------------------------------------------------
     def _pixels_before(self, *_) -> None:
         """The render window's StartEvent: in per-pixel mode the picture for the camera VTK
-        draws with (:meth:`PixelLayer.before`); a drag that falls back to per vertex says so."""
+        draws with (:meth:`PixelLayer.before`), side B's (:meth:`SideB.before_a_frame`); a drag
+        that falls back to per vertex says so."""
         was = self.pixels.fallback
         self.pixels.before(self.controller.state)
+        if self.side_b is not None:  # (side B's work is not side A's frame time)
+            t0 = time.perf_counter()
+            self.side_b.before_a_frame(self.controller.state)
+            self.pixels.set_aside(time.perf_counter() - t0)
         if self.pixels.fallback and not was:
             p = self.pixels
             self.controller.say(

@@ -9,10 +9,14 @@ import numpy as np
 import pytest
 from helpers.controllers import FakeFront, FakeWorker
 
+from explorer.analysis.comparison import heat_map
+from explorer.app import model as M
 from explorer.app import start as A
 from explorer.app.controller import Controller
 from explorer.app.controller.ports import Ports
+from explorer.app.difference import VMAX
 from explorer.app.pixellayer import fill_edges
+from explorer.app.sides import SideB
 from explorer.app.view import HANDLE_RADIUS, RING_GAP, SELECTED_SCALE, handle_point
 from explorer.app.viewport import PlotterView
 from explorer.cli import build_parser
@@ -43,7 +47,7 @@ class Pictures:
         pass
 
 
-def make_port(mesh_name, tmp_path, monkeypatch, *args):
+def make_port(mesh_name, tmp_path, monkeypatch, *args, side_b=None):
     monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
     parsed = build_parser().parse_args(["gui", "--mesh", mesh_name, *args])
     scene, mesh, preset = start(parsed)
@@ -53,7 +57,7 @@ def make_port(mesh_name, tmp_path, monkeypatch, *args):
     pictures.view = view
     ports = Ports.of(FakeFront(), worker=FakeWorker(), view=view)
     c = Controller(state, mesh, ports, output_dir=tmp_path, last_session=tmp_path / "last.yaml")
-    view.attach(c, mesh)
+    view.attach(c, mesh, side_b=None if side_b is None else SideB(view, side_b))
     c.start()
     view.show_start(c.state)
     view.redraw()
@@ -62,7 +66,7 @@ def make_port(mesh_name, tmp_path, monkeypatch, *args):
 
 @pytest.fixture
 def torus(tmp_path, monkeypatch):
-    view = make_port("torus", tmp_path, monkeypatch, "--preset", "jade")
+    view = make_port("torus", tmp_path, monkeypatch, "--preset", "glossy_plastic")
     yield view
     view.plotter.close()
 
@@ -160,3 +164,90 @@ def test_fill_edges_takes_a_covered_neighbours_colour():
     out = fill_edges(rgb.copy(), mask)
     assert (out[0:3, 0:3] == (9, 8, 7)).all()  # the 8 neighbours
     assert (out[:, 3] == 0).all()  # two pixels away: left as it was
+
+
+class Pane:
+    """Side B's pane: an off-screen plotter of the same size."""
+
+    handles = False
+
+    def __init__(self):
+        self.plotters: list = []
+
+    def make_plotter(self):
+        self.plotters.append(plotter(SIZE, BACKGROUND))
+        return self.plotters[-1]
+
+    def made(self, pl, view):
+        pass
+
+    def show_pane(self, visible):
+        pass
+
+    def follow(self):
+        self.plotters[-1].render_window.Render()
+
+    def beside(self, img):
+        return img
+
+
+@pytest.fixture
+def compare(tmp_path, monkeypatch):
+    """The torus with side B in an off-screen pane."""
+    view = make_port("torus", tmp_path, monkeypatch, "--preset", "glossy_plastic", side_b=Pane())
+    yield view
+    view.plotter.close()
+    for pl in view.side_b.pane.plotters:
+        pl.close()
+
+
+def test_gouraud_vs_per_pixel_says_each_sides_time_and_the_error(compare):
+    c, b = compare.controller, compare.side_b
+    c.gouraud_vs_per_pixel()
+    assert c.state.scene.shading == "per-vertex" and b.pixels.shown and not compare.pixels.shown
+    a_img = picture(compare)  # (side B follows side A's frame)
+    b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    errors, mask = b.errors
+    # the errors are the two pictures' differences, pixel by pixel (within the rasteriser's
+    # rounding of the interpolated colours) where nothing is drawn over the mesh
+    seen = np.zeros(mask.shape, np.int64)
+    seen[mask] = errors
+    free = interior(mask) & ~overlays(compare)
+    free[:60] = False  # (the captions)
+    shown = np.abs(a_img - b_img).max(axis=2)
+    assert free.sum() > 5000 and np.abs(shown[free] - seen[free]).max() <= 1
+    f = b.figures
+    assert f.pixels == mask.sum() == errors.size
+    assert f.max_levels == errors.max() > 10  # Gouraud misses the highlight's shape
+    assert f.p95_levels == pytest.approx(np.percentile(errors, 95))
+    assert f.share == pytest.approx(np.count_nonzero(errors > 2) / errors.size)
+    assert 0.0 < f.vertex_ms < 1e5 and 0.0 < f.pixel_ms < 1e5
+    line = f.line()
+    assert f"error: max {f.max_levels}, p95 {f.p95_levels:.0f} levels" in line
+    for view in (compare.view, b.view):  # the line in both panes
+        assert view.caption.GetInput().endswith(line)
+    assert "per-vertex" in compare.view.caption.GetInput()
+    assert "per-pixel" in b.view.caption.GetInput()
+
+
+def test_gouraud_vs_per_pixel_difference_draws_the_heat_map_per_pixel(compare):
+    c, b = compare.controller, compare.side_b
+    c.gouraud_vs_per_pixel()
+    c.act(M.set_compare_difference, True)
+    picture(compare)
+    errors, mask = b.errors
+    b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    want = heat_map(_levels(errors, mask), mask, vmax=VMAX)
+    free = interior(mask) & ~overlays(compare)
+    free[:60] = False
+    assert np.abs(b_img[free] - want[free]).max() == 0  # the map, texel for pixel
+    c.act(M.set_compare_difference, False)
+    picture(compare)
+    b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    assert np.abs(b_img[free] - b.pixels.rgb[free]).max() == 0  # the picture again
+
+
+def _levels(errors, mask):
+    out = np.zeros(mask.shape, np.int64)
+    out[mask] = errors
+    return out
