@@ -251,3 +251,59 @@ def _levels(errors, mask):
     out = np.zeros(mask.shape, np.int64)
     out[mask] = errors
     return out
+
+
+@pytest.mark.parametrize(
+    ("ms", "vertex_ms", "falls_back"), [(30.0, 10.0, True), (15.0, 10.0, False)]
+)
+def test_a_camera_drag_falls_back_to_per_vertex_when_per_pixel_costs_twice(
+    torus, ms, vertex_ms, falls_back
+):
+    c, layer = torus.controller, torus.pixels
+    c.set_value("shading", "per-pixel")
+    picture(torus)
+    made = layer.live.gbuffers
+    torus.begin_drag()
+    layer.ms, layer.vertex_ms = ms, vertex_ms  # what the last frames measured
+    c.set_value("kd", 0.4)  # a slider drag moves no camera: per pixel still
+    assert layer.shown and not layer.fallback
+    torus.plotter.camera.Azimuth(20.0)
+    torus.plotter.render_window.Render()  # a frame of the camera drag
+    assert layer.fallback is falls_back and layer.shown is not falls_back
+    said = [m for m in c.ports.messages.messages if "camera drag drawn per vertex" in m[1]]
+    assert bool(said) is falls_back
+    assert layer.live.gbuffers == made + (0 if falls_back else 1)
+    torus.end_drag()  # the release: per pixel again, for the camera where the drag ended
+    assert layer.shown and not layer.fallback and layer.live.gbuffers == made + 1
+    assert against_reference(torus)[0] <= 1
+
+
+def test_a_cube_lit_near_a_face_shows_the_highlight_per_pixel_only(tmp_path, monkeypatch):
+    args = ("--preset", "glossy_plastic", "--light-type", "point", "--light-position",
+            "0.2", "0.3", "1.6", "--viewer-eye", "0.4", "0.6", "6")  # fmt: skip
+    view = make_port("cube", tmp_path, monkeypatch, *args)
+    try:
+        c = view.controller
+        for handle in view.view.handles:
+            handle.Off()
+        vertex = picture(view)
+        c.set_value("shading", "per-pixel")
+        for handle in view.view.handles:
+            handle.Off()  # (the light's handle is right over the highlight)
+        pixel = picture(view)
+        s = c.state
+        ref = reference(s.shown_scene(), view.view.mesh, SIZE, camera=s.camera)
+        peak = ref.peak_index()
+        x0, y0, bw, bh = view.view.lobe.box
+        assert peak is not None and not (peak[1] <= x0 + bw and peak[0] >= SIZE[1] - y0 - bh)
+        want = ref.image(BACKGROUND)[peak].astype(int)
+        assert np.abs(pixel[peak] - want).max() <= 1  # the peak where the engine puts it
+        white = want.min()  # (a highlight is whiter than the blue plastic: its least channel)
+        assert white > 150  # a highlight...
+        assert vertex[peak].min() < white - 100  # ...that per vertex does not show
+        face = interior(ref.mask)
+        face[SIZE[1] - y0 - bh :, : x0 + bw + 1] = False  # (the inset)
+        face &= ~handle_disks(view)  # (the selected light's ring, drawn with its handle off)
+        assert vertex[face].min(axis=1).max() < white - 100  # anywhere on the cube
+    finally:
+        view.plotter.close()
