@@ -264,9 +264,9 @@ def test_a_camera_drag_falls_back_to_per_vertex_when_per_pixel_costs_twice(
     picture(torus)
     made = layer.live.gbuffers
     torus.begin_drag()
-    layer.ms, layer.vertex_ms = ms, vertex_ms  # what the last frames measured
     c.set_value("kd", 0.4)  # a slider drag moves no camera: per pixel still
     assert layer.shown and not layer.fallback
+    layer.ms, layer.vertex_ms = ms, vertex_ms  # what the last frames measured
     torus.plotter.camera.Azimuth(20.0)
     torus.plotter.render_window.Render()  # a frame of the camera drag
     assert layer.fallback is falls_back and layer.shown is not falls_back
