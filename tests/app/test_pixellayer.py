@@ -279,8 +279,8 @@ def test_a_camera_drag_falls_back_to_per_vertex_when_per_pixel_costs_twice(
 
 
 def test_a_cube_lit_near_a_face_shows_the_highlight_per_pixel_only(tmp_path, monkeypatch):
-    args = ("--preset", "glossy_plastic", "--light-type", "point", "--light-position",
-            "0.2", "0.3", "1.6", "--viewer-eye", "0.4", "0.6", "6")  # fmt: skip
+    light = ("--light-type", "point", "--light-position", "0.2", "0.3", "1.6")
+    args = ("--preset", "glossy_plastic", *light, "--viewer-eye", "0.4", "0.6", "6")
     view = make_port("cube", tmp_path, monkeypatch, *args)
     try:
         c = view.controller
