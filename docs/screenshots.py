@@ -82,6 +82,12 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         size = (640, 480)
     elif name == "gui_translucent":
         argv = ("--preset", "jade")
+    elif name == "gui_per_pixel":  # the 24-vertex cube lit near its front face
+        argv = ("--mesh", "cube", "--preset", "glossy_plastic", "--light-type", "point",
+                "--light-position", "0.2", "0.3", "1.6", "--viewer-eye", "2.5", "2", "5",
+                "--per-pixel")  # fmt: skip
+    elif name == "gui_gouraud_vs_per_pixel":
+        argv = ("--mesh", "icosphere", "--resolution", "2", "--preset", "polished_silver")
     w = open_window(app, tmp, argv, size)
     c = w.controller
     if name == "gui_640x480":
@@ -95,6 +101,11 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         w.panel.view.compare.click()
         c.act(M.set_compare_model, "phong")
         c.act(M.place_light, 12.0, 30.0)  # the handle in both narrow panes
+    elif name in ("gui_per_pixel", "gui_gouraud_vs_per_pixel"):
+        w.panel.setCurrentIndex(2)  # the view tab: the shading row
+        if name == "gui_gouraud_vs_per_pixel":
+            c.gouraud_vs_per_pixel()
+            wait_for(app, "the line", lambda: w.viewport.side_b.figures is not None)
     elif name == "gui_difference":
         w.panel.setCurrentIndex(2)
         c.toggle_difference()
@@ -121,7 +132,8 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
 
 
 NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "gui_difference",
-         "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent")  # fmt: skip
+         "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent", "gui_per_pixel",
+         "gui_gouraud_vs_per_pixel")  # fmt: skip
 
 
 def main(argv=None) -> int:
