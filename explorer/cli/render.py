@@ -38,7 +38,10 @@ from explorer.core.mtl import preset_name, preset_names
 from explorer.core.progress import Progress
 from explorer.core.text import say
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
+from explorer.render.faceids import MAX_FACES
 from explorer.render.images import encode_png
+from explorer.render.live import METHODS as PER_PIXEL_METHODS
+from explorer.render.live import picture
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
 from explorer.render.turntable import (
@@ -69,9 +72,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--size", default="400x400", metavar="WxH", help="picture size in pixels (default 400x400)"
     )
     p.add_argument(
+        "--per-pixel-method",
+        choices=PER_PIXEL_METHODS,
+        default=None,
+        help="what --per-pixel lights: raster (default) the triangles VTK draws at each pixel, "
+        "as the live view; raycast the nearest triangle along each pixel's ray; sphere the exact "
+        "sphere (built-in spheres: the accuracy reference); auto sphere for those, else raycast",
+    )
+    p.add_argument(
         "--per-pixel", action="store_true",
-        help="light every pixel instead of every vertex (exact sphere for the built-in spheres, "
-        "else ray casting with interpolated normals): the accuracy reference; .png only",
+        help="light every pixel instead of every vertex: the engine at the surface point each "
+        "pixel shows, with the interpolated normal (the live per-pixel view's picture); .png only",
     )  # fmt: skip
     add_scene_arguments(p, mesh_default="sphere")
 
@@ -108,6 +119,8 @@ def run(args) -> int:
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
+    if args.per_pixel_method is not None:  # (a picture per vertex: nothing for it to choose)
+        raise ExplorerError("--per-pixel-method chooses what --per-pixel lights: give --per-pixel")
     if turntable:
         return run_turntable(args, scene, mesh, materials, size, background, suffix)
     colors = colors_of(scene, mesh, materials)
@@ -209,9 +222,21 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
             f"{scene.material.opacity:g} is not blended)",
             file=sys.stderr,
         )
-    ref = reference(scene, mesh, size)
-    write_atomic(args.out, encode_png(ref.image(background)), overwrite=args.force)
-    how = "exact sphere" if ref.hits.method == "sphere" else "ray cast"
+    method = args.per_pixel_method or "raster"
+    if method == "raster" and mesh.n_faces > MAX_FACES:
+        raise ExplorerError(
+            f"--per-pixel: mesh {mesh.name!r} has {mesh.n_faces:,} triangles, more than a "
+            f"picture of triangle indices tells apart ({MAX_FACES:,}); give --per-pixel-method "
+            "raycast"
+        )
+    if method == "raster":
+        image = picture(scene, mesh, size, background=background).rgb
+        how = "rasterised"
+    else:
+        ref = reference(scene, mesh, size, method=method)
+        image = ref.image(background)
+        how = "exact sphere" if ref.hits.method == "sphere" else "ray cast"
+    write_atomic(args.out, encode_png(image), overwrite=args.force)
     name = scene.material.name or "material"
     say(
         f"wrote {args.out}: {size[0]}x{size[1]} per-pixel picture ({mesh.name}, {how}, {name}, "

@@ -279,13 +279,17 @@ def pixel_ndc(size: Sequence[int]) -> tuple[np.ndarray, np.ndarray]:
     return x, y
 
 
-def pixel_rays(camera, size: Sequence[int], rect=None) -> tuple[np.ndarray, np.ndarray]:
+def pixel_rays(
+    camera, size: Sequence[int], rect=None, *, pixels=None
+) -> tuple[np.ndarray, np.ndarray]:
     """The ray through the centre of every pixel.
 
     camera : an :class:`explorer.render.camera.Camera`
     size : (width, height) of the picture
     rect : (col0, col1, row0, row1), inclusive: only the rays of these pixels (the same
         numbers as in the whole picture's arrays); None: every pixel
+    pixels : (rows, cols), two (k,) int arrays: only the rays of these k pixels, as (k, 3)
+        arrays (the same numbers again; instead of ``rect``)
     Returns origins and unit directions, each (h, w, 3) float64 (the rectangle's height and
     width with ``rect``), in image row order (row 0 at the top). A parallel camera's rays start
     on the plane through the camera position; a perspective camera's all start at its position.
@@ -294,23 +298,28 @@ def pixel_rays(camera, size: Sequence[int], rect=None) -> tuple[np.ndarray, np.n
     aspect = w / h
     forward, right, up = _basis(camera)
     nx, ny = pixel_ndc((w, h))
-    if rect is not None:
-        c0, c1, r0, r1 = (int(v) for v in rect)
-        nx, ny = nx[c0 : c1 + 1], ny[r0 : r1 + 1]
-    rows, cols = len(ny), len(nx)
     cx, cy = camera.window_center
-    sx = (nx + cx)[None, :, None]
-    sy = (ny + cy)[:, None, None]
+    if pixels is not None:
+        r, c = pixels
+        sx, sy = (nx[c] + cx)[:, None], (ny[r] + cy)[:, None]
+        shape: tuple = (len(sx), 3)
+    else:
+        if rect is not None:
+            c0, c1, r0, r1 = (int(v) for v in rect)
+            nx, ny = nx[c0 : c1 + 1], ny[r0 : r1 + 1]
+        sx = (nx + cx)[None, :, None]
+        sy = (ny + cy)[:, None, None]
+        shape = (len(ny), len(nx), 3)
     pos = np.asarray(camera.position, np.float64)
     if camera.parallel:
         s = float(camera.parallel_scale)
         origins = pos + sx * (s * aspect) * right + sy * s * up
-        directions = np.broadcast_to(forward, (rows, cols, 3)).copy()
+        directions = np.broadcast_to(forward, shape).copy()
         return origins, directions
     t = math.tan(math.radians(camera.view_angle) / 2.0)
     d = forward + sx * (t * aspect) * right + sy * t * up
-    d /= np.linalg.norm(d, axis=2, keepdims=True)
-    return np.broadcast_to(pos, (rows, cols, 3)).copy(), d
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    return np.broadcast_to(pos, shape).copy(), d
 
 
 def project(camera, points, size: Sequence[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -38,14 +38,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
-from explorer.render.camera import Camera
+from explorer.render.camera import Camera, camera_for
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
+from explorer.render.perpixel import METHODS as PERPIXEL_METHODS
 from explorer.render.perpixel import Hits, raster_hits
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import PRECISIONS, Shader
 
-__all__ = ["GBuffer", "LivePixels", "PixelFrame"]
+__all__ = ["METHODS", "GBuffer", "LivePixels", "PixelFrame", "picture"]
+
+#: where a per-pixel picture's surface points come from (``render --per-pixel-method``):
+#: "raster", the rasteriser's triangles (:class:`LivePixels`, the live view's picture), then
+#: the per-pixel reference's methods (:func:`explorer.render.perpixel.hits`)
+METHODS = ("raster", *PERPIXEL_METHODS)
 
 
 @dataclass(frozen=True)
@@ -70,12 +76,21 @@ class GBuffer:
 
     camera, size : what it was made for
     hits : :class:`~explorer.render.perpixel.Hits` (method "raster"): the mask, and per covered
-        pixel (row-major order) the triangle, float64 position and unit normal
+        pixel (row-major order) the triangle, its float64 barycentrics ``(u, v)``, the float64
+        position and unit normal
     """
 
     camera: Camera
     size: tuple[int, int]
     hits: Hits
+
+    @property
+    def pixels(self) -> np.ndarray:
+        """(k,) int64 the covered pixels' indices in the picture's row-major order (made on
+        first use): pixel i of the hits is ``rgb.reshape(-1, 3)[pixels[i]]``."""
+        if "_pixels" not in self.__dict__:
+            object.__setattr__(self, "_pixels", np.flatnonzero(self.hits.mask))
+        return self.__dict__["_pixels"]
 
 
 class LivePixels:
@@ -89,6 +104,10 @@ class LivePixels:
     per-pixel shader: a pass that computes light sums, not a compose or a lobe); :attr:`stats`
     has the shader's passes by kind. Call :meth:`close` (or use as a context manager) to close
     the face-id window.
+
+    One thread at a time: a front end that draws frames in a worker keeps its LivePixels
+    there (its face-id window is an OpenGL context of its own). Each pixel shows the nearest
+    surface: a translucent material is not blended (as ``render --per-pixel``).
     """
 
     def __init__(self, mesh, *, precision: str = "float64"):
@@ -102,6 +121,7 @@ class LivePixels:
         self._shader: Shader | None = None
         self._shader_key = None  # (G-buffer, with the mesh's vertices, clamped)
         self._retired: Counter = Counter()  # the stats of shaders replaced
+        self._bg_key, self._bg = None, None  # the background picture kept (_background)
 
     # -- life --------------------------------------------------------------------------------
     def __enter__(self):
@@ -159,8 +179,16 @@ class LivePixels:
         self.gbuffers += 1
         return g, True
 
-    def frame(self, scene, camera: Camera, size: Sequence[int], *, materials=None,
-              cancelled=None, background=None) -> PixelFrame:  # fmt: skip
+    def frame(
+        self,
+        scene,
+        camera: Camera,
+        size: Sequence[int],
+        *,
+        materials=None,
+        cancelled=None,
+        background=None,
+    ) -> PixelFrame:
         """The per-pixel picture of ``scene`` on the mesh through ``camera`` at ``size`` (w, h).
 
         materials : one Material per group of ``mesh.groups`` (a mesh file's own), or None:
@@ -174,19 +202,28 @@ class LivePixels:
         _check(cancelled)
         g, made = self.gbuffer(camera, size)
         _check(cancelled)
-        h = g.hits
         colors = self._colors(scene, g, materials, cancelled)
-        w_, h_ = g.size
-        bg = BACKGROUND if background is None else background
-        rgb = np.empty((h_, w_, 3), np.uint8)
-        rgb[:] = to_bytes(np.asarray(bg, np.float64)[None, :])[0]
+        rgb = self._background(g.size, BACKGROUND if background is None else background)
         if len(colors):
-            rgb[h.mask] = to_bytes(shown(colors, scene))
-        return PixelFrame(rgb, h.mask, time.perf_counter() - t0, made)
+            # the engine's clamped colours are the display's (shown: the same array); a display
+            # effect reads float64, as display_colors gives it the engine's colours
+            c = colors if engine_clamps(scene) else np.asarray(colors, np.float64)
+            rgb.reshape(-1, 3)[g.pixels] = to_bytes(shown(c, scene))
+        return PixelFrame(rgb, g.hits.mask, time.perf_counter() - t0, made)
+
+    def _background(self, size: tuple[int, int], background) -> np.ndarray:
+        """A new (h, w, 3) uint8 picture of the background colour (copied from a kept one)."""
+        key = (size, tuple(float(c) for c in background))
+        if self._bg_key != key:
+            w, h = size
+            self._bg = np.empty((h, w, 3), np.uint8)
+            self._bg[:] = to_bytes(np.asarray(key[1], np.float64)[None, :])[0]
+            self._bg_key = key
+        return self._bg.copy()
 
     def _colors(self, scene, g: GBuffer, materials, cancelled) -> np.ndarray:
-        """The engine's colours (k, 3) float64 of the G-buffer's pixels (clamped or not, as
-        :func:`~explorer.shading.display.display_colors` has them)."""
+        """The engine's colours (k, 3) of the G-buffer's pixels in the working precision
+        (clamped or not, as :func:`~explorer.shading.display.display_colors` has them)."""
         h, mesh = g.hits, self.mesh
         k = len(h.positions)
         if k == 0:
@@ -198,26 +235,29 @@ class LivePixels:
             if self._shader is not None:
                 self._retired.update(self._shader.stats)
             self._shader = None
-        if shadows:
+        first = mesh.n_vertices if shadows else 0
+
+        def geometry():  # the points shaded (after the mesh's vertices when they cast shadows)
+            if not shadows:
+                return h.positions, h.normals, None
             P = np.vstack([mesh.positions, h.positions])
-            N = np.vstack([mesh.normals, h.normals])
-            faces, first = mesh.faces, mesh.n_vertices
-        else:
-            P, N, faces, first = h.positions, h.normals, None, 0
+            return P, np.vstack([mesh.normals, h.normals]), mesh.faces
+
         if self._shader is None:
-            self._shader = Shader(scene, P, N, precision=self.precision, clamp=clamp,
-                                  faces=faces, cancelled=cancelled)  # fmt: skip
+            P, N, faces = geometry()
+            kw = {"precision": self.precision, "clamp": clamp, "faces": faces}
+            self._shader = Shader(scene, P, N, cancelled=cancelled, **kw)
         else:
             self._shader.cancelled = cancelled
             self._shader.set_scene(scene)
             if self._shader_key[0] is not g:
-                self._shader.set_geometry(P, N, faces)
+                self._shader.set_geometry(*geometry())
         self._shader_key = key
         if materials is None:
             c = self._shader.colors
         else:
             c = grouped_colors(self._shader, self._group_rows(g, materials, first), materials)
-        return np.asarray(c[first:], np.float64)
+        return c[first:]
 
     def _group_rows(self, g: GBuffer, materials, first: int) -> list[np.ndarray]:
         """The shader's rows of each group's pixels (offset by ``first``, the mesh's vertices
@@ -231,6 +271,21 @@ class LivePixels:
         of_hit = groups.of_vertex[np.asarray(mesh.faces, np.int64)[g.hits.triangles, 0]]
         every = np.arange(len(of_hit)) + first
         return [every[of_hit == i] for i in range(len(groups.names))]
+
+
+def picture(
+    scene, mesh, size: Sequence[int], *, camera=None, background=None, precision: str = "float64"
+) -> PixelFrame:
+    """``render --per-pixel``'s picture: one frame of a new :class:`LivePixels` of ``mesh``
+    (its face-id window closed after).
+
+    camera : default :func:`explorer.render.camera.camera_for` (scene, mesh, w / h), the camera
+        of a per-vertex render of the same scene
+    """
+    w, h = check_size(size)
+    camera = camera_for(scene, mesh, w / h) if camera is None else camera
+    with LivePixels(mesh, precision=precision) as live:
+        return live.frame(scene, camera, (w, h), background=background)
 
 
 def _check(cancelled) -> None:

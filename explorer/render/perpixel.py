@@ -38,7 +38,6 @@ import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import DET_EPS, PIXEL_RAY_T_MIN
-from explorer.geometry.bvh_numpy import surface_points
 from explorer.render.camera import camera_for, mesh_frame, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
@@ -66,6 +65,8 @@ class Hits:
     method : "sphere" (closed form), "raycast" (triangles, interpolated normals) or "raster"
         (:func:`raster_hits`)
     triangles : (k,) int64 the triangle of the mesh each hit lies on (None for the closed form)
+    barycentrics : (k, 2) float64 ``(u, v)`` of each hit on its triangle (corner weights
+        ``1-u-v, u, v``), for method "raster"; None otherwise
     """
 
     mask: np.ndarray
@@ -73,6 +74,7 @@ class Hits:
     normals: np.ndarray
     method: str
     triangles: np.ndarray | None = None
+    barycentrics: np.ndarray | None = None
 
 
 def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0) -> Hits:
@@ -184,6 +186,27 @@ def mesh_hits(camera, size: Sequence[int], mesh, *, cancelled=None) -> Hits:
     return Hits(mask, pos, n, "raycast", best_tri[hit])
 
 
+_corner_cache: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def triangle_corners(mesh) -> np.ndarray:
+    """(9, m) float64 rows of the mesh's triangles, what :func:`raster_hits` reads of each: the
+    first corner ``a`` (rows 0-2) and the edges ``e1 = b - a`` (3-5) and ``e2 = c - a`` (6-8);
+    made on first use and kept while the mesh lives (a
+    :class:`~explorer.geometry.meshes.Mesh`'s arrays are read-only)."""
+    with _bvh_lock:
+        table = _corner_cache.get(mesh)
+    if table is None:
+        F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
+        P = np.asarray(mesh.positions, np.float64)
+        a = P[F[:, 0]]
+        table = np.ascontiguousarray(np.hstack((a, P[F[:, 1]] - a, P[F[:, 2]] - a)).T)
+        table.flags.writeable = False
+        with _bvh_lock:
+            _corner_cache[mesh] = table
+    return table
+
+
 def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hits:
     """The hits of the pixel rays on the triangles a rasteriser says the pixels show: no search,
     each pixel's ray meets the plane of its own triangle (the Möller-Trumbore arithmetic of
@@ -192,39 +215,44 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
 
     faces_seen : (h, w) int triangle index per pixel, -1 where none
         (:class:`explorer.render.faceids.FaceIdRenderer`, same camera and size)
-    A pixel whose ray runs within DET_EPS of its triangle's plane counts as a miss. Returns
-    :class:`Hits` (method "raster").
+    A pixel whose ray runs within DET_EPS of its triangle's plane counts as a miss. The
+    arithmetic runs on one component at a time over the covered pixels (each triangle's corner
+    and edges gathered from :func:`triangle_corners`); the point ``O + t·D`` and the normal
+    ``(1-u-v)·n0 + u·n1 + v·n2`` normalised (zero stays zero) are the ray engine's
+    ``surface_points``, as for the ray caster (:func:`mesh_hits`). Returns :class:`Hits`
+    (method "raster").
     """
     w, h = (int(v) for v in size)
     seen = np.asarray(faces_seen)
     if seen.shape != (h, w):
         raise ExplorerError(f"faces_seen must have shape ({h}, {w}), got {seen.shape}")
-    rows, cols = np.nonzero(seen >= 0)
-    if rows.size == 0:
+    flat = np.flatnonzero(seen >= 0)
+    if flat.size == 0:
         none = np.zeros((0, 3))
-        return Hits(np.zeros((h, w), bool), none, none, "raster", np.zeros(0, np.int64))
-    r0, c0 = int(rows.min()), int(cols.min())
-    origins, dirs = pixel_rays(camera, (w, h), (c0, int(cols.max()), r0, int(rows.max())))
-    O, D = origins[rows - r0, cols - c0], dirs[rows - r0, cols - c0]
-    f = seen[rows, cols].astype(np.int64)
-    F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
-    P = np.asarray(mesh.positions, np.float64)
-    a = P[F[f, 0]]
-    e1, e2 = P[F[f, 1]] - a, P[F[f, 2]] - a
-    p = np.cross(D, e2)
-    det = np.einsum("ij,ij->i", e1, p)
+        empty = (np.zeros(0, np.int64), np.zeros((0, 2)))
+        return Hits(np.zeros((h, w), bool), none, none, "raster", *empty)
+    O, D = pixel_rays(camera, (w, h), pixels=np.divmod(flat, w))  # (k, 3) each
+    f = seen.reshape(-1)[flat].astype(np.int64)
+    a0, a1, a2, e10, e11, e12, e20, e21, e22 = np.take(triangle_corners(mesh), f, axis=1)
+    d0, d1, d2 = D.T  # (one component at a time)
+    p0, p1, p2 = d1 * e22 - d2 * e21, d2 * e20 - d0 * e22, d0 * e21 - d1 * e20  # D x e2
+    det = e10 * p0 + e11 * p1 + e12 * p2
     ok = np.abs(det) > DET_EPS
     inv = 1.0 / np.where(ok, det, 1.0)
-    s = O - a
-    q = np.cross(s, e1)
-    u = np.einsum("ij,ij->i", s, p) * inv
-    v = np.einsum("ij,ij->i", D, q) * inv
-    t = np.einsum("ij,ij->i", e2, q) * inv
-    tri = np.where(ok, f, -1)
-    hit, pos, n = surface_points(O, D, t, tri, u, v, F, np.asarray(mesh.normals, np.float64))
-    mask = np.zeros((h, w), bool)
-    mask[rows[hit], cols[hit]] = True
-    return Hits(mask, pos, n, "raster", tri[hit])
+    s0, s1, s2 = O[:, 0] - a0, O[:, 1] - a1, O[:, 2] - a2
+    q0, q1, q2 = s1 * e12 - s2 * e11, s2 * e10 - s0 * e12, s0 * e11 - s1 * e10  # s x e1
+    u = (s0 * p0 + s1 * p1 + s2 * p2) * inv
+    v = (d0 * q0 + d1 * q1 + d2 * q2) * inv
+    t = (e20 * q0 + e21 * q1 + e22 * q2) * inv
+    tri = np.where(ok, f, -1)  # (rays along their triangle's plane: misses)
+    F = np.asarray(mesh.faces, np.int64).reshape(-1, 3)
+    Nv = np.asarray(mesh.normals, np.float64)
+    engine = ray_engine(ray_work(0, len(f)))  # (the compiled points once the kernels load)
+    hit, pos, n = engine.surface_points(O, D, t, tri, u, v, F, Nv)
+    mask = np.zeros(h * w, bool)
+    mask[flat[hit]] = True
+    uv = np.stack([u[hit], v[hit]], axis=1)
+    return Hits(mask.reshape(h, w), pos, n, "raster", f[hit], uv)
 
 
 def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:

@@ -338,8 +338,8 @@ def test_per_pixel_agrees_with_a_very_fine_per_vertex_render(viewer, bottom):
 
 def test_render_per_pixel_command(tmp_path, capsys):
     out = tmp_path / "pp.png"
-    assert main(["render", "--preset", "chrome", "--per-pixel", "--size", "64x48",
-                 "--out", str(out)]) == 0  # fmt: skip
+    assert main(["render", "--preset", "chrome", "--per-pixel", "--per-pixel-method", "sphere",
+                 "--size", "64x48", "--out", str(out)]) == 0  # fmt: skip
     assert "per-pixel picture (sphere, exact sphere, chrome, blinn)" in capsys.readouterr().out
     img = read_png(out)
     scene = _scene().replace(lights=explorer.Scene().lights)
@@ -348,9 +348,29 @@ def test_render_per_pixel_command(tmp_path, capsys):
     # an existing file is kept without --force
     assert main(["render", "--per-pixel", "--out", str(out)]) == 2
     assert "already exists" in capsys.readouterr().err
-    assert main(["render", "--per-pixel", "--mesh", "torus", "--resolution", "12", "--size",
-                 "40x40", "--out", str(out), "--force"]) == 0  # fmt: skip
+    torus = "--mesh torus --resolution 12 --size 40x40".split()
+    argv = ["render", "--per-pixel", "--per-pixel-method", "raycast", *torus, "--out", str(out)]
+    assert main([*argv, "--force"]) == 0
     assert "ray cast" in capsys.readouterr().out
+    # what the method chooses needs --per-pixel; the exact sphere needs a sphere
+    assert main(["render", "--per-pixel-method", "sphere", "--out", str(out), "--force"]) == 2
+    assert "give --per-pixel" in capsys.readouterr().err
+    argv = ["render", "--per-pixel", "--per-pixel-method", "sphere", "--mesh", "torus"]
+    assert main([*argv, "--out", str(out), "--force"]) == 2
+    assert "not a built-in unit sphere" in capsys.readouterr().err
+
+
+def test_render_per_pixel_names_the_method_for_more_triangles_than_the_index_picture(
+    tmp_path, capsys, monkeypatch
+):
+    import explorer.cli.render as R
+
+    monkeypatch.setattr(R, "MAX_FACES", 100)  # (the 24-bit picture's limit, made small)
+    out = tmp_path / "pp.png"
+    assert main(["render", "--per-pixel", "--mesh", "torus", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "more than a picture of triangle indices" in err
+    assert "--per-pixel-method raycast" in err and not out.exists()
     assert main(["render", "--per-pixel", "--out", str(tmp_path / "x.ply")]) == 2
     assert "--per-pixel draws a picture" in capsys.readouterr().err
     assert not (tmp_path / "x.ply").exists()
@@ -404,8 +424,8 @@ def test_ctrl_c_stops_ray_work_at_the_end_of_the_current_chunk(tmp_path):
     """SIGINT in the middle of the per-pixel rays (many chunks of 0.1 s or more): the command
     stops after the chunks already running, with one line and exit status 130, and leaves no
     file (not even a temporary one). Counted in chunks, not timed."""
-    argv = ["render", "--per-pixel", "--mesh", "teapot", "--size", "640x480",
-            "--out", str(tmp_path / "pp.png")]  # fmt: skip
+    argv = ["render", "--per-pixel", "--per-pixel-method", "raycast", "--mesh", "teapot",
+            "--size", "640x480", "--out", str(tmp_path / "pp.png")]  # fmt: skip
     lines, chunks, status = interrupt_ray_work("_nearest_chunk", argv)
     # at most the other thread's chunk started before the signal, and one chunk per thread
     # that was already handed out
@@ -421,6 +441,9 @@ def test_pixel_rays_of_a_rectangle_are_those_of_the_whole_picture(index):
     origins, dirs = pixel_rays(cam, size)
     o, d = pixel_rays(cam, size, (5, 20, 3, 11))
     assert np.array_equal(o, origins[3:12, 5:21]) and np.array_equal(d, dirs[3:12, 5:21])
+    rows, cols = np.array([0, 3, 3, 22, 11]), np.array([0, 5, 36, 36, 20])  # (any pixels)
+    o, d = pixel_rays(cam, size, pixels=(rows, cols))
+    assert np.array_equal(o, origins[rows, cols]) and np.array_equal(d, dirs[rows, cols])
 
 
 # -- the rasteriser's triangles ----------------------------------------------------------------
