@@ -21,6 +21,7 @@ from explorer.app.view import HANDLE_RADIUS, RING_GAP, SELECTED_SCALE, handle_po
 from explorer.app.viewport import PlotterView
 from explorer.cli import build_parser
 from explorer.cli.explorerstart import start
+from explorer.render.live import picture as render_per_pixel
 from explorer.render.perpixel import reference
 from explorer.render.vtk import plotter
 
@@ -137,6 +138,13 @@ def test_per_pixel_mode_draws_the_engines_per_pixel_picture(torus):
     # the per-vertex picture differs from it (else the test could not fail)
     d = np.abs(before - ref.image(BACKGROUND).astype(int)).max(axis=2)
     assert d[interior(ref.mask) & ~overlays(torus)].max() > 4
+    # and `render --per-pixel`'s picture (explorer.render.live.picture) of the same state
+    s = c.state
+    rendered = render_per_pixel(
+        s.shown_scene(), torus.view.mesh, SIZE, camera=s.camera, background=BACKGROUND
+    )
+    d = np.abs(picture(torus) - rendered.rgb.astype(int)).max(axis=2)
+    assert d[interior(rendered.mask) & ~overlays(torus)].max() <= 1
     c.undo()  # one undo step: the per-vertex view again
     assert c.state.scene.shading == "per-vertex" and not torus.pixels.shown
     assert np.array_equal(picture(torus), before)
@@ -307,3 +315,12 @@ def test_a_cube_lit_near_a_face_shows_the_highlight_per_pixel_only(tmp_path, mon
         assert vertex[face].min(axis=1).max() < white - 100  # anywhere on the cube
     finally:
         view.plotter.close()
+
+
+def test_a_mesh_switch_in_per_pixel_mode_draws_the_new_mesh_per_pixel(torus):
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    c.files.choose_mesh("cube")
+    assert torus.view.mesh is c.meshes["cube"] and torus.pixels.shown
+    worst, off, edge, ref = against_reference(torus)
+    assert ref.mask.sum() > 5000 and worst <= 1 and off <= 0.05 * edge
