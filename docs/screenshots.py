@@ -73,6 +73,7 @@ def grab(display: str, path: Path, size, crop=None) -> None:
 
 def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     """Set up the window for picture ``name`` and grab it into ``out/name.png``."""
+    from explorer.app import intents
     from explorer.app import model as M
 
     size, argv, crop = SIZE, (), None
@@ -104,7 +105,7 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     elif name in ("gui_per_pixel", "gui_gouraud_vs_per_pixel"):
         w.panel.setCurrentIndex(2)  # the view tab: the shading row
         if name == "gui_gouraud_vs_per_pixel":
-            c.gouraud_vs_per_pixel()
+            intents.run("gouraud_vs_per_pixel", c, {})
             wait_for(app, "the line", lambda: w.viewport.side_b.figures is not None)
     elif name == "gui_difference":
         w.panel.setCurrentIndex(2)

@@ -10,6 +10,7 @@ import pytest
 from helpers.controllers import FakeFront, FakeWorker
 
 from explorer.analysis.comparison import heat_map
+from explorer.app import intents
 from explorer.app import model as M
 from explorer.app import start as A
 from explorer.app.controller import Controller
@@ -211,7 +212,7 @@ def compare(tmp_path, monkeypatch):
 
 def test_gouraud_vs_per_pixel_says_each_sides_time_and_the_error(compare):
     c, b = compare.controller, compare.side_b
-    c.gouraud_vs_per_pixel()
+    intents.run("gouraud_vs_per_pixel", c, {})  # View > Gouraud vs per-pixel
     assert c.state.scene.shading == "per-vertex" and b.pixels.shown and not compare.pixels.shown
     a_img = picture(compare)  # (side B follows side A's frame)
     b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
@@ -240,7 +241,7 @@ def test_gouraud_vs_per_pixel_says_each_sides_time_and_the_error(compare):
 
 def test_gouraud_vs_per_pixel_difference_draws_the_heat_map_per_pixel(compare):
     c, b = compare.controller, compare.side_b
-    c.gouraud_vs_per_pixel()
+    intents.run("gouraud_vs_per_pixel", c, {})  # View > Gouraud vs per-pixel
     c.act(M.set_compare_difference, True)
     picture(compare)
     errors, mask = b.errors

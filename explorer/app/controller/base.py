@@ -12,7 +12,6 @@ from explorer.app import panelmodel
 from explorer.app.controller.files import FileFlows
 from explorer.app.controller.ports import Ports
 from explorer.app.difference import Job
-from explorer.app.effectactions import gouraud_vs_per_pixel
 from explorer.app.start import MESH_CHOICES
 from explorer.app.view import framed_camera
 from explorer.core.errors import ExplorerError
@@ -209,10 +208,6 @@ class Controller:
 
     def swap_sides(self) -> None:
         self.act(M.swap_compare, label="swap A and B")
-
-    def gouraud_vs_per_pixel(self) -> None:
-        """The compare view with A lit per vertex and B per pixel (one undo step)."""
-        self.act(gouraud_vs_per_pixel, label="Gouraud vs per-pixel")
 
     def toggle_model(self) -> None:
         """The next specular model of :data:`explorer.core.material.MODELS`."""
