@@ -214,6 +214,7 @@ def test_gouraud_vs_per_pixel_says_each_sides_time_and_the_error(compare):
     c, b = compare.controller, compare.side_b
     intents.run("gouraud_vs_per_pixel", c, {})  # View > Gouraud vs per-pixel
     assert c.state.scene.shading == "per-vertex" and b.pixels.shown and not compare.pixels.shown
+    assert c.store.undo_label() == "Gouraud vs per-pixel"  # one undo step
     a_img = picture(compare)  # (side B follows side A's frame)
     b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
     errors, mask = b.errors
