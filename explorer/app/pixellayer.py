@@ -48,12 +48,13 @@ FRAGMENT = (
 )
 
 
-def fill_edges(rgb: np.ndarray, mask: np.ndarray) -> np.ndarray:
-    """``rgb`` (h, w, 3) uint8 with each uncovered pixel (``mask`` False) next to a covered one
-    given that neighbour's colour (the first of its 8 neighbours, in a fixed order): the
-    silhouette pixels the view's rasterisation covers and the G-buffer's does not. In place;
-    returns ``rgb``."""
+def edge_sources(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The silhouette's fill for ``mask`` (h, w) bool, the covered pixels: ``(dst, src)``, flat
+    pixel indices, each uncovered pixel next to a covered one and that neighbour (the first of
+    its 8, in a fixed order). Made once per G-buffer (:meth:`PixelLayer.update` keeps it)."""
     h, w = mask.shape
+    index = np.arange(h * w).reshape(h, w)
+    src = np.full(h * w, -1, np.int64)
     todo = ~mask
     for dy, dx in ((0, -1), (0, 1), (-1, 0), (1, 0), (-1, -1), (-1, 1), (1, -1), (1, 1)):
         ys = slice(max(dy, 0), h + min(dy, 0))
@@ -61,8 +62,20 @@ def fill_edges(rgb: np.ndarray, mask: np.ndarray) -> np.ndarray:
         xs = slice(max(dx, 0), w + min(dx, 0))
         xd = slice(max(-dx, 0), w + min(-dx, 0))
         take = todo[yd, xd] & mask[ys, xs]
-        rgb[yd, xd][take] = rgb[ys, xs][take]
+        src[index[yd, xd][take]] = index[ys, xs][take]
         todo[yd, xd] &= ~take
+    dst = np.flatnonzero(src >= 0)
+    return dst, src[dst]
+
+
+def fill_edges(rgb: np.ndarray, mask: np.ndarray, edges=None) -> np.ndarray:
+    """``rgb`` (h, w, 3) uint8 with each uncovered pixel (``mask`` False) next to a covered one
+    given that neighbour's colour (:func:`edge_sources`, or ``edges`` made by it): the
+    silhouette pixels the view's rasterisation covers and the G-buffer's does not. In place;
+    returns ``rgb``."""
+    dst, src = edge_sources(mask) if edges is None else edges
+    flat = rgb.reshape(-1, 3)
+    flat[dst] = flat[src]
     return rgb
 
 
@@ -96,6 +109,7 @@ class PixelLayer:
         self._texture = None
         self._texels: np.ndarray | None = None
         self._actor = None
+        self._edges = (None, None)  # (the G-buffer's mask, its edge_sources)
 
     # -- the picture ---------------------------------------------------------------------------
     def wanted(self, state: M.State) -> bool:
@@ -146,7 +160,9 @@ class PixelLayer:
         if key != self._key:
             t0 = time.perf_counter()
             frame = self._live_for(mesh).frame(scene, camera, (w, h), materials=groups)
-            rgb = fill_edges(np.array(frame.rgb), frame.mask)
+            if self._edges[0] is not frame.mask:  # (a new G-buffer)
+                self._edges = (frame.mask, edge_sources(frame.mask))
+            rgb = fill_edges(np.array(frame.rgb), frame.mask, self._edges[1])
             self.last, self._key = frame, key
             self.camera, self.size, self.rgb = camera, (w, h), rgb
             self.draw(rgb)

@@ -151,13 +151,13 @@ def test_per_pixel_mode_draws_the_engines_per_pixel_picture(torus):
     assert np.array_equal(picture(torus), before)
 
 
-def test_a_material_change_makes_no_gbuffer_and_a_camera_change_one(torus):
+def test_a_material_change_makes_no_gbuffer_nor_light_pass_and_a_camera_change_one(torus):
     c = torus.controller
     c.set_value("shading", "per-pixel")
-    live = torus.pixels._live
-    made = live.gbuffers
+    live = torus.pixels.live
+    made, passes = live.gbuffers, live.light_passes
     c.set_value("kd", 0.3, merge=False)
-    assert live.gbuffers == made and torus.pixels.last is not None
+    assert live.gbuffers == made and live.light_passes == passes  # a recompose, no light pass
     assert against_reference(torus)[0] <= 1
     torus.plotter.camera.Azimuth(30.0)
     torus.plotter.render_window.Render()
