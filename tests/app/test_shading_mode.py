@@ -86,3 +86,16 @@ def test_per_pixel_flag_starts_the_view_per_pixel(command, tmp_path):
     path = S.save_session(tmp_path / "s.yaml", plain)
     args = build_parser().parse_args([command, "--session", str(path), "--per-pixel"])
     assert start_state(args)[0].scene.shading == "per-pixel"
+
+
+def test_render_draws_a_scene_that_asks_for_per_pixel_per_pixel(tmp_path, capsys):
+    from explorer.cli import main
+
+    scene = tmp_path / "s.yaml"
+    scene.write_text("material: gold\nshading: per-pixel\n")
+    out = tmp_path / "a.png"
+    assert main(["render", str(scene), "--mesh", "cube", "--size", "64x48", "--out", str(out)]) == 0
+    assert "per-pixel picture" in capsys.readouterr().out and out.exists()
+    ply = tmp_path / "a.ply"  # a mesh file is per vertex whatever the scene asks
+    assert main(["render", str(scene), "--mesh", "cube", "--out", str(ply)]) == 0
+    assert "vertices with colours" in capsys.readouterr().out
