@@ -326,3 +326,18 @@ def test_a_mesh_switch_in_per_pixel_mode_draws_the_new_mesh_per_pixel(torus):
     assert torus.view.mesh is c.meshes["cube"] and torus.pixels.shown
     worst, off, edge, ref = against_reference(torus)
     assert ref.mask.sum() > 5000 and worst <= 1 and off <= 0.05 * edge
+
+
+def test_the_per_pixel_view_carries_every_setting_of_the_state(torus):
+    """A spot that casts shadows, HDR with a tone map, Fresnel, an infinite viewer and a
+    hidden term: the view's per-pixel picture is still the engine's for the state."""
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    settings = {"type": "spot", "cutoff": 40.0, "shadows": True, "hdr": True}
+    settings.update(tone_map="aces", fresnel=0.2, local_viewer=False, show_ambient=False)
+    for key, value in settings.items():
+        c.set_value(key, value, merge=False)
+    s = c.state
+    assert s.selected_light.shadows and s.scene.hdr.tone_map == "aces" and not s.local_viewer
+    worst, off, edge, ref = against_reference(torus)
+    assert worst <= 1 and off <= 0.05 * edge
