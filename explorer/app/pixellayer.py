@@ -102,6 +102,8 @@ class PixelLayer:
         self.fallback = False
         self._t0: float | None = None
         self._made_ms = 0.0
+        self._aside_ms = 0.0
+        self.aside_ms = 0.0  # the last frame's other work (:meth:`set_aside`)
         self._live = None
         self._mesh = None
         self._key = None
@@ -120,20 +122,24 @@ class PixelLayer:
     def before(self, state: M.State) -> bool:
         """The render window's StartEvent: :meth:`update`, the frame's time started."""
         self._t0 = time.perf_counter()
+        self._aside_ms = 0.0
         made = self.update(state)
         self._made_ms = self.ms if made else 0.0
         return made
 
     def after(self) -> None:
-        """The render window's EndEvent: the frame's time less the picture's is
-        :attr:`vertex_ms`."""
+        """The render window's EndEvent: the frame's time less the picture's and the other
+        work set aside is :attr:`vertex_ms`."""
         if self._t0 is not None:
-            self.vertex_ms = 1000.0 * (time.perf_counter() - self._t0) - self._made_ms
+            total = 1000.0 * (time.perf_counter() - self._t0)
+            self.vertex_ms = total - self._made_ms - self._aside_ms
+            self.aside_ms = self._aside_ms
             self._t0 = None
 
     def set_aside(self, seconds: float) -> None:
-        """Leave ``seconds`` of other work done in this frame out of :attr:`vertex_ms`."""
-        self._made_ms += 1000.0 * seconds
+        """Leave ``seconds`` of other work done in this frame (side B's) out of
+        :attr:`vertex_ms` (and say how much: :attr:`aside_ms`)."""
+        self._aside_ms += 1000.0 * seconds
 
     def too_slow(self) -> bool:
         """A per-pixel picture costs more than :data:`FALLBACK_RATIO` per-vertex frames."""

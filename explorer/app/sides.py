@@ -124,7 +124,10 @@ class SideB:
         elif b_pp and self._heat:
             self.pixels.draw(self.pixels.rgb)
         self._heat = b_pp and state.compare_difference
-        vertex_ms = self.main.pixels.vertex_ms if b_pp else self.pixels.vertex_ms
+        if b_pp:  # side A's last frame, from its change to its picture, side B's work left out
+            vertex_ms = self.main.frame_ms - self.main.pixels.aside_ms
+        else:
+            vertex_ms = self.pixels.vertex_ms
         return PC.figures(errors, vertex_ms, layer.ms)
 
     def _captions(self) -> None:

@@ -219,6 +219,8 @@ class PlotterView:
         """The render window's StartEvent: in per-pixel mode the picture for the camera VTK
         draws with (:meth:`PixelLayer.before`), side B's (:meth:`SideB.before_a_frame`); a drag
         that falls back to per vertex says so."""
+        if self._t0 is None:  # (a camera frame: its time starts here, its picture's too)
+            self._t0 = time.perf_counter()
         was = self.pixels.fallback
         self.pixels.before(self.controller.state)
         if self.side_b is not None:  # (side B's work is not side A's frame time)
