@@ -85,18 +85,8 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         argv = ("--preset", "jade")
     elif name == "gui_per_pixel":  # the 24-vertex cube lit near its front face
         light = ("--light-type", "point", "--light-position", "0.2", "0.3", "1.6")
-        argv = (
-            "--mesh",
-            "cube",
-            "--preset",
-            "glossy_plastic",
-            *light,
-            "--viewer-eye",
-            "2.5",
-            "2",
-            "5",
-            "--per-pixel",
-        )
+        eye = ("--viewer-eye", "2.5", "2", "5")
+        argv = ("--mesh", "cube", "--preset", "glossy_plastic", *light, *eye, "--per-pixel")
     elif name == "gui_gouraud_vs_per_pixel":
         argv = ("--mesh", "icosphere", "--resolution", "2", "--preset", "polished_silver")
     w = open_window(app, tmp, argv, size)
