@@ -73,6 +73,7 @@ def grab(display: str, path: Path, size, crop=None) -> None:
 
 def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     """Set up the window for picture ``name`` and grab it into ``out/name.png``."""
+    from explorer.app import intents
     from explorer.app import model as M
 
     size, argv, crop = SIZE, (), None
@@ -82,6 +83,12 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         size = (640, 480)
     elif name == "gui_translucent":
         argv = ("--preset", "jade")
+    elif name == "gui_per_pixel":  # the 24-vertex cube lit near its front face
+        light = ("--light-type", "point", "--light-position", "0.2", "0.3", "1.6")
+        eye = ("--viewer-eye", "2.5", "2", "5")
+        argv = ("--mesh", "cube", "--preset", "glossy_plastic", *light, *eye, "--per-pixel")
+    elif name == "gui_gouraud_vs_per_pixel":
+        argv = ("--mesh", "icosphere", "--resolution", "2", "--preset", "polished_silver")
     w = open_window(app, tmp, argv, size)
     c = w.controller
     if name == "gui_640x480":
@@ -95,6 +102,11 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         w.panel.view.compare.click()
         c.act(M.set_compare_model, "phong")
         c.act(M.place_light, 12.0, 30.0)  # the handle in both narrow panes
+    elif name in ("gui_per_pixel", "gui_gouraud_vs_per_pixel"):
+        w.panel.setCurrentIndex(2)  # the view tab: the shading row
+        if name == "gui_gouraud_vs_per_pixel":
+            intents.run("gouraud_vs_per_pixel", c, {})
+            wait_for(app, "the line", lambda: w.viewport.side_b.figures is not None)
     elif name == "gui_difference":
         w.panel.setCurrentIndex(2)
         c.toggle_difference()
@@ -121,7 +133,8 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
 
 
 NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "gui_difference",
-         "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent")  # fmt: skip
+         "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent", "gui_per_pixel",
+         "gui_gouraud_vs_per_pixel")  # fmt: skip
 
 
 def main(argv=None) -> int:

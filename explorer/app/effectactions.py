@@ -1,14 +1,15 @@
 """The actions that switch the engine's effects from the explorer's panel (docs/effects.md):
 the material's Fresnel and energy-conserving specular, the scene's two-sided lighting, HDR
-display (exposure, tone map) and local viewer. A light's shadows are a light field
-(:func:`explorer.app.model.set_light_field`); translucency is the material's opacity
-(:func:`explorer.app.model.set_opacity`). Each is a pure action of the
+display (exposure, tone map) and local viewer; and where the surface is lit, per vertex or per
+pixel (the scene's ``shading``), with the compare view that puts the two side by side. A light's
+shadows are a light field (:func:`explorer.app.model.set_light_field`); translucency is the
+material's opacity (:func:`explorer.app.model.set_opacity`). Each is a pure action of the
 :mod:`explorer.app.model` kind (one undo step; the scene keeps the value, so a session saves it).
 """
 
 from __future__ import annotations
 
-from explorer.app.model import State, set_camera
+from explorer.app.model import State, set_camera, start_compare
 from explorer.app.model import _material as with_material
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import HDR, HDR_KEYS
@@ -59,3 +60,23 @@ def set_local_viewer(state: State, on: bool) -> State:
     viewer follows the camera at once."""
     new = state.replace(local_viewer=bool(on))
     return set_camera(new, new.camera) if new.camera is not None else new
+
+
+def set_shading(state: State, shading: str) -> State:
+    """The view lit per vertex (``per-vertex``, Gouraud) or per pixel (``per-pixel``, the engine
+    at every pixel's surface point); the scene checks the name."""
+    return state.replace(scene=state.scene.replace(shading=shading))
+
+
+def gouraud_vs_per_pixel(state: State) -> State:
+    """The compare view with side A per vertex and side B per pixel, the same material, model
+    and everything else: what Gouraud costs and misses, side by side."""
+    a = set_shading(state, "per-vertex")
+    b = start_compare(a) if a.compare is None else a
+    return b.replace(
+        compare=a.material,
+        compare_model=a.scene.model,
+        compare_preset=a.preset,
+        compare_shading="per-pixel",
+        compare_difference=False,
+    )

@@ -16,7 +16,8 @@ close, tab switching, quit). An intent bound to one of them says its page key in
 :attr:`Intent.page_keys` (Ctrl+T, the turntable, is Alt+T on the page); the other desktop keys
 work on the page as they are (the page's listener takes them before the browser).
 
-Toolkit-free: imports only the core (an import-linter contract keeps Qt and trame out).
+Toolkit-free: imports the core and the model's actions (an import-linter contract keeps Qt and
+trame out).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 
+from explorer.app.effectactions import gouraud_vs_per_pixel
 from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS
 
@@ -49,6 +51,8 @@ BROWSER_KEYS = frozenset(
 MENUS = ("File", "Edit", "View", "Help")
 #: a front end's own callbacks (``run="front:NAME"``): what each must provide
 FRONT = ("quit", "help", "messages")
+#: the model actions an intent applies itself (``act:NAME``): what needs no flow of its own
+ACTIONS = {"gouraud_vs_per_pixel": gouraud_vs_per_pixel}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -62,7 +66,8 @@ class Intent:
         sequences, the first one shown); view_key : the 3D view's key (a plain character, while
         the view has the keyboard); help : what the help says of it (default: the title);
         run : the controller method it calls (``files.NAME``: of its file flows,
-        :class:`~explorer.app.controller.files.FileFlows`), or ``front:NAME`` (:data:`FRONT`);
+        :class:`~explorer.app.controller.files.FileFlows`), ``front:NAME`` (:data:`FRONT`), or
+        ``act:NAME``: the model action :data:`ACTIONS` names, one undo step named by the title;
         enabled : ``enabled(controller)``, whether it can run now (None: always);
         page : how the page runs it (``server``: the controller's method through a trigger;
         ``download:KIND``, ``click:LABEL[@TAB]``, ``focus:LABEL[@TAB]``, ``toggle:STATE``: in
@@ -256,6 +261,16 @@ INTENTS: tuple[Intent, ...] = (
     ),
     I("swap_sides", "&Swap A and B", "swap_sides", "View", 0, view_key="x"),
     I(
+        "gouraud_vs_per_pixel",
+        "&Gouraud vs per-pixel",
+        "act:gouraud_vs_per_pixel",
+        "View",
+        0,
+        view_key="g",
+        help="compare A | B with A lit per vertex (Gouraud) and B per pixel: each one's time "
+        "and the error, live",
+    ),
+    I(
         "messages",
         "&Messages",
         "front:messages",
@@ -351,7 +366,8 @@ def enabled(controller) -> dict[str, bool]:
 
 
 def run(intent_id: str, controller, front: dict[str, Callable[[], object]]):
-    """Run intent ``intent_id``: its controller method, or ``front[NAME]`` for ``front:NAME``;
+    """Run intent ``intent_id``: its controller method, ``front[NAME]`` for ``front:NAME``, its
+    model action through :meth:`Controller.act` for ``act:NAME``;
     an intent that cannot run now (:attr:`Intent.enabled`) does nothing and returns False."""
     intent = BY_ID.get(intent_id)
     if intent is None:
@@ -360,6 +376,8 @@ def run(intent_id: str, controller, front: dict[str, Callable[[], object]]):
         return False
     if intent.run.startswith("front:"):
         return front[intent.run.removeprefix("front:")]()
+    if intent.run.startswith("act:"):
+        return controller.act(ACTIONS[intent.run.removeprefix("act:")], label=intent.label)
     target = controller
     for name in intent.run.split("."):  # files.NAME: a method of the controller's file flows
         target = getattr(target, name)

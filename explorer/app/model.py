@@ -103,6 +103,7 @@ class State:
     compare : side B's material when the A / B compare view is on, else None
     compare_model, compare_preset : side B's specular model and preset name
     compare_difference : side B's pane shows the difference A − B instead of B
+    compare_shading : side B's shading (``per-vertex`` / ``per-pixel``), or None: A's
     mesh_materials : the materials the mesh file brings (:class:`MeshMaterials`), or None
     groups : each group's material as shown (the mesh's own materials, edited), or None when
         one material (:attr:`material`: a preset, the scene's) covers the whole mesh
@@ -130,6 +131,7 @@ class State:
     compare_model: str | None = None
     compare_preset: str | None = None
     compare_difference: bool = False
+    compare_shading: str | None = None
     mesh_materials: MeshMaterials | None = None
     groups: tuple[Material, ...] | None = None
     group: int = 0
@@ -341,7 +343,7 @@ def start_compare(state: State) -> State:
 
 def stop_compare(state: State) -> State:
     return state.replace(compare=None, compare_model=None, compare_preset=None,
-                         compare_difference=False)  # fmt: skip
+                         compare_difference=False, compare_shading=None)  # fmt: skip
 
 
 def set_compare(state: State, on: bool) -> State:
@@ -376,18 +378,21 @@ def set_compare_difference(state: State, on: bool) -> State:
 def swap_compare(state: State) -> State:
     """A becomes B and B becomes A (the panel edits side A)."""
     _needs_compare(state)
-    scene = state.scene.replace(material=state.compare, model=state.compare_model)
+    shading = state.compare_shading or state.scene.shading
+    scene = state.scene.replace(material=state.compare, model=state.compare_model, shading=shading)
     return state.replace(
         scene=scene, preset=state.compare_preset, preset_material=None, groups=None,
         compare=state.material, compare_model=state.scene.model, compare_preset=state.preset,
+        compare_shading=None if state.compare_shading is None else state.scene.shading,
     )  # fmt: skip
 
 
 def side_b(state: State) -> State:
-    """The state side B shows: B's material (over the whole mesh) and model, everything else
-    shared."""
+    """The state side B shows: B's material (over the whole mesh), model and shading,
+    everything else shared."""
     _needs_compare(state)
-    scene = state.scene.replace(material=state.compare, model=state.compare_model)
+    shading = state.compare_shading or state.scene.shading
+    scene = state.scene.replace(material=state.compare, model=state.compare_model, shading=shading)
     return state.replace(scene=scene, preset=state.compare_preset, preset_material=None,
                          groups=None)  # fmt: skip
 

@@ -33,6 +33,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS
+from explorer.core.scene import SHADINGS
 
 KINDS = ("number", "colour", "choice", "toggle", "triple")
 TABS = ("material", "lights", "view")
@@ -314,6 +315,17 @@ def _hdr_on(s: M.State) -> bool:
 
 def _view_rows() -> list[Row]:
     return [
+        Row(
+            "shading",
+            "view",
+            "choice",
+            lambda s: s.scene.shading,
+            lambda s, v: (E.set_shading, (v,)),
+            choices=SHADINGS,
+            inline=True,
+            tip="per-vertex: lit at the vertices, colours interpolated (Gouraud, OpenGL 2.1); "
+            "per-pixel: the engine at every pixel's surface point, with the interpolated normal",
+        ),
         Row(
             "two_sided",
             "view",

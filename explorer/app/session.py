@@ -16,7 +16,8 @@ A session file is YAML (or JSON, which YAML reads too)::
     local_viewer: true         # optional: the viewer at the camera (false: infinitely far
                                # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
-                               # the A / B compare view's side B
+                               # the A / B compare view's side B (and its shading: per-pixel,
+                               # when it differs from the scene's: "Gouraud vs per-pixel")
     groups: {group: 1, materials: [{...}, ...]}   # optional: the mesh file's own materials
                                # as shown (one per usemtl group, edited), the group edited;
                                # absent: one material covers the mesh
@@ -43,7 +44,7 @@ from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS, parse_material
 from explorer.core.mtl import MtlError
-from explorer.core.scene import load_scene
+from explorer.core.scene import SHADINGS, load_scene
 from explorer.core.yamlio import dump_yaml, load_yaml
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
@@ -102,6 +103,8 @@ def session_mapping(state: State) -> dict:
             "preset": state.compare_preset,
             "difference": bool(state.compare_difference),
         }
+        if state.compare_shading is not None:
+            out["compare"]["shading"] = state.compare_shading
     if state.groups is not None:
         out["groups"] = {
             "group": state.group + 1,
@@ -196,7 +199,7 @@ def _compare(checker, value) -> dict:
     c = checker.mapping(value, path)
     if c is None:
         return {}
-    checker.keys(c, path, ("material", "model", "preset", "difference"),
+    checker.keys(c, path, ("material", "model", "preset", "difference", "shading"),
                  required=("material", "model"))  # fmt: skip
     material = parse_material(c.get("material"), checker, path + ("material",))
     model = checker.choice(c.get("model"), path + ("model",), MODELS)
@@ -204,8 +207,11 @@ def _compare(checker, value) -> dict:
     if preset is not None:
         preset = checker.string(preset, path + ("preset",))
     difference = checker.boolean(c.get("difference", False), path + ("difference",))
+    shading = c.get("shading")
+    if shading is not None:
+        shading = checker.choice(shading, path + ("shading",), SHADINGS)
     return {"compare": material, "compare_model": model, "compare_preset": preset,
-            "compare_difference": bool(difference)}  # fmt: skip
+            "compare_difference": bool(difference), "compare_shading": shading}  # fmt: skip
 
 
 def _groups(checker, value) -> tuple[int, tuple] | None:

@@ -13,7 +13,9 @@ from typing import Protocol
 import numpy as np
 
 from explorer.app import model as M
+from explorer.app import pixelcompare as PC
 from explorer.app.handledrag import HandleDragger
+from explorer.app.pixellayer import PER_PIXEL, PixelLayer
 from explorer.app.view import SceneView, view_camera
 from explorer.shading.display import to_bytes
 
@@ -49,6 +51,10 @@ class SideB:
         self.pane = pane
         self.plotter = None
         self.view: SceneView | None = None
+        self.pixels: PixelLayer | None = None  # side B's per-pixel picture
+        self.figures: PC.Figures | None = None  # Gouraud vs per-pixel: this frame's line
+        self._heat = False  # side B's per-pixel pane draws the heat map
+        self.errors = None  # the errors (k,) and the mask (h, w) of the figures
 
     @property
     def shown(self) -> bool:
@@ -68,6 +74,10 @@ class SideB:
         if self.pane.handles:  # the lights are shared: B's handles move them too
             self.handles = HandleDragger(main, pl, self.view)
         pl.renderer.AddObserver("StartEvent", main.guard(self._before_frame, "compare"))
+        self.pixels = PixelLayer(self.view)
+        window = pl.render_window  # (before VTK makes its context current: see pixellayer)
+        window.AddObserver("StartEvent", main.guard(self._pixels_before, "compare"))
+        window.AddObserver("EndEvent", main.guard(lambda *_: self.pixels.after(), "compare"))
         self.pane.made(pl, self.view)
 
     def _before_frame(self, *_) -> None:
@@ -77,6 +87,56 @@ class SideB:
         s = self.main.controller.state
         self.view.before_frame(view_camera(self.plotter.camera, s.centre, s.radius))
         self.plotter.renderer.ResetCameraClippingRange()
+
+    def _pixels_before(self, *_) -> None:
+        """Side B's render window's StartEvent: its per-pixel picture (made already when side
+        A's frame came first: :meth:`before_a_frame`)."""
+        state = self.main.controller.state
+        if state.compare is not None:
+            self.pixels.before(M.side_b(state))
+
+    def before_a_frame(self, state: M.State) -> None:
+        """Side A's render window's StartEvent, after side A's picture: side B's per-pixel
+        picture for the shared camera, and with one side per vertex and the other per pixel
+        the line of both panes (so both show the same line in the same frame) and, with the
+        difference on, the heat map in side B's pane."""
+        if not self.shown:
+            return
+        self.pixels.update(M.side_b(state))
+        self.figures = self._compare(state)
+        self._captions()
+
+    def _compare(self, state: M.State) -> PC.Figures | None:
+        """The figures of Gouraud vs per-pixel (:mod:`explorer.app.pixelcompare`), or None
+        when both sides are lit alike (or the per-pixel side draws per vertex: a drag)."""
+        b_pp = M.side_b(state).scene.shading == PER_PIXEL
+        if (state.scene.shading == PER_PIXEL) == b_pp:
+            return None
+        layer, other = (self.pixels, self.main.view) if b_pp else (self.main.pixels, self.view)
+        if layer.last is None or not layer.shown:
+            return None
+        g, _ = layer.live.gbuffer(layer.camera, layer.size)
+        vertex = PC.gouraud(other.mesh, g.hits, to_bytes(other.drawings[0].colors()))
+        errors = PC.levels(vertex, layer.last.rgb[g.hits.mask])
+        self.errors = (errors, g.hits.mask)  # (what the line and the heat map are made of)
+        if b_pp and state.compare_difference:
+            self.pixels.draw(PC.heat_picture(errors, g.hits.mask))
+        elif b_pp and self._heat:
+            self.pixels.draw(self.pixels.rgb)
+        self._heat = b_pp and state.compare_difference
+        if b_pp:  # side A's last frame, from its change to its picture, side B's work left out
+            vertex_ms = self.main.frame_ms - self.main.pixels.aside_ms
+        else:
+            vertex_ms = self.pixels.vertex_ms
+        return PC.figures(errors, vertex_ms, layer.ms)
+
+    def _captions(self) -> None:
+        """Both panes' captions with the figures' line under them (none without figures)."""
+        for view in (self.main.view, self.view):
+            caption = getattr(view, "caption", None)
+            first = (caption.GetInput() or "") if caption is not None else ""
+            first = first.split("\n")[0]
+            view.set_caption(first if self.figures is None else f"{first}\n{self.figures.line()}")
 
     def show(self, old: M.State | None, new: M.State) -> None:
         """Side B made, shown, hidden, and given side B's state (or A − B)."""
@@ -88,6 +148,7 @@ class SideB:
         if self.view is None:
             self._make(new)
         show_side_b(self.main.view, self.view, old, new)
+        self._captions()
         self.pane.show_pane(True)
 
     def after_frame(self) -> None:
@@ -120,7 +181,10 @@ def show_side_b(view_a, view_b, old: M.State | None, new: M.State) -> None:
         view_b.paint_levels(np.abs(a - other).max(axis=1))
     elif old is not None and old.compare_difference:
         view_b.drawings[0].upload()
-    view_a.set_caption(f"A: {M.material_title(new)} ({new.scene.model})")
+    b_shading = b.scene.shading
+    how_a = f", {new.scene.shading}" if b_shading != new.scene.shading else ""
+    how_b = f", {b_shading}" if how_a else ""
+    view_a.set_caption(f"A: {M.material_title(new)} ({new.scene.model}{how_a})")
     view_b.set_caption("A − B (levels, as the difference view)" if new.compare_difference
                        else f"B: {new.compare_preset or 'material'} "
-                       f"({new.compare_model})")  # fmt: skip
+                       f"({new.compare_model}{how_b})")  # fmt: skip

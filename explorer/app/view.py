@@ -389,15 +389,17 @@ class SceneView:
         return self.lobe.caption
 
     def set_caption(self, text: str) -> None:
-        """A line at the top left of the view (which side of the compare view it is)."""
+        """A line (or two) at the top left of the view (which side of the compare view it is,
+        and Gouraud vs per-pixel's figures)."""
         import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
         from vtkmodules.vtkRenderingCore import vtkTextActor
 
         if getattr(self, "caption", None) is None:
             self.caption = vtkTextActor()
             self.caption.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-            self.caption.SetPosition(0.02, 0.94)
+            self.caption.SetPosition(0.02, 0.98)
             prop = self.caption.GetTextProperty()
+            prop.SetVerticalJustificationToTop()  # (a second line goes below the first)
             prop.SetFontSize(14)
             prop.SetColor(0.92, 0.92, 0.92)
             self.plotter.renderer.AddViewProp(self.caption)

@@ -23,6 +23,7 @@ import numpy as np
 from explorer.app import model as M
 from explorer.app.difference import PENDING, HeatMap, advice_lines
 from explorer.app.handledrag import HandleDragger
+from explorer.app.pixellayer import PixelLayer
 from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, view_camera
 from explorer.render.images import encode_png
 
@@ -68,6 +69,7 @@ class PlotterView:
         self.view: SceneView | None = None
         self.side_b = None  # an explorer.app.sides.SideB, when the front end has a pane B
         self.handles: HandleDragger | None = None
+        self.pixels: PixelLayer | None = None  # the per-pixel picture (shading: per-pixel)
         self.frames = 0
         self.frame_ms = float("nan")  # from the change (or redraw) to its frame's end
         self._t0: float | None = None
@@ -93,6 +95,9 @@ class PlotterView:
         self._mesh = state.mesh
         self.view.apply_camera(state.camera)
         self.handles = HandleDragger(self)
+        self.pixels = PixelLayer(self.view)
+        window = self.plotter.render_window  # (before VTK makes its context current)
+        window.AddObserver("StartEvent", self.guard(self._pixels_before, "per-pixel view"))
         self.plotter.renderer.AddObserver("StartEvent", self.guard(self._before_frame, "frame"))
         self.plotter.render_window.AddObserver("EndEvent", self.guard(self._after_frame, "frame"))
         self.side_b = side_b
@@ -210,6 +215,26 @@ class PlotterView:
         return encode_png(np.ascontiguousarray(img))
 
     # -- frames ----------------------------------------------------------------------------------
+    def _pixels_before(self, *_) -> None:
+        """The render window's StartEvent: in per-pixel mode the picture for the camera VTK
+        draws with (:meth:`PixelLayer.before`), side B's (:meth:`SideB.before_a_frame`); a drag
+        that falls back to per vertex says so."""
+        if self._t0 is None:  # (a camera frame: its time starts here, its picture's too)
+            self._t0 = time.perf_counter()
+        was = self.pixels.fallback
+        self.pixels.before(self.controller.state)
+        if self.side_b is not None:  # (side B's work is not side A's frame time)
+            t0 = time.perf_counter()
+            self.side_b.before_a_frame(self.controller.state)
+            self.pixels.set_aside(time.perf_counter() - t0)
+        if self.pixels.fallback and not was:
+            p = self.pixels
+            self.controller.say(
+                f"camera drag drawn per vertex: a per-pixel frame takes {p.ms:.0f} ms, a "
+                f"per-vertex one {p.vertex_ms:.0f} ms; per pixel again on release",
+                open_log=False,
+            )
+
     def _before_frame(self, *_) -> None:
         """The renderer's StartEvent: the camera is the viewer, it goes into the state (no undo
         step); translucent triangles sorted, the inset and the handles' ring laid out."""
@@ -221,6 +246,7 @@ class PlotterView:
         """The render window's EndEvent: the frame counted and timed, side B follows (the same
         camera), then the front end's own step."""
         self.frames += 1
+        self.pixels.after()
         if self.side_b is not None:
             self.side_b.after_frame()
         if self._t0 is not None:

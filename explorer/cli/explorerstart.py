@@ -9,6 +9,7 @@ import sys
 
 from explorer.app import session as S
 from explorer.app import start as gui
+from explorer.app.effectactions import set_shading
 from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import build_scene
 from explorer.core.errors import ExplorerError
@@ -23,6 +24,17 @@ def add_preset_option(p: argparse.ArgumentParser) -> None:
         "--preset", metavar="NAME",
         help=f"start preset (overrides the scene's material; default {gui.DEFAULT_PRESET})",
     )  # fmt: skip
+
+
+def add_shading_option(p: argparse.ArgumentParser) -> None:
+    """``--per-pixel``: the view lit per pixel (the scene and session key ``shading``)."""
+    p.add_argument(
+        "--per-pixel",
+        action="store_true",
+        help="light every pixel of the view (the engine at each pixel's surface point, as "
+        "render --per-pixel; the scene key shading: per-pixel); the panel's shading row "
+        "switches back",
+    )
 
 
 def start(args):
@@ -53,6 +65,15 @@ def start(args):
 
 
 def start_state(args, warnings: list | None = None):
+    """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s, lit per
+    pixel with ``--per-pixel``."""
+    state, mesh = _start_state(args, warnings)
+    if getattr(args, "per_pixel", False):
+        state = set_shading(state, "per-pixel")
+    return state, mesh
+
+
+def _start_state(args, warnings: list | None = None):
     """``(state, mesh)``: a session (``--session``, ``--last``) or :func:`start`'s; a mesh
     file's own materials are shown unless ``--preset`` is given (as ``render`` does). The
     warnings of the mesh's materials are printed, and appended to ``warnings`` when given (the

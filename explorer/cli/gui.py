@@ -25,7 +25,7 @@ import sys
 
 from explorer.app import qtlibs
 from explorer.app import start as gui
-from explorer.cli.explorerstart import add_preset_option
+from explorer.cli.explorerstart import add_preset_option, add_shading_option
 from explorer.cli.explorerstart import start as shared_start
 from explorer.cli.explorerstart import start_state as shared_start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
@@ -37,6 +37,7 @@ from explorer.render.images import parse_size
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_preset_option(p)
+    add_shading_option(p)
     p.add_argument(
         "--size", default="{}x{}".format(*gui.WINDOW_SIZE), metavar="WxH",
         help="window size in pixels (default %(default)s)",

@@ -108,7 +108,8 @@ def run(args) -> int:
         for m in materials or (scene.material,):
             for w in energy_warnings(m):
                 say(f"warning: {w}", file=sys.stderr)
-    if args.per_pixel:
+    # the flag, or the scene's key for a picture (a mesh file or a turntable is per vertex)
+    if args.per_pixel or (scene.shading == "per-pixel" and suffix == ".png" and not turntable):
         if materials:
             raise ExplorerError(
                 "--per-pixel draws one material: give --preset NAME for a mesh with its own "

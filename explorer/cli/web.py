@@ -25,7 +25,7 @@ import logging
 import sys
 
 from explorer.app import start as gui
-from explorer.cli.explorerstart import add_preset_option, start_state
+from explorer.cli.explorerstart import add_preset_option, add_shading_option, start_state
 from explorer.cli.options import add_scene_arguments, background_from_options
 from explorer.core.errors import ExplorerError
 from explorer.core.text import say
@@ -38,6 +38,7 @@ NEEDS = ("trame", "trame_vuetify", "trame_vtk")
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_preset_option(p)
+    add_shading_option(p)
     p.add_argument(
         "--port", type=int, default=DEFAULT_PORT, metavar="N",
         help="port to listen on (default %(default)s; 0: any free port)",

@@ -14,6 +14,7 @@ The scene-file schema (every key optional)::
     mesh: sphere              # built-in name or mesh file (relative to the scene file)
     hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
                               # (hdr: true: these defaults; hdr: false: off)
+    shading: per-vertex       # or per-pixel: where the explorer and render light the surface
 
 Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
 light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
@@ -46,6 +47,10 @@ Vec3 = tuple[float, float, float]
 
 VIEWER_KEYS = ("eye", "to_viewer")
 DEFAULT_AMBIENT = (0.2, 0.2, 0.2)
+#: where the surface is lit: at the vertices, the colours interpolated across each triangle
+#: (Gouraud, OpenGL 2.1's fixed function), or at every pixel's surface point with the
+#: interpolated normal (the engine per pixel: :mod:`explorer.render.perpixel`)
+SHADINGS = ("per-vertex", "per-pixel")
 
 
 # -- the checks of each key ------------------------------------------------------------------
@@ -174,6 +179,10 @@ def _hdr(checker: Checker, value, path):
     return parse_hdr(value, checker, path)
 
 
+def _shading(checker: Checker, value, path):
+    return checker.choice(value, path, SHADINGS)
+
+
 DEFAULT_VIEWER = Viewer(to_viewer=(0.0, 0.0, 1.0))
 DEFAULT_LIGHTS: tuple = (DirectionalLight(to_light=(0.0, 0.0, 1.0)),)
 
@@ -194,6 +203,9 @@ class Scene(Checked):
     hdr : display unclamped colours with this exposure and tone map
         (:mod:`explorer.shading.display`), or None (OpenGL: clamp to [0, 1])
     source : the file the scene came from (for messages), or None
+    shading : "per-vertex" (Gouraud) or "per-pixel" (:data:`SHADINGS`): where the explorer's
+        view and ``render`` light the surface; the engine's per-vertex colours do not depend
+        on it
     """
 
     material: Material = field(default_factory=Material)
@@ -205,6 +217,7 @@ class Scene(Checked):
     mesh: str | None = None
     source: str | None = field(default=None, compare=False)
     hdr: HDR | None = None
+    shading: str = "per-vertex"
 
     #: key -> its check, run by the scene-file parser and by the constructor, in the order a
     #: file's problems are listed (a constructor also takes a mapping where a file does)
@@ -217,6 +230,7 @@ class Scene(Checked):
         "lights": _lights,
         "mesh": _mesh,
         "hdr": _hdr,
+        "shading": _shading,
     }
 
     def to_mapping(self) -> dict:
@@ -233,6 +247,8 @@ class Scene(Checked):
             out["mesh"] = self.mesh
         if self.hdr is not None:
             out["hdr"] = self.hdr.to_mapping()
+        if self.shading != "per-vertex":
+            out["shading"] = self.shading
         return out
 
 

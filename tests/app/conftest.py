@@ -22,6 +22,7 @@ QT_MODULES = (
     "test_panel.py",
     "test_window_view.py",
     "test_intents.py",
+    "test_window_pixels.py",
 )
 
 

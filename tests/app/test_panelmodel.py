@@ -52,6 +52,7 @@ SAMPLES = {
     "exposure": 1.5,
     "tone_map": "aces",
     "local_viewer": False,
+    "shading": "per-pixel",
 }
 
 

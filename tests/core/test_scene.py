@@ -26,6 +26,7 @@ SCENE_BAD = [
     ("hdr", {"tone_map": "filmic"}, "must be one of clamp, reinhard, aces, got 'filmic'"),
     ("viewer", {"eye": [0, "a", 0]}, "must be a number, got text 'a'"),
     ("material", {"opacity": 2}, "must be in [0, 1], got 2"),
+    ("shading", "per-face", "must be one of per-vertex, per-pixel, got 'per-face'"),
 ]
 
 

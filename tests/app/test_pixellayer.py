@@ -1,0 +1,343 @@
+"""The per-pixel view (explorer.app.pixellayer) in the view port both front ends share, on an
+off-screen plotter: the pixels read from the plotter equal the engine's per-pixel picture
+(explorer.render.perpixel.reference, what ``render --per-pixel`` writes) for the view's camera
+and size; a cube's highlight per pixel that per vertex misses; the drag fallback."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.controllers import FakeFront, FakeWorker
+
+from explorer.analysis.comparison import heat_map
+from explorer.app import intents
+from explorer.app import model as M
+from explorer.app import start as A
+from explorer.app.controller import Controller
+from explorer.app.controller.ports import Ports
+from explorer.app.difference import VMAX
+from explorer.app.pixellayer import fill_edges
+from explorer.app.sides import SideB
+from explorer.app.view import HANDLE_RADIUS, RING_GAP, SELECTED_SCALE, handle_point
+from explorer.app.viewport import PlotterView
+from explorer.cli import build_parser
+from explorer.cli.explorerstart import start
+from explorer.render.live import picture as render_per_pixel
+from explorer.render.perpixel import reference
+from explorer.render.vtk import plotter
+
+SIZE = (320, 240)
+BACKGROUND = (0.1, 0.1, 0.1)
+
+
+class Pictures:
+    """The front end's part: a picture is a frame drawn now."""
+
+    def __init__(self):
+        self.view = None
+
+    def send(self):
+        self.view.plotter.render_window.Render()
+
+    def show_controls(self, state):
+        pass
+
+    def show_legend(self, legend, advice):
+        pass
+
+    def after_frame(self):
+        pass
+
+
+def make_port(mesh_name, tmp_path, monkeypatch, *args, side_b=None):
+    monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
+    parsed = build_parser().parse_args(["gui", "--mesh", mesh_name, *args])
+    scene, mesh, preset = start(parsed)
+    state = A.first_state(scene, mesh, name=mesh_name, preset=preset)
+    pictures = Pictures()
+    view = PlotterView(plotter(SIZE, BACKGROUND), pictures)
+    pictures.view = view
+    ports = Ports.of(FakeFront(), worker=FakeWorker(), view=view)
+    c = Controller(state, mesh, ports, output_dir=tmp_path, last_session=tmp_path / "last.yaml")
+    view.attach(c, mesh, side_b=None if side_b is None else SideB(view, side_b))
+    c.start()
+    view.show_start(c.state)
+    view.redraw()
+    return view
+
+
+@pytest.fixture
+def torus(tmp_path, monkeypatch):
+    view = make_port("torus", tmp_path, monkeypatch, "--preset", "glossy_plastic")
+    yield view
+    view.plotter.close()
+
+
+def picture(view) -> np.ndarray:
+    view.plotter.render_window.Render()
+    return view.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+
+
+def handle_disks(view) -> np.ndarray:
+    """(h, w) bool: the pixels of every light handle and the selected one's ring."""
+    w, h = SIZE
+    yy, xx = np.mgrid[0:h, 0:w]
+    out = np.zeros((h, w), bool)
+    s = view.view.state
+    for i, (x, y, _ahead) in enumerate(view.view.handle_pixels()):
+        size = HANDLE_RADIUS * SELECTED_SCALE * s.radius / view.view.frame[1]
+        r = view.view._pixel_radius(view.view.to_view(handle_point(s, i)), size)
+        out |= np.hypot(xx - x, (h - 1 - yy) - y) <= r + RING_GAP + 3
+    return out
+
+
+def overlays(view) -> np.ndarray:
+    """(h, w) bool: what the view draws over the mesh (the light handles, the selected one's
+    ring, the lobe inset's panel), grown by 2 pixels."""
+    w, h = SIZE
+    out = handle_disks(view)
+    x0, y0, bw, bh = view.view.lobe.box  # display pixels, origin bottom-left
+    out[max(h - (y0 + bh) - 2, 0) : h - y0 + 2, max(x0 - 2, 0) : x0 + bw + 2] = True
+    return out
+
+
+def interior(mask: np.ndarray) -> np.ndarray:
+    """The covered pixels whose 8 neighbours are covered too (the rest: the silhouette)."""
+    m = np.pad(mask, 1)
+    h, w = mask.shape
+    out = mask.copy()
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            out &= m[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
+    return out
+
+
+def against_reference(view):
+    """The view's pixels and the engine's per-pixel picture for its state, camera and size
+    (explorer.render.perpixel.reference, what ``render --per-pixel`` writes): the largest
+    difference over the interior pixels, the silhouette pixels off by more than 1 and their
+    count, over the pixels the overlays leave free."""
+    s = view.controller.state
+    img = picture(view)
+    ref = reference(s.shown_scene(), view.view.mesh, SIZE, camera=s.camera)
+    d = np.abs(img - ref.image(BACKGROUND).astype(int)).max(axis=2)
+    free = ~overlays(view)
+    inner = interior(ref.mask) & free
+    edge = ref.mask & ~interior(ref.mask) & free
+    return int(d[inner].max()), int((d[edge] > 1).sum()), int(edge.sum()), ref
+
+
+def test_per_pixel_mode_draws_the_engines_per_pixel_picture(torus):
+    c = torus.controller
+    before = picture(torus)
+    c.set_value("shading", "per-pixel")
+    assert c.state.scene.shading == "per-pixel" and torus.pixels.shown
+    worst, off, edge, ref = against_reference(torus)
+    assert ref.mask.sum() > 5000 and edge > 200
+    assert worst <= 1  # every interior pixel within 1 level of the engine's per-pixel picture
+    assert off <= 0.05 * edge  # silhouette pixels: where two rasterisations may disagree
+    # the per-vertex picture differs from it (else the test could not fail)
+    d = np.abs(before - ref.image(BACKGROUND).astype(int)).max(axis=2)
+    assert d[interior(ref.mask) & ~overlays(torus)].max() > 4
+    # and `render --per-pixel`'s picture (explorer.render.live.picture) of the same state
+    s = c.state
+    rendered = render_per_pixel(
+        s.shown_scene(), torus.view.mesh, SIZE, camera=s.camera, background=BACKGROUND
+    )
+    d = np.abs(picture(torus) - rendered.rgb.astype(int)).max(axis=2)
+    assert d[interior(rendered.mask) & ~overlays(torus)].max() <= 1
+    c.undo()  # one undo step: the per-vertex view again
+    assert c.state.scene.shading == "per-vertex" and not torus.pixels.shown
+    assert np.array_equal(picture(torus), before)
+
+
+def test_a_material_change_makes_no_gbuffer_nor_light_pass_and_a_camera_change_one(torus):
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    live = torus.pixels.live
+    made, passes = live.gbuffers, live.light_passes
+    c.set_value("kd", 0.3, merge=False)
+    assert live.gbuffers == made and live.light_passes == passes  # a recompose, no light pass
+    assert against_reference(torus)[0] <= 1
+    torus.plotter.camera.Azimuth(30.0)
+    torus.plotter.render_window.Render()
+    assert live.gbuffers == made + 1
+    assert against_reference(torus)[0] <= 1  # the new camera's picture
+
+
+def test_fill_edges_takes_a_covered_neighbours_colour():
+    rgb = np.zeros((3, 4, 3), np.uint8)
+    mask = np.zeros((3, 4), bool)
+    rgb[1, 1] = (9, 8, 7)
+    mask[1, 1] = True
+    out = fill_edges(rgb.copy(), mask)
+    assert (out[0:3, 0:3] == (9, 8, 7)).all()  # the 8 neighbours
+    assert (out[:, 3] == 0).all()  # two pixels away: left as it was
+
+
+class Pane:
+    """Side B's pane: an off-screen plotter of the same size."""
+
+    handles = False
+
+    def __init__(self):
+        self.plotters: list = []
+
+    def make_plotter(self):
+        self.plotters.append(plotter(SIZE, BACKGROUND))
+        return self.plotters[-1]
+
+    def made(self, pl, view):
+        pass
+
+    def show_pane(self, visible):
+        pass
+
+    def follow(self):
+        self.plotters[-1].render_window.Render()
+
+    def beside(self, img):
+        return img
+
+
+@pytest.fixture
+def compare(tmp_path, monkeypatch):
+    """The torus with side B in an off-screen pane."""
+    view = make_port("torus", tmp_path, monkeypatch, "--preset", "glossy_plastic", side_b=Pane())
+    yield view
+    view.plotter.close()
+    for pl in view.side_b.pane.plotters:
+        pl.close()
+
+
+def test_gouraud_vs_per_pixel_says_each_sides_time_and_the_error(compare):
+    c, b = compare.controller, compare.side_b
+    intents.run("gouraud_vs_per_pixel", c, {})  # View > Gouraud vs per-pixel
+    assert c.state.scene.shading == "per-vertex" and b.pixels.shown and not compare.pixels.shown
+    assert c.store.undo_label() == "Gouraud vs per-pixel"  # one undo step
+    a_img = picture(compare)  # (side B follows side A's frame)
+    b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    errors, mask = b.errors
+    # the errors are the two pictures' differences, pixel by pixel (within the rasteriser's
+    # rounding of the interpolated colours) where nothing is drawn over the mesh
+    seen = np.zeros(mask.shape, np.int64)
+    seen[mask] = errors
+    free = interior(mask) & ~overlays(compare)
+    free[:60] = False  # (the captions)
+    shown = np.abs(a_img - b_img).max(axis=2)
+    assert free.sum() > 5000 and np.abs(shown[free] - seen[free]).max() <= 1
+    f = b.figures
+    assert f.pixels == mask.sum() == errors.size
+    assert f.max_levels == errors.max() > 10  # Gouraud misses the highlight's shape
+    assert f.p95_levels == pytest.approx(np.percentile(errors, 95))
+    assert f.share == pytest.approx(np.count_nonzero(errors > 2) / errors.size)
+    assert 0.0 < f.vertex_ms < 1e5 and 0.0 < f.pixel_ms < 1e5
+    line = f.line()
+    assert f"error: max {f.max_levels}, p95 {f.p95_levels:.0f} levels" in line
+    for view in (compare.view, b.view):  # the line in both panes
+        assert view.caption.GetInput().endswith(line)
+    assert "per-vertex" in compare.view.caption.GetInput()
+    assert "per-pixel" in b.view.caption.GetInput()
+
+
+def test_gouraud_vs_per_pixel_difference_draws_the_heat_map_per_pixel(compare):
+    c, b = compare.controller, compare.side_b
+    intents.run("gouraud_vs_per_pixel", c, {})  # View > Gouraud vs per-pixel
+    c.act(M.set_compare_difference, True)
+    picture(compare)
+    errors, mask = b.errors
+    b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    want = heat_map(_levels(errors, mask), mask, vmax=VMAX)
+    free = interior(mask) & ~overlays(compare)
+    free[:60] = False
+    assert np.abs(b_img[free] - want[free]).max() == 0  # the map, texel for pixel
+    c.act(M.set_compare_difference, False)
+    picture(compare)
+    b_img = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    assert np.abs(b_img[free] - b.pixels.rgb[free]).max() == 0  # the picture again
+
+
+def _levels(errors, mask):
+    out = np.zeros(mask.shape, np.int64)
+    out[mask] = errors
+    return out
+
+
+@pytest.mark.parametrize(
+    ("ms", "vertex_ms", "falls_back"), [(30.0, 10.0, True), (15.0, 10.0, False)]
+)
+def test_a_camera_drag_falls_back_to_per_vertex_when_per_pixel_costs_twice(
+    torus, ms, vertex_ms, falls_back
+):
+    c, layer = torus.controller, torus.pixels
+    c.set_value("shading", "per-pixel")
+    picture(torus)
+    made = layer.live.gbuffers
+    torus.begin_drag()
+    c.set_value("kd", 0.4)  # a slider drag moves no camera: per pixel still
+    assert layer.shown and not layer.fallback
+    layer.ms, layer.vertex_ms = ms, vertex_ms  # what the last frames measured
+    torus.plotter.camera.Azimuth(20.0)
+    torus.plotter.render_window.Render()  # a frame of the camera drag
+    assert layer.fallback is falls_back and layer.shown is not falls_back
+    said = [m for m in c.ports.messages.messages if "camera drag drawn per vertex" in m[1]]
+    assert bool(said) is falls_back
+    assert layer.live.gbuffers == made + (0 if falls_back else 1)
+    torus.end_drag()  # the release: per pixel again, for the camera where the drag ended
+    assert layer.shown and not layer.fallback and layer.live.gbuffers == made + 1
+    assert against_reference(torus)[0] <= 1
+
+
+def test_a_cube_lit_near_a_face_shows_the_highlight_per_pixel_only(tmp_path, monkeypatch):
+    light = ("--light-type", "point", "--light-position", "0.2", "0.3", "1.6")
+    args = ("--preset", "glossy_plastic", *light, "--viewer-eye", "0.4", "0.6", "6")
+    view = make_port("cube", tmp_path, monkeypatch, *args)
+    try:
+        c = view.controller
+        for handle in view.view.handles:
+            handle.Off()
+        vertex = picture(view)
+        c.set_value("shading", "per-pixel")
+        for handle in view.view.handles:
+            handle.Off()  # (the light's handle is right over the highlight)
+        pixel = picture(view)
+        s = c.state
+        ref = reference(s.shown_scene(), view.view.mesh, SIZE, camera=s.camera)
+        peak = ref.peak_index()
+        x0, y0, bw, bh = view.view.lobe.box
+        assert peak is not None and not (peak[1] <= x0 + bw and peak[0] >= SIZE[1] - y0 - bh)
+        want = ref.image(BACKGROUND)[peak].astype(int)
+        assert np.abs(pixel[peak] - want).max() <= 1  # the peak where the engine puts it
+        white = want.min()  # (a highlight is whiter than the blue plastic: its least channel)
+        assert white > 150  # a highlight...
+        assert vertex[peak].min() < white - 100  # ...that per vertex does not show
+        face = interior(ref.mask)
+        face[SIZE[1] - y0 - bh :, : x0 + bw + 1] = False  # (the inset)
+        face &= ~handle_disks(view)  # (the selected light's ring, drawn with its handle off)
+        assert vertex[face].min(axis=1).max() < white - 100  # anywhere on the cube
+    finally:
+        view.plotter.close()
+
+
+def test_a_mesh_switch_in_per_pixel_mode_draws_the_new_mesh_per_pixel(torus):
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    c.files.choose_mesh("cube")
+    assert torus.view.mesh is c.meshes["cube"] and torus.pixels.shown
+    worst, off, edge, ref = against_reference(torus)
+    assert ref.mask.sum() > 5000 and worst <= 1 and off <= 0.05 * edge
+
+
+def test_the_per_pixel_view_carries_every_setting_of_the_state(torus):
+    """A spot that casts shadows, HDR with a tone map, Fresnel, an infinite viewer and a
+    hidden term: the view's per-pixel picture is still the engine's for the state."""
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    settings = {"type": "spot", "cutoff": 40.0, "shadows": True, "hdr": True}
+    settings.update(tone_map="aces", fresnel=0.2, local_viewer=False, show_ambient=False)
+    for key, value in settings.items():
+        c.set_value(key, value, merge=False)
+    s = c.state
+    assert s.selected_light.shadows and s.scene.hdr.tone_map == "aces" and not s.local_viewer
+    worst, off, edge, ref = against_reference(torus)
+    assert worst <= 1 and off <= 0.05 * edge
