@@ -15,13 +15,16 @@ from explorer.app.session import load_session, save_session
 from explorer.app.start import first_state
 from explorer.core.controls import CONTROLS
 from explorer.core.errors import ExplorerError
+from explorer.core.presets import list_presets
 from explorer.core.lights import DirectionalLight, PointLight, SpotLight
 from explorer.core.scene import Scene
 from explorer.geometry.meshes import get_mesh
 
 ROOT = Path(__file__).resolve().parents[2]
-#: a value for each row, other than the start's (a spot light, the HDR display on)
+#: a value for each row, other than the start's (a spot light and a point light, the HDR
+#: display and the compare view on)
 SAMPLES = {
+    "preset": "jade",
     "ka": 0.1,
     "kd": 0.3,
     "ks": 0.9,
@@ -52,7 +55,15 @@ SAMPLES = {
     "exposure": 1.5,
     "tone_map": "aces",
     "local_viewer": False,
+    "light": 1,
+    "difference": True,
+    "compare": False,
+    "compare_preset": "jade",
+    "compare_model": "threejs",
+    "compare_difference": True,
 }
+#: the presets a preset row's edit is given (the controller's)
+PRESETS = list_presets()
 
 
 @pytest.fixture(scope="module")
@@ -61,10 +72,15 @@ def mesh():
 
 
 def start(mesh, **scene) -> M.State:
-    """A spot light (every light row shown) and the HDR display on (its rows shown)."""
-    lights = (SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),)
+    """A spot light selected (every light row shown) and a point light, the HDR display on (its
+    rows shown) and the compare view on (side B's rows shown)."""
+    lights = (
+        SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),
+        PointLight(position=(2.0, 2.0, 0.0)),
+    )
     base = Scene(lights=lights, hdr={"exposure": 0.0, "tone_map": "reinhard"})
-    return first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
+    s = first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
+    return M.set_compare(s, True)
 
 
 def test_every_row_is_one_declared_control():
@@ -73,8 +89,8 @@ def test_every_row_is_one_declared_control():
         assert r.kind in P.KINDS and r.tab in P.TABS, r.key
         if r.kind in ("number", "triple"):
             assert r.key in CONTROLS, r.key  # its range, scale and decimals: core.controls
-        if r.kind == "choice":
-            assert r.choices, r.key
+        if r.kind in ("choice", "list"):  # fixed values, or items (the state's, a catalogue's)
+            assert bool(r.choices) + (r.items is not None) + bool(r.source) == 1, r.key
     assert set(SAMPLES) == set(P.BY_KEY)  # every row is tried below
     with pytest.raises(ExplorerError, match="no control named 'glossiness'"):
         P.row("glossiness")
@@ -86,16 +102,19 @@ def test_each_row_edits_the_state_in_one_undo_step_that_a_session_keeps(key, mes
     r = P.row(key)
     assert r.visible(s)
     store = M.Store(s)
-    action, args, label = P.edit(s, key, SAMPLES[key])
+    action, args, label = P.edit(s, key, SAMPLES[key], PRESETS)
     assert store.apply(action, *args, label=label)
     new = store.state
     if key == "hdr":  # the display off: its own value, and its rows hidden
         assert not r.value(new) and not P.row("exposure").visible(new)
+    elif key == "compare":  # the view off: side B's rows hidden
+        assert not r.value(new) and not P.row("compare_preset").visible(new)
     elif key == "type":
         assert new.selected_light.type == "point"
     else:
         assert r.value(new) == pytest.approx(SAMPLES[key]), key
-    assert store.undo_label() == r.undo_label
+    # a preset's step says the preset (``preset jade``, ``B jade``); another the row's label
+    assert store.undo_label() == (f"{label.split()[0]} jade" if r.source else r.undo_label)
     path = save_session(tmp_path / "s.yaml", new)
     again, _ = load_session(path)
     assert r.value(again) == pytest.approx(r.value(new)), key
@@ -111,11 +130,12 @@ def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
         (DirectionalLight(), ("attenuation", "cutoff", "exponent")),
     ):
         t = M.State(scene=s.scene.replace(lights=(light,)), mesh="icosphere")
-        shown = {r.key for r in P.rows("lights") if r.visible(t)}
+        shown = {r.key for r in P.rows("lights") if r.visible(t)} - {"light"}  # the list
         assert shown == set(light.CONTROL_KEYS)
         assert not set(hidden) & set(light.CONTROL_KEYS)
     none = M.State(scene=s.scene.replace(lights=()), mesh="icosphere")
-    assert not any(r.visible(none) for r in P.rows("lights"))
+    assert [r.key for r in P.rows("lights") if r.visible(none)] == ["light"]  # empty
+    assert P.row("light").value(none) is None
     store = M.Store(start(mesh, lights=(PointLight(),)))
     with pytest.raises(ExplorerError, match="'cutoff' cannot be set on a point light"):
         action, args, _ = P.edit(store.state, "cutoff", 10.0)
@@ -144,10 +164,13 @@ def test_client_keys_name_every_state_key_a_row_lets_the_page_set_with_its_kind(
             assert keys[f"{r.key}_step"] == "number"
         elif r.kind in ("choice", "toggle"):
             assert keys[r.key] == ("text" if r.kind == "choice" else "bool")
+        elif r.kind == "list":  # a preset's name, a light's index
+            assert keys[r.key] == ("text" if r.source else "index")
         else:  # typed text and picks go to the page's handlers, not the state
             assert r.key not in keys
     assert keys["fresnel_on"] == "bool" and keys["tone_map"] == "text"
-    assert keys["show_specular"] == keys["shadows"] == keys["hdr"] == "bool"
+    assert keys["show_specular"] == keys["shadows"] == keys["hdr"] == keys["compare"] == "bool"
+    assert keys["preset"] == keys["compare_preset"] == "text" and keys["light"] == "index"
 
 
 def test_no_front_end_module_names_a_light_type():

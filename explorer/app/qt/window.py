@@ -23,6 +23,7 @@ import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
+from explorer.app import panelmodel
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker
 from explorer.app.qt.compare import CompareView
@@ -194,8 +195,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
 
     # -- ports: choices ------------------------------------------------------------------------
     def show_presets(self, presets) -> None:
-        self.panel.material.set_presets(presets)
-        self.panel.view.set_presets(presets)
+        self.panel.show_items("presets", panelmodel.preset_items(presets))
 
     def show_meshes(self, labels) -> None:
         self.panel.view.set_meshes(labels)

@@ -30,7 +30,7 @@ import tempfile
 import time
 from collections.abc import Sequence
 
-from explorer.app import intents
+from explorer.app import intents, panelmodel
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker
@@ -219,7 +219,7 @@ class WebExplorer:
 
     # -- Choices ---------------------------------------------------------------------------------
     def show_presets(self, presets: list) -> None:
-        self.server.state.presets = [panel.preset_item(p) for p in presets]
+        self.server.state.presets = [panel.item(i) for i in panelmodel.preset_items(presets)]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
         self.server.state.meshes = [{"title": t, "value": self.mesh_values.page(n)}

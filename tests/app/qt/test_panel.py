@@ -358,10 +358,12 @@ def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
 
 # -- issue 38: the panel model's rows ----------------------------------------------------------
 def every_row_shown(c) -> None:
-    """A spot light, the HDR display and Fresnel on: every row of the panel model is shown."""
+    """A spot light, the HDR display, Fresnel and the compare view on: every row of the panel
+    model is shown."""
     from explorer.app import panelmodel as P
 
     c.act(M.set_light_type, "spot", label="light type")
+    assert c.set_value("compare", True, merge=False)
     assert c.set_value("hdr", True, merge=False)
     assert c.set_value("fresnel", P.row("fresnel").optional, merge=False)
 
@@ -372,6 +374,8 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     from explorer.app import panelmodel as P
 
     every_row_shown(win.controller)
+    # the lists and the views' toggles are rows too, drawn by no code of the tab's own
+    assert {"preset", "light", "difference", "compare", "compare_preset"} <= set(P.BY_KEY)
     for r in P.ROWS:
         tab = getattr(win.panel, r.tab)
         for name in P.names(r):

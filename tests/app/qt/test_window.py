@@ -130,8 +130,8 @@ def test_model_terms_and_presets(win, qtbot):
     tab.search.setText("green")
     shown = [tab.presets.item(i).text() for i in range(tab.presets.count())
              if not tab.presets.item(i).isHidden()]  # fmt: skip
-    assert shown and all("green" in n or "green" in tab._infos[n].material.description.lower()
-                         for n in shown)  # fmt: skip
+    described = {it.title: it.subtitle for it in tab.rows.items["preset"]}
+    assert shown and all("green" in n or "green" in described[n].lower() for n in shown)
     item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
     tab.search.clear()
     tab.presets.scrollToItem(item)

@@ -34,17 +34,21 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     wait("the view tab", lambda: shown(browser, "hdr"))
     click(browser, "hdr")
     wait("the HDR display's rows", lambda: shown(browser, "exposure"))
+    click(browser, "compare")
+    wait("side B's rows", lambda: shown(browser, "compare_preset"))
     click(browser, "material tab")
     wait("the material tab", lambda: shown(browser, "fresnel_on"))
     click(browser, "fresnel_on")
     wait("fresnel's number", lambda: shown(browser, "fresnel"))
+    # the lists and the views' toggles are rows too, drawn by no code of the page's own
+    assert {"preset", "light", "difference", "compare", "compare_preset"} <= set(P.BY_KEY)
     for tab in P.TABS:
         click(browser, f"{tab} tab")
         wait(f"the {tab} tab", lambda t=tab: shown(browser, P.rows(t)[0].key))
         for r in P.rows(tab):
             for name in P.names(r):
                 assert shown(browser, name), (tab, name)
-    for _ in range(3):  # fresnel, hdr, the spot: back to the start
+    for _ in range(4):  # fresnel, compare, hdr, the spot: back to the start
         click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
 
