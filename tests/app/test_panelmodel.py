@@ -15,8 +15,8 @@ from explorer.app.session import load_session, save_session
 from explorer.app.start import first_state
 from explorer.core.controls import CONTROLS
 from explorer.core.errors import ExplorerError
-from explorer.core.presets import list_presets
 from explorer.core.lights import DirectionalLight, PointLight, SpotLight
+from explorer.core.presets import list_presets
 from explorer.core.scene import Scene
 from explorer.geometry.meshes import get_mesh
 
@@ -174,9 +174,10 @@ def test_client_keys_name_every_state_key_a_row_lets_the_page_set_with_its_kind(
 
 
 def test_no_front_end_module_names_a_light_type():
-    """Which controls a light has is the light's (its CONTROL_KEYS): the Qt panel and the web
-    modules hold no light-type rule."""
-    files = [*ROOT.glob("explorer/app/qt/*.py"), *ROOT.glob("explorer/app/web/*.py")]
+    """Which controls a light has is the light's (its CONTROL_KEYS), and what its handle
+    shows (its GLYPH): the Qt panel, the web modules and the toolkit-free kit (the view among
+    them) hold no light-type rule."""
+    files = [*ROOT.glob("explorer/app/**/*.py")]
     assert len(files) > 10, files  # both front ends' modules are read
     pattern = re.compile(r"""["'](directional|point|spot)["']|\.type\s*(==|!=|in)\s*[("']""")
     found = [

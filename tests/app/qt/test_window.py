@@ -166,7 +166,7 @@ def test_every_light_control(win):
     tab.type.activated.emit(2)  # spot
     light = win.controller.state.selected_light
     assert light.type == "spot" and tab.cutoff.isVisibleTo(tab)
-    assert win.view.glyph_kind == "spot"
+    assert win.view.glyph_kind == "cone"
     tab.cutoff.field.setValue(12.0)
     tab.exponent.field.setValue(3.0)
     light = win.controller.state.selected_light
@@ -174,7 +174,7 @@ def test_every_light_control(win):
     tab.colour.open_dialog().colorSelected.emit(QtGui.QColor(255, 128, 0))
     assert M.light_colour(win.controller.state.selected_light)[0][1] == pytest.approx(128 / 255)
     tab.type.activated.emit(0)  # directional: an arrow, no attenuation
-    assert win.view.glyph_kind == "directional" and not tab.attenuation_box.isVisibleTo(tab)
+    assert win.view.glyph_kind == "arrow" and not tab.attenuation_box.isVisibleTo(tab)
     win.render()
     drawn_equals_engine(win)
 
