@@ -95,7 +95,7 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     # a preset covers the whole mesh; undo brings the groups back; so does the button
     tab = win.panel.material
     item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
-    tab._chosen(item)
+    tab.presets.itemClicked.emit(item)  # a click on it
     s = win.controller.state
     assert s.groups is None and s.preset == "jade" and box.use.isVisibleTo(win.panel)
     assert not box.group_row.isVisibleTo(win.panel)
