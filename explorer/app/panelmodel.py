@@ -10,8 +10,10 @@ A row says what a control is, never how a toolkit draws it:
 - ``tab`` (``material``, ``lights``, ``view``), ``group`` (rows drawn together: a grid of
   colours, a line of toggles) and ``kind``: ``number`` (a slider and a field; range, scale,
   decimals and unit from :data:`explorer.core.controls.CONTROLS`), ``colour`` (r, g, b),
-  ``choice`` (one of ``choices``), ``toggle`` (on / off), ``triple`` (three numbers) or
-  ``list`` (one of a list of :class:`Item`: the presets, the scene's lights);
+  ``choice`` (one of ``choices``), ``toggle`` (on / off), ``triple`` (three numbers),
+  ``list`` (one of a list of :class:`Item`: the presets, the scene's lights) or ``button`` (an
+  action that takes no value: add a light, swap A and B; its value is whether it can be
+  pressed now, and ``set_value(key, True)`` presses it);
 - ``value(state)`` what it shows, ``visible(state)`` whether it is shown, and ``edit(state,
   value)`` the model action that sets it: the one table of the edits
   (:func:`edit`, which :meth:`Controller.set_value` applies), so no front end names an action.
@@ -41,7 +43,7 @@ from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS, Material
 
-KINDS = ("number", "colour", "choice", "toggle", "triple", "list")
+KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button")
 TABS = ("material", "lights", "view")
 
 
@@ -300,7 +302,24 @@ def _light_list_rows() -> list[Row]:
             items=lambda s: tuple(
                 Item(i, light_summary(i, lt, s)) for i, lt in enumerate(s.scene.lights)
             ),
-        )
+        ),
+        *(
+            Row(
+                f"{name}_light",
+                "lights",
+                "button",
+                _always if name == "add" else lambda s: s.selected_light is not None,
+                lambda s, v, a=action: (a, ()),
+                group="light_buttons",
+                label=f"{name} light",
+                text=name,
+            )
+            for name, action in (
+                ("add", M.add_light),
+                ("duplicate", M.duplicate_light),
+                ("remove", M.remove_light),
+            )
+        ),
     ]
 
 
@@ -423,6 +442,15 @@ def _compare_rows() -> list[Row]:
             text="B shows A − B",
             tip="pane B shows the difference of the two sides' colours (largest channel, "
             "1/255 levels, the difference view's colours)",
+        ),
+        Row(
+            "swap",
+            "view",
+            "button",
+            _always,
+            lambda s, v: (M.swap_compare, ()),
+            label="swap A and B",
+            text="swap A and B",
         ),
     ]
     return [

@@ -61,6 +61,11 @@ SAMPLES = {
     "compare_preset": "jade",
     "compare_model": "threejs",
     "compare_difference": True,
+    # a button's value is whether it can be pressed (still so after each press here)
+    "add_light": True,
+    "duplicate_light": True,
+    "remove_light": True,
+    "swap": True,
 }
 #: the presets a preset row's edit is given (the controller's)
 PRESETS = list_presets()
@@ -122,6 +127,26 @@ def test_each_row_edits_the_state_in_one_undo_step_that_a_session_keeps(key, mes
     assert r.value(store.state) == r.value(s)
 
 
+def test_a_button_row_applies_its_action_and_says_when_it_can_be_pressed(mesh):
+    s = start(mesh)
+    store = M.Store(s)
+    for key, n in (("add_light", 3), ("duplicate_light", 4), ("remove_light", 3)):
+        action, args, label = P.edit(store.state, key, True)
+        store.apply(action, *args, label=label)
+        assert len(store.state.scene.lights) == n and store.undo_label() == label
+    assert label == "remove light"
+    none = M.State(scene=s.scene.replace(lights=()), mesh="icosphere")
+    assert [P.row(k).value(none) for k in ("add_light", "duplicate_light", "remove_light")] == [
+        True,
+        False,
+        False,
+    ]
+    action, args, _ = P.edit(s, "swap", True)
+    swapped = action(s, *args)
+    assert (swapped.compare_model, swapped.scene.model) == (s.scene.model, s.compare_model)
+    assert not P.row("swap").visible(M.set_compare(s, False))
+
+
 def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
     s = start(mesh)
     for light, hidden in (
@@ -130,11 +155,13 @@ def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
         (DirectionalLight(), ("attenuation", "cutoff", "exponent")),
     ):
         t = M.State(scene=s.scene.replace(lights=(light,)), mesh="icosphere")
-        shown = {r.key for r in P.rows("lights") if r.visible(t)} - {"light"}  # the list
+        lists = {"light", "add_light", "duplicate_light", "remove_light"}  # the scene's
+        shown = {r.key for r in P.rows("lights") if r.visible(t)} - lists
         assert shown == set(light.CONTROL_KEYS)
         assert not set(hidden) & set(light.CONTROL_KEYS)
     none = M.State(scene=s.scene.replace(lights=()), mesh="icosphere")
-    assert [r.key for r in P.rows("lights") if r.visible(none)] == ["light"]  # empty
+    shown = [r.key for r in P.rows("lights") if r.visible(none)]
+    assert shown == ["light", "add_light", "duplicate_light", "remove_light"]
     assert P.row("light").value(none) is None
     store = M.Store(start(mesh, lights=(PointLight(),)))
     with pytest.raises(ExplorerError, match="'cutoff' cannot be set on a point light"):

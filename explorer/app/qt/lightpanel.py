@@ -19,20 +19,12 @@ class LightsTab(QtWidgets.QWidget):
     """The scene's lights (the list; add, duplicate, remove) and the selected light's
     controls."""
 
-    def __init__(self, act, send, parent=None):
+    def __init__(self, send, parent=None):
         super().__init__(parent)
         box = _form(self)
-        buttons = QtWidgets.QHBoxLayout()
-        self.buttons = {}
-        for name, action in (("add", M.add_light), ("duplicate", M.duplicate_light),
-                             ("remove", M.remove_light)):  # fmt: skip
-            b = QtWidgets.QPushButton(name)
-            b.setObjectName(f"{name}_light")
-            b.clicked.connect(lambda _=False, a=action, n=name: act(a, label=f"{n} light"))
-            buttons.addWidget(b)
-            self.buttons[name] = b
-        self.rows = RowWidgets(panelmodel.rows("lights"), box, send, self, {"light": [buttons]})
+        self.rows = RowWidgets(panelmodel.rows("lights"), box, send, self)
         self.list, self.sliders = self.rows.widgets["light"], self.rows.sliders
+        self.buttons = {n: self.rows.widgets[f"{n}_light"] for n in ("add", "duplicate", "remove")}
         self.type, self.colour = self.rows.widgets["type"], self.rows.widgets["color"]
         self.attenuation_box = self.rows.widgets["attenuation"]
         self.attenuation = self.rows.fields["attenuation"]
@@ -43,10 +35,7 @@ class LightsTab(QtWidgets.QWidget):
 
     def show_state(self, s: M.State) -> None:
         self.rows.show_state(s)
-        light = s.selected_light
-        self.none.setVisible(light is None)
-        self.buttons["remove"].setEnabled(light is not None)
-        self.buttons["duplicate"].setEnabled(light is not None)
+        self.none.setVisible(s.selected_light is None)
 
 
 class MaterialTab(QtWidgets.QWidget):
@@ -90,7 +79,7 @@ class ViewTab(QtWidgets.QWidget):
     """The mesh chooser, then the view tab's rows (the difference view, with its legend and
     advice; the compare view, with the swap button; the scene's effects)."""
 
-    def __init__(self, act, choose_mesh, send, parent=None):
+    def __init__(self, choose_mesh, send, parent=None):
         super().__init__(parent)
         box = _form(self)
         row = QtWidgets.QHBoxLayout()
@@ -112,13 +101,10 @@ class ViewTab(QtWidgets.QWidget):
         for w, name in ((self.legend, "legend"), (self.advice, "advice")):
             w.setObjectName(name)
             w.setWordWrap(True)
-        self.swap = QtWidgets.QPushButton("swap A and B")
-        self.swap.setObjectName("swap")
-        self.swap.clicked.connect(lambda: act(M.swap_compare, label="swap A and B"))
-        after = {"difference": [self.legend, self.advice], "compare_difference": [self.swap]}
+        after = {"difference": [self.legend, self.advice]}
         self.rows = RowWidgets(panelmodel.rows("view"), box, send, self, after)
         w = self.rows.widgets
-        self.difference, self.compare = w["difference"], w["compare"]
+        self.difference, self.compare, self.swap = w["difference"], w["compare"], w["swap"]
         self.compare_preset, self.compare_difference = w["compare_preset"], w["compare_difference"]
         box.addStretch(1)
 
@@ -137,7 +123,6 @@ class ViewTab(QtWidgets.QWidget):
         self.mesh_info.setToolTip(s.mesh)
         self.legend.setVisible(s.difference)
         self.advice.setVisible(s.difference)
-        self.swap.setVisible(s.compare is not None)
 
 
 class Panel(QtWidgets.QTabWidget):
@@ -153,8 +138,8 @@ class Panel(QtWidgets.QTabWidget):
         super().__init__(parent)
         self.setObjectName("panel")
         self.material = MaterialTab(act, send)
-        self.lights = LightsTab(act, send)
-        self.view = ViewTab(act, choose_mesh, send)
+        self.lights = LightsTab(send)
+        self.view = ViewTab(choose_mesh, send)
         self.areas = [_scroll(self.material), _scroll(self.lights), _scroll(self.view)]
         for area, name in zip(self.areas, ("material", "lights", "view"), strict=True):
             area.setObjectName(f"{name}_scroll")

@@ -1,14 +1,16 @@
 """The panel's rows drawn in Qt: one widget factory per kind of
-:class:`~explorer.app.panelmodel.Row` (number, colour, choice, toggle, triple, list). Nothing
-here knows a control: :class:`RowWidgets` builds the widgets of any rows, shows a state in them
-(:meth:`RowWidgets.show_state`: each row's ``visible``, ``value`` and items, signals blocked)
-and sends every edit as ``set_value(key, value, merge=...)`` (the controller's one dialect).
+:class:`~explorer.app.panelmodel.Row` (number, colour, choice, toggle, triple, list, button).
+Nothing here knows a control: :class:`RowWidgets` builds the widgets of any rows, shows a state
+in them (:meth:`RowWidgets.show_state`: each row's ``visible``, ``value`` and items, signals
+blocked) and sends every edit as ``set_value(key, value, merge=...)`` (the controller's one
+dialect).
 
 Every row's widget (or the box of one drawn as several widgets) is named like its key, as
 object name and accessible name; a row's label is its caption (its key unless it says other
-words: a term's toggle its term). A list is a list widget (a searched one with its search field
-``<key>_search`` above and its selected item's subtitle ``<key>_description`` below); a choice
-whose values are not fixed (side B's preset) a combo box of its items.
+words: a term's toggle its term). A list is a list widget (a searched one with its search
+field ``<key>_search`` above and its selected item's subtitle ``<key>_description`` below); a
+choice whose values are not fixed (side B's preset) a combo box of its items; a button is
+enabled when its value says it can be pressed.
 """
 
 from __future__ import annotations
@@ -38,15 +40,16 @@ def _named(widget: QtWidgets.QWidget, name: str, tip: str = "") -> QtWidgets.QWi
 
 class RowWidgets(QtCore.QObject):
     """The widgets of ``rows`` added to ``box`` (a ``QVBoxLayout``) in order; rows of one
-    ``group`` share a grid (colours) or a line (toggles, in a group of their own).
+    ``group`` share a grid (colours) or a line (toggles, buttons, in a group of their own).
 
     send(key, value, merge=...) : the edit (``Controller.set_value``)
     after : key -> the front end's own widgets or layouts drawn after that row (the difference
-        view's legend, the swap button); they show and hide themselves
+        view's legend); they show and hide themselves
     ``rejected(message)``: a typed value was refused; ``widgets[key]``: each row's widget
     (a :class:`ValueSlider`, :class:`ColourButton`, ``QComboBox``, ``QCheckBox``,
-    ``QListWidget``, or the box of radio buttons / three fields), ``parts[key]``: every widget
-    the row shows or hides; ``items[key]``: a list's (or a choice's) items shown.
+    ``QListWidget``, ``QPushButton``, or the box of radio buttons / three fields),
+    ``parts[key]``: every widget the row shows or hides; ``items[key]``: a list's (or a
+    choice's) items shown.
     """
 
     rejected = QtCore.Signal(str)
@@ -67,11 +70,11 @@ class RowWidgets(QtCore.QObject):
         grids: dict[str, QtWidgets.QGridLayout] = {}
         lines: dict[str, QtWidgets.QHBoxLayout] = {}
         for r in self.rows:
-            if r.kind == "toggle" and r.group:
+            if r.kind in ("toggle", "button") and r.group:
                 if r.group not in lines:
                     lines[r.group] = QtWidgets.QHBoxLayout()
                     box.addLayout(lines[r.group])
-                self._add(r, self._toggle(r), lines[r.group])
+                self._add(r, getattr(self, f"_{r.kind}")(r), lines[r.group])
             elif r.kind in ("colour", "choice") and not r.inline:
                 key = r.group or r.key
                 if key not in grids:
@@ -91,8 +94,9 @@ class RowWidgets(QtCore.QObject):
                 self._add(r, getattr(self, f"_{r.kind}")(r), box)
             for extra in (after or {}).get(r.key, ()):
                 (box.addLayout if isinstance(extra, QtWidgets.QLayout) else box.addWidget)(extra)
-        for line in lines.values():
-            line.addStretch(1)
+        for r in self.rows:  # a line of toggles keeps them left; buttons share its width
+            if r.kind == "toggle" and r.group in lines:
+                lines.pop(r.group).addStretch(1)
 
     def _add(self, r: Row, widget: QtWidgets.QWidget, layout) -> None:
         layout.addWidget(widget)
@@ -167,6 +171,11 @@ class RowWidgets(QtCore.QObject):
         c = _named(QtWidgets.QCheckBox(r.caption), r.key, r.tip)
         c.toggled.connect(lambda on, k=r.key: self.send(k, on, merge=False))
         return c
+
+    def _button(self, r: Row) -> QtWidgets.QWidget:
+        b = _named(QtWidgets.QPushButton(r.caption), r.key, r.tip)
+        b.clicked.connect(lambda _=False, k=r.key: self.send(k, True, merge=False))
+        return b
 
     def _triple(self, r: Row) -> QtWidgets.QWidget:
         """Three number fields (the attenuation's kc, kl, kq), a row a part (a narrow panel),
@@ -321,6 +330,9 @@ class RowWidgets(QtCore.QObject):
                 w.scrollToItem(w.item(i))
         if r.key in self.descriptions:
             self._describe(r, i)
+
+    def _show_button(self, r: Row, w, v, s) -> None:
+        w.setEnabled(bool(v))
 
     def _show_triple(self, r: Row, w, v, s) -> None:
         for f, x in zip(self.fields[r.key], v, strict=True):

@@ -122,6 +122,14 @@ def _checkbox(v3, key: str, label: str, tip: str) -> None:
     v3.VCheckbox(v_model=(key, False), label=label, **_shown_as(key, tip))
 
 
+def _button(v3, ctrl, r) -> None:
+    """A button row: pressed through the server's ``press`` handler, disabled while its state
+    key (whether it can be pressed) is false, hidden while it is null."""
+    v3.VBtn(r.caption, click=(ctrl.press, f"['{r.key}']"), size="small", classes="mr-1 my-1",
+            disabled=(f"!{r.key}",), v_show=f"{r.key} != null", title=r.tip,
+            raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+
+
 def _triple(v3, ctrl, r) -> None:
     v3.VTextField(
         model_value=(r.key, ""), label=f"{r.key} ({', '.join(r.choices)})", variant="outlined",
@@ -133,15 +141,16 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     """The rows of ``tab`` (:mod:`explorer.app.panelmodel`), one factory per kind; a group of
     toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
     key is null (the row is not shown). ``after``: key -> a function that draws the page's own
-    controls after that row (the light buttons, the difference view's legend, swap)."""
+    controls after that row (the difference view's legend)."""
     line, group = None, None
     for r in panelmodel.rows(tab):
-        if r.kind == "toggle" and r.group:
+        if r.kind in ("toggle", "button") and r.group:
             if r.group != group:
                 line = html.Div(classes="d-flex")
                 group = r.group
             with line:
-                _checkbox(v3, r.key, r.caption, r.tip)
+                (_button(v3, ctrl, r) if r.kind == "button" else
+                 _checkbox(v3, r.key, r.caption, r.tip))  # fmt: skip
         elif r.kind == "number":
             if r.optional is not None:
                 _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
@@ -152,9 +161,11 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
             _choice(v3, r)
         elif r.kind == "toggle":
             _checkbox(v3, r.key, r.caption, r.tip)
+        elif r.kind == "button":
+            _button(v3, ctrl, r)
         else:
             _triple(v3, ctrl, r)
-        group = r.group if r.kind == "toggle" else None
+        group = r.group if r.kind in ("toggle", "button") else None
         (after or {}).get(r.key, lambda: None)()
 
 
@@ -184,14 +195,7 @@ def _material_tab(v3, html, ctrl) -> None:
 
 def _lights_tab(v3, html, ctrl) -> None:
     """The light list, add / duplicate / remove, and the selected light."""
-
-    def buttons():
-        with html.Div(classes="d-flex my-1"):
-            for name in ("add", "duplicate", "remove"):
-                v3.VBtn(name, click=getattr(ctrl, f"{name}_light"), size="small",
-                        classes="mr-1", raw_attrs=[f'aria-label="{name} light"'])  # fmt: skip
-
-    _rows(v3, html, ctrl, "lights", {"light": buttons})
+    _rows(v3, html, ctrl, "lights")
 
 
 def _view_tab(v3, html, ctrl) -> None:
@@ -210,11 +214,7 @@ def _view_tab(v3, html, ctrl) -> None:
     def legend():
         html.Div("{{ legend }}", classes="text-caption", v_show="difference")
 
-    def swap():
-        v3.VBtn("swap A and B", click=ctrl.swap_sides, size="small", v_show="compare",
-                raw_attrs=['aria-label="swap"'])  # fmt: skip
-
-    _rows(v3, html, ctrl, "view", {"difference": legend, "compare_difference": swap})
+    _rows(v3, html, ctrl, "view", {"difference": legend})
     _turntable(v3, html, ctrl)
 
 

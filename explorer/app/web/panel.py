@@ -233,7 +233,8 @@ def _numbers(app) -> None:
 
 def _rows(app, user) -> None:
     """The choices', the toggles', the lists' and the optional numbers' switches' handlers:
-    each ``set_value`` of its row, when the page's value is not the state's."""
+    each ``set_value`` of its row, when the page's value is not the state's (a button is
+    pressed through ``press``)."""
     c = app.controller
     for r in panelmodel.ROWS:
         if r.kind in ("choice", "toggle", "list"):
@@ -286,14 +287,15 @@ def _choices(app) -> None:
             c.reject_input(MESH_REFUSED)
 
     user("mesh", lambda v, s: v != app.mesh_values.page(s.mesh), choose_mesh)
-    ctrl.swap_sides = app.guard(c.swap_sides, "swap A and B")
-    for name, action in (("add", M.add_light), ("duplicate", M.duplicate_light),
-                         ("remove", M.remove_light)):  # fmt: skip
-        setattr(
-            ctrl,
-            f"{name}_light",
-            app.guard(lambda a=action, n=name: c.act(a, label=f"{n} light"), f"{name} light"),
-        )
+
+    def press(key):
+        """A button row pressed (any other key from the page is refused)."""
+        r = panelmodel.BY_KEY.get(str(key))
+        if r is None or r.kind != "button":
+            raise ExplorerError(f"the page has no button named '{key}'")
+        c.set_value(r.key, True, merge=False)
+
+    ctrl.press = app.guard(press, "button")
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
     ctrl.turntable = app.guard(lambda: app.files.start_turntable(
