@@ -13,7 +13,8 @@ A row says what a control is, never how a toolkit draws it:
   ``choice`` (one of ``choices``), ``toggle`` (on / off), ``triple`` (three numbers),
   ``list`` (one of a list of :class:`Item`: the presets, the scene's lights) or ``button`` (an
   action that takes no value: add a light, swap A and B; its value is whether it can be
-  pressed now, and ``set_value(key, True)`` presses it);
+  pressed now, and ``set_value(key, True)`` presses it) or ``text`` (a line the state says:
+  what the mesh's own materials are; nothing to set);
 - ``value(state)`` what it shows, ``visible(state)`` whether it is shown, and ``edit(state,
   value)`` the model action that sets it: the one table of the edits
   (:func:`edit`, which :meth:`Controller.set_value` applies), so no front end names an action.
@@ -43,7 +44,7 @@ from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS, Material
 
-KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button")
+KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text")
 TABS = ("material", "lights", "view")
 
 
@@ -137,6 +138,59 @@ def preset_items(presets) -> tuple[Item, ...]:
     """The items of a ``source="presets"`` row: each preset (``PresetInfo``) by name, with its
     description and its swatch."""
     return tuple(Item(p.name, p.name, p.material.description or "", p.material) for p in presets)
+
+
+def _read_only(key: str):
+    """A text row's edit: it sets nothing (an :class:`ExplorerError`)."""
+
+    def edit(s: M.State, v):
+        raise ExplorerError(f"'{key}' is a line of text: nothing to set")
+
+    return edit
+
+
+def _mesh_materials_rows() -> list[Row]:
+    """A mesh file's own materials, first in the material tab (shown when the mesh brings
+    some): what is drawn, the group the controls edit, or a button that draws them again."""
+
+    def brings(s: M.State) -> bool:
+        return s.mesh_materials is not None
+
+    def groups(s: M.State) -> tuple[Item, ...]:
+        names = s.mesh_materials.names
+        return tuple(Item(i, names[i] or "(no usemtl)", "", m) for i, m in enumerate(s.groups))
+
+    return [
+        Row(
+            "mesh_materials",
+            "material",
+            "text",
+            M.mesh_materials_line,
+            _read_only("mesh_materials"),
+            brings,
+        ),
+        Row(
+            "group",
+            "material",
+            "choice",
+            lambda s: s.group,
+            lambda s, v: (M.select_group, (int(v),)),
+            lambda s: s.groups is not None,
+            items=groups,
+            tip="the group of the mesh whose material the controls below edit",
+        ),
+        Row(
+            "use_mesh_materials",
+            "material",
+            "button",
+            _always,
+            lambda s, v: (M.use_mesh_materials, ()),
+            lambda s: brings(s) and s.groups is None,
+            label="mesh materials",
+            text="use the mesh's materials",
+            tip="draw each group in the material its file gives (undoable)",
+        ),
+    ]
 
 
 def _preset_rows() -> list[Row]:
@@ -529,6 +583,7 @@ def _view_rows() -> list[Row]:
 
 #: every row, in the order each tab draws them
 ROWS: tuple[Row, ...] = (
+    *_mesh_materials_rows(),
     *_preset_rows(),
     *_material_rows(),
     *_material_effect_rows(),
@@ -595,17 +650,15 @@ def client_keys() -> dict[str, str]:
     ``<key>_step`` and an optional number's switch ``<key>_on``, a choice's value, a toggle's.
     A number's, a colour's and a triple's typed text and a colour's picks are not state: they
     call the page's handlers, which parse what they are given. A list's value is its item's
-    (a preset's name, a light's index)."""
+    (a preset's name, a light's index); a button's and a text's are not the page's to set."""
     out: dict[str, str] = {}
     for r in ROWS:
         if r.kind == "number":
             out[f"{r.key}_step"] = "number"
             if r.optional is not None:
                 out[f"{r.key}_on"] = "bool"
-        elif r.kind == "choice" or r.source:
-            out[r.key] = "text"
-        elif r.kind == "list":
-            out[r.key] = "index"
+        elif r.kind in ("choice", "list"):  # an index into the state's items, or a name
+            out[r.key] = "index" if r.items is not None else "text"
         elif r.kind == "toggle":
             out[r.key] = "bool"
     return out

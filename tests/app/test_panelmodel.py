@@ -67,6 +67,8 @@ SAMPLES = {
     "remove_light": True,
     "swap": True,
 }
+#: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
+MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
 #: the presets a preset row's edit is given (the controller's)
 PRESETS = list_presets()
 
@@ -96,7 +98,7 @@ def test_every_row_is_one_declared_control():
             assert r.key in CONTROLS, r.key  # its range, scale and decimals: core.controls
         if r.kind in ("choice", "list"):  # fixed values, or items (the state's, a catalogue's)
             assert bool(r.choices) + (r.items is not None) + bool(r.source) == 1, r.key
-    assert set(SAMPLES) == set(P.BY_KEY)  # every row is tried below
+    assert set(SAMPLES) | set(MESH_MATERIALS) == set(P.BY_KEY)  # every row is tried below
     with pytest.raises(ExplorerError, match="no control named 'glossiness'"):
         P.row("glossiness")
 
@@ -147,6 +149,35 @@ def test_a_button_row_applies_its_action_and_says_when_it_can_be_pressed(mesh):
     assert not P.row("swap").visible(M.set_compare(s, False))
 
 
+def test_a_mesh_files_own_materials_are_rows_a_line_a_group_and_a_button(tmp_path):
+    from helpers.files import write_two_groups
+
+    from explorer.cli import build_parser
+    from explorer.cli.gui import start_state
+
+    two = write_two_groups(tmp_path)
+    s, _ = start_state(build_parser().parse_args(["gui", "--mesh", str(two)]))
+    line, group, use = (P.row(k) for k in MESH_MATERIALS)
+    assert line.value(s) == M.mesh_materials_line(s) and group.visible(s)
+    assert not use.visible(s)
+    items = group.items(s)
+    assert [i.title for i in items] == list(s.mesh_materials.names)
+    assert [i.swatch for i in items] == list(s.groups)  # each with its swatch
+    with pytest.raises(ExplorerError, match="'mesh_materials' is a line of text"):
+        P.edit(s, "mesh_materials", "x")
+    store = M.Store(s)
+    for key, value in (("group", 1 - s.group), ("preset", "jade"), ("use_mesh_materials", True)):
+        action, args, label = P.edit(store.state, key, value, PRESETS)
+        store.apply(action, *args, label=label)
+        if key == "preset":  # a preset covers the mesh: the button draws the groups again
+            assert not group.visible(store.state) and use.visible(store.state)
+            assert "preset 'jade' covers the whole mesh" in line.value(store.state)
+    assert store.state.groups is not None and store.state.group == 1 - s.group
+    assert store.undo_label() == "mesh materials"
+    none = start(get_mesh("icosphere", 1))
+    assert not any(P.row(k).visible(none) for k in MESH_MATERIALS)
+
+
 def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
     s = start(mesh)
     for light, hidden in (
@@ -189,15 +220,16 @@ def test_client_keys_name_every_state_key_a_row_lets_the_page_set_with_its_kind(
     for r in P.ROWS:
         if r.kind == "number":
             assert keys[f"{r.key}_step"] == "number"
-        elif r.kind in ("choice", "toggle"):
-            assert keys[r.key] == ("text" if r.kind == "choice" else "bool")
-        elif r.kind == "list":  # a preset's name, a light's index
-            assert keys[r.key] == ("text" if r.source else "index")
-        else:  # typed text and picks go to the page's handlers, not the state
+        elif r.kind == "toggle":
+            assert keys[r.key] == "bool"
+        elif r.kind in ("choice", "list"):  # a name, or an index into the state's items
+            assert keys[r.key] == ("index" if r.items is not None else "text"), r.key
+        else:  # typed text, picks and buttons go to the page's handlers, not the state
             assert r.key not in keys
     assert keys["fresnel_on"] == "bool" and keys["tone_map"] == "text"
     assert keys["show_specular"] == keys["shadows"] == keys["hdr"] == keys["compare"] == "bool"
-    assert keys["preset"] == keys["compare_preset"] == "text" and keys["light"] == "index"
+    assert keys["preset"] == keys["compare_preset"] == "text"
+    assert keys["light"] == keys["group"] == "index" and "add_light" not in keys
 
 
 def test_no_front_end_module_names_a_light_type():

@@ -10,7 +10,7 @@ from PySide6 import QtCore, QtWidgets
 
 from explorer.app import model as M
 from explorer.app import panelmodel
-from explorer.app.qt.panel import MeshMaterialsBox, _form, _scroll, guard_wheel
+from explorer.app.qt.panel import _form, _scroll, guard_wheel
 from explorer.app.qt.rows import RowWidgets
 from explorer.core.material import RGB_KEYS
 
@@ -43,16 +43,14 @@ class MaterialTab(QtWidgets.QWidget):
     (:mod:`explorer.app.panelmodel`: the presets, searchable, with descriptions and swatches;
     coefficients, colours, model, terms, the material's effects) and the save button."""
 
-    def __init__(self, act, send, parent=None):
+    def __init__(self, send, parent=None):
         super().__init__(parent)
         box = _form(self)
         self.preset_label = QtWidgets.QLabel("")
         self.preset_label.setObjectName("preset_label")
         self.preset_label.setWordWrap(True)
-        self.mesh_materials = MeshMaterialsBox(act)
-        box.addWidget(self.mesh_materials)
-        box.addWidget(self.preset_label)
         self.rows = RowWidgets(panelmodel.rows("material"), box, send, self)
+        box.insertWidget(box.indexOf(self.rows.searches["preset"]), self.preset_label)
         self.presets, self.search = self.rows.widgets["preset"], self.rows.searches["preset"]
         self.description = self.rows.descriptions["preset"]
         self.sliders = self.rows.sliders
@@ -65,7 +63,6 @@ class MaterialTab(QtWidgets.QWidget):
 
     def show_state(self, s: M.State) -> None:
         self.rows.show_state(s)
-        self.mesh_materials.show_state(s)
         edited = " (edited)" if s.edited else ""
         if s.groups is not None:
             label = s.mesh_materials.label(s.group)
@@ -134,10 +131,10 @@ class Panel(QtWidgets.QTabWidget):
 
     rejected = QtCore.Signal(str)
 
-    def __init__(self, act, choose_mesh, send, parent=None):
+    def __init__(self, choose_mesh, send, parent=None):
         super().__init__(parent)
         self.setObjectName("panel")
-        self.material = MaterialTab(act, send)
+        self.material = MaterialTab(send)
         self.lights = LightsTab(send)
         self.view = ViewTab(choose_mesh, send)
         self.areas = [_scroll(self.material), _scroll(self.lights), _scroll(self.view)]

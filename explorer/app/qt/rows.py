@@ -9,13 +9,13 @@ Every row's widget (or the box of one drawn as several widgets) is named like it
 object name and accessible name; a row's label is its caption (its key unless it says other
 words: a term's toggle its term). A list is a list widget (a searched one with its search
 field ``<key>_search`` above and its selected item's subtitle ``<key>_description`` below); a
-choice whose values are not fixed (side B's preset) a combo box of its items; a button is
-enabled when its value says it can be pressed.
+choice whose values are not fixed (side B's preset, the mesh's groups) a combo box of its items;
+a button is enabled when its value says it can be pressed; a text a label.
 """
 
 from __future__ import annotations
 
-from PySide6 import QtCore, QtWidgets
+from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app.panelmodel import Item, Row
 from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider, swatch
@@ -172,6 +172,11 @@ class RowWidgets(QtCore.QObject):
         c.toggled.connect(lambda on, k=r.key: self.send(k, on, merge=False))
         return c
 
+    def _text(self, r: Row) -> QtWidgets.QWidget:
+        label = _named(QtWidgets.QLabel(""), r.key, r.tip)
+        label.setWordWrap(True)
+        return label
+
     def _button(self, r: Row) -> QtWidgets.QWidget:
         b = _named(QtWidgets.QPushButton(r.caption), r.key, r.tip)
         b.clicked.connect(lambda _=False, k=r.key: self.send(k, True, merge=False))
@@ -255,7 +260,8 @@ class RowWidgets(QtCore.QObject):
             w.clear()
             for it in items:
                 if r.kind == "choice":
-                    w.addItem(it.title)
+                    icon = QtGui.QIcon() if it.swatch is None else swatch(it.swatch, 16)
+                    w.addItem(icon, it.title)
                     continue
                 item = QtWidgets.QListWidgetItem(it.title)
                 if it.swatch is not None:
@@ -330,6 +336,9 @@ class RowWidgets(QtCore.QObject):
                 w.scrollToItem(w.item(i))
         if r.key in self.descriptions:
             self._describe(r, i)
+
+    def _show_text(self, r: Row, w, v, s) -> None:
+        w.setText(v)
 
     def _show_button(self, r: Row, w, v, s) -> None:
         w.setEnabled(bool(v))

@@ -77,7 +77,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.controller = c = Controller(state, mesh, ports, materials_dirs=materials_dirs,
                                          preset_dir=preset_dir, output_dir=output_dir,
                                          last_session=last_session)  # fmt: skip
-        self.panel = Panel(c.act, c.files.choose_mesh, c.set_value)
+        self.panel = Panel(c.files.choose_mesh, c.set_value)
         self.splitter.addWidget(self.panel)
         self.splitter.setSizes([round(w * (1 - PANEL_FRACTION)), round(w * PANEL_FRACTION)])
         self.bar = MessageBar(self)

@@ -217,7 +217,6 @@ def key_table(rows: Iterable[tuple[str, str]]) -> dict[str, str]:
 CLIENT_KEYS: Mapping[str, str] = key_table(
     [
         *panelmodel.client_keys().items(),
-        ("group", "index"),
         ("mesh", "text"),
         ("turntable_frames", "text or number"),
         ("turntable_format", "text"),

@@ -122,6 +122,12 @@ def _checkbox(v3, key: str, label: str, tip: str) -> None:
     v3.VCheckbox(v_model=(key, False), label=label, **_shown_as(key, tip))
 
 
+def _text(html, r) -> None:
+    """A text row: the line its state key holds, hidden while it is null."""
+    html.Div(f"{{{{ {r.key} }}}}", v_show=f"{r.key} != null", classes="text-body-2 mb-1",
+             title=r.tip, raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+
+
 def _button(v3, ctrl, r) -> None:
     """A button row: pressed through the server's ``press`` handler, disabled while its state
     key (whether it can be pressed) is false, hidden while it is null."""
@@ -163,33 +169,17 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
             _checkbox(v3, r.key, r.caption, r.tip)
         elif r.kind == "button":
             _button(v3, ctrl, r)
+        elif r.kind == "text":
+            _text(html, r)
         else:
             _triple(v3, ctrl, r)
         group = r.group if r.kind in ("toggle", "button") else None
         (after or {}).get(r.key, lambda: None)()
 
 
-def _mesh_materials(v3, html, ctrl) -> None:
-    """A mesh file's own materials (shown when the mesh brings some): what is drawn, the group
-    the controls edit, or a button that draws the file's materials again."""
-    with html.Div(v_show="mesh_materials", classes="mb-2 pa-2 border rounded"):
-        html.Div("{{ mesh_materials }}", classes="text-body-2 mb-1",
-                 raw_attrs=['aria-label="mesh_materials"'])  # fmt: skip
-        v3.VSelect(v_model=("group", None), items=("groups", []), label="group",
-                   item_props=True, density="compact", hide_details=True,
-                   v_show="group != null",
-                   title="the group of the mesh whose material the controls below edit",
-                   raw_attrs=['aria-label="group"'])  # fmt: skip
-        v3.VBtn("use the mesh's materials", click=ctrl.use_mesh_materials, size="small",
-                v_show="group == null",
-                title="draw each group in the material its file gives (undoable)",
-                raw_attrs=['aria-label="use_mesh_materials"'])  # fmt: skip
-
-
 def _material_tab(v3, html, ctrl) -> None:
     """The mesh's own materials, the preset, the numbers, the colours, the model and the
     terms."""
-    _mesh_materials(v3, html, ctrl)
     _rows(v3, html, ctrl, "material")
 
 

@@ -74,19 +74,6 @@ def items_key(r: panelmodel.Row) -> str:
     return r.source or f"{r.key}_items"
 
 
-def mesh_materials_values(state: M.State) -> dict:
-    """What the page says of a mesh file's own materials (as the desktop's box): the line
-    (``mesh_materials``: empty when the mesh brings none), the groups with their swatches and
-    the one the controls edit (``groups``, ``group``: None while a preset covers the mesh)."""
-    line = M.mesh_materials_line(state)
-    mm = state.mesh_materials
-    if mm is None or state.groups is None:
-        return {"mesh_materials": line, "groups": [], "group": None}
-    groups = [{"title": mm.names[i] or "(no usemtl)", "value": i, "prependAvatar": swatch_url(m)}
-              for i, m in enumerate(state.groups)]  # fmt: skip
-    return {"mesh_materials": line, "groups": groups, "group": state.group}
-
-
 def slider_step(r: panelmodel.Row, state: M.State) -> int | None:
     """Number row ``r``'s slider step in ``state`` (None while the row is not shown): its value
     rounded to its decimals, as its field shows it."""
@@ -121,7 +108,6 @@ def values(state: M.State) -> dict:
     """Every trame state key the panel shows, from ``state``."""
     out = row_values(state)
     out.update(edited=state.edited, mesh=state.mesh)
-    out.update(mesh_materials_values(state))
     return out
 
 
@@ -270,11 +256,6 @@ def _choices(app) -> None:
         state.change(name)(app.guard(changed, name))
 
     _rows(app, user)
-    user("group", lambda v, s: s.groups is not None and int(v) != s.group,
-         lambda v: c.act(M.select_group, int(v), label="group"))  # fmt: skip
-    ctrl.use_mesh_materials = app.guard(
-        lambda: c.act(M.use_mesh_materials, label="mesh materials"), "mesh materials"
-    )
 
     def choose_mesh(value):
         """A mesh of the chooser's list only (a built-in, the start's, an upload: values the
