@@ -83,7 +83,8 @@ class Row:
     note(state) : a line under a number (None: none)
     slider(state) : a number's slider range when the table's is not the one (None: the
         table's)
-    items(state) : a list's (or a choice's) items from the state (the lights); source : the
+    items(state) : a list's (or a choice's) items from the state (the lights; defined for any
+        state, empty while the row is hidden); source : the
         catalogue its items come from instead (``"presets"``); search : the list is long and
         searched by words (the presets): a field to type them, the selected item's subtitle
         under it, and a click takes an item (browsing with the keys only shows it)
@@ -157,6 +158,8 @@ def _mesh_materials_rows() -> list[Row]:
         return s.mesh_materials is not None
 
     def groups(s: M.State) -> tuple[Item, ...]:
+        if s.groups is None:  # a preset covers the mesh (or it brings no materials)
+            return ()
         names = s.mesh_materials.names
         return tuple(Item(i, names[i] or "(no usemtl)", "", m) for i, m in enumerate(s.groups))
 

@@ -99,8 +99,8 @@ def row_values(state: M.State) -> dict:
             out[r.key] = None if v is None else rgb_text(v)
         else:
             out[r.key] = v
-        if r.items is not None:
-            out[items_key(r)] = [item(it) for it in r.items(state)]
+        if r.items is not None:  # (none while the row is hidden)
+            out[items_key(r)] = [item(it) for it in r.items(state)] if r.visible(state) else []
     return out
 
 
