@@ -10,10 +10,20 @@ A row says what a control is, never how a toolkit draws it:
 - ``tab`` (``material``, ``lights``, ``view``), ``group`` (rows drawn together: a grid of
   colours, a line of toggles) and ``kind``: ``number`` (a slider and a field; range, scale,
   decimals and unit from :data:`explorer.core.controls.CONTROLS`), ``colour`` (r, g, b),
-  ``choice`` (one of ``choices``), ``toggle`` (on / off) or ``triple`` (three numbers);
+  ``choice`` (one of ``choices``), ``toggle`` (on / off), ``triple`` (three numbers),
+  ``list`` (one of a list of :class:`Item`: the presets, the scene's lights) or ``button`` (an
+  action that takes no value: add a light, swap A and B; its value is whether it can be
+  pressed now, and ``set_value(key, True)`` presses it) or ``text`` (a line the state says:
+  what the mesh's own materials are; nothing to set);
 - ``value(state)`` what it shows, ``visible(state)`` whether it is shown, and ``edit(state,
   value)`` the model action that sets it: the one table of the edits
   (:func:`edit`, which :meth:`Controller.set_value` applies), so no front end names an action.
+
+A list, or a choice whose values are not fixed, has :class:`Item` s: from the state
+(``items(state)``: the light list) or from a catalogue the controller holds (``source``:
+``"presets"``, the preset list and side B's preset, whose items :func:`preset_items` makes when
+the controller's presets change). Its value is an item's ``value``; a preset row's edit is given
+the preset itself (:func:`edit` finds it by name).
 
 A light's rows are shown when the selected light has them (its ``CONTROL_KEYS``,
 :mod:`explorer.core.lights`): no front end knows a light type. A new control is a row here (and
@@ -32,10 +42,10 @@ from explorer.core.controls import CONTROLS, Control
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
-from explorer.core.material import MODELS, RGB_KEYS
+from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import SHADINGS
 
-KINDS = ("number", "colour", "choice", "toggle", "triple")
+KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text")
 TABS = ("material", "lights", "view")
 
 
@@ -44,12 +54,25 @@ def _always(_state: M.State) -> bool:
 
 
 @dataclass(frozen=True)
+class Item:
+    """One entry of a list row (or of a choice whose values are not fixed): its ``value`` (what
+    the row's value and edit hold), the words shown (``title``), a second line (``subtitle``:
+    a preset's description) and the material whose swatch is drawn beside it (None: none)."""
+
+    value: object
+    title: str
+    subtitle: str = ""
+    swatch: Material | None = None
+
+
+@dataclass(frozen=True)
 class Row:
     """One control of the panel (see the module docstring).
 
     key, tab, kind, group : its name, where it is drawn and what it is
     value(state) : the value shown (an optional number's None: off)
-    edit(state, value) : ``(action, args)``, the model action that sets ``value``
+    edit(state, value) : ``(action, args)``, the model action that sets ``value`` (or
+        ``(action, args, label)`` when the undo step's name says the value: a preset's)
     visible(state) : whether the row is shown
     label : the undo step's name (default: the key); text : the words beside the control
         (default: the key)
@@ -61,6 +84,11 @@ class Row:
     note(state) : a line under a number (None: none)
     slider(state) : a number's slider range when the table's is not the one (None: the
         table's)
+    items(state) : a list's (or a choice's) items from the state (the lights; defined for any
+        state, empty while the row is hidden); source : the
+        catalogue its items come from instead (``"presets"``); search : the list is long and
+        searched by words (the presets): a field to type them, the selected item's subtitle
+        under it, and a click takes an item (browsing with the keys only shows it)
     """
 
     key: str
@@ -78,6 +106,9 @@ class Row:
     tip: str = ""
     note: Callable[[M.State], str | None] | None = None
     slider: Callable[[M.State], tuple[float, float]] | None = None
+    items: Callable[[M.State], tuple[Item, ...]] | None = None
+    source: str = ""
+    search: bool = False
 
     @property
     def control(self) -> Control:
@@ -105,6 +136,83 @@ class Row:
 
 
 # -- the rows ----------------------------------------------------------------------------------
+def preset_items(presets) -> tuple[Item, ...]:
+    """The items of a ``source="presets"`` row: each preset (``PresetInfo``) by name, with its
+    description and its swatch."""
+    return tuple(Item(p.name, p.name, p.material.description or "", p.material) for p in presets)
+
+
+def _read_only(key: str):
+    """A text row's edit: it sets nothing (an :class:`ExplorerError`)."""
+
+    def edit(s: M.State, v):
+        raise ExplorerError(f"'{key}' is a line of text: nothing to set")
+
+    return edit
+
+
+def _mesh_materials_rows() -> list[Row]:
+    """A mesh file's own materials, first in the material tab (shown when the mesh brings
+    some): what is drawn, the group the controls edit, or a button that draws them again."""
+
+    def brings(s: M.State) -> bool:
+        return s.mesh_materials is not None
+
+    def groups(s: M.State) -> tuple[Item, ...]:
+        if s.groups is None:  # a preset covers the mesh (or it brings no materials)
+            return ()
+        names = s.mesh_materials.names
+        return tuple(Item(i, names[i] or "(no usemtl)", "", m) for i, m in enumerate(s.groups))
+
+    return [
+        Row(
+            "mesh_materials",
+            "material",
+            "text",
+            M.mesh_materials_line,
+            _read_only("mesh_materials"),
+            brings,
+        ),
+        Row(
+            "group",
+            "material",
+            "choice",
+            lambda s: s.group,
+            lambda s, v: (M.select_group, (int(v),)),
+            lambda s: s.groups is not None,
+            items=groups,
+            tip="the group of the mesh whose material the controls below edit",
+        ),
+        Row(
+            "use_mesh_materials",
+            "material",
+            "button",
+            _always,
+            lambda s, v: (M.use_mesh_materials, ()),
+            lambda s: brings(s) and s.groups is None,
+            label="mesh materials",
+            text="use the mesh's materials",
+            tip="draw each group in the material its file gives (undoable)",
+        ),
+    ]
+
+
+def _preset_rows() -> list[Row]:
+    """The preset list, first in the material tab."""
+    return [
+        Row(
+            "preset",
+            "material",
+            "list",
+            lambda s: s.preset,
+            lambda s, p: (M.apply_preset, (p.name, p.material), f"preset {p.name}"),
+            source="presets",
+            search=True,
+            tip="the built-in and the user's presets (type to search)",
+        )
+    ]
+
+
 def _material_rows() -> list[Row]:
     def scalar(i):
         return lambda s: s.material.scalars()[i]
@@ -228,6 +336,51 @@ def _distance_slider(s: M.State) -> tuple[float, float]:
     return lo / s.radius, hi / s.radius
 
 
+def light_summary(i: int, light, state: M.State) -> str:
+    """One line of the light list: number, type and placement, and the light it shares its
+    place with (a duplicate, until moved)."""
+    az, el, d = state.placement(i)
+    where = "from" if light.AT_INFINITY else "at"
+    dist = "" if light.AT_INFINITY else f", {d / state.radius:.2f} r"
+    j = M.same_place_as(state, i)
+    same = "" if j is None else f" (same place as {j + 1})"
+    return f"{i + 1}: {light.type} {where} az {az:.0f}°, el {el:.0f}°{dist}{same}"
+
+
+def _light_list_rows() -> list[Row]:
+    """The scene's lights, first in the lights tab: the selected one is the value."""
+    return [
+        Row(
+            "light",
+            "lights",
+            "list",
+            lambda s: s.light if s.scene.lights else None,
+            lambda s, v: (M.select_light, (int(v),)),
+            label="select light",
+            items=lambda s: tuple(
+                Item(i, light_summary(i, lt, s)) for i, lt in enumerate(s.scene.lights)
+            ),
+        ),
+        *(
+            Row(
+                f"{name}_light",
+                "lights",
+                "button",
+                _always if name == "add" else lambda s: s.selected_light is not None,
+                lambda s, v, a=action: (a, ()),
+                group="light_buttons",
+                label=f"{name} light",
+                text=name,
+            )
+            for name, action in (
+                ("add", M.add_light),
+                ("duplicate", M.duplicate_light),
+                ("remove", M.remove_light),
+            )
+        ),
+    ]
+
+
 def _light_rows() -> list[Row]:
     def light(name):
         return lambda s: getattr(s.selected_light, name)
@@ -309,6 +462,77 @@ def _light_rows() -> list[Row]:
     return [replace(r, visible=_has(r.key)) for r in rows]
 
 
+def _comparing(s: M.State) -> bool:
+    return s.compare is not None
+
+
+def _compare_rows() -> list[Row]:
+    """The difference view and the A / B compare view, first in the view tab."""
+    b_rows = [
+        Row(
+            "compare_preset",
+            "view",
+            "choice",
+            lambda s: s.compare_preset or "",
+            lambda s, p: (M.set_compare_preset, (p.name, p.material), f"B {p.name}"),
+            text="B preset",
+            source="presets",
+            search=True,
+        ),
+        Row(
+            "compare_model",
+            "view",
+            "choice",
+            lambda s: s.compare_model,
+            lambda s, v: (M.set_compare_model, (v,)),
+            label="B model",
+            text="B model",
+            choices=MODELS,
+            inline=True,
+        ),
+        Row(
+            "compare_difference",
+            "view",
+            "toggle",
+            lambda s: s.compare_difference,
+            lambda s, v: (M.set_compare_difference, (bool(v),)),
+            label="A − B",
+            text="B shows A − B",
+            tip="pane B shows the difference of the two sides' colours (largest channel, "
+            "1/255 levels, the difference view's colours)",
+        ),
+        Row(
+            "swap",
+            "view",
+            "button",
+            _always,
+            lambda s, v: (M.swap_compare, ()),
+            label="swap A and B",
+            text="swap A and B",
+        ),
+    ]
+    return [
+        Row(
+            "difference",
+            "view",
+            "toggle",
+            lambda s: s.difference,
+            lambda s, v: (M.set_difference, (bool(v),)),
+            tip="the per-pixel error of this view as a heat map (key d)",
+        ),
+        Row(
+            "compare",
+            "view",
+            "toggle",
+            _comparing,
+            lambda s, v: (M.set_compare, (bool(v),)),
+            text="compare A | B",
+            tip="two panes with linked cameras and the same lights (key c)",
+        ),
+        *(replace(r, visible=_comparing) for r in b_rows),
+    ]
+
+
 def _hdr_on(s: M.State) -> bool:
     return s.scene.hdr is not None
 
@@ -374,9 +598,13 @@ def _view_rows() -> list[Row]:
 
 #: every row, in the order each tab draws them
 ROWS: tuple[Row, ...] = (
+    *_mesh_materials_rows(),
+    *_preset_rows(),
     *_material_rows(),
     *_material_effect_rows(),
+    *_light_list_rows(),
     *_light_rows(),
+    *_compare_rows(),
     *_view_rows(),
 )
 #: the rows by key
@@ -408,13 +636,20 @@ def row(key: str) -> Row:
         raise ExplorerError(f"no control named '{key}' (one of {', '.join(BY_KEY)})") from None
 
 
-def edit(state: M.State, key: str, value) -> tuple[Callable, tuple, str]:
+def edit(state: M.State, key: str, value, presets=()) -> tuple[Callable, tuple, str]:
     """``(action, args, label)``: what sets control ``key`` to ``value`` in ``state`` (the
     undo step's label). The action refuses a row the state does not show (a spot's cutoff on
-    a point light: :func:`explorer.app.model.set_light_field`)."""
+    a point light: :func:`explorer.app.model.set_light_field`). A preset row's ``value`` is a
+    preset's name, found in ``presets`` (the controller's ``PresetInfo`` list; an
+    :class:`ExplorerError` when none has it)."""
     r = row(key)
-    action, args = r.edit(state, value)
-    return action, args, r.undo_label
+    if r.source == "presets":
+        found = next((p for p in presets if p.name == value), None)
+        if found is None:
+            raise ExplorerError(f"no preset named '{value}'")
+        value = found
+    action, args, *label = r.edit(state, value)
+    return action, args, label[0] if label else r.undo_label
 
 
 def names(r: Row) -> tuple[str, ...]:
@@ -429,15 +664,16 @@ def client_keys() -> dict[str, str]:
     as the web guard names kinds (``number``, ``bool``, ``text``): a number's slider step
     ``<key>_step`` and an optional number's switch ``<key>_on``, a choice's value, a toggle's.
     A number's, a colour's and a triple's typed text and a colour's picks are not state: they
-    call the page's handlers, which parse what they are given."""
+    call the page's handlers, which parse what they are given. A list's value is its item's
+    (a preset's name, a light's index); a button's and a text's are not the page's to set."""
     out: dict[str, str] = {}
     for r in ROWS:
         if r.kind == "number":
             out[f"{r.key}_step"] = "number"
             if r.optional is not None:
                 out[f"{r.key}_on"] = "bool"
-        elif r.kind == "choice":
-            out[r.key] = "text"
+        elif r.kind in ("choice", "list"):  # an index into the state's items, or a name
+            out[r.key] = "index" if r.items is not None else "text"
         elif r.kind == "toggle":
             out[r.key] = "bool"
     return out

@@ -63,7 +63,7 @@ SELECTED_SCALE = 1.3
 #: the ring that marks the selected light's handle: its colour and its gap (pixels) around it
 RING_COLOR = (1.0, 1.0, 1.0)
 RING_GAP = 4
-#: the selected handle's glyph (arrow for directional, cone for spot), in mesh radii
+#: the selected handle's glyph (the light's GLYPH: an arrow, a cone), in mesh radii
 GLYPH_LENGTH = 0.6
 GLYPH_COLOR = (1.0, 0.85, 0.2)
 #: a handle nearer than this (mesh radii) is kept in view when the camera is framed
@@ -518,12 +518,12 @@ class SceneView:
         return radius * h / (2.0 * depth * math.tan(math.radians(0.5 * cam.GetViewAngle())))
 
     def _set_glyph(self, light, state: State) -> None:
-        """An arrow toward the mesh for a directional light, the spot's cone for a spot,
-        nothing for a point light."""
+        """What the light says its handle shows (its ``GLYPH``): an arrow toward the mesh, its
+        cone, or nothing."""
         import pyvista as pv
 
-        kind = None if light is None else light.type
-        if kind not in ("directional", "spot"):
+        kind = "" if light is None else light.GLYPH
+        if not kind:
             if self._glyph is not None:
                 self._glyph.SetVisibility(False)
             return
@@ -531,30 +531,31 @@ class SceneView:
         toward = -at  # toward the mesh's centre, the view's origin
         toward /= max(float(np.linalg.norm(toward)), 1e-300)
         length = GLYPH_LENGTH * state.radius / self.frame[1]
-        if kind == "directional":
+        if kind == "arrow":
             shape = pv.Arrow(start=at, direction=toward, scale=length, tip_length=0.3,
                              tip_radius=0.12, shaft_radius=0.04)  # fmt: skip
         else:
-            cutoff = min(float(light.cutoff), 89.0)
-            aim = np.asarray(light.aim)
+            aim, cutoff = light.cone()
+            aim = np.asarray(aim)
+            cutoff = min(cutoff, 89.0)
             shape = pv.Cone(center=at + 0.5 * length * aim, direction=-aim, height=length,
                             radius=length * math.tan(math.radians(cutoff)), resolution=32,
                             capping=False)  # fmt: skip
         if self._glyph is None:
             self._glyph_poly = shape
             self._glyph = self.plotter.add_mesh(
-                self._glyph_poly, color=GLYPH_COLOR, opacity=0.55 if kind == "spot" else 1.0,
+                self._glyph_poly, color=GLYPH_COLOR, opacity=0.55 if kind == "cone" else 1.0,
                 lighting=False, reset_camera=False, pickable=False,
             )  # fmt: skip
         else:
             self._glyph_poly.copy_from(shape)
-            self._glyph.GetProperty().SetOpacity(0.55 if kind == "spot" else 1.0)
+            self._glyph.GetProperty().SetOpacity(0.55 if kind == "cone" else 1.0)
         self._glyph.SetVisibility(True)
         self._glyph_kind = kind
 
     @property
     def glyph_kind(self) -> str | None:
-        """ "directional" (arrow), "spot" (cone) or None: what the handle shows."""
+        """ "arrow", "cone" or None: what the selected light's handle shows."""
         if self._glyph is None or not self._glyph.GetVisibility():
             return None
         return self._glyph_kind

@@ -29,7 +29,12 @@ shader, the reference equation, shadows, the window) asks the light and never it
   window;
 - ``CONTROL_KEYS``, ``AT_INFINITY``: the explorer's controls it has (a spot's cone, a
   positional light's attenuation) and whether it is at infinity: the panel's rows
-  (:mod:`explorer.app.panelmodel`) ask these, so no front end knows a light type.
+  (:mod:`explorer.app.panelmodel`) ask these, so no front end knows a light type;
+- ``GLYPH``, :meth:`Light.cone`: what the window's handle of the selected light shows (an
+  arrow, the light's cone, nothing), which :mod:`explorer.app.view` draws.
+
+A new light type is a class here, in :data:`LIGHT_CLASSES` (whose names are
+:data:`LIGHT_TYPES`); no file of :mod:`explorer.app` changes.
 
 The old key ``direction`` (``to_light`` or ``aim``) still loads, with a
 :class:`~explorer.core.errors.DeprecatedName` notice.
@@ -58,7 +63,6 @@ from explorer.core.validate import (
 Vec3 = tuple[float, float, float]
 RGB = tuple[float, float, float]
 
-LIGHT_TYPES = ("directional", "point", "spot")
 NO_ATTENUATION: Vec3 = (1.0, 0.0, 0.0)
 #: Upper bound accepted for a light colour channel (HDR lights above 1 are allowed).
 MAX_LIGHT_VALUE = 1e6
@@ -237,6 +241,14 @@ class Light(Checked):
     )
     #: the light is at infinity (only its direction counts; its handle's distance is a choice)
     AT_INFINITY: ClassVar[bool] = False
+    #: what the explorer draws at the selected light's handle (:mod:`explorer.app.view`):
+    #: ``"arrow"`` (toward the mesh: where the light comes from), ``"cone"`` (its cone,
+    #: :meth:`cone`) or ``""`` (the handle alone): the view asks the light, never its type
+    GLYPH: ClassVar[str] = ""
+
+    def cone(self) -> tuple[Vec3, float] | None:
+        """The light's cone as its glyph draws it: ``(aim, half-angle in degrees)``, or None."""
+        return None
 
     def _settle(self) -> None:
         """Store direction fields unit length (after the checks)."""
@@ -374,6 +386,7 @@ class DirectionalLight(Light):
     RENAMED: ClassVar[dict] = {"direction": ("to_light", "the direction toward the light")}
     FILE_KEYS: ClassVar[tuple[str, ...]] = _COMMON + ("to_light",)
     AT_INFINITY: ClassVar[bool] = True
+    GLYPH: ClassVar[str] = "arrow"
 
     def _settle(self) -> None:
         object.__setattr__(self, "to_light", unit_vector(self.to_light))
@@ -563,9 +576,13 @@ class SpotLight(PositionalLight):
     #: the cone of a spot made from another light (:meth:`like`)
     LIKE_DEFAULTS: ClassVar[dict] = {"cutoff": 25.0, "exponent": 10.0}
     CONTROL_KEYS: ClassVar[tuple[str, ...]] = PositionalLight.CONTROL_KEYS + ("cutoff", "exponent")
+    GLYPH: ClassVar[str] = "cone"
 
     def _settle(self) -> None:
         object.__setattr__(self, "aim", unit_vector(self.aim))
+
+    def cone(self) -> tuple[Vec3, float]:
+        return self.aim, float(self.cutoff)
 
     def _own_mapping(self) -> dict:
         return {
@@ -617,6 +634,8 @@ class SpotLight(PositionalLight):
 LIGHT_CLASSES: dict[str, type[Light]] = {
     cls.type: cls for cls in (DirectionalLight, PointLight, SpotLight)
 }
+#: the light types' names, in the order the explorer steps through them
+LIGHT_TYPES = tuple(LIGHT_CLASSES)
 #: every key any light type accepts in a file (old names included)
 ALL_LIGHT_KEYS = tuple(
     dict.fromkeys(k for cls in LIGHT_CLASSES.values() for k in cls.FILE_KEYS + tuple(cls.RENAMED))

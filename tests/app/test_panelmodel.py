@@ -16,12 +16,15 @@ from explorer.app.start import first_state
 from explorer.core.controls import CONTROLS
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import DirectionalLight, PointLight, SpotLight
+from explorer.core.presets import list_presets
 from explorer.core.scene import Scene
 from explorer.geometry.meshes import get_mesh
 
 ROOT = Path(__file__).resolve().parents[2]
-#: a value for each row, other than the start's (a spot light, the HDR display on)
+#: a value for each row, other than the start's (a spot light and a point light, the HDR
+#: display and the compare view on)
 SAMPLES = {
+    "preset": "jade",
     "ka": 0.1,
     "kd": 0.3,
     "ks": 0.9,
@@ -53,7 +56,22 @@ SAMPLES = {
     "tone_map": "aces",
     "local_viewer": False,
     "shading": "per-pixel",
+    "light": 1,
+    "difference": True,
+    "compare": False,
+    "compare_preset": "jade",
+    "compare_model": "threejs",
+    "compare_difference": True,
+    # a button's value is whether it can be pressed (still so after each press here)
+    "add_light": True,
+    "duplicate_light": True,
+    "remove_light": True,
+    "swap": True,
 }
+#: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
+MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
+#: the presets a preset row's edit is given (the controller's)
+PRESETS = list_presets()
 
 
 @pytest.fixture(scope="module")
@@ -62,10 +80,15 @@ def mesh():
 
 
 def start(mesh, **scene) -> M.State:
-    """A spot light (every light row shown) and the HDR display on (its rows shown)."""
-    lights = (SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),)
+    """A spot light selected (every light row shown) and a point light, the HDR display on (its
+    rows shown) and the compare view on (side B's rows shown)."""
+    lights = (
+        SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),
+        PointLight(position=(2.0, 2.0, 0.0)),
+    )
     base = Scene(lights=lights, hdr={"exposure": 0.0, "tone_map": "reinhard"})
-    return first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
+    s = first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
+    return M.set_compare(s, True)
 
 
 def test_every_row_is_one_declared_control():
@@ -74,9 +97,9 @@ def test_every_row_is_one_declared_control():
         assert r.kind in P.KINDS and r.tab in P.TABS, r.key
         if r.kind in ("number", "triple"):
             assert r.key in CONTROLS, r.key  # its range, scale and decimals: core.controls
-        if r.kind == "choice":
-            assert r.choices, r.key
-    assert set(SAMPLES) == set(P.BY_KEY)  # every row is tried below
+        if r.kind in ("choice", "list"):  # fixed values, or items (the state's, a catalogue's)
+            assert bool(r.choices) + (r.items is not None) + bool(r.source) == 1, r.key
+    assert set(SAMPLES) | set(MESH_MATERIALS) == set(P.BY_KEY)  # every row is tried below
     with pytest.raises(ExplorerError, match="no control named 'glossiness'"):
         P.row("glossiness")
 
@@ -87,21 +110,73 @@ def test_each_row_edits_the_state_in_one_undo_step_that_a_session_keeps(key, mes
     r = P.row(key)
     assert r.visible(s)
     store = M.Store(s)
-    action, args, label = P.edit(s, key, SAMPLES[key])
+    action, args, label = P.edit(s, key, SAMPLES[key], PRESETS)
     assert store.apply(action, *args, label=label)
     new = store.state
     if key == "hdr":  # the display off: its own value, and its rows hidden
         assert not r.value(new) and not P.row("exposure").visible(new)
+    elif key == "compare":  # the view off: side B's rows hidden
+        assert not r.value(new) and not P.row("compare_preset").visible(new)
     elif key == "type":
         assert new.selected_light.type == "point"
     else:
         assert r.value(new) == pytest.approx(SAMPLES[key]), key
-    assert store.undo_label() == r.undo_label
+    # a preset's step says the preset (``preset jade``, ``B jade``); another the row's label
+    assert store.undo_label() == (f"{label.split()[0]} jade" if r.source else r.undo_label)
     path = save_session(tmp_path / "s.yaml", new)
     again, _ = load_session(path)
     assert r.value(again) == pytest.approx(r.value(new)), key
     store.undo()
     assert r.value(store.state) == r.value(s)
+
+
+def test_a_button_row_applies_its_action_and_says_when_it_can_be_pressed(mesh):
+    s = start(mesh)
+    store = M.Store(s)
+    for key, n in (("add_light", 3), ("duplicate_light", 4), ("remove_light", 3)):
+        action, args, label = P.edit(store.state, key, True)
+        store.apply(action, *args, label=label)
+        assert len(store.state.scene.lights) == n and store.undo_label() == label
+    assert label == "remove light"
+    none = M.State(scene=s.scene.replace(lights=()), mesh="icosphere")
+    assert [P.row(k).value(none) for k in ("add_light", "duplicate_light", "remove_light")] == [
+        True,
+        False,
+        False,
+    ]
+    action, args, _ = P.edit(s, "swap", True)
+    swapped = action(s, *args)
+    assert (swapped.compare_model, swapped.scene.model) == (s.scene.model, s.compare_model)
+    assert not P.row("swap").visible(M.set_compare(s, False))
+
+
+def test_a_mesh_files_own_materials_are_rows_a_line_a_group_and_a_button(tmp_path):
+    from helpers.files import write_two_groups
+
+    from explorer.cli import build_parser
+    from explorer.cli.gui import start_state
+
+    two = write_two_groups(tmp_path)
+    s, _ = start_state(build_parser().parse_args(["gui", "--mesh", str(two)]))
+    line, group, use = (P.row(k) for k in MESH_MATERIALS)
+    assert line.value(s) == M.mesh_materials_line(s) and group.visible(s)
+    assert not use.visible(s)
+    items = group.items(s)
+    assert [i.title for i in items] == list(s.mesh_materials.names)
+    assert [i.swatch for i in items] == list(s.groups)  # each with its swatch
+    with pytest.raises(ExplorerError, match="'mesh_materials' is a line of text"):
+        P.edit(s, "mesh_materials", "x")
+    store = M.Store(s)
+    for key, value in (("group", 1 - s.group), ("preset", "jade"), ("use_mesh_materials", True)):
+        action, args, label = P.edit(store.state, key, value, PRESETS)
+        store.apply(action, *args, label=label)
+        if key == "preset":  # a preset covers the mesh: the button draws the groups again
+            assert not group.visible(store.state) and use.visible(store.state)
+            assert "preset 'jade' covers the whole mesh" in line.value(store.state)
+    assert store.state.groups is not None and store.state.group == 1 - s.group
+    assert store.undo_label() == "mesh materials"
+    none = start(get_mesh("icosphere", 1))
+    assert not any(P.row(k).visible(none) for k in MESH_MATERIALS)
 
 
 def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
@@ -112,11 +187,14 @@ def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
         (DirectionalLight(), ("attenuation", "cutoff", "exponent")),
     ):
         t = M.State(scene=s.scene.replace(lights=(light,)), mesh="icosphere")
-        shown = {r.key for r in P.rows("lights") if r.visible(t)}
+        lists = {"light", "add_light", "duplicate_light", "remove_light"}  # the scene's
+        shown = {r.key for r in P.rows("lights") if r.visible(t)} - lists
         assert shown == set(light.CONTROL_KEYS)
         assert not set(hidden) & set(light.CONTROL_KEYS)
     none = M.State(scene=s.scene.replace(lights=()), mesh="icosphere")
-    assert not any(r.visible(none) for r in P.rows("lights"))
+    shown = [r.key for r in P.rows("lights") if r.visible(none)]
+    assert shown == ["light", "add_light", "duplicate_light", "remove_light"]
+    assert P.row("light").value(none) is None
     store = M.Store(start(mesh, lights=(PointLight(),)))
     with pytest.raises(ExplorerError, match="'cutoff' cannot be set on a point light"):
         action, args, _ = P.edit(store.state, "cutoff", 10.0)
@@ -143,18 +221,23 @@ def test_client_keys_name_every_state_key_a_row_lets_the_page_set_with_its_kind(
     for r in P.ROWS:
         if r.kind == "number":
             assert keys[f"{r.key}_step"] == "number"
-        elif r.kind in ("choice", "toggle"):
-            assert keys[r.key] == ("text" if r.kind == "choice" else "bool")
-        else:  # typed text and picks go to the page's handlers, not the state
+        elif r.kind == "toggle":
+            assert keys[r.key] == "bool"
+        elif r.kind in ("choice", "list"):  # a name, or an index into the state's items
+            assert keys[r.key] == ("index" if r.items is not None else "text"), r.key
+        else:  # typed text, picks and buttons go to the page's handlers, not the state
             assert r.key not in keys
     assert keys["fresnel_on"] == "bool" and keys["tone_map"] == "text"
-    assert keys["show_specular"] == keys["shadows"] == keys["hdr"] == "bool"
+    assert keys["show_specular"] == keys["shadows"] == keys["hdr"] == keys["compare"] == "bool"
+    assert keys["preset"] == keys["compare_preset"] == "text"
+    assert keys["light"] == keys["group"] == "index" and "add_light" not in keys
 
 
 def test_no_front_end_module_names_a_light_type():
-    """Which controls a light has is the light's (its CONTROL_KEYS): the Qt panel and the web
-    modules hold no light-type rule."""
-    files = [*ROOT.glob("explorer/app/qt/*.py"), *ROOT.glob("explorer/app/web/*.py")]
+    """Which controls a light has is the light's (its CONTROL_KEYS), and what its handle
+    shows (its GLYPH): the Qt panel, the web modules and the toolkit-free kit (the view among
+    them) hold no light-type rule."""
+    files = [*ROOT.glob("explorer/app/**/*.py")]
     assert len(files) > 10, files  # both front ends' modules are read
     pattern = re.compile(r"""["'](directional|point|spot)["']|\.type\s*(==|!=|in)\s*[("']""")
     found = [

@@ -132,11 +132,12 @@ class Controller:
 
     def set_value(self, key: str, value, *, merge: bool = True) -> bool:
         """Set control ``key`` (a row of :mod:`explorer.app.panelmodel`: a number, a colour's
-        (r, g, b), a choice, a toggle, the attenuation's triple; ``distance`` in mesh radii);
-        a run of steps of one control is one undo step until :meth:`release`. A key the state
-        does not show (a spot's cutoff on a point light) is refused by its action and said; an
-        unknown key raises :class:`ExplorerError`."""
-        action, args, label = panelmodel.edit(self.store.state, key, value)
+        (r, g, b), a choice, a toggle, the attenuation's triple; ``distance`` in mesh radii; a
+        list's item: a preset's name, a light's index); a run of steps of one control is one
+        undo step until :meth:`release`. A key the state does not show (a spot's cutoff on a
+        point light) is refused by its action and said; an unknown key or preset raises
+        :class:`ExplorerError`."""
+        action, args, label = panelmodel.edit(self.store.state, key, value, self.presets)
         return self.act(action, *args, label=label, merge=key if merge else None)
 
     def release(self) -> None:
@@ -245,11 +246,8 @@ class Controller:
         self.ports.choices.show_presets(self.presets)
 
     def pick_preset(self, name: str) -> bool:
-        """Show preset ``name`` (one undo step)."""
-        info = next((p for p in self.presets if p.name == name), None)
-        if info is None:
-            raise ExplorerError(f"no preset named '{name}'")
-        return self.act(M.apply_preset, info.name, info.material, label=f"preset {info.name}")
+        """Show preset ``name`` (one undo step; the preset row's edit)."""
+        return self.set_value("preset", name, merge=False)
 
     def _step_preset(self, step: int) -> None:
         if not self.presets:

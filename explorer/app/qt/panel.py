@@ -15,8 +15,6 @@ sets.
 
 from __future__ import annotations
 
-import html
-
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
@@ -340,58 +338,3 @@ def swatch(material, size: int = 18) -> QtGui.QIcon:
     p.fillRect(size // 2, 0, size - size // 2, size // 2, spec)
     p.end()
     return QtGui.QIcon(pm)
-
-
-class MeshMaterialsBox(QtWidgets.QFrame):
-    """What the panel says of a mesh file's own materials (shown only when the mesh brings
-    some): whether they are drawn or a preset covers the mesh, the group the controls edit
-    (``group``), and a button to draw them again (``use_mesh_materials``)."""
-
-    def __init__(self, act, parent=None):
-        super().__init__(parent)
-        self.setObjectName("mesh_materials")
-        self.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
-        self.act = act
-        box = _form(self)
-        self.label = QtWidgets.QLabel("")
-        self.label.setObjectName("mesh_materials_label")
-        self.label.setWordWrap(True)
-        self.group_row = QtWidgets.QWidget()
-        row = QtWidgets.QHBoxLayout(self.group_row)
-        row.setContentsMargins(0, 0, 0, 0)
-        row.addWidget(QtWidgets.QLabel("group"))
-        self.group = QtWidgets.QComboBox()
-        self.group.setObjectName("group")
-        self.group.setToolTip("the group of the mesh whose material the controls below edit")
-        self.group.setIconSize(QtCore.QSize(16, 16))
-        row.addWidget(self.group, 1)
-        self.use = QtWidgets.QPushButton("Use the mesh's materials")
-        self.use.setObjectName("use_mesh_materials")
-        self.use.setToolTip("draw each group in the material its file gives (undoable)")
-        box.addWidget(self.label)
-        box.addWidget(self.group_row)
-        box.addWidget(self.use)
-        self.group.activated.connect(lambda i: self.act(M.select_group, i, label="group"))
-        self.use.clicked.connect(lambda: self.act(M.use_mesh_materials, label="mesh materials"))
-        self._shown = None
-        self.setVisible(False)
-
-    def show_state(self, s: M.State) -> None:
-        mm = s.mesh_materials
-        self.setVisible(mm is not None)
-        if mm is None:
-            return
-        own = s.groups is not None
-        key = (mm, s.groups, s.group, s.preset)
-        if key == self._shown:
-            return
-        self._shown = key
-        self.label.setText(M.mesh_materials_line(s, lambda name: f"<b>{html.escape(name)}</b>"))
-        if own:
-            with QtCore.QSignalBlocker(self.group):
-                self.group.clear()
-                for name, m in zip(mm.names, s.groups, strict=True):
-                    self.group.addItem(swatch(m, 16), name or "(no usemtl)")
-                self.group.setCurrentIndex(s.group)
-        self.group_row.setVisible(own)
-        self.use.setVisible(not own)

@@ -1,19 +1,24 @@
 """The panel's rows drawn in Qt: one widget factory per kind of
-:class:`~explorer.app.panelmodel.Row` (number, colour, choice, toggle, triple). Nothing here
-knows a control: :class:`RowWidgets` builds the widgets of any rows, shows a state in them
-(:meth:`RowWidgets.show_state`: each row's ``visible`` and ``value``, signals blocked) and sends
-every edit as ``set_value(key, value, merge=...)`` (the controller's one dialect).
+:class:`~explorer.app.panelmodel.Row` (number, colour, choice, toggle, triple, list, button).
+Nothing here knows a control: :class:`RowWidgets` builds the widgets of any rows, shows a state
+in them (:meth:`RowWidgets.show_state`: each row's ``visible``, ``value`` and items, signals
+blocked) and sends every edit as ``set_value(key, value, merge=...)`` (the controller's one
+dialect).
 
 Every row's widget (or the box of one drawn as several widgets) is named like its key, as
-object name and accessible name; a row's label is its key (a term's toggle its term).
+object name and accessible name; a row's label is its caption (its key unless it says other
+words: a term's toggle its term). A list is a list widget (a searched one with its search
+field ``<key>_search`` above and its selected item's subtitle ``<key>_description`` below); a
+choice whose values are not fixed (side B's preset, the mesh's groups) a combo box of its items;
+a button is enabled when its value says it can be pressed; a text a label.
 """
 
 from __future__ import annotations
 
-from PySide6 import QtCore, QtWidgets
+from PySide6 import QtCore, QtGui, QtWidgets
 
-from explorer.app.panelmodel import Row
-from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider
+from explorer.app.panelmodel import Item, Row
+from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider, swatch
 
 #: a label's least width (pixels): the labels of a tab line up with the sliders' own
 LABEL_WIDTH = 64
@@ -35,17 +40,21 @@ def _named(widget: QtWidgets.QWidget, name: str, tip: str = "") -> QtWidgets.QWi
 
 class RowWidgets(QtCore.QObject):
     """The widgets of ``rows`` added to ``box`` (a ``QVBoxLayout``) in order; rows of one
-    ``group`` share a grid (colours) or a line (toggles, in a group of their own).
+    ``group`` share a grid (colours) or a line (toggles, buttons, in a group of their own).
 
     send(key, value, merge=...) : the edit (``Controller.set_value``)
+    after : key -> the front end's own widgets or layouts drawn after that row (the difference
+        view's legend); they show and hide themselves
     ``rejected(message)``: a typed value was refused; ``widgets[key]``: each row's widget
-    (a :class:`ValueSlider`, :class:`ColourButton`, ``QComboBox``, ``QCheckBox``, or the box
-    of radio buttons / three fields), ``parts[key]``: every widget the row shows or hides.
+    (a :class:`ValueSlider`, :class:`ColourButton`, ``QComboBox``, ``QCheckBox``,
+    ``QListWidget``, ``QPushButton``, or the box of radio buttons / three fields),
+    ``parts[key]``: every widget the row shows or hides; ``items[key]``: a list's (or a
+    choice's) items shown.
     """
 
     rejected = QtCore.Signal(str)
 
-    def __init__(self, rows, box: QtWidgets.QVBoxLayout, send, parent=None):
+    def __init__(self, rows, box: QtWidgets.QVBoxLayout, send, parent=None, after=None):
         super().__init__(parent)
         self.rows = tuple(rows)
         self.send = send
@@ -55,14 +64,17 @@ class RowWidgets(QtCore.QObject):
         self.radios: dict[str, dict[str, QtWidgets.QRadioButton]] = {}
         self.fields: dict[str, list[NumberField]] = {}  # a triple's three fields
         self.sliders: dict[str, ValueSlider] = {}  # a number's slider and field
+        self.items: dict[str, tuple[Item, ...]] = {}
+        self.searches: dict[str, QtWidgets.QLineEdit] = {}  # a searched list's field
+        self.descriptions: dict[str, QtWidgets.QLabel] = {}  # its selected item's subtitle
         grids: dict[str, QtWidgets.QGridLayout] = {}
         lines: dict[str, QtWidgets.QHBoxLayout] = {}
         for r in self.rows:
-            if r.kind == "toggle" and r.group:
+            if r.kind in ("toggle", "button") and r.group:
                 if r.group not in lines:
                     lines[r.group] = QtWidgets.QHBoxLayout()
                     box.addLayout(lines[r.group])
-                self._add(r, self._toggle(r), lines[r.group])
+                self._add(r, getattr(self, f"_{r.kind}")(r), lines[r.group])
             elif r.kind in ("colour", "choice") and not r.inline:
                 key = r.group or r.key
                 if key not in grids:
@@ -70,16 +82,21 @@ class RowWidgets(QtCore.QObject):
                     grids[key].setColumnStretch(1, 1)
                     box.addLayout(grids[key])
                 grid = grids[key]
-                label, widget = _label(r.key), getattr(self, f"_{r.kind}")(r)
+                label, widget = _label(r.caption), getattr(self, f"_{r.kind}")(r)
                 n = grid.rowCount()
                 grid.addWidget(label, n, 0)
                 grid.addWidget(widget, n, 1)
                 self.widgets[r.key] = widget
                 self.parts[r.key] = [label, widget]
+            elif r.kind == "list":
+                self._list(r, box)
             else:
                 self._add(r, getattr(self, f"_{r.kind}")(r), box)
-        for line in lines.values():
-            line.addStretch(1)
+            for extra in (after or {}).get(r.key, ()):
+                (box.addLayout if isinstance(extra, QtWidgets.QLayout) else box.addWidget)(extra)
+        for r in self.rows:  # a line of toggles keeps them left; buttons share its width
+            if r.kind == "toggle" and r.group in lines:
+                lines.pop(r.group).addStretch(1)
 
     def _add(self, r: Row, widget: QtWidgets.QWidget, layout) -> None:
         layout.addWidget(widget)
@@ -117,16 +134,27 @@ class RowWidgets(QtCore.QObject):
         b.picked.connect(lambda rgb, k=r.key: self.send(k, rgb, merge=False))
         return b
 
+    def _values(self, r: Row) -> tuple:
+        """A choice's or a list's values, in the order shown."""
+        return r.choices or tuple(i.value for i in self.items.get(r.key, ()))
+
     def _choice(self, r: Row) -> QtWidgets.QWidget:
         if not r.inline:
             combo = _named(QtWidgets.QComboBox(), r.key, r.tip)
             combo.addItems(list(r.choices))
-            combo.activated.connect(lambda i, k=r.key, c=r.choices: self.send(k, c[i], merge=False))
+            if r.source or r.items:  # its items come and go: long names do not widen it
+                combo.setSizeAdjustPolicy(
+                    QtWidgets.QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon
+                )
+                combo.setMinimumContentsLength(8)
+            combo.activated.connect(
+                lambda i, k=r.key, r=r: self.send(k, self._values(r)[i], merge=False)
+            )
             return combo
         box = _named(QtWidgets.QWidget(), r.key, r.tip)
         row = QtWidgets.QHBoxLayout(box)
         row.setContentsMargins(0, 0, 0, 0)
-        row.addWidget(QtWidgets.QLabel(r.key))
+        row.addWidget(QtWidgets.QLabel(r.caption))
         group = QtWidgets.QButtonGroup(box)
         self.radios[r.key] = {}
         for name in r.choices:
@@ -143,6 +171,16 @@ class RowWidgets(QtCore.QObject):
         c = _named(QtWidgets.QCheckBox(r.caption), r.key, r.tip)
         c.toggled.connect(lambda on, k=r.key: self.send(k, on, merge=False))
         return c
+
+    def _text(self, r: Row) -> QtWidgets.QWidget:
+        label = _named(QtWidgets.QLabel(""), r.key, r.tip)
+        label.setWordWrap(True)
+        return label
+
+    def _button(self, r: Row) -> QtWidgets.QWidget:
+        b = _named(QtWidgets.QPushButton(r.caption), r.key, r.tip)
+        b.clicked.connect(lambda _=False, k=r.key: self.send(k, True, merge=False))
+        return b
 
     def _triple(self, r: Row) -> QtWidgets.QWidget:
         """Three number fields (the attenuation's kc, kl, kq), a row a part (a narrow panel),
@@ -168,6 +206,81 @@ class RowWidgets(QtCore.QObject):
 
     def _send_triple(self, key: str) -> None:
         self.send(key, tuple(f.value() for f in self.fields[key]), merge=False)
+
+    def _list(self, r: Row, box: QtWidgets.QVBoxLayout) -> None:
+        """A list widget; a searched one (a long list: it takes the tab's spare height) with its
+        search field above and its selected item's subtitle below, and an item is taken by a
+        click (the keys browse it); another takes its current item (a short list)."""
+        w = _named(QtWidgets.QListWidget(), r.key, r.tip)
+        w.setWordWrap(True)  # a long line (a duplicate light's) wraps in a narrow panel
+        w.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.widgets[r.key] = w
+        self.parts[r.key] = [w]
+        self.items[r.key] = ()
+        if not r.search:
+            w.setMinimumHeight(60)
+            w.setMaximumHeight(110)
+            w.currentRowChanged.connect(
+                lambda i, r=r: i >= 0 and self.send(r.key, self._values(r)[i], merge=False)
+            )
+            box.addWidget(w)
+            return
+        search = QtWidgets.QLineEdit()
+        search.setObjectName(f"{r.key}_search")
+        search.setPlaceholderText(f"search {r.key}s")
+        search.setClearButtonEnabled(True)
+        description = QtWidgets.QLabel("")
+        description.setObjectName(f"{r.key}_description")
+        description.setWordWrap(True)
+        w.setMinimumHeight(90)
+        w.setIconSize(QtCore.QSize(18, 18))
+        self.searches[r.key], self.descriptions[r.key] = search, description
+        self.parts[r.key] = [search, w, description]
+        search.textChanged.connect(lambda _t, r=r: self._filter(r))
+        w.itemClicked.connect(
+            lambda item, r=r: self.send(r.key, self._values(r)[w.row(item)], merge=False)
+        )
+        w.currentRowChanged.connect(lambda i, r=r: self._describe(r, i))
+        box.addWidget(search)
+        box.addWidget(w, 1)  # the list takes the spare height
+        box.addWidget(description)
+
+    def show_items(self, source: str, items) -> None:
+        """The items of every row whose items come from catalogue ``source`` (the presets)."""
+        for r in self.rows:
+            if r.source == source:
+                self._set_items(r, tuple(items))
+
+    def _set_items(self, r: Row, items: tuple[Item, ...]) -> None:
+        if items == self.items.get(r.key):
+            return
+        self.items[r.key] = items
+        w = self.widgets[r.key]
+        with QtCore.QSignalBlocker(w):
+            w.clear()
+            for it in items:
+                if r.kind == "choice":
+                    icon = QtGui.QIcon() if it.swatch is None else swatch(it.swatch, 16)
+                    w.addItem(icon, it.title)
+                    continue
+                item = QtWidgets.QListWidgetItem(it.title)
+                if it.swatch is not None:
+                    item.setIcon(swatch(it.swatch))
+                item.setToolTip(it.subtitle or it.title)
+                w.addItem(item)
+        if r.key in self.searches:
+            self._filter(r)
+
+    def _filter(self, r: Row) -> None:
+        """A searched list shows the items whose title or subtitle has the typed words."""
+        t = self.searches[r.key].text().strip().lower()
+        w = self.widgets[r.key]
+        for i, it in enumerate(self.items[r.key]):
+            w.item(i).setHidden(bool(t) and t not in f"{it.title} {it.subtitle}".lower())
+
+    def _describe(self, r: Row, i: int) -> None:
+        items = self.items[r.key]
+        self.descriptions[r.key].setText(items[i].subtitle if 0 <= i < len(items) else "")
 
     # -- showing a state ---------------------------------------------------------------------
     def show_state(self, s) -> None:
@@ -197,9 +310,12 @@ class RowWidgets(QtCore.QObject):
         w.set_rgb(v)
 
     def _show_choice(self, r: Row, w, v, s) -> None:
+        if r.items is not None:
+            self._set_items(r, r.items(s))
         if not r.inline:
+            values = self._values(r)
             with QtCore.QSignalBlocker(w):
-                w.setCurrentIndex(r.choices.index(v))
+                w.setCurrentIndex(values.index(v) if v in values else -1)
             return
         for name, b in self.radios[r.key].items():
             with QtCore.QSignalBlocker(b):
@@ -208,6 +324,24 @@ class RowWidgets(QtCore.QObject):
     def _show_toggle(self, r: Row, w, v, s) -> None:
         with QtCore.QSignalBlocker(w):
             w.setChecked(bool(v))
+
+    def _show_list(self, r: Row, w, v, s) -> None:
+        if r.items is not None:
+            self._set_items(r, r.items(s))
+        values = self._values(r)
+        i = values.index(v) if v in values else -1
+        with QtCore.QSignalBlocker(w):
+            w.setCurrentRow(i)
+            if i >= 0:
+                w.scrollToItem(w.item(i))
+        if r.key in self.descriptions:
+            self._describe(r, i)
+
+    def _show_text(self, r: Row, w, v, s) -> None:
+        w.setText(v)
+
+    def _show_button(self, r: Row, w, v, s) -> None:
+        w.setEnabled(bool(v))
 
     def _show_triple(self, r: Row, w, v, s) -> None:
         for f, x in zip(self.fields[r.key], v, strict=True):

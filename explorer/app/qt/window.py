@@ -23,6 +23,7 @@ import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
+from explorer.app import panelmodel
 from explorer.app.controller import Controller, Ports
 from explorer.app.difference import DifferenceWorker
 from explorer.app.qt.compare import CompareView
@@ -76,7 +77,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.controller = c = Controller(state, mesh, ports, materials_dirs=materials_dirs,
                                          preset_dir=preset_dir, output_dir=output_dir,
                                          last_session=last_session)  # fmt: skip
-        self.panel = Panel(c.act, c.files.choose_mesh, c.set_value)
+        self.panel = Panel(c.files.choose_mesh, c.set_value)
         self.splitter.addWidget(self.panel)
         self.splitter.setSizes([round(w * (1 - PANEL_FRACTION)), round(w * PANEL_FRACTION)])
         self.bar = MessageBar(self)
@@ -194,8 +195,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
 
     # -- ports: choices ------------------------------------------------------------------------
     def show_presets(self, presets) -> None:
-        self.panel.material.set_presets(presets)
-        self.panel.view.set_presets(presets)
+        self.panel.show_items("presets", panelmodel.preset_items(presets))
 
     def show_meshes(self, labels) -> None:
         self.panel.view.set_meshes(labels)

@@ -13,7 +13,7 @@ class WebCompare:
     """Side B's pane of ``app`` (a :class:`~explorer.app.web.WebExplorer`: its ``plotter``,
     ``server``, ``loop``, ``guard`` and ``_send``): :attr:`plotter` is made with the page (its
     remote view needs it). The page shows or hides side B's view itself (state
-    ``compare_on``); side B draws no light handles."""
+    ``compare``); side B draws no light handles."""
 
     handles = False
 

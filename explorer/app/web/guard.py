@@ -209,23 +209,15 @@ def key_table(rows: Iterable[tuple[str, str]]) -> dict[str, str]:
 
 
 #: every state key the page's controls set (their ``v_model``), with its kind: the panel
-#: model's rows (:func:`explorer.app.panelmodel.client_keys`: the sliders' steps, the choices
-#: and toggles), then the page's own selects, switches and text fields that are state, the
+#: model's rows (:func:`explorer.app.panelmodel.client_keys`: the sliders' steps, the choices,
+#: toggles and lists), then the page's own selects, switches and text fields that are state, the
 #: uploads, the tab and the drawer. The number fields, colour fields and pickers, buttons and
 #: downloads are not state: they call the server's handlers, which parse what they are given.
 #: tests/app/web/test_web_security.py checks it against the page's template (every ``v-model``).
 CLIENT_KEYS: Mapping[str, str] = key_table(
     [
         *panelmodel.client_keys().items(),
-        ("preset", "text"),
-        ("group", "index"),
-        ("light", "index"),
         ("mesh", "text"),
-        ("difference", "bool"),
-        ("compare_on", "bool"),
-        ("compare_preset", "text"),
-        ("compare_model", "text"),
-        ("compare_difference", "bool"),
         ("turntable_frames", "text or number"),
         ("turntable_format", "text"),
         ("preset_name", "text"),

@@ -14,8 +14,8 @@ from explorer.app import panelmodel
 from explorer.app.turntablejob import DEFAULT_FRAMES
 from explorer.app.web import intents as webintents
 from explorer.app.web.files import turntable_formats
+from explorer.app.web.panel import items_key
 from explorer.core.controls import STEPS
-from explorer.core.material import MODELS
 from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
 from explorer.core.version import __version__
 from explorer.geometry.meshes import MESH_SUFFIXES
@@ -137,17 +137,39 @@ def _shown_as(key: str, tip: str) -> dict:
 
 
 def _choice(v3, r) -> None:
-    v3.VSelect(
+    """A select of a choice's values, or of a list's items (state ``<key>_items`` or the
+    catalogue's key, with their subtitles and swatches): searched by words when the row says
+    so. A list is always shown (its value is null when nothing is selected)."""
+    listed = r.kind == "list" or not r.choices
+    shown = _shown_as(r.key, r.tip)
+    if r.kind == "list":
+        del shown["v_show"]
+    (v3.VAutocomplete if r.search else v3.VSelect)(
         v_model=(r.key, None),
-        items=(repr(list(r.choices)),),
+        items=(items_key(r) if listed else repr(list(r.choices)),),
+        item_props=listed,
         label=r.caption,
-        **_shown_as(r.key, r.tip),
+        **shown,
     )
 
 
 def _checkbox(v3, key: str, label: str, tip: str) -> None:
     """A toggle row's box, or an optional number's ``<key>_on`` switch."""
     v3.VCheckbox(v_model=(key, False), label=label, **_shown_as(key, tip))
+
+
+def _text(html, r) -> None:
+    """A text row: the line its state key holds, hidden while it is null."""
+    html.Div(f"{{{{ {r.key} }}}}", v_show=f"{r.key} != null", classes="text-body-2 mb-1",
+             title=r.tip, raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
+
+
+def _button(v3, ctrl, r) -> None:
+    """A button row: pressed through the server's ``press`` handler, disabled while its state
+    key (whether it can be pressed) is false, hidden while it is null."""
+    v3.VBtn(r.caption, click=(ctrl.press, f"['{r.key}']"), size="small", classes="mr-1 my-1",
+            disabled=(f"!{r.key}",), v_show=f"{r.key} != null", title=r.tip,
+            raw_attrs=[f'aria-label="{r.key}"'])  # fmt: skip
 
 
 def _triple(v3, ctrl, r) -> None:
@@ -157,71 +179,48 @@ def _triple(v3, ctrl, r) -> None:
     )  # fmt: skip
 
 
-def _rows(v3, html, ctrl, tab: str) -> None:
+def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     """The rows of ``tab`` (:mod:`explorer.app.panelmodel`), one factory per kind; a group of
     toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
-    key is null (the row is not shown)."""
+    key is null (the row is not shown). ``after``: key -> a function that draws the page's own
+    controls after that row (the difference view's legend)."""
     line, group = None, None
     for r in panelmodel.rows(tab):
-        if r.kind == "toggle" and r.group:
+        if r.kind in ("toggle", "button") and r.group:
             if r.group != group:
                 line = html.Div(classes="d-flex")
                 group = r.group
             with line:
-                _checkbox(v3, r.key, r.caption, r.tip)
-            continue
-        group = None
-        if r.kind == "number":
+                (_button(v3, ctrl, r) if r.kind == "button" else
+                 _checkbox(v3, r.key, r.caption, r.tip))  # fmt: skip
+        elif r.kind == "number":
             if r.optional is not None:
                 _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
             _number(v3, html, ctrl, r.key, r.caption)
         elif r.kind == "colour":
             _colour(v3, html, ctrl, r.key, r.key)
-        elif r.kind == "choice":
+        elif r.kind in ("choice", "list"):
             _choice(v3, r)
         elif r.kind == "toggle":
             _checkbox(v3, r.key, r.caption, r.tip)
+        elif r.kind == "button":
+            _button(v3, ctrl, r)
+        elif r.kind == "text":
+            _text(html, r)
         else:
             _triple(v3, ctrl, r)
-
-
-def _mesh_materials(v3, html, ctrl) -> None:
-    """A mesh file's own materials (shown when the mesh brings some): what is drawn, the group
-    the controls edit, or a button that draws the file's materials again."""
-    with html.Div(v_show="mesh_materials", classes="mb-2 pa-2 border rounded"):
-        html.Div("{{ mesh_materials }}", classes="text-body-2 mb-1",
-                 raw_attrs=['aria-label="mesh_materials"'])  # fmt: skip
-        v3.VSelect(v_model=("group", None), items=("groups", []), label="group",
-                   item_props=True, density="compact", hide_details=True,
-                   v_show="group != null",
-                   title="the group of the mesh whose material the controls below edit",
-                   raw_attrs=['aria-label="group"'])  # fmt: skip
-        v3.VBtn("use the mesh's materials", click=ctrl.use_mesh_materials, size="small",
-                v_show="group == null",
-                title="draw each group in the material its file gives (undoable)",
-                raw_attrs=['aria-label="use_mesh_materials"'])  # fmt: skip
+        group = r.group if r.kind in ("toggle", "button") else None
+        (after or {}).get(r.key, lambda: None)()
 
 
 def _material_tab(v3, html, ctrl) -> None:
     """The mesh's own materials, the preset, the numbers, the colours, the model and the
     terms."""
-    _mesh_materials(v3, html, ctrl)
-    v3.VAutocomplete(
-        v_model=("preset", None), items=("presets", []), label="preset", item_props=True,
-        density="compact", hide_details=True, raw_attrs=['aria-label="preset"'],
-    )  # fmt: skip
     _rows(v3, html, ctrl, "material")
 
 
 def _lights_tab(v3, html, ctrl) -> None:
     """The light list, add / duplicate / remove, and the selected light."""
-    v3.VSelect(v_model=("light", 0), items=("lights",), label="light",
-               density="compact", hide_details=True,
-               raw_attrs=['aria-label="light"'])  # fmt: skip
-    with html.Div(classes="d-flex my-1"):
-        for name in ("add", "duplicate", "remove"):
-            v3.VBtn(name, click=getattr(ctrl, f"{name}_light"), size="small",
-                    classes="mr-1", raw_attrs=[f'aria-label="{name} light"'])  # fmt: skip
     _rows(v3, html, ctrl, "lights")
 
 
@@ -235,34 +234,14 @@ def _view_tab(v3, html, ctrl) -> None:
         multiple=True, density="compact", hide_details=True, classes="my-2",
         accept=",".join(MESH_SUFFIXES) + ",.mtl", raw_attrs=['aria-label="upload mesh"'],
     )  # fmt: skip
-    v3.VSwitch(v_model=("difference", False), label="difference from the exact lighting",
-               density="compact", hide_details=True, color="primary",
-               raw_attrs=['aria-label="difference"'])  # fmt: skip
-    html.Div("{{ legend }}", classes="text-caption", v_show="difference")
     v3.VBtn("reset camera", click=ctrl.reset_camera, size="small", classes="my-2",
             raw_attrs=['aria-label="reset camera"'])  # fmt: skip
-    _compare(v3, html, ctrl)
-    _rows(v3, html, ctrl, "view")
+
+    def legend():
+        html.Div("{{ legend }}", classes="text-caption", v_show="difference")
+
+    _rows(v3, html, ctrl, "view", {"difference": legend})
     _turntable(v3, html, ctrl)
-
-
-def _compare(v3, html, ctrl) -> None:
-    """Compare A | B: side B's preset and model, A − B, swap."""
-    v3.VSwitch(v_model=("compare_on", False), label="compare A | B", density="compact",
-               hide_details=True, color="primary", raw_attrs=['aria-label="compare"'])  # fmt: skip
-    with html.Div(v_show="compare_on", classes="ml-2"):
-        v3.VAutocomplete(v_model=("compare_preset", None), items=("presets", []),
-                         label="B preset", item_props=True, density="compact",
-                         hide_details=True, raw_attrs=['aria-label="compare_preset"'])  # fmt: skip
-        v3.VSelect(v_model=("compare_model", None), items=("models",), label="B model",
-                   density="compact", hide_details=True,
-                   raw_attrs=['aria-label="compare_model"'])  # fmt: skip
-        with html.Div(classes="d-flex align-center"):
-            v3.VCheckbox(v_model=("compare_difference", False), label="A − B",
-                         density="compact", hide_details=True,
-                         raw_attrs=['aria-label="compare_difference"'])  # fmt: skip
-            v3.VBtn("swap", click=ctrl.swap_sides, size="small",
-                    raw_attrs=['aria-label="swap"'])  # fmt: skip
 
 
 def _turntable(v3, html, ctrl) -> None:
@@ -372,13 +351,12 @@ def _page_state(state) -> None:
     """The page's own keys, their first values, and which of them each page keeps to itself
     (trame's client-only keys: never sent to the server, so never to another page)."""
     state.update(
-        models=list(MODELS), message="", message_level="info", message_seq=0, seen_seq=0,
-        page_w=1280,
+        message="", message_level="info", message_seq=0, seen_seq=0, page_w=1280,
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         turntable_ready=False, turntable_made="",
         turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
-        compare_on=False,
+        compare=False,
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
     state.client_only("show_messages")  # the log opens in the tab that asks, alone
@@ -452,7 +430,7 @@ def build(app) -> None:
                     view = vtkw.VtkRemoteView(app.plotter.render_window, interactive_ratio=1,
                                               still_quality=100, interactive_quality=100,
                                               raw_attrs=['aria-label="view"'])  # fmt: skip
-                with html.Div(v_if="compare_on", style="flex: 1 1 0; height: 100%; "
+                with html.Div(v_if="compare", style="flex: 1 1 0; height: 100%; "
                               "position: relative; margin-left: 4px"):  # fmt: skip
                     view_b = vtkw.VtkRemoteView(
                         app.compare.plotter.render_window, interactive_ratio=1,

@@ -10,9 +10,11 @@ the shininess, as the desktop's) and a field (state key ``<key>``): a slider dra
 step (sealed when it ends), a value typed into a field and confirmed (Enter, or leaving the
 field) is one step, parsed as the desktop's fields parse it
 (:func:`explorer.app.model.parse_number`). An optional number has its switch ``<key>_on``; a
-colour its ``r, g, b`` text and its 8-bit ``<key>_hex``; a choice, a toggle and a triple their
-value. Every edit is :meth:`Controller.set_value`. A change the server pushed itself, or one
-equal to what the state shows, is no change.
+colour its ``r, g, b`` text and its 8-bit ``<key>_hex``; a choice, a toggle, a list and a triple
+their value. A list's (or a choice's) items are state key ``<key>_items`` when the state gives
+them (the lights), or the catalogue's own key (``presets``, set when the controller's presets
+change: :func:`item`). Every edit is :meth:`Controller.set_value`. A change the server pushed
+itself, or one equal to what the state shows, is no change.
 """
 
 from __future__ import annotations
@@ -56,24 +58,20 @@ def swatch_url(m) -> str:
     return "data:image/svg+xml;utf8," + quote(svg)
 
 
-def preset_item(info) -> dict:
-    """A preset as the searchable list shows it: its name, its description and its swatch."""
-    m = info.material
-    return {"title": info.name, "value": info.name, "subtitle": m.description or "",
-            "prependAvatar": swatch_url(m)}  # fmt: skip
+def item(it: panelmodel.Item) -> dict:
+    """A list's item as the page's lists show it: its title, its value, its subtitle and its
+    swatch when it has them."""
+    out = {"title": it.title, "value": it.value}
+    if it.subtitle:
+        out["subtitle"] = it.subtitle
+    if it.swatch is not None:
+        out["prependAvatar"] = swatch_url(it.swatch)
+    return out
 
 
-def mesh_materials_values(state: M.State) -> dict:
-    """What the page says of a mesh file's own materials (as the desktop's box): the line
-    (``mesh_materials``: empty when the mesh brings none), the groups with their swatches and
-    the one the controls edit (``groups``, ``group``: None while a preset covers the mesh)."""
-    line = M.mesh_materials_line(state)
-    mm = state.mesh_materials
-    if mm is None or state.groups is None:
-        return {"mesh_materials": line, "groups": [], "group": None}
-    groups = [{"title": mm.names[i] or "(no usemtl)", "value": i, "prependAvatar": swatch_url(m)}
-              for i, m in enumerate(state.groups)]  # fmt: skip
-    return {"mesh_materials": line, "groups": groups, "group": state.group}
+def items_key(r: panelmodel.Row) -> str:
+    """The state key of a list's (or a choice's) items: its catalogue's, else its own."""
+    return r.source or f"{r.key}_items"
 
 
 def slider_step(r: panelmodel.Row, state: M.State) -> int | None:
@@ -101,22 +99,15 @@ def row_values(state: M.State) -> dict:
             out[r.key] = None if v is None else rgb_text(v)
         else:
             out[r.key] = v
+        if r.items is not None:  # (none while the row is hidden)
+            out[items_key(r)] = [item(it) for it in r.items(state)] if r.visible(state) else []
     return out
 
 
 def values(state: M.State) -> dict:
     """Every trame state key the panel shows, from ``state``."""
     out = row_values(state)
-    lights = state.scene.lights
-    out.update(
-        preset=state.preset, edited=state.edited, mesh=state.mesh,
-        lights=[{"title": f"{i + 1}: {lt.type}", "value": i} for i, lt in enumerate(lights)],
-        light=state.light if lights else None,
-        difference=state.difference, compare_on=state.compare is not None,
-        compare_preset=state.compare_preset, compare_model=state.compare_model,
-        compare_difference=state.compare_difference,
-    )  # fmt: skip
-    out.update(mesh_materials_values(state))
+    out.update(edited=state.edited, mesh=state.mesh)
     return out
 
 
@@ -227,11 +218,12 @@ def _numbers(app) -> None:
 
 
 def _rows(app, user) -> None:
-    """The choices', the toggles' and the optional numbers' switches' handlers: each
-    ``set_value`` of its row, when the page's value is not the state's."""
+    """The choices', the toggles', the lists' and the optional numbers' switches' handlers:
+    each ``set_value`` of its row, when the page's value is not the state's (a button is
+    pressed through ``press``)."""
     c = app.controller
     for r in panelmodel.ROWS:
-        if r.kind in ("choice", "toggle"):
+        if r.kind in ("choice", "toggle", "list"):
             user(
                 r.key,
                 lambda v, s, r=r: r.visible(s) and v != r.value(s),
@@ -264,14 +256,6 @@ def _choices(app) -> None:
         state.change(name)(app.guard(changed, name))
 
     _rows(app, user)
-    user("preset", lambda v, s: v != s.preset, c.pick_preset)
-    user("group", lambda v, s: s.groups is not None and int(v) != s.group,
-         lambda v: c.act(M.select_group, int(v), label="group"))  # fmt: skip
-    ctrl.use_mesh_materials = app.guard(
-        lambda: c.act(M.use_mesh_materials, label="mesh materials"), "mesh materials"
-    )
-    user("light", lambda v, s: int(v) != s.light,
-         lambda v: c.act(M.select_light, int(v), label="select light"))  # fmt: skip
 
     def choose_mesh(value):
         """A mesh of the chooser's list only (a built-in, the start's, an upload: values the
@@ -284,16 +268,15 @@ def _choices(app) -> None:
             c.reject_input(MESH_REFUSED)
 
     user("mesh", lambda v, s: v != app.mesh_values.page(s.mesh), choose_mesh)
-    user("difference", lambda v, s: bool(v) != s.difference,
-         lambda v: c.act(M.set_difference, bool(v), label="difference"))  # fmt: skip
-    _compare(app, user)
-    for name, action in (("add", M.add_light), ("duplicate", M.duplicate_light),
-                         ("remove", M.remove_light)):  # fmt: skip
-        setattr(
-            ctrl,
-            f"{name}_light",
-            app.guard(lambda a=action, n=name: c.act(a, label=f"{n} light"), f"{name} light"),
-        )
+
+    def press(key):
+        """A button row pressed (any other key from the page is refused)."""
+        r = panelmodel.BY_KEY.get(str(key))
+        if r is None or r.kind != "button":
+            raise ExplorerError(f"the page has no button named '{key}'")
+        c.set_value(r.key, True, merge=False)
+
+    ctrl.press = app.guard(press, "button")
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
     ctrl.turntable = app.guard(lambda: app.files.start_turntable(
@@ -301,28 +284,6 @@ def _choices(app) -> None:
     ctrl.cancel_job = app.guard(app.cancel_job, "cancel")
     ctrl.save_preset = app.guard(lambda: app.files.save_preset(
         state.preset_name or "", bool(state.preset_replace)), "save preset")  # fmt: skip
-
-
-def _compare(app, user) -> None:
-    """The compare view's controls: on / off, side B's preset and model, A − B, swap."""
-    c = app.controller
-
-    def preset_b(name):
-        info = next((p for p in c.presets if p.name == name), None)
-        if info is None:
-            raise ExplorerError(f"no preset named '{name}'")
-        c.act(M.set_compare_preset, info.name, info.material, label=f"B {info.name}")
-
-    user("compare_on", lambda v, s: bool(v) != (s.compare is not None),
-         lambda v: c.act(M.set_compare, bool(v), label="compare"))  # fmt: skip
-    user("compare_preset", lambda v, s: s.compare is not None and v != s.compare_preset,
-         preset_b)  # fmt: skip
-    user("compare_model", lambda v, s: s.compare is not None and v != s.compare_model,
-         lambda v: c.act(M.set_compare_model, v, label="B model"))  # fmt: skip
-    user("compare_difference", lambda v, s: s.compare is not None
-         and bool(v) != s.compare_difference,
-         lambda v: c.act(M.set_compare_difference, bool(v), label="A − B"))  # fmt: skip
-    app.server.controller.swap_sides = app.guard(c.swap_sides, "swap A and B")
 
 
 def _files(app) -> None:

@@ -30,7 +30,7 @@ import tempfile
 import time
 from collections.abc import Sequence
 
-from explorer.app import intents
+from explorer.app import intents, panelmodel
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
 from explorer.app.controller.ports import log_head
@@ -229,7 +229,7 @@ class WebExplorer:
     # change from a worker's callback reaches the pages now, not at the user's next action)
     def show_presets(self, presets: list) -> None:
         with self.server.state as s:
-            s.presets = [panel.preset_item(p) for p in presets]
+            s.presets = [panel.item(i) for i in panelmodel.preset_items(presets)]
 
     def show_meshes(self, labels: dict[str, str]) -> None:
         with self.server.state as s:

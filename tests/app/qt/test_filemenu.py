@@ -70,16 +70,17 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     red, blue = group_rgb(win, "left_red"), group_rgb(win, "right_blue")
     assert red[0] > 100 > red[2] and blue[2] > 100 > blue[0]  # both group colours drawn
     drawn_equals_groups(win)
-    box = win.panel.material.mesh_materials
-    assert box.isVisibleTo(win.panel) and "two.obj</b> brings its own materials" in (
-        box.label.text())  # fmt: skip
-    assert box.group.count() == 2 and not box.use.isVisibleTo(win.panel)
+    rows = win.panel.material.rows.widgets  # the mesh's own materials: rows of the tab
+    line, group, use = rows["mesh_materials"], rows["group"], rows["use_mesh_materials"]
+    assert line.isVisibleTo(win.panel) and "two.obj brings its own materials" in line.text()
+    assert group.count() == 2 and not use.isVisibleTo(win.panel)
+    assert not group.itemIcon(0).isNull()  # each group with its swatch
     assert "of the mesh" in win.panel.material.preset_label.text()
     assert "two.obj's materials" in win.status_label.text()
     # the controls edit the chosen group only
     i = s.mesh_materials.names.index("right_blue")
-    box.group.activated.emit(i)
-    assert win.controller.state.group == i and box.label.text().endswith("'right_blue'")
+    group.activated.emit(i)
+    assert win.controller.state.group == i and line.text().endswith("'right_blue'")
     before = group_rgb(win, "left_red")
     win.panel.material.sliders["kd"].field.setValue(0.3)
     assert max(win.controller.state.groups[i].diffuse) == pytest.approx(0.3)
@@ -95,11 +96,11 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
     # a preset covers the whole mesh; undo brings the groups back; so does the button
     tab = win.panel.material
     item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
-    tab._chosen(item)
+    tab.presets.itemClicked.emit(item)  # a click on it
     s = win.controller.state
-    assert s.groups is None and s.preset == "jade" and box.use.isVisibleTo(win.panel)
-    assert not box.group_row.isVisibleTo(win.panel)
-    assert "preset 'jade' covers the whole mesh" in box.label.text()
+    assert s.groups is None and s.preset == "jade" and use.isVisibleTo(win.panel)
+    assert not group.isVisibleTo(win.panel)
+    assert "preset 'jade' covers the whole mesh" in line.text()
     want = to_bytes(vertex_colors(s.shown_scene(), win.view.mesh)).astype(int)
     assert np.abs(win.view.displayed_colors().astype(int) - want).max() <= 1  # jade all over
     win.controller.undo()
@@ -108,7 +109,7 @@ def test_a_grouped_obj_opens_with_its_own_materials(win, answers, tmp_path, qtbo
         and max(win.controller.state.groups[i].diffuse) == 0.3
     )
     win.controller.redo()
-    qtbot.mouseClick(box.use, QtCore.Qt.MouseButton.LeftButton)
+    qtbot.mouseClick(use, QtCore.Qt.MouseButton.LeftButton)
     assert win.controller.state.groups == win.controller.state.mesh_materials.materials
     # the difference view compares each group in its own material; editing a group that is
     # not the one drawn by the scene's material asks for a new map

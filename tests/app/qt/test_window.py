@@ -133,8 +133,8 @@ def test_model_terms_and_presets(win, qtbot):
     tab.search.setText("green")
     shown = [tab.presets.item(i).text() for i in range(tab.presets.count())
              if not tab.presets.item(i).isHidden()]  # fmt: skip
-    assert shown and all("green" in n or "green" in tab._infos[n].material.description.lower()
-                         for n in shown)  # fmt: skip
+    described = {it.title: it.subtitle for it in tab.rows.items["preset"]}
+    assert shown and all("green" in n or "green" in described[n].lower() for n in shown)
     item = tab.presets.findItems("jade", QtCore.Qt.MatchFlag.MatchExactly)[0]
     tab.search.clear()
     tab.presets.scrollToItem(item)
@@ -169,7 +169,7 @@ def test_every_light_control(win):
     tab.type.activated.emit(2)  # spot
     light = win.controller.state.selected_light
     assert light.type == "spot" and tab.cutoff.isVisibleTo(tab)
-    assert win.view.glyph_kind == "spot"
+    assert win.view.glyph_kind == "cone"
     tab.cutoff.field.setValue(12.0)
     tab.exponent.field.setValue(3.0)
     light = win.controller.state.selected_light
@@ -177,7 +177,7 @@ def test_every_light_control(win):
     tab.colour.open_dialog().colorSelected.emit(QtGui.QColor(255, 128, 0))
     assert M.light_colour(win.controller.state.selected_light)[0][1] == pytest.approx(128 / 255)
     tab.type.activated.emit(0)  # directional: an arrow, no attenuation
-    assert win.view.glyph_kind == "directional" and not tab.attenuation_box.isVisibleTo(tab)
+    assert win.view.glyph_kind == "arrow" and not tab.attenuation_box.isVisibleTo(tab)
     win.render()
     drawn_equals_engine(win)
 

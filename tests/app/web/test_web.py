@@ -241,7 +241,7 @@ def test_every_control_is_named_by_its_scene_key(server, browser):
     names = {e.get_attribute("aria-label")
              for e in browser.find_elements(By.CSS_SELECTOR, "[aria-label]")}  # fmt: skip
     for key in ("light", "type", "color", "intensity", "azimuth", "elevation", "distance",
-                "attenuation", "add light", "duplicate light", "remove light",
+                "attenuation", "add_light", "duplicate_light", "remove_light",
                 "color picker"):  # fmt: skip
         assert key in names, key
     click(browser, "view tab")
@@ -275,7 +275,7 @@ def test_a_light_added_a_session_downloaded_and_opened_again(server, browser, do
     rep = open_page(browser, server.url)
     n = len(rep["session"]["scene"]["lights"])
     click(browser, "lights tab")
-    click(browser, "add light")
+    click(browser, "add_light")
     rep = wait("a new light", lambda: (r := report(browser))
                and len(r["session"]["scene"]["lights"]) == n + 1 and r)  # fmt: skip
     assert rep["session"]["light"] == n + 1  # the new light is selected (1-based in the file)

@@ -247,7 +247,7 @@ FUZZ_KEYS = [
     "light_color",
     "turntable_format",
     "difference",
-    "compare_on",
+    "compare",
     "group",
     "attenuation",
     "session_upload",
