@@ -90,7 +90,8 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
             classes="flex-grow-1 mr-2",
         )  # fmt: skip
         v3.VTextField(
-            model_value=(key, 0), type="text", density="compact", hide_details=True,
+            model_value=(key, 0), key=(f"'{key}-' + field_rev",), type="text",
+            density="compact", hide_details=True,
             variant="outlined", style="max-width: 92px",
             change=(ctrl.on_field, f"['{key}', $event.target.value]"),
             raw_attrs=[f'aria-label="{key}"'],
@@ -103,7 +104,8 @@ def _colour(v3, html, ctrl, key: str, label: str) -> None:
     colour picker (``<label> picker``); hidden while ``key`` is null (no light to colour)."""
     with html.Div(v_show=f"{key} != null"), html.Div(classes="d-flex align-center my-1"):
         v3.VTextField(
-            model_value=(key, ""), label=label, density="compact", hide_details=True,
+            model_value=(key, ""), key=(f"'{key}-' + field_rev",), label=label,
+            density="compact", hide_details=True,
             variant="outlined", classes="flex-grow-1",
             change=(ctrl.on_colour, f"['{key}', $event.target.value]"),
             raw_attrs=[f'aria-label="{label}"'],
@@ -174,7 +176,8 @@ def _button(v3, ctrl, r) -> None:
 
 def _triple(v3, ctrl, r) -> None:
     v3.VTextField(
-        model_value=(r.key, ""), label=f"{r.key} ({', '.join(r.choices)})", variant="outlined",
+        model_value=(r.key, ""), key=(f"'{r.key}-' + field_rev",), variant="outlined",
+        label=f"{r.key} ({', '.join(r.choices)})",
         change=(ctrl.on_triple, f"['{r.key}', $event.target.value]"), **_shown_as(r.key, r.tip),
     )  # fmt: skip
 
@@ -351,7 +354,7 @@ def _page_state(state) -> None:
     """The page's own keys, their first values, and which of them each page keeps to itself
     (trame's client-only keys: never sent to the server, so never to another page)."""
     state.update(
-        message="", message_level="info", message_seq=0, seen_seq=0, page_w=1280,
+        message="", message_level="info", message_seq=0, seen_seq=0, page_w=1280, field_rev=0,
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         turntable_ready=False, turntable_made="",

@@ -136,14 +136,26 @@ def page_value(name: str, read, value, like=None):
 
 
 def _typed(app, parse, send) -> None:
-    """A value typed into a field: parsed (``parse()``) and sent (``send(value)``) as one undo
-    step; a refused value is said, and the field shows the state's again."""
+    """A value typed into a field: parsed (``parse()``) and sent (``send(value)``, true when
+    the state took it) as one undo step; a refused value is said, and the fields show the
+    state's values again (:func:`show_fields_again`)."""
     try:
         value = parse()
     except ExplorerError as exc:
         app.controller.reject_input(str(exc))
+        show_fields_again(app)
         return
-    send(value)
+    if not send(value):
+        show_fields_again(app)
+
+
+def show_fields_again(app) -> None:
+    """The page's typed fields drawn anew from the state (state ``field_rev``, each field's Vue
+    key): a field shows its state key one way, and trame sends no value equal to the one it
+    sent last, so a field holding refused text (``5000``, ``abc``) kept it beside a slider
+    showing the state."""
+    with app.server.state as s:
+        s.field_rev = (s.field_rev or 0) + 1
 
 
 def _numbers(app) -> None:
@@ -192,7 +204,7 @@ def _numbers(app) -> None:
             app,
             lambda: parse_hex(key, str(text)),
             lambda rgb: (
-                rgb_hex(rgb) != values(app.store.state)[f"{key}_hex"] and c.set_value(key, rgb)
+                rgb_hex(rgb) == values(app.store.state)[f"{key}_hex"] or c.set_value(key, rgb)
             ),
         )
 

@@ -114,6 +114,38 @@ def test_a_bad_mtl_is_refused_with_the_desktops_message_and_nothing_written(serv
     assert "Traceback" not in server.output(), server.output()
 
 
+def field_text(driver, name: str) -> str:
+    """What the field named ``name`` shows (its input's value)."""
+    from selenium.webdriver.common.by import By
+
+    e = by_name(driver, name)
+    return (e if e.tag_name == "input" else e.find_element(By.CSS_SELECTOR, "input")).get_attribute(
+        "value"
+    )
+
+
+@pytest.mark.parametrize(
+    ("key", "text", "tab"),
+    [("shininess", "5000", None), ("ka", "-1", None), ("kd", "abc", None),
+     ("azimuth", "500", "lights tab"), ("intensity", "-2", "lights tab"),
+     ("attenuation", "0,0,0", "lights tab")],
+)  # fmt: skip
+def test_a_refused_value_leaves_the_field_showing_the_state(server, browser, key, text, tab):
+    """A typed value the explorer refuses (out of range, not a number, an attenuation of
+    zero) is said, and the field shows the state's value again, as the window's does (it kept
+    the refused text beside a slider showing the state)."""
+    open_page(browser, server.url)
+    if tab:
+        click(browser, tab)
+    shown = field_text(browser, key)
+    type_value(browser, key, text)
+    wait("the refusal", lambda: "error" in status(browser))
+    wait("the state's value in the field", lambda: field_text(browser, key) == shown)
+    server_errors = report(browser)["errors"]
+    assert server_errors and key.split()[0] in server_errors[-1], server_errors
+    browser.execute_script("window.phongIntent('reset_camera')")  # (a message that is no error)
+
+
 def test_the_message_log_lists_the_sessions_messages(server, browser):
     open_page(browser, server.url)
     type_value(browser, "kd", "7")  # refused: the message names the key and the range
