@@ -9,6 +9,8 @@
     phong-explorer render --preset gold --mesh teapot --out gold.glb   (unlit glTF)
     phong-explorer render --preset gold --mesh teapot --out gold.obj   (gold.obj + gold.mtl)
     phong-explorer render --preset gold --mesh teapot --turntable 36 --out spin.gif
+    phong-explorer render --preset gold --mesh teapot --strip --out strip.png  (term by term)
+    phong-explorer render --preset gold --strip --strip-mode raw --strip-lights --out s.png
 
 An OBJ whose ``mtllib`` defines materials is drawn with them, each ``usemtl`` group in its own
 material; ``--preset`` draws the whole mesh in one preset instead. The scene options are in
@@ -41,6 +43,7 @@ from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
+from explorer.render.strip import STRIP_TILE, render_strip
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -50,6 +53,7 @@ from explorer.render.turntable import (
     iter_frames,
 )
 from explorer.shading.display import group_vertex_colors, vertex_colors
+from explorer.shading.strip import MODES as STRIP_MODES
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -73,6 +77,26 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="light every pixel instead of every vertex (exact sphere for the built-in spheres, "
         "else ray casting with interpolated normals): the accuracy reference; .png only",
     )  # fmt: skip
+    p.add_argument(
+        "--strip",
+        action="store_true",
+        help="the equation term by term: emission | ambient | diffuse | specular | sum | "
+        "overflow, one tile each (--tile), labelled; .png only",
+    )
+    p.add_argument(
+        "--strip-mode",
+        choices=STRIP_MODES,
+        default="weighted",
+        help="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light sums "
+        "A, D, S alone (default weighted)",
+    )
+    p.add_argument("--strip-lights", action="store_true", help="with --strip: a row per light")
+    p.add_argument(
+        "--tile",
+        default=None,
+        metavar="WxH",
+        help=f"with --strip: the size of one tile (default {STRIP_TILE[0]}x{STRIP_TILE[1]})",
+    )
     add_scene_arguments(p, mesh_default="sphere")
 
 
@@ -86,6 +110,12 @@ def run(args) -> int:
     suffix = check_out(args.out, suffixes, args.force)
     if turntable:
         check_frames(args.turntable)
+    if args.strip and (turntable or args.per_pixel):
+        raise ExplorerError(
+            "--strip draws the terms per vertex: not with --turntable or --per-pixel"
+        )
+    if args.strip and suffix != ".png":
+        raise ExplorerError(f"--strip draws a picture: give --out FILE.png, not {suffix}")
     size = size_from_option(args.size, "--size")
     if turntable:  # its format's needs and its total, before the mesh is read or a frame drawn
         check_turntable(args.turntable, size, suffix)
@@ -104,6 +134,10 @@ def run(args) -> int:
                 "materials"
             )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
+    if args.strip:
+        return run_strip(args, scene, mesh, materials, background)
+    if args.tile is not None or args.strip_lights:
+        raise ExplorerError("--tile and --strip-lights draw the strip: give --strip too")
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
@@ -216,4 +250,32 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
         f"wrote {args.out}: {size[0]}x{size[1]} per-pixel picture ({mesh.name}, {how}, {name}, "
         f"{scene.model})"
     )
+    return 0
+
+
+def run_strip(args, scene, mesh, materials, background) -> int:
+    """``phong-explorer render --strip``: the term strip
+    (:func:`explorer.render.strip.render_strip`) to ``args.out``, and its caption."""
+    if materials:
+        raise ExplorerError(
+            "--strip draws one material: give --preset NAME for a mesh with its own materials"
+        )
+    tile = STRIP_TILE if args.tile is None else size_from_option(args.tile, "--tile")
+    picture = render_strip(
+        scene,
+        mesh,
+        tile=tile,
+        mode=args.strip_mode,
+        lights=args.strip_lights,
+        background=background,
+    )
+    write_atomic(args.out, encode_png(picture.image), overwrite=args.force)
+    h, w = picture.image.shape[:2]
+    name = scene.material.name or "material"
+    rows = len(picture.rows)
+    say(
+        f"wrote {args.out}: {w}x{h} term strip, {rows} row{'s' if rows != 1 else ''} "
+        f"({mesh.name}, {name}, {scene.model}, {args.strip_mode})"
+    )
+    say(picture.caption)
     return 0
