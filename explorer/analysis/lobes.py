@@ -252,7 +252,8 @@ class Curve:
 @dataclass(frozen=True)
 class Chart:
     """A plot in plot units: x in [-1, 1], y in [0, 1] (polar: the origin at (0, 0), the normal
-    up, radius 1 the top of the scale; Cartesian: x the angle from -90° to 90°, y up).
+    up, radius 1 the top of the scale; Cartesian: x the angle from -90° to 90° (the albedo's θ_i
+    from 0 to 90°: x in [0, 1]), y up).
 
     curves : the visible lobes' :class:`Curve`; legend : ``(label, colour, visible)`` of every
     lobe; top : the value at radius / height 1 (log: 10**top decades, see ``floor``); floor :
@@ -308,11 +309,11 @@ def chart(
             r = np.clip(np.log10(np.maximum(values, floor) / floor) / LOG_DECADES, 0.0, 1.0)
         else:
             r = np.clip(values / top, 0.0, 1.0)
-        angle = -x if quantity == "albedo" else x  # the albedo: drawn on the light's side
-        if view == "polar":
+        if view == "polar":  # (the albedo on the light's side: its θ_i is where light comes from)
+            angle = -x if quantity == "albedo" else x
             pts = np.column_stack([r * np.sin(angle), r * np.cos(angle)])
-        else:
-            pts = np.column_stack([angle / (0.5 * math.pi), r])
+        else:  # (the albedo's θ_i from 0 to 90°: x from 0 to 1)
+            pts = np.column_stack([x / (0.5 * math.pi), r])
         curves.append(Curve(lb, x, values, pts))
     legend = tuple((lb.label, lb.colour, lb.visible) for lb in lobes)
     what = {

@@ -11,6 +11,7 @@
     phong-explorer render --preset gold --mesh teapot --turntable 36 --out spin.gif
     phong-explorer render --preset gold --mesh teapot --strip --out strip.png  (term by term)
     phong-explorer render --preset gold --strip --strip-mode raw --strip-lights --out s.png
+    phong-explorer render --preset gold --lobes --out lobes.png   (the lobes, BRDF, albedo)
 
 An OBJ whose ``mtllib`` defines materials is drawn with them, each ``usemtl`` group in its own
 material; ``--preset`` draws the whole mesh in one preset instead. The scene options are in
@@ -20,10 +21,12 @@ material; ``--preset`` draws the whole mesh in one preset instead. The scene opt
 from __future__ import annotations
 
 import argparse
+import math
 import re
 import sys
 from pathlib import Path
 
+from explorer.analysis.lobeplot import light_incidences, lobe_picture, scene_charts
 from explorer.cli.options import (
     add_scene_arguments,
     background_from_options,
@@ -39,6 +42,7 @@ from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
 from explorer.core.progress import Progress
 from explorer.core.text import say
+from explorer.geometry.frame import frame_of
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
@@ -92,6 +96,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--strip-lights", action="store_true", help="with --strip: a row per light")
     p.add_argument(
+        "--lobes",
+        action="store_true",
+        help="the lobe plots of the material at the scene's lights: the three models' lobes "
+        "(polar, and BRDF on a log scale), their directional albedo, one lobe per light; .png",
+    )
+    p.add_argument(
         "--tile",
         default=None,
         metavar="WxH",
@@ -110,6 +120,11 @@ def run(args) -> int:
     suffix = check_out(args.out, suffixes, args.force)
     if turntable:
         check_frames(args.turntable)
+    if args.lobes and (turntable or args.per_pixel or args.strip or suffix != ".png"):
+        raise ExplorerError(
+            "--lobes draws one picture: give --out FILE.png, and no --strip, "
+            "--per-pixel or --turntable"
+        )
     if args.strip and (turntable or args.per_pixel):
         raise ExplorerError(
             "--strip draws the terms per vertex: not with --turntable or --per-pixel"
@@ -127,6 +142,8 @@ def run(args) -> int:
         for m in materials or (scene.material,):
             for w in energy_warnings(m):
                 say(f"warning: {w}", file=sys.stderr)
+    if args.lobes:
+        return run_lobes(args, scene, mesh)
     if args.per_pixel:
         if materials:
             raise ExplorerError(
@@ -278,4 +295,19 @@ def run_strip(args, scene, mesh, materials, background) -> int:
         f"({mesh.name}, {name}, {scene.model}, {args.strip_mode})"
     )
     say(picture.caption)
+    return 0
+
+
+def run_lobes(args, scene, mesh) -> int:
+    """``phong-explorer render --lobes``: the lobe plots
+    (:func:`explorer.analysis.lobeplot.scene_charts`) of the scene's material, each light at
+    its incidence on the mesh's point that faces the viewer, to ``args.out``."""
+    centre, _ = frame_of(mesh.positions)
+    incidences = light_incidences(scene, centre)
+    image = lobe_picture(scene_charts(scene, incidences))
+    write_atomic(args.out, encode_png(image), overwrite=args.force)
+    h, w = image.shape[:2]
+    degrees = ", ".join(f"{math.degrees(t):.0f}°" for t in incidences)
+    name = scene.material.name or "material"
+    say(f"wrote {args.out}: {w}x{h} lobe plots ({name}, incidence {degrees})")
     return 0
