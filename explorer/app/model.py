@@ -111,6 +111,8 @@ class State:
     local_viewer : the engine's viewer is at the camera (a local viewer, OpenGL's
         ``GL_LIGHT_MODEL_LOCAL_VIEWER``); off: infinitely far along the camera's view (OpenGL's
         default; a parallel camera's viewer is always so)
+    strip, strip_mode : the term strip under the view is on, and its tiles: ``weighted`` or
+        ``raw`` (:mod:`explorer.app.termstrip`)
     """
 
     scene: Scene
@@ -134,6 +136,8 @@ class State:
     groups: tuple[Material, ...] | None = None
     group: int = 0
     local_viewer: bool = True
+    strip: bool = False
+    strip_mode: str = "weighted"
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)

@@ -28,11 +28,13 @@ from dataclasses import dataclass, replace
 
 from explorer.app import effectactions as E
 from explorer.app import model as M
+from explorer.app import termstrip as T
 from explorer.core.controls import CONTROLS, Control
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS
+from explorer.shading.strip import MODES as STRIP_MODES
 
 KINDS = ("number", "colour", "choice", "toggle", "triple")
 TABS = ("material", "lights", "view")
@@ -356,6 +358,26 @@ def _view_rows() -> list[Row]:
             lambda s, v: (E.set_hdr_field, ("tone_map", v)),
             visible=_hdr_on,
             choices=TONE_MAPS,
+        ),
+        Row(
+            "strip",
+            "view",
+            "toggle",
+            lambda s: s.strip,
+            lambda s, v: (T.set_strip, (bool(v),)),
+            tip="the equation term by term under the view: emission, ambient, diffuse, "
+            "specular, their sum and where the display clamps it (docs/terms.md)",
+        ),
+        Row(
+            "strip_mode",
+            "view",
+            "choice",
+            lambda s: s.strip_mode,
+            lambda s, v: (T.set_strip_mode, (v,)),
+            choices=STRIP_MODES,
+            inline=True,
+            tip="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light "
+            "sums A, D, S alone",
         ),
     ]
 

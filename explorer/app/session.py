@@ -13,6 +13,8 @@ A session file is YAML (or JSON, which YAML reads too)::
     camera: {position: [..], focal_point: [..], view_up: [..], parallel: false,
              parallel_scale: 1.0, view_angle: 30.0}
     difference: false
+    strip: false               # optional: the term strip under the view (docs/terms.md),
+    strip_mode: weighted       #   its tiles: weighted or raw
     local_viewer: true         # optional: the viewer at the camera (false: infinitely far
                                # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
@@ -51,7 +53,7 @@ from explorer.render.camera import Camera
 FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
-    "camera", "difference", "compare", "groups", "window", "local_viewer",
+    "camera", "difference", "compare", "groups", "window", "local_viewer", "strip", "strip_mode",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -92,6 +94,8 @@ def session_mapping(state: State) -> dict:
         "handle_distance": float(state.handle_distance),
         "difference": bool(state.difference),
         "local_viewer": bool(state.local_viewer),
+        "strip": bool(state.strip),
+        "strip_mode": state.strip_mode,
     }
     if state.camera is not None:
         out["camera"] = camera_mapping(state.camera)
@@ -151,6 +155,10 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
                             lo_open=True)  # fmt: skip
     difference = checker.boolean(m.get("difference", False), ("difference",))
     local_viewer = checker.boolean(m.get("local_viewer", True), ("local_viewer",))
+    strip = checker.boolean(m.get("strip", False), ("strip",))
+    from explorer.shading.strip import MODES as STRIP_MODES  # (the engine: when a file is read)
+
+    strip_mode = checker.choice(m.get("strip_mode", "weighted"), ("strip_mode",), STRIP_MODES)
     camera = _camera(checker, m["camera"]) if "camera" in m else None
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
     groups = _groups(checker, m["groups"]) if m.get("groups") is not None else None
@@ -185,6 +193,8 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         camera=camera,
         difference=bool(difference),
         local_viewer=bool(local_viewer),
+        strip=bool(strip),
+        strip_mode=strip_mode,
         **compare,
     )
     return state, mesh

@@ -52,6 +52,8 @@ SAMPLES = {
     "exposure": 1.5,
     "tone_map": "aces",
     "local_viewer": False,
+    "strip": True,
+    "strip_mode": "raw",
 }
 
 
