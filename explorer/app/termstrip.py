@@ -97,6 +97,15 @@ class TermStrip:
         _, h = self.plotter.window_size
         return [int(round(x)), int(round(h - 1 - y))]
 
+    def report(self, point) -> dict | None:
+        """What a test of a front end reads (plain JSON values): each tile's window pixel of
+        ``point`` (3,) in the view's coordinates (:meth:`tile_pixel`), and the overflow's
+        share; None while the strip is off."""
+        if not self.on:
+            return None
+        share = float(self.overflow.mean()) if self.overflow is not None else 0.0
+        return {"px": {c: self.tile_pixel(c, point) for c in COLUMNS}, "overflow": share}
+
     def _switch(self, on: bool) -> None:
         """Make room for the tiles (or give it back), creating them the first time."""
         main = self.plotter.renderer
