@@ -113,6 +113,8 @@ class State:
         default; a parallel camera's viewer is always so)
     strip, strip_mode : the term strip under the view is on, and its tiles: ``weighted`` or
         ``raw`` (:mod:`explorer.app.termstrip`)
+    lobes, lobe_view, lobe_quantity, lobe_log, lobe_ndl : the lobe inset's lobes (the selected
+        light's, or several) and how it plots them (:mod:`explorer.app.lobeinset`)
     """
 
     scene: Scene
@@ -138,6 +140,11 @@ class State:
     local_viewer: bool = True
     strip: bool = False
     strip_mode: str = "weighted"
+    lobes: str = "selected"
+    lobe_view: str = "polar"
+    lobe_quantity: str = "intensity"
+    lobe_log: bool = False
+    lobe_ndl: bool = False
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)

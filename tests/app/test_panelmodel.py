@@ -54,6 +54,11 @@ SAMPLES = {
     "local_viewer": False,
     "strip": True,
     "strip_mode": "raw",
+    "lobes": "lights",
+    "lobe_view": "cartesian",
+    "lobe_quantity": "brdf",
+    "lobe_log": True,
+    "lobe_ndl": True,
 }
 
 
@@ -63,10 +68,12 @@ def mesh():
 
 
 def start(mesh, **scene) -> M.State:
-    """A spot light (every light row shown) and the HDR display on (its rows shown)."""
+    """A spot light (every light row shown), the HDR display on and the inset's several lobes
+    (their rows shown)."""
     lights = (SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),)
     base = Scene(lights=lights, hdr={"exposure": 0.0, "tone_map": "reinhard"})
-    return first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
+    state = first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
+    return state.replace(lobes="models")
 
 
 def test_every_row_is_one_declared_control():

@@ -54,3 +54,22 @@ def test_the_strip_is_drawn_under_the_view_from_the_panel(open_window, qtbot, tm
     w.grab().save(str(tmp_path / "window_strip.png"))
     box.click()
     assert not w.view.strip.on
+
+
+def test_the_inset_plots_the_three_models_lobes_from_the_panel(open_window, tmp_path):
+    w = open_window("--mesh", "sphere", "--preset", "chrome")
+    combo = w.findChild(QtWidgets.QComboBox, "lobes")
+    _tab_with(w, combo)
+    combo.setCurrentIndex(combo.findText("models"))
+    combo.activated.emit(combo.currentIndex())  # (what a pick in the list sends)
+    assert w.controller.state.lobes == "models"
+    rep = w.view.lobe.report()
+    assert [c["label"].split()[0] for c in rep["curves"]] == ["Phong", "Blinn", "three.js"]
+    img = _pixels(w.plotter)
+    last = rep["curves"][-1]  # (drawn last: nothing over it)
+    hits = 0
+    for x, y in last["px"]:
+        patch = img[max(y - 1, 0) : y + 2, max(x - 1, 0) : x + 2].reshape(-1, 3)
+        hits += bool((np.abs(patch - last["colour"]) <= 1).all(axis=1).any())
+    assert hits >= 0.9 * len(last["px"])
+    w.grab().save(str(tmp_path / "window_lobes.png"))
