@@ -358,11 +358,13 @@ def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
 
 # -- issue 38: the panel model's rows ----------------------------------------------------------
 def every_row_shown(c) -> None:
-    """A spot light, the HDR display and Fresnel on: every row of the panel model is shown."""
+    """A spot light, the HDR display, Fresnel on and the inset's several lobes: every row of the
+    panel model is shown."""
     from explorer.app import panelmodel as P
 
     c.act(M.set_light_type, "spot", label="light type")
     assert c.set_value("hdr", True, merge=False)
+    assert c.set_value("lobes", "models", merge=False)
     assert c.set_value("fresnel", P.row("fresnel").optional, merge=False)
 
 

@@ -34,6 +34,8 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     wait("the view tab", lambda: shown(browser, "hdr"))
     click(browser, "hdr")
     wait("the HDR display's rows", lambda: shown(browser, "exposure"))
+    choose(browser, "lobes", "models")
+    wait("the several lobes' rows", lambda: shown(browser, "lobe_view"))
     click(browser, "material tab")
     wait("the material tab", lambda: shown(browser, "fresnel_on"))
     click(browser, "fresnel_on")
@@ -44,7 +46,7 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
         for r in P.rows(tab):
             for name in P.names(r):
                 assert shown(browser, name), (tab, name)
-    for _ in range(3):  # fresnel, hdr, the spot: back to the start
+    for _ in range(4):  # fresnel, the lobes, hdr, the spot: back to the start
         click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
 
