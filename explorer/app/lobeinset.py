@@ -1,6 +1,13 @@
 """The lobe inset at the bottom left of the 3D view: the plot of
 :mod:`explorer.analysis.lobe` for the selected light, the model in use and the material, in a
-panel of its own (everything drawn inside it). VTK is imported inside the functions."""
+panel of its own (everything drawn inside it).
+
+The state's ``lobes`` turns it into a plot of several lobes (:mod:`explorer.analysis.lobes`):
+``models`` the three models' for the material, ``lights`` the scene's for each light, ``sides``
+A's and B's of the compare view; each in its colour, named in the legend under the caption;
+``lobe_view`` polar or cartesian, ``lobe_quantity`` intensity, brdf or albedo, ``lobe_log`` and
+``lobe_ndl`` (× N·L): the panel model's rows (:data:`ROWS`' actions here). VTK is imported
+inside the functions."""
 
 from __future__ import annotations
 
@@ -9,8 +16,10 @@ import math
 import numpy as np
 
 from explorer.analysis import lobe
+from explorer.analysis import lobes as many
 from explorer.app.model import State, handle_point
 from explorer.app.overlay import overlay, set_lines, set_triangles
+from explorer.core.errors import ExplorerError
 from explorer.shading.effects.energy import specular_scale
 
 #: the lobe inset (:mod:`explorer.analysis.lobe`): left and bottom margin in pixels, its width
@@ -27,6 +36,52 @@ LOBE_COLOR = (1.0, 0.85, 0.2)
 LOBE_DIFFUSE_COLOR = (0.62, 0.62, 0.68)
 LOBE_INCIDENT_COLOR = (1.0, 1.0, 1.0)
 LOBE_MIRROR_COLOR = (0.4, 0.8, 1.0)
+#: the state's ``lobes``: one lobe (the selected light's, as before) or several
+LOBE_SETS = ("selected", "models", "lights", "sides")
+#: the albedo's quadrature nodes in the inset (a plot of pixels: the interaction stays quick)
+INSET_NODES = (24, 24)
+#: the Greek letters of a plot's title written out (VTK's own fonts have none)
+LATIN = {"ρ": "rho", "θ": "theta"}
+#: the legend's font size (pixels)
+LEGEND_FONT = 10
+
+
+def set_lobe_option(state: State, name: str, value) -> State:
+    """One of the inset's options: ``lobes`` (:data:`LOBE_SETS`), ``lobe_view``
+    (:data:`explorer.analysis.lobes.VIEWS`), ``lobe_quantity``
+    (:data:`explorer.analysis.lobes.QUANTITIES`), ``lobe_log`` or ``lobe_ndl`` (on / off)."""
+    allowed = {"lobes": LOBE_SETS, "lobe_view": many.VIEWS, "lobe_quantity": many.QUANTITIES}
+    if name in allowed:
+        if value not in allowed[name]:
+            raise ExplorerError(f"{name} must be one of {allowed[name]}, got {value!r}")
+    elif name in ("lobe_log", "lobe_ndl"):
+        value = bool(value)
+    else:
+        raise ExplorerError(f"no lobe option named {name!r}")
+    return state.replace(**{name: value})
+
+
+def lobe_set(state: State) -> list:
+    """The lobes the state's ``lobes`` asks for (:class:`explorer.analysis.lobes.Lobe`), each in
+    its colour: the three models', each light's, or sides A and B (B while it is shown)."""
+    scene = state.shown_scene()
+    if state.lobes == "lights":
+        out = []
+        for i in range(len(scene.lights)):
+            t = _incidence(state, i)
+            name = f"light {i + 1} ({math.degrees(t):.0f}°)"
+            out.append(many.scene_lobe(scene, t, name, many.COLOURS[i % len(many.COLOURS)]))
+        return out
+    if not scene.lights:
+        return []
+    theta = lobe_incidence(state)
+    if state.lobes == "models":
+        return many.model_lobes(scene, theta)
+    out = [many.scene_lobe(scene, theta, "A", many.COLOURS[0])]
+    if state.compare is not None:
+        b = scene.replace(material=state.compare, model=state.compare_model or scene.model)
+        out.append(many.scene_lobe(b, theta, "B", many.COLOURS[1]))
+    return out
 
 
 class LobeInset:
@@ -73,6 +128,9 @@ class LobeInset:
             self.actors.append(t)
         self._key = None
         self.box = None
+        self._curves: list = []  # (polydata, actor) of the several lobes' curves, one a colour
+        self._legend: list = []  # their legend's text actors
+        self.chart = None  # the plot of several lobes shown, or None
         self.layout(state)
 
     def layout(self, state: State) -> None:
@@ -113,9 +171,22 @@ class LobeInset:
                    "energy": specular_scale(scene)}  # fmt: skip
         degrees = None if theta is None else round(math.degrees(theta), 1)
         key = (model, n, kd, ks, tuple(effects.values()), degrees)
+        if state.lobes != "selected":
+            key = (
+                state.lobes,
+                state.lobe_view,
+                state.lobe_quantity,
+                state.lobe_log,
+                state.lobe_ndl,
+                tuple(lobe_set(state)),
+            )
         if key == self._key:
             return
         self._key = key
+        if state.lobes != "selected":
+            self._show_many(state)
+            return
+        self._hide_many()
         box = self._plot_box
         x, y, w, h = box
         frame = [(x, y), (x + w, y), (x + w, y + h), (x, y + h), (x, y)]
@@ -152,6 +223,104 @@ class LobeInset:
             set_lines(self._polys[key], polylines)
         self._fit_caption()
 
+    def _show_many(self, state: State) -> None:
+        """The plot of several lobes (:func:`lobe_set`) in the panel: the single lobe's
+        lines hidden, a curve per lobe in its colour, the caption the plot's title, the legend
+        under it."""
+        x, y, w, h = self._plot_box
+        frame = [(x, y), (x + w, y), (x + w, y + h), (x, y + h), (x, y)]
+        axis = [(x + 0.5 * w, y), (x + 0.5 * w, y + h)]
+        if state.lobe_view == "cartesian" and state.lobe_quantity == "albedo":
+            axis = [(x, y), (x, y + h)]
+        lines = {"frame": [frame, [(x, y), (x + w, y)], axis]}
+        lines.update(diffuse=[], incident=[], mirror=[], lobe=[])
+        for key, polylines in lines.items():
+            set_lines(self._polys[key], polylines)
+        for key in ("L", "R"):
+            self._labels[key].SetVisibility(False)
+        found = lobe_set(state)
+        self.chart = many.chart(found, view=state.lobe_view, quantity=state.lobe_quantity,
+                                log=state.lobe_log, times_ndl=state.lobe_ndl,
+                                nodes=INSET_NODES)  # fmt: skip
+        while len(self._curves) < len(self.chart.curves):
+            self._curves.append(overlay(self.plotter, (1.0, 1.0, 1.0), 2.0))
+            self.actors.append(self._curves[-1][1])
+        for i, (poly, actor) in enumerate(self._curves):
+            if i < len(self.chart.curves):
+                c = self.chart.curves[i]
+                actor.GetProperty().SetColor(*c.lobe.colour)
+                set_lines(poly, [self.to_pixels(c.points)])
+            else:
+                set_lines(poly, [])
+        title = self.chart.title
+        for k, v in LATIN.items():  # (VTK's own fonts have no Greek letters)
+            title = title.replace(k, v)
+        self.caption.SetInput(f"{title}\n{state.lobes}: {len(found)} lobes")
+        self._fit_caption()
+        self._show_legend()
+
+    def to_pixels(self, points) -> np.ndarray:
+        """Plot points (k, 2) of :attr:`chart` in display pixels (origin bottom-left): x from
+        -1 to 1 across the plot's box, y from 0 to 1 up it (the albedo's Cartesian plot: x
+        from 0 to 1)."""
+        x, y, w, h = self._plot_box
+        p = np.asarray(points, np.float64).reshape(-1, 2)
+        if self.chart.view == "cartesian":
+            x0 = 0.0 if self.chart.quantity == "albedo" else -1.0
+            return np.column_stack([x + (p[:, 0] - x0) / (1.0 - x0) * w, y + p[:, 1] * h])
+        return lobe.to_box(p, self._plot_box)
+
+    def _show_legend(self) -> None:
+        """A line of text per lobe in its colour, over the plot's top left."""
+        import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
+        from vtkmodules.vtkRenderingCore import vtkTextActor
+
+        entries = self.chart.legend
+        while len(self._legend) < len(entries):
+            t = vtkTextActor()
+            prop = t.GetTextProperty()
+            prop.SetFontFamilyToArial()
+            prop.SetFontSize(LEGEND_FONT)
+            prop.ShadowOff()
+            prop.SetVerticalJustificationToTop()
+            self.plotter.renderer.AddViewProp(t)
+            self._legend.append(t)
+            self.actors.append(t)
+        x, y, _, h = self._plot_box
+        for i, t in enumerate(self._legend):
+            if i < len(entries):
+                label, colour, _ = entries[i]
+                t.SetInput(label)
+                t.GetTextProperty().SetColor(*colour)
+                t.SetPosition(x + 3, y + h - 2 - i * (LEGEND_FONT + 2))
+            t.SetVisibility(i < len(entries))
+
+    def report(self) -> dict | None:
+        """What a test of a front end reads (plain JSON values): each curve's label, colour
+        (8-bit) and 24 of its points in window pixels (origin top-left); None for one lobe."""
+        if self.chart is None:
+            return None
+        _, h = self.plotter.window_size
+        out = []
+        for c in self.chart.curves:
+            px = self.to_pixels(c.points)
+            pick = np.linspace(0, len(px) - 1, 24).astype(int)
+            out.append(
+                {
+                    "label": c.lobe.label,
+                    "colour": [int(round(v * 255)) for v in c.lobe.colour],
+                    "px": [[int(round(x)), int(round(h - 1 - y))] for x, y in px[pick]],
+                }
+            )
+        return {"title": self.chart.title, "curves": out}
+
+    def _hide_many(self) -> None:
+        self.chart = None
+        for poly, _ in self._curves:
+            set_lines(poly, [])
+        for t in self._legend:
+            t.SetVisibility(False)
+
     def _fit_caption(self) -> None:
         """The caption's font: the inset's own size, smaller (down to 8 px) while the text is
         wider than the panel."""
@@ -171,10 +340,15 @@ def lobe_incidence(state: State) -> float:
     """theta_i (radians) of the selected light at the mesh's point that faces the viewer: the
     angle between the directions from the mesh centre toward the viewer and toward the light's
     handle (:func:`explorer.analysis.lobe.incidence`)."""
+    return _incidence(state, None)
+
+
+def _incidence(state: State, index) -> float:
+    """:func:`lobe_incidence` of light ``index`` (None: the selected one)."""
     viewer = state.scene.viewer
     centre = np.asarray(state.centre)
     to_viewer = np.subtract(viewer.eye, centre) if viewer.local else viewer.to_viewer
-    return lobe.incidence(to_viewer, handle_point(state) - centre)
+    return lobe.incidence(to_viewer, handle_point(state, index) - centre)
 
 
 def _arrow_head(ray) -> list:

@@ -112,6 +112,10 @@ class State:
     local_viewer : the engine's viewer is at the camera (a local viewer, OpenGL's
         ``GL_LIGHT_MODEL_LOCAL_VIEWER``); off: infinitely far along the camera's view (OpenGL's
         default; a parallel camera's viewer is always so)
+    strip, strip_mode : the term strip under the view is on, and its tiles: ``weighted`` or
+        ``raw`` (:mod:`explorer.app.termstrip`)
+    lobes, lobe_view, lobe_quantity, lobe_log, lobe_ndl : the lobe inset's lobes (the selected
+        light's, or several) and how it plots them (:mod:`explorer.app.lobeinset`)
     """
 
     scene: Scene
@@ -136,6 +140,13 @@ class State:
     groups: tuple[Material, ...] | None = None
     group: int = 0
     local_viewer: bool = True
+    strip: bool = False
+    strip_mode: str = "weighted"
+    lobes: str = "selected"
+    lobe_view: str = "polar"
+    lobe_quantity: str = "intensity"
+    lobe_log: bool = False
+    lobe_ndl: bool = False
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)

@@ -36,14 +36,19 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
+from explorer.analysis.lobes import QUANTITIES as LOBE_QUANTITIES
+from explorer.analysis.lobes import VIEWS as LOBE_VIEWS
 from explorer.app import effectactions as E
+from explorer.app import lobeinset as LI
 from explorer.app import model as M
+from explorer.app import termstrip as T
 from explorer.core.controls import CONTROLS, Control
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import SHADINGS
+from explorer.shading.strip import MODES as STRIP_MODES
 
 KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text")
 TABS = ("material", "lights", "view")
@@ -592,6 +597,91 @@ def _view_rows() -> list[Row]:
             lambda s, v: (E.set_hdr_field, ("tone_map", v)),
             visible=_hdr_on,
             choices=TONE_MAPS,
+        ),
+        Row(
+            "strip",
+            "view",
+            "toggle",
+            lambda s: s.strip,
+            lambda s, v: (T.set_strip, (bool(v),)),
+            tip="the equation term by term under the view: emission, ambient, diffuse, "
+            "specular, their sum and where the display clamps it (docs/terms.md)",
+        ),
+        Row(
+            "strip_mode",
+            "view",
+            "choice",
+            lambda s: s.strip_mode,
+            lambda s, v: (T.set_strip_mode, (v,)),
+            choices=STRIP_MODES,
+            inline=True,
+            tip="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light "
+            "sums A, D, S alone",
+        ),
+        *_lobe_rows(),
+    ]
+
+
+def _lobe_option(name: str):
+    return lambda s, v: (LI.set_lobe_option, (name, v))
+
+
+def _lobe_rows() -> list[Row]:
+    """The lobe inset's rows: which lobes, and how they are plotted (docs/terms.md)."""
+    several = lambda s: s.lobes != "selected"  # noqa: E731 - the rows' one test
+    return [
+        Row(
+            "lobes",
+            "view",
+            "choice",
+            lambda s: s.lobes,
+            _lobe_option("lobes"),
+            choices=LI.LOBE_SETS,
+            tip="the inset's lobes: the selected light's, the three models', each light's, or "
+            "sides A and B",
+        ),
+        Row(
+            "lobe_view",
+            "view",
+            "choice",
+            lambda s: s.lobe_view,
+            _lobe_option("lobe_view"),
+            visible=several,
+            choices=LOBE_VIEWS,
+            inline=True,
+            tip="polar: the plane of incidence, the normal up; cartesian: against the view angle",
+        ),
+        Row(
+            "lobe_quantity",
+            "view",
+            "choice",
+            lambda s: s.lobe_quantity,
+            _lobe_option("lobe_quantity"),
+            visible=several,
+            choices=LOBE_QUANTITIES,
+            tip="intensity per unit light, the BRDF (intensity / (π N·L), 1/sr), or the "
+            "directional albedo ρ(θ_i)",
+        ),
+        Row(
+            "lobe_log",
+            "view",
+            "toggle",
+            lambda s: s.lobe_log,
+            _lobe_option("lobe_log"),
+            visible=several,
+            group="lobe_scale",
+            tip="a log scale: four decades",
+        ),
+        Row(
+            "lobe_ndl",
+            "view",
+            "toggle",
+            lambda s: s.lobe_ndl,
+            _lobe_option("lobe_ndl"),
+            visible=several,
+            group="lobe_scale",
+            text="× N·L",
+            tip="each value times N·L",
         ),
     ]
 

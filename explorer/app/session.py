@@ -13,6 +13,10 @@ A session file is YAML (or JSON, which YAML reads too)::
     camera: {position: [..], focal_point: [..], view_up: [..], parallel: false,
              parallel_scale: 1.0, view_angle: 30.0}
     difference: false
+    strip: false               # optional: the term strip under the view (docs/terms.md),
+    strip_mode: weighted       #   its tiles: weighted or raw
+    lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false}
+                               # optional: the lobe inset's lobes and plot (docs/terms.md)
     local_viewer: true         # optional: the viewer at the camera (false: infinitely far
                                # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
@@ -52,7 +56,8 @@ from explorer.render.camera import Camera
 FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
-    "camera", "difference", "compare", "groups", "window", "local_viewer",
+    "camera", "difference", "compare", "groups", "window", "local_viewer", "strip", "strip_mode",
+    "lobes",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -93,6 +98,15 @@ def session_mapping(state: State) -> dict:
         "handle_distance": float(state.handle_distance),
         "difference": bool(state.difference),
         "local_viewer": bool(state.local_viewer),
+        "strip": bool(state.strip),
+        "strip_mode": state.strip_mode,
+        "lobes": {
+            "set": state.lobes,
+            "view": state.lobe_view,
+            "quantity": state.lobe_quantity,
+            "log": bool(state.lobe_log),
+            "ndl": bool(state.lobe_ndl),
+        },
     }
     if state.camera is not None:
         out["camera"] = camera_mapping(state.camera)
@@ -154,6 +168,11 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
                             lo_open=True)  # fmt: skip
     difference = checker.boolean(m.get("difference", False), ("difference",))
     local_viewer = checker.boolean(m.get("local_viewer", True), ("local_viewer",))
+    strip = checker.boolean(m.get("strip", False), ("strip",))
+    from explorer.shading.strip import MODES as STRIP_MODES  # (the engine: when a file is read)
+
+    strip_mode = checker.choice(m.get("strip_mode", "weighted"), ("strip_mode",), STRIP_MODES)
+    lobes = _lobes(checker, m["lobes"]) if m.get("lobes") is not None else {}
     camera = _camera(checker, m["camera"]) if "camera" in m else None
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
     groups = _groups(checker, m["groups"]) if m.get("groups") is not None else None
@@ -188,9 +207,33 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         camera=camera,
         difference=bool(difference),
         local_viewer=bool(local_viewer),
+        strip=bool(strip),
+        strip_mode=strip_mode,
+        **lobes,
         **compare,
     )
     return state, mesh
+
+
+def _lobes(checker, value) -> dict:
+    """The ``lobes`` section: the lobe inset's State fields."""
+    from explorer.analysis.lobes import QUANTITIES, VIEWS  # (the plots: when a file is read)
+    from explorer.app.lobeinset import LOBE_SETS  # (VTK-free, but the engine: likewise)
+
+    path = ("lobes",)
+    c = checker.mapping(value, path)
+    if c is None:
+        return {}
+    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl"), required=())
+    return {
+        "lobes": checker.choice(c.get("set", "selected"), (*path, "set"), LOBE_SETS),
+        "lobe_view": checker.choice(c.get("view", "polar"), (*path, "view"), VIEWS),
+        "lobe_quantity": checker.choice(
+            c.get("quantity", "intensity"), (*path, "quantity"), QUANTITIES
+        ),
+        "lobe_log": bool(checker.boolean(c.get("log", False), (*path, "log"))),
+        "lobe_ndl": bool(checker.boolean(c.get("ndl", False), (*path, "ndl"))),
+    }
 
 
 def _compare(checker, value) -> dict:

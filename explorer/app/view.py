@@ -36,6 +36,7 @@ from explorer.app.difference import VMAX
 from explorer.app.lobeinset import LobeInset
 from explorer.app.model import State, handle_point, light_colour
 from explorer.app.overlay import overlay, set_lines, set_triangles
+from explorer.app.termstrip import TermStrip
 from explorer.geometry.meshes import Mesh, area_weighted_normals
 from explorer.render.camera import (
     Camera,
@@ -274,6 +275,8 @@ class SceneView:
         self._switching = False  # set while the drawings change meshes
         self.set_mesh(mesh, state)
         self.lobe = LobeInset(plotter, state)
+        self.strip = TermStrip(plotter)
+        self.strip.show(state, self.active)
 
     # -- mesh --------------------------------------------------------------------------------
     @property
@@ -337,6 +340,7 @@ class SceneView:
         self._show_handle(state)
         if getattr(self, "lobe", None) is not None:
             self.lobe.update(state)
+            self.strip.show(state, self.active)
 
     def frame_camera(self, state: State, camera_moved) -> None:
         """Before a frame of either front end: the VTK camera read as the viewer's camera
@@ -358,6 +362,7 @@ class SceneView:
         if self.state.material.opacity < 1.0:
             self.active.sort_for(camera)
         self.lobe.layout(self.state)
+        self.strip.show(self.state, self.active)  # (the drawn mesh: a drag's level of detail)
         self._show_markers()
 
     def begin_drag(self) -> None:

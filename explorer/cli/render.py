@@ -9,6 +9,9 @@
     phong-explorer render --preset gold --mesh teapot --out gold.glb   (unlit glTF)
     phong-explorer render --preset gold --mesh teapot --out gold.obj   (gold.obj + gold.mtl)
     phong-explorer render --preset gold --mesh teapot --turntable 36 --out spin.gif
+    phong-explorer render --preset gold --mesh teapot --strip --out strip.png  (term by term)
+    phong-explorer render --preset gold --strip --strip-mode raw --strip-lights --out s.png
+    phong-explorer render --preset gold --lobes --out lobes.png   (the lobes, BRDF, albedo)
 
 An OBJ whose ``mtllib`` defines materials is drawn with them, each ``usemtl`` group in its own
 material; ``--preset`` draws the whole mesh in one preset instead. The scene options are in
@@ -18,10 +21,12 @@ material; ``--preset`` draws the whole mesh in one preset instead. The scene opt
 from __future__ import annotations
 
 import argparse
+import math
 import re
 import sys
 from pathlib import Path
 
+from explorer.analysis.lobeplot import light_incidences, lobe_picture, scene_charts
 from explorer.cli.options import (
     add_scene_arguments,
     background_from_options,
@@ -37,6 +42,7 @@ from explorer.core.hdr import energy_warnings
 from explorer.core.mtl import preset_name, preset_names
 from explorer.core.progress import Progress
 from explorer.core.text import say
+from explorer.geometry.frame import frame_of
 from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.faceids import MAX_FACES
 from explorer.render.images import encode_png
@@ -44,6 +50,7 @@ from explorer.render.live import METHODS as PER_PIXEL_METHODS
 from explorer.render.live import picture
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
+from explorer.render.strip import STRIP_TILE, render_strip
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -53,6 +60,7 @@ from explorer.render.turntable import (
     iter_frames,
 )
 from explorer.shading.display import group_vertex_colors, vertex_colors
+from explorer.shading.strip import MODES as STRIP_MODES
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -84,6 +92,32 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="light every pixel instead of every vertex: the engine at the surface point each "
         "pixel shows, with the interpolated normal (the live per-pixel view's picture); .png only",
     )  # fmt: skip
+    p.add_argument(
+        "--strip",
+        action="store_true",
+        help="the equation term by term: emission | ambient | diffuse | specular | sum | "
+        "overflow, one tile each (--tile), labelled; .png only",
+    )
+    p.add_argument(
+        "--strip-mode",
+        choices=STRIP_MODES,
+        default="weighted",
+        help="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light sums "
+        "A, D, S alone (default weighted)",
+    )
+    p.add_argument("--strip-lights", action="store_true", help="with --strip: a row per light")
+    p.add_argument(
+        "--lobes",
+        action="store_true",
+        help="the lobe plots of the material at the scene's lights: the three models' lobes "
+        "(polar, and BRDF on a log scale), their directional albedo, one lobe per light; .png",
+    )
+    p.add_argument(
+        "--tile",
+        default=None,
+        metavar="WxH",
+        help=f"with --strip: the size of one tile (default {STRIP_TILE[0]}x{STRIP_TILE[1]})",
+    )
     add_scene_arguments(p, mesh_default="sphere")
 
 
@@ -97,6 +131,17 @@ def run(args) -> int:
     suffix = check_out(args.out, suffixes, args.force)
     if turntable:
         check_frames(args.turntable)
+    if args.lobes and (turntable or args.per_pixel or args.strip or suffix != ".png"):
+        raise ExplorerError(
+            "--lobes draws one picture: give --out FILE.png, and no --strip, "
+            "--per-pixel or --turntable"
+        )
+    if args.strip and (turntable or args.per_pixel):
+        raise ExplorerError(
+            "--strip draws the terms per vertex: not with --turntable or --per-pixel"
+        )
+    if args.strip and suffix != ".png":
+        raise ExplorerError(f"--strip draws a picture: give --out FILE.png, not {suffix}")
     size = size_from_option(args.size, "--size")
     if turntable:  # its format's needs and its total, before the mesh is read or a frame drawn
         check_turntable(args.turntable, size, suffix)
@@ -108,6 +153,8 @@ def run(args) -> int:
         for m in materials or (scene.material,):
             for w in energy_warnings(m):
                 say(f"warning: {w}", file=sys.stderr)
+    if args.lobes:
+        return run_lobes(args, scene, mesh)
     # the flag, or the scene's key for a picture (a mesh file or a turntable is per vertex)
     if args.per_pixel or (scene.shading == "per-pixel" and suffix == ".png" and not turntable):
         if materials:
@@ -116,6 +163,10 @@ def run(args) -> int:
                 "materials"
             )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
+    if args.strip:
+        return run_strip(args, scene, mesh, materials, background)
+    if args.tile is not None or args.strip_lights:
+        raise ExplorerError("--tile and --strip-lights draw the strip: give --strip too")
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
@@ -242,4 +293,47 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
         f"wrote {args.out}: {size[0]}x{size[1]} per-pixel picture ({mesh.name}, {how}, {name}, "
         f"{scene.model})"
     )
+    return 0
+
+
+def run_strip(args, scene, mesh, materials, background) -> int:
+    """``phong-explorer render --strip``: the term strip
+    (:func:`explorer.render.strip.render_strip`) to ``args.out``, and its caption."""
+    if materials:
+        raise ExplorerError(
+            "--strip draws one material: give --preset NAME for a mesh with its own materials"
+        )
+    tile = STRIP_TILE if args.tile is None else size_from_option(args.tile, "--tile")
+    picture = render_strip(
+        scene,
+        mesh,
+        tile=tile,
+        mode=args.strip_mode,
+        lights=args.strip_lights,
+        background=background,
+    )
+    write_atomic(args.out, encode_png(picture.image), overwrite=args.force)
+    h, w = picture.image.shape[:2]
+    name = scene.material.name or "material"
+    rows = len(picture.rows)
+    say(
+        f"wrote {args.out}: {w}x{h} term strip, {rows} row{'s' if rows != 1 else ''} "
+        f"({mesh.name}, {name}, {scene.model}, {args.strip_mode})"
+    )
+    say(picture.caption)
+    return 0
+
+
+def run_lobes(args, scene, mesh) -> int:
+    """``phong-explorer render --lobes``: the lobe plots
+    (:func:`explorer.analysis.lobeplot.scene_charts`) of the scene's material, each light at
+    its incidence on the mesh's point that faces the viewer, to ``args.out``."""
+    centre, _ = frame_of(mesh.positions)
+    incidences = light_incidences(scene, centre)
+    image = lobe_picture(scene_charts(scene, incidences))
+    write_atomic(args.out, encode_png(image), overwrite=args.force)
+    h, w = image.shape[:2]
+    degrees = ", ".join(f"{math.degrees(t):.0f}°" for t in incidences)
+    name = scene.material.name or "material"
+    say(f"wrote {args.out}: {w}x{h} lobe plots ({name}, incidence {degrees})")
     return 0

@@ -5,7 +5,9 @@
     phong-explorer sheet --out presets.png --mesh teapot --columns 6 --tile 200x200
     phong-explorer sheet --out models.png --model blinn,threejs --preset bronze --preset chrome
 
-``--model a,b`` draws each preset under each model, side by side (the same numbers under
+``--strip`` draws each preset as a row of its terms instead (``emission | ambient | diffuse |
+specular | sum | overflow``, :mod:`explorer.render.strip`), ``--strip-mode raw`` the light sums
+alone. ``--model a,b`` draws each preset under each model, side by side (the same numbers under
 OpenGL's Blinn-Phong and three.js's MeshPhongMaterial, say).
 
 A mesh file with its own materials (an OBJ's ``mtllib``) gets a first tile in them, each
@@ -32,6 +34,8 @@ from explorer.core.presets import find_preset, list_presets
 from explorer.core.text import say
 from explorer.render.images import encode_png
 from explorer.render.offscreen import SHEET_LIGHT_DIRECTION, sheet
+from explorer.render.strip import OVERFLOW_NOTE, strip_picture
+from explorer.shading.strip import MODES as STRIP_MODES
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -42,6 +46,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument("--columns", type=int, default=6, metavar="N", help="tiles per row (6)")
     p.add_argument("--tile", default="200x150", metavar="WxH", help="tile size (200x150)")
+    p.add_argument(
+        "--strip",
+        action="store_true",
+        help="each preset as a row of its terms: emission | ambient | diffuse | specular | "
+        "sum | overflow (one --tile each)",
+    )
+    p.add_argument(
+        "--strip-mode",
+        choices=STRIP_MODES,
+        default="weighted",
+        help="with --strip: weighted (k·A, k·D, k·S) or raw (the light sums A, D, S alone)",
+    )
     add_scene_arguments(p, mesh_default="teapot", models=True)
 
 
@@ -63,8 +79,10 @@ def run(args) -> int:
     else:
         items = [(info.name, info.material) for info in list_presets(materials_dirs)]
         _, own = mesh_materials(args, scene, mesh)
-        if own:
+        if own and not args.strip:  # (a strip's row is one material)
             items.insert(0, (f"{mesh.name} (its materials)", own))
+    if args.strip:
+        return run_strip(args, items, scene, mesh, tile, background, models)
     image = sheet(
         items, scene, mesh, tile=tile, columns=args.columns, background=background,
         model=models,
@@ -73,4 +91,21 @@ def run(args) -> int:
     h, w = image.shape[:2]
     under = f" under {', '.join(models)}" if models else ""
     say(f"wrote {args.out}: {len(items)} presets{under} on {mesh.name}, {w}x{h}")
+    return 0
+
+
+def run_strip(args, items, scene, mesh, tile, background, models) -> int:
+    """``sheet --strip``: a strip row per preset (and per model of ``--model``)."""
+    rows = []
+    for name, material in items:
+        for m in models or (None,):
+            label = name if m is None else f"{name} · {m}"
+            model = m or material.model or scene.model
+            rows.append((label, scene.replace(material=material, model=model)))
+    picture = strip_picture(
+        rows, mesh, tile=tile, mode=args.strip_mode, background=background, note=OVERFLOW_NOTE
+    )
+    write_atomic(args.out, encode_png(picture.image), overwrite=args.force)
+    h, w = picture.image.shape[:2]
+    say(f"wrote {args.out}: term strips of {len(rows)} presets on {mesh.name}, {w}x{h}")
     return 0

@@ -531,6 +531,30 @@ def _compiled_now(tier: str | None, model: str) -> bool:
     return tier == "compiled" or tiers.loaded()
 
 
+def kept_sums(shader: Shader) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The light sums as a :class:`Shader` keeps them, without the copies its ``terms`` make
+    (the term strip's recompose, :func:`explorer.shading.strip.shader_strip_bytes`):
+    ``(aconst, sums)``. ``aconst`` (3,) in the working precision is the constant ambient
+    ``terms`` adds to ``sums["ambient"]`` (in that precision; zeros on the numpy tier,
+    whose ambient sum holds it); ``sums``: ``ambient`` (n, 3), ``diffuse`` and
+    ``specular`` (n, 3) or (n, 1) grey (every channel that value), and ``specular_f90``
+    under ``threejs``. Computes what is missing first (as ``terms`` does); read-only."""
+    if not shader.keep:
+        raise ExplorerError("terms need a Shader with keep=True")
+    if shader._served == "numpy":
+        ready = shader._np is not None
+    else:
+        kept = (shader._A, shader._D, shader._S)
+        ready = shader._served == "compiled" and all(x is not None for x in kept)
+    if not ready or shader._colors is None:
+        shader._update(force=(True, True, True))
+    if shader._served == "numpy":
+        sums = {k: _readonly(v.astype(shader._T, copy=False)) for k, v in shader._np.items()}
+        return _readonly(np.zeros(3, shader._T)), sums
+    sums = {"ambient": shader._A, "diffuse": shader._D, "specular": shader._S}
+    return _readonly(shader._aconst.astype(shader._T)), sums
+
+
 def stored_terms(aconst, A, D, S, n: int, dtype) -> dict[str, np.ndarray]:
     """The compiled tier's sums as :attr:`Shader.terms` gives them: (n, 3) read-only each, the
     constant ambient ``aconst`` (3,) added to the per-vertex ambient ``A``, sums not computed

@@ -30,6 +30,7 @@ from explorer.geometry.meshes import sphere, torus
 from explorer.shading import tiers
 from explorer.shading.display import to_bytes
 from explorer.shading.shader import Shader
+from explorer.shading.strip import shader_strip_bytes
 
 #: the lights of the exercise: one of each type, every option that takes its own kernel path
 LIGHTS = (
@@ -99,6 +100,8 @@ def _changes(shader: Shader) -> None:
     shader.set_viewer({"eye": [0.5, 1.0, 4.0]})
     to_bytes(shader.colors)
     _ = shader.terms if shader.keep else None
+    if shader.keep:  # the term strip's bytes (explorer.shading.strip)
+        shader_strip_bytes(shader)
 
 
 def _pixel_rays() -> None:

@@ -67,6 +67,13 @@ SAMPLES = {
     "duplicate_light": True,
     "remove_light": True,
     "swap": True,
+    "strip": True,
+    "strip_mode": "raw",
+    "lobes": "lights",
+    "lobe_view": "cartesian",
+    "lobe_quantity": "brdf",
+    "lobe_log": True,
+    "lobe_ndl": True,
 }
 #: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
 MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
@@ -81,14 +88,15 @@ def mesh():
 
 def start(mesh, **scene) -> M.State:
     """A spot light selected (every light row shown) and a point light, the HDR display on (its
-    rows shown) and the compare view on (side B's rows shown)."""
+    rows shown), the compare view on (side B's rows shown) and the inset's several lobes
+    (their rows shown)."""
     lights = (
         SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),
         PointLight(position=(2.0, 2.0, 0.0)),
     )
     base = Scene(lights=lights, hdr={"exposure": 0.0, "tone_map": "reinhard"})
     s = first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
-    return M.set_compare(s, True)
+    return M.set_compare(s, True).replace(lobes="models")
 
 
 def test_every_row_is_one_declared_control():

@@ -330,6 +330,8 @@ class WebExplorer:
             "n_vertices": self.view.mesh.n_vertices,
             "difference": self.heat.state(),
             "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
+            "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
+            "lobes": self.view.lobe.report(),
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 

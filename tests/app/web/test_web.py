@@ -633,3 +633,95 @@ def test_a_light_shows_only_the_controls_its_type_has_and_the_page_no_scrollbar(
     click(browser, "undo")
     wait("a point light again", lambda: not by_name(browser, "cutoff").is_displayed())
     click(browser, "material tab")
+
+
+def test_the_term_strip_is_drawn_under_the_view(server, browser, mesh, tmp_path):
+    """The view tab's ``strip`` check box: the tiles under the view, each tile's pixel under
+    the probe vertex within its one-ring's colours of the engine's term (weighted, then raw
+    through the ``strip_mode`` radios)."""
+    from explorer.render.strip import COLUMNS
+    from explorer.shading.shader import Shader
+    from explorer.shading.strip import shader_strip
+
+    open_page(browser, server.url)
+    click(browser, "view tab")
+    before = picture_src(browser)
+    click(browser, "strip")
+    wait("the strip", lambda: (r := report(browser)) and r["strip"] and r)
+    wait("a new picture", lambda: picture_src(browser) not in (None, before))
+    for mode in ("weighted", "raw"):
+        if mode == "raw":
+            before = picture_src(browser)
+            choose(browser, "strip_mode", "raw")
+            wait("raw", lambda: report(browser)["session"]["strip_mode"] == "raw")
+            wait("a new picture", lambda b=before: picture_src(browser) not in (None, b))
+        end = time.monotonic() + STEP_TIMEOUT
+        while True:
+            rep = report(browser)
+            scene = explorer.load_scene(rep["session"]["scene"])
+            sh = Shader(scene, mesh.positions, mesh.normals, precision="float64")
+            strip = shader_strip(sh, rep["session"]["strip_mode"])
+            i = rep["probe"]["vertex"]
+            around = np.unique(mesh.faces[(mesh.faces == i).any(axis=1)])
+            shot, box = view_pixels(browser)
+            w, h = rep["size"]
+            bad = []
+            for column in COLUMNS[:-1]:  # (the overflow tile: the sum's, magenta where clamped)
+                colours = to_bytes(strip.tiles[column]).astype(int)[around]
+                px, py = rep["strip"]["px"][column]
+                x = round((box["x"] + (px + 0.5) * box["w"] / w) * box["dpr"] - 0.5)
+                y = round((box["y"] + (py + 0.5) * box["h"] / h) * box["dpr"] - 0.5)
+                pixel = shot[y, x].astype(int)
+                if not (
+                    (pixel >= colours.min(0) - 2).all() and (pixel <= colours.max(0) + 2).all()
+                ):
+                    bad.append((column, pixel, colours.min(0), colours.max(0)))
+            if not bad and report(browser) == rep:
+                break
+            if time.monotonic() > end:
+                pytest.fail(f"tiles off the engine's terms: {bad}")
+            time.sleep(0.1)
+    browser.save_screenshot(str(tmp_path / "web_strip.png"))
+    click(browser, "strip")
+    wait("the strip off", lambda: report(browser)["strip"] is None)
+    assert not console_errors(browser)
+
+
+def test_the_inset_plots_the_three_models_lobes(server, browser):
+    """The view tab's ``lobes`` select on ``models``: the inset draws each model's lobe in its
+    colour where its values put it (the page's pixels along each curve the server reports).
+    The picture comes as a JPEG (quality 100, colour subsampled): a thin line's pixels are
+    told by the colour they lie nearest of the curves' and the panel's, not to a level."""
+    from explorer.app.lobeinset import LOBE_FRAME_COLOR, LOBE_PANEL_COLOR
+
+    open_page(browser, server.url)
+    click(browser, "view tab")
+    before = picture_src(browser)
+    choose(browser, "lobes", "models")
+    rep = wait("three lobes", lambda: (r := report(browser))["lobes"] and r)
+    wait("a new picture", lambda: picture_src(browser) not in (None, before))
+    assert [c["label"].split()[0] for c in rep["lobes"]["curves"]] == ["Phong", "Blinn", "three.js"]
+    end = time.monotonic() + STEP_TIMEOUT
+    while True:
+        shot, box = view_pixels(browser)
+        w, h = report(browser)["size"]
+        last = rep["lobes"]["curves"][-1]  # (drawn last: nothing over it)
+        classes = np.array(
+            [c["colour"] for c in rep["lobes"]["curves"]]
+            + [to_bytes([LOBE_PANEL_COLOR, LOBE_FRAME_COLOR]).tolist()][0]
+        )
+        hits = 0
+        for px, py in last["px"]:
+            x = round((box["x"] + (px + 0.5) * box["w"] / w) * box["dpr"] - 0.5)
+            y = round((box["y"] + (py + 0.5) * box["h"] / h) * box["dpr"] - 0.5)
+            patch = shot[max(y - 1, 0) : y + 2, max(x - 1, 0) : x + 2].reshape(-1, 3).astype(int)
+            nearest = np.argmin(np.abs(patch[:, None, :] - classes[None]).sum(axis=2), axis=1)
+            hits += bool((nearest == len(rep["lobes"]["curves"]) - 1).any())
+        if hits >= 0.8 * len(last["px"]):
+            break
+        if time.monotonic() > end:
+            pytest.fail(f"{hits} of {len(last['px'])} points of {last['label']} in its colour")
+        time.sleep(0.1)
+    choose(browser, "lobes", "selected")
+    wait("one lobe", lambda: report(browser)["lobes"] is None)
+    assert not console_errors(browser)

@@ -1,0 +1,74 @@
+"""The term strip in the explorer's view (explorer.app.termstrip), on an off-screen plotter as
+both front ends draw it: the tiles under the main view, each the engine's term at its pixels."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from helpers.probes import in_ring, one_ring
+
+from explorer.app import panelmodel as PM
+from explorer.app.termstrip import STRIP_HEIGHT, set_strip, set_strip_mode
+from explorer.app.view import SceneView
+from explorer.cli import build_parser
+from explorer.cli.gui import start_state
+from explorer.render.strip import COLUMNS
+from explorer.render.vtk import plotter
+from explorer.shading.strip import shader_strip
+
+SIZE = (900, 600)
+
+
+@pytest.fixture
+def view():
+    state, mesh = start_state(
+        build_parser().parse_args(["gui", "--mesh", "sphere", "--preset", "gold"])
+    )
+    pl = plotter(SIZE, (0.1, 0.1, 0.1))
+    v = SceneView(pl, mesh, state)
+    yield v
+    pl.close()
+
+
+def _picture(view):
+    view.before_frame(view.state.camera) if view.state.camera else None
+    view.plotter.render()
+    return view.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+
+
+@pytest.mark.parametrize("mode", ["weighted", "raw"])
+def test_each_tile_shows_the_engines_term_at_the_probe_vertex(view, mode):
+    before = _picture(view)
+    state = set_strip_mode(set_strip(view.state, True), mode)
+    view.show_state(state)
+    img = _picture(view)
+    strip = view.strip
+    assert strip.on and len(strip.renderers) == len(COLUMNS)
+    assert view.plotter.renderer.GetViewport() == pytest.approx((0, STRIP_HEIGHT, 1, 1))
+    band = img[int(SIZE[1] * (1 - STRIP_HEIGHT)) + 1 :]
+    assert not np.array_equal(band, before[-len(band) :])  # the tiles are drawn there
+    i = view.probe_vertex()
+    ring = one_ring(view.mesh, i)
+    point = view.to_view(view.mesh.positions[i])
+    terms = shader_strip(view.drawings[0].shader, mode)
+    for k, column in enumerate(COLUMNS):
+        x, y = strip.tile_pixel(column, point)
+        assert SIZE[1] * (1 - STRIP_HEIGHT) <= y < SIZE[1]  # in the band under the view
+        want = strip.tiles[k][i].astype(int)
+        if column in terms.tiles:  # (the float term's bytes: the tile is the engine's term)
+            assert np.abs(want - np.rint(terms.tiles[column][i] * 255)).max() <= 1
+        assert in_ring(img[y, x], strip.tiles[k], ring), column
+    assert strip.labels[-1].GetInput().startswith("overflow ")
+
+
+def test_the_strip_turns_off_and_its_rows_are_panel_rows(view):
+    view.show_state(set_strip(view.state, True))
+    _picture(view)
+    view.show_state(set_strip(view.state, False))
+    assert not view.strip.on
+    assert view.plotter.renderer.GetViewport() == pytest.approx((0, 0, 1, 1))
+    assert PM.row("strip").tab == "view" and PM.row("strip_mode").choices == ("weighted", "raw")
+    action, args, _ = PM.edit(view.state, "strip_mode", "raw")
+    assert action(view.state, *args).strip_mode == "raw"
+    with pytest.raises(ValueError, match="strip_mode must be one of"):
+        set_strip_mode(view.state, "linear")
