@@ -13,9 +13,9 @@ routine shared by two entry points is compiled by the first that calls it (``fix
 of ``shade``), so the column sums to the session's total, and each figure is what that call adds.
 
 The row "shade, one light variant" compiles the same session with the light loop's variants cut
-down to the one the scene uses (:data:`explorer.shading.kernels.LIGHT_LOOPS` set to it in
-the child, or the old dispatch tables replaced at revisions that had them): its difference
-from "shade" is what the literal-dispatched variants cost to compile.
+down to the one the scene uses (the kernels' :data:`explorer.shading.codegen.LIGHT_LOOPS` set to
+it in the child, or the old dispatch tables replaced at revisions that had them): its
+difference from "shade" is what the literal-dispatched variants cost to compile.
 
 Wall-clock seconds on a shared machine: the load average is printed with the table.
 
@@ -106,8 +106,9 @@ from explorer.shading import display, kernels as K
 assert explorer.__file__.startswith({root!r}), explorer.__file__
 import_s = time.perf_counter() - t0
 if cut:
-    if hasattr(K, "LIGHT_LOOPS"):
-        K.LIGHT_LOOPS = (K.loop_code(K.Loop(K.SRC_INLINE, K.LOBE_BLINN, True)),)
+    if hasattr(K, "LIGHT_LOOPS"):  # (the table's module: codegen, or kernels at older revisions)
+        G = K if hasattr(K, "Loop") else __import__("explorer.shading.codegen", fromlist=["G"])
+        K.LIGHT_LOOPS = (G.loop_code(G.Loop(G.SRC_INLINE, G.LOBE_BLINN, True)),)
     else:  # the hand-written tables of older revisions: one branch each
         import numba as nb
         from explorer.core.lightrow import POSITIONAL
