@@ -25,7 +25,9 @@ with an empty ``NUMBA_CACHE_DIR``) in CPU seconds (user + system: the compile is
 single-threaded, so its CPU time is what it takes on an idle core whatever the load), and each
 specialisation's own share: numba's ``numba:compile`` events, a function's time less that of
 the functions it compiles on the way (each kernel x signature; the light loop's variants, the
-compose variants...), summed by function with the count of signatures.
+compose variants...), summed by function with the count of signatures; and LLVM's share of the
+whole (its function and module passes and its machine code, numba's libraries timed; the rest
+is numba's own typing and lowering, in Python).
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; two runs, each child compiling alone
 but beside other engineers' jobs: load average 3.4 to 8.0 during the 7552fa3 run, 1.2 to 1.6
@@ -155,7 +157,20 @@ print(json.dumps({{"import": import_s, **times}}))
 #: the background compile, timed by specialisation (run in a child, like CHILD)
 WARM = r"""
 import json, sys, time
-from numba.core import event
+from numba.core import codegen, event
+llvm = {{"function passes": 0.0, "module passes": 0.0, "machine code": 0.0}}
+def timed(cls, name, key):  # LLVM's share: numba's own typing and lowering is the rest
+    real = getattr(cls, name)
+    def call(self, *a, **kw):
+        t = time.process_time()
+        try:
+            return real(self, *a, **kw)
+        finally:
+            llvm[key] += time.process_time() - t
+    setattr(cls, name, call)
+timed(codegen.CPUCodeLibrary, "_optimize_functions", "function passes")
+timed(codegen.CPUCodeLibrary, "_optimize_final_module", "module passes")
+timed(codegen.JITCodeLibrary, "_finalize_specific", "machine code")
 stack, rows = [], []
 class Listener(event.Listener):
     def on_start(self, ev):
@@ -173,7 +188,7 @@ with event.install_listener("numba:compile", Listener()):
     assert explorer.__file__.startswith({root!r}), explorer.__file__
     from explorer.shading import warm
     warm.exercise()
-print(json.dumps({{"cpu": time.process_time() - t, "rows": rows}}))
+print(json.dumps({{"cpu": time.process_time() - t, "rows": rows, "llvm": llvm}}))
 """
 
 
@@ -193,7 +208,9 @@ def warm_table(root: Path, label: str, top: int = 25) -> list[str]:
         by.setdefault(name, [0, 0.0])
         by[name][0] += 1
         by[name][1] += s
-    lines = [f"\n{label}: {res['cpu']:.1f} CPU s in all\n", "| function | signatures | CPU s |"]
+    split = ", ".join(f"{k} {v:.1f}" for k, v in res.get("llvm", {}).items())
+    lines = [f"\n{label}: {res['cpu']:.1f} CPU s in all (LLVM: {split})\n"]
+    lines.append("| function | signatures | CPU s |")
     lines.append("|---|---:|---:|")
     ranked = sorted(by.items(), key=lambda kv: -kv[1][1])
     for name, (n, s) in ranked[:top]:
