@@ -81,6 +81,26 @@ The light loops' float64 variants cost more after: they are compiled with 512-bi
 whatever compiles them first (``fixup`` used to, with LLVM's 256-bit choice). What is left is
 spread thin: 36 light loops of 1-2 s each, two ``_block`` of 10 s, and some 300 small
 functions of a fraction of a second each (numba's typing and lowering, LLVM, a cache file).
+
+Issue 38's second part (scratch rows through intrinsics instead of numba's inliner, one
+``_light_run`` site in ``_block``, the compose variants through one generated dispatch; see
+docs/speed.md), ``--warm``'s child with LLVM's share, 11dae47 and the change each on an empty
+cache, the two runs within minutes of each other on the same 2-core VM (load 12-18 for 11dae47,
+10-13 for the change: both inflated, 11dae47 by some 8 % more, by the functions neither run
+changed: the BVH's, ``extent``, ``bounds``):
+
+| function | signatures | 11dae47 CPU s | after CPU s |
+|---|---:|---:|---:|
+| shading.kernels._light_overload.impl (the light loops) | 36 | 57.7 | 33.3 |
+| shading.kernels.shade | 2 | 22.9 | 19.8 |
+| shading.kernels._block | 2 | 22.2 | 11.8 |
+| the compose loops and the level that called them (``_compose_a``) | 54 / 36 | 11.4 | 11.1 |
+| shading.kernels._task | 2 | 6.5 | 5.0 |
+| LLVM: function passes, module passes, machine code | | 10.7, 33.0, 26.9 | 9.8, 27.0, 22.3 |
+| **the whole compile** (``/usr/bin/time``, user + system) | | 213.2 | 164.8 |
+
+(the light loops' own LLVM time, summed: 3.9 s at 11dae47 on a quieter run: their cost was
+numba's typing and lowering, grown by its inliner copying ``_row``'s IR twenty times a loop).
 """
 
 from __future__ import annotations
