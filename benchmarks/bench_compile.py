@@ -13,9 +13,9 @@ routine shared by two entry points is compiled by the first that calls it (``fix
 of ``shade``), so the column sums to the session's total, and each figure is what that call adds.
 
 The row "shade, one light variant" compiles the same session with the light loop's variants cut
-down to the one the scene uses (:data:`explorer.shading.kernels.LIGHT_LOOPS` set to it in
-the child, or the old dispatch tables replaced at revisions that had them): its difference
-from "shade" is what the literal-dispatched variants cost to compile.
+down to the one the scene uses (the kernels' :data:`explorer.shading.codegen.LIGHT_LOOPS` set to
+it in the child, or the old dispatch tables replaced at revisions that had them): its
+difference from "shade" is what the literal-dispatched variants cost to compile.
 
 Wall-clock seconds on a shared machine: the load average is printed with the table.
 
@@ -25,7 +25,9 @@ with an empty ``NUMBA_CACHE_DIR``) in CPU seconds (user + system: the compile is
 single-threaded, so its CPU time is what it takes on an idle core whatever the load), and each
 specialisation's own share: numba's ``numba:compile`` events, a function's time less that of
 the functions it compiles on the way (each kernel x signature; the light loop's variants, the
-compose variants...), summed by function with the count of signatures.
+compose variants...), summed by function with the count of signatures; and LLVM's share of the
+whole (its function and module passes and its machine code, numba's libraries timed; the rest
+is numba's own typing and lowering, in Python).
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; two runs, each child compiling alone
 but beside other engineers' jobs: load average 3.4 to 8.0 during the 7552fa3 run, 1.2 to 1.6
@@ -79,6 +81,29 @@ The light loops' float64 variants cost more after: they are compiled with 512-bi
 whatever compiles them first (``fixup`` used to, with LLVM's 256-bit choice). What is left is
 spread thin: 36 light loops of 1-2 s each, two ``_block`` of 10 s, and some 300 small
 functions of a fraction of a second each (numba's typing and lowering, LLVM, a cache file).
+
+Issue 38's second part (scratch rows through intrinsics instead of numba's inliner, one
+``_light_run`` site in ``_block``, the compose variants through one generated dispatch; see
+docs/speed.md), ``--warm``'s child with LLVM's share, 11dae47 and the change each on an empty
+cache, the two runs within minutes of each other on the same 2-core VM (load 12-18 for 11dae47,
+10-13 for the change: both inflated, 11dae47 by some 8 % more, by the functions neither run
+changed: the BVH's, ``extent``, ``bounds``):
+
+| function | signatures | 11dae47 CPU s | after CPU s |
+|---|---:|---:|---:|
+| shading.kernels._light_overload.impl (the light loops) | 36 | 57.7 | 33.3 |
+| shading.kernels.shade | 2 | 22.9 | 19.8 |
+| shading.kernels._block | 2 | 22.2 | 11.8 |
+| the compose loops and the level that called them (``_compose_a``) | 54 / 36 | 11.4 | 11.1 |
+| shading.kernels._task | 2 | 6.5 | 5.0 |
+| LLVM: function passes, module passes, machine code | | 10.7, 33.0, 26.9 | 9.8, 27.0, 22.3 |
+| **the whole compile** (``/usr/bin/time``, user + system) | | 213.2 | 164.8 |
+
+(the light loops' own LLVM time, summed: 3.9 s at 11dae47 on a quieter run: their cost was
+numba's typing and lowering, grown by its inliner copying ``_row``'s IR twenty times a loop).
+Side by side instead (both children at once, one core each, load 3-6; the VM an Intel Xeon with
+AVX-512 then): the whole compile 203.0 -> 173.6 s (0.86x), the light loops 60.1 -> 36.6 s,
+``_block`` 20.2 -> 13.0 s, LLVM 62.5 -> 62.8 s (unchanged: all of the gain is numba's Python).
 """
 
 from __future__ import annotations
@@ -106,8 +131,9 @@ from explorer.shading import display, kernels as K
 assert explorer.__file__.startswith({root!r}), explorer.__file__
 import_s = time.perf_counter() - t0
 if cut:
-    if hasattr(K, "LIGHT_LOOPS"):
-        K.LIGHT_LOOPS = (K.loop_code(K.Loop(K.SRC_INLINE, K.LOBE_BLINN, True)),)
+    if hasattr(K, "LIGHT_LOOPS"):  # (the table's module: codegen, or kernels at older revisions)
+        G = K if hasattr(K, "Loop") else __import__("explorer.shading.codegen", fromlist=["G"])
+        K.LIGHT_LOOPS = (G.loop_code(G.Loop(G.SRC_INLINE, G.LOBE_BLINN, True)),)
     else:  # the hand-written tables of older revisions: one branch each
         import numba as nb
         from explorer.core.lightrow import POSITIONAL
@@ -154,7 +180,20 @@ print(json.dumps({{"import": import_s, **times}}))
 #: the background compile, timed by specialisation (run in a child, like CHILD)
 WARM = r"""
 import json, sys, time
-from numba.core import event
+from numba.core import codegen, event
+llvm = {{"function passes": 0.0, "module passes": 0.0, "machine code": 0.0}}
+def timed(cls, name, key):  # LLVM's share: numba's own typing and lowering is the rest
+    real = getattr(cls, name)
+    def call(self, *a, **kw):
+        t = time.process_time()
+        try:
+            return real(self, *a, **kw)
+        finally:
+            llvm[key] += time.process_time() - t
+    setattr(cls, name, call)
+timed(codegen.CPUCodeLibrary, "_optimize_functions", "function passes")
+timed(codegen.CPUCodeLibrary, "_optimize_final_module", "module passes")
+timed(codegen.JITCodeLibrary, "_finalize_specific", "machine code")
 stack, rows = [], []
 class Listener(event.Listener):
     def on_start(self, ev):
@@ -172,7 +211,7 @@ with event.install_listener("numba:compile", Listener()):
     assert explorer.__file__.startswith({root!r}), explorer.__file__
     from explorer.shading import warm
     warm.exercise()
-print(json.dumps({{"cpu": time.process_time() - t, "rows": rows}}))
+print(json.dumps({{"cpu": time.process_time() - t, "rows": rows, "llvm": llvm}}))
 """
 
 
@@ -192,7 +231,9 @@ def warm_table(root: Path, label: str, top: int = 25) -> list[str]:
         by.setdefault(name, [0, 0.0])
         by[name][0] += 1
         by[name][1] += s
-    lines = [f"\n{label}: {res['cpu']:.1f} CPU s in all\n", "| function | signatures | CPU s |"]
+    split = ", ".join(f"{k} {v:.1f}" for k, v in res.get("llvm", {}).items())
+    lines = [f"\n{label}: {res['cpu']:.1f} CPU s in all (LLVM: {split})\n"]
+    lines.append("| function | signatures | CPU s |")
     lines.append("|---|---:|---:|")
     ranked = sorted(by.items(), key=lambda kv: -kv[1][1])
     for name, (n, s) in ranked[:top]:

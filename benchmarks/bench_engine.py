@@ -56,8 +56,8 @@ import explorer
 from explorer.core.lights import PointLight, SpotLight
 from explorer.core.material import Material
 from explorer.core.scene import Scene, Viewer
+from explorer.shading import codegen, prepared
 from explorer.shading import kernels as K
-from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
@@ -67,7 +67,7 @@ def machine() -> str:
     return (
         f"{cpu_name()}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
-        f"vectors: {WIDTH[K.WIDE_VECTORS]}; "
+        f"vectors: {WIDTH[codegen.WIDE_VECTORS]}; "
         f"load average {load_average():.2f}"
     )
 

@@ -33,14 +33,14 @@ from bench_engine import machine, scene_with, sphere_points  # its machine line,
 
 import explorer
 from explorer.core import tolerances as tol
-from explorer.shading import kernels as K
+from explorer.shading import codegen
 from explorer.shading.kernels import _LEAF, _OPTS
 from explorer.shading.vmath import pow32
 
 BLOCK = 512
 F = np.float32
 # compiled as the engine's kernels are: the light loop without reference counting, both with
-# 16-lane vectors where the engine gets them (explorer.shading.kernels.wide_vectors)
+# 16-lane vectors where the engine gets them (explorer.shading.codegen.wide_vectors)
 _JIT = {k: v for k, v in _OPTS.items() if k != "cache"}
 _JIT_LEAF = {k: v for k, v in _LEAF.items() if k != "cache"}
 # the engine's tolerances, in float32 (frozen into the kernels as constants)
@@ -165,7 +165,7 @@ def main(argv=None) -> int:
         fn = make(track, floors, store)
         D, S = sums.get(store, sums[1])
         fns[name] = lambda fn=fn, D=D, S=S: fn(G, lights, eye, F(25.6), mat, out, D, S)
-        with K.wide_vectors():
+        with codegen.wide_vectors():
             fns[name]()  # compile
     # the engine itself, in the same rounds: a light change on a float32 Shader, as bench_engine
     scene = scene_with(L, np.random.default_rng(0))

@@ -5,19 +5,20 @@
     python benchmarks/bench_revisions.py 7552fa3 HEAD --precision float64
 
 Each revision is checked out in a temporary git worktree (its numba cache is its own, so the
-first process of each compiles: not timed) and imported from there. Processes alternate A, B,
-A, B, ... so that this VM's drift from one minute to the next falls on both alike. Each process
-times a light change on a ``Shader`` (float32, or ``--precision``; 1M vertices, 8 point lights,
-Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on random points (every
-vertex-light computed) and on a UV sphere with as many vertices in mesh order (light culling
-skips what faces away), then a one-shot ``explorer.shade`` (10 calls), the geometry preparation
-of a one-shot call (11: ``bench_engine.py``'s row, the prepared geometry handed back as the call
-does) and a viewer change on a kept ``Shader`` (25), all on the random points, in the same
-precision; the table gives the best and the median of the per-process medians, and the ratios.
-``--cpu`` runs each process on one numba thread and times the process's CPU seconds instead of
-the wall clock: the work each revision does, unaffected by other processes taking a core (a
-parallel pass waits for its slowest thread, so on a busy machine the wall clock mostly measures
-the others).
+first process of each compiles: not timed) and imported from there; a directory that holds an
+``explorer`` package is taken as it is instead (a checkout and its numba cache, kept).
+Processes alternate A, B, A, B, ... so that this VM's drift from one minute to the next falls
+on both alike. Each process times a light change on a ``Shader`` (float32, or ``--precision``;
+1M vertices, 8 point lights, Blinn, local viewer: ``bench_engine.py``'s first row) 25 times, on
+random points (every vertex-light computed) and on a UV sphere with as many vertices in mesh
+order (light culling skips what faces away), then a one-shot ``explorer.shade`` (10 calls), the
+geometry preparation of a one-shot call (11: ``bench_engine.py``'s row, the prepared geometry
+handed back as the call does) and a viewer change on a kept ``Shader`` (25), all on the random
+points, in the same precision; the table gives the best and the median of the per-process
+medians, and the ratios. ``--cpu`` runs each process on one numba thread and times the
+process's CPU seconds instead of the wall clock: the work each revision does, unaffected by
+other processes taking a core (a parallel pass waits for its slowest thread, so on a busy
+machine the wall clock mostly measures the others).
 
 Last results (AMD EPYC, 2 cores, AVX-512, numba 0.68.1; medians of per-process medians):
 
@@ -229,8 +230,8 @@ def run(root: Path, n: int, precision: str = "float32", cpu=False) -> list[tuple
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("a", help="a git revision (the baseline)")
-    ap.add_argument("b", help="another git revision")
+    ap.add_argument("a", help="a git revision (the baseline), or a checkout's directory")
+    ap.add_argument("b", help="another git revision, or a checkout's directory")
     ap.add_argument("--rounds", type=int, default=3, help="processes per revision")
     ap.add_argument("--vertices", type=int, default=1_000_000)
     ap.add_argument("--precision", choices=("float32", "float64"), default="float32")
@@ -246,6 +247,9 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         roots = {}
         for rev in (args.a, args.b):
+            if Path(rev, "explorer").is_dir():  # a checkout as it is, with its own numba cache
+                roots[rev] = Path(rev).resolve()
+                continue
             root = Path(tmp) / f"rev{len(roots)}"
             subprocess.run(
                 ["git", "-C", repo, "worktree", "add", "--detach", "-f", str(root), rev],
@@ -262,6 +266,8 @@ def main(argv=None) -> int:
                     res[rev].append(run(root, args.vertices, args.precision, args.cpu))
         finally:
             for root in roots.values():
+                if not root.is_relative_to(tmp):  # (a checkout given as a directory: kept)
+                    continue
                 subprocess.run(
                     ["git", "-C", repo, "worktree", "remove", "--force", str(root)],
                     capture_output=True,

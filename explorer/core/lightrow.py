@@ -3,8 +3,11 @@ flag bits per light, in the normalised frame (:mod:`explorer.geometry.frame`).
 
 Plain constants, so that a light (:mod:`explorer.core.lights`) and an effect
 (:mod:`explorer.shading.effects`) pack their own slots without importing the compiled kernels
-(:mod:`explorer.shading.kernels`), which read the same slots.
+(:mod:`explorer.shading.kernels`), which read the same slots. The columns are one table
+(:class:`explorer.core.slots.Slots`): each declares its width, and its offset follows.
 """
+
+from explorer.core.slots import Slots
 
 # per-light flag bits (int32)
 POSITIONAL = 1
@@ -19,15 +22,16 @@ SHADOW = 256  # w *= visibility row (explorer.shading.shadows) for diffuse and s
 FRESNEL = 512  # specular weight *= Schlick F = F0 + (1 - F0)(1 - V·H)^5
 GREY = 1024  # diffuse and specular colours have r = g = b (one sum per vertex, not three)
 
-# per-light parameter columns
-P_POS = 0  # position, or the unit vector toward a directional light (3)
-P_AXIS = 3  # spot axis, the unit vector it shines along (3)
-P_ATT = 6  # kc, kl·scale, kq·scale² (3)
-P_COS = 9  # cos(cutoff)
-P_EXP = 10  # spot exponent
-P_AMB = 11  # ambient colour × constant factor (3)
-P_DIF = 14  # diffuse colour × constant factor (3)
-P_SPEC = 17  # specular colour × constant factor (3)
-P_H = 20  # constant halfway vector (3)
-P_F0 = 23  # Schlick F0 (Fresnel)
-N_PARAMS = 24
+# per-light parameter columns, each as wide as its comment says (a light's row: N_PARAMS floats)
+_params = Slots()
+P_POS = _params.slot(3)  # position, or the unit vector toward a directional light
+P_AXIS = _params.slot(3)  # spot axis, the unit vector it shines along
+P_ATT = _params.slot(3)  # kc, kl·scale, kq·scale²
+P_COS = _params.slot()  # cos(cutoff)
+P_EXP = _params.slot()  # spot exponent
+P_AMB = _params.slot(3)  # ambient colour × constant factor
+P_DIF = _params.slot(3)  # diffuse colour × constant factor
+P_SPEC = _params.slot(3)  # specular colour × constant factor
+P_H = _params.slot(3)  # constant halfway vector
+P_F0 = _params.slot()  # Schlick F0 (Fresnel)
+N_PARAMS = _params.count

@@ -54,7 +54,13 @@ KERNEL_MODULES = (
     "explorer.geometry.bvh",
 )
 #: modules whose constants the kernels read at compile time (numba freezes a global's value)
-CONSTANT_MODULES = ("explorer.core.tolerances", "explorer.core.lightrow")
+CONSTANT_MODULES = (
+    "explorer.core.tolerances",
+    "explorer.core.lightrow",
+    "explorer.shading.codegen",
+    "explorer.shading.layout",
+    "explorer.core.slots",
+)
 
 #: a claimed file (its real path) -> the real paths of the files its stamp hashes
 _claimed: dict[str, tuple[str, ...]] = {}

@@ -35,18 +35,20 @@ entry point has about ten arguments, each with one meaning.
 Light loops, variants and what they cost to compile. Each light of a pass runs its pre-passes
 (:func:`_light_run`: rows L and the weight w for a positional light, its spot cone, shadow,
 Fresnel, per-vertex ambient) and then one light loop (:func:`_light`), compiled for a few named
-compile-time choices (:class:`Loop`: where L comes from, how the lobe's base is found, grey or
-RGB sums; see the comment above :func:`_light`). :data:`LIGHT_LOOPS` lists the 18 valid
-combinations; a light's loop is picked at run time from its flags (:func:`_loop_code`), through
-tests written from that tuple when :func:`_light_loop` is compiled, so no table spells the
-combinations out.
+compile-time choices (:class:`explorer.shading.codegen.Loop`: where L comes from, how the lobe's
+base is found, grey or RGB sums; see the comment above :func:`_light`).
+:data:`explorer.shading.codegen.LIGHT_LOOPS` lists the 18 valid combinations; a light's loop is
+picked at run time from its flags (:func:`_loop_code`), through tests written from that tuple
+(:func:`explorer.shading.codegen.dispatch_source`) when :func:`_light_loop` is compiled, so no
+table spells the combinations out.
 Everything cheap to decide at run time is decided there (whether a light adds diffuse, whether
 it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and fills the rows
 the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
 :mod:`explorer.shading.equation`). Every loop is compiled with the entry point that first meets
 a precision (``shade``; ``fixup`` for the float64 redo of a float32 pass), and numba caches
-the result on disk (``cache=True``: per machine, keyed on this file's and :mod:`.vmath`'s
-contents, :mod:`explorer.geometry.kernelcache`; an edit to either recompiles). What that costs is
+the result on disk (``cache=True``: per machine, keyed on the contents of this file and of
+those it compiles from, :mod:`.vmath`, :mod:`.codegen`, :mod:`explorer.core.lightrow` ...,
+:mod:`explorer.geometry.kernelcache`; an edit to any of them recompiles). What that costs is
 measured by ``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of
 the loops a scene does not use (its docstring keeps the last table, with the machine).
 
@@ -56,20 +58,15 @@ threads of a pass contend for (about a fifth of a full pass at 1M vertices).
 
 On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many x86 cores still picks 256-bit
 ones; the entry points are compiled with 512-bit vectors there (16 float32 or 8 float64 lanes),
-two vector iterations interleaved (see :func:`wide_vectors`).
+two vector iterations interleaved (see :func:`explorer.shading.codegen.wide_vectors`).
 """
 
 from __future__ import annotations
 
-import contextlib
-import functools
-import os
-import sys
-import tempfile
+import operator
 import warnings
 from typing import NamedTuple
 
-import llvmlite.binding as llvm
 import numba as nb
 import numpy as np
 from llvmlite import ir
@@ -102,6 +99,88 @@ from explorer.core.lightrow import (  # the row layout, shared with the lights t
     SPOT_EXP,
 )
 from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
+from explorer.shading.codegen import (  # the light loops' variants, the vector width
+    COMPOSE_VARIANTS,
+    LIGHT_LOOPS,
+    LOBE_BLINN,
+    LOBE_CONST_H,
+    LOBE_FLAT,
+    LOBE_NONE,
+    LOBE_PHONG,
+    SRC_CONST,
+    SRC_INLINE,
+    SRC_ROWS,
+    dispatch_source,
+    loop_of,
+    wide,
+)
+from explorer.shading.layout import (  # the kernels' layouts (O_, R_, K_, B_ slots)
+    B_AX,
+    B_AY,
+    B_AZ,
+    B_COS,
+    B_CX,
+    B_CY,
+    B_CZ,
+    B_R,
+    B_SIN,
+    CONSTANTS,
+    K_ATT_FLOOR,
+    K_HALF_EPS2,
+    K_INF,
+    K_MARGIN_DIST2,
+    K_MARGIN_DOT,
+    K_MARGIN_LEN2,
+    K_NORMAL_EPS2,
+    K_ONE,
+    K_POINT_EPS,
+    K_TWO,
+    K_ZERO,
+    N_ROWS,
+    O_CLAMP,
+    O_COMPOSE,
+    O_DO_AMB,
+    O_DO_DIF,
+    O_DO_SPEC,
+    O_FLAT,
+    O_LOCAL,
+    O_PHONG,
+    O_STORE,
+    O_STORE_LOBE,
+    O_TRACK,
+    O_TWO_SIDED,
+    O_VIEW,
+    R_AX,
+    R_AY,
+    R_AZ,
+    R_BASE,
+    R_DX,
+    R_DY,
+    R_DZ,
+    R_GD,
+    R_GS,
+    R_LOBE,
+    R_LX,
+    R_LY,
+    R_LZ,
+    R_NV,
+    R_NX,
+    R_NY,
+    R_NZ,
+    R_PACK,
+    R_PX,
+    R_PY,
+    R_PZ,
+    R_SX,
+    R_SY,
+    R_SZ,
+    R_TRK,
+    R_VX,
+    R_VY,
+    R_VZ,
+    R_W,
+    R_WS,
+)
 from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
@@ -123,103 +202,16 @@ _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: po
 _OPTS = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True)
 _LEAF = dict(_OPTS, _nrt=False)
 
-# option slots (int64 array)
-O_LOCAL, O_TWO_SIDED, O_PHONG, O_FLAT = 0, 1, 2, 3
-O_DO_AMB, O_DO_DIF, O_DO_SPEC = 4, 5, 6  # recompute these sums in this pass
-O_STORE, O_STORE_LOBE, O_COMPOSE, O_CLAMP, O_TRACK = 7, 8, 9, 10, 11
-O_VIEW = 12  # V rows are needed even for a flat lobe (Fresnel)
-N_OPTS = 13
-
-# scratch rows
-(
-    R_PX,
-    R_PY,
-    R_PZ,
-    R_NX,
-    R_NY,
-    R_NZ,
-    R_VX,
-    R_VY,
-    R_VZ,
-    R_AX,
-    R_AY,
-    R_AZ,
-    R_DX,
-    R_DY,
-    R_DZ,
-    R_SX,
-    R_SY,
-    R_SZ,
-    R_LX,
-    R_LY,
-    R_LZ,
-    R_W,
-    R_BASE,
-    R_WS,
-    R_TRK,
-    R_GD,
-    R_GS,
-    R_NV,
-    R_PACK,
-    R_LOBE,
-) = range(30)
-N_ROWS = 30
-# R_TRK holds, per lane, the smallest margin met so far: a quantity that decides a sign or a
-# policy (N·L, N·H, the cone test, |l|², |L + V|²) over its ambiguity band's width
-# (explorer.core.tolerances.AMBIGUOUS_*); a lane whose margin ends below 1 is marked ambiguous.
-# R_NV holds N·V (after a two-sided flip), for the inline lobes. R_PACK and R_LOBE: the float64
-# lobe loop's packed bases and their powers (see _split_lobe).
-
-# lobe modes
-LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG = 0, 1, 2, 3
-
 #: vertices per culling chunk (two 16-lane vector iterations): a light is skipped for a chunk
 #: that provably gets nothing from it (see :func:`bounds` and :func:`_reach`)
 CHUNK = 32
 CHUNKS = BLOCK // CHUNK  # chunks per block
 
-# chunk bound rows (float64, see :func:`bounds`): the chunk's bounding sphere (centre, radius)
-# and its cone of normals (unit axis, cosine and sine of the half-angle; cosine -1 where the
-# cone is 90° or wider, or some normal is absent: such a chunk is never culled)
-B_CX, B_CY, B_CZ, B_R, B_AX, B_AY, B_AZ, B_COS, B_SIN = range(9)
-N_BOUNDS = 9
-
-
-# constants passed in the working precision (a float literal would promote float32 to float64)
-(
-    K_ZERO,
-    K_ONE,
-    K_TWO,
-    K_POINT_EPS,
-    K_HALF_EPS2,
-    K_ATT_FLOOR,
-    K_INF,
-    K_NORMAL_EPS2,
-    K_MARGIN_DOT,
-    K_MARGIN_LEN2,
-    K_MARGIN_DIST2,
-) = range(11)
-N_CONSTS = 11
-
 
 def constants(dtype) -> np.ndarray:
-    """The kernel's constants (see :mod:`explorer.core.tolerances`) in ``dtype``."""
-    return np.array(
-        [
-            0.0,
-            1.0,
-            2.0,
-            tol.POINT_EPS,
-            tol.HALFWAY_EPS2,
-            tol.ATTENUATION_FLOOR,
-            np.inf,
-            tol.NORMAL_EPS**2,
-            1.0 / tol.AMBIGUOUS_DOT,  # margins: a quantity over its band's width (< 1: inside)
-            1.0 / tol.AMBIGUOUS_LEN2,
-            1.0 / tol.AMBIGUOUS_DIST**2,
-        ],
-        dtype=dtype,
-    )
+    """The kernel's constants (:data:`explorer.shading.layout.CONSTANTS`, from
+    :mod:`explorer.core.tolerances`) in ``dtype``, indexed by the ``K_*`` slots."""
+    return np.array(CONSTANTS, dtype=dtype)
 
 
 def unit(k):
@@ -280,27 +272,67 @@ def _assume(typingctx, cond):
     return types.none(cond), codegen
 
 
-@nb.njit(inline="always", **_LEAF)
-def _row_checked(scr, r, m):
+def _row_view(context, builder, sig, args, assume):
+    """The code of ``scr[r * ROW : r * ROW + m]`` (numba's own slice, clamped to the array),
+    after ``llvm.assume`` of ``(r + 1) * ROW <= len(scr)`` and ``0 <= m <= BLOCK`` when
+    ``assume``. Written as an intrinsic, not a function numba inlines into its caller: a light
+    loop takes some twenty rows, and numba's inliner copies and types the callee's IR again at
+    every call (a tenth of the cold compile, ``benchmarks/bench_compile.py``); LLVM gets the
+    same instructions either way."""
+    scr_t, view_t = sig.args[0], sig.return_type
+    ary = context.make_array(scr_t)(context, builder, args[0])
+    intp = context.get_value_type(types.intp)
+    r, m = args[1], args[2]
+    start = builder.mul(r, intp(ROW))
+    stop = builder.add(start, m)
+    if assume:
+        fn = builder.module.declare_intrinsic(
+            "llvm.assume", fnty=ir.FunctionType(ir.VoidType(), [ir.IntType(1)])
+        )
+        n = builder.extract_value(ary.shape, 0)
+        end = builder.mul(builder.add(r, intp(1)), intp(ROW))
+        builder.call(fn, [builder.icmp_signed(">=", n, end)])
+        builder.call(fn, [builder.icmp_signed("<=", m, intp(BLOCK))])
+        builder.call(fn, [builder.icmp_signed(">=", m, intp(0))])
+    make_slice = context.get_function(slice, types.slice2_type(types.intp, types.intp))
+    sl = make_slice(builder, (start, stop))
+    getitem = context.get_function(operator.getitem, view_t(scr_t, types.slice2_type))
+    return getitem(builder, (args[0], sl))
+
+
+def _row_type(typingctx, scr):
+    """The type of a row of ``scr`` (numba's type of ``scr[a:b]``)."""
+    return typingctx.resolve_function_type(operator.getitem, (scr, types.slice2_type), {})
+
+
+@intrinsic
+def _row_checked(typingctx, scr, r, m):
     """:func:`_row` without telling LLVM that the row lies whole in the scratch: the slice is
     then clamped at run time, and LLVM checks a loop's rows for overlap before it enters the
     vector loop. For the inline light loops: rows at a known constant distance make LLVM refuse to
     interleave two vector iterations (it takes the distance as a limit), and interleaving is
     worth more there (0.93x without it, full pass at 1M)."""
-    return scr[r * ROW : r * ROW + m]
+    view = _row_type(typingctx, scr).return_type
+
+    def codegen(context, builder, sig, args):
+        return _row_view(context, builder, sig, args, False)
+
+    return view(scr, types.intp, types.intp), codegen
 
 
-@nb.njit(inline="always", **_LEAF)
-def _row(scr, r, m):
+@intrinsic
+def _row(typingctx, scr, r, m):
     """Row ``r`` of a block's scratch, its first ``m`` lanes (m <= BLOCK). The rows lie ROW
     apart in one flat array, and LLVM is told the scratch holds row ``r`` whole: the slice is
     then the scratch's start plus a constant, not clamped at run time, so LLVM proves the rows
     of a loop disjoint (no run-time overlap checks: a loop that reads and writes many rows had
     too many to vectorise at all) and addresses them all from one register."""
-    _assume(scr.shape[0] >= (r + 1) * ROW)
-    _assume(m <= BLOCK)
-    _assume(m >= 0)
-    return _row_checked(scr, r, m)
+    view = _row_type(typingctx, scr).return_type
+
+    def codegen(context, builder, sig, args):
+        return _row_view(context, builder, sig, args, True)
+
+    return view(scr, types.intp, types.intp), codegen
 
 
 @nb.njit(**_LEAF)
@@ -698,8 +730,8 @@ def _reach(bd, c0, nc, q, fl, back, act):
 
 # --------------------------------------------------------------------------------------------
 # One light over one block: the light loop. It is specialised at compile time on a few named
-# choices (a :class:`Loop`), so that each combination is a loop that holds exactly the terms it
-# needs and no run-time test:
+# choices (a :class:`~explorer.shading.codegen.Loop`), so that each combination is a loop that
+# holds exactly the terms it needs and no run-time test:
 #
 # - ``source``, where L and the weight w come from: SRC_CONST (a directional light: L constant,
 #   w = 1), SRC_ROWS (rows the light's pre-passes filled: L, w = attenuation · spot · shadow ...,
@@ -712,9 +744,9 @@ def _reach(bd, c0, nc, q, fl, back, act):
 #   lights are): it adds one number per vertex to a grey row instead of three to the RGB rows; the
 #   block adds the grey rows to every channel once.
 #
-# Every valid combination is in :data:`LIGHT_LOOPS`; :func:`_light_loop` calls the one a light
-# needs (its code from :func:`_loop_code`), through tests written from that tuple when it is
-# compiled: no table is written by hand, and all of them are compiled with
+# Every valid combination is in :data:`~explorer.shading.codegen.LIGHT_LOOPS`; :func:`_light_loop`
+# calls the one a light needs (its code from :func:`_loop_code`), through tests written from
+# that tuple when it is compiled: no table is written by hand, and all of them are compiled with
 # the entry point that calls them (the module docstring gives the cost). What is cheap to decide
 # at run time is not a variant: whether the light adds diffuse (a specular-only pass adds w·N·L
 # times a zero colour), whether it is attenuated (1, 0, 0 otherwise: w = 1 exactly).
@@ -737,44 +769,6 @@ def _reach(bd, c0, nc, q, fl, back, act):
 # base^n = (base²)^(n/2), and Blinn's base² = (N·u)²/|u|² with u = l + |l|·V = |l|·(L + V) needs
 # neither 1/|L + V| (a square root and a division) nor 1/|l|; the inline loop then divides
 # twice and takes one square root per vertex-light, where it took two of each.
-
-SRC_CONST, SRC_ROWS, SRC_INLINE = 0, 1, 2
-LOBE_NONE = 4  # (after the LOBE_* modes above)
-
-
-class Loop(NamedTuple):
-    """The compile-time choices of one light loop (see the comment above)."""
-
-    source: int
-    lobe: int
-    grey: bool
-
-
-def loop_code(loop: Loop) -> int:
-    """A loop's code: the literal the light loop is compiled for (and :func:`_loop_code`)."""
-    return loop.source | loop.lobe << 2 | int(loop.grey) << 5
-
-
-def loop_of(code: int) -> Loop:
-    return Loop(code & 3, (code >> 2) & 7, bool(code & 32))
-
-
-def _valid(loop: Loop) -> bool:
-    inline = loop.source == SRC_INLINE
-    return (inline or not loop.grey) and not (inline and loop.lobe == LOBE_CONST_H)
-
-
-#: every light loop that is compiled (codes, see :func:`loop_code`)
-LIGHT_LOOPS = tuple(
-    loop_code(lp)
-    for lp in (
-        Loop(s, lobe, g)
-        for s in (SRC_CONST, SRC_ROWS, SRC_INLINE)
-        for lobe in (LOBE_NONE, LOBE_FLAT, LOBE_CONST_H, LOBE_BLINN, LOBE_PHONG)
-        for g in (False, True)
-    )
-    if _valid(lp)
-)
 
 
 @nb.njit(inline="always", **_LEAF)
@@ -993,22 +987,20 @@ def _light_loop(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - over
 
 @overload(_light_loop, jit_options=dict(_LEAF, cache=False))  # (cached with its callers)
 def _light_loop_overload(scr, m, q, y, k, atten, l_dif, code):
-    """Run the light loop compiled for the run-time ``code`` (see :func:`loop_code`): one test
-    and one literal call per entry of :data:`LIGHT_LOOPS`, written from that tuple into one
-    function (not a chain of functions each calling the next: LLVM would optimise every loop
-    again at each link of the chain)."""
-    src = ["def impl(scr, m, q, y, k, atten, l_dif, code):"]
-    for c in LIGHT_LOOPS:
-        src += [f"    if code == {c}:", f"        _light(scr, m, q, y, k, atten, l_dif, {c})"]
-        src += ["        return"]
+    """Run the light loop compiled for the run-time ``code`` (see
+    :func:`explorer.shading.codegen.loop_code`): one test and one literal call per entry of
+    :data:`~explorer.shading.codegen.LIGHT_LOOPS`, written from that tuple into one function
+    (:func:`~explorer.shading.codegen.dispatch_source`)."""
+    params = "scr, m, q, y, k, atten, l_dif, code"
     space = {"_light": _light}
-    exec("\n".join(src), space)  # noqa: S102 (source written above, from LIGHT_LOOPS)
+    exec(dispatch_source("impl", params, "_light", LIGHT_LOOPS), space)  # noqa: S102
     return space["impl"]
 
 
 @nb.njit(**_LEAF)
 def _loop_code(source, mode, l_spec, grey):
-    """The code of the loop for a light (as :func:`loop_code`, at run time)."""
+    """The code of the loop for a light (as :func:`explorer.shading.codegen.loop_code`, at run
+    time)."""
     lobe = mode if l_spec else LOBE_NONE
     return source | lobe << 2 | (32 if grey else 0)
 
@@ -1412,28 +1404,25 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
             reach = 0
             for j in range(nc):
                 reach += act[li, j]
-        if reach == nc:  # the whole block
-            v = vrows[max(vindex[li], 0), :]  # (read only by a light flagged SHADOW)
-            _light_run(scr, m, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline)
-        else:  # runs of chunks it can reach; the others get nothing (a zero lobe weight)
-            c = 0
-            while c < nc:
-                e = c + 1
-                while e < nc and act[li, e] == act[li, c]:
-                    e += 1
-                s0, s1 = c * CHUNK, min(m, e * CHUNK)
-                if act[li, c]:  # the scratch from lane s0 on: every row starts at its lane s0
-                    sub = scr[s0 : s0 + N_ROWS * ROW]
-                    v = vrows[max(vindex[li], 0), s0:s1]  # (empty when no light casts shadows)
-                    _light_run(
-                        sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
-                    )
-                else:
-                    skipped += s1 - s0
-                    if store_lobe and l_spec:
-                        _fill(_row(scr, R_WS, m)[s0:s1], zero)
-                        _fill(_row(scr, R_BASE, m)[s0:s1], zero)
-                c = e
+        # the runs of chunks it can reach (the whole block when it reaches every chunk); the
+        # others get nothing (a zero lobe weight). One call site of the inlined _light_run: a
+        # second, for the whole block, cost numba as much typing again at the cold compile
+        c = 0
+        while c < nc:
+            e = nc if reach == nc else c + 1
+            while e < nc and act[li, e] == act[li, c]:
+                e += 1
+            s0, s1 = c * CHUNK, min(m, e * CHUNK)
+            if reach == nc or act[li, c]:  # the scratch from lane s0 on: rows start at lane s0
+                sub = scr[s0 : s0 + N_ROWS * ROW]
+                v = vrows[max(vindex[li], 0), s0:s1]  # (read only by a light flagged SHADOW)
+                _light_run(sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline)
+            else:
+                skipped += s1 - s0
+                if store_lobe and l_spec:
+                    _fill(_row(scr, R_WS, m)[s0:s1], zero)
+                    _fill(_row(scr, R_BASE, m)[s0:s1], zero)
+            c = e
         if store_lobe and l_spec:
             _keep_lobe(scr, m, base_out[li, :], ws_out[li, :], flat)
     culled[0] = skipped
@@ -1528,115 +1517,6 @@ def _task(
             culled[b : b + 1],
         )
     return outside
-
-
-def _host_has_avx512() -> bool:
-    try:
-        return bool(llvm.get_host_cpu_features().get("avx512f", False))
-    except RuntimeError:  # llvmlite cannot read this host's features: keep LLVM's choice
-        return False
-
-
-#: loops are vectorised 512 bits wide (16 float32 or 8 float64 lanes) where the CPU has AVX-512
-#: (LLVM's tunings for many x86 cores prefer 256-bit vectors; 512-bit ones shade about 12%
-#: faster here in float32, and the float64 light loop, whose power is long, gains more; see
-#: benchmarks/bench_engine.py). Set the environment variable PHONG_EXPLORER_WIDE_VECTORS=0 to
-#: keep LLVM's choice (numba's on-disk cache keeps whichever was compiled first: clear it, or use
-#: another NUMBA_CACHE_DIR, to compare).
-WIDE_VECTORS = (
-    os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
-    and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
-    and _host_has_avx512()
-)
-
-
-@contextlib.contextmanager
-def _quiet_llvm_remarks():
-    """Drop the "remark: ... loop not vectorized" lines LLVM writes to the process's stderr
-    (file descriptor 2) for loops it leaves scalar once a vector width is forced; any other
-    output is passed on."""
-    try:
-        sys.stderr.flush()
-        saved = os.dup(2)
-    except (OSError, ValueError):  # no usable stderr: nothing to filter
-        yield
-        return
-    with tempfile.TemporaryFile() as tmp:
-        os.dup2(tmp.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            tmp.seek(0)
-            rest = [ln for ln in tmp.read().splitlines(True) if not ln.startswith(b"remark: ")]
-            if rest:
-                os.write(2, b"".join(rest))
-
-
-#: and their loops run two vector iterations interleaved (LLVM's -force-vector-interleave): a
-#: light loop is one long dependency chain per iteration (two square roots, pow), which the
-#: out-of-order core overlaps too little on its own; two independent chains side by side make
-#: the light loop about 15% faster here (LLVM picks 1 for a loop that large)
-INTERLEAVE = 2
-
-
-@contextlib.contextmanager
-def wide_vectors(lanes: int = 16):
-    """Compile numba code inside this block with ``lanes``-lane vectors (16 for float32, 8 for
-    float64: 512 bits) where :data:`WIDE_VECTORS` (else a no-op). LLVM's
-    ``-force-vector-width`` is a process-wide option: it is set for the block only and reset to 0
-    (LLVM's own choice) after, so other numba code is not affected."""
-    if not WIDE_VECTORS:
-        yield
-        return
-    with _quiet_llvm_remarks():
-        llvm.set_option("", f"-force-vector-width={lanes}")
-        llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
-        try:
-            yield
-        finally:
-            llvm.set_option("", "-force-vector-width=0")
-            llvm.set_option("", "-force-vector-interleave=0")
-
-
-def _kind(a):
-    """What of a kernel argument decides numba's signature, roughly: an array's dtype, number
-    of dimensions and writability, a tuple's members' kinds, else the type."""
-    if isinstance(a, np.ndarray):
-        return a.dtype, a.ndim, a.flags.writeable
-    if isinstance(a, tuple):
-        return tuple(_kind(x) for x in a)
-    return type(a)
-
-
-def _wide(kernel, dtype_arg: int, lanes: int = 0):
-    """Call ``kernel`` so that a signature it meets for the first time (by the :func:`_kind` of
-    its first argument, the data, and the dtype of positional argument ``dtype_arg``, float
-    data) is compiled with 512-bit vectors (:func:`wide_vectors` around such first calls, which
-    compile or load from numba's cache); later calls go straight to the kernel. ``lanes``: a
-    fixed width instead (8: a kernel whose arithmetic is float64 whatever its data)."""
-    if not WIDE_VECTORS:
-        return kernel
-    seen: set = set()
-
-    @functools.wraps(kernel.py_func)
-    def call(*args):
-        dt = args[dtype_arg].dtype
-        key = (_kind(args[0]), dt)
-        if key in seen:
-            return kernel(*args)
-        if dt not in (np.float32, np.float64):
-            seen.add(key)
-            return kernel(*args)
-        with wide_vectors(lanes or 64 // dt.itemsize):
-            try:
-                return kernel(*args)
-            finally:
-                seen.add(key)
-
-    call.dispatcher = kernel  # the numba dispatcher itself (signatures, inspection)
-    return call
 
 
 #: parallel tasks of a pass: blocks are dealt out in this many contiguous runs (enough to keep
@@ -2035,49 +1915,20 @@ def _compose_block_overload(o, A, D, S, c, lo, hi, variant):
     return impl
 
 
-def _compose_a(o, A, D, S, c, lo, hi, base, has_a):  # pragma: no cover - overloaded below
+def _compose_any(o, A, D, S, c, lo, hi, v):  # pragma: no cover - overloaded below
     raise NotImplementedError
 
 
-@overload(_compose_a, prefer_literal=True, jit_options=_LEAF)
-def _compose_a_overload(o, A, D, S, c, lo, hi, base, has_a):
-    """The compose loop for the D and S layout ``base`` (a literal), with or without A."""
-    if not isinstance(base, types.IntegerLiteral):
-        raise TypingError("_compose_a needs a literal base variant")
-    without, with_a = base.literal_value, base.literal_value | 1
-
-    def impl(o, A, D, S, c, lo, hi, base, has_a):
-        if has_a:
-            _compose_block(o, A, D, S, c, lo, hi, with_a)
-        else:
-            _compose_block(o, A, D, S, c, lo, hi, without)
-
-    return impl
-
-
-@nb.njit(**_LEAF)
-def _compose_any(o, A, D, S, c, lo, hi, v):
-    """Call the compose loop compiled for variant ``v`` (see :func:`_compose_block`): D and S
-    each absent, RGB or grey, A present or not."""
-    a, ds = v & 1, v & ~1
-    if ds == 0:
-        _compose_a(o, A, D, S, c, lo, hi, 0, a)
-    elif ds == 2:  # D
-        _compose_a(o, A, D, S, c, lo, hi, 2, a)
-    elif ds == 4:  # S
-        _compose_a(o, A, D, S, c, lo, hi, 4, a)
-    elif ds == 6:  # D, S
-        _compose_a(o, A, D, S, c, lo, hi, 6, a)
-    elif ds == 2 | 8:  # D grey
-        _compose_a(o, A, D, S, c, lo, hi, 2 | 8, a)
-    elif ds == 6 | 8:  # D grey, S
-        _compose_a(o, A, D, S, c, lo, hi, 6 | 8, a)
-    elif ds == 4 | 16:  # S grey
-        _compose_a(o, A, D, S, c, lo, hi, 4 | 16, a)
-    elif ds == 6 | 16:  # D, S grey
-        _compose_a(o, A, D, S, c, lo, hi, 6 | 16, a)
-    else:  # D grey, S grey
-        _compose_a(o, A, D, S, c, lo, hi, 6 | 8 | 16, a)
+@overload(_compose_any, jit_options=dict(_LEAF, cache=False))  # (cached with its callers)
+def _compose_any_overload(o, A, D, S, c, lo, hi, v):
+    """Call the compose loop compiled for the run-time variant ``v`` (see
+    :func:`_compose_block`: D and S each absent, RGB or grey, A present or not): one test and
+    one literal call per entry of :data:`~explorer.shading.codegen.COMPOSE_VARIANTS`
+    (:func:`~explorer.shading.codegen.dispatch_source`)."""
+    params = "o, A, D, S, c, lo, hi, v"
+    space = {"_compose_block": _compose_block}
+    exec(dispatch_source("impl", params, "_compose_block", COMPOSE_VARIANTS), space)  # noqa: S102
+    return space["impl"]
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -2137,13 +1988,13 @@ def _add(p, q, o):
         o[i] = p[i] + q[i]
 
 
-# the entry points, each compiled with wide float32 vectors where the CPU has them (see _wide);
-# the number is the argument whose dtype picks the precision
-prepare = _wide(prepare, 5)
-extent = _wide(extent, 0)
-bounds = _wide(bounds, 1, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
-shade = _wide(shade, 4)
-lobe = _wide(lobe, 2)
-compose = _wide(compose, 7)
-fixup = _wide(fixup, 5, lanes=8)  # (float64: it shares the float64 pass's compiled code)
-stream = _wide(stream, 2)
+# the entry points, each compiled with wide float32 vectors where the CPU has them (see
+# explorer.shading.codegen.wide); the number is the argument whose dtype picks the precision
+prepare = wide(prepare, 5)
+extent = wide(extent, 0)
+bounds = wide(bounds, 1, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
+shade = wide(shade, 4)
+lobe = wide(lobe, 2)
+compose = wide(compose, 7)
+fixup = wide(fixup, 5, lanes=8)  # (float64: it shares the float64 pass's compiled code)
+stream = wide(stream, 2)

@@ -11,6 +11,7 @@ import numpy as np
 
 from explorer.geometry.frame import check_finite, frame_from_extent, frame_of, scale_normals
 from explorer.shading import kernels as K
+from explorer.shading import layout
 
 #: light culling is kept for a mesh where one chunk of vertices in this many or more has a
 #: normal cone narrower than 90° (only such chunks can ever be skipped)
@@ -92,13 +93,13 @@ def chunk_bounds(src, k) -> np.ndarray:
     already fall short, the rest are not (on vertices in no particular order most of the
     bounds' cost)."""
     n = src.G.shape[1] + len(src.P) + len(src.P32)  # (two of them are empty)
-    b = np.empty((K.N_BOUNDS, -(-n // K.CHUNK)), np.float64)
+    b = np.empty((layout.N_BOUNDS, -(-n // K.CHUNK)), np.float64)
     K.bounds(src, k, b, CULL_SAMPLE)
-    sample = b[K.B_COS, ::CULL_SAMPLE]
+    sample = b[layout.B_COS, ::CULL_SAMPLE]
     if np.count_nonzero(sample > 0) * CULL_MIN_SHARE < sample.size:
         return readonly(b[:, :0])
     K.bounds(src, k, b, 1)
-    if np.count_nonzero(b[K.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
+    if np.count_nonzero(b[layout.B_COS] > 0) * CULL_MIN_SHARE < b.shape[1]:
         b = b[:, :0]
     return readonly(b)
 

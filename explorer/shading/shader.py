@@ -53,7 +53,7 @@ from explorer.geometry.frame import (
     scale_normals,
 )
 from explorer.shading import kernels as K
-from explorer.shading import tiers
+from explorer.shading import layout, tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
@@ -67,7 +67,7 @@ TIERS = ("compiled", "numpy")
 #: the specular models the compiled kernels implement; the others run on the numpy tier
 COMPILED_MODELS = ("blinn", "phong")
 #: chunk bounds of a pass without light culling
-_NO_BOUNDS = _readonly(np.zeros((K.N_BOUNDS, 0)))
+_NO_BOUNDS = _readonly(np.zeros((layout.N_BOUNDS, 0)))
 #: what the cached sums depend on in a scene, and the work a change of it invalidates (one of
 #: :data:`explorer.shading.effects.LEVELS`); each effect adds its own setting
 #: (:func:`invalidated`)
@@ -434,9 +434,9 @@ class Shader:
         params, flags, view = self._params_for(T)
         keep = self.keep
         opts = pass_options(scene, self._plan, flat, (do_amb, do_dif, do_spec), T)
-        opts[K.O_STORE] = keep
-        opts[K.O_STORE_LOBE] = keep and do_spec and self._keep_lobe
-        opts[K.O_CLAMP] = self.clamp
+        opts[layout.O_STORE] = keep
+        opts[layout.O_STORE_LOBE] = keep and do_spec and self._keep_lobe
+        opts[layout.O_CLAMP] = self.clamp
         empty3 = np.zeros((0, 3), T)
 
         def cache(current, do, grey=False):
@@ -454,7 +454,7 @@ class Shader:
         A = cache(self._A, do_amb)
         D = cache(self._D, True, grey) if do_dif else D
         S = cache(self._S, do_spec, grey)
-        base, ws = self._memory.lobe_rows((len(params), n if opts[K.O_STORE_LOBE] else 0), T)
+        base, ws = self._memory.lobe_rows((len(params), n if opts[layout.O_STORE_LOBE] else 0), T)
         vis = self._visibility()
         inputs = (
             K.Lights(params, flags, view),
@@ -475,7 +475,7 @@ class Shader:
             self._A, self._D = A if do_amb else self._A, D if do_dif else self._D
             if do_spec:
                 self._S, self._spec_shininess = S, scene.material.shininess
-                if opts[K.O_STORE_LOBE]:
+                if opts[layout.O_STORE_LOBE]:
                     self._base, self._ws = None if flat else base, ws
 
     def _one_shot(self, vis, inputs) -> None:
@@ -506,7 +506,7 @@ class Shader:
             return outside
         self._scaled = True  # (every normal was tested: inside NORMAL_RANGE)
         self.stats["culled"] += int(self._culled.sum())  # vertex-lights skipped
-        if opts[K.O_TRACK]:  # the ambiguous lanes again, in float64
+        if opts[layout.O_TRACK]:  # the ambiguous lanes again, in float64
             src64 = vertices(self._P, self._N, self._centre, self._scale, np.float64)
             params64, flags, view64 = self._params_for(np.float64)
             surface64 = kernel_surface(self._scene.material, self._aconst, np.float64)
@@ -638,15 +638,15 @@ def pass_options(scene: Scene, plan: Plan, flat: bool, do: tuple, dtype) -> np.n
     sidedness, model, flat lobe, the sums ``do`` = (ambient, diffuse, specular) recomputed,
     ambiguity tracking (float32) and V rows for an effect that reads V (Fresnel); storing and
     clamping are the caller's."""
-    opts = np.zeros(K.N_OPTS, np.int64)
-    opts[K.O_LOCAL] = scene.viewer.local
-    opts[K.O_TWO_SIDED] = scene.two_sided
-    opts[K.O_PHONG] = scene.model == "phong"
-    opts[K.O_FLAT] = flat
-    opts[K.O_DO_AMB], opts[K.O_DO_DIF], opts[K.O_DO_SPEC] = do
-    opts[K.O_COMPOSE] = 1
-    opts[K.O_TRACK] = dtype is np.float32
-    opts[K.O_VIEW] = any(e.needs_view(plan.effect(e.name)) for e in EFFECTS)
+    opts = np.zeros(layout.N_OPTS, np.int64)
+    opts[layout.O_LOCAL] = scene.viewer.local
+    opts[layout.O_TWO_SIDED] = scene.two_sided
+    opts[layout.O_PHONG] = scene.model == "phong"
+    opts[layout.O_FLAT] = flat
+    opts[layout.O_DO_AMB], opts[layout.O_DO_DIF], opts[layout.O_DO_SPEC] = do
+    opts[layout.O_COMPOSE] = 1
+    opts[layout.O_TRACK] = dtype is np.float32
+    opts[layout.O_VIEW] = any(e.needs_view(plan.effect(e.name)) for e in EFFECTS)
     return opts
 
 

@@ -148,9 +148,9 @@ def test_each_kernel_file_hashes_the_files_it_compiles_in():
     names = {
         m: {os.path.relpath(p, ROOT)[:-3].replace(os.sep, ".") for p in f} for m, f in files.items()
     }
-    tol, row = kernelcache.CONSTANT_MODULES
-    assert names["explorer.shading.kernels"] == {
-        "explorer.shading.kernels", "explorer.shading.vmath", tol, row}  # fmt: skip
+    tol, row, codegen, layout, slots = kernelcache.CONSTANT_MODULES
+    assert names["explorer.shading.kernels"] == {"explorer.shading.kernels",
+        "explorer.shading.vmath", tol, row, codegen, layout, slots}  # fmt: skip
     assert names["explorer.geometry.bvh"] == {"explorer.geometry.bvh", "explorer.geometry.rays",
         "explorer.geometry.traverse", "explorer.geometry.occluders", tol}  # fmt: skip
     assert names["explorer.geometry.traverse"] == {

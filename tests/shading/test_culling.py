@@ -18,6 +18,7 @@ import explorer
 from explorer.core import tolerances as tol
 from explorer.geometry import meshes as M
 from explorer.shading import kernels as K
+from explorer.shading import layout
 
 MATERIAL = {
     "ambient": [0.2, 0.1, 0.1],
@@ -64,15 +65,15 @@ def test_bounds_hold_every_vertex_of_their_chunk(name):
     sh = explorer.Shader({"material": MATERIAL}, mesh.positions, mesh.normals)
     _ = sh.colors  # the compiled tier prepares its geometry at its first pass
     G = sh._G.astype(np.float64)
-    b = np.empty((K.N_BOUNDS, -(-sh.n // K.CHUNK)))
+    b = np.empty((layout.N_BOUNDS, -(-sh.n // K.CHUNK)))
     K.bounds(sh._G, sh._k, b, 1)
     chunk = np.arange(sh.n) // K.CHUNK
-    d = np.linalg.norm(G[:3].T - b[[K.B_CX, K.B_CY, K.B_CZ]][:, chunk].T, axis=1)
-    assert np.all(d <= b[K.B_R, chunk])
-    cone = b[K.B_COS, chunk] > 0
-    cosine = np.einsum("ij,ij->j", G[3:], b[[K.B_AX, K.B_AY, K.B_AZ]][:, chunk])
-    assert np.all(cosine[cone] >= b[K.B_COS, chunk][cone])
-    assert np.all(b[K.B_COS] ** 2 + b[K.B_SIN] ** 2 >= 1 - 1e-12)  # sine never too small
+    d = np.linalg.norm(G[:3].T - b[[layout.B_CX, layout.B_CY, layout.B_CZ]][:, chunk].T, axis=1)
+    assert np.all(d <= b[layout.B_R, chunk])
+    cone = b[layout.B_COS, chunk] > 0
+    cosine = np.einsum("ij,ij->j", G[3:], b[[layout.B_AX, layout.B_AY, layout.B_AZ]][:, chunk])
+    assert np.all(cosine[cone] >= b[layout.B_COS, chunk][cone])
+    assert np.all(b[layout.B_COS] ** 2 + b[layout.B_SIN] ** 2 >= 1 - 1e-12)  # sine never too small
     assert cone.mean() > 0.5  # a smooth mesh in its own order: most cones are narrow
     assert np.array_equal(sh._bounds, b)  # the shader's, found while preparing the geometry
 
@@ -83,7 +84,7 @@ def test_bounds_can_be_sampled_every_kth_chunk():
     mesh = _mesh("sphere")
     sh = explorer.Shader({"material": MATERIAL}, mesh.positions, mesh.normals)
     _ = sh.colors
-    full = np.empty((K.N_BOUNDS, -(-sh.n // K.CHUNK)))
+    full = np.empty((layout.N_BOUNDS, -(-sh.n // K.CHUNK)))
     K.bounds(sh._G, sh._k, full, 1)
     sampled = np.full_like(full, np.nan)
     K.bounds(sh._G, sh._k, sampled, 5)
@@ -101,7 +102,7 @@ def test_shuffled_vertices_are_not_tested_at_all():
     P, N = mesh.positions[order], mesh.normals[order]
     sh = explorer.Shader({"material": MATERIAL}, P, N, precision="float32")
     _ = sh.colors
-    assert sh._bounds.shape == (K.N_BOUNDS, 0)
+    assert sh._bounds.shape == (layout.N_BOUNDS, 0)
     assert sh.stats["culled"] == 0
 
 

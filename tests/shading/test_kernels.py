@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from explorer.shading import codegen, prepared
 from explorer.shading import kernels as K
-from explorer.shading import prepared
 from explorer.shading.equation import equation_shade
 
 
@@ -41,7 +41,7 @@ def test_llvm_remarks_are_dropped_and_other_stderr_kept(capfd):
     # first compile; those lines are dropped, anything else written there is passed on
     import os
 
-    with K._quiet_llvm_remarks():
+    with codegen.quiet_llvm_remarks():
         os.write(2, b"remark: <unknown>:0:0: loop not vectorized: call instruction\n")
         os.write(2, b"a real warning\n")
     assert capfd.readouterr().err == "a real warning\n"
@@ -55,8 +55,8 @@ def test_wide_vectors_can_be_switched_off():
     import sys
 
     code = (
-        "from explorer.shading import kernels as K; import numba; "
-        "assert not K.WIDE_VECTORS; "
+        "from explorer.shading import codegen, kernels as K; import numba; "
+        "assert not codegen.WIDE_VECTORS; "
         "assert isinstance(K.shade, numba.core.registry.CPUDispatcher); print('ok')"
     )
     env = dict(os.environ, PHONG_EXPLORER_WIDE_VECTORS="0")
@@ -65,7 +65,7 @@ def test_wide_vectors_can_be_switched_off():
 
 
 def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
-    # _wide compiles a call inside wide_vectors() the first time it meets a kind of data (the
+    # codegen.wide compiles a call inside wide_vectors() the first time it meets a kind of data (the
     # first argument's dtype, dimensions, writability; a record's members) with a float dtype:
     # G (6, n) and a kernels.Source are separate signatures, and a Source of the prepared rows
     # or of float32 or float64 vertices is one (per precision)
@@ -85,9 +85,9 @@ def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
         def __call__(self, *args):
             return None
 
-    monkeypatch.setattr(K, "WIDE_VECTORS", True)
-    monkeypatch.setattr(K, "wide_vectors", wide)
-    call = K._wide(Kernel(), 1)
+    monkeypatch.setattr(codegen, "WIDE_VECTORS", True)
+    monkeypatch.setattr(codegen, "wide_vectors", wide)
+    call = codegen.wide(Kernel(), 1)
     f32, f64 = K.constants(np.float32), K.constants(np.float64)
     G32, P32, P64 = np.zeros((6, 4), np.float32), np.zeros((4, 3), np.float32), np.zeros((4, 3))
     R32 = prepared.rows(G32)

@@ -12,7 +12,7 @@ import explorer
 from explorer.core.errors import ExplorerError
 from explorer.geometry import meshes as M
 from explorer.shading import kernels as K
-from explorer.shading import prepared
+from explorer.shading import layout, prepared
 from explorer.shading.equation import equation_shade
 
 pytestmark = pytest.mark.filterwarnings("ignore::numba.NumbaPerformanceWarning")
@@ -76,13 +76,13 @@ def test_chunk_bounds_of_vertices_are_those_of_the_prepared_geometry(precision, 
     s = explorer.Shader(SCENE, P, N, precision=precision, tier="compiled")
     _ = s.colors
     src = prepared.vertices(P, N, s._centre, s._scale, s._k.dtype)
-    want = np.full((K.N_BOUNDS, -(-len(P) // K.CHUNK)), np.nan)
+    want = np.full((layout.N_BOUNDS, -(-len(P) // K.CHUNK)), np.nan)
     got = want.copy()
     K.bounds(prepared.rows(s._G), s._k, want, step)
     K.bounds(src, s._k, got, step)
     np.testing.assert_array_equal(got, want)
     assert np.isnan(got[:, 1]).all() == (step > 1) and not np.isnan(got[:, ::step]).any()
-    assert got[K.B_COS, 0] == -1.0
+    assert got[layout.B_COS, 0] == -1.0
 
 
 def test_float32_lanes_redone_in_a_one_shot_pass():

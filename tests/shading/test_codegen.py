@@ -1,0 +1,106 @@
+"""How the kernels are generated: the layouts declared once, the variant tables and the
+dispatch written from them, and what compiling a light loop asks of numba."""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+import pytest
+
+from explorer.core import lightrow
+from explorer.core.slots import Slots
+from explorer.shading import codegen, layout
+from explorer.shading import kernels as K
+
+
+def test_slots_take_the_next_offset_by_width():
+    s = Slots()
+    assert (s.slot(), s.slot(3), s.slot()) == (0, 1, 4)
+    assert s.count == 5
+    with pytest.raises(ValueError, match="at least 1 wide"):
+        s.slot(0)
+    v = Slots()
+    assert (v.value(0.5), v.value(2.0)) == (0, 1)
+    assert v.values == [0.5, 2.0] and v.count == 2
+    s.values.clear()
+    with pytest.raises(ValueError, match="every slot"):
+        s.value(1.0)  # a layout with slots of no value cannot take one
+
+
+def _names(module, prefix):
+    return {n: getattr(module, n) for n in vars(module) if n.startswith(prefix)}
+
+
+@pytest.mark.parametrize(
+    ("module", "prefix", "count"),
+    [
+        (layout, "O_", "N_OPTS"),
+        (layout, "R_", "N_ROWS"),
+        (layout, "K_", "N_CONSTS"),
+        (layout, "B_", "N_BOUNDS"),
+    ],
+)
+def test_each_layout_is_one_run_of_distinct_slots(module, prefix, count):
+    slots = _names(module, prefix)
+    assert sorted(slots.values()) == list(range(getattr(module, count)))
+
+
+def test_the_constants_are_the_layouts_values_in_slot_order():
+    k = K.constants(np.float64)
+    assert len(k) == layout.N_CONSTS
+    assert k[layout.K_ONE] == 1.0 and k[layout.K_INF] == np.inf
+
+
+def test_a_light_row_s_columns_tile_it():
+    # each column's width is what lies up to the next one; together they fill N_PARAMS
+    cols = sorted(_names(lightrow, "P_").values())
+    assert cols[0] == 0 and cols[-1] < lightrow.N_PARAMS
+    assert lightrow.P_POS + 3 == lightrow.P_AXIS and lightrow.P_F0 + 1 == lightrow.N_PARAMS
+
+
+def test_the_dispatch_calls_the_variant_its_code_names():
+    calls = []
+    src = codegen.dispatch_source("run", "a, b, code", "variant", (3, 7))
+    space = {"variant": lambda *args: calls.append(args)}
+    exec(src, space)  # noqa: S102 - the source under test
+    space["run"]("x", "y", 7)
+    space["run"]("x", "y", 3)
+    space["run"]("x", "y", 5)  # no such variant: nothing runs
+    assert calls == [("x", "y", 7), ("x", "y", 3)]
+
+
+def test_every_light_loop_code_names_its_loop_once():
+    loops = [codegen.loop_of(c) for c in codegen.LIGHT_LOOPS]
+    assert len(set(codegen.LIGHT_LOOPS)) == len(loops) == 18
+    assert all(
+        codegen.valid(lp) and codegen.loop_code(lp) == c
+        for lp, c in zip(loops, codegen.LIGHT_LOOPS, strict=True)
+    )
+    assert len(set(codegen.COMPOSE_VARIANTS)) == 18
+
+
+def test_a_light_loop_is_compiled_without_numba_inlining_its_rows(monkeypatch):
+    # numba's IR inliner copies and types the callee again at each call (the cold compile's
+    # largest Python cost): a light loop takes its ~20 scratch rows through intrinsics, and
+    # inlines only its sums (_add_light) and its power (pow32, log2_32, exp2_32: numba types
+    # the power's overload twice, so its chain comes twice)
+    from numba.core import inline_closurecall
+
+    inlined = []
+    real = inline_closurecall.InlineWorker.inline_ir
+
+    def counting(self, caller_ir, block, i, callee_ir, *args, **kw):
+        inlined.append(callee_ir.func_id.func_qualname)
+        return real(self, caller_ir, block, i, callee_ir, *args, **kw)
+
+    monkeypatch.setattr(inline_closurecall.InlineWorker, "inline_ir", counting)
+    code = codegen.loop_code(codegen.Loop(codegen.SRC_ROWS, codegen.LOBE_PHONG, False))
+
+    @nb.njit(cache=False, _nrt=False)
+    def one_loop(scr, m, q, y, k):
+        K._light(scr, m, q, y, k, True, True, code)
+
+    T = np.float32
+    one_loop(np.zeros((layout.N_ROWS + 1) * K.ROW, T), 3, np.zeros(24, T), T(3), K.constants(T))
+    assert "_row" not in inlined and "_row_checked" not in inlined
+    assert len(inlined) <= 12, inlined
