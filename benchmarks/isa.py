@@ -159,8 +159,8 @@ def write_results() -> None:
 
 def side_by_side(figures: dict[str, list[list]]) -> str:
     """A table of each recorded case: per ISA the median over its processes, and (avx2 beside
-    native) how many times slower AVX2 is (time over time, rate over rate; a ratio: avx2's over
-    native's)."""
+    native) AVX2's time over native's (> 1: AVX2 is slower; a rate: native's over AVX2's; a
+    ratio such as "recolour / floor": AVX2's over native's)."""
     order = list(figures)
     runs = {isa: len(v) for isa, v in figures.items()}
     cases: dict[str, str] = {}
@@ -172,7 +172,7 @@ def side_by_side(figures: dict[str, list[list]]) -> str:
                 values.setdefault((case, isa), []).append(value)
     both = "native" in figures and "avx2" in figures
     head = " | ".join(f"{isa} ({runs[isa]} processes)" for isa in order)
-    lines = [f"| case | unit | {head} |" + (" avx2 vs native |" if both else "")]
+    lines = [f"| case | unit | {head} |" + (" avx2 / native (time) |" if both else "")]
     lines.append("|---|---|" + "---:|" * (len(order) + both))
     for case, unit in cases.items():
         med = {isa: statistics.median(values.get((case, isa), [float("nan")])) for isa in order}
@@ -181,13 +181,13 @@ def side_by_side(figures: dict[str, list[list]]) -> str:
         if both:
             a, n = med["avx2"], med["native"]
             if unit.endswith("/s"):  # a rate: larger is faster
-                line += f" {n / a:.2f}x slower |" if a else " |"
+                line += f" {n / a:.2f}x |" if a else " |"
             elif unit == "x":
                 line += f" {a / n:.2f}x |" if n else " |"
             elif not unit:  # (a figure that is no speed: the load)
                 line += " |"
             else:  # a time (ms, ns per ray): smaller is faster
-                line += f" {a / n:.2f}x slower |" if n else " |"
+                line += f" {a / n:.2f}x |" if n else " |"
         lines.append(line)
     return "\n".join(lines)
 
