@@ -145,7 +145,37 @@ def split_lobe():
     return nb.njit(**OPTS)(f), lambda: (scr, K.BLOCK, 12.8)
 
 
-def spot_light(dtype):
+def spot_part(dtype, part: str):
+    """A piece of :func:`spot_light` (``part``: "to_light", the pre-pass of L, d and w;
+    "pre-passes", that and ``_spot``; "loop", the rows light loop), on the rows a spot light's
+    pre-passes leave. (``_spot`` alone, repeated, would multiply the weights by the cone's
+    factor again and again, down to subnormal numbers: slow for another reason.)"""
+    code = K.loop_code(K.Loop(K.SRC_ROWS, K.LOBE_BLINN, False))
+
+    def to_light(scr, m, q, y, k, on):
+        K._to_light(scr, m, q, k, on)
+
+    def pre_passes(scr, m, q, y, k, on):
+        K._to_light(scr, m, q, k, on)
+        K._spot(scr, m, q, k, on)
+
+    def loop(scr, m, q, y, k, on):
+        K._light(scr, m, q, y, k, False, True, code)
+
+    whole, args_of = spot_light(dtype)
+    done = []
+
+    def prepared():  # (called inside wide_vectors: the pieces compile at the kernels' width)
+        if not done:
+            whole(*args_of())
+            done.append(True)
+        return args_of()
+
+    fns = {"to_light": to_light, "pre-passes": pre_passes, "loop": loop}
+    return nb.njit(**OPTS)(fns[part]), prepared
+
+
+def spot_light(dtype, flags_fixed: bool = False):
     """A spot light's row path: the pre-passes (``kernels._to_light``: L, d, w;
     ``kernels._spot``: the cone and its exponent; their flags at run time, as ``_light_run``
     passes them) and the row-source Blinn light loop."""
@@ -156,12 +186,18 @@ def spot_light(dtype):
         K._spot(scr, m, q, k, on)
         K._light(scr, m, q, y, k, False, True, code)
 
+    def fixed(scr, m, q, y, k, on):  # the flags as constants (the fix's item 2, docs/speed.md)
+        K._to_light(scr, m, q, k, True)
+        K._spot(scr, m, q, k, True)
+        K._light(scr, m, q, y, k, False, True, code)
+
     scr, q = scratch(dtype), light_params(dtype)
     q[K.P_AXIS : K.P_AXIS + 3] = -q[K.P_POS : K.P_POS + 3] / np.linalg.norm(
         q[K.P_POS : K.P_POS + 3]
     )
     q[K.P_COS], q[K.P_EXP] = np.cos(np.radians(40.0)), 8.0
-    return nb.njit(**OPTS)(f), lambda: (scr, K.BLOCK, q, dtype(25.6), K.constants(dtype), True)
+    fn = nb.njit(**OPTS)(fixed if flags_fixed else f)
+    return fn, lambda: (scr, K.BLOCK, q, dtype(25.6), K.constants(dtype), True)
 
 
 def compose_loop(dtype, variant):
@@ -214,6 +250,10 @@ def loops() -> dict:
         "lights float64 (inline point, Blinn, grey; base² rows)": (8, light_loop(f64, blinn)),
         "lights float64: the split lobe (as a light loop calls it)": (8, split_lobe()),
         "lights float32 rows (spot pre-pass + light loop, Blinn)": (16, spot_light(f32)),
+        "lights float32 rows, spot flags constant": (16, spot_light(f32, flags_fixed=True)),
+        "lights float32 rows: _to_light alone": (16, spot_part(f32, "to_light")),
+        "lights float32 rows: _to_light and _spot": (16, spot_part(f32, "pre-passes")),
+        "lights float32 rows: the rows light loop alone": (16, spot_part(f32, "loop")),
         "lobe float32 (_lobe_task, a shininess change)": (16, fresh(K._lobe_task, lobe_args)),
         "recompose float32 (grey D and S)": (16, compose_loop(f32, 2 | 4 | 8 | 16)),
         "prepare float32 (_prepare_blocks)": (16, fresh(K._prepare_blocks, prep(f32))),
