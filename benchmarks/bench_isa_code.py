@@ -46,7 +46,8 @@ import tempfile
 import time
 from pathlib import Path
 
-os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="isa-code-")  # nothing from a cache
+if __name__ == "__main__":  # (run, not imported: numba reads this when it is imported)
+    os.environ["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(prefix="isa-code-")  # nothing from a cache
 os.environ.setdefault("PHONG_EXPLORER_KERNELS", "compiled")
 
 import isa  # noqa: E402 - benchmarks/isa.py

@@ -181,3 +181,37 @@ def test_the_arguments():
     with pytest.raises(SystemExit):
         ap.parse_args(["--isa", "avx512"])
     assert textwrap.dedent(isa.__doc__).startswith("``--isa native|avx2|both``")
+
+
+ASM = """_ZN8__main__1fB2v1:
+\tvaddps\t%ymm1, %ymm2, %ymm3
+\tvfmadd213ss\t%xmm1, %xmm2, %xmm3
+\tvsqrtpd\t%ymm0, %ymm0
+\tjne\t.LBB0_1
+_ZN7cpython8__main__1fB2v1:
+\tvaddps\t%zmm1, %zmm2, %zmm3
+\tcallq\t*%rax
+"""
+IR = """define i32 @_ZN8__main__1fB2v1(ptr %a) {
+  %x = fmul fast <8 x float> %a, %b
+  %y = fadd fast <8 x float> %x, %b
+  %z = fadd fast <4 x double> %c, %d
+  %p = call double @pow(double %u, double %v)
+  %e = call i32 @numba_gil_ensure()
+}
+define i32 @_ZN7cpython8__main__1fB2v1(ptr %a) {
+  %w = fmul fast <16 x float> %a, %b
+}
+"""
+
+
+def test_the_loop_counts_read_the_compiled_functions_only():
+    """bench_isa_code.py counts the instructions of the compiled functions, not of numba's
+    Python wrappers (``cpython.*``), and names the IR's main vector type and its libm calls."""
+    import bench_isa_code as C
+
+    s = C.stats(ASM, IR)
+    assert (s["zmm"], s["ymm"]) == (0, 5)  # the wrapper's zmm is not counted
+    assert (s["packed fp"], s["scalar fp"], s["sqrt"], s["branches"]) == (1, 1, 1, 1)
+    assert s["IR vectors"] == "<8 x float>"  # the most frequent, not the wrapper's widest
+    assert s["IR calls"] == "pow"  # libm, not numba's own helpers
