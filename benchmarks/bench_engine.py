@@ -3,6 +3,7 @@
     python benchmarks/bench_engine.py                # 1M vertices, 8 point lights
     python benchmarks/bench_engine.py --vertices 200000 --lights 4 --repeat 15
     python benchmarks/bench_engine.py --flows        # the one-shot pass against slabs
+    python benchmarks/bench_engine.py --isa both --alternate 3 --cpu   # AVX2 beside AVX-512
 
 The full-shading rows run on random points (every vertex-light computed: the kernel's raw
 rate; float32 vertices, and in float64 also float64 ones: the pass reads the same prepared
@@ -37,6 +38,14 @@ of this script at 97356cc and at k13 (the float64 lobe from base², see
 (float32 row in the same runs: 11.21 / 10.43, 10.14 / 10.97, 9.54 / 9.56, 8.70 / 8.87.)
 
 Timings are wall-clock and vary with machine load: the load average is printed with the table.
+``--cpu`` runs on one numba thread and times the process's CPU seconds instead (the work,
+whatever else the machine runs; ``benchmarks/bench_revisions.py --cpu`` does the same).
+
+``--isa native|avx2|both`` measures in child processes compiled for the host's ISA, for AVX2
+(a Zen 3 target on any x86-64 host with AVX2, its numba cache kept in ``--cache-dir``) or for
+both, ``--alternate N`` processes each taking turns, and ends with the figures side by side
+(``benchmarks/isa.py``); the machine line names the ISA each child measured and what numba
+compiled for it.
 """
 
 from __future__ import annotations
@@ -48,9 +57,11 @@ import statistics
 import sys
 import time
 
+import common  # benchmarks/common.py
+import isa  # benchmarks/isa.py
 import numba
 import numpy as np
-from common import cpu_name, load_average, timed, uv_sphere  # benchmarks/common.py
+from common import cpu_name, load_average, timed, uv_sphere
 
 import explorer
 from explorer.core.lights import PointLight, SpotLight
@@ -67,7 +78,7 @@ def machine() -> str:
     return (
         f"{cpu_name()}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
-        f"vectors: {WIDTH[codegen.WIDE_VECTORS]}; "
+        f"vectors: {WIDTH[codegen.WIDE_VECTORS]}; {isa.isa_line()}; "
         f"load average {load_average():.2f}"
     )
 
@@ -119,6 +130,12 @@ def one_shot_geometry(scene, P, N, precision: str) -> None:
     sh._compiled_geometry()  # (the frame: found by the constructor when kernels serve)
     src = prepared.vertices(sh._P, sh._N, sh._centre, sh._scale, sh._k.dtype)
     prepared.chunk_bounds(src, sh._k)
+
+
+def kept_geometry(P, N, precision: str) -> None:
+    """What a kept ``Shader`` does to its geometry once (:func:`prepared.prepared_geometry`):
+    the frame, the prepared copy G (``kernels.prepare``) and the chunk bounds."""
+    prepared.prepared_geometry(P, N, np.dtype(precision), K.constants(np.dtype(precision)))
 
 
 def one_shot_flows(scene, P, N, R: int) -> int:
@@ -182,9 +199,11 @@ def _flows(scene, P, N, precision: str) -> dict:
     return {"vertices": vertices, "slabs": slabs}
 
 
-def in_turns(fns: dict, R: int, clock=time.perf_counter) -> dict:
-    """(median, best) seconds of each of ``fns`` (name -> function) by ``clock``, timed in
-    turns: one call of each per round, ``R`` rounds after a warm-up round."""
+def in_turns(fns: dict, R: int, clock=None) -> dict:
+    """(median, best) seconds of each of ``fns`` (name -> function) by ``clock`` (default
+    :data:`common.clock`), timed in turns: one call of each per round, ``R`` rounds after a
+    warm-up round."""
+    clock = clock or common.clock
     for fn in fns.values():
         fn()
     ts: dict = {name: [] for name in fns}
@@ -206,7 +225,18 @@ def main(argv=None) -> int:
         action="store_true",
         help="only the one-shot pass over the vertices against slabs prepared first",
     )
+    ap.add_argument(
+        "--cpu",
+        action="store_true",
+        help="one numba thread, timed by the process's CPU seconds (not the wall clock)",
+    )
+    isa.add_arguments(ap)
     args = ap.parse_args(argv)
+    if args.isa and not isa.in_child():
+        return isa.run(__file__, sys.argv[1:] if argv is None else list(argv), args)
+    if args.cpu:  # the work of one thread, whatever else the machine runs
+        numba.set_num_threads(1)
+        common.clock = time.process_time
     n, L, R = args.vertices, args.lights, args.repeat
     rng = np.random.default_rng(0)
     P, N = sphere_points(n, rng)  # float32, as GPU-bound meshes (glTF, PLY) mostly come
@@ -314,12 +344,19 @@ def main(argv=None) -> int:
             "add": lambda: np.add(P, N, out=out),
             "float32": lambda: one_shot_geometry(scene, P, N, "float32"),
             "float64": lambda: one_shot_geometry(scene, P, N, "float64"),
+            "kept float32": lambda: kept_geometry(P, N, "float32"),
+            "kept float64": lambda: kept_geometry(P, N, "float64"),
         },
         R,
     )
     geometry = {p: turns[p] for p in ("float32", "float64")}
     for precision, (med, best) in geometry.items():
         row(f"geometry preparation, {precision} (of a one-shot call, before its pass)", med, best)
+    for precision in ("float32", "float64"):
+        row(
+            f"geometry preparation, {precision} (a kept shader's: frame, prepare, chunk bounds)",
+            *turns[f"kept {precision}"],
+        )
     for precision in ("float32", "float64"):
         # (bests: the first rows' medians carry the VM's warm-up, by 10-50 %)
         extra = one_shot[precision][1] - full[precision][1]
@@ -371,13 +408,20 @@ def main(argv=None) -> int:
         n * L,
     )
 
+    clock = "CPU seconds of one numba thread" if args.cpu else "wall clock"
     print(f"machine: {machine()}")
-    print(f"mesh: {n} vertices, {L} point lights; median and best of {R} runs\n")
+    print(f"mesh: {n} vertices, {L} point lights; median and best of {R} runs; {clock}\n")
     print("| case | median ms | best ms | G vertex-lights/s | note |")
     print("|---|---:|---:|---:|---|")
     for name, med, best, rate, note in rows:
         print(f"| {name} | {med:.2f} | {best:.2f} | {rate} | {note} |")
+        isa.record(name, med)
     print()
+    isa.record("recolour / bandwidth floor", recol[0] / floor[0], "x")
+    for precision, (med, _) in geometry.items():
+        isa.record(f"geometry preparation {precision} / bandwidth floor", med / floor[0], "x")
+    isa.record("load average at the end", load_average(), "")
+    isa.write_results()
     print(
         f"recolour / bandwidth floor: {recol[0] / floor[0]:.2f}x (median), "
         f"{recol[1] / floor[1]:.2f}x (best)"

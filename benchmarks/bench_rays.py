@@ -2,6 +2,7 @@
 shadow update and the window's difference view.
 
     python benchmarks/bench_rays.py [--repeat N] [--section shadows scaling engine view numpy]
+    python benchmarks/bench_rays.py --isa both --section shadows scaling   # AVX2 beside native
 
 Sections (all by default):
 
@@ -40,6 +41,11 @@ Every figure is wall-clock: median and best of ``--repeat`` runs after a warm-up
 and its load average are printed with the tables. Compare rows of one run. One line gives the
 BVH cast's CPU time per ray instead (every thread's, over ``--repeat`` casts): on a VM whose
 other jobs hold a core, it says what two idle cores would do.
+
+``--isa native|avx2|both`` (``--alternate N``, ``--cache-dir``) runs the sections in child
+processes compiled for the host's ISA, for AVX2 or for both, and ends with the rays' figures side
+by side (``benchmarks/isa.py``; Embree picks its own code path at run time, so its figures in
+the avx2 child are its native ones: the yardstick on this machine).
 """
 
 from __future__ import annotations
@@ -52,8 +58,9 @@ import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+import isa  # benchmarks/isa.py
 import numpy as np
-from common import cpu_name, load_average, timed  # benchmarks/common.py
+from common import cpu_name, load_average, timed
 
 from explorer.core.scene import load_scene
 from explorer.geometry.meshes import get_mesh
@@ -78,7 +85,7 @@ def machine() -> str:
     embree = "embreex " + _version("embreex") if _has("embreex") else "embreex not installed"
     return (
         f"{cpu_name()}; {os.cpu_count()} cores, {threads}; Python {platform.python_version()}, "
-        f"numpy {np.__version__}, numba {numba.__version__}; {embree}; "
+        f"numpy {np.__version__}, numba {numba.__version__}; {embree}; {isa.isa_line()}; "
         f"load average {load_average():.2f}"
     )
 
@@ -148,6 +155,22 @@ def measure_rays(mesh, repeat: int, light=LIGHT, embree: bool = True,
     if embree and _has("embreex"):
         row.update(embree_rays(O, D, tmax, tri, hit, repeat))
     return row
+
+
+def record_rays(mesh: str, r: dict) -> None:
+    """Keep the rays' figures of :func:`measure_rays` for ``--isa``'s side-by-side table."""
+    names = {
+        "bvh": "BVH as the engine casts (refit + rays)",
+        "alone": "BVH, rays alone",
+        "full": "BVH, full tree",
+        "brute": "brute force",
+        "embree": "embreex occlusion",
+    }
+    for key, what in names.items():
+        if key in r:
+            isa.record(f"{mesh}: {what}", r[key] / 1e6, "M rays/s")
+    isa.record(f"{mesh}: BVH CPU per ray", r["cpu_ns"], "ns")
+    isa.record(f"{mesh}: BVH build", r["build_s"], "s")
 
 
 def embree_rays(O, D, tmax, tri, hit, repeat: int) -> dict:
@@ -262,6 +285,7 @@ def section_shadows(repeat: int) -> None:
     )
     same_full = f"; with the full tree: {r['same_full']}" if "same_full" in r else ""
     print(f"\nBVH answers equal the brute force's on its sample: {r['same']}{same_full}")
+    record_rays("teapot", r)
 
 
 def section_scaling(repeat: int) -> None:
@@ -274,6 +298,7 @@ def section_scaling(repeat: int) -> None:
     for res in (32, 100, 316, 1000):
         r = measure_rays(get_mesh("torus", res), repeat, light=(2.5, 0.6, 0.5), embree=False)
         full = f"{r['full'] / 1e6:.2f}" if "full" in r else "-"
+        record_rays(f"torus {r['triangles']:,} triangles", r)
         print(f"| {r['triangles']:,} | {r['rays']:,} | {r['build_s']:.3f} | {r['bvh'] / 1e6:.2f} | "
               f"{full} | {r['brute'] / 1e6:.4f} | {r['bvh'] / r['brute']:,.0f}x | "
               f"{r['shadowed']:.1%} | {r['same'] and r.get('same_full', True)} |")  # fmt: skip
@@ -313,6 +338,7 @@ def section_engine(repeat: int) -> None:
         work = " (BVH build, every light's rays)" if shadows else ""
         print(f"| first colours, {what}{work} | {first * 1e3:.1f} | |")
         print(f"| one light moved, {what} | {med * 1e3:.1f} | {best * 1e3:.1f} |")
+        isa.record(f"engine, teapot: one light moved, {what}", med * 1e3)
         if shadows:
             before = sh.stats["shadow_rays"]
             move()
@@ -338,6 +364,7 @@ def section_view(repeat: int) -> None:
     def row(what, f):
         med, best = timed(f, repeat)
         print(f"| {what} | {med * 1e3:.0f} | {best * 1e3:.0f} |")
+        isa.record(f"difference view: {what}", med * 1e3)
         sys.stdout.flush()
 
     with C.ViewComparer(size) as v:
@@ -434,12 +461,17 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--repeat", type=int, default=7, help="timed runs per figure (default 7)")
     p.add_argument("--section", nargs="+", choices=SECTIONS, default=list(SECTIONS))
+    isa.add_arguments(p)
     args = p.parse_args(argv)
+    if args.isa and not isa.in_child():
+        return isa.run(__file__, sys.argv[1:] if argv is None else list(argv), args)
     print("machine:", machine())
     for name in args.section:
         globals()[f"section_{name}"](args.repeat)
         sys.stdout.flush()
     print("\nload average after:", f"{load_average():.2f}")
+    isa.record("load average at the end", load_average(), "")
+    isa.write_results()
     return 0
 
 
