@@ -19,6 +19,24 @@ flattened with their transforms. Normals stored in the file are kept; where a fi
 vertices at the same position are welded and given smooth area-weighted normals.
 
 Every array of a :class:`Mesh` is read-only.
+
+Texture coordinates (``Mesh.uv``, (n, 2), None for a mesh without them): an OBJ's ``vt``; a
+built-in mesh asked for them (``get_mesh(name, uv=True)``) gets its own parametrisation, with
+the vertices on a seam split so each side keeps its (u, v) (same position and normal, so the
+same colours):
+
+=============  ================================================================================
+name           (u, v)
+=============  ================================================================================
+``sphere``     longitude / 2π from the +z meridian eastward, latitude from the south pole (0)
+               to the north (1); the seam at u = 0 | 1 split, a pole takes its triangle's u
+``icosphere``  the same spherical mapping
+``torus``      around the ring / 2π, around the tube / 2π; both seams split
+``cube``       each face the whole [0, 1]² square
+``plane``      ((x + 1) / 2, (y + 1) / 2)
+``teapot``     each Bézier patch its own (u, v) in [0, 1]², as ``glMap2``/``glutSolidTeapot``
+               give them; vertices welded across patches split again by (u, v)
+=============  ================================================================================
 """
 
 from __future__ import annotations
@@ -73,6 +91,8 @@ class Mesh:
     faces : (m, 3) int64 indices into positions, counter-clockwise seen from outside
     name : the built-in name or the file name
     groups : the file's material groups (an OBJ's ``usemtl``), or None
+    uv : (n, 2) float64 texture coordinates (an OBJ's ``vt``, a built-in's own), or None: the
+        mesh has none and cannot wear a texture
     """
 
     positions: np.ndarray
@@ -80,6 +100,7 @@ class Mesh:
     faces: np.ndarray
     name: str = "mesh"
     groups: MaterialGroups | None = None
+    uv: np.ndarray | None = None
 
     def __post_init__(self):
         # the engine's checks (shapes, real finite numbers, index ranges), then read-only
@@ -97,6 +118,14 @@ class Mesh:
         object.__setattr__(self, "positions", _frozen(p, np.float64))
         object.__setattr__(self, "normals", _frozen(n, np.float64))
         object.__setattr__(self, "faces", _frozen(f, np.int64))
+        if self.uv is not None:
+            uv = np.asarray(self.uv)
+            if uv.shape != (len(p), 2) or not np.isfinite(uv).all():
+                raise ExplorerError(
+                    f"mesh '{self.name}': uv must be ({len(p)}, 2) finite texture coordinates, "
+                    f"got shape {uv.shape}"
+                )
+            object.__setattr__(self, "uv", _frozen(uv, np.float64))
 
     @property
     def n_vertices(self) -> int:
@@ -163,7 +192,7 @@ class MaterialGroups:
 
 
 def _frozen(a: np.ndarray, dtype) -> np.ndarray:
-    """A read-only C-contiguous copy of a checked (n, 3) array."""
+    """A read-only C-contiguous copy of a checked (n, 3) (or (n, 2)) array."""
     arr = np.array(a, dtype=dtype, copy=True, order="C")
     arr.flags.writeable = False
     return arr
@@ -216,10 +245,13 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     return _unit_rows(acc)
 
 
-def _weld(positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False):
+def _weld(
+    positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False, kept=None
+):
     """Merge vertices at the same position (and the same key); average their normals; drop
     triangles that become degenerate. keys : (n,) int group of each vertex or None.
-    sources : also return (k,) the index of a source vertex of each new vertex."""
+    sources : also return (k,) the index of a source vertex of each new vertex.
+    kept : a list that receives the (m,) bool mask of the triangles kept."""
     q = np.round(positions, decimals)
     q[q == 0] = 0.0  # -0.0 and 0.0 are the same place
     table = q if keys is None else np.column_stack([q, keys])
@@ -236,9 +268,64 @@ def _weld(positions, normals, faces, keys=None, decimals: int = 9, *, sources: b
     keep = (
         (new_f[:, 0] != new_f[:, 1]) & (new_f[:, 1] != new_f[:, 2]) & (new_f[:, 0] != new_f[:, 2])
     )
+    if kept is not None:
+        kept.append(keep)
     if sources:
         return new_p, _unit_rows(acc), new_f[keep], first[order]
     return new_p, _unit_rows(acc), new_f[keep]
+
+
+def split_by_uv(faces, corner_uv, decimals: int = 12):
+    """Vertices split where the triangles meeting there give them different (u, v).
+
+    faces : (m, 3) int; corner_uv : (m, 3, 2) the (u, v) of each triangle's corners
+    Returns ``(source, faces, uv)``: (k,) the vertex each new vertex copies (in the old order,
+    copies of one vertex side by side, so a mesh with no seam keeps its vertices as they were),
+    the (m, 3) triangles over the new vertices, (k, 2) their (u, v).
+    """
+    faces = np.asarray(faces, np.int64).reshape(-1, 3)
+    uv = np.asarray(corner_uv, np.float64).reshape(-1, 2)
+    q = np.round(uv, decimals)
+    q[q == 0] = 0.0
+    table = np.column_stack([faces.reshape(-1).astype(np.float64), q])
+    unique, first, inverse = np.unique(table, axis=0, return_index=True, return_inverse=True)
+    return unique[:, 0].astype(np.int64), inverse.reshape(-1, 3), uv[first]
+
+
+def _wrapped_corners(uv: np.ndarray, faces: np.ndarray, wrap=(True, False), poles=None):
+    """(m, 3, 2) corner (u, v) of a mesh whose vertex (u, v) wraps around (1 is 0 again): in a
+    triangle spanning the seam, the corners more than 0.5 below its largest take + 1; a pole
+    vertex (its u undefined) takes the mean u of its triangle's other corners."""
+    c = uv[faces].copy()
+    for axis, wraps in enumerate(wrap):
+        if wraps:
+            col = c[:, :, axis]
+            span = col.max(axis=1) - col.min(axis=1)
+            across = (span > 0.5)[:, None] & (col < col.max(axis=1, keepdims=True) - 0.5)
+            col[across] += 1.0
+    if poles is not None:
+        at = poles[faces]
+        for k in range(3):
+            rows = np.flatnonzero(at[:, k])
+            others = [j for j in range(3) if j != k]
+            c[rows, k, 0] = c[rows][:, others, 0].mean(axis=1)
+    return c
+
+
+def _with_uv(mesh: Mesh, corner_uv: np.ndarray) -> Mesh:
+    """``mesh`` with its vertices split by ``corner_uv`` (:func:`split_by_uv`), wearing them."""
+    src, faces, uv = split_by_uv(mesh.faces, corner_uv)
+    return Mesh(mesh.positions[src], mesh.normals[src], faces, mesh.name, uv=uv)
+
+
+def _spherical_uv(mesh: Mesh) -> Mesh:
+    """The sphere's and icosphere's (u, v) (see the module docstring)."""
+    p = mesh.positions
+    u = np.mod(np.arctan2(p[:, 0], p[:, 2]) / (2.0 * np.pi), 1.0)
+    v = 0.5 + np.arcsin(np.clip(p[:, 1], -1.0, 1.0)) / np.pi
+    poles = np.hypot(p[:, 0], p[:, 2]) < 1e-12
+    corners = _wrapped_corners(np.column_stack([u, v]), mesh.faces, poles=poles)
+    return _with_uv(mesh, corners)
 
 
 def _grid_faces(rows: int, cols: int, wrap_cols: bool = False, offset: int = 0) -> np.ndarray:
@@ -277,11 +364,12 @@ def _check_resolution(name: str, value) -> int:
 # -- built-in meshes -----------------------------------------------------------------------
 
 
-def sphere(resolution: int | None = None) -> Mesh:
+def sphere(resolution: int | None = None, *, uv: bool = False) -> Mesh:
     """UV sphere of radius 1 centred on the origin, poles on ±y.
 
     resolution : segments around the y axis (default 64); there are resolution // 2 bands
     (at least 2) from pole to pole, one vertex at each pole, no seam (watertight).
+    uv : give it texture coordinates (its seam split; see the module docstring)
     """
     seg = _check_resolution("sphere", resolution)
     bands = max(2, seg // 2)
@@ -304,7 +392,8 @@ def sphere(resolution: int | None = None) -> Mesh:
         ]
     )
     faces = np.concatenate([body, caps])
-    return Mesh(pos, pos.copy(), _outward(pos, faces), "sphere")
+    mesh = Mesh(pos, pos.copy(), _outward(pos, faces), "sphere")
+    return _spherical_uv(mesh) if uv else mesh
 
 
 def _outward(pos, faces):
@@ -337,10 +426,11 @@ _ICO_FACES = np.array(
 )  # fmt: skip
 
 
-def icosphere(subdivisions: int | None = None) -> Mesh:
+def icosphere(subdivisions: int | None = None, *, uv: bool = False) -> Mesh:
     """Subdivided icosahedron of radius 1: 10·4^k + 2 vertices, 20·4^k triangles.
 
     subdivisions : k, how often each triangle is split in four (default 4)
+    uv : give it the sphere's texture coordinates (see the module docstring)
     """
     k = _check_resolution("icosphere", subdivisions)
     pos = _ICO_VERTICES / np.linalg.norm(_ICO_VERTICES, axis=1, keepdims=True)
@@ -359,14 +449,18 @@ def icosphere(subdivisions: int | None = None) -> Mesh:
             [np.stack(t, 1) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
         )
         pos = np.vstack([pos, mid])
-    return Mesh(pos, pos.copy(), _outward(pos, faces), "icosphere")
+    mesh = Mesh(pos, pos.copy(), _outward(pos, faces), "icosphere")
+    return _spherical_uv(mesh) if uv else mesh
 
 
-def torus(resolution: int | None = None, major: float = 0.7, minor: float = 0.3) -> Mesh:
+def torus(
+    resolution: int | None = None, major: float = 0.7, minor: float = 0.3, *, uv: bool = False
+) -> Mesh:
     """Torus about the z axis (its hole faces the default viewer), centred on the origin.
 
     resolution : segments around the ring (default 64); the tube gets resolution // 2 (>= 3)
     major, minor : ring and tube radii (defaults 0.7 and 0.3: the torus fits [-1, 1]³)
+    uv : give it texture coordinates (its seams split; see the module docstring)
     """
     seg = _check_resolution("torus", resolution)
     if not (0 < minor < major):
@@ -383,13 +477,17 @@ def torus(resolution: int | None = None, major: float = 0.7, minor: float = 0.3)
     faces = _grid_faces(seg + 1, tube, wrap_cols=True)
     faces = faces % (seg * tube)
     # d/du × d/dv points outward from the tube for this parametrisation
-    return Mesh(pos, normals, faces, "torus")
+    mesh = Mesh(pos, normals, faces, "torus")
+    if not uv:
+        return mesh
+    tex = np.column_stack([(uu / (2.0 * np.pi)).ravel(), (vv / (2.0 * np.pi)).ravel()])
+    return _with_uv(mesh, _wrapped_corners(tex, faces, wrap=(True, True)))
 
 
-def cube() -> Mesh:
+def cube(*, uv: bool = False) -> Mesh:
     """Cube of side 2 centred on the origin: 24 vertices (4 per face, so each face keeps its
-    own flat normal) and 12 triangles."""
-    pos, nrm, faces = [], [], []
+    own flat normal) and 12 triangles. uv : each face the whole [0, 1]² square."""
+    pos, nrm, faces, tex = [], [], [], []
     for axis in range(3):
         for sign in (1.0, -1.0):
             n = np.zeros(3)
@@ -401,15 +499,17 @@ def cube() -> Mesh:
             for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
                 pos.append(n + a * u + b * v)
                 nrm.append(n)
+                tex.append(((a + 1) / 2.0, (b + 1) / 2.0))
             faces += [[base, base + 1, base + 2], [base, base + 2, base + 3]]
-    return Mesh(np.array(pos), np.array(nrm), np.array(faces), "cube")
+    return Mesh(np.array(pos), np.array(nrm), np.array(faces), "cube", uv=tex if uv else None)
 
 
-def plane(resolution: int | None = None) -> Mesh:
+def plane(resolution: int | None = None, *, uv: bool = False) -> Mesh:
     """Square [-1, 1]² in the xy plane (z = 0) with normal +z, facing the default viewer.
 
     resolution : subdivisions per side (default 32): (resolution + 1)² vertices. Per-vertex
     lighting needs them for a point or spot light's pool of light to show.
+    uv : texture coordinates ((x + 1) / 2, (y + 1) / 2)
     """
     k = _check_resolution("plane", resolution)
     t = np.linspace(-1.0, 1.0, k + 1)
@@ -418,7 +518,8 @@ def plane(resolution: int | None = None) -> Mesh:
     normals = np.tile([0.0, 0.0, 1.0], (len(pos), 1))
     # rows go +y, columns +x: (+y) × (+x) = -z, so wind the other way
     faces = _grid_faces(k + 1, k + 1)[:, ::-1]
-    return Mesh(pos, normals, faces, "plane")
+    tex = 0.5 * (pos[:, :2] + 1.0) if uv else None
+    return Mesh(pos, normals, faces, "plane", uv=tex)
 
 
 def _bernstein(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -445,7 +546,7 @@ def _patch_points(ctrl: np.ndarray, u: np.ndarray, v: np.ndarray):
 _TEAPOT_SIGN = -1.0
 
 
-def teapot(tessellation: int | None = None) -> Mesh:
+def teapot(tessellation: int | None = None, *, uv: bool = False) -> Mesh:
     """The Utah teapot from Newell's 32 bicubic Bézier patches.
 
     tessellation : samples per patch edge (default 12): each patch becomes a
@@ -456,6 +557,8 @@ def teapot(tessellation: int | None = None) -> Mesh:
     into the body, as in the original, so the teapot is not watertight.
 
     The model is turned y up (spout toward +x, lid toward +y) and fitted to [-1, 1]³.
+    uv : each patch's own (u, v) as texture coordinates (the welded vertices split again where
+    patches meet with different (u, v); see the module docstring)
     """
 
     t = _check_resolution("teapot", tessellation)
@@ -488,21 +591,29 @@ def teapot(tessellation: int | None = None) -> Mesh:
             names.append(name)
         group_of[list(rows)] = names.index(name)
     keys = np.repeat(group_of, per)
-    pos, nrm, faces = _weld(pos.reshape(-1, 3), nrm.reshape(-1, 3), faces, keys)
+    su, sv = np.meshgrid(s, s, indexing="ij")
+    patch_uv = np.tile(np.column_stack([su.ravel(), sv.ravel()]), (n_patch, 1))
+    corner_uv = patch_uv[faces]
+    kept: list = []
+    pos, nrm, faces = _weld(pos.reshape(-1, 3), nrm.reshape(-1, 3), faces, keys, kept=kept)
+    tex = None
+    if uv:
+        src, faces, tex = split_by_uv(faces, corner_uv[kept[0]])
+        pos, nrm = pos[src], nrm[src]
     # Newell's z up -> y up: (x, y, z) -> (x, z, -y), a proper rotation (keeps winding)
     rot = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
     pos = pos @ rot.T
     nrm = nrm @ rot.T
     lo, hi = pos.min(axis=0), pos.max(axis=0)
     pos = (pos - 0.5 * (lo + hi)) / float(np.max(0.5 * (hi - lo)))
-    return Mesh(pos, nrm, faces, "teapot")
+    return Mesh(pos, nrm, faces, "teapot", uv=tex)
 
 
 _BUILDERS = {
     "sphere": sphere,
     "icosphere": icosphere,
     "torus": torus,
-    "cube": lambda resolution=None: cube(),
+    "cube": lambda resolution=None, uv=False: cube(uv=uv),
     "plane": plane,
     "teapot": teapot,
 }
@@ -637,12 +748,14 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(
             f"mesh file '{shown}' holds {reason}: a mesh needs triangles (or polygons)"
         )
-    _say_unread_materials(shown, parts, libraries)
+    _say_unread_materials(shown, parts, ext == ".obj")
     group_names: list[str] = []
     keys = []
     positions, normals, faces, has_normals = [], [], [], True
+    uvs: list = []
     base = 0
     for m, matrix in parts:
+        uvs.append(_part_uv(m))
         name = _material_name(m) if libraries else None
         if name is not None and name not in group_names:
             group_names.append(name)
@@ -669,6 +782,13 @@ def load_mesh(path) -> Mesh:
     pos = np.vstack(positions)
     faces = np.vstack(faces)
     keys = np.concatenate(keys)
+    tex = None
+    if all(t is not None for t in uvs):  # every part has its vt (else the mesh has none)
+        tex = np.vstack(uvs)
+        if not np.isfinite(tex).all():
+            raise ExplorerError(
+                f"mesh file '{shown}' has texture coordinates (vt) that are not finite numbers"
+            )
     if (keys < 0).any() and group_names:  # faces before any usemtl, or an unknown material
         group_names.append("")
         keys[keys < 0] = len(group_names) - 1
@@ -682,12 +802,19 @@ def load_mesh(path) -> Mesh:
     else:
         centre, scale = frame_of(pos)  # welded to 12 decimals of the mesh's frame: any scale
         Q = pos / scale - centre / scale
-        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True)
+        corner_uv = None if tex is None else tex[faces]
+        kept: list = []
+        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True, kept=kept)
         pos, keys = pos[src], keys[src]
         nrm = area_weighted_normals(pos, faces)
+        if corner_uv is not None:  # welded for the normals, split again by (u, v)
+            src, faces, tex = split_by_uv(faces, corner_uv[kept[0]])
+            pos, nrm, keys = pos[src], nrm[src], keys[src]
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")
     used = _used(pos, faces)
+    if tex is not None:
+        tex = tex[used]
     pos, nrm, faces = _drop_unused(pos, nrm, faces)
     groups = None
     if group_names:  # in the file's order (trimesh's parts come in another)
@@ -698,7 +825,16 @@ def load_mesh(path) -> Mesh:
         groups = MaterialGroups(tuple(group_names), keys[used], libraries, used_names)
     elif libraries:  # no usemtl matched a material trimesh found: one group, named nothing
         groups = MaterialGroups(("",), np.zeros(len(pos), np.int32), libraries, used_names)
-    return Mesh(pos, nrm, faces, os.path.basename(path), groups)
+    return Mesh(pos, nrm, faces, os.path.basename(path), groups, tex)
+
+
+def _part_uv(part) -> np.ndarray | None:
+    """(n, 2) texture coordinates trimesh read for a part (an OBJ's ``vt``), or None."""
+    uv = getattr(getattr(part, "visual", None), "uv", None)
+    if uv is None:
+        return None
+    uv = np.asarray(uv, np.float64)
+    return uv if uv.shape == (len(part.vertices), 2) else None
 
 
 def _used(pos, faces) -> np.ndarray:
@@ -707,12 +843,12 @@ def _used(pos, faces) -> np.ndarray:
     return used
 
 
-def _say_unread_materials(shown: str, parts, libraries) -> None:
+def _say_unread_materials(shown: str, parts, obj: bool) -> None:
     """A :class:`~explorer.core.errors.Notice` when the file carries colours or materials the
     engine does not read (anything but an OBJ's .mtl materials)."""
     kinds = {getattr(getattr(m, "visual", None), "kind", None) for m, _ in parts}
-    if libraries:
-        kinds.discard("texture")  # an OBJ's usemtl materials: read from the .mtl
+    if obj:  # an OBJ's texture visuals are its vt (read) and its .mtl materials (read there)
+        kinds.discard("texture")
     kinds.discard(None)
     if kinds:
         what = "texture materials" if kinds == {"texture"} else "colours or materials"
@@ -762,9 +898,10 @@ def _drop_unused(pos, nrm, faces):
 # -- lookup --------------------------------------------------------------------------------
 
 
-def get_mesh(spec, resolution: int | None = None) -> Mesh:
+def get_mesh(spec, resolution: int | None = None, *, uv: bool = False) -> Mesh:
     """A built-in mesh by name (with its ``resolution`` option, see :data:`RESOLUTION`) or a
-    mesh file by path. ``resolution`` is ignored by ``cube`` and by files.
+    mesh file by path. ``resolution`` is ignored by ``cube`` and by files. ``uv``: a built-in
+    mesh with its texture coordinates (a file has the ones it holds, or none).
 
     An unknown name that does not look like a path raises an :class:`ExplorerError` with a
     did-you-mean and the list of built-in names.
@@ -777,7 +914,7 @@ def get_mesh(spec, resolution: int | None = None) -> Mesh:
         raise ExplorerError(f"a mesh must be a built-in name or a file path, got {spec!r}")
     text = os.fspath(spec)
     if text in _BUILDERS:
-        return _BUILDERS[text](resolution)
+        return _BUILDERS[text](resolution, uv=uv)
     if _looks_like_file(text):
         return load_mesh(os.path.expanduser(text))
 
