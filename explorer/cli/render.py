@@ -9,6 +9,7 @@
     phong-explorer render --preset gold --mesh teapot --out gold.glb   (unlit glTF)
     phong-explorer render --preset gold --mesh teapot --out gold.obj   (gold.obj + gold.mtl)
     phong-explorer render --preset gold --mesh teapot --turntable 36 --out spin.gif
+    phong-explorer render --preset gold --mesh teapot --diffuse-map wood.png --out t.png
 
 An OBJ whose ``mtllib`` defines materials is drawn with them, each ``usemtl`` group in its own
 material; ``--preset`` draws the whole mesh in one preset instead. The scene options are in
@@ -41,6 +42,7 @@ from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
+from explorer.render.textured import not_drawn_per_vertex, textured
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -103,7 +105,26 @@ def run(args) -> int:
                 "--per-pixel draws one material: give --preset NAME for a mesh with its own "
                 "materials"
             )
+        if scene.material.maps():
+            say(
+                "warning: --per-pixel does not draw texture maps yet; the picture is untextured",
+                file=sys.stderr,
+            )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
+    texture = textured(scene, mesh, materials)  # the image read (or refused) before any work
+    for m in materials or (scene.material,):
+        for key in not_drawn_per_vertex(m):
+            say(
+                f"warning: {key} {getattr(m, key).file}: not drawn per vertex (it needs "
+                "per-pixel shading); the material keeps it",
+                file=sys.stderr,
+            )
+    if texture is not None and (turntable or suffix not in (".png",)):
+        say(
+            f"warning: {args.out}: the diffuse_map is not drawn into this output (only a PNG "
+            "picture wears it); the vertices carry their untextured colours",
+            file=sys.stderr,
+        )
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
@@ -113,7 +134,9 @@ def run(args) -> int:
     if suffix == ".obj":
         return run_obj(args, scene, mesh, materials)
     if suffix == ".png":
-        image = render_image(scene, mesh, size, background=background, colors=colors)
+        image = render_image(
+            scene, mesh, size, background=background, colors=colors, texture=texture
+        )
         data = encode_png(image)
         what = f"{size[0]}x{size[1]} picture"
     else:

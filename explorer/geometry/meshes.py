@@ -21,43 +21,35 @@ vertices at the same position are welded and given smooth area-weighted normals.
 Every array of a :class:`Mesh` is read-only.
 
 Texture coordinates (``Mesh.uv``, (n, 2), None for a mesh without them): an OBJ's ``vt``; a
-built-in mesh asked for them (``get_mesh(name, uv=True)``) gets its own parametrisation, with
-the vertices on a seam split so each side keeps its (u, v) (same position and normal, so the
-same colours):
-
-=============  ================================================================================
-name           (u, v)
-=============  ================================================================================
-``sphere``     longitude / 2π from the +z meridian eastward, latitude from the south pole (0)
-               to the north (1); the seam at u = 0 | 1 split, a pole takes its triangle's u
-``icosphere``  the same spherical mapping
-``torus``      around the ring / 2π, around the tube / 2π; both seams split
-``cube``       each face the whole [0, 1]² square
-``plane``      ((x + 1) / 2, (y + 1) / 2)
-``teapot``     each Bézier patch its own (u, v) in [0, 1]², as ``glMap2``/``glutSolidTeapot``
-               give them; vertices welded across patches split again by (u, v)
-=============  ================================================================================
+built-in mesh asked for them (``get_mesh(name, uv=True)``) gets its own parametrisation
+(:mod:`explorer.geometry.uv`), the vertices on a seam split so each side keeps its (u, v).
 """
 
 from __future__ import annotations
 
-import bz2
-import gzip
 import io
 import os
 import warnings
-import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
-from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError, Notice
-from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
 from explorer.geometry.frame import check_faces, check_vertices, frame_of
+from explorer.geometry.meshfile import (
+    drop_unused,
+    file_uv,
+    material_name,
+    part_uv,
+    read_mesh_file,
+    say_unread_materials,
+    triangle_parts,
+    used_vertices,
+)
 from explorer.geometry.sidefiles import CheckedResolver, library_names, obj_material_names
+from explorer.geometry.uv import spherical_corners, split_by_uv, wrapped_corners
 
 #: resolution option of each built-in mesh: (default, lowest, highest); None = no option
 RESOLUTION: dict[str, tuple[int, int, int] | None] = {
@@ -275,43 +267,6 @@ def _weld(
     return new_p, _unit_rows(acc), new_f[keep]
 
 
-def split_by_uv(faces, corner_uv, decimals: int = 12):
-    """Vertices split where the triangles meeting there give them different (u, v).
-
-    faces : (m, 3) int; corner_uv : (m, 3, 2) the (u, v) of each triangle's corners
-    Returns ``(source, faces, uv)``: (k,) the vertex each new vertex copies (in the old order,
-    copies of one vertex side by side, so a mesh with no seam keeps its vertices as they were),
-    the (m, 3) triangles over the new vertices, (k, 2) their (u, v).
-    """
-    faces = np.asarray(faces, np.int64).reshape(-1, 3)
-    uv = np.asarray(corner_uv, np.float64).reshape(-1, 2)
-    q = np.round(uv, decimals)
-    q[q == 0] = 0.0
-    table = np.column_stack([faces.reshape(-1).astype(np.float64), q])
-    unique, first, inverse = np.unique(table, axis=0, return_index=True, return_inverse=True)
-    return unique[:, 0].astype(np.int64), inverse.reshape(-1, 3), uv[first]
-
-
-def _wrapped_corners(uv: np.ndarray, faces: np.ndarray, wrap=(True, False), poles=None):
-    """(m, 3, 2) corner (u, v) of a mesh whose vertex (u, v) wraps around (1 is 0 again): in a
-    triangle spanning the seam, the corners more than 0.5 below its largest take + 1; a pole
-    vertex (its u undefined) takes the mean u of its triangle's other corners."""
-    c = uv[faces].copy()
-    for axis, wraps in enumerate(wrap):
-        if wraps:
-            col = c[:, :, axis]
-            span = col.max(axis=1) - col.min(axis=1)
-            across = (span > 0.5)[:, None] & (col < col.max(axis=1, keepdims=True) - 0.5)
-            col[across] += 1.0
-    if poles is not None:
-        at = poles[faces]
-        for k in range(3):
-            rows = np.flatnonzero(at[:, k])
-            others = [j for j in range(3) if j != k]
-            c[rows, k, 0] = c[rows][:, others, 0].mean(axis=1)
-    return c
-
-
 def _with_uv(mesh: Mesh, corner_uv: np.ndarray) -> Mesh:
     """``mesh`` with its vertices split by ``corner_uv`` (:func:`split_by_uv`), wearing them."""
     src, faces, uv = split_by_uv(mesh.faces, corner_uv)
@@ -319,13 +274,8 @@ def _with_uv(mesh: Mesh, corner_uv: np.ndarray) -> Mesh:
 
 
 def _spherical_uv(mesh: Mesh) -> Mesh:
-    """The sphere's and icosphere's (u, v) (see the module docstring)."""
-    p = mesh.positions
-    u = np.mod(np.arctan2(p[:, 0], p[:, 2]) / (2.0 * np.pi), 1.0)
-    v = 0.5 + np.arcsin(np.clip(p[:, 1], -1.0, 1.0)) / np.pi
-    poles = np.hypot(p[:, 0], p[:, 2]) < 1e-12
-    corners = _wrapped_corners(np.column_stack([u, v]), mesh.faces, poles=poles)
-    return _with_uv(mesh, corners)
+    """The sphere's and icosphere's (u, v) (:func:`explorer.geometry.uv.spherical_corners`)."""
+    return _with_uv(mesh, spherical_corners(mesh.positions, mesh.faces))
 
 
 def _grid_faces(rows: int, cols: int, wrap_cols: bool = False, offset: int = 0) -> np.ndarray:
@@ -481,7 +431,7 @@ def torus(
     if not uv:
         return mesh
     tex = np.column_stack([(uu / (2.0 * np.pi)).ravel(), (vv / (2.0 * np.pi)).ravel()])
-    return _with_uv(mesh, _wrapped_corners(tex, faces, wrap=(True, True)))
+    return _with_uv(mesh, wrapped_corners(tex, faces, wrap=(True, True)))
 
 
 def cube(*, uv: bool = False) -> Mesh:
@@ -622,74 +572,6 @@ _BUILDERS = {
 # -- files ---------------------------------------------------------------------------------
 
 
-def read_mesh_file(path) -> bytes:
-    """The bytes of a mesh file, read once through the checked open
-    (:func:`explorer.core.files.read_checked`): a file that does not exist, is a directory, a
-    FIFO, socket or device (never opened in a way that blocks), is empty, is larger than
-    ``MAX_MESH_FILE_BYTES``, or is an archive unpacking to more than
-    ``MAX_MESH_UNPACKED_BYTES`` (see :mod:`explorer.core.tolerances`) raises an
-    :class:`ExplorerError` naming the file and the cap."""
-    shown = os.fspath(path)
-    try:
-        data = read_checked(shown, cap=tol.MAX_MESH_FILE_BYTES, what="mesh file")
-    except UnreadableFile as exc:
-        raise ExplorerError(f"mesh file '{shown}' {_unreadable(exc)}") from None
-    if not data:
-        raise ExplorerError(f"mesh file '{shown}' is empty")
-    unpacked = _unpacked_size(data, tol.MAX_MESH_UNPACKED_BYTES)
-    if unpacked is not None and unpacked > tol.MAX_MESH_UNPACKED_BYTES:
-        raise ExplorerError(
-            f"mesh file '{shown}' is an archive that unpacks to more than "
-            f"{tol.MAX_MESH_UNPACKED_BYTES} bytes ({tol.MAX_MESH_UNPACKED_BYTES >> 20} MiB), "
-            "the limit for a mesh; unpack it yourself if it is really meant"
-        )
-    return data
-
-
-def _unreadable(exc: UnreadableFile) -> str:
-    """The end of a mesh-file message for what :func:`read_checked` refused."""
-    reason = exc.reason
-    if reason == "no such file":
-        return "does not exist"
-    if reason.startswith("it is a directory"):
-        return "is a directory, not a mesh file"
-    if reason == "permission denied":
-        return "cannot be read (permission denied)"
-    if reason.startswith("too large"):
-        size = f"{exc.size} bytes" if exc.size is not None else "more bytes than that"
-        return (
-            f"is too large: {size}, the limit is {tol.MAX_MESH_FILE_BYTES} bytes "
-            f"({tol.MAX_MESH_FILE_BYTES >> 20} MiB)"
-        )
-    if reason.startswith("it is a"):
-        return f"is not a regular file ({reason[6:].split(', not')[0]})"
-    return f"cannot be read: {reason}"
-
-
-def _unpacked_size(data: bytes, cap: int) -> int | None:
-    """The size an archive's bytes unpack to (zip: the declared sizes; bz2 / gzip: counted
-    while unpacking, stopping once past ``cap``); None for a file that is no archive."""
-    stream = io.BytesIO(data)
-    try:
-        if zipfile.is_zipfile(stream):
-            with zipfile.ZipFile(stream) as archive:
-                return sum(info.file_size for info in archive.infolist())
-        unpack = {b"BZh": bz2.BZ2File, b"\x1f\x8b\x08": lambda f: gzip.GzipFile(fileobj=f)}
-        opener = unpack.get(data[:3])
-        if opener is None:
-            return None
-        total = 0
-        with opener(io.BytesIO(data)) as unpacking:
-            while total <= cap:
-                chunk = unpacking.read(1 << 20)
-                if not chunk:
-                    break
-                total += len(chunk)
-        return total
-    except (OSError, EOFError, zipfile.BadZipFile, ValueError):
-        return None  # a damaged archive: the loader reports it
-
-
 def load_mesh(path) -> Mesh:
     """Read a triangle mesh with trimesh (OBJ, STL, PLY, OFF, GLB, ...).
 
@@ -740,7 +622,7 @@ def load_mesh(path) -> Mesh:
             f"mesh file '{shown}' is not a valid {ext} file or is damaged "
             f"({type(exc).__name__}: {exc})"
         ) from exc
-    parts = _triangle_parts(loaded)
+    parts = triangle_parts(loaded)
     if not parts:
         kind = type(loaded).__name__
         what = {"PointCloud": "points only", "Path2D": "lines only", "Path3D": "lines only"}
@@ -748,15 +630,13 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(
             f"mesh file '{shown}' holds {reason}: a mesh needs triangles (or polygons)"
         )
-    _say_unread_materials(shown, parts, ext == ".obj")
+    say_unread_materials(shown, parts, ext == ".obj")
     group_names: list[str] = []
     keys = []
     positions, normals, faces, has_normals = [], [], [], True
-    uvs: list = []
     base = 0
     for m, matrix in parts:
-        uvs.append(_part_uv(m))
-        name = _material_name(m) if libraries else None
+        name = material_name(m) if libraries else None
         if name is not None and name not in group_names:
             group_names.append(name)
         keys.append(np.full(len(m.vertices), -1 if name is None else group_names.index(name)))
@@ -782,13 +662,7 @@ def load_mesh(path) -> Mesh:
     pos = np.vstack(positions)
     faces = np.vstack(faces)
     keys = np.concatenate(keys)
-    tex = None
-    if all(t is not None for t in uvs):  # every part has its vt (else the mesh has none)
-        tex = np.vstack(uvs)
-        if not np.isfinite(tex).all():
-            raise ExplorerError(
-                f"mesh file '{shown}' has texture coordinates (vt) that are not finite numbers"
-            )
+    tex = file_uv([part_uv(m) for m, _ in parts], shown)
     if (keys < 0).any() and group_names:  # faces before any usemtl, or an unknown material
         group_names.append("")
         keys[keys < 0] = len(group_names) - 1
@@ -800,22 +674,13 @@ def load_mesh(path) -> Mesh:
         if missing.any():
             nrm[missing] = area_weighted_normals(pos, faces)[missing]
     else:
-        centre, scale = frame_of(pos)  # welded to 12 decimals of the mesh's frame: any scale
-        Q = pos / scale - centre / scale
-        corner_uv = None if tex is None else tex[faces]
-        kept: list = []
-        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True, kept=kept)
-        pos, keys = pos[src], keys[src]
-        nrm = area_weighted_normals(pos, faces)
-        if corner_uv is not None:  # welded for the normals, split again by (u, v)
-            src, faces, tex = split_by_uv(faces, corner_uv[kept[0]])
-            pos, nrm, keys = pos[src], nrm[src], keys[src]
+        pos, nrm, faces, keys, tex = _welded(pos, faces, keys, tex)
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")
-    used = _used(pos, faces)
+    used = used_vertices(pos, faces)
     if tex is not None:
         tex = tex[used]
-    pos, nrm, faces = _drop_unused(pos, nrm, faces)
+    pos, nrm, faces = drop_unused(pos, nrm, faces)
     groups = None
     if group_names:  # in the file's order (trimesh's parts come in another)
         rank = [used_names.index(g) if g in used_names else len(used_names) for g in group_names]
@@ -828,74 +693,24 @@ def load_mesh(path) -> Mesh:
     return Mesh(pos, nrm, faces, os.path.basename(path), groups, tex)
 
 
-def _part_uv(part) -> np.ndarray | None:
-    """(n, 2) texture coordinates trimesh read for a part (an OBJ's ``vt``), or None."""
-    uv = getattr(getattr(part, "visual", None), "uv", None)
-    if uv is None:
-        return None
-    uv = np.asarray(uv, np.float64)
-    return uv if uv.shape == (len(part.vertices), 2) else None
-
-
-def _used(pos, faces) -> np.ndarray:
-    used = np.zeros(len(pos), bool)
-    used[faces.ravel()] = True
-    return used
-
-
-def _say_unread_materials(shown: str, parts, obj: bool) -> None:
-    """A :class:`~explorer.core.errors.Notice` when the file carries colours or materials the
-    engine does not read (anything but an OBJ's .mtl materials)."""
-    kinds = {getattr(getattr(m, "visual", None), "kind", None) for m, _ in parts}
-    if obj:  # an OBJ's texture visuals are its vt (read) and its .mtl materials (read there)
-        kinds.discard("texture")
-    kinds.discard(None)
-    if kinds:
-        what = "texture materials" if kinds == {"texture"} else "colours or materials"
-        warnings.warn(
-            f"mesh file '{shown}': its {what} are not read (only an OBJ's .mtl materials "
-            "are); the scene's material is used",
-            Notice,
-            stacklevel=3,
-        )
-
-
-def _material_name(part) -> str | None:
-    """The name of the material trimesh's OBJ reader gave a part (one per ``usemtl``)."""
-    material = getattr(getattr(part, "visual", None), "material", None)
-    name = getattr(material, "name", None)
-    return name if isinstance(name, str) and name else None
-
-
-def _triangle_parts(loaded) -> list:
-    """``[(Trimesh, 4x4 transform or None), ...]`` of the triangle meshes in what trimesh
-    loaded; scene nodes keep their own geometry (and its normals) with the node's transform."""
-    import trimesh
-
-    if isinstance(loaded, trimesh.Trimesh):
-        items = [(loaded, None)]
-    elif isinstance(loaded, trimesh.Scene):
-        items = []
-        for node in loaded.graph.nodes_geometry:
-            matrix, name = loaded.graph[node]
-            geometry = loaded.geometry.get(name)
-            matrix = np.asarray(matrix, np.float64)
-            items.append((geometry, None if np.allclose(matrix, np.eye(4)) else matrix))
-    else:
-        items = []
-    return [(m, t) for m, t in items if isinstance(m, trimesh.Trimesh) and len(m.faces)]
-
-
-def _drop_unused(pos, nrm, faces):
-    used = np.zeros(len(pos), bool)
-    used[faces.ravel()] = True
-    if used.all():
-        return pos, nrm, faces
-    new_index = np.cumsum(used) - 1
-    return pos[used], nrm[used], new_index[faces]
-
-
 # -- lookup --------------------------------------------------------------------------------
+
+
+def _welded(pos, faces, keys, tex):
+    """A file without normals: vertices welded by position (and group) to 12 decimals of the
+    mesh's frame (any scale), smooth normals, then split again where their (u, v) differ.
+    Returns ``(positions, normals, faces, keys, uv)``."""
+    centre, scale = frame_of(pos)
+    Q = pos / scale - centre / scale
+    corner_uv = None if tex is None else tex[faces]
+    kept: list = []
+    _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True, kept=kept)
+    pos, keys = pos[src], keys[src]
+    nrm = area_weighted_normals(pos, faces)
+    if corner_uv is not None:
+        src, faces, tex = split_by_uv(faces, corner_uv[kept[0]])
+        pos, nrm, keys = pos[src], nrm[src], keys[src]
+    return pos, nrm, faces, keys, tex
 
 
 def get_mesh(spec, resolution: int | None = None, *, uv: bool = False) -> Mesh:
