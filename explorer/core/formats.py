@@ -52,11 +52,14 @@ class Converted:
     notes: tuple[str, ...]
 
 
-def convert(material: Material, name: str, fmt: str) -> Converted:
-    """``material`` (preset ``name``) in format ``fmt`` (:data:`SHOW_FORMATS`)."""
+def convert(material: Material, name: str, fmt: str, folder=None) -> Converted:
+    """``material`` (preset ``name``) in format ``fmt`` (:data:`SHOW_FORMATS`); folder : where
+    the file goes (its texture images are named relative to it when inside it)."""
     writers = {"mtl": to_mtl, "threejs": to_threejs, "x3d": to_x3d, "blender": to_blender}
     if fmt not in writers:
         raise ExplorerError(f"unknown material format {fmt!r}; use one of {', '.join(writers)}")
+    if fmt == "mtl":
+        return to_mtl(material, name, folder)
     return writers[fmt](material, name)
 
 
@@ -64,10 +67,12 @@ def _header(name: str) -> str:
     return f"material '{name}', written by phong-explorer {__version__}"
 
 
-def to_mtl(material: Material, name: str) -> Converted:
-    """Wavefront MTL: exact (floats written in ``repr`` form)."""
+def to_mtl(material: Material, name: str, folder=None) -> Converted:
+    """Wavefront MTL: exact (floats written in ``repr`` form), the texture maps with their
+    options (images inside ``folder`` named relative to it)."""
     notes = [f"MTL cannot hold {what}" for what in lost_in_mtl(material)]
-    return Converted(format_mtl([(name, material)], header=_header(name)), tuple(notes))
+    text = format_mtl([(name, material)], header=_header(name), folder=folder)
+    return Converted(text, tuple(notes))
 
 
 def hex_colour(rgb) -> int:

@@ -168,11 +168,15 @@ def parse_texture_map(checker: Checker, value, path) -> TextureMap | None:
     return TextureMap(**kw)
 
 
-def resolve_map(tmap: TextureMap, folder: str | None) -> TextureMap | None:
+def resolve_map(
+    tmap: TextureMap, folder: str | None, *, absolute: bool = False
+) -> TextureMap | None:
     """``tmap`` with its file named from the folder of the file that gave it (``folder``; None
-    or "" for the current directory), or None when the name leads outside that folder."""
+    for a mapping given in code: the name as it is), or None when the name leads outside that
+    folder. absolute : an absolute name is taken as it is (a preset file: ``presets import``
+    writes the image's full name into the user's own library)."""
     name = os.path.expanduser(tmap.file) if folder is None else tmap.file
-    if folder is None:
+    if folder is None or (absolute and os.path.isabs(name)):
         return tmap if name == tmap.file else TextureMap(**{**_fields(tmap), "file": name})
     full = inside(folder, name)
     if full is None:

@@ -119,3 +119,46 @@ def test_color_control_is_a_scene_key():
 def test_parse_mtl_map_takes_a_name_starting_with_a_dash():
     tmap, dropped, problem = parse_mtl_map(["map_Kd", "-clamp", "off", "-x.png"], "w")
     assert tmap == TextureMap("-x.png") and dropped == [] and problem == ""
+
+
+def test_presets_import_keeps_the_maps_and_export_writes_them_back(tmp_path, capsys):
+    from explorer.cli import main
+    from explorer.core.presets import load_material_file
+
+    (tmp_path / "wood.mtl").write_text(ALL_MAPS)
+    library = tmp_path / "library"
+    assert main(["presets", "import", str(tmp_path / "wood.mtl"), "--into", str(library)]) == 0
+    preset = load_material_file(library / "wood.yaml")
+    assert preset.diffuse_map.file == str(tmp_path / "wood grain.png")  # its full name
+    assert preset.diffuse_map.scale == (2.0, 2.0, 1.0) and preset.bump_map.bump_multiplier == 0.5
+    out = tmp_path / "again.mtl"
+    argv = ["presets", "export", "wood", "--out", str(out), "--materials-dir", str(library)]
+    assert main(argv) == 0
+    (back,) = read_mtl(out)  # the images beside it: named relative to it
+    assert "map_Kd -s 2.0 2.0 1.0 -o 0.5 0.25 0.0 -clamp on wood grain.png" in out.read_text()
+    assert back.material.replace(name=None) == preset.replace(name=None)
+
+
+def test_a_preset_names_a_relative_map_from_its_folder(tmp_path):
+    from explorer.core.presets import load_material_file
+
+    (tmp_path / "p.yaml").write_text("diffuse: [1, 1, 1]\ndiffuse_map: img/a.png\n")
+    assert load_material_file(tmp_path / "p.yaml").diffuse_map.file == str(tmp_path / "img/a.png")
+    (tmp_path / "q.yaml").write_text("diffuse_map: ../a.png\n")
+    with pytest.raises(ValidationError, match="outside the preset's folder"):
+        load_material_file(tmp_path / "q.yaml")
+
+
+def test_a_session_keeps_the_maps_and_the_colour_control(tmp_path):
+    from explorer.app.session import load_session, save_session
+    from explorer.app.start import first_state
+    from explorer.geometry.meshes import get_mesh
+
+    tmap = TextureMap(str(tmp_path / "a.png"), scale=(2.0, 3.0, 1.0), clamp=True)
+    scene = Scene(material=Material(diffuse_map=tmap), color_control="separate")
+    mesh = get_mesh("sphere", 8)
+    state = first_state(scene, mesh, name="sphere")
+    save_session(tmp_path / "s.yaml", state)
+    back, _ = load_session(tmp_path / "s.yaml")
+    assert back.scene.material.diffuse_map == tmap
+    assert back.scene.color_control == "separate"
