@@ -119,10 +119,18 @@ def run(args) -> int:
                 "per-pixel shading); the material keeps it",
                 file=sys.stderr,
             )
-    if texture is not None and (turntable or suffix not in (".png",)):
+    if texture is not None and suffix == ".glb" and scene.color_control == "separate":
         say(
-            f"warning: {args.out}: the diffuse_map is not drawn into this output (only a PNG "
-            "picture wears it); the vertices carry their untextured colours",
+            f"warning: {args.out}: glTF's base colour is texture x COLOR_0, OpenGL's single "
+            "colour: the GLB holds that (the texture darkens the highlight; glTF has no "
+            "separate specular colour)",
+            file=sys.stderr,
+        )
+        texture = textured(scene.replace(color_control="single"), mesh, materials)
+    elif texture is not None and (turntable or suffix not in (".png", ".glb")):
+        say(
+            f"warning: {args.out}: the diffuse_map is not drawn into this output (a PNG "
+            "picture and a GLB wear it); the vertices carry their untextured colours",
             file=sys.stderr,
         )
     name = scene.material.name or "material"
@@ -141,7 +149,12 @@ def run(args) -> int:
         what = f"{size[0]}x{size[1]} picture"
     else:
         data = mesh_file_bytes(
-            mesh, colors, suffix, scene.material.opacity, double_sided=scene.two_sided
+            mesh,
+            colors,
+            suffix,
+            scene.material.opacity,
+            double_sided=scene.two_sided,
+            texture=texture if suffix == ".glb" else None,
         )
         what = f"{mesh.n_vertices} vertices with colours"
         warn_if_unreadable(args.out, len(data))
