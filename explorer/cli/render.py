@@ -42,7 +42,7 @@ from explorer.render.exports import OUTPUT_SUFFIXES, mesh_file_bytes, obj_files
 from explorer.render.images import encode_png
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
-from explorer.render.textured import not_drawn_per_vertex, textured
+from explorer.render.textured import file_maps, not_drawn_per_vertex, textured
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -111,6 +111,9 @@ def run(args) -> int:
                 file=sys.stderr,
             )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
+    materials, notes = file_maps(mesh, materials)
+    for note in notes:
+        say(f"warning: {note}", file=sys.stderr)
     texture = textured(scene, mesh, materials)  # the image read (or refused) before any work
     for m in materials or (scene.material,):
         for key in not_drawn_per_vertex(m):

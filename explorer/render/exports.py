@@ -231,7 +231,8 @@ def glb_bytes(
 
 
 def obj_files(mesh: Mesh, materials, mtl_name: str) -> tuple[bytes, bytes]:
-    """``(obj, mtl)`` file contents: the mesh with normals, and its materials.
+    """``(obj, mtl)`` file contents: the mesh with normals (and its texture coordinates as
+    ``vt`` when it has them), and its materials (their maps as they name them).
 
     materials : ``[(name, Material), ...]``: one for the whole mesh, or one per group of
         ``mesh.groups`` (each group becomes a ``usemtl`` block)
@@ -245,6 +246,9 @@ def obj_files(mesh: Mesh, materials, mtl_name: str) -> tuple[bytes, bytes]:
     lines = [f"# written by phong-explorer {__version__}", f"mtllib {mtl_name}"]
     lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in mesh.positions.tolist()]
     lines += [f"vn {x!r} {y!r} {z!r}" for x, y, z in mesh.normals.tolist()]
+    if mesh.uv is not None:  # the texture coordinates: vertex k's vt is k too
+        lines += [f"vt {u!r} {v!r}" for u, v in mesh.uv.tolist()]
+    corner = "{0}/{0}/{0}" if mesh.uv is not None else "{0}//{0}"
     faces = mesh.faces + 1
     if per_group:
         owner = groups.of_vertex[mesh.faces[:, 0]]
@@ -253,7 +257,7 @@ def obj_files(mesh: Mesh, materials, mtl_name: str) -> tuple[bytes, bytes]:
         blocks = [(materials[0][0], faces)]
     for name, block in blocks:
         lines.append(f"usemtl {name}")
-        lines += [f"f {a}//{a} {b}//{b} {c}//{c}" for a, b, c in block.tolist()]
+        lines += ["f " + " ".join(corner.format(i) for i in tri) for tri in block.tolist()]
     obj = "\n".join(lines) + "\n"
     header = f"materials of {mesh.name}, written by phong-explorer {__version__}"
     return obj.encode("utf-8"), format_mtl(materials, header=header).encode("utf-8")

@@ -58,7 +58,8 @@ class Textured:
 def texture_map(scene, materials=None) -> TextureMap | None:
     """The ``diffuse_map`` a per-vertex picture of the scene wears, or None.
 
-    materials : a mesh file's group materials; they must name one map between them (or none)
+    materials : a mesh file's group materials; they must name one map between them (or none:
+        see :func:`file_maps`)
     """
     found = {m.diffuse_map for m in (materials or (scene.material,))}
     if len(found) > 1:
@@ -67,6 +68,23 @@ def texture_map(scene, materials=None) -> TextureMap | None:
             "picture draws one texture; give --preset NAME (or --diffuse-map IMG) to draw one"
         )
     return found.pop()
+
+
+def file_maps(mesh: Mesh, materials) -> tuple[tuple | None, list[str]]:
+    """``(materials, warnings)``: a mesh file's own materials as a picture can draw them. Their
+    diffuse maps are kept when the mesh has texture coordinates and the groups name one map
+    between them; else they are taken off (the picture is untextured), with one warning."""
+    if not materials or not any(m.diffuse_map is not None for m in materials):
+        return materials, []
+    names = sorted({m.diffuse_map.file for m in materials if m.diffuse_map is not None})
+    if mesh.uv is None:
+        why = "it has no texture coordinates (vt lines)"
+    elif len({m.diffuse_map for m in materials}) > 1:
+        why = "its groups wear different diffuse maps (or some none); a picture draws one"
+    else:
+        return materials, []
+    plain = tuple(m.replace(diffuse_map=None) for m in materials)
+    return plain, [f"{mesh.name}: diffuse_map {', '.join(names)} not drawn: {why}"]
 
 
 def not_drawn_per_vertex(material) -> list[str]:

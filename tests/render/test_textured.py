@@ -264,3 +264,57 @@ def test_render_diffuse_map_on_the_teapot(tmp_path, capsys):
     ]
     assert main(argv) == 0
     assert out.exists()
+
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "docs" / "examples"
+
+
+def test_the_textured_example_is_drawn_in_its_own_map(tmp_path, capsys):
+    """docs/examples/textured_teapot.obj: its vt, its .mtl's map_Kd, tiles.png beside it."""
+    out = tmp_path / "t.png"
+    obj = str(EXAMPLES / "textured_teapot.obj")
+    assert main(["render", "--mesh", obj, "--size", "96x72", "--out", str(out)]) == 0
+    assert "warning" not in capsys.readouterr().err
+    from explorer.geometry.filematerials import group_materials
+
+    mesh = M.load_mesh(obj)
+    (material,), _ = group_materials(mesh, explorer.Scene().material)
+    assert material.diffuse_map.file == str(EXAMPLES / "tiles.png")
+    plain = explorer.load_scene({}).replace(material=material.replace(diffuse_map=None))
+    tiled = explorer.load_scene({}).replace(material=material)
+    from explorer.render.offscreen import render_image
+
+    a, b = render_image(plain, mesh, (96, 72)), render_image(tiled, mesh, (96, 72))
+    assert np.abs(a.astype(int) - b.astype(int)).max() > 100  # the tiles show
+
+
+def test_a_mesh_files_map_without_vt_is_a_warning_and_an_untextured_picture(tmp_path, capsys):
+    (tmp_path / "m.mtl").write_text("newmtl red\nKd 1 0 0\nmap_Kd tex.png\n")
+    (tmp_path / "m.obj").write_text(
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"
+    )
+    out = tmp_path / "out.png"
+    assert main(["render", "--mesh", str(tmp_path / "m.obj"), "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "m.obj: diffuse_map" in err and "not drawn: it has no texture coordinates" in err
+    assert out.exists()
+
+
+def test_an_obj_export_keeps_the_texture_coordinates(tmp_path, capsys):
+    out = tmp_path / "t.obj"
+    argv = [
+        "render",
+        "--mesh",
+        "plane",
+        "--resolution",
+        "2",
+        "--diffuse-map",
+        _white(tmp_path),
+        "--out",
+        str(out),
+    ]
+    assert main(argv) == 0
+    back = M.load_mesh(out)
+    plane = M.plane(2, uv=True)
+    np.testing.assert_allclose(back.uv[back.faces], plane.uv[plane.faces])
+    assert "map_Kd" in (tmp_path / "t.mtl").read_text()
