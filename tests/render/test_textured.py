@@ -318,3 +318,22 @@ def test_an_obj_export_keeps_the_texture_coordinates(tmp_path, capsys):
     plane = M.plane(2, uv=True)
     np.testing.assert_allclose(back.uv[back.faces], plane.uv[plane.faces])
     assert "map_Kd" in (tmp_path / "t.mtl").read_text()
+
+
+def test_the_sheet_refuses_a_diffuse_map_it_would_not_draw(tmp_path, capsys):
+    out = tmp_path / "s.png"
+    argv = ["sheet", "--diffuse-map", _white(tmp_path), "--out", str(out)]
+    assert main(argv) == 2
+    assert "--diffuse-map: the sheet draws each preset untextured" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_the_explorer_starts_on_a_built_in_mesh_with_uv_for_a_diffuse_map(tmp_path):
+    from explorer.cli import build_parser
+    from explorer.cli.explorerstart import start
+
+    args = build_parser().parse_args(["gui", "--mesh", "torus", "--diffuse-map", _white(tmp_path)])
+    scene, mesh, _ = start(args)
+    assert scene.material.diffuse_map is not None and mesh.uv is not None
+    _, plain, _ = start(build_parser().parse_args(["gui", "--mesh", "torus"]))
+    assert plain.uv is None  # without a map the explorer's meshes are as before
