@@ -236,4 +236,7 @@ class PixelLayer:
             self._actor.SetTexture(None)
             self._actor.GetShaderProperty().ClearAllFragmentShaderReplacements()
             self._actor = None
+            if drawing.texture is not None:  # a diffuse_map's actor: made anew, with its (u, v)
+                drawing.texture = None
+                drawing.set_texture(self.view.plotter, self.view.state.shown_scene())
         self.shown = self._actor is not None

@@ -48,6 +48,8 @@ from explorer.render.camera import (
     mesh_frame,
     out_of_frame,
 )
+from explorer.render.textured import SECONDARY, Textured, add_textured, texture_arrays
+from explorer.render.textures import read_texture
 from explorer.render.vtk import add_unlit, cells, polydata
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import Shader
@@ -217,6 +219,8 @@ class MeshDrawing:
         self.sorted_for = None  # camera the triangles were last sorted for (translucency)
         self.groups = None  # one material per group of mesh.groups, or None: the scene's
         self._rows = None
+        self.texture = None  # (diffuse map, color_control) worn, or None
+        self.secondary = None  # the separate specular colour VTK draws (RGBA float32 view)
 
     def set_groups(self, materials) -> None:
         """Draw each group of ``mesh.groups`` in its own material (a tuple, one per group),
@@ -226,17 +230,55 @@ class MeshDrawing:
             self._rows = [g.vertices(i) for i in range(len(g.names))]
         self.groups = materials
 
-    def colors(self) -> np.ndarray:
+    def set_texture(self, plotter, scene) -> None:
+        """Wear the drawn materials' one ``diffuse_map`` as ``render`` does
+        (:mod:`explorer.render.textured`: GL_MODULATE, the scene's ``color_control``) when the
+        mesh has (u, v); else none. The actor is made anew only when the map or mode changes."""
+        materials = self.groups or (scene.material,)
+        maps = {m.diffuse_map for m in materials}
+        tmap = maps.pop() if len(maps) == 1 and self.mesh.uv is not None else None
+        texture = None if tmap is None else (tmap, scene.color_control)
+        if texture == self.texture:
+            return
+        visible = self.actor.GetVisibility()
+        plotter.remove_actor(self.actor, render=False)
+        self.texture, self.secondary = texture, None
+        if tmap is None:
+            self.actor = add_unlit(plotter, self.poly)
+        else:
+            n = self.mesh.n_vertices
+            t = Textured(self.rgb, np.zeros((n, 3), np.uint8), read_texture(tmap), tmap)
+            texture_arrays(self.poly, self.mesh, t)
+            self.actor = add_textured(plotter, self.poly, t)
+            self.secondary = self.poly.point_data[SECONDARY]
+        self.actor.SetVisibility(visible)
+
+    def colors(self, change=None) -> np.ndarray:
         """(n, 3) display colours in [0, 1] (:func:`explorer.shading.display.shown`): each
         group in its material when :attr:`groups` is set (the Shader keeps the light sums;
-        each material recomposes them)."""
-        if self.groups is None:
+        each material recomposes them); ``change(material)``: each material changed so."""
+        if change is None and self.groups is None:
             return shown(self.shader.colors, self.shader.scene)
-        return shown(grouped_colors(self.shader, self._rows, self.groups), self.shader.scene)
+        own = self.shader.scene.material
+        if self.groups is None:
+            self.shader.set_material(change(own))
+            out = np.array(self.shader.colors)
+            self.shader.set_material(own)
+            return shown(out, self.shader.scene)
+        groups = [change(m) for m in self.groups] if change else self.groups
+        return shown(grouped_colors(self.shader, self._rows, groups), self.shader.scene)
 
     def upload(self) -> None:
-        """Write the display colours into VTK's array as 8-bit values and mark it modified."""
-        to_bytes(self.colors(), out=self.rgb)
+        """Write the display colours into VTK's array as 8-bit values and mark it modified
+        (under separate specular: the primary colour there, the specular one beside it)."""
+        if self.secondary is None or self.texture[1] != "separate":
+            to_bytes(self.colors(), out=self.rgb)
+        else:
+            black = (0.0, 0.0, 0.0)
+            to_bytes(self.colors(lambda m: m.replace(specular=black)), out=self.rgb)
+            q = self.colors(lambda m: m.replace(ambient=black, diffuse=black, emission=black))
+            self.secondary[:, :3] = to_bytes(q) / np.float32(255.0)
+            self.poly.GetPointData().GetArray(SECONDARY).Modified()
         self.vtk_colors.Modified()
 
     def sort_for(self, camera: Camera) -> None:
@@ -335,6 +377,7 @@ class SceneView:
             for d in self.drawings:
                 d.shader.set_scene(scene)
                 d.set_groups(groups if d.mesh.groups is not None else None)
+                d.set_texture(self.plotter, scene)
                 d.actor.GetProperty().SetOpacity(state.material.opacity)
             self.active.upload()
         self._show_handle(state)

@@ -53,7 +53,7 @@ def start(args):
     spec = args.mesh if args.mesh is not None else (scene.mesh or gui.DEFAULT_MESH)
     scene = scene.replace(mesh=spec)  # the state names the mesh shown
     if args.resolution is None and spec in gui.MESH_CHOICES:
-        mesh = get_mesh(spec, gui.MESH_CHOICES[spec])
+        mesh = get_mesh(spec, gui.MESH_CHOICES[spec], uv=bool(scene.material.maps()))
     r = mesh.radius or 1.0
     if scene.lights == (placeholder,):  # no scene lights and no --light-* option
         az, el, d = DEFAULT_PLACEMENT

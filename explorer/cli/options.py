@@ -24,7 +24,7 @@ from explorer.core.lights import LIGHT_CLASSES, LIGHT_TYPES, parse_light
 from explorer.core.material import MODELS
 from explorer.core.mtl import MtlError
 from explorer.core.presets import find_preset
-from explorer.core.scene import Scene, Viewer, load_scene
+from explorer.core.scene import COLOR_CONTROLS, Scene, Viewer, load_scene
 from explorer.core.text import printable, say
 from explorer.core.validate import Checker, notice
 from explorer.geometry.filematerials import group_materials
@@ -156,6 +156,22 @@ def add_scene_arguments(
         "--background", nargs=3, type=float, metavar=("R", "G", "B"),
         help="background colour, each in [0, 1] (default 0.32 0.32 0.32)",
     )  # fmt: skip
+    t = p.add_argument_group("texture (docs/formats.md)")
+    t.add_argument(
+        "--diffuse-map",
+        dest="diffuse_map",
+        metavar="IMG",
+        default=None,
+        help="the material's diffuse_map: a PNG or JPEG image the surface wears (GL_MODULATE)",
+    )
+    t.add_argument(
+        "--color-control",
+        dest="color_control",
+        choices=COLOR_CONTROLS,
+        default=None,
+        help="how a texture meets the highlight: single (OpenGL's default: the texture "
+        "darkens it) or separate (GL_SEPARATE_SPECULAR_COLOR: added after the texture)",
+    )
     h = p.add_argument_group("HDR (scene key hdr: {exposure, tone_map}); either option turns it on")
     h.add_argument(
         "--exposure", type=float, metavar="STOPS", default=None,
@@ -290,6 +306,12 @@ def build_scene(args, *, default_light=None):
             )
         except ValidationError as exc:
             raise ValidationError([as_flag(p, "--") for p in exc.problems]) from None
+    diffuse_map = getattr(args, "diffuse_map", None)
+    if diffuse_map is not None:
+        material = changes.get("material", scene.material)
+        changes["material"] = material.replace(diffuse_map=os.path.expanduser(diffuse_map))
+    if getattr(args, "color_control", None) is not None:
+        changes["color_control"] = args.color_control
     scene = scene.replace(**changes)
     spec = args.mesh if args.mesh is not None else scene.mesh
     if spec is None:
@@ -299,7 +321,7 @@ def build_scene(args, *, default_light=None):
         raise ExplorerError(
             f"--resolution applies to the built-in meshes {have}; not to {str(spec)!r}"
         )
-    return scene, get_mesh(spec, args.resolution)
+    return scene, get_mesh(spec, args.resolution, uv=bool(scene.material.maps()))
 
 
 def check_out(path: str, suffixes: tuple[str, ...], force: bool) -> str:

@@ -239,7 +239,8 @@ def export(name: str, out_path: str, force: bool, materials_dirs, out=None, err=
             f"--out {out_path!r}: the file name must end in {' or '.join(EXPORT_SUFFIXES)}"
         )
     material, preset, origin = _load(name, materials_dirs)
-    converted = convert(material, preset, EXPORT_SUFFIXES[suffix])
+    folder = os.path.dirname(os.path.abspath(out_path))
+    converted = convert(material, preset, EXPORT_SUFFIXES[suffix], folder)
     write_atomic(out_path, converted.text.encode("utf-8"), overwrite=force)
     out.write(f"wrote {printable(out_path)}: {printable(origin)} as {EXPORT_SUFFIXES[suffix]}\n")
     for note in converted.notes:

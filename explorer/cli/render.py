@@ -12,6 +12,7 @@
     phong-explorer render --preset gold --mesh teapot --strip --out strip.png  (term by term)
     phong-explorer render --preset gold --strip --strip-mode raw --strip-lights --out s.png
     phong-explorer render --preset gold --lobes --out lobes.png   (the lobes, BRDF, albedo)
+    phong-explorer render --preset gold --mesh teapot --diffuse-map wood.png --out t.png
 
 An OBJ whose ``mtllib`` defines materials is drawn with them, each ``usemtl`` group in its own
 material; ``--preset`` draws the whole mesh in one preset instead. The scene options are in
@@ -51,6 +52,7 @@ from explorer.render.live import picture
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
 from explorer.render.strip import STRIP_TILE, render_strip
+from explorer.render.textured import file_maps, not_drawn_per_vertex, textured
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -162,11 +164,41 @@ def run(args) -> int:
                 "--per-pixel draws one material: give --preset NAME for a mesh with its own "
                 "materials"
             )
+        if scene.material.maps():
+            say(
+                "warning: --per-pixel does not draw texture maps yet; the picture is untextured",
+                file=sys.stderr,
+            )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
     if args.strip:
         return run_strip(args, scene, mesh, materials, background)
     if args.tile is not None or args.strip_lights:
         raise ExplorerError("--tile and --strip-lights draw the strip: give --strip too")
+    materials, notes = file_maps(mesh, materials)
+    for note in notes:
+        say(f"warning: {note}", file=sys.stderr)
+    texture = textured(scene, mesh, materials)  # the image read (or refused) before any work
+    for m in materials or (scene.material,):
+        for key in not_drawn_per_vertex(m):
+            say(
+                f"warning: {key} {getattr(m, key).file}: not drawn per vertex (it needs "
+                "per-pixel shading); the material keeps it",
+                file=sys.stderr,
+            )
+    if texture is not None and suffix == ".glb" and scene.color_control == "separate":
+        say(
+            f"warning: {args.out}: glTF's base colour is texture x COLOR_0, OpenGL's single "
+            "colour: the GLB holds that (the texture darkens the highlight; glTF has no "
+            "separate specular colour)",
+            file=sys.stderr,
+        )
+        texture = textured(scene.replace(color_control="single"), mesh, materials)
+    elif texture is not None and (turntable or suffix not in (".png", ".glb")):
+        say(
+            f"warning: {args.out}: the diffuse_map is not drawn into this output (a PNG "
+            "picture and a GLB wear it); the vertices carry their untextured colours",
+            file=sys.stderr,
+        )
     name = scene.material.name or "material"
     if materials:
         name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
@@ -178,12 +210,19 @@ def run(args) -> int:
     if suffix == ".obj":
         return run_obj(args, scene, mesh, materials)
     if suffix == ".png":
-        image = render_image(scene, mesh, size, background=background, colors=colors)
+        image = render_image(
+            scene, mesh, size, background=background, colors=colors, texture=texture
+        )
         data = encode_png(image)
         what = f"{size[0]}x{size[1]} picture"
     else:
         data = mesh_file_bytes(
-            mesh, colors, suffix, scene.material.opacity, double_sided=scene.two_sided
+            mesh,
+            colors,
+            suffix,
+            scene.material.opacity,
+            double_sided=scene.two_sided,
+            texture=texture if suffix == ".glb" else None,
         )
         what = f"{mesh.n_vertices} vertices with colours"
         warn_if_unreadable(args.out, len(data))

@@ -67,6 +67,8 @@ def run(args) -> int:
     tile = size_from_option(args.tile, "--tile")
     if args.columns < 1:
         raise ExplorerError(f"--columns must be at least 1, got {args.columns}")
+    if args.diffuse_map is not None:
+        raise ExplorerError("--diffuse-map: the sheet draws each preset untextured; use render")
     background = background_from_options(args)
     args.mesh_default = "teapot"
     chosen = args.preset

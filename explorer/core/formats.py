@@ -52,11 +52,14 @@ class Converted:
     notes: tuple[str, ...]
 
 
-def convert(material: Material, name: str, fmt: str) -> Converted:
-    """``material`` (preset ``name``) in format ``fmt`` (:data:`SHOW_FORMATS`)."""
+def convert(material: Material, name: str, fmt: str, folder=None) -> Converted:
+    """``material`` (preset ``name``) in format ``fmt`` (:data:`SHOW_FORMATS`); folder : where
+    the file goes (its texture images are named relative to it when inside it)."""
     writers = {"mtl": to_mtl, "threejs": to_threejs, "x3d": to_x3d, "blender": to_blender}
     if fmt not in writers:
         raise ExplorerError(f"unknown material format {fmt!r}; use one of {', '.join(writers)}")
+    if fmt == "mtl":
+        return to_mtl(material, name, folder)
     return writers[fmt](material, name)
 
 
@@ -64,10 +67,12 @@ def _header(name: str) -> str:
     return f"material '{name}', written by phong-explorer {__version__}"
 
 
-def to_mtl(material: Material, name: str) -> Converted:
-    """Wavefront MTL: exact (floats written in ``repr`` form)."""
+def to_mtl(material: Material, name: str, folder=None) -> Converted:
+    """Wavefront MTL: exact (floats written in ``repr`` form), the texture maps with their
+    options (images inside ``folder`` named relative to it)."""
     notes = [f"MTL cannot hold {what}" for what in lost_in_mtl(material)]
-    return Converted(format_mtl([(name, material)], header=_header(name)), tuple(notes))
+    text = format_mtl([(name, material)], header=_header(name), folder=folder)
+    return Converted(text, tuple(notes))
 
 
 def hex_colour(rgb) -> int:
@@ -92,6 +97,8 @@ def to_threejs(material: Material, name: str) -> Converted:
         "transparent": material.opacity < 1.0,
         "userData": {"phong_explorer": material.to_mapping()},
     }
+    if material.diffuse_map is not None:
+        data.update(_threejs_map(material.diffuse_map))
     notes = [
         "colours become 8-bit sRGB hex numbers (three.js's JSON form), within 1/510 of the "
         "values; the exact floats are kept in userData.phong_explorer",
@@ -105,9 +112,47 @@ def to_threejs(material: Material, name: str) -> Converted:
     ]
     if material.model == "phong":
         notes.append("model phong becomes Blinn-Phong (three.js's only Phong lobe)")
+    if material.diffuse_map is not None:
+        notes.append(
+            "map: three.js decodes the image as sRGB and multiplies in linear light "
+            "(colorSpace SRGBColorSpace); OpenGL 2.1 multiplies the stored values, so mid "
+            "tones of the texture come out darker in three.js"
+        )
     notes += [f"three.js has no {what}" for what in _effects(material)]
+    notes += [
+        f"{key} is not written (MeshPhongMaterial JSON here keeps only map)"
+        for key in material.maps()
+        if key != "diffuse_map"
+    ]
     text = json.dumps(data, indent=2) + "\n"
     return Converted(text, tuple(notes))
+
+
+#: three.js's constants: RepeatWrapping, ClampToEdgeWrapping, NearestFilter
+_THREE_REPEAT, _THREE_CLAMP, _THREE_NEAREST = 1000, 1001, 1003
+
+
+def _threejs_map(tmap) -> dict:
+    """``map`` and the texture and image it names, as three.js's ``toJSON`` writes them (the
+    ids fixed, so a file is the same every time)."""
+    wrap = _THREE_CLAMP if tmap.clamp else _THREE_REPEAT
+    return {
+        "map": "phong-explorer-diffuse-map",
+        "textures": [
+            {
+                "uuid": "phong-explorer-diffuse-map",
+                "image": "phong-explorer-diffuse-image",
+                "repeat": [tmap.scale[0], tmap.scale[1]],
+                "offset": [tmap.offset[0], tmap.offset[1]],
+                "wrap": [wrap, wrap],
+                "magFilter": _THREE_NEAREST,
+                "minFilter": _THREE_NEAREST,
+                "flipY": True,
+                "colorSpace": "srgb",
+            }
+        ],
+        "images": [{"uuid": "phong-explorer-diffuse-image", "url": tmap.file}],
+    }
 
 
 def x3d_ambient_intensity(material: Material) -> float:
@@ -143,6 +188,7 @@ def to_x3d(material: Material, name: str) -> Converted:
         "    <Shape>\n"
         "      <Appearance>\n"
         f"        <Material {body}/>\n"
+        f"{_x3d_texture(material.diffuse_map)}"
         "      </Appearance>\n"
         "      <Sphere/>\n"
         "    </Shape>\n"
@@ -167,8 +213,27 @@ def to_x3d(material: Material, name: str) -> Converted:
         notes.append(f"shininess {material.shininess:g} is written as {shininess:.6g} × 128")
     if material.model == "phong":
         notes.append("model phong: X3D does not say which lobe a browser uses (mostly Blinn)")
+    if material.diffuse_map is not None:
+        notes.append(
+            "ImageTexture: an RGB texture replaces diffuseColor in X3D's lighting (it does not "
+            "multiply it as OpenGL's GL_MODULATE does the lit colour)"
+        )
     notes += [f"X3D has no {what}" for what in _effects(material)]
     return Converted(text, tuple(notes))
+
+
+def _x3d_texture(tmap) -> str:
+    """The ``ImageTexture`` (and its ``TextureTransform``) of a diffuse map, or ""."""
+    if tmap is None:
+        return ""
+    repeat = "false" if tmap.clamp else "true"
+    url = quoteattr(json.dumps(tmap.file))
+    text = f"        <ImageTexture url={url} repeatS='{repeat}' repeatT='{repeat}'/>\n"
+    if tmap.scale[:2] != (1.0, 1.0) or tmap.offset[:2] != (0.0, 0.0):
+        scale = f"{tmap.scale[0]!r} {tmap.scale[1]!r}"
+        offset = f"{tmap.offset[0]!r} {tmap.offset[1]!r}"
+        text += f"        <TextureTransform scale='{scale}' translation='{offset}'/>\n"
+    return text
 
 
 def blender_settings(material: Material) -> dict:

@@ -19,7 +19,9 @@ the lecture notes; a material may use either form per term, but not both for the
   so ``{color: [1, 0, 0]}`` alone is OpenGL's default material in red.
 
 ``shininess`` (exponent in [0, 1000]), ``opacity`` (in [0, 1], 1 = opaque), an optional default
-``model`` (``blinn`` / ``phong``) and a one-line ``description`` complete it. Only the resolved
+``model`` (``blinn`` / ``phong``) and a one-line ``description`` complete it; so do the texture
+maps (``diffuse_map``, ``ambient_map``, ``emission_map``, ``specular_map``, ``shininess_map``,
+``bump_map``: :mod:`explorer.core.texture`), each optional. Only the resolved
 RGB coefficients are kept: a material read in the scalar form is saved in the RGB form, with
 identical colours.
 
@@ -45,6 +47,7 @@ from dataclasses import dataclass, field
 from functools import partial
 from typing import ClassVar
 
+from explorer.core.texture import MAP_KEYS, TextureMap, parse_texture_map
 from explorer.core.validate import Check, Checked, Checker, check_fields, check_values
 
 RGB = tuple[float, float, float]
@@ -65,6 +68,7 @@ MATERIAL_KEYS = (
         "fresnel",
         "energy_conserving",
     )
+    + MAP_KEYS
 )
 #: Allowed shininess in files and sliders (the engine itself accepts any finite value >= 0).
 SHININESS_RANGE = (0.0, 1000.0)
@@ -129,6 +133,8 @@ class Material(Checked):
         weighted by ``F = F0 + (1 - F0)·(1 - V·H)^5`` (see :mod:`explorer.shading.effects`)
     energy_conserving : normalise the specular lobe, ``(n + 2)/(2π)`` (Phong) or
         ``(n + 8)/(8π)`` (Blinn), so a higher shininess narrows the highlight without dimming it
+    diffuse_map, ambient_map, emission_map, specular_map, shininess_map, bump_map : a
+        :class:`~explorer.core.texture.TextureMap` each, or None (no texture)
     """
 
     ambient: RGB = (0.2, 0.2, 0.2)
@@ -142,6 +148,12 @@ class Material(Checked):
     description: str = field(default="", compare=False)
     fresnel: float | None = None
     energy_conserving: bool = False
+    diffuse_map: TextureMap | None = None
+    ambient_map: TextureMap | None = None
+    emission_map: TextureMap | None = None
+    specular_map: TextureMap | None = None
+    shininess_map: TextureMap | None = None
+    bump_map: TextureMap | None = None
 
     #: key -> its check (the engine's range: coefficients and shininess >= 0), in the order a
     #: file's problems are listed
@@ -153,6 +165,7 @@ class Material(Checked):
         "description": _text,
         "fresnel": _fresnel,
         "energy_conserving": _flag,
+        **dict.fromkeys(MAP_KEYS, parse_texture_map),
     }
 
     def to_mapping(self) -> dict:
@@ -175,7 +188,14 @@ class Material(Checked):
             out["fresnel"] = float(self.fresnel)
         if self.energy_conserving:
             out["energy_conserving"] = True
+        for key in MAP_KEYS:
+            if getattr(self, key) is not None:
+                out[key] = getattr(self, key).to_mapping()
         return out
+
+    def maps(self) -> dict[str, TextureMap]:
+        """The texture maps the material has, key -> map, in :data:`MAP_KEYS` order."""
+        return {key: getattr(self, key) for key in MAP_KEYS if getattr(self, key) is not None}
 
     # -- scalar view (ka / kd / ks sliders) ---------------------------------------------------
     def scalars(self) -> tuple[float, float, float]:

@@ -9,9 +9,13 @@ approximations and the sources it was checked against: ``docs/formats.md``)::
 
 A colour with one number is grey (``Kd 0.5`` is ``Kd 0.5 0.5 0.5``). A material without a
 statement keeps the engine's default for it (OpenGL's: ambient 0.2, diffuse 0.8, specular 0,
-emission 0, shininess 0). ``Ni``, ``illum``, ``Tf``, ``sharpness``, texture maps and unknown
-statements are kept out of the material, each with a warning; so are values that work
-differently here (``Ka 1 1 1``, ``Ns 0``, ``Ns`` above OpenGL's 128).
+emission 0, shininess 0). The texture maps ``map_Kd``, ``map_Ka``, ``map_Ke``, ``map_Ks``,
+``map_Ns`` and ``bump`` (``map_Bump``) become the material's maps with their options ``-s``,
+``-o``, ``-clamp``, ``-bm``, ``-imfchan`` (:mod:`explorer.core.texture`; an image named
+outside the .mtl's folder is refused); the other options of a map and the other maps (``disp``,
+``decal``, ``refl``, ``map_d``, ...) are dropped with a warning. ``Ni``, ``illum``, ``Tf``,
+``sharpness`` and unknown statements are kept out of the material, each with a warning; so are
+values that work differently here (``Ka 1 1 1``, ``Ns 0``, ``Ns`` above OpenGL's 128).
 
 A file the reader cannot take (a word where a number belongs, ``spectral`` / ``xyz``
 colours, a value outside the range a preset file holds, a statement before any ``newmtl``, no
@@ -24,6 +28,7 @@ the line; nothing is half read.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import re
@@ -41,6 +46,7 @@ from explorer.core.material import (
     Material,
 )
 from explorer.core.presets import MAX_NAME_LENGTH, SUFFIX, save_presets
+from explorer.core.texture import MAP_STATEMENTS, MTL_MAP_KEYS, parse_mtl_map, resolve_map
 from explorer.core.validate import format_number
 
 #: colour statement -> the material field it sets
@@ -96,12 +102,15 @@ class MtlMaterial:
     material : the engine's material (``material.name`` is None: see :func:`preset_name`)
     line : the line of its ``newmtl``
     warnings : what was dropped or works differently here, one sentence each
+    source : the file name the messages give; map_lines : map key -> the line of its statement
     """
 
     name: str
     material: Material
     line: int
     warnings: tuple[str, ...] = field(default=())
+    source: str = field(default="<mtl>", compare=False)
+    map_lines: dict = field(default_factory=dict, compare=False)
 
 
 def read_mtl(path) -> list[MtlMaterial]:
@@ -114,7 +123,25 @@ def read_mtl(path) -> list[MtlMaterial]:
         data = read_checked(shown, cap=tol.MAX_MTL_FILE_BYTES, what="material library")
     except UnreadableFile as exc:
         raise MtlUnreadable(exc) from None
-    return parse_mtl(data, shown)
+    return [_resolved(m, os.path.dirname(shown)) for m in parse_mtl(data, shown)]
+
+
+def _resolved(found: MtlMaterial, folder: str) -> MtlMaterial:
+    """``found`` with its maps' images named from the .mtl's ``folder``; a name leading outside
+    it is an :class:`MtlError` at the map's line."""
+    changes = {}
+    for key, tmap in found.material.maps().items():
+        full = resolve_map(tmap, folder)
+        if full is None:
+            line = found.map_lines.get(key, found.line)
+            raise MtlError(
+                f"{found.source}:{line}: {MAP_STATEMENTS[key]} {tmap.file}: the image is outside "
+                "the .mtl's folder; put it beside the .mtl (or in a folder below it)"
+            )
+        changes[key] = full
+    if not changes:
+        return found
+    return dataclasses.replace(found, material=found.material.replace(**changes))
 
 
 def parse_mtl(data: bytes | str, source: str = "<mtl>") -> list[MtlMaterial]:
@@ -209,6 +236,7 @@ class _Builder:
         self.d_given = False
         self.illum: int | None = None
         self.seen: dict[str, int] = {}
+        self.map_lines: dict[str, int] = {}
 
     def statement(self, key: str, words: list[str], where: str) -> None:
         line = int(where.rsplit(":", 1)[1])
@@ -243,11 +271,19 @@ class _Builder:
         elif key in DROPPED:
             _number(words, None, where, words[0])
             self._warn(line, f"{where}: {DROPPED[key]}")
+        elif key in MTL_MAP_KEYS:
+            tmap, dropped, problem = parse_mtl_map(words, where)
+            if problem:
+                raise MtlError(problem)
+            for option in dropped:
+                self._warn(line, f"{where}: {words[0]} option {option} is not modelled; dropped")
+            self.fields[MTL_MAP_KEYS[key]] = tmap
+            self.map_lines[MTL_MAP_KEYS[key]] = line
         elif _TEXTURE.fullmatch(key):
             self._warn(
                 line,
-                f"{where}: texture map '{words[0]}' is not used: the engine shades with one "
-                "colour per term",
+                f"{where}: texture map '{words[0]}' is not used: the engine has no "
+                f"{words[0]} (it reads map_Kd, map_Ka, map_Ke, map_Ks, map_Ns and bump)",
             )
         else:
             self._warn(line, f"{where}: '{words[0]}' is not an MTL statement this reader uses")
@@ -277,7 +313,9 @@ class _Builder:
         material = Material(**self.fields)
         self._suspicious(material)
         warnings = [message for _, message in sorted(self.warnings, key=lambda w: w[0])]
-        return MtlMaterial(self.name, material, self.line, tuple(warnings))
+        return MtlMaterial(
+            self.name, material, self.line, tuple(warnings), self.source, dict(self.map_lines)
+        )
 
     def _warn_at(self, key: str, text: str) -> None:
         """Warn at the statement ``key`` (the ``newmtl`` line when it is absent)."""
@@ -450,11 +488,12 @@ def mtl_import(path, directory) -> MtlImport:
 
 
 # -- writing ---------------------------------------------------------------------------------
-def format_mtl(materials, header: str = "") -> str:
+def format_mtl(materials, header: str = "", folder=None) -> str:
     """An .mtl file of ``[(name, Material), ...]``: ``Ka Kd Ks Ke Ns d illum`` with every float
-    in ``repr`` form (it reads back identical). ``illum`` is 2 (highlight on), 1 when the
-    material has no specular colour. What MTL has no statement for (the specular model,
-    ``fresnel``, ``energy_conserving``) is written as a comment."""
+    in ``repr`` form (it reads back identical), then its maps (``map_Kd [options] file``; an
+    image inside ``folder``, the .mtl's own, is named relative to it). ``illum`` is 2
+    (highlight on), 1 when the material has no specular colour. What MTL has no statement for
+    (the specular model, ``fresnel``, ``energy_conserving``) is written as a comment."""
     lines = [f"# {line}" for line in header.splitlines()] if header else []
     for name, m in materials:
         if not name or any(c.isspace() for c in name):
@@ -468,6 +507,12 @@ def format_mtl(materials, header: str = "") -> str:
         lines.append(f"Ns {float(m.shininess)!r}")
         lines.append(f"d {float(m.opacity)!r}")
         lines.append(f"illum {2 if max(m.specular) > 0.0 else 1}")
+        for key, tmap in m.maps().items():
+            if folder is not None and os.path.isabs(tmap.file):
+                inside_folder = os.path.relpath(tmap.file, folder)
+                if not inside_folder.startswith(os.pardir):
+                    tmap = dataclasses.replace(tmap, file=inside_folder)
+            lines.append(" ".join([MAP_STATEMENTS[key], *tmap.mtl_words()]))
         lines.extend(f"# not in MTL: {note}" for note in lost_in_mtl(m))
     return "\n".join(lines) + "\n"
 

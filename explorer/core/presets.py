@@ -30,6 +30,7 @@ from explorer.core.atomic import write_all_atomic, write_atomic
 from explorer.core.errors import ExplorerError, Notice, ValidationError
 from explorer.core.files import file_kind
 from explorer.core.material import Material, parse_material
+from explorer.core.texture import resolve_map
 from explorer.core.validate import Checker, suggest
 from explorer.core.version import __version__
 from explorer.core.yamlio import dump_yaml, load_yaml
@@ -150,12 +151,28 @@ def load_material_file(path) -> Material:
     line order. The material's name is the file stem."""
     doc = load_yaml(path, what="material file", collect=True)
     checker = doc.checker()
+    material = None
     if checker.mapping(doc.data, (), "a mapping of material keys") is not None:
         material = parse_material(doc.data, checker, ())
+    if material is not None and material.maps():
+        material = _maps_from(material, os.path.dirname(os.fspath(path)), checker)
     if checker.problems:
         raise ValidationError(sorted(checker.problems, key=lambda p: p.line or 0))
     assert material is not None  # parse_material records a problem whenever it gives None
     return material.replace(name=Path(os.fspath(path)).stem)
+
+
+def _maps_from(material: Material, folder: str, checker: Checker) -> Material:
+    """A preset's maps: a relative image name from the preset's folder (inside it), a full
+    one as it is (:func:`~explorer.core.texture.resolve_map`)."""
+    changes = {}
+    for key, tmap in material.maps().items():
+        full = resolve_map(tmap, folder, absolute=True)
+        if full is None:
+            checker.problem((key,), f"the image {tmap.file!r} is outside the preset's folder")
+        else:
+            changes[key] = full
+    return material.replace(**changes)
 
 
 def _scan(dirs, notices) -> dict[str, list[tuple[Path, str]]]:

@@ -15,6 +15,8 @@ The scene-file schema (every key optional)::
     hdr: {exposure: 0, tone_map: reinhard}   # unclamped colours, exposure, tone map, sRGB
                               # (hdr: true: these defaults; hdr: false: off)
     shading: per-vertex       # or per-pixel: where the explorer and render light the surface
+    color_control: single     # or separate: how a texture meets the specular light (OpenGL
+                              # 2.1's GL_LIGHT_MODEL_COLOR_CONTROL; docs/formats.md)
 
 Effects beyond the local model are off by default (docs/effects.md): ``shadows: true`` on a
 light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` on the scene.
@@ -22,8 +24,8 @@ light, ``fresnel: F0`` and ``energy_conserving: true`` on the material, ``hdr`` 
 Each key is checked by one function (:attr:`Scene.KEYS`, :attr:`Viewer.KEYS`; see
 :mod:`explorer.core.validate`), run by :func:`load_scene` on a file and by the constructor, with
 the same messages. The file's own forms stay in :func:`load_scene`: a material given by preset
-name, the model taken from the material when the file gives none, a mesh path relative to the
-file.
+name, the model taken from the material when the file gives none, a mesh path and the
+material's texture maps relative to the file (a map must lie inside the file's folder).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from explorer.core.hdr import HDR, parse_hdr
 from explorer.core.lights import DirectionalLight, parse_light, span, unit_vector
 from explorer.core.material import MODELS, Material, parse_material
 from explorer.core.presets import find_preset
+from explorer.core.texture import resolve_map
 from explorer.core.validate import Check, Checked, Checker, check_fields, old_keywords
 from explorer.core.yamlio import load_yaml
 
@@ -51,6 +54,10 @@ DEFAULT_AMBIENT = (0.2, 0.2, 0.2)
 #: (Gouraud, OpenGL 2.1's fixed function), or at every pixel's surface point with the
 #: interpolated normal (the engine per pixel: :mod:`explorer.render.perpixel`)
 SHADINGS = ("per-vertex", "per-pixel")
+#: how a textured picture adds the specular light (OpenGL 2.1's GL_LIGHT_MODEL_COLOR_CONTROL):
+#: ``single`` (GL_SINGLE_COLOR, the default: the texture multiplies every term) or
+#: ``separate`` (GL_SEPARATE_SPECULAR_COLOR: the specular sum is added after the texture)
+COLOR_CONTROLS = ("single", "separate")
 
 
 # -- the checks of each key ------------------------------------------------------------------
@@ -183,6 +190,10 @@ def _shading(checker: Checker, value, path):
     return checker.choice(value, path, SHADINGS)
 
 
+def _color_control(checker: Checker, value, path):
+    return checker.choice(value, path, COLOR_CONTROLS)
+
+
 DEFAULT_VIEWER = Viewer(to_viewer=(0.0, 0.0, 1.0))
 DEFAULT_LIGHTS: tuple = (DirectionalLight(to_light=(0.0, 0.0, 1.0)),)
 
@@ -206,6 +217,8 @@ class Scene(Checked):
     shading : "per-vertex" (Gouraud) or "per-pixel" (:data:`SHADINGS`): where the explorer's
         view and ``render`` light the surface; the engine's per-vertex colours do not depend
         on it
+    color_control : "single" or "separate": where a texture's picture adds the specular sum
+        (:data:`COLOR_CONTROLS`); a picture without a texture is the same under both
     """
 
     material: Material = field(default_factory=Material)
@@ -218,6 +231,7 @@ class Scene(Checked):
     source: str | None = field(default=None, compare=False)
     hdr: HDR | None = None
     shading: str = "per-vertex"
+    color_control: str = "single"
 
     #: key -> its check, run by the scene-file parser and by the constructor, in the order a
     #: file's problems are listed (a constructor also takes a mapping where a file does)
@@ -231,6 +245,7 @@ class Scene(Checked):
         "mesh": _mesh,
         "hdr": _hdr,
         "shading": _shading,
+        "color_control": _color_control,
     }
 
     def to_mapping(self) -> dict:
@@ -249,6 +264,8 @@ class Scene(Checked):
             out["hdr"] = self.hdr.to_mapping()
         if self.shading != "per-vertex":
             out["shading"] = self.shading
+        if self.color_control != "single":
+            out["color_control"] = self.color_control
         return out
 
 
@@ -323,8 +340,27 @@ def _parse(data, checker: Checker, materials_dirs, base_dir) -> Scene:
     mesh = kw.get("mesh")
     if mesh is not None and base_dir and _looks_like_path(mesh):
         kw["mesh"] = os.path.normpath(os.path.join(base_dir, os.path.expanduser(mesh)))
+    if material is not None and material.maps() and isinstance(m.get("material"), Mapping):
+        kw["material"] = _maps_from(material, base_dir, checker)
     checker.raise_if_any()
     return Scene(source=checker.file, **kw)
+
+
+def _maps_from(material: Material, base_dir, checker: Checker) -> Material:
+    """``material`` with its maps' images named from the scene file's folder ``base_dir`` (a
+    mapping given in code: as they are); a name leading outside that folder is a problem."""
+    changes = {}
+    for key, tmap in material.maps().items():
+        full = resolve_map(tmap, base_dir or None)
+        if full is None:
+            checker.problem(
+                ("material", key),
+                f"the image {tmap.file!r} is outside the scene file's folder; put it beside the "
+                "scene (or in a folder below it)",
+            )
+            continue
+        changes[key] = full
+    return material.replace(**changes)
 
 
 def _looks_like_path(mesh: str) -> bool:

@@ -223,6 +223,13 @@ MAX_MTL_FILE_BYTES = 16 << 20
 MAX_MTL_NAME_LENGTH = 256
 #: How many ``mtllib`` libraries one OBJ may name: each is a file opened and read.
 MAX_MTL_LIBRARIES = 64
+#: Largest texture image file read (bytes): a PNG or JPEG of the largest size below is at most
+#: a few tens of MiB; anything larger is refused before it is read.
+MAX_TEXTURE_FILE_BYTES = 64 << 20
+#: Most pixels a texture image may have (width × height), checked from the image's header
+#: before it is decoded: 4096 × 4096, 64 MiB as RGBA bytes. A 100 KB PNG can declare
+#: 50 000 × 50 000 pixels (10 GB decoded); OpenGL 2.1 drivers take 4096 or 8192 a side.
+MAX_TEXTURE_PIXELS = 4096 * 4096
 #: Largest of the other files the product reads (bytes): the window's recent-files list, the
 #: accuracy table (about 400 KB), ``/proc/cpuinfo`` for a benchmark's machine line (a few KB
 #: per core). Read through the checked open, which never trusts a size (``/proc`` gives 0).

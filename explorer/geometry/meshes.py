@@ -19,27 +19,37 @@ flattened with their transforms. Normals stored in the file are kept; where a fi
 vertices at the same position are welded and given smooth area-weighted normals.
 
 Every array of a :class:`Mesh` is read-only.
+
+Texture coordinates (``Mesh.uv``, (n, 2), None for a mesh without them): an OBJ's ``vt``; a
+built-in mesh asked for them (``get_mesh(name, uv=True)``) gets its own parametrisation
+(:mod:`explorer.geometry.uv`), the vertices on a seam split so each side keeps its (u, v).
 """
 
 from __future__ import annotations
 
-import bz2
-import gzip
 import io
 import os
 import warnings
-import zipfile
 from dataclasses import dataclass
 
 import numpy as np
 
-from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError, Notice
-from explorer.core.files import UnreadableFile, read_checked
 from explorer.core.validate import suggest
 from explorer.geometry import teapot_patches as data
 from explorer.geometry.frame import check_faces, check_vertices, frame_of
+from explorer.geometry.meshfile import (
+    drop_unused,
+    file_uv,
+    material_name,
+    part_uv,
+    read_mesh_file,
+    say_unread_materials,
+    triangle_parts,
+    used_vertices,
+)
 from explorer.geometry.sidefiles import CheckedResolver, library_names, obj_material_names
+from explorer.geometry.uv import spherical_corners, split_by_uv, wrapped_corners
 
 #: resolution option of each built-in mesh: (default, lowest, highest); None = no option
 RESOLUTION: dict[str, tuple[int, int, int] | None] = {
@@ -73,6 +83,8 @@ class Mesh:
     faces : (m, 3) int64 indices into positions, counter-clockwise seen from outside
     name : the built-in name or the file name
     groups : the file's material groups (an OBJ's ``usemtl``), or None
+    uv : (n, 2) float64 texture coordinates (an OBJ's ``vt``, a built-in's own), or None: the
+        mesh has none and cannot wear a texture
     """
 
     positions: np.ndarray
@@ -80,6 +92,7 @@ class Mesh:
     faces: np.ndarray
     name: str = "mesh"
     groups: MaterialGroups | None = None
+    uv: np.ndarray | None = None
 
     def __post_init__(self):
         # the engine's checks (shapes, real finite numbers, index ranges), then read-only
@@ -97,6 +110,14 @@ class Mesh:
         object.__setattr__(self, "positions", _frozen(p, np.float64))
         object.__setattr__(self, "normals", _frozen(n, np.float64))
         object.__setattr__(self, "faces", _frozen(f, np.int64))
+        if self.uv is not None:
+            uv = np.asarray(self.uv)
+            if uv.shape != (len(p), 2) or not np.isfinite(uv).all():
+                raise ExplorerError(
+                    f"mesh '{self.name}': uv must be ({len(p)}, 2) finite texture coordinates, "
+                    f"got shape {uv.shape}"
+                )
+            object.__setattr__(self, "uv", _frozen(uv, np.float64))
 
     @property
     def n_vertices(self) -> int:
@@ -163,7 +184,7 @@ class MaterialGroups:
 
 
 def _frozen(a: np.ndarray, dtype) -> np.ndarray:
-    """A read-only C-contiguous copy of a checked (n, 3) array."""
+    """A read-only C-contiguous copy of a checked (n, 3) (or (n, 2)) array."""
     arr = np.array(a, dtype=dtype, copy=True, order="C")
     arr.flags.writeable = False
     return arr
@@ -216,10 +237,13 @@ def area_weighted_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarra
     return _unit_rows(acc)
 
 
-def _weld(positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False):
+def _weld(
+    positions, normals, faces, keys=None, decimals: int = 9, *, sources: bool = False, kept=None
+):
     """Merge vertices at the same position (and the same key); average their normals; drop
     triangles that become degenerate. keys : (n,) int group of each vertex or None.
-    sources : also return (k,) the index of a source vertex of each new vertex."""
+    sources : also return (k,) the index of a source vertex of each new vertex.
+    kept : a list that receives the (m,) bool mask of the triangles kept."""
     q = np.round(positions, decimals)
     q[q == 0] = 0.0  # -0.0 and 0.0 are the same place
     table = q if keys is None else np.column_stack([q, keys])
@@ -236,9 +260,22 @@ def _weld(positions, normals, faces, keys=None, decimals: int = 9, *, sources: b
     keep = (
         (new_f[:, 0] != new_f[:, 1]) & (new_f[:, 1] != new_f[:, 2]) & (new_f[:, 0] != new_f[:, 2])
     )
+    if kept is not None:
+        kept.append(keep)
     if sources:
         return new_p, _unit_rows(acc), new_f[keep], first[order]
     return new_p, _unit_rows(acc), new_f[keep]
+
+
+def _with_uv(mesh: Mesh, corner_uv: np.ndarray) -> Mesh:
+    """``mesh`` with its vertices split by ``corner_uv`` (:func:`split_by_uv`), wearing them."""
+    src, faces, uv = split_by_uv(mesh.faces, corner_uv)
+    return Mesh(mesh.positions[src], mesh.normals[src], faces, mesh.name, uv=uv)
+
+
+def _spherical_uv(mesh: Mesh) -> Mesh:
+    """The sphere's and icosphere's (u, v) (:func:`explorer.geometry.uv.spherical_corners`)."""
+    return _with_uv(mesh, spherical_corners(mesh.positions, mesh.faces))
 
 
 def _grid_faces(rows: int, cols: int, wrap_cols: bool = False, offset: int = 0) -> np.ndarray:
@@ -277,11 +314,12 @@ def _check_resolution(name: str, value) -> int:
 # -- built-in meshes -----------------------------------------------------------------------
 
 
-def sphere(resolution: int | None = None) -> Mesh:
+def sphere(resolution: int | None = None, *, uv: bool = False) -> Mesh:
     """UV sphere of radius 1 centred on the origin, poles on ±y.
 
     resolution : segments around the y axis (default 64); there are resolution // 2 bands
     (at least 2) from pole to pole, one vertex at each pole, no seam (watertight).
+    uv : give it texture coordinates (its seam split; see the module docstring)
     """
     seg = _check_resolution("sphere", resolution)
     bands = max(2, seg // 2)
@@ -304,7 +342,8 @@ def sphere(resolution: int | None = None) -> Mesh:
         ]
     )
     faces = np.concatenate([body, caps])
-    return Mesh(pos, pos.copy(), _outward(pos, faces), "sphere")
+    mesh = Mesh(pos, pos.copy(), _outward(pos, faces), "sphere")
+    return _spherical_uv(mesh) if uv else mesh
 
 
 def _outward(pos, faces):
@@ -337,10 +376,11 @@ _ICO_FACES = np.array(
 )  # fmt: skip
 
 
-def icosphere(subdivisions: int | None = None) -> Mesh:
+def icosphere(subdivisions: int | None = None, *, uv: bool = False) -> Mesh:
     """Subdivided icosahedron of radius 1: 10·4^k + 2 vertices, 20·4^k triangles.
 
     subdivisions : k, how often each triangle is split in four (default 4)
+    uv : give it the sphere's texture coordinates (see the module docstring)
     """
     k = _check_resolution("icosphere", subdivisions)
     pos = _ICO_VERTICES / np.linalg.norm(_ICO_VERTICES, axis=1, keepdims=True)
@@ -359,14 +399,18 @@ def icosphere(subdivisions: int | None = None) -> Mesh:
             [np.stack(t, 1) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
         )
         pos = np.vstack([pos, mid])
-    return Mesh(pos, pos.copy(), _outward(pos, faces), "icosphere")
+    mesh = Mesh(pos, pos.copy(), _outward(pos, faces), "icosphere")
+    return _spherical_uv(mesh) if uv else mesh
 
 
-def torus(resolution: int | None = None, major: float = 0.7, minor: float = 0.3) -> Mesh:
+def torus(
+    resolution: int | None = None, major: float = 0.7, minor: float = 0.3, *, uv: bool = False
+) -> Mesh:
     """Torus about the z axis (its hole faces the default viewer), centred on the origin.
 
     resolution : segments around the ring (default 64); the tube gets resolution // 2 (>= 3)
     major, minor : ring and tube radii (defaults 0.7 and 0.3: the torus fits [-1, 1]³)
+    uv : give it texture coordinates (its seams split; see the module docstring)
     """
     seg = _check_resolution("torus", resolution)
     if not (0 < minor < major):
@@ -383,13 +427,17 @@ def torus(resolution: int | None = None, major: float = 0.7, minor: float = 0.3)
     faces = _grid_faces(seg + 1, tube, wrap_cols=True)
     faces = faces % (seg * tube)
     # d/du × d/dv points outward from the tube for this parametrisation
-    return Mesh(pos, normals, faces, "torus")
+    mesh = Mesh(pos, normals, faces, "torus")
+    if not uv:
+        return mesh
+    tex = np.column_stack([(uu / (2.0 * np.pi)).ravel(), (vv / (2.0 * np.pi)).ravel()])
+    return _with_uv(mesh, wrapped_corners(tex, faces, wrap=(True, True)))
 
 
-def cube() -> Mesh:
+def cube(*, uv: bool = False) -> Mesh:
     """Cube of side 2 centred on the origin: 24 vertices (4 per face, so each face keeps its
-    own flat normal) and 12 triangles."""
-    pos, nrm, faces = [], [], []
+    own flat normal) and 12 triangles. uv : each face the whole [0, 1]² square."""
+    pos, nrm, faces, tex = [], [], [], []
     for axis in range(3):
         for sign in (1.0, -1.0):
             n = np.zeros(3)
@@ -401,15 +449,17 @@ def cube() -> Mesh:
             for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
                 pos.append(n + a * u + b * v)
                 nrm.append(n)
+                tex.append(((a + 1) / 2.0, (b + 1) / 2.0))
             faces += [[base, base + 1, base + 2], [base, base + 2, base + 3]]
-    return Mesh(np.array(pos), np.array(nrm), np.array(faces), "cube")
+    return Mesh(np.array(pos), np.array(nrm), np.array(faces), "cube", uv=tex if uv else None)
 
 
-def plane(resolution: int | None = None) -> Mesh:
+def plane(resolution: int | None = None, *, uv: bool = False) -> Mesh:
     """Square [-1, 1]² in the xy plane (z = 0) with normal +z, facing the default viewer.
 
     resolution : subdivisions per side (default 32): (resolution + 1)² vertices. Per-vertex
     lighting needs them for a point or spot light's pool of light to show.
+    uv : texture coordinates ((x + 1) / 2, (y + 1) / 2)
     """
     k = _check_resolution("plane", resolution)
     t = np.linspace(-1.0, 1.0, k + 1)
@@ -418,7 +468,8 @@ def plane(resolution: int | None = None) -> Mesh:
     normals = np.tile([0.0, 0.0, 1.0], (len(pos), 1))
     # rows go +y, columns +x: (+y) × (+x) = -z, so wind the other way
     faces = _grid_faces(k + 1, k + 1)[:, ::-1]
-    return Mesh(pos, normals, faces, "plane")
+    tex = 0.5 * (pos[:, :2] + 1.0) if uv else None
+    return Mesh(pos, normals, faces, "plane", uv=tex)
 
 
 def _bernstein(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -445,7 +496,7 @@ def _patch_points(ctrl: np.ndarray, u: np.ndarray, v: np.ndarray):
 _TEAPOT_SIGN = -1.0
 
 
-def teapot(tessellation: int | None = None) -> Mesh:
+def teapot(tessellation: int | None = None, *, uv: bool = False) -> Mesh:
     """The Utah teapot from Newell's 32 bicubic Bézier patches.
 
     tessellation : samples per patch edge (default 12): each patch becomes a
@@ -456,6 +507,8 @@ def teapot(tessellation: int | None = None) -> Mesh:
     into the body, as in the original, so the teapot is not watertight.
 
     The model is turned y up (spout toward +x, lid toward +y) and fitted to [-1, 1]³.
+    uv : each patch's own (u, v) as texture coordinates (the welded vertices split again where
+    patches meet with different (u, v); see the module docstring)
     """
 
     t = _check_resolution("teapot", tessellation)
@@ -488,95 +541,35 @@ def teapot(tessellation: int | None = None) -> Mesh:
             names.append(name)
         group_of[list(rows)] = names.index(name)
     keys = np.repeat(group_of, per)
-    pos, nrm, faces = _weld(pos.reshape(-1, 3), nrm.reshape(-1, 3), faces, keys)
+    su, sv = np.meshgrid(s, s, indexing="ij")
+    patch_uv = np.tile(np.column_stack([su.ravel(), sv.ravel()]), (n_patch, 1))
+    corner_uv = patch_uv[faces]
+    kept: list = []
+    pos, nrm, faces = _weld(pos.reshape(-1, 3), nrm.reshape(-1, 3), faces, keys, kept=kept)
+    tex = None
+    if uv:
+        src, faces, tex = split_by_uv(faces, corner_uv[kept[0]])
+        pos, nrm = pos[src], nrm[src]
     # Newell's z up -> y up: (x, y, z) -> (x, z, -y), a proper rotation (keeps winding)
     rot = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
     pos = pos @ rot.T
     nrm = nrm @ rot.T
     lo, hi = pos.min(axis=0), pos.max(axis=0)
     pos = (pos - 0.5 * (lo + hi)) / float(np.max(0.5 * (hi - lo)))
-    return Mesh(pos, nrm, faces, "teapot")
+    return Mesh(pos, nrm, faces, "teapot", uv=tex)
 
 
 _BUILDERS = {
     "sphere": sphere,
     "icosphere": icosphere,
     "torus": torus,
-    "cube": lambda resolution=None: cube(),
+    "cube": lambda resolution=None, uv=False: cube(uv=uv),
     "plane": plane,
     "teapot": teapot,
 }
 
 
 # -- files ---------------------------------------------------------------------------------
-
-
-def read_mesh_file(path) -> bytes:
-    """The bytes of a mesh file, read once through the checked open
-    (:func:`explorer.core.files.read_checked`): a file that does not exist, is a directory, a
-    FIFO, socket or device (never opened in a way that blocks), is empty, is larger than
-    ``MAX_MESH_FILE_BYTES``, or is an archive unpacking to more than
-    ``MAX_MESH_UNPACKED_BYTES`` (see :mod:`explorer.core.tolerances`) raises an
-    :class:`ExplorerError` naming the file and the cap."""
-    shown = os.fspath(path)
-    try:
-        data = read_checked(shown, cap=tol.MAX_MESH_FILE_BYTES, what="mesh file")
-    except UnreadableFile as exc:
-        raise ExplorerError(f"mesh file '{shown}' {_unreadable(exc)}") from None
-    if not data:
-        raise ExplorerError(f"mesh file '{shown}' is empty")
-    unpacked = _unpacked_size(data, tol.MAX_MESH_UNPACKED_BYTES)
-    if unpacked is not None and unpacked > tol.MAX_MESH_UNPACKED_BYTES:
-        raise ExplorerError(
-            f"mesh file '{shown}' is an archive that unpacks to more than "
-            f"{tol.MAX_MESH_UNPACKED_BYTES} bytes ({tol.MAX_MESH_UNPACKED_BYTES >> 20} MiB), "
-            "the limit for a mesh; unpack it yourself if it is really meant"
-        )
-    return data
-
-
-def _unreadable(exc: UnreadableFile) -> str:
-    """The end of a mesh-file message for what :func:`read_checked` refused."""
-    reason = exc.reason
-    if reason == "no such file":
-        return "does not exist"
-    if reason.startswith("it is a directory"):
-        return "is a directory, not a mesh file"
-    if reason == "permission denied":
-        return "cannot be read (permission denied)"
-    if reason.startswith("too large"):
-        size = f"{exc.size} bytes" if exc.size is not None else "more bytes than that"
-        return (
-            f"is too large: {size}, the limit is {tol.MAX_MESH_FILE_BYTES} bytes "
-            f"({tol.MAX_MESH_FILE_BYTES >> 20} MiB)"
-        )
-    if reason.startswith("it is a"):
-        return f"is not a regular file ({reason[6:].split(', not')[0]})"
-    return f"cannot be read: {reason}"
-
-
-def _unpacked_size(data: bytes, cap: int) -> int | None:
-    """The size an archive's bytes unpack to (zip: the declared sizes; bz2 / gzip: counted
-    while unpacking, stopping once past ``cap``); None for a file that is no archive."""
-    stream = io.BytesIO(data)
-    try:
-        if zipfile.is_zipfile(stream):
-            with zipfile.ZipFile(stream) as archive:
-                return sum(info.file_size for info in archive.infolist())
-        unpack = {b"BZh": bz2.BZ2File, b"\x1f\x8b\x08": lambda f: gzip.GzipFile(fileobj=f)}
-        opener = unpack.get(data[:3])
-        if opener is None:
-            return None
-        total = 0
-        with opener(io.BytesIO(data)) as unpacking:
-            while total <= cap:
-                chunk = unpacking.read(1 << 20)
-                if not chunk:
-                    break
-                total += len(chunk)
-        return total
-    except (OSError, EOFError, zipfile.BadZipFile, ValueError):
-        return None  # a damaged archive: the loader reports it
 
 
 def load_mesh(path) -> Mesh:
@@ -629,7 +622,7 @@ def load_mesh(path) -> Mesh:
             f"mesh file '{shown}' is not a valid {ext} file or is damaged "
             f"({type(exc).__name__}: {exc})"
         ) from exc
-    parts = _triangle_parts(loaded)
+    parts = triangle_parts(loaded)
     if not parts:
         kind = type(loaded).__name__
         what = {"PointCloud": "points only", "Path2D": "lines only", "Path3D": "lines only"}
@@ -637,13 +630,13 @@ def load_mesh(path) -> Mesh:
         raise ExplorerError(
             f"mesh file '{shown}' holds {reason}: a mesh needs triangles (or polygons)"
         )
-    _say_unread_materials(shown, parts, libraries)
+    say_unread_materials(shown, parts, ext == ".obj")
     group_names: list[str] = []
     keys = []
     positions, normals, faces, has_normals = [], [], [], True
     base = 0
     for m, matrix in parts:
-        name = _material_name(m) if libraries else None
+        name = material_name(m) if libraries else None
         if name is not None and name not in group_names:
             group_names.append(name)
         keys.append(np.full(len(m.vertices), -1 if name is None else group_names.index(name)))
@@ -669,6 +662,7 @@ def load_mesh(path) -> Mesh:
     pos = np.vstack(positions)
     faces = np.vstack(faces)
     keys = np.concatenate(keys)
+    tex = file_uv([part_uv(m) for m, _ in parts], shown)
     if (keys < 0).any() and group_names:  # faces before any usemtl, or an unknown material
         group_names.append("")
         keys[keys < 0] = len(group_names) - 1
@@ -680,15 +674,13 @@ def load_mesh(path) -> Mesh:
         if missing.any():
             nrm[missing] = area_weighted_normals(pos, faces)[missing]
     else:
-        centre, scale = frame_of(pos)  # welded to 12 decimals of the mesh's frame: any scale
-        Q = pos / scale - centre / scale
-        _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True)
-        pos, keys = pos[src], keys[src]
-        nrm = area_weighted_normals(pos, faces)
+        pos, nrm, faces, keys, tex = _welded(pos, faces, keys, tex)
     if not has_area(pos, faces).any():
         raise ExplorerError(f"mesh file '{shown}' holds only degenerate (zero-area) triangles")
-    used = _used(pos, faces)
-    pos, nrm, faces = _drop_unused(pos, nrm, faces)
+    used = used_vertices(pos, faces)
+    if tex is not None:
+        tex = tex[used]
+    pos, nrm, faces = drop_unused(pos, nrm, faces)
     groups = None
     if group_names:  # in the file's order (trimesh's parts come in another)
         rank = [used_names.index(g) if g in used_names else len(used_names) for g in group_names]
@@ -698,73 +690,33 @@ def load_mesh(path) -> Mesh:
         groups = MaterialGroups(tuple(group_names), keys[used], libraries, used_names)
     elif libraries:  # no usemtl matched a material trimesh found: one group, named nothing
         groups = MaterialGroups(("",), np.zeros(len(pos), np.int32), libraries, used_names)
-    return Mesh(pos, nrm, faces, os.path.basename(path), groups)
-
-
-def _used(pos, faces) -> np.ndarray:
-    used = np.zeros(len(pos), bool)
-    used[faces.ravel()] = True
-    return used
-
-
-def _say_unread_materials(shown: str, parts, libraries) -> None:
-    """A :class:`~explorer.core.errors.Notice` when the file carries colours or materials the
-    engine does not read (anything but an OBJ's .mtl materials)."""
-    kinds = {getattr(getattr(m, "visual", None), "kind", None) for m, _ in parts}
-    if libraries:
-        kinds.discard("texture")  # an OBJ's usemtl materials: read from the .mtl
-    kinds.discard(None)
-    if kinds:
-        what = "texture materials" if kinds == {"texture"} else "colours or materials"
-        warnings.warn(
-            f"mesh file '{shown}': its {what} are not read (only an OBJ's .mtl materials "
-            "are); the scene's material is used",
-            Notice,
-            stacklevel=3,
-        )
-
-
-def _material_name(part) -> str | None:
-    """The name of the material trimesh's OBJ reader gave a part (one per ``usemtl``)."""
-    material = getattr(getattr(part, "visual", None), "material", None)
-    name = getattr(material, "name", None)
-    return name if isinstance(name, str) and name else None
-
-
-def _triangle_parts(loaded) -> list:
-    """``[(Trimesh, 4x4 transform or None), ...]`` of the triangle meshes in what trimesh
-    loaded; scene nodes keep their own geometry (and its normals) with the node's transform."""
-    import trimesh
-
-    if isinstance(loaded, trimesh.Trimesh):
-        items = [(loaded, None)]
-    elif isinstance(loaded, trimesh.Scene):
-        items = []
-        for node in loaded.graph.nodes_geometry:
-            matrix, name = loaded.graph[node]
-            geometry = loaded.geometry.get(name)
-            matrix = np.asarray(matrix, np.float64)
-            items.append((geometry, None if np.allclose(matrix, np.eye(4)) else matrix))
-    else:
-        items = []
-    return [(m, t) for m, t in items if isinstance(m, trimesh.Trimesh) and len(m.faces)]
-
-
-def _drop_unused(pos, nrm, faces):
-    used = np.zeros(len(pos), bool)
-    used[faces.ravel()] = True
-    if used.all():
-        return pos, nrm, faces
-    new_index = np.cumsum(used) - 1
-    return pos[used], nrm[used], new_index[faces]
+    return Mesh(pos, nrm, faces, os.path.basename(path), groups, tex)
 
 
 # -- lookup --------------------------------------------------------------------------------
 
 
-def get_mesh(spec, resolution: int | None = None) -> Mesh:
+def _welded(pos, faces, keys, tex):
+    """A file without normals: vertices welded by position (and group) to 12 decimals of the
+    mesh's frame (any scale), smooth normals, then split again where their (u, v) differ.
+    Returns ``(positions, normals, faces, keys, uv)``."""
+    centre, scale = frame_of(pos)
+    Q = pos / scale - centre / scale
+    corner_uv = None if tex is None else tex[faces]
+    kept: list = []
+    _, _, faces, src = _weld(Q, np.zeros_like(pos), faces, keys, 12, sources=True, kept=kept)
+    pos, keys = pos[src], keys[src]
+    nrm = area_weighted_normals(pos, faces)
+    if corner_uv is not None:
+        src, faces, tex = split_by_uv(faces, corner_uv[kept[0]])
+        pos, nrm, keys = pos[src], nrm[src], keys[src]
+    return pos, nrm, faces, keys, tex
+
+
+def get_mesh(spec, resolution: int | None = None, *, uv: bool = False) -> Mesh:
     """A built-in mesh by name (with its ``resolution`` option, see :data:`RESOLUTION`) or a
-    mesh file by path. ``resolution`` is ignored by ``cube`` and by files.
+    mesh file by path. ``resolution`` is ignored by ``cube`` and by files. ``uv``: a built-in
+    mesh with its texture coordinates (a file has the ones it holds, or none).
 
     An unknown name that does not look like a path raises an :class:`ExplorerError` with a
     did-you-mean and the list of built-in names.
@@ -777,7 +729,7 @@ def get_mesh(spec, resolution: int | None = None) -> Mesh:
         raise ExplorerError(f"a mesh must be a built-in name or a file path, got {spec!r}")
     text = os.fspath(spec)
     if text in _BUILDERS:
-        return _BUILDERS[text](resolution)
+        return _BUILDERS[text](resolution, uv=uv)
     if _looks_like_file(text):
         return load_mesh(os.path.expanduser(text))
 

@@ -7,6 +7,11 @@
   engine's display colours converted from sRGB to linear (glTF's vertex colours are linear;
   the viewer encodes its output to sRGB again), as float RGBA. A glTF viewer then shows the
   engine's pixels.
+* **GLB with a texture** (a ``diffuse_map``): ``TEXCOORD_0`` (v turned over: glTF's v = 0 is
+  the image's top row), the image as a PNG in the file, ``baseColorTexture`` with nearest
+  filtering and the map's wrap. glTF's base colour is factor × texture × ``COLOR_0``: exactly
+  OpenGL's single colour mode (``COLOR_0`` is the whole lit colour), so the file always holds
+  it; the separate specular colour has no place there (``docs/formats.md``).
 * **OBJ + MTL**: the mesh with normals and its material(s) as an .mtl (one ``usemtl`` group
   per material), for tools that light the mesh themselves.
 """
@@ -22,6 +27,8 @@ from explorer.core.errors import ExplorerError
 from explorer.core.mtl import format_mtl
 from explorer.core.version import __version__
 from explorer.geometry.meshes import Mesh, has_area
+from explorer.render.images import encode_png
+from explorer.render.textured import Textured
 from explorer.shading.display import to_bytes
 from explorer.shading.effects.hdr import srgb_decode
 
@@ -35,17 +42,25 @@ _CHUNK_JSON = 0x4E4F534A  # "JSON"
 _CHUNK_BIN = 0x004E4942  # "BIN\0"
 _FLOAT, _UINT = 5126, 5125  # glTF componentType: float32, uint32
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
+_NEAREST, _REPEAT, _CLAMP_TO_EDGE = 9728, 10497, 33071  # glTF sampler values (OpenGL's)
 
 
 def mesh_file_bytes(
-    mesh: Mesh, colors, suffix: str, opacity: float = 1.0, *, double_sided: bool = False
+    mesh: Mesh,
+    colors,
+    suffix: str,
+    opacity: float = 1.0,
+    *,
+    double_sided: bool = False,
+    texture: Textured | None = None,
 ) -> bytes:
     """A PLY or GLB file (by ``suffix``) holding the mesh, its normals and its per-vertex
     colours (see the module docstring); ``double_sided``: the GLB material's flag (the
-    scene's ``two_sided``)."""
+    scene's ``two_sided``); ``texture``: the GLB's base colour texture (its ``primary``, the
+    single colour mode's colours, is ``COLOR_0`` then)."""
     kind = suffix.lower().lstrip(".")
     if kind == "glb":
-        return glb_bytes(mesh, colors, opacity, double_sided=double_sided)
+        return glb_bytes(mesh, colors, opacity, double_sided=double_sided, texture=texture)
     if kind != "ply":
         raise ExplorerError(f"mesh export writes .ply or .glb, got {suffix!r}")
     check_float32(mesh, ".ply")
@@ -96,13 +111,23 @@ def linear_colors(colors) -> np.ndarray:
     return srgb_decode(c)
 
 
-def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = False) -> bytes:
+def glb_bytes(
+    mesh: Mesh,
+    colors,
+    opacity: float = 1.0,
+    *,
+    double_sided: bool = False,
+    texture: Textured | None = None,
+) -> bytes:
     """A binary glTF 2.0 file: one mesh, one unlit material, linear ``COLOR_0`` (float RGBA,
     alpha = opacity); see the module docstring.
 
-    colors : (n, 3) display colours in [0, 1]
+    colors : (n, 3) display colours in [0, 1] (with ``texture``: its primary colours instead)
+    texture : a textured picture's :class:`~explorer.render.textured.Textured` (single colour)
     """
     n = mesh.n_vertices
+    if texture is not None:
+        colors = texture.primary / 255.0
     colors = np.asarray(colors, np.float64)
     if colors.shape != (n, 3):
         raise ExplorerError(f"colors must have shape ({n}, 3), got {colors.shape}")
@@ -115,13 +140,22 @@ def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = 
         (rgba, "VEC4", _FLOAT, _ARRAY_BUFFER),
         (np.asarray(mesh.faces, np.uint32).ravel(), "SCALAR", _UINT, _ELEMENT_ARRAY_BUFFER),
     ]
+    if texture is not None:
+        st = texture.tmap.lookup(mesh.uv)
+        st[:, 1] = 1.0 - st[:, 1]  # glTF's v = 0 is the image's top row; OBJ's and GL's bottom
+        arrays.append((st.astype(np.float32), "VEC2", _FLOAT, _ARRAY_BUFFER))
+        arrays.append((np.frombuffer(encode_png(texture.image), np.uint8), "", 0, 0))
     blob = bytearray()
     views, accessors = [], []
     for data, kind, component, target in arrays:
         raw = np.ascontiguousarray(data).tobytes()
-        views.append(
-            {"buffer": 0, "byteOffset": len(blob), "byteLength": len(raw), "target": target}
-        )
+        view = {"buffer": 0, "byteOffset": len(blob), "byteLength": len(raw), "target": target}
+        if not kind:  # the image: a view with no target and no accessor
+            del view["target"]
+            views.append(view)
+            blob += raw + b"\0" * (-len(raw) % 4)
+            continue
+        views.append(view)
         accessor = {
             "bufferView": len(views) - 1,
             "componentType": component,
@@ -144,6 +178,19 @@ def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = 
         "alphaMode": "BLEND" if opacity < 1.0 else "OPAQUE",
         "doubleSided": bool(double_sided),
     }
+    primitive = {"POSITION": 0, "NORMAL": 1, "COLOR_0": 2}
+    textures = {}
+    if texture is not None:
+        primitive["TEXCOORD_0"] = 4
+        material["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0, "texCoord": 0}
+        wrap = _CLAMP_TO_EDGE if texture.tmap.clamp else _REPEAT
+        textures = {
+            "images": [{"bufferView": len(views) - 1, "mimeType": "image/png"}],
+            "samplers": [
+                {"magFilter": _NEAREST, "minFilter": _NEAREST, "wrapS": wrap, "wrapT": wrap}
+            ],
+            "textures": [{"source": 0, "sampler": 0}],
+        }
     doc = {
         "asset": {"version": "2.0", "generator": f"phong-explorer {__version__}"},
         "extensionsUsed": [UNLIT],
@@ -155,7 +202,7 @@ def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = 
                 "name": mesh.name,
                 "primitives": [
                     {
-                        "attributes": {"POSITION": 0, "NORMAL": 1, "COLOR_0": 2},
+                        "attributes": primitive,
                         "indices": 3,
                         "material": 0,
                         "mode": 4,
@@ -164,6 +211,7 @@ def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = 
             }
         ],
         "materials": [material],
+        **textures,
         "accessors": accessors,
         "bufferViews": views,
         "buffers": [{"byteLength": len(blob)}],
@@ -183,7 +231,8 @@ def glb_bytes(mesh: Mesh, colors, opacity: float = 1.0, *, double_sided: bool = 
 
 
 def obj_files(mesh: Mesh, materials, mtl_name: str) -> tuple[bytes, bytes]:
-    """``(obj, mtl)`` file contents: the mesh with normals, and its materials.
+    """``(obj, mtl)`` file contents: the mesh with normals (and its texture coordinates as
+    ``vt`` when it has them), and its materials (their maps as they name them).
 
     materials : ``[(name, Material), ...]``: one for the whole mesh, or one per group of
         ``mesh.groups`` (each group becomes a ``usemtl`` block)
@@ -197,6 +246,9 @@ def obj_files(mesh: Mesh, materials, mtl_name: str) -> tuple[bytes, bytes]:
     lines = [f"# written by phong-explorer {__version__}", f"mtllib {mtl_name}"]
     lines += [f"v {x!r} {y!r} {z!r}" for x, y, z in mesh.positions.tolist()]
     lines += [f"vn {x!r} {y!r} {z!r}" for x, y, z in mesh.normals.tolist()]
+    if mesh.uv is not None:  # the texture coordinates: vertex k's vt is k too
+        lines += [f"vt {u!r} {v!r}" for u, v in mesh.uv.tolist()]
+    corner = "{0}/{0}/{0}" if mesh.uv is not None else "{0}//{0}"
     faces = mesh.faces + 1
     if per_group:
         owner = groups.of_vertex[mesh.faces[:, 0]]
@@ -205,7 +257,7 @@ def obj_files(mesh: Mesh, materials, mtl_name: str) -> tuple[bytes, bytes]:
         blocks = [(materials[0][0], faces)]
     for name, block in blocks:
         lines.append(f"usemtl {name}")
-        lines += [f"f {a}//{a} {b}//{b} {c}//{c}" for a, b, c in block.tolist()]
+        lines += ["f " + " ".join(corner.format(i) for i in tri) for tri in block.tolist()]
     obj = "\n".join(lines) + "\n"
     header = f"materials of {mesh.name}, written by phong-explorer {__version__}"
     return obj.encode("utf-8"), format_mtl(materials, header=header).encode("utf-8")

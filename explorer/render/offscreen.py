@@ -30,6 +30,7 @@ from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera, Vec3, back_to_front, camera_for, mesh_frame
 from explorer.render.images import DEFAULT_SIZE, check_picture_pixels, check_size
+from explorer.render.textured import Textured, add_textured, texture_arrays, textured
 from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import group_vertex_colors, to_bytes, vertex_colors
 
@@ -100,6 +101,7 @@ class OffscreenRenderer(OffscreenWindow):
     def _forget(self) -> None:
         self._actor = self._mesh = self._poly = self._text = self._frame = None
         self._sorted = False
+        self._texture = None
 
     def render(
         self,
@@ -111,6 +113,7 @@ class OffscreenRenderer(OffscreenWindow):
         label_size: int | None = None,
         camera: Camera | None = None,
         backdrop=None,
+        texture: Textured | None = None,
     ) -> np.ndarray:
         """Draw the mesh in the engine's colours and return the picture.
 
@@ -123,24 +126,33 @@ class OffscreenRenderer(OffscreenWindow):
         backdrop : an opaque second object drawn with the mesh, ``(Mesh, colors (k, 3))``; a
             translucent mesh in front of it blends over it (VTK draws opaque geometry first,
             then the translucent triangles back to front with the depth test on)
+        texture : what a textured picture draws (:func:`explorer.render.textured.textured`);
+            None: the scene's own ``diffuse_map`` when it has one and ``colors`` is None
         Returns (height, width, 3) uint8.
         """
         pl = self.plotter
-        if colors is None:
-            colors = vertex_colors(scene, mesh)
-        rgb = to_bytes(colors)
+        if texture is None and colors is None:
+            texture = textured(scene, mesh)
+        if texture is not None:
+            rgb = texture.primary
+        else:
+            rgb = to_bytes(vertex_colors(scene, mesh) if colors is None else colors)
         if rgb.shape != (mesh.n_vertices, 3):
             raise ExplorerError(
                 f"colors must have shape ({mesh.n_vertices}, 3), got {np.shape(colors)}"
             )
-        if self._mesh is not mesh:
+        if self._mesh is not mesh or texture is not None or self._texture is not None:
             if self._actor is not None:
                 pl.remove_actor(self._actor)
             self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
             self._poly = polydata(mesh, rgb, frame=self._frame)
             self._sorted = False
-            self._actor = add_unlit(pl, self._poly)
-            self._mesh = mesh
+            if texture is None:
+                self._actor = add_unlit(pl, self._poly)
+            else:
+                texture_arrays(self._poly, mesh, texture)
+                self._actor = add_textured(pl, self._poly, texture)
+            self._mesh, self._texture = mesh, texture
         else:
             self._poly.point_data["colors"] = rgb
         opacity = float(scene.material.opacity)
@@ -231,13 +243,16 @@ def render_image(
     label: str | None = None,
     camera: Camera | None = None,
     backdrop=None,
+    texture: Textured | None = None,
 ) -> np.ndarray:
     """One off-screen picture of the mesh under the scene: (height, width, 3) uint8.
 
     See :meth:`OffscreenRenderer.render`; the window is closed before returning.
     """
     with OffscreenRenderer(size, background) as r:
-        return r.render(scene, mesh, colors, label=label, camera=camera, backdrop=backdrop)
+        return r.render(
+            scene, mesh, colors, label=label, camera=camera, backdrop=backdrop, texture=texture
+        )
 
 
 def sheet(

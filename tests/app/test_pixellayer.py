@@ -341,3 +341,25 @@ def test_the_per_pixel_view_carries_every_setting_of_the_state(torus):
     assert s.selected_light.shadows and s.scene.hdr.tone_map == "aces" and not s.local_viewer
     worst, off, edge, ref = against_reference(torus)
     assert worst <= 1 and off <= 0.05 * edge
+
+
+def test_a_textured_mesh_wears_its_texture_again_after_per_pixel(tmp_path, monkeypatch):
+    """A mesh wearing a diffuse_map, shown per pixel and then per vertex again: the
+    texture is back, the picture the same as before (leaving per-pixel cleared the actor's
+    texture and shader, and the mesh came back untextured)."""
+    from pathlib import Path
+
+    tiles = Path(__file__).resolve().parents[2] / "docs" / "examples" / "tiles.png"
+    view = make_port("teapot", tmp_path, monkeypatch, "--diffuse-map", str(tiles))
+    try:
+        c = view.controller
+        assert view.view.drawings[0].texture is not None
+        before = picture(view)
+        assert c.set_value("shading", "per-pixel", merge=False)
+        picture(view)
+        assert c.set_value("shading", "per-vertex", merge=False)
+        after = picture(view)
+        assert view.view.drawings[0].texture is not None
+        np.testing.assert_array_equal(after, before)
+    finally:
+        view.plotter.close()

@@ -105,3 +105,49 @@ def test_level_of_detail_of_a_mesh_at_any_scale(scale):
     lod = lod_mesh(mesh, 1000)
     assert np.isfinite(lod.positions).all() and 700 <= lod.n_vertices <= 1300
     assert np.abs(np.linalg.norm(lod.positions / scale, axis=1) - 1.0).max() < 0.05
+
+
+def test_the_view_wears_a_mesh_files_texture_as_render_does(tmp_path):
+    """The window's and the page's view (SceneView) draws the .mtl's map_Kd with render's one
+    pass (explorer.render.textured): a white image changes no pixel, the tiles change many,
+    and under separate specular the highlight goes to its own vertex array."""
+    import dataclasses
+    from pathlib import Path
+
+    from PIL import Image
+
+    from explorer.shading.display import vertex_colors
+
+    obj = Path(__file__).resolve().parents[2] / "docs" / "examples" / "textured_teapot.obj"
+    state, mesh = start_state(build_parser().parse_args(["gui", "--mesh", str(obj)]))
+    Image.fromarray(np.full((2, 2, 3), 255, np.uint8)).save(tmp_path / "white.png")
+
+    def with_map(tmap):
+        return tuple(m.replace(diffuse_map=tmap) for m in state.groups)
+
+    pl = plotter((200, 150), (0.3, 0.3, 0.3))
+    try:
+        view = SceneView(pl, mesh, state)
+        pl.view_xy()  # the teapot from the front, the same camera for every picture
+
+        def picture(s):
+            view.show_state(s)
+            pl.render()
+            return pl.screenshot(return_img=True)[:, :, :3].copy()
+
+        tiled = picture(state)
+        assert view.drawings[0].texture is not None
+        plain = picture(dataclasses.replace(state, groups=with_map(None)))
+        assert view.drawings[0].texture is None
+        assert np.abs(tiled.astype(int) - plain.astype(int)).max() > 100
+        white = picture(dataclasses.replace(state, groups=with_map(str(tmp_path / "white.png"))))
+        np.testing.assert_array_equal(white, plain)
+        separate = dataclasses.replace(state, scene=state.scene.replace(color_control="separate"))
+        picture(separate)
+        shown_scene = separate.shown_scene().replace(material=separate.shown_groups()[0])
+        only = shown_scene.material.replace(ambient=(0, 0, 0), diffuse=(0, 0, 0))
+        want = to_bytes(vertex_colors(shown_scene.replace(material=only), mesh))
+        got = np.rint(np.asarray(view.drawings[0].secondary)[:, :3] * 255).astype(int)
+        assert np.abs(got - want.astype(int)).max() <= 1  # the window shades in float32
+    finally:
+        pl.close()

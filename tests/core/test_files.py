@@ -94,6 +94,9 @@ ALLOWED = {
     ),
     ("explorer/shading/tiers.py", "open"): "appends to the compile log (a write)",
     ("explorer/render/images.py", "x.open"): "Pillow decodes PNG bytes already read (BytesIO)",
+    ("explorer/render/textures.py", "x.open"): (
+        "Pillow decodes a texture's bytes already read by read_checked (BytesIO)"
+    ),
     ("explorer/shading/tiers.py", "os.open"): (
         "the compile lock, opened (O_NONBLOCK, O_NOFOLLOW) to flock it, after lstat set aside "
         "anything that is not a regular file"
@@ -102,7 +105,7 @@ ALLOWED = {
     ("explorer/render/turntable.py", "open"): (
         "reads back the MP4 its encoder just wrote into a private temporary directory"
     ),
-    ("explorer/geometry/meshes.py", "ZipFile"): "an archive's bytes read by read_mesh_file",
+    ("explorer/geometry/meshfile.py", "ZipFile"): "an archive's bytes read by read_mesh_file",
     ("explorer/app/web/server.py", "x.open"): "webbrowser.open hands the browser the page's URL",
     ("explorer/geometry/kernelcache.py", "open"): (
         "hashes and parses the package's own kernel sources (numba's cache stamp)"

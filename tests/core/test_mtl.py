@@ -63,7 +63,8 @@ def test_blender_files_warn_of_ka_1_texture_maps_and_ni():
     text = "\n".join(m.warnings)
     assert "blender.mtl:6: 'Ka 1 1 1'" in text and "metallic" in text
     assert "blender.mtl:10: Ni" in text
-    assert "blender.mtl:13: texture map 'map_Kd' is not used" in text
+    assert "map_Kd" not in text  # read now: the material's diffuse_map, beside the .mtl
+    assert m.material.diffuse_map.file == str(DATA / "wood.png")
     assert "Ns 250 is above OpenGL's largest GL_SHININESS (128)" in text
 
 

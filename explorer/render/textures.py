@@ -1,0 +1,95 @@
+"""Texture images: read safely, and looked up as OpenGL looks them up.
+
+:func:`read_texture` reads a map's image (PNG or JPEG, decoded by Pillow) through the checked open
+(:func:`explorer.core.files.read_checked`: a FIFO or device is refused without blocking, at most
+``MAX_TEXTURE_FILE_BYTES`` bytes are read) and refuses an image of more than
+``MAX_TEXTURE_PIXELS`` pixels from its header, before decoding. Every refusal is one
+:class:`TextureError` line naming the file, the map key and what is wrong.
+
+The image's rows go to OpenGL bottom row first (``glTexImage2D``'s first row is v = 0), so
+(u, v) = (0, 0) is the image's lower-left corner, as in OBJ and OpenGL (:func:`gl_rows`).
+:func:`sample_nearest` is the texel ``GL_NEAREST`` picks with ``GL_REPEAT`` (or
+``GL_CLAMP_TO_EDGE`` for a ``-clamp on`` map): the reference the tests hold the drawing to.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import warnings
+
+import numpy as np
+
+from explorer.core import tolerances as tol
+from explorer.core.errors import ExplorerError
+from explorer.core.files import NO_SUCH_FILE, UnreadableFile, read_checked
+from explorer.core.texture import TextureMap
+
+#: image formats read (Pillow's names)
+FORMATS = ("PNG", "JPEG")
+
+
+class TextureError(ExplorerError):
+    """A texture image that cannot be used: the message names the file, the map and why."""
+
+
+def read_texture(tmap: TextureMap | str, key: str = "diffuse_map") -> np.ndarray:
+    """The image of ``tmap`` as (height, width, 4) uint8 RGBA, rows top first (as stored).
+
+    key : the material key the map is (for the message)
+    A missing file, one that is not a regular file, is larger than ``MAX_TEXTURE_FILE_BYTES``,
+    is no PNG or JPEG, is truncated or damaged, or has more than ``MAX_TEXTURE_PIXELS`` pixels
+    raises a :class:`TextureError`.
+    """
+    name = tmap.file if isinstance(tmap, TextureMap) else os.fspath(tmap)
+    where = f"{key} '{name}'"
+    try:
+        data = read_checked(name, cap=tol.MAX_TEXTURE_FILE_BYTES, what=f"{key} image")
+    except UnreadableFile as exc:
+        reason = "does not exist" if exc.reason == NO_SUCH_FILE else exc.reason
+        raise TextureError(f"{where}: {reason}") from None
+    if not data:
+        raise TextureError(f"{where}: the file is empty, not a PNG or JPEG image")
+    from PIL import Image, UnidentifiedImageError
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", Image.DecompressionBombWarning)
+            image = Image.open(io.BytesIO(data), formats=list(FORMATS))
+            w, h = image.size
+            if w * h > tol.MAX_TEXTURE_PIXELS:
+                raise TextureError(
+                    f"{where}: {w}x{h} is {w * h} pixels, more than the limit of "
+                    f"{tol.MAX_TEXTURE_PIXELS} (4096x4096); use a smaller image"
+                )
+            image.load()
+            rgba = np.asarray(image.convert("RGBA"), dtype=np.uint8)
+    except TextureError:
+        raise
+    except UnidentifiedImageError:
+        raise TextureError(f"{where}: not a PNG or JPEG image") from None
+    except (OSError, ValueError, SyntaxError, Image.DecompressionBombError) as exc:
+        raise TextureError(f"{where}: a damaged or truncated image ({exc})") from None
+    except Image.DecompressionBombWarning as exc:  # pragma: no cover - the cap comes first
+        raise TextureError(f"{where}: {exc}") from None
+    return np.ascontiguousarray(rgba)
+
+
+def gl_rows(image: np.ndarray) -> np.ndarray:
+    """The image's rows bottom first: OpenGL's order (row 0 is v = 0)."""
+    return np.ascontiguousarray(image[::-1])
+
+
+def sample_nearest(image: np.ndarray, st, *, clamp: bool = False) -> np.ndarray:
+    """The texels ``GL_NEAREST`` gives at texture coordinates ``st`` (k, 2): ``GL_REPEAT``
+    (or ``GL_CLAMP_TO_EDGE`` when ``clamp``). image : (h, w, c) rows top first.
+    Returns (k, c) of the image's dtype."""
+    rows = gl_rows(image)
+    h, w = rows.shape[:2]
+    st = np.asarray(st, np.float64)
+    s, t = st[:, 0], st[:, 1]
+    if not clamp:
+        s, t = s - np.floor(s), t - np.floor(t)
+    i = np.clip(np.floor(s * w), 0, w - 1).astype(np.int64)
+    j = np.clip(np.floor(t * h), 0, h - 1).astype(np.int64)
+    return rows[j, i]
