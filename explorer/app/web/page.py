@@ -146,11 +146,16 @@ def _choice(v3, r) -> None:
     shown = _shown_as(r.key, r.tip)
     if r.kind == "list":
         del shown["v_show"]
+    # a searched list finds its items by their subtitles too (Vuetify filters its own items:
+    # the page's item is their ``raw``), as the window's search does ("stone" finds jade and
+    # turquoise by their descriptions)
+    searched = {"filter_keys": ("['title', 'raw.subtitle']",)} if r.search else {}
     (v3.VAutocomplete if r.search else v3.VSelect)(
         v_model=(r.key, None),
         items=(items_key(r) if listed else repr(list(r.choices)),),
         item_props=listed,
         label=r.caption,
+        **searched,
         **shown,
     )
 

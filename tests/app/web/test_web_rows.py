@@ -7,7 +7,7 @@ server is its own (the effects it turns on stay out of the other modules' pictur
 from __future__ import annotations
 
 import pytest
-from test_web import choose, click, open_page, picture_src, report, wait
+from test_web import by_name, choose, click, open_page, picture_src, report, wait
 
 from explorer.app import panelmodel as P
 
@@ -108,3 +108,25 @@ def test_a_lights_shadows_two_sided_lighting_and_the_viewer_reach_the_session(se
     for _ in range(3):
         click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
+
+
+def test_the_preset_search_finds_presets_by_their_descriptions(server, browser):
+    """Typing "stone" into the preset list's search lists the presets whose descriptions say
+    stone, jade and turquoise, as the window's search does (the page searched names only and
+    found none)."""
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+
+    open_page(browser, server.url)
+    click(browser, "preset")
+    field = by_name(browser, "preset")
+    field = field if field.tag_name == "input" else field.find_element(By.CSS_SELECTOR, "input")
+    field.send_keys(Keys.CONTROL, "a")
+    field.send_keys("stone")
+
+    def listed():
+        items = browser.find_elements(By.CSS_SELECTOR, ".v-overlay--active .v-list-item-title")
+        return sorted({e.text for e in items if e.text}) or None
+
+    assert wait("the search's items", listed) == ["jade", "turquoise"]
+    field.send_keys(Keys.ESCAPE)
