@@ -67,6 +67,19 @@ class Control:
         return self.step if self.step is not None else 10.0 ** -min(self.decimals, 2)
 
 
+def field_text(control: Control, value: float) -> str:
+    """``value`` as a number field shows it: ``control.decimals`` decimals and its unit
+    (``40.0°``, ``2.50 r``, ``0.300``), as the window's fields do and the page's."""
+    return f"{float(value):.{control.decimals}f}{control.unit}"
+
+
+def without_unit(control: Control, text: str) -> str:
+    """Typed ``text`` without the control's unit at its end (``"45°"``, ``"2.5 r"``), what
+    a field shows being typed back."""
+    t, unit = str(text).strip(), control.unit.strip()
+    return t[: -len(unit)].strip() if unit and t.endswith(unit) else t
+
+
 def _controls(*items: Control) -> dict[str, Control]:
     return {c.key: c for c in items}
 

@@ -90,7 +90,7 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
             classes="flex-grow-1 mr-2",
         )  # fmt: skip
         v3.VTextField(
-            model_value=(key, 0), key=(f"'{key}-' + field_rev",), type="text",
+            model_value=(f"{key}_text", ""), key=(f"'{key}-' + field_rev",), type="text",
             density="compact", hide_details=True,
             variant="outlined", style="max-width: 92px",
             change=(ctrl.on_field, f"['{key}', $event.target.value]"),

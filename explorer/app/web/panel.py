@@ -24,7 +24,7 @@ from urllib.parse import quote
 from explorer.app import model as M
 from explorer.app import panelmodel
 from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
-from explorer.core.controls import from_step, to_step
+from explorer.core.controls import field_text, from_step, to_step, without_unit
 from explorer.core.errors import ExplorerError
 
 #: the number rows (a slider and a field each)
@@ -90,6 +90,7 @@ def row_values(state: M.State) -> dict:
         v = r.shown(state)
         if r.kind == "number":
             out[f"{r.key}_step"] = slider_step(r, state)
+            out[f"{r.key}_text"] = None if v is None else field_text(r.control, v)
             if r.optional is not None:
                 out[f"{r.key}_on"] = (v is not None) if r.visible(state) else None
         elif r.kind == "colour":
@@ -182,8 +183,9 @@ def _numbers(app) -> None:
         state.change(f"{r.key}_step")(on_slider(r))
 
     def on_field(key, text):
-        lo, hi = panelmodel.row(key).control.field_range
-        _typed(app, lambda: M.parse_number(key, str(text), lo, hi),
+        control = panelmodel.row(key).control
+        lo, hi = control.field_range
+        _typed(app, lambda: M.parse_number(key, without_unit(control, text), lo, hi),
                lambda v: v != number_values(app.store.state)[key]
                and c.set_value(key, v, merge=False))  # fmt: skip
 

@@ -332,7 +332,7 @@ def test_the_cell_shows_the_explorer_through_a_prefix_proxy(kernel, make_proxy, 
         type_value(driver, "kd", target)
         wait(f"kd {target} in the state", lambda: abs(kd(report(driver)) - float(target)) < 1e-9)
         wait("a new picture", lambda: picture_src(driver) not in (None, first))
-        assert by_name(driver, "kd").get_attribute("value") == target
+        assert by_name(driver, "kd").get_attribute("value") == f"{float(target):.3f}"
         known = (*KNOWN_CONSOLE_ERRORS, f"{proxy.port}/favicon.ico")  # the notebook's icon
         errors = [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"
                   and not any(k in e["message"] for k in known)]  # fmt: skip

@@ -263,7 +263,7 @@ def test_kd_through_its_field_draws_the_engines_colour_and_undo_restores_it(serv
     wait("a new picture", lambda: picture_src(browser) not in (None, before))
     rep = check_probe(browser, mesh)
     assert rep["can_undo"]
-    assert by_name(browser, "kd").get_attribute("value") == "0.3"
+    assert by_name(browser, "kd").get_attribute("value") == "0.300"  # the window's 3 decimals
     click(browser, "undo")
     rep = wait("undo", lambda: (r := report(browser)) and abs(kd(r) - start) < 1e-9 and r)
     check_probe(browser, mesh)
