@@ -260,6 +260,18 @@ def material_title(state: State) -> str:
     return state.preset or state.scene.material.name or "scene material"
 
 
+def material_line(state: State) -> str:
+    """What both front ends say of the material the controls edit, above the preset list:
+    ``preset: gold``, ``material: Porcelain of the mesh`` (a group of the mesh's own), or
+    ``material: NAME`` (:func:`material_title`), each with `` (edited)`` once changed."""
+    edited = " (edited)" if state.edited else ""
+    if state.groups is not None:
+        return f"material: {state.mesh_materials.label(state.group)} of the mesh{edited}"
+    if state.preset:
+        return f"preset: {state.preset}{edited}"
+    return f"material: {material_title(state)}{edited}"
+
+
 def use_mesh_materials(state: State) -> State:
     """Show the mesh's own materials as its file has them, each group its own; the panel
     edits the group it edited last (at first the largest)."""

@@ -203,8 +203,17 @@ def _mesh_materials_rows() -> list[Row]:
 
 
 def _preset_rows() -> list[Row]:
-    """The preset list, first in the material tab."""
+    """The line naming the material the controls edit (``preset: gold (edited)``), then the
+    preset list."""
     return [
+        Row(
+            "material_line",
+            "material",
+            "text",
+            M.material_line,
+            _read_only("material_line"),
+            _always,
+        ),
         Row(
             "preset",
             "material",
@@ -214,7 +223,7 @@ def _preset_rows() -> list[Row]:
             source="presets",
             search=True,
             tip="the built-in and the user's presets (type to search)",
-        )
+        ),
     ]
 
 

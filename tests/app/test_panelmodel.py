@@ -77,6 +77,8 @@ SAMPLES = {
 }
 #: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
 MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
+#: the rows that are lines of text the state gives (read, never set)
+LINES = ("material_line",)
 #: the presets a preset row's edit is given (the controller's)
 PRESETS = list_presets()
 
@@ -107,7 +109,7 @@ def test_every_row_is_one_declared_control():
             assert r.key in CONTROLS, r.key  # its range, scale and decimals: core.controls
         if r.kind in ("choice", "list"):  # fixed values, or items (the state's, a catalogue's)
             assert bool(r.choices) + (r.items is not None) + bool(r.source) == 1, r.key
-    assert set(SAMPLES) | set(MESH_MATERIALS) == set(P.BY_KEY)  # every row is tried below
+    assert set(SAMPLES) | set(MESH_MATERIALS) | set(LINES) == set(P.BY_KEY)  # each tried below
     with pytest.raises(ExplorerError, match="no control named 'glossiness'"):
         P.row("glossiness")
 
@@ -255,3 +257,16 @@ def test_no_front_end_module_names_a_light_type():
         if pattern.search(line)
     ]
     assert not found, found
+
+
+def test_the_material_line_names_the_preset_and_says_when_it_is_edited(mesh):
+    """Both front ends' line above the preset list (the page had none: the window's was its
+    own code): the preset, then " (edited)" after a change, and a line that cannot be set."""
+    jade = next(p for p in PRESETS if p.name == "jade")
+    s = M.apply_preset(start(mesh), "jade", jade.material)
+    line = P.row("material_line")
+    assert line.kind == "text" and line.visible(s)
+    assert line.value(s) == "preset: jade"
+    assert line.value(M.set_coefficient(s, "kd", 0.1)) == "preset: jade (edited)"
+    with pytest.raises(ExplorerError, match="'material_line' is a line of text"):
+        P.edit(s, "material_line", "x")

@@ -39,18 +39,15 @@ class LightsTab(QtWidgets.QWidget):
 
 
 class MaterialTab(QtWidgets.QWidget):
-    """The mesh's own materials and the preset's line, then the material tab's rows
-    (:mod:`explorer.app.panelmodel`: the presets, searchable, with descriptions and swatches;
+    """The material tab's rows (:mod:`explorer.app.panelmodel`: the mesh's own materials, the
+    line naming the material, the presets, searchable, with descriptions and swatches;
     coefficients, colours, model, terms, the material's effects) and the save button."""
 
     def __init__(self, send, parent=None):
         super().__init__(parent)
         box = _form(self)
-        self.preset_label = QtWidgets.QLabel("")
-        self.preset_label.setObjectName("preset_label")
-        self.preset_label.setWordWrap(True)
         self.rows = RowWidgets(panelmodel.rows("material"), box, send, self)
-        box.insertWidget(box.indexOf(self.rows.searches["preset"]), self.preset_label)
+        self.preset_label = self.rows.widgets["material_line"]  # (a text row)
         self.presets, self.search = self.rows.widgets["preset"], self.rows.searches["preset"]
         self.description = self.rows.descriptions["preset"]
         self.sliders = self.rows.sliders
@@ -63,14 +60,6 @@ class MaterialTab(QtWidgets.QWidget):
 
     def show_state(self, s: M.State) -> None:
         self.rows.show_state(s)
-        edited = " (edited)" if s.edited else ""
-        if s.groups is not None:
-            label = s.mesh_materials.label(s.group)
-            self.preset_label.setText(f"material: <b>{label}</b> of the mesh{edited}")
-        elif s.preset:
-            self.preset_label.setText(f"preset: <b>{s.preset}</b>{edited}")
-        else:
-            self.preset_label.setText(f"material: <b>{M.material_title(s)}</b>{edited}")
 
 
 class ViewTab(QtWidgets.QWidget):

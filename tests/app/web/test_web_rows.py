@@ -130,3 +130,17 @@ def test_the_preset_search_finds_presets_by_their_descriptions(server, browser):
 
     assert wait("the search's items", listed) == ["jade", "turquoise"]
     field.send_keys(Keys.ESCAPE)
+
+
+def test_the_page_names_the_material_and_says_when_it_is_edited(server, browser):
+    """The line above the preset list, as the window's: ``preset: NAME``, then ``(edited)``
+    after a change (the page had no such line), and again without it after undo."""
+    from test_web import type_value
+
+    rep = open_page(browser, server.url)
+    line = wait("the material's line", lambda: by_name(browser, "material_line").text or None)
+    assert line == f"preset: {rep['session']['preset']}", line
+    type_value(browser, "kd", "0.25")
+    wait("(edited)", lambda: by_name(browser, "material_line").text == f"{line} (edited)")
+    click(browser, "undo")
+    wait("the line again", lambda: by_name(browser, "material_line").text == line)
