@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.views import sphere_view
 
 from explorer.analysis import lobes as many
 from explorer.app import lobeinset as LI
 from explorer.app import model as M
-from explorer.app.view import SceneView
 from explorer.cli import build_parser
 from explorer.cli.gui import start_state
-from explorer.render.vtk import plotter
 from explorer.shading.display import to_bytes
 
 SIZE = (700, 520)
@@ -20,13 +19,9 @@ SIZE = (700, 520)
 
 @pytest.fixture
 def view():
-    state, mesh = start_state(
-        build_parser().parse_args(["gui", "--mesh", "sphere", "--preset", "chrome"])
-    )
-    pl = plotter(SIZE, (0.1, 0.1, 0.1))
-    v = SceneView(pl, mesh, state)
+    v = sphere_view("chrome", SIZE)
     yield v
-    pl.close()
+    v.plotter.close()
 
 
 def test_the_lobe_sets():

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.controllers import FakeFront, FakeWorker
+from helpers.probes import interior
 
 from explorer.analysis.comparison import heat_map
 from explorer.app import intents
@@ -98,17 +99,6 @@ def overlays(view) -> np.ndarray:
     out = handle_disks(view)
     x0, y0, bw, bh = view.view.lobe.box  # display pixels, origin bottom-left
     out[max(h - (y0 + bh) - 2, 0) : h - y0 + 2, max(x0 - 2, 0) : x0 + bw + 2] = True
-    return out
-
-
-def interior(mask: np.ndarray) -> np.ndarray:
-    """The covered pixels whose 8 neighbours are covered too (the rest: the silhouette)."""
-    m = np.pad(mask, 1)
-    h, w = mask.shape
-    out = mask.copy()
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            out &= m[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
     return out
 
 

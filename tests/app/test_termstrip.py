@@ -6,14 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from helpers.probes import in_ring, one_ring
+from helpers.views import sphere_view
 
 from explorer.app import panelmodel as PM
 from explorer.app.termstrip import STRIP_HEIGHT, set_strip, set_strip_mode
-from explorer.app.view import SceneView
-from explorer.cli import build_parser
-from explorer.cli.gui import start_state
 from explorer.render.strip import COLUMNS
-from explorer.render.vtk import plotter
 from explorer.shading.strip import shader_strip
 
 SIZE = (900, 600)
@@ -21,13 +18,9 @@ SIZE = (900, 600)
 
 @pytest.fixture
 def view():
-    state, mesh = start_state(
-        build_parser().parse_args(["gui", "--mesh", "sphere", "--preset", "gold"])
-    )
-    pl = plotter(SIZE, (0.1, 0.1, 0.1))
-    v = SceneView(pl, mesh, state)
+    v = sphere_view("gold", SIZE)
     yield v
-    pl.close()
+    v.plotter.close()
 
 
 def _picture(view):

@@ -19,3 +19,15 @@ def in_ring(pixel, colours, ring, slack: int = 1) -> bool:
     c = np.asarray(colours, int)[ring]
     p = np.asarray(pixel, int)
     return bool(np.all(p >= c.min(axis=0) - slack) and np.all(p <= c.max(axis=0) + slack))
+
+
+def interior(mask: np.ndarray) -> np.ndarray:
+    """(h, w) bool: the covered pixels of ``mask`` whose 8 neighbours are covered too (the
+    rest of ``mask`` is the silhouette, where two rasterisations may differ by a pixel)."""
+    m = np.pad(mask, 1)
+    h, w = mask.shape
+    out = mask.copy()
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            out &= m[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
+    return out

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from helpers.probes import interior
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import view as V
@@ -23,17 +24,6 @@ def pixels(pl) -> np.ndarray:
     """(h, w, 3) int: what the pane shows now (origin top-left)."""
     pl.render()
     return np.asarray(pl.screenshot(return_img=True)[:, :, :3]).astype(int)
-
-
-def interior(mask: np.ndarray) -> np.ndarray:
-    """The covered pixels whose 8 neighbours are covered too (the rest: the silhouette)."""
-    m = np.pad(mask, 1)
-    h, w = mask.shape
-    out = mask.copy()
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            out &= m[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
-    return out
 
 
 def rings(view, size) -> np.ndarray:

@@ -10,6 +10,7 @@ import os
 import numpy as np
 import pytest
 import yaml
+from helpers.probes import interior
 from test_web import open_page, report, view_pixels, wait
 from webserver import Server, need_browser, new_browser
 
@@ -47,16 +48,6 @@ def inset_box(w: int, h: int) -> tuple[int, int, int, int]:
     font = 13 if side >= 170 else 11
     height = side // 2 + 3 * LI.LOBE_PAD + 2 * (font + 4)
     return LI.LOBE_MARGIN, LI.LOBE_MARGIN, side, height
-
-
-def interior(mask: np.ndarray) -> np.ndarray:
-    m = np.pad(mask, 1)
-    h, w = mask.shape
-    out = mask.copy()
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            out &= m[1 + dy : 1 + dy + h, 1 + dx : 1 + dx + w]
-    return out
 
 
 def as_the_page_sends(picture: np.ndarray) -> np.ndarray:
