@@ -159,7 +159,15 @@ class FileFlows:
             for w in warnings:
                 log.warning("%s", w)
         text = f"{mesh_name}: its materials read with {plural(len(warnings), 'warning')}"
-        self.c.say(text + " (details in the message log)", "warning", list(warnings), STATUS_MS)
+        # the start's mesh: the log keeps them but does not open over the window at start
+        # (they were printed where the explorer was started; the status bar says where they are)
+        self.c.say(
+            text + " (details in the message log)",
+            "warning",
+            list(warnings),
+            STATUS_MS,
+            open_log=not logged,
+        )
 
     # -- open -------------------------------------------------------------------------------
     def open_file(self, path=None) -> None:
