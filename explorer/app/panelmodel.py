@@ -622,6 +622,7 @@ def _view_rows() -> list[Row]:
             "choice",
             lambda s: s.strip_mode,
             lambda s, v: (T.set_strip_mode, (v,)),
+            visible=lambda s: s.strip,  # (shown with the strip, as exposure with hdr)
             choices=STRIP_MODES,
             inline=True,
             tip="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light "

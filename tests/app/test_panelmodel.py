@@ -67,7 +67,7 @@ SAMPLES = {
     "duplicate_light": True,
     "remove_light": True,
     "swap": True,
-    "strip": True,
+    "strip": False,  # (on at the start: its mode's row shown)
     "strip_mode": "raw",
     "lobes": "lights",
     "lobe_view": "cartesian",
@@ -90,15 +90,15 @@ def mesh():
 
 def start(mesh, **scene) -> M.State:
     """A spot light selected (every light row shown) and a point light, the HDR display on (its
-    rows shown), the compare view on (side B's rows shown) and the inset's several lobes
-    (their rows shown)."""
+    rows shown), the compare view on (side B's rows shown), the strip on (its mode's row shown)
+    and the inset's several lobes (their rows shown)."""
     lights = (
         SpotLight(position=(0.0, 2.0, 2.0), aim=(0.0, -1.0, -1.0), cutoff=30.0),
         PointLight(position=(2.0, 2.0, 0.0)),
     )
     base = Scene(lights=lights, hdr={"exposure": 0.0, "tone_map": "reinhard"})
     s = first_state(base.replace(**scene) if scene else base, mesh, name="icosphere")
-    return M.set_compare(s, True).replace(lobes="models")
+    return M.set_compare(s, True).replace(lobes="models", strip=True)
 
 
 def test_every_row_is_one_declared_control():
@@ -127,6 +127,8 @@ def test_each_row_edits_the_state_in_one_undo_step_that_a_session_keeps(key, mes
         assert not r.value(new) and not P.row("exposure").visible(new)
     elif key == "compare":  # the view off: side B's rows hidden
         assert not r.value(new) and not P.row("compare_preset").visible(new)
+    elif key == "strip":  # the strip off: its mode's row hidden
+        assert not r.value(new) and not P.row("strip_mode").visible(new)
     elif key == "type":
         assert new.selected_light.type == "point"
     else:

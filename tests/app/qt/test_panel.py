@@ -407,14 +407,15 @@ MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
 
 
 def every_row_shown(c) -> None:
-    """A spot light, the HDR display, Fresnel, the compare view and the inset's several lobes
-    on: every row of the panel model is shown."""
+    """A spot light, the HDR display, Fresnel, the compare view, the strip and the inset's
+    several lobes on: every row of the panel model is shown."""
     from explorer.app import panelmodel as P
 
     c.act(M.set_light_type, "spot", label="light type")
     assert c.set_value("compare", True, merge=False)
     assert c.set_value("hdr", True, merge=False)
     assert c.set_value("lobes", "models", merge=False)
+    assert c.set_value("strip", True, merge=False)
     assert c.set_value("fresnel", P.row("fresnel").optional, merge=False)
 
 

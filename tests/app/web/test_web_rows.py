@@ -40,6 +40,8 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     wait("side B's rows", lambda: shown(browser, "compare_preset"))
     choose(browser, "lobes", "models")
     wait("the several lobes' rows", lambda: shown(browser, "lobe_view"))
+    click(browser, "strip")
+    wait("the strip's mode", lambda: shown(browser, "strip_mode"))
     click(browser, "material tab")
     wait("the material tab", lambda: shown(browser, "fresnel_on"))
     click(browser, "fresnel_on")
@@ -56,7 +58,7 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
             for name in P.names(r):
                 assert shown(browser, name) != (name in hidden), (tab, name)
                 assert browser.find_elements(By.CSS_SELECTOR, f'[aria-label="{name}"]'), name
-    for _ in range(5):  # fresnel, the lobes, compare, hdr, the spot: back to the start
+    for _ in range(6):  # fresnel, the strip, the lobes, compare, hdr, the spot: the start
         click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
 
