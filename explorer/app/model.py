@@ -265,8 +265,9 @@ def material_line(state: State) -> str:
     ``preset: gold``, ``material: Porcelain of the mesh`` (a group of the mesh's own), or
     ``material: NAME`` (:func:`material_title`), each with `` (edited)`` once changed."""
     edited = " (edited)" if state.edited else ""
-    if state.groups is not None:
-        return f"material: {state.mesh_materials.label(state.group)} of the mesh{edited}"
+    mm = state.mesh_materials
+    if state.groups is not None and mm is not None:
+        return f"material: {mm.label(state.group)} of the mesh{edited}"
     if state.preset:
         return f"preset: {state.preset}{edited}"
     return f"material: {material_title(state)}{edited}"
