@@ -66,22 +66,6 @@ class MeshMaterials:
         return f"'{name}'" if name else "(no usemtl)"
 
 
-def mesh_materials_line(state: State, source=str) -> str:
-    """What a front end says of the mesh file's own materials: whether they are drawn (and
-    which group the controls edit) or what covers the mesh instead ("" when it brings none).
-    ``source`` formats the file's name (the Qt label makes it bold, HTML-escaped)."""
-    mm = state.mesh_materials
-    if mm is None:
-        return ""
-    k, name = len(mm.names), source(mm.source)
-    if state.groups is not None:
-        return (f"{name} brings its own materials, one per group ({k}); the controls below "
-                f"edit group {mm.label(state.group)}")  # fmt: skip
-    cover = f"preset {state.preset!r}" if state.preset else "one material"
-    return (f"{name} brings {k} material{'s' * (k != 1)} of its own; {cover} covers the whole "
-            "mesh instead")  # fmt: skip
-
-
 @dataclass(frozen=True)
 class State:
     """Everything the explorer shows.
@@ -252,25 +236,6 @@ def apply_preset(state: State, name: str, material: Material) -> State:
     if material.model is not None:
         scene = scene.replace(model=material.model)
     return state.replace(scene=scene, preset=name, preset_material=material, groups=None)
-
-
-def material_title(state: State) -> str:
-    """What the captions call the material shown: the preset's name, else the material's own
-    (an OBJ's ``newmtl`` name, kept when another mesh is chosen), else ``"scene material"``."""
-    return state.preset or state.scene.material.name or "scene material"
-
-
-def material_line(state: State) -> str:
-    """What both front ends say of the material the controls edit, above the preset list:
-    ``preset: gold``, ``material: Porcelain of the mesh`` (a group of the mesh's own), or
-    ``material: NAME`` (:func:`material_title`), each with `` (edited)`` once changed."""
-    edited = " (edited)" if state.edited else ""
-    mm = state.mesh_materials
-    if state.groups is not None and mm is not None:
-        return f"material: {mm.label(state.group)} of the mesh{edited}"
-    if state.preset:
-        return f"preset: {state.preset}{edited}"
-    return f"material: {material_title(state)}{edited}"
 
 
 def use_mesh_materials(state: State) -> State:

@@ -38,6 +38,7 @@ from dataclasses import dataclass, replace
 
 from explorer.analysis.lobes import QUANTITIES as LOBE_QUANTITIES
 from explorer.analysis.lobes import VIEWS as LOBE_VIEWS
+from explorer.app import captions
 from explorer.app import effectactions as E
 from explorer.app import lobeinset as LI
 from explorer.app import model as M
@@ -174,7 +175,7 @@ def _mesh_materials_rows() -> list[Row]:
             "mesh_materials",
             "material",
             "text",
-            M.mesh_materials_line,
+            captions.mesh_materials_line,
             _read_only("mesh_materials"),
             brings,
         ),
@@ -210,7 +211,7 @@ def _preset_rows() -> list[Row]:
             "material_line",
             "material",
             "text",
-            M.material_line,
+            captions.material_line,
             _read_only("material_line"),
             _always,
         ),

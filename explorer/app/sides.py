@@ -12,6 +12,7 @@ from typing import Protocol
 
 import numpy as np
 
+from explorer.app import captions
 from explorer.app import model as M
 from explorer.app import pixelcompare as PC
 from explorer.app.handledrag import HandleDragger
@@ -184,7 +185,7 @@ def show_side_b(view_a, view_b, old: M.State | None, new: M.State) -> None:
     b_shading = b.scene.shading
     how_a = f", {new.scene.shading}" if b_shading != new.scene.shading else ""
     how_b = f", {b_shading}" if how_a else ""
-    view_a.set_caption(f"A: {M.material_title(new)} ({new.scene.model}{how_a})")
+    view_a.set_caption(f"A: {captions.material_title(new)} ({new.scene.model}{how_a})")
     view_b.set_caption("A − B (levels, as the difference view)" if new.compare_difference
                        else f"B: {new.compare_preset or 'material'} "
                        f"({new.compare_model}{how_b})")  # fmt: skip

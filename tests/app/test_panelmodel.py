@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from explorer.app import captions
 from explorer.app import model as M
 from explorer.app import panelmodel as P
 from explorer.app.session import load_session, save_session
@@ -171,7 +172,7 @@ def test_a_mesh_files_own_materials_are_rows_a_line_a_group_and_a_button(tmp_pat
     two = write_two_groups(tmp_path)
     s, _ = start_state(build_parser().parse_args(["gui", "--mesh", str(two)]))
     line, group, use = (P.row(k) for k in MESH_MATERIALS)
-    assert line.value(s) == M.mesh_materials_line(s) and group.visible(s)
+    assert line.value(s) == captions.mesh_materials_line(s) and group.visible(s)
     assert not use.visible(s)
     items = group.items(s)
     assert [i.title for i in items] == list(s.mesh_materials.names)

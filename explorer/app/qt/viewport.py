@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 
+from explorer.app import captions
 from explorer.app import model as M
 from explorer.app.session import session_mapping
 from explorer.core.atomic import write_atomic
@@ -27,7 +28,7 @@ class QtPictures:
         """The controls and the status bar's summary show ``state``."""
         w = self.w
         w.panel.show_state(state, w.view.mesh.n_vertices)
-        what = M.material_title(state)
+        what = captions.material_title(state)
         if state.groups is not None:
             what = f"{state.mesh_materials.source}'s materials"
         parts = [what, state.scene.model]

@@ -1,0 +1,42 @@
+"""What both front ends say of the state in words (no toolkit): the line of the mesh file's own
+materials, the name of the material shown, and the line above the preset list. The panel
+model's text rows and the views' captions read them."""
+
+from __future__ import annotations
+
+from explorer.app.model import State
+
+
+def mesh_materials_line(state: State, source=str) -> str:
+    """What a front end says of the mesh file's own materials: whether they are drawn (and
+    which group the controls edit) or what covers the mesh instead ("" when it brings none).
+    ``source`` formats the file's name (the Qt label makes it bold, HTML-escaped)."""
+    mm = state.mesh_materials
+    if mm is None:
+        return ""
+    k, name = len(mm.names), source(mm.source)
+    if state.groups is not None:
+        return (f"{name} brings its own materials, one per group ({k}); the controls below "
+                f"edit group {mm.label(state.group)}")  # fmt: skip
+    cover = f"preset {state.preset!r}" if state.preset else "one material"
+    return (f"{name} brings {k} material{'s' * (k != 1)} of its own; {cover} covers the whole "
+            "mesh instead")  # fmt: skip
+
+
+def material_title(state: State) -> str:
+    """What the captions call the material shown: the preset's name, else the material's own
+    (an OBJ's ``newmtl`` name, kept when another mesh is chosen), else ``"scene material"``."""
+    return state.preset or state.scene.material.name or "scene material"
+
+
+def material_line(state: State) -> str:
+    """What both front ends say of the material the controls edit, above the preset list:
+    ``preset: gold``, ``material: Porcelain of the mesh`` (a group of the mesh's own), or
+    ``material: NAME`` (:func:`material_title`), each with `` (edited)`` once changed."""
+    edited = " (edited)" if state.edited else ""
+    mm = state.mesh_materials
+    if state.groups is not None and mm is not None:
+        return f"material: {mm.label(state.group)} of the mesh{edited}"
+    if state.preset:
+        return f"preset: {state.preset}{edited}"
+    return f"material: {material_title(state)}{edited}"
