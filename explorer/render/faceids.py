@@ -22,7 +22,7 @@ from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera, mesh_frame
 from explorer.render.offscreen import OffscreenWindow
-from explorer.render.vtk import polydata, set_camera
+from explorer.render.vtk import DRAW_LOCK, polydata, set_camera
 
 #: triangles a picture of indices can tell apart (24 bits; 0 is the background)
 MAX_FACES = (1 << 24) - 1
@@ -71,5 +71,7 @@ class FaceIdRenderer(OffscreenWindow):
                                       reset_camera=False)  # fmt: skip
             self._mesh = mesh
         set_camera(pl, camera, self._frame)
-        pl.render()
-        return decode(pl.screenshot(return_img=True)[:, :, :3])
+        with DRAW_LOCK:  # the render and its read-back, no other thread drawing
+            pl.render()
+            picture = pl.screenshot(return_img=True)[:, :, :3]
+        return decode(picture)

@@ -31,7 +31,7 @@ from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera, Vec3, back_to_front, camera_for, mesh_frame
 from explorer.render.images import DEFAULT_SIZE, check_picture_pixels, check_size
 from explorer.render.textured import Textured, add_textured, texture_arrays, textured
-from explorer.render.vtk import add_unlit, cells, plotter, polydata, set_camera
+from explorer.render.vtk import DRAW_LOCK, add_unlit, cells, plotter, polydata, set_camera
 from explorer.shading.display import group_vertex_colors, to_bytes, vertex_colors
 
 #: background colour of every render (linear RGB in [0, 1]): a neutral mid-dark grey on which
@@ -176,8 +176,9 @@ class OffscreenRenderer(OffscreenWindow):
             bmesh, bcolors = backdrop
             extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors), frame=self._frame))
         try:
-            pl.render()
-            img = pl.screenshot(return_img=True)
+            with DRAW_LOCK:  # the render and its read-back, no other thread drawing
+                pl.render()
+                img = pl.screenshot(return_img=True)
         finally:
             if extra is not None:
                 pl.remove_actor(extra)

@@ -18,6 +18,7 @@ PyVista and VTK are imported inside the functions only.
 from __future__ import annotations
 
 import os
+import threading
 from collections.abc import Sequence
 from contextlib import contextmanager
 
@@ -46,6 +47,35 @@ def headless_egl():
             del os.environ[WINDOW_ENV]
 
 
+#: VTK draws in one thread at a time: a window's (or the page's) frames and the difference
+#: worker's off-screen pictures share VTK's and Mesa's process-wide state, and the two drawn at
+#: once crashed the window (a segmentation fault in the worker's render while the window drew,
+#: tests/app/qt/test_panel.py's compare and difference test, 1 CI run in 3). Every render window
+#: made here or by a front end holds it through each frame (:func:`one_frame_at_a_time`); an
+#: off-screen picture holds it through its render and its read-back. Re-entrant: a frame's
+#: observers may draw another window (side B, the per-pixel G-buffer) in the same thread.
+DRAW_LOCK = threading.RLock()
+
+
+def one_frame_at_a_time(render_window) -> None:
+    """``render_window`` holds :data:`DRAW_LOCK` from each frame's start to its end (VTK's
+    StartEvent and EndEvent, in the drawing thread); an end without its start releases
+    nothing."""
+    held = []
+
+    def start(*_):
+        DRAW_LOCK.acquire()
+        held.append(True)
+
+    def end(*_):
+        if held:
+            held.pop()
+            DRAW_LOCK.release()
+
+    render_window.AddObserver("StartEvent", start)
+    render_window.AddObserver("EndEvent", end)
+
+
 def plotter(size: Sequence[int], background, *, off_screen: bool = True, title: str | None = None):
     """A ``pyvista.Plotter`` set up to draw the engine's colours.
 
@@ -65,6 +95,7 @@ def plotter(size: Sequence[int], background, *, off_screen: bool = True, title: 
     pl.disable_anti_aliasing()
     plain_blending(pl.renderer)
     pl.set_background(background)
+    one_frame_at_a_time(pl.render_window)
     return pl
 
 

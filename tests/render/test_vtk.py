@@ -72,3 +72,37 @@ def test_plotter_draws_without_extras():
         assert np.all(img[..., :3] == np.rint(np.array([0.25, 0.5, 0.75]) * 255))
     finally:
         pl.close()
+
+
+def test_one_thread_draws_at_a_time():
+    """A frame of a plotter holds DRAW_LOCK from its start to its end, and an off-screen picture
+    made in another thread (the difference worker's) waits for it: VTK drawing in two threads
+    at once crashed the window."""
+    import threading
+    import time
+
+    import explorer
+    from explorer.render.offscreen import OffscreenRenderer
+    from explorer.render.vtk import DRAW_LOCK
+
+    pl = plotter((64, 48), (0.2, 0.2, 0.2))
+    held = []
+    pl.renderer.AddObserver("StartEvent", lambda *_: held.append(DRAW_LOCK._is_owned()))
+    pl.render_window.Render()
+    assert held and all(held)  # held through the frame
+    assert DRAW_LOCK.acquire(blocking=False)  # and let go after it (in this thread)
+    DRAW_LOCK.release()
+
+    renderer = OffscreenRenderer((64, 48))
+    scene, mesh = explorer.load_scene({"material": "gold"}), M.sphere(8)
+    renderer.render(scene, mesh)  # (the window made before the race)
+    done = threading.Event()
+    worker = threading.Thread(target=lambda: (renderer.render(scene, mesh), done.set()))
+    with DRAW_LOCK:  # a frame of the window, as it were
+        worker.start()
+        time.sleep(0.3)
+        assert not done.is_set()  # the worker's picture waits for the frame
+    worker.join(30)
+    assert done.is_set()
+    renderer.close()
+    pl.close()

@@ -10,7 +10,7 @@ from PySide6 import QtCore
 
 from explorer.app.qt.menus import ViewKeys
 from explorer.render.images import side_by_side
-from explorer.render.vtk import plain_blending
+from explorer.render.vtk import one_frame_at_a_time, plain_blending
 
 
 class CompareView:
@@ -30,6 +30,7 @@ class CompareView:
 
         w = self.w
         pl = QtInteractor(w.views, multi_samples=0, auto_update=False)
+        one_frame_at_a_time(pl.render_window)  # (the difference worker draws too)
         pl.setObjectName("view_b")
         pl.setMinimumSize(120, 150)
         pl.disable_anti_aliasing()

@@ -38,7 +38,7 @@ from explorer.app.start import TITLE, WINDOW_SIZE
 from explorer.app.view import LOD_TARGET, LOD_VERTICES
 from explorer.app.viewport import PlotterView
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import plain_blending
+from explorer.render.vtk import one_frame_at_a_time, plain_blending
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
@@ -103,6 +103,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.views = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
         self.views.setChildrenCollapsible(False)
         self.plotter = QtInteractor(self.views, multi_samples=0, auto_update=False)
+        one_frame_at_a_time(self.plotter.render_window)  # (the difference worker draws too)
         self.plotter.setObjectName("view")
         self.plotter.setMinimumSize(120, 120)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
