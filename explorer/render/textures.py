@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import io
 import os
+import re
 import warnings
 
 import numpy as np
@@ -68,10 +69,17 @@ def read_texture(tmap: TextureMap | str, key: str = "diffuse_map") -> np.ndarray
         raise
     except UnidentifiedImageError:
         raise TextureError(f"{where}: not a PNG or JPEG image") from None
-    except (OSError, ValueError, SyntaxError, Image.DecompressionBombError) as exc:
+    except (Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
+        # Pillow's own guard, at open (more than ~89 M pixels, far above the cap): the header
+        # declares a size too large, which is no damage (it said "damaged or truncated")
+        n = re.search(r"\((\d+) pixels\)", str(exc))
+        size = f"{n.group(1)} pixels" if n else "its size"
+        raise TextureError(
+            f"{where}: {size}, more than the limit of {tol.MAX_TEXTURE_PIXELS} (4096x4096); "
+            "use a smaller image"
+        ) from None
+    except (OSError, ValueError, SyntaxError) as exc:
         raise TextureError(f"{where}: a damaged or truncated image ({exc})") from None
-    except Image.DecompressionBombWarning as exc:  # pragma: no cover - the cap comes first
-        raise TextureError(f"{where}: {exc}") from None
     return np.ascontiguousarray(rgba)
 
 
