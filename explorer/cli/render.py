@@ -164,11 +164,6 @@ def run(args) -> int:
                 "--per-pixel draws one material: give --preset NAME for a mesh with its own "
                 "materials"
             )
-        if scene.material.maps():
-            say(
-                "warning: --per-pixel does not draw texture maps yet; the picture is untextured",
-                file=sys.stderr,
-            )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
     if args.strip:
         return run_strip(args, scene, mesh, materials, background)
@@ -313,6 +308,12 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
             file=sys.stderr,
         )
     method = args.per_pixel_method or "raster"
+    if method != "raster" and scene.material.maps():
+        raise ExplorerError(
+            f"--per-pixel-method {method} draws no texture maps (the G-buffer's (u, v) are the "
+            "raster method's): leave --per-pixel-method out (raster) to draw "
+            f"{', '.join(scene.material.maps())}"
+        )
     if method == "raster" and mesh.n_faces > MAX_FACES:
         raise ExplorerError(
             f"--per-pixel: mesh {mesh.name!r} has {mesh.n_faces:,} triangles, more than a "

@@ -22,7 +22,7 @@ checked open, with the caps of :mod:`explorer.core.tolerances`).
 
 How each map is drawn per vertex (OpenGL 2.1's ``GL_MODULATE`` on the exact light sums) is in
 ``docs/formats.md``; ``specular_map``, ``shininess_map`` and ``bump_map`` need per-pixel
-shading and are kept (files, sessions, exports) but not drawn per vertex.
+shading: a per-pixel picture draws every map (:mod:`explorer.render.pixelmaps`).
 """
 
 from __future__ import annotations
