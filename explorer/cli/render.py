@@ -52,7 +52,7 @@ from explorer.render.live import picture
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
 from explorer.render.strip import STRIP_TILE, render_strip
-from explorer.render.textured import file_maps, not_drawn_per_vertex, textured
+from explorer.render.textured import file_maps, layered, not_drawn_per_vertex, textured
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -173,6 +173,13 @@ def run(args) -> int:
     for note in notes:
         say(f"warning: {note}", file=sys.stderr)
     texture = textured(scene, mesh, materials)  # the image read (or refused) before any work
+    if suffix == ".glb" and layered(scene, materials):
+        say(
+            f"warning: {args.out}: a GLB holds the diffuse_map alone (glTF's base colour "
+            "texture); ambient_map and emission_map are not written into it",
+            file=sys.stderr,
+        )
+        texture = textured(scene, mesh, materials, layers=False)
     for m in materials or (scene.material,):
         for key in not_drawn_per_vertex(m):
             say(
@@ -187,11 +194,11 @@ def run(args) -> int:
             "separate specular colour)",
             file=sys.stderr,
         )
-        texture = textured(scene.replace(color_control="single"), mesh, materials)
+        texture = textured(scene.replace(color_control="single"), mesh, materials, layers=False)
     elif texture is not None and (turntable or suffix not in (".png", ".glb")):
         say(
-            f"warning: {args.out}: the diffuse_map is not drawn into this output (a PNG "
-            "picture and a GLB wear it); the vertices carry their untextured colours",
+            f"warning: {args.out}: the texture maps are not drawn into this output (a PNG "
+            "picture and a GLB wear them); the vertices carry their untextured colours",
             file=sys.stderr,
         )
     name = scene.material.name or "material"

@@ -50,8 +50,9 @@ MTL_MAP_KEYS = {
     **{statement.lower(): key for key, statement in MAP_STATEMENTS.items()},
     "map_bump": "bump_map",
 }
-#: the maps a per-vertex picture draws (GL_MODULATE of the interpolated light sums)
-PER_VERTEX_MAPS = ("diffuse_map",)
+#: the maps a per-vertex picture draws (GL_MODULATE of the interpolated light sums; the ambient
+#: and emission maps as layers of their own: explorer.render.textured)
+PER_VERTEX_MAPS = ("diffuse_map", "ambient_map", "emission_map")
 #: ``-imfchan`` values: red, green, blue, matte, luminance, depth
 CHANNELS = ("r", "g", "b", "m", "l", "z")
 #: keys of a map written as a mapping
