@@ -61,7 +61,7 @@ _LAYERED_FRAGMENT = """vec4 texel = texture(actortexture, tcoordVCVSOutput);
   vec3 layered = fragOutput0.rgb * texel.rgb{layers};
   fragOutput0 = vec4(min(layered + {specular}, vec3(1.0)), fragOutput0.a * texel.a);"""
 #: a white texel: the texture of a term without a map
-_WHITE = np.full((1, 1, 4), 255, np.uint8)
+WHITE = np.full((1, 1, 4), 255, np.uint8)
 
 
 @dataclass(frozen=True)
@@ -194,11 +194,11 @@ def textured(scene, mesh: Mesh, materials=None, *, layers: bool = True) -> Textu
                 f"mesh '{mesh.name}' has no texture coordinates, so it cannot wear {key} "
                 f"'{t.file}' (an OBJ needs vt lines; a built-in mesh has its own)"
             )
-    image = _WHITE if tmap is None else read_texture(tmap, "diffuse_map")
+    image = WHITE if tmap is None else read_texture(tmap, "diffuse_map")
     if not layers:
         primary, secondary = textured_colors(scene, mesh, materials)
         return Textured(to_bytes(primary), to_bytes(secondary), image, tmap)
-    images = {k: _WHITE if t is None else read_texture(t, k) for k, t in maps.items()}
+    images = {k: WHITE if t is None else read_texture(t, k) for k, t in maps.items()}
 
     def term(name):
         change = only(name)
