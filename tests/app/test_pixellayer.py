@@ -353,3 +353,28 @@ def test_a_textured_mesh_wears_its_texture_again_after_per_pixel(tmp_path, monke
         np.testing.assert_array_equal(after, before)
     finally:
         view.plotter.close()
+
+
+def test_a_built_in_mesh_chosen_after_the_start_wears_the_map(tmp_path, monkeypatch):
+    """The explorer started on the teapot with a diffuse_map; the sphere chosen after it comes
+    with its (u, v) and wears the map (it was drawn untextured: the chooser loaded it without
+    texture coordinates)."""
+    from pathlib import Path
+
+    tiles = Path(__file__).resolve().parents[2] / "docs" / "examples" / "tiles.png"
+    view = make_port("teapot", tmp_path, monkeypatch, "--diffuse-map", str(tiles))
+    try:
+        c = view.controller
+        assert c.files.choose_mesh("sphere")
+        view.redraw()
+        assert c.meshes["sphere"].uv is not None
+        assert view.view.drawings[0].texture is not None
+        tiled = picture(view)
+        material = c.state.scene.material
+        assert c.set_value("preset", "gold", merge=False)  # a material without the map
+        view.redraw()
+        assert c.state.scene.material.diffuse_map is None and material.diffuse_map is not None
+        assert view.view.drawings[0].texture is None
+        assert np.abs(picture(view) - tiled).max() > 100
+    finally:
+        view.plotter.close()
