@@ -59,6 +59,12 @@ def any_maps(materials) -> bool:
     return any(m.maps() for m in materials)
 
 
+def bare(material):
+    """``material`` without its maps (the same object when it has none)."""
+    maps = material.maps()
+    return material.replace(**dict.fromkeys(maps)) if maps else material
+
+
 def pixel_uv(mesh, triangles, barycentrics) -> np.ndarray:
     """(k, 2) float64 the mesh's (u, v) at hits on ``triangles`` (k,) with ``barycentrics``
     (k, 2) ``(b1, b2)``: ``(1-b1-b2)·uv0 + b1·uv1 + b2·uv2`` over the triangle's corners."""
