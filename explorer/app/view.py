@@ -267,8 +267,10 @@ class MeshDrawing:
             image = WHITE if tmap is None else read_texture(tmap)
             built = ()
             if any(t is not None for t in layers.values()):
-                built = tuple(Layer(k, black, WHITE if t is None else read_texture(t, k), t)
-                              for k, t in layers.items())  # fmt: skip
+                built = tuple(
+                    Layer(k, black, WHITE if t is None else read_texture(t, k), t)
+                    for k, t in layers.items()
+                )
             t = Textured(self.rgb, black, image, tmap, built, scene.color_control)
             texture_arrays(self.poly, self.mesh, t)
             self.actor = add_textured(plotter, self.poly, t)

@@ -277,9 +277,9 @@ class PixelMaps:
             for (rows, _), tmap in zip(parts, bumps, strict=True):
                 if tmap is not None and len(rows):
                     image = self.image("bump_map", tmap)
-                    out[rows] = bumped_normals(mesh, hits.triangles[rows],
-                                               hits.barycentrics[rows], out[rows], image,
-                                               tmap)  # fmt: skip
+                    out[rows] = bumped_normals(
+                        mesh, hits.triangles[rows], hits.barycentrics[rows], out[rows], image, tmap
+                    )
             return out
 
         return self._kept(hits, ("normals", bumps), make)
@@ -293,8 +293,11 @@ class PixelMaps:
         for rows, m in parts:
             if not len(rows):
                 continue
-            factors = {k: self.factor(hits, mesh, k, t)[rows] for k, t in m.maps().items()
-                       if k != "bump_map" and k != "shininess_map"}  # fmt: skip
+            factors = {
+                k: self.factor(hits, mesh, k, t)[rows]
+                for k, t in m.maps().items()
+                if k != "bump_map" and k != "shininess_map"
+            }
             shader.set_material(m)
             aconst, sums = kept_sums(shader)
             srows = rows + first
@@ -310,8 +313,10 @@ def _own_lobes(shader, material, srows, tn, sums) -> dict:
     """``sums`` at the shader rows ``srows`` (r, 3) float64 each, the specular (and three.js's
     ``specular_f90``) at each row's own exponent ``shininess · tn``: the shader's specular at
     each distinct exponent (after the first, the lobe alone)."""
-    out = {k: np.broadcast_to(np.asarray(v[srows], np.float64), (len(srows), 3)).copy()
-           for k, v in sums.items()}  # fmt: skip
+    out = {
+        k: np.broadcast_to(np.asarray(v[srows], np.float64), (len(srows), 3)).copy()
+        for k, v in sums.items()
+    }
     exponents = material.shininess * np.asarray(tn, np.float64)
     for n in np.unique(exponents):
         pick = exponents == n

@@ -172,8 +172,9 @@ def only(term: str):
 def layered(scene, materials=None) -> bool:
     """Whether a per-vertex picture draws the primary colour's terms apart (an ``ambient_map``
     or ``emission_map``: see the module docstring)."""
-    return any(getattr(m, k) is not None for m in (materials or (scene.material,))
-               for k in LAYER_MAPS)  # fmt: skip
+    return any(
+        getattr(m, k) is not None for m in (materials or (scene.material,)) for k in LAYER_MAPS
+    )
 
 
 def textured(scene, mesh: Mesh, materials=None, *, layers: bool = True) -> Textured | None:
@@ -314,18 +315,25 @@ def _layers(mapper, actor, t: Textured) -> str:
         n = layer.name
         for array in (f"{n}_c", f"{n}_st"):
             mapper.MapDataArrayToVertexAttribute(array, array, points, -1)
-        vs_dec += [f"in vec4 {n}_c;", f"in vec2 {n}_st;", f"out vec4 {n}_cVS;",
-                   f"out vec2 {n}_stVS;"]  # fmt: skip
+        vs_dec += [
+            f"in vec4 {n}_c;",
+            f"in vec2 {n}_st;",
+            f"out vec4 {n}_cVS;",
+            f"out vec2 {n}_stVS;",
+        ]
         vs_impl += [f"{n}_cVS = {n}_c;", f"{n}_stVS = {n}_st;"]
         fs_dec += [f"in vec4 {n}_cVS;", f"in vec2 {n}_stVS;"]
         terms.append(f" + {n}_cVS.rgb * texture({n}, {n}_stVS).rgb")
         actor.GetProperty().SetTexture(n, vtk_texture(layer))
-    sp.AddVertexShaderReplacement("//VTK::Normal::Dec", True,
-                                  "//VTK::Normal::Dec\n" + "\n".join(vs_dec), False)  # fmt: skip
-    sp.AddVertexShaderReplacement("//VTK::Normal::Impl", True,
-                                  "//VTK::Normal::Impl\n" + "\n".join(vs_impl), False)  # fmt: skip
-    sp.AddFragmentShaderReplacement("//VTK::Normal::Dec", True,
-                                    "//VTK::Normal::Dec\n" + "\n".join(fs_dec), False)  # fmt: skip
+    sp.AddVertexShaderReplacement(
+        "//VTK::Normal::Dec", True, "//VTK::Normal::Dec\n" + "\n".join(vs_dec), False
+    )
+    sp.AddVertexShaderReplacement(
+        "//VTK::Normal::Impl", True, "//VTK::Normal::Impl\n" + "\n".join(vs_impl), False
+    )
+    sp.AddFragmentShaderReplacement(
+        "//VTK::Normal::Dec", True, "//VTK::Normal::Dec\n" + "\n".join(fs_dec), False
+    )
     specular = "secondaryVSOut.rgb"
     if t.color_control == "single":
         specular += " * texel.rgb"

@@ -387,8 +387,15 @@ def test_a_mesh_without_uv_is_drawn_untextured_per_pixel(tmp_path, monkeypatch):
     from pathlib import Path
 
     examples = Path(__file__).resolve().parents[2] / "docs" / "examples"
-    view = make_port(str(examples / "teapot_parts.obj"), tmp_path, monkeypatch, "--preset",
-                     "gold", "--diffuse-map", str(examples / "tiles.png"))  # fmt: skip
+    view = make_port(
+        str(examples / "teapot_parts.obj"),
+        tmp_path,
+        monkeypatch,
+        "--preset",
+        "gold",
+        "--diffuse-map",
+        str(examples / "tiles.png"),
+    )
     try:
         c = view.controller
         assert view.view.mesh.uv is None and c.state.scene.material.diffuse_map is not None

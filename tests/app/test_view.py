@@ -188,8 +188,9 @@ def test_the_view_wears_ambient_and_emission_maps_as_layers(tmp_path):
             return pl.screenshot(return_img=True)[:, :, :3].astype(int)
 
         plain = picture(wearing())
-        lit = wearing(emission_map=str(tmp_path / "white.png"),
-                      ambient_map=str(tmp_path / "white.png"))  # fmt: skip
+        lit = wearing(
+            emission_map=str(tmp_path / "white.png"), ambient_map=str(tmp_path / "white.png")
+        )
         white = picture(lit)
         d = view.drawings[0]
         assert set(d.layers) == {"emission", "ambient"}
@@ -200,8 +201,11 @@ def test_the_view_wears_ambient_and_emission_maps_as_layers(tmp_path):
             assert np.abs(got - want.astype(int)).max() <= 1
         assert np.abs(white - plain).max() <= 2
         dark = picture(wearing(emission_map=str(tmp_path / "black.png")))
-        no_emission = picture(dataclasses.replace(state, scene=state.scene.replace(
-            material=base.replace(emission=(0.0, 0.0, 0.0)))))  # fmt: skip
+        no_emission = picture(
+            dataclasses.replace(
+                state, scene=state.scene.replace(material=base.replace(emission=(0.0, 0.0, 0.0)))
+            )
+        )
         assert np.abs(dark - no_emission).max() <= 2
         assert np.abs(dark - plain).max() > 40
     finally:

@@ -59,14 +59,13 @@ TERMS = {
     "emission_map": Material(emission=(0.6, 0.8, 0.4), ambient=BLACK, diffuse=BLACK),
     "specular_map": Material(
         specular=(1.0, 0.9, 0.8), ambient=BLACK, diffuse=BLACK, shininess=30.0
-    ),  # fmt: skip
+    ),
 }
 
 
 @pytest.mark.parametrize("precision", ["float64", "float32"])
 @pytest.mark.parametrize("key", [*TERMS, "shininess_map"])
-def test_a_constant_map_gives_its_value_times_the_untextured_term(tmp_path, teapot, key,
-                                                                  precision):  # fmt: skip
+def test_a_constant_map_gives_its_value_times_the_untextured_term(tmp_path, teapot, key, precision):
     """A map whose every texel is c (= 128/255, or an RGB triple) gives each pixel c times the
     untextured term there (the engine's colours on the same hits); a constant shininess map
     gives the picture of shininess n·c. Within one level in float32, the same bytes on 99 % of
@@ -120,8 +119,10 @@ def test_a_nonuniform_diffuse_map_shows_each_pixels_texel(tmp_path):
     rgb[:, 0] = 255
     plane = M.plane(8, uv=True)
     material = Material(ambient=BLACK, diffuse=(0.8, 0.6, 0.4))
-    scene = _scene(material.replace(diffuse_map=TextureMap(_png(tmp_path / "h.png", rgb))),
-                   Viewer(to_viewer=(0.0, 0.0, 1.0)))  # fmt: skip
+    scene = _scene(
+        material.replace(diffuse_map=TextureMap(_png(tmp_path / "h.png", rgb))),
+        Viewer(to_viewer=(0.0, 0.0, 1.0)),
+    )
     with LivePixels(plane) as live:
         f = live.frame(scene, camera_for(scene, plane, 1.0), (64, 64))
         h = live._gbuffer.hits
@@ -153,8 +154,7 @@ def test_a_linear_ramp_bump_map_tilts_the_normal_by_the_hand_computed_angle(tmp_
     with LivePixels(plane, precision=precision) as live:
         f = live.frame(scene, camera_for(scene, plane, 1.0), (64, 64))
         h = live._gbuffer.hits
-    tilted = bumped_normals(plane, h.triangles, h.barycentrics, h.normals,
-                            _image(tmap), tmap)  # fmt: skip
+    tilted = bumped_normals(plane, h.triangles, h.barycentrics, h.normals, _image(tmap), tmap)
     np.testing.assert_allclose(tilted, np.broadcast_to(n, tilted.shape), atol=1e-12)
     lit = d * max(0.0, float(n @ (TO_LIGHT / np.linalg.norm(TO_LIGHT))))
     got = f.rgb[f.mask]
@@ -192,16 +192,22 @@ def test_a_colour_change_of_a_textured_material_runs_no_light_pass(tmp_path, tea
     rng = np.random.default_rng(4)
     one = _png(tmp_path / "a.png", rng.integers(0, 256, (8, 8, 3)))
     two = _png(tmp_path / "b.png", rng.integers(0, 256, (8, 8, 3)))
-    m = Material(diffuse=(0.7, 0.5, 0.3), specular=(0.5,) * 3, shininess=20.0,
-                 diffuse_map=TextureMap(one), specular_map=TextureMap(two))  # fmt: skip
+    m = Material(
+        diffuse=(0.7, 0.5, 0.3),
+        specular=(0.5,) * 3,
+        shininess=20.0,
+        diffuse_map=TextureMap(one),
+        specular_map=TextureMap(two),
+    )
     scene = _scene(m)
     cam = camera_for(scene, teapot, SIZE[0] / SIZE[1])
     with LivePixels(teapot) as live:
         first = live.frame(scene, cam, SIZE)
         assert live.light_passes == 1
         second = live.frame(scene.replace(material=m.replace(diffuse=(0.2, 0.9, 0.4))), cam, SIZE)
-        third = live.frame(scene.replace(material=m.replace(diffuse_map=TextureMap(two))),
-                           cam, SIZE)  # fmt: skip
+        third = live.frame(
+            scene.replace(material=m.replace(diffuse_map=TextureMap(two))), cam, SIZE
+        )
         assert live.light_passes == 1
         assert _levels(first.rgb, second.rgb).max() > 10
         assert _levels(first.rgb, third.rgb).max() > 10
@@ -223,14 +229,26 @@ def test_render_per_pixel_draws_the_maps(tmp_path, capsys):
     rng = np.random.default_rng(7)
     image = _png(tmp_path / "t.png", rng.integers(0, 256, (8, 8, 3)))
     out = tmp_path / "p.png"
-    args = ["render", "--mesh", "teapot", "--per-pixel", "--size", "96x72", "--diffuse-map",
-            image]  # fmt: skip
+    args = ["render", "--mesh", "teapot", "--per-pixel", "--size", "96x72", "--diffuse-map", image]
     assert main([*args, "--out", str(out)]) == 0
     err = capsys.readouterr().err
     assert "warning" not in err
     drawn = read_png(out)
-    assert main(["render", "--mesh", "teapot", "--per-pixel", "--size", "96x72", "--out",
-                 str(tmp_path / "plain.png")]) == 0  # fmt: skip
+    assert (
+        main(
+            [
+                "render",
+                "--mesh",
+                "teapot",
+                "--per-pixel",
+                "--size",
+                "96x72",
+                "--out",
+                str(tmp_path / "plain.png"),
+            ]
+        )
+        == 0
+    )
     assert _levels(drawn, read_png(tmp_path / "plain.png")).max() > 10
     capsys.readouterr()
     bad = [*args, "--per-pixel-method", "raycast", "--out", str(tmp_path / "r.png")]

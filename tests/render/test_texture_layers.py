@@ -23,8 +23,13 @@ from explorer.shading.display import to_bytes, vertex_colors
 BLACK = (0.0, 0.0, 0.0)
 #: every vertex's primary and specular sums below 1 (0.96 at most), where the layers' separately
 #: clamped terms and GL's one clamped colour agree
-MATERIAL = Material(ambient=(0.3, 0.25, 0.2), diffuse=(0.3, 0.35, 0.25), specular=(0.35,) * 3,
-                    emission=(0.1, 0.05, 0.15), shininess=30.0)  # fmt: skip
+MATERIAL = Material(
+    ambient=(0.3, 0.25, 0.2),
+    diffuse=(0.3, 0.35, 0.25),
+    specular=(0.35,) * 3,
+    emission=(0.1, 0.05, 0.15),
+    shininess=30.0,
+)
 
 
 def _png(path, rgb) -> str:
@@ -58,8 +63,9 @@ def teapot():
 
 
 @pytest.mark.parametrize("color_control", ["single", "separate"])
-def test_white_ambient_and_emission_maps_give_the_untextured_picture(renderer, tmp_path, teapot,
-                                                                     color_control):  # fmt: skip
+def test_white_ambient_and_emission_maps_give_the_untextured_picture(
+    renderer, tmp_path, teapot, color_control
+):
     """Each term rounded to 8 bits apart and summed: within two levels of the untextured picture
     (one term's rounding is half a level) where no vertex's sum exceeds 1 (the terms are clamped
     apart: docs/formats.md); the layers are drawn."""
@@ -68,8 +74,10 @@ def test_white_ambient_and_emission_maps_give_the_untextured_picture(renderer, t
     scene = _scene(m, color_control=color_control)
     t = textured(scene, teapot)
     assert [layer.key for layer in t.layers] == ["emission_map", "ambient_map"]
-    terms = [vertex_colors(scene.replace(material=only(k)(MATERIAL)), teapot)
-             for k in ("emission", "ambient", "diffuse", "specular")]  # fmt: skip
+    terms = [
+        vertex_colors(scene.replace(material=only(k)(MATERIAL)), teapot)
+        for k in ("emission", "ambient", "diffuse", "specular")
+    ]
     assert sum(terms).max() < 1.0
     got = renderer.render(scene, teapot)
     want = renderer.render(scene.replace(material=MATERIAL), teapot)
@@ -85,8 +93,10 @@ def test_a_constant_layer_map_gives_its_value_times_its_term(renderer, tmp_path,
     c = np.array([200, 100, 30])
     image = _png(tmp_path / "c.png", np.broadcast_to(c, (4, 4, 3)))
     term = "emission" if key == "emission_map" else "ambient"
-    alone = Material(**{k: BLACK for k in ("ambient", "diffuse", "specular", "emission")
-                        if k != term}, **{term: (0.9, 0.8, 0.7)})  # fmt: skip
+    alone = Material(
+        **{k: BLACK for k in ("ambient", "diffuse", "specular", "emission") if k != term},
+        **{term: (0.9, 0.8, 0.7)},
+    )
     scaled = alone.replace(**{term: tuple(np.array((0.9, 0.8, 0.7)) * c / 255.0)})
     got = renderer.render(_scene(alone.replace(**{key: TextureMap(image)})), teapot)
     want = renderer.render(_scene(scaled), teapot)
@@ -104,10 +114,17 @@ def test_a_layer_map_samples_its_own_texels(renderer, tmp_path):
     rgb[:, 1] = 255
     plane = M.plane(8, uv=True)
     e = (0.9, 0.6, 0.3)
-    m = Material(emission=e, ambient=BLACK, diffuse=BLACK,
-                 emission_map=TextureMap(_png(tmp_path / "h.png", rgb)))  # fmt: skip
-    scene = explorer.Scene(material=m, lights=(DirectionalLight(to_light=(0, 0, 1)),),
-                           viewer=Viewer(to_viewer=(0, 0, 1)))  # fmt: skip
+    m = Material(
+        emission=e,
+        ambient=BLACK,
+        diffuse=BLACK,
+        emission_map=TextureMap(_png(tmp_path / "h.png", rgb)),
+    )
+    scene = explorer.Scene(
+        material=m,
+        lights=(DirectionalLight(to_light=(0, 0, 1)),),
+        viewer=Viewer(to_viewer=(0, 0, 1)),
+    )
     image = renderer.render(scene, plane)
     covered = _covered(image)
     rows, cols = np.nonzero(covered)
@@ -125,11 +142,13 @@ def test_render_draws_ambient_and_emission_maps_without_a_warning(tmp_path, caps
     image = _png(tmp_path / "t.png", np.random.default_rng(2).integers(0, 256, (8, 8, 3)))
     scene = tmp_path / "s.yaml"
     assert image.endswith("t.png")
-    scene.write_text("material: {ambient_map: t.png, emission: [0.2, 0.2, 0.2], "
-                     "emission_map: t.png}\n")  # fmt: skip
+    scene.write_text(
+        "material: {ambient_map: t.png, emission: [0.2, 0.2, 0.2], emission_map: t.png}\n"
+    )
     out = tmp_path / "p.png"
-    assert main(["render", str(scene), "--mesh", "teapot", "--size", "96x72",
-                 "--out", str(out)]) == 0  # fmt: skip
+    assert (
+        main(["render", str(scene), "--mesh", "teapot", "--size", "96x72", "--out", str(out)]) == 0
+    )
     assert "warning" not in capsys.readouterr().err
     assert main(["render", str(scene), "--mesh", "teapot", "--out", str(tmp_path / "m.glb")]) == 0
     err = capsys.readouterr().err
