@@ -256,3 +256,38 @@ def test_render_per_pixel_draws_the_maps(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "raster" in err[0] and "raycast" in err[0]
     assert not (tmp_path / "r.png").exists()
+
+
+def test_each_group_wears_its_own_materials_maps(tmp_path):
+    """A mesh file's groups per pixel: the group whose material wears a constant diffuse map
+    of c shows c times its diffuse term, the others their own untextured colours (each pixel
+    in its triangle's group's material, the maps included)."""
+    from pathlib import Path
+
+    from explorer.geometry.meshes import load_mesh
+
+    parts = load_mesh(Path(__file__).resolve().parents[2] / "docs/examples/teapot_parts.obj")
+    uv = (parts.positions[:, :2] - parts.positions[:, :2].min(axis=0)) / 4.0
+    mesh = M.Mesh(parts.positions, parts.normals, parts.faces, "parts", parts.groups, uv=uv)
+    c = np.array([100, 200, 150])
+    image = _png(tmp_path / "c.png", np.broadcast_to(c, (2, 2, 3)))
+    first = Material(ambient=BLACK, diffuse=(0.9, 0.8, 0.7))
+    others = (
+        Material(diffuse=(0.2, 0.3, 0.9)),
+        Material(diffuse=(0.8, 0.7, 0.1), specular=(1, 1, 1), shininess=50.0),
+    )
+    worn = (first.replace(diffuse_map=TextureMap(image)), *others)
+    scaled = (first.replace(diffuse=tuple(np.array(first.diffuse) * c / 255.0)), *others)
+    scene = _scene(Material())
+    cam = camera_for(scene, mesh, SIZE[0] / SIZE[1])
+    with LivePixels(mesh) as live:
+        f = live.frame(scene, cam, SIZE, materials=worn)
+        hits = live._gbuffer.hits
+    want = to_bytes(reference_of(scene, mesh, hits, materials=scaled).colors)
+    plain = to_bytes(reference_of(scene, mesh, hits, materials=(first, *others)).colors)
+    got = f.rgb[f.mask]
+    assert _levels(got, want).max() <= 1
+    of_hit = mesh.groups.of_vertex[mesh.faces[hits.triangles, 0]]
+    assert (of_hit == 0).sum() > 200 and (of_hit > 0).sum() > 200
+    changed = _levels(got, plain) > 5
+    assert changed[of_hit == 0].mean() > 0.5 and not changed[of_hit > 0].any()
