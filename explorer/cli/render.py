@@ -184,7 +184,7 @@ def run(args) -> int:
         for key in not_drawn_per_vertex(m):
             say(
                 f"warning: {key} {getattr(m, key).file}: not drawn per vertex (it needs "
-                "per-pixel shading); the material keeps it",
+                "per-pixel shading: --per-pixel draws it); the material keeps it",
                 file=sys.stderr,
             )
     if texture is not None and suffix == ".glb" and scene.color_control == "separate":

@@ -24,8 +24,9 @@ A map absent is a factor of 1: the colour is then ``compose_terms``'s, bit for b
 The sums are the per-pixel shader's kept ones (:func:`explorer.shading.shader.kept_sums`): a
 change of the material's colours or of a colour or scalar map composes again with no light
 pass. A shininess map needs the specular sum at each exponent its pixels have (at most 256: one
-8-bit channel): the lobe alone at each, from the bases the shader stores after its first
-shininess change. A bump map changes the normals: the light sums are computed anew.
+8-bit channel): on the compiled tier the lobe alone at each, from the bases the shader stores
+after its first shininess change (the numpy tier computes each anew). A bump map changes the
+normals: the light sums are computed anew.
 
 GL 2.1 has no per-pixel lighting, so ``color_control`` plays no part here: the specular is
 never multiplied by the diffuse texture (as under ``separate``, and every term its own map).
@@ -312,7 +313,7 @@ class PixelMaps:
 def _own_lobes(shader, material, srows, tn, sums) -> dict:
     """``sums`` at the shader rows ``srows`` (r, 3) float64 each, the specular (and three.js's
     ``specular_f90``) at each row's own exponent ``shininess · tn``: the shader's specular at
-    each distinct exponent (after the first, the lobe alone)."""
+    each distinct exponent (after the first, the lobe alone on the compiled tier)."""
     out = {
         k: np.broadcast_to(np.asarray(v[srows], np.float64), (len(srows), 3)).copy()
         for k, v in sums.items()
