@@ -1,6 +1,6 @@
 """The page's finish, in a real browser: pane B of the compare view with the light handles
-and the arrows at its edge (dragged there as in pane A), and the panel's sliders lined up at
-every size."""
+and the arrows at its edge (dragged there as in pane A), the panel's sliders lined up at
+every size, and the lobe inset scaled to a small view."""
 
 from __future__ import annotations
 
@@ -8,7 +8,10 @@ import time
 
 import numpy as np
 import pytest
+from helpers.insets import panel_extent
 from test_web import click, open_page, report, type_value, view_pixels, wait
+
+from explorer.app import lobeinset as LI
 
 pytestmark = pytest.mark.web
 
@@ -99,3 +102,96 @@ def test_pane_b_draws_the_handles_and_a_drag_there_moves_the_light(server, brows
     click(browser, "compare")
     wait("side B gone", lambda: report(browser)["compare"] is None)
     click(browser, "material tab")
+
+
+#: every slider of the tab shown: its track and its number field, as (left, right) in CSS
+#: pixels (a tab shown before stays in the page, moved aside)
+SLIDERS_JS = """
+const box = e => { const r = e.getBoundingClientRect(); return [r.left, r.right]; };
+return [...document.querySelectorAll('[aria-label$=" slider"]')]
+  .filter(e => e.closest('.v-window-item--active') && e.getClientRects().length)
+  .map(e => { const key = e.getAttribute('aria-label').replace(/ slider$/, '');
+              const field = document.querySelector(`input[aria-label="${key}"]`);
+              return {key: key, track: box(e.closest('.v-slider').querySelector('.v-slider-track')),
+                      field: box(field.closest('.v-field'))}; });
+"""
+
+
+def settled(driver, script: str):
+    """What ``script`` returns once the page stands still: the same in two reads 0.2 s apart
+    (the drawer slides in as a page opens), or None."""
+    first = driver.execute_script(script)
+    time.sleep(0.2)
+    return first if first and driver.execute_script(script) == first else None
+
+
+@pytest.mark.parametrize("size", [(1280, 900), (900, 720), (640, 480)])
+def test_every_slider_starts_and_ends_at_the_same_x(server, browser, size):
+    """Every slider of every tab (the material's, the light's, the view's exposure) starts and
+    ends at the same x, and so does every number field beside them: the labels are a column of
+    one width (issue 42: shininess's and opacity's sliders started further right than ka's,
+    their labels being longer)."""
+    try:
+        browser.get("about:blank")
+        browser.set_window_size(*size)
+        open_page(browser, server.url)
+        click(browser, "view tab")
+        click(browser, "hdr")  # (the exposure's slider is shown with hdr on)
+        wait("hdr", lambda: report(browser)["session"]["scene"].get("hdr"))
+        rows = []
+        for tab in ("material", "lights", "view"):
+            click(browser, f"{tab} tab")
+            got = wait(f"the {tab} tab's sliders", lambda: settled(browser, SLIDERS_JS))
+            rows += [{**r, "tab": tab} for r in got]
+        assert {r["key"] for r in rows} >= {"ka", "shininess", "opacity", "intensity",
+                                             "elevation", "exposure"}, rows  # fmt: skip
+        for part in ("track", "field"):
+            for side in (0, 1):
+                xs = [r[part][side] for r in rows]
+                assert max(xs) - min(xs) <= 1, (part, side, rows)
+        assert min(r["track"][1] - r["track"][0] for r in rows) >= 60, rows  # still a slider
+    finally:
+        click(browser, "view tab")
+        click(browser, "hdr")
+        wait("hdr off", lambda: not report(browser)["session"]["scene"].get("hdr"))
+        browser.get("about:blank")
+        browser.set_window_size(1280, 900)
+
+
+def view_picture(driver, view: str, size) -> np.ndarray:
+    """View ``view``'s picture as the page shows it (h, w, 3), at the server's size."""
+    from PIL import Image
+
+    shot, box = view_pixels(driver, view)
+    d = box["dpr"]
+    x, y, w, h = (round(v * d) for v in (box["x"], box["y"], box["w"], box["h"]))
+    img = Image.fromarray(np.ascontiguousarray(shot[y : y + h, x : x + w]))
+    return np.asarray(img.resize(tuple(size), Image.NEAREST))
+
+
+def test_the_lobe_inset_covers_at_most_a_fifth_of_a_small_view(server, browser):
+    """At 640x480, compare on: in each pane (183x251 pixels) the inset's panel, read from the
+    page's pixels, covers at most LOBE_AREA of the pane and is still there (issue 42: the
+    130-pixel inset covered 32% of each pane, 40% of the view before the drawer narrowed)."""
+    try:
+        browser.get("about:blank")
+        browser.set_window_size(640, 480)
+        open_page(browser, server.url)
+        click(browser, "view tab")
+        click(browser, "compare")
+        rep = wait("side B", lambda: (r := report(browser))["compare"] and r)
+        for view, size in (("view", rep["size"]), ("view_b", rep["compare"]["size"])):
+            w, h = size
+
+            def fits(view=view, size=size, w=w, h=h):
+                side, height = panel_extent(view_picture(browser, view, size))
+                small = side * height <= LI.LOBE_AREA * w * h + 2 * (side + height)
+                return small and side >= LI.LOBE_MIN_SIDE - 2 and (side, height)
+
+            wait(f"{view}'s inset at most {LI.LOBE_AREA:.0%} of {w}x{h}", fits)
+    finally:
+        click(browser, "compare")
+        wait("side B gone", lambda: report(browser)["compare"] is None)
+        click(browser, "material tab")
+        browser.get("about:blank")
+        browser.set_window_size(1280, 900)
