@@ -29,7 +29,8 @@ class WebCompare:
         return self.plotter
 
     def made(self, plotter, view) -> None:
-        pass
+        """Side B's camera drags are drags too (one camera: B's drag moves A's)."""
+        self.app.watch_camera(plotter)
 
     def show_pane(self, visible: bool) -> None:
         pass

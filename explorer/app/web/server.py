@@ -25,6 +25,7 @@ stays free of them).
 from __future__ import annotations
 
 import logging
+import math
 import os
 import tempfile
 import time
@@ -119,6 +120,7 @@ class WebExplorer:
         self.view = self.viewport.attach(
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
+        self.watch_camera(self.plotter)
         panel.connect(self)
         page.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
@@ -133,6 +135,16 @@ class WebExplorer:
         """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
         logged, never lost (:meth:`PlotterView.guard`)."""
         return self.viewport.guard(fn, where)
+
+    def watch_camera(self, pl) -> None:
+        """``pl``'s camera drags are drags, as the window's (the level of detail; in per-pixel
+        mode the drag fallback, said on the page): the remote view passes the page's pointer
+        to ``pl``'s interactor, whose style starts and ends each camera interaction."""
+        style = pl.iren.interactor.GetInteractorStyle()
+        if style is not None:
+            vp = self.viewport
+            style.AddObserver("StartInteractionEvent", self.guard(vp.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self.guard(vp.end_drag, "camera"))
 
     def _ready(self, **_) -> None:
         """The server runs: its loop is kept (the difference worker delivers into it), and
@@ -332,6 +344,7 @@ class WebExplorer:
             "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
             "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
             "lobes": self.view.lobe.report(),
+            "pixels": pixels_report(self.viewport.pixels),
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 
@@ -339,6 +352,22 @@ class WebExplorer:
         self.worker.close()
         self._uploads.cleanup()
         self.plotter.close()
+
+
+def pixels_report(layer) -> dict:
+    """What a test reads of the per-pixel picture (:class:`~explorer.app.pixellayer.PixelLayer`
+    ``layer``): the pictures made, whether a drag draws per vertex now, and the last per-pixel
+    picture's and per-vertex frame's times (ms; None before one)."""
+
+    def ms(v: float):
+        return None if math.isnan(v) else round(v, 2)
+
+    return {
+        "frames": layer.frames,
+        "fallback": layer.fallback,
+        "ms": ms(layer.ms),
+        "vertex_ms": ms(layer.vertex_ms),
+    }
 
 
 def own_arguments() -> None:

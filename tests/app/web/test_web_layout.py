@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 from helpers.insets import panel_extent
-from test_web import click, open_page, report, type_value, view_pixels, wait
+from test_web import choose, click, open_page, report, type_value, view_pixels, wait
 
 from explorer.app import lobeinset as LI
 
@@ -48,6 +48,34 @@ def drag_in(driver, view: str, size, start, moves) -> None:
     chain.release().perform()
 
 
+#: the pause between two moves of :func:`steady_drag` (seconds): the remote view sends a move
+#: to the server only while the pointer keeps moving (vtk.js starts a new "mouse move" after
+#: 200 ms still, and sends none for its start; Selenium's moves, 250 ms each, were never sent)
+MOVE_PAUSE = 0.08
+
+
+def steady_drag(driver, view: str, start, moves) -> None:
+    """A drag as a hand makes it: press at CSS pixel ``start`` of view ``view``'s picture
+    (from its top left), move by each ``(dx, dy)`` of ``moves`` every :data:`MOVE_PAUSE`
+    seconds, release (Chromium's own input events, through the DevTools protocol)."""
+    box = driver.execute_script(
+        f"return document.querySelector('[aria-label=\"{view}\"] img')"
+        ".getBoundingClientRect().toJSON()"
+    )
+    x, y = box["x"] + start[0], box["y"] + start[1]
+
+    def mouse(kind: str, **kw) -> None:
+        driver.execute_cdp_cmd("Input.dispatchMouseEvent", {"type": kind, "x": x, "y": y, **kw})
+
+    mouse("mouseMoved")
+    mouse("mousePressed", button="left", buttons=1, clickCount=1)
+    for dx, dy in moves:
+        time.sleep(MOVE_PAUSE)
+        x, y = x + dx, y + dy
+        mouse("mouseMoved", button="left", buttons=1)
+    mouse("mouseReleased", button="left", buttons=0, clickCount=1)
+
+
 def shows(driver, view: str, px, size) -> bool:
     """Whether view ``view``'s picture is white (a white light's handle or arrow) at ``px``."""
     return bool((picture_patch(driver, view, px, size).mean(axis=0) >= WHITE).all())
@@ -61,8 +89,8 @@ def test_pane_b_draws_the_handles_and_a_drag_there_moves_the_light(server, brows
     open_page(browser, server.url)
     click(browser, "view tab")
     click(browser, "compare")
-    rep = wait("side B's arrow", lambda: (r := report(browser))["compare"]
-               and r["compare"]["arrows_px"] and r)  # fmt: skip
+    rep = wait("side B's arrow", lambda: (r := report(browser))["compare"] and r)
+    rep = wait("side B's arrow", lambda: (r := report(browser))["compare"]["arrows_px"] and r)
     light = rep["session"]["light"] - 1
     size = rep["compare"]["size"]
     arrow = np.asarray(rep["compare"]["arrows_px"][str(light)]).mean(axis=0)
@@ -143,8 +171,8 @@ def test_every_slider_starts_and_ends_at_the_same_x(server, browser, size):
             click(browser, f"{tab} tab")
             got = wait(f"the {tab} tab's sliders", lambda: settled(browser, SLIDERS_JS))
             rows += [{**r, "tab": tab} for r in got]
-        assert {r["key"] for r in rows} >= {"ka", "shininess", "opacity", "intensity",
-                                             "elevation", "exposure"}, rows  # fmt: skip
+        want = {"ka", "shininess", "opacity", "intensity", "elevation", "exposure"}
+        assert {r["key"] for r in rows} >= want, rows
         for part in ("track", "field"):
             for side in (0, 1):
                 xs = [r[part][side] for r in rows]
@@ -195,3 +223,53 @@ def test_the_lobe_inset_covers_at_most_a_fifth_of_a_small_view(server, browser):
         click(browser, "material tab")
         browser.get("about:blank")
         browser.set_window_size(1280, 900)
+
+
+def test_a_camera_drag_in_per_pixel_mode_draws_per_vertex_when_per_pixel_costs_twice(
+    server, browser
+):
+    """Issue 39 item 4 in the page: in per-pixel mode, a camera drag (the page's pointer on
+    the view) draws per vertex while a per-pixel picture costs more than FALLBACK_RATIO
+    per-vertex frames, the page says so, and the release draws per pixel again; a per-pixel
+    picture that costs less is drawn through the drag. Frames counted on the server (the
+    page's remote view did not report its drags: every frame of a drag was per pixel)."""
+    from explorer.app.pixellayer import FALLBACK_RATIO
+
+    open_page(browser, server.url)
+    click(browser, "view tab")
+    choose(browser, "shading", "per-pixel")
+    try:
+
+        def timed():
+            r = report(browser)
+            return r["pixels"]["ms"] and r["pixels"]["vertex_ms"] is not None and r
+
+        rep = wait("per-pixel frames timed", timed)
+        p0 = rep["pixels"]
+        slow = p0["ms"] > FALLBACK_RATIO * p0["vertex_ms"]
+        w, h = rep["size"]
+        eye = rep["session"]["scene"]["viewer"]
+        steady_drag(browser, "view", (w // 2, h // 2 + 40), [(5, 0)] * 20)
+
+        def released():  # the camera turned, and a per-pixel picture since the drag
+            r = report(browser)
+            p = r["pixels"]
+            turned = r["session"]["scene"]["viewer"] != eye
+            return turned and not p["fallback"] and p["frames"] > p0["frames"] and r
+
+        wait("the camera to turn and the drag to end", released)
+        time.sleep(1.0)  # the drag's last frames
+        after = report(browser)
+        frames = after["frame"] - rep["frame"]
+        per_pixel = after["pixels"]["frames"] - p0["frames"]
+        said = (
+            "camera drag drawn per vertex"
+            in browser.find_element("css selector", '[role="status"]').text
+        )
+        if slow:
+            assert frames - per_pixel >= 3 and per_pixel <= 2 and said, (frames, per_pixel)
+        else:
+            assert frames - per_pixel <= 1 and not said, (frames, per_pixel)
+    finally:
+        choose(browser, "shading", "per-vertex")
+        click(browser, "material tab")
