@@ -26,15 +26,17 @@ DRAWER_WIDTH = 380
 #: DRAWER_WIDTH; at 640 pixels a 380-pixel drawer left the view 260 pixels
 DRAWER_WIDTHS = ((800, 270), (1100, 320))
 #: a number row's label column and its field (pixels): every slider of every tab starts and
-#: ends at the same x (a label's own width moved its slider: shininess's started 50 pixels
-#: right of ka's); the longest label, "shininess", is 70 pixels wide
-NUMBER_LABEL_WIDTH, NUMBER_FIELD_WIDTH = 76, 92
+#: ends at the same x (a label's own width moved its slider: shininess's started 52 pixels
+#: right of ka's); the label is 4 pixels narrower than its column (its margin), "shininess" is
+#: 69 pixels wide
+NUMBER_LABEL_WIDTH, NUMBER_FIELD_WIDTH = 78, 92
 #: the same below 800 pixels (the drawer's 270 pixels left the slider 46), the labels in 14
-#: pixels ("shininess" 61 pixels wide); a field still shows "0.247", "2.50 r", "40.0°"
-NARROW_NUMBER_WIDTHS = (64, 72)
+#: pixels ("shininess" 60 pixels wide); a field still shows "0.247", "2.50 r", "40.0°"
+NARROW_NUMBER_WIDTHS = (66, 72)
 #: the page's own rules for small windows: the toolbar scrolls sideways rather than squeezing
 #: its title to a letter, the title goes below 1100 pixels (the tab's title says it), and the
-#: toolbar's buttons and the panel's tabs are narrower below 900
+#: toolbar's buttons and the panel's tabs are narrower below 900 (Vuetify's own tab rule is
+#: ``.v-tab.v-tab.v-btn``: its 90-pixel tabs overflowed the 270-pixel drawer)
 PAGE_CSS = """
 html { overflow-y: auto; }
 .v-app-bar .v-toolbar__content { overflow-x: auto; overflow-y: hidden; scrollbar-width: thin; }
@@ -42,7 +44,7 @@ html { overflow-y: auto; }
 .v-app-bar .v-file-input { min-width: 150px; }
 @media (max-width: 1099px) { .v-app-bar .v-toolbar-title { display: none; } }
 @media (max-width: 899px) {
-  .v-app-bar .v-btn, .v-tab.v-btn { padding: 0 6px; min-width: 0; }
+  .v-app-bar .v-btn, .v-tab.v-tab.v-btn { padding: 0 6px; min-width: 0; }
 }
 """
 #: the number rows' label and field columns (narrower below 800 pixels), and the drawer's room
@@ -50,8 +52,10 @@ html { overflow-y: auto; }
 #: not): the sliders of every tab line up
 NUMBER_CSS = f"""
 .v-navigation-drawer__content {{ scrollbar-gutter: stable; }}
-.phong-number .v-input__prepend {{ width: {NUMBER_LABEL_WIDTH}px; flex: none; }}
-.phong-number .v-label {{ display: block; overflow: hidden; text-overflow: ellipsis; }}
+.phong-number .v-input__prepend {{ width: {NUMBER_LABEL_WIDTH}px; flex: none;
+  margin-inline-end: 8px; }}
+.phong-number .v-label {{ display: block; overflow: hidden; text-overflow: ellipsis;
+  margin-inline-end: 4px; }}
 .phong-number .v-text-field {{ width: {NUMBER_FIELD_WIDTH}px; flex: none; }}
 @media (max-width: 799px) {{
   .phong-number .v-input__prepend {{ width: {NARROW_NUMBER_WIDTHS[0]}px; }}

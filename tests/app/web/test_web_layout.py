@@ -140,8 +140,17 @@ return [...document.querySelectorAll('[aria-label$=" slider"]')]
   .filter(e => e.closest('.v-window-item--active') && e.getClientRects().length)
   .map(e => { const key = e.getAttribute('aria-label').replace(/ slider$/, '');
               const field = document.querySelector(`input[aria-label="${key}"]`);
+              const label = e.closest('.v-slider').querySelector('.v-label');
               return {key: key, track: box(e.closest('.v-slider').querySelector('.v-slider-track')),
+                      cut: label.scrollWidth > label.clientWidth,
                       field: box(field.closest('.v-field'))}; });
+"""
+
+
+#: the panel's tab bar: its content's width and the width it has (CSS pixels)
+TABS_JS = """
+const g = document.querySelector('.v-navigation-drawer .v-slide-group__container');
+return [g.firstElementChild.scrollWidth, g.clientWidth];
 """
 
 
@@ -158,7 +167,8 @@ def test_every_slider_starts_and_ends_at_the_same_x(server, browser, size):
     """Every slider of every tab (the material's, the light's, the view's exposure) starts and
     ends at the same x, and so does every number field beside them: the labels are a column of
     one width (issue 42: shininess's and opacity's sliders started further right than ka's,
-    their labels being longer)."""
+    their labels being longer). Every label is whole ("shinine..." was cut in the first
+    column), and the panel's tabs fit their bar (at 640x480 it scrolled, "MATERIAL" cut)."""
     try:
         browser.get("about:blank")
         browser.set_window_size(*size)
@@ -178,6 +188,9 @@ def test_every_slider_starts_and_ends_at_the_same_x(server, browser, size):
                 xs = [r[part][side] for r in rows]
                 assert max(xs) - min(xs) <= 1, (part, side, rows)
         assert min(r["track"][1] - r["track"][0] for r in rows) >= 60, rows  # still a slider
+        assert not [r["key"] for r in rows if r["cut"]], rows  # every label whole
+        tabs = browser.execute_script(TABS_JS)
+        assert tabs[0] <= tabs[1], f"the panel's tabs scroll sideways: {tabs}"
     finally:
         click(browser, "view tab")
         click(browser, "hdr")
