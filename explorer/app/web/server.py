@@ -92,6 +92,8 @@ class WebExplorer:
         from explorer.render.vtk import plotter  # VTK only once a server is made
 
         self.pushing = False  # the server is setting the page's values (no user change)
+        # the start framed again for the first page's view (as the window frames it when shown)
+        self._frame_at = tuple(int(v) for v in size) if state.camera is None else None
         self.messages: list[dict] = []
         self.message_seq = 0  # messages said so far (a page shows those after it opened)
         self.answers: dict = {}  # the page's answers to the controller's next questions
@@ -121,6 +123,7 @@ class WebExplorer:
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
         self.watch_camera(self.plotter)
+        self.plotter.render_window.AddObserver("StartEvent", self.guard(self._frame, "view"), 1.0)
         panel.connect(self)
         page.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
@@ -145,6 +148,18 @@ class WebExplorer:
             vp = self.viewport
             style.AddObserver("StartInteractionEvent", self.guard(vp.begin_drag, "camera"))
             style.AddObserver("EndInteractionEvent", self.guard(vp.end_drag, "camera"))
+
+    def _frame(self, *_) -> None:
+        """Before a frame: the first time the view is drawn at another size than it was made
+        (the page's own), the start's mesh is framed for that shape (``Controller.frame_start``)
+        unless the session gave a camera: a page narrower than the server's 800x600 showed the
+        light's handle half out of the view, the mesh framed for 4:3."""
+        w, h = (int(v) for v in self.plotter.window_size)
+        if self._frame_at is None or (w, h) == self._frame_at or min(w, h) < 2:
+            return
+        self._frame_at = None
+        self.controller.frame_start()
+        self.view.apply_camera(self.store.state.camera)
 
     def _ready(self, **_) -> None:
         """The server runs: its loop is kept (the difference worker delivers into it), and

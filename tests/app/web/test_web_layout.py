@@ -286,3 +286,31 @@ def test_a_camera_drag_in_per_pixel_mode_draws_per_vertex_when_per_pixel_costs_t
     finally:
         choose(browser, "shading", "per-vertex")
         click(browser, "material tab")
+
+
+def test_the_handle_starts_inside_a_narrower_pages_view(tmp_path):
+    """A page narrower than the server's 800x600 view (900x720: a 580x490 view) frames the
+    start for its own view, as the window does when shown: the selected light's handle starts
+    inside it, white in the page's pixels (it started half out of the view, the teapot framed
+    for 4:3)."""
+    from webserver import Server, need_browser, new_browser
+
+    need_browser()
+    srv = Server(["--mesh", "teapot"], tmp_path / "server.log")
+    driver = new_browser(tmp_path)
+    try:
+        driver.set_window_size(900, 720)
+        open_page(driver, srv.url)
+
+        def inside():
+            r = report(driver)
+            (w, h), light = r["size"], r["session"]["light"] - 1
+            x, y = r["handles_px"][light]
+            return (w, h) != (800, 600) and 20 <= x < w - 20 and 20 <= y < h - 20 and r
+
+        rep = wait("the handle inside the view", inside)
+        px = rep["handles_px"][rep["session"]["light"] - 1]
+        wait("the handle in the page's pixels", lambda: shows(driver, "view", px, rep["size"]))
+    finally:
+        driver.quit()
+        srv.stop()
