@@ -71,14 +71,20 @@ from explorer.shading import codegen, prepared
 from explorer.shading import kernels as K
 from explorer.shading.equation import equation_shade
 
-WIDTH = {True: "16 float32 / 8 float64 lanes (AVX-512)", False: "LLVM default width"}
+
+def width() -> str:
+    """The vector width the kernels are compiled with (``codegen.VECTOR_BITS``)."""
+    bits = codegen.VECTOR_BITS
+    if not bits:
+        return "LLVM default width"
+    return f"{codegen.lanes(4)} float32 / {codegen.lanes(8)} float64 lanes ({bits} bits)"
 
 
 def machine() -> str:
     return (
         f"{cpu_name()}; {os.cpu_count()} cores, numba threads {numba.get_num_threads()}; "
         f"Python {platform.python_version()}, numpy {np.__version__}, numba {numba.__version__}; "
-        f"vectors: {WIDTH[codegen.WIDE_VECTORS]}; {isa.isa_line()}; "
+        f"vectors: {width()}; {isa.isa_line()}; "
         f"load average {load_average():.2f}"
     )
 

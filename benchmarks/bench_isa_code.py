@@ -314,15 +314,15 @@ def main(argv=None) -> int:
         "--width",
         type=int,
         choices=(128, 256, 512),
-        help="force this vector width in bits (and interleave 2), as codegen.wide_vectors does "
-        "with 512 where the host has AVX-512: the loops' code with it on any ISA",
+        help="force this vector width in bits (and interleave 2) instead of the target's own "
+        "(codegen.VECTOR_BITS: 512 with AVX-512, 256 with AVX2): the loops' code with it",
     )
     isa.add_arguments(ap)
     args = ap.parse_args(argv)
     if args.isa and not isa.in_child():
         return isa.run(__file__, sys.argv[1:] if argv is None else list(argv), args)
     if args.width:  # (codegen.wide_vectors sets LLVM's options only where this is true)
-        G.WIDE_VECTORS = True
+        G.WIDE_VECTORS, G.VECTOR_BITS = True, args.width
     print(isa.isa_line() + (f"; loops forced to {args.width}-bit vectors" if args.width else ""))
     keys = list(COUNTS) + ["zmm", "ymm", "xmm", "IR vectors", "IR calls"]
     keys += ["CPU ns per lane"] if args.time else []
@@ -331,7 +331,7 @@ def main(argv=None) -> int:
     for name, (lanes, (fn, args_of)) in loops().items():
         if args.only and args.only not in name:
             continue
-        with G.wide_vectors(lanes * (args.width or 512) // 512):
+        with G.wide_vectors(lanes * (G.VECTOR_BITS or 512) // 512):
             fn(*args_of())
         sig = fn.signatures[0]
         asm, ir_ = fn.inspect_asm(sig), fn.inspect_llvm(sig)

@@ -17,7 +17,8 @@ Sections (all by default):
   brute force (:func:`explorer.geometry.rays.any_hit`, every triangle, every thread) on a
   random sample of the same rays (its cost per ray does not depend on the count), and, when
   the package is installed, embreex's occlusion query on the same rays (float32, one call: its
-  answers count back faces as occluders, so they differ; how many is printed).
+  answers count back faces as occluders, so they differ; how many is printed), with its CPU
+  time per ray beside the BVH cast's (on a loaded machine the fair comparison).
 - ``scaling``: the same on tori from 1,024 to 1,048,576 triangles (a point light near the
   ring's plane, so the far side is shadowed), with the BVH's build time.
 - ``engine``: a float32 :class:`explorer.Shader` on the 100k-vertex teapot with two point
@@ -170,6 +171,8 @@ def record_rays(mesh: str, r: dict) -> None:
         if key in r:
             isa.record(f"{mesh}: {what}", r[key] / 1e6, "M rays/s")
     isa.record(f"{mesh}: BVH CPU per ray", r["cpu_ns"], "ns")
+    if "embree_cpu_ns" in r:
+        isa.record(f"{mesh}: embreex occlusion CPU per ray", r["embree_cpu_ns"], "ns")
     isa.record(f"{mesh}: BVH build", r["build_s"], "s")
 
 
@@ -191,6 +194,10 @@ def embree_rays(O, D, tmax, tri, hit, repeat: int) -> dict:
         return np.asarray(scene.run(O32, D32, query="OCCLUDED", dists=far))
 
     med, _ = timed(run, repeat)
+    cpu = time.process_time()  # (one thread: what a ray costs, whatever else runs)
+    for _ in range(repeat):
+        run()
+    cpu = (time.process_time() - cpu) / repeat
     occluded = run() != -1  # the index of a hit geometry, -1 for none
     half = len(O) // 2
     with ThreadPoolExecutor(2) as pool:  # does a call let the other thread run?
@@ -228,6 +235,7 @@ def embree_rays(O, D, tmax, tri, hit, repeat: int) -> dict:
     ruled = by_the_rule()
     return {
         "embree": len(O) / med,
+        "embree_cpu_ns": cpu / len(O) * 1e9,
         "embree_two_threads": len(O) / med2,
         "embree_build_s": build,
         "embree_differs": float(np.mean(occluded != hit)),
@@ -283,6 +291,11 @@ def section_shadows(repeat: int) -> None:
         f"\nCPU time of one BVH cast (every thread, refit included): {r['cpu_ns']:.0f} ns per "
         f"ray, i.e. {2e3 / r['cpu_ns']:.1f} M rays/s if two idle cores shared it evenly"
     )
+    if "embree_cpu_ns" in r:
+        print(
+            f"CPU time of embreex's occlusion query (one thread): {r['embree_cpu_ns']:.0f} ns "
+            f"per ray; the BVH cast takes {r['cpu_ns'] / r['embree_cpu_ns']:.2f}x that"
+        )
     same_full = f"; with the full tree: {r['same_full']}" if "same_full" in r else ""
     print(f"\nBVH answers equal the brute force's on its sample: {r['same']}{same_full}")
     record_rays("teapot", r)

@@ -19,7 +19,8 @@ median over the processes of each ISA, and AVX2's ratio to native.
 
 A child's machine line names its ISA (:func:`isa_line`): what numba targets (CPU name and
 feature string) and which registers a float32 loop compiled as the kernels are compiled
-(``explorer.shading.codegen.wide``) uses: ``zmm`` (512 bits) or ``ymm`` (256 bits).
+(``explorer.shading.codegen.wide``) uses: ``zmm`` (512 bits) or ``ymm`` (256 bits), and how the
+float64 lobe packs its lanes (``explorer.shading.vmath.PACK``).
 """
 
 from __future__ import annotations
@@ -220,7 +221,7 @@ def probe_asm() -> str:
 
     fn = nb.njit(fastmath=K._FASTMATH, error_model="numpy", boundscheck=False)(K._add.py_func)
     a = np.zeros(64, np.float32)
-    with codegen.wide_vectors(16):
+    with codegen.wide_vectors():
         fn(a, a, a)
     return fn.inspect_asm(fn.signatures[0])
 
@@ -237,7 +238,7 @@ def isa_line() -> str:
     isa = os.environ.get(CHILD) or "in process (no --isa)"
     cpu = config.CPU_NAME or llvm.get_host_cpu_name()
     feats = "host features" if config.CPU_FEATURES is None else f"features {config.CPU_FEATURES}"
-    pack = "AVX-512 compress" if vmath.NATIVE_COMPRESS else "no packing"
+    pack = {"compress": "AVX-512 compress", "permute": "AVX2 permute"}.get(vmath.PACK, "no packing")
     return (
         f"ISA {isa}: numba targets {cpu} ({feats}); kernel code in {widest(probe_asm())} "
         f"registers; float64 lobe: {pack} (PACK_SHARE {K.PACK_SHARE})"

@@ -7,9 +7,9 @@ compiled code, apart from the compiled code itself (:mod:`explorer.shading.kerne
   writes the function that calls the variant a run-time code names (one test and one literal
   call per variant, from the table: no table is spelt out by hand). The comment above
   :func:`explorer.shading.kernels._light` says what each choice means to a light loop.
-- The vector width: where the CPU has 512-bit vectors (AVX-512), the entry points are compiled
-  with them (:data:`WIDE_VECTORS`, :func:`wide_vectors`, :func:`wide`), two vector iterations
-  interleaved (:data:`INTERLEAVE`).
+- The vector width: the entry points are compiled with vectors as wide as the target's registers
+  (:data:`VECTOR_BITS`: 512 bits with AVX-512, 256 with AVX2; :func:`register_bits` asks LLVM),
+  two vector iterations interleaved (:data:`INTERLEAVE`; :func:`wide_vectors`, :func:`wide`).
 
 Every name here that the kernels read at compile time is frozen into the compiled code, so this
 module is one of :data:`explorer.geometry.kernelcache.CONSTANT_MODULES`: an edit recompiles the
@@ -93,24 +93,66 @@ def dispatch_source(name: str, params: str, callee: str, codes: Iterable[int]) -
     return "\n".join(src) + "\n"
 
 
-def host_has_avx512() -> bool:
+#: the probe :func:`register_bits` compiles: a 16-lane integer multiply, which LLVM writes in
+#: the widest integer vector registers the target has (integer, not float: AVX without AVX2 has
+#: 256-bit float registers but 128-bit integer operations, and the AVX2 lane packing,
+#: :mod:`explorer.shading.vmath`, needs AVX2's cross-lane permute)
+_PROBE = """
+define void @probe(ptr %p) {
+  %a = load <16 x i32>, ptr %p, align 4
+  %b = mul <16 x i32> %a, %a
+  store <16 x i32> %b, ptr %p, align 4
+  ret void
+}
+"""
+
+
+@functools.cache
+def register_bits() -> int:
+    """The width in bits of the integer vector registers of the CPU numba compiles for: 512
+    (AVX-512F), 256 (AVX2), 128 (SSE2 or AVX), 0 (not x86 or unknown). The target is numba's own
+    (``NUMBA_CPU_NAME`` and ``NUMBA_CPU_FEATURES``, else the host's name and features), so a
+    named CPU gets its own features (``znver3``: AVX2) less those the feature string takes off;
+    LLVM compiles :data:`_PROBE` for it and the registers its assembly names say the width."""
+    from numba.core.codegen import get_host_cpu_features
+
     try:
-        return bool(llvm.get_host_cpu_features().get("avx512f", False))
-    except RuntimeError:  # llvmlite cannot read this host's features: keep LLVM's choice
-        return False
+        llvm.initialize_native_target()
+        llvm.initialize_native_asmprinter()
+        cpu = nb.config.CPU_NAME or llvm.get_host_cpu_name()
+        feats = nb.config.CPU_FEATURES
+        if feats is None:
+            feats = get_host_cpu_features()
+        tm = llvm.Target.from_default_triple().create_target_machine(cpu=cpu, features=feats)
+        asm = tm.emit_assembly(llvm.parse_assembly(_PROBE))
+    except RuntimeError:  # llvmlite cannot target or describe this CPU: keep LLVM's choice
+        return 0
+    for reg, bits in (("%zmm", 512), ("%ymm", 256), ("%xmm", 128)):
+        if reg in asm:
+            return bits
+    return 0
 
 
-#: loops are vectorised 512 bits wide (16 float32 or 8 float64 lanes) where the CPU has AVX-512
-#: (LLVM's tunings for many x86 cores prefer 256-bit vectors; 512-bit ones shade about 12%
-#: faster here in float32, and the float64 light loop, whose power is long, gains more; see
-#: benchmarks/bench_engine.py). Set the environment variable PHONG_EXPLORER_WIDE_VECTORS=0 to
-#: keep LLVM's choice (numba's on-disk cache keeps whichever was compiled first: clear it, or use
-#: another NUMBA_CACHE_DIR, to compare).
-WIDE_VECTORS = (
-    os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0"
-    and nb.config.CPU_NAME is None  # a portable target (NUMBA_CPU_NAME) is left alone
-    and host_has_avx512()
-)
+#: the vector width in bits the entry points' loops are compiled with (16 float32 or 8 float64
+#: lanes at 512, 8 or 4 at 256), the target's register width (:func:`register_bits`) where it
+#: has AVX-512 or AVX2, else 0: LLVM's own choice. LLVM's tunings for many x86 cores prefer
+#: 256-bit vectors on AVX-512 (512-bit ones shade about 12% faster here in float32, and the
+#: float64 light loop, whose power is long, gains more), and its cost model for AMD Zen 3 left
+#: loops scalar that are faster in 8 lanes (a spot light's ``_to_light``: 256 bits forced made
+#: the spot lights 1.37x faster on AVX2, the shininess change 1.54x, full passes 1.08x; see
+#: docs/speed.md). Set the environment variable PHONG_EXPLORER_WIDE_VECTORS=0 to keep LLVM's
+#: choice (numba's on-disk cache keeps whichever was compiled first: clear it, or use another
+#: NUMBA_CACHE_DIR, to compare).
+VECTOR_BITS = register_bits() if os.environ.get("PHONG_EXPLORER_WIDE_VECTORS", "1") != "0" else 0
+VECTOR_BITS = VECTOR_BITS if VECTOR_BITS >= 256 else 0
+#: whether the loops' vector width is forced (:data:`VECTOR_BITS`)
+WIDE_VECTORS = VECTOR_BITS > 0
+
+
+def lanes(itemsize: int) -> int:
+    """How many lanes of ``itemsize`` bytes a vector of :data:`VECTOR_BITS` holds (0: none
+    forced)."""
+    return VECTOR_BITS // (8 * itemsize)
 
 
 @contextlib.contextmanager
@@ -140,21 +182,22 @@ def quiet_llvm_remarks():
 #: and their loops run two vector iterations interleaved (LLVM's -force-vector-interleave): a
 #: light loop is one long dependency chain per iteration (two square roots, pow), which the
 #: out-of-order core overlaps too little on its own; two independent chains side by side make
-#: the light loop about 15% faster here (LLVM picks 1 for a loop that large)
+#: the light loop about 15% faster here (LLVM picks 1 for a loop that large), at 512 bits and at
+#: 256 alike
 INTERLEAVE = 2
 
 
 @contextlib.contextmanager
-def wide_vectors(lanes: int = 16):
-    """Compile numba code inside this block with ``lanes``-lane vectors (16 for float32, 8 for
-    float64: 512 bits) where :data:`WIDE_VECTORS` (else a no-op). LLVM's
-    ``-force-vector-width`` is a process-wide option: it is set for the block only and reset to 0
-    (LLVM's own choice) after, so other numba code is not affected."""
+def wide_vectors(n: int = 0):
+    """Compile numba code inside this block with ``n``-lane vectors (default: float32 lanes of
+    :data:`VECTOR_BITS`, 16 at 512 bits, 8 at 256) where :data:`WIDE_VECTORS` (else a no-op).
+    LLVM's ``-force-vector-width`` is a process-wide option: it is set for the block only and
+    reset to 0 (LLVM's own choice) after, so other numba code is not affected."""
     if not WIDE_VECTORS:
         yield
         return
     with quiet_llvm_remarks():
-        llvm.set_option("", f"-force-vector-width={lanes}")
+        llvm.set_option("", f"-force-vector-width={n or lanes(4)}")
         llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
         try:
             yield
@@ -173,12 +216,13 @@ def kind(a):
     return type(a)
 
 
-def wide(kernel, dtype_arg: int, lanes: int = 0):
+def wide(kernel, dtype_arg: int, item: int = 0):
     """Call ``kernel`` so that a signature it meets for the first time (by the :func:`kind` of
     its first argument, the data, and the dtype of positional argument ``dtype_arg``, float
-    data) is compiled with 512-bit vectors (:func:`wide_vectors` around such first calls, which
-    compile or load from numba's cache); later calls go straight to the kernel. ``lanes``: a
-    fixed width instead (8: a kernel whose arithmetic is float64 whatever its data)."""
+    data) is compiled with vectors of :data:`VECTOR_BITS` (:func:`wide_vectors` around such
+    first calls, which compile or load from numba's cache); later calls go straight to the
+    kernel. ``item``: the lanes' size in bytes instead of the dtype's (8: a kernel whose
+    arithmetic is float64 whatever its data)."""
     if not WIDE_VECTORS:
         return kernel
     seen: set = set()
@@ -192,7 +236,7 @@ def wide(kernel, dtype_arg: int, lanes: int = 0):
         if dt not in (np.float32, np.float64):
             seen.add(key)
             return kernel(*args)
-        with wide_vectors(lanes or 64 // dt.itemsize):
+        with wide_vectors(lanes(item or dt.itemsize)):
             try:
                 return kernel(*args)
             finally:

@@ -59,9 +59,10 @@ Leaf kernels are compiled without numba's reference counting (``_nrt=False``): e
 shared array would otherwise be an atomic increment and decrement of its count, which the two
 threads of a pass contend for (about a fifth of a full pass at 1M vertices).
 
-On CPUs with 512-bit vectors (AVX-512) LLVM's tuning for many x86 cores still picks 256-bit
-ones; the entry points are compiled with 512-bit vectors there (16 float32 or 8 float64 lanes),
-two vector iterations interleaved (see :func:`explorer.shading.codegen.wide_vectors`).
+The entry points are compiled with vectors as wide as the target's registers (512 bits on
+AVX-512, where LLVM's tuning for many x86 cores still picks 256; 256 on AVX2, where its cost
+model for Zen 3 leaves some loops scalar), two vector iterations interleaved (see
+:data:`explorer.shading.codegen.VECTOR_BITS`).
 """
 
 from __future__ import annotations
@@ -186,7 +187,7 @@ from explorer.shading.layout import (  # the kernels' layouts (O_, R_, K_, B_ sl
     R_W,
     R_WS,
 )
-from explorer.shading.vmath import NATIVE_COMPRESS, compress8, expand8, fpow, from_key, order_key
+from explorer.shading.vmath import PACK, compress8, expand8, fpow, from_key, order_key
 
 BLOCK = 512
 #: the scratch's row stride (elements): a block's rows lie ROW apart, not BLOCK. At BLOCK, a
@@ -940,9 +941,13 @@ def _light_overload(scr, m, q, y, k, atten, l_dif, code):
 #: the float64 lobe loop packs the lanes that have a lobe weight before it takes their powers
 #: when they are at most this share of its lanes (see :func:`_split_lobe`; 1/2 against 3/4 was
 #: faster on random points and on a mesh in its own order: ``benchmarks/bench_revisions.py``).
-#: Without AVX-512 the packing is written out lane by lane (see :mod:`explorer.shading.vmath`)
-#: and costs more than it saves: there only a run with no weight at all skips its powers (0)
-PACK_SHARE = 0.5 if NATIVE_COMPRESS else 0.0
+#: AVX2 packs by a table-driven permute (:data:`explorer.shading.vmath.PACK`) and takes its
+#: powers in 4 lanes, so packing pays up to a larger share there: 3/4 (the lobe loop alone,
+#: ``benchmarks/bench_isa_code.py``'s: packing every run was faster up to about 80 % of the
+#: lanes weighted, 1.75 against 3.04 ns a lane at 40 %). Without either the packing is written
+#: out lane by lane and costs more than it saves: there only a run with no weight at all skips
+#: its powers (0)
+PACK_SHARE = {"compress": 0.5, "permute": 0.75}.get(PACK, 0.0)
 
 
 @nb.njit(**_LEAF)
@@ -2079,9 +2084,9 @@ def _add(p, q, o):
 # explorer.shading.codegen.wide); the number is the argument whose dtype picks the precision
 prepare = wide(prepare, 5)
 extent = wide(extent, 0)
-bounds = wide(bounds, 1, lanes=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
+bounds = wide(bounds, 1, item=8)  # (float64 arithmetic; 16 lanes left its 32-lane chunks scalar)
 shade = wide(shade, 4)
 lobe = wide(lobe, 2)
 compose = wide(compose, 7)
-fixup = wide(fixup, 5, lanes=8)  # (float64: it shares the float64 pass's compiled code)
+fixup = wide(fixup, 5, item=8)  # (float64: it shares the float64 pass's compiled code)
 stream = wide(stream, 2)

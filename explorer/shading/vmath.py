@@ -25,11 +25,18 @@ As OpenGL: 0**0 = 1, 0**y = 0 for y > 0, 1**y = 1.
 :func:`compress8` and :func:`expand8` pack the float64 lanes a mask keeps to the front of a row
 and put them back (AVX-512's ``vcompresspd`` / ``vexpandpd``): the float64 lobe loop computes its
 power only for lanes whose lobe weight is positive (:func:`explorer.shading.kernels._split_lobe`).
-Where the target numba compiles for has AVX-512F (:data:`NATIVE_COMPRESS`) the packing is
-LLVM's register-form vector compress (one instruction); elsewhere it is a masked compress-store,
-which LLVM writes out lane by lane on every target (its generic expansion of the register form
-aborts on CPUs without AVX-512: ``tests/shading/test_portable.py``), and the kernels do not pack
-there (:data:`explorer.shading.kernels.PACK_SHARE`).
+How, by the target numba compiles for (:data:`PACK`):
+
+- AVX-512F (:data:`NATIVE_COMPRESS`): LLVM's register-form vector compress and masked expand
+  (one instruction each);
+- AVX2 (:data:`PERMUTE_PACK`): each half of 4 lanes is moved by one cross-lane permute
+  (``vpermps``) whose indices a table gives for its 4 mask bits (:data:`_COMPRESS`,
+  :data:`_EXPAND`: 16 entries each), the lanes beyond the kept ones zeroed; the second half is
+  stored after the first's kept lanes (or read from there);
+- otherwise a masked compress-store and expand-load, which LLVM writes out lane by lane (its
+  generic expansion of the register form aborts on CPUs without AVX-512:
+  ``tests/shading/test_portable.py``), and the kernels do not pack there
+  (:data:`explorer.shading.kernels.PACK_SHARE`).
 
 :func:`order_key` maps a float to an integer of the same order (and :func:`from_key` back):
 a smallest or largest value found on the keys is a reduction LLVM vectorises without
@@ -45,11 +52,11 @@ import numba as nb
 import numpy as np
 from llvmlite import ir
 from numba import types
-from numba.core import cgutils, config
-from numba.core.codegen import get_host_cpu_features
+from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
 from explorer.geometry import kernelcache  # noqa: F401 - before the decorators: the cache key
+from explorer.shading.codegen import register_bits
 
 _FASTMATH = {"nsz", "arcp", "contract", "afn", "reassoc"}  # never nnan/ninf: policies test them
 _LEAF = dict(fastmath=_FASTMATH, error_model="numpy", boundscheck=False, cache=True, _nrt=False)
@@ -252,14 +259,79 @@ _V8 = ir.VectorType(ir.DoubleType(), 8)
 _M8 = ir.VectorType(ir.IntType(1), 8)
 
 
-def target_features() -> str:
-    """The CPU features numba compiles for (LLVM's "+name,-name,..." string): the host's, or
-    what ``NUMBA_CPU_FEATURES`` says (numba's own rule, ``JITCPUCodegen``)."""
-    return config.CPU_FEATURES if config.CPU_FEATURES is not None else get_host_cpu_features()
-
-
 #: whether the compiled code may use AVX-512F's register-form compress (see the module docstring)
-NATIVE_COMPRESS = "+avx512f" in target_features().split(",")
+NATIVE_COMPRESS = register_bits() >= 512
+#: whether it packs by AVX2's cross-lane permute and a table instead (see the module docstring)
+PERMUTE_PACK = register_bits() == 256
+#: how :func:`compress8` and :func:`expand8` pack: "compress" (AVX-512F), "permute" (AVX2) or
+#: "" (lane by lane: too slow to pay, the kernels do not pack)
+PACK = "compress" if NATIVE_COMPRESS else "permute" if PERMUTE_PACK else ""
+
+_V4 = ir.VectorType(ir.DoubleType(), 4)
+_I32x8 = ir.VectorType(ir.IntType(32), 8)
+_F32x8 = ir.VectorType(ir.FloatType(), 8)
+
+
+def _pairs(lanes) -> list[int]:
+    """``vpermps`` indices (float32 lanes) that move float64 lanes ``lanes`` (4 of them)."""
+    return [x for j in lanes for x in (2 * j, 2 * j + 1)]
+
+
+#: per 4 mask bits m: the permute that moves the lanes m keeps to the front, in order (the
+#: others after them: zeroed)
+_COMPRESS = [_pairs([j for j in range(4) if m >> j & 1] + [0] * 4)[:8] for m in range(16)]
+#: per 4 mask bits m: the permute that puts the packed lanes 0, 1, ... back in the lanes m keeps
+#: (lane j takes the packed lane of its rank among them; the others: zeroed)
+_EXPAND = [_pairs([bin(m & ((1 << j) - 1)).count("1") for j in range(4)]) for m in range(16)]
+
+
+def _table_row(context, builder, name, table, nibble):
+    """Row ``nibble`` (i64) of a permute table (16 x 8 int32), a constant of the module."""
+    aty = ir.ArrayType(_I32x8, 16)
+    init = ir.Constant(aty, [ir.Constant(_I32x8, row) for row in table])
+    gv = context.insert_unique_const(builder.module, name, init)
+    gv.align = 32
+    zero = ir.Constant(ir.IntType(32), 0)
+    return builder.load(builder.gep(gv, [zero, nibble], inbounds=True), align=32)
+
+
+def _permute4(context, builder, name, table, half, nibble, keep):
+    """The 4 float64 lanes ``half`` permuted by row ``nibble`` of ``table``, 0 where ``keep``
+    (<4 x i1>) is false."""
+    fnty = ir.FunctionType(_F32x8, [_F32x8, _I32x8])
+    fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.x86.avx2.permps")
+    idx = _table_row(context, builder, name, table, nibble)
+    moved = builder.bitcast(builder.call(fn, [builder.bitcast(half, _F32x8), idx]), _V4)
+    return builder.select(keep, moved, ir.Constant(_V4, [0.0] * 4))
+
+
+def _nibbles(builder, mask):
+    """The low and high 4 bits of an 8-lane mask (i64 each) and the low half's count (i64)."""
+    bits = builder.zext(builder.bitcast(mask, ir.IntType(8)), ir.IntType(64))
+    lo = builder.and_(bits, ir.Constant(ir.IntType(64), 15))
+    hi = builder.lshr(bits, ir.Constant(ir.IntType(64), 4))
+    fnty = ir.FunctionType(ir.IntType(64), [ir.IntType(64)])
+    ctpop = cgutils.get_or_insert_function(builder.module, fnty, "llvm.ctpop.i64")
+    return lo, hi, builder.call(ctpop, [lo])
+
+
+def _first(builder, count):
+    """The mask of lanes j < ``count`` (i64) of 4."""
+    splat = builder.insert_element(
+        ir.Constant(ir.VectorType(ir.IntType(64), 4), None), count, ir.Constant(ir.IntType(32), 0)
+    )
+    splat = builder.shuffle_vector(
+        splat, splat, ir.Constant(ir.VectorType(ir.IntType(32), 4), [0] * 4)
+    )
+    lane = ir.Constant(ir.VectorType(ir.IntType(64), 4), [0, 1, 2, 3])
+    return builder.icmp_unsigned("<", lane, splat)
+
+
+def _half(builder, v, high):
+    """Lanes 0-3 (or 4-7) of 8."""
+    first = 4 if high else 0
+    idx = ir.Constant(ir.VectorType(ir.IntType(32), 4), list(range(first, first + 4)))
+    return builder.shuffle_vector(v, v, idx)
 
 
 def _lanes(context, builder, aryty, ary, i):
@@ -306,6 +378,34 @@ def compress8(typingctx, src, w, i, dst, k):
                 builder.module, fnty, "llvm.experimental.vector.compress.v8f64"
             )
             builder.store(builder.call(fn, [s, mask, zeros]), to, align=8)
+        elif PERMUTE_PACK:  # zeros in lanes 4-7, the low half's kept lanes, then the high's
+            lo, hi, c0 = _nibbles(builder, mask)
+            whole = _lanes(context, builder, tdst, args[3], args[4])
+            at = builder.bitcast(whole, ir.DoubleType().as_pointer())
+            four = builder.bitcast(
+                builder.gep(at, [ir.Constant(ir.IntType(64), 4)]), _V4.as_pointer()
+            )
+            builder.store(ir.Constant(_V4, [0.0] * 4), four, align=8)
+            low = _permute4(
+                context,
+                builder,
+                "vmath_compress4",
+                _COMPRESS,
+                _half(builder, s, False),
+                lo,
+                _first(builder, c0),
+            )
+            builder.store(low, builder.bitcast(at, _V4.as_pointer()), align=8)
+            high = _permute4(
+                context,
+                builder,
+                "vmath_compress4",
+                _COMPRESS,
+                _half(builder, s, True),
+                hi,
+                _first(builder, builder.sub(count, c0)),
+            )
+            builder.store(high, builder.bitcast(builder.gep(at, [c0]), _V4.as_pointer()), align=8)
         else:  # zeros, then the kept lanes over them
             builder.store(zeros, to, align=8)
             fnty = ir.FunctionType(ir.VoidType(), [_V8, ir.DoubleType().as_pointer(), _M8])
@@ -322,7 +422,9 @@ def compress8(typingctx, src, w, i, dst, k):
 def expand8(typingctx, src, k, w, i, dst):
     """dst[i : i + 8] <- src[k], src[k + 1] ... in the lanes j with w[j] > 0 (w[i : i + 8]), in
     order, 0 in the others (the inverse of :func:`compress8`); returns how many it took (int64).
-    Reads only those; 1-D float64 arrays, i + 8 <= len(w), len(dst), no bounds checks."""
+    Reads within src[k : k + 8] (with :data:`PERMUTE_PACK`, whole halves of 4 from there: k + 8
+    <= len(src), as when k <= i); 1-D float64 arrays, i + 8 <= len(w), len(dst), no bounds
+    checks."""
     if not (_is_row64(src) and _is_row64(w) and _is_row64(dst)):
         return None
     sig = types.int64(src, types.intp, w, types.intp, dst)
@@ -334,9 +436,25 @@ def expand8(typingctx, src, k, w, i, dst):
         )
         a = context.make_array(tsrc)(context, builder, value=args[0])
         first = builder.gep(a.data, [args[1]])
-        fnty = ir.FunctionType(_V8, [ir.DoubleType().as_pointer(), _M8, _V8])
-        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.masked.expandload.v8f64")
-        lanes = builder.call(fn, [first, mask, ir.Constant(_V8, [0.0] * 8)])
+        if PERMUTE_PACK:  # the low half's lanes from src[k:], the high half's after them
+            lo, hi, c0 = _nibbles(builder, mask)
+            parts = []
+            for nib, at, keep in (
+                (lo, first, _half(builder, mask, False)),
+                (hi, builder.gep(first, [c0]), _half(builder, mask, True)),
+            ):
+                packed = builder.load(builder.bitcast(at, _V4.as_pointer()), align=8)
+                parts.append(
+                    _permute4(context, builder, "vmath_expand4", _EXPAND, packed, nib, keep)
+                )
+            idx = ir.Constant(ir.VectorType(ir.IntType(32), 8), list(range(8)))
+            lanes = builder.shuffle_vector(parts[0], parts[1], idx)
+        else:
+            fnty = ir.FunctionType(_V8, [ir.DoubleType().as_pointer(), _M8, _V8])
+            fn = cgutils.get_or_insert_function(
+                builder.module, fnty, "llvm.masked.expandload.v8f64"
+            )
+            lanes = builder.call(fn, [first, mask, ir.Constant(_V8, [0.0] * 8)])
         builder.store(lanes, _lanes(context, builder, tdst, args[4], args[3]), align=8)
         return count
 

@@ -94,6 +94,56 @@ def test_bounds_can_be_sampled_every_kth_chunk():
     assert np.isnan(sampled[:, keep]).all()
 
 
+@pytest.mark.parametrize("source", ["prepared rows", "float32 vertices", "float64 vertices"])
+def test_the_sample_is_every_kth_whole_chunk_of_the_full_bounds(source):
+    # prepared.sample_bounds finds chunks 0, CULL_SAMPLE, 2·CULL_SAMPLE ... on a compact copy:
+    # the same columns as the full pass, for every kind of a pass's geometry
+    from explorer.shading import prepared
+
+    mesh = _mesh("sphere")
+    assert mesh.n_vertices % K.CHUNK  # a last, shorter chunk: left out of the sample
+    sh = explorer.Shader({"material": MATERIAL}, mesh.positions, mesh.normals)
+    _ = sh.colors
+    dtype = np.float64 if source == "float64 vertices" else np.float32
+    P, N = mesh.positions.astype(dtype), mesh.normals.astype(dtype)
+    src = (
+        prepared.rows(sh._G)
+        if source == "prepared rows"
+        else prepared.vertices(P, N, sh._centre, sh._scale, sh._k.dtype)
+    )
+    full = np.empty((layout.N_BOUNDS, -(-sh.n // K.CHUNK)))
+    K.bounds(src, sh._k, full, 1)
+    whole = sh.n // K.CHUNK
+    want = full[:, : whole : prepared.CULL_SAMPLE]
+    np.testing.assert_array_equal(prepared.sample_bounds(src, sh._k), want)
+
+
+def test_a_sample_that_falls_short_finds_the_sampled_chunks_alone(monkeypatch):
+    # shuffled vertices: the sample of the chunks' bounds says culling cannot pay, and finding
+    # it ran the bounds over the sampled chunks alone, into an array of their size: not in
+    # place into a bounds array for every chunk (written sparsely, each of its pages touched,
+    # each sampled chunk a cache miss: twice the time on a million vertices)
+    from explorer.shading import prepared
+
+    n = 20_000
+    rng = np.random.default_rng(0)
+    N = rng.normal(size=(n, 3)).astype(np.float32)
+    N /= np.linalg.norm(N, axis=1, keepdims=True)
+    k = K.constants(np.float32)
+    src = prepared.vertices(N, N, np.zeros(3), 1.0, np.float32)
+    calls = []
+    bounds = K.bounds
+
+    def spy(src, k, out, step):
+        calls.append((len(src.P32), out.shape[1], step))
+        return bounds(src, k, out, step)
+
+    monkeypatch.setattr(K, "bounds", spy)
+    assert prepared.chunk_bounds(src, k).shape == (layout.N_BOUNDS, 0)
+    sampled = -(-(n // K.CHUNK) // prepared.CULL_SAMPLE)
+    assert calls == [(sampled * K.CHUNK, sampled, 1)]
+
+
 def test_shuffled_vertices_are_not_tested_at_all():
     # no chunk of shuffled sphere vertices has a cone narrower than 90°: the shader keeps no
     # bounds, so a pass does not even run the test

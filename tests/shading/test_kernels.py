@@ -74,8 +74,8 @@ def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
     widths = []
 
     @contextlib.contextmanager
-    def wide(lanes=16):
-        widths.append(lanes)
+    def wide(n=0):
+        widths.append(n)
         yield
 
     class Kernel:  # stands for a numba dispatcher
@@ -87,17 +87,25 @@ def test_each_new_kind_of_data_is_compiled_with_wide_vectors(monkeypatch):
 
     monkeypatch.setattr(codegen, "WIDE_VECTORS", True)
     monkeypatch.setattr(codegen, "wide_vectors", wide)
-    call = codegen.wide(Kernel(), 1)
     f32, f64 = K.constants(np.float32), K.constants(np.float64)
     G32, P32, P64 = np.zeros((6, 4), np.float32), np.zeros((4, 3), np.float32), np.zeros((4, 3))
     R32 = prepared.rows(G32)
     V32, V64 = (prepared.vertices(P, P, np.zeros(3), 1.0, np.float32) for P in (P32, P64))
     V32d = prepared.vertices(P32, P32, np.zeros(3), 1.0, np.float64)
-    for data, k in [(G32, f32), (G32, f32), (R32, f32), (V32, f32), (V64, f32), (V32d, f64)]:
-        call(data, k)
-    assert widths == [16, 16, 8]  # G32, then the Sources in float32, then in float64: once each
-    call(np.zeros(3, np.int64), np.zeros(3, np.int64))  # no float data: no wide vectors
-    assert widths == [16, 16, 8]
+    # the lanes are the target's vector width (codegen.VECTOR_BITS): AVX-512's 512 bits, AVX2's 256
+    for bits, lanes in ((512, [16, 16, 8]), (256, [8, 8, 4])):
+        monkeypatch.setattr(codegen, "VECTOR_BITS", bits)
+        widths.clear()
+        call = codegen.wide(Kernel(), 1)
+        for data, k in [(G32, f32), (G32, f32), (R32, f32), (V32, f32), (V64, f32), (V32d, f64)]:
+            call(data, k)
+        assert widths == lanes  # G32, then the Sources in float32, then in float64: once each
+        call(np.zeros(3, np.int64), np.zeros(3, np.int64))  # no float data: no wide vectors
+        assert widths == lanes
+    # a kernel whose arithmetic is float64 whatever its data (item=8): float64's lanes
+    call = codegen.wide(Kernel(), 1, item=8)
+    call(G32, f32)
+    assert widths == [8, 8, 4, 4]
 
 
 def test_marked_reads_only_the_blocks_that_count_marks():

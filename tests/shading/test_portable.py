@@ -4,7 +4,8 @@ without AVX-512.
 The float64 lobe's lane packing (vmath.compress8 / expand8) emits LLVM's vector compress and
 masked expand intrinsics, which AVX-512 does in one instruction each and LLVM writes out
 otherwise (its generic expansion of the register-form compress aborted the process on such CPUs,
-hence vmath.NATIVE_COMPRESS). This machine may have AVX-512, so the intrinsics are compiled here
+hence vmath.NATIVE_COMPRESS; on AVX2 a permute by table, vmath.PERMUTE_PACK). This machine may
+have AVX-512, so the intrinsics are compiled here
 for portable x86-64 targets (numba's ``NUMBA_CPU_NAME`` / ``NUMBA_CPU_FEATURES``, in a
 subprocess with a cache directory of its own) and must give what they give on this host: the
 packing's lanes, the powers (pow32 / pow64: their bit tricks), the ordered keys, and the shadow
@@ -77,7 +78,9 @@ D[::7, 0] = 0.0
 bits = entered(wide, O, D, rng.uniform(0.1, 3.0, 2000))
 assert 0 < bits.mean() < 15
 asm = next(iter(round_trip.inspect_asm().values()))
-print("ok", vmath.NATIVE_COMPRESS, "zmm" in asm, hashlib.sha256(bits.tobytes()).hexdigest()[:16])
+from explorer.shading import codegen
+print("ok", vmath.NATIVE_COMPRESS, "zmm" in asm, hashlib.sha256(bits.tobytes()).hexdigest()[:16],
+      vmath.PACK or "-", codegen.VECTOR_BITS, "vpermd" in asm or "vpermps" in asm)
 """
 
 
@@ -98,12 +101,20 @@ def _run(tmp_path, **target) -> list[str]:
 
 
 # (numba takes the host's features for a named CPU unless NUMBA_CPU_FEATURES says otherwise)
-@pytest.mark.parametrize("cpu", ["x86-64", "znver3"])  # SSE2 only; AVX2 (Zen 3)
-def test_intrinsics_on_cpus_without_avx512(cpu, tmp_path):
+@pytest.mark.parametrize(
+    "cpu, pack, bits, permute",
+    [
+        ("x86-64", "-", "0", "False"),  # SSE2 only: lane by lane, LLVM's own vector width
+        ("znver3", "permute", "256", "True"),  # AVX2 (Zen 3): the table's permute, 256 bits
+    ],
+)
+def test_intrinsics_on_cpus_without_avx512(cpu, pack, bits, permute, tmp_path):
     if os.uname().machine not in ("x86_64", "AMD64"):
         pytest.skip("x86-64 targets")
     got = _run(tmp_path / cpu, NUMBA_CPU_NAME=cpu, NUMBA_CPU_FEATURES="-avx512f")
-    # compiled for the target asked for: the packing's portable form, no 512-bit registers
+    # compiled for the target asked for: no AVX-512 compress, no 512-bit registers; the
+    # packing and the kernels' vector width (vmath.PACK, codegen.VECTOR_BITS) the target's
     assert got[:3] == ["ok", "False", "False"], got
+    assert got[4:] == [pack, bits, permute], got
     # the four-box test enters the same boxes as on this host
     assert got[3] == _run(tmp_path / "host")[3]
