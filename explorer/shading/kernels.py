@@ -116,6 +116,7 @@ from explorer.shading.codegen import (  # the light loops' variants, the vector 
     SRC_INLINE,
     SRC_ROWS,
     dispatch_source,
+    lanes,
     loop_of,
     wide,
     wide_vectors,
@@ -1032,8 +1033,9 @@ def loop_table(dtype) -> np.ndarray:
     LLVM optimises and generates all of it again for each kernel of the chain that calls it
     (``_light_loop``, :func:`_block`, :func:`_task`, the parallel loop of :func:`shade`,
     :func:`shade`, :func:`fixup`): the 36 light loops were most of the cold compile's LLVM time.
-    Compiled with the precision's 512-bit vectors
-    (:func:`explorer.shading.codegen.wide_vectors`)."""
+    Compiled with the target's vectors in the precision's lanes (16 float32 or 8 float64 at
+    512 bits, 8 or 4 at 256: :func:`explorer.shading.codegen.lanes`,
+    :func:`explorer.shading.codegen.wide_vectors`)."""
     dt = np.dtype(dtype)
     table = _tables.get(dt)
     if table is not None:
@@ -1042,7 +1044,7 @@ def loop_table(dtype) -> np.ndarray:
         if dt not in _tables:
             sig = light_signature(dt)
             table = np.zeros(64, np.int64)
-            with wide_vectors(64 // dt.itemsize):
+            with wide_vectors(lanes(dt.itemsize)):
                 for code in LIGHT_LOOPS:
                     d = globals()[f"_light_{code}"]
                     d.compile(sig)
