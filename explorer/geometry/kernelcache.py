@@ -52,6 +52,7 @@ KERNEL_MODULES = (
     "explorer.geometry.traverse",
     "explorer.geometry.occluders",
     "explorer.geometry.bvh",
+    "explorer.geometry.raster",
 )
 #: modules whose constants the kernels read at compile time (numba freezes a global's value)
 CONSTANT_MODULES = (
