@@ -277,7 +277,9 @@ class LivePixels:
 
         if self._shader is None:
             P, N, faces = geometry()
-            kw = {"precision": self.precision, "clamp": clamp, "faces": faces}
+            # no light culling: its chunk bounds, found anew at each camera frame, cost two
+            # passes over the pixels, more than culling saves them (docs/perpixel_bench.md)
+            kw = {"precision": self.precision, "clamp": clamp, "faces": faces, "cull": False}
             self._shader = Shader(scene, P, N, cancelled=cancelled, **kw)
         else:
             self._shader.cancelled = cancelled

@@ -129,3 +129,27 @@ def test_the_live_view_draws_from_the_compiled_gbuffer():
     assert (a.mask ^ b.mask).sum() <= 3
     levels = np.abs(a.rgb.astype(int) - b.rgb.astype(int)).max(axis=2)
     assert np.mean(levels[both] <= 1) > 0.995
+
+
+def test_a_camera_change_in_the_live_view_finds_no_chunk_bounds(monkeypatch):
+    """The live view's shader does not cull lights (``cull=False``), so a new G-buffer costs
+    no chunk bounds of the pixels (two passes over them, more than culling saves: counted),
+    and its colours are those of a culling shader."""
+    from explorer.shading import prepared
+    from explorer.shading.shader import Shader
+
+    calls = []
+    real = prepared.chunk_bounds
+    monkeypatch.setattr(prepared, "chunk_bounds", lambda *a: calls.append(1) or real(*a))
+    mesh = M.teapot(6)
+    scene = _scene(Viewer(eye=(2.0, 1.5, 3.0)))
+    cams = _cameras(mesh)
+    with LivePixels(mesh, precision="float32") as live:
+        for cam in cams:
+            frame = live.frame(scene, cam, SIZE)
+            assert frame.gbuffer_made
+        h = live.gbuffer(cams[-1], SIZE)[0].hits
+        colors = live._shader.colors
+    assert calls == []
+    culling = Shader(scene, h.positions, h.normals, precision="float32")
+    assert calls and np.array_equal(culling.colors, colors)
