@@ -53,7 +53,7 @@ BANDS_PER_THREAD = 4
 
 
 @nb.njit(cache=True, nogil=True, boundscheck=False)
-def _setup(P, F, cam, persp, w, h, X, Y, Q, spans):  # pragma: no cover - compiled
+def _setup(P, F, cam, persp, w, h, X, Y, Q, spans):
     """Vertices ``P`` (n, 3) float64 into pixel units ``X`` (columns), ``Y`` (rows) and the
     depth key ``Q``, ``cam`` (18,) as :func:`gbuffer` takes it; then each triangle's pixel
     centres' rows and columns, ``spans`` (m, 4) int32: first row, last row, first column,
@@ -95,7 +95,7 @@ def _setup(P, F, cam, persp, w, h, X, Y, Q, spans):  # pragma: no cover - compil
 
 
 @nb.njit(inline="always")
-def _ray(r, c, w, h, cam, persp, O, D):  # pragma: no cover - compiled
+def _ray(r, c, w, h, cam, persp, O, D):
     """The ray through pixel (r, c)'s centre into ``O``, ``D`` (3,): the numbers of
     ``explorer.render.camera.pixel_rays``."""
     sx = (2.0 * (c + 0.5)) / w - 1.0 + cam[14]
@@ -116,7 +116,7 @@ def _ray(r, c, w, h, cam, persp, O, D):  # pragma: no cover - compiled
 
 
 @nb.njit(inline="always")
-def _plane(P, F, f, O, D):  # pragma: no cover - compiled
+def _plane(P, F, f, O, D):
     """Möller-Trumbore without the inside test (:func:`explorer.render.perpixel.raster_hits`):
     (det, u, v, t) of the ray ``O``, ``D`` on triangle ``f``'s plane."""
     i0, i1, i2 = F[f, 0], F[f, 1], F[f, 2]
@@ -136,37 +136,54 @@ def _plane(P, F, f, O, D):  # pragma: no cover - compiled
 
 
 @nb.njit(inline="always")
-def _edge(ia, ib, X, Y, px, py):  # pragma: no cover - compiled
-    """The edge function of the edge from vertex ``ia`` to ``ib`` at (px, py), computed from
-    its ends in the order of their indices (so that the edge's other triangle gets exactly the
-    opposite value)."""
+def _edge(ia, ib, X, Y, s):
+    """The edge from vertex ``ia`` to ``ib`` of a triangle whose area has the sign ``s``, as
+    (x0, y0, dx, dy, sign, top_left): its edge function at (px, py) is
+    ``sign * (dx * (py - y0) - dy * (px - x0))``, computed from its ends in the order of their
+    indices (so that the edge's other triangle gets exactly the opposite value: a negation is
+    exact); ``top_left``: the edge, directed with the triangle's interior on its positive side,
+    is a top or a left one (the top-left rule: of two triangles sharing the edge, exactly one
+    owns a pixel centre on it)."""
     if ia < ib:
-        return (X[ib] - X[ia]) * (py - Y[ia]) - (Y[ib] - Y[ia]) * (px - X[ia])
-    return -((X[ia] - X[ib]) * (py - Y[ib]) - (Y[ia] - Y[ib]) * (px - X[ib]))
+        x0, y0, dx, dy, sign = X[ia], Y[ia], X[ib] - X[ia], Y[ib] - Y[ia], 1.0
+    else:
+        x0, y0, dx, dy, sign = X[ib], Y[ib], X[ia] - X[ib], Y[ia] - Y[ib], -1.0
+    tx, ty = s * sign * dx, s * sign * dy  # (the edge ia -> ib, interior on its left)
+    return x0, y0, dx, dy, sign, ty > 0.0 or (ty == 0.0 and tx < 0.0)
 
 
-@nb.njit(inline="always")
-def _owns(e, s, ia, ib, X, Y):  # pragma: no cover - compiled
-    """Whether a pixel centre whose edge function for the edge ``ia`` -> ``ib`` is ``e`` lies on
-    the triangle's side of it (``s``: the sign of the triangle's area): inside, or on the edge
-    and the edge (directed with the triangle's interior on its positive side) is a top or left
-    one (the top-left rule: of two triangles sharing the edge, exactly one owns it)."""
-    v = s * e
-    if v > 0.0:
-        return True
-    if v < 0.0:
-        return False
-    dx, dy = s * (X[ib] - X[ia]), s * (Y[ib] - Y[ia])
-    return dy > 0.0 or (dy == 0.0 and dx < 0.0)
+@nb.njit(cache=True, nogil=True, boundscheck=False)
+def _bins(spans, bands, size):
+    """Each band's triangles (those with pixel centres among its ``size`` rows), in index
+    order: (starts (bands + 1,), triangles): band b's are ``triangles[starts[b]:starts[b+1]]``
+    (a triangle over several bands is in each)."""
+    starts = np.zeros(bands + 1, np.int64)
+    for f in range(spans.shape[0]):
+        if spans[f, 0] >= 0:
+            for band in range(spans[f, 0] // size, spans[f, 1] // size + 1):
+                starts[band + 1] += 1
+    for band in range(bands):
+        starts[band + 1] += starts[band]
+    fill = starts[:-1].copy()
+    out = np.empty(starts[bands], np.int64)
+    for f in range(spans.shape[0]):
+        if spans[f, 0] >= 0:
+            for band in range(spans[f, 0] // size, spans[f, 1] // size + 1):
+                out[fill[band]] = f
+                fill[band] += 1
+    return starts, out
 
 
 @nb.njit(cache=True, nogil=True, parallel=True, boundscheck=False)
-def _raster(P, F, X, Y, Q, spans, cam, persp, bands, ids, depth, counts):  # pragma: no cover
-    """Draw every triangle into ``ids`` (h, w) int64 (-1: none) with the depth test on
-    ``depth`` (h, w) float64, ``bands`` horizontal bands, one per task; then per row, how many
-    pixels hit their triangle's plane (``counts`` (h,)): a pixel whose ray runs within DET_EPS
-    of the plane is made a miss (-1)."""
+def _raster(P, F, X, Y, Q, spans, cam, persp, starts, order, ids, depth, counts):
+    """Draw the triangles into ``ids`` (h, w) int64 (-1: none) with the depth test on
+    ``depth`` (h, w) float64, one horizontal band per task (its triangles: :func:`_bins`'
+    ``starts``, ``order``); then per row, how many pixels hit their triangle's plane
+    (``counts`` (h,)): a pixel whose ray runs within DET_EPS of the plane is made a miss (-1).
+    A pixel centre is inside when its three edge functions have the sign of the triangle's
+    area, or one is zero and its edge is a top-left one (:func:`_edge`)."""
     h, w = ids.shape
+    bands = len(starts) - 1
     size = -(-h // bands)
     for band in nb.prange(bands):
         top, bottom = band * size, min((band + 1) * size, h) - 1
@@ -174,26 +191,32 @@ def _raster(P, F, X, Y, Q, spans, cam, persp, bands, ids, depth, counts):  # pra
             for c in range(w):
                 ids[r, c] = -1
                 depth[r, c] = -np.inf
-        for f in range(F.shape[0]):
-            if spans[f, 0] < 0 or spans[f, 0] > bottom or spans[f, 1] < top:
-                continue
+        for j in range(starts[band], starts[band + 1]):
+            f = order[j]
             a, b, c3 = F[f, 0], F[f, 1], F[f, 2]
             area = (X[b] - X[a]) * (Y[c3] - Y[a]) - (Y[b] - Y[a]) * (X[c3] - X[a])
             s = 1.0 if area > 0.0 else -1.0
+            ax, ay, adx, ady, asg, atl = _edge(b, c3, X, Y, s)  # (the weight of corner a)
+            bx, by, bdx, bdy, bsg, btl = _edge(c3, a, X, Y, s)
+            cx, cy, cdx, cdy, csg, ctl = _edge(a, b, X, Y, s)
+            qa, qb, qc = Q[a], Q[b], Q[c3]
             for r in range(max(spans[f, 0], top), min(spans[f, 1], bottom) + 1):
                 py = float(r)
                 for c in range(spans[f, 2], spans[f, 3] + 1):
                     px = float(c)
-                    ea = _edge(b, c3, X, Y, px, py)  # (the weight of corner a)
-                    if not _owns(ea, s, b, c3, X, Y):
+                    ea = asg * (adx * (py - ay) - ady * (px - ax))
+                    v = s * ea
+                    if v < 0.0 or (v == 0.0 and not atl):
                         continue
-                    eb = _edge(c3, a, X, Y, px, py)
-                    if not _owns(eb, s, c3, a, X, Y):
+                    eb = bsg * (bdx * (py - by) - bdy * (px - bx))
+                    v = s * eb
+                    if v < 0.0 or (v == 0.0 and not btl):
                         continue
-                    ec = _edge(a, b, X, Y, px, py)
-                    if not _owns(ec, s, a, b, X, Y):
+                    ec = csg * (cdx * (py - cy) - cdy * (px - cx))
+                    v = s * ec
+                    if v < 0.0 or (v == 0.0 and not ctl):
                         continue
-                    q = (ea * Q[a] + eb * Q[b] + ec * Q[c3]) / area
+                    q = (ea * qa + eb * qb + ec * qc) / area
                     if q > depth[r, c]:
                         depth[r, c] = q
                         ids[r, c] = f
@@ -213,7 +236,7 @@ def _raster(P, F, X, Y, Q, spans, cam, persp, bands, ids, depth, counts):  # pra
 
 
 @nb.njit(cache=True, nogil=True, parallel=True, boundscheck=False)
-def _hits(P, N, F, cam, persp, ids, starts, pixels, tri, uv, pos, nrm):  # pragma: no cover
+def _hits(P, N, F, cam, persp, ids, starts, pixels, tri, uv, pos, nrm):
     """Per covered pixel (row-major; row r's first at ``starts[r]``): its flat index, triangle,
     (u, v), point and unit interpolated normal."""
     h, w = ids.shape
@@ -263,7 +286,8 @@ def gbuffer(positions, normals, faces, cam, persp: bool, size) -> tuple | None:
         return None
     ids, depth, counts = np.empty((h, w), np.int64), np.empty((h, w)), np.empty(h, np.int64)
     bands = max(1, min(h, nb.get_num_threads() * BANDS_PER_THREAD))
-    _raster(P, F, X, Y, Q, spans, cam, persp, bands, ids, depth, counts)
+    starts, order = _bins(spans, bands, -(-h // bands))
+    _raster(P, F, X, Y, Q, spans, cam, persp, starts, order, ids, depth, counts)
     starts = np.zeros(h, np.int64)
     np.cumsum(counts[:-1], out=starts[1:])
     k = int(counts.sum())
