@@ -7,7 +7,7 @@ z-buffer rasteriser that samples each pixel at its centre, as OpenGL does, inste
 picture of triangle indices (:mod:`explorer.render.faceids`) and the numpy arithmetic of
 :func:`explorer.render.perpixel.raster_hits` (a camera frame of the 100,578-vertex teapot at
 800x600: VTK's picture and the numpy arithmetic cost about 70 ms of CPU under load, this
-about 20-30; docs/perpixel_bench.md).
+about 20; docs/perpixel_bench.md).
 
 - :func:`_setup` puts every vertex in pixel units (``explorer.render.camera.project``'s
   numbers: pixel centres at whole numbers, row 0 at the top) with the depth key ``1/z``
@@ -175,13 +175,19 @@ def _bins(spans, bands, size):
 
 
 @nb.njit(cache=True, nogil=True, parallel=True, boundscheck=False)
-def _raster(P, F, X, Y, Q, spans, cam, persp, starts, order, ids, depth, counts):
+def _raster(P, F, screen, view, bins, out):
     """Draw the triangles into ``ids`` (h, w) int64 (-1: none) with the depth test on
     ``depth`` (h, w) float64, one horizontal band per task (its triangles: :func:`_bins`'
     ``starts``, ``order``); then per row, how many pixels hit their triangle's plane
     (``counts`` (h,)): a pixel whose ray runs within DET_EPS of the plane is made a miss (-1).
+    ``screen``: (X, Y, Q, spans) of :func:`_setup`; ``view``: (cam, persp); ``bins``:
+    (starts, order); ``out``: (ids, depth, counts).
     A pixel centre is inside when its three edge functions have the sign of the triangle's
     area, or one is zero and its edge is a top-left one (:func:`_edge`)."""
+    X, Y, Q, spans = screen
+    cam, persp = view
+    starts, order = bins
+    ids, depth, counts = out
     h, w = ids.shape
     bands = len(starts) - 1
     size = -(-h // bands)
@@ -236,9 +242,12 @@ def _raster(P, F, X, Y, Q, spans, cam, persp, starts, order, ids, depth, counts)
 
 
 @nb.njit(cache=True, nogil=True, parallel=True, boundscheck=False)
-def _hits(P, N, F, cam, persp, ids, starts, pixels, tri, uv, pos, nrm):
+def _hits(P, N, F, view, ids, starts, out):
     """Per covered pixel (row-major; row r's first at ``starts[r]``): its flat index, triangle,
-    (u, v), point and unit interpolated normal."""
+    (u, v), point and unit interpolated normal, into ``out`` (pixels, tri, uv, pos, nrm);
+    ``view``: (cam, persp)."""
+    cam, persp = view
+    pixels, tri, uv, pos, nrm = out
     h, w = ids.shape
     for r in nb.prange(h):
         O, D = np.empty(3), np.empty(3)
@@ -287,11 +296,12 @@ def gbuffer(positions, normals, faces, cam, persp: bool, size) -> tuple | None:
     ids, depth, counts = np.empty((h, w), np.int64), np.empty((h, w)), np.empty(h, np.int64)
     bands = max(1, min(h, nb.get_num_threads() * BANDS_PER_THREAD))
     starts, order = _bins(spans, bands, -(-h // bands))
-    _raster(P, F, X, Y, Q, spans, cam, persp, starts, order, ids, depth, counts)
+    view = (cam, persp)
+    _raster(P, F, (X, Y, Q, spans), view, (starts, order), (ids, depth, counts))
     starts = np.zeros(h, np.int64)
     np.cumsum(counts[:-1], out=starts[1:])
     k = int(counts.sum())
     pixels, tri = np.empty(k, np.int64), np.empty(k, np.int64)
     uv, pos, nrm = np.empty((k, 2)), np.empty((k, 3)), np.empty((k, 3))
-    _hits(P, N, F, cam, persp, ids, starts, pixels, tri, uv, pos, nrm)
+    _hits(P, N, F, view, ids, starts, (pixels, tri, uv, pos, nrm))
     return ids >= 0, pixels, tri, uv, pos, nrm

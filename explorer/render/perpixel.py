@@ -277,11 +277,8 @@ def compiled_hits(camera, size: Sequence[int], mesh) -> Hits | None:
     else:
         t = math.tan(math.radians(camera.view_angle) / 2.0)
         half = (t * aspect, t)
-    cam = np.concatenate([
-        np.asarray(camera.position, np.float64), right, up, forward, half,
-        np.asarray(camera.window_center, np.float64),
-        np.asarray(camera.clipping_range, np.float64),
-    ])  # fmt: skip
+    ends = (camera.position, right, up, forward, half, camera.window_center, camera.clipping_range)
+    cam = np.concatenate([np.asarray(x, np.float64) for x in ends])
     out = gbuffer(mesh.positions, mesh.normals, mesh.faces, cam, not camera.parallel, (w, h))
     if out is None:
         return None

@@ -79,8 +79,8 @@ def test_a_pixel_centre_on_a_shared_edge_or_corner_belongs_to_one_triangle():
     the square is covered by exactly one (no gap, no double hit: the top-left rule)."""
     size = (9, 9)
     square = [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
-    fan = [(0, 0, 0), (-1, -1, 0), (0, -1, 0), (1, -1, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0),
-           (-1, 1, 0), (-1, 0, 0)]  # fmt: skip
+    ring = [(-1, -1), (0, -1), (1, -1), (1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0)]
+    fan = [(0, 0, 0)] + [(x, y, 0) for x, y in ring]
     cases = {
         "diagonal": (square, [(0, 1, 2), (0, 2, 3)]),
         "diagonal, one wound the other way": (square, [(0, 1, 2), (0, 3, 2)]),
