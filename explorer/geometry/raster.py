@@ -16,20 +16,21 @@ about 20; docs/perpixel_bench.md).
   counts the vertices outside the camera's clipping range or not finite, which the caller
   leaves to VTK (whose clipping this rasteriser does not copy).
 - :func:`_raster` draws the triangles into horizontal bands of the picture, one band per task
-  (no two tasks write one pixel). A pixel centre is inside when its three edge functions have
-  the sign of the triangle's area; exactly on an edge, the top-left rule decides. Each edge
-  function is computed from its two ends in the order of their vertex indices, so two
-  triangles that share an edge get exactly opposite values: a centre on a shared edge or a
-  shared corner belongs to exactly one of them (no gap, no double hit; as OpenGL's
-  rasterisation rules ask of any rasteriser). Each band then counts its rows' pixels whose ray
-  meets its triangle's plane (a ray within DET_EPS of the plane is a miss).
+  (no two tasks write one pixel; each reads only its own triangles, binned by :func:`_bins`).
+  A pixel centre is inside when its three edge functions have the sign of the triangle's area;
+  exactly on an edge, the top-left rule decides. Each edge function is computed from its two
+  ends in the order of their vertex indices, so two triangles that share an edge get exactly
+  opposite values: a centre on a shared edge or a shared corner belongs to exactly one of them
+  (no gap, no double hit; as OpenGL's rasterisation rules ask of any rasteriser). Each band
+  then counts its rows' pixels whose ray meets its triangle's plane (a ray within DET_EPS of
+  the plane is a miss).
 - :func:`_hits` gives, per covered pixel in row-major order, the Möller-Trumbore arithmetic of
   :func:`explorer.render.perpixel.raster_hits` on the pixel's own ray and triangle (the same
   numbers: the ray of ``explorer.render.camera.pixel_rays``, the point ``O + t·D``, the normal
   ``(1-u-v)·n0 + u·n1 + v·n2`` normalised, zero staying zero).
 
 Two parallel regions a frame: under load each costs the threads' wake-up and spin on top of
-the work, so the small passes (:func:`_setup`) run on one thread.
+the work, so the small passes (:func:`_setup`, :func:`_bins`) run on one thread.
 
 Coverage is that of any OpenGL rasteriser up to where a pixel centre lies within rounding of an
 edge (VTK's llvmpipe snaps vertices to 1/256 pixel and draws in float32): a few silhouette pixels
