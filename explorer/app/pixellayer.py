@@ -15,9 +15,9 @@ The picture is made before the window draws (the render window's ``StartEvent``,
 makes its context current, so the G-buffer's own off-screen window may draw), for the camera
 VTK is about to draw with and the state it makes (the camera is the viewer):
 :meth:`PixelLayer.update`. A frame that shows the same scene, camera and size reuses the picture.
-The rasteriser behind the G-buffer is VTK's, like the view's, but it draws the mesh in its own
-frame: a silhouette pixel the view covers and the G-buffer does not takes its covered
-neighbour's colour (:func:`fill_edges`).
+The rasteriser behind the G-buffer samples pixel centres as the view's does (the compiled one,
+or VTK's drawing the mesh in its own frame), but in other arithmetic: a silhouette pixel the
+view covers and the G-buffer does not takes its covered neighbour's colour (:func:`fill_edges`).
 
 The drag fallback: while a drag moves the camera and a per-pixel picture costs more than
 :data:`FALLBACK_RATIO` times the per-vertex frame (the same window's frame without it: the

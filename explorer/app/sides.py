@@ -1,8 +1,9 @@
 """The compare view's side B, for both front ends (no toolkit): :class:`SideB`, side B's pane
 beside side A's :class:`~explorer.app.viewport.PlotterView`, with the same camera (one
 ``vtkCamera`` for both), lights and mesh, and side B's material and model, or "A − B" (the
-difference of the two sides' colours per vertex, largest channel in 1/255 levels, in the
-difference view's colours), and both sides' captions. The front end's :class:`Pane` makes
+difference of what the two panes show, largest channel in 1/255 levels, in the difference
+view's colours: the colours per vertex, or with both sides lit per pixel their two per-pixel
+pictures, pixel by pixel), and both sides' captions. The front end's :class:`Pane` makes
 side B's plotter and shows it (Qt: a second ``QtInteractor`` beside the view; the page: a
 second off-screen plotter in its own remote view)."""
 
@@ -112,6 +113,7 @@ class SideB:
         when both sides are lit alike (or the per-pixel side draws per vertex: a drag)."""
         b_pp = M.side_b(state).scene.shading == PER_PIXEL
         if (state.scene.shading == PER_PIXEL) == b_pp:
+            self._pixel_difference(state if b_pp else None)
             return None
         layer, other = (self.pixels, self.main.view) if b_pp else (self.main.pixels, self.view)
         if layer.last is None or not layer.shown:
@@ -130,6 +132,34 @@ class SideB:
         else:
             vertex_ms = self.pixels.vertex_ms
         return PC.figures(errors, vertex_ms, layer.ms)
+
+    def _pixel_difference(self, state: M.State | None) -> None:
+        """A − B with both sides lit per pixel (``state``; None: they are not): side B's pane
+        draws the difference of the two pictures, the largest channel in 8-bit levels at the
+        pixels both cover (what each pane shows; the per-vertex colours' A − B of
+        :func:`show_side_b` lies under B's picture), in the difference view's colours;
+        :attr:`errors` holds it. Turned off, or a side not drawn per pixel (a drag's
+        fallback): side B's picture again."""
+        a, b = self.main.pixels, self.pixels
+        both = (
+            state is not None
+            and a is not None
+            and state.compare_difference
+            and a.shown
+            and b.shown
+            and a.last is not None
+            and b.last is not None
+            and a.camera == b.camera
+            and a.size == b.size
+        )
+        if both:
+            mask = a.last.mask & b.last.mask
+            errors = PC.levels(a.last.rgb[mask], b.last.rgb[mask])
+            self.errors = (errors, mask)
+            b.draw(PC.heat_picture(errors, mask))
+        elif self._heat and b.shown and b.rgb is not None:
+            b.draw(b.rgb)
+        self._heat = both
 
     def _captions(self) -> None:
         """Both panes' captions with the figures' line under them (none without figures)."""

@@ -41,6 +41,15 @@ from pathlib import Path
 
 from numba.core import caching
 
+#: OpenMP's worker threads (numba's "omp" threading layer: libgomp reads this when numba starts
+#: its threads, at the first parallel kernel) wait for work asleep rather than spinning; a
+#: user's own OMP_WAIT_POLICY wins. Spinning after each parallel region burnt a core the
+#: window's other work (VTK's llvmpipe threads, the GUI) needed, and under load each short
+#: pass cost several times its work in CPU: a camera frame of the live per-pixel view (100k-vertex
+#: teapot, 800x600; docs/perpixel_bench.md) took 65 ms of CPU spinning, 33 ms asleep.
+WAIT_POLICY = "PASSIVE"
+os.environ.setdefault("OMP_WAIT_POLICY", WAIT_POLICY)
+
 #: the directory that holds the ``explorer`` package (a checkout, or site-packages)
 ROOT = Path(__file__).resolve().parents[2]
 #: modules with numba functions the product compiles (each imports this module first)
@@ -52,6 +61,7 @@ KERNEL_MODULES = (
     "explorer.geometry.traverse",
     "explorer.geometry.occluders",
     "explorer.geometry.bvh",
+    "explorer.geometry.raster",
 )
 #: modules whose constants the kernels read at compile time (numba freezes a global's value)
 CONSTANT_MODULES = (

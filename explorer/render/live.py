@@ -3,11 +3,16 @@
 A :class:`LivePixels` draws the per-pixel picture of one mesh for any scene, camera and size
 (:meth:`LivePixels.frame`), and keeps what the next frame can reuse:
 
-- **the G-buffer** (:class:`GBuffer`): which triangle each pixel shows, from VTK's own
-  rasterisation (:class:`explorer.render.faceids.FaceIdRenderer`: coverage equals the per-vertex
-  picture's), then the float64 surface point and interpolated normal of each covered pixel
-  (:func:`explorer.render.perpixel.raster_hits`). Made once per camera, mesh or size change
-  (counted: :attr:`LivePixels.gbuffers`).
+- **the G-buffer** (:class:`GBuffer`): which triangle each pixel shows, then the float64
+  surface point and interpolated normal of each covered pixel. Compiled
+  (:func:`explorer.render.perpixel.compiled_hits`: a z-buffer rasteriser that samples pixel
+  centres as OpenGL does, then the points, in parallel passes; about 20 ms of CPU against
+  about 70 by the VTK path on a camera change of the 100k-vertex teapot at 800x600) once the
+  compiled kernels serve; else (and where the mesh reaches outside the camera's clipping
+  range) from VTK's own rasterisation (:class:`explorer.render.faceids.FaceIdRenderer`, then
+  :func:`explorer.render.perpixel.raster_hits`). Both cover what the per-vertex picture
+  covers, up to a silhouette pixel whose centre lies within rounding of an edge. Made once
+  per camera, mesh or size change (counted: :attr:`LivePixels.gbuffers`).
 - **the light sums** of the covered pixels, in one :class:`explorer.shading.shader.Shader` over
   the hit points (its ``set_geometry``): a material change recomposes the cached sums with no
   light pass, a shininess change reruns only the specular (then only the lobe), a light change
@@ -29,7 +34,7 @@ Texture maps (issue 40): every map of the material at each pixel, on the same ke
 (:mod:`explorer.render.pixelmaps`): a colour or scalar map composes with no light pass; a
 ``bump_map`` tilts the normals the shader shades (new light sums when it changes).
 
-VTK is imported only when a G-buffer is made (the face-id window).
+VTK is imported only when a G-buffer is made from its picture (the face-id window).
 """
 
 from __future__ import annotations
@@ -46,17 +51,20 @@ from explorer.render.camera import Camera, camera_for
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.render.perpixel import METHODS as PERPIXEL_METHODS
-from explorer.render.perpixel import Hits, raster_hits
+from explorer.render.perpixel import Hits, compiled_hits, raster_hits
 from explorer.render.pixelmaps import PixelMaps, any_maps
+from explorer.shading import tiers
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import PRECISIONS, Shader
 
-__all__ = ["METHODS", "GBuffer", "LivePixels", "PixelFrame", "picture"]
+__all__ = ["GBUFFER_METHODS", "METHODS", "GBuffer", "LivePixels", "PixelFrame", "picture"]
 
 #: where a per-pixel picture's surface points come from (``render --per-pixel-method``):
 #: "raster", the rasteriser's triangles (:class:`LivePixels`, the live view's picture), then
 #: the per-pixel reference's methods (:func:`explorer.render.perpixel.hits`)
 METHODS = ("raster", *PERPIXEL_METHODS)
+#: how a :class:`LivePixels` finds each pixel's triangle (its ``gbuffer_method``)
+GBUFFER_METHODS = ("auto", "compiled", "vtk")
 
 
 @dataclass(frozen=True)
@@ -94,7 +102,9 @@ class GBuffer:
         """(k,) int64 the covered pixels' indices in the picture's row-major order (made on
         first use): pixel i of the hits is ``rgb.reshape(-1, 3)[pixels[i]]``."""
         if "_pixels" not in self.__dict__:
-            object.__setattr__(self, "_pixels", np.flatnonzero(self.hits.mask))
+            given = self.hits.pixels  # (the compiled G-buffer's, else found here)
+            pixels = np.flatnonzero(self.hits.mask) if given is None else given
+            object.__setattr__(self, "_pixels", pixels)
         return self.__dict__["_pixels"]
 
 
@@ -104,6 +114,10 @@ class LivePixels:
     mesh : an :class:`explorer.geometry.meshes.Mesh` (:meth:`set_mesh` changes it)
     precision : "float64" (the exact path, the numbers of ``render --per-pixel``) or "float32"
         (the shader's fast path: within one level of float64)
+    gbuffer_method : how the G-buffer finds each pixel's triangle (:data:`GBUFFER_METHODS`):
+        "compiled", the compiled rasteriser (:func:`explorer.render.perpixel.compiled_hits`,
+        VTK's picture where the mesh reaches outside the clipping range); "vtk", VTK's picture
+        of triangle indices; "auto" (default), compiled when the compiled kernels serve
 
     Counters: :attr:`gbuffers` (G-buffers made), :attr:`light_passes` (light passes of the
     per-pixel shader: a pass that computes light sums, not a compose or a lobe); :attr:`stats`
@@ -115,10 +129,15 @@ class LivePixels:
     surface: a translucent material is not blended (as ``render --per-pixel``).
     """
 
-    def __init__(self, mesh, *, precision: str = "float64"):
+    def __init__(self, mesh, *, precision: str = "float64", gbuffer_method: str = "auto"):
         if precision not in PRECISIONS:
             raise ExplorerError(f"precision must be one of {PRECISIONS}, got {precision!r}")
+        if gbuffer_method not in GBUFFER_METHODS:
+            raise ExplorerError(
+                f"gbuffer_method must be one of {GBUFFER_METHODS}, got {gbuffer_method!r}"
+            )
         self.precision = precision
+        self.gbuffer_method = gbuffer_method
         self.mesh = mesh
         self.gbuffers = 0
         self._faceids = None  # the face-id window (of self._gbuffer's size)
@@ -174,17 +193,30 @@ class LivePixels:
         g = self._gbuffer
         if g is not None and g.size == (w, h) and g.camera == camera:
             return g, False
-        from explorer.render.faceids import FaceIdRenderer  # (VTK: only here)
+        hits = compiled_hits(camera, (w, h), self.mesh) if self._compiled() else None
+        if hits is None:  # VTK's picture of triangle indices (it clips at the clipping range)
+            from explorer.render.faceids import FaceIdRenderer  # (VTK: only here)
 
-        if self._faceids is not None and self._faceids.size != (w, h):
-            self.close()
-        if self._faceids is None:
-            self._faceids = FaceIdRenderer((w, h))
-        seen = self._faceids.render(self.mesh, camera)
-        g = GBuffer(camera, (w, h), raster_hits(camera, (w, h), self.mesh, seen))
+            if self._faceids is not None and self._faceids.size != (w, h):
+                self.close()
+            if self._faceids is None:
+                self._faceids = FaceIdRenderer((w, h))
+            seen = self._faceids.render(self.mesh, camera)
+            hits = raster_hits(camera, (w, h), self.mesh, seen)
+        g = GBuffer(camera, (w, h), hits)
         self._gbuffer = g
         self.gbuffers += 1
         return g, True
+
+    def _compiled(self) -> bool:
+        """Whether the G-buffer is the compiled one
+        (:func:`~explorer.render.perpixel.compiled_hits`): when :attr:`gbuffer_method` is
+        "compiled", or "auto" and the compiled kernels serve in
+        this process (:func:`explorer.shading.tiers.loaded`: they were compiled in the
+        background with the engine's, :mod:`explorer.shading.warm`); else VTK's picture."""
+        if self.gbuffer_method == "auto":
+            return tiers.loaded()
+        return self.gbuffer_method == "compiled"
 
     def frame(
         self,
@@ -255,7 +287,9 @@ class LivePixels:
 
         if self._shader is None:
             P, N, faces = geometry()
-            kw = {"precision": self.precision, "clamp": clamp, "faces": faces}
+            # no light culling: its chunk bounds, found anew at each camera frame, cost two
+            # passes over the pixels, more than culling saves them (docs/perpixel_bench.md)
+            kw = {"precision": self.precision, "clamp": clamp, "faces": faces, "cull": False}
             self._shader = Shader(scene, P, N, cancelled=cancelled, **kw)
         else:
             self._shader.cancelled = cancelled

@@ -29,6 +29,7 @@ Nothing here imports VTK.
 
 from __future__ import annotations
 
+import math
 import threading
 import weakref
 from collections.abc import Sequence
@@ -38,7 +39,7 @@ import numpy as np
 
 from explorer.core.errors import Cancelled, ExplorerError
 from explorer.core.tolerances import DET_EPS, PIXEL_RAY_T_MIN
-from explorer.render.camera import camera_for, mesh_frame, pixel_rays, project
+from explorer.render.camera import _basis, camera_for, mesh_frame, pixel_rays, project
 from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.shading.display import display_colors, to_bytes
@@ -67,6 +68,8 @@ class Hits:
     triangles : (k,) int64 the triangle of the mesh each hit lies on (None for the closed form)
     barycentrics : (k, 2) float64 ``(u, v)`` of each hit on its triangle (corner weights
         ``1-u-v, u, v``), for method "raster"; None otherwise
+    pixels : (k,) int64 the hits' flat pixel indices (row-major), when the maker had them
+        (:func:`compiled_hits`); None otherwise (``np.flatnonzero(mask)``)
     """
 
     mask: np.ndarray
@@ -75,6 +78,7 @@ class Hits:
     method: str
     triangles: np.ndarray | None = None
     barycentrics: np.ndarray | None = None
+    pixels: np.ndarray | None = None
 
 
 def sphere_hits(camera, size: Sequence[int], centre=(0.0, 0.0, 0.0), radius=1.0) -> Hits:
@@ -253,6 +257,33 @@ def raster_hits(camera, size: Sequence[int], mesh, faces_seen: np.ndarray) -> Hi
     mask[flat[hit]] = True
     uv = np.stack([u[hit], v[hit]], axis=1)
     return Hits(mask.reshape(h, w), pos, n, "raster", f[hit], uv)
+
+
+def compiled_hits(camera, size: Sequence[int], mesh) -> Hits | None:
+    """:func:`raster_hits` without VTK: the compiled G-buffer
+    (:func:`explorer.geometry.raster.gbuffer`: its own z-buffer rasteriser, sampling pixel
+    centres as OpenGL does, then the same arithmetic in one parallel pass), or None when the
+    mesh reaches outside the camera's clipping range (VTK's picture, which clips, then
+    decides). Returns :class:`Hits` (method "raster") with ``pixels`` given: the covered
+    pixels' flat indices."""
+    from explorer.geometry.raster import gbuffer  # (compiled: loaded on first use)
+
+    w, h = check_size(size)
+    forward, right, up = _basis(camera)
+    aspect = w / h
+    if camera.parallel:
+        s = float(camera.parallel_scale)
+        half = (s * aspect, s)
+    else:
+        t = math.tan(math.radians(camera.view_angle) / 2.0)
+        half = (t * aspect, t)
+    ends = (camera.position, right, up, forward, half, camera.window_center, camera.clipping_range)
+    cam = np.concatenate([np.asarray(x, np.float64) for x in ends])
+    out = gbuffer(mesh.positions, mesh.normals, mesh.faces, cam, not camera.parallel, (w, h))
+    if out is None:
+        return None
+    mask, pixels, tri, uv, pos, n = out
+    return Hits(mask, pos, n, "raster", tri, uv, pixels)
 
 
 def is_unit_sphere(mesh, tol: float = 1e-9) -> bool:

@@ -32,12 +32,13 @@ def frame_of_positions(P) -> tuple:
     return frame_from_extent(*lohi)
 
 
-def prepared_geometry(P, N, dtype, k) -> tuple:
+def prepared_geometry(P, N, dtype, k, bounds: bool = True) -> tuple:
     """The compiled tier's geometry of positions ``P`` and normals ``N`` (n, 3) in precision
     ``dtype`` (``k``: its constants): (centre, scale) of the normalised frame (:func:`frame_of`,
     the extent found in one compiled pass), ``G`` (6, n) (:func:`explorer.shading.kernels.prepare`),
-    the chunk bounds (:func:`chunk_bounds`) and the normals as prepared: ``N``, or scaled into
-    NORMAL_RANGE where some lay outside it (prepare tests what scale_normals would).
+    the chunk bounds (:func:`chunk_bounds`; ``bounds`` False, a shader that does not cull: none,
+    two passes fewer) and the normals as prepared: ``N``, or scaled into NORMAL_RANGE where
+    some lay outside it (prepare tests what scale_normals would).
     These passes test the values too: a NaN or an infinite value raises the error of
     :func:`~explorer.geometry.frame.check_finite` naming the first such vertex."""
     centre, scale = frame_of_positions(P)
@@ -47,15 +48,16 @@ def prepared_geometry(P, N, dtype, k) -> tuple:
         check_finite("normals", N)
         N = scale_normals(N)
         K.prepare(readonly(P), readonly(N), *frame, G)
-    return centre, scale, G, chunk_bounds(rows(G), k), N
+    found = chunk_bounds(rows(G), k) if bounds else readonly(np.empty((layout.N_BOUNDS, 0)))
+    return centre, scale, G, found, N
 
 
-def geometry_of(P, N, dtype, k, whole: bool = True) -> tuple:
-    """(centre, scale, G, bounds, N): :func:`prepared_geometry`; ``whole`` False (a one-shot
-    shader, whose pass prepares each block as it shades: :func:`vertices`): the frame alone,
-    (centre, scale, None, None, None)."""
+def geometry_of(P, N, dtype, k, whole: bool = True, bounds: bool = True) -> tuple:
+    """(centre, scale, G, bounds, N): :func:`prepared_geometry` (``bounds``: whether to find
+    the chunk bounds); ``whole`` False (a one-shot shader, whose pass prepares each block as it
+    shades: :func:`vertices`): the frame alone, (centre, scale, None, None, None)."""
     if whole:
-        return prepared_geometry(P, N, dtype, k)
+        return prepared_geometry(P, N, dtype, k, bounds)
     return (*frame_of_positions(P), None, None, None)
 
 

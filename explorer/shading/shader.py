@@ -131,7 +131,7 @@ class Shader:
     faces : (m, 3) int triangles for shadows (None: no shadows)
     force_all : the plan skips nothing (same colours; benchmark only)
     cull : skip a light for runs of vertices that provably get nothing from it (the plan's
-        ``culling``); False computes every vertex-light (same colours; benchmark and tests)
+        ``culling``); False: every vertex-light, no chunk bounds (same colours; live pixels)
     tier : "compiled" or "numpy" for every pass of this shader; None (default): the tier
         :func:`explorer.shading.tiers.compiled` picks at each pass. The ``threejs`` model is
         always computed by the numpy tier (the kernels implement :data:`COMPILED_MODELS`).
@@ -192,7 +192,7 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        geometry = geometry_of(P, N, self._T, self._k, self.keep) if now else None
+        geometry = geometry_of(P, N, self._T, self._k, self.keep, self.cull) if now else None
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -218,7 +218,8 @@ class Shader:
         """The compiled tier's geometry (:func:`~explorer.shading.prepared.geometry_of`;
         ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_one_shot`)."""
         if self._centre is None:
-            geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, self.keep)
+            how = (self.keep, self.cull)  # (the whole geometry, its chunk bounds)
+            geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, *how)
             self._centre, self._scale, self._G, self._bounds, N = geometry
             self._N, self._scaled = (self._N, False) if N is None else (N, True)
             self.stats["geometry"] += 1

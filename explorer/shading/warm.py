@@ -25,7 +25,7 @@ import traceback
 
 import numpy as np
 
-from explorer.geometry import bvh
+from explorer.geometry import bvh, raster
 from explorer.geometry.meshes import sphere, torus
 from explorer.shading import tiers
 from explorer.shading.display import to_bytes
@@ -118,6 +118,15 @@ def _pixel_rays() -> None:
     bvh.surface_points(O, D, t, f, u, v, faces, np.asarray(mesh.normals, np.float64))
 
 
+def _gbuffer() -> None:
+    """The live per-pixel view's compiled G-buffer (:func:`explorer.geometry.raster.gbuffer`)
+    of a mesh's read-only arrays, one camera (perspective and parallel take the same
+    signatures)."""
+    mesh = torus(12)
+    cam = [0, 0, 5, 1, 0, 0, 0, 1, 0, 0, 0, -1, 0.5, 0.5, 0.0, 0.0, 1.0, 10.0]
+    raster.gbuffer(mesh.positions, mesh.normals, mesh.faces, cam, True, (16, 12))
+
+
 def _refits() -> None:
     """The shadow rays' per-light refit of the tree (:func:`explorer.geometry.bvh.toward_light`)
     both ways: whole, and split among the threads (``occluders.refit_top``, ``refit`` and
@@ -136,6 +145,7 @@ def exercise() -> int:
     """Run every kind of pass the product makes on the compiled tier; returns the passes."""
     tiers.guard_cache()  # a cache file numba cannot read is set aside and compiled anew
     _pixel_rays()
+    _gbuffer()
     _refits()
     passes = 0
     for P, N, faces in _meshes():

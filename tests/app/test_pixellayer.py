@@ -407,3 +407,43 @@ def test_a_mesh_without_uv_is_drawn_untextured_per_pixel(tmp_path, monkeypatch):
         assert np.abs(after - before).max() > 0  # (the per-pixel picture is drawn)
     finally:
         view.plotter.close()
+
+
+def test_a_minus_b_per_pixel_is_the_difference_of_the_two_per_pixel_pictures(tmp_path, monkeypatch):
+    """Both sides per pixel (a coarse sphere, B the same material under the other model): A − B
+    draws, at every free pixel, the heat map of the difference of the two ``render
+    --per-pixel`` pictures, not the per-vertex colours' difference (the map per vertex
+    differs), and B's picture again when turned off."""
+    pane = Pane()
+    args = ("--preset", "glossy_plastic", "--resolution", "8")
+    view = make_port("sphere", tmp_path, monkeypatch, *args, side_b=pane)
+    try:
+        c, b = view.controller, view.side_b
+        c.act(M.set_compare, True)
+        c.act(M.set_compare_difference, True)
+        picture(view)
+        vertex_map = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+        c.set_value("shading", "per-pixel")
+        picture(view)
+        shown = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+        s = c.state
+        assert s.scene.shading == M.side_b(s).scene.shading == "per-pixel"
+        kw = {"camera": s.camera, "background": BACKGROUND}
+        pa = render_per_pixel(s.shown_scene(), view.view.mesh, SIZE, **kw)
+        pb = render_per_pixel(M.side_b(s).shown_scene(), view.view.mesh, SIZE, **kw)
+        mask = pa.mask & pb.mask
+        d = np.abs(pa.rgb.astype(int) - pb.rgb.astype(int)).max(axis=2)
+        want = heat_map(np.where(mask, d, 0), mask, vmax=VMAX)
+        free = interior(mask) & ~overlays(view)
+        free[:60] = False  # (the captions)
+        assert free.sum() > 5000 and d[free].max() > 10  # the models differ in the highlight
+        assert np.abs(shown[free] - want[free]).max() == 0  # the map, texel for pixel
+        assert np.count_nonzero(np.abs(vertex_map[free] - want[free]).max(axis=1) > 8) > 200
+        c.act(M.set_compare_difference, False)
+        picture(view)
+        shown = b.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+        assert np.abs(shown[free] - pb.rgb[free].astype(int)).max() <= 1  # B's picture again
+    finally:
+        view.plotter.close()
+        for pl in pane.plotters:
+            pl.close()

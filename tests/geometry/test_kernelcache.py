@@ -192,3 +192,17 @@ def test_the_marker_key_follows_contents_not_modification_times(tmp_path, monkey
     assert tiers.marker_key() == key
     (tmp_path / "pkg" / "vmath.py").write_text("X = 'edited'\n")
     assert tiers.marker_key() != key
+
+
+@pytest.mark.parametrize(("given", "want"), [(None, "PASSIVE"), ("ACTIVE", "ACTIVE")])
+def test_the_engine_s_openmp_threads_wait_asleep_unless_told_otherwise(given, want):
+    """A process that loads the kernels has OMP_WAIT_POLICY=PASSIVE before numba starts its
+    OpenMP threads (docs/perpixel_bench.md: spinning threads cost a loaded machine's camera
+    frame twice its CPU); a user's own setting stays."""
+    env = {k: v for k, v in os.environ.items() if k != "OMP_WAIT_POLICY"}
+    if given is not None:
+        env["OMP_WAIT_POLICY"] = given
+    code = "import os, explorer.shading.kernels; print(os.environ.get('OMP_WAIT_POLICY'))"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == want
