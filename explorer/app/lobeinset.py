@@ -6,8 +6,9 @@ The state's ``lobes`` turns it into a plot of several lobes (:mod:`explorer.anal
 ``models`` the three models' for the material, ``lights`` the scene's for each light, ``sides``
 A's and B's of the compare view; each in its colour, named in the legend under the caption;
 ``lobe_view`` polar or cartesian, ``lobe_quantity`` intensity, brdf or albedo, ``lobe_log`` and
-``lobe_ndl`` (× N·L): the panel model's rows (:data:`ROWS`' actions here). VTK is imported
-inside the functions."""
+``lobe_ndl`` (× N·L): the panel model's rows (:data:`ROWS`' actions here). Beside the plot,
+the lit sphere (:mod:`explorer.app.litsphere`): the material at the plot's incidence, which a
+drag on it sets (``lobe_incidence``). VTK is imported inside the functions."""
 
 from __future__ import annotations
 
@@ -17,8 +18,10 @@ import numpy as np
 
 from explorer.analysis import lobe
 from explorer.analysis import lobes as many
+from explorer.app.litsphere import LitSphere
 from explorer.app.model import State, handle_point
 from explorer.app.overlay import overlay, set_lines, set_triangles
+from explorer.core.controls import CONTROLS
 from explorer.core.errors import ExplorerError
 from explorer.shading.effects.energy import specular_scale
 
@@ -59,6 +62,19 @@ def set_lobe_option(state: State, name: str, value) -> State:
     else:
         raise ExplorerError(f"no lobe option named {name!r}")
     return state.replace(**{name: value})
+
+
+def set_lobe_incidence(state: State, degrees) -> State:
+    """The lobe plot's incidence θ_i in degrees (the lit sphere's drag; the range of
+    :data:`explorer.core.controls.CONTROLS`' ``lobe_incidence``), or None: the selected
+    light's."""
+    if degrees is not None:
+        c = CONTROLS["lobe_incidence"]
+        if not isinstance(degrees, (int, float)) or not c.lo <= degrees <= c.hi:
+            raise ExplorerError(f"lobe_incidence must be a number from {c.lo:g} to {c.hi:g}"
+                                f" degrees, or off, got {degrees!r}")  # fmt: skip
+        degrees = float(degrees)
+    return state.replace(lobe_incidence=degrees)
 
 
 def lobe_set(state: State) -> list:
@@ -128,9 +144,13 @@ class LobeInset:
             self.actors.append(t)
         self._key = None
         self.box = None
+        self._peak = None  # the one lobe's point farthest from the plot's origin (pixels)
+        self._side = 0  # the plot's part of the panel (the sphere's is beside it)
         self._curves: list = []  # (polydata, actor) of the several lobes' curves, one a colour
         self._legend: list = []  # their legend's text actors
         self.chart = None  # the plot of several lobes shown, or None
+        self.sphere = LitSphere(self.plotter, LOBE_PANEL_COLOR)  # beside the plot
+        self.actors += self.sphere.actors
         self.layout(state)
 
     def layout(self, state: State) -> None:
@@ -139,20 +159,25 @@ class LobeInset:
         w, h = self.plotter.window_size
         lo, hi = LOBE_SIDE
         side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi, max(w - 2 * LOBE_MARGIN, 40)))
-        if self.box is not None and self.box[2] == side:
+        if self.box is not None and self._side == side:
             return
+        self._side = side
         font = self._font = 13 if side >= 170 else 11
         t = self.caption
         text = 2 * (font + 4)
         plot_h = side // 2
         height = plot_h + 3 * LOBE_PAD + text
         x0 = y0 = LOBE_MARGIN
-        self.box = (x0, y0, side, height)  # display pixels, origin bottom-left
+        ball = plot_h - LOBE_PAD  # the lit sphere's side, right of the plot
+        self.sphere.place(x0 + side, y0 + LOBE_PAD, ball)
+        side_all = side + ball + LOBE_PAD
+        self.box = (x0, y0, side_all, height)  # display pixels, origin bottom-left
         self._plot_box = (x0 + LOBE_PAD, y0 + LOBE_PAD, side - 2 * LOBE_PAD, plot_h - LOBE_PAD)
         t.SetPosition(x0 + LOBE_PAD, y0 + height - LOBE_PAD)
         for key in ("L", "R"):
             self._labels[key].GetTextProperty().SetFontSize(max(font - 1, 8))
-        corners = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + height), (x0, y0 + height)]
+        corners = [(x0, y0), (x0 + side_all, y0), (x0 + side_all, y0 + height),
+                   (x0, y0 + height)]  # fmt: skip
         set_triangles(self._polys["panel"], [corners[:3], [corners[0], *corners[2:]]],
                        [LOBE_PANEL_COLOR] * 2)  # fmt: skip
         self._key = None
@@ -165,7 +190,9 @@ class LobeInset:
         scene = state.shown_scene()
         m = scene.material
         _, kd, ks = m.scalars()
-        theta = None if light is None else lobe_incidence(state)
+        set_by_sphere = state.lobe_incidence is not None
+        theta = None if light is None and not set_by_sphere else lobe_incidence(state)
+        self.sphere.update(scene, theta)
         model, n = scene.model, m.shininess
         effects = {"fresnel": None if model == "threejs" else m.fresnel,
                    "energy": specular_scale(scene)}  # fmt: skip
@@ -193,6 +220,7 @@ class LobeInset:
         ox = x + 0.5 * w
         lines = {"frame": [frame, [(x, y), (x + w, y)], [(ox, y), (ox, y + 4)]]}
         label = lobe.MODEL_LABELS[model]
+        self._peak = None  # the lobe's point farthest from the plot's origin (pixels)
         if theta is None:
             lines.update(diffuse=[], incident=[], mirror=[], lobe=[])
             self.caption.SetInput(f"{label}\nno light, n = {n:g}")
@@ -210,6 +238,8 @@ class LobeInset:
                 mirror=dashes if plot.lit else [],
                 lobe=[lobe.to_box(plot.lobe, box)] if len(plot.lobe) else [],
             )
+            self._peak = lines["lobe"][0][np.argmax(np.hypot(*(plot.lobe.T)))] if len(
+                plot.lobe) else None  # fmt: skip
             for key, end, shown, away in (("L", ray_l[1], plot.lit, -9.0),
                                           ("R", ray_r[1], plot.lit, 9.0)):  # fmt: skip
                 lx = min(max(end[0] + away, x + 6), x + w - 6)
@@ -314,6 +344,21 @@ class LobeInset:
             )
         return {"title": self.chart.title, "curves": out}
 
+    def sphere_report(self) -> dict | None:
+        """What a test of a front end reads of the lit sphere (:meth:`LitSphere.report`) and
+        of the one lobe's plot: its origin and the lobe's farthest point (its peak) in window
+        pixels (origin top-left; None while no lobe is drawn)."""
+        rep = self.sphere.report()
+        if rep is None:
+            return None
+        _, h = self.plotter.window_size
+        x, y, w, _ = self._plot_box
+        peak = self._peak
+        rep["origin"] = [x + 0.5 * w, h - 1 - y]
+        rep["peak"] = None if peak is None or self.chart is not None else [
+            float(peak[0]), h - 1 - float(peak[1])]  # fmt: skip
+        return rep
+
     def _hide_many(self) -> None:
         self.chart = None
         for poly, _ in self._curves:
@@ -339,7 +384,10 @@ class LobeInset:
 def lobe_incidence(state: State) -> float:
     """theta_i (radians) of the selected light at the mesh's point that faces the viewer: the
     angle between the directions from the mesh centre toward the viewer and toward the light's
-    handle (:func:`explorer.analysis.lobe.incidence`)."""
+    handle (:func:`explorer.analysis.lobe.incidence`); the state's ``lobe_incidence`` instead
+    when the lit sphere (or its row) set one."""
+    if state.lobe_incidence is not None:
+        return math.radians(state.lobe_incidence)
     return _incidence(state, None)
 
 

@@ -694,6 +694,16 @@ def _lobe_rows() -> list[Row]:
             text="× N·L",
             tip="each value times N·L",
         ),
+        Row(
+            "lobe_incidence",
+            "view",
+            "number",
+            lambda s: s.lobe_incidence,
+            lambda s, v: (LI.set_lobe_incidence, (v,)),
+            optional=45.0,
+            tip="the incidence θ_i the lobe plot and its lit sphere show (drag on the sphere); "
+            "off: the selected light's",
+        ),
     ]
 
 

@@ -15,8 +15,9 @@ A session file is YAML (or JSON, which YAML reads too)::
     difference: false
     strip: false               # optional: the term strip under the view (docs/terms.md),
     strip_mode: weighted       #   its tiles: weighted or raw
-    lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false}
-                               # optional: the lobe inset's lobes and plot (docs/terms.md)
+    lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false,
+            incidence: null}   # optional: the lobe inset's lobes and plot (docs/terms.md);
+                               # incidence: the plot's θ_i in degrees (null: the light's)
     local_viewer: true         # optional: the viewer at the camera (false: infinitely far
                                # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
@@ -45,6 +46,7 @@ from platformdirs import user_config_dir
 from explorer.app.model import TERMS, State, check_window_lights
 from explorer.app.start import add_mesh_materials, first_state, load_mesh_choice
 from explorer.core.atomic import write_atomic
+from explorer.core.controls import LOBE_INCIDENCE_RANGE
 from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS, parse_material
 from explorer.core.mtl import MtlError
@@ -106,6 +108,7 @@ def session_mapping(state: State) -> dict:
             "quantity": state.lobe_quantity,
             "log": bool(state.lobe_log),
             "ndl": bool(state.lobe_ndl),
+            "incidence": state.lobe_incidence,
         },
     }
     if state.camera is not None:
@@ -224,7 +227,10 @@ def _lobes(checker, value) -> dict:
     c = checker.mapping(value, path)
     if c is None:
         return {}
-    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl"), required=())
+    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl", "incidence"), required=())
+    incidence = c.get("incidence")
+    if incidence is not None:
+        incidence = checker.number(incidence, (*path, "incidence"), *LOBE_INCIDENCE_RANGE)
     return {
         "lobes": checker.choice(c.get("set", "selected"), (*path, "set"), LOBE_SETS),
         "lobe_view": checker.choice(c.get("view", "polar"), (*path, "view"), VIEWS),
@@ -233,6 +239,7 @@ def _lobes(checker, value) -> dict:
         ),
         "lobe_log": bool(checker.boolean(c.get("log", False), (*path, "log"))),
         "lobe_ndl": bool(checker.boolean(c.get("ndl", False), (*path, "ndl"))),
+        "lobe_incidence": None if incidence is None else float(incidence),
     }
 
 

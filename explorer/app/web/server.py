@@ -332,6 +332,7 @@ class WebExplorer:
             "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
             "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
             "lobes": self.view.lobe.report(),
+            "sphere": self.view.lobe.sphere_report(),
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 
