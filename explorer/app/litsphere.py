@@ -135,12 +135,14 @@ class LitSphere:
 class SphereDrag:
     """A press on the lit sphere of ``window`` (an :class:`explorer.app.viewport.PlotterView`)
     and a drag set the lobe plot's incidence (``lobe_incidence``, through the controller as the
-    panel's row sets it: the drag's steps are one undo step); the camera does not turn. VTK's
-    interactor events, so the window and the page alike."""
+    panel's row sets it: the drag's steps are one undo step); a click on a legend entry of the
+    plot of several lobes shows or hides its lobe. The camera does not turn. VTK's interactor
+    events, so the window and the page alike."""
 
     def __init__(self, window):
         self.window = window
         self.dragging = False
+        self.clicked = False
         iren = window.plotter.iren.interactor
         self._commands = {}
         for event, fn in (("LeftButtonPressEvent", self._press), ("MouseMoveEvent", self._move),
@@ -161,6 +163,8 @@ class SphereDrag:
         self._commands[event].SetAbortFlag(1)
 
     def _press(self, _obj, event) -> None:
+        if self._legend(event):
+            return
         sphere = self._sphere()
         if sphere is None or sphere.box is None or not sphere.actor.GetVisibility():
             return
@@ -171,6 +175,25 @@ class SphereDrag:
         self.dragging = True
         self._set(u, v)
 
+    def _legend(self, event) -> bool:
+        """A press on a legend entry of the inset's plot of several lobes: its lobe shown or
+        hidden (its ``show_lobe_<i>`` row; one undo step); True when it was one."""
+        view = self.window.view
+        i = None if view is None else view.lobe.legend_at(*self._pointer())
+        if i is None:
+            return False
+        from explorer.app import lobeinset as LI  # (it draws this module's sphere)
+
+        self._take(event)
+        self.clicked = True
+        c = self.window.controller
+        show = i in c.state.lobe_hidden
+        if i < LI.LOBE_ROWS:
+            c.set_value(f"show_lobe_{i + 1}", show, merge=False)
+        else:
+            c.act(LI.set_lobe_shown, i, show, label=f"lobe {i + 1}")
+        return True
+
     def _move(self, _obj, event) -> None:
         if not self.dragging:
             return
@@ -178,6 +201,10 @@ class SphereDrag:
         self._set(*self._sphere().disc_point(*self._pointer()))
 
     def _release(self, _obj, event) -> None:
+        if self.clicked:  # (the legend's press was ours: its release too)
+            self.clicked = False
+            self._take(event)
+            return
         if not self.dragging:
             return
         self._take(event)

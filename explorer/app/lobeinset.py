@@ -13,6 +13,7 @@ drag on it sets (``lobe_incidence``). VTK is imported inside the functions."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -47,6 +48,11 @@ INSET_NODES = (24, 24)
 LATIN = {"ρ": "rho", "θ": "theta"}
 #: the legend's font size (pixels)
 LEGEND_FONT = 10
+#: a hidden lobe's legend entry (its lobe not drawn; a click on it shows it again)
+LEGEND_HIDDEN_COLOR = (0.6, 0.6, 0.6)
+#: the lobes the panel has a ``show_lobe_<i>`` row for (the first ones of the set; every
+#: legend entry drawn toggles its lobe by a click)
+LOBE_ROWS = 8
 
 
 def set_lobe_option(state: State, name: str, value) -> State:
@@ -77,7 +83,24 @@ def set_lobe_incidence(state: State, degrees) -> State:
     return state.replace(lobe_incidence=degrees)
 
 
+def set_lobe_shown(state: State, index: int, on: bool) -> State:
+    """Lobe ``index`` (0-based, in the set the state's ``lobes`` asks for) drawn or not (its
+    legend entry stays, greyed)."""
+    if not isinstance(index, int) or index < 0:
+        raise ExplorerError(f"a lobe's index must be a whole number from 0, got {index!r}")
+    hidden = set(state.lobe_hidden)
+    (hidden.discard if on else hidden.add)(index)
+    return state.replace(lobe_hidden=frozenset(hidden))
+
+
 def lobe_set(state: State) -> list:
+    """The lobes of :func:`lobe_set_all`, those the state hides (``lobe_hidden``) with
+    ``visible`` off."""
+    return [lb if i not in state.lobe_hidden else replace(lb, visible=False)
+            for i, lb in enumerate(lobe_set_all(state))]  # fmt: skip
+
+
+def lobe_set_all(state: State) -> list:
     """The lobes the state's ``lobes`` asks for (:class:`explorer.analysis.lobes.Lobe`), each in
     its colour: the three models', each light's, or sides A and B (B while it is shown)."""
     scene = state.shown_scene()
@@ -319,9 +342,9 @@ class LobeInset:
         x, y, _, h = self._plot_box
         for i, t in enumerate(self._legend):
             if i < len(entries):
-                label, colour, _ = entries[i]
+                label, colour, shown = entries[i]
                 t.SetInput(label)
-                t.GetTextProperty().SetColor(*colour)
+                t.GetTextProperty().SetColor(*(colour if shown else LEGEND_HIDDEN_COLOR))
                 t.SetPosition(x + 3, y + h - 2 - i * (LEGEND_FONT + 2))
             t.SetVisibility(i < len(entries))
 
@@ -342,7 +365,10 @@ class LobeInset:
                     "px": [[int(round(x)), int(round(h - 1 - y))] for x, y in px[pick]],
                 }
             )
-        return {"title": self.chart.title, "curves": out}
+        legend = [[round(x), round(h - y - bh), round(bw), round(bh)]
+                  for x, y, bw, bh in self.legend_boxes()]  # fmt: skip
+        shown = [bool(v) for _, _, v in self.chart.legend]
+        return {"title": self.chart.title, "curves": out, "legend": legend, "shown": shown}
 
     def sphere_report(self) -> dict | None:
         """What a test of a front end reads of the lit sphere (:meth:`LitSphere.report`) and
@@ -358,6 +384,27 @@ class LobeInset:
         rep["peak"] = None if peak is None or self.chart is not None else [
             float(peak[0]), h - 1 - float(peak[1])]  # fmt: skip
         return rep
+
+    def legend_at(self, px: float, py: float) -> int | None:
+        """The legend entry (its lobe's index) at display pixel ``(px, py)`` (origin
+        bottom-left), or None."""
+        if self.chart is None:
+            return None
+        for i, (x, y, w, h) in enumerate(self.legend_boxes()):
+            if x <= px <= x + w and y <= py <= y + h:
+                return i
+        return None
+
+    def legend_boxes(self) -> list:
+        """Each legend entry's box ``(x, y, width, height)`` in display pixels (origin
+        bottom-left): the line of its text, as wide as the text."""
+        out = []
+        for t in self._legend[: len(self.chart.legend) if self.chart is not None else 0]:
+            extent = [0.0, 0.0]
+            t.GetSize(self.plotter.renderer, extent)
+            x, top = t.GetPosition()
+            out.append((x, top - (LEGEND_FONT + 2), max(extent[0], 12.0), LEGEND_FONT + 2))
+        return out
 
     def _hide_many(self) -> None:
         self.chart = None

@@ -694,6 +694,22 @@ def _lobe_rows() -> list[Row]:
             text="× N·L",
             tip="each value times N·L",
         ),
+        *(
+            Row(
+                f"show_lobe_{i + 1}",
+                "view",
+                "toggle",
+                lambda s, i=i: i not in s.lobe_hidden,
+                lambda s, v, i=i: (LI.set_lobe_shown, (i, bool(v))),
+                visible=lambda s, i=i: several(s) and i < len(LI.lobe_set_all(s)),
+                group="lobe_shown",
+                label=f"lobe {i + 1}",
+                text=f"lobe {i + 1}",
+                tip=f"draw lobe {i + 1} of the inset's plot (the legend's line {i + 1}; a click "
+                "on it there does the same)",
+            )
+            for i in range(LI.LOBE_ROWS)
+        ),
         Row(
             "lobe_incidence",
             "view",

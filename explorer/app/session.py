@@ -16,8 +16,10 @@ A session file is YAML (or JSON, which YAML reads too)::
     strip: false               # optional: the term strip under the view (docs/terms.md),
     strip_mode: weighted       #   its tiles: weighted or raw
     lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false,
-            incidence: null}   # optional: the lobe inset's lobes and plot (docs/terms.md);
-                               # incidence: the plot's θ_i in degrees (null: the light's)
+            incidence: null, hidden: []}
+                               # optional: the lobe inset's lobes and plot (docs/terms.md);
+                               # incidence: the plot's θ_i in degrees (null: the light's);
+                               # hidden: the lobes not drawn (1 is the set's first)
     local_viewer: true         # optional: the viewer at the camera (false: infinitely far
                                # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
@@ -109,6 +111,7 @@ def session_mapping(state: State) -> dict:
             "log": bool(state.lobe_log),
             "ndl": bool(state.lobe_ndl),
             "incidence": state.lobe_incidence,
+            "hidden": sorted(i + 1 for i in state.lobe_hidden),
         },
     }
     if state.camera is not None:
@@ -227,7 +230,14 @@ def _lobes(checker, value) -> dict:
     c = checker.mapping(value, path)
     if c is None:
         return {}
-    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl", "incidence"), required=())
+    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl", "incidence", "hidden"),
+                   required=())  # fmt: skip
+    hidden = c.get("hidden", [])
+    if not isinstance(hidden, list) or any(
+        isinstance(i, bool) or not isinstance(i, int) or i < 1 for i in hidden
+    ):
+        checker.problem((*path, "hidden"), f"must be a list of whole numbers >= 1, got {hidden!r}")
+        hidden = []
     incidence = c.get("incidence")
     if incidence is not None:
         incidence = checker.number(incidence, (*path, "incidence"), *LOBE_INCIDENCE_RANGE)
@@ -240,6 +250,7 @@ def _lobes(checker, value) -> dict:
         "lobe_log": bool(checker.boolean(c.get("log", False), (*path, "log"))),
         "lobe_ndl": bool(checker.boolean(c.get("ndl", False), (*path, "ndl"))),
         "lobe_incidence": None if incidence is None else float(incidence),
+        "lobe_hidden": frozenset(i - 1 for i in hidden),
     }
 
 

@@ -109,3 +109,59 @@ def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(open_w
     assert w.controller.state.lobe_incidence is None
     assert lobe.sphere_report()["theta"] == pytest.approx(t0)
     w.grab().save(str(tmp_path / "window_litsphere.png"))
+
+
+def _hits(img, curve) -> int:
+    """How many of ``curve``'s reported points have a pixel of its colour within one pixel."""
+    n = 0
+    for x, y in curve["px"]:
+        patch = img[max(y - 1, 0) : y + 2, max(x - 1, 0) : x + 2].reshape(-1, 3)
+        n += bool((np.abs(patch - curve["colour"]) <= 1).all(axis=1).any())
+    return n
+
+
+def _near(patch, colour, within: int = 40) -> int:
+    """How many pixels of ``patch`` (h, w, 3) lie within ``within`` levels of ``colour``."""
+    return int((np.abs(patch.reshape(-1, 3) - colour) <= within).all(axis=1).sum())
+
+
+def test_a_lobe_is_hidden_from_its_row_and_shown_again_by_a_click_on_its_legend(open_window):
+    """The three models' lobes: ``show_lobe_3`` off, three.js's curve leaves the window's
+    pixels and its legend entry turns grey; a real click on that entry draws it again (the
+    camera unturned)."""
+    from explorer.app import lobeinset as LI
+
+    w = open_window("--mesh", "sphere", "--preset", "chrome")
+    combo = w.findChild(QtWidgets.QComboBox, "lobes")
+    combo.setCurrentIndex(combo.findText("models"))
+    combo.activated.emit(combo.currentIndex())  # (what a pick in the list sends)
+    pl = w.plotter
+    rep = w.view.lobe.report()
+    three = rep["curves"][-1]
+    assert three["label"].startswith("three.js") and rep["shown"] == [True] * 3
+    img = _pixels(pl)
+    assert _hits(img, three) >= 0.9 * len(three["px"])
+    x, y, bw, bh = rep["legend"][2]
+    assert _near(img[y : y + bh, x : x + bw], three["colour"]) >= 5  # its text in its colour
+    box = w.findChild(QtWidgets.QCheckBox, "show_lobe_3")
+    assert box is not None and box.isChecked()
+    box.click()
+    assert w.controller.state.lobe_hidden == frozenset({2})
+    img = _pixels(pl)
+    assert _hits(img, three) <= 0.2 * len(three["px"])
+    rep = w.view.lobe.report()
+    assert rep["shown"] == [True, True, False] and len(rep["curves"]) == 2
+    assert rep["legend"][2] == [x, y, bw, bh]
+    entry = img[y : y + bh, x : x + bw]
+    assert _near(entry, three["colour"]) == 0  # its text grey now
+    frame = np.rint(np.asarray(LI.LOBE_FRAME_COLOR) * 255)
+    text = ((entry.max(axis=2) > 60) & (np.ptp(entry, axis=2) <= 6)
+            & (np.abs(entry - frame).max(axis=2) > 6))  # fmt: skip
+    assert text.sum() >= 5
+    camera = w.controller.state.camera
+    Type, left = QtCore.QEvent.Type, QtCore.Qt.MouseButton.LeftButton
+    _mouse(pl, Type.MouseButtonPress, x + bw // 2, y + bh // 2, left)
+    _mouse(pl, Type.MouseButtonRelease, x + bw // 2, y + bh // 2, QtCore.Qt.MouseButton.NoButton)
+    assert w.controller.state.lobe_hidden == frozenset() and box.isChecked()
+    assert w.controller.state.camera == camera
+    assert _hits(_pixels(pl), three) >= 0.9 * len(three["px"])

@@ -88,7 +88,7 @@ def _settled(browser, check):
         if got[0] and report(browser) == rep:
             return rep
         if time.monotonic() > end:
-            pytest.fail(f"the page's sphere or plot did not show the engine's: {got}")
+            pytest.fail(f"the page's pixels did not show it: {got}")
         time.sleep(0.1)
 
 
@@ -126,4 +126,57 @@ def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(server
     browser.save_screenshot(str(tmp_path / "web_litsphere.png"))
     click(browser, "undo")
     wait("undo", lambda: report(browser)["session"]["lobes"]["incidence"] is None)
+    assert not console_errors(browser)
+
+
+def _curve_hits(img, rep, index: int) -> int:
+    """How many of curve ``index``'s points (as reported while it was drawn) have, within one
+    pixel, a pixel whose colour lies nearest its colour of the curves' and the panel's."""
+    from explorer.app.lobeinset import LOBE_FRAME_COLOR, LOBE_PANEL_COLOR
+
+    curves = rep["lobes"]["curves"]
+    classes = np.array([c["colour"] for c in curves]
+                       + to_bytes([LOBE_PANEL_COLOR, LOBE_FRAME_COLOR]).tolist())  # fmt: skip
+    n = 0
+    for px, py in curves[index]["px"]:
+        patch = img[max(py - 1, 0) : py + 2, max(px - 1, 0) : px + 2].reshape(-1, 3)
+        nearest = np.argmin(np.abs(patch[:, None, :] - classes[None]).sum(axis=2), axis=1)
+        n += bool((nearest == index).any())
+    return n
+
+
+def test_a_lobe_is_hidden_from_its_row_and_shown_again_by_a_click_on_its_legend(server, browser):
+    """The three models' lobes: the page's ``show_lobe_3`` check box off, three.js's curve
+    leaves the page's pixels; a click on its legend entry in the view draws it again."""
+    from test_web import choose
+
+    open_page(browser, server.url)
+    click(browser, "view tab")
+    choose(browser, "lobes", "models")
+    drawn = wait("three lobes", lambda: (r := report(browser))["lobes"] and r)
+    k = len(drawn["lobes"]["curves"][2]["px"])
+
+    def hits(img, q):
+        return (True, _curve_hits(img, drawn, 2))
+
+    def shown(img, q):
+        n = hits(img, q)[1]
+        return (n >= 0.8 * k and q["session"]["lobes"]["hidden"] == [], n)
+
+    _settled(browser, shown)
+    click(browser, "show_lobe_3")
+
+    def hidden(img, q):
+        n = hits(img, q)[1]
+        return (n <= 0.2 * k and q["session"]["lobes"]["hidden"] == [3], n)
+
+    rep = _settled(browser, hidden)
+    assert rep["lobes"]["shown"] == [True, True, False]
+    x, y, bw, bh = rep["lobes"]["legend"][2]
+    camera = rep["session"]["camera"]
+    drag(browser, (x + bw // 2, y + bh // 2), [])  # (a press and a release: a click)
+    rep = _settled(browser, shown)
+    assert rep["session"]["camera"] == camera  # the click was the legend's
+    choose(browser, "lobes", "selected")
+    wait("one lobe", lambda: report(browser)["lobes"] is None)
     assert not console_errors(browser)
