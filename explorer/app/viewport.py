@@ -225,6 +225,9 @@ class PlotterView:
             self._t0 = time.perf_counter()
         was = self.pixels.fallback
         self.pixels.before(self.controller.state)
+        state = self.controller.state  # the term strip's tiles per pixel as the view is drawn
+        per_pixel = self.pixels.wanted(state) and not self.pixels.fallback
+        self.view.strip.before_pixels(state, per_pixel, self.view.mesh)
         if self.side_b is not None:  # (side B's work is not side A's frame time)
             t0 = time.perf_counter()
             self.side_b.before_a_frame(self.controller.state)

@@ -73,3 +73,68 @@ def test_the_inset_plots_the_three_models_lobes_from_the_panel(open_window, tmp_
         hits += bool((np.abs(patch - last["colour"]) <= 1).all(axis=1).any())
     assert hits >= 0.9 * len(last["px"])
     w.grab().save(str(tmp_path / "window_lobes.png"))
+
+
+#: the rows at a tile's bottom its label may cover (pixels)
+LABEL_ROWS = 20
+
+
+def test_per_pixel_the_tiles_are_the_per_pixel_terms_and_the_sum_tile_the_picture(
+    open_window, tmp_path
+):
+    """With the view lit per pixel, each tile is a per-pixel picture at the tile's size and
+    the view's camera: the window's sum tile is ``render --per-pixel``'s picture there bit for
+    bit, and the diffuse tile the per-pixel shader's diffuse term (its kept sums recomposed)."""
+    from explorer.app import model as M
+    from explorer.app.view import view_camera
+    from explorer.render.live import LivePixels, picture
+    from explorer.shading.display import to_bytes
+    from explorer.shading.strip import compose_strip
+
+    w = open_window("--mesh", "torus", "--preset", "glossy_plastic", "--per-pixel")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    img = _pixels(w.plotter)
+    strip = w.view.strip
+    assert strip.pixel_tiles is not None and strip.report((0, 0, 0))["per_pixel"]
+    state = w.controller.state
+    camera = view_camera(w.plotter.camera, state.centre, state.radius)
+    scene = M.set_camera(state, camera).shown_scene()
+    bg = tuple(w.plotter.renderer.GetBackground())
+    x, y, tw, th = strip.tile_box("sum")
+    ref = picture(scene, w.view.mesh, (tw, th), camera=camera, background=bg).rgb
+    rows = slice(0, th - LABEL_ROWS)
+    assert (ref != to_bytes([bg])[0]).any(axis=2).mean() > 0.1  # the mesh fills the tile
+    assert np.array_equal(img[y : y + th, x : x + tw][rows], ref[rows])
+    with LivePixels(w.view.mesh) as live:
+        live.frame(scene, camera, (tw, th), background=bg)
+        g, _ = live.gbuffer(camera, (tw, th))
+        terms = compose_strip(scene, live.shader.terms, live.shader.colors, "weighted")
+        want = np.array(ref)
+        want.reshape(-1, 3)[g.pixels] = to_bytes(terms.tiles["diffuse"])
+    x, y, tw, th = strip.tile_box("diffuse")
+    assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
+    # the main view above the strip: the per-pixel picture of its own part of the window
+    from helpers.probes import interior
+    from test_window_pixels import rings
+
+    from explorer.render.perpixel import reference
+
+    x0, y0 = (int(v) for v in w.plotter.renderer.GetOrigin())
+    vw, vh = (int(v) for v in w.plotter.renderer.GetSize())
+    assert y0 > 0 and vh < w.plotter.window_size[1]  # (the strip under it)
+    ref = reference(scene, w.view.mesh, (vw, vh), camera=camera)
+    H = w.plotter.window_size[1]
+    got = img[H - y0 - vh : H - y0, x0 : x0 + vw]
+    d = np.abs(got - ref.image(bg).astype(int)).max(axis=2)
+    W = w.plotter.window_size[0]
+    free = interior(ref.mask) & ~rings(w.view, (W, H))[H - y0 - vh : H - y0, x0 : x0 + vw]
+    lx, ly, lw, lh = w.view.lobe.box  # (the inset, above the strip's band)
+    free[vh - (ly + lh - y0) - 2 :, : lx + lw + 3] = False
+    assert free.sum() > 5000 and d[free].max() <= 1
+    w.grab().save(str(tmp_path / "window_strip_per_pixel.png"))
+    # per vertex again: the tiles draw the mesh, the pictures gone
+    w.controller.set_value("shading", "per-vertex")
+    _pixels(w.plotter)
+    assert strip.pixel_tiles is None and not strip.report((0, 0, 0))["per_pixel"]
