@@ -23,8 +23,9 @@ from explorer.core.scene import Viewer
 from explorer.shading.display import display_colors, to_bytes
 
 #: the light's colour: a white light of colour 1, the lobe plot's unit light
-SPHERE_LIGHT = DirectionalLight(ambient=(0.0, 0.0, 0.0), diffuse=(1.0, 1.0, 1.0),
-                                specular=(1.0, 1.0, 1.0))  # fmt: skip
+SPHERE_LIGHT = DirectionalLight(
+    ambient=(0.0, 0.0, 0.0), diffuse=(1.0, 1.0, 1.0), specular=(1.0, 1.0, 1.0)
+)
 
 
 def to_light(theta_i: float) -> tuple[float, float, float]:

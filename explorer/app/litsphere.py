@@ -145,8 +145,11 @@ class SphereDrag:
         self.clicked = False
         iren = window.plotter.iren.interactor
         self._commands = {}
-        for event, fn in (("LeftButtonPressEvent", self._press), ("MouseMoveEvent", self._move),
-                          ("LeftButtonReleaseEvent", self._release)):  # fmt: skip
+        for event, fn in (
+            ("LeftButtonPressEvent", self._press),
+            ("MouseMoveEvent", self._move),
+            ("LeftButtonReleaseEvent", self._release),
+        ):
             tag = iren.AddObserver(event, window.guard(fn, "lit sphere"), PRIORITY)
             self._commands[event] = iren.GetCommand(tag)
 

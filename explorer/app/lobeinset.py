@@ -77,8 +77,10 @@ def set_lobe_incidence(state: State, degrees) -> State:
     if degrees is not None:
         c = CONTROLS["lobe_incidence"]
         if not isinstance(degrees, (int, float)) or not c.lo <= degrees <= c.hi:
-            raise ExplorerError(f"lobe_incidence must be a number from {c.lo:g} to {c.hi:g}"
-                                f" degrees, or off, got {degrees!r}")  # fmt: skip
+            raise ExplorerError(
+                f"lobe_incidence must be a number from {c.lo:g} to {c.hi:g}"
+                f" degrees, or off, got {degrees!r}"
+            )
         degrees = float(degrees)
     return state.replace(lobe_incidence=degrees)
 
@@ -96,8 +98,10 @@ def set_lobe_shown(state: State, index: int, on: bool) -> State:
 def lobe_set(state: State) -> list:
     """The lobes of :func:`lobe_set_all`, those the state hides (``lobe_hidden``) with
     ``visible`` off."""
-    return [lb if i not in state.lobe_hidden else replace(lb, visible=False)
-            for i, lb in enumerate(lobe_set_all(state))]  # fmt: skip
+    return [
+        lb if i not in state.lobe_hidden else replace(lb, visible=False)
+        for i, lb in enumerate(lobe_set_all(state))
+    ]
 
 
 def lobe_set_all(state: State) -> list:
@@ -199,8 +203,7 @@ class LobeInset:
         t.SetPosition(x0 + LOBE_PAD, y0 + height - LOBE_PAD)
         for key in ("L", "R"):
             self._labels[key].GetTextProperty().SetFontSize(max(font - 1, 8))
-        corners = [(x0, y0), (x0 + side_all, y0), (x0 + side_all, y0 + height),
-                   (x0, y0 + height)]  # fmt: skip
+        corners = [(x0, y0), (x0 + side_all, y0), (x0 + side_all, y0 + height), (x0, y0 + height)]
         set_triangles(self._polys["panel"], [corners[:3], [corners[0], *corners[2:]]],
                        [LOBE_PANEL_COLOR] * 2)  # fmt: skip
         self._key = None
@@ -261,8 +264,9 @@ class LobeInset:
                 mirror=dashes if plot.lit else [],
                 lobe=[lobe.to_box(plot.lobe, box)] if len(plot.lobe) else [],
             )
-            self._peak = lines["lobe"][0][np.argmax(np.hypot(*(plot.lobe.T)))] if len(
-                plot.lobe) else None  # fmt: skip
+            self._peak = (
+                lines["lobe"][0][np.argmax(np.hypot(*(plot.lobe.T)))] if len(plot.lobe) else None
+            )
             for key, end, shown, away in (("L", ray_l[1], plot.lit, -9.0),
                                           ("R", ray_r[1], plot.lit, 9.0)):  # fmt: skip
                 lx = min(max(end[0] + away, x + 6), x + w - 6)
@@ -365,8 +369,10 @@ class LobeInset:
                     "px": [[int(round(x)), int(round(h - 1 - y))] for x, y in px[pick]],
                 }
             )
-        legend = [[round(x), round(h - y - bh), round(bw), round(bh)]
-                  for x, y, bw, bh in self.legend_boxes()]  # fmt: skip
+        legend = [
+            [round(x), round(h - y - bh), round(bw), round(bh)]
+            for x, y, bw, bh in self.legend_boxes()
+        ]
         shown = [bool(v) for _, _, v in self.chart.legend]
         return {"title": self.chart.title, "curves": out, "legend": legend, "shown": shown}
 
@@ -381,8 +387,11 @@ class LobeInset:
         x, y, w, _ = self._plot_box
         peak = self._peak
         rep["origin"] = [x + 0.5 * w, h - 1 - y]
-        rep["peak"] = None if peak is None or self.chart is not None else [
-            float(peak[0]), h - 1 - float(peak[1])]  # fmt: skip
+        rep["peak"] = (
+            None
+            if peak is None or self.chart is not None
+            else [float(peak[0]), h - 1 - float(peak[1])]
+        )
         return rep
 
     def legend_at(self, px: float, py: float) -> int | None:

@@ -163,8 +163,14 @@ class PixelLayer:
         # the main renderer's own size: the term strip under it takes the window's bottom
         w, h = (int(v) for v in self.plotter.renderer.GetSize())
         mesh = self.view.mesh
-        key = (repr(scene), repr(groups), camera, (w, h), id(mesh),
-               tuple(self.plotter.renderer.GetOrigin()))  # fmt: skip
+        key = (
+            repr(scene),
+            repr(groups),
+            camera,
+            (w, h),
+            id(mesh),
+            tuple(self.plotter.renderer.GetOrigin()),
+        )
         if key != self._key:
             t0 = time.perf_counter()
             frame = self._live_for(mesh).frame(scene, camera, (w, h), materials=groups)

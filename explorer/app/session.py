@@ -230,8 +230,9 @@ def _lobes(checker, value) -> dict:
     c = checker.mapping(value, path)
     if c is None:
         return {}
-    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl", "incidence", "hidden"),
-                   required=())  # fmt: skip
+    checker.keys(
+        c, path, ("set", "view", "quantity", "log", "ndl", "incidence", "hidden"), required=()
+    )
     hidden = c.get("hidden", [])
     if not isinstance(hidden, list) or any(
         isinstance(i, bool) or not isinstance(i, int) or i < 1 for i in hidden

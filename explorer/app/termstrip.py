@@ -107,7 +107,7 @@ class TermStrip:
         if not (self.on and state.strip and per_pixel):
             self._show_pictures(False)
             return
-        from explorer.app.view import view_camera
+        from explorer.app.view import view_camera  # (a cycle: the view holds the strip)
 
         camera = view_camera(self.plotter.camera, state.centre, state.radius)
         scene = M.set_camera(state, camera).shown_scene()
@@ -218,9 +218,12 @@ class TermStrip:
         if not self.on:
             return None
         share = float(self.overflow.mean()) if self.overflow is not None else 0.0
-        return {"px": {c: self.tile_pixel(c, point) for c in COLUMNS}, "overflow": share,
-                "boxes": {c: self.tile_box(c) for c in COLUMNS},
-                "per_pixel": self.pixel_tiles is not None}  # fmt: skip
+        return {
+            "px": {c: self.tile_pixel(c, point) for c in COLUMNS},
+            "overflow": share,
+            "boxes": {c: self.tile_box(c) for c in COLUMNS},
+            "per_pixel": self.pixel_tiles is not None,
+        }
 
     def _switch(self, on: bool) -> None:
         """Make room for the tiles (or give it back), creating them the first time."""

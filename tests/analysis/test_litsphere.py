@@ -17,8 +17,9 @@ from explorer.shading.shader import shade
 
 
 def _scene(model="phong"):
-    m = Material(ambient=(0.1, 0.1, 0.1), diffuse=(0.5, 0.3, 0.2), specular=(0.8,) * 3,
-                 shininess=40.0)  # fmt: skip
+    m = Material(
+        ambient=(0.1, 0.1, 0.1), diffuse=(0.5, 0.3, 0.2), specular=(0.8,) * 3, shininess=40.0
+    )
     return Scene(material=m, model=model)
 
 
@@ -35,8 +36,9 @@ def test_each_pixel_is_the_engine_at_its_point_of_the_sphere(model, degrees):
     assert np.array_equal(img[inside], want)
     assert (img[~inside] == to_bytes([(0.2, 0.2, 0.2)])[0]).all()
     # the brightest diffuse point faces the light: the light's mark there
-    lit = LS.sphere_scene(_scene(model).replace(material=_scene().material.replace(
-        specular=(0.0,) * 3)), t)  # fmt: skip
+    lit = LS.sphere_scene(
+        _scene(model).replace(material=_scene().material.replace(specular=(0.0,) * 3)), t
+    )
     d = shade(lit, normals, normals)[:, 0]
     u, v = LS.light_point(t)
     best = normals[np.argmax(d)]

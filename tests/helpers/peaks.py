@@ -19,6 +19,10 @@ def engine_peak(scene, theta_i: float) -> float:
     lit = LS.sphere_scene(scene, theta_i)
     angles = np.radians(np.arange(-89.0, 89.01, 0.25))
     up = np.array([[0.0, 0.0, 1.0]])
-    got = [shade(lit.replace(viewer=Viewer(to_viewer=(math.sin(t), 0.0, math.cos(t)))),
-                 up * 0.0, up)[0].sum() for t in angles]  # fmt: skip
+    got = [
+        shade(lit.replace(viewer=Viewer(to_viewer=(math.sin(t), 0.0, math.cos(t)))), up * 0.0, up)[
+            0
+        ].sum()
+        for t in angles
+    ]
     return float(np.degrees(angles[int(np.argmax(got))]))

@@ -24,8 +24,14 @@ def _pixels(pl) -> np.ndarray:
 
 def _mouse(pl, kind, x, y, buttons) -> None:
     left = QtCore.Qt.MouseButton.LeftButton
-    ev = QtGui.QMouseEvent(kind, QtCore.QPointF(x, y), QtCore.QPointF(x, y), left, buttons,
-                           QtCore.Qt.KeyboardModifier.NoModifier)  # fmt: skip
+    ev = QtGui.QMouseEvent(
+        kind,
+        QtCore.QPointF(x, y),
+        QtCore.QPointF(x, y),
+        left,
+        buttons,
+        QtCore.Qt.KeyboardModifier.NoModifier,
+    )
     QtWidgets.QApplication.sendEvent(pl, ev)
 
 
@@ -71,7 +77,8 @@ def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(open_w
     assert sphere_matches(img, rep, state.shown_scene()) >= 0.99
     t0 = rep["theta"]
     assert plot_peak(img, rep) == pytest.approx(
-        engine_peak(state.shown_scene(), math.radians(t0)), abs=3.0)  # fmt: skip
+        engine_peak(state.shown_scene(), math.radians(t0)), abs=3.0
+    )
     camera = state.camera
     # press on the sphere's middle, drag up and right to sin(62°) of its radius, let go
     x, y, size = rep["box"]
@@ -82,8 +89,13 @@ def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(open_w
     r = math.sin(math.radians(want)) * size / 2
     steps = 6
     for i in range(1, steps + 1):
-        _mouse(pl, Type.MouseMove, round(cx + 0.6 * r * i / steps), round(cy - 0.8 * r * i / steps),
-               left)  # fmt: skip
+        _mouse(
+            pl,
+            Type.MouseMove,
+            round(cx + 0.6 * r * i / steps),
+            round(cy - 0.8 * r * i / steps),
+            left,
+        )
     ex, ey = round(cx + 0.6 * r), round(cy - 0.8 * r)
     _mouse(pl, Type.MouseButtonRelease, ex, ey, QtCore.Qt.MouseButton.NoButton)
     state = w.controller.state
@@ -155,8 +167,11 @@ def test_a_lobe_is_hidden_from_its_row_and_shown_again_by_a_click_on_its_legend(
     entry = img[y : y + bh, x : x + bw]
     assert _near(entry, three["colour"]) == 0  # its text grey now
     frame = np.rint(np.asarray(LI.LOBE_FRAME_COLOR) * 255)
-    text = ((entry.max(axis=2) > 60) & (np.ptp(entry, axis=2) <= 6)
-            & (np.abs(entry - frame).max(axis=2) > 6))  # fmt: skip
+    text = (
+        (entry.max(axis=2) > 60)
+        & (np.ptp(entry, axis=2) <= 6)
+        & (np.abs(entry - frame).max(axis=2) > 6)
+    )
     assert text.sum() >= 5
     camera = w.controller.state.camera
     Type, left = QtCore.QEvent.Type, QtCore.Qt.MouseButton.LeftButton

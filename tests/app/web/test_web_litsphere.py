@@ -65,9 +65,16 @@ def _plot_peak(img, rep, dx: int = 0, dy: int = 0) -> float:
     x, y, size = s["box"]
     left = int(2 * ox - x)
     part = img[int(y - 2) : int(oy) + 1, left : x - 4]
-    classes = to_bytes([LI.LOBE_COLOR, LI.LOBE_PANEL_COLOR, LI.LOBE_FRAME_COLOR,
-                        LI.LOBE_DIFFUSE_COLOR, LI.LOBE_INCIDENT_COLOR,
-                        LI.LOBE_MIRROR_COLOR]).astype(int)  # fmt: skip
+    classes = to_bytes(
+        [
+            LI.LOBE_COLOR,
+            LI.LOBE_PANEL_COLOR,
+            LI.LOBE_FRAME_COLOR,
+            LI.LOBE_DIFFUSE_COLOR,
+            LI.LOBE_INCIDENT_COLOR,
+            LI.LOBE_MIRROR_COLOR,
+        ]
+    ).astype(int)
     nearest = np.argmin(np.abs(part[:, :, None, :] - classes).sum(axis=3), axis=2)
     rows, cols = np.nonzero(nearest == 0)
     assert len(rows) > 10
@@ -92,8 +99,9 @@ def _settled(browser, check):
         time.sleep(0.1)
 
 
-def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(server, browser,
-                                                                            tmp_path):  # fmt: skip
+def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(
+    server, browser, tmp_path
+):
     rep = open_page(browser, server.url)
     assert rep["session"]["lobes"]["incidence"] is None
     t0 = rep["sphere"]["theta"]
@@ -112,15 +120,24 @@ def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(server
     # press near the sphere's middle, drag 5 right and 6 up (about 10°), let go
     drag(browser, (cx, cy), [(2, -2), (2, -2), (1, -2)])
     ex, ey = cx + 5, cy - 6
-    rep = wait("the incidence", lambda: (q := report(browser))["session"]["lobes"]["incidence"]
-               and q)  # fmt: skip
-    rep = _settled(browser, lambda img, q: (q["session"]["lobes"]["incidence"] == q["sphere"][
-        "theta"] and shows(img, q)[0], q["sphere"]["theta"], *shows(img, q)))  # fmt: skip
+    rep = wait(
+        "the incidence", lambda: (q := report(browser))["session"]["lobes"]["incidence"] and q
+    )
+    rep = _settled(
+        browser,
+        lambda img, q: (
+            q["session"]["lobes"]["incidence"] == q["sphere"]["theta"] and shows(img, q)[0],
+            q["sphere"]["theta"],
+            *shows(img, q),
+        ),
+    )
     theta = rep["session"]["lobes"]["incidence"]
     # the pointer's pixel asks for asin(its distance / the radius): within 2 pixels of it
-    near = [LS.incidence_at((ex + 0.5 + i - x) * 2 / size - 1,
-                            (y + size - ey - 0.5 + j) * 2 / size - 1)
-            for i in (-2, 0, 2) for j in (-2, 0, 2)]  # fmt: skip
+    near = [
+        LS.incidence_at((ex + 0.5 + i - x) * 2 / size - 1, (y + size - ey - 0.5 + j) * 2 / size - 1)
+        for i in (-2, 0, 2)
+        for j in (-2, 0, 2)
+    ]
     assert min(near) <= theta <= max(near) and abs(theta - t0) > 20
     assert rep["session"]["camera"] == camera  # the press was the sphere's
     browser.save_screenshot(str(tmp_path / "web_litsphere.png"))
@@ -135,8 +152,9 @@ def _curve_hits(img, rep, index: int) -> int:
     from explorer.app.lobeinset import LOBE_FRAME_COLOR, LOBE_PANEL_COLOR
 
     curves = rep["lobes"]["curves"]
-    classes = np.array([c["colour"] for c in curves]
-                       + to_bytes([LOBE_PANEL_COLOR, LOBE_FRAME_COLOR]).tolist())  # fmt: skip
+    classes = np.array(
+        [c["colour"] for c in curves] + to_bytes([LOBE_PANEL_COLOR, LOBE_FRAME_COLOR]).tolist()
+    )
     n = 0
     for px, py in curves[index]["px"]:
         patch = img[max(py - 1, 0) : py + 2, max(px - 1, 0) : px + 2].reshape(-1, 3)
