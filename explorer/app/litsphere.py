@@ -61,10 +61,16 @@ class LitSphere:
         self._key = None
 
     def place(self, x: int, y: int, size: int) -> None:
-        """The sphere's square: bottom-left ``(x, y)`` display pixels, ``size`` wide."""
-        if self.box != (x, y, size):
-            self.box = (x, y, size)
+        """The sphere's square: bottom-left ``(x, y)`` display pixels, ``size`` wide (0: no
+        sphere, the view too small)."""
+        box = (x, y, size) if size > 0 else None
+        if self.box != box:
+            self.box = box
             self._key = None
+        if box is None:
+            self.actor.SetVisibility(False)
+            for poly, _ in self._rings:
+                set_lines(poly, [])
 
     def update(self, scene, theta: float | None) -> None:
         """Draw ``scene``'s material and model lit at ``theta`` (radians; None: no light, the

@@ -46,6 +46,9 @@ LOBE_SETS = ("selected", "models", "lights", "sides")
 INSET_NODES = (24, 24)
 #: the Greek letters of a plot's title written out (VTK's own fonts have none)
 LATIN = {"ρ": "rho", "θ": "theta"}
+#: the lit sphere is drawn beside the plot while the inset with it takes at most this share of
+#: the view's width (a small view keeps the plot alone)
+SPHERE_SHARE = 0.5
 #: the legend's font size (pixels)
 LEGEND_FONT = 10
 #: a hidden lobe's legend entry (its lobe not drawn; a click on it shows it again)
@@ -172,7 +175,7 @@ class LobeInset:
         self._key = None
         self.box = None
         self._peak = None  # the one lobe's point farthest from the plot's origin (pixels)
-        self._side = 0  # the plot's part of the panel (the sphere's is beside it)
+        self._side = None  # (the plot's part of the panel, whether the sphere is beside it)
         self._curves: list = []  # (polydata, actor) of the several lobes' curves, one a colour
         self._legend: list = []  # their legend's text actors
         self.chart = None  # the plot of several lobes shown, or None
@@ -186,18 +189,19 @@ class LobeInset:
         w, h = self.plotter.window_size
         lo, hi = LOBE_SIDE
         side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi, max(w - 2 * LOBE_MARGIN, 40)))
-        if self.box is not None and self._side == side:
+        ball = side // 2 - LOBE_PAD  # the lit sphere's side, right of the plot
+        room = side + ball + LOBE_PAD <= SPHERE_SHARE * w  # (else no sphere: a small view)
+        if self.box is not None and self._side == (side, room):
             return
-        self._side = side
+        self._side = (side, room)
         font = self._font = 13 if side >= 170 else 11
         t = self.caption
         text = 2 * (font + 4)
         plot_h = side // 2
         height = plot_h + 3 * LOBE_PAD + text
         x0 = y0 = LOBE_MARGIN
-        ball = plot_h - LOBE_PAD  # the lit sphere's side, right of the plot
-        self.sphere.place(x0 + side, y0 + LOBE_PAD, ball)
-        side_all = side + ball + LOBE_PAD
+        self.sphere.place(x0 + side, y0 + LOBE_PAD, ball if room else 0)
+        side_all = side + ball + LOBE_PAD if room else side
         self.box = (x0, y0, side_all, height)  # display pixels, origin bottom-left
         self._plot_box = (x0 + LOBE_PAD, y0 + LOBE_PAD, side - 2 * LOBE_PAD, plot_h - LOBE_PAD)
         t.SetPosition(x0 + LOBE_PAD, y0 + height - LOBE_PAD)
