@@ -93,7 +93,7 @@ def lobe_view_rows(Row, several) -> list:
                 visible=lambda s, i=i: several(s) and i < len(LI.lobe_set_all(s)),
                 group="lobe_shown",
                 label=f"lobe {i + 1}",
-                text=f"lobe {i + 1}",
+                text=f"lobe {i + 1}" if i == 0 else str(i + 1),  # (a line: lobe 1, 2, 3)
                 tip=f"draw lobe {i + 1} of the inset's plot (the legend's line {i + 1}; a click "
                 "on it there does the same)",
             )

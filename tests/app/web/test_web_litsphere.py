@@ -24,10 +24,17 @@ pytestmark = pytest.mark.web
 SHIFT = 4
 
 
-def _picture(browser, rep) -> np.ndarray:
-    """The view's picture as the page shows it (h, w, 3) int, in the server's pixels."""
+def _picture(browser, rep) -> np.ndarray | None:
+    """The view's picture as the page shows it (h, w, 3) int, in the server's pixels; None
+    while the picture shown is not of the reported size (it would be drawn stretched)."""
     shot, box = view_pixels(browser)
     w, h = rep["size"]
+    natural = browser.execute_script(
+        "const i = document.querySelector('[aria-label=\"view\"] img');"
+        "return [i.naturalWidth, i.naturalHeight];"
+    )
+    if not [round(box["w"]), round(box["h"])] == rep["size"] == natural:
+        return None
     xs = np.round((box["x"] + (np.arange(w) + 0.5) * box["w"] / w) * box["dpr"] - 0.5).astype(int)
     ys = np.round((box["y"] + (np.arange(h) + 0.5) * box["h"] / h) * box["dpr"] - 0.5).astype(int)
     return shot[ys][:, xs].astype(int)
@@ -36,8 +43,9 @@ def _picture(browser, rep) -> np.ndarray:
 def _sphere_error(img, rep, scene) -> tuple[float, int, int]:
     """The mean difference (levels) between the page's sphere and the engine's, over the disc
     away from its rim and the light's mark, at the offset (up to 4 pixels each way) where the
-    page's picture matches best, and that offset (dx, dy): the picture as the page lays it out
-    may lie a few pixels off the box the server reports (3 left and 1 up, seen here)."""
+    page's picture matches best, and that offset (dx, dy): the page's first picture showed the
+    sphere 3 pixels left and 1 up of the box the server reports (0, 0 after a change: not
+    understood yet, see the report of issue 41's helper)."""
     s = rep["sphere"]
     x, y, size = s["box"]
     want = LS.sphere_picture(scene, math.radians(s["theta"]), size).astype(int)
@@ -91,7 +99,7 @@ def _settled(browser, check):
     while True:
         rep = report(browser)
         img = _picture(browser, rep)
-        got = check(img, rep)
+        got = (False, "a picture of another size") if img is None else check(img, rep)
         if got[0] and report(browser) == rep:
             return rep
         if time.monotonic() > end:
@@ -111,7 +119,7 @@ def test_a_drag_on_the_lit_sphere_sets_the_incidence_and_the_lobe_follows(
         err, dx, dy = _sphere_error(img, r, scene)
         peak = _plot_peak(img, r, dx, dy)
         want = engine_peak(scene, math.radians(r["sphere"]["theta"]))
-        return (err <= 4.0 and abs(peak - want) <= 3.0, err, peak, want)
+        return (err <= 4.0 and abs(peak - want) <= 3.0, err, peak, want, dx, dy)
 
     rep = _settled(browser, shows)
     camera = rep["session"]["camera"]
