@@ -409,8 +409,8 @@ MORE_LOBES = tuple(f"show_lobe_{i}" for i in range(4, 9))
 
 
 def every_row_shown(c) -> None:
-    """A spot light, the HDR display, Fresnel, the compare view, the strip and the inset's
-    several lobes on: every row of the panel model is shown."""
+    """A spot light, the HDR display, Fresnel, the compare view, the strip, the inset's
+    several lobes and its incidence on: every row of the panel model is shown."""
     from explorer.app import panelmodel as P
 
     c.act(M.set_light_type, "spot", label="light type")
@@ -418,6 +418,7 @@ def every_row_shown(c) -> None:
     assert c.set_value("hdr", True, merge=False)
     assert c.set_value("lobes", "models", merge=False)
     assert c.set_value("strip", True, merge=False)
+    assert c.set_value("lobe_incidence", P.row("lobe_incidence").optional, merge=False)
     assert c.set_value("fresnel", P.row("fresnel").optional, merge=False)
 
 
