@@ -49,6 +49,33 @@ def set_strip_mode(state: State, mode: str) -> State:
     return state.replace(strip_mode=mode)
 
 
+def _drawing_strip_bytes(drawing, mode: str) -> tuple:
+    """:func:`~explorer.shading.strip.shader_strip_bytes` of a drawing's Shader, each group of
+    the mesh in its own material when the drawing shows a mesh file's materials (the sums kept
+    once, each material recomposing them, as the drawing's own colours are made)."""
+    shader = drawing.shader
+    if drawing.groups is None:
+        return shader_strip_bytes(shader, mode)
+    own = shader.scene.material
+    groups = drawing.mesh.groups
+    tiles, over = None, None
+    try:
+        for i, material in enumerate(drawing.groups):
+            rows = groups.vertices(i)
+            if not len(rows):
+                continue
+            shader.set_material(material)
+            t, o = shader_strip_bytes(shader, mode)
+            if tiles is None:
+                tiles, over = [np.array(x) for x in t], np.array(o)
+            for out, x in zip(tiles, t, strict=True):
+                out[rows] = x[rows]
+            over[rows] = o[rows]
+    finally:
+        shader.set_material(own)
+    return (tiles, over) if tiles is not None else shader_strip_bytes(shader, mode)
+
+
 class TermStrip:
     """The strip in ``plotter``'s render window under its main renderer (see the module
     docstring): :meth:`show` draws it for a state and a drawing, :attr:`renderers` its tiles'
@@ -83,11 +110,11 @@ class TermStrip:
             self._switch(True)
         if drawing is not self._drawing:
             self._geometry(drawing)
-        key = (id(drawing), drawing.shader.scene, state.strip_mode)
+        key = (id(drawing), drawing.shader.scene, state.strip_mode, drawing.groups)
         if key == self._key:
             return
         self._key = key
-        tiles, over = shader_strip_bytes(drawing.shader, state.strip_mode)
+        tiles, over = _drawing_strip_bytes(drawing, state.strip_mode)
         mask = tiles[4].copy()
         mask[over] = to_bytes([OVERFLOW_COLOR])[0]
         self.tiles, self.overflow = (*tiles, mask), over

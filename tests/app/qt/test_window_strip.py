@@ -138,3 +138,33 @@ def test_per_pixel_the_tiles_are_the_per_pixel_terms_and_the_sum_tile_the_pictur
     w.controller.set_value("shading", "per-vertex")
     _pixels(w.plotter)
     assert strip.pixel_tiles is None and not strip.report((0, 0, 0))["per_pixel"]
+
+
+def test_a_mesh_files_groups_each_in_its_material_in_the_strip(open_window, tmp_path):
+    """An OBJ of two groups in two materials drawn in them: the sum tile is the view's own
+    colours on every vertex, and each group's tiles recompose its own material (the window's
+    pixel at a vertex of each group within its one-ring's colours)."""
+    from helpers.files import write_two_groups
+
+    from explorer.shading.shader import Shader
+
+    w = open_window("--mesh", str(write_two_groups(tmp_path)))
+    state = w.controller.state
+    assert state.groups is not None and state.groups[0] != state.groups[1]
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    img = _pixels(w.plotter)
+    view, strip = w.view, w.view.strip
+    assert np.array_equal(strip.tiles[COLUMNS.index("sum")], view.displayed_colors())
+    mesh = view.mesh
+    for g, material in enumerate(state.groups):
+        rows = mesh.groups.vertices(g)
+        scene = view.drawings[0].shader.scene.replace(material=material)
+        own = Shader(scene, mesh.positions, mesh.normals, precision="float64")
+        terms = shader_strip(own, "weighted")
+        diffuse = strip.tiles[COLUMNS.index("diffuse")].astype(int)[rows]
+        assert np.abs(diffuse - np.rint(terms.tiles["diffuse"][rows] * 255)).max() <= 1
+        face = mesh.faces[np.isin(mesh.faces, rows).all(axis=1)][0]  # (a corner lies on the edge)
+        x, y = strip.tile_pixel("sum", view.to_view(mesh.positions[face].mean(axis=0)))
+        assert in_ring(img[y, x], strip.tiles[COLUMNS.index("sum")], face)
