@@ -168,3 +168,26 @@ def test_a_mesh_files_groups_each_in_its_material_in_the_strip(open_window, tmp_
         face = mesh.faces[np.isin(mesh.faces, rows).all(axis=1)][0]  # (a corner lies on the edge)
         x, y = strip.tile_pixel("sum", view.to_view(mesh.positions[face].mean(axis=0)))
         assert in_ring(img[y, x], strip.tiles[COLUMNS.index("sum")], face)
+
+
+def test_the_compare_views_panes_each_show_their_sides_strip(open_window):
+    """The compare view with the strip on: side B's pane has the strip of side B (its
+    material and model), side A's pane A's; each sum tile is its pane's own colours, and the
+    window's pixel of B's sum tile at the probe is within its one-ring's."""
+    w = open_window("--mesh", "sphere", "--preset", "gold")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    assert w.controller.set_value("compare", True, merge=False)
+    state = w.controller.state
+    assert state.compare != state.material or state.compare_model != state.scene.model
+    img = _pixels(w.plotter_b)
+    for view in (w.view, w.view_b):
+        assert view.strip.on
+        sum_tile = view.strip.tiles[COLUMNS.index("sum")]
+        assert np.array_equal(sum_tile, view.displayed_colors())
+    assert not np.array_equal(w.view.strip.tiles[3], w.view_b.strip.tiles[3])  # (specular)
+    view = w.view_b
+    i = view.probe_vertex()
+    x, y = view.strip.tile_pixel("sum", view.to_view(view.mesh.positions[i]))
+    assert in_ring(img[y, x], view.strip.tiles[COLUMNS.index("sum")], one_ring(view.mesh, i))
