@@ -6,19 +6,23 @@ The state's ``lobes`` turns it into a plot of several lobes (:mod:`explorer.anal
 ``models`` the three models' for the material, ``lights`` the scene's for each light, ``sides``
 A's and B's of the compare view; each in its colour, named in the legend under the caption;
 ``lobe_view`` polar or cartesian, ``lobe_quantity`` intensity, brdf or albedo, ``lobe_log`` and
-``lobe_ndl`` (× N·L): the panel model's rows (:data:`ROWS`' actions here). VTK is imported
-inside the functions."""
+``lobe_ndl`` (× N·L): the panel model's rows (:data:`ROWS`' actions here). Beside the plot,
+the lit sphere (:mod:`explorer.app.litsphere`): the material at the plot's incidence, which a
+drag on it sets (``lobe_incidence``). VTK is imported inside the functions."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from explorer.analysis import lobe
 from explorer.analysis import lobes as many
+from explorer.app.litsphere import LitSphere
 from explorer.app.model import State, handle_point
 from explorer.app.overlay import overlay, set_lines, set_triangles
+from explorer.core.controls import CONTROLS
 from explorer.core.errors import ExplorerError
 from explorer.shading.effects.energy import specular_scale
 
@@ -48,8 +52,16 @@ LOBE_SETS = ("selected", "models", "lights", "sides")
 INSET_NODES = (24, 24)
 #: the Greek letters of a plot's title written out (VTK's own fonts have none)
 LATIN = {"ρ": "rho", "θ": "theta"}
+#: the lit sphere is drawn beside the plot while the inset with it takes at most this share of
+#: the view's width (a small view keeps the plot alone)
+SPHERE_SHARE = 0.5
 #: the legend's font size (pixels)
 LEGEND_FONT = 10
+#: a hidden lobe's legend entry (its lobe not drawn; a click on it shows it again)
+LEGEND_HIDDEN_COLOR = (0.6, 0.6, 0.6)
+#: the lobes the panel has a ``show_lobe_<i>`` row for (the first ones of the set; every
+#: legend entry drawn toggles its lobe by a click)
+LOBE_ROWS = 8
 
 
 def set_lobe_option(state: State, name: str, value) -> State:
@@ -67,7 +79,41 @@ def set_lobe_option(state: State, name: str, value) -> State:
     return state.replace(**{name: value})
 
 
+def set_lobe_incidence(state: State, degrees) -> State:
+    """The lobe plot's incidence θ_i in degrees (the lit sphere's drag; the range of
+    :data:`explorer.core.controls.CONTROLS`' ``lobe_incidence``), or None: the selected
+    light's."""
+    if degrees is not None:
+        c = CONTROLS["lobe_incidence"]
+        if not isinstance(degrees, (int, float)) or not c.lo <= degrees <= c.hi:
+            raise ExplorerError(
+                f"lobe_incidence must be a number from {c.lo:g} to {c.hi:g}"
+                f" degrees, or off, got {degrees!r}"
+            )
+        degrees = float(degrees)
+    return state.replace(lobe_incidence=degrees)
+
+
+def set_lobe_shown(state: State, index: int, on: bool) -> State:
+    """Lobe ``index`` (0-based, in the set the state's ``lobes`` asks for) drawn or not (its
+    legend entry stays, greyed)."""
+    if not isinstance(index, int) or index < 0:
+        raise ExplorerError(f"a lobe's index must be a whole number from 0, got {index!r}")
+    hidden = set(state.lobe_hidden)
+    (hidden.discard if on else hidden.add)(index)
+    return state.replace(lobe_hidden=frozenset(hidden))
+
+
 def lobe_set(state: State) -> list:
+    """The lobes of :func:`lobe_set_all`, those the state hides (``lobe_hidden``) with
+    ``visible`` off."""
+    return [
+        lb if i not in state.lobe_hidden else replace(lb, visible=False)
+        for i, lb in enumerate(lobe_set_all(state))
+    ]
+
+
+def lobe_set_all(state: State) -> list:
     """The lobes the state's ``lobes`` asks for (:class:`explorer.analysis.lobes.Lobe`), each in
     its colour: the three models', each light's, or sides A and B (B while it is shown)."""
     scene = state.shown_scene()
@@ -135,19 +181,29 @@ class LobeInset:
         self._key = None
         self.box = None
         self.labelled = True  # the caption and the L and R labels drawn (a large enough inset)
+        self._peak = None  # the one lobe's point farthest from the plot's origin (pixels)
+        self._side = None  # (the plot's part of the panel, whether the sphere is beside it)
         self._curves: list = []  # (polydata, actor) of the several lobes' curves, one a colour
         self._legend: list = []  # their legend's text actors
         self.chart = None  # the plot of several lobes shown, or None
+        self.sphere = LitSphere(self.plotter, LOBE_PANEL_COLOR)  # beside the plot
+        self.actors += self.sphere.actors
         self.layout(state)
 
     def layout(self, state: State) -> None:
         """Size the inset for the view: :data:`LOBE_FRACTION` of its smaller side, held within
         :data:`LOBE_SIDE` and within the view, and narrower while it would cover more than
         :data:`LOBE_AREA` of the view (down to :data:`LOBE_MIN_SIDE`, the plot alone below
-        LOBE_SIDE's least width); the caption's font the largest that fits."""
+        LOBE_SIDE's least width); the lit sphere right of the plot while the inset with it takes
+        at most :data:`SPHERE_SHARE` of the view's width; the caption's font the largest that
+        fits."""
+        w = self.plotter.window_size[0]
         side = inset_side(*self.plotter.window_size)
-        if self.box is not None and self.box[2] == side:
+        ball = side // 2 - LOBE_PAD  # the lit sphere's side, right of the plot
+        room = side + ball + LOBE_PAD <= SPHERE_SHARE * w  # (else no sphere: a small view)
+        if self.box is not None and self._side == (side, room):
             return
+        self._side = (side, room)
         font = self._font = 13 if side >= 170 else 11
         t = self.caption
         self.labelled = side >= LOBE_SIDE[0]
@@ -155,12 +211,14 @@ class LobeInset:
         plot_h = side // 2
         height = inset_height(side)
         x0 = y0 = LOBE_MARGIN
-        self.box = (x0, y0, side, height)  # display pixels, origin bottom-left
+        self.sphere.place(x0 + side, y0 + LOBE_PAD, ball if room else 0)
+        side_all = side + ball + LOBE_PAD if room else side
+        self.box = (x0, y0, side_all, height)  # display pixels, origin bottom-left
         self._plot_box = (x0 + LOBE_PAD, y0 + LOBE_PAD, side - 2 * LOBE_PAD, plot_h - LOBE_PAD)
         t.SetPosition(x0 + LOBE_PAD, y0 + height - LOBE_PAD)
         for key in ("L", "R"):
             self._labels[key].GetTextProperty().SetFontSize(max(font - 1, 8))
-        corners = [(x0, y0), (x0 + side, y0), (x0 + side, y0 + height), (x0, y0 + height)]
+        corners = [(x0, y0), (x0 + side_all, y0), (x0 + side_all, y0 + height), (x0, y0 + height)]
         set_triangles(self._polys["panel"], [corners[:3], [corners[0], *corners[2:]]],
                        [LOBE_PANEL_COLOR] * 2)  # fmt: skip
         self._key = None
@@ -173,7 +231,9 @@ class LobeInset:
         scene = state.shown_scene()
         m = scene.material
         _, kd, ks = m.scalars()
-        theta = None if light is None else lobe_incidence(state)
+        set_by_sphere = state.lobe_incidence is not None
+        theta = None if light is None and not set_by_sphere else lobe_incidence(state)
+        self.sphere.update(scene, theta)
         model, n = scene.model, m.shininess
         effects = {"fresnel": None if model == "threejs" else m.fresnel,
                    "energy": specular_scale(scene)}  # fmt: skip
@@ -201,6 +261,7 @@ class LobeInset:
         ox = x + 0.5 * w
         lines = {"frame": [frame, [(x, y), (x + w, y)], [(ox, y), (ox, y + 4)]]}
         label = lobe.MODEL_LABELS[model]
+        self._peak = None  # the lobe's point farthest from the plot's origin (pixels)
         if theta is None:
             lines.update(diffuse=[], incident=[], mirror=[], lobe=[])
             self.caption.SetInput(f"{label}\nno light, n = {n:g}")
@@ -217,6 +278,9 @@ class LobeInset:
                 incident=[ray_l, _arrow_head(ray_l)] if plot.lit else [],
                 mirror=dashes if plot.lit else [],
                 lobe=[lobe.to_box(plot.lobe, box)] if len(plot.lobe) else [],
+            )
+            self._peak = (
+                lines["lobe"][0][np.argmax(np.hypot(*(plot.lobe.T)))] if len(plot.lobe) else None
             )
             for key, end, shown, away in (("L", ray_l[1], plot.lit, -9.0),
                                           ("R", ray_r[1], plot.lit, 9.0)):  # fmt: skip
@@ -297,9 +361,9 @@ class LobeInset:
         x, y, _, h = self._plot_box
         for i, t in enumerate(self._legend):
             if i < len(entries):
-                label, colour, _ = entries[i]
+                label, colour, shown = entries[i]
                 t.SetInput(label)
-                t.GetTextProperty().SetColor(*colour)
+                t.GetTextProperty().SetColor(*(colour if shown else LEGEND_HIDDEN_COLOR))
                 t.SetPosition(x + 3, y + h - 2 - i * (LEGEND_FONT + 2))
             t.SetVisibility(i < len(entries))
 
@@ -320,7 +384,51 @@ class LobeInset:
                     "px": [[int(round(x)), int(round(h - 1 - y))] for x, y in px[pick]],
                 }
             )
-        return {"title": self.chart.title, "curves": out}
+        legend = [
+            [round(x), round(h - y - bh), round(bw), round(bh)]
+            for x, y, bw, bh in self.legend_boxes()
+        ]
+        shown = [bool(v) for _, _, v in self.chart.legend]
+        return {"title": self.chart.title, "curves": out, "legend": legend, "shown": shown}
+
+    def sphere_report(self) -> dict | None:
+        """What a test of a front end reads of the lit sphere (:meth:`LitSphere.report`) and
+        of the one lobe's plot: its origin and the lobe's farthest point (its peak) in window
+        pixels (origin top-left; None while no lobe is drawn)."""
+        rep = self.sphere.report()
+        if rep is None:
+            return None
+        _, h = self.plotter.window_size
+        x, y, w, _ = self._plot_box
+        peak = self._peak
+        rep["origin"] = [x + 0.5 * w, h - 1 - y]
+        rep["peak"] = (
+            None
+            if peak is None or self.chart is not None
+            else [float(peak[0]), h - 1 - float(peak[1])]
+        )
+        return rep
+
+    def legend_at(self, px: float, py: float) -> int | None:
+        """The legend entry (its lobe's index) at display pixel ``(px, py)`` (origin
+        bottom-left), or None."""
+        if self.chart is None:
+            return None
+        for i, (x, y, w, h) in enumerate(self.legend_boxes()):
+            if x <= px <= x + w and y <= py <= y + h:
+                return i
+        return None
+
+    def legend_boxes(self) -> list:
+        """Each legend entry's box ``(x, y, width, height)`` in display pixels (origin
+        bottom-left): the line of its text, as wide as the text."""
+        out = []
+        for t in self._legend[: len(self.chart.legend) if self.chart is not None else 0]:
+            extent = [0.0, 0.0]
+            t.GetSize(self.plotter.renderer, extent)
+            x, top = t.GetPosition()
+            out.append((x, top - (LEGEND_FONT + 2), max(extent[0], 12.0), LEGEND_FONT + 2))
+        return out
 
     def _hide_many(self) -> None:
         self.chart = None
@@ -365,7 +473,10 @@ def inset_height(side: int) -> int:
 def lobe_incidence(state: State) -> float:
     """theta_i (radians) of the selected light at the mesh's point that faces the viewer: the
     angle between the directions from the mesh centre toward the viewer and toward the light's
-    handle (:func:`explorer.analysis.lobe.incidence`)."""
+    handle (:func:`explorer.analysis.lobe.incidence`); the state's ``lobe_incidence`` instead
+    when the lit sphere (or its row) set one."""
+    if state.lobe_incidence is not None:
+        return math.radians(state.lobe_incidence)
     return _incidence(state, None)
 
 

@@ -100,6 +100,9 @@ class State:
         ``raw`` (:mod:`explorer.app.termstrip`)
     lobes, lobe_view, lobe_quantity, lobe_log, lobe_ndl : the lobe inset's lobes (the selected
         light's, or several) and how it plots them (:mod:`explorer.app.lobeinset`)
+    lobe_hidden : the lobes of the inset's set not drawn (0-based indices in the set)
+    lobe_incidence : the incidence θ_i (degrees) the lobe plot and its lit sphere show, set by
+        a drag on the sphere (:mod:`explorer.app.litsphere`); None: the selected light's
     """
 
     scene: Scene
@@ -131,6 +134,8 @@ class State:
     lobe_quantity: str = "intensity"
     lobe_log: bool = False
     lobe_ndl: bool = False
+    lobe_hidden: frozenset = frozenset()
+    lobe_incidence: float | None = None
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)

@@ -36,11 +36,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from explorer.analysis.lobes import QUANTITIES as LOBE_QUANTITIES
-from explorer.analysis.lobes import VIEWS as LOBE_VIEWS
-from explorer.app import captions
+from explorer.app import captions, loberows
 from explorer.app import effectactions as E
-from explorer.app import lobeinset as LI
 from explorer.app import model as M
 from explorer.app import termstrip as T
 from explorer.core.controls import CONTROLS, Control
@@ -629,71 +626,7 @@ def _view_rows() -> list[Row]:
             tip="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light "
             "sums A, D, S alone",
         ),
-        *_lobe_rows(),
-    ]
-
-
-def _lobe_option(name: str):
-    return lambda s, v: (LI.set_lobe_option, (name, v))
-
-
-def _lobe_rows() -> list[Row]:
-    """The lobe inset's rows: which lobes, and how they are plotted (docs/terms.md)."""
-    several = lambda s: s.lobes != "selected"  # noqa: E731 - the rows' one test
-    return [
-        Row(
-            "lobes",
-            "view",
-            "choice",
-            lambda s: s.lobes,
-            _lobe_option("lobes"),
-            choices=LI.LOBE_SETS,
-            tip="the inset's lobes: the selected light's, the three models', each light's, or "
-            "sides A and B",
-        ),
-        Row(
-            "lobe_view",
-            "view",
-            "choice",
-            lambda s: s.lobe_view,
-            _lobe_option("lobe_view"),
-            visible=several,
-            choices=LOBE_VIEWS,
-            inline=True,
-            tip="polar: the plane of incidence, the normal up; cartesian: against the view angle",
-        ),
-        Row(
-            "lobe_quantity",
-            "view",
-            "choice",
-            lambda s: s.lobe_quantity,
-            _lobe_option("lobe_quantity"),
-            visible=several,
-            choices=LOBE_QUANTITIES,
-            tip="intensity per unit light, the BRDF (intensity / (π N·L), 1/sr), or the "
-            "directional albedo ρ(θ_i)",
-        ),
-        Row(
-            "lobe_log",
-            "view",
-            "toggle",
-            lambda s: s.lobe_log,
-            _lobe_option("lobe_log"),
-            visible=several,
-            group="lobe_scale",
-            tip="a log scale: four decades",
-        ),
-        Row(
-            "lobe_ndl",
-            "view",
-            "toggle",
-            lambda s: s.lobe_ndl,
-            _lobe_option("lobe_ndl"),
-            visible=several,
-            group="lobe_scale",
-            text="× N·L",
-            tip="each value times N·L",
-        ),
+        *loberows.lobe_rows(Row),
     ]
 
 

@@ -161,12 +161,20 @@ class PixelLayer:
         made = False
         scene = M.set_camera(state, camera).shown_scene()
         groups = state.shown_groups()
-        w, h = (int(v) for v in self.plotter.window_size)
+        # the main renderer's own size: the term strip under it takes the window's bottom
+        w, h = (int(v) for v in self.plotter.renderer.GetSize())
         mesh = self.view.mesh
         if mesh.uv is None:  # no (u, v): untextured, as the per-vertex view draws it
             scene = scene.replace(material=bare(scene.material))
             groups = None if groups is None else tuple(bare(m) for m in groups)
-        key = (repr(scene), repr(groups), camera, (w, h), id(mesh))
+        key = (
+            repr(scene),
+            repr(groups),
+            camera,
+            (w, h),
+            id(mesh),
+            tuple(self.plotter.renderer.GetOrigin()),
+        )
         if key != self._key:
             t0 = time.perf_counter()
             frame = self._live_for(mesh).frame(scene, camera, (w, h), materials=groups)
@@ -198,7 +206,14 @@ class PixelLayer:
     # -- drawing -------------------------------------------------------------------------------
     def draw(self, rgb: np.ndarray) -> None:
         """Draw ``rgb`` (h, w, 3) uint8, top row first, on the mesh (the texture; VTK's rows
-        run bottom up): the picture, or the compare view's heat map in its place."""
+        run bottom up): the picture, or the compare view's heat map in its place; a picture of
+        the main renderer's part of the window (the strip on) goes where that part is."""
+        rw, rh = (int(v) for v in self.plotter.window_size)
+        if rgb.shape[:2] != (rh, rw):  # (the main renderer's part of the window: its texels)
+            ox, oy = (int(v) for v in self.plotter.renderer.GetOrigin())
+            full = np.zeros((rh, rw, 3), np.uint8)
+            full[rh - oy - rgb.shape[0] : rh - oy, ox : ox + rgb.shape[1]] = rgb
+            rgb = full
         h, w = rgb.shape[:2]
         if self._texels is None or self._texels.shape[:2] != (h, w):
             self._make_texture(w, h)

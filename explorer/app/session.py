@@ -15,8 +15,11 @@ A session file is YAML (or JSON, which YAML reads too)::
     difference: false
     strip: false               # optional: the term strip under the view (docs/terms.md),
     strip_mode: weighted       #   its tiles: weighted or raw
-    lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false}
-                               # optional: the lobe inset's lobes and plot (docs/terms.md)
+    lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false,
+            incidence: null, hidden: []}
+                               # optional: the lobe inset's lobes and plot (docs/terms.md);
+                               # incidence: the plot's θ_i in degrees (null: the light's);
+                               # hidden: the lobes not drawn (1 is the set's first)
     local_viewer: true         # optional: the viewer at the camera (false: infinitely far
                                # along its view)
     compare: {material: {...}, model: phong, preset: gold, difference: false}   # optional:
@@ -45,6 +48,7 @@ from platformdirs import user_config_dir
 from explorer.app.model import TERMS, State, check_window_lights
 from explorer.app.start import add_mesh_materials, first_state, load_mesh_choice
 from explorer.core.atomic import write_atomic
+from explorer.core.controls import LOBE_INCIDENCE_RANGE
 from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS, parse_material
 from explorer.core.mtl import MtlError
@@ -106,6 +110,8 @@ def session_mapping(state: State) -> dict:
             "quantity": state.lobe_quantity,
             "log": bool(state.lobe_log),
             "ndl": bool(state.lobe_ndl),
+            "incidence": state.lobe_incidence,
+            "hidden": sorted(i + 1 for i in state.lobe_hidden),
         },
     }
     if state.camera is not None:
@@ -224,7 +230,18 @@ def _lobes(checker, value) -> dict:
     c = checker.mapping(value, path)
     if c is None:
         return {}
-    checker.keys(c, path, ("set", "view", "quantity", "log", "ndl"), required=())
+    checker.keys(
+        c, path, ("set", "view", "quantity", "log", "ndl", "incidence", "hidden"), required=()
+    )
+    hidden = c.get("hidden", [])
+    if not isinstance(hidden, list) or any(
+        isinstance(i, bool) or not isinstance(i, int) or i < 1 for i in hidden
+    ):
+        checker.problem((*path, "hidden"), f"must be a list of whole numbers >= 1, got {hidden!r}")
+        hidden = []
+    incidence = c.get("incidence")
+    if incidence is not None:
+        incidence = checker.number(incidence, (*path, "incidence"), *LOBE_INCIDENCE_RANGE)
     return {
         "lobes": checker.choice(c.get("set", "selected"), (*path, "set"), LOBE_SETS),
         "lobe_view": checker.choice(c.get("view", "polar"), (*path, "view"), VIEWS),
@@ -233,6 +250,8 @@ def _lobes(checker, value) -> dict:
         ),
         "lobe_log": bool(checker.boolean(c.get("log", False), (*path, "log"))),
         "lobe_ndl": bool(checker.boolean(c.get("ndl", False), (*path, "ndl"))),
+        "lobe_incidence": None if incidence is None else float(incidence),
+        "lobe_hidden": frozenset(i - 1 for i in hidden),
     }
 
 

@@ -9,18 +9,26 @@ bytes, :func:`explorer.shading.strip.shader_strip_bytes` of that drawing's Shade
 light sums recomposed, no light pass; the overflow tile is the sum tile with the vertices the
 display clamped in magenta, its label the share of them. The state's ``strip`` switches it,
 ``strip_mode`` picks ``weighted`` or ``raw`` tiles (the panel model's rows, :data:`ROWS`).
-VTK is imported inside the methods.
+
+Per pixel (the view's ``shading: per-pixel``), each tile is a picture instead: the engine lit
+at each pixel of the tile (a :class:`~explorer.render.live.LivePixels` of the strip's own at the
+tile's size, the main view's camera), its per-pixel shader's kept sums recomposed
+(:func:`explorer.shading.strip.compose_strip` on pixel rows); the sum tile is ``render
+--per-pixel``'s picture at that size and camera, bit for bit. Made before the window draws
+(:meth:`TermStrip.before_pixels`, the render window's StartEvent, as the view's own per-pixel
+picture). VTK is imported inside the methods.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from explorer.app import model as M
 from explorer.app.model import State
 from explorer.core.errors import ExplorerError
 from explorer.render.strip import COLUMNS, OVERFLOW_COLOR
 from explorer.shading.display import to_bytes
-from explorer.shading.strip import MODES, shader_strip_bytes
+from explorer.shading.strip import MODES, compose_strip, shader_strip_bytes
 
 #: the strip's height as a fraction of the view's (the main view keeps the rest above it)
 STRIP_HEIGHT = 0.2
@@ -41,6 +49,33 @@ def set_strip_mode(state: State, mode: str) -> State:
     return state.replace(strip_mode=mode)
 
 
+def _drawing_strip_bytes(drawing, mode: str) -> tuple:
+    """:func:`~explorer.shading.strip.shader_strip_bytes` of a drawing's Shader, each group of
+    the mesh in its own material when the drawing shows a mesh file's materials (the sums kept
+    once, each material recomposing them, as the drawing's own colours are made)."""
+    shader = drawing.shader
+    if drawing.groups is None:
+        return shader_strip_bytes(shader, mode)
+    own = shader.scene.material
+    groups = drawing.mesh.groups
+    tiles, over = None, None
+    try:
+        for i, material in enumerate(drawing.groups):
+            rows = groups.vertices(i)
+            if not len(rows):
+                continue
+            shader.set_material(material)
+            t, o = shader_strip_bytes(shader, mode)
+            if tiles is None:
+                tiles, over = [np.array(x) for x in t], np.array(o)
+            for out, x in zip(tiles, t, strict=True):
+                out[rows] = x[rows]
+            over[rows] = o[rows]
+    finally:
+        shader.set_material(own)
+    return (tiles, over) if tiles is not None else shader_strip_bytes(shader, mode)
+
+
 class TermStrip:
     """The strip in ``plotter``'s render window under its main renderer (see the module
     docstring): :meth:`show` draws it for a state and a drawing, :attr:`renderers` its tiles'
@@ -58,6 +93,10 @@ class TermStrip:
         self.tiles = None
         self.overflow = None
         self.on = False
+        self.pixel_tiles = None  # per pixel: each tile's picture (h, w, 3) uint8, else None
+        self._live = None  # the per-pixel tiles' LivePixels
+        self._pixel_key = None
+        self._images: list = []  # per tile: (vtkImageData, its actor)
 
     def show(self, state: State, drawing) -> None:
         """Show the strip for ``state`` (off: the main view fills the window again), its tiles
@@ -71,11 +110,11 @@ class TermStrip:
             self._switch(True)
         if drawing is not self._drawing:
             self._geometry(drawing)
-        key = (id(drawing), drawing.shader.scene, state.strip_mode)
+        key = (id(drawing), drawing.shader.scene, state.strip_mode, drawing.groups)
         if key == self._key:
             return
         self._key = key
-        tiles, over = shader_strip_bytes(drawing.shader, state.strip_mode)
+        tiles, over = _drawing_strip_bytes(drawing, state.strip_mode)
         mask = tiles[4].copy()
         mask[over] = to_bytes([OVERFLOW_COLOR])[0]
         self.tiles, self.overflow = (*tiles, mask), over
@@ -86,6 +125,108 @@ class TermStrip:
         for name, label in zip(COLUMNS, self.labels, strict=True):
             text = f"{name} {share:.1f}%" if name == "overflow" else name
             label.SetInput(f"{text} ({state.strip_mode})" if name == "sum" else text)
+
+    def before_pixels(self, state: State, per_pixel: bool, mesh) -> None:
+        """The render window's StartEvent: with the strip on and the view drawn per pixel
+        (``per_pixel``), each tile's per-pixel picture of ``mesh`` for the camera VTK is about
+        to draw with (made again when the scene, camera, tile size or mode changed); else the
+        tiles draw the mesh per vertex."""
+        if not (self.on and state.strip and per_pixel):
+            self._show_pictures(False)
+            return
+        from explorer.app.view import view_camera  # (a cycle: the view holds the strip)
+
+        camera = view_camera(self.plotter.camera, state.centre, state.radius)
+        scene = M.set_camera(state, camera).shown_scene()
+        w, h = (int(v) for v in self.renderers[0].GetSize())
+        bg = tuple(self.plotter.renderer.GetBackground())
+        key = (repr(scene), camera, (w, h), id(mesh), state.strip_mode, bg)
+        if key != self._pixel_key and min(w, h) > 0:
+            self.pixel_tiles = self._pictures(scene, camera, (w, h), mesh, state.strip_mode, bg)
+            self._pixel_key = key
+            for (image, _), rgb in zip(self._images_for(w, h), self.pixel_tiles, strict=True):
+                arr = image.GetPointData().GetScalars()
+                from vtkmodules.util.numpy_support import vtk_to_numpy
+
+                vtk_to_numpy(arr).reshape(h, w, 3)[:] = rgb[::-1]  # (VTK's rows: bottom up)
+                arr.Modified()
+                image.Modified()
+        self._show_pictures(self.pixel_tiles is not None)
+
+    def _pictures(self, scene, camera, size, mesh, mode, background) -> list:
+        """The tiles' pictures (:data:`COLUMNS`' order), each (h, w, 3) uint8: the per-pixel
+        shader's sums at ``size`` recomposed; the overflow's share in the label."""
+        from explorer.render.live import LivePixels  # (VTK, for the G-buffer's rasterisation)
+
+        if self._live is None:
+            self._live = LivePixels(mesh)
+        self._live.set_mesh(mesh)
+        frame = self._live.frame(scene, camera, size, background=background)
+        g, _ = self._live.gbuffer(camera, size)
+        sh = self._live.shader
+        strip = compose_strip(scene, sh.terms, sh.colors, mode)
+        first = len(sh.colors) - len(g.pixels)  # (the mesh's vertices first, with shadows)
+        out = []
+        for name in COLUMNS:
+            rgb = np.array(frame.rgb)
+            flat = rgb.reshape(-1, 3)
+            if name == "overflow":
+                flat[g.pixels] = to_bytes(strip.tiles["sum"][first:])
+                flat[g.pixels[strip.overflow[first:]]] = to_bytes([OVERFLOW_COLOR])[0]
+            else:
+                flat[g.pixels] = to_bytes(strip.tiles[name][first:])
+            out.append(rgb)
+        over = strip.overflow[first:]
+        share = 100.0 * float(over.mean()) if over.size else 0.0
+        self.labels[COLUMNS.index("overflow")].SetInput(f"overflow {share:.1f}%")
+        return out
+
+    def _images_for(self, w: int, h: int) -> list:
+        """Each tile's picture actor (made, or remade for a new size), under its label."""
+        from vtkmodules.util.numpy_support import numpy_to_vtk
+        from vtkmodules.vtkCommonDataModel import vtkImageData
+        from vtkmodules.vtkRenderingCore import vtkActor2D, vtkImageMapper
+
+        if self._images and self._images[0][0].GetDimensions()[:2] == (w, h):
+            return self._images
+        for r, (_, actor) in zip(self.renderers, self._images, strict=False):
+            r.RemoveViewProp(actor)
+        self._images = []
+        for r, label in zip(self.renderers, self.labels, strict=True):
+            image = vtkImageData()
+            image.SetDimensions(w, h, 1)
+            arr = numpy_to_vtk(np.zeros((w * h, 3), np.uint8), deep=True)
+            arr.SetName("pixels")
+            image.GetPointData().SetScalars(arr)
+            mapper = vtkImageMapper()
+            mapper.SetInputData(image)
+            mapper.SetColorWindow(255.0)
+            mapper.SetColorLevel(127.5)
+            actor = vtkActor2D()
+            actor.SetMapper(mapper)
+            r.RemoveViewProp(label)  # (the label drawn over the picture)
+            r.AddViewProp(actor)
+            r.AddViewProp(label)
+            self._images.append((image, actor))
+        return self._images
+
+    def _show_pictures(self, on: bool) -> None:
+        """The tiles show their per-pixel pictures (on) or draw the mesh per vertex."""
+        if not on:
+            self.pixel_tiles = None
+            self._pixel_key = None
+        for _, actor in self._images:
+            actor.SetVisibility(on)
+        for actor in self._actors:
+            actor.SetVisibility(not on)
+
+    def tile_box(self, column: str) -> list[int]:
+        """Tile ``column``'s box ``[x, y, width, height]`` in window pixels (origin top-left)."""
+        r = self.renderers[COLUMNS.index(column)]
+        x, y = r.GetOrigin()
+        w, h = r.GetSize()
+        _, wh = self.plotter.window_size
+        return [int(x), int(wh - y - h), int(w), int(h)]
 
     def tile_pixel(self, column: str, point) -> list[int]:
         """Window pixel (origin top-left) of ``point`` (3,) in the view's coordinates (as
@@ -104,7 +245,12 @@ class TermStrip:
         if not self.on:
             return None
         share = float(self.overflow.mean()) if self.overflow is not None else 0.0
-        return {"px": {c: self.tile_pixel(c, point) for c in COLUMNS}, "overflow": share}
+        return {
+            "px": {c: self.tile_pixel(c, point) for c in COLUMNS},
+            "overflow": share,
+            "boxes": {c: self.tile_box(c) for c in COLUMNS},
+            "per_pixel": self.pixel_tiles is not None,
+        }
 
     def _switch(self, on: bool) -> None:
         """Make room for the tiles (or give it back), creating them the first time."""

@@ -23,6 +23,7 @@ import numpy as np
 from explorer.app import model as M
 from explorer.app.difference import PENDING, HeatMap, advice_lines
 from explorer.app.handledrag import HandleDragger
+from explorer.app.litsphere import SphereDrag
 from explorer.app.pixellayer import PixelLayer
 from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, view_camera
 from explorer.render.images import encode_png
@@ -95,6 +96,7 @@ class PlotterView:
         self._mesh = state.mesh
         self.view.apply_camera(state.camera)
         self.handles = HandleDragger(self)
+        self.sphere_drag = SphereDrag(self)  # (the lobe inset's lit sphere)
         self.pixels = PixelLayer(self.view)
         window = self.plotter.render_window  # (before VTK makes its context current)
         window.AddObserver("StartEvent", self.guard(self._pixels_before, "per-pixel view"))
@@ -223,6 +225,9 @@ class PlotterView:
             self._t0 = time.perf_counter()
         was = self.pixels.fallback
         self.pixels.before(self.controller.state)
+        state = self.controller.state  # the term strip's tiles per pixel as the view is drawn
+        per_pixel = self.pixels.wanted(state) and not self.pixels.fallback
+        self.view.strip.before_pixels(state, per_pixel, self.view.mesh)
         if self.side_b is not None:  # (side B's work is not side A's frame time)
             t0 = time.perf_counter()
             self.side_b.before_a_frame(self.controller.state)

@@ -40,6 +40,8 @@ ATTENUATION_RANGE = (0.0, 100.0)
 #: the exposure slider's range in stops (x 1/16 to x 16); a typed value may take the file's
 #: whole range, :data:`explorer.core.hdr.EXPOSURE_RANGE`
 EXPOSURE_SLIDER = (-4.0, 4.0)
+#: the lobe plot's incidence θ_i in degrees (the lit sphere's drag): from the normal to grazing
+LOBE_INCIDENCE_RANGE = (0.0, 90.0)
 
 
 @dataclass(frozen=True)
@@ -100,6 +102,7 @@ CONTROLS: dict[str, Control] = _controls(
     Control("attenuation", *ATTENUATION_RANGE, step=0.05),
     Control("fresnel", *FRESNEL_RANGE),
     Control("exposure", *EXPOSURE_SLIDER, decimals=2, unit=" EV", field=EXPOSURE_RANGE),
+    Control("lobe_incidence", *LOBE_INCIDENCE_RANGE, decimals=1, unit="°"),
 )
 
 

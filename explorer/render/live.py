@@ -185,6 +185,12 @@ class LivePixels:
         s = self.stats
         return int(s["pass"] + s["numpy"])
 
+    @property
+    def shader(self) -> Shader | None:
+        """The per-pixel shader of the last frame (its rows: the mesh's vertices when shadows
+        are cast, then the G-buffer's pixels; its kept sums are the term strip's), or None."""
+        return self._shader
+
     # -- frames ------------------------------------------------------------------------------
     def gbuffer(self, camera: Camera, size: Sequence[int]) -> tuple[GBuffer, bool]:
         """The G-buffer of ``camera`` and ``size`` (w, h): the kept one when it was made for

@@ -196,6 +196,8 @@ def test_session_round_trip(state, mesh, tmp_path):
         ("session: 1\nscene: {material: nope}\nmesh: sphere\n", "scene"),
         ("session: 1\nscene: {}\nmesh: sphere\ncamera: {position: [0, 0, 1]}\n", "camera"),
         ("session: 1\nscene: {}\nmesh: sphere\nzoom: 2\n", "zoom"),
+        ("session: 1\nscene: {}\nmesh: sphere\nlobes: {incidence: 95}\n", "lobes.incidence"),
+        ("session: 1\nscene: {}\nmesh: sphere\nlobes: {hidden: [0]}\n", "lobes.hidden"),
     ],
 )
 def test_bad_sessions_name_file_and_key(tmp_path, text, words):

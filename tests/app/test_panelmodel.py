@@ -75,7 +75,13 @@ SAMPLES = {
     "lobe_quantity": "brdf",
     "lobe_log": True,
     "lobe_ndl": True,
+    "lobe_incidence": 30.0,
+    "show_lobe_1": False,
+    "show_lobe_2": False,
+    "show_lobe_3": False,
 }
+#: the rows of the lobes past the start's three (tried with eight lights, below)
+MORE_LOBES = tuple(f"show_lobe_{i}" for i in range(4, 9))
 #: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
 MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
 #: the rows that are lines of text the state gives (read, never set)
@@ -110,7 +116,7 @@ def test_every_row_is_one_declared_control():
             assert r.key in CONTROLS, r.key  # its range, scale and decimals: core.controls
         if r.kind in ("choice", "list"):  # fixed values, or items (the state's, a catalogue's)
             assert bool(r.choices) + (r.items is not None) + bool(r.source) == 1, r.key
-    assert set(SAMPLES) | set(MESH_MATERIALS) | set(LINES) == set(P.BY_KEY)  # each tried below
+    assert set(SAMPLES) | set(MESH_MATERIALS) | set(LINES) | set(MORE_LOBES) == set(P.BY_KEY)
     with pytest.raises(ExplorerError, match="no control named 'glossiness'"):
         P.row("glossiness")
 
@@ -141,6 +147,29 @@ def test_each_row_edits_the_state_in_one_undo_step_that_a_session_keeps(key, mes
     assert r.value(again) == pytest.approx(r.value(new)), key
     store.undo()
     assert r.value(store.state) == r.value(s)
+
+
+def test_a_lobe_row_a_lobe_of_the_set_each_hidden_and_kept_by_a_session(mesh, tmp_path):
+    """``show_lobe_<i>``: shown while the set has an i-th lobe; off, that lobe is not drawn
+    (its legend entry kept, greyed), and a session keeps which; a bad index is one line."""
+    from explorer.app import lobeinset as LI
+
+    lights = tuple(DirectionalLight(to_light=(0.1 * i, 0.5, 1.0)) for i in range(8))
+    s = first_state(Scene(lights=lights), mesh, name="icosphere").replace(lobes="lights")
+    assert [P.row(f"show_lobe_{i}").visible(s) for i in range(1, 9)] == [True] * 8
+    assert not P.row("show_lobe_8").visible(s.replace(lobes="models"))
+    assert not P.row("show_lobe_1").visible(s.replace(lobes="selected"))
+    store = M.Store(s)
+    for key in ("show_lobe_2", *MORE_LOBES):
+        action, args, label = P.edit(store.state, key, False)
+        store.apply(action, *args, label=label)
+    assert store.undo_label() == "lobe 8"
+    shown = [lb.visible for lb in LI.lobe_set(store.state)]
+    assert shown == [True, False, True, False, False, False, False, False]
+    again, _ = load_session(save_session(tmp_path / "s.yaml", store.state))
+    assert again.lobe_hidden == store.state.lobe_hidden == frozenset({1, 3, 4, 5, 6, 7})
+    with pytest.raises(ExplorerError, match="a lobe's index"):
+        LI.set_lobe_shown(s, -1, False)
 
 
 def test_a_button_row_applies_its_action_and_says_when_it_can_be_pressed(mesh):

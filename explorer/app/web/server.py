@@ -360,6 +360,7 @@ class WebExplorer:
             "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
             "lobes": self.view.lobe.report(),
             "pixels": pixels_report(self.viewport.pixels),
+            "sphere": self.view.lobe.sphere_report(),
             "session": session_mapping(self.store.state),
         }  # fmt: skip
 

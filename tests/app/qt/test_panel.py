@@ -404,11 +404,13 @@ def test_duplicate_is_an_exact_copy_and_the_list_says_so(win):
 # -- issue 38: the panel model's rows ----------------------------------------------------------
 #: the rows of a mesh file's own materials: hidden here (a built-in mesh)
 MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
+#: the lobes past the three models' (shown with more lobes in the set: four lights or more)
+MORE_LOBES = tuple(f"show_lobe_{i}" for i in range(4, 9))
 
 
 def every_row_shown(c) -> None:
-    """A spot light, the HDR display, Fresnel, the compare view, the strip and the inset's
-    several lobes on: every row of the panel model is shown."""
+    """A spot light, the HDR display, Fresnel, the compare view, the strip, the inset's
+    several lobes and its incidence on: every row of the panel model is shown."""
     from explorer.app import panelmodel as P
 
     c.act(M.set_light_type, "spot", label="light type")
@@ -416,6 +418,7 @@ def every_row_shown(c) -> None:
     assert c.set_value("hdr", True, merge=False)
     assert c.set_value("lobes", "models", merge=False)
     assert c.set_value("strip", True, merge=False)
+    assert c.set_value("lobe_incidence", P.row("lobe_incidence").optional, merge=False)
     assert c.set_value("fresnel", P.row("fresnel").optional, merge=False)
 
 
@@ -434,7 +437,7 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
             assert len(found) == 1, (r.key, name, found)
             assert found[0].accessibleName() == name, name
             # a mesh file's own materials are shown with an OBJ's groups (test_filemenu.py)
-            assert found[0].isVisibleTo(tab) != (r.key in MESH_MATERIALS), name
+            assert found[0].isVisibleTo(tab) != (r.key in MESH_MATERIALS + MORE_LOBES), name
     win.controller.undo()  # fresnel off: its number hidden, its switch shown and unchecked
     rows = win.panel.material.rows
     assert not rows.sliders["fresnel"].isVisibleTo(win.panel.material)

@@ -73,3 +73,121 @@ def test_the_inset_plots_the_three_models_lobes_from_the_panel(open_window, tmp_
         hits += bool((np.abs(patch - last["colour"]) <= 1).all(axis=1).any())
     assert hits >= 0.9 * len(last["px"])
     w.grab().save(str(tmp_path / "window_lobes.png"))
+
+
+#: the rows at a tile's bottom its label may cover (pixels)
+LABEL_ROWS = 20
+
+
+def test_per_pixel_the_tiles_are_the_per_pixel_terms_and_the_sum_tile_the_picture(
+    open_window, tmp_path
+):
+    """With the view lit per pixel, each tile is a per-pixel picture at the tile's size and
+    the view's camera: the window's sum tile is ``render --per-pixel``'s picture there bit for
+    bit, and the diffuse tile the per-pixel shader's diffuse term (its kept sums recomposed)."""
+    from explorer.app import model as M
+    from explorer.app.view import view_camera
+    from explorer.render.live import LivePixels, picture
+    from explorer.shading.display import to_bytes
+    from explorer.shading.strip import compose_strip
+
+    w = open_window("--mesh", "torus", "--preset", "glossy_plastic", "--per-pixel")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    img = _pixels(w.plotter)
+    strip = w.view.strip
+    assert strip.pixel_tiles is not None and strip.report((0, 0, 0))["per_pixel"]
+    state = w.controller.state
+    camera = view_camera(w.plotter.camera, state.centre, state.radius)
+    scene = M.set_camera(state, camera).shown_scene()
+    bg = tuple(w.plotter.renderer.GetBackground())
+    x, y, tw, th = strip.tile_box("sum")
+    ref = picture(scene, w.view.mesh, (tw, th), camera=camera, background=bg).rgb
+    rows = slice(0, th - LABEL_ROWS)
+    assert (ref != to_bytes([bg])[0]).any(axis=2).mean() > 0.1  # the mesh fills the tile
+    assert np.array_equal(img[y : y + th, x : x + tw][rows], ref[rows])
+    with LivePixels(w.view.mesh) as live:
+        live.frame(scene, camera, (tw, th), background=bg)
+        g, _ = live.gbuffer(camera, (tw, th))
+        terms = compose_strip(scene, live.shader.terms, live.shader.colors, "weighted")
+        want = np.array(ref)
+        want.reshape(-1, 3)[g.pixels] = to_bytes(terms.tiles["diffuse"])
+    x, y, tw, th = strip.tile_box("diffuse")
+    assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
+    # the main view above the strip: the per-pixel picture of its own part of the window
+    from helpers.probes import interior
+    from test_window_pixels import rings
+
+    from explorer.render.perpixel import reference
+
+    x0, y0 = (int(v) for v in w.plotter.renderer.GetOrigin())
+    vw, vh = (int(v) for v in w.plotter.renderer.GetSize())
+    assert y0 > 0 and vh < w.plotter.window_size[1]  # (the strip under it)
+    ref = reference(scene, w.view.mesh, (vw, vh), camera=camera)
+    H = w.plotter.window_size[1]
+    got = img[H - y0 - vh : H - y0, x0 : x0 + vw]
+    d = np.abs(got - ref.image(bg).astype(int)).max(axis=2)
+    W = w.plotter.window_size[0]
+    free = interior(ref.mask) & ~rings(w.view, (W, H))[H - y0 - vh : H - y0, x0 : x0 + vw]
+    lx, ly, lw, lh = w.view.lobe.box  # (the inset: in the main renderer's own pixels)
+    free[vh - (ly + lh) - 2 :, : lx + lw + 3] = False
+    assert free.sum() > 5000 and d[free].max() <= 1
+    w.grab().save(str(tmp_path / "window_strip_per_pixel.png"))
+    # per vertex again: the tiles draw the mesh, the pictures gone
+    w.controller.set_value("shading", "per-vertex")
+    _pixels(w.plotter)
+    assert strip.pixel_tiles is None and not strip.report((0, 0, 0))["per_pixel"]
+
+
+def test_a_mesh_files_groups_each_in_its_material_in_the_strip(open_window, tmp_path):
+    """An OBJ of two groups in two materials drawn in them: the sum tile is the view's own
+    colours on every vertex, and each group's tiles recompose its own material (the window's
+    pixel at a vertex of each group within its one-ring's colours)."""
+    from helpers.files import write_two_groups
+
+    from explorer.shading.shader import Shader
+
+    w = open_window("--mesh", str(write_two_groups(tmp_path)))
+    state = w.controller.state
+    assert state.groups is not None and state.groups[0] != state.groups[1]
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    img = _pixels(w.plotter)
+    view, strip = w.view, w.view.strip
+    assert np.array_equal(strip.tiles[COLUMNS.index("sum")], view.displayed_colors())
+    mesh = view.mesh
+    for g, material in enumerate(state.groups):
+        rows = mesh.groups.vertices(g)
+        scene = view.drawings[0].shader.scene.replace(material=material)
+        own = Shader(scene, mesh.positions, mesh.normals, precision="float64")
+        terms = shader_strip(own, "weighted")
+        diffuse = strip.tiles[COLUMNS.index("diffuse")].astype(int)[rows]
+        assert np.abs(diffuse - np.rint(terms.tiles["diffuse"][rows] * 255)).max() <= 1
+        face = mesh.faces[np.isin(mesh.faces, rows).all(axis=1)][0]  # (a corner lies on the edge)
+        x, y = strip.tile_pixel("sum", view.to_view(mesh.positions[face].mean(axis=0)))
+        assert in_ring(img[y, x], strip.tiles[COLUMNS.index("sum")], face)
+
+
+def test_the_compare_views_panes_each_show_their_sides_strip(open_window):
+    """The compare view with the strip on: side B's pane has the strip of side B (its
+    material and model), side A's pane A's; each sum tile is its pane's own colours, and the
+    window's pixel of B's sum tile at the probe is within its one-ring's."""
+    w = open_window("--mesh", "sphere", "--preset", "gold")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    assert w.controller.set_value("compare", True, merge=False)
+    state = w.controller.state
+    assert state.compare != state.material or state.compare_model != state.scene.model
+    img = _pixels(w.plotter_b)
+    for view in (w.view, w.view_b):
+        assert view.strip.on
+        sum_tile = view.strip.tiles[COLUMNS.index("sum")]
+        assert np.array_equal(sum_tile, view.displayed_colors())
+    assert not np.array_equal(w.view.strip.tiles[3], w.view_b.strip.tiles[3])  # (specular)
+    view = w.view_b
+    i = view.probe_vertex()
+    x, y = view.strip.tile_pixel("sum", view.to_view(view.mesh.positions[i]))
+    assert in_ring(img[y, x], view.strip.tiles[COLUMNS.index("sum")], one_ring(view.mesh, i))

@@ -141,6 +141,7 @@ def test_the_lobe_follows_the_light_and_its_text_reads(win):
     pl = w.plotter
     w.render()
     x0, y0, bw, bh = w.view.lobe.box
+    bw = w.view.lobe._plot_box[2] + 2 * LI.LOBE_PAD  # (the plot's part: the lit sphere beside)
     _, h = pl.window_size
 
     def yellow_column():

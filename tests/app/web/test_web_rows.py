@@ -40,6 +40,8 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     wait("side B's rows", lambda: shown(browser, "compare_preset"))
     choose(browser, "lobes", "models")
     wait("the several lobes' rows", lambda: shown(browser, "lobe_view"))
+    click(browser, "lobe_incidence_on")
+    wait("the lobe incidence's number", lambda: shown(browser, "lobe_incidence"))
     click(browser, "strip")
     wait("the strip's mode", lambda: shown(browser, "strip_mode"))
     click(browser, "material tab")
@@ -49,8 +51,13 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     # the lists, the buttons and the views' toggles are rows too, drawn by no code of the page's
     assert {"preset", "light", "add_light", "difference", "compare", "swap"} <= set(P.BY_KEY)
     # a mesh file's own materials are shown with an OBJ's groups (test_web_parity.py): here
-    # they are on the page, hidden
-    hidden = ("mesh_materials", "group", "use_mesh_materials")
+    # they are on the page, hidden; so are the lobes past the three models'
+    hidden = (
+        "mesh_materials",
+        "group",
+        "use_mesh_materials",
+        *(f"show_lobe_{i}" for i in range(4, 9)),
+    )
     for tab in P.TABS:
         click(browser, f"{tab} tab")
         wait(f"the {tab} tab", lambda t=tab: shown(browser, P.rows(t)[-1].key))
@@ -58,7 +65,7 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
             for name in P.names(r):
                 assert shown(browser, name) != (name in hidden), (tab, name)
                 assert browser.find_elements(By.CSS_SELECTOR, f'[aria-label="{name}"]'), name
-    for _ in range(6):  # fresnel, the strip, the lobes, compare, hdr, the spot: the start
+    for _ in range(7):  # fresnel, the strip, the incidence, the lobes, compare, hdr, the spot
         click(browser, "undo")
     wait("the start again", lambda: report(browser)["session"] == rep["session"])
 

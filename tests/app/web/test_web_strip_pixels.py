@@ -1,0 +1,84 @@
+"""The term strip per pixel in a real browser (headless Chromium, issue 41): ``web --per-pixel``
+with the view tab's ``strip`` on draws each tile as a per-pixel picture at the tile's size and
+the view's camera; the page's sum tile is ``render --per-pixel``'s picture there (through the
+page's JPEG: within a few levels), not the per-vertex tile."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+import yaml
+from helpers.probes import interior
+from test_web import click, console_errors, open_page, report, wait
+from test_web_litsphere import _picture
+from webserver import Server, need_browser, new_browser
+
+from explorer.app import session as S
+from explorer.render.live import picture
+from explorer.render.offscreen import render_image
+
+pytestmark = pytest.mark.web
+#: the rows at a tile's bottom its label may cover (pixels)
+LABEL_ROWS = 20
+#: the per-pixel and the per-vertex tile are told apart where they differ by more than this
+DIFFER = 6
+
+
+@pytest.fixture(scope="module")
+def strip_server(tmp_path_factory):
+    """``phong-explorer web --mesh torus --preset glossy_plastic --per-pixel``."""
+    need_browser()
+    tmp = tmp_path_factory.mktemp("web_strip_pp")
+    env = dict(os.environ, PHONG_EXPLORER_MATERIALS=str(tmp / "presets"))
+    args = ["--mesh", "torus", "--preset", "glossy_plastic", "--per-pixel"]
+    srv = Server(args, tmp / "server.log", env=env)
+    yield srv
+    srv.stop()
+
+
+@pytest.fixture(scope="module")
+def strip_browser(strip_server, tmp_path_factory):
+    driver = new_browser(tmp_path_factory.mktemp("downloads_strip_pp"))
+    yield driver
+    driver.quit()
+
+
+def test_the_pages_sum_tile_is_the_per_pixel_picture(strip_server, strip_browser, tmp_path):
+    b = strip_browser
+    open_page(b, strip_server.url)
+    click(b, "view tab")
+    click(b, "strip")
+    wait("the per-pixel strip", lambda: (r := report(b))["strip"] and r["strip"]["per_pixel"])
+    last = {}
+
+    def agree():  # polled: the picture shown may be an older one on its way out
+        rep = report(b)
+        img = _picture(b, rep)
+        if img is None or not rep["strip"]:
+            return False
+        path = tmp_path / "page.yaml"
+        path.write_text(yaml.safe_dump(rep["session"]))
+        state, mesh = S.load_session(path)
+        x, y, tw, th = rep["strip"]["boxes"]["sum"]
+        ref = picture(state.shown_scene(), mesh, (tw, th), camera=state.camera)  # (its background)
+        got = img[y : y + th - LABEL_ROWS, x : x + tw]
+        # where the per-pixel picture and the per-vertex one differ by more than DIFFER levels,
+        # the page's tile lies nearer the per-pixel one (the page's JPEG moves both alike)
+        vertex = render_image(state.shown_scene(), mesh, (tw, th), camera=state.camera)
+        rows = slice(0, th - LABEL_ROWS)
+        pp, pv = ref.rgb[rows].astype(int), np.asarray(vertex)[rows, :, :3].astype(int)
+        where = interior(ref.mask)[rows] & (np.abs(pp - pv).max(axis=2) > DIFFER)
+        near_pp = float(np.abs(got - pp).max(axis=2)[where].mean()) if where.any() else 0.0
+        near_pv = float(np.abs(got - pv).max(axis=2)[where].mean()) if where.any() else 0.0
+        last["d"] = (int(where.sum()), near_pp, near_pv)
+        return where.sum() >= 30 and near_pp < 0.5 * near_pv and report(b) == rep
+
+    try:
+        wait("the page's sum tile to be the per-pixel picture", agree)
+    finally:
+        print("sum tile: pixels compared, off the per-pixel, off the per-vertex:", last.get("d"))
+    click(b, "strip")
+    wait("the strip off", lambda: report(b)["strip"] is None)
+    assert not console_errors(b)
