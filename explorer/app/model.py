@@ -28,6 +28,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import Scene, Viewer
+from explorer.core.texture import MAP_KEYS, TextureMap
 from explorer.render.camera import Camera, too_large
 
 Vec3 = tuple[float, float, float]
@@ -78,7 +79,8 @@ class State:
     preset : name of the preset the material came from, or None
     preset_material : that preset's material as loaded or last saved (the material is
         "edited" when it differs)
-    hidden : the terms not drawn (the material itself is unchanged)
+    hidden : the terms not drawn, and the texture maps turned off (the material itself is
+        unchanged: it keeps each map)
     light : index of the light the controls move
     handle_distance : where a directional light's handle sits, in mesh radii
     held_azimuth : the azimuth asked for last, kept while the light sits at a pole
@@ -100,6 +102,7 @@ class State:
         ``raw`` (:mod:`explorer.app.termstrip`)
     lobes, lobe_view, lobe_quantity, lobe_log, lobe_ndl : the lobe inset's lobes (the selected
         light's, or several) and how it plots them (:mod:`explorer.app.lobeinset`)
+    mesh_uv : the mesh has texture coordinates (its maps can be drawn)
     """
 
     scene: Scene
@@ -131,6 +134,7 @@ class State:
     lobe_quantity: str = "intensity"
     lobe_log: bool = False
     lobe_ndl: bool = False
+    mesh_uv: bool = False
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)
@@ -186,10 +190,12 @@ class State:
 
 def display_material(material: Material, hidden) -> Material:
     """The material drawn with some terms hidden: each hidden term's colour is 0
-    (``ambient`` also hides the emission, the other constant term)."""
-    changes = {t: (0.0, 0.0, 0.0) for t in TERMS if t in hidden}
+    (``ambient`` also hides the emission, the other constant term), and each map turned off
+    (a map key in ``hidden``) is drawn as no map."""
+    changes: dict = {t: (0.0, 0.0, 0.0) for t in TERMS if t in hidden}
     if "ambient" in changes:
         changes["emission"] = (0.0, 0.0, 0.0)
+    changes.update({k: None for k in MAP_KEYS if k in hidden and getattr(material, k)})
     return material.replace(**changes) if changes else material
 
 
@@ -294,6 +300,35 @@ def set_term(state: State, term: str, shown: bool) -> State:
         raise ExplorerError(f"term must be one of {TERMS}, got {term!r}")
     hidden = set(state.hidden)
     (hidden.discard if shown else hidden.add)(term)
+    return state.replace(hidden=frozenset(hidden))
+
+
+def set_map(state: State, key: str, file: str | None) -> State:
+    """Texture map ``key`` of the material read from image ``file`` (its options kept), or
+    taken away (None). The image is read first (:func:`explorer.render.textures.read_texture`:
+    a missing, damaged, too large or non-image file is one line and nothing changes); a map
+    set or taken away is drawn (it is no longer turned off)."""
+    from explorer.render.textures import read_texture  # (Pillow: only when a map is chosen)
+
+    if key not in MAP_KEYS:
+        raise ExplorerError(f"map must be one of {', '.join(MAP_KEYS)}, got {key!r}")
+    tmap = None
+    if file is not None:
+        old = getattr(state.material, key)
+        tmap = TextureMap(os.path.abspath(os.fspath(file)))
+        if old is not None:
+            tmap = replace(old, file=tmap.file)
+        read_texture(tmap, key)
+    state = _material(state, state.material.replace(**{key: tmap}))
+    return state.replace(hidden=state.hidden - {key})
+
+
+def show_map(state: State, key: str, on: bool) -> State:
+    """Texture map ``key`` drawn or turned off (the material keeps it)."""
+    if key not in MAP_KEYS or getattr(state.material, key) is None:
+        raise ExplorerError(f"the material has no {key} to turn on or off")
+    hidden = set(state.hidden)
+    (hidden.discard if on else hidden.add)(key)
     return state.replace(hidden=frozenset(hidden))
 
 
@@ -615,12 +650,13 @@ def _is_number(t: str) -> bool:
 # -- mesh ----------------------------------------------------------------------------------------
 
 
-def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = None) -> State:
+def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = None,
+             uv: bool = False) -> State:  # fmt: skip
     """Show another mesh: each light and a local viewer keep their places relative to the
     mesh, scaled to the new mesh's size (so the camera frames a mesh of size 1e-20 or 1e300 as
     it framed the last one); the material shown is kept over the whole mesh
     (:func:`with_mesh_materials` adds the new mesh's own). ``spec`` is the scene's ``mesh``
-    value (default: ``name``)."""
+    value (default: ``name``); ``uv``: the mesh has texture coordinates."""
     centre = tuple(float(c) for c in np.asarray(centre, dtype=np.float64))
     radius = float(radius) or 1.0
     # in radii first: no overflow from 1e-300 to 1e300
@@ -646,7 +682,7 @@ def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = 
     scene = state.scene.replace(lights=tuple(lights), mesh=spec or name, viewer=viewer)
     return state.replace(
         scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None,
-        mesh_materials=None, groups=None, group=0,
+        mesh_materials=None, groups=None, group=0, mesh_uv=uv,
     )  # fmt: skip
 
 

@@ -13,8 +13,12 @@ A row says what a control is, never how a toolkit draws it:
   ``choice`` (one of ``choices``), ``toggle`` (on / off), ``triple`` (three numbers),
   ``list`` (one of a list of :class:`Item`: the presets, the scene's lights) or ``button`` (an
   action that takes no value: add a light, swap A and B; its value is whether it can be
-  pressed now, and ``set_value(key, True)`` presses it) or ``text`` (a line the state says:
-  what the mesh's own materials are; nothing to set);
+  pressed now, and ``set_value(key, True)`` presses it), ``text`` (a line the state says:
+  what the mesh's own materials are; nothing to set) or ``image`` (a texture map of the
+  material: its thumbnail, its file's name, an on / off toggle ``<key>_on``, a choose-file and
+  a clear; its value is ``(file, on)``, ``(None, False)`` without a map, and its edit takes a
+  file name (choose), None (clear), True / False (on / off) or :data:`ASK_FILE` (the window
+  asks for a file first));
 - ``value(state)`` what it shows, ``visible(state)`` whether it is shown, and ``edit(state,
   value)`` the model action that sets it: the one table of the edits
   (:func:`edit`, which :meth:`Controller.set_value` applies), so no front end names an action.
@@ -49,9 +53,15 @@ from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import SHADINGS
+from explorer.core.texture import MAP_KEYS
 from explorer.shading.strip import MODES as STRIP_MODES
 
-KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text")
+KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text", "image")
+#: an image row's value that asks the front end's file dialog for the file first
+#: (:meth:`Controller.set_value <explorer.app.controller.Controller.set_value>`)
+ASK_FILE = object()
+#: why a mesh's texture maps are not shown
+NO_UV = "this mesh has no texture coordinates: its texture maps are not shown"
 TABS = ("material", "lights", "view")
 
 
@@ -313,6 +323,55 @@ def _material_effect_rows() -> list[Row]:
             lambda s, v: (E.set_material_field, ("energy_conserving", bool(v))),
             tip="normalise the specular lobe: a higher shininess narrows the highlight and "
             "raises its peak",
+        ),
+    ]
+
+
+def _map_edit(key: str):
+    """An image row's edit: a file name chooses the map's image, None takes the map away,
+    True / False turns it on / off; each one undo step named by what it did."""
+
+    def edit(s: M.State, v):
+        if isinstance(v, bool):
+            return M.show_map, (key, v), f"{key} {'on' if v else 'off'}"
+        if v is None:
+            return M.set_map, (key, None), f"clear {key}"
+        return M.set_map, (key, str(v)), f"{key} file"
+
+    return edit
+
+
+def _map_rows() -> list[Row]:
+    """The material's texture maps, after its own rows: shown when the mesh has (u, v), else
+    one line says why not."""
+
+    def shown(key):
+        def value(s: M.State):
+            tmap = getattr(s.material, key)
+            return (None, False) if tmap is None else (tmap.file, key not in s.hidden)
+
+        return value
+
+    return [
+        Row(
+            "maps_note",
+            "material",
+            "text",
+            lambda s: NO_UV,
+            _read_only("maps_note"),
+            lambda s: not s.mesh_uv,
+        ),
+        *(
+            Row(
+                key,
+                "material",
+                "image",
+                shown(key),
+                _map_edit(key),
+                lambda s: s.mesh_uv,
+                tip=f"the material's {key}: choose an image (PNG or JPEG), turn it off, clear it",
+            )
+            for key in MAP_KEYS
         ),
     ]
 
@@ -703,6 +762,7 @@ ROWS: tuple[Row, ...] = (
     *_preset_rows(),
     *_material_rows(),
     *_material_effect_rows(),
+    *_map_rows(),
     *_light_list_rows(),
     *_light_rows(),
     *_compare_rows(),
@@ -756,7 +816,10 @@ def edit(state: M.State, key: str, value, presets=()) -> tuple[Callable, tuple, 
 def names(r: Row) -> tuple[str, ...]:
     """The accessible names of a row's widgets that both front ends give: its key (the
     control, or the box of a control drawn as several widgets), and an optional number's
-    ``<key>_on`` toggle."""
+    ``<key>_on`` toggle; an image's toggle, choose-file and clear (``<key>_on``,
+    ``<key>_choose``, ``<key>_clear``)."""
+    if r.kind == "image":
+        return r.key, f"{r.key}_on", f"{r.key}_choose", f"{r.key}_clear"
     return (r.key, f"{r.key}_on") if r.kind == "number" and r.optional is not None else (r.key,)
 
 
@@ -777,4 +840,7 @@ def client_keys() -> dict[str, str]:
             out[r.key] = "index" if r.items is not None else "text"
         elif r.kind == "toggle":
             out[r.key] = "bool"
+        elif r.kind == "image":  # (its clear calls the page's handler)
+            out[f"{r.key}_on"] = "bool"
+            out[f"{r.key}_upload"] = "upload"
     return out
