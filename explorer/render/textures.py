@@ -117,9 +117,10 @@ THUMBNAIL_SIZE = 48
 
 
 def thumbnail(file: str, key: str = "diffuse_map", size: int = THUMBNAIL_SIZE) -> np.ndarray:
-    """Image ``file`` fitted to ``size`` pixels on its longer side, (h, w, 3) uint8 RGB, rows top
-    first: shrunk, each pixel the mean of the texels it covers (Pillow's box filter), so the
-    thumbnail's mean colour is the image's; a smaller image is grown, each texel a block.
+    """Image ``file`` as at most ``size`` pixels on its longer side, (h, w, 3) uint8 RGB, rows
+    top first, with the image's mean colour: a larger image shrunk, each pixel the mean of the
+    texels it covers (Pillow's box filter); a smaller one grown by a whole factor, each texel a
+    square block.
     Made once per file (name, size and modification time) and kept; a bad file raises
     :func:`read_texture`'s :class:`TextureError`."""
     try:
@@ -136,10 +137,12 @@ def _thumbnail(file: str, key: str, size: int, stamp) -> np.ndarray:
 
     image = Image.fromarray(read_texture(file, key)).convert("RGB")
     w, h = image.size
-    scale = size / max(w, h)
-    if scale != 1:
-        shape = (max(1, round(w * scale)), max(1, round(h * scale)))
-        image = image.resize(shape, Image.BOX if scale < 1 else Image.NEAREST)
+    if max(w, h) > size:
+        scale = size / max(w, h)
+        image = image.resize((max(1, round(w * scale)), max(1, round(h * scale))), Image.BOX)
+    elif max(w, h) * 2 <= size:
+        k = size // max(w, h)
+        image = image.resize((w * k, h * k), Image.NEAREST)
     out = np.ascontiguousarray(np.asarray(image, np.uint8))
     out.setflags(write=False)
     return out
