@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from PIL import Image
-from PySide6 import QtCore, QtWidgets
+from PySide6 import QtGui, QtWidgets
 
 from explorer.app.session import load_session, save_session
 
@@ -49,9 +49,6 @@ def show_maps(w, qtbot):
     w.panel.setCurrentIndex(0)
     w.panel.areas[0].ensureWidgetVisible(child(w, QtWidgets.QWidget, "diffuse_map"))
     qtbot.wait(50)
-
-
-from PySide6 import QtGui  # noqa: E402  (after the helpers that name it)
 
 
 def test_the_diffuse_maps_thumbnail_shows_the_image_and_its_name(open_window, qtbot):
