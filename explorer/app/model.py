@@ -28,7 +28,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import Scene, Viewer
-from explorer.core.texture import MAP_KEYS, TextureMap
+from explorer.core.texture import MAP_KEYS
 from explorer.render.camera import Camera, too_large
 
 Vec3 = tuple[float, float, float]
@@ -300,35 +300,6 @@ def set_term(state: State, term: str, shown: bool) -> State:
         raise ExplorerError(f"term must be one of {TERMS}, got {term!r}")
     hidden = set(state.hidden)
     (hidden.discard if shown else hidden.add)(term)
-    return state.replace(hidden=frozenset(hidden))
-
-
-def set_map(state: State, key: str, file: str | None) -> State:
-    """Texture map ``key`` of the material read from image ``file`` (its options kept), or
-    taken away (None). The image is read first (:func:`explorer.render.textures.read_texture`:
-    a missing, damaged, too large or non-image file is one line and nothing changes); a map
-    set or taken away is drawn (it is no longer turned off)."""
-    from explorer.render.textures import read_texture  # (Pillow: only when a map is chosen)
-
-    if key not in MAP_KEYS:
-        raise ExplorerError(f"map must be one of {', '.join(MAP_KEYS)}, got {key!r}")
-    tmap = None
-    if file is not None:
-        old = getattr(state.material, key)
-        tmap = TextureMap(os.path.abspath(os.fspath(file)))
-        if old is not None:
-            tmap = replace(old, file=tmap.file)
-        read_texture(tmap, key)
-    state = _material(state, state.material.replace(**{key: tmap}))
-    return state.replace(hidden=state.hidden - {key})
-
-
-def show_map(state: State, key: str, on: bool) -> State:
-    """Texture map ``key`` drawn or turned off (the material keeps it)."""
-    if key not in MAP_KEYS or getattr(state.material, key) is None:
-        raise ExplorerError(f"the material has no {key} to turn on or off")
-    hidden = set(state.hidden)
-    (hidden.discard if on else hidden.add)(key)
     return state.replace(hidden=frozenset(hidden))
 
 
@@ -650,8 +621,9 @@ def _is_number(t: str) -> bool:
 # -- mesh ----------------------------------------------------------------------------------------
 
 
-def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = None,
-             uv: bool = False) -> State:  # fmt: skip
+def set_mesh(
+    state: State, name: str, centre, radius: float, spec: str | None = None, uv: bool = False
+) -> State:
     """Show another mesh: each light and a local viewer keep their places relative to the
     mesh, scaled to the new mesh's size (so the camera frames a mesh of size 1e-20 or 1e300 as
     it framed the last one); the material shown is kept over the whole mesh

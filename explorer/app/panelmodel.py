@@ -42,7 +42,7 @@ from dataclasses import dataclass, replace
 
 from explorer.analysis.lobes import QUANTITIES as LOBE_QUANTITIES
 from explorer.analysis.lobes import VIEWS as LOBE_VIEWS
-from explorer.app import captions
+from explorer.app import captions, maprows
 from explorer.app import effectactions as E
 from explorer.app import lobeinset as LI
 from explorer.app import model as M
@@ -53,15 +53,13 @@ from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import SHADINGS
-from explorer.core.texture import MAP_KEYS
 from explorer.shading.strip import MODES as STRIP_MODES
 
 KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text", "image")
 #: an image row's value that asks the front end's file dialog for the file first
 #: (:meth:`Controller.set_value <explorer.app.controller.Controller.set_value>`)
 ASK_FILE = object()
-#: why a mesh's texture maps are not shown
-NO_UV = "this mesh has no texture coordinates: its texture maps are not shown"
+
 TABS = ("material", "lights", "view")
 
 
@@ -323,55 +321,6 @@ def _material_effect_rows() -> list[Row]:
             lambda s, v: (E.set_material_field, ("energy_conserving", bool(v))),
             tip="normalise the specular lobe: a higher shininess narrows the highlight and "
             "raises its peak",
-        ),
-    ]
-
-
-def _map_edit(key: str):
-    """An image row's edit: a file name chooses the map's image, None takes the map away,
-    True / False turns it on / off; each one undo step named by what it did."""
-
-    def edit(s: M.State, v):
-        if isinstance(v, bool):
-            return M.show_map, (key, v), f"{key} {'on' if v else 'off'}"
-        if v is None:
-            return M.set_map, (key, None), f"clear {key}"
-        return M.set_map, (key, str(v)), f"{key} file"
-
-    return edit
-
-
-def _map_rows() -> list[Row]:
-    """The material's texture maps, after its own rows: shown when the mesh has (u, v), else
-    one line says why not."""
-
-    def shown(key):
-        def value(s: M.State):
-            tmap = getattr(s.material, key)
-            return (None, False) if tmap is None else (tmap.file, key not in s.hidden)
-
-        return value
-
-    return [
-        Row(
-            "maps_note",
-            "material",
-            "text",
-            lambda s: NO_UV,
-            _read_only("maps_note"),
-            lambda s: not s.mesh_uv,
-        ),
-        *(
-            Row(
-                key,
-                "material",
-                "image",
-                shown(key),
-                _map_edit(key),
-                lambda s: s.mesh_uv,
-                tip=f"the material's {key}: choose an image (PNG or JPEG), turn it off, clear it",
-            )
-            for key in MAP_KEYS
         ),
     ]
 
@@ -762,7 +711,7 @@ ROWS: tuple[Row, ...] = (
     *_preset_rows(),
     *_material_rows(),
     *_material_effect_rows(),
-    *_map_rows(),
+    *maprows.map_rows(),
     *_light_list_rows(),
     *_light_rows(),
     *_compare_rows(),

@@ -163,8 +163,11 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         preset = checker.string(preset, ("preset",))
     hidden = m.get("hidden", [])
     if not isinstance(hidden, list) or any(h not in (*TERMS, *MAP_KEYS) for h in hidden):
-        checker.problem(("hidden",), f"must be a list of terms from {', '.join(TERMS)} and "
-                        f"maps turned off from {', '.join(MAP_KEYS)}")  # fmt: skip
+        checker.problem(
+            ("hidden",),
+            f"must be a list of terms from {', '.join(TERMS)} and "
+            f"maps turned off from {', '.join(MAP_KEYS)}",
+        )
         hidden = []
     handle = checker.number(m.get("handle_distance", 2.5), ("handle_distance",), 0.0, 1e6,
                             lo_open=True)  # fmt: skip

@@ -135,8 +135,9 @@ class FileFlows:
         try:
             mesh = self.c.meshes.get(name) or load_mesh_choice(name, self.c.mesh_choices.get(name))
             self._known_mesh(name, mesh)
-            state = M.set_mesh(self.c.store.state, name, mesh.centre, mesh.radius,
-                               uv=mesh.uv is not None)  # fmt: skip
+            state = M.set_mesh(
+                self.c.store.state, name, mesh.centre, mesh.radius, uv=mesh.uv is not None
+            )
             state = M.set_camera(state, self.c.framed(state, mesh))
             try:
                 state, warnings = add_mesh_materials(state, mesh)

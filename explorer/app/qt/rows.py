@@ -203,8 +203,11 @@ class RowWidgets(QtCore.QObject):
         name.setMinimumWidth(40)
         on = _named(QtWidgets.QCheckBox("on"), f"{r.key}_on", f"draw the {r.key}")
         on.toggled.connect(lambda v, k=r.key: self.send(k, bool(v), merge=False))
-        choose = _named(QtWidgets.QPushButton("choose…"), f"{r.key}_choose",
-                        f"choose the {r.key}'s image (PNG or JPEG)")  # fmt: skip
+        choose = _named(
+            QtWidgets.QPushButton("choose…"),
+            f"{r.key}_choose",
+            f"choose the {r.key}'s image (PNG or JPEG)",
+        )
         choose.clicked.connect(lambda _=False, k=r.key: self.send(k, ASK_FILE, merge=False))
         clear = _named(QtWidgets.QPushButton("clear"), f"{r.key}_clear", f"take the {r.key} away")
         clear.clicked.connect(lambda _=False, k=r.key: self.send(k, None, merge=False))

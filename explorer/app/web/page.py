@@ -192,27 +192,50 @@ def _image(v3, html, ctrl, r) -> None:
     """A texture map: its key, its thumbnail (``<key>_thumbnail``), its file's name, its switch
     ``<key>_on``, its upload ``<key>_upload`` (an image where the page's other uploads go) and
     its clear; hidden while the row is not shown."""
-    with html.Div(v_show=f"{r.key} != null", classes="my-1", title=r.tip,
-                  raw_attrs=[f'aria-label="{r.key}"']):  # fmt: skip
+    with html.Div(
+        v_show=f"{r.key} != null", classes="my-1", title=r.tip, raw_attrs=[f'aria-label="{r.key}"']
+    ):
         html.Div(r.caption, classes="text-body-2")
         with html.Div(classes="d-flex align-center"):
-            html.Img(src=(f"{r.key}_thumbnail",), v_show=f"{r.key}_thumbnail",
-                     width=THUMBNAIL_SIZE, height=THUMBNAIL_SIZE,
-                     style="object-fit: contain; image-rendering: pixelated", classes="mr-2",
-                     raw_attrs=[f'aria-label="{r.key}_thumbnail"'])  # fmt: skip
-            html.Span(f"{{{{ {r.key} }}}}", classes="text-body-2",
-                      raw_attrs=[f'aria-label="{r.key}_file"'])  # fmt: skip
+            html.Img(
+                src=(f"{r.key}_thumbnail",),
+                v_show=f"{r.key}_thumbnail",
+                width=THUMBNAIL_SIZE,
+                height=THUMBNAIL_SIZE,
+                style="object-fit: contain; image-rendering: pixelated",
+                classes="mr-2",
+                raw_attrs=[f'aria-label="{r.key}_thumbnail"'],
+            )
+            html.Span(
+                f"{{{{ {r.key} }}}}",
+                classes="text-body-2",
+                raw_attrs=[f'aria-label="{r.key}_file"'],
+            )
         with html.Div(classes="d-flex align-center"):
-            v3.VCheckbox(v_model=(f"{r.key}_on", False), label="on", density="compact",
-                         hide_details=True, disabled=(f"!{r.key}_thumbnail",),
-                         raw_attrs=[f'aria-label="{r.key}_on"'])  # fmt: skip
-            v3.VFileInput(v_model=(f"{r.key}_upload", None), label="upload",
-                          accept=".png,.jpg,.jpeg", density="compact", hide_details=True,
-                          classes="mx-1",
-                          raw_attrs=[f'aria-label="{r.key}_choose"'])  # fmt: skip
-            v3.VBtn("clear", click=(ctrl.clear_map, f"['{r.key}']"), size="small",
-                    disabled=(f"!{r.key}_thumbnail",),
-                    raw_attrs=[f'aria-label="{r.key}_clear"'])  # fmt: skip
+            v3.VCheckbox(
+                v_model=(f"{r.key}_on", False),
+                label="on",
+                density="compact",
+                hide_details=True,
+                disabled=(f"!{r.key}_thumbnail",),
+                raw_attrs=[f'aria-label="{r.key}_on"'],
+            )
+            v3.VFileInput(
+                v_model=(f"{r.key}_upload", None),
+                label="upload",
+                accept=".png,.jpg,.jpeg",
+                density="compact",
+                hide_details=True,
+                classes="mx-1",
+                raw_attrs=[f'aria-label="{r.key}_choose"'],
+            )
+            v3.VBtn(
+                "clear",
+                click=(ctrl.clear_map, f"['{r.key}']"),
+                size="small",
+                disabled=(f"!{r.key}_thumbnail",),
+                raw_attrs=[f'aria-label="{r.key}_clear"'],
+            )
 
 
 def _rows(v3, html, ctrl, tab: str, after=None) -> None:

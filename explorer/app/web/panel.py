@@ -391,8 +391,9 @@ def _files(app) -> None:
     on_upload("mtl_upload", app.files.import_uploaded_materials, "import materials")
     for r in panelmodel.ROWS:
         if r.kind == "image":
-            on_upload(f"{r.key}_upload",
-                      lambda u, k=r.key: app.files.open_uploaded_map(k, u), r.key)  # fmt: skip
+            on_upload(
+                f"{r.key}_upload", lambda u, k=r.key: app.files.open_uploaded_map(k, u), r.key
+            )
 
 
 def connect(app) -> None:

@@ -129,8 +129,11 @@ def test_choose_file_puts_the_image_on_the_mesh_and_a_bad_file_is_one_line(
     noise = np.random.default_rng(0).integers(0, 256, (64, 64, 3), np.uint8)
     Image.fromarray(noise).save(truncated)
     truncated.write_bytes(truncated.read_bytes()[:6000])
-    for bad, words in ((text, "not a PNG or JPEG"), (tmp_path / "gone.png", "does not exist"),
-                       (truncated, "damaged or truncated")):  # fmt: skip
+    for bad, words in (
+        (text, "not a PNG or JPEG"),
+        (tmp_path / "gone.png", "does not exist"),
+        (truncated, "damaged or truncated"),
+    ):
         state = w.controller.state
         answers.append(str(bad))
         click(qtbot, choose)

@@ -112,8 +112,11 @@ def test_an_uploaded_map_is_worn_shown_turned_off_and_on_and_undone(
     # off: the untextured picture; on again: the red one
     click(browser, "diffuse_map_on")
     wait("the map off", lambda: "diffuse_map" in report(browser)["session"].get("hidden", []))
-    off = settled(browser, "the mesh without its map",
-                  lambda p: min(np.abs(p - worn).mean(), np.abs(p - tiled).mean()) > 3)  # fmt: skip
+    off = settled(
+        browser,
+        "the mesh without its map",
+        lambda p: min(np.abs(p - worn).mean(), np.abs(p - tiled).mean()) > 3,
+    )
     click(browser, "diffuse_map_on")
     settled(browser, "the map on", lambda p: np.abs(p - worn).mean() < 1.5)
     # a bad file: one line, nothing changed
