@@ -84,6 +84,7 @@ def test_turning_the_map_off_draws_the_untextured_mesh_and_on_again_the_texture(
     click(qtbot, on)
     off = view_pixels(w)
     assert not on.isChecked() and "diffuse_map" in w.controller.state.hidden
+    assert "hidden: diffuse_map" in w.status_label.text()  # the status bar names it
     assert np.abs(off - textured).max() > 100
     assert w.controller.state.material.diffuse_map is not None  # kept
     w.controller.undo()
