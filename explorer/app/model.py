@@ -28,6 +28,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight, angles_of, direction_of
 from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import Scene, Viewer
+from explorer.core.texture import MAP_KEYS
 from explorer.render.camera import Camera, too_large
 
 Vec3 = tuple[float, float, float]
@@ -78,7 +79,8 @@ class State:
     preset : name of the preset the material came from, or None
     preset_material : that preset's material as loaded or last saved (the material is
         "edited" when it differs)
-    hidden : the terms not drawn (the material itself is unchanged)
+    hidden : the terms not drawn, and the texture maps turned off (the material itself is
+        unchanged: it keeps each map)
     light : index of the light the controls move
     handle_distance : where a directional light's handle sits, in mesh radii
     held_azimuth : the azimuth asked for last, kept while the light sits at a pole
@@ -103,6 +105,7 @@ class State:
     lobe_hidden : the lobes of the inset's set not drawn (0-based indices in the set)
     lobe_incidence : the incidence θ_i (degrees) the lobe plot and its lit sphere show, set by
         a drag on the sphere (:mod:`explorer.app.litsphere`); None: the selected light's
+    mesh_uv : the mesh has texture coordinates (its maps can be drawn)
     """
 
     scene: Scene
@@ -136,6 +139,7 @@ class State:
     lobe_ndl: bool = False
     lobe_hidden: frozenset = frozenset()
     lobe_incidence: float | None = None
+    mesh_uv: bool = False
 
     def replace(self, **changes) -> State:
         return replace(self, **changes)
@@ -191,10 +195,12 @@ class State:
 
 def display_material(material: Material, hidden) -> Material:
     """The material drawn with some terms hidden: each hidden term's colour is 0
-    (``ambient`` also hides the emission, the other constant term)."""
-    changes = {t: (0.0, 0.0, 0.0) for t in TERMS if t in hidden}
+    (``ambient`` also hides the emission, the other constant term), and each map turned off
+    (a map key in ``hidden``) is drawn as no map."""
+    changes: dict = {t: (0.0, 0.0, 0.0) for t in TERMS if t in hidden}
     if "ambient" in changes:
         changes["emission"] = (0.0, 0.0, 0.0)
+    changes.update({k: None for k in MAP_KEYS if k in hidden and getattr(material, k)})
     return material.replace(**changes) if changes else material
 
 
@@ -620,12 +626,14 @@ def _is_number(t: str) -> bool:
 # -- mesh ----------------------------------------------------------------------------------------
 
 
-def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = None) -> State:
+def set_mesh(
+    state: State, name: str, centre, radius: float, spec: str | None = None, uv: bool = False
+) -> State:
     """Show another mesh: each light and a local viewer keep their places relative to the
     mesh, scaled to the new mesh's size (so the camera frames a mesh of size 1e-20 or 1e300 as
     it framed the last one); the material shown is kept over the whole mesh
     (:func:`with_mesh_materials` adds the new mesh's own). ``spec`` is the scene's ``mesh``
-    value (default: ``name``)."""
+    value (default: ``name``); ``uv``: the mesh has texture coordinates."""
     centre = tuple(float(c) for c in np.asarray(centre, dtype=np.float64))
     radius = float(radius) or 1.0
     # in radii first: no overflow from 1e-300 to 1e300
@@ -651,7 +659,7 @@ def set_mesh(state: State, name: str, centre, radius: float, spec: str | None = 
     scene = state.scene.replace(lights=tuple(lights), mesh=spec or name, viewer=viewer)
     return state.replace(
         scene=scene, mesh=name, resolution=None, centre=centre, radius=radius, camera=None,
-        mesh_materials=None, groups=None, group=0,
+        mesh_materials=None, groups=None, group=0, mesh_uv=uv,
     )  # fmt: skip
 
 

@@ -13,8 +13,12 @@ A row says what a control is, never how a toolkit draws it:
   ``choice`` (one of ``choices``), ``toggle`` (on / off), ``triple`` (three numbers),
   ``list`` (one of a list of :class:`Item`: the presets, the scene's lights) or ``button`` (an
   action that takes no value: add a light, swap A and B; its value is whether it can be
-  pressed now, and ``set_value(key, True)`` presses it) or ``text`` (a line the state says:
-  what the mesh's own materials are; nothing to set);
+  pressed now, and ``set_value(key, True)`` presses it), ``text`` (a line the state says:
+  what the mesh's own materials are; nothing to set) or ``image`` (a texture map of the
+  material: its thumbnail, its file's name, an on / off toggle ``<key>_on``, a choose-file and
+  a clear; its value is ``(file, on)``, ``(None, False)`` without a map, and its edit takes a
+  file name (choose), None (clear), True / False (on / off) or :data:`ASK_FILE` (the window
+  asks for a file first));
 - ``value(state)`` what it shows, ``visible(state)`` whether it is shown, and ``edit(state,
   value)`` the model action that sets it: the one table of the edits
   (:func:`edit`, which :meth:`Controller.set_value` applies), so no front end names an action.
@@ -36,7 +40,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from explorer.app import captions, loberows
+from explorer.app import captions, loberows, maprows
 from explorer.app import effectactions as E
 from explorer.app import model as M
 from explorer.app import termstrip as T
@@ -48,7 +52,11 @@ from explorer.core.material import MODELS, RGB_KEYS, Material
 from explorer.core.scene import SHADINGS
 from explorer.shading.strip import MODES as STRIP_MODES
 
-KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text")
+KINDS = ("number", "colour", "choice", "toggle", "triple", "list", "button", "text", "image")
+#: an image row's value that asks the front end's file dialog for the file first
+#: (:meth:`Controller.set_value <explorer.app.controller.Controller.set_value>`)
+ASK_FILE = object()
+
 TABS = ("material", "lights", "view")
 
 
@@ -636,6 +644,7 @@ ROWS: tuple[Row, ...] = (
     *_preset_rows(),
     *_material_rows(),
     *_material_effect_rows(),
+    *maprows.map_rows(),
     *_light_list_rows(),
     *_light_rows(),
     *_compare_rows(),
@@ -689,7 +698,10 @@ def edit(state: M.State, key: str, value, presets=()) -> tuple[Callable, tuple, 
 def names(r: Row) -> tuple[str, ...]:
     """The accessible names of a row's widgets that both front ends give: its key (the
     control, or the box of a control drawn as several widgets), and an optional number's
-    ``<key>_on`` toggle."""
+    ``<key>_on`` toggle; an image's toggle, choose-file and clear (``<key>_on``,
+    ``<key>_choose``, ``<key>_clear``)."""
+    if r.kind == "image":
+        return r.key, f"{r.key}_on", f"{r.key}_choose", f"{r.key}_clear"
     return (r.key, f"{r.key}_on") if r.kind == "number" and r.optional is not None else (r.key,)
 
 
@@ -710,4 +722,7 @@ def client_keys() -> dict[str, str]:
             out[r.key] = "index" if r.items is not None else "text"
         elif r.kind == "toggle":
             out[r.key] = "bool"
+        elif r.kind == "image":  # (its clear calls the page's handler)
+            out[f"{r.key}_on"] = "bool"
+            out[f"{r.key}_upload"] = "upload"
     return out

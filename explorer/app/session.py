@@ -7,7 +7,7 @@ A session file is YAML (or JSON, which YAML reads too)::
     mesh: teapot               # the mesh chooser's name (a built-in name or a file path)
     resolution: null           # a built-in mesh's resolution (null: the explorer's)
     preset: gold               # the preset the material came from, or null
-    hidden: [specular]         # terms not drawn
+    hidden: [specular]         # terms not drawn (and maps turned off: diffuse_map...)
     light: 1                   # the light the controls move (1 is the first)
     handle_distance: 2.5       # where a directional light's handle sits, in mesh radii
     camera: {position: [..], focal_point: [..], view_up: [..], parallel: false,
@@ -53,6 +53,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.material import MODELS, parse_material
 from explorer.core.mtl import MtlError
 from explorer.core.scene import SHADINGS, load_scene
+from explorer.core.texture import MAP_KEYS
 from explorer.core.yamlio import dump_yaml, load_yaml
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
@@ -97,7 +98,7 @@ def session_mapping(state: State) -> dict:
         "mesh": state.mesh,
         "resolution": state.resolution,
         "preset": state.preset,
-        "hidden": [t for t in TERMS if t in state.hidden],
+        "hidden": [t for t in (*TERMS, *MAP_KEYS) if t in state.hidden],
         "light": state.light + 1,
         "handle_distance": float(state.handle_distance),
         "difference": bool(state.difference),
@@ -167,8 +168,12 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     if preset is not None:
         preset = checker.string(preset, ("preset",))
     hidden = m.get("hidden", [])
-    if not isinstance(hidden, list) or any(h not in TERMS for h in hidden):
-        checker.problem(("hidden",), f"must be a list of terms from {', '.join(TERMS)}")
+    if not isinstance(hidden, list) or any(h not in (*TERMS, *MAP_KEYS) for h in hidden):
+        checker.problem(
+            ("hidden",),
+            f"must be a list of terms from {', '.join(TERMS)} and "
+            f"maps turned off from {', '.join(MAP_KEYS)}",
+        )
         hidden = []
     handle = checker.number(m.get("handle_distance", 2.5), ("handle_distance",), 0.0, 1e6,
                             lo_open=True)  # fmt: skip

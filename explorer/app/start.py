@@ -92,6 +92,7 @@ def first_state(
         radius=float(mesh.radius or 1.0),
         preset=preset,
         preset_material=clean,
+        mesh_uv=mesh.uv is not None,
     )
 
 

@@ -14,6 +14,7 @@ The image's rows go to OpenGL bottom row first (``glTexImage2D``'s first row is 
 
 from __future__ import annotations
 
+import functools
 import io
 import os
 import re
@@ -109,3 +110,39 @@ def texel_index(shape, st, *, clamp: bool = False) -> tuple[np.ndarray, np.ndarr
     i = np.clip(np.floor(s * w), 0, w - 1).astype(np.int64)
     j = np.clip(np.floor(t * h), 0, h - 1).astype(np.int64)
     return j, i
+
+
+#: a map's thumbnail in the panels: its longer side (pixels)
+THUMBNAIL_SIZE = 48
+
+
+def thumbnail(file: str, key: str = "diffuse_map", size: int = THUMBNAIL_SIZE) -> np.ndarray:
+    """Image ``file`` as at most ``size`` pixels on its longer side, (h, w, 3) uint8 RGB, rows
+    top first, with the image's mean colour: a larger image shrunk, each pixel the mean of the
+    texels it covers (Pillow's box filter); a smaller one grown by a whole factor, each texel a
+    square block.
+    Made once per file (name, size and modification time) and kept; a bad file raises
+    :func:`read_texture`'s :class:`TextureError`."""
+    try:
+        st = os.stat(file)
+        stamp = (st.st_mtime_ns, st.st_size)
+    except OSError:
+        stamp = None  # read_texture says what is wrong
+    return _thumbnail(os.fspath(file), key, size, stamp)
+
+
+@functools.lru_cache(maxsize=64)
+def _thumbnail(file: str, key: str, size: int, stamp) -> np.ndarray:
+    from PIL import Image
+
+    image = Image.fromarray(read_texture(file, key)).convert("RGB")
+    w, h = image.size
+    if max(w, h) > size:
+        scale = size / max(w, h)
+        image = image.resize((max(1, round(w * scale)), max(1, round(h * scale))), Image.BOX)
+    elif max(w, h) * 2 <= size:
+        k = size // max(w, h)
+        image = image.resize((w * k, h * k), Image.NEAREST)
+    out = np.ascontiguousarray(np.asarray(image, np.uint8))
+    out.setflags(write=False)
+    return out

@@ -19,6 +19,7 @@ from explorer.core.errors import ExplorerError
 from explorer.core.lights import DirectionalLight, PointLight, SpotLight
 from explorer.core.presets import list_presets
 from explorer.core.scene import Scene
+from explorer.core.texture import MAP_KEYS
 from explorer.geometry.meshes import get_mesh
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -85,7 +86,10 @@ MORE_LOBES = tuple(f"show_lobe_{i}" for i in range(4, 9))
 #: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
 MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
 #: the rows that are lines of text the state gives (read, never set)
-LINES = ("material_line",)
+LINES = ("material_line", "maps_note")
+#: the material's texture maps (image rows, tried below)
+MAPS = MAP_KEYS
+TILES = ROOT / "docs" / "examples" / "tiles.png"
 #: the presets a preset row's edit is given (the controller's)
 PRESETS = list_presets()
 
@@ -116,7 +120,9 @@ def test_every_row_is_one_declared_control():
             assert r.key in CONTROLS, r.key  # its range, scale and decimals: core.controls
         if r.kind in ("choice", "list"):  # fixed values, or items (the state's, a catalogue's)
             assert bool(r.choices) + (r.items is not None) + bool(r.source) == 1, r.key
-    assert set(SAMPLES) | set(MESH_MATERIALS) | set(LINES) | set(MORE_LOBES) == set(P.BY_KEY)
+    assert set(SAMPLES) | set(MESH_MATERIALS) | set(LINES) | set(MORE_LOBES) | set(MAPS) == set(
+        P.BY_KEY
+    )  # each tried below
     with pytest.raises(ExplorerError, match="no control named 'glossiness'"):
         P.row("glossiness")
 
@@ -170,6 +176,47 @@ def test_a_lobe_row_a_lobe_of_the_set_each_hidden_and_kept_by_a_session(mesh, tm
     assert again.lobe_hidden == store.state.lobe_hidden == frozenset({1, 3, 4, 5, 6, 7})
     with pytest.raises(ExplorerError, match="a lobe's index"):
         LI.set_lobe_shown(s, -1, False)
+
+
+@pytest.mark.parametrize("key", MAPS)
+def test_each_map_row_chooses_turns_off_clears_in_undo_steps_a_session_keeps(key, tmp_path):
+    """A map row on a mesh with (u, v): a file chosen, turned off (the material keeps it, the
+    shown scene has none), cleared: one undo step each, kept by a session; a file that is not
+    an image is one line naming it and changes nothing."""
+    s = start(get_mesh("icosphere", 2, uv=True))
+    r = P.row(key)
+    assert r.visible(s) and not P.row("maps_note").visible(s) and r.value(s) == (None, False)
+    store = M.Store(s)
+
+    def do(value):
+        action, args, label = P.edit(store.state, key, value)
+        assert store.apply(action, *args, label=label)
+        return label
+
+    assert do(str(TILES)) == f"{key} file"
+    assert r.value(store.state) == (str(TILES), True)
+    assert getattr(store.state.shown_scene().material, key).file == str(TILES)
+    assert do(False) == f"{key} off"
+    assert r.value(store.state) == (str(TILES), False)
+    assert getattr(store.state.shown_scene().material, key) is None
+    again, _ = load_session(save_session(tmp_path / "s.yaml", store.state))
+    assert r.value(again) == (str(TILES), False)
+    bad = tmp_path / "notes.png"
+    bad.write_text("not an image")
+    action, args, _ = P.edit(store.state, key, str(bad))
+    with pytest.raises(ExplorerError, match=f"{key} '.*notes.png': not a PNG or JPEG image"):
+        action(store.state, *args)
+    assert do(None) == f"clear {key}" and r.value(store.state) == (None, False)
+    store.undo()
+    assert r.value(store.state) == (str(TILES), False)
+    store.undo()
+    assert r.value(store.state) == (str(TILES), True)
+
+
+def test_a_mesh_without_texture_coordinates_shows_why_and_no_map_row(mesh):
+    s = start(mesh)  # (no (u, v))
+    assert P.row("maps_note").visible(s) and "no texture coordinates" in P.row("maps_note").value(s)
+    assert not any(P.row(k).visible(s) for k in MAPS)
 
 
 def test_a_button_row_applies_its_action_and_says_when_it_can_be_pressed(mesh):

@@ -20,6 +20,9 @@ from explorer.core.presets import list_presets
 from explorer.geometry.meshes import Mesh
 from explorer.render.camera import Camera
 
+#: the file dialog's filter for a texture map's image
+IMAGE_FILTER = "images (*.png *.jpg *.jpeg);;all files (*)"
+
 log = logging.getLogger(__name__)
 
 #: a view smaller than this (either side, pixels) is not laid out yet: no difference asked
@@ -136,7 +139,12 @@ class Controller:
         list's item: a preset's name, a light's index); a run of steps of one control is one
         undo step until :meth:`release`. A key the state does not show (a spot's cutoff on a
         point light) is refused by its action and said; an unknown key or preset raises
-        :class:`ExplorerError`."""
+        :class:`ExplorerError`. An image row's :data:`~explorer.app.panelmodel.ASK_FILE` asks
+        the front end's file dialog for the image first (nothing when none is given)."""
+        if value is panelmodel.ASK_FILE:
+            value = self.ports.dialogs.ask_path(f"Choose the {key} image", filter=IMAGE_FILTER)
+            if not value:
+                return False
         action, args, label = panelmodel.edit(self.store.state, key, value, self.presets)
         return self.act(action, *args, label=label, merge=key if merge else None)
 

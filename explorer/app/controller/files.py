@@ -135,7 +135,9 @@ class FileFlows:
         try:
             mesh = self.c.meshes.get(name) or load_mesh_choice(name, self.c.mesh_choices.get(name))
             self._known_mesh(name, mesh)
-            state = M.set_mesh(self.c.store.state, name, mesh.centre, mesh.radius)
+            state = M.set_mesh(
+                self.c.store.state, name, mesh.centre, mesh.radius, uv=mesh.uv is not None
+            )
             state = M.set_camera(state, self.c.framed(state, mesh))
             try:
                 state, warnings = add_mesh_materials(state, mesh)
@@ -199,7 +201,7 @@ class FileFlows:
         if scene.mesh is not None and scene.mesh != s.mesh:
             mesh = load_mesh_choice(scene.mesh)
             self._known_mesh(scene.mesh, mesh)
-            new = M.set_mesh(new, scene.mesh, mesh.centre, mesh.radius)
+            new = M.set_mesh(new, scene.mesh, mesh.centre, mesh.radius, uv=mesh.uv is not None)
             new = new.replace(scene=new.scene.replace(lights=scene.lights))
             try:
                 new, _ = add_mesh_materials(new, mesh, use=False)

@@ -10,15 +10,22 @@ object name and accessible name; a row's label is its caption (its key unless it
 words: a term's toggle its term). A list is a list widget (a searched one with its search
 field ``<key>_search`` above and its selected item's subtitle ``<key>_description`` below); a
 choice whose values are not fixed (side B's preset, the mesh's groups) a combo box of its items;
-a button is enabled when its value says it can be pressed; a text a label.
+a button is enabled when its value says it can be pressed; a text a label; an image (a texture
+map) its caption over a line of its thumbnail ``<key>_thumbnail`` (made once per file:
+:func:`explorer.render.textures.thumbnail`), its file's name ``<key>_file``, the toggle
+``<key>_on``, ``<key>_choose`` (the window's file dialog) and ``<key>_clear``.
 """
 
 from __future__ import annotations
 
+import os
+
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from explorer.app.panelmodel import Item, Row
+from explorer.app.panelmodel import ASK_FILE, Item, Row
 from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider, swatch
+from explorer.core.errors import ExplorerError
+from explorer.render.textures import THUMBNAIL_SIZE, thumbnail
 
 #: a label's least width (pixels): the labels of a tab line up with the sliders' own
 LABEL_WIDTH = 64
@@ -67,6 +74,7 @@ class RowWidgets(QtCore.QObject):
         self.items: dict[str, tuple[Item, ...]] = {}
         self.searches: dict[str, QtWidgets.QLineEdit] = {}  # a searched list's field
         self.descriptions: dict[str, QtWidgets.QLabel] = {}  # its selected item's subtitle
+        self.images: dict[str, dict[str, QtWidgets.QWidget]] = {}  # an image's parts
         grids: dict[str, QtWidgets.QGridLayout] = {}
         lines: dict[str, QtWidgets.QHBoxLayout] = {}
         for r in self.rows:
@@ -181,6 +189,37 @@ class RowWidgets(QtCore.QObject):
         b = _named(QtWidgets.QPushButton(r.caption), r.key, r.tip)
         b.clicked.connect(lambda _=False, k=r.key: self.send(k, True, merge=False))
         return b
+
+    def _image(self, r: Row) -> QtWidgets.QWidget:
+        """A texture map: its key over its thumbnail, its file's name, on / off, choose, clear."""
+        box = _named(QtWidgets.QWidget(), r.key, r.tip)
+        lay = QtWidgets.QGridLayout(box)
+        lay.setContentsMargins(0, 0, 0, 0)
+        thumb = _named(QtWidgets.QLabel(), f"{r.key}_thumbnail")
+        thumb.setFixedSize(THUMBNAIL_SIZE, THUMBNAIL_SIZE)
+        thumb.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
+        thumb.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
+        name = _named(QtWidgets.QLabel(""), f"{r.key}_file")
+        name.setMinimumWidth(40)
+        on = _named(QtWidgets.QCheckBox("on"), f"{r.key}_on", f"draw the {r.key}")
+        on.toggled.connect(lambda v, k=r.key: self.send(k, bool(v), merge=False))
+        choose = _named(
+            QtWidgets.QPushButton("choose…"),
+            f"{r.key}_choose",
+            f"choose the {r.key}'s image (PNG or JPEG)",
+        )
+        choose.clicked.connect(lambda _=False, k=r.key: self.send(k, ASK_FILE, merge=False))
+        clear = _named(QtWidgets.QPushButton("clear"), f"{r.key}_clear", f"take the {r.key} away")
+        clear.clicked.connect(lambda _=False, k=r.key: self.send(k, None, merge=False))
+        lay.addWidget(QtWidgets.QLabel(r.caption), 0, 0, 1, 4)
+        lay.addWidget(thumb, 1, 0, 2, 1)
+        lay.addWidget(name, 1, 1, 1, 3)
+        lay.addWidget(on, 2, 1)
+        lay.addWidget(choose, 2, 2)
+        lay.addWidget(clear, 2, 3)
+        lay.setColumnStretch(1, 1)
+        self.images[r.key] = {"thumbnail": thumb, "file": name, "on": on, "clear": clear}
+        return box
 
     def _triple(self, r: Row) -> QtWidgets.QWidget:
         """Three number fields (the attenuation's kc, kl, kq), a row a part (a narrow panel),
@@ -342,6 +381,28 @@ class RowWidgets(QtCore.QObject):
 
     def _show_button(self, r: Row, w, v, s) -> None:
         w.setEnabled(bool(v))
+
+    def _show_image(self, r: Row, w, v, s) -> None:
+        file, on = v
+        parts = self.images[r.key]
+        thumb, name = parts["thumbnail"], parts["file"]
+        with QtCore.QSignalBlocker(parts["on"]):
+            parts["on"].setChecked(bool(on))
+        parts["on"].setEnabled(file is not None)
+        parts["clear"].setEnabled(file is not None)
+        name.setText("(none)" if file is None else os.path.basename(file))
+        name.setToolTip(file or "")
+        if file is None:
+            thumb.clear()
+            return
+        try:
+            rgb = thumbnail(file, r.key)
+        except ExplorerError:  # the file went away or changed: its name says it, no picture
+            thumb.clear()
+            return
+        h, wd = rgb.shape[:2]
+        image = QtGui.QImage(rgb.data, wd, h, 3 * wd, QtGui.QImage.Format.Format_RGB888)
+        thumb.setPixmap(QtGui.QPixmap.fromImage(image.copy()))
 
     def _show_triple(self, r: Row, w, v, s) -> None:
         for f, x in zip(self.fields[r.key], v, strict=True):

@@ -11,6 +11,7 @@ from explorer.app import captions
 from explorer.app import model as M
 from explorer.app.session import session_mapping
 from explorer.core.atomic import write_atomic
+from explorer.core.texture import MAP_KEYS
 
 
 class QtPictures:
@@ -32,8 +33,9 @@ class QtPictures:
         if state.groups is not None:
             what = f"{state.mesh_materials.source}'s materials"
         parts = [what, state.scene.model]
-        if state.hidden:
-            parts.append("hidden: " + ", ".join(t for t in M.TERMS if t in state.hidden))
+        hidden = [t for t in (*M.TERMS, *MAP_KEYS) if t in state.hidden]  # (terms, maps off)
+        if hidden:
+            parts.append("hidden: " + ", ".join(hidden))
         w.status_label.setText(";  ".join(parts))
 
     def show_legend(self, legend: str, advice: str) -> None:

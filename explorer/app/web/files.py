@@ -197,6 +197,19 @@ class WebFiles:
             )
         self.app.controller.files.open_session(path)
 
+    def open_uploaded_map(self, key: str, upload) -> None:
+        """An image chosen in the page for texture map ``key``: capped at
+        :data:`~explorer.core.tolerances.MAX_TEXTURE_FILE_BYTES`, kept under its own safe name
+        where the page's other uploads go, then set by the controller (one undo step; a file
+        that is not a PNG or JPEG image is one line and nothing changes)."""
+        uploads = upload if isinstance(upload, list) else [upload]
+        if len(uploads) != 1:
+            raise ExplorerError(f"{key}: upload one image (PNG or JPEG), got {len(uploads)}")
+        name, data = upload_bytes(uploads[0], tol.MAX_TEXTURE_FILE_BYTES, f"{key} image")
+        path = self._fresh_folder("map") / upload_name(name)
+        path.write_bytes(data)
+        self.app.controller.set_value(key, os.fspath(path), merge=False)
+
     @staticmethod
     def _upload_limit(name: str) -> tuple[int, str]:
         """The cap of an upload named ``name`` in a mesh's upload, and what it is called."""

@@ -19,6 +19,7 @@ from explorer.core.controls import STEPS
 from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
 from explorer.core.version import __version__
 from explorer.geometry.meshes import MESH_SUFFIXES
+from explorer.render.textures import THUMBNAIL_SIZE
 
 #: the drawer's width on a wide page (pixels)
 DRAWER_WIDTH = 380
@@ -213,6 +214,56 @@ def _triple(v3, ctrl, r) -> None:
     )  # fmt: skip
 
 
+def _image(v3, html, ctrl, r) -> None:
+    """A texture map: its key, its thumbnail (``<key>_thumbnail``), its file's name, its switch
+    ``<key>_on``, its upload ``<key>_upload`` (an image where the page's other uploads go) and
+    its clear; hidden while the row is not shown."""
+    with html.Div(
+        v_show=f"{r.key} != null", classes="my-1", title=r.tip, raw_attrs=[f'aria-label="{r.key}"']
+    ):
+        html.Div(r.caption, classes="text-body-2")
+        with html.Div(classes="d-flex align-center"):
+            html.Img(
+                src=(f"{r.key}_thumbnail",),
+                v_show=f"{r.key}_thumbnail",
+                width=THUMBNAIL_SIZE,
+                height=THUMBNAIL_SIZE,
+                style="object-fit: contain; image-rendering: pixelated",
+                classes="mr-2",
+                raw_attrs=[f'aria-label="{r.key}_thumbnail"'],
+            )
+            html.Span(
+                f"{{{{ {r.key} }}}}",
+                classes="text-body-2",
+                raw_attrs=[f'aria-label="{r.key}_file"'],
+            )
+        with html.Div(classes="d-flex align-center"):
+            v3.VCheckbox(
+                v_model=(f"{r.key}_on", False),
+                label="on",
+                density="compact",
+                hide_details=True,
+                disabled=(f"!{r.key}_thumbnail",),
+                raw_attrs=[f'aria-label="{r.key}_on"'],
+            )
+            v3.VFileInput(
+                v_model=(f"{r.key}_upload", None),
+                label="upload",
+                accept=".png,.jpg,.jpeg",
+                density="compact",
+                hide_details=True,
+                classes="mx-1",
+                raw_attrs=[f'aria-label="{r.key}_choose"'],
+            )
+            v3.VBtn(
+                "clear",
+                click=(ctrl.clear_map, f"['{r.key}']"),
+                size="small",
+                disabled=(f"!{r.key}_thumbnail",),
+                raw_attrs=[f'aria-label="{r.key}_clear"'],
+            )
+
+
 def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     """The rows of ``tab`` (:mod:`explorer.app.panelmodel`), one factory per kind; a group of
     toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
@@ -241,6 +292,8 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
             _button(v3, ctrl, r)
         elif r.kind == "text":
             _text(html, r)
+        elif r.kind == "image":
+            _image(v3, html, ctrl, r)
         else:
             _triple(v3, ctrl, r)
         group = r.group if r.kind in ("toggle", "button") else None
@@ -388,6 +441,7 @@ def _page_state(state) -> None:
         message="", message_level="info", message_seq=0, seen_seq=0, page_w=1280, field_rev=0,
         message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
+        **{f"{r.key}_upload": None for r in panelmodel.ROWS if r.kind == "image"},
         turntable_ready=False, turntable_made="",
         turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
         compare=False,

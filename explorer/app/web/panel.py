@@ -11,14 +11,21 @@ step (sealed when it ends), a value typed into a field and confirmed (Enter, or 
 field) is one step, parsed as the desktop's fields parse it
 (:func:`explorer.app.model.parse_number`). An optional number has its switch ``<key>_on``; a
 colour its ``r, g, b`` text and its 8-bit ``<key>_hex``; a choice, a toggle, a list and a triple
-their value. A list's (or a choice's) items are state key ``<key>_items`` when the state gives
-them (the lights), or the catalogue's own key (``presets``, set when the controller's presets
-change: :func:`item`). Every edit is :meth:`Controller.set_value`. A change the server pushed
-itself, or one equal to what the state shows, is no change.
+their value; an image (a texture map) its file's name (state key ``<key>``), its switch
+``<key>_on``, its thumbnail as a PNG data URL (``<key>_thumbnail``, made once per file) and its
+upload ``<key>_upload``. A list's (or a choice's) items are state key ``<key>_items`` when the
+state gives them (the lights), or the catalogue's own key (``presets``, set when the
+controller's presets change: :func:`item`). Every edit is :meth:`Controller.set_value`. A
+change the server pushed itself, or one equal to what the state shows, is no change.
 """
 
 from __future__ import annotations
 
+import base64
+import functools
+import io
+import os
+from os.path import basename
 from urllib.parse import quote
 
 from explorer.app import model as M
@@ -26,6 +33,7 @@ from explorer.app import panelmodel
 from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
 from explorer.core.controls import field_text, from_step, to_step, without_unit
 from explorer.core.errors import ExplorerError
+from explorer.render.textures import thumbnail
 
 #: the number rows (a slider and a field each)
 NUMBERS = tuple(r for r in panelmodel.ROWS if r.kind == "number")
@@ -56,6 +64,32 @@ def swatch_url(m) -> str:
            f"<rect width='18' height='18' fill='{css(m.diffuse)}'/>"
            f"<rect x='9' width='9' height='9' fill='{css(m.specular)}'/></svg>")  # fmt: skip
     return "data:image/svg+xml;utf8," + quote(svg)
+
+
+def thumbnail_url(file: str, key: str) -> str:
+    """Image ``file``'s thumbnail (:func:`explorer.render.textures.thumbnail`, the window's) as
+    a PNG data URL; "" when the file cannot be read now (its name says which)."""
+    try:
+        return _png_url(file, key, *_stamp(file))
+    except ExplorerError:
+        return ""
+
+
+def _stamp(file: str) -> tuple:
+    try:
+        st = os.stat(file)
+    except OSError:
+        return (None, None)
+    return st.st_mtime_ns, st.st_size
+
+
+@functools.lru_cache(maxsize=64)
+def _png_url(file: str, key: str, *_stamp) -> str:
+    from PIL import Image
+
+    out = io.BytesIO()
+    Image.fromarray(thumbnail(file, key)).save(out, format="PNG")
+    return "data:image/png;base64," + base64.b64encode(out.getvalue()).decode("ascii")
 
 
 def item(it: panelmodel.Item) -> dict:
@@ -98,6 +132,11 @@ def row_values(state: M.State) -> dict:
             out[f"{r.key}_hex"] = None if v is None else rgb_hex(v)
         elif r.kind == "triple":
             out[r.key] = None if v is None else rgb_text(v)
+        elif r.kind == "image":
+            file, on = v if v is not None else (None, None)
+            out[r.key] = None if v is None else ("(none)" if file is None else basename(file))
+            out[f"{r.key}_on"] = None if v is None else bool(on)
+            out[f"{r.key}_thumbnail"] = "" if file is None else thumbnail_url(file, r.key)
         else:
             out[r.key] = v
         if r.items is not None:  # (none while the row is hidden)
@@ -243,6 +282,14 @@ def _rows(app, user) -> None:
                 lambda v, s, r=r: r.visible(s) and v != r.value(s),
                 lambda v, r=r: c.set_value(r.key, v, merge=False),
             )
+        elif r.kind == "image":
+            user(
+                f"{r.key}_on",
+                lambda v, s, r=r: (
+                    r.visible(s) and r.value(s)[0] is not None and bool(v) != r.value(s)[1]
+                ),
+                lambda v, r=r: c.set_value(r.key, bool(v), merge=False),
+            )
         elif r.optional is not None:
             user(
                 f"{r.key}_on",
@@ -291,6 +338,15 @@ def _choices(app) -> None:
         c.set_value(r.key, True, merge=False)
 
     ctrl.press = app.guard(press, "button")
+
+    def clear_map(key):
+        """An image row's clear (any other key from the page is refused)."""
+        r = panelmodel.BY_KEY.get(str(key))
+        if r is None or r.kind != "image":
+            raise ExplorerError(f"the page has no texture map named '{key}'")
+        c.set_value(r.key, None, merge=False)
+
+    ctrl.clear_map = app.guard(clear_map, "clear map")
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
     ctrl.turntable = app.guard(lambda: app.files.start_turntable(
@@ -333,6 +389,11 @@ def _files(app) -> None:
     on_upload("session_upload", app.files.open_uploaded_session)
     on_upload("mesh_upload", app.files.open_uploaded_mesh)
     on_upload("mtl_upload", app.files.import_uploaded_materials, "import materials")
+    for r in panelmodel.ROWS:
+        if r.kind == "image":
+            on_upload(
+                f"{r.key}_upload", lambda u, k=r.key: app.files.open_uploaded_map(k, u), r.key
+            )
 
 
 def connect(app) -> None:

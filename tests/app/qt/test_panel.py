@@ -428,6 +428,7 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     from explorer.app import panelmodel as P
 
     every_row_shown(win.controller)
+    assert not win.controller.state.mesh_uv
     # the lists, the buttons and the views' toggles are rows too, drawn by no code of the tab's
     assert {"preset", "light", "add_light", "difference", "compare", "swap"} <= set(P.BY_KEY)
     for r in P.ROWS:
@@ -436,8 +437,10 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
             found = tab.findChildren(QtWidgets.QWidget, name)
             assert len(found) == 1, (r.key, name, found)
             assert found[0].accessibleName() == name, name
-            # a mesh file's own materials are shown with an OBJ's groups (test_filemenu.py)
-            assert found[0].isVisibleTo(tab) != (r.key in MESH_MATERIALS + MORE_LOBES), name
+            # a mesh file's own materials are shown with an OBJ's groups (test_filemenu.py), the
+            # maps with a mesh's (u, v) (test_window_maps.py): the start's icosphere has none
+            hidden = r.key in MESH_MATERIALS + MORE_LOBES or r.kind == "image"
+            assert found[0].isVisibleTo(tab) != hidden, name
     win.controller.undo()  # fresnel off: its number hidden, its switch shown and unchecked
     rows = win.panel.material.rows
     assert not rows.sliders["fresnel"].isVisibleTo(win.panel.material)
