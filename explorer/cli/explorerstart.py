@@ -43,7 +43,9 @@ def start(args):
     Without a SCENE file the start is :data:`explorer.app.start.DEFAULT_PRESET` on the teapot
     under one point light placed at :data:`explorer.app.model.DEFAULT_PLACEMENT`, seen from a
     local viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
-    (:data:`explorer.app.start.MESH_CHOICES`) unless ``--resolution`` is given.
+    (:data:`explorer.app.start.MESH_CHOICES`) unless ``--resolution`` is given, with their
+    (u, v) as the mesh chooser loads them (:func:`explorer.app.start.load_mesh_choice`), so the
+    material tab's texture maps can be chosen for the start's mesh too.
     """
     if args.scene is None and args.preset is None:
         args.preset = gui.DEFAULT_PRESET
@@ -53,7 +55,7 @@ def start(args):
     spec = args.mesh if args.mesh is not None else (scene.mesh or gui.DEFAULT_MESH)
     scene = scene.replace(mesh=spec)  # the state names the mesh shown
     if args.resolution is None and spec in gui.MESH_CHOICES:
-        mesh = get_mesh(spec, gui.MESH_CHOICES[spec], uv=bool(scene.material.maps()))
+        mesh = get_mesh(spec, gui.MESH_CHOICES[spec], uv=True)  # (maps can be chosen later)
     r = mesh.radius or 1.0
     if scene.lights == (placeholder,):  # no scene lights and no --light-* option
         az, el, d = DEFAULT_PLACEMENT

@@ -281,7 +281,7 @@ def test_default_start_is_a_preset_on_the_teapot_under_one_light():
     scene, mesh, preset = start(_gui_args())
     assert preset == A.DEFAULT_PRESET and scene.material == find_preset(A.DEFAULT_PRESET)
     assert mesh.name == "teapot" and len(scene.lights) == 1 and scene.viewer.local
-    assert mesh.n_vertices == G.get_mesh("teapot", A.MESH_CHOICES["teapot"]).n_vertices
+    assert mesh.n_vertices == G.get_mesh("teapot", A.MESH_CHOICES["teapot"], uv=True).n_vertices
 
 
 def test_start_from_options_scene_file_and_session(tmp_path):

@@ -208,7 +208,7 @@ def kd(s) -> float:
 
 @pytest.mark.slow  # a real X window driven with xdotool, waiting for each frame
 def test_real_window(display, tmp_path):
-    mesh = M.get_mesh(MESH, gui.MESH_CHOICES[MESH])
+    mesh = M.get_mesh(MESH, gui.MESH_CHOICES[MESH], uv=True)  # as the start loads it
     win = Window(display, tmp_path)
     try:
         win.find()

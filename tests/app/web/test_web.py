@@ -222,7 +222,7 @@ def console_errors(driver) -> list[str]:
 
 @pytest.fixture(scope="module")
 def mesh():
-    return get_mesh(*MESH)
+    return get_mesh(*MESH, uv=True)  # as the start loads it (its maps can be chosen)
 
 
 def test_every_control_is_named_by_its_scene_key(server, browser):

@@ -26,7 +26,7 @@ def test_a_cold_cache_serves_the_numpy_tier_then_the_compiled_one(cold_tiers, tm
     try:
         open_page(driver, shown.url)
         assert "preparing the compiled engine" in by_name(driver, "engine").text
-        mesh = get_mesh("sphere", 128)
+        mesh = get_mesh("sphere", 128, uv=True)
         check_probe(driver, mesh)
         drawing = shown.app.view.drawings[0].shader
         assert drawing.stats["numpy"] >= 1 and drawing.stats["pass"] == 0

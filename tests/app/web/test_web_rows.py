@@ -50,23 +50,22 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     wait("fresnel's number", lambda: shown(browser, "fresnel"))
     # the lists, the buttons and the views' toggles are rows too, drawn by no code of the page's
     assert {"preset", "light", "add_light", "difference", "compare", "swap"} <= set(P.BY_KEY)
-    # a mesh file's own materials are shown with an OBJ's groups (test_web_parity.py), the maps
-    # with a mesh's (u, v) (test_web_maps.py): here they are on the page, hidden (the start's
-    # sphere has no (u, v)); so are the lobes past the three models'
+    # a mesh file's own materials are shown with an OBJ's groups (test_web_parity.py): here
+    # they are on the page, hidden; so are the lobes past the three models' and the line that
+    # says a mesh has no (u, v) (the start's sphere has them: its maps' rows are shown)
     hidden = (
         "mesh_materials",
         "group",
         "use_mesh_materials",
         *(f"show_lobe_{i}" for i in range(4, 9)),
+        "maps_note",
     )
-    maps = {n for r in P.ROWS if r.kind == "image" for n in P.names(r)}
     for tab in P.TABS:
         click(browser, f"{tab} tab")
-        last = [r for r in P.rows(tab) if r.kind != "image"][-1].key
-        wait(f"the {tab} tab", lambda last=last: shown(browser, last))
+        wait(f"the {tab} tab", lambda t=tab: shown(browser, P.rows(t)[-1].key))
         for r in P.rows(tab):
             for name in P.names(r):
-                assert shown(browser, name) != (name in hidden or name in maps), (tab, name)
+                assert shown(browser, name) != (name in hidden), (tab, name)
                 assert browser.find_elements(By.CSS_SELECTOR, f'[aria-label="{name}"]'), name
     for _ in range(7):  # fresnel, the strip, the incidence, the lobes, compare, hdr, the spot
         click(browser, "undo")
