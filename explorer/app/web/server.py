@@ -293,8 +293,10 @@ class WebExplorer:
 
     def report_state(self) -> dict:
         """What a test may read (plain JSON values): the frame count, the view's size, the
-        probe vertex and its pixel in the view (origin top-left), the session."""
+        probe vertex and its pixel in the view (origin top-left), the session, the last picture's
+        steps."""
         probe = self.view.probe_vertex()
+        ms = self.viewport.frame_ms
         return {
             "frame": self.viewport.frames,
             "size": list(self.viewport.size()),
@@ -313,6 +315,10 @@ class WebExplorer:
             "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
             "lobes": self.view.lobe.report(),
             "session": session_mapping(self.store.state),
+            # the last picture's steps (ms; explorer.app.web.pictures) and the last change's
+            # time to its frame's end (the benchmark's breakdown)
+            "picture": {**(self.pictures.times if self.pictures else {}),
+                        "frame_ms": None if ms != ms else ms},  # (NaN: no frame yet)
         }  # fmt: skip
 
     def close(self) -> None:
