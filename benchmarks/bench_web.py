@@ -142,6 +142,16 @@ def start_server(port: int, log) -> subprocess.Popen:
     )  # fmt: skip
 
 
+def stop(proc: subprocess.Popen) -> None:
+    """End a server (it keeps its session on the way out: a loaded machine may take a while)."""
+    proc.terminate()
+    try:
+        proc.wait(60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(10)
+
+
 def wait_url(port: int, log: Path, timeout: float = 120.0) -> str:
     """The page's address the server on ``port`` printed into ``log`` (with its token), once
     it answers."""
@@ -191,12 +201,14 @@ def ready_times(driver, starts: int) -> dict:
                 picture_s.append(time.perf_counter() - t0)
                 request_s.append(time.perf_counter() - t1)
             finally:
-                proc.terminate()
-                proc.wait(10)
+                stop(proc)
         path.unlink()
         driver.get("about:blank")
-    return {"url": statistics.median(url_s), "picture": statistics.median(picture_s),
-            "request": statistics.median(request_s)}  # fmt: skip
+    return {
+        "url": statistics.median(url_s),
+        "picture": statistics.median(picture_s),
+        "request": statistics.median(request_s),
+    }
 
 
 def size_view(driver) -> tuple[int, int]:
@@ -239,8 +251,13 @@ def latency(driver, url: str, repeat: int) -> dict:
     size = tuple(int(v) for v in wait_picture(driver)[:2])
     keys = [k for k in steps[0] if all(s.get(k) is not None for s in steps)]  # (none: VTK's path)
     median = {k: statistics.median(float(s[k]) for s in steps) for k in keys}
-    return {"ms": statistics.median(ts), "best": min(ts), "size": size, "steps": median,
-            "decode": decode}  # fmt: skip
+    return {
+        "ms": statistics.median(ts),
+        "best": min(ts),
+        "size": size,
+        "steps": median,
+        "decode": decode,
+    }
 
 
 def burners(n: int) -> list[subprocess.Popen]:
@@ -270,8 +287,10 @@ def codecs(repeat: int) -> list[str]:
     teapot = M.teapot(56)
     torus = M.get_mesh("torus")
     glossy = Scene(material=find_preset("glossy_plastic"))
-    frames = {"teapot": render_image(Scene(), teapot, SIZE),
-              "per-pixel torus": reference(glossy, torus, SIZE).image()}  # fmt: skip
+    frames = {
+        "teapot": render_image(Scene(), teapot, SIZE),
+        "per-pixel torus": reference(glossy, torus, SIZE).image(),
+    }
 
     def vtk_jpeg(a, progressive):
         img = vtkImageData()
@@ -294,15 +313,17 @@ def codecs(repeat: int) -> list[str]:
         "VTK JPEG q100, progressive, 4:2:0 (VTK's web path)": lambda a: vtk_jpeg(a, 1),
         "VTK JPEG q100, baseline, 4:2:0": lambda a: vtk_jpeg(a, 0),
         "Pillow JPEG q100, baseline, 4:2:0": lambda a: pil(a, "JPEG", quality=100, subsampling=2),
-        "Pillow JPEG q100, baseline, 4:4:4 (the page's)":
-            lambda a: pil(a, "JPEG", quality=100, subsampling=0),
-        "PNG, zlib level 1 (the page's still picture)":
-            lambda a: pil(a, "PNG", compress_level=1),
+        "Pillow JPEG q100, baseline, 4:4:4 (the page's)": lambda a: pil(
+            a, "JPEG", quality=100, subsampling=0
+        ),
+        "PNG, zlib level 1 (the page's still picture)": lambda a: pil(a, "PNG", compress_level=1),
         "PNG, zlib level 6": lambda a: pil(a, "PNG", compress_level=6),
         "WebP lossless, method 0": lambda a: pil(a, "WEBP", lossless=True, quality=0, method=0),
-    }  # fmt: skip
-    lines = ["| encoder | " + " | ".join(f"{n}: ms, KiB, max error" for n in frames) + " |",
-             "|---|" + "---:|" * len(frames)]  # fmt: skip
+    }
+    lines = [
+        "| encoder | " + " | ".join(f"{n}: ms, KiB, max error" for n in frames) + " |",
+        "|---|" + "---:|" * len(frames),
+    ]
     jpeg = {}
     for name, way in ways.items():
         cells = []
@@ -314,8 +335,11 @@ def codecs(repeat: int) -> list[str]:
             jpeg.setdefault(fname, data)
         lines.append(f"| {name} | " + " | ".join(cells) + " |")
     cells = [f"{timed_call(lambda d=d: base64.b64encode(d), repeat)[0]:.2f}" for d in jpeg.values()]
-    lines.append("| base64 of VTK's JPEG (VTK's web path; decoded again by the publisher) | "
-                 + " | ".join(cells) + " |")  # fmt: skip
+    lines.append(
+        "| base64 of VTK's JPEG (VTK's web path; decoded again by the publisher) | "
+        + " | ".join(cells)
+        + " |"
+    )
     return lines
 
 
@@ -347,8 +371,10 @@ def breakdown(web: dict) -> list[str]:
     lines += [f"| {name} | {'n/a' if v is None else f'{v:.1f}'} |" for name, v in rows]
     size = [f"JPEG {st['bytes'] / 1024:.0f} KiB" if "bytes" in st else ""]
     if "png" in dec:
-        size.append(f"the still picture's PNG {dec['png'][1] / 1024:.0f} KiB, decoded in "
-                    f"{dec['png'][0]:.1f} ms")  # fmt: skip
+        size.append(
+            f"the still picture's PNG {dec['png'][1] / 1024:.0f} KiB, decoded in "
+            f"{dec['png'][0]:.1f} ms"
+        )
     return lines + ["", "Picture sizes: " + "; ".join(x for x in size if x) + "."]
 
 
@@ -356,8 +382,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=21, help="timed samples per row (21)")
     ap.add_argument("--starts", type=int, default=3, help="server starts timed (3)")
-    ap.add_argument("--burners", type=int, default=0,
-                    help="processes spinning on the CPU through the run (0)")  # fmt: skip
+    ap.add_argument(
+        "--burners", type=int, default=0, help="processes spinning on the CPU through the run (0)"
+    )
     ap.add_argument("--no-write", action="store_true", help="do not write docs/web_bench.md")
     args = ap.parse_args(argv)
     spinning = burners(args.burners)
@@ -381,8 +408,7 @@ def measure(args) -> int:
             try:
                 web = latency(driver, wait_url(port, path), args.repeat)
             finally:
-                proc.terminate()
-                proc.wait(10)
+                stop(proc)
         path.unlink()
         version = driver.capabilities.get("browserVersion", "?")
     finally:
@@ -402,8 +428,11 @@ def measure(args) -> int:
     burning = f", {args.burners} CPU burners running" if args.burners else ""
     lines = ["# Web benchmark", "", "Machine:", ""]
     lines += [f"- {x}" for x in info]
-    lines += [f"- browser: headless Chromium {version} (Selenium), on the same machine",
-              f"- load average before / after: {before} / {after}{burning}", ""]  # fmt: skip
+    lines += [
+        f"- browser: headless Chromium {version} (Selenium), on the same machine",
+        f"- load average before / after: {before} / {after}{burning}",
+        "",
+    ]
     lines += [
         f"A kd change to the new picture, {teapot.n_vertices:,}-vertex teapot, 1 point light; "
         f"median (best) ms over {args.repeat} changes:",

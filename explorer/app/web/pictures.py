@@ -120,13 +120,13 @@ class Pictures:
     def still_render(self, options: dict) -> dict:
         """The publisher's ``still_render``: view ``options["view"]`` rendered at
         ``options["size"]``, read back and encoded as JPEG (its reply, ``image`` as bytes)."""
-        from explorer.render.vtk import DRAW_LOCK
+        from explorer.render.vtk import DRAW_LOCK  # (VTK only once a page asks)
 
         t0 = time.perf_counter()
         view = self.pub.get_view(options["view"])
         v_id = str(self.pub.get_global_id(view))
         size = list(options.get("size", view.GetSize()[:2]))
-        with DRAW_LOCK:
+        with DRAW_LOCK:  # (VTK draws one thread at a time; the read-back is of this frame)
             if size != list(view.GetSize()[:2]) and size[0] > 10 and size[1] > 10:
                 view.SetSize(size)
             view.Render()
@@ -137,13 +137,24 @@ class Pictures:
         t3 = time.perf_counter()
         self.count += 1
         self.last[v_id] = (self.count, pixels)
-        self.times = {"render": 1e3 * (t1 - t0), "read": 1e3 * (t2 - t1),
-                      "encode": 1e3 * (t3 - t2), "bytes": len(image)}  # fmt: skip
+        self.times = {
+            "render": 1e3 * (t1 - t0),
+            "read": 1e3 * (t2 - t1),
+            "encode": 1e3 * (t3 - t2),
+            "bytes": len(image),
+        }
         h, w = pixels.shape[:2]
-        return {"image": image, "format": "jpeg", "stale": False, "mtime": self.count,
-                "size": [w, h], "memsize": len(image), "global_id": v_id,
-                "localTime": options.get("localTime", 0),
-                "workTime": round(1e3 * (t3 - t0))}  # fmt: skip
+        return {
+            "image": image,
+            "format": "jpeg",
+            "stale": False,
+            "mtime": self.count,
+            "size": [w, h],
+            "memsize": len(image),
+            "global_id": v_id,
+            "localTime": options.get("localTime", 0),
+            "workTime": round(1e3 * (t3 - t0)),
+        }
 
     # -- the still picture -----------------------------------------------------------------------
     def _publish(self, reply: dict) -> None:
@@ -164,9 +175,19 @@ class Pictures:
                 return  # (a newer picture went while this one was encoded)
             h, w = pixels.shape[:2]
             png = future.result()
-            self._publish({"image": png, "format": "png", "stale": False, "mtime": count,
-                           "size": [w, h], "memsize": len(png), "global_id": v_id,
-                           "localTime": 0, "workTime": 0})  # fmt: skip
+            self._publish(
+                {
+                    "image": png,
+                    "format": "png",
+                    "stale": False,
+                    "mtime": count,
+                    "size": [w, h],
+                    "memsize": len(png),
+                    "global_id": v_id,
+                    "localTime": 0,
+                    "workTime": 0,
+                }
+            )
 
         job = self._pool.submit(encode, pixels, True)
         job.add_done_callback(

@@ -106,9 +106,11 @@ def exact(driver, tmp_path, per_pixel: bool):
         c = last.get("c")
         if c is not None:
             d = np.abs(c[1] - c[2]).max(axis=2)
-            print(f"interior pixels {c[3].sum()}: off by > 1: {(d[c[3]] > 1).sum()}, max "
-                  f"{d[c[3]].max()}; silhouette {c[4].sum()}: off by > 1: "
-                  f"{(d[c[4]] > 1).sum()}")  # fmt: skip
+            print(
+                f"interior pixels {c[3].sum()}: off by > 1: {(d[c[3]] > 1).sum()}, max "
+                f"{d[c[3]].max()}; silhouette {c[4].sum()}: off by > 1: "
+                f"{(d[c[4]] > 1).sum()}"
+            )
     return last["c"]
 
 
