@@ -55,7 +55,8 @@ ROOT = Path(__file__).resolve().parent.parent
 
 #: one sample, in the page: set kd's slider step, resolve when the view's picture shows a new
 #: colour at the probe vertex's pixel (more than 8 levels away: kd 0.3 and 0.7 are far apart,
-#: and a still picture's lossless copy differs from its JPEG by a level)
+#: and a still picture's lossless copy differs from its JPEG by a level): the ms taken, the
+#: change's and the picture's arrival (epoch ms; the arrival: its Blob made, KEEP_BLOBS_JS)
 SAMPLE_JS = """
 const [step, x, y, done] = arguments;
 const img = document.querySelector('[aria-label="view"] img');
@@ -71,19 +72,23 @@ const t0 = performance.now();
 const on = () => {
   const now = pixel();
   if (Math.max(...now.map((v, i) => Math.abs(v - before[i]))) > 8) {
-    img.removeEventListener('load', on); done(performance.now() - t0);
+    img.removeEventListener('load', on);
+    const t = performance.now();  // the epoch clock too (the server's is the same machine's)
+    done([t - t0, performance.timeOrigin + t0, performance.timeOrigin + window.blobAt]);
   }
 };
 img.addEventListener('load', on);
 window.trame.state.set('kd_step', step);
 setTimeout(() => done(-1), 20000);
 """
-#: the page keeps the last pictures' bytes it receives (the remote view makes each a Blob URL)
+#: the page keeps the last pictures' bytes it receives and when (the remote view makes a Blob
+#: URL of each as its message arrives)
 KEEP_BLOBS_JS = """
 if (!window.keptBlobs) {
   window.keptBlobs = [];
   const make = URL.createObjectURL;
   URL.createObjectURL = (b) => {
+    window.blobAt = performance.now();
     window.keptBlobs.push(b);
     if (window.keptBlobs.length > 4) window.keptBlobs.shift();
     return make.call(URL, b);
@@ -240,12 +245,18 @@ def latency(driver, url: str, repeat: int) -> dict:
     ts, steps = [], []
     for i in range(repeat + 2):
         step = 300 + 400 * (i % 2)  # kd 0.3 and 0.7
-        t = driver.execute_async_script(SAMPLE_JS, step, x, y)
-        if t < 0:
+        got = driver.execute_async_script(SAMPLE_JS, step, x, y)
+        if got == -1:
             raise RuntimeError("the picture did not change within 20 s")
+        t, changed, arrived = got
         if i >= 2:
             ts.append(float(t))
-            steps.append(driver.execute_async_script(REPORT_JS).get("picture") or {})
+            st = driver.execute_async_script(REPORT_JS).get("picture") or {}
+            if "at" in st:  # (the page's and the server's clocks: one machine's)
+                st["sent"] = st.pop("at") - changed  # the change to the picture sent
+                st["back"] = arrived - changed - st["sent"]  # its way to the page
+                st["shown"] = t - (arrived - changed)  # its arrival to the <img> loaded
+            steps.append(st)
         time.sleep(0.3)  # (the view still again: its lossless picture has gone)
     decode = driver.execute_async_script(DECODE_JS)
     size = tuple(int(v) for v in wait_picture(driver)[:2])
@@ -354,21 +365,46 @@ def timed_call(fn, repeat: int):
 
 
 def breakdown(web: dict) -> list[str]:
-    """Where the page's time goes (medians of the samples' server steps, the decode)."""
+    """Where the page's time goes (medians of the samples' steps, the decode)."""
     st, dec = web["steps"], web["decode"]
-    server = st.get("frame_ms", float("nan")) + st.get("read", 0.0) + st.get("encode", 0.0)
-    rows = [
-        ("the change's way to the server, the controller, the engine and the frame's render "
-         "(the server's clock, from the change to the frame's end)", st.get("frame_ms")),
-        ("  of which the frame's render (VTK)", st.get("render")),
-        ("read-back (vtkWindowToImageFilter)", st.get("read")),
-        ("JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
-        ("the browser's JPEG decode (createImageBitmap)", dec.get("jpeg", [None])[0]),
-        ("the rest: the picture's way to the page, trame's work and the <img> load",
-         web["ms"] - server - dec.get("jpeg", [0.0])[0]),
-    ]  # fmt: skip
+    work = st.get("frame_ms", float("nan")) + st.get("read", 0.0) + st.get("encode", 0.0)
+
+    def row(name, v):
+        return f"| {name} | {'n/a' if v is None else f'{v:.1f}'} |"
+
+    sent = st.get("sent")
     lines = ["| step | ms |", "|---|---:|"]
-    lines += [f"| {name} | {'n/a' if v is None else f'{v:.1f}'} |" for name, v in rows]
+    lines += [
+        row(
+            "the change set in the page → the picture sent by the server (the machine's clock)",
+            sent,
+        ),
+        row(
+            "  the change's way to the server and trame's handling (the rest of the above)",
+            None if sent is None else sent - work,
+        ),
+        row(
+            "  the controller, the engine and the frame (the server's clock, from the change "
+            "to the frame's end)",
+            st.get("frame_ms"),
+        ),
+        row(
+            "    of which the frame's render (VTK, the engine's colours for the viewer)",
+            st.get("render"),
+        ),
+        row("  read-back (vtkWindowToImageFilter)", st.get("read")),
+        row("  JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
+        row("the picture's way to the page (sent → its Blob made in the page)", st.get("back")),
+        row(
+            "its Blob made → the view's <img> loaded (trame's decode in a pooled image, then "
+            "the <img>)",
+            st.get("shown"),
+        ),
+        row(
+            "  of which one JPEG decode (createImageBitmap on the same bytes)",
+            dec.get("jpeg", [None])[0],
+        ),
+    ]
     size = [f"JPEG {st['bytes'] / 1024:.0f} KiB" if "bytes" in st else ""]
     if "png" in dec:
         size.append(

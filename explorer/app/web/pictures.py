@@ -76,7 +76,7 @@ class Pictures:
     """The picture path of ``publisher`` (trame-vtk's ``vtkWebPublishImageDelivery``, found
     once the server runs) in ``loop`` (the server's asyncio loop); ``guard(fn, where)`` makes a
     callback safe (an error is said on the page). :attr:`times` keeps the last picture's steps
-    (ms: render, read, encode; bytes) for the benchmark."""
+    (ms: render, read, encode; bytes; ``at``: when it was made, epoch ms) for the benchmark."""
 
     def __init__(self, publisher, loop, guard):
         self.pub = publisher
@@ -142,6 +142,7 @@ class Pictures:
             "read": 1e3 * (t2 - t1),
             "encode": 1e3 * (t3 - t2),
             "bytes": len(image),
+            "at": 1e3 * time.time(),  # (epoch ms: the page's clock is the same machine's)
         }
         h, w = pixels.shape[:2]
         return {

@@ -123,3 +123,29 @@ def test_a_resize_is_drawn_at_the_new_size(path):
     pub.push_render("1")
     assert pub.sent[0]["size"] == [80, 50]
     assert pixels(pub.sent[0]["data"]).shape == (50, 80, 3)
+
+
+def test_the_publishers_api_relied_on_is_there():
+    """What Pictures takes over of trame-vtk's publisher: its attributes, and that its RPCs
+    (``viewport.image.push``, the observers, the drag's ticks) reach the picture through the
+    instance's ``push_render`` and ``still_render`` (replaced per instance)."""
+    import inspect
+
+    from trame_vtk.modules.vtk.protocols import publish_image_delivery as D
+
+    pub = D.vtkWebPublishImageDelivery(decode=True)
+    for name in ("tracking_views", "views_in_animations", "decode"):
+        assert hasattr(pub, name), name
+    called = (
+        "push_render",
+        "still_render",
+        "publish",
+        "addAttachment",
+        "get_view",
+        "get_global_id",
+    )
+    for name in called:
+        assert callable(getattr(pub, name)), name
+    src = inspect.getsource(D.vtkWebPublishImageDelivery)
+    assert src.count("self.push_render(") >= 4  # image_push, the observers, animate
+    assert "self.still_render(" in src
