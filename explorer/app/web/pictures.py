@@ -170,12 +170,10 @@ class Pictures:
             return  # a newer picture of the view went since: it is not still
 
         def sent(future) -> None:
-            if future.cancelled() or future.exception() is not None:
-                return
-            if self.last.get(v_id, (None,))[0] != count:
+            if future.cancelled() or self.last.get(v_id, (None,))[0] != count:
                 return  # (a newer picture went while this one was encoded)
+            png = future.result()  # (an encoder's error is said, by the guard)
             h, w = pixels.shape[:2]
-            png = future.result()
             self._publish(
                 {
                     "image": png,
@@ -191,6 +189,11 @@ class Pictures:
             )
 
         job = self._pool.submit(encode, pixels, True)
-        job.add_done_callback(
-            lambda f: self.loop.call_soon_threadsafe(self.guard(sent, "picture"), f)
-        )
+
+        def back(future) -> None:  # (in the worker thread)
+            try:
+                self.loop.call_soon_threadsafe(self.guard(sent, "picture"), future)
+            except RuntimeError:  # the loop closed since (the server stopped): nothing to send
+                pass
+
+        job.add_done_callback(back)
