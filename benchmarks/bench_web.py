@@ -253,6 +253,8 @@ def latency(driver, url: str, repeat: int) -> dict:
             ts.append(float(t))
             st = driver.execute_async_script(REPORT_JS).get("picture") or {}
             if "at" in st:  # (the page's and the server's clocks: one machine's)
+                if st.get("change_at"):
+                    st["in"] = st.pop("change_at") - changed  # the change's way to the server
                 st["sent"] = st.pop("at") - changed  # the change to the picture sent
                 st["back"] = arrived - changed - st["sent"]  # its way to the page
                 st["shown"] = t - (arrived - changed)  # its arrival to the <img> loaded

@@ -76,7 +76,8 @@ class Pictures:
     """The picture path of ``publisher`` (trame-vtk's ``vtkWebPublishImageDelivery``, found
     once the server runs) in ``loop`` (the server's asyncio loop); ``guard(fn, where)`` makes a
     callback safe (an error is said on the page). :attr:`times` keeps the last picture's steps
-    (ms: render, read, encode; bytes; ``at``: when it was made, epoch ms) for the benchmark."""
+    (ms: render, read, encode; bytes; ``at``: when it was made and ``change_at`` when the last
+    change arrived, epoch ms) for the benchmark."""
 
     def __init__(self, publisher, loop, guard):
         self.pub = publisher
@@ -120,6 +121,7 @@ class Pictures:
     def still_render(self, options: dict) -> dict:
         """The publisher's ``still_render``: view ``options["view"]`` rendered at
         ``options["size"]``, read back and encoded as JPEG (its reply, ``image`` as bytes)."""
+        from explorer.app.web.wire import ARRIVED  # (wslink's, imported with the server)
         from explorer.render.vtk import DRAW_LOCK  # (VTK only once a page asks)
 
         t0 = time.perf_counter()
@@ -143,6 +145,7 @@ class Pictures:
             "encode": 1e3 * (t3 - t2),
             "bytes": len(image),
             "at": 1e3 * time.time(),  # (epoch ms: the page's clock is the same machine's)
+            "change_at": ARRIVED.get("trame.state.update"),  # (the last change's arrival)
         }
         h, w = pixels.shape[:2]
         return {
