@@ -381,9 +381,10 @@ def breakdown(web: dict) -> list[str]:
             "the change set in the page → the picture sent by the server (the machine's clock)",
             sent,
         ),
+        row("  the change's way to the server (set in the page → its message read)", st.get("in")),
         row(
-            "  the change's way to the server and trame's handling (the rest of the above)",
-            None if sent is None else sent - work,
+            "  trame's handling (the rest of the above)",
+            None if sent is None else sent - work - st.get("in", 0.0),
         ),
         row(
             "  the controller, the engine and the frame (the server's clock, from the change "
