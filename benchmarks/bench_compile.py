@@ -104,6 +104,23 @@ numba's typing and lowering, grown by its inliner copying ``_row``'s IR twenty t
 Side by side instead (both children at once, one core each, load 3-6; the VM an Intel Xeon with
 AVX-512 then): the whole compile 203.0 -> 173.6 s (0.86x), the light loops 60.1 -> 36.6 s,
 ``_block`` 20.2 -> 13.0 s, LLVM 62.5 -> 62.8 s (unchanged: all of the gain is numba's Python).
+
+The light loops out of the linked chain (each ``_light_<code>`` compiled once per precision by
+``kernels.loop_table`` and called through its table of entry points), 750ec5e and the change,
+``--warm`` under ``/usr/bin/time -v``, each tree checked out apart, one run after the other at
+load 15-20 (both inflated alike; see docs/speed.md):
+
+| function | signatures | 750ec5e CPU s | after: signatures | CPU s |
+|---|---:|---:|---:|---:|
+| shading.kernels._light_overload.impl (the light loops) | 36 | 37.8 | 36 | 32.9 |
+| shading.kernels.shade | 2 | 23.3 | 2 | 12.2 |
+| shading.kernels._block | 2 | 13.3 | 2 | 10.7 |
+| shading.kernels._compose_block_overload.impl | 36 | 12.7 | 36 | 9.7 |
+| shading.kernels._task | 2 | 6.6 | 2 | 3.7 |
+| None.impl (the dispatches: light loops, compose) | 4 | 4.9 | 2 | 1.5 |
+| shading.kernels.fixup | 1 | 4.0 | 1 | 3.1 |
+| LLVM: function passes, module passes, machine code | | 11.4, 32.1, 26.3 | | 10.9, 21.4, 19.5 |
+| **the whole compile** (child CPU s; command user + sys) | | 186.4 (191.6) | | 158.7 (164.0) |
 """
 
 from __future__ import annotations

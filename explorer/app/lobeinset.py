@@ -29,6 +29,12 @@ LOBE_MARGIN = 12
 LOBE_FRACTION = 0.3
 LOBE_SIDE = (130, 200)
 LOBE_PAD = 6
+#: the most of the view's area the inset covers (a share): in a small view it narrows below
+#: LOBE_SIDE's least width, down to LOBE_MIN_SIDE pixels, and is then the plot alone (its
+#: caption and the L and R labels hidden: at 8 pixels and less they were not legible). The
+#: 640x480 page's compare pane (183x251 pixels) was 32% covered by the 130-pixel inset
+LOBE_AREA = 0.2
+LOBE_MIN_SIDE = 72
 LOBE_PANEL_COLOR = (0.12, 0.12, 0.13)
 LOBE_FRAME_COLOR = (0.45, 0.45, 0.48)
 LOBE_TEXT_COLOR = (0.93, 0.93, 0.93)
@@ -128,6 +134,7 @@ class LobeInset:
             self.actors.append(t)
         self._key = None
         self.box = None
+        self.labelled = True  # the caption and the L and R labels drawn (a large enough inset)
         self._curves: list = []  # (polydata, actor) of the several lobes' curves, one a colour
         self._legend: list = []  # their legend's text actors
         self.chart = None  # the plot of several lobes shown, or None
@@ -135,17 +142,18 @@ class LobeInset:
 
     def layout(self, state: State) -> None:
         """Size the inset for the view: :data:`LOBE_FRACTION` of its smaller side, held within
-        :data:`LOBE_SIDE` and within the view; the caption's font the largest that fits."""
-        w, h = self.plotter.window_size
-        lo, hi = LOBE_SIDE
-        side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi, max(w - 2 * LOBE_MARGIN, 40)))
+        :data:`LOBE_SIDE` and within the view, and narrower while it would cover more than
+        :data:`LOBE_AREA` of the view (down to :data:`LOBE_MIN_SIDE`, the plot alone below
+        LOBE_SIDE's least width); the caption's font the largest that fits."""
+        side = inset_side(*self.plotter.window_size)
         if self.box is not None and self.box[2] == side:
             return
         font = self._font = 13 if side >= 170 else 11
         t = self.caption
-        text = 2 * (font + 4)
+        self.labelled = side >= LOBE_SIDE[0]
+        t.SetVisibility(self.labelled)
         plot_h = side // 2
-        height = plot_h + 3 * LOBE_PAD + text
+        height = inset_height(side)
         x0 = y0 = LOBE_MARGIN
         self.box = (x0, y0, side, height)  # display pixels, origin bottom-left
         self._plot_box = (x0 + LOBE_PAD, y0 + LOBE_PAD, side - 2 * LOBE_PAD, plot_h - LOBE_PAD)
@@ -215,7 +223,7 @@ class LobeInset:
                 lx = min(max(end[0] + away, x + 6), x + w - 6)
                 ly = min(max(end[1] - 4, y + 6), y + h - 6)
                 self._labels[key].SetPosition(lx, ly)
-                self._labels[key].SetVisibility(shown)
+                self._labels[key].SetVisibility(shown and self.labelled)
             deg = math.degrees(theta)
             where = f"incidence {deg:.0f}°" if plot.lit else f"light below ({deg:.0f}°)"
             self.caption.SetInput(f"{label}\n{where}, n = {n:g}")
@@ -334,6 +342,24 @@ class LobeInset:
                 break
             font -= 1
         t.GetTextProperty().SetFontSize(font)
+
+
+def inset_side(w: int, h: int) -> int:
+    """The inset's width (pixels) in a view of ``w`` x ``h`` pixels (see
+    :meth:`LobeInset.layout`)."""
+    lo, hi = LOBE_SIDE
+    side = int(min(max(LOBE_FRACTION * min(w, h), lo), hi, max(w - 2 * LOBE_MARGIN, 40)))
+    while side > LOBE_MIN_SIDE and side * inset_height(side) > LOBE_AREA * w * h:
+        side -= 2
+    return side
+
+
+def inset_height(side: int) -> int:
+    """The inset's height (pixels) for its width ``side``: the plot (half the width), the
+    padding, and two lines of caption when it is labelled (``side`` at least LOBE_SIDE's
+    least width; the caption's font is 13 pixels from 170 on, else 11)."""
+    text = 2 * ((13 if side >= 170 else 11) + 4) if side >= LOBE_SIDE[0] else 0
+    return side // 2 + 3 * LOBE_PAD + text
 
 
 def lobe_incidence(state: State) -> float:

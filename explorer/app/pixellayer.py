@@ -34,6 +34,7 @@ import numpy as np
 
 from explorer.app import model as M
 from explorer.app.view import SceneView, view_camera
+from explorer.render.pixelmaps import bare
 
 #: the per-pixel mode's name (:data:`explorer.core.scene.SHADINGS`)
 PER_PIXEL = "per-pixel"
@@ -162,6 +163,9 @@ class PixelLayer:
         groups = state.shown_groups()
         w, h = (int(v) for v in self.plotter.window_size)
         mesh = self.view.mesh
+        if mesh.uv is None:  # no (u, v): untextured, as the per-vertex view draws it
+            scene = scene.replace(material=bare(scene.material))
+            groups = None if groups is None else tuple(bare(m) for m in groups)
         key = (repr(scene), repr(groups), camera, (w, h), id(mesh))
         if key != self._key:
             t0 = time.perf_counter()

@@ -162,10 +162,21 @@ class SideB:
         return self.pane.beside(img) if self.shown else img
 
     def probe(self) -> dict:
-        """Side B's probe vertex and its pixel (origin top-left), its picture's size."""
-        i = self.view.probe_vertex()
-        return {"vertex": i, "px": self.view.world_to_window(self.view.mesh.positions[i]),
-                "size": list(self.plotter.window_size)}  # fmt: skip
+        """Side B's probe vertex and its pixel (origin top-left), its picture's size, each
+        light's handle pixel (origin top-left) and the arrows at its edge (light -> the
+        triangle's corners, origin top-left) while its handles are drawn."""
+        v = self.view
+        i = v.probe_vertex()
+        s = self.main.controller.state
+        h = self.plotter.window_size[1]
+        drawn = self.pane.handles
+        return {"vertex": i, "px": v.world_to_window(v.mesh.positions[i]),
+                "size": list(self.plotter.window_size),
+                "handles_px": [v.world_to_window(M.handle_point(s, k))
+                               for k in range(len(s.scene.lights))] if drawn else [],
+                "arrows_px": {str(k): [[float(x), float(h - 1 - y)] for x, y in t]
+                              for k, t in v.marker_triangles.items()} if drawn else {},
+                }  # fmt: skip
 
 
 def show_side_b(view_a, view_b, old: M.State | None, new: M.State) -> None:

@@ -52,10 +52,13 @@ class NoDisplayError(ExplorerError):
 
 
 def load_mesh_choice(name: str, resolution: int | None = None) -> Mesh:
-    """A chooser's mesh: a built-in name at the explorer's resolution, or a file."""
+    """A chooser's mesh: a built-in name at the explorer's resolution, or a file. A built-in
+    mesh comes with its (u, v) (:mod:`explorer.geometry.uv`: a few more vertices where the
+    texture's seams split them, the same triangles and colours), so that a material chosen
+    after it can wear a texture map."""
     if resolution is None:
         resolution = MESH_CHOICES.get(name)
-    return get_mesh(name, resolution)
+    return get_mesh(name, resolution, uv=True)
 
 
 def default_viewer(mesh: Mesh) -> Viewer:

@@ -48,7 +48,16 @@ from explorer.render.camera import (
     mesh_frame,
     out_of_frame,
 )
-from explorer.render.textured import SECONDARY, Textured, add_textured, texture_arrays
+from explorer.render.textured import (
+    LAYER_MAPS,
+    SECONDARY,
+    WHITE,
+    Layer,
+    Textured,
+    add_textured,
+    only,
+    texture_arrays,
+)
 from explorer.render.textures import read_texture
 from explorer.render.vtk import add_unlit, cells, polydata
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
@@ -219,8 +228,9 @@ class MeshDrawing:
         self.sorted_for = None  # camera the triangles were last sorted for (translucency)
         self.groups = None  # one material per group of mesh.groups, or None: the scene's
         self._rows = None
-        self.texture = None  # (diffuse map, color_control) worn, or None
+        self.texture = None  # (diffuse map, color_control, layer maps...) worn, or None
         self.secondary = None  # the separate specular colour VTK draws (RGBA float32 view)
+        self.layers: dict = {}  # term -> the name of its layer's colour array (RGBA float32)
 
     def set_groups(self, materials) -> None:
         """Draw each group of ``mesh.groups`` in its own material (a tuple, one per group),
@@ -232,25 +242,40 @@ class MeshDrawing:
 
     def set_texture(self, plotter, scene) -> None:
         """Wear the drawn materials' one ``diffuse_map`` as ``render`` does
-        (:mod:`explorer.render.textured`: GL_MODULATE, the scene's ``color_control``) when the
-        mesh has (u, v); else none. The actor is made anew only when the map or mode changes."""
+        (:mod:`explorer.render.textured`: GL_MODULATE, the scene's ``color_control``), and
+        their ``ambient_map`` and ``emission_map`` as its layers, when the mesh has (u, v);
+        else none. The actor is made anew only when a map or the mode changes."""
         materials = self.groups or (scene.material,)
-        maps = {m.diffuse_map for m in materials}
-        tmap = maps.pop() if len(maps) == 1 and self.mesh.uv is not None else None
-        texture = None if tmap is None else (tmap, scene.color_control)
+
+        def one(key):
+            maps = {getattr(m, key) for m in materials}
+            return maps.pop() if len(maps) == 1 and self.mesh.uv is not None else None
+
+        tmap, layers = one("diffuse_map"), {k: one(k) for k in LAYER_MAPS}
+        drawn = tmap is not None or any(t is not None for t in layers.values())
+        texture = (tmap, scene.color_control, *layers.values()) if drawn else None
         if texture == self.texture:
             return
         visible = self.actor.GetVisibility()
         plotter.remove_actor(self.actor, render=False)
-        self.texture, self.secondary = texture, None
-        if tmap is None:
+        self.texture, self.secondary, self.layers = texture, None, {}
+        if not drawn:
             self.actor = add_unlit(plotter, self.poly)
         else:
             n = self.mesh.n_vertices
-            t = Textured(self.rgb, np.zeros((n, 3), np.uint8), read_texture(tmap), tmap)
+            black = np.zeros((n, 3), np.uint8)
+            image = WHITE if tmap is None else read_texture(tmap)
+            built = ()
+            if any(t is not None for t in layers.values()):
+                built = tuple(
+                    Layer(k, black, WHITE if t is None else read_texture(t, k), t)
+                    for k, t in layers.items()
+                )
+            t = Textured(self.rgb, black, image, tmap, built, scene.color_control)
             texture_arrays(self.poly, self.mesh, t)
             self.actor = add_textured(plotter, self.poly, t)
             self.secondary = self.poly.point_data[SECONDARY]
+            self.layers = {LAYER_MAPS[x.key]: x.name + "_c" for x in built}
         self.actor.SetVisibility(visible)
 
     def colors(self, change=None) -> np.ndarray:
@@ -270,15 +295,19 @@ class MeshDrawing:
 
     def upload(self) -> None:
         """Write the display colours into VTK's array as 8-bit values and mark it modified
-        (under separate specular: the primary colour there, the specular one beside it)."""
-        if self.secondary is None or self.texture[1] != "separate":
+        (under separate specular: the primary colour there, the specular one beside it; with
+        layers: the diffuse term there, the specular and each layer's term beside it)."""
+        if self.secondary is None or (self.texture[1] != "separate" and not self.layers):
             to_bytes(self.colors(), out=self.rgb)
         else:
-            black = (0.0, 0.0, 0.0)
-            to_bytes(self.colors(lambda m: m.replace(specular=black)), out=self.rgb)
-            q = self.colors(lambda m: m.replace(ambient=black, diffuse=black, emission=black))
+            to_bytes(self.colors(only("diffuse" if self.layers else "primary")), out=self.rgb)
+            q = self.colors(only("specular"))
             self.secondary[:, :3] = to_bytes(q) / np.float32(255.0)
             self.poly.GetPointData().GetArray(SECONDARY).Modified()
+            for term, name in self.layers.items():
+                array = self.poly.point_data[name]  # (a view of VTK's memory)
+                array[:, :3] = to_bytes(self.colors(only(term))) / np.float32(255.0)
+                self.poly.GetPointData().GetArray(name).Modified()
         self.vtk_colors.Modified()
 
     def sort_for(self, camera: Camera) -> None:

@@ -52,7 +52,7 @@ from explorer.render.live import picture
 from explorer.render.offscreen import render_image
 from explorer.render.perpixel import reference
 from explorer.render.strip import STRIP_TILE, render_strip
-from explorer.render.textured import file_maps, not_drawn_per_vertex, textured
+from explorer.render.textured import file_maps, layered, not_drawn_per_vertex, textured
 from explorer.render.turntable import (
     FPS,
     TURNTABLE_SUFFIXES,
@@ -164,11 +164,6 @@ def run(args) -> int:
                 "--per-pixel draws one material: give --preset NAME for a mesh with its own "
                 "materials"
             )
-        if scene.material.maps():
-            say(
-                "warning: --per-pixel does not draw texture maps yet; the picture is untextured",
-                file=sys.stderr,
-            )
         return run_per_pixel(args, scene, mesh, size, background, suffix)
     if args.strip:
         return run_strip(args, scene, mesh, materials, background)
@@ -178,11 +173,18 @@ def run(args) -> int:
     for note in notes:
         say(f"warning: {note}", file=sys.stderr)
     texture = textured(scene, mesh, materials)  # the image read (or refused) before any work
+    if suffix == ".glb" and layered(scene, materials):
+        say(
+            f"warning: {args.out}: a GLB holds the diffuse_map alone (glTF's base colour "
+            "texture); ambient_map and emission_map are not written into it",
+            file=sys.stderr,
+        )
+        texture = textured(scene, mesh, materials, layers=False)
     for m in materials or (scene.material,):
         for key in not_drawn_per_vertex(m):
             say(
                 f"warning: {key} {getattr(m, key).file}: not drawn per vertex (it needs "
-                "per-pixel shading); the material keeps it",
+                "per-pixel shading: --per-pixel draws it); the material keeps it",
                 file=sys.stderr,
             )
     if texture is not None and suffix == ".glb" and scene.color_control == "separate":
@@ -192,11 +194,11 @@ def run(args) -> int:
             "separate specular colour)",
             file=sys.stderr,
         )
-        texture = textured(scene.replace(color_control="single"), mesh, materials)
+        texture = textured(scene.replace(color_control="single"), mesh, materials, layers=False)
     elif texture is not None and (turntable or suffix not in (".png", ".glb")):
         say(
-            f"warning: {args.out}: the diffuse_map is not drawn into this output (a PNG "
-            "picture and a GLB wear it); the vertices carry their untextured colours",
+            f"warning: {args.out}: the texture maps are not drawn into this output (a PNG "
+            "picture and a GLB wear them); the vertices carry their untextured colours",
             file=sys.stderr,
         )
     name = scene.material.name or "material"
@@ -313,6 +315,12 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
             file=sys.stderr,
         )
     method = args.per_pixel_method or "raster"
+    if method != "raster" and scene.material.maps():
+        raise ExplorerError(
+            f"--per-pixel-method {method} draws no texture maps (the G-buffer's (u, v) are the "
+            "raster method's): leave --per-pixel-method out (raster) to draw "
+            f"{', '.join(scene.material.maps())}"
+        )
     if method == "raster" and mesh.n_faces > MAX_FACES:
         raise ExplorerError(
             f"--per-pixel: mesh {mesh.name!r} has {mesh.n_faces:,} triangles, more than a "

@@ -22,7 +22,7 @@ checked open, with the caps of :mod:`explorer.core.tolerances`).
 
 How each map is drawn per vertex (OpenGL 2.1's ``GL_MODULATE`` on the exact light sums) is in
 ``docs/formats.md``; ``specular_map``, ``shininess_map`` and ``bump_map`` need per-pixel
-shading and are kept (files, sessions, exports) but not drawn per vertex.
+shading: a per-pixel picture draws every map (:mod:`explorer.render.pixelmaps`).
 """
 
 from __future__ import annotations
@@ -50,8 +50,9 @@ MTL_MAP_KEYS = {
     **{statement.lower(): key for key, statement in MAP_STATEMENTS.items()},
     "map_bump": "bump_map",
 }
-#: the maps a per-vertex picture draws (GL_MODULATE of the interpolated light sums)
-PER_VERTEX_MAPS = ("diffuse_map",)
+#: the maps a per-vertex picture draws (GL_MODULATE of the interpolated light sums; the ambient
+#: and emission maps as layers of their own: explorer.render.textured)
+PER_VERTEX_MAPS = ("diffuse_map", "ambient_map", "emission_map")
 #: ``-imfchan`` values: red, green, blue, matte, luminance, depth
 CHANNELS = ("r", "g", "b", "m", "l", "z")
 #: keys of a map written as a mapping

@@ -230,6 +230,13 @@ MAX_TEXTURE_FILE_BYTES = 64 << 20
 #: before it is decoded: 4096 × 4096, 64 MiB as RGBA bytes. A 100 KB PNG can declare
 #: 50 000 × 50 000 pixels (10 GB decoded); OpenGL 2.1 drivers take 4096 or 8192 a side.
 MAX_TEXTURE_PIXELS = 4096 * 4096
+
+#: A bump map's tangent frame (:func:`explorer.render.pixelmaps.bumped_normals`): a triangle
+#: whose (u, v) corners span an area below this (``|du1·dv2 - du2·dv1|``: corners sharing a
+#: texture coordinate, or on one line of the image), or whose surface spans less than this per
+#: unit of (u, v) squared (``|P_u × P_v|``: a degenerate triangle), has no frame; its pixels
+#: keep their normal (dividing by either would make the tilt arbitrary).
+BUMP_FRAME_EPS = 1e-12
 #: Largest of the other files the product reads (bytes): the window's recent-files list, the
 #: accuracy table (about 400 KB), ``/proc/cpuinfo`` for a benchmark's machine line (a few KB
 #: per core). Read through the checked open, which never trusts a size (``/proc`` gives 0).

@@ -25,6 +25,10 @@ the mesh's vertices followed by the pixels' hit points (the triangles index the 
 Per-group materials (``materials=``, a mesh file's own): each pixel in its triangle's group's
 material, recomposed from the same sums (:func:`explorer.shading.display.grouped_colors`).
 
+Texture maps (issue 40): every map of the material at each pixel, on the same kept sums
+(:mod:`explorer.render.pixelmaps`): a colour or scalar map composes with no light pass; a
+``bump_map`` tilts the normals the shader shades (new light sums when it changes).
+
 VTK is imported only when a G-buffer is made (the face-id window).
 """
 
@@ -43,6 +47,7 @@ from explorer.render.images import check_size
 from explorer.render.offscreen import BACKGROUND
 from explorer.render.perpixel import METHODS as PERPIXEL_METHODS
 from explorer.render.perpixel import Hits, raster_hits
+from explorer.render.pixelmaps import PixelMaps, any_maps
 from explorer.shading.display import engine_clamps, grouped_colors, shown, to_bytes
 from explorer.shading.shader import PRECISIONS, Shader
 
@@ -122,6 +127,8 @@ class LivePixels:
         self._shader_key = None  # (G-buffer, with the mesh's vertices, clamped)
         self._retired: Counter = Counter()  # the stats of shaders replaced
         self._bg_key, self._bg = None, None  # the background picture kept (_background)
+        self._maps = PixelMaps()  # the texture maps at the pixels (explorer.render.pixelmaps)
+        self._normals = None  # the normals the shader has (the hits', or bumped)
 
     # -- life --------------------------------------------------------------------------------
     def __enter__(self):
@@ -236,12 +243,15 @@ class LivePixels:
                 self._retired.update(self._shader.stats)
             self._shader = None
         first = mesh.n_vertices if shadows else 0
+        textured = any_maps((scene.material,) if materials is None else materials)
+        parts = self._map_parts(g, scene, materials) if textured else []
+        normals = self._maps.normals(h, mesh, parts) if textured else h.normals
 
         def geometry():  # the points shaded (after the mesh's vertices when they cast shadows)
             if not shadows:
-                return h.positions, h.normals, None
+                return h.positions, normals, None
             P = np.vstack([mesh.positions, h.positions])
-            return P, np.vstack([mesh.normals, h.normals]), mesh.faces
+            return P, np.vstack([mesh.normals, normals]), mesh.faces
 
         if self._shader is None:
             P, N, faces = geometry()
@@ -250,14 +260,22 @@ class LivePixels:
         else:
             self._shader.cancelled = cancelled
             self._shader.set_scene(scene)
-            if self._shader_key[0] is not g:
+            if self._shader_key[0] is not g or self._normals is not normals:
                 self._shader.set_geometry(*geometry())
-        self._shader_key = key
+        self._shader_key, self._normals = key, normals
+        if textured:  # every map at each pixel, on the kept sums
+            return self._maps.colors(self._shader, h, mesh, parts, first)
         if materials is None:
             c = self._shader.colors
         else:
             c = grouped_colors(self._shader, self._group_rows(g, materials, first), materials)
         return c[first:]
+
+    def _map_parts(self, g: GBuffer, scene, materials) -> list:
+        """[(rows of the hits, material)]: which pixels wear which material's maps."""
+        if materials is None:
+            return [(np.arange(len(g.hits.positions)), scene.material)]
+        return list(zip(self._group_rows(g, materials, 0), materials, strict=True))
 
     def _group_rows(self, g: GBuffer, materials, first: int) -> list[np.ndarray]:
         """The shader's rows of each group's pixels (offset by ``first``, the mesh's vertices

@@ -17,6 +17,20 @@ colour as the usual RGB point scalars (so a white texture gives today's pixels, 
 the secondary as a second vertex array, and a fragment-shader replacement of two lines doing
 the multiply and the sum. The image goes to VTK bottom row first (v = 0 is the image's lower
 edge, as in OBJ and OpenGL).
+
+**Ambient and emission maps** (beyond OpenGL 2.1, whose one texture unit in this mode
+multiplies the whole primary colour): when the material has an ``ambient_map`` or an
+``emission_map``, the picture passes the primary colour's terms apart (:attr:`Textured.layers`):
+``E = clamp(e)``, ``Ā = clamp(a·A)`` and ``D̄ = clamp(d·D)``, each interpolated, each times its
+own map's texel (white where a map is absent), then
+
+- ``single``: ``out = min(1, E·Te + Ā·Ta + D̄·Td + S̄·Td)`` (the diffuse texture darkens the
+  highlight, as GL's one texture does);
+- ``separate``: ``out = min(1, E·Te + Ā·Ta + D̄·Td + S̄)``.
+
+With the diffuse map alone the picture is GL 2.1's (the oracle's); with the other two it
+departs from GL's ``clamp(e + a·A + d·D)·T`` only where a vertex's primary sum exceeds 1 (each
+term is clamped apart) and by the rounding of each term to 8 bits (``docs/formats.md``).
 """
 
 from __future__ import annotations
@@ -38,34 +52,72 @@ SECONDARY = "secondary"
 _FRAGMENT = """vec4 texel = texture(actortexture, tcoordVCVSOutput);
   fragOutput0 = vec4(min(fragOutput0.rgb * texel.rgb + secondaryVSOut.rgb, vec3(1.0)),
                      fragOutput0.a * texel.a);"""
+#: the maps drawn as layers of their own (the module docstring), in the order of
+#: :attr:`Textured.layers`, and the material colour each multiplies
+LAYER_MAPS = {"emission_map": "emission", "ambient_map": "ambient"}
+#: the fragment's sum with the layers (``{layers}``: each layer's colour times its texel;
+#: ``{specular}``: the secondary colour, times the diffuse texel under ``single``)
+_LAYERED_FRAGMENT = """vec4 texel = texture(actortexture, tcoordVCVSOutput);
+  vec3 layered = fragOutput0.rgb * texel.rgb{layers};
+  fragOutput0 = vec4(min(layered + {specular}, vec3(1.0)), fragOutput0.a * texel.a);"""
+#: a white texel: the texture of a term without a map
+WHITE = np.full((1, 1, 4), 255, np.uint8)
 
 
 @dataclass(frozen=True)
 class Textured:
     """What a textured per-vertex picture draws.
 
-    primary : (n, 3) uint8 the primary colour per vertex (the whole colour under ``single``)
-    secondary : (n, 3) uint8 the specular colour per vertex (zeros under ``single``)
-    image : (h, w, 4) uint8 RGBA rows top first; tmap : the map (its scale, offset, clamp)
+    primary : (n, 3) uint8 the primary colour per vertex (the whole colour under ``single``;
+        with layers, the diffuse term ``D̄`` alone)
+    secondary : (n, 3) uint8 the specular colour per vertex (zeros under ``single``, but with
+        layers)
+    image : (h, w, 4) uint8 RGBA rows top first; tmap : the map (its scale, offset, clamp), or
+        None with layers and no diffuse map (a white texel)
+    layers : () for OpenGL 2.1's one texture; else one :class:`Layer` per key of
+        :data:`LAYER_MAPS` (the ambient and emission terms with their maps)
+    color_control : the scene's (with layers, the fragment's sum depends on it)
     """
 
     primary: np.ndarray
     secondary: np.ndarray
     image: np.ndarray
-    tmap: TextureMap
+    tmap: TextureMap | None
+    layers: tuple = ()
+    color_control: str = "single"
 
 
-def texture_map(scene, materials=None) -> TextureMap | None:
-    """The ``diffuse_map`` a per-vertex picture of the scene wears, or None.
+@dataclass(frozen=True)
+class Layer:
+    """One term drawn with its own map: ``key`` (of :data:`LAYER_MAPS`), ``colors`` (n, 3)
+    uint8 the term per vertex, ``image`` (h, w, 4) uint8 and ``tmap`` (None: a white texel)."""
+
+    key: str
+    colors: np.ndarray
+    image: np.ndarray
+    tmap: TextureMap | None
+
+    @property
+    def name(self) -> str:
+        """The layer's names in the shader: ``<name>`` its sampler, ``<name>_c`` its colour,
+        ``<name>_st`` its texture coordinates."""
+        return self.key.replace("_", "")
+
+
+def texture_map(scene, materials=None, key: str = "diffuse_map") -> TextureMap | None:
+    """The map ``key`` (default ``diffuse_map``) a per-vertex picture of the scene wears, or
+    None.
 
     materials : a mesh file's group materials; they must name one map between them (or none:
         see :func:`file_maps`)
     """
-    found = {m.diffuse_map for m in (materials or (scene.material,))}
+    found = {getattr(m, key) for m in (materials or (scene.material,))}
     if len(found) > 1:
+        what = key.replace("_", " ") + "s"
         raise ExplorerError(
-            "the mesh's materials wear different diffuse maps (or some none): a per-vertex "
-            "picture draws one texture; give --preset NAME (or --diffuse-map IMG) to draw one"
+            f"the mesh's materials wear different {what} (or some none): a per-vertex "
+            "picture draws one texture each; give --preset NAME (or --diffuse-map IMG) to "
+            "draw one"
         )
     return found.pop()
 
@@ -105,46 +157,92 @@ def textured_colors(scene, mesh: Mesh, materials=None) -> tuple[np.ndarray, np.n
 
     if scene.color_control == "single":
         return colours(lambda m: m), np.zeros((mesh.n_vertices, 3))
+    return colours(only("primary")), colours(only("specular"))
+
+
+def only(term: str):
+    """material -> the material with only ``term`` kept (the others black): ``emission``,
+    ``ambient``, ``diffuse``, ``specular``, or ``primary`` (all but the specular)."""
     black = (0.0, 0.0, 0.0)
-    primary = colours(lambda m: m.replace(specular=black))
-    secondary = colours(lambda m: m.replace(ambient=black, diffuse=black, emission=black))
-    return primary, secondary
+    keep = ("emission", "ambient", "diffuse") if term == "primary" else (term,)
+    off = {k: black for k in ("emission", "ambient", "diffuse", "specular") if k not in keep}
+    return lambda m: m.replace(**off)
 
 
-def textured(scene, mesh: Mesh, materials=None) -> Textured | None:
+def layered(scene, materials=None) -> bool:
+    """Whether a per-vertex picture draws the primary colour's terms apart (an ``ambient_map``
+    or ``emission_map``: see the module docstring)."""
+    return any(
+        getattr(m, k) is not None for m in (materials or (scene.material,)) for k in LAYER_MAPS
+    )
+
+
+def textured(scene, mesh: Mesh, materials=None, *, layers: bool = True) -> Textured | None:
     """What a per-vertex picture of the textured scene draws (None: it wears no texture).
 
+    layers : draw an ``ambient_map`` and ``emission_map`` too (:attr:`Textured.layers`); False:
+        the ``diffuse_map`` alone, as GL 2.1 draws it (a GLB holds that)
     A mesh without texture coordinates, or a map whose image cannot be read
     (:func:`explorer.render.textures.read_texture`), raises an :class:`ExplorerError`."""
     tmap = texture_map(scene, materials)
-    if tmap is None:
+    layers = layers and layered(scene, materials)
+    if tmap is None and not layers:
         return None
-    if mesh.uv is None:
-        raise ExplorerError(
-            f"mesh '{mesh.name}' has no texture coordinates, so it cannot wear diffuse_map "
-            f"'{tmap.file}' (an OBJ needs vt lines; a built-in mesh has its own)"
-        )
-    image = read_texture(tmap, "diffuse_map")
-    primary, secondary = textured_colors(scene, mesh, materials)
-    return Textured(to_bytes(primary), to_bytes(secondary), image, tmap)
+    maps = {k: texture_map(scene, materials, k) for k in LAYER_MAPS} if layers else {}
+    for key, t in (("diffuse_map", tmap), *maps.items()):
+        if t is not None and mesh.uv is None:
+            raise ExplorerError(
+                f"mesh '{mesh.name}' has no texture coordinates, so it cannot wear {key} "
+                f"'{t.file}' (an OBJ needs vt lines; a built-in mesh has its own)"
+            )
+    image = WHITE if tmap is None else read_texture(tmap, "diffuse_map")
+    if not layers:
+        primary, secondary = textured_colors(scene, mesh, materials)
+        return Textured(to_bytes(primary), to_bytes(secondary), image, tmap)
+    images = {k: WHITE if t is None else read_texture(t, k) for k, t in maps.items()}
+
+    def term(name):
+        change = only(name)
+        if materials:
+            return to_bytes(group_vertex_colors(scene, mesh, [change(m) for m in materials]))
+        return to_bytes(vertex_colors(scene.replace(material=change(scene.material)), mesh))
+
+    built = tuple(Layer(k, term(LAYER_MAPS[k]), images[k], t) for k, t in maps.items())
+    return Textured(term("diffuse"), term("specular"), image, tmap, built, scene.color_control)
 
 
 def texture_arrays(poly, mesh: Mesh, t: Textured) -> None:
     """Put the texture coordinates and the secondary colour on ``poly`` (a PyVista PolyData of
-    ``mesh``, its ``"colors"`` the primary colour)."""
-    poly.active_texture_coordinates = t.tmap.lookup(mesh.uv).astype(np.float32)
-    secondary = np.ones((mesh.n_vertices, 4), np.float32)
-    secondary[:, :3] = t.secondary / np.float32(255.0)
-    poly.point_data[SECONDARY] = secondary
+    ``mesh``, its ``"colors"`` the primary colour), and each layer's colour and coordinates."""
+    poly.active_texture_coordinates = _st(t.tmap, mesh)
+    poly.point_data[SECONDARY] = _rgba(t.secondary)
+    for layer in t.layers:
+        poly.point_data[layer.name + "_c"] = _rgba(layer.colors)
+        poly.point_data[layer.name + "_st"] = _st(layer.tmap, mesh)
 
 
-def vtk_texture(t: Textured):
+def _st(tmap: TextureMap | None, mesh: Mesh) -> np.ndarray:
+    """(n, 2) float32 the texture coordinates the map looks up (zeros: a white texel's)."""
+    if tmap is None:
+        return np.zeros((mesh.n_vertices, 2), np.float32)
+    return tmap.lookup(mesh.uv).astype(np.float32)
+
+
+def _rgba(colors) -> np.ndarray:
+    """(n, 4) float32 the bytes / 255 and an alpha of 1: a colour as a vertex array."""
+    out = np.ones((len(colors), 4), np.float32)
+    out[:, :3] = np.asarray(colors) / np.float32(255.0)
+    return out
+
+
+def vtk_texture(t: Textured | Layer):
     """The VTK texture of ``t``'s image: nearest texel, repeated (or clamped to the edge), no
     mipmaps, bottom row first."""
     from vtkmodules.util.numpy_support import numpy_to_vtk
     from vtkmodules.vtkCommonDataModel import vtkImageData
     from vtkmodules.vtkRenderingCore import vtkTexture
 
+    clamp = t.tmap is not None and t.tmap.clamp
     rows = gl_rows(t.image)  # VTK's image: x fastest, then y from the bottom (v = 0)
     h, w = rows.shape[:2]
     data = vtkImageData()
@@ -157,8 +255,8 @@ def vtk_texture(t: Textured):
     texture.SetColorModeToDirectScalars()
     texture.SetInterpolate(False)
     texture.SetMipmap(False)
-    texture.SetRepeat(not t.tmap.clamp)
-    texture.SetEdgeClamp(t.tmap.clamp)
+    texture.SetRepeat(not clamp)
+    texture.SetEdgeClamp(clamp)
     return texture
 
 
@@ -197,6 +295,46 @@ def add_textured(plotter, poly, t: Textured):
     sp.AddFragmentShaderReplacement(
         "//VTK::Color::Dec", True, "//VTK::Color::Dec\nin vec4 secondaryVSOut;", False
     )
-    sp.AddFragmentShaderReplacement("//VTK::TCoord::Impl", True, _FRAGMENT, False)
+    fragment = _FRAGMENT
+    if t.layers:
+        fragment = _layers(mapper, actor, t)
+    sp.AddFragmentShaderReplacement("//VTK::TCoord::Impl", True, fragment, False)
     plotter.add_actor(actor, reset_camera=False)
     return actor
+
+
+def _layers(mapper, actor, t: Textured) -> str:
+    """Bind each layer's colour, coordinates and texture (a named texture of the actor's
+    property: VTK declares and binds its sampler) and return the fragment's sum."""
+    from vtkmodules.vtkCommonDataModel import vtkDataObject
+
+    points = vtkDataObject.FIELD_ASSOCIATION_POINTS
+    sp = actor.GetShaderProperty()
+    vs_dec, vs_impl, fs_dec, terms = [], [], [], []
+    for layer in t.layers:
+        n = layer.name
+        for array in (f"{n}_c", f"{n}_st"):
+            mapper.MapDataArrayToVertexAttribute(array, array, points, -1)
+        vs_dec += [
+            f"in vec4 {n}_c;",
+            f"in vec2 {n}_st;",
+            f"out vec4 {n}_cVS;",
+            f"out vec2 {n}_stVS;",
+        ]
+        vs_impl += [f"{n}_cVS = {n}_c;", f"{n}_stVS = {n}_st;"]
+        fs_dec += [f"in vec4 {n}_cVS;", f"in vec2 {n}_stVS;"]
+        terms.append(f" + {n}_cVS.rgb * texture({n}, {n}_stVS).rgb")
+        actor.GetProperty().SetTexture(n, vtk_texture(layer))
+    sp.AddVertexShaderReplacement(
+        "//VTK::Normal::Dec", True, "//VTK::Normal::Dec\n" + "\n".join(vs_dec), False
+    )
+    sp.AddVertexShaderReplacement(
+        "//VTK::Normal::Impl", True, "//VTK::Normal::Impl\n" + "\n".join(vs_impl), False
+    )
+    sp.AddFragmentShaderReplacement(
+        "//VTK::Normal::Dec", True, "//VTK::Normal::Dec\n" + "\n".join(fs_dec), False
+    )
+    specular = "secondaryVSOut.rgb"
+    if t.color_control == "single":
+        specular += " * texel.rgb"
+    return _LAYERED_FRAGMENT.format(layers="".join(terms), specular=specular)

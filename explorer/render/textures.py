@@ -93,11 +93,19 @@ def sample_nearest(image: np.ndarray, st, *, clamp: bool = False) -> np.ndarray:
     (or ``GL_CLAMP_TO_EDGE`` when ``clamp``). image : (h, w, c) rows top first.
     Returns (k, c) of the image's dtype."""
     rows = gl_rows(image)
-    h, w = rows.shape[:2]
+    j, i = texel_index(rows.shape[:2], st, clamp=clamp)
+    return rows[j, i]
+
+
+def texel_index(shape, st, *, clamp: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """``(j, i)`` (k,) int64 each: the row (bottom first, OpenGL's order: :func:`gl_rows`) and
+    column of the texel ``GL_NEAREST`` picks at ``st`` (k, 2) in an image of ``shape`` (h, w),
+    repeated (``GL_REPEAT``) or clamped to the edge (``clamp``)."""
+    h, w = (int(n) for n in shape[:2])
     st = np.asarray(st, np.float64)
     s, t = st[:, 0], st[:, 1]
     if not clamp:
         s, t = s - np.floor(s), t - np.floor(t)
     i = np.clip(np.floor(s * w), 0, w - 1).astype(np.int64)
     j = np.clip(np.floor(t * h), 0, h - 1).astype(np.int64)
-    return rows[j, i]
+    return j, i

@@ -37,20 +37,23 @@ Light loops, variants and what they cost to compile. Each light of a pass runs i
 Fresnel, per-vertex ambient) and then one light loop (:func:`_light`), compiled for a few named
 compile-time choices (:class:`explorer.shading.codegen.Loop`: where L comes from, how the lobe's
 base is found, grey or RGB sums; see the comment above :func:`_light`).
-:data:`explorer.shading.codegen.LIGHT_LOOPS` lists the 18 valid combinations; a light's loop is
-picked at run time from its flags (:func:`_loop_code`), through tests written from that tuple
-(:func:`explorer.shading.codegen.dispatch_source`) when :func:`_light_loop` is compiled, so no
-table spells the combinations out.
+:data:`explorer.shading.codegen.LIGHT_LOOPS` lists the 18 valid combinations, each a function of
+its own (``_light_<code>``, :func:`_light_entry`), compiled once per precision by
+:func:`loop_table` (or loaded from numba's cache) before the first pass of that precision; a
+light's loop is picked at run time from its flags (:func:`_loop_code`) and called through that
+table of entry points (:func:`_light_loop`, :func:`_call_light`), so no table spells the
+combinations out and no kernel of the chain that calls them holds a copy of them (numba links a
+called function's code into its caller, and LLVM optimised the 36 loops again at every level:
+``_light_loop``, ``_block``, ``_task``, ``shade``'s parallel loop, ``shade``, ``fixup``).
 Everything cheap to decide at run time is decided there (whether a light adds diffuse, whether
 it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and fills the rows
 the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
-:mod:`explorer.shading.equation`). Every loop is compiled with the entry point that first meets
-a precision (``shade``; ``fixup`` for the float64 redo of a float32 pass), and numba caches
-the result on disk (``cache=True``: per machine, keyed on the contents of this file and of
-those it compiles from, :mod:`.vmath`, :mod:`.codegen`, :mod:`explorer.core.lightrow` ...,
-:mod:`explorer.geometry.kernelcache`; an edit to any of them recompiles). What that costs is
-measured by ``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of
-the loops a scene does not use (its docstring keeps the last table, with the machine).
+:mod:`explorer.shading.equation`). numba caches every kernel on disk (``cache=True``: per
+machine, keyed on the contents of this file and of those it compiles from, :mod:`.vmath`,
+:mod:`.codegen`, :mod:`explorer.core.lightrow` ..., :mod:`explorer.geometry.kernelcache`; an
+edit to any of them recompiles). What that costs is measured by
+``benchmarks/bench_compile.py``: each entry point's cold compile, and the share of the loops a
+scene does not use (its docstring keeps the last table, with the machine).
 
 Leaf kernels are compiled without numba's reference counting (``_nrt=False``): every slice of a
 shared array would otherwise be an atomic increment and decrement of its count, which the two
@@ -64,6 +67,7 @@ two vector iterations interleaved (see :func:`explorer.shading.codegen.wide_vect
 from __future__ import annotations
 
 import operator
+import threading
 import warnings
 from typing import NamedTuple
 
@@ -113,6 +117,7 @@ from explorer.shading.codegen import (  # the light loops' variants, the vector 
     dispatch_source,
     loop_of,
     wide,
+    wide_vectors,
 )
 from explorer.shading.layout import (  # the kernels' layouts (O_, R_, K_, B_ slots)
     B_AX,
@@ -745,9 +750,9 @@ def _reach(bd, c0, nc, q, fl, back, act):
 #   block adds the grey rows to every channel once.
 #
 # Every valid combination is in :data:`~explorer.shading.codegen.LIGHT_LOOPS`; :func:`_light_loop`
-# calls the one a light needs (its code from :func:`_loop_code`), through tests written from
-# that tuple when it is compiled: no table is written by hand, and all of them are compiled with
-# the entry point that calls them (the module docstring gives the cost). What is cheap to decide
+# calls the one a light needs (its code from :func:`_loop_code`) through the table of entry
+# points :func:`loop_table` fills: no table is written by hand, and each loop is compiled once,
+# on its own (the module docstring gives the cost). What is cheap to decide
 # at run time is not a variant: whether the light adds diffuse (a specular-only pass adds w·N·L
 # times a zero colour), whether it is attenuated (1, 0, 0 otherwise: w = 1 exactly).
 #
@@ -981,20 +986,97 @@ def _split_lobe(scr, m, y, sr, sg, sb, grey):
         _add_light(GS, Sx, Sy, Sz, i, WS[i] * E[i], sr, sg, sb, grey)
 
 
-def _light_loop(scr, m, q, y, k, atten, l_dif, code):  # pragma: no cover - overloaded below
-    raise NotImplementedError
+def _light_entry(code: int):
+    """The light loop of ``code`` as a function of its own, ``_light_<code>`` (a numba
+    dispatcher, cached on its own like any kernel; its source is written here, one line that
+    calls :func:`_light` with the literal code)."""
+    name = f"_light_{code}"
+    params = "scr, m, q, y, k, atten, l_dif"
+    src = f"def {name}({params}):\n    _light({params}, {code})\n"
+    space = {"__name__": __name__, "_light": _light}
+    exec(compile(src, __file__, "exec"), space)  # noqa: S102
+    return nb.njit(**_LEAF)(space[name])
 
 
-@overload(_light_loop, jit_options=dict(_LEAF, cache=False))  # (cached with its callers)
-def _light_loop_overload(scr, m, q, y, k, atten, l_dif, code):
-    """Run the light loop compiled for the run-time ``code`` (see
-    :func:`explorer.shading.codegen.loop_code`): one test and one literal call per entry of
-    :data:`~explorer.shading.codegen.LIGHT_LOOPS`, written from that tuple into one function
-    (:func:`~explorer.shading.codegen.dispatch_source`)."""
-    params = "scr, m, q, y, k, atten, l_dif, code"
-    space = {"_light": _light}
-    exec(dispatch_source("impl", params, "_light", LIGHT_LOOPS), space)  # noqa: S102
-    return space["impl"]
+# every light loop, a module global each (so that the cache's guard and its list of files,
+# :func:`explorer.shading.warm.dispatchers`, find them as they find every kernel)
+for _code in LIGHT_LOOPS:
+    globals()[f"_light_{_code}"] = _light_entry(_code)
+
+
+def light_signature(dtype) -> tuple:
+    """The numba types a light loop is compiled for (and :func:`_call_light` calls it with):
+    scratch, lanes, the light's parameter row, the exponent, the constants, attenuated,
+    adds diffuse."""
+    T = nb.from_dtype(np.dtype(dtype))
+    row = types.Array(T, 1, "C", readonly=True)
+    return (types.Array(T, 1, "C"), types.intp, row, T, row, types.boolean, types.boolean)
+
+
+_tables: dict = {}
+_tables_lock = threading.Lock()
+
+
+def loop_table(dtype) -> np.ndarray:
+    """The light loops of a precision, compiled (or loaded from numba's cache) once per process:
+    (64,) int64, the entry point of each code of :data:`~explorer.shading.codegen.LIGHT_LOOPS`
+    (0 for a code that names none), given to the kernels with the lights (:class:`Lights`).
+
+    The kernels call a light loop through this table (:func:`_call_light`), not as a function
+    numba links in: numba copies every function a kernel calls into the kernel's own code, and
+    LLVM optimises and generates all of it again for each kernel of the chain that calls it
+    (``_light_loop``, :func:`_block`, :func:`_task`, the parallel loop of :func:`shade`,
+    :func:`shade`, :func:`fixup`): the 36 light loops were most of the cold compile's LLVM time.
+    Compiled with the precision's 512-bit vectors
+    (:func:`explorer.shading.codegen.wide_vectors`)."""
+    dt = np.dtype(dtype)
+    table = _tables.get(dt)
+    if table is not None:
+        return table
+    with _tables_lock:
+        if dt not in _tables:
+            sig = light_signature(dt)
+            table = np.zeros(64, np.int64)
+            with wide_vectors(64 // dt.itemsize):
+                for code in LIGHT_LOOPS:
+                    d = globals()[f"_light_{code}"]
+                    d.compile(sig)
+                    cres = d.overloads[sig]
+                    table[code] = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
+            if not table[list(LIGHT_LOOPS)].all():  # pragma: no cover - numba lost a symbol
+                raise RuntimeError("a light loop has no entry point")
+            table.flags.writeable = False
+            _tables[dt] = table
+    return _tables[dt]
+
+
+@intrinsic
+def _call_light(typingctx, fn, scr, m, q, y, k, atten, l_dif):
+    """Call the light loop at address ``fn`` (an entry of :func:`loop_table`) with numba's own
+    calling convention, the arguments cast to :func:`light_signature`: an indirect call, so the
+    caller's code holds no copy of the loop."""
+    if not isinstance(fn, types.Integer) or not isinstance(scr, types.Array):
+        return None
+    target = light_signature(scr.dtype.name)
+
+    def codegen(context, builder, sig, args):
+        given = zip(args[1:], sig.args[1:], target, strict=True)
+        vals = [context.cast(builder, v, t, to) for v, t, to in given]
+        fnty = context.call_conv.get_function_type(types.none, target)
+        callee = builder.inttoptr(args[0], fnty.as_pointer())
+        context.call_conv.call_function(builder, callee, types.none, target, vals)
+        return context.get_dummy_value()
+
+    return types.none(fn, scr, m, q, y, k, atten, l_dif), codegen
+
+
+@nb.njit(**_LEAF)
+def _light_loop(loops, scr, m, q, y, k, atten, l_dif, code):
+    """Run the light loop of the run-time ``code`` (see
+    :func:`explorer.shading.codegen.loop_code`) from ``loops`` (:func:`loop_table`)."""
+    fn = loops[code]
+    if fn != 0:
+        _call_light(fn, scr, m, q, y, k, atten, l_dif)
 
 
 @nb.njit(**_LEAF)
@@ -1276,14 +1358,14 @@ def _compose_grey(out, mat, aconst, Ax, Ay, Az, GD, GS, clamp, k, has_a):
 
 
 @nb.njit(inline="always", **_LEAF)
-def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
+def _light_run(loops, scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inline):
     """One light over the first ``m`` lanes of a scratch (a block, or a run of its chunks: then
     ``scr`` starts at the run's first lane, see _block): its pre-passes (rows L and the weight
     w), then its light loop; ``vis`` : (m,) uint8 its visibility, or (0,)."""
     atten = (fl & ATTEN) != 0
     if inline:  # a plain point light (see _is_inline): no pre-pass
         code = _loop_code(SRC_INLINE, mode, l_spec, (fl & GREY) != 0)
-        _light_loop(scr, m, q, shininess, k, atten, l_dif, code)
+        _light_loop(loops, scr, m, q, shininess, k, atten, l_dif, code)
         return
     fres = l_spec and (fl & FRESNEL) != 0
     rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
@@ -1300,13 +1382,14 @@ def _light_run(scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mode, inl
     source = SRC_ROWS if rows else SRC_CONST
     if fres:  # diffuse with w, then specular with w·F
         if l_dif:
-            _light_loop(
-                scr, m, q, shininess, k, False, True, _loop_code(source, mode, False, False)
-            )
+            code = _loop_code(source, mode, False, False)
+            _light_loop(loops, scr, m, q, shininess, k, False, True, code)
         _fresnel(scr, m, q, k)
-        _light_loop(scr, m, q, shininess, k, False, False, _loop_code(source, mode, True, False))
+        code = _loop_code(source, mode, True, False)
+        _light_loop(loops, scr, m, q, shininess, k, False, False, code)
     elif l_dif or l_spec:  # (the weight rows hold the attenuation: not again in the loop)
-        _light_loop(scr, m, q, shininess, k, False, l_dif, _loop_code(source, mode, l_spec, False))
+        code = _loop_code(source, mode, l_spec, False)
+        _light_loop(loops, scr, m, q, shininess, k, False, l_dif, code)
 
 
 @nb.njit(**_LEAF)
@@ -1322,7 +1405,7 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
     rows copies each row's array structure: ~1 µs per light and block)
     """
     gpx, gpy, gpz, gx, gy, gz = g
-    params, flags, view = lights
+    params, flags, view, loops = lights
     mat, aconst, shininess = surface
     A, D, S = sums
     base_out, ws_out = lobes
@@ -1416,7 +1499,9 @@ def _block(g, lights, opts, surface, k, sums, lobes, vis, marks, out, scr, layou
             if reach == nc or act[li, c]:  # the scratch from lane s0 on: rows start at lane s0
                 sub = scr[s0 : s0 + N_ROWS * ROW]
                 v = vrows[max(vindex[li], 0), s0:s1]  # (read only by a light flagged SHADOW)
-                _light_run(sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline)
+                _light_run(
+                    loops, sub, s1 - s0, fl, q, shininess, k, v, l_amb, l_dif, l_spec, mode, inline
+                )
             else:
                 skipped += s1 - s0
                 if store_lobe and l_spec:
@@ -1567,11 +1652,13 @@ def _flat(A, D, S, out):
 class Lights(NamedTuple):
     """A pass's lights in the normalised frame: ``params`` (L, N_PARAMS) T, one row per light
     (:mod:`explorer.core.lightrow`); ``flags`` (L,) int32; ``view`` (3,) T, the eye (local
-    viewer) or V (infinite viewer)."""
+    viewer) or V (infinite viewer); ``loops`` (64,) int64, the light loops of T
+    (:func:`loop_table`)."""
 
     params: np.ndarray
     flags: np.ndarray
     view: np.ndarray
+    loops: np.ndarray
 
 
 class Surface(NamedTuple):

@@ -353,3 +353,57 @@ def test_a_textured_mesh_wears_its_texture_again_after_per_pixel(tmp_path, monke
         np.testing.assert_array_equal(after, before)
     finally:
         view.plotter.close()
+
+
+def test_a_built_in_mesh_chosen_after_the_start_wears_the_map(tmp_path, monkeypatch):
+    """The explorer started on the teapot with a diffuse_map; the sphere chosen after it comes
+    with its (u, v) and wears the map (it was drawn untextured: the chooser loaded it without
+    texture coordinates)."""
+    from pathlib import Path
+
+    tiles = Path(__file__).resolve().parents[2] / "docs" / "examples" / "tiles.png"
+    view = make_port("teapot", tmp_path, monkeypatch, "--diffuse-map", str(tiles))
+    try:
+        c = view.controller
+        assert c.files.choose_mesh("sphere")
+        view.redraw()
+        assert c.meshes["sphere"].uv is not None
+        assert view.view.drawings[0].texture is not None
+        tiled = picture(view)
+        material = c.state.scene.material
+        assert c.set_value("preset", "gold", merge=False)  # a material without the map
+        view.redraw()
+        assert c.state.scene.material.diffuse_map is None and material.diffuse_map is not None
+        assert view.view.drawings[0].texture is None
+        assert np.abs(picture(view) - tiled).max() > 100
+    finally:
+        view.plotter.close()
+
+
+def test_a_mesh_without_uv_is_drawn_untextured_per_pixel(tmp_path, monkeypatch):
+    """An OBJ without vt lines under a material with a diffuse_map: per pixel as per vertex,
+    the view draws it untextured (the per-pixel frame raised 'no texture coordinates' at every
+    frame)."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[2] / "docs" / "examples"
+    view = make_port(
+        str(examples / "teapot_parts.obj"),
+        tmp_path,
+        monkeypatch,
+        "--preset",
+        "gold",
+        "--diffuse-map",
+        str(examples / "tiles.png"),
+    )
+    try:
+        c = view.controller
+        assert view.view.mesh.uv is None and c.state.scene.material.diffuse_map is not None
+        before = picture(view)
+        assert c.set_value("shading", "per-pixel", merge=False)
+        view.redraw()
+        after = picture(view)
+        assert view.pixels.frames >= 1 and view.pixels.last is not None
+        assert np.abs(after - before).max() > 0  # (the per-pixel picture is drawn)
+    finally:
+        view.plotter.close()

@@ -151,3 +151,62 @@ def test_the_view_wears_a_mesh_files_texture_as_render_does(tmp_path):
         assert np.abs(got - want.astype(int)).max() <= 1  # the window shades in float32
     finally:
         pl.close()
+
+
+def test_the_view_wears_ambient_and_emission_maps_as_layers(tmp_path):
+    """An emission map and an ambient map on the window's (and page's) view: each layer's
+    colour array holds its term (the engine's, within the float32 window's one level), a black
+    emission map takes the emission off every pixel (the picture is the material without
+    emission, within two levels: each term is rounded apart), a white one gives it back."""
+    import dataclasses
+
+    from PIL import Image
+
+    from explorer.render.textured import only
+    from explorer.shading.display import vertex_colors
+
+    for name, value in (("white", 255), ("black", 0)):
+        Image.fromarray(np.full((2, 2, 3), value, np.uint8)).save(tmp_path / f"{name}.png")
+    state, _ = start_state(build_parser().parse_args(["gui", "--mesh", "torus"]))
+    mesh = G.torus(uv=True)
+    grey = (0.2, 0.2, 0.2)
+    base = state.scene.material.replace(
+        emission=(0.3, 0.2, 0.1), ambient=grey, diffuse=(0.3, 0.3, 0.3), specular=grey
+    )
+
+    def wearing(**maps):
+        return dataclasses.replace(state, scene=state.scene.replace(material=base.replace(**maps)))
+
+    pl = plotter((200, 150), (0.3, 0.3, 0.3))
+    try:
+        view = SceneView(pl, mesh, wearing())
+        pl.view_xy()
+
+        def picture(s):
+            view.show_state(s)
+            pl.render()
+            return pl.screenshot(return_img=True)[:, :, :3].astype(int)
+
+        plain = picture(wearing())
+        lit = wearing(
+            emission_map=str(tmp_path / "white.png"), ambient_map=str(tmp_path / "white.png")
+        )
+        white = picture(lit)
+        d = view.drawings[0]
+        assert set(d.layers) == {"emission", "ambient"}
+        scene = lit.shown_scene()
+        for term, name in d.layers.items():
+            want = to_bytes(vertex_colors(scene.replace(material=only(term)(scene.material)), mesh))
+            got = np.rint(np.asarray(d.poly.point_data[name])[:, :3] * 255).astype(int)
+            assert np.abs(got - want.astype(int)).max() <= 1
+        assert np.abs(white - plain).max() <= 2
+        dark = picture(wearing(emission_map=str(tmp_path / "black.png")))
+        no_emission = picture(
+            dataclasses.replace(
+                state, scene=state.scene.replace(material=base.replace(emission=(0.0, 0.0, 0.0)))
+            )
+        )
+        assert np.abs(dark - no_emission).max() <= 2
+        assert np.abs(dark - plain).max() > 40
+    finally:
+        pl.close()

@@ -104,3 +104,63 @@ def test_a_light_loop_is_compiled_without_numba_inlining_its_rows(monkeypatch):
     one_loop(np.zeros((layout.N_ROWS + 1) * K.ROW, T), 3, np.zeros(24, T), T(3), K.constants(T))
     assert "_row" not in inlined and "_row_checked" not in inlined
     assert len(inlined) <= 12, inlined
+
+
+def _pass(scene, precision):
+    from explorer.geometry.meshes import torus
+    from explorer.shading.shader import Shader
+
+    mesh = torus(12)
+    s = Shader(scene, mesh.positions, mesh.normals, precision=precision, tier="compiled")
+    return np.asarray(s.colors, np.float64)
+
+
+LIT = {
+    "material": {"emission": [0.1, 0.05, 0.0], "diffuse": [0.6, 0.5, 0.4], "shininess": 20.0},
+    "viewer": {"eye": [0, 0, 5]},
+    "lights": [
+        {"type": "point", "position": [2.0, 1.5, 3.0], "ambient": [0, 0, 0]},
+        {"type": "directional", "to_light": [0.3, 1.0, 0.5], "ambient": [0, 0, 0]},
+    ],
+}
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_the_kernels_run_the_light_loops_from_their_table(monkeypatch, precision):
+    # the light loops are called through the table of entry points given with the lights
+    # (kernels.loop_table), not linked into the pass: a table of no loops adds no light
+    real = _pass(LIT, precision)
+    none = np.zeros(64, np.int64)
+    none.flags.writeable = False  # (as the real table: no other signature of shade to compile)
+    monkeypatch.setattr(K, "loop_table", lambda dtype: none)
+    dark = _pass(LIT, precision)
+    monkeypatch.undo()
+    unlit = {**LIT, "lights": [dict(lt, diffuse=[0] * 3, specular=[0] * 3) for lt in LIT["lights"]]}
+    assert np.array_equal(dark, _pass(unlit, precision))
+    assert (real - dark).max() > 0.3  # (and with the table, the lights shine)
+
+
+def test_each_light_loop_is_a_kernel_of_its_own():
+    # compiled once per precision and cached on its own (so the cache's guard and its list of
+    # files know it: warm.dispatchers), and no copy of any in the pass's compiled code: numba
+    # links a called function's code into its caller, and LLVM optimised the 36 light loops
+    # again at every level of the chain (_light_loop, _block, _task, shade's parallel loop,
+    # shade, fixup: most of the cold compile's LLVM time, benchmarks/bench_compile.py --warm)
+    from explorer.shading import warm
+
+    names = {f"explorer.shading.kernels._light_{c}" for c in codegen.LIGHT_LOOPS}
+    assert names <= set(warm.dispatchers())
+    for dtype in (np.float32, np.float64):
+        table = K.loop_table(dtype)
+        assert np.count_nonzero(table) == len(codegen.LIGHT_LOOPS) == 18
+        assert table is K.loop_table(dtype)  # (once per process)
+        for code in codegen.LIGHT_LOOPS:
+            assert K.light_signature(dtype) in getattr(K, f"_light_{code}").overloads
+    _pass(LIT, "float32")  # (compiled, or loaded from the cache)
+    shade = getattr(K.shade, "dispatcher", K.shade)
+    assert shade.overloads
+    for cres in shade.overloads.values():
+        # numba's private API (numba.core.codegen.CPUCodeLibrary): the module other code links
+        linked = cres.library._get_module_for_linking()
+        defined = [f.name for f in linked.functions if not f.is_declaration]
+        assert defined and not [f for f in defined if "_light_overload" in f]

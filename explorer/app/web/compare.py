@@ -13,9 +13,11 @@ class WebCompare:
     """Side B's pane of ``app`` (a :class:`~explorer.app.web.WebExplorer`: its ``plotter``,
     ``server``, ``loop``, ``guard`` and ``_send``): :attr:`plotter` is made with the page (its
     remote view needs it). The page shows or hides side B's view itself (state
-    ``compare``); side B draws no light handles."""
+    ``compare``). Side B draws the light handles, the selected one's ring and the arrows at
+    its edge toward handles out of it, as the window's pane B does: a drag on B's handle moves
+    the light in both panes (the remote view passes the page's pointer to B's interactor)."""
 
-    handles = False
+    handles = True
 
     def __init__(self, app, size):
         from explorer.render.vtk import plotter  # VTK only once a server is made
@@ -27,7 +29,8 @@ class WebCompare:
         return self.plotter
 
     def made(self, plotter, view) -> None:
-        pass
+        """Side B's camera drags are drags too (one camera: B's drag moves A's)."""
+        self.app.watch_camera(plotter)
 
     def show_pane(self, visible: bool) -> None:
         pass

@@ -25,9 +25,18 @@ DRAWER_WIDTH = 380
 #: the drawer's width (pixels) by the page's width: (narrower than, drawer) in order, else
 #: DRAWER_WIDTH; at 640 pixels a 380-pixel drawer left the view 260 pixels
 DRAWER_WIDTHS = ((800, 270), (1100, 320))
+#: a number row's label column and its field (pixels): every slider of every tab starts and
+#: ends at the same x (a label's own width moved its slider: shininess's started 52 pixels
+#: right of ka's); the label is 4 pixels narrower than its column (its margin), "shininess" is
+#: 69 pixels wide
+NUMBER_LABEL_WIDTH, NUMBER_FIELD_WIDTH = 78, 92
+#: the same below 800 pixels (the drawer's 270 pixels left the slider 46), the labels in 14
+#: pixels ("shininess" 60 pixels wide); a field still shows "0.247", "2.50 r", "40.0°"
+NARROW_NUMBER_WIDTHS = (66, 72)
 #: the page's own rules for small windows: the toolbar scrolls sideways rather than squeezing
 #: its title to a letter, the title goes below 1100 pixels (the tab's title says it), and the
-#: toolbar's buttons and the panel's tabs are narrower below 900
+#: toolbar's buttons and the panel's tabs are narrower below 900 (Vuetify's own tab rule is
+#: ``.v-tab.v-tab.v-btn``: its 90-pixel tabs overflowed the 270-pixel drawer)
 PAGE_CSS = """
 html { overflow-y: auto; }
 .v-app-bar .v-toolbar__content { overflow-x: auto; overflow-y: hidden; scrollbar-width: thin; }
@@ -35,8 +44,24 @@ html { overflow-y: auto; }
 .v-app-bar .v-file-input { min-width: 150px; }
 @media (max-width: 1099px) { .v-app-bar .v-toolbar-title { display: none; } }
 @media (max-width: 899px) {
-  .v-app-bar .v-btn, .v-tab.v-btn { padding: 0 6px; min-width: 0; }
+  .v-app-bar .v-btn, .v-tab.v-tab.v-btn { padding: 0 6px; min-width: 0; }
 }
+"""
+#: the number rows' label and field columns (narrower below 800 pixels), and the drawer's room
+#: for its scroll bar kept in every tab (a tab that scrolls is no narrower than one that does
+#: not): the sliders of every tab line up
+NUMBER_CSS = f"""
+.v-navigation-drawer__content {{ scrollbar-gutter: stable; }}
+.phong-number .v-input__prepend {{ width: {NUMBER_LABEL_WIDTH}px; flex: none;
+  margin-inline-end: 8px; }}
+.phong-number .v-label {{ display: block; overflow: hidden; text-overflow: ellipsis;
+  margin-inline-end: 4px; }}
+.phong-number .v-text-field {{ width: {NUMBER_FIELD_WIDTH}px; flex: none; }}
+@media (max-width: 799px) {{
+  .phong-number .v-input__prepend {{ width: {NARROW_NUMBER_WIDTHS[0]}px; }}
+  .phong-number .v-label {{ font-size: 14px; }}
+  .phong-number .v-text-field {{ width: {NARROW_NUMBER_WIDTHS[1]}px; }}
+}}
 """
 #: the page's width as a client-only key (``page_w``), on load and on every resize
 PAGE_WIDTH_JS = """
@@ -81,9 +106,10 @@ DOWNLOAD_JS = ("trigger('download', ['{kind}']).then(f => f && utils.download(f.
 
 def _number(v3, html, ctrl, key: str, label: str) -> None:
     """A slider (:data:`~explorer.core.controls.STEPS` steps) and a number field for ``key`` in
-    one row, shown when the state has a value for it (``v_show`` on a wrapper: Vuetify's
-    ``d-flex`` is ``display: flex !important``, which would override v-show's ``display: none``)."""
-    with html.Div(v_show=f"{key} != null"), html.Div(classes="d-flex align-center"):
+    one row (its label and its field in columns of fixed width: :data:`NUMBER_CSS`), shown
+    when the state has a value for it (``v_show`` on a wrapper: Vuetify's ``d-flex`` is
+    ``display: flex !important``, which would override v-show's ``display: none``)."""
+    with html.Div(v_show=f"{key} != null"), html.Div(classes="d-flex align-center phong-number"):
         v3.VSlider(
             v_model=(f"{key}_step", 0), min=0, max=STEPS, step=1, label=label, hide_details=True,
             density="compact", end=ctrl.seal, raw_attrs=[f'aria-label="{key} slider"'],
@@ -92,7 +118,7 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
         v3.VTextField(
             model_value=(f"{key}_text", ""), key=(f"'{key}-' + field_rev",), type="text",
             density="compact", hide_details=True,
-            variant="outlined", style="max-width: 92px",
+            variant="outlined",
             change=(ctrl.on_field, f"['{key}', $event.target.value]"),
             raw_attrs=[f'aria-label="{key}"'],
         )  # fmt: skip
@@ -408,7 +434,7 @@ def build(app) -> None:
         client.Script(webintents.keys_js())  # the registry's keys (the desktop's)
         client.ClientTriggers(mounted="seen_seq = message_seq")
         # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window
-        client.Style(PAGE_CSS)
+        client.Style(PAGE_CSS + NUMBER_CSS)
         client.Script(PAGE_WIDTH_JS)
         with layout.toolbar:
             webintents.menus(v3)

@@ -25,6 +25,7 @@ stays free of them).
 from __future__ import annotations
 
 import logging
+import math
 import os
 import tempfile
 import time
@@ -87,6 +88,8 @@ class WebExplorer:
         from explorer.render.vtk import plotter  # VTK only once a server is made
 
         self.pushing = False  # the server is setting the page's values (no user change)
+        # the start framed again for the first page's view (as the window frames it when shown)
+        self._frame_at = tuple(int(v) for v in size) if state.camera is None else None
         self.messages: list[dict] = []
         self.message_seq = 0  # messages said so far (a page shows those after it opened)
         self.answers: dict = {}  # the page's answers to the controller's next questions
@@ -115,6 +118,8 @@ class WebExplorer:
         self.view = self.viewport.attach(
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
+        self.watch_camera(self.plotter)
+        self.plotter.render_window.AddObserver("StartEvent", self.guard(self._frame, "view"), 1.0)
         panel.connect(self)
         page.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
@@ -129,6 +134,28 @@ class WebExplorer:
         """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
         logged, never lost (:meth:`PlotterView.guard`)."""
         return self.viewport.guard(fn, where)
+
+    def watch_camera(self, pl) -> None:
+        """``pl``'s camera drags are drags, as the window's (the level of detail; in per-pixel
+        mode the drag fallback, said on the page): the remote view passes the page's pointer
+        to ``pl``'s interactor, whose style starts and ends each camera interaction."""
+        style = pl.iren.interactor.GetInteractorStyle()
+        if style is not None:
+            vp = self.viewport
+            style.AddObserver("StartInteractionEvent", self.guard(vp.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self.guard(vp.end_drag, "camera"))
+
+    def _frame(self, *_) -> None:
+        """Before a frame: the first time the view is drawn at another size than it was made
+        (the page's own), the start's mesh is framed for that shape (``Controller.frame_start``)
+        unless the session gave a camera: a page narrower than the server's 800x600 showed the
+        light's handle half out of the view, the mesh framed for 4:3."""
+        w, h = (int(v) for v in self.plotter.window_size)
+        if self._frame_at is None or (w, h) == self._frame_at or min(w, h) < 2:
+            return
+        self._frame_at = None
+        self.controller.frame_start()
+        self.view.apply_camera(self.store.state.camera)
 
     def _ready(self, **_) -> None:
         """The server runs: its loop is kept (the difference worker delivers into it), and
@@ -314,6 +341,7 @@ class WebExplorer:
             "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
             "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
             "lobes": self.view.lobe.report(),
+            "pixels": pixels_report(self.viewport.pixels),
             "session": session_mapping(self.store.state),
             # the last picture's steps (ms; explorer.app.web.pictures) and the last change's
             # time to its frame's end (the benchmark's breakdown)
@@ -327,6 +355,22 @@ class WebExplorer:
             self.pictures.close()
         self._uploads.cleanup()
         self.plotter.close()
+
+
+def pixels_report(layer) -> dict:
+    """What a test reads of the per-pixel picture (:class:`~explorer.app.pixellayer.PixelLayer`
+    ``layer``): the pictures made, whether a drag draws per vertex now, and the last per-pixel
+    picture's and per-vertex frame's times (ms; None before one)."""
+
+    def ms(v: float):
+        return None if math.isnan(v) else round(v, 2)
+
+    return {
+        "frames": layer.frames,
+        "fallback": layer.fallback,
+        "ms": ms(layer.ms),
+        "vertex_ms": ms(layer.vertex_ms),
+    }
 
 
 def own_arguments() -> None:

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers.insets import panel_extent
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.analysis import lobe
@@ -473,3 +474,21 @@ def test_compare_pane_b_follows_the_lights_after_a_mesh_change(win, qtbot, mesh)
     meshes = [a for a in pl.renderer.actors.values() if a.IsA("vtkActor")]
     drawn = [a for a in meshes if a.GetMapper().GetInput().GetNumberOfPoints() >= 1000]
     assert len(drawn) == len(vb.drawings)  # one actor per drawing, none left behind
+
+
+def test_the_lobe_inset_covers_at_most_a_fifth_of_a_small_pane(open_window, qtbot):
+    """At 640x480, compare on: in each pane the inset's panel, read from its pixels, covers at
+    most LOBE_AREA of the pane and is still there (issue 42's small sizes; the page's own
+    test is test_the_lobe_inset_covers_at_most_a_fifth_of_a_small_view)."""
+    w = open_window()
+    w.resize(640, 480)
+    qtbot.waitUntil(lambda: (w.width(), w.height()) == (640, 480), timeout=5000)
+    w.panel.view.compare.click()
+    qtbot.waitUntil(lambda: w.plotter_b.isVisible() and w.plotter_b.width() > 50)
+    QtWidgets.QApplication.processEvents()
+    for pl in (w.plotter, w.plotter_b):
+        img = pixels(pl)
+        h, wide = img.shape[:2]
+        side, height = panel_extent(img)
+        assert side * height <= LI.LOBE_AREA * wide * h + 2 * (side + height), (wide, h)
+        assert side >= LI.LOBE_MIN_SIDE - 2, (side, height)
