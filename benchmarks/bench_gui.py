@@ -281,9 +281,10 @@ def lod_frames(mesh, repeat: int) -> dict:
     return out
 
 
-def qt_frames(mesh, repeat: int) -> dict:
+def qt_frames(mesh, repeat: int, view: tuple[int, int] | None = None) -> dict:
     """The Qt window itself (panel refresh included): a number field set, then the frame.
-    Needs an X display; a private Xvfb is started when DISPLAY is not set."""
+    ``view``: the window is resized so its 3D view is that many pixels (the page's view size,
+    for bench_web). Needs an X display; a private Xvfb is started when DISPLAY is not set."""
     server = None
     if not os.environ.get("DISPLAY"):
         server, os.environ["DISPLAY"] = start_xvfb()
@@ -295,6 +296,10 @@ def qt_frames(mesh, repeat: int) -> dict:
     win = ExplorerWindow(first_state(scene, mesh, name=mesh.name), mesh, size=(1150, 640))
     win.show()
     app.processEvents()
+    for _ in range(3 if view else 0):  # (the window manager may round the first resize)
+        w, h = win.plotter.window_size
+        win.resize(win.width() + view[0] - w, win.height() + view[1] - h)
+        app.processEvents()
     win.render()
     fields = win.panel.material.sliders
     values = {"kd": lambda i: 0.3 + 0.4 * (i % 2), "shininess": lambda i: 16.0 + 48.0 * (i % 2)}

@@ -3,6 +3,7 @@ to frame, in the same run; and how soon ``phong-explorer web`` is ready.
 
     python benchmarks/bench_web.py                    # prints the table, writes docs/web_bench.md
     python benchmarks/bench_web.py --repeat 15 --no-write
+    python benchmarks/bench_web.py --burners 2 --no-write   # under two CPU burners
 
 - Latency: ``phong-explorer web --mesh teapot --resolution 56`` (100,578 vertices, one point
   light) in its own process, its view sized to 800x600 in headless Chromium (Debian's, driven
@@ -10,9 +11,17 @@ to frame, in the same run; and how soon ``phong-explorer web`` is ready.
   does: the trame state key ``kd_step``) and waits, in the page, for the view's ``<img>`` to load
   the next picture; the time is the page's own clock (``performance.now()``) from the change to
   that load: the message to the server, the engine update, the frame, the JPEG and its way back,
-  the decode. Median and best over ``--repeat`` samples after two warm-up ones.
+  the decode. Median and best over ``--repeat`` samples after two warm-up ones, each sample
+  started with the view still (its lossless picture gone). Where the time goes: the server's
+  own steps for each sample (``report``'s ``picture``: the change to its frame's end, the
+  frame's render, read-back and encode, explorer.app.web.pictures), and the browser's decode
+  of the last JPEG and PNG (``createImageBitmap`` on the bytes received, in the page); the rest
+  is the two messages (the change to the server, the picture back) and trame's work.
 - The Qt window's figure of the same run: :func:`bench_gui.qt_frames` (a number field set, the
-  action, the panel, the engine, the upload and the frame; a private Xvfb).
+  action, the panel, the engine, the upload and the frame; a private Xvfb), its view resized
+  to the page's 800x600.
+- ``--burners N``: N processes that spin on the CPU for the whole run (the issue's "under two
+  CPU burners"), the load printed as usual.
 - Ready: from starting the process (numba's cache warm) to the URL answering, and to the first
   picture in a browser already running; median of ``--starts`` starts.
 
@@ -33,6 +42,7 @@ import time
 import urllib.request
 from pathlib import Path
 
+import numpy as np
 from bench_gui import load, machine, qt_frames  # this script's directory is on sys.path
 from common import publish
 
@@ -44,7 +54,9 @@ DOCS = Path(__file__).resolve().parent.parent / "docs" / "web_bench.md"
 ROOT = Path(__file__).resolve().parent.parent
 
 #: one sample, in the page: set kd's slider step, resolve when the view's picture shows a new
-#: colour at the probe vertex's pixel (a picture still being encoded arrives first unchanged)
+#: colour at the probe vertex's pixel (more than 8 levels away: kd 0.3 and 0.7 are far apart,
+#: and a still picture's lossless copy differs from its JPEG by a level): the ms taken, the
+#: change's and the picture's arrival (epoch ms; the arrival: its Blob made, KEEP_BLOBS_JS)
 SAMPLE_JS = """
 const [step, x, y, done] = arguments;
 const img = document.querySelector('[aria-label="view"] img');
@@ -53,16 +65,56 @@ const ctx = canvas.getContext('2d', {willReadFrequently: true});
 const pixel = () => {
   canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
   ctx.drawImage(img, 0, 0);
-  return Array.from(ctx.getImageData(x, y, 1, 1).data.slice(0, 3)).join(',');
+  return Array.from(ctx.getImageData(x, y, 1, 1).data.slice(0, 3));
 };
 const before = pixel();
 const t0 = performance.now();
 const on = () => {
-  if (pixel() !== before) { img.removeEventListener('load', on); done(performance.now() - t0); }
+  const now = pixel();
+  if (Math.max(...now.map((v, i) => Math.abs(v - before[i]))) > 8) {
+    img.removeEventListener('load', on);
+    const t = performance.now();  // the epoch clock too (the server's is the same machine's)
+    done([t - t0, performance.timeOrigin + t0, performance.timeOrigin + window.blobAt]);
+  }
 };
 img.addEventListener('load', on);
 window.trame.state.set('kd_step', step);
 setTimeout(() => done(-1), 20000);
+"""
+#: the page keeps the last pictures' bytes it receives and when (the remote view makes a Blob
+#: URL of each as its message arrives)
+KEEP_BLOBS_JS = """
+if (!window.keptBlobs) {
+  window.keptBlobs = [];
+  const make = URL.createObjectURL;
+  URL.createObjectURL = (b) => {
+    window.blobAt = performance.now();
+    window.keptBlobs.push(b);
+    if (window.keptBlobs.length > 4) window.keptBlobs.shift();
+    return make.call(URL, b);
+  };
+}
+"""
+#: the browser's decode (ms, median of 7) of the last JPEG and the last PNG kept
+DECODE_JS = """
+const done = arguments[0];
+(async () => {
+  const out = {};
+  for (const b of window.keptBlobs) {
+    const head = new Uint8Array(await b.slice(0, 4).arrayBuffer());
+    const kind = head[0] === 0x89 ? 'png' : 'jpeg';
+    const ts = [];
+    for (let i = 0; i < 7; i++) {
+      const t0 = performance.now();
+      const bmp = await createImageBitmap(b);
+      ts.push(performance.now() - t0);
+      bmp.close();
+    }
+    ts.sort((a, b) => a - b);
+    out[kind] = [ts[3], b.size];
+  }
+  done(out);
+})();
 """
 PICTURE_JS = """
 const i = document.querySelector('[aria-label="view"] img');
@@ -78,7 +130,7 @@ def free_port() -> int:
 
 
 def browser():
-    sys.path.insert(0, str(ROOT / "tests" / "web"))
+    sys.path.insert(0, str(ROOT / "tests" / "app" / "web"))
     from webserver import new_browser  # the tests' headless Chromium
 
     return new_browser(Path(os.environ.get("TMPDIR", "/tmp")))
@@ -93,6 +145,16 @@ def start_server(port: int, log) -> subprocess.Popen:
          "--port", str(port)],
         stdout=log, stderr=subprocess.STDOUT, env=env,
     )  # fmt: skip
+
+
+def stop(proc: subprocess.Popen) -> None:
+    """End a server (it keeps its session on the way out: a loaded machine may take a while)."""
+    proc.terminate()
+    try:
+        proc.wait(60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(10)
 
 
 def wait_url(port: int, log: Path, timeout: float = 120.0) -> str:
@@ -126,8 +188,9 @@ def wait_picture(driver, timeout: float = 60.0):
 
 
 def ready_times(driver, starts: int) -> dict:
-    """Median seconds from the process start to the URL answering and to the first picture."""
-    url_s, picture_s = [], []
+    """Median seconds from the process start to the URL answering and to the first picture,
+    and from the page's request to its first picture."""
+    url_s, picture_s, request_s = [], [], []
     for _ in range(starts):
         port = free_port()
         path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
@@ -137,15 +200,20 @@ def ready_times(driver, starts: int) -> dict:
             try:
                 url = wait_url(port, path)
                 url_s.append(time.perf_counter() - t0)
+                t1 = time.perf_counter()
                 driver.get(url)
                 wait_picture(driver)
                 picture_s.append(time.perf_counter() - t0)
+                request_s.append(time.perf_counter() - t1)
             finally:
-                proc.terminate()
-                proc.wait(10)
+                stop(proc)
         path.unlink()
         driver.get("about:blank")
-    return {"url": statistics.median(url_s), "picture": statistics.median(picture_s)}
+    return {
+        "url": statistics.median(url_s),
+        "picture": statistics.median(picture_s),
+        "request": statistics.median(request_s),
+    }
 
 
 def size_view(driver) -> tuple[int, int]:
@@ -161,34 +229,213 @@ def size_view(driver) -> tuple[int, int]:
     return int(nw), int(nh)
 
 
-def latency(driver, url: str, repeat: int) -> tuple[float, float, tuple[int, int]]:
-    """Median and best ms from a kd slider change to the new picture loaded in the page."""
+REPORT_JS = "const done = arguments[0]; window.trame.trigger('report').then(done);"
+
+
+def latency(driver, url: str, repeat: int) -> dict:
+    """Median and best ms from a kd slider change to the new picture loaded in the page
+    (``ms``, ``best``), the view's ``size``, the median of each server step (``steps``) and the
+    browser's decode (``decode``: kind -> (ms, bytes))."""
     driver.get(url)
     size = size_view(driver)
+    driver.execute_script(KEEP_BLOBS_JS)
     time.sleep(1.0)
-    rep = driver.execute_async_script(
-        "const done = arguments[0]; window.trame.trigger('report').then(done);"
-    )
+    rep = driver.execute_async_script(REPORT_JS)
     x, y = rep["probe"]["px"]
-    ts = []
+    ts, steps = [], []
     for i in range(repeat + 2):
         step = 300 + 400 * (i % 2)  # kd 0.3 and 0.7
-        t = driver.execute_async_script(SAMPLE_JS, step, x, y)
-        if t < 0:
+        got = driver.execute_async_script(SAMPLE_JS, step, x, y)
+        if got == -1:
             raise RuntimeError("the picture did not change within 20 s")
+        t, changed, arrived = got
         if i >= 2:
             ts.append(float(t))
-        time.sleep(0.05)
+            st = driver.execute_async_script(REPORT_JS).get("picture") or {}
+            if "at" in st:  # (the page's and the server's clocks: one machine's)
+                if st.get("change_at"):
+                    st["in"] = st.pop("change_at") - changed  # the change's way to the server
+                st["sent"] = st.pop("at") - changed  # the change to the picture sent
+                st["back"] = arrived - changed - st["sent"]  # its way to the page
+                st["shown"] = t - (arrived - changed)  # its arrival to the <img> loaded
+            steps.append(st)
+        time.sleep(0.3)  # (the view still again: its lossless picture has gone)
+    decode = driver.execute_async_script(DECODE_JS)
     size = tuple(int(v) for v in wait_picture(driver)[:2])
-    return statistics.median(ts), min(ts), size
+    keys = [k for k in steps[0] if all(s.get(k) is not None for s in steps)]  # (none: VTK's path)
+    median = {k: statistics.median(float(s[k]) for s in steps) for k in keys}
+    return {
+        "ms": statistics.median(ts),
+        "best": min(ts),
+        "size": size,
+        "steps": median,
+        "decode": decode,
+    }
+
+
+def burners(n: int) -> list[subprocess.Popen]:
+    """``n`` processes that spin on the CPU until terminated."""
+    spin = "while True: pass"
+    return [subprocess.Popen([sys.executable, "-c", spin]) for _ in range(n)]
+
+
+def codecs(repeat: int) -> list[str]:
+    """The encoders' time (ms, median of ``repeat``), size and largest error (levels) on two
+    800x600 frames: the teapot as ``render`` draws it, and the per-pixel torus (glossy plastic;
+    sharp coloured highlights); VTK's JPEG writer as VTK's web path used it (progressive) and
+    baseline, Pillow's JPEG (4:2:0 and 4:4:4), PNG and WebP (lossless), base64 of the JPEG."""
+    import base64
+    import io
+
+    from PIL import Image
+    from vtkmodules.util.numpy_support import numpy_to_vtk
+    from vtkmodules.vtkCommonDataModel import vtkImageData
+    from vtkmodules.vtkIOImage import vtkJPEGWriter
+
+    from explorer.core.presets import find_preset
+    from explorer.core.scene import Scene
+    from explorer.render.offscreen import render_image
+    from explorer.render.perpixel import reference
+
+    teapot = M.teapot(56)
+    torus = M.get_mesh("torus")
+    glossy = Scene(material=find_preset("glossy_plastic"))
+    frames = {
+        "teapot": render_image(Scene(), teapot, SIZE),
+        "per-pixel torus": reference(glossy, torus, SIZE).image(),
+    }
+
+    def vtk_jpeg(a, progressive):
+        img = vtkImageData()
+        img.SetDimensions(a.shape[1], a.shape[0], 1)
+        img.GetPointData().SetScalars(numpy_to_vtk(np.ascontiguousarray(a[::-1]).reshape(-1, 3)))
+        w = vtkJPEGWriter()
+        w.SetInputData(img)
+        w.SetQuality(100)
+        w.SetProgressive(progressive)
+        w.WriteToMemoryOn()
+        w.Write()
+        return memoryview(w.GetResult()).tobytes()
+
+    def pil(a, fmt, **kw):
+        buf = io.BytesIO()
+        Image.fromarray(a).save(buf, fmt, **kw)
+        return buf.getvalue()
+
+    ways = {
+        "VTK JPEG q100, progressive, 4:2:0 (VTK's web path)": lambda a: vtk_jpeg(a, 1),
+        "VTK JPEG q100, baseline, 4:2:0": lambda a: vtk_jpeg(a, 0),
+        "Pillow JPEG q100, baseline, 4:2:0": lambda a: pil(a, "JPEG", quality=100, subsampling=2),
+        "Pillow JPEG q100, baseline, 4:4:4 (the page's)": lambda a: pil(
+            a, "JPEG", quality=100, subsampling=0
+        ),
+        "PNG, zlib level 1 (the page's still picture)": lambda a: pil(a, "PNG", compress_level=1),
+        "PNG, zlib level 6": lambda a: pil(a, "PNG", compress_level=6),
+        "WebP lossless, method 0": lambda a: pil(a, "WEBP", lossless=True, quality=0, method=0),
+    }
+    lines = [
+        "| encoder | " + " | ".join(f"{n}: ms, KiB, max error" for n in frames) + " |",
+        "|---|" + "---:|" * len(frames),
+    ]
+    jpeg = {}
+    for name, way in ways.items():
+        cells = []
+        for fname, a in frames.items():
+            ms, data = timed_call(lambda: way(a), repeat)  # noqa: B023
+            back = np.asarray(Image.open(io.BytesIO(data)).convert("RGB")).astype(int)
+            err = int(np.abs(back - a.astype(int)).max())
+            cells.append(f"{ms:.1f}, {len(data) / 1024:.0f}, {err}")
+            jpeg.setdefault(fname, data)
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    cells = [f"{timed_call(lambda d=d: base64.b64encode(d), repeat)[0]:.2f}" for d in jpeg.values()]
+    lines.append(
+        "| base64 of VTK's JPEG (VTK's web path; decoded again by the publisher) | "
+        + " | ".join(cells)
+        + " |"
+    )
+    return lines
+
+
+def timed_call(fn, repeat: int):
+    """Median ms of ``fn()`` over ``repeat`` calls, and its last result."""
+    ts = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        ts.append(1000.0 * (time.perf_counter() - t))
+    return statistics.median(ts), out
+
+
+def breakdown(web: dict) -> list[str]:
+    """Where the page's time goes (medians of the samples' steps, the decode)."""
+    st, dec = web["steps"], web["decode"]
+    work = st.get("frame_ms", float("nan")) + st.get("read", 0.0) + st.get("encode", 0.0)
+
+    def row(name, v):
+        return f"| {name} | {'n/a' if v is None else f'{v:.1f}'} |"
+
+    sent = st.get("sent")
+    lines = ["| step | ms |", "|---|---:|"]
+    lines += [
+        row(
+            "the change set in the page → the picture sent by the server (the machine's clock)",
+            sent,
+        ),
+        row("  the change's way to the server (set in the page → its message read)", st.get("in")),
+        row(
+            "  trame's handling (the rest of the above)",
+            None if sent is None else sent - work - st.get("in", 0.0),
+        ),
+        row(
+            "  the controller, the engine and the frame (the server's clock, from the change "
+            "to the frame's end)",
+            st.get("frame_ms"),
+        ),
+        row(
+            "    of which the frame's render (VTK, the engine's colours for the viewer)",
+            st.get("render"),
+        ),
+        row("  read-back (vtkWindowToImageFilter)", st.get("read")),
+        row("  JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
+        row("the picture's way to the page (sent → its Blob made in the page)", st.get("back")),
+        row(
+            "its Blob made → the view's <img> loaded (trame's decode in a pooled image, then "
+            "the <img>)",
+            st.get("shown"),
+        ),
+        row(
+            "  of which one JPEG decode (createImageBitmap on the same bytes)",
+            dec.get("jpeg", [None])[0],
+        ),
+    ]
+    size = [f"JPEG {st['bytes'] / 1024:.0f} KiB" if "bytes" in st else ""]
+    if "png" in dec:
+        size.append(
+            f"the still picture's PNG {dec['png'][1] / 1024:.0f} KiB, decoded in "
+            f"{dec['png'][0]:.1f} ms"
+        )
+    return lines + ["", "Picture sizes: " + "; ".join(x for x in size if x) + "."]
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=21, help="timed samples per row (21)")
     ap.add_argument("--starts", type=int, default=3, help="server starts timed (3)")
+    ap.add_argument(
+        "--burners", type=int, default=0, help="processes spinning on the CPU through the run (0)"
+    )
     ap.add_argument("--no-write", action="store_true", help="do not write docs/web_bench.md")
     args = ap.parse_args(argv)
+    spinning = burners(args.burners)
+    try:
+        return measure(args)
+    finally:
+        for p in spinning:
+            p.terminate()
+            p.wait(10)
+
+
+def measure(args) -> int:
     driver = browser()
     before = load()
     try:
@@ -200,14 +447,14 @@ def main(argv=None) -> int:
             try:
                 web = latency(driver, wait_url(port, path), args.repeat)
             finally:
-                proc.terminate()
-                proc.wait(10)
+                stop(proc)
         path.unlink()
         version = driver.capabilities.get("browserVersion", "?")
     finally:
         driver.quit()
     teapot = M.teapot(56)
-    qt = qt_frames(teapot, args.repeat)
+    qt = qt_frames(teapot, args.repeat, view=SIZE)
+    codec_rows = codecs(args.repeat)
     after = load()
     pl = plotter(SIZE, (0.0, 0.0, 0.0))
     pl.render()  # the renderer's name is known once it has drawn
@@ -215,10 +462,16 @@ def main(argv=None) -> int:
     pl.close()
 
     vw, vh = qt["view"]
+    ww, wh = web["size"]
+    ratio = web["ms"] / qt["kd"][0]
+    burning = f", {args.burners} CPU burners running" if args.burners else ""
     lines = ["# Web benchmark", "", "Machine:", ""]
     lines += [f"- {x}" for x in info]
-    lines += [f"- browser: headless Chromium {version} (Selenium), on the same machine",
-              f"- load average before / after: {before} / {after}", ""]  # fmt: skip
+    lines += [
+        f"- browser: headless Chromium {version} (Selenium), on the same machine",
+        f"- load average before / after: {before} / {after}{burning}",
+        "",
+    ]
     lines += [
         f"A kd change to the new picture, {teapot.n_vertices:,}-vertex teapot, 1 point light; "
         f"median (best) ms over {args.repeat} changes:",
@@ -226,15 +479,27 @@ def main(argv=None) -> int:
         "| front end | view | ms |",
         "|---|---|---:|",
         f"| web page: slider value set in the page → the view's next picture loaded (page "
-        f"clock) | {web[2][0]}x{web[2][1]} | {web[0]:.1f} ({web[1]:.1f}) |",
+        f"clock) | {ww}x{wh} | {web['ms']:.1f} ({web['best']:.1f}) |",
         f"| Qt window: number field set → frame done (glFinish) | {vw}x{vh} | "
         f"{qt['kd'][0]:.1f} ({qt['kd'][1]:.1f}) |",
         "",
+        f"The page takes {web['ms'] - qt['kd'][0]:+.1f} ms ({ratio:.2f}x) the window's time.",
+        "",
+        "Where the page's time goes (medians over the same changes):",
+        "",
+        *breakdown(web),
+        "",
+        f"Encoding one {SIZE[0]}x{SIZE[1]} frame (median of {args.repeat}; size; largest "
+        f"error in 8-bit levels):",
+        "",
+        *codec_rows,
+        "",
         f"Ready (numba's cache warm), median of {args.starts} starts: the URL answers "
         f"{ready['url']:.2f} s after the process starts; the first picture is in the page "
-        f"{ready['picture']:.2f} s after it.",
+        f"{ready['picture']:.2f} s after it, {ready['request']:.2f} s after the page's request.",
         "",
-        f"Command: `python benchmarks/bench_web.py --repeat {args.repeat} --starts {args.starts}`",
+        f"Command: `python benchmarks/bench_web.py --repeat {args.repeat} --starts {args.starts}"
+        f"{f' --burners {args.burners}' if args.burners else ''}`",
     ]  # fmt: skip
     text = "\n".join(lines) + "\n"
     publish(text, DOCS, write=not args.no_write)

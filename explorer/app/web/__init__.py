@@ -22,7 +22,6 @@ contract).
 from explorer.app.web.jupyter import Shown, notebook_state, page_url, proxy_prefix, show
 from explorer.app.web.server import (
     DEFAULT_HOST,
-    FOLLOW_S,
     OPEN_HOST_WARNING,
     WebExplorer,
     check_listen,
@@ -31,7 +30,6 @@ from explorer.app.web.server import (
 
 __all__ = [
     "DEFAULT_HOST",
-    "FOLLOW_S",
     "OPEN_HOST_WARNING",
     "Shown",
     "WebExplorer",

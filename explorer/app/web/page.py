@@ -456,6 +456,19 @@ def _page_state(state) -> None:
     state.client_only("seen_seq")
 
 
+def remote_view(vtkw, window, name: str):
+    """A view of the server's ``window`` (pane A's or pane B's) named ``name``: trame's remote
+    view, whose pictures :mod:`explorer.app.web.pictures` makes for both panes alike (a JPEG
+    with full chroma at once, the still frame as PNG); the quality it asks for is not used."""
+    return vtkw.VtkRemoteView(
+        window,
+        interactive_ratio=1,
+        still_quality=100,
+        interactive_quality=100,
+        raw_attrs=[f'aria-label="{name}"'],
+    )
+
+
 def build(app) -> None:
     """The page: the toolbar (the registry's menus, undo / redo, files), the drawer (the
     panel) and the view; the registry's keys (:mod:`explorer.app.web.intents`)."""
@@ -515,16 +528,10 @@ def build(app) -> None:
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
             with html.Div(classes="d-flex", style="width: 100%; height: 100%"):
                 with html.Div(style="flex: 1 1 0; height: 100%; position: relative"):
-                    view = vtkw.VtkRemoteView(app.plotter.render_window, interactive_ratio=1,
-                                              still_quality=100, interactive_quality=100,
-                                              raw_attrs=['aria-label="view"'])  # fmt: skip
+                    view = remote_view(vtkw, app.plotter.render_window, "view")
                 with html.Div(v_if="compare", style="flex: 1 1 0; height: 100%; "
                               "position: relative; margin-left: 4px"):  # fmt: skip
-                    view_b = vtkw.VtkRemoteView(
-                        app.compare.plotter.render_window, interactive_ratio=1,
-                        still_quality=100, interactive_quality=100,
-                        raw_attrs=['aria-label="view_b"'],
-                    )  # fmt: skip
+                    view_b = remote_view(vtkw, app.compare.plotter.render_window, "view_b")
             ctrl.view_update = view.update
             ctrl.view_b_update = view_b.update
     app.layout = layout

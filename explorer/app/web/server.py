@@ -45,6 +45,7 @@ from explorer.app.viewport import PlotterView
 from explorer.app.web import guard, page, panel, wire
 from explorer.app.web.compare import WebCompare
 from explorer.app.web.files import WebFiles
+from explorer.app.web.pictures import Pictures
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.offscreen import BACKGROUND
@@ -62,11 +63,6 @@ OPEN_HOST_WARNING = (
     "(and save presets into your preset folder) once they have the address printed below: "
     "its token is the only key, share it with care"
 )
-#: VTK encodes each picture in a thread of its own, and trame sends a picture still being
-#: encoded half a second later: instead, every FOLLOW_S seconds the server asks for it again
-#: and sends it once it is done (FOLLOW_TRIES times at most; trame's own retry stays behind)
-FOLLOW_S = 0.004
-FOLLOW_TRIES = 1000
 #: how many messages the page's message log keeps
 MESSAGE_LOG = 50
 
@@ -100,7 +96,7 @@ class WebExplorer:
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
         self.files = WebFiles(self, self._uploads.name)  # the uploads and downloads
         self.loop = None  # the server's event loop (the difference worker delivers into it)
-        self._publisher = None  # trame's image publisher (its vtkWebPublishImageDelivery)
+        self.pictures = None  # the pages' picture path (web.pictures.Pictures), once it runs
         self._job = None  # the long job running (run_steps) and its cancel
         self.server = get_server(name, client_type="vue3")
         self.token = guard.new_token()  # the page's key: in the URL the user is given only
@@ -163,13 +159,14 @@ class WebExplorer:
 
     def _ready(self, **_) -> None:
         """The server runs: its loop is kept (the difference worker delivers into it), and
-        trame's image publisher (see :meth:`_follow_picture`)."""
+        trame's image publisher sends the pictures as :class:`~explorer.app.web.pictures.Pictures`
+        makes them (baseline JPEG 4:4:4 at once, PNG once the view is still)."""
         import asyncio
 
         self.loop = asyncio.get_event_loop()
         for p in self.server.protocol.getLinkProtocols():
             if hasattr(p, "push_render") and hasattr(p, "tracking_views"):
-                self._publisher = p
+                self.pictures = Pictures(p, self.loop, self.guard)
 
     # -- Dialogs ---------------------------------------------------------------------------------
     def ask_text(self, title: str, label: str, default: str = "") -> str | None:
@@ -298,26 +295,9 @@ class WebExplorer:
         """Nothing of the page's own after a frame (side B's picture follows: WebCompare)."""
 
     def _send(self, update, window) -> None:
-        """``update()`` (a remote view's push) and then :meth:`_follow_picture` for
-        ``window``'s picture."""
-        pub = self._publisher
-        vid = None if pub is None else str(pub.get_global_id(window))
-        sent = None if vid is None else pub.tracking_views.get(vid, {}).get("mtime")
+        """``update()``: the remote view of ``window`` asks for a picture, which
+        :class:`~explorer.app.web.pictures.Pictures` makes and sends at once."""
         update()
-        if vid is not None and self.loop is not None:
-            self.loop.call_later(FOLLOW_S, self.guard(self._follow_picture, "view"), vid, sent,
-                                 FOLLOW_TRIES)  # fmt: skip
-
-    def _follow_picture(self, vid: str, sent, tries: int) -> None:
-        """Send the view's picture as soon as VTK has encoded it: until a picture newer than
-        ``sent`` (the publisher's time of the last one sent) has gone, look every
-        :data:`FOLLOW_S` seconds (``tries`` times at most)."""
-        pub = self._publisher
-        if pub.tracking_views.get(vid, {}).get("mtime") != sent or tries <= 0:
-            return  # sent (by trame itself, or below)
-        pub.push_render(vid)  # sends the picture if it is encoded by now
-        self.loop.call_later(FOLLOW_S, self.guard(self._follow_picture, "view"), vid, sent,
-                             tries - 1)  # fmt: skip
 
     # -- the worker's results ------------------------------------------------------------------
     def _deliver(self, result) -> None:
@@ -340,8 +320,10 @@ class WebExplorer:
 
     def report_state(self) -> dict:
         """What a test may read (plain JSON values): the frame count, the view's size, the
-        probe vertex and its pixel in the view (origin top-left), the session."""
+        probe vertex and its pixel in the view (origin top-left), the session, the last picture's
+        steps."""
         probe = self.view.probe_vertex()
+        ms = self.viewport.frame_ms
         return {
             "frame": self.viewport.frames,
             "size": list(self.viewport.size()),
@@ -362,10 +344,16 @@ class WebExplorer:
             "pixels": pixels_report(self.viewport.pixels),
             "sphere": self.view.lobe.sphere_report(),
             "session": session_mapping(self.store.state),
+            # the last picture's steps (ms; explorer.app.web.pictures) and the last change's
+            # time to its frame's end (the benchmark's breakdown)
+            "picture": {**(self.pictures.times if self.pictures else {}),
+                        "frame_ms": None if ms != ms else ms},  # (NaN: no frame yet)
         }  # fmt: skip
 
     def close(self) -> None:
         self.worker.close()
+        if self.pictures is not None:
+            self.pictures.close()
         self._uploads.cleanup()
         self.plotter.close()
 

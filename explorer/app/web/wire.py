@@ -48,6 +48,7 @@ import collections
 import inspect
 import logging
 import os
+import time
 
 import aiohttp
 import msgpack
@@ -82,6 +83,11 @@ AUTH_MESSAGE_BYTES = int(os.environ.get("WSLINK_AUTH_MSG_SIZE", "512"))
 #: the calls no tab may make: wslink's ``application.exit`` and ``application.exit.later``
 #: stop the server for every tab (trame's page calls the second when it is destroyed)
 REFUSED_METHODS = frozenset({"application.exit", "application.exit.later"})
+
+
+#: when each call last arrived (its method -> epoch ms): the benchmark's split of a change's
+#: time (bench_web: the page's clock is the same machine's)
+ARRIVED: dict[str, float] = {}
 
 
 class WireError(ValueError):
@@ -307,6 +313,7 @@ class WireHandler(AioHttpWsHandler):
         if "id" not in rpc:
             return
         rpcid, method = rpc["id"], rpc["method"]
+        ARRIVED[method] = 1e3 * time.time()
         args, kwargs = rpc.get("args", []), rpc.get("kwargs", {})
         if (
             not isinstance(args, list)

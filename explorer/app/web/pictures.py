@@ -1,0 +1,202 @@
+"""The page's pictures: how a frame of the server's off-screen view reaches the browser.
+
+trame's remote view (``VtkRemoteView``) gets its pictures from trame-vtk's image publisher
+(``vtkWebPublishImageDelivery``): VTK's ``vtkWebApplication`` renders, reads the frame back and
+hands it to ``vtkDataEncoder``, which encodes it in a thread of its own with VTK's JPEG writer
+(progressive, 4:2:0 chroma), then as base64 that the publisher decodes again; the publisher
+finds the picture still being encoded and sends it half a second later (or when asked again).
+:class:`Pictures` replaces that step for every view the publisher serves (pane A and pane B
+alike, and every page): the frame is rendered and read back under
+:data:`explorer.render.vtk.DRAW_LOCK` and encoded at once, in the server's loop, as a baseline
+JPEG with full chroma (4:4:4, Pillow's libjpeg-turbo, :data:`JPEG_QUALITY`), sent as a binary
+attachment; once the view has been still for :data:`STILL_S` seconds the same frame follows
+as a lossless PNG, encoded in a worker thread (Pillow lets go of the GIL while it encodes), so
+the page's pixels are then exactly the server's. The browser's ``<img>`` reads PNG and JPEG
+alike (it looks at the bytes, not at the Blob's ``image/jpeg`` type).
+
+What asks for a picture stays trame's: the page (its first picture, a resize, the end of a
+camera drag), the camera drag's animation ticks (a picture only when something asked since the
+last), and the explorer's own frames (:meth:`WebExplorer.send`, through the view's
+``update()``).
+
+VTK, Pillow and numpy's pictures are imported inside the methods (``import explorer`` stays free
+of VTK).
+"""
+
+from __future__ import annotations
+
+import io
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+#: the JPEG's quality (libjpeg's scale, 1-100) while the view changes: at 100 with 4:4:4 chroma
+#: the teapot's frame comes back within 1 level of every pixel, the per-pixel torus's within 4
+JPEG_QUALITY = 100
+#: seconds without a new frame after which the last one is sent again losslessly (PNG): longer
+#: than the gap between two frames of a slider drag (about 40-80 ms) so a drag sends JPEGs only
+STILL_S = 0.15
+#: zlib's level for the still picture's PNG (1: the fastest; 800x600 in 5-45 ms here)
+PNG_LEVEL = 1
+
+
+def encode(pixels: np.ndarray, lossless: bool) -> bytes:
+    """``pixels`` (h, w, 3 uint8, rows top to bottom) as PNG (``lossless``) or as a baseline
+    JPEG with 4:4:4 chroma at :data:`JPEG_QUALITY`."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    if lossless:
+        Image.fromarray(pixels).save(buf, "PNG", compress_level=PNG_LEVEL)
+    else:
+        Image.fromarray(pixels).save(buf, "JPEG", quality=JPEG_QUALITY, subsampling=0)
+    return buf.getvalue()
+
+
+def read_back(window) -> np.ndarray:
+    """The frame ``window`` drew last (h, w, 3 uint8, rows top to bottom), read from its back
+    buffer as ``vtkWebApplication`` reads it."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+
+    w2i = vtkWindowToImageFilter()
+    w2i.SetInput(window)
+    w2i.ReadFrontBufferOff()
+    w2i.ShouldRerenderOff()
+    w2i.FixBoundaryOn()
+    w2i.Update()
+    img = w2i.GetOutput()
+    w, h, _ = img.GetDimensions()
+    flat = vtk_to_numpy(img.GetPointData().GetScalars())
+    return np.ascontiguousarray(flat.reshape(h, w, -1)[::-1, :, :3])
+
+
+class Pictures:
+    """The picture path of ``publisher`` (trame-vtk's ``vtkWebPublishImageDelivery``, found
+    once the server runs) in ``loop`` (the server's asyncio loop); ``guard(fn, where)`` makes a
+    callback safe (an error is said on the page). :attr:`times` keeps the last picture's steps
+    (ms: render, read, encode; bytes; ``at``: when it was made and ``change_at`` when the last
+    change arrived, epoch ms) for the benchmark."""
+
+    def __init__(self, publisher, loop, guard):
+        self.pub = publisher
+        self.loop = loop
+        self.guard = guard
+        self.asked: set[str] = set()  # views asked for a picture since their last one
+        self.last: dict[str, tuple[int, np.ndarray]] = {}  # view -> (picture number, pixels)
+        self.count = 0  # pictures made (every view's)
+        self.times: dict[str, float] = {}
+        self._pool = ThreadPoolExecutor(1, thread_name_prefix="page-png")
+        publisher.decode = False  # (bytes, no base64)
+        publisher.push_render = self.push_render
+        publisher.still_render = self.still_render
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+    # -- trame-vtk's publisher, replaced ---------------------------------------------------------
+    def push_render(self, v_id, ignore_animation=False, stale_count=0) -> None:
+        """The publisher's ``push_render``: a picture of view ``v_id`` is sent when anything but
+        an animation tick asked for one (a tick sends what was asked during a camera drag)."""
+        info = self.pub.tracking_views.get(v_id)
+        if info is None or not info["enabled"]:
+            return
+        if not ignore_animation:
+            self.asked.add(v_id)
+            if self.pub.views_in_animations:
+                return  # the drag's next tick sends it
+        if v_id not in self.asked:
+            return
+        self.asked.discard(v_id)
+        if "originalSize" not in info:
+            info["originalSize"] = list(self.pub.get_view(v_id).GetSize())
+        ratio = info.get("ratio", 1)
+        size = [int(s * ratio + 0.5) for s in info["originalSize"]]
+        reply = self.still_render({"view": v_id, "size": size})
+        info["mtime"] = reply["mtime"]
+        self._publish(reply)
+        self.loop.call_later(STILL_S, self.guard(self._still, "picture"), v_id, reply["mtime"])
+
+    def still_render(self, options: dict) -> dict:
+        """The publisher's ``still_render``: view ``options["view"]`` rendered at
+        ``options["size"]``, read back and encoded as JPEG (its reply, ``image`` as bytes)."""
+        from explorer.app.web.wire import ARRIVED  # (wslink's, imported with the server)
+        from explorer.render.vtk import DRAW_LOCK  # (VTK only once a page asks)
+
+        t0 = time.perf_counter()
+        view = self.pub.get_view(options["view"])
+        v_id = str(self.pub.get_global_id(view))
+        size = list(options.get("size", view.GetSize()[:2]))
+        with DRAW_LOCK:  # (VTK draws one thread at a time; the read-back is of this frame)
+            if size != list(view.GetSize()[:2]) and size[0] > 10 and size[1] > 10:
+                view.SetSize(size)
+            view.Render()
+            t1 = time.perf_counter()
+            pixels = read_back(view)
+        t2 = time.perf_counter()
+        image = encode(pixels, lossless=False)
+        t3 = time.perf_counter()
+        self.count += 1
+        self.last[v_id] = (self.count, pixels)
+        self.times = {
+            "render": 1e3 * (t1 - t0),
+            "read": 1e3 * (t2 - t1),
+            "encode": 1e3 * (t3 - t2),
+            "bytes": len(image),
+            "at": 1e3 * time.time(),  # (epoch ms: the page's clock is the same machine's)
+            "change_at": ARRIVED.get("trame.state.update"),  # (the last change's arrival)
+        }
+        h, w = pixels.shape[:2]
+        return {
+            "image": image,
+            "format": "jpeg",
+            "stale": False,
+            "mtime": self.count,
+            "size": [w, h],
+            "memsize": len(image),
+            "global_id": v_id,
+            "localTime": options.get("localTime", 0),
+            "workTime": round(1e3 * (t3 - t0)),
+        }
+
+    # -- the still picture -----------------------------------------------------------------------
+    def _publish(self, reply: dict) -> None:
+        reply = dict(reply, id=reply["global_id"], image=self.pub.addAttachment(reply["image"]))
+        self.pub.publish("viewport.image.push.subscription", reply)
+
+    def _still(self, v_id: str, count: int) -> None:
+        """View ``v_id``'s picture number ``count`` again as PNG, if it is still the last
+        picture sent (encoded in the worker thread, sent from the loop)."""
+        n, pixels = self.last.get(v_id, (None, None))
+        if n != count:
+            return  # a newer picture of the view went since: it is not still
+
+        def sent(future) -> None:
+            if future.cancelled() or self.last.get(v_id, (None,))[0] != count:
+                return  # (a newer picture went while this one was encoded)
+            png = future.result()  # (an encoder's error is said, by the guard)
+            h, w = pixels.shape[:2]
+            self._publish(
+                {
+                    "image": png,
+                    "format": "png",
+                    "stale": False,
+                    "mtime": count,
+                    "size": [w, h],
+                    "memsize": len(png),
+                    "global_id": v_id,
+                    "localTime": 0,
+                    "workTime": 0,
+                }
+            )
+
+        job = self._pool.submit(encode, pixels, True)
+
+        def back(future) -> None:  # (in the worker thread)
+            try:
+                self.loop.call_soon_threadsafe(self.guard(sent, "picture"), future)
+            except RuntimeError:  # the loop closed since (the server stopped): nothing to send
+                pass
+
+        job.add_done_callback(back)
