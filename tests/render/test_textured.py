@@ -346,4 +346,5 @@ def test_the_explorer_starts_on_a_built_in_mesh_with_uv_for_a_diffuse_map(tmp_pa
     scene, mesh, _ = start(args)
     assert scene.material.diffuse_map is not None and mesh.uv is not None
     _, plain, _ = start(build_parser().parse_args(["gui", "--mesh", "torus"]))
-    assert plain.uv is None  # without a map the explorer's meshes are as before
+    # without a map too: the material tab's map rows can give the start's mesh one later
+    assert plain.uv is not None and plain.n_faces == mesh.n_faces

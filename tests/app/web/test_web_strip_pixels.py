@@ -28,11 +28,12 @@ DIFFER = 6
 
 @pytest.fixture(scope="module")
 def strip_server(tmp_path_factory):
-    """``phong-explorer web --mesh torus --preset glossy_plastic --per-pixel``."""
+    """``phong-explorer web --mesh torus --resolution 32 --preset glossy_plastic --per-pixel``
+    (a coarse torus: its per-vertex and per-pixel tiles differ on many pixels)."""
     need_browser()
     tmp = tmp_path_factory.mktemp("web_strip_pp")
     env = dict(os.environ, PHONG_EXPLORER_MATERIALS=str(tmp / "presets"))
-    args = ["--mesh", "torus", "--preset", "glossy_plastic", "--per-pixel"]
+    args = ["--mesh", "torus", "--resolution", "32", "--preset", "glossy_plastic", "--per-pixel"]
     srv = Server(args, tmp / "server.log", env=env)
     yield srv
     srv.stop()
