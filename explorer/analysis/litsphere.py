@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from explorer.analysis.lobes import to_light
 from explorer.core.lights import DirectionalLight
 from explorer.core.scene import Viewer
 from explorer.shading.display import display_colors, to_bytes
@@ -26,11 +27,6 @@ from explorer.shading.display import display_colors, to_bytes
 SPHERE_LIGHT = DirectionalLight(
     ambient=(0.0, 0.0, 0.0), diffuse=(1.0, 1.0, 1.0), specular=(1.0, 1.0, 1.0)
 )
-
-
-def to_light(theta_i: float) -> tuple[float, float, float]:
-    """The unit direction toward the light at incidence ``theta_i`` (radians), from the left."""
-    return (-math.sin(theta_i), 0.0, math.cos(theta_i))
 
 
 def sphere_scene(scene, theta_i: float):
@@ -67,7 +63,7 @@ def sphere_picture(scene, theta_i: float, size: int, background=(0.0, 0.0, 0.0))
 def light_point(theta_i: float) -> tuple[float, float]:
     """Where the light's mark sits on the disc (u right, v up, each in [-1, 1]): the sphere's
     point whose normal is toward the light."""
-    return (-math.sin(theta_i), 0.0)
+    return to_light(theta_i)[:2]
 
 
 def incidence_at(u: float, v: float) -> float:

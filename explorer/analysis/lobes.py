@@ -125,6 +125,12 @@ def model_lobes(scene, theta_i: float) -> list[Lobe]:
     ]
 
 
+def to_light(theta_i: float) -> tuple[float, float, float]:
+    """The unit direction toward the light at incidence ``theta_i`` (radians) from the normal
+    +z, in the plane of incidence x-z, the light coming from the left."""
+    return (-math.sin(theta_i), 0.0, math.cos(theta_i))
+
+
 def directions(theta) -> np.ndarray:
     """(k, 3) unit directions in the plane of incidence at angles ``theta`` from the normal."""
     t = np.atleast_1d(np.asarray(theta, np.float64))
@@ -136,7 +142,7 @@ def intensity(lobe: Lobe, V) -> np.ndarray:
     the light at the lobe's incidence: (k,) float64 (0 below either horizon of the light)."""
     V = np.atleast_2d(np.asarray(V, np.float64))
     ti = lobe.theta_i
-    L = np.array([-math.sin(ti), 0.0, math.cos(ti)])
+    L = np.array(to_light(ti))
     ndl = L[2]
     if ndl <= 0.0:
         return np.zeros(len(V))

@@ -34,14 +34,18 @@ never multiplied by the diffuse texture (as under ``separate``, and every term i
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.texture import TextureMap
-from explorer.render.textures import gl_rows, read_texture, sample_nearest, texel_index
+from explorer.render.textures import (
+    file_stamp,
+    gl_rows,
+    read_texture,
+    sample_nearest,
+    texel_index,
+)
 from explorer.shading.shader import kept_sums
 
 #: the maps that scale a colour term, and the material colour each scales
@@ -229,11 +233,7 @@ class PixelMaps:
     def image(self, key: str, tmap: TextureMap) -> np.ndarray:
         """The map's image (:func:`~explorer.render.textures.read_texture`: a bad file raises
         its one line), read again only when the file changed."""
-        try:
-            st = os.stat(tmap.file)
-            stamp = (st.st_mtime_ns, st.st_size, st.st_ino)
-        except OSError:
-            stamp = None  # (read_texture says what is wrong)
+        stamp = file_stamp(tmap.file)
         kept = self._images.get(tmap.file)
         if kept is not None and stamp is not None and kept[0] == stamp:
             return kept[1]

@@ -112,6 +112,17 @@ def texel_index(shape, st, *, clamp: bool = False) -> tuple[np.ndarray, np.ndarr
     return j, i
 
 
+def file_stamp(file) -> tuple | None:
+    """``(modification time in ns, size, inode)`` of ``file``, what a kept image or thumbnail
+    of it is kept by (a changed or replaced file is read again); None where it cannot be
+    stat'ed (:func:`read_texture` then says what is wrong)."""
+    try:
+        st = os.stat(file)
+    except OSError:
+        return None
+    return st.st_mtime_ns, st.st_size, st.st_ino
+
+
 #: a map's thumbnail in the panels: its longer side (pixels)
 THUMBNAIL_SIZE = 48
 
@@ -121,14 +132,9 @@ def thumbnail(file: str, key: str = "diffuse_map", size: int = THUMBNAIL_SIZE) -
     top first, with the image's mean colour: a larger image shrunk, each pixel the mean of the
     texels it covers (Pillow's box filter); a smaller one grown by a whole factor, each texel a
     square block.
-    Made once per file (name, size and modification time) and kept; a bad file raises
+    Made once per file (name and :func:`file_stamp`) and kept; a bad file raises
     :func:`read_texture`'s :class:`TextureError`."""
-    try:
-        st = os.stat(file)
-        stamp = (st.st_mtime_ns, st.st_size)
-    except OSError:
-        stamp = None  # read_texture says what is wrong
-    return _thumbnail(os.fspath(file), key, size, stamp)
+    return _thumbnail(os.fspath(file), key, size, file_stamp(file))
 
 
 @functools.lru_cache(maxsize=64)

@@ -24,7 +24,6 @@ from __future__ import annotations
 import base64
 import functools
 import io
-import os
 from os.path import basename
 from urllib.parse import quote
 
@@ -33,7 +32,7 @@ from explorer.app import panelmodel
 from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
 from explorer.core.controls import field_text, from_step, to_step, without_unit
 from explorer.core.errors import ExplorerError
-from explorer.render.textures import thumbnail
+from explorer.render.textures import file_stamp, thumbnail
 
 #: the number rows (a slider and a field each)
 NUMBERS = tuple(r for r in panelmodel.ROWS if r.kind == "number")
@@ -70,21 +69,13 @@ def thumbnail_url(file: str, key: str) -> str:
     """Image ``file``'s thumbnail (:func:`explorer.render.textures.thumbnail`, the window's) as
     a PNG data URL; "" when the file cannot be read now (its name says which)."""
     try:
-        return _png_url(file, key, *_stamp(file))
+        return _png_url(file, key, file_stamp(file))
     except ExplorerError:
         return ""
 
 
-def _stamp(file: str) -> tuple:
-    try:
-        st = os.stat(file)
-    except OSError:
-        return (None, None)
-    return st.st_mtime_ns, st.st_size
-
-
 @functools.lru_cache(maxsize=64)
-def _png_url(file: str, key: str, *_stamp) -> str:
+def _png_url(file: str, key: str, _stamp) -> str:
     from PIL import Image
 
     out = io.BytesIO()
@@ -330,23 +321,20 @@ def _choices(app) -> None:
 
     user("mesh", lambda v, s: v != app.mesh_values.page(s.mesh), choose_mesh)
 
-    def press(key):
-        """A button row pressed (any other key from the page is refused)."""
-        r = panelmodel.BY_KEY.get(str(key))
-        if r is None or r.kind != "button":
-            raise ExplorerError(f"the page has no button named '{key}'")
-        c.set_value(r.key, True, merge=False)
+    def row_edit(kind: str, value, noun: str):
+        """What the page's ``kind`` rows send by key (a button pressed: True; an image row's
+        clear: None); any other key from the page is refused."""
 
-    ctrl.press = app.guard(press, "button")
+        def edit(key):
+            r = panelmodel.BY_KEY.get(str(key))
+            if r is None or r.kind != kind:
+                raise ExplorerError(f"the page has no {noun} named '{key}'")
+            c.set_value(r.key, value, merge=False)
 
-    def clear_map(key):
-        """An image row's clear (any other key from the page is refused)."""
-        r = panelmodel.BY_KEY.get(str(key))
-        if r is None or r.kind != "image":
-            raise ExplorerError(f"the page has no texture map named '{key}'")
-        c.set_value(r.key, None, merge=False)
+        return edit
 
-    ctrl.clear_map = app.guard(clear_map, "clear map")
+    ctrl.press = app.guard(row_edit("button", True, "button"), "button")
+    ctrl.clear_map = app.guard(row_edit("image", None, "texture map"), "clear map")
     ctrl.undo, ctrl.redo = app.guard(c.undo, "undo"), app.guard(c.redo, "redo")
     ctrl.reset_camera = app.guard(c.reset_camera, "reset camera")
     ctrl.turntable = app.guard(lambda: app.files.start_turntable(
