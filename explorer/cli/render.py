@@ -346,10 +346,6 @@ def run_per_pixel(args, scene, mesh, size, background, suffix: str) -> int:
 def run_strip(args, scene, mesh, materials, background) -> int:
     """``phong-explorer render --strip``: the term strip
     (:func:`explorer.render.strip.render_strip`) to ``args.out``, and its caption."""
-    if materials:
-        raise ExplorerError(
-            "--strip draws one material: give --preset NAME for a mesh with its own materials"
-        )
     tile = STRIP_TILE if args.tile is None else size_from_option(args.tile, "--tile")
     picture = render_strip(
         scene,
@@ -358,10 +354,13 @@ def run_strip(args, scene, mesh, materials, background) -> int:
         mode=args.strip_mode,
         lights=args.strip_lights,
         background=background,
+        materials=materials,  # (a mesh file's own: each group's tiles in its material)
     )
     write_atomic(args.out, encode_png(picture.image), overwrite=args.force)
     h, w = picture.image.shape[:2]
     name = scene.material.name or "material"
+    if materials:
+        name = f"{len(materials)} material{'s' if len(materials) != 1 else ''} of the file"
     rows = len(picture.rows)
     say(
         f"wrote {args.out}: {w}x{h} term strip, {rows} row{'s' if rows != 1 else ''} "

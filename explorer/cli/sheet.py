@@ -81,7 +81,7 @@ def run(args) -> int:
     else:
         items = [(info.name, info.material) for info in list_presets(materials_dirs)]
         _, own = mesh_materials(args, scene, mesh)
-        if own and not args.strip:  # (a strip's row is one material)
+        if own:
             items.insert(0, (f"{mesh.name} (its materials)", own))
     if args.strip:
         return run_strip(args, items, scene, mesh, tile, background, models)
@@ -100,10 +100,12 @@ def run_strip(args, items, scene, mesh, tile, background, models) -> int:
     """``sheet --strip``: a strip row per preset (and per model of ``--model``)."""
     rows = []
     for name, material in items:
+        own = material if isinstance(material, tuple) else None  # (the file's, one per group)
+        first = material[0] if own else material
         for m in models or (None,):
             label = name if m is None else f"{name} · {m}"
-            model = m or material.model or scene.model
-            rows.append((label, scene.replace(material=material, model=model)))
+            model = m or first.model or scene.model
+            rows.append((label, scene.replace(material=first, model=model), own))
     picture = strip_picture(
         rows, mesh, tile=tile, mode=args.strip_mode, background=background, note=OVERFLOW_NOTE
     )

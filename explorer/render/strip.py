@@ -15,7 +15,12 @@ is the sum tile with every vertex the display clamped in :data:`OVERFLOW_COLOR`.
 
 A row per light (``lights=True``) shows what that light alone adds: its own ambient, diffuse and
 specular terms and their sum, with no emission and no scene ambient
-(:func:`~explorer.shading.strip.light_scene`). VTK is imported inside the functions.
+(:func:`~explorer.shading.strip.light_scene`).
+
+A mesh file's own materials (``materials``: one per group of ``mesh.groups``, as ``render``
+draws the file) give each group's tiles its own material's terms
+(:func:`~explorer.shading.strip.grouped_strip`): the sum tile is then ``render`` of the file in
+its materials, bit for bit. VTK is imported inside the functions.
 """
 
 from __future__ import annotations
@@ -31,7 +36,14 @@ from explorer.render.images import check_picture_pixels, check_size
 from explorer.render.offscreen import BACKGROUND, LABEL_COLOR, OffscreenRenderer, OffscreenWindow
 from explorer.shading.display import engine_clamps, to_bytes
 from explorer.shading.shader import Shader
-from explorer.shading.strip import TERMS, Strip, caption, light_scene, shader_strip
+from explorer.shading.strip import (
+    TERMS,
+    Strip,
+    caption,
+    grouped_strip,
+    light_scene,
+    shader_strip,
+)
 
 #: the tiles of a row: the strip's terms, then the overflow mask
 COLUMNS = (*TERMS, "overflow")
@@ -62,19 +74,24 @@ class StripPicture:
     caption: str
 
 
-def scene_rows(scene, *, lights: bool = False) -> list:
-    """``(name, Scene)`` rows of a strip: the scene, and with ``lights`` each of its lights
-    alone (:func:`~explorer.shading.strip.light_scene`)."""
-    rows = [("all lights", scene)]
+def scene_rows(scene, *, lights: bool = False, materials=None) -> list:
+    """``(name, Scene, materials)`` rows of a strip: the scene, and with ``lights`` each of its
+    lights alone (:func:`~explorer.shading.strip.light_scene`; the groups' ``materials``, when
+    given, with no emission either)."""
+    rows = [("all lights", scene, materials)]
     if lights:
+        dark = materials
+        if materials is not None:
+            dark = tuple(m.replace(emission=(0.0, 0.0, 0.0)) for m in materials)
         for i, light in enumerate(scene.lights):
-            rows.append((f"light {i + 1}: {light.type}", light_scene(scene, i)))
+            rows.append((f"light {i + 1}: {light.type}", light_scene(scene, i), dark))
     return rows
 
 
-def mesh_strip(scene, mesh: Mesh, mode: str = "weighted") -> Strip:
+def mesh_strip(scene, mesh: Mesh, mode: str = "weighted", materials=None) -> Strip:
     """The strip of ``scene`` on the mesh's vertices (float64, the mesh's triangles for
-    shadows), as the render draws them."""
+    shadows), as the render draws them; ``materials``: one per group of ``mesh.groups``, each
+    group's tiles in its own (:func:`~explorer.shading.strip.grouped_strip`)."""
     shader = Shader(
         scene,
         mesh.positions,
@@ -83,7 +100,14 @@ def mesh_strip(scene, mesh: Mesh, mode: str = "weighted") -> Strip:
         clamp=engine_clamps(scene),
         faces=mesh.faces,
     )
-    return shader_strip(shader, mode)
+    if materials is None:
+        return shader_strip(shader, mode)
+    groups = mesh.groups
+    if groups is None or len(materials) != len(groups.names):
+        n = 0 if groups is None else len(groups.names)
+        raise ExplorerError(f"need one material per group of the mesh ({n}), got {len(materials)}")
+    rows = [groups.vertices(g) for g in range(len(groups.names))]
+    return grouped_strip(shader, rows, materials, mode)
 
 
 def overflow_colors(strip: Strip) -> np.ndarray:
@@ -101,12 +125,13 @@ def render_strip(
     mode: str = "weighted",
     lights: bool = False,
     background=BACKGROUND,
+    materials=None,
 ) -> StripPicture:
     """The strip of ``scene`` on ``mesh`` as one labelled picture (see the module docstring),
-    captioned with the first row's overflow (:func:`~explorer.shading.strip.caption`)."""
-    return strip_picture(
-        scene_rows(scene, lights=lights), mesh, tile=tile, mode=mode, background=background
-    )
+    captioned with the first row's overflow (:func:`~explorer.shading.strip.caption`);
+    ``materials``: the mesh file's own, one per group."""
+    rows = scene_rows(scene, lights=lights, materials=materials)
+    return strip_picture(rows, mesh, tile=tile, mode=mode, background=background)
 
 
 def strip_picture(
@@ -119,7 +144,8 @@ def strip_picture(
     gap: int = 2,
     note: str | None = None,
 ) -> StripPicture:
-    """A strip per ``(name, Scene)`` of ``rows`` on ``mesh``, one row of tiles each under a
+    """A strip per ``(name, Scene)`` or ``(name, Scene, materials)`` of ``rows`` on ``mesh``
+    (``materials``: None, or one per group of ``mesh.groups``), one row of tiles each under a
     band with its name, the mode and its overflow, and a band of the tiles' names; ``note``
     (default: the first row's caption) in a band below them."""
     tw, th = check_size(tile)
@@ -139,8 +165,8 @@ def strip_picture(
     heads = [(x, c, "centre") for x, c in zip(centres, COLUMNS, strict=True)]
     with OffscreenRenderer((tw, th), background) as r, TextBand((width, band), background) as t:
         y = 0
-        for row, (name, scene) in enumerate(rows):
-            strip = mesh_strip(scene, mesh, mode)
+        for row, (name, scene, *own) in enumerate(rows):
+            strip = mesh_strip(scene, mesh, mode, own[0] if own else None)
             title = f"{name} ({mode}), overflow {100.0 * strip.overflow_fraction:.1f}%"
             out[y : y + band] = t.draw([(gap + 4, title, "left")], font)
             out[y + band : y + 2 * band] = t.draw(heads, font)

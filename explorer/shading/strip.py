@@ -130,6 +130,33 @@ def shader_strip(shader: Shader, mode: str = "weighted") -> Strip:
     return compose_strip(shader.scene, shader.terms, shader.colors, mode)
 
 
+def grouped_strip(shader: Shader, rows, materials, mode: str = "weighted") -> Strip:
+    """The strip of a :class:`~explorer.shading.shader.Shader` (``keep=True``) whose vertices
+    are drawn in several materials (a mesh file's groups): rows : one index array per group;
+    materials : one Material per group. Each group's rows are :func:`shader_strip` of the
+    shader with that group's material (its kept sums recomposed, as
+    :func:`~explorer.shading.display.grouped_colors` makes the colours), so the sum tile is
+    the picture of the mesh in its materials. The shader is left with its own material."""
+    own = shader.scene.material
+    n = shader.n
+    terms = {name: np.zeros((n, 3), np.float64) for name in TERMS}
+    tiles = {name: np.zeros((n, 3), np.float64) for name in TERMS}
+    overflow = np.zeros(n, np.bool_)
+    try:
+        for r, material in zip(rows, materials, strict=True):
+            if not len(r):
+                continue
+            shader.set_material(material)
+            part = shader_strip(shader, mode)
+            for name in TERMS:
+                terms[name][r] = part.terms[name][r]
+                tiles[name][r] = part.tiles[name][r]
+            overflow[r] = part.overflow[r]
+    finally:
+        shader.set_material(own)
+    return Strip(terms, tiles, overflow, mode)
+
+
 def strip_bytes(scene: Scene, sums, colors, mode: str = "weighted", aconst=None) -> tuple:
     """The strip's tiles as the pictures take them: ``(tiles, overflow)``, tiles (5, k, 3)
     uint8 in :data:`TERMS`' order, each ``to_bytes`` of :func:`compose_strip`'s tile, and its

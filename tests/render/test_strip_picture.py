@@ -98,3 +98,41 @@ def test_sheet_strip_is_a_row_per_preset(tmp_path, capsys):
     assert main([*argv, "--strip-mode", "raw", "--out", str(out)]) == 0
     assert "term strips of 2 presets on teapot" in capsys.readouterr().out
     assert read_png(out).shape[0] > 2 * 80
+
+
+def test_render_strip_draws_each_group_of_a_mesh_file_in_its_own_material(tmp_path, capsys):
+    """``render --strip`` of an OBJ of three materials (docs/examples/teapot_parts.obj): its
+    sum tile is ``render`` of the file in its materials bit for bit, and each group's tiles are
+    the engine's terms of that group's material (the diffuse tile is the render of the diffuse
+    colours of a Shader in each group's material, group by group)."""
+    from pathlib import Path
+
+    from explorer.cli import build_parser
+    from explorer.cli.options import build_scene, mesh_materials
+    from explorer.render.strip import mesh_strip
+
+    obj = Path(__file__).resolve().parents[2] / "docs" / "examples" / "teapot_parts.obj"
+    strip_png, whole_png = tmp_path / "strip.png", tmp_path / "whole.png"
+    argv = ["--mesh", str(obj)]
+    tile = ["--tile", "96x80", "--out", str(strip_png)]
+    assert main(["render", *argv, "--strip", *tile]) == 0
+    assert "term strip, 1 row (teapot_parts.obj, 3 materials of the file" in capsys.readouterr().out
+    assert main(["render", *argv, "--size", "96x80", "--out", str(whole_png)]) == 0
+    args = build_parser().parse_args(["render", *argv, "--out", "x.png"])
+    args.mesh_default = "sphere"
+    scene, mesh = build_scene(args)
+    scene, materials = mesh_materials(args, scene, mesh)
+    assert len(set(materials)) == 3
+    picture = render_strip(scene, mesh, tile=TILE, materials=materials)
+    np.testing.assert_array_equal(read_png(strip_png), picture.image)
+    np.testing.assert_array_equal(_tile(picture, 0, "sum"), read_png(whole_png))
+    diffuse = np.zeros((mesh.n_vertices, 3))
+    for g, material in enumerate(materials):
+        rows = mesh.groups.vertices(g)
+        alone = mesh_strip(scene.replace(material=material), mesh)
+        for term in ("emission", "ambient", "diffuse", "specular", "sum"):
+            np.testing.assert_array_equal(picture.strips[0].terms[term][rows],
+                                          alone.terms[term][rows])  # fmt: skip
+        diffuse[rows] = alone.tiles["diffuse"][rows]
+    want = render_image(scene, mesh, TILE, colors=diffuse)
+    np.testing.assert_array_equal(_tile(picture, 0, "diffuse"), want)
