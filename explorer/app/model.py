@@ -100,6 +100,7 @@ class State:
         default; a parallel camera's viewer is always so)
     strip, strip_mode : the term strip under the view is on, and its tiles: ``weighted`` or
         ``raw`` (:mod:`explorer.app.termstrip`)
+    strip_side : the compare view's panes that show their side's strip: ``both``, ``a``, ``b``
     lobes, lobe_view, lobe_quantity, lobe_log, lobe_ndl : the lobe inset's lobes (the selected
         light's, or several) and how it plots them (:mod:`explorer.app.lobeinset`)
     lobe_hidden : the lobes of the inset's set not drawn (0-based indices in the set)
@@ -132,6 +133,7 @@ class State:
     local_viewer: bool = True
     strip: bool = False
     strip_mode: str = "weighted"
+    strip_side: str = "both"
     lobes: str = "selected"
     lobe_view: str = "polar"
     lobe_quantity: str = "intensity"

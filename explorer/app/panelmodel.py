@@ -634,6 +634,17 @@ def _view_rows() -> list[Row]:
             tip="weighted: each term as it enters the colour (k·A, k·D, k·S); raw: the light "
             "sums A, D, S alone",
         ),
+        Row(
+            "strip_side",
+            "view",
+            "choice",
+            lambda s: s.strip_side,
+            lambda s, v: (T.set_strip_side, (v,)),
+            visible=lambda s: s.strip and s.compare is not None,  # (the compare view's)
+            choices=T.STRIP_SIDES,
+            inline=True,
+            tip="the compare view's panes that show their side's strip: both, A's or B's",
+        ),
         *loberows.lobe_rows(Row),
     ]
 

@@ -15,6 +15,7 @@ A session file is YAML (or JSON, which YAML reads too)::
     difference: false
     strip: false               # optional: the term strip under the view (docs/terms.md),
     strip_mode: weighted       #   its tiles: weighted or raw
+    strip_side: both           #   the compare view's panes with a strip: both, a or b
     lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false,
             incidence: null, hidden: []}
                                # optional: the lobe inset's lobes and plot (docs/terms.md);
@@ -62,7 +63,7 @@ FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
     "camera", "difference", "compare", "groups", "window", "local_viewer", "strip", "strip_mode",
-    "lobes",
+    "strip_side", "lobes",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -105,6 +106,7 @@ def session_mapping(state: State) -> dict:
         "local_viewer": bool(state.local_viewer),
         "strip": bool(state.strip),
         "strip_mode": state.strip_mode,
+        "strip_side": state.strip_side,
         "lobes": {
             "set": state.lobes,
             "view": state.lobe_view,
@@ -180,9 +182,11 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     difference = checker.boolean(m.get("difference", False), ("difference",))
     local_viewer = checker.boolean(m.get("local_viewer", True), ("local_viewer",))
     strip = checker.boolean(m.get("strip", False), ("strip",))
+    from explorer.app.termstrip import STRIP_SIDES
     from explorer.shading.strip import MODES as STRIP_MODES  # (the engine: when a file is read)
 
     strip_mode = checker.choice(m.get("strip_mode", "weighted"), ("strip_mode",), STRIP_MODES)
+    strip_side = checker.choice(m.get("strip_side", "both"), ("strip_side",), STRIP_SIDES)
     lobes = _lobes(checker, m["lobes"]) if m.get("lobes") is not None else {}
     camera = _camera(checker, m["camera"]) if "camera" in m else None
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
@@ -220,6 +224,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         local_viewer=bool(local_viewer),
         strip=bool(strip),
         strip_mode=strip_mode,
+        strip_side=strip_side,
         **lobes,
         **compare,
     )

@@ -72,7 +72,7 @@ class SideB:
         pl.camera_set = True
         a = main.view
         self.view = SceneView(pl, a.mesh, M.side_b(state), lod_vertices=a.lod_vertices,
-                              lod_target=a.lod_target)  # fmt: skip
+                              lod_target=a.lod_target, side="b")  # fmt: skip
         if self.pane.handles:  # the lights are shared: B's handles move them too
             self.handles = HandleDragger(main, pl, self.view)
         pl.renderer.AddObserver("StartEvent", main.guard(self._before_frame, "compare"))
@@ -92,10 +92,14 @@ class SideB:
 
     def _pixels_before(self, *_) -> None:
         """Side B's render window's StartEvent: its per-pixel picture (made already when side
-        A's frame came first: :meth:`before_a_frame`)."""
+        A's frame came first: :meth:`before_a_frame`), and its term strip's tiles per pixel
+        while side B is drawn per pixel."""
         state = self.main.controller.state
         if state.compare is not None:
-            self.pixels.before(M.side_b(state))
+            b = M.side_b(state)
+            self.pixels.before(b)
+            per_pixel = self.pixels.wanted(b) and not self.pixels.fallback
+            self.view.strip.before_pixels(b, per_pixel, self.view.mesh)
 
     def before_a_frame(self, state: M.State) -> None:
         """Side A's render window's StartEvent, after side A's picture: side B's per-pixel
@@ -194,7 +198,8 @@ class SideB:
     def probe(self) -> dict:
         """Side B's probe vertex and its pixel (origin top-left), its picture's size, each
         light's handle pixel (origin top-left) and the arrows at its edge (light -> the
-        triangle's corners, origin top-left) while its handles are drawn."""
+        triangle's corners, origin top-left) while its handles are drawn, and its term strip's
+        report (:meth:`~explorer.app.termstrip.TermStrip.report`; None while it has none)."""
         v = self.view
         i = v.probe_vertex()
         s = self.main.controller.state
@@ -206,6 +211,7 @@ class SideB:
                                for k in range(len(s.scene.lights))] if drawn else [],
                 "arrows_px": {str(k): [[float(x), float(h - 1 - y)] for x, y in t]
                               for k, t in v.marker_triangles.items()} if drawn else {},
+                "strip": v.strip.report(v.to_view(v.mesh.positions[i])),
                 }  # fmt: skip
 
 

@@ -17,6 +17,12 @@ tile's size, the main view's camera), its per-pixel shader's kept sums recompose
 --per-pixel``'s picture at that size and camera, bit for bit. Made before the window draws
 (:meth:`TermStrip.before_pixels`, the render window's StartEvent, as the view's own per-pixel
 picture). VTK is imported inside the methods.
+
+In the compare view each pane has a strip of its own (side B's :class:`TermStrip` is made by
+side B's SceneView, :attr:`TermStrip.side` ``b``): each shows its side's terms, per pixel when
+its side is, under a caption naming the side at its top left. The state's ``strip_side``
+(:data:`STRIP_SIDES`) picks the panes that show one: ``both``, or side ``a``'s or ``b``'s alone
+(the other pane's view then fills its pane).
 """
 
 from __future__ import annotations
@@ -35,6 +41,21 @@ STRIP_HEIGHT = 0.2
 #: the tiles' label colour and font size (pixels)
 LABEL_COLOUR = (0.93, 0.93, 0.93)
 LABEL_FONT = 12
+#: the smallest font (pixels) a label is drawn at before it is shortened (:func:`label_texts`)
+LABEL_MIN_FONT = 9
+#: the label's room: the tile's width less this many pixels (4 at its left, 4 at its right)
+LABEL_ROOM = 8
+#: the compare view's panes that show their side's strip (the state's ``strip_side``)
+STRIP_SIDES = ("both", "a", "b")
+#: each tile's label shortened, longest first, for narrow tiles (the first that fits is drawn)
+SHORT = {
+    "emission": ("emis.", "e"),
+    "ambient": ("amb.", "a"),
+    "diffuse": ("diff.", "d"),
+    "specular": ("spec.", "s"),
+    "sum": ("sum", "+"),
+    "overflow": (),
+}
 
 
 def set_strip(state: State, on: bool) -> State:
@@ -47,6 +68,44 @@ def set_strip_mode(state: State, mode: str) -> State:
     if mode not in MODES:
         raise ExplorerError(f"strip_mode must be one of {MODES}, got {mode!r}")
     return state.replace(strip_mode=mode)
+
+
+def set_strip_side(state: State, side: str) -> State:
+    """The compare view's panes that show the strip: ``both``, or side ``a``'s or ``b``'s."""
+    if side not in STRIP_SIDES:
+        raise ExplorerError(f"strip_side must be one of {STRIP_SIDES}, got {side!r}")
+    return state.replace(strip_side=side)
+
+
+def strip_shown(state: State, side: str = "a") -> bool:
+    """Whether the pane of ``side`` (``a``, or ``b`` in the compare view) shows the strip."""
+    if not state.strip:
+        return False
+    return state.compare is None or state.strip_side in ("both", side)
+
+
+def side_caption(state: State, side: str) -> str:
+    """The strip's caption in the compare view: which side's terms it shows ("" outside it)."""
+    return "" if state.compare is None else f"side {side.upper()}"
+
+
+def label_texts(column: str, mode: str, share: float) -> tuple[str, ...]:
+    """Tile ``column``'s label and its shorter forms, longest first: ``sum (weighted)``,
+    ``sum``, ``+``; ``overflow 1.3%``, ``1.3%`` (``share`` the clamped share, in %)."""
+    if column == "overflow":
+        return (f"overflow {share:.1f}%", f"{share:.1f}%")
+    full = f"{column} ({mode})" if column == "sum" else column
+    return (full, *SHORT[column])
+
+
+def tile_boxes(width: int, height: int, n: int) -> list[tuple[int, int, int, int]]:
+    """The strip's ``n`` tiles in a window of ``width`` x ``height`` pixels: each ``(x, y, w,
+    h)`` (pixels, origin bottom-left), all of one width (``width // n``: every tile's per-pixel
+    picture is one picture's size), side by side and centred; the strip's band its height."""
+    tw = width // n
+    th = int(round(STRIP_HEIGHT * height))
+    x0 = (width - n * tw) // 2
+    return [(x0 + i * tw, 0, tw, th) for i in range(n)]
 
 
 def _drawing_strip_bytes(drawing, mode: str) -> tuple:
@@ -80,12 +139,18 @@ class TermStrip:
     """The strip in ``plotter``'s render window under its main renderer (see the module
     docstring): :meth:`show` draws it for a state and a drawing, :attr:`renderers` its tiles'
     renderers in :data:`~explorer.render.strip.COLUMNS`' order, :attr:`tiles` the bytes each
-    draws, :attr:`overflow` the clamped vertices."""
+    draws, :attr:`overflow` the clamped vertices; :attr:`side` the compare view's pane it is
+    under (``a``, or ``b`` for side B's), :attr:`caption` the line naming it."""
 
-    def __init__(self, plotter):
+    def __init__(self, plotter, side: str = "a"):
         self.plotter = plotter
+        self.side = side
+        self.caption = None  # the text actor naming the side (made with the tiles)
         self.renderers: list = []
         self.labels: list = []
+        self._texts: list = []  # each label's texts, longest first (label_texts)
+        self._band = None  # the renderer under the tiles (the strip's background)
+        self._placed = None  # the window size the tiles were placed for
         self._actors: list = []
         self._colours: list = []
         self._key = None
@@ -102,12 +167,13 @@ class TermStrip:
         """Show the strip for ``state`` (off: the main view fills the window again), its tiles
         from ``drawing`` (a :class:`~explorer.app.view.MeshDrawing`) when anything they depend
         on changed."""
-        if not state.strip:
+        if not strip_shown(state, self.side):
             if self.on:
                 self._switch(False)
             return
         if not self.on:
             self._switch(True)
+        self.caption.SetInput(side_caption(state, self.side))
         if drawing is not self._drawing:
             self._geometry(drawing)
         key = (id(drawing), drawing.shader.scene, state.strip_mode, drawing.groups)
@@ -122,16 +188,17 @@ class TermStrip:
             colours[0][:] = rgb
             colours[1].Modified()
         share = 100.0 * float(over.mean()) if over.size else 0.0
-        for name, label in zip(COLUMNS, self.labels, strict=True):
-            text = f"{name} {share:.1f}%" if name == "overflow" else name
-            label.SetInput(f"{text} ({state.strip_mode})" if name == "sum" else text)
+        self._texts = [label_texts(c, state.strip_mode, share) for c in COLUMNS]
+        self._fit_labels()
 
     def before_pixels(self, state: State, per_pixel: bool, mesh) -> None:
         """The render window's StartEvent: with the strip on and the view drawn per pixel
         (``per_pixel``), each tile's per-pixel picture of ``mesh`` for the camera VTK is about
         to draw with (made again when the scene, camera, tile size or mode changed); else the
         tiles draw the mesh per vertex."""
-        if not (self.on and state.strip and per_pixel):
+        if self.on:
+            self._place()
+        if not (self.on and strip_shown(state, self.side) and per_pixel):
             self._show_pictures(False)
             return
         from explorer.app.view import view_camera  # (a cycle: the view holds the strip)
@@ -178,7 +245,8 @@ class TermStrip:
             out.append(rgb)
         over = strip.overflow[first:]
         share = 100.0 * float(over.mean()) if over.size else 0.0
-        self.labels[COLUMNS.index("overflow")].SetInput(f"overflow {share:.1f}%")
+        self._texts[COLUMNS.index("overflow")] = label_texts("overflow", mode, share)
+        self._fit_labels()
         return out
 
     def _images_for(self, w: int, h: int) -> list:
@@ -204,9 +272,12 @@ class TermStrip:
             mapper.SetColorLevel(127.5)
             actor = vtkActor2D()
             actor.SetMapper(mapper)
-            r.RemoveViewProp(label)  # (the label drawn over the picture)
+            r.RemoveViewProp(label)  # (the labels drawn over the picture)
             r.AddViewProp(actor)
             r.AddViewProp(label)
+            if r is self.renderers[0]:
+                r.RemoveViewProp(self.caption)
+                r.AddViewProp(self.caption)
             self._images.append((image, actor))
         return self._images
 
@@ -219,6 +290,47 @@ class TermStrip:
             actor.SetVisibility(on)
         for actor in self._actors:
             actor.SetVisibility(not on)
+
+    def _place(self) -> None:
+        """The tiles at :func:`tile_boxes` of the window's present size (again when it changed),
+        their labels fitted to them."""
+        size = tuple(int(v) for v in self.plotter.window_size)
+        if size == self._placed or min(size) <= 0:
+            return
+        self._placed = size
+        W, H = size
+        for r, (x, _, w, _) in zip(self.renderers, tile_boxes(W, H, len(COLUMNS)), strict=True):
+            r.SetViewport(x / W, 0.0, (x + w) / W, STRIP_HEIGHT)
+        self._fit_labels()
+
+    def _fit_labels(self) -> None:
+        """Each label its longest text that fits its tile (:data:`LABEL_ROOM`), at
+        :data:`LABEL_FONT` down to :data:`LABEL_MIN_FONT`, else the shortest at that font."""
+        for r, label, texts in zip(self.renderers, self.labels, self._texts, strict=False):
+            room = int(r.GetSize()[0]) - LABEL_ROOM
+            prop = label.GetTextProperty()
+            for text in texts:
+                label.SetInput(text)
+                font = fit_font(label, r, room)
+                if font is not None:
+                    break
+            else:
+                font = LABEL_MIN_FONT
+            prop.SetFontSize(font)
+
+    def label_boxes(self) -> dict:
+        """Each tile's label box ``[x, y, width, height]`` in window pixels (origin top-left),
+        as drawn (its position and its text's measured size), and its text."""
+        _, wh = self.plotter.window_size
+        out = {}
+        for column, r, label in zip(COLUMNS, self.renderers, self.labels, strict=True):
+            extent = [0.0, 0.0]
+            label.GetSize(r, extent)
+            x, y = r.GetOrigin()
+            lx, ly = label.GetPosition()
+            top = wh - (y + ly + extent[1])
+            out[column] = [int(x + lx), int(top), int(round(extent[0])), int(round(extent[1]))]
+        return out
 
     def tile_box(self, column: str) -> list[int]:
         """Tile ``column``'s box ``[x, y, width, height]`` in window pixels (origin top-left)."""
@@ -250,6 +362,9 @@ class TermStrip:
             "overflow": share,
             "boxes": {c: self.tile_box(c) for c in COLUMNS},
             "per_pixel": self.pixel_tiles is not None,
+            "caption": self.caption.GetInput() or "",
+            "labels": self.label_boxes(),
+            "texts": {c: t.GetInput() for c, t in zip(COLUMNS, self.labels, strict=True)},
         }
 
     def _switch(self, on: bool) -> None:
@@ -259,20 +374,27 @@ class TermStrip:
             self._make()
         main.SetViewport(0.0, STRIP_HEIGHT if on else 0.0, 1.0, 1.0)
         window = self.plotter.render_window
-        for r in self.renderers:
+        for r in (self._band, *self.renderers):
             if on:
                 window.AddRenderer(r)
             else:
                 window.RemoveRenderer(r)
         self.on = on
         self._key = None
+        self._placed = None
+        if on:
+            self._place()
 
     def _make(self) -> None:
         import vtkmodules.vtkRenderingFreeType  # noqa: F401 - registers the text renderer
-        from vtkmodules.vtkRenderingCore import vtkRenderer, vtkTextActor
+        from vtkmodules.vtkRenderingCore import vtkCoordinate, vtkRenderer, vtkTextActor
 
         main = self.plotter.renderer
         n = len(COLUMNS)
+        band = self._band = vtkRenderer()  # (the pixels the equal tiles leave: the background)
+        band.SetViewport(0.0, 0.0, 1.0, STRIP_HEIGHT)
+        band.SetBackground(main.GetBackground())
+        band.InteractiveOff()
         for i in range(n):
             r = vtkRenderer()
             r.SetViewport(i / n, 0.0, (i + 1) / n, STRIP_HEIGHT)
@@ -291,6 +413,22 @@ class TermStrip:
             r.AddViewProp(label)
             self.renderers.append(r)
             self.labels.append(label)
+        caption = self.caption = vtkTextActor()  # the side's name, over the first tile's top
+        prop = caption.GetTextProperty()
+        prop.SetColor(*LABEL_COLOUR)
+        prop.SetFontSize(LABEL_FONT)
+        prop.SetFontFamilyToArial()
+        prop.BoldOn()
+        prop.ShadowOff()
+        prop.SetVerticalJustificationToTop()
+        corner = vtkCoordinate()  # the tile's top left, whatever its size
+        corner.SetCoordinateSystemToNormalizedViewport()
+        corner.SetValue(0.0, 1.0)
+        at = caption.GetPositionCoordinate()
+        at.SetCoordinateSystemToViewport()
+        at.SetReferenceCoordinate(corner)
+        at.SetValue(4.0, -3.0)  # (pixels from that corner)
+        self.renderers[0].AddViewProp(caption)
 
     def _geometry(self, drawing) -> None:
         """Each tile's actor: the drawing's points and triangles, colours of its own."""
@@ -321,3 +459,16 @@ class TermStrip:
             self._colours.append((vtk_to_numpy(arr), arr, poly))
         self._drawing = drawing
         self._key = None
+
+
+def fit_font(label, renderer, room: float) -> int | None:
+    """The largest font from :data:`LABEL_FONT` down to :data:`LABEL_MIN_FONT` at which the
+    text actor ``label``'s text is at most ``room`` pixels wide in ``renderer``, or None."""
+    prop = label.GetTextProperty()
+    for font in range(LABEL_FONT, LABEL_MIN_FONT - 1, -1):
+        prop.SetFontSize(font)
+        extent = [0.0, 0.0]
+        label.GetSize(renderer, extent)
+        if extent[0] <= room:
+            return font
+    return None

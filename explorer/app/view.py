@@ -326,10 +326,11 @@ class SceneView:
 
     plotter : a PyVista plotter (``QtInteractor`` or off-screen); mesh, state : the start
     lod_vertices, lod_target : see :data:`LOD_VERTICES`, :data:`LOD_TARGET`
+    side : the compare view's side it shows (``a``, or ``b``: side B's pane), for its strip
     """
 
     def __init__(self, plotter, mesh: Mesh, state: State, *, lod_vertices: int = LOD_VERTICES,
-                 lod_target: int = LOD_TARGET):  # fmt: skip
+                 lod_target: int = LOD_TARGET, side: str = "a"):  # fmt: skip
         self.plotter = plotter
         self.lod_vertices = int(lod_vertices)
         self.lod_target = int(lod_target)
@@ -346,7 +347,7 @@ class SceneView:
         self._switching = False  # set while the drawings change meshes
         self.set_mesh(mesh, state)
         self.lobe = LobeInset(plotter, state)
-        self.strip = TermStrip(plotter)
+        self.strip = TermStrip(plotter, side)
         self.strip.show(state, self.active)
 
     # -- mesh --------------------------------------------------------------------------------

@@ -71,6 +71,7 @@ SAMPLES = {
     "swap": True,
     "strip": False,  # (on at the start: its mode's row shown)
     "strip_mode": "raw",
+    "strip_side": "b",
     "lobes": "lights",
     "lobe_view": "cartesian",
     "lobe_quantity": "brdf",

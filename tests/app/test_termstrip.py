@@ -65,3 +65,51 @@ def test_the_strip_turns_off_and_its_rows_are_panel_rows(view):
     assert action(view.state, *args).strip_mode == "raw"
     with pytest.raises(ValueError, match="strip_mode must be one of"):
         set_strip_mode(view.state, "linear")
+
+
+def _label_boxes(strip, height: int) -> dict:
+    """Each label's box (x, y, w, h) in window pixels (origin top-left), measured here from
+    the label's position and its text's size as drawn."""
+    out = {}
+    for column, r, label in zip(COLUMNS, strip.renderers, strip.labels, strict=True):
+        extent = [0.0, 0.0]
+        label.GetSize(r, extent)
+        x, y = r.GetOrigin()
+        lx, ly = label.GetPosition()
+        out[column] = (x + lx, height - (y + ly + extent[1]), extent[0], extent[1])
+    return out
+
+
+@pytest.mark.parametrize("width", [330, 900])
+def test_the_tile_labels_fit_their_tiles_and_do_not_touch(width):
+    """A narrow view (tiles 55 pixels wide) draws its labels smaller, or shorter (``sum`` for
+    ``sum (weighted)``; initials at the narrowest), so that each lies inside its tile with room
+    to spare: no label box reaches its tile's right edge or the next label, and the tiles'
+    rightmost columns under the labels hold no text's pixels (a label cut by the tile's edge
+    left its letters there). A wide one keeps the full names."""
+    from explorer.app.termstrip import LABEL_COLOUR
+
+    v = sphere_view("gold", (width, 400))
+    try:
+        v.show_state(set_strip(v.state, True))
+        img = _picture(v)
+        strip = v.strip
+        boxes = _label_boxes(strip, 400)
+        light = np.rint(np.multiply(LABEL_COLOUR, 255)).astype(int)
+        ends = []
+        for column in COLUMNS:
+            x, y, w, h = strip.tile_box(column)
+            lx, ly, lw, lh = boxes[column]
+            assert x < lx and lx + lw <= x + w - 2, (column, strip.labels[0].GetInput())
+            assert y <= ly and ly + lh <= y + h
+            edge = img[int(ly) : int(ly + lh) + 1, x + w - 2 : x + w].reshape(-1, 3)
+            assert not (np.abs(edge - light).max(axis=1) <= 60).any(), column
+            ends.append((lx, lx + lw))
+        assert all(a[1] < b[0] for a, b in zip(ends, ends[1:], strict=False))
+        texts = [t.GetInput() for t in strip.labels]
+        if width == 900:
+            assert texts[:5] == ["emission", "ambient", "diffuse", "specular", "sum (weighted)"]
+        else:
+            assert texts[4] in ("sum", "+")  # (shortened: "sum (weighted)" did not fit)
+    finally:
+        v.plotter.close()

@@ -191,3 +191,57 @@ def test_the_compare_views_panes_each_show_their_sides_strip(open_window):
     i = view.probe_vertex()
     x, y = view.strip.tile_pixel("sum", view.to_view(view.mesh.positions[i]))
     assert in_ring(img[y, x], view.strip.tiles[COLUMNS.index("sum")], one_ring(view.mesh, i))
+
+
+def test_side_bs_strip_per_pixel_under_its_caption_and_the_strip_side_row(open_window):
+    """Gouraud vs per-pixel with the strip on: side B's pane (lit per pixel) has the per-pixel
+    tiles of side B (its sum tile is ``render --per-pixel``'s picture of B's scene at the
+    tile's size and the shared camera, bit for bit, read from pane B's pixels), side A's the
+    per-vertex ones; each strip's caption names its side (its text drawn at the first tile's
+    top left). The ``strip_side`` radios keep the strip in one pane: the other's view fills it."""
+    from explorer.app import model as M
+    from explorer.app.effectactions import gouraud_vs_per_pixel
+    from explorer.app.termstrip import LABEL_COLOUR
+    from explorer.app.view import view_camera
+    from explorer.render.live import picture
+
+    w = open_window("--mesh", "torus", "--resolution", "32", "--preset", "glossy_plastic")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    w.controller.act(gouraud_vs_per_pixel)
+    state = w.controller.state
+    b = M.side_b(state)
+    assert b.scene.shading == "per-pixel" and state.scene.shading == "per-vertex"
+    _pixels(w.plotter)
+    img = _pixels(w.plotter_b)
+    strip_a, strip_b = w.view.strip, w.view_b.strip
+    assert strip_a.pixel_tiles is None and strip_b.pixel_tiles is not None
+    camera = view_camera(w.plotter_b.camera, state.centre, state.radius)
+    scene = M.set_camera(b, camera).shown_scene()
+    bg = tuple(w.plotter_b.renderer.GetBackground())
+    x, y, tw, th = strip_b.tile_box("sum")
+    ref = picture(scene, w.view_b.mesh, (tw, th), camera=camera, background=bg).rgb
+    rows = slice(0, th - LABEL_ROWS)
+    assert (np.abs(ref.astype(int) - img[y : y + th, x : x + tw]).max(axis=2) > 0).mean() < 0.5
+    assert np.array_equal(img[y : y + th, x : x + tw][rows], ref[rows])
+    # the captions: named in the report, drawn at the first tile's top left
+    light = np.rint(np.multiply(LABEL_COLOUR, 255)).astype(int)
+    assert strip_a.report((0, 0, 0))["caption"] == "side A"
+    assert strip_b.report((0, 0, 0))["caption"] == "side B"
+    x, y, tw, th = strip_b.tile_box("emission")
+    corner = img[y + 2 : y + 16, x + 2 : x + 44].reshape(-1, 3)
+    assert (np.abs(corner - light).max(axis=1) <= 40).sum() >= 10  # (the text's own pixels)
+    # one pane's strip: the other's view fills its pane
+    for side, a_on, b_on in (("b", False, True), ("a", True, False), ("both", True, True)):
+        radio = w.findChild(QtWidgets.QRadioButton, side)
+        _tab_with(w, radio)
+        radio.click()
+        assert w.controller.state.strip_side == side
+        _pixels(w.plotter)
+        _pixels(w.plotter_b)
+        assert (strip_a.on, strip_b.on) == (a_on, b_on)
+        for pl, on in ((w.plotter, a_on), (w.plotter_b, b_on)):
+            assert (pl.renderer.GetViewport()[1] > 0) == on
+    w.controller.set_value("compare", False, merge=False)
+    assert w.view.strip.on and w.view.strip.report((0, 0, 0))["caption"] == ""
