@@ -55,8 +55,9 @@ LATIN = {"ρ": "rho", "θ": "theta"}
 #: the lit sphere is drawn beside the plot while the inset with it takes at most this share of
 #: the view's width (a small view keeps the plot alone)
 SPHERE_SHARE = 0.5
-#: the legend's font size (pixels)
+#: the legend's font size (pixels), and the smallest it is drawn at before an entry is shortened
 LEGEND_FONT = 10
+LEGEND_MIN_FONT = 8
 #: a hidden lobe's legend entry (its lobe not drawn; a click on it shows it again)
 LEGEND_HIDDEN_COLOR = (0.6, 0.6, 0.6)
 #: the lobes the panel has a ``show_lobe_<i>`` row for (the first ones of the set; every
@@ -358,14 +359,30 @@ class LobeInset:
             self.plotter.renderer.AddViewProp(t)
             self._legend.append(t)
             self.actors.append(t)
-        x, y, _, h = self._plot_box
+        x, y, w, h = self._plot_box
         for i, t in enumerate(self._legend):
             if i < len(entries):
                 label, colour, shown = entries[i]
-                t.SetInput(label)
+                self._fit_legend(t, label, w - 6)
                 t.GetTextProperty().SetColor(*(colour if shown else LEGEND_HIDDEN_COLOR))
                 t.SetPosition(x + 3, y + h - 2 - i * (LEGEND_FONT + 2))
             t.SetVisibility(i < len(entries))
+
+    def _fit_legend(self, t, label: str, room: float) -> None:
+        """A legend entry within ``room`` pixels (the plot's width: the lit sphere is right of
+        it): the label at :data:`LEGEND_FONT`, else smaller (down to
+        :data:`LEGEND_MIN_FONT`), else its words from the end dropped (``three.js (n/2+1)/4
+        (N·H)^n`` -> ``three.js``)."""
+        prop = t.GetTextProperty()
+        words = label.split(" ")
+        for n in range(len(words), 0, -1):
+            t.SetInput(" ".join(words[:n]))
+            for font in range(LEGEND_FONT, LEGEND_MIN_FONT - 1, -1):
+                prop.SetFontSize(font)
+                extent = [0.0, 0.0]
+                t.GetSize(self.plotter.renderer, extent)
+                if extent[0] <= room:
+                    return
 
     def report(self) -> dict | None:
         """What a test of a front end reads (plain JSON values): each curve's label, colour

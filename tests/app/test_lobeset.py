@@ -65,3 +65,35 @@ def test_each_lobe_is_drawn_where_its_values_are_in_its_colour(view, plot, quant
         assert hits >= 0.9 * len(px)
     view.show_state(state.replace(lobes="selected"))
     assert view.lobe.chart is None
+
+
+@pytest.mark.parametrize("size", [(600, 440), SIZE])
+def test_the_legend_stays_left_of_the_lit_sphere(size):
+    """The three models' legend (``three.js (n/2+1)/4 (N·H)^n`` the longest) beside the lit
+    sphere, in a small inset (600x440: its least side, 130 pixels) and a larger one: each
+    entry's box ends inside the plot, and the panel's pixels between the plot and the sphere,
+    over the legend's rows, are the panel's colour (the three.js line ran across them into the
+    sphere)."""
+    view = sphere_view("chrome", size)
+    try:
+        _legend_left_of_the_sphere(view)
+    finally:
+        view.plotter.close()
+
+
+def _legend_left_of_the_sphere(view) -> None:
+    state = view.state.replace(lobes="models")
+    view.show_state(state)
+    view.plotter.render()
+    img = view.plotter.screenshot(return_img=True)[:, :, :3].astype(int)
+    rep = view.lobe.report()
+    sphere = view.lobe.sphere_report()
+    assert sphere is not None  # (the sphere is drawn beside the plot at this size)
+    sx = sphere["box"][0]
+    x, _, w, _ = view.lobe._plot_box
+    assert [e[0] + e[2] <= x + w for e in rep["legend"]] == [True] * 3
+    assert rep["legend"][2][2] > 12  # (an entry, not an empty line)
+    panel = to_bytes([LI.LOBE_PANEL_COLOR])[0].astype(int)
+    top, bottom = rep["legend"][0][1], rep["legend"][-1][1] + rep["legend"][-1][3]
+    gap = img[top:bottom, int(x + w) + 1 : sx - 1]
+    assert gap.size and (np.abs(gap - panel).max(axis=2) <= 2).all()
