@@ -83,3 +83,72 @@ def test_the_pages_sum_tile_is_the_per_pixel_picture(strip_server, strip_browser
     click(b, "strip")
     wait("the strip off", lambda: report(b)["strip"] is None)
     assert not console_errors(b)
+
+
+def _pane_picture(browser, size, view: str) -> np.ndarray | None:
+    """Pane ``view``'s picture as the page shows it (h, w, 3) int, in the server's pixels;
+    None while the picture shown is not of the reported ``size``."""
+    from test_web import view_pixels
+
+    shot, box = view_pixels(browser, view)
+    w, h = size
+    natural = browser.execute_script(
+        f"const i = document.querySelector('[aria-label=\"{view}\"] img');"
+        "return [i.naturalWidth, i.naturalHeight];"
+    )
+    if not [round(box["w"]), round(box["h"])] == list(size) == natural:
+        return None
+    xs = np.round((box["x"] + (np.arange(w) + 0.5) * box["w"] / w) * box["dpr"] - 0.5).astype(int)
+    ys = np.round((box["y"] + (np.arange(h) + 0.5) * box["h"] / h) * box["dpr"] - 0.5).astype(int)
+    return shot[ys][:, xs].astype(int)
+
+
+def test_side_bs_strip_in_the_page_is_per_pixel_and_named(strip_server, strip_browser, tmp_path):
+    """The compare view with the strip on, both sides lit per pixel: pane B's strip is side B's
+    per-pixel strip (its sum tile, read from the page's picture once it is still, a PNG: ``render
+    --per-pixel``'s picture of B's scene at the tile's size, bit for bit), under the caption
+    ``side B``; pane A's is named ``side A``."""
+    from explorer.app import model as M
+
+    b = strip_browser
+    open_page(b, strip_server.url)
+    click(b, "view tab")
+    click(b, "strip")
+    click(b, "compare")
+
+    def ready():
+        side = (r := report(b))["compare"]
+        return side and side["strip"] and side["strip"]["per_pixel"] and r
+
+    rep = wait("side B's per-pixel strip", ready)
+    assert rep["strip"]["caption"] == "side A" and rep["compare"]["strip"]["caption"] == "side B"
+    last = {}
+
+    def agree():  # polled: the picture shown may be an older one, or the JPEG of a change
+        rep = report(b)
+        side = rep["compare"]
+        if not side or not side["strip"]:
+            return False
+        img = _pane_picture(b, side["size"], "view_b")
+        if img is None:
+            return False
+        path = tmp_path / "page.yaml"
+        path.write_text(yaml.safe_dump(rep["session"]))
+        state, mesh = S.load_session(path)
+        scene = M.side_b(state).shown_scene()
+        x, y, tw, th = side["strip"]["boxes"]["sum"]
+        ref = picture(scene, mesh, (tw, th), camera=state.camera)  # (the view's background)
+        got = img[y : y + th - LABEL_ROWS, x : x + tw]
+        d = np.abs(got - ref.rgb[: th - LABEL_ROWS].astype(int)).max(axis=2)
+        last["d"] = (int(d.max()), int((d > 0).sum()), int(ref.mask.sum()))
+        return ref.mask.sum() > 200 and not d.any() and report(b) == rep
+
+    try:
+        wait("pane B's sum tile to be B's per-pixel picture", agree)
+    finally:
+        print("B's sum tile: largest difference, pixels off, the mesh's:", last.get("d"))
+    click(b, "compare")
+    wait("side B gone", lambda: report(b)["compare"] is None)
+    click(b, "strip")
+    wait("the strip off", lambda: report(b)["strip"] is None)
+    assert not console_errors(b)
