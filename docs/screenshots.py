@@ -89,6 +89,12 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         argv = ("--mesh", "cube", "--preset", "glossy_plastic", *light, *eye, "--per-pixel")
     elif name == "gui_gouraud_vs_per_pixel":
         argv = ("--mesh", "icosphere", "--resolution", "2", "--preset", "polished_silver")
+    elif name == "gui_strip":  # the compare view's two strips, each under its side's caption
+        argv = ("--mesh", "teapot", "--preset", "gold")
+    elif name == "gui_strip_per_pixel":
+        argv = ("--mesh", "torus", "--preset", "glossy_plastic", "--per-pixel")
+    elif name == "gui_lobes":
+        argv = ("--mesh", "sphere", "--preset", "chrome")
     w = open_window(app, tmp, argv, size)
     c = w.controller
     if name == "gui_640x480":
@@ -107,6 +113,16 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         if name == "gui_gouraud_vs_per_pixel":
             intents.run("gouraud_vs_per_pixel", c, {})
             wait_for(app, "the line", lambda: w.viewport.side_b.figures is not None)
+    elif name in ("gui_strip", "gui_strip_per_pixel"):
+        w.panel.setCurrentIndex(2)  # the view tab: the strip's rows
+        c.set_value("strip", True)
+        if name == "gui_strip":
+            c.set_value("compare", True, merge=False)
+            c.act(M.set_compare_model, "phong")
+            c.act(M.place_light, 12.0, 30.0)
+    elif name == "gui_lobes":
+        w.panel.setCurrentIndex(2)  # the view tab: the inset's rows
+        c.set_value("lobes", "models")
     elif name == "gui_difference":
         w.panel.setCurrentIndex(2)
         c.toggle_difference()
@@ -132,15 +148,83 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     settle(app)
 
 
+#: the page's pictures (docs/web*.png this script takes): ``phong-explorer web`` on a session,
+#: in headless Chromium (Debian's chromium and chromium-driver, driven by Selenium)
+WEB_NAMES = ("web_strip",)
+#: the browser's window in the page's pictures
+WEB_SIZE = (1280, 760)
+
+
+def shoot_web(name: str, tmp: Path, out: Path) -> None:
+    """Start ``phong-explorer web`` on the session of picture ``name``, open the page in headless
+    Chromium and save its screenshot into ``out/name.png`` once the picture is still."""
+    import re
+
+    from selenium import webdriver
+
+    from explorer.app import model as M
+    from explorer.app.effectactions import gouraud_vs_per_pixel
+    from explorer.app.session import save_session
+    from explorer.cli import build_parser
+    from explorer.cli.gui import start_state
+
+    argv = ["gui", "--mesh", "torus", "--resolution", "48", "--preset", "glossy_plastic"]
+    state, _ = start_state(build_parser().parse_args(argv))
+    if name == "web_strip":  # Gouraud vs per-pixel, a strip under each pane
+        state = gouraud_vs_per_pixel(state).replace(strip=True)
+        state = M.set_compare_model(state, "phong")
+    session = save_session(tmp / f"{name}.yaml", state, overwrite=True)
+    log = tmp / f"{name}.log"
+    with open(log, "w") as output:
+        server = subprocess.Popen([sys.executable, "-m", "explorer.cli", "web", "--port", "0",
+                                   "--session", str(session)], stdout=output,
+                                  stderr=subprocess.STDOUT)  # fmt: skip
+    driver = None
+    try:
+        end = time.monotonic() + WAIT_S
+        while not (url := re.search(r"http://\S+\?secret=[\w-]+", log.read_text())):
+            if server.poll() is not None or time.monotonic() > end:
+                raise SystemExit(f"screenshots: the server did not start:\n{log.read_text()}")
+            time.sleep(0.2)
+        opts = webdriver.ChromeOptions()
+        for a in ("--headless=new", "--no-sandbox", "--disable-gpu",
+                  f"--window-size={WEB_SIZE[0]},{WEB_SIZE[1]}", "--disable-dev-shm-usage",
+                  "--force-device-scale-factor=1"):  # fmt: skip
+            opts.add_argument(a)
+        opts.binary_location = "/usr/bin/chromium"
+        driver = webdriver.Chrome(options=opts, service=webdriver.ChromeService(
+            executable_path="/usr/bin/chromedriver"))  # fmt: skip
+        driver.get(url.group(0))
+        still = (
+            "const i = document.querySelector('[aria-label=\"view_b\"] img');"
+            "return i !== null && i.complete && i.naturalWidth > 0;"
+        )
+        end = time.monotonic() + WAIT_S
+        while not driver.execute_script(still):  # (pane B's first picture)
+            if time.monotonic() > end:
+                raise SystemExit("screenshots: gave up waiting for the page's picture")
+            time.sleep(0.2)
+        driver.find_element("css selector", '[aria-label="view tab"]').click()
+        time.sleep(8.0)  # the tab shown, the pictures still (then sent as PNGs, exact)
+        driver.save_screenshot(str(out / f"{name}.png"))
+    finally:
+        if driver is not None:
+            driver.quit()
+        server.terminate()
+        server.wait(10)
+
+
 NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "gui_difference",
          "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent", "gui_per_pixel",
-         "gui_gouraud_vs_per_pixel")  # fmt: skip
+         "gui_gouraud_vs_per_pixel", "gui_strip", "gui_strip_per_pixel",
+         "gui_lobes")  # fmt: skip
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out-dir", type=Path, default=HERE, help="where the PNGs go (docs/)")
-    ap.add_argument("--only", action="append", choices=NAMES, help="this picture (repeatable)")
+    ap.add_argument("--only", action="append", choices=NAMES + WEB_NAMES,
+                    help="this picture (repeatable)")  # fmt: skip
     args = ap.parse_args(argv)
     for tool in ("Xvfb", "import"):
         if shutil.which(tool) is None:
@@ -157,8 +241,11 @@ def main(argv=None) -> int:
     app = application()
     try:
         args.out_dir.mkdir(parents=True, exist_ok=True)
-        for name in args.only or NAMES:
-            shoot(name, app, display, tmp, args.out_dir)
+        for name in args.only or NAMES + WEB_NAMES:
+            if name in WEB_NAMES:
+                shoot_web(name, tmp, args.out_dir)
+            else:
+                shoot(name, app, display, tmp, args.out_dir)
             print(f"wrote {args.out_dir / name}.png")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

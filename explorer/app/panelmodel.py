@@ -613,6 +613,15 @@ def _view_rows() -> list[Row]:
             visible=_hdr_on,
             choices=TONE_MAPS,
         ),
+        *_strip_rows(),
+        *loberows.lobe_rows(Row),
+    ]
+
+
+def _strip_rows() -> list[Row]:
+    """The term strip's rows (:mod:`explorer.app.termstrip`): on, its tiles' mode, and the
+    compare view's panes that show one."""
+    return [
         Row(
             "strip",
             "view",
@@ -645,7 +654,6 @@ def _view_rows() -> list[Row]:
             inline=True,
             tip="the compare view's panes that show their side's strip: both, A's or B's",
         ),
-        *loberows.lobe_rows(Row),
     ]
 
 

@@ -182,7 +182,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
     difference = checker.boolean(m.get("difference", False), ("difference",))
     local_viewer = checker.boolean(m.get("local_viewer", True), ("local_viewer",))
     strip = checker.boolean(m.get("strip", False), ("strip",))
-    from explorer.app.termstrip import STRIP_SIDES
+    from explorer.app.termstrip import STRIP_SIDES  # (the strip's VTK side: as STRIP_MODES)
     from explorer.shading.strip import MODES as STRIP_MODES  # (the engine: when a file is read)
 
     strip_mode = checker.choice(m.get("strip_mode", "weighted"), ("strip_mode",), STRIP_MODES)

@@ -32,6 +32,7 @@ import numpy as np
 from explorer.app import model as M
 from explorer.app.model import State
 from explorer.core.errors import ExplorerError
+from explorer.render.images import SIZE_RANGE
 from explorer.render.strip import COLUMNS, OVERFLOW_COLOR
 from explorer.shading.display import to_bytes
 from explorer.shading.strip import MODES, compose_strip, shader_strip_bytes
@@ -198,8 +199,9 @@ class TermStrip:
         tiles draw the mesh per vertex."""
         if self.on:
             self._place()
-        if not (self.on and strip_shown(state, self.side) and per_pixel):
-            self._show_pictures(False)
+        small = self.on and min(self.renderers[0].GetSize()) < SIZE_RANGE[0]
+        if not (self.on and strip_shown(state, self.side) and per_pixel) or small:
+            self._show_pictures(False)  # (tiles under SIZE_RANGE's least side: per vertex)
             return
         from explorer.app.view import view_camera  # (a cycle: the view holds the strip)
 
@@ -208,7 +210,7 @@ class TermStrip:
         w, h = (int(v) for v in self.renderers[0].GetSize())
         bg = tuple(self.plotter.renderer.GetBackground())
         key = (repr(scene), camera, (w, h), id(mesh), state.strip_mode, bg)
-        if key != self._pixel_key and min(w, h) > 0:
+        if key != self._pixel_key:
             self.pixel_tiles = self._pictures(scene, camera, (w, h), mesh, state.strip_mode, bg)
             self._pixel_key = key
             for (image, _), rgb in zip(self._images_for(w, h), self.pixel_tiles, strict=True):

@@ -113,3 +113,20 @@ def test_the_tile_labels_fit_their_tiles_and_do_not_touch(width):
             assert texts[4] in ("sum", "+")  # (shortened: "sum (weighted)" did not fit)
     finally:
         v.plotter.close()
+
+
+def test_tiles_too_small_for_a_picture_draw_per_vertex():
+    """A pane so narrow that the tiles are under 16 pixels wide (a picture's least side, the
+    page's compare pane as it opens): the per-pixel view's strip draws its tiles per vertex,
+    and says nothing (it said 'image size must be ... got (10, 12)' in the page's log)."""
+    v = sphere_view("gold", (80, 300))
+    try:
+        state = set_strip(v.state, True)
+        state = state.replace(scene=state.scene.replace(shading="per-pixel"))
+        v.show_state(state)
+        _picture(v)
+        assert v.strip.on and v.strip.renderers[0].GetSize()[0] < 16
+        v.strip.before_pixels(state, True, v.mesh)
+        assert v.strip.pixel_tiles is None and not v.strip.report((0, 0, 0))["per_pixel"]
+    finally:
+        v.plotter.close()
