@@ -14,9 +14,10 @@ Per pixel (the view's ``shading: per-pixel``), each tile is a picture instead: t
 at each pixel of the tile (a :class:`~explorer.render.live.LivePixels` of the strip's own at the
 tile's size, the main view's camera), its per-pixel shader's kept sums recomposed
 (:func:`explorer.shading.strip.compose_strip` on pixel rows); the sum tile is ``render
---per-pixel``'s picture at that size and camera, bit for bit. Made before the window draws
-(:meth:`TermStrip.before_pixels`, the render window's StartEvent, as the view's own per-pixel
-picture). VTK is imported inside the methods.
+--per-pixel``'s picture at that size and camera, bit for bit (a mesh file's own materials:
+each group's pixels recomposed in its material, as the view's picture is). Made before the
+window draws (:meth:`TermStrip.before_pixels`, the render window's StartEvent, as the view's
+own per-pixel picture). VTK is imported inside the methods.
 
 In the compare view each pane has a strip of its own (side B's :class:`TermStrip` is made by
 side B's SceneView, :attr:`TermStrip.side` ``b``): each shows its side's terms, per pixel when
@@ -35,7 +36,7 @@ from explorer.core.errors import ExplorerError
 from explorer.render.images import SIZE_RANGE
 from explorer.render.strip import COLUMNS, OVERFLOW_COLOR
 from explorer.shading.display import to_bytes
-from explorer.shading.strip import MODES, compose_strip, shader_strip_bytes
+from explorer.shading.strip import MODES, compose_strip, grouped_strip, shader_strip_bytes
 
 #: the strip's height as a fraction of the view's (the main view keeps the rest above it)
 STRIP_HEIGHT = 0.2
@@ -209,9 +210,12 @@ class TermStrip:
         scene = M.set_camera(state, camera).shown_scene()
         w, h = (int(v) for v in self.renderers[0].GetSize())
         bg = tuple(self.plotter.renderer.GetBackground())
-        key = (repr(scene), camera, (w, h), id(mesh), state.strip_mode, bg)
+        groups = state.shown_groups()  # (a mesh file's own materials, group by group)
+        key = (repr(scene), camera, (w, h), id(mesh), state.strip_mode, bg, groups)
         if key != self._pixel_key:
-            self.pixel_tiles = self._pictures(scene, camera, (w, h), mesh, state.strip_mode, bg)
+            self.pixel_tiles = self._pictures(
+                scene, camera, (w, h), mesh, state.strip_mode, bg, groups
+            )
             self._pixel_key = key
             for (image, _), rgb in zip(self._images_for(w, h), self.pixel_tiles, strict=True):
                 arr = image.GetPointData().GetScalars()
@@ -222,19 +226,24 @@ class TermStrip:
                 image.Modified()
         self._show_pictures(self.pixel_tiles is not None)
 
-    def _pictures(self, scene, camera, size, mesh, mode, background) -> list:
+    def _pictures(self, scene, camera, size, mesh, mode, background, groups=None) -> list:
         """The tiles' pictures (:data:`COLUMNS`' order), each (h, w, 3) uint8: the per-pixel
-        shader's sums at ``size`` recomposed; the overflow's share in the label."""
+        shader's sums at ``size`` recomposed (each group's pixels in its material of
+        ``groups``, as the view's picture is made); the overflow's share in the label."""
         from explorer.render.live import LivePixels  # (VTK, for the G-buffer's rasterisation)
 
         if self._live is None:
             self._live = LivePixels(mesh)
         self._live.set_mesh(mesh)
-        frame = self._live.frame(scene, camera, size, background=background)
+        frame = self._live.frame(scene, camera, size, background=background, materials=groups)
         g, _ = self._live.gbuffer(camera, size)
         sh = self._live.shader
-        strip = compose_strip(scene, sh.terms, sh.colors, mode)
         first = len(sh.colors) - len(g.pixels)  # (the mesh's vertices first, with shadows)
+        if groups is None:
+            strip = compose_strip(scene, sh.terms, sh.colors, mode)
+        else:  # (the shader's rows of each group's pixels, as LivePixels lights them)
+            rows = self._live._group_rows(g, groups, first)
+            strip = grouped_strip(sh, rows, groups, mode)
         out = []
         for name in COLUMNS:
             rgb = np.array(frame.rgb)

@@ -245,3 +245,48 @@ def test_side_bs_strip_per_pixel_under_its_caption_and_the_strip_side_row(open_w
             assert (pl.renderer.GetViewport()[1] > 0) == on
     w.controller.set_value("compare", False, merge=False)
     assert w.view.strip.on and w.view.strip.report((0, 0, 0))["caption"] == ""
+
+
+def test_per_pixel_a_mesh_files_groups_each_in_its_material_in_the_tiles(open_window, tmp_path):
+    """A mesh file of two groups in two materials, lit per pixel, with the strip on: the sum
+    tile is the per-pixel picture of the file in its materials (LivePixels with them) bit for
+    bit, and the diffuse tile's pixels of each group are that group's material's diffuse term
+    (the per-pixel shader's sums recomposed with it)."""
+    from helpers.files import write_two_groups
+
+    from explorer.app import model as M
+    from explorer.app.view import view_camera
+    from explorer.render.live import LivePixels
+    from explorer.shading.display import to_bytes
+    from explorer.shading.strip import compose_strip
+
+    w = open_window("--mesh", str(write_two_groups(tmp_path)), "--per-pixel")
+    state = w.controller.state
+    assert state.groups is not None and state.groups[0] != state.groups[1]
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    img = _pixels(w.plotter)
+    strip = w.view.strip
+    assert strip.pixel_tiles is not None
+    state = w.controller.state
+    camera = view_camera(w.plotter.camera, state.centre, state.radius)
+    scene = M.set_camera(state, camera).shown_scene()
+    bg = tuple(w.plotter.renderer.GetBackground())
+    x, y, tw, th = strip.tile_box("sum")
+    rows = slice(0, th - LABEL_ROWS)
+    groups = state.shown_groups()
+    with LivePixels(w.view.mesh) as live:
+        ref = live.frame(scene, camera, (tw, th), background=bg, materials=groups).rgb
+        assert np.array_equal(img[y : y + th, x : x + tw][rows], ref[rows])
+        g, _ = live.gbuffer(camera, (tw, th))
+        sh = live.shader
+        first = len(sh.colors) - len(g.pixels)
+        want = np.array(ref)
+        flat = want.reshape(-1, 3)
+        for k, r in enumerate(live._group_rows(g, groups, first)):
+            own = compose_strip(scene.replace(material=groups[k]), sh.terms, sh.colors)
+            flat[g.pixels[r - first]] = to_bytes(own.tiles["diffuse"][r])
+        assert len({tuple(c) for c in flat[g.pixels]}) > 10  # (the mesh in the tile)
+    x, y, tw, th = strip.tile_box("diffuse")
+    assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
