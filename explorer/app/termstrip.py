@@ -23,7 +23,7 @@ In the compare view each pane has a strip of its own (side B's :class:`TermStrip
 side B's SceneView, :attr:`TermStrip.side` ``b``): each shows its side's terms, per pixel when
 its side is, under a caption naming the side at its top left. The state's ``strip_side``
 (:data:`STRIP_SIDES`) picks the panes that show one: ``both``, or side ``a``'s or ``b``'s alone
-(the other pane's view then fills its pane).
+(the other pane keeps the strip's band, empty: both views keep one size).
 """
 
 from __future__ import annotations
@@ -159,7 +159,8 @@ class TermStrip:
         self._drawing = None
         self.tiles = None
         self.overflow = None
-        self.on = False
+        self.on = False  # the tiles drawn
+        self.band = False  # the strip's room under the view taken (the tiles drawn in it, or not)
         self.pixel_tiles = None  # per pixel: each tile's picture (h, w, 3) uint8, else None
         self._live = None  # the per-pixel tiles' LivePixels
         self._pixel_key = None
@@ -168,13 +169,22 @@ class TermStrip:
     def show(self, state: State, drawing) -> None:
         """Show the strip for ``state`` (off: the main view fills the window again), its tiles
         from ``drawing`` (a :class:`~explorer.app.view.MeshDrawing`) when anything they depend
-        on changed."""
-        if not strip_shown(state, self.side):
-            if self.on:
+        on changed. A pane whose side the compare view's ``strip_side`` leaves out keeps the
+        strip's band, empty: both panes keep one size (the same picture of the shared camera,
+        and A − B per pixel needs both pictures of one size)."""
+        if not state.strip:
+            if self.band:
                 self._switch(False)
             return
-        if not self.on:
+        if not self.band:
             self._switch(True)
+        here = strip_shown(state, self.side)
+        if here != self.on:
+            for r in self.renderers:
+                r.SetDraw(here)  # (left out: the band's background under them)
+            self.on, self._key = here, None
+        if not here:
+            return
         self.caption.SetInput(side_caption(state, self.side))
         if drawing is not self._drawing:
             self._geometry(drawing)
@@ -198,7 +208,7 @@ class TermStrip:
         (``per_pixel``), each tile's per-pixel picture of ``mesh`` for the camera VTK is about
         to draw with (made again when the scene, camera, tile size or mode changed); else the
         tiles draw the mesh per vertex."""
-        if self.on:
+        if self.band:
             self._place()
         small = self.on and min(self.renderers[0].GetSize()) < SIZE_RANGE[0]
         if not (self.on and strip_shown(state, self.side) and per_pixel) or small:
@@ -388,9 +398,10 @@ class TermStrip:
         for r in (self._band, *self.renderers):
             if on:
                 window.AddRenderer(r)
+                r.SetDraw(True)
             else:
                 window.RemoveRenderer(r)
-        self.on = on
+        self.on = self.band = on
         self._key = None
         self._placed = None
         if on:

@@ -198,7 +198,8 @@ def test_side_bs_strip_per_pixel_under_its_caption_and_the_strip_side_row(open_w
     tiles of side B (its sum tile is ``render --per-pixel``'s picture of B's scene at the
     tile's size and the shared camera, bit for bit, read from pane B's pixels), side A's the
     per-vertex ones; each strip's caption names its side (its text drawn at the first tile's
-    top left). The ``strip_side`` radios keep the strip in one pane: the other's view fills it."""
+    top left). The ``strip_side`` radios keep the strip in one pane: the other keeps the
+    strip's band, empty (its view the same size as the other's)."""
     from explorer.app import model as M
     from explorer.app.effectactions import gouraud_vs_per_pixel
     from explorer.app.termstrip import LABEL_COLOUR
@@ -232,17 +233,21 @@ def test_side_bs_strip_per_pixel_under_its_caption_and_the_strip_side_row(open_w
     x, y, tw, th = strip_b.tile_box("emission")
     corner = img[y + 2 : y + 16, x + 2 : x + 44].reshape(-1, 3)
     assert (np.abs(corner - light).max(axis=1) <= 40).sum() >= 10  # (the text's own pixels)
-    # one pane's strip: the other's view fills its pane
+    # one pane's strip: the other pane's band stays, empty (both views of one size)
+    size = tuple(w.plotter_b.renderer.GetSize())
     for side, a_on, b_on in (("b", False, True), ("a", True, False), ("both", True, True)):
         radio = w.findChild(QtWidgets.QRadioButton, side)
         _tab_with(w, radio)
         radio.click()
         assert w.controller.state.strip_side == side
-        _pixels(w.plotter)
-        _pixels(w.plotter_b)
-        assert (strip_a.on, strip_b.on) == (a_on, b_on)
-        for pl, on in ((w.plotter, a_on), (w.plotter_b, b_on)):
-            assert (pl.renderer.GetViewport()[1] > 0) == on
+        for pl, strip, on in ((w.plotter, strip_a, a_on), (w.plotter_b, strip_b, b_on)):
+            img = _pixels(pl)
+            assert strip.on == on and (strip.report((0, 0, 0)) is not None) == on
+            assert tuple(pl.renderer.GetSize()) == size  # (the band under the view)
+            x, y, tw, th = strip.tile_box("diffuse")
+            band = img[y : y + th, x : x + tw].reshape(-1, 3)
+            empty = (band == np.rint(np.multiply(bg, 255)).astype(int)).all(axis=1).all()
+            assert empty != on, (side, pl is w.plotter)
     w.controller.set_value("compare", False, merge=False)
     assert w.view.strip.on and w.view.strip.report((0, 0, 0))["caption"] == ""
 
