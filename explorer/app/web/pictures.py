@@ -110,11 +110,21 @@ PAGE_JS = """
   const plain = (v) => v === null || ['number', 'string', 'boolean'].includes(typeof v);
   const state = window.trame && window.trame.state;
   if (state && state.flush && state.dirtyKeys) {
+    // trame's own decorators pass a number, a text or a switch as it is (they read files and
+    // objects); one registered since may not: then every change takes trame's path
+    let decorated = false;
+    if (state.registerDecorator) {
+      const register = state.registerDecorator;
+      state.registerDecorator = function (...a) {
+        decorated = true;
+        return register.apply(this, a);
+      };
+    }
     const flush = state.flush;
     state.flush = function (...keys) {
       const client = this.client;
       const dirty = [...this.dirtyKeys];
-      if (keys.length || !dirty.length || client.isBusy() || !client.isConnected()
+      if (decorated || keys.length || !dirty.length || client.isBusy() || !client.isConnected()
           || !dirty.every((k) => plain(this.state[k]))) {
         return flush.apply(this, keys);
       }
