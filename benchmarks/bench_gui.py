@@ -310,7 +310,10 @@ def qt_frames(mesh, repeat: int, view: tuple[int, int] | None = None) -> dict:
             fields[name].field.setValue(value(i))  # action, panel, engine, upload, frame
             finish(win.plotter)
 
+        cpu = time.process_time()
         out[name] = timed(step, repeat)
+        # the window's process CPU per change (its threads: Qt, the engine's, llvmpipe's)
+        out.setdefault("cpu", {})[name] = 1e3 * (time.process_time() - cpu) / (repeat + 2)
     # where a kd change's time goes: the panel's refresh, the engine and upload, the frame
     state = win.controller.state
     out["panel refresh"] = timed(lambda i: win.panel.show_state(state, mesh.n_vertices), repeat)

@@ -16,7 +16,9 @@ to frame, in the same run; and how soon ``phong-explorer web`` is ready.
   own steps for each sample (``report``'s ``picture``: the change to its frame's end, the
   frame's render, read-back and encode, explorer.app.web.pictures), and the browser's decode
   of the last JPEG and PNG (``createImageBitmap`` on the bytes received, in the page); the rest
-  is the two messages (the change to the server, the picture back) and trame's work.
+  is the two messages (the change to the server, the picture back) and trame's work. The CPU
+  a change takes: the server's process and the browser's processes (``/proc``), from the
+  change to its picture loaded, and the window's process per change (bench_gui).
 - The Qt window's figure of the same run: :func:`bench_gui.qt_frames` (a number field set, the
   action, the panel, the engine, the upload and the frame; a private Xvfb), its view resized
   to the page's 800x600.
@@ -232,25 +234,62 @@ def size_view(driver) -> tuple[int, int]:
 REPORT_JS = "const done = arguments[0]; window.trame.trigger('report').then(done);"
 
 
-def latency(driver, url: str, repeat: int) -> dict:
+def cpu_ms(pids) -> float:
+    """The CPU time (ms, user and system) processes ``pids`` have used so far."""
+    total = 0
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            total += int(fields[11]) + int(fields[12])  # utime, stime (clock ticks)
+        except (OSError, IndexError, ValueError):
+            pass  # (a process that ended)
+    return 1e3 * total / os.sysconf("SC_CLK_TCK")
+
+
+def descendants(pid: int) -> list[int]:
+    """``pid`` and every process under it (the browser's: chromedriver's children)."""
+    parent = {}
+    for d in os.listdir("/proc"):
+        if d.isdigit():
+            try:
+                with open(f"/proc/{d}/stat") as f:
+                    parent[int(d)] = int(f.read().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                pass
+    out, todo = [], [pid]
+    while todo:
+        p = todo.pop()
+        out.append(p)
+        todo += [c for c, pp in parent.items() if pp == p]
+    return out
+
+
+def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dict:
     """Median and best ms from a kd slider change to the new picture loaded in the page
-    (``ms``, ``best``), the view's ``size``, the median of each server step (``steps``) and the
-    browser's decode (``decode``: kind -> (ms, bytes))."""
+    (``ms``, ``best``), the view's ``size``, the median of each server step (``steps``), the
+    browser's decode (``decode``: kind -> (ms, bytes)) and the CPU a change takes (``cpu``:
+    median ms of the server's process and of the browser's processes, from the change to its
+    picture loaded)."""
     driver.get(url)
     size = size_view(driver)
     driver.execute_script(KEEP_BLOBS_JS)
     time.sleep(1.0)
     rep = driver.execute_async_script(REPORT_JS)
     x, y = rep["probe"]["px"]
-    ts, steps = [], []
+    ts, steps, cpus = [], [], []
+    browser_pids = descendants(driver.service.process.pid)
     for i in range(repeat + 2):
         step = 300 + 400 * (i % 2)  # kd 0.3 and 0.7
+        c0 = cpu_ms([server_pid] if server_pid else []), cpu_ms(browser_pids)
         got = driver.execute_async_script(SAMPLE_JS, step, x, y)
+        c1 = cpu_ms([server_pid] if server_pid else []), cpu_ms(browser_pids)
         if got == -1:
             raise RuntimeError("the picture did not change within 20 s")
         t, changed, arrived = got
         if i >= 2:
             ts.append(float(t))
+            cpus.append((c1[0] - c0[0], c1[1] - c0[1]))
             st = driver.execute_async_script(REPORT_JS).get("picture") or {}
             if "at" in st:  # (the page's and the server's clocks: one machine's)
                 if st.get("change_at"):
@@ -270,6 +309,7 @@ def latency(driver, url: str, repeat: int) -> dict:
         "size": size,
         "steps": median,
         "decode": decode,
+        "cpu": tuple(statistics.median(c[k] for c in cpus) for k in (0, 1)),
     }
 
 
@@ -399,8 +439,7 @@ def breakdown(web: dict) -> list[str]:
         row("  JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
         row("the picture's way to the page (sent → its Blob made in the page)", st.get("back")),
         row(
-            "its Blob made → the view's <img> loaded (trame's decode in a pooled image, then "
-            "the <img>)",
+            "its Blob made → the view's <img> loaded (the <img> loads the Blob's URL: one decode)",
             st.get("shown"),
         ),
         row(
@@ -445,7 +484,7 @@ def measure(args) -> int:
         with open(path, "w") as log:
             proc = start_server(port, log)
             try:
-                web = latency(driver, wait_url(port, path), args.repeat)
+                web = latency(driver, wait_url(port, path), args.repeat, proc.pid)
             finally:
                 stop(proc)
         path.unlink()
@@ -484,6 +523,12 @@ def measure(args) -> int:
         f"{qt['kd'][0]:.1f} ({qt['kd'][1]:.1f}) |",
         "",
         f"The page takes {web['ms'] - qt['kd'][0]:+.1f} ms ({ratio:.2f}x) the window's time.",
+        "",
+        f"CPU a change takes (median ms, user and system, from the change to its picture "
+        f"loaded; the clock ticks are 10 ms): the page's server process {web['cpu'][0]:.0f}, "
+        f"the browser's processes {web['cpu'][1]:.0f} (the sample's own read of the probe "
+        f"pixel included); the window's process {qt.get('cpu', {}).get('kd', float('nan')):.0f}"
+        f" (mean over its changes).",
         "",
         "Where the page's time goes (medians over the same changes):",
         "",

@@ -13,6 +13,7 @@ from __future__ import annotations
 from explorer.app import panelmodel
 from explorer.app.turntablejob import DEFAULT_FRAMES
 from explorer.app.web import intents as webintents
+from explorer.app.web import pictures
 from explorer.app.web.files import turntable_formats
 from explorer.app.web.panel import items_key
 from explorer.core.controls import STEPS
@@ -527,6 +528,7 @@ def build(app) -> None:
                          raw_attrs=['role="status"'])  # fmt: skip
         with layout.content, v3.VContainer(fluid=True, classes="pa-0 fill-height"):
             with html.Div(classes="d-flex", style="width: 100%; height: 100%"):
+                client.Script(pictures.PAGE_JS)  # (before the views: their streams)
                 with html.Div(style="flex: 1 1 0; height: 100%; position: relative"):
                     view = remote_view(vtkw, app.plotter.render_window, "view")
                 with html.Div(v_if="compare", style="flex: 1 1 0; height: 100%; "

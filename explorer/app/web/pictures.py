@@ -19,6 +19,14 @@ camera drag), the camera drag's animation ticks (a picture only when something a
 last), and the explorer's own frames (:meth:`WebExplorer.send`, through the view's
 ``update()``).
 
+In the page, :data:`PAGE_JS` (a script the page runs before its views are made) takes the
+picture the rest of its way: wslink's client reads the socket's messages as bytes (it asked for
+Blobs and read each back asynchronously, twice a message), and each view's ``<img>`` loads the
+picture's Blob URL itself (trame's view stream loaded it into a pooled image first, then the
+``<img>`` loaded the same URL again: two loads and decodes a picture). The server's socket
+does not deflate (:func:`explorer.app.web.wire.bind`): a JPEG or PNG does not shrink, and
+deflating it cost a worker thread's round trip and the browser's inflate.
+
 VTK, Pillow and numpy's pictures are imported inside the methods (``import explorer`` stays free
 of VTK).
 """
@@ -39,6 +47,102 @@ JPEG_QUALITY = 100
 STILL_S = 0.15
 #: zlib's level for the still picture's PNG (1: the fastest; 800x600 in 5-45 ms here)
 PNG_LEVEL = 1
+
+#: the page's side of the pictures (run by the page before its views are made, again harmless):
+#: (1) each trame view stream hands its picture's Blob URL to the view's ``<img>`` at once (no
+#: pooled image decoding it first: ``decodeImage`` off, and the event's ``image`` is the URL and
+#: size the ``<img>`` takes, which is what trame-vtk's canvas view reads of it), for the streams
+#: made before and after this script; (2) the socket's binary messages arrive as ArrayBuffers,
+#: handed to wslink's client as the Blob-like object it reads (``slice``, ``arrayBuffer``):
+#: the socket is found at its next ``send``; (3) a change of a plain value (a number, text, a
+#: switch) goes to the server at once: trame's ``state.flush`` first awaits its value
+#: decorators, a few microtasks during which Vue re-renders the page's whole template for the
+#: change (about 10 ms: the change's message waited for it); any other value, a busy or
+#: unconnected client, a flush of named keys keep trame's own path. ``window.phongPictures``
+#: counts the pictures handed on (``shown``) and the changes sent at once (``sent``).
+PAGE_JS = """
+(() => {
+  if (window.phongPictures) return;
+  const P = window.phongPictures = {shown: 0, streams: 0, bytes: false, sent: 0};
+  // (1) trame's objects are frozen: each view stream is told not to decode, and a listener of
+  // its own (priority 1: before the canvas view's and the view's first-picture listeners)
+  // gives the event the URL as its image
+  const patched = new WeakSet();
+  const give = (ev) => {
+    if (ev && ev.url && !ev.image) {
+      const [w, h] = ev.metadata.size;
+      ev.image = {src: ev.url, width: w, height: h};
+      P.shown += 1;
+    }
+  };
+  const streams = () => {
+    const client = window.trame && window.trame.client;
+    const is = client && client.getImageStream && client.getImageStream();
+    for (const vs of (is && is.get('viewStreams').viewStreams) || []) {
+      if (patched.has(vs)) continue;
+      patched.add(vs);
+      vs.onImageReady(give, 1);
+      vs.setDecodeImage(false);
+      P.streams += 1;
+    }
+  };
+  streams();
+  class Bytes {
+    constructor(b) { this.b = b; }
+    get size() { return this.b.byteLength; }
+    slice(s, e) { return new Bytes(this.b.slice(s, e)); }
+    arrayBuffer() { return Promise.resolve(this.b); }
+  }
+  const send = WebSocket.prototype.send;
+  WebSocket.prototype.send = function (data) {
+    const on = this.onmessage;
+    if (!this.phongBytes && on) {
+      this.phongBytes = true;
+      this.binaryType = 'arraybuffer';
+      this.onmessage = (e) => {
+        streams();  // (a view made since: patched before its first picture)
+        return on.call(this, e.data instanceof ArrayBuffer ? {data: new Bytes(e.data)} : e);
+      };
+      P.bytes = true;
+    }
+    return send.call(this, data);
+  };
+  const plain = (v) => v === null || ['number', 'string', 'boolean'].includes(typeof v);
+  const state = window.trame && window.trame.state;
+  if (state && state.flush && state.dirtyKeys) {
+    // trame's own decorators pass a number, a text or a switch as it is (they read files and
+    // objects); one registered since may not: then every change takes trame's path
+    let decorated = false;
+    if (state.registerDecorator) {
+      const register = state.registerDecorator;
+      state.registerDecorator = function (...a) {
+        decorated = true;
+        return register.apply(this, a);
+      };
+    }
+    const flush = state.flush;
+    state.flush = function (...keys) {
+      const client = this.client;
+      const dirty = [...this.dirtyKeys];
+      if (decorated || keys.length || !dirty.length || client.isBusy() || !client.isConnected()
+          || !dirty.every((k) => plain(this.state[k]))) {
+        return flush.apply(this, keys);
+      }
+      this.dirtyKeys.clear();
+      P.sent += 1;
+      const change = dirty.map((k) => ({key: k, value: this.state[k]}));
+      return client.getRemote().Trame.updateState(change).then(() => {
+        this.pushFailed = false;
+        return this.dirtyKeys.size ? this.flush() : undefined;
+      }, (err) => {
+        dirty.forEach((k) => this.dirtyKeys.add(k));
+        if (!this.pushFailed) console.log('Could not push state, keys stay dirty', dirty, err);
+        this.pushFailed = true;
+      });
+    };
+  }
+})();
+"""
 
 
 def encode(pixels: np.ndarray, lossless: bool) -> bytes:

@@ -439,6 +439,12 @@ def wire(handler) -> WireHandler:
 
 def bind(ws_server) -> None:
     """trame's ``on_server_bind``: every websocket handler of wslink's server ``ws_server``
-    wired (:func:`wire`)."""
+    wired (:func:`wire`), and its sockets made without permessage-deflate (wslink's
+    ``ws_compress``, on by default: aiohttp deflated every frame above 16 KiB in a worker
+    thread, the page's JPEGs and PNGs that do not shrink, and the browser inflated them again:
+    about 10 ms a picture here; the page's state messages are a few KiB)."""
+    config = getattr(ws_server, "config", None)
+    if isinstance(config, dict):
+        config["ws_compress"] = False
     for handler in getattr(ws_server, "_ws_handlers", ()):
         wire(handler)

@@ -1,0 +1,130 @@
+"""The page's side of the pictures (explorer.app.web.pictures.PAGE_JS, the server's socket):
+in headless Chromium, each picture is loaded once, by the view's own ``<img>``, which shows the
+new frame after a change and the still frame's PNG after the JPEG; a change the page makes goes
+to the server before the page redraws; the server's socket does not deflate."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from test_web import open_page, report, view_pixels, wait
+
+pytestmark = pytest.mark.web
+
+#: kept from the page's start (Chromium runs it in every new document, before the page's own
+#: scripts): every ``src`` given to an image (the view's ``<img>``, trame's pooled images), and
+#: every picture's Blob made, with its first bytes (JPEG ff d8, PNG 89 50)
+WATCH_JS = """
+window.watched = {srcs: [], blobs: []};
+const d = Object.getOwnPropertyDescriptor(HTMLImageElement.prototype, 'src');
+Object.defineProperty(HTMLImageElement.prototype, 'src', {
+  get() { return d.get.call(this); },
+  set(v) { if (String(v).startsWith('blob:')) window.watched.srcs.push(String(v));
+           d.set.call(this, v); },
+  configurable: true,
+});
+const make = URL.createObjectURL;
+URL.createObjectURL = (b) => {
+  const url = make.call(URL, b);
+  const seen = {url, head: null};
+  window.watched.blobs.push(seen);
+  b.slice(0, 2).arrayBuffer().then((a) => { seen.head = Array.from(new Uint8Array(a)); });
+  return url;
+};
+"""
+
+#: the view's ``<img>``: its URL once loaded
+SHOWN_JS = """
+const i = document.querySelector('[aria-label="view"] img');
+return i && i.complete && i.naturalWidth > 0 ? i.src : null;
+"""
+
+
+@pytest.fixture(scope="module")
+def page(server, browser):
+    """The page, opened with :data:`WATCH_JS` running from its start."""
+    browser.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": WATCH_JS})
+    open_page(browser, server.url)
+    return browser
+
+
+def probe_pixel(driver, rep: dict) -> np.ndarray:
+    """The view's pixel under the probe vertex, from the page's screenshot."""
+    shot, box = view_pixels(driver)
+    x, y = rep["probe"]["px"]
+    return shot[round(box["y"] + y), round(box["x"] + x)].astype(int)
+
+
+def still(driver, count: int = 1):
+    """The pictures kept since the last clear once the view shows the last of at least
+    ``count``, a PNG (the still frame), else None."""
+    w = driver.execute_script("return window.watched")
+    heads = [b["head"] for b in w["blobs"]]
+    if len(heads) < count or None in heads or heads[-1] != [0x89, 0x50]:
+        return None
+    return w if driver.execute_script(SHOWN_JS) == w["blobs"][-1]["url"] else None
+
+
+def test_each_picture_is_loaded_once_by_the_views_img_which_shows_it(page):
+    wait("the start's still picture", lambda: still(page))
+    rep = report(page)
+    before = probe_pixel(page, rep)
+    page.execute_script("window.watched.srcs = []; window.watched.blobs = [];")
+    page.execute_script("window.trame.state.set('kd_step', arguments[0]);", 150)
+    # the change's JPEG, then the still frame's PNG, shown by the view
+    w = wait("the still picture shown", lambda: still(page, 2))
+    heads = [b["head"] for b in w["blobs"]]
+    assert heads[0] == [0xFF, 0xD8]  # a JPEG while it changes, then the PNG
+    urls = [b["url"] for b in w["blobs"]]
+    # each picture's URL given to an image once: trame's view stream loaded it into a pooled
+    # image first, then the view's <img> loaded it again (every URL twice)
+    assert sorted(w["srcs"]) == sorted(urls)
+    assert page.execute_script("return window.phongPictures.shown") > 0
+
+    def moved():  # what a person sees: the new frame (kd 0.15 is far from the start's)
+        p = probe_pixel(page, rep)
+        return p.tolist() if np.abs(p - before).max() > 8 else None
+
+    wait("the new colour under the probe", moved)
+
+
+def test_a_change_leaves_for_the_server_before_the_page_redraws(page):
+    """The kd slider's change is on the socket when ``state.set`` returns: trame awaited its
+    value decorators first, and Vue redrew the page's whole template in between."""
+    rep = report(page)
+    old = rep["session"]["scene"]["material"]["diffuse"]
+    sent = page.execute_script(
+        """
+        const ws = WebSocket.prototype, send = ws.send;
+        let n = 0;
+        ws.send = function (d) { n += 1; return send.call(this, d); };
+        window.trame.state.set('kd_step', arguments[0]);
+        ws.send = send;
+        return n;
+        """,
+        850,
+    )
+    assert sent >= 1
+    wait("the server's new kd", lambda: report(page)["session"]["scene"]["material"]["diffuse"]
+         != old)  # fmt: skip
+
+
+def test_the_servers_socket_does_not_deflate(server):
+    """Offered permessage-deflate (as Chromium offers it), the server does not take it: a
+    JPEG or PNG does not shrink, and deflating each picture cost a worker thread's round trip
+    and the browser's inflate."""
+    import websocket
+
+    url = server.base.replace("http://", "ws://", 1) + "ws"
+    ws = websocket.create_connection(
+        url,
+        timeout=30,
+        origin=server.base.rstrip("/"),
+        header=["Sec-WebSocket-Extensions: permessage-deflate; client_max_window_bits"],
+    )
+    try:
+        headers = {k.lower(): v for k, v in (ws.getheaders() or {}).items()}
+    finally:
+        ws.close()
+    assert ws.getstatus() == 101
+    assert "permessage-deflate" not in headers.get("sec-websocket-extensions", "")
