@@ -561,11 +561,14 @@ class SceneView:
         if self._handle_calls is None:
             return
         s = self.state
-        w, h = self.plotter.window_size
+        ox, oy, w, h = self.viewport_pixels()
         shown = self.handle_pixels()
         self.marker_triangles = {}
         rings = []
         for i, (x, y, ahead) in enumerate(shown):
+            # the overlay draws in the renderer's own pixels: the window's, less its viewport's
+            # origin (the main renderer starts above the term strip's band when it is on)
+            x, y = x - ox, y - oy
             tri = edge_marker(x, y, ahead, w, h)
             if tri is not None:
                 self.marker_triangles[i] = tri
@@ -585,11 +588,19 @@ class SceneView:
         triangles = list(self.marker_triangles.values())
         set_lines(self._marker_edges, [np.vstack([t, t[:1]]) for t in triangles])
 
+    def viewport_pixels(self) -> tuple[float, float, float, float]:
+        """The main renderer's area of the window in pixels: its origin (bottom-left, the
+        window's display coordinates) and its width and height (the whole window unless the
+        term strip's band takes the bottom)."""
+        W, H = self.plotter.window_size
+        x0, y0, x1, y1 = self.plotter.renderer.GetViewport()
+        return x0 * W, y0 * H, (x1 - x0) * W, (y1 - y0) * H
+
     def _pixel_radius(self, point, radius: float) -> float:
         """How many pixels a sphere of ``radius`` at ``point`` (VTK's coordinates) spans (its
-        projected radius)."""
+        projected radius; the view angle spans the renderer's height, not the window's)."""
         cam = self.plotter.renderer.GetActiveCamera()
-        _, h = self.plotter.window_size
+        h = self.viewport_pixels()[3]
         if cam.GetParallelProjection():
             return radius * h / (2.0 * cam.GetParallelScale())
         depth = float(np.linalg.norm(np.subtract(point, cam.GetPosition())))

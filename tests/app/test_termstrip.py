@@ -130,3 +130,28 @@ def test_tiles_too_small_for_a_picture_draw_per_vertex():
         assert v.strip.pixel_tiles is None and not v.strip.report((0, 0, 0))["per_pixel"]
     finally:
         v.plotter.close()
+
+
+def test_the_selected_handles_ring_stays_around_its_handle_above_the_strip(view):
+    """The ring is drawn in the main renderer's own pixels: with the strip's band under the
+    view it stays around the handle's sphere (it was drawn the band's height above it)."""
+    import math
+
+    from explorer.app import view as V
+    from explorer.app.model import handle_point
+
+    view.add_handles(lambda i: None, lambda i: None, lambda i: None)
+    view.show_state(set_strip(view.state, True))
+    s = view.state
+    view.before_frame(V.view_camera(view.plotter.camera, s.centre, s.radius))  # (places the ring)
+    img = _picture(view)
+    point = handle_point(s, s.light)
+    x, y = view.world_to_window(point)
+    assert 0 <= x < SIZE[0] and 0 <= y < SIZE[1] * (1 - STRIP_HEIGHT)  # (the test's premise)
+    size = V.HANDLE_RADIUS * V.SELECTED_SCALE * s.radius / view.frame[1]
+    r = view._pixel_radius(view.to_view(point), size) + V.RING_GAP
+    t = np.linspace(0, 2 * math.pi, 72, endpoint=False)
+    xs, ys = (x + r * np.cos(t)).round().astype(int), (y - r * np.sin(t)).round().astype(int)
+    inside = (ys >= 0) & (ys < SIZE[1]) & (xs >= 0) & (xs < SIZE[0])
+    on_ring = img[ys[inside], xs[inside]].min(axis=1) > 235
+    assert inside.mean() > 0.9 and on_ring.mean() > 0.5
