@@ -312,13 +312,161 @@ def summary(results: dict, before: str = "") -> list[str]:
     return lines
 
 
+# -- through the real view layer (--view) --------------------------------------------------------
+
+#: the camera's turn per frame of the --view drag (degrees about the view's up)
+VIEW_TURN = 1.0
+
+
+def view_port(count: int, resolution: int):
+    """The page's explorer (:class:`explorer.app.web.server.WebExplorer`, not served): the
+    view layer both front ends share (:class:`explorer.app.viewport.PlotterView` over an
+    off-screen plotter of 800x600, the window's ``QtInteractor`` being the other), on the
+    explorer's start (``phong-explorer web --resolution RESOLUTION``: the teapot at that
+    tessellation, 56 the issue's 100,578 vertices; gold, the start's light and camera), with
+    ``count`` lights (white point lights added as the panel's "add light" does)."""
+    from explorer.app import model as AM
+    from explorer.app.web.server import WebExplorer
+    from explorer.cli import build_parser
+    from explorer.cli.explorerstart import start_state
+
+    state, mesh = start_state(build_parser().parse_args(["web", "--resolution", str(resolution)]))
+    app = WebExplorer(state, mesh, size=SIZE, name=f"bench-view-{count}", last_session=None)
+    for _ in range(count - len(app.controller.state.scene.lights)):
+        app.controller.act(AM.add_light)
+    return app
+
+
+def view_frames(app, mode: str, repeat: int, warm: int = 3) -> dict:
+    """``repeat`` frames (after ``warm``) of a camera drag in ``mode`` (the shading): each frame
+    the camera turned :data:`VIEW_TURN` degrees, then the render window's ``Render()`` (the
+    view's own frame observers: the camera into the state, the per-pixel picture, side B, the
+    page's frame step) and ``WaitForCompletion()``. Between ``begin_drag`` and ``end_drag``, as
+    a mouse drag does (so the drag fallback to per vertex may act: counted), after ``warm``
+    such frames without a drag (the fallback compares the last picture's time with the last
+    frame's: a camera frame's, not the mode switch's). Returns the median and best wall ms,
+    the median CPU ms of this process, the per-pixel pictures made and whether a frame fell
+    back to per vertex."""
+    vp, c = app.viewport, app.controller
+    c.set_value("shading", mode, merge=False)
+    vp.redraw()
+    cam, window = app.plotter.camera, app.plotter.render_window
+    for _ in range(warm):
+        cam.Azimuth(VIEW_TURN)
+        window.Render()
+    walls, cpus = [], []
+    made, fell = vp.pixels.frames, False
+    vp.begin_drag()
+    try:
+        for i in range(warm + repeat):
+            cam.Azimuth(VIEW_TURN)
+            t, p = time.perf_counter(), time.process_time()
+            window.Render()
+            window.WaitForCompletion()
+            wall, cpu = 1000.0 * (time.perf_counter() - t), 1000.0 * (time.process_time() - p)
+            fell = fell or vp.pixels.fallback
+            if i >= warm:
+                walls.append(wall)
+                cpus.append(cpu)
+    finally:
+        vp.end_drag()
+    return {
+        "ms": (statistics.median(walls), min(walls)),
+        "cpu": statistics.median(cpus),
+        "pictures": vp.pixels.frames - made,
+        "fallback": fell,
+    }
+
+
+def view_run(counts, repeat: int, resolution: int, rounds: int = 2) -> dict:
+    """For each light count: per-vertex and per-pixel drags through the real view, alternated
+    ``rounds`` times (a change in the load falls on both); each mode's best round (by median
+    wall) is kept."""
+    out = {}
+    for n in counts:
+        app = view_port(n, resolution)
+        try:
+            best: dict = {}
+            for _ in range(rounds):
+                for mode in ("per-vertex", "per-pixel"):
+                    r = view_frames(app, mode, repeat)
+                    if mode not in best or r["ms"][0] < best[mode]["ms"][0]:
+                        best[mode] = r
+            view = app.viewport.view
+            out[n] = {
+                "modes": best,
+                "vertices": view.mesh.n_vertices,
+                "lights": len(app.controller.state.scene.lights),
+                "machine": machine(app.plotter),
+            }
+        finally:
+            app.plotter.close()
+    return out
+
+
+def view_table(results: dict, before: str, after: str, repeat: int, resolution: int) -> list[str]:
+    """The --view section's lines (markdown)."""
+    first = next(iter(results.values()))
+    out = [
+        "## Through the real view (`--view`)",
+        "",
+        "A camera drag through the view layer both front ends share (`PlotterView`, the page's "
+        f"off-screen plotter at {SIZE[0]}x{SIZE[1]}; the explorer's start: the "
+        f"{first['vertices']:,}-vertex teapot, gold): per frame the camera turns "
+        f"{VIEW_TURN:g} degree and the render window draws with every observer of the view "
+        "(the camera into the state, the per-pixel picture, the page's frame step), between "
+        "`begin_drag` and `end_drag` as a mouse drag. Per pixel, the picture is a screen quad "
+        "writing the G-buffer's depth (the mesh is not rasterised).",
+        "",
+        *(f"- {line}" for line in first["machine"]),
+        f"- load average before / after: {before} / {after}",
+        "",
+        "| lights | shading | wall ms median (best) | CPU ms | frames/s (wall) "
+        "| per-pixel pictures | fell back to per vertex |",
+        "|---:|---|---:|---:|---:|---:|---|",
+    ]
+    for res in results.values():
+        for mode, r in res["modes"].items():
+            fell = "" if mode != "per-pixel" else ("yes" if r["fallback"] else "no")
+            out.append(
+                f"| {res['lights']} | {mode} | {r['ms'][0]:.1f} ({r['ms'][1]:.1f}) | "
+                f"{r['cpu']:.1f} | {1000.0 / r['ms'][0]:.0f} | {r['pictures']} | {fell} |"
+            )
+    out += [
+        "",
+        f"Each row: the best of two alternated rounds of {repeat} frames (after 3 warm-up "
+        "frames, and 3 in the drag), its median and best wall time per frame and its median "
+        "CPU time (this process, every thread).",
+        "",
+        f"Command: `python benchmarks/bench_perpixel.py --view --repeat {repeat}` "
+        f"(`--view-resolution {resolution}`)",
+    ]
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=15, help="timed frames per row (15)")
     ap.add_argument("--lights", type=int, nargs="+", default=[1, 8])
     ap.add_argument("--no-write", action="store_true", help="do not write the docs page")
+    ap.add_argument(
+        "--view",
+        action="store_true",
+        help="only the camera drag through the real view layer (prints its section)",
+    )
+    ap.add_argument(
+        "--view-resolution",
+        type=int,
+        default=56,
+        help="--view: the start teapot's tessellation (56: the issue's 100,578 vertices)",
+    )
     args = ap.parse_args(argv)
     before = load()
+    if args.view:
+        results = view_run(args.lights, args.repeat, args.view_resolution)
+        lines = view_table(results, before, load(), args.repeat, args.view_resolution)
+        print("\n".join(lines))
+        return 0
     mesh = M.teapot(56)
     results = {n: run(mesh, n, args.repeat) for n in args.lights}
     text = table(mesh, results, before, load(), args.repeat)

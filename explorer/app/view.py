@@ -344,6 +344,9 @@ class SceneView:
         self._glyph = None
         self._glyph_kind = None
         self._switching = False  # set while the drawings change meshes
+        # the full mesh's colours are not seen (the per-pixel picture stands in for the mesh:
+        # explorer.app.pixellayer): a change does not upload them; shown again, they are
+        self.colors_unseen = False
         self.set_mesh(mesh, state)
         self.lobe = LobeInset(plotter, state)
         self.strip = TermStrip(plotter)
@@ -408,7 +411,8 @@ class SceneView:
                 d.set_groups(groups if d.mesh.groups is not None else None)
                 d.set_texture(self.plotter, scene)
                 d.actor.GetProperty().SetOpacity(state.material.opacity)
-            self.active.upload()
+            if not (self.colors_unseen and self.active is self.drawings[0]):
+                self.active.upload()
         self._show_handle(state)
         if getattr(self, "lobe", None) is not None:
             self.lobe.update(state)
