@@ -133,8 +133,9 @@ class PixelLayer:
     screen quad.
 
     frames : per-pixel pictures made; ms : the last one's time (LivePixels' frame, the
-    texture's colour half and, after a new G-buffer, its depth half); last : the last :class:`~explorer.render.live.PixelFrame`,
-    made for ``camera`` and ``size``; rgb : that picture (the G-buffer's pixels covered);
+    texture's colour half and, after a new G-buffer, its depth half); last : the last
+    :class:`~explorer.render.live.PixelFrame`, made for ``camera`` and ``size``; rgb : that
+    picture (the G-buffer's pixels covered);
     vertex_ms : the last frame's time without the per-pixel picture (the per-vertex frame);
     fallback : this drag draws per vertex (the camera moves and per pixel costs too much)
     """
