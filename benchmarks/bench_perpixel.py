@@ -3,6 +3,7 @@
 
     python benchmarks/bench_perpixel.py           # prints the table, writes docs/perpixel_bench.md
     python benchmarks/bench_perpixel.py --repeat 9 --no-write
+    python benchmarks/bench_perpixel.py --view --repeat 15   # the drag through the real view
 
 800x600 off-screen, anti-aliasing and multisampling off, the 100,578-vertex teapot (tessellation
 56) under 1 and 8 white point lights, gold, the local viewer of ``bench_gui`` (its scene), float32
@@ -18,6 +19,11 @@
   specular sum and the frame; per pixel a new G-buffer (the compiled rasteriser and the surface
   points, :func:`explorer.render.perpixel.compiled_hits`) and every light sum of the pixels,
   with where that time goes.
+
+``--view``: a camera drag through the real view layer instead (:func:`view_run`): the page's
+``PlotterView`` (the one the window's is too) at 800x600 on the explorer's start teapot, 1
+and 8 lights, the camera turning 1 degree a frame, per vertex and per pixel alternated; frames/s,
+CPU ms per frame and the load (printed, not written: docs/perpixel_bench.md quotes it).
 
 Each row: median and best (ms) over ``--repeat`` frames after two warm-up ones; the per-pixel
 rows carry the ratio to the per-vertex row of the same change. A frame ends when VTK's

@@ -29,8 +29,9 @@ VTK is about to draw with and the state it makes (the camera is the viewer):
 picture; a new G-buffer (a camera or size change) draws a new depth half.
 
 The drag fallback: while a drag moves the camera and a per-pixel picture costs more than
-:data:`FALLBACK_RATIO` times the per-vertex frame (the same window's frame without it: the
-engine's per-vertex update, the upload and VTK's draw), the mesh is drawn with its per-vertex
+:data:`FALLBACK_RATIO` times the per-vertex frame (the last frame this view drew per vertex:
+the engine's per-vertex update, the upload and VTK's draw of the mesh; none yet, no
+fallback), the mesh is drawn with its per-vertex
 colours (and the level of detail, as any drag draws it) and :attr:`PixelLayer.fallback` says
 so; the release draws per pixel again.
 """
@@ -136,7 +137,7 @@ class PixelLayer:
     texture's colour half and, after a new G-buffer, its depth half); last : the last
     :class:`~explorer.render.live.PixelFrame`, made for ``camera`` and ``size``; rgb : that
     picture (the G-buffer's pixels covered);
-    vertex_ms : the last frame's time without the per-pixel picture (the per-vertex frame);
+    vertex_ms : the time of the last frame drawn per vertex (NaN before one);
     fallback : this drag draws per vertex (the camera moves and per pixel costs too much)
     """
 
@@ -182,11 +183,13 @@ class PixelLayer:
         return made
 
     def after(self) -> None:
-        """The render window's EndEvent: the frame's time less the picture's and the other
-        work set aside is :attr:`vertex_ms`."""
+        """The render window's EndEvent: a frame drawn per vertex (no quad), its time less
+        the other work set aside, is :attr:`vertex_ms` (a per-pixel frame's own time without
+        its picture is no per-vertex frame's: it neither draws nor shades the mesh)."""
         if self._t0 is not None:
             total = 1000.0 * (time.perf_counter() - self._t0)
-            self.vertex_ms = total - self._made_ms - self._aside_ms
+            if not self.shown:
+                self.vertex_ms = total - self._made_ms - self._aside_ms
             self.aside_ms = self._aside_ms
             self._t0 = None
 

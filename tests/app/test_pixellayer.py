@@ -508,3 +508,18 @@ def test_depth_codes_and_the_quad_box():
     mask[1, 2] = mask[2, 5] = True  # rows 1-2 of 4, columns 2-5 of 8
     assert quad_box(mask) == pytest.approx((-0.5, -0.5, 0.5, 0.5))
     assert quad_box(np.zeros((4, 8), bool)) == (0.0, 0.0, 0.0, 0.0)
+
+
+def test_the_per_vertex_frame_time_is_a_per_vertex_frames(torus):
+    """The drag fallback compares a per-pixel picture with the last frame drawn per vertex:
+    per-pixel frames (the quad: no mesh drawn nor shaded) leave that time as it was."""
+    c, layer = torus.controller, torus.pixels
+    torus.plotter.camera.Azimuth(10.0)
+    picture(torus)  # a camera frame per vertex
+    vertex_ms = layer.vertex_ms
+    assert 0.0 < vertex_ms < 1e5
+    c.set_value("shading", "per-pixel")
+    for _ in range(2):
+        torus.plotter.camera.Azimuth(10.0)
+        picture(torus)
+    assert layer.shown and layer.vertex_ms == vertex_ms
