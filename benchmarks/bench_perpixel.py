@@ -36,6 +36,7 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
+import sys
 import time
 from pathlib import Path
 
@@ -312,8 +313,9 @@ def summary(results: dict, before: str = "") -> list[str]:
         )
     lines.append(
         "- The per-pixel picture is drawn here as an image layer (the renderer's background "
-        "texture, one texel per pixel, the mesh not drawn); a front end that draws it through "
-        "the mesh actor also pays the mesh's rasterisation."
+        "texture, one texel per pixel, the mesh not drawn); the front ends draw it as a screen "
+        "quad writing the surface's depth, the mesh not drawn either (the --view section: "
+        "the drag through the real view)."
     )
     return lines
 
@@ -322,6 +324,23 @@ def summary(results: dict, before: str = "") -> list[str]:
 
 #: the camera's turn per frame of the --view drag (degrees about the view's up)
 VIEW_TURN = 1.0
+#: the --view section's heading in docs/perpixel_bench.md (the page's last section: a run
+#: without --view keeps it, a run with --view replaces it)
+VIEW_HEADING = "## Through the real view (`--view`)"
+
+
+def view_section(page: str) -> str:
+    """The --view section of ``page`` (a docs/perpixel_bench.md), from its heading to the end,
+    or ""."""
+    at = page.find(VIEW_HEADING)
+    return "" if at < 0 else page[at:]
+
+
+def with_view_section(page: str, section: str) -> str:
+    """``page`` with its --view section replaced by ``section`` (added when it had none)."""
+    at = page.find(VIEW_HEADING)
+    head = page if at < 0 else page[:at]
+    return head.rstrip("\n") + "\n\n" + section.rstrip("\n") + "\n"
 
 
 def view_port(count: int, resolution: int):
@@ -414,7 +433,7 @@ def view_table(results: dict, before: str, after: str, repeat: int, resolution: 
     """The --view section's lines (markdown)."""
     first = next(iter(results.values()))
     out = [
-        "## Through the real view (`--view`)",
+        VIEW_HEADING,
         "",
         "A camera drag through the view layer both front ends share (`PlotterView`, the page's "
         f"off-screen plotter at {SIZE[0]}x{SIZE[1]}; the explorer's start: the "
@@ -438,6 +457,16 @@ def view_table(results: dict, before: str, after: str, repeat: int, resolution: 
                 f"| {res['lights']} | {mode} | {r['ms'][0]:.1f} ({r['ms'][1]:.1f}) | "
                 f"{r['cpu']:.1f} | {1000.0 / r['ms'][0]:.0f} | {r['pictures']} | {fell} |"
             )
+    out.append("")
+    for res in results.values():
+        v, p = res["modes"]["per-vertex"], res["modes"]["per-pixel"]
+        out.append(
+            f"- {res['lights']} light{'s' if res['lights'] > 1 else ''}: a per-pixel drag "
+            f"frame takes {p['cpu']:.1f} ms of CPU ({1000.0 / p['cpu']:.0f} frames/s of CPU "
+            f"time), {p['cpu'] / v['cpu']:.2f}x the per-vertex frame's CPU and "
+            f"{p['ms'][0] / v['ms'][0]:.2f}x its wall time; {1000.0 / p['ms'][0]:.0f} frames/s "
+            f"of this run's wall time (target: 20 or more, idle)."
+        )
     out += [
         "",
         f"Each row: the best of two alternated rounds of {repeat} frames (after 3 warm-up "
@@ -472,11 +501,15 @@ def main(argv=None) -> int:
         results = view_run(args.lights, args.repeat, args.view_resolution)
         lines = view_table(results, before, load(), args.repeat, args.view_resolution)
         print("\n".join(lines))
+        if not args.no_write:
+            DOCS.write_text(with_view_section(DOCS.read_text(), "\n".join(lines)))
+            print(f"wrote {DOCS}", file=sys.stderr)
         return 0
     mesh = M.teapot(56)
     results = {n: run(mesh, n, args.repeat) for n in args.lights}
     text = table(mesh, results, before, load(), args.repeat)
-    publish(text, DOCS, write=not args.no_write)
+    kept = view_section(DOCS.read_text()) if DOCS.exists() else ""
+    publish(with_view_section(text, kept) if kept else text, DOCS, write=not args.no_write)
     return 0
 
 
