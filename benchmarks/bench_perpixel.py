@@ -324,23 +324,28 @@ def summary(results: dict, before: str = "") -> list[str]:
 
 #: the camera's turn per frame of the --view drag (degrees about the view's up)
 VIEW_TURN = 1.0
-#: the --view section's heading in docs/perpixel_bench.md (the page's last section: a run
-#: without --view keeps it, a run with --view replaces it)
+#: the --view section's heading in docs/perpixel_bench.md: it and the sections after it (the
+#: page's slider, ``bench_web.py --per-pixel``'s figures) end the page; a run without --view
+#: keeps them, a run with --view replaces its own section only
 VIEW_HEADING = "## Through the real view (`--view`)"
 
 
 def view_section(page: str) -> str:
-    """The --view section of ``page`` (a docs/perpixel_bench.md), from its heading to the end,
-    or ""."""
+    """The --view section of ``page`` (a docs/perpixel_bench.md) and the sections after it, to
+    the end, or ""."""
     at = page.find(VIEW_HEADING)
     return "" if at < 0 else page[at:]
 
 
 def with_view_section(page: str, section: str) -> str:
-    """``page`` with its --view section replaced by ``section`` (added when it had none)."""
+    """``page`` with its --view section (to the next ``## `` heading) replaced by ``section``
+    (added at the end when it had none)."""
     at = page.find(VIEW_HEADING)
-    head = page if at < 0 else page[:at]
-    return head.rstrip("\n") + "\n\n" + section.rstrip("\n") + "\n"
+    if at < 0:
+        return page.rstrip("\n") + "\n\n" + section.rstrip("\n") + "\n"
+    end = page.find("\n## ", at + len(VIEW_HEADING))
+    tail = "" if end < 0 else "\n" + page[end + 1 :]
+    return page[:at] + section.rstrip("\n") + "\n" + tail
 
 
 def view_port(count: int, resolution: int):
