@@ -151,6 +151,7 @@ class PixelLayer:
         self.shown = False
         self.vertex_ms = float("nan")
         self.fallback = False
+        self._decided = False  # this drag's fallback is decided
         self._t0: float | None = None
         self._made_ms = 0.0
         self._aside_ms = 0.0
@@ -208,9 +209,11 @@ class PixelLayer:
         mesh drawn per vertex. Returns whether a picture was made."""
         camera = view_camera(self.plotter.camera, state.centre, state.radius)
         if self.view.dragging == 0:
-            self.fallback = False
-        elif not self.fallback and self._key is not None and camera != self._key[2]:
-            self.fallback = self.too_slow()  # (decided once per drag, when the camera moves)
+            self.fallback = self._decided = False
+        elif not self._decided and self._key is not None and camera != self._key[2]:
+            # decided once per drag, when the camera first moves, on the pictures made before
+            # it (a picture of the drag that happens to take longer does not switch mid-drag)
+            self.fallback, self._decided = self.too_slow(), True
         if not self.wanted(state) or self.fallback:
             self._show(False)
             return False

@@ -523,3 +523,22 @@ def test_the_per_vertex_frame_time_is_a_per_vertex_frames(torus):
         torus.plotter.camera.Azimuth(10.0)
         picture(torus)
     assert layer.shown and layer.vertex_ms == vertex_ms
+
+
+def test_the_drag_fallback_is_decided_once_when_the_camera_first_moves(torus):
+    """A drag that starts per pixel stays per pixel though a later picture of it costs more
+    than FALLBACK_RATIO per-vertex frames (under load one picture may): the decision is the
+    drag's first camera frame's, on the pictures made before it."""
+    c, layer = torus.controller, torus.pixels
+    c.set_value("shading", "per-pixel")
+    picture(torus)
+    torus.begin_drag()
+    layer.ms, layer.vertex_ms = 10.0, 10.0
+    torus.plotter.camera.Azimuth(10.0)
+    picture(torus)  # the decision: per pixel
+    assert layer.shown and not layer.fallback
+    layer.ms, layer.vertex_ms = 50.0, 10.0  # a slow picture in the drag
+    torus.plotter.camera.Azimuth(10.0)
+    picture(torus)
+    assert layer.shown and not layer.fallback  # still per pixel
+    torus.end_drag()
