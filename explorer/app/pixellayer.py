@@ -283,10 +283,12 @@ class PixelLayer:
         d = (g.hits.positions - np.asarray(cam.position)) @ np.asarray(cam.direction) / scale
         codes, first, step = depth_codes(d)
         w, h = g.size
-        picture = np.full((h * w, 3), 255, np.uint8)
-        picture[g.pixels] = codes
-        _, width = self._texels_for()
-        self._texels[:, width:] = self._in_window(picture.reshape(h, w, 3), fill=255)[::-1]
+        rh, rw = self._texels_for()
+        half = self._texels[:, rw:]  # (VTK's rows: bottom up)
+        half[:] = 255
+        ox, oy = (0, 0) if (w, h) == (rw, rh) else self.plotter.renderer.GetOrigin()
+        rows, cols = np.divmod(g.pixels, w)
+        half[h - 1 - rows + int(oy), cols + int(ox)] = codes  # (the renderer's part)
         self._image.GetPointData().GetScalars().Modified()
         self._image.Modified()
         self._depth_of, self._depth = g, (first, step)
