@@ -461,7 +461,11 @@ class SceneView:
             d.show(visible and (i == 1) == self.lod_active)
 
     def displayed_colors(self) -> np.ndarray:
-        """(n, 3) uint8 colours VTK draws for the full mesh (a copy)."""
+        """(n, 3) uint8 colours VTK draws for the full mesh (a copy); while the per-pixel
+        picture stands in for the mesh (:attr:`colors_unseen`), uploaded first (a change did
+        not upload them)."""
+        if self.colors_unseen:
+            self.drawings[0].upload()
         return np.array(self.drawings[0].rgb)
 
     @property

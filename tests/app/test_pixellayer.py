@@ -542,3 +542,21 @@ def test_the_drag_fallback_is_decided_once_when_the_camera_first_moves(torus):
     picture(torus)
     assert layer.shown and not layer.fallback  # still per pixel
     torus.end_drag()
+
+
+def test_a_minus_b_per_vertex_under_a_per_pixel_side_a_is_of_the_current_colours(compare):
+    """Side A per pixel, side B per vertex, A − B on: B's mesh shows the per-vertex A − B of
+    A's current colours (A's are not uploaded while its per-pixel picture stands in: they were
+    those of the start)."""
+    c, b = compare.controller, compare.side_b
+    c.set_value("shading", "per-pixel")
+    c.act(lambda s: s.replace(compare_shading="per-vertex"))
+    c.act(M.set_compare, True)
+    c.act(M.set_compare_difference, True)
+    c.set_value("kd", 0.1, merge=False)
+    picture(compare)
+    a = to_bytes(compare.view.drawings[0].colors()).astype(int)
+    other = to_bytes(b.view.drawings[0].colors()).astype(int)
+    want = heat_map(np.abs(a - other).max(axis=1)[None, :], vmax=VMAX)[0]
+    assert np.abs(a - other).max() > 10  # (B's material differs from A's)
+    assert np.array_equal(b.view.drawings[0].rgb, want)
