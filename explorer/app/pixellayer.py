@@ -294,14 +294,14 @@ class PixelLayer:
         self._depth_of, self._depth = g, (first, step)
         self._box = quad_box(g.hits.mask)
 
-    def _in_window(self, rgb: np.ndarray, fill: int = 0) -> np.ndarray:
+    def _in_window(self, rgb: np.ndarray) -> np.ndarray:
         """``rgb`` of the main renderer's part of the window placed in the whole window's
-        picture (``fill`` elsewhere), as it is when the renderer is the whole window."""
+        picture (black elsewhere), as it is when the renderer is the whole window."""
         rw, rh = (int(v) for v in self.plotter.window_size)
         if rgb.shape[:2] == (rh, rw):
             return rgb
         ox, oy = (int(v) for v in self.plotter.renderer.GetOrigin())
-        full = np.full((rh, rw, 3), fill, np.uint8)
+        full = np.zeros((rh, rw, 3), np.uint8)
         full[rh - oy - rgb.shape[0] : rh - oy, ox : ox + rgb.shape[1]] = rgb
         return full
 
