@@ -3,6 +3,7 @@
 
     python benchmarks/bench_perpixel.py           # prints the table, writes docs/perpixel_bench.md
     python benchmarks/bench_perpixel.py --repeat 9 --no-write
+    python benchmarks/bench_perpixel.py --view --repeat 15   # the drag through the real view
 
 800x600 off-screen, anti-aliasing and multisampling off, the 100,578-vertex teapot (tessellation
 56) under 1 and 8 white point lights, gold, the local viewer of ``bench_gui`` (its scene), float32
@@ -19,6 +20,11 @@
   points, :func:`explorer.render.perpixel.compiled_hits`) and every light sum of the pixels,
   with where that time goes.
 
+``--view``: a camera drag through the real view layer instead (:func:`view_run`): the page's
+``PlotterView`` (the one the window's is too) at 800x600 on the explorer's start teapot, 1
+and 8 lights, the camera turning 1 degree a frame, per vertex and per pixel alternated; frames/s,
+CPU ms per frame and the load (printed, not written: docs/perpixel_bench.md quotes it).
+
 Each row: median and best (ms) over ``--repeat`` frames after two warm-up ones; the per-pixel
 rows carry the ratio to the per-vertex row of the same change. A frame ends when VTK's
 ``Render()`` returns and ``WaitForCompletion()`` says the GPU (Mesa llvmpipe here) is done. Wall
@@ -30,6 +36,7 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
+import sys
 import time
 from pathlib import Path
 
@@ -306,10 +313,175 @@ def summary(results: dict, before: str = "") -> list[str]:
         )
     lines.append(
         "- The per-pixel picture is drawn here as an image layer (the renderer's background "
-        "texture, one texel per pixel, the mesh not drawn); a front end that draws it through "
-        "the mesh actor also pays the mesh's rasterisation."
+        "texture, one texel per pixel, the mesh not drawn); the front ends draw it as a screen "
+        "quad writing the surface's depth, the mesh not drawn either (the --view section: "
+        "the drag through the real view)."
     )
     return lines
+
+
+# -- through the real view layer (--view) --------------------------------------------------------
+
+#: the camera's turn per frame of the --view drag (degrees about the view's up)
+VIEW_TURN = 1.0
+#: the --view section's heading in docs/perpixel_bench.md: it and the sections after it (the
+#: page's slider, ``bench_web.py --per-pixel``'s figures) end the page; a run without --view
+#: keeps them, a run with --view replaces its own section only
+VIEW_HEADING = "## Through the real view (`--view`)"
+
+
+def view_section(page: str) -> str:
+    """The --view section of ``page`` (a docs/perpixel_bench.md) and the sections after it, to
+    the end, or ""."""
+    at = page.find(VIEW_HEADING)
+    return "" if at < 0 else page[at:]
+
+
+def with_view_section(page: str, section: str) -> str:
+    """``page`` with its --view section (to the next ``## `` heading) replaced by ``section``
+    (added at the end when it had none)."""
+    at = page.find(VIEW_HEADING)
+    if at < 0:
+        return page.rstrip("\n") + "\n\n" + section.rstrip("\n") + "\n"
+    end = page.find("\n## ", at + len(VIEW_HEADING))
+    tail = "" if end < 0 else "\n" + page[end + 1 :]
+    return page[:at] + section.rstrip("\n") + "\n" + tail
+
+
+def view_port(count: int, resolution: int):
+    """The page's explorer (:class:`explorer.app.web.server.WebExplorer`, not served): the
+    view layer both front ends share (:class:`explorer.app.viewport.PlotterView` over an
+    off-screen plotter of 800x600, the window's ``QtInteractor`` being the other), on the
+    explorer's start (``phong-explorer web --resolution RESOLUTION``: the teapot at that
+    tessellation, 56 the issue's 100,578 vertices; gold, the start's light and camera), with
+    ``count`` lights (white point lights added as the panel's "add light" does)."""
+    from explorer.app import model as AM
+    from explorer.app.web.server import WebExplorer
+    from explorer.cli import build_parser
+    from explorer.cli.explorerstart import start_state
+
+    state, mesh = start_state(build_parser().parse_args(["web", "--resolution", str(resolution)]))
+    app = WebExplorer(state, mesh, size=SIZE, name=f"bench-view-{count}", last_session=None)
+    for _ in range(count - len(app.controller.state.scene.lights)):
+        app.controller.act(AM.add_light)
+    return app
+
+
+def view_frames(app, mode: str, repeat: int, warm: int = 3) -> dict:
+    """``repeat`` frames (after ``warm``) of a camera drag in ``mode`` (the shading): each frame
+    the camera turned :data:`VIEW_TURN` degrees, then the render window's ``Render()`` (the
+    view's own frame observers: the camera into the state, the per-pixel picture, side B, the
+    page's frame step) and ``WaitForCompletion()``. Between ``begin_drag`` and ``end_drag``, as
+    a mouse drag does (so the drag fallback to per vertex may act: counted), after ``warm``
+    such frames without a drag (the fallback compares the last picture's time with the last
+    frame's: a camera frame's, not the mode switch's). Returns the median and best wall ms,
+    the median CPU ms of this process, the per-pixel pictures made and whether a frame fell
+    back to per vertex."""
+    vp, c = app.viewport, app.controller
+    c.set_value("shading", mode, merge=False)
+    vp.redraw()
+    cam, window = app.plotter.camera, app.plotter.render_window
+    for _ in range(warm):
+        cam.Azimuth(VIEW_TURN)
+        window.Render()
+    walls, cpus = [], []
+    made, fell = vp.pixels.frames, False
+    vp.begin_drag()
+    try:
+        for i in range(warm + repeat):
+            cam.Azimuth(VIEW_TURN)
+            t, p = time.perf_counter(), time.process_time()
+            window.Render()
+            window.WaitForCompletion()
+            wall, cpu = 1000.0 * (time.perf_counter() - t), 1000.0 * (time.process_time() - p)
+            fell = fell or vp.pixels.fallback
+            if i >= warm:
+                walls.append(wall)
+                cpus.append(cpu)
+    finally:
+        vp.end_drag()
+    return {
+        "ms": (statistics.median(walls), min(walls)),
+        "cpu": statistics.median(cpus),
+        "pictures": vp.pixels.frames - made,
+        "fallback": fell,
+    }
+
+
+def view_run(counts, repeat: int, resolution: int, rounds: int = 2) -> dict:
+    """For each light count: per-vertex and per-pixel drags through the real view, alternated
+    ``rounds`` times (a change in the load falls on both); each mode's best round (by median
+    wall) is kept."""
+    out = {}
+    for n in counts:
+        app = view_port(n, resolution)
+        try:
+            best: dict = {}
+            for _ in range(rounds):
+                for mode in ("per-vertex", "per-pixel"):
+                    r = view_frames(app, mode, repeat)
+                    if mode not in best or r["ms"][0] < best[mode]["ms"][0]:
+                        best[mode] = r
+            view = app.viewport.view
+            out[n] = {
+                "modes": best,
+                "vertices": view.mesh.n_vertices,
+                "lights": len(app.controller.state.scene.lights),
+                "machine": machine(app.plotter),
+            }
+        finally:
+            app.plotter.close()
+    return out
+
+
+def view_table(results: dict, before: str, after: str, repeat: int, resolution: int) -> list[str]:
+    """The --view section's lines (markdown)."""
+    first = next(iter(results.values()))
+    out = [
+        VIEW_HEADING,
+        "",
+        "A camera drag through the view layer both front ends share (`PlotterView`, the page's "
+        f"off-screen plotter at {SIZE[0]}x{SIZE[1]}; the explorer's start: the "
+        f"{first['vertices']:,}-vertex teapot, gold): per frame the camera turns "
+        f"{VIEW_TURN:g} degree and the render window draws with every observer of the view "
+        "(the camera into the state, the per-pixel picture, the page's frame step), between "
+        "`begin_drag` and `end_drag` as a mouse drag. Per pixel, the picture is a screen quad "
+        "writing the G-buffer's depth (the mesh is not rasterised).",
+        "",
+        *(f"- {line}" for line in first["machine"]),
+        f"- load average before / after: {before} / {after}",
+        "",
+        "| lights | shading | wall ms median (best) | CPU ms | frames/s (wall) "
+        "| per-pixel pictures | fell back to per vertex |",
+        "|---:|---|---:|---:|---:|---:|---|",
+    ]
+    for res in results.values():
+        for mode, r in res["modes"].items():
+            fell = "" if mode != "per-pixel" else ("yes" if r["fallback"] else "no")
+            out.append(
+                f"| {res['lights']} | {mode} | {r['ms'][0]:.1f} ({r['ms'][1]:.1f}) | "
+                f"{r['cpu']:.1f} | {1000.0 / r['ms'][0]:.0f} | {r['pictures']} | {fell} |"
+            )
+    out.append("")
+    for res in results.values():
+        v, p = res["modes"]["per-vertex"], res["modes"]["per-pixel"]
+        out.append(
+            f"- {res['lights']} light{'s' if res['lights'] > 1 else ''}: a per-pixel drag "
+            f"frame takes {p['cpu']:.1f} ms of CPU ({1000.0 / p['cpu']:.0f} frames/s of CPU "
+            f"time), {p['cpu'] / v['cpu']:.2f}x the per-vertex frame's CPU and "
+            f"{p['ms'][0] / v['ms'][0]:.2f}x its wall time; {1000.0 / p['ms'][0]:.0f} frames/s "
+            f"of this run's wall time (target: 20 or more, idle)."
+        )
+    out += [
+        "",
+        f"Each row: the best of two alternated rounds of {repeat} frames (after 3 warm-up "
+        "frames, and 3 in the drag), its median and best wall time per frame and its median "
+        "CPU time (this process, every thread).",
+        "",
+        f"Command: `python benchmarks/bench_perpixel.py --view --repeat {repeat}` "
+        f"(`--view-resolution {resolution}`)",
+    ]
+    return out
 
 
 def main(argv=None) -> int:
@@ -317,12 +489,32 @@ def main(argv=None) -> int:
     ap.add_argument("--repeat", type=int, default=15, help="timed frames per row (15)")
     ap.add_argument("--lights", type=int, nargs="+", default=[1, 8])
     ap.add_argument("--no-write", action="store_true", help="do not write the docs page")
+    ap.add_argument(
+        "--view",
+        action="store_true",
+        help="only the camera drag through the real view layer (prints its section)",
+    )
+    ap.add_argument(
+        "--view-resolution",
+        type=int,
+        default=56,
+        help="--view: the start teapot's tessellation (56: the issue's 100,578 vertices)",
+    )
     args = ap.parse_args(argv)
     before = load()
+    if args.view:
+        results = view_run(args.lights, args.repeat, args.view_resolution)
+        lines = view_table(results, before, load(), args.repeat, args.view_resolution)
+        print("\n".join(lines))
+        if not args.no_write:
+            DOCS.write_text(with_view_section(DOCS.read_text(), "\n".join(lines)))
+            print(f"wrote {DOCS}", file=sys.stderr)
+        return 0
     mesh = M.teapot(56)
     results = {n: run(mesh, n, args.repeat) for n in args.lights}
     text = table(mesh, results, before, load(), args.repeat)
-    publish(text, DOCS, write=not args.no_write)
+    kept = view_section(DOCS.read_text()) if DOCS.exists() else ""
+    publish(with_view_section(text, kept) if kept else text, DOCS, write=not args.no_write)
     return 0
 
 

@@ -4,6 +4,7 @@ to frame, in the same run; and how soon ``phong-explorer web`` is ready.
     python benchmarks/bench_web.py                    # prints the table, writes docs/web_bench.md
     python benchmarks/bench_web.py --repeat 15 --no-write
     python benchmarks/bench_web.py --burners 2 --no-write   # under two CPU burners
+    python benchmarks/bench_web.py --per-pixel --repeat 15   # kd change per vertex vs per pixel
 
 - Latency: ``phong-explorer web --mesh teapot --resolution 56`` (100,578 vertices, one point
   light) in its own process, its view sized to 800x600 in headless Chromium (Debian's, driven
@@ -138,13 +139,15 @@ def browser():
     return new_browser(Path(os.environ.get("TMPDIR", "/tmp")))
 
 
-def start_server(port: int, log) -> subprocess.Popen:
+def start_server(port: int, log, *extra: str) -> subprocess.Popen:
+    """``phong-explorer web`` on the 100,578-vertex teapot (``extra``: more options, e.g.
+    ``--per-pixel``)."""
     # the server keeps its session when it stops (web --last): not over the user's own
     last = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-last-session.yaml"
     env = dict(os.environ, PYTHONPATH=str(ROOT), PHONG_EXPLORER_LAST_SESSION=str(last))
     return subprocess.Popen(
         [sys.executable, "-m", "explorer.cli", "web", "--mesh", "teapot", "--resolution", "56",
-         "--port", str(port)],
+         "--port", str(port), *extra],
         stdout=log, stderr=subprocess.STDOUT, env=env,
     )  # fmt: skip
 
@@ -456,6 +459,48 @@ def breakdown(web: dict) -> list[str]:
     return lines + ["", "Picture sizes: " + "; ".join(x for x in size if x) + "."]
 
 
+def per_pixel_lines(repeat: int, rounds: int = 2) -> list[str]:
+    """The page's kd change to its new picture with the explorer started per vertex and
+    started ``--per-pixel`` (issue 39: per pixel within 1.3x per vertex), each a server of its
+    own, alternated ``rounds`` times (a change in the load falls on both); each shading's best
+    round (by median) kept. Returns the lines (markdown)."""
+    driver = browser()
+    before = load()
+    best: dict = {}
+    try:
+        for _ in range(rounds):
+            for name, extra in (("per-vertex", ()), ("per-pixel", ("--per-pixel",))):
+                port = free_port()
+                path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
+                with open(path, "w") as log:
+                    proc = start_server(port, log, *extra)
+                    try:
+                        got = latency(driver, wait_url(port, path), repeat)
+                    finally:
+                        stop(proc)
+                path.unlink()
+                if name not in best or got["ms"] < best[name]["ms"]:
+                    best[name] = got
+    finally:
+        driver.quit()
+    v, p = best["per-vertex"], best["per-pixel"]
+    w, h = p["size"]
+    return [
+        f"The page's kd change to its new picture, 100,578-vertex teapot, 1 point light, view "
+        f"{w}x{h}: median (best) ms over {repeat} changes, the best of {rounds} alternated "
+        f"rounds (load average before / after: {before} / {load()}):",
+        "",
+        "| shading | ms |",
+        "|---|---:|",
+        f"| per vertex | {v['ms']:.1f} ({v['best']:.1f}) |",
+        f"| per pixel | {p['ms']:.1f} ({p['best']:.1f}) |",
+        "",
+        f"Per pixel / per vertex: {p['ms'] / v['ms']:.2f}x (issue 39's target: 1.3x or less).",
+        "",
+        f"Command: `python benchmarks/bench_web.py --per-pixel --repeat {repeat}`",
+    ]
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeat", type=int, default=21, help="timed samples per row (21)")
@@ -464,9 +509,17 @@ def main(argv=None) -> int:
         "--burners", type=int, default=0, help="processes spinning on the CPU through the run (0)"
     )
     ap.add_argument("--no-write", action="store_true", help="do not write docs/web_bench.md")
+    ap.add_argument(
+        "--per-pixel",
+        action="store_true",
+        help="only the page's kd change per vertex and per pixel (prints its lines)",
+    )
     args = ap.parse_args(argv)
     spinning = burners(args.burners)
     try:
+        if args.per_pixel:
+            print("\n".join(per_pixel_lines(args.repeat)))
+            return 0
         return measure(args)
     finally:
         for p in spinning:

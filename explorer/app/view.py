@@ -345,6 +345,9 @@ class SceneView:
         self._glyph = None
         self._glyph_kind = None
         self._switching = False  # set while the drawings change meshes
+        # the full mesh's colours are not seen (the per-pixel picture stands in for the mesh:
+        # explorer.app.pixellayer): a change does not upload them; shown again, they are
+        self.colors_unseen = False
         self.set_mesh(mesh, state)
         self.lobe = LobeInset(plotter, state)
         self.strip = TermStrip(plotter, side)
@@ -409,7 +412,8 @@ class SceneView:
                 d.set_groups(groups if d.mesh.groups is not None else None)
                 d.set_texture(self.plotter, scene)
                 d.actor.GetProperty().SetOpacity(state.material.opacity)
-            self.active.upload()
+            if not (self.colors_unseen and self.active is self.drawings[0]):
+                self.active.upload()
         self._show_handle(state)
         if getattr(self, "lobe", None) is not None:
             self.lobe.update(state)
@@ -458,7 +462,11 @@ class SceneView:
             d.show(visible and (i == 1) == self.lod_active)
 
     def displayed_colors(self) -> np.ndarray:
-        """(n, 3) uint8 colours VTK draws for the full mesh (a copy)."""
+        """(n, 3) uint8 colours VTK draws for the full mesh (a copy); while the per-pixel
+        picture stands in for the mesh (:attr:`colors_unseen`), uploaded first (a change did
+        not upload them)."""
+        if self.colors_unseen:
+            self.drawings[0].upload()
         return np.array(self.drawings[0].rgb)
 
     @property

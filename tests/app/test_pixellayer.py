@@ -17,7 +17,7 @@ from explorer.app import start as A
 from explorer.app.controller import Controller
 from explorer.app.controller.ports import Ports
 from explorer.app.difference import VMAX
-from explorer.app.pixellayer import fill_edges
+from explorer.app.pixellayer import DEPTH_NONE, depth_codes, quad_box
 from explorer.app.sides import SideB
 from explorer.app.view import HANDLE_RADIUS, RING_GAP, SELECTED_SCALE, handle_point
 from explorer.app.viewport import PlotterView
@@ -26,6 +26,7 @@ from explorer.cli.explorerstart import start
 from explorer.render.live import picture as render_per_pixel
 from explorer.render.perpixel import reference
 from explorer.render.vtk import plotter
+from explorer.shading.display import to_bytes
 
 SIZE = (320, 240)
 BACKGROUND = (0.1, 0.1, 0.1)
@@ -153,16 +154,6 @@ def test_a_material_change_makes_no_gbuffer_nor_light_pass_and_a_camera_change_o
     torus.plotter.render_window.Render()
     assert live.gbuffers == made + 1
     assert against_reference(torus)[0] <= 1  # the new camera's picture
-
-
-def test_fill_edges_takes_a_covered_neighbours_colour():
-    rgb = np.zeros((3, 4, 3), np.uint8)
-    mask = np.zeros((3, 4), bool)
-    rgb[1, 1] = (9, 8, 7)
-    mask[1, 1] = True
-    out = fill_edges(rgb.copy(), mask)
-    assert (out[0:3, 0:3] == (9, 8, 7)).all()  # the 8 neighbours
-    assert (out[:, 3] == 0).all()  # two pixels away: left as it was
 
 
 class Pane:
@@ -447,3 +438,125 @@ def test_a_minus_b_per_pixel_is_the_difference_of_the_two_per_pixel_pictures(tmp
         view.plotter.close()
         for pl in pane.plotters:
             pl.close()
+
+
+def _handle_on_the_ray_of(view, row: int, col: int, along: float) -> None:
+    """Move the selected light so that its handle lies on the ray of pixel (row, col),
+    ``along`` mesh radii past the surface point the pixel shows (negative: before it)."""
+    s = view.controller.state
+    g, _ = view.pixels.live.gbuffer(view.pixels.camera, view.pixels.size)
+    hit = g.hits.positions[int(np.searchsorted(g.pixels, row * SIZE[0] + col))]
+    ray = hit - np.asarray(s.camera.position)
+    point = hit + along * s.radius * ray / np.linalg.norm(ray)
+    view.controller.act(M.place_light, *M.angles_of(point - np.asarray(s.centre)))
+
+
+def test_the_light_handle_passes_in_front_of_and_behind_the_per_pixel_surface(torus):
+    """The per-pixel picture is drawn by a screen quad that writes each pixel's depth from
+    the G-buffer (the mesh is not rasterised): a handle before the surface is drawn over it,
+    the same handle past the surface on the same pixel's ray is hidden by it, near the
+    surface and farther (no one depth for the whole quad passes)."""
+    from scipy.ndimage import distance_transform_edt
+
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    picture(torus)
+    assert torus.view.drawings[0].actor.GetMapper() is not torus.pixels._mapper  # the quad's
+    inside = distance_transform_edt(torus.pixels.last.mask)
+    row, col = np.unravel_index(int(np.argmax(inside)), inside.shape)
+    assert inside[row, col] > 8  # (a pixel deep inside the surface: the handle's centre)
+    for along in (-0.5, -0.15, 0.15, 0.5):
+        _handle_on_the_ray_of(torus, row, col, along)
+        img = picture(torus)
+        x, y, ahead = torus.view.handle_pixels()[c.state.light]
+        assert ahead and abs(x - col) < 1.5 and abs((SIZE[1] - 1 - y) - row) < 1.5
+        want = torus.pixels.rgb[row - 1 : row + 2, col - 1 : col + 2].astype(int)
+        off = np.abs(img[row - 1 : row + 2, col - 1 : col + 2] - want).max()
+        if along < 0:
+            assert off > 40, along  # the handle in front: drawn over the surface
+        else:
+            assert off <= 1, along  # the handle behind: the surface's own pixels
+
+
+def test_a_camera_change_per_pixel_runs_no_per_vertex_pass_and_per_vertex_is_current_after(torus):
+    """While the per-pixel picture stands in for the mesh, a camera change (the local viewer
+    moves: every specular sum changes) computes no per-vertex colours (the full mesh's shader
+    runs no pass); back per vertex, the mesh's colours are those of the new camera."""
+    c = torus.controller
+    c.set_value("shading", "per-pixel")
+    picture(torus)
+    drawing = torus.view.drawings[0]
+    passes = sum(drawing.shader.stats.values())
+    torus.plotter.camera.Azimuth(40.0)
+    picture(torus)
+    assert sum(drawing.shader.stats.values()) == passes  # no per-vertex work
+    c.set_value("shading", "per-vertex")
+    picture(torus)
+    assert np.array_equal(drawing.rgb, to_bytes(drawing.colors()))  # the new camera's colours
+
+
+def test_depth_codes_and_the_quad_box():
+    """The depth half's 24-bit codes decode (as the quad's fragment shader does) to the
+    distances within one step; the quad covers exactly the surface pixels' bounding box."""
+    d = np.array([3.0, 3.25, 4.0, 3.0000001])
+    codes, first, step = depth_codes(d)
+    c = codes.astype(np.int64)
+    decoded = first + step * (c[:, 0] * 65536 + c[:, 1] * 256 + c[:, 2])
+    assert np.abs(decoded - d).max() <= step and step == pytest.approx(1.0 / (DEPTH_NONE - 1))
+    assert (c[:, 0] * 65536 + c[:, 1] * 256 + c[:, 2]).max() == DEPTH_NONE - 1
+    mask = np.zeros((4, 8), bool)
+    mask[1, 2] = mask[2, 5] = True  # rows 1-2 of 4, columns 2-5 of 8
+    assert quad_box(mask) == pytest.approx((-0.5, -0.5, 0.5, 0.5))
+    assert quad_box(np.zeros((4, 8), bool)) == (0.0, 0.0, 0.0, 0.0)
+
+
+def test_the_per_vertex_frame_time_is_a_per_vertex_frames(torus):
+    """The drag fallback compares a per-pixel picture with the last frame drawn per vertex:
+    per-pixel frames (the quad: no mesh drawn nor shaded) leave that time as it was."""
+    c, layer = torus.controller, torus.pixels
+    torus.plotter.camera.Azimuth(10.0)
+    picture(torus)  # a camera frame per vertex
+    vertex_ms = layer.vertex_ms
+    assert 0.0 < vertex_ms < 1e5
+    c.set_value("shading", "per-pixel")
+    for _ in range(2):
+        torus.plotter.camera.Azimuth(10.0)
+        picture(torus)
+    assert layer.shown and layer.vertex_ms == vertex_ms
+
+
+def test_the_drag_fallback_is_decided_once_when_the_camera_first_moves(torus):
+    """A drag that starts per pixel stays per pixel though a later picture of it costs more
+    than FALLBACK_RATIO per-vertex frames (under load one picture may): the decision is the
+    drag's first camera frame's, on the pictures made before it."""
+    c, layer = torus.controller, torus.pixels
+    c.set_value("shading", "per-pixel")
+    picture(torus)
+    torus.begin_drag()
+    layer.ms, layer.vertex_ms = 10.0, 10.0
+    torus.plotter.camera.Azimuth(10.0)
+    picture(torus)  # the decision: per pixel
+    assert layer.shown and not layer.fallback
+    layer.ms, layer.vertex_ms = 50.0, 10.0  # a slow picture in the drag
+    torus.plotter.camera.Azimuth(10.0)
+    picture(torus)
+    assert layer.shown and not layer.fallback  # still per pixel
+    torus.end_drag()
+
+
+def test_a_minus_b_per_vertex_under_a_per_pixel_side_a_is_of_the_current_colours(compare):
+    """Side A per pixel, side B per vertex, A − B on: B's mesh shows the per-vertex A − B of
+    A's current colours (A's are not uploaded while its per-pixel picture stands in: they were
+    those of the start)."""
+    c, b = compare.controller, compare.side_b
+    c.set_value("shading", "per-pixel")
+    c.act(lambda s: s.replace(compare_shading="per-vertex"))
+    c.act(M.set_compare, True)
+    c.act(M.set_compare_difference, True)
+    c.set_value("kd", 0.1, merge=False)
+    picture(compare)
+    a = to_bytes(compare.view.drawings[0].colors()).astype(int)
+    other = to_bytes(b.view.drawings[0].colors()).astype(int)
+    want = heat_map(np.abs(a - other).max(axis=1)[None, :], vmax=VMAX)[0]
+    assert np.abs(a - other).max() > 10  # (B's material differs from A's)
+    assert np.array_equal(b.view.drawings[0].rgb, want)
