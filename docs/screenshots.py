@@ -176,9 +176,11 @@ def shoot_web(name: str, tmp: Path, out: Path) -> None:
     session = save_session(tmp / f"{name}.yaml", state, overwrite=True)
     log = tmp / f"{name}.log"
     with open(log, "w") as output:
-        server = subprocess.Popen([sys.executable, "-m", "explorer.cli", "web", "--port", "0",
-                                   "--session", str(session)], stdout=output,
-                                  stderr=subprocess.STDOUT)  # fmt: skip
+        server = subprocess.Popen(
+            [sys.executable, "-m", "explorer.cli", "web", "--port", "0", "--session", str(session)],
+            stdout=output,
+            stderr=subprocess.STDOUT,
+        )
     driver = None
     try:
         end = time.monotonic() + WAIT_S
@@ -187,13 +189,19 @@ def shoot_web(name: str, tmp: Path, out: Path) -> None:
                 raise SystemExit(f"screenshots: the server did not start:\n{log.read_text()}")
             time.sleep(0.2)
         opts = webdriver.ChromeOptions()
-        for a in ("--headless=new", "--no-sandbox", "--disable-gpu",
-                  f"--window-size={WEB_SIZE[0]},{WEB_SIZE[1]}", "--disable-dev-shm-usage",
-                  "--force-device-scale-factor=1"):  # fmt: skip
+        for a in (
+            "--headless=new",
+            "--no-sandbox",
+            "--disable-gpu",
+            f"--window-size={WEB_SIZE[0]},{WEB_SIZE[1]}",
+            "--disable-dev-shm-usage",
+            "--force-device-scale-factor=1",
+        ):
             opts.add_argument(a)
         opts.binary_location = "/usr/bin/chromium"
-        driver = webdriver.Chrome(options=opts, service=webdriver.ChromeService(
-            executable_path="/usr/bin/chromedriver"))  # fmt: skip
+        driver = webdriver.Chrome(
+            options=opts, service=webdriver.ChromeService(executable_path="/usr/bin/chromedriver")
+        )
         driver.get(url.group(0))
         still = (
             "const i = document.querySelector('[aria-label=\"view_b\"] img');"
@@ -223,8 +231,9 @@ NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "g
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out-dir", type=Path, default=HERE, help="where the PNGs go (docs/)")
-    ap.add_argument("--only", action="append", choices=NAMES + WEB_NAMES,
-                    help="this picture (repeatable)")  # fmt: skip
+    ap.add_argument(
+        "--only", action="append", choices=NAMES + WEB_NAMES, help="this picture (repeatable)"
+    )
     args = ap.parse_args(argv)
     for tool in ("Xvfb", "import"):
         if shutil.which(tool) is None:

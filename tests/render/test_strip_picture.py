@@ -131,8 +131,9 @@ def test_render_strip_draws_each_group_of_a_mesh_file_in_its_own_material(tmp_pa
         rows = mesh.groups.vertices(g)
         alone = mesh_strip(scene.replace(material=material), mesh)
         for term in ("emission", "ambient", "diffuse", "specular", "sum"):
-            np.testing.assert_array_equal(picture.strips[0].terms[term][rows],
-                                          alone.terms[term][rows])  # fmt: skip
+            np.testing.assert_array_equal(
+                picture.strips[0].terms[term][rows], alone.terms[term][rows]
+            )
         diffuse[rows] = alone.tiles["diffuse"][rows]
     want = render_image(scene, mesh, TILE, colors=diffuse)
     np.testing.assert_array_equal(_tile(picture, 0, "diffuse"), want)

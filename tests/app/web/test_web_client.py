@@ -105,8 +105,10 @@ def test_a_change_leaves_for_the_server_before_the_page_redraws(page):
         850,
     )
     assert sent >= 1
-    wait("the server's new kd", lambda: report(page)["session"]["scene"]["material"]["diffuse"]
-         != old)  # fmt: skip
+    wait(
+        "the server's new kd",
+        lambda: report(page)["session"]["scene"]["material"]["diffuse"] != old,
+    )
 
 
 def test_the_servers_socket_does_not_deflate(server):
