@@ -57,7 +57,7 @@ from explorer.shading import layout, tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.prepared import chunk_bounds, geometry_of, rows, vertices
+from explorer.shading.prepared import RowMemory, chunk_bounds, geometry_of, rows, vertices
 from explorer.shading.prepared import readonly as _readonly
 from explorer.shading.shadows import pending_work, visibility_rows
 
@@ -170,6 +170,7 @@ class Shader:
         self._k = K.constants(self._T)
         self._keep_lobe = False
         self._k64 = K.constants(np.float64)
+        self._rows = RowMemory()  # the prepared geometry's, kept from one geometry to the next
         self.set_geometry(positions, normals, faces)
 
     # -- inputs ------------------------------------------------------------------------------
@@ -192,7 +193,8 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        geometry = geometry_of(P, N, self._T, self._k, self.keep, self.cull) if now else None
+        how = (self.keep, self.cull, self._rows)  # (the whole geometry, its chunk bounds, G's)
+        geometry = geometry_of(P, N, self._T, self._k, *how) if now else None
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -218,7 +220,7 @@ class Shader:
         """The compiled tier's geometry (:func:`~explorer.shading.prepared.geometry_of`;
         ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_one_shot`)."""
         if self._centre is None:
-            how = (self.keep, self.cull)  # (the whole geometry, its chunk bounds)
+            how = (self.keep, self.cull, self._rows)  # (the whole geometry, its bounds, G's)
             geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, *how)
             self._centre, self._scale, self._G, self._bounds, N = geometry
             self._N, self._scaled = (self._N, False) if N is None else (N, True)
