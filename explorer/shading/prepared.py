@@ -78,8 +78,9 @@ class RowMemory:
     in by the threads that first wrote them: 8 ms of CPU for 48 MB, and 40-47 ms of wall clock
     for two threads faulting at once on the 2-core VM, where preparing into warm memory takes
     5 ms. Here G is a (6, n) view of a flat buffer of this memory's that nothing else views
-    any more (a caller's earlier G, or a view of one, is never written), with room to spare
-    (an eighth: a per-pixel shader's hits change in number from frame to frame); at most two
+    any more (a caller's earlier G, or a view of one, is never written), the first of the
+    geometry's size, later ones with room to spare (an eighth: a per-pixel shader's hits change
+    in number from frame to frame); at most two
     buffers are kept, the shader's current G and the spare its next geometry is prepared into
     (a geometry that fails half-way leaves the current one as it was)."""
 
@@ -107,7 +108,7 @@ class RowMemory:
         # shader's current G, free once the new one replaces it) is kept beside the new one
         buf = None  # (the loop's last one: not a view)
         held = [b for b in self.buffers if sys.getrefcount(b) > 3]  # (list, b, the argument)
-        buf = np.empty(need + need // 8, dtype)
+        buf = np.empty(need + (need // 8 if self.buffers else 0), dtype)  # (room: a change)
         self.buffers = [*held[len(held) - self.KEEP + 1 :], buf]
         return buf[:need].reshape(6, n)
 

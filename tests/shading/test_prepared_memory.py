@@ -69,8 +69,8 @@ def test_rows_prepared_in_kept_memory_give_the_colours_of_a_new_shader_bit_for_b
         P, N = _vertices(m, seed)
         sh.set_geometry(P, N)
         np.testing.assert_array_equal(sh.colors, _fresh(P, N, precision))
-    held = {b.size for b in sh._rows.buffers}
-    assert len(sh._rows.buffers) == 2 and held == {n * 6 + n * 6 // 8}  # (both reused)
+    held = sorted(b.size for b in sh._rows.buffers)
+    assert held == [n * 6, n * 6 + n * 6 // 8]  # (both reused: the first's, then with room)
 
 
 def test_an_array_handed_out_earlier_is_never_written_by_a_later_geometry():
@@ -117,14 +117,15 @@ def test_kept_memory_lets_a_much_larger_buffer_go_and_keeps_two():
     memory = prepared.RowMemory()
     a = memory.rows(1000, np.float64)
     assert a.shape == (6, 1000) and a.flags.c_contiguous and a.flags.writeable
-    b = memory.rows(1000, np.float64)  # (a still held: another buffer)
-    assert not np.shares_memory(a, b)
+    assert a.base.size == 6000  # (the first: the size asked for)
+    b = memory.rows(1000, np.float64)  # (a still held: another buffer, an eighth larger)
+    assert not np.shares_memory(a, b) and b.base.size == 6750
     del a
     c = memory.rows(900, np.float64)  # fits in a's buffer (free now)
     assert c.base is memory.buffers[-1] and not np.shares_memory(b, c)  # (the latest: last)
     del b, c
-    small = memory.rows(100, np.float64)  # 600 values: the 6,750-value buffers are too large
-    assert small.base.size == 675 and [x.size for x in memory.buffers] == [675]  # (let go)
+    small = memory.rows(100, np.float64)  # 600 values: the 6,000 and 6,750 are too large
+    assert [x.size for x in memory.buffers] == [675] and small.base is memory.buffers[0]
     assert memory.rows(0, np.float64).shape == (6, 0)
     assert memory.rows(100, np.float32).dtype == np.float32
 
