@@ -169,8 +169,7 @@ class Shader:
         self._scene = load_scene(scene, materials_dirs=self._materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
-        self._k64 = K.constants(np.float64)
-        self._rows = RowMemory()  # the prepared geometry's, kept from one geometry to the next
+        self._k64, self._rows = K.constants(np.float64), RowMemory()  # (G's memory: kept)
         self.set_geometry(positions, normals, faces)
 
     # -- inputs ------------------------------------------------------------------------------
@@ -193,8 +192,7 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        how = (self.keep, self.cull, self._rows)  # (the whole geometry, its chunk bounds, G's)
-        geometry = geometry_of(P, N, self._T, self._k, *how) if now else None
+        geometry = now and geometry_of(P, N, self._T, self._k, self.keep, self.cull, self._rows)
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -212,7 +210,7 @@ class Shader:
         self._redo = np.zeros(n if self._T is np.float32 else 0, np.bool_)
         self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
-        if geometry is not None:
+        if geometry:  # (a tuple)
             self._compiled_geometry(geometry)
         self._lights_changed()
 
