@@ -7,8 +7,10 @@ bounds: at most CULL_SAMPLES chunks, the same columns as the full bounds.
 
 from __future__ import annotations
 
+import functools
 import tracemalloc
 
+import numba
 import numpy as np
 import pytest
 
@@ -131,10 +133,15 @@ def test_kept_memory_lets_a_much_larger_buffer_go_and_keeps_two():
 
 
 @pytest.mark.parametrize("source", ["prepared rows", "float32 vertices"])
-def test_a_large_mesh_samples_at_most_cull_samples_chunks_evenly(source, monkeypatch):
+def test_a_large_mesh_samples_at_most_cull_samples_chunks_evenly(source, monkeypatch, request):
     # every 16th chunk of a million vertices was 1,953 chunks, their bounds 0.6 ms of CPU, more
     # than the frame's pass over the positions: now at most CULL_SAMPLES chunks, evenly spread,
-    # the same columns as the full bounds of every chunk
+    # the same columns as the full bounds of every chunk, on one numba thread (a parallel
+    # region for 0.1 ms of work waits for the second thread to wake)
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one numba thread: nothing to tell apart")
+    request.addfinalizer(functools.partial(numba.set_num_threads, numba.get_num_threads()))
+    numba.set_num_threads(2)
     n = 20 * K.CHUNK * prepared.CULL_SAMPLES + 5  # (20·512 chunks, more than 16·512)
     P, N = _vertices(n, 0, np.float32)
     k = K.constants(np.float32)
@@ -154,10 +161,12 @@ def test_a_large_mesh_samples_at_most_cull_samples_chunks_evenly(source, monkeyp
     bounds = K.bounds
 
     def spy(src, k, out, step):
-        calls.append(out.shape[1])
+        calls.append((out.shape[1], numba.get_num_threads()))
         return bounds(src, k, out, step)
 
     monkeypatch.setattr(K, "bounds", spy)
+    threads = numba.get_num_threads()
     sample = prepared.sample_bounds(src, k)
-    assert calls == [sample.shape[1]] and sample.shape[1] <= prepared.CULL_SAMPLES
+    assert calls == [(sample.shape[1], 1)] and sample.shape[1] <= prepared.CULL_SAMPLES
+    assert numba.get_num_threads() == threads  # (one thread for the sample alone)
     np.testing.assert_array_equal(sample, full[:, :whole:step])
