@@ -21,9 +21,13 @@ check the vertices, find the frame and its extent, the plan, and the chunk bound
 culling would use); its pass then prepares each block of vertices as it shades it (a
 ``kernels.Source`` of vertices), so that share is inside the one-shot rows, and the row "one-shot -
 full shading" gives what a one-shot call costs beyond a kept shader's pass over the same
-lights. The geometry rows and the floor are timed in turns, call after call, so the ratio
-between them sees the same machine (the floor moves by 2x between runs, with what of the
-arrays the cache still holds).
+lights. "a kept shader's" geometry is what new vertices cost a kept ``Shader``
+(:func:`kept_geometry`: the frame, the prepared copy G and the chunk bounds), G in the memory
+the shader keeps from one geometry to the next, and beside it in new memory (as before the
+shader kept any: page faults at a million float64 vertices). The geometry rows and the floor
+are timed in turns, call after call, so the ratio between them sees the same machine (the floor
+moves by 2x between runs, with what of the arrays the cache still holds); ``--geometry`` times
+those alone.
 
 The float64 full-shading row (the issue's target: 0.4 G vertex-lights/s, <= 20 ms), four runs
 of this script at 97356cc and at k13 (the float64 lobe from base², see
