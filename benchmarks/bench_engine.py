@@ -3,6 +3,7 @@
     python benchmarks/bench_engine.py                # 1M vertices, 8 point lights
     python benchmarks/bench_engine.py --vertices 200000 --lights 4 --repeat 15
     python benchmarks/bench_engine.py --flows        # the one-shot pass against slabs
+    python benchmarks/bench_engine.py --geometry     # the geometry rows and the floor alone
     python benchmarks/bench_engine.py --isa both --alternate 3 --cpu   # AVX2 beside AVX-512
 
 The full-shading rows run on random points (every vertex-light computed: the kernel's raw
@@ -20,9 +21,13 @@ check the vertices, find the frame and its extent, the plan, and the chunk bound
 culling would use); its pass then prepares each block of vertices as it shades it (a
 ``kernels.Source`` of vertices), so that share is inside the one-shot rows, and the row "one-shot -
 full shading" gives what a one-shot call costs beyond a kept shader's pass over the same
-lights. The geometry rows and the floor are timed in turns, call after call, so the ratio
-between them sees the same machine (the floor moves by 2x between runs, with what of the
-arrays the cache still holds).
+lights. "a kept shader's" geometry is what new vertices cost a kept ``Shader``
+(:func:`kept_geometry`: the frame, the prepared copy G and the chunk bounds), G in the memory
+the shader keeps from one geometry to the next, and beside it in new memory (as before the
+shader kept any: page faults at a million float64 vertices). The geometry rows and the floor
+are timed in turns, call after call, so the ratio between them sees the same machine (the floor
+moves by 2x between runs, with what of the arrays the cache still holds); ``--geometry`` times
+those alone.
 
 The float64 full-shading row (the issue's target: 0.4 G vertex-lights/s, <= 20 ms), four runs
 of this script at 97356cc and at k13 (the float64 lobe from base², see
@@ -138,10 +143,67 @@ def one_shot_geometry(scene, P, N, precision: str) -> None:
     prepared.chunk_bounds(src, sh._k)
 
 
-def kept_geometry(P, N, precision: str) -> None:
-    """What a kept ``Shader`` does to its geometry once (:func:`prepared.prepared_geometry`):
-    the frame, the prepared copy G (``kernels.prepare``) and the chunk bounds."""
-    prepared.prepared_geometry(P, N, np.dtype(precision), K.constants(np.dtype(precision)))
+#: the memory of :func:`kept_geometry`'s rows, per precision (as a kept shader keeps its own)
+_ROWS: dict = {}
+
+
+def kept_geometry(P, N, precision: str, memory: bool = True) -> None:
+    """What a kept ``Shader`` does to new vertices (:func:`prepared.prepared_geometry`): the
+    frame, the prepared copy G (``kernels.prepare``) and the chunk bounds; G in the memory the
+    shader keeps from one geometry to the next (:class:`prepared.RowMemory`), or (``memory``
+    False) new memory, as before it kept any: fresh pages from the kernel when G is larger
+    than glibc's 32 MB threshold (float64 from 700k vertices, float32 from 1.4M)."""
+    rows = _ROWS.setdefault(precision, prepared.RowMemory()) if memory else None
+    dtype = np.dtype(precision)
+    prepared.prepared_geometry(P, N, dtype, K.constants(dtype), memory=rows)
+
+
+def geometry_turns(scene, P, N, R: int) -> dict:
+    """(median, best) seconds of the geometry rows and the bandwidth floor's two loops, timed in
+    turns (:func:`in_turns`): "stream" and "add" (the floor), "float32" and "float64" (a one-shot
+    call's, :func:`one_shot_geometry`), "kept ..." and "new ..." (:func:`kept_geometry` in
+    kept and in new memory)."""
+    out = np.empty((len(P), 3), np.float32)
+    return in_turns(
+        {
+            "stream": lambda: K.stream(P, N, out),
+            "add": lambda: np.add(P, N, out=out),
+            "float32": lambda: one_shot_geometry(scene, P, N, "float32"),
+            "float64": lambda: one_shot_geometry(scene, P, N, "float64"),
+            "kept float32": lambda: kept_geometry(P, N, "float32"),
+            "kept float64": lambda: kept_geometry(P, N, "float64"),
+            "new float32": lambda: kept_geometry(P, N, "float32", memory=False),
+            "new float64": lambda: kept_geometry(P, N, "float64", memory=False),
+        },
+        R,
+    )
+
+
+def geometry_only(scene, P, N, R: int) -> int:
+    """``--geometry``: the geometry rows alone (:func:`geometry_turns`), each with its ratio to
+    the bandwidth floor of the same run."""
+    turns = geometry_turns(scene, P, N, R)
+    floor = min(turns["stream"], turns["add"])
+    names = {
+        "float32": "geometry preparation float32 (of a one-shot call)",
+        "float64": "geometry preparation float64 (of a one-shot call)",
+        "kept float32": "kept shader's geometry float32",
+        "kept float64": "kept shader's geometry float64",
+        "new float32": "kept shader's geometry float32, G in new memory",
+        "new float64": "kept shader's geometry float64, G in new memory",
+    }
+    print("| case | median ms | best ms | median / floor's median |")
+    print("|---|---:|---:|---:|")
+    print(f"| bandwidth floor | {floor[0] * 1e3:.2f} | {floor[1] * 1e3:.2f} | 1.00x |")
+    isa.record("bandwidth floor", floor[0] * 1e3)
+    for key, name in names.items():
+        med, best = turns[key]
+        print(f"| {name} | {med * 1e3:.2f} | {best * 1e3:.2f} | {med / floor[0]:.2f}x |")
+        isa.record(name, med * 1e3)
+        isa.record(f"{name} / bandwidth floor", med / floor[0], "x")
+    isa.record("load average at the end", load_average(), "")
+    isa.write_results()
+    return 0
 
 
 def one_shot_flows(scene, P, N, R: int) -> int:
@@ -232,6 +294,11 @@ def main(argv=None) -> int:
         help="only the one-shot pass over the vertices against slabs prepared first",
     )
     ap.add_argument(
+        "--geometry",
+        action="store_true",
+        help="only the geometry preparation rows and the bandwidth floor, timed in turns",
+    )
+    ap.add_argument(
         "--cpu",
         action="store_true",
         help="one numba thread, timed by the process's CPU seconds (not the wall clock)",
@@ -250,6 +317,10 @@ def main(argv=None) -> int:
     if args.flows:
         print(f"machine: {machine()}\nmesh: {n} vertices, {L} point lights; medians of {R}")
         return one_shot_flows(scene, P, N, R)
+    if args.geometry:
+        clock = "CPU seconds of one numba thread" if args.cpu else "wall clock"
+        print(f"machine: {machine()}\nmesh: {n} vertices, {L} point lights; {R} turns; {clock}")
+        return geometry_only(scene, P, N, R)
     other = scene_with(L, np.random.default_rng(1)).lights
 
     rows = []
@@ -343,18 +414,7 @@ def main(argv=None) -> int:
         what = "float64 (the default)" if precision == "float64" else precision
         row(f"one-shot `shade()` {what}, incl. preparing the geometry", *one_shot[precision], n * L)
     # what a one-shot call does before its pass, in turns with the bandwidth floor (below)
-    out = np.empty((n, 3), np.float32)
-    turns = in_turns(
-        {
-            "stream": lambda: K.stream(P, N, out),
-            "add": lambda: np.add(P, N, out=out),
-            "float32": lambda: one_shot_geometry(scene, P, N, "float32"),
-            "float64": lambda: one_shot_geometry(scene, P, N, "float64"),
-            "kept float32": lambda: kept_geometry(P, N, "float32"),
-            "kept float64": lambda: kept_geometry(P, N, "float64"),
-        },
-        R,
-    )
+    turns = geometry_turns(scene, P, N, R)
     geometry = {p: turns[p] for p in ("float32", "float64")}
     for precision, (med, best) in geometry.items():
         row(f"geometry preparation, {precision} (of a one-shot call, before its pass)", med, best)
@@ -362,6 +422,12 @@ def main(argv=None) -> int:
         row(
             f"geometry preparation, {precision} (a kept shader's: frame, prepare, chunk bounds)",
             *turns[f"kept {precision}"],
+            note="G in the memory the shader keeps",
+        )
+        row(
+            f"geometry preparation, {precision} (a kept shader's, G in new memory)",
+            *turns[f"new {precision}"],
+            note="as before prepared.RowMemory",
         )
     for precision in ("float32", "float64"):
         # (bests: the first rows' medians carry the VM's warm-up, by 10-50 %)
@@ -426,6 +492,9 @@ def main(argv=None) -> int:
     isa.record("recolour / bandwidth floor", recol[0] / floor[0], "x")
     for precision, (med, _) in geometry.items():
         isa.record(f"geometry preparation {precision} / bandwidth floor", med / floor[0], "x")
+    for precision in ("float32", "float64"):
+        kept = turns[f"kept {precision}"][0]
+        isa.record(f"kept shader's geometry {precision} / bandwidth floor", kept / floor[0], "x")
     isa.record("load average at the end", load_average(), "")
     isa.write_results()
     print(

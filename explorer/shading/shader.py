@@ -57,7 +57,7 @@ from explorer.shading import layout, tiers
 from explorer.shading.effects import EFFECTS
 from explorer.shading.equation import compose_terms, equation_terms
 from explorer.shading.plan import Plan, make_plan
-from explorer.shading.prepared import chunk_bounds, geometry_of, rows, vertices
+from explorer.shading.prepared import RowMemory, chunk_bounds, geometry_of, rows, vertices
 from explorer.shading.prepared import readonly as _readonly
 from explorer.shading.shadows import pending_work, visibility_rows
 
@@ -169,7 +169,7 @@ class Shader:
         self._scene = load_scene(scene, materials_dirs=self._materials_dirs)
         self._k = K.constants(self._T)
         self._keep_lobe = False
-        self._k64 = K.constants(np.float64)
+        self._k64, self._rows = K.constants(np.float64), RowMemory()  # (G's memory: kept)
         self.set_geometry(positions, normals, faces)
 
     # -- inputs ------------------------------------------------------------------------------
@@ -192,7 +192,7 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        geometry = geometry_of(P, N, self._T, self._k, self.keep, self.cull) if now else None
+        geometry = now and geometry_of(P, N, self._T, self._k, self.keep, self.cull, self._rows)
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -210,7 +210,7 @@ class Shader:
         self._redo = np.zeros(n if self._T is np.float32 else 0, np.bool_)
         self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
-        if geometry is not None:
+        if geometry:  # (a tuple)
             self._compiled_geometry(geometry)
         self._lights_changed()
 
@@ -218,7 +218,7 @@ class Shader:
         """The compiled tier's geometry (:func:`~explorer.shading.prepared.geometry_of`;
         ``geometry``: found already); keep=False: the frame alone (each pass: :meth:`_one_shot`)."""
         if self._centre is None:
-            how = (self.keep, self.cull)  # (the whole geometry, its chunk bounds)
+            how = (self.keep, self.cull, self._rows)  # (the whole geometry, its bounds, G's)
             geometry = geometry or geometry_of(self._P, self._N, self._T, self._k, *how)
             self._centre, self._scale, self._G, self._bounds, N = geometry
             self._N, self._scaled = (self._N, False) if N is None else (N, True)
