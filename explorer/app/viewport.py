@@ -127,6 +127,16 @@ class PlotterView:
 
         return call
 
+    def watch_drags(self, plotter) -> None:
+        """``plotter``'s camera drags are drags (:meth:`begin_drag`, :meth:`end_drag`: the level
+        of detail; in per-pixel mode the drag fallback): its interactor's style starts and ends
+        each camera interaction (Qt's mouse, or the page's pointer passed on by its remote
+        view). Side A's plotter and side B's are watched alike."""
+        style = plotter.iren.interactor.GetInteractorStyle()
+        if style is not None:
+            style.AddObserver("StartInteractionEvent", self.guard(self.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self.guard(self.end_drag, "camera"))
+
     def begin_drag(self, *_) -> None:
         """A drag starts (a slider, the camera, a handle): the level of detail is drawn, and
         the difference waits for the end."""

@@ -248,3 +248,15 @@ def test_side_b_draws_its_mesh_while_side_a_shows_the_heat_map(port):
     port.redraw()
     b.plotter.render_window.Render()
     assert np.array_equal(b.plotter.screenshot(return_img=True)[:, :, :3], before)
+
+
+def test_a_watched_plotters_camera_interaction_is_a_drag(port):
+    """Both front ends watch their plotters (side A's, side B's) through the view port: the
+    interactor style's interaction is a drag, its end a picture."""
+    port.watch_drags(port.plotter)
+    style = port.plotter.iren.interactor.GetInteractorStyle()
+    sent = port.pictures.sent
+    style.InvokeEvent("StartInteractionEvent")
+    assert port.dragging() and port.view.lod_active
+    style.InvokeEvent("EndInteractionEvent")
+    assert not port.dragging() and port.pictures.sent == sent + 1

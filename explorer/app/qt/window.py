@@ -127,12 +127,8 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         """``pl``'s camera drags are drags (the level of detail, one undo step); VTK's and
         PyVista's own keys (w wireframe, s surface, ...) would change the picture behind the
         state's back: the window's keys are the only keys."""
+        self.viewport.watch_drags(pl)
         iren = pl.iren.interactor
-        style = iren.GetInteractorStyle()
-        if style is not None:
-            vp = self.viewport
-            style.AddObserver("StartInteractionEvent", self._guard(vp.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self._guard(vp.end_drag, "camera"))
         for key in list(getattr(pl, "_key_press_event_callbacks", {})):
             pl.clear_events_for_key(key)
 

@@ -118,7 +118,7 @@ class WebExplorer:
         self.view = self.viewport.attach(
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
-        self.watch_camera(self.plotter)
+        self.viewport.watch_drags(self.plotter)  # (the remote view passes the page's pointer)
         self.plotter.render_window.AddObserver("StartEvent", self.guard(self._frame, "view"), 1.0)
         panel.connect(self)
         page.build(self)
@@ -134,16 +134,6 @@ class WebExplorer:
         """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
         logged, never lost (:meth:`PlotterView.guard`)."""
         return self.viewport.guard(fn, where)
-
-    def watch_camera(self, pl) -> None:
-        """``pl``'s camera drags are drags, as the window's (the level of detail; in per-pixel
-        mode the drag fallback, said on the page): the remote view passes the page's pointer
-        to ``pl``'s interactor, whose style starts and ends each camera interaction."""
-        style = pl.iren.interactor.GetInteractorStyle()
-        if style is not None:
-            vp = self.viewport
-            style.AddObserver("StartInteractionEvent", self.guard(vp.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self.guard(vp.end_drag, "camera"))
 
     def _frame(self, *_) -> None:
         """Before a frame: the first time the view is drawn at another size than it was made
