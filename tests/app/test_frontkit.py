@@ -1,5 +1,5 @@
 """What both front ends share, tested once in the toolkit-free kit (:mod:`explorer.app`): the
-start's light, ..."""
+start's light, the message log, ..."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from explorer.app import start
+from explorer.app.messagelog import MessageLog
 from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.geometry.meshes import Mesh, get_mesh
 
@@ -21,3 +22,27 @@ def test_the_start_light_is_a_point_light_at_the_default_placement_in_mesh_radii
     assert d == pytest.approx(DEFAULT_PLACEMENT[2] * mesh.radius)
     assert mesh.radius == pytest.approx(2.0 * unit.radius)
     assert np.allclose(mesh.centre, (1.0, 0.0, 0.0), atol=1e-9)
+
+
+def test_the_message_log_keeps_each_message_whole_with_its_head_and_the_last_ones():
+    log = MessageLog(keep=2)
+    log.add("info", "saved")
+    log.add("warning", "two materials", ["a.mtl:3: Ka 2", "a.mtl:4: Kd -1"])
+    m = log.add("error", "error (kd): kd must be in [0, 1]")
+    assert [x.text for x in log.messages] == ["two materials", m.text]  # the oldest went
+    assert log.count("warning") == 1 and log.count("info") == 0
+    assert m.head == f"{m.at} error (kd): kd must be in [0, 1]"  # the level said once
+    w = log.messages[0]
+    assert w.lines() == [
+        f"{w.at} warning: two materials",
+        "    a.mtl:3: Ka 2",
+        "    a.mtl:4: Kd -1",
+    ]
+    assert w.as_dict() == {
+        "text": "two materials",
+        "level": "warning",
+        "at": w.at,
+        "details": ["a.mtl:3: Ka 2", "a.mtl:4: Kd -1"],
+        "head": w.head,
+    }
+    assert len(MessageLog().messages) == 0

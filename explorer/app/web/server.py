@@ -28,14 +28,13 @@ import logging
 import math
 import os
 import tempfile
-import time
 from collections.abc import Sequence
 
 from explorer.app import intents, panelmodel
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
-from explorer.app.controller.ports import log_head
 from explorer.app.difference import DifferenceWorker
+from explorer.app.messagelog import MessageLog
 from explorer.app.session import session_mapping
 from explorer.app.sides import SideB
 from explorer.app.start import (
@@ -90,7 +89,7 @@ class WebExplorer:
         self.pushing = False  # the server is setting the page's values (no user change)
         # the start framed again for the first page's view (as the window frames it when shown)
         self._frame_at = tuple(int(v) for v in size) if state.camera is None else None
-        self.messages: list[dict] = []
+        self.said = MessageLog(keep=MESSAGE_LOG)  # the page's message log
         self.message_seq = 0  # messages said so far (a page shows those after it opened)
         self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
@@ -186,17 +185,14 @@ class WebExplorer:
                      msecs: int | None = None, open_log: bool = True) -> None:  # fmt: skip
         page_text = self.files.page_text
         text, details = page_text(text), [page_text(d) for d in details]
-        at = time.strftime("%H:%M:%S")
-        head = log_head(at, level, text)
-        entry = {"text": text, "level": level, "details": details, "at": at, "head": head}
         if text:  # (empty: the message shown taken away, nothing logged)
-            self.messages = [*self.messages, entry][-MESSAGE_LOG:]
+            self.said.add(level, text, details)
         self.message_seq += 1
         with self.server.state as s:
             s.message = text
             s.message_level = level
             s.message_seq = self.message_seq
-            s.message_log = self.messages
+            s.message_log = [m.as_dict() for m in self.said.messages]
 
     # -- Progress --------------------------------------------------------------------------------
     def run_steps(self, title: str, text: str, total: int, step, cancel) -> object:
