@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
@@ -214,9 +213,12 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         return [p.x(), p.y(), widget.width(), widget.height()]
 
     def report_state(self) -> dict:
-        """What a test or a script may want to know beyond the session (plain JSON values)."""
-        s, store, view = self.controller.state, self.controller.store, self.view
-        probe = view.probe_vertex()
+        """What a test or a script may want to know beyond the session (plain JSON values): the
+        view port's report (:meth:`PlotterView.report`, its pixels in the window's), and the
+        window's own: its size, the view's box, the selected light's handle and the arrows
+        toward handles out of the view, the handle's glyph, the drag and the level of detail,
+        every named widget's box, the last message."""
+        s, view = self.controller.state, self.view
         origin = self.widget_box(self.plotter)[:2]
 
         def in_window(px):
@@ -225,8 +227,6 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         handle = None
         if s.selected_light is not None:
             handle = in_window(view.world_to_window(M.handle_point(s)))
-        handles = [in_window(view.world_to_window(M.handle_point(s, i)))
-                   for i in range(len(s.scene.lights))]  # fmt: skip
         _, h = self.plotter.window_size
         arrows = {str(i): in_window([round(float(t[0, 0])), round(h - 1 - float(t[0, 1]))])
                   for i, t in view.marker_triangles.items()}  # fmt: skip
@@ -235,22 +235,19 @@ class ExplorerWindow(QtWidgets.QMainWindow):
             for w in self.findChildren(QtWidgets.QWidget)
             if w.objectName() and not w.objectName().startswith("qt_") and w.isVisible()
         }
-        frame_ms = self.viewport.frame_ms
         return {
-            "frame": self.viewport.frames,
-            "frame_ms": None if not np.isfinite(frame_ms) else frame_ms,
+            **self.viewport.report(at=in_window),
             "window_size": [self.width(), self.height()],
             "view_box": self.widget_box(self.plotter),
-            "n_vertices": view.mesh.n_vertices, "edited": s.edited,
-            "dragging": view.dragging > 0, "lod": view.lod_active,
-            "handle_px": handle, "handles_px": handles, "arrows_px": arrows,
+            "edited": s.edited,
+            "dragging": view.dragging > 0,
+            "lod": view.lod_active,
+            "handle_px": handle,
+            "arrows_px": arrows,
             "glyph": view.glyph_kind,
-            "probe": {"vertex": probe,
-                      "px": in_window(view.world_to_window(view.mesh.positions[probe]))},
-            "difference": self.heat.state(), "widgets": widgets,
-            "can_undo": store.can_undo, "can_redo": store.can_redo,
-            "message": self.message, "errors": list(self.controller.errors),
-        }  # fmt: skip
+            "widgets": widgets,
+            "message": self.message,
+        }
 
     def showEvent(self, event: QtGui.QShowEvent) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)

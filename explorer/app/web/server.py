@@ -25,7 +25,6 @@ stays free of them).
 from __future__ import annotations
 
 import logging
-import math
 import os
 import tempfile
 from collections.abc import Sequence
@@ -305,36 +304,28 @@ class WebExplorer:
             self.pushing = False
 
     def report_state(self) -> dict:
-        """What a test may read (plain JSON values): the frame count, the view's size, the
-        probe vertex and its pixel in the view (origin top-left), the session, the last picture's
-        steps."""
-        probe = self.view.probe_vertex()
-        ms = self.viewport.frame_ms
+        """What a test may read (plain JSON values): the view port's report
+        (:meth:`PlotterView.report`, the probe and the handles in the view's pixels, origin
+        top-left), the view's size, the selected light's placement, side B's probe, the term
+        strip, the lobe inset and its lit sphere, the session, the last picture's steps."""
+        state, view, shared = self.store.state, self.view, self.viewport.report()
+        probe = view.mesh.positions[view.probe_vertex()]
         return {
-            "frame": self.viewport.frames,
+            **shared,
             "size": list(self.viewport.size()),
-            "probe": {"vertex": probe,
-                      "px": self.view.world_to_window(self.view.mesh.positions[probe])},
-            "handles_px": [self.view.world_to_window(M.handle_point(self.store.state, i))
-                           for i in range(len(self.store.state.scene.lights))],
-            "placement": (list(self.store.state.placement())
-                          if self.store.state.selected_light is not None else None),
-            "can_undo": self.store.can_undo,
-            "can_redo": self.store.can_redo,
-            "errors": list(self.controller.errors),
-            "n_vertices": self.view.mesh.n_vertices,
-            "difference": self.heat.state(),
+            "placement": list(state.placement()) if state.selected_light is not None else None,
             "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
-            "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
-            "lobes": self.view.lobe.report(),
-            "pixels": pixels_report(self.viewport.pixels),
-            "sphere": self.view.lobe.sphere_report(),
-            "session": session_mapping(self.store.state),
+            "strip": view.strip.report(view.to_view(probe)),
+            "lobes": view.lobe.report(),
+            "sphere": view.lobe.sphere_report(),
+            "session": session_mapping(state),
             # the last picture's steps (ms; explorer.app.web.pictures) and the last change's
             # time to its frame's end (the benchmark's breakdown)
-            "picture": {**(self.pictures.times if self.pictures else {}),
-                        "frame_ms": None if ms != ms else ms},  # (NaN: no frame yet)
-        }  # fmt: skip
+            "picture": {
+                **(self.pictures.times if self.pictures else {}),
+                "frame_ms": shared["frame_ms"],
+            },
+        }
 
     def close(self) -> None:
         self.worker.close()
@@ -342,22 +333,6 @@ class WebExplorer:
             self.pictures.close()
         self._uploads.cleanup()
         self.plotter.close()
-
-
-def pixels_report(layer) -> dict:
-    """What a test reads of the per-pixel picture (:class:`~explorer.app.pixellayer.PixelLayer`
-    ``layer``): the pictures made, whether a drag draws per vertex now, and the last per-pixel
-    picture's and per-vertex frame's times (ms; None before one)."""
-
-    def ms(v: float):
-        return None if math.isnan(v) else round(v, 2)
-
-    return {
-        "frames": layer.frames,
-        "fallback": layer.fallback,
-        "ms": ms(layer.ms),
-        "vertex_ms": ms(layer.vertex_ms),
-    }
 
 
 def own_arguments() -> None:
