@@ -1,14 +1,15 @@
 """What both front ends share, tested once in the toolkit-free kit (:mod:`explorer.app`): the
-start's light, the message log, ..."""
+start's light, the message log, the state's summary, ..."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from explorer.app import start
+from explorer.app import captions, start
 from explorer.app.messagelog import MessageLog
 from explorer.app.model import DEFAULT_PLACEMENT
+from explorer.core.scene import Scene
 from explorer.geometry.meshes import Mesh, get_mesh
 
 
@@ -46,3 +47,15 @@ def test_the_message_log_keeps_each_message_whole_with_its_head_and_the_last_one
         "head": w.head,
     }
     assert len(MessageLog().messages) == 0
+
+
+def test_the_summary_names_the_material_the_model_and_what_is_hidden():
+    mesh = get_mesh("sphere", 8)
+    scene = Scene(lights=(start.default_light(mesh),))
+    state = start.first_state(scene, mesh, preset="gold")
+    assert captions.summary(state) == f"gold;  {state.scene.model}"
+    hidden = state.replace(hidden=frozenset({"specular", "ambient", "diffuse_map"}))
+    assert (
+        captions.summary(hidden)
+        == f"gold;  {state.scene.model};  hidden: ambient, specular, diffuse_map"
+    )
