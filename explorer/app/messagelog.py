@@ -35,8 +35,13 @@ class Message:
 
     def as_dict(self) -> dict:
         """Plain values (the page's state): text, level, details, at and head."""
-        return {"text": self.text, "level": self.level, "details": list(self.details),
-                "at": self.at, "head": self.head}  # fmt: skip
+        return {
+            "text": self.text,
+            "level": self.level,
+            "details": list(self.details),
+            "at": self.at,
+            "head": self.head,
+        }
 
 
 class MessageLog:

@@ -1,5 +1,5 @@
 """What both front ends share, tested once in the toolkit-free kit (:mod:`explorer.app`): the
-start's light, the message log, the state's summary, ..."""
+start's light, the message log, the state's summary, a long job's steps, ..."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import pytest
 from explorer.app import captions, start
 from explorer.app.messagelog import MessageLog
 from explorer.app.model import DEFAULT_PLACEMENT
+from explorer.app.steps import Steps
 from explorer.core.scene import Scene
 from explorer.geometry.meshes import Mesh, get_mesh
 
@@ -59,3 +60,20 @@ def test_the_summary_names_the_material_the_model_and_what_is_hidden():
         captions.summary(hidden)
         == f"gold;  {state.scene.model};  hidden: ambient, specular, diffuse_map"
     )
+
+
+def test_a_long_jobs_steps_run_until_it_says_it_is_over_and_a_cancel_stops_them_once():
+    said = []
+    left = iter([(1, None), (2, "encoding"), None])
+    job = Steps("turntable", "drawing", 3, lambda: next(left), lambda: said.append("cancel"))
+    shown = {"title": "turntable", "text": "drawing", "done": 0, "total": 3, "running": True}
+    assert job.as_dict() == shown
+    assert job.next() and (job.done, job.text) == (1, "drawing")  # the text stays
+    assert job.next() and (job.done, job.text) == (2, "encoding")
+    assert not job.next() and not job.running and not job.next()  # over: no more steps
+    job.cancel()
+    assert said == []  # a finished job is not cancelled
+    other = Steps("t", "x", 5, lambda: (1, None), lambda: said.append("cancel"))
+    other.cancel()
+    other.cancel()
+    assert said == ["cancel"] and not other.next() and other.done == 0

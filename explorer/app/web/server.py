@@ -39,6 +39,7 @@ from explorer.app.sides import SideB
 from explorer.app.start import (
     MESH_CHOICES,
 )
+from explorer.app.steps import Steps
 from explorer.app.viewport import PlotterView
 from explorer.app.web import guard, page, panel, wire
 from explorer.app.web.compare import WebCompare
@@ -95,7 +96,7 @@ class WebExplorer:
         self.files = WebFiles(self, self._uploads.name)  # the uploads and downloads
         self.loop = None  # the server's event loop (the difference worker delivers into it)
         self.pictures = None  # the pages' picture path (web.pictures.Pictures), once it runs
-        self._job = None  # the long job running (run_steps) and its cancel
+        self._job: Steps | None = None  # the long job running (run_steps)
         self.server = get_server(name, client_type="vue3")
         self.token = guard.new_token()  # the page's key: in the URL the user is given only
         self.hosts = guard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
@@ -196,22 +197,18 @@ class WebExplorer:
     # -- Progress --------------------------------------------------------------------------------
     def run_steps(self, title: str, text: str, total: int, step, cancel) -> object:
         """A long job stepped from the server's loop (pictures keep coming), its progress in the
-        page (state ``progress``: title, text, done, total; the page's Cancel calls
-        ``cancel``). Returns the job's progress record."""
-        job = {"title": title, "text": text, "done": 0, "total": int(total), "running": True}
-        self._job = (job, cancel)
+        page (state ``progress``: title, text, done, total, running; the page's Cancel calls
+        ``cancel``). Returns the job's :class:`~explorer.app.steps.Steps`."""
+        job = self._job = Steps(title, text, total, step, cancel)
         self._show_progress(job)
 
         def go():
-            if not job["running"]:
-                return
-            out = step()
-            if out is None:
-                job["running"] = False
-                self._job = None
-            else:
-                job["done"], job["text"] = out[0], out[1] or job["text"]
+            if not job.running:
+                return  # cancelled (cancel_job showed it)
+            if job.next():
                 self.loop.call_soon(self.guard(go, title))
+            elif self._job is job:
+                self._job = None
             self._show_progress(job)
 
         self.loop.call_soon(self.guard(go, title))
@@ -220,17 +217,15 @@ class WebExplorer:
     def cancel_job(self) -> None:
         """The page's Cancel: the running job stops, and its flow says what was left."""
         if self._job is not None:
-            job, cancel = self._job
-            job["running"] = False
-            self._job = None
-            cancel()
+            job, self._job = self._job, None
+            job.cancel()
             self._show_progress(job)
 
-    def _show_progress(self, job: dict) -> None:
+    def _show_progress(self, job: Steps) -> None:
         path = self.files.turntable_path
         with self.server.state as s:
-            s.progress = dict(job)
-            s.turntable_ready = not job["running"] and path is not None and path.is_file()
+            s.progress = job.as_dict()
+            s.turntable_ready = not job.running and path is not None and path.is_file()
             s.turntable_made = self.files.turntable_made if s.turntable_ready else ""
 
     # -- Choices ---------------------------------------------------------------------------------
