@@ -1,15 +1,16 @@
 """What both front ends share, tested once in the toolkit-free kit (:mod:`explorer.app`): the
-start's light, the message log, the state's summary, a long job's steps, ..."""
+start's light, the message log, the state's summary, a long job's steps, a typed value's meaning."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from explorer.app import captions, start
+from explorer.app import captions, panelmodel, start
 from explorer.app.messagelog import MessageLog
 from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.app.steps import Steps
+from explorer.core.errors import ExplorerError
 from explorer.core.scene import Scene
 from explorer.geometry.meshes import Mesh, get_mesh
 
@@ -77,3 +78,32 @@ def test_a_long_jobs_steps_run_until_it_says_it_is_over_and_a_cancel_stops_them_
     other.cancel()
     other.cancel()
     assert said == ["cancel"] and not other.next() and other.done == 0
+
+
+@pytest.mark.parametrize(
+    ("key", "text", "value"),
+    [
+        ("kd", " 0.25 ", 0.25),
+        ("cutoff", "45°", 45.0),  # the unit the field shows, typed back
+        ("color", "1, 0.5, 0", (1.0, 0.5, 0.0)),
+        ("color", "#ff0000", (1.0, 0.0, 0.0)),
+        ("attenuation", "1, 0.5, 0.25", (1.0, 0.5, 0.25)),
+    ],
+)
+def test_a_typed_value_is_read_as_its_row_reads_it(key, text, value):
+    assert panelmodel.row(key).parse(text) == pytest.approx(value)
+
+
+@pytest.mark.parametrize(
+    ("key", "text", "said"),
+    [
+        ("kd", "5000", "kd must be a number within 0 .. 1, got '5000'"),
+        ("kd", "abc", "kd"),
+        ("color", "1, 2", "color"),
+        ("attenuation", "1, 0.5", "attenuation: give 3 numbers kc, kl, kq, got '1, 0.5'"),
+        ("model", "phong", "'model' takes no typed value"),
+    ],
+)
+def test_a_typed_value_out_of_range_or_of_another_shape_is_one_line_naming_the_key(key, text, said):
+    with pytest.raises(ExplorerError, match=said):
+        panelmodel.row(key).parse(text)
