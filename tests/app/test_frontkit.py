@@ -1,7 +1,11 @@
 """What both front ends share, tested once in the toolkit-free kit (:mod:`explorer.app`): the
-start's light, the message log, the state's summary, a long job's steps, a typed value's meaning."""
+start's light, the message log, the state's summary, a long job's steps, a typed value's
+meaning; and no front end holds a light-type site."""
 
 from __future__ import annotations
+
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,8 +15,27 @@ from explorer.app.messagelog import MessageLog
 from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.app.steps import Steps
 from explorer.core.errors import ExplorerError
+from explorer.core.lights import LIGHT_CLASSES
 from explorer.core.scene import Scene
 from explorer.geometry.meshes import Mesh, get_mesh
+
+APP = Path(__file__).resolve().parents[2] / "explorer" / "app"
+
+
+def test_no_front_end_file_imports_the_lights_or_names_a_light_class():
+    """The front ends (explorer/app/qt, explorer/app/web) hold no light-type site: not even the
+    start's light (the notebook's start placed a PointLight itself)."""
+    files = [*APP.glob("qt/*.py"), *APP.glob("web/*.py")]
+    assert len(files) > 15, files
+    names = "|".join(c.__name__ for c in {*LIGHT_CLASSES.values()})
+    pattern = re.compile(rf"explorer\.core\.lights|\b({names})\b")
+    found = [
+        f"{f.parent.name}/{f.name}:{i}"
+        for f in files
+        for i, line in enumerate(f.read_text().splitlines(), 1)
+        if pattern.search(line)
+    ]
+    assert not found, found
 
 
 def test_the_start_light_is_a_point_light_at_the_default_placement_in_mesh_radii():
