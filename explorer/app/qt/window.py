@@ -37,7 +37,7 @@ from explorer.app.start import TITLE, WINDOW_SIZE
 from explorer.app.view import LOD_TARGET, LOD_VERTICES
 from explorer.app.viewport import PlotterView
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import one_frame_at_a_time, plain_blending
+from explorer.render.vtk import draw_as_the_engine
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
@@ -102,13 +102,11 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.views = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
         self.views.setChildrenCollapsible(False)
         self.plotter = QtInteractor(self.views, multi_samples=0, auto_update=False)
-        one_frame_at_a_time(self.plotter.render_window)  # (the difference worker draws too)
+        # the engine's colours, translucency drawn as the off-screen renders draw it
+        draw_as_the_engine(self.plotter, BACKGROUND if background is None else background)
         self.plotter.setObjectName("view")
         self.plotter.setMinimumSize(120, 120)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
-        self.plotter.disable_anti_aliasing()
-        plain_blending(self.plotter.renderer)  # translucency drawn as the off-screen renders
-        self.plotter.set_background(BACKGROUND if background is None else background)
         self.views.addWidget(self.plotter)
         self.splitter.addWidget(self.views)
         self.splitter.setStretchFactor(0, 1)
