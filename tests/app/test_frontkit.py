@@ -1,6 +1,6 @@
 """What both front ends share, tested once in the toolkit-free kit (:mod:`explorer.app`): the
 start's light, the message log, the state's summary, a long job's steps, a typed value's
-meaning; and no front end holds a light-type site."""
+meaning, a material's swatch; and no front end holds a light-type site."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from explorer.app import captions, panelmodel, start
+from explorer.app.colours import rgb_bytes, swatch_squares
 from explorer.app.messagelog import MessageLog
 from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.app.steps import Steps
@@ -130,3 +131,12 @@ def test_a_typed_value_is_read_as_its_row_reads_it(key, text, value):
 def test_a_typed_value_out_of_range_or_of_another_shape_is_one_line_naming_the_key(key, text, said):
     with pytest.raises(ExplorerError, match=said):
         panelmodel.row(key).parse(text)
+
+
+def test_a_swatch_is_the_diffuse_colour_with_the_specular_in_the_top_right_quarter():
+    from explorer.core.presets import find_preset
+
+    gold = find_preset("gold")
+    d, s = rgb_bytes(gold.diffuse), rgb_bytes(gold.specular)
+    assert swatch_squares(gold, 18) == ((0, 0, 18, 18, d), (9, 0, 9, 9, s))
+    assert swatch_squares(gold, 17) == ((0, 0, 17, 17, d), (8, 0, 9, 8, s))  # the quarter whole

@@ -29,7 +29,7 @@ from urllib.parse import quote
 
 from explorer.app import model as M
 from explorer.app import panelmodel
-from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
+from explorer.app.colours import parse_hex, rgb_hex, rgb_text, swatch_squares
 from explorer.core.controls import field_text, from_step, to_step
 from explorer.core.errors import ExplorerError
 from explorer.render.textures import file_stamp, thumbnail
@@ -53,15 +53,14 @@ def number_values(state: M.State) -> dict:
 
 
 def swatch_url(m) -> str:
-    """The desktop's swatch of material ``m`` (the diffuse colour with the specular colour in
-    the top right quarter) as an SVG data URL."""
-
-    def css(rgb):
-        return "rgb({},{},{})".format(*rgb_bytes(rgb))
-
-    svg = ("<svg xmlns='http://www.w3.org/2000/svg' width='18' height='18'>"
-           f"<rect width='18' height='18' fill='{css(m.diffuse)}'/>"
-           f"<rect x='9' width='9' height='9' fill='{css(m.specular)}'/></svg>")  # fmt: skip
+    """The desktop's swatch of material ``m`` (:func:`~explorer.app.colours.swatch_squares`:
+    the diffuse colour with the specular colour in the top right quarter) as an SVG data
+    URL."""
+    rects = "".join(
+        f"<rect x='{x}' y='{y}' width='{w}' height='{h}' fill='rgb({r},{g},{b})'/>"
+        for x, y, w, h, (r, g, b) in swatch_squares(m, 18)
+    )
+    svg = f"<svg xmlns='http://www.w3.org/2000/svg' width='18' height='18'>{rects}</svg>"
     return "data:image/svg+xml;utf8," + quote(svg)
 
 
