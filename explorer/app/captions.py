@@ -1,10 +1,12 @@
 """What both front ends say of the state in words (no toolkit): the line of the mesh file's own
-materials, the name of the material shown, and the line above the preset list. The panel
-model's text rows and the views' captions read them."""
+materials, the name of the material shown, the line above the preset list and the state's
+summary. The panel model's text rows, the views' captions and the window's status bar read
+them."""
 
 from __future__ import annotations
 
-from explorer.app.model import State
+from explorer.app.model import TERMS, State
+from explorer.core.texture import MAP_KEYS
 
 
 def mesh_materials_line(state: State, source=str) -> str:
@@ -40,3 +42,17 @@ def material_line(state: State) -> str:
     if state.preset:
         return f"preset: {state.preset}{edited}"
     return f"material: {material_title(state)}{edited}"
+
+
+def summary(state: State) -> str:
+    """The state in one line (the window's status bar): the material shown (or the mesh file's
+    own materials), the model, and the terms and texture maps hidden:
+    ``gold;  blinn-phong;  hidden: specular``."""
+    what = material_title(state)
+    if state.groups is not None:
+        what = f"{state.mesh_materials.source}'s materials"
+    parts = [what, state.scene.model]
+    hidden = [t for t in (*TERMS, *MAP_KEYS) if t in state.hidden]  # (terms, maps off)
+    if hidden:
+        parts.append("hidden: " + ", ".join(hidden))
+    return ";  ".join(parts)

@@ -1,5 +1,5 @@
 """Colours as the controls of both front ends show them (no Qt, no trame): a colour value as
-text, and the 8-bit colour the view draws for it."""
+text, the 8-bit colour the view draws for it, and a material's swatch."""
 
 from __future__ import annotations
 
@@ -61,3 +61,14 @@ def text_on(rgb) -> str:
     luminance where both ratios meet."""
     y = relative_luminance(rgb)
     return "#000000" if contrast_ratio(y, 0.0) >= contrast_ratio(y, 1.0) else "#ffffff"
+
+
+def swatch_squares(material, size: int) -> tuple[tuple[int, int, int, int, tuple], ...]:
+    """A material's swatch (beside a preset in both front ends' lists) as filled squares
+    ``(x, y, width, height, rgb_bytes)`` of a ``size`` x ``size`` picture, top-left origin:
+    the diffuse colour, with the specular colour in the top right quarter."""
+    half = size // 2
+    return (
+        (0, 0, size, size, rgb_bytes(material.diffuse)),
+        (half, 0, size - half, half, rgb_bytes(material.specular)),
+    )

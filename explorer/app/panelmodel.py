@@ -44,7 +44,7 @@ from explorer.app import captions, loberows, maprows
 from explorer.app import effectactions as E
 from explorer.app import model as M
 from explorer.app import termstrip as T
-from explorer.core.controls import CONTROLS, Control
+from explorer.core.controls import CONTROLS, Control, without_unit
 from explorer.core.errors import ExplorerError
 from explorer.core.hdr import TONE_MAPS
 from explorer.core.lights import LIGHT_TYPES
@@ -138,6 +138,27 @@ class Row:
         """The value when the row is shown, else None (the page hides a row whose value is
         None)."""
         return self.value(state) if self.visible(state) else None
+
+    def parse(self, text):
+        """The value of ``text`` typed into this row's field: a number (its unit may follow,
+        :func:`~explorer.core.controls.without_unit`) or a triple's numbers (``kc, kl, kq``),
+        each within the field's range (:func:`~explorer.app.model.parse_number`), or a colour
+        (``r, g, b`` or ``#rrggbb``, :func:`~explorer.app.model.parse_colour`). Anything else
+        is an :class:`ExplorerError` naming the key (and the range)."""
+        if self.kind == "colour":
+            return M.parse_colour(self.key, str(text))
+        if self.kind not in ("number", "triple"):
+            raise ExplorerError(f"'{self.key}' takes no typed value")
+        lo, hi = self.control.field_range
+        if self.kind == "number":
+            return M.parse_number(self.key, without_unit(self.control, str(text)), lo, hi)
+        parts = [M.parse_number(self.key, t, lo, hi) for t in str(text).split(",")]
+        if len(parts) != len(self.choices):
+            names = ", ".join(self.choices)
+            raise ExplorerError(
+                f"{self.key}: give {len(self.choices)} numbers {names}, got {text!r}"
+            )
+        return tuple(parts)
 
     def slider_range(self, state: M.State) -> tuple[float, float]:
         """A number's slider range in ``state`` (:attr:`slider`, else the table's)."""

@@ -15,8 +15,15 @@ import sys
 
 import numpy as np
 
-from explorer.app.model import MeshMaterials, State, check_window_lights, with_mesh_materials
+from explorer.app.model import (
+    DEFAULT_PLACEMENT,
+    MeshMaterials,
+    State,
+    check_window_lights,
+    with_mesh_materials,
+)
 from explorer.core.errors import ExplorerError
+from explorer.core.lights import PointLight
 from explorer.core.material import Material
 from explorer.core.presets import list_presets
 from explorer.core.scene import Scene, Viewer
@@ -66,6 +73,13 @@ def default_viewer(mesh: Mesh) -> Viewer:
     e = np.asarray(DEFAULT_EYE_DIRECTION, dtype=np.float64)
     eye = mesh.centre + DEFAULT_EYE_DISTANCE * (mesh.radius or 1.0) * e / np.linalg.norm(e)
     return Viewer(eye=tuple(float(c) for c in eye))
+
+
+def default_light(mesh: Mesh) -> PointLight:
+    """The start's light: a white point light at :data:`~explorer.app.model.DEFAULT_PLACEMENT`
+    (its distance in mesh radii) around the mesh centre."""
+    az, el, d = DEFAULT_PLACEMENT
+    return PointLight().placed(az, el, d * (mesh.radius or 1.0), mesh.centre)
 
 
 def first_state(

@@ -127,6 +127,16 @@ class PlotterView:
 
         return call
 
+    def watch_drags(self, plotter) -> None:
+        """``plotter``'s camera drags are drags (:meth:`begin_drag`, :meth:`end_drag`: the level
+        of detail; in per-pixel mode the drag fallback): its interactor's style starts and ends
+        each camera interaction (Qt's mouse, or the page's pointer passed on by its remote
+        view). Side A's plotter and side B's are watched alike."""
+        style = plotter.iren.interactor.GetInteractorStyle()
+        if style is not None:
+            style.AddObserver("StartInteractionEvent", self.guard(self.begin_drag, "camera"))
+            style.AddObserver("EndInteractionEvent", self.guard(self.end_drag, "camera"))
+
     def begin_drag(self, *_) -> None:
         """A drag starts (a slider, the camera, a handle): the level of detail is drawn, and
         the difference waits for the end."""
@@ -215,6 +225,45 @@ class PlotterView:
         if self.side_b is not None:
             img = self.side_b.beside(img)
         return encode_png(np.ascontiguousarray(img))
+
+    # -- what a test or a script reads ----------------------------------------------------------
+    def report(self, at=None) -> dict:
+        """What either front end reports of its view (plain JSON values): the frames drawn and
+        the last change's time to its frame's end (ms; None before one), the mesh's vertices,
+        the probe vertex and its pixel, each light handle's pixel, undo and redo, the errors
+        said, the difference view, and the per-pixel picture (its pictures made, whether a
+        drag draws per vertex now, the last per-pixel picture's and per-vertex frame's times
+        in ms, None before one). ``at``: a pixel of the view (origin top-left) -> the pixel
+        the front end reports (the window's own; default the view's)."""
+        c, view = self.controller, self.view
+        s = c.state
+
+        def px(world):
+            p = view.world_to_window(world)
+            return p if at is None else at(p)
+
+        def ms(v: float):
+            return None if np.isnan(v) else round(float(v), 2)
+
+        probe = view.probe_vertex()
+        p = self.pixels
+        return {
+            "frame": self.frames,
+            "frame_ms": None if np.isnan(self.frame_ms) else self.frame_ms,
+            "n_vertices": view.mesh.n_vertices,
+            "probe": {"vertex": probe, "px": px(view.mesh.positions[probe])},
+            "handles_px": [px(M.handle_point(s, i)) for i in range(len(s.scene.lights))],
+            "can_undo": c.store.can_undo,
+            "can_redo": c.store.can_redo,
+            "errors": list(c.errors),
+            "difference": self.heat.state(),
+            "pixels": {
+                "frames": p.frames,
+                "fallback": p.fallback,
+                "ms": ms(p.ms),
+                "vertex_ms": ms(p.vertex_ms),
+            },
+        }
 
     # -- frames ----------------------------------------------------------------------------------
     def _pixels_before(self, *_) -> None:

@@ -10,7 +10,6 @@ import sys
 from explorer.app import session as S
 from explorer.app import start as gui
 from explorer.app.effectactions import set_shading
-from explorer.app.model import DEFAULT_PLACEMENT
 from explorer.cli.options import build_scene
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
@@ -41,7 +40,8 @@ def start(args):
     """The explorer's start from the command line: ``(scene, mesh, preset name)``.
 
     Without a SCENE file the start is :data:`explorer.app.start.DEFAULT_PRESET` on the teapot
-    under one point light placed at :data:`explorer.app.model.DEFAULT_PLACEMENT`, seen from a
+    under one point light placed at :data:`explorer.app.model.DEFAULT_PLACEMENT`
+    (:func:`explorer.app.start.default_light`), seen from a
     local viewer (a perspective camera); built-in meshes get the explorer's finer resolutions
     (:data:`explorer.app.start.MESH_CHOICES`) unless ``--resolution`` is given, with their
     (u, v) as the mesh chooser loads them (:func:`explorer.app.start.load_mesh_choice`), so the
@@ -56,10 +56,8 @@ def start(args):
     scene = scene.replace(mesh=spec)  # the state names the mesh shown
     if args.resolution is None and spec in gui.MESH_CHOICES:
         mesh = get_mesh(spec, gui.MESH_CHOICES[spec], uv=True)  # (maps can be chosen later)
-    r = mesh.radius or 1.0
     if scene.lights == (placeholder,):  # no scene lights and no --light-* option
-        az, el, d = DEFAULT_PLACEMENT
-        scene = scene.replace(lights=(PointLight().placed(az, el, d * r, mesh.centre),))
+        scene = scene.replace(lights=(gui.default_light(mesh),))
     if args.scene is None and args.viewer_eye is None and args.viewer_to_viewer is None:
         scene = scene.replace(viewer=gui.default_viewer(mesh))
     preset = args.preset if isinstance(args.preset, str) else scene.material.name

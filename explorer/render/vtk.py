@@ -92,11 +92,19 @@ def plotter(size: Sequence[int], background, *, off_screen: bool = True, title: 
     else:
         pl = pv.Plotter(window_size=[w, h], lighting=None, title=title)
     pl.render_window.SetMultiSamples(0)  # before the first render: no multisampling
+    draw_as_the_engine(pl, background)
+    return pl
+
+
+def draw_as_the_engine(pl, background) -> None:
+    """Any PyVista plotter (an off-screen one, a window, the Qt window's ``QtInteractor`` s)
+    set up to show the engine's colours as they are: no anti-aliasing, translucency blended
+    in draw order (:func:`plain_blending`), ``background`` (RGB in [0, 1]), and one frame at a
+    time (:func:`one_frame_at_a_time`: the difference worker draws too)."""
     pl.disable_anti_aliasing()
     plain_blending(pl.renderer)
     pl.set_background(background)
     one_frame_at_a_time(pl.render_window)
-    return pl
 
 
 def plain_blending(renderer) -> None:

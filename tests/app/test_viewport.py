@@ -248,3 +248,34 @@ def test_side_b_draws_its_mesh_while_side_a_shows_the_heat_map(port):
     port.redraw()
     b.plotter.render_window.Render()
     assert np.array_equal(b.plotter.screenshot(return_img=True)[:, :, :3], before)
+
+
+def test_a_watched_plotters_camera_interaction_is_a_drag(port):
+    """Both front ends watch their plotters (side A's, side B's) through the view port: the
+    interactor style's interaction is a drag, its end a picture."""
+    port.watch_drags(port.plotter)
+    style = port.plotter.iren.interactor.GetInteractorStyle()
+    sent = port.pictures.sent
+    style.InvokeEvent("StartInteractionEvent")
+    assert port.dragging() and port.view.lod_active
+    style.InvokeEvent("EndInteractionEvent")
+    assert not port.dragging() and port.pictures.sent == sent + 1
+
+
+def test_the_report_is_the_views_in_the_front_ends_pixels(port):
+    """Both front ends report their view through the view port (the window in its own pixels,
+    the page in the view's): JSON values, the probe and the handles where they are drawn."""
+    import json
+
+    c = port.controller
+    c.set_value("kd", 0.4, merge=False)
+    rep = port.report()
+    json.dumps(rep)  # plain values
+    i = rep["probe"]["vertex"]
+    assert list(rep["probe"]["px"]) == list(port.view.world_to_window(port.view.mesh.positions[i]))
+    assert len(rep["handles_px"]) == len(c.state.scene.lights) >= 1
+    assert rep["frame"] == port.frames and rep["frame_ms"] > 0 and rep["can_undo"]
+    assert rep["n_vertices"] == port.view.mesh.n_vertices and rep["errors"] == []
+    assert rep["difference"]["shown"] is False and rep["pixels"]["frames"] == 0
+    moved = port.report(at=lambda px: [px[0] + 10, px[1] + 20])
+    assert list(moved["probe"]["px"]) == [rep["probe"]["px"][0] + 10, rep["probe"]["px"][1] + 20]

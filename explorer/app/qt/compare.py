@@ -10,7 +10,7 @@ from PySide6 import QtCore
 
 from explorer.app.qt.menus import ViewKeys
 from explorer.render.images import side_by_side
-from explorer.render.vtk import one_frame_at_a_time, plain_blending
+from explorer.render.vtk import draw_as_the_engine
 
 
 class CompareView:
@@ -30,12 +30,9 @@ class CompareView:
 
         w = self.w
         pl = QtInteractor(w.views, multi_samples=0, auto_update=False)
-        one_frame_at_a_time(pl.render_window)  # (the difference worker draws too)
+        draw_as_the_engine(pl, w.plotter.renderer.GetBackground())  # as side A's
         pl.setObjectName("view_b")
         pl.setMinimumSize(120, 150)
-        pl.disable_anti_aliasing()
-        plain_blending(pl.renderer)
-        pl.set_background(w.plotter.renderer.GetBackground())
         w.views.addWidget(pl)
         w.plotter_b = pl
         return pl

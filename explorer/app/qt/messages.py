@@ -5,42 +5,24 @@ bar has room for one short line; a message that does not fit it, or that comes w
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass
-
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from explorer.app.controller.ports import log_head
+from explorer.app.messagelog import Message
+from explorer.app.messagelog import MessageLog as Said
 
 #: how long a status message stays (ms); errors stay until the next message
 MESSAGE_MS = 6000
-#: the levels of a message, in the order of their weight
-LEVELS = ("info", "warning", "error")
-
-
-@dataclass(frozen=True)
-class Message:
-    """One message: ``level`` (one of :data:`LEVELS`), its text and its details (each whole),
-    and when it came (``HH:MM:SS``)."""
-
-    level: str
-    text: str
-    details: tuple[str, ...] = ()
-    at: str = ""
-
-    def lines(self) -> list[str]:
-        head = log_head(self.at, self.level, self.text)
-        return [head, *(f"    {d}" for d in self.details)]
 
 
 class MessageLog(QtWidgets.QDialog):
-    """The log (non-modal): a read-only text of every message, a Copy all button."""
+    """The log (non-modal): a read-only text of every message (``said``, the kit's
+    :class:`~explorer.app.messagelog.MessageLog`), a Copy all button."""
 
     def __init__(self, parent=None):
         super().__init__(parent)
         self.setObjectName("messages")
         self.setWindowTitle("phong-explorer: messages")
-        self.messages: list[Message] = []
+        self.said = Said()
         self.text = QtWidgets.QPlainTextEdit()
         self.text.setObjectName("messages_text")
         self.text.setReadOnly(True)
@@ -60,8 +42,7 @@ class MessageLog(QtWidgets.QDialog):
         self.resize(640, 300)
 
     def add(self, level: str, text: str, details=()) -> Message:
-        m = Message(level, text, tuple(details), time.strftime("%H:%M:%S"))
-        self.messages.append(m)
+        m = self.said.add(level, text, details)
         self.text.appendPlainText("\n".join(m.lines()))
         return m
 
@@ -72,7 +53,7 @@ class MessageLog(QtWidgets.QDialog):
         QtGui.QGuiApplication.clipboard().setText(self.plain_text())
 
     def count(self, level: str) -> int:
-        return sum(m.level == level for m in self.messages)
+        return self.said.count(level)
 
 
 class MessageIndicator(QtWidgets.QToolButton):

@@ -18,7 +18,7 @@ from __future__ import annotations
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
-from explorer.app.colours import rgb_bytes, rgb_text, text_on
+from explorer.app.colours import rgb_bytes, rgb_text, swatch_squares, text_on
 from explorer.core.controls import CONTROLS, STEPS, Control, from_step, to_step
 from explorer.core.errors import ExplorerError
 
@@ -330,11 +330,11 @@ def _scroll(widget: QtWidgets.QWidget) -> QtWidgets.QScrollArea:
 
 
 def swatch(material, size: int = 18) -> QtGui.QIcon:
-    """A small square of the material's diffuse colour with its specular colour in a corner."""
+    """A small square of the material's diffuse colour with its specular colour in a corner
+    (:func:`~explorer.app.colours.swatch_squares`)."""
     pm = QtGui.QPixmap(size, size)
-    pm.fill(qcolour(material.diffuse))
     p = QtGui.QPainter(pm)
-    spec = qcolour(material.specular)
-    p.fillRect(size // 2, 0, size - size // 2, size // 2, spec)
+    for x, y, w, h, rgb in swatch_squares(material, size):
+        p.fillRect(x, y, w, h, QtGui.QColor(*rgb))
     p.end()
     return QtGui.QIcon(pm)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
+from explorer.app.steps import Steps
 from explorer.shading import tiers
 
 #: how often the job's timer takes a step (ms; 0: whenever the event loop is idle)
@@ -19,8 +20,9 @@ ENGINE_CHARS = 30
 
 def run_steps(parent, title: str, text: str, total: int, step, cancel):
     """``step()`` called from the event loop under a window-modal progress dialog until it
-    returns None (see :class:`explorer.app.controller.ports.Progress`); the dialog's Cancel
-    calls ``cancel()``. Returns the dialog."""
+    returns None (see :class:`explorer.app.controller.ports.Progress`; stepped as
+    :class:`~explorer.app.steps.Steps`); the dialog's Cancel calls ``cancel()``. Returns the
+    dialog."""
     dialog = QtWidgets.QProgressDialog(text, "Cancel", 0, total, parent)
     dialog.setObjectName(f"{title}_progress")
     dialog.setWindowTitle(f"phong-explorer: {title}")
@@ -29,23 +31,20 @@ def run_steps(parent, title: str, text: str, total: int, step, cancel):
     dialog.setAutoClose(False)
     dialog.setAutoReset(False)
     timer = QtCore.QTimer(dialog)
+    job = Steps(title, text, total, step, cancel)
 
     def tick() -> None:
         if dialog.wasCanceled():
             timer.stop()
             dialog.close()
-            cancel()
-            return
-        out = step()
-        if out is None:
+            job.cancel()
+        elif job.next():
+            dialog.setValue(job.done)
+            dialog.setLabelText(job.text)
+        else:
             timer.stop()
             dialog.setValue(total)
             dialog.close()
-            return
-        done, label = out
-        dialog.setValue(done)
-        if label:
-            dialog.setLabelText(label)
 
     timer.timeout.connect(tick)
     timer.start(STEP_MS)

@@ -11,7 +11,6 @@ from explorer.app import captions
 from explorer.app import model as M
 from explorer.app.session import session_mapping
 from explorer.core.atomic import write_atomic
-from explorer.core.texture import MAP_KEYS
 
 
 class QtPictures:
@@ -26,17 +25,11 @@ class QtPictures:
         self.w.plotter.render_window.Render()
 
     def show_controls(self, state: M.State) -> None:
-        """The controls and the status bar's summary show ``state``."""
+        """The controls and the status bar's summary (:func:`~explorer.app.captions.summary`)
+        show ``state``."""
         w = self.w
         w.panel.show_state(state, w.view.mesh.n_vertices)
-        what = captions.material_title(state)
-        if state.groups is not None:
-            what = f"{state.mesh_materials.source}'s materials"
-        parts = [what, state.scene.model]
-        hidden = [t for t in (*M.TERMS, *MAP_KEYS) if t in state.hidden]  # (terms, maps off)
-        if hidden:
-            parts.append("hidden: " + ", ".join(hidden))
-        w.status_label.setText(";  ".join(parts))
+        w.status_label.setText(captions.summary(state))
 
     def show_legend(self, legend: str, advice: str) -> None:
         """The panel's legend and advice (hidden while the difference is off)."""

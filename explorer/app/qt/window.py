@@ -19,7 +19,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
@@ -38,7 +37,7 @@ from explorer.app.start import TITLE, WINDOW_SIZE
 from explorer.app.view import LOD_TARGET, LOD_VERTICES
 from explorer.app.viewport import PlotterView
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import one_frame_at_a_time, plain_blending
+from explorer.render.vtk import draw_as_the_engine
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
@@ -103,13 +102,11 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.views = QtWidgets.QSplitter(QtCore.Qt.Orientation.Horizontal)
         self.views.setChildrenCollapsible(False)
         self.plotter = QtInteractor(self.views, multi_samples=0, auto_update=False)
-        one_frame_at_a_time(self.plotter.render_window)  # (the difference worker draws too)
+        # the engine's colours, translucency drawn as the off-screen renders draw it
+        draw_as_the_engine(self.plotter, BACKGROUND if background is None else background)
         self.plotter.setObjectName("view")
         self.plotter.setMinimumSize(120, 120)
         self.plotter.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
-        self.plotter.disable_anti_aliasing()
-        plain_blending(self.plotter.renderer)  # translucency drawn as the off-screen renders
-        self.plotter.set_background(BACKGROUND if background is None else background)
         self.views.addWidget(self.plotter)
         self.splitter.addWidget(self.views)
         self.splitter.setStretchFactor(0, 1)
@@ -127,12 +124,8 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         """``pl``'s camera drags are drags (the level of detail, one undo step); VTK's and
         PyVista's own keys (w wireframe, s surface, ...) would change the picture behind the
         state's back: the window's keys are the only keys."""
+        self.viewport.watch_drags(pl)
         iren = pl.iren.interactor
-        style = iren.GetInteractorStyle()
-        if style is not None:
-            vp = self.viewport
-            style.AddObserver("StartInteractionEvent", self._guard(vp.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self._guard(vp.end_drag, "camera"))
         for key in list(getattr(pl, "_key_press_event_callbacks", {})):
             pl.clear_events_for_key(key)
 
@@ -218,9 +211,12 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         return [p.x(), p.y(), widget.width(), widget.height()]
 
     def report_state(self) -> dict:
-        """What a test or a script may want to know beyond the session (plain JSON values)."""
-        s, store, view = self.controller.state, self.controller.store, self.view
-        probe = view.probe_vertex()
+        """What a test or a script may want to know beyond the session (plain JSON values): the
+        view port's report (:meth:`PlotterView.report`, its pixels in the window's), and the
+        window's own: its size, the view's box, the selected light's handle and the arrows
+        toward handles out of the view, the handle's glyph, the drag and the level of detail,
+        every named widget's box, the last message."""
+        s, view = self.controller.state, self.view
         origin = self.widget_box(self.plotter)[:2]
 
         def in_window(px):
@@ -229,8 +225,6 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         handle = None
         if s.selected_light is not None:
             handle = in_window(view.world_to_window(M.handle_point(s)))
-        handles = [in_window(view.world_to_window(M.handle_point(s, i)))
-                   for i in range(len(s.scene.lights))]  # fmt: skip
         _, h = self.plotter.window_size
         arrows = {str(i): in_window([round(float(t[0, 0])), round(h - 1 - float(t[0, 1]))])
                   for i, t in view.marker_triangles.items()}  # fmt: skip
@@ -239,22 +233,19 @@ class ExplorerWindow(QtWidgets.QMainWindow):
             for w in self.findChildren(QtWidgets.QWidget)
             if w.objectName() and not w.objectName().startswith("qt_") and w.isVisible()
         }
-        frame_ms = self.viewport.frame_ms
         return {
-            "frame": self.viewport.frames,
-            "frame_ms": None if not np.isfinite(frame_ms) else frame_ms,
+            **self.viewport.report(at=in_window),
             "window_size": [self.width(), self.height()],
             "view_box": self.widget_box(self.plotter),
-            "n_vertices": view.mesh.n_vertices, "edited": s.edited,
-            "dragging": view.dragging > 0, "lod": view.lod_active,
-            "handle_px": handle, "handles_px": handles, "arrows_px": arrows,
+            "edited": s.edited,
+            "dragging": view.dragging > 0,
+            "lod": view.lod_active,
+            "handle_px": handle,
+            "arrows_px": arrows,
             "glyph": view.glyph_kind,
-            "probe": {"vertex": probe,
-                      "px": in_window(view.world_to_window(view.mesh.positions[probe]))},
-            "difference": self.heat.state(), "widgets": widgets,
-            "can_undo": store.can_undo, "can_redo": store.can_redo,
-            "message": self.message, "errors": list(self.controller.errors),
-        }  # fmt: skip
+            "widgets": widgets,
+            "message": self.message,
+        }
 
     def showEvent(self, event: QtGui.QShowEvent) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)

@@ -11,8 +11,8 @@ import numpy as np
 
 class WebCompare:
     """Side B's pane of ``app`` (a :class:`~explorer.app.web.WebExplorer`: its ``plotter``,
-    ``server``, ``loop``, ``guard`` and ``_send``): :attr:`plotter` is made with the page (its
-    remote view needs it). The page shows or hides side B's view itself (state
+    ``viewport``, ``server``, ``loop``, ``guard`` and ``_send``): :attr:`plotter` is made with
+    the page (its remote view needs it). The page shows or hides side B's view itself (state
     ``compare``). Side B draws the light handles, the selected one's ring and the arrows at
     its edge toward handles out of it, as the window's pane B does: a drag on B's handle moves
     the light in both panes (the remote view passes the page's pointer to B's interactor)."""
@@ -30,7 +30,7 @@ class WebCompare:
 
     def made(self, plotter, view) -> None:
         """Side B's camera drags are drags too (one camera: B's drag moves A's)."""
-        self.app.watch_camera(plotter)
+        self.app.viewport.watch_drags(plotter)
 
     def show_pane(self, visible: bool) -> None:
         pass

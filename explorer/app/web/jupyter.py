@@ -19,6 +19,7 @@ from explorer.app.session import session_mapping
 from explorer.app.start import (
     DEFAULT_MESH,
     DEFAULT_PRESET,
+    default_light,
     default_viewer,
     first_state,
     load_mesh_choice,
@@ -32,7 +33,6 @@ from explorer.app.web.server import (
     own_arguments,
 )
 from explorer.core.errors import ExplorerError, ExplorerTypeError
-from explorer.core.lights import PointLight
 from explorer.core.presets import find_preset
 from explorer.core.scene import Scene, load_scene
 from explorer.geometry.meshes import Mesh
@@ -55,9 +55,7 @@ def notebook_state(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str
     material)."""
     m = load_mesh_choice(mesh)
     if scene is None:
-        az, el, d = M.DEFAULT_PLACEMENT
-        light = PointLight().placed(az, el, d * (m.radius or 1.0), m.centre)
-        scene = Scene(lights=(light,), viewer=default_viewer(m))
+        scene = Scene(lights=(default_light(m),), viewer=default_viewer(m))
     else:
         scene = load_scene(scene, materials_dirs=materials_dirs)
     if preset is not None:

@@ -121,7 +121,7 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
             model_value=(f"{key}_text", ""), key=(f"'{key}-' + field_rev",), type="text",
             density="compact", hide_details=True,
             variant="outlined",
-            change=(ctrl.on_field, f"['{key}', $event.target.value]"),
+            change=(ctrl.on_typed, f"['{key}', $event.target.value]"),
             raw_attrs=[f'aria-label="{key}"'],
         )  # fmt: skip
 
@@ -135,7 +135,7 @@ def _colour(v3, html, ctrl, key: str, label: str) -> None:
             model_value=(key, ""), key=(f"'{key}-' + field_rev",), label=label,
             density="compact", hide_details=True,
             variant="outlined", classes="flex-grow-1",
-            change=(ctrl.on_colour, f"['{key}', $event.target.value]"),
+            change=(ctrl.on_typed, f"['{key}', $event.target.value]"),
             raw_attrs=[f'aria-label="{label}"'],
         )  # fmt: skip
         with v3.VMenu(close_on_content_click=False, location="end", update_modelValue=ctrl.seal):
@@ -211,7 +211,7 @@ def _triple(v3, ctrl, r) -> None:
     v3.VTextField(
         model_value=(r.key, ""), key=(f"'{r.key}-' + field_rev",), variant="outlined",
         label=f"{r.key} ({', '.join(r.choices)})",
-        change=(ctrl.on_triple, f"['{r.key}', $event.target.value]"), **_shown_as(r.key, r.tip),
+        change=(ctrl.on_typed, f"['{r.key}', $event.target.value]"), **_shown_as(r.key, r.tip),
     )  # fmt: skip
 
 

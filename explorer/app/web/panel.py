@@ -29,8 +29,8 @@ from urllib.parse import quote
 
 from explorer.app import model as M
 from explorer.app import panelmodel
-from explorer.app.colours import parse_hex, rgb_bytes, rgb_hex, rgb_text
-from explorer.core.controls import field_text, from_step, to_step, without_unit
+from explorer.app.colours import parse_hex, rgb_hex, rgb_text, swatch_squares
+from explorer.core.controls import field_text, from_step, to_step
 from explorer.core.errors import ExplorerError
 from explorer.render.textures import file_stamp, thumbnail
 
@@ -53,15 +53,14 @@ def number_values(state: M.State) -> dict:
 
 
 def swatch_url(m) -> str:
-    """The desktop's swatch of material ``m`` (the diffuse colour with the specular colour in
-    the top right quarter) as an SVG data URL."""
-
-    def css(rgb):
-        return "rgb({},{},{})".format(*rgb_bytes(rgb))
-
-    svg = ("<svg xmlns='http://www.w3.org/2000/svg' width='18' height='18'>"
-           f"<rect width='18' height='18' fill='{css(m.diffuse)}'/>"
-           f"<rect x='9' width='9' height='9' fill='{css(m.specular)}'/></svg>")  # fmt: skip
+    """The desktop's swatch of material ``m`` (:func:`~explorer.app.colours.swatch_squares`:
+    the diffuse colour with the specular colour in the top right quarter) as an SVG data
+    URL."""
+    rects = "".join(
+        f"<rect x='{x}' y='{y}' width='{w}' height='{h}' fill='rgb({r},{g},{b})'/>"
+        for x, y, w, h, (r, g, b) in swatch_squares(m, 18)
+    )
+    svg = f"<svg xmlns='http://www.w3.org/2000/svg' width='18' height='18'>{rects}</svg>"
     return "data:image/svg+xml;utf8," + quote(svg)
 
 
@@ -212,18 +211,14 @@ def _numbers(app) -> None:
     for r in NUMBERS:
         state.change(f"{r.key}_step")(on_slider(r))
 
-    def on_field(key, text):
-        control = panelmodel.row(key).control
-        lo, hi = control.field_range
-        _typed(app, lambda: M.parse_number(key, without_unit(control, text), lo, hi),
-               lambda v: v != number_values(app.store.state)[key]
-               and c.set_value(key, v, merge=False))  # fmt: skip
-
-    def on_colour(key, text):
+    def on_typed(key, text):
+        """A number's, a colour's or a triple's field confirmed: its text parsed as the row
+        parses it (:meth:`~explorer.app.panelmodel.Row.parse`), set when it is not the value
+        the field shows (a number's, rounded)."""
+        r = panelmodel.row(str(key))
+        shown = number_values(app.store.state).get(r.key)
         _typed(
-            app,
-            lambda: M.parse_colour(key, str(text)),
-            lambda rgb: c.set_value(key, rgb, merge=False),
+            app, lambda: r.parse(text), lambda v: v != shown and c.set_value(r.key, v, merge=False)
         )
 
     def on_pick(key, text):
@@ -240,24 +235,8 @@ def _numbers(app) -> None:
             ),
         )
 
-    def on_triple(key, text):
-        r = panelmodel.row(key)
-        lo, hi = r.control.field_range
-
-        def parse():
-            parts = [M.parse_number(key, t, lo, hi) for t in str(text).split(",")]
-            if len(parts) != len(r.choices):
-                raise ExplorerError(
-                    f"{key}: give {len(r.choices)} numbers {', '.join(r.choices)}, got {text!r}"
-                )
-            return tuple(parts)
-
-        _typed(app, parse, lambda v: c.set_value(key, v, merge=False))
-
-    ctrl.on_field = app.guard(on_field, "field")
-    ctrl.on_colour = app.guard(on_colour, "colour")
+    ctrl.on_typed = app.guard(on_typed, "field")
     ctrl.on_pick = app.guard(on_pick, "colour picker")
-    ctrl.on_triple = app.guard(on_triple, "triple")
     ctrl.seal = app.guard(c.release, "slider")
 
 

@@ -25,22 +25,21 @@ stays free of them).
 from __future__ import annotations
 
 import logging
-import math
 import os
 import tempfile
-import time
 from collections.abc import Sequence
 
 from explorer.app import intents, panelmodel
 from explorer.app import model as M
 from explorer.app.controller import Controller, Ports
-from explorer.app.controller.ports import log_head
 from explorer.app.difference import DifferenceWorker
+from explorer.app.messagelog import MessageLog
 from explorer.app.session import session_mapping
 from explorer.app.sides import SideB
 from explorer.app.start import (
     MESH_CHOICES,
 )
+from explorer.app.steps import Steps
 from explorer.app.viewport import PlotterView
 from explorer.app.web import guard, page, panel, wire
 from explorer.app.web.compare import WebCompare
@@ -90,14 +89,14 @@ class WebExplorer:
         self.pushing = False  # the server is setting the page's values (no user change)
         # the start framed again for the first page's view (as the window frames it when shown)
         self._frame_at = tuple(int(v) for v in size) if state.camera is None else None
-        self.messages: list[dict] = []
+        self.said = MessageLog(keep=MESSAGE_LOG)  # the page's message log
         self.message_seq = 0  # messages said so far (a page shows those after it opened)
         self.answers: dict = {}  # the page's answers to the controller's next questions
         self._uploads = tempfile.TemporaryDirectory(prefix="phong-explorer-web-")
         self.files = WebFiles(self, self._uploads.name)  # the uploads and downloads
         self.loop = None  # the server's event loop (the difference worker delivers into it)
         self.pictures = None  # the pages' picture path (web.pictures.Pictures), once it runs
-        self._job = None  # the long job running (run_steps) and its cancel
+        self._job: Steps | None = None  # the long job running (run_steps)
         self.server = get_server(name, client_type="vue3")
         self.token = guard.new_token()  # the page's key: in the URL the user is given only
         self.hosts = guard.listening_names(DEFAULT_HOST)  # what a Host may name (None: any)
@@ -118,7 +117,7 @@ class WebExplorer:
         self.view = self.viewport.attach(
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
-        self.watch_camera(self.plotter)
+        self.viewport.watch_drags(self.plotter)  # (the remote view passes the page's pointer)
         self.plotter.render_window.AddObserver("StartEvent", self.guard(self._frame, "view"), 1.0)
         panel.connect(self)
         page.build(self)
@@ -134,16 +133,6 @@ class WebExplorer:
         """``fn`` made safe for VTK's and trame's callbacks: an error is said on the page and
         logged, never lost (:meth:`PlotterView.guard`)."""
         return self.viewport.guard(fn, where)
-
-    def watch_camera(self, pl) -> None:
-        """``pl``'s camera drags are drags, as the window's (the level of detail; in per-pixel
-        mode the drag fallback, said on the page): the remote view passes the page's pointer
-        to ``pl``'s interactor, whose style starts and ends each camera interaction."""
-        style = pl.iren.interactor.GetInteractorStyle()
-        if style is not None:
-            vp = self.viewport
-            style.AddObserver("StartInteractionEvent", self.guard(vp.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self.guard(vp.end_drag, "camera"))
 
     def _frame(self, *_) -> None:
         """Before a frame: the first time the view is drawn at another size than it was made
@@ -196,37 +185,30 @@ class WebExplorer:
                      msecs: int | None = None, open_log: bool = True) -> None:  # fmt: skip
         page_text = self.files.page_text
         text, details = page_text(text), [page_text(d) for d in details]
-        at = time.strftime("%H:%M:%S")
-        head = log_head(at, level, text)
-        entry = {"text": text, "level": level, "details": details, "at": at, "head": head}
         if text:  # (empty: the message shown taken away, nothing logged)
-            self.messages = [*self.messages, entry][-MESSAGE_LOG:]
+            self.said.add(level, text, details)
         self.message_seq += 1
         with self.server.state as s:
             s.message = text
             s.message_level = level
             s.message_seq = self.message_seq
-            s.message_log = self.messages
+            s.message_log = [m.as_dict() for m in self.said.messages]
 
     # -- Progress --------------------------------------------------------------------------------
     def run_steps(self, title: str, text: str, total: int, step, cancel) -> object:
         """A long job stepped from the server's loop (pictures keep coming), its progress in the
-        page (state ``progress``: title, text, done, total; the page's Cancel calls
-        ``cancel``). Returns the job's progress record."""
-        job = {"title": title, "text": text, "done": 0, "total": int(total), "running": True}
-        self._job = (job, cancel)
+        page (state ``progress``: title, text, done, total, running; the page's Cancel calls
+        ``cancel``). Returns the job's :class:`~explorer.app.steps.Steps`."""
+        job = self._job = Steps(title, text, total, step, cancel)
         self._show_progress(job)
 
         def go():
-            if not job["running"]:
-                return
-            out = step()
-            if out is None:
-                job["running"] = False
-                self._job = None
-            else:
-                job["done"], job["text"] = out[0], out[1] or job["text"]
+            if not job.running:
+                return  # cancelled (cancel_job showed it)
+            if job.next():
                 self.loop.call_soon(self.guard(go, title))
+            elif self._job is job:
+                self._job = None
             self._show_progress(job)
 
         self.loop.call_soon(self.guard(go, title))
@@ -235,17 +217,15 @@ class WebExplorer:
     def cancel_job(self) -> None:
         """The page's Cancel: the running job stops, and its flow says what was left."""
         if self._job is not None:
-            job, cancel = self._job
-            job["running"] = False
-            self._job = None
-            cancel()
+            job, self._job = self._job, None
+            job.cancel()
             self._show_progress(job)
 
-    def _show_progress(self, job: dict) -> None:
+    def _show_progress(self, job: Steps) -> None:
         path = self.files.turntable_path
         with self.server.state as s:
-            s.progress = dict(job)
-            s.turntable_ready = not job["running"] and path is not None and path.is_file()
+            s.progress = job.as_dict()
+            s.turntable_ready = not job.running and path is not None and path.is_file()
             s.turntable_made = self.files.turntable_made if s.turntable_ready else ""
 
     # -- Choices ---------------------------------------------------------------------------------
@@ -319,36 +299,28 @@ class WebExplorer:
             self.pushing = False
 
     def report_state(self) -> dict:
-        """What a test may read (plain JSON values): the frame count, the view's size, the
-        probe vertex and its pixel in the view (origin top-left), the session, the last picture's
-        steps."""
-        probe = self.view.probe_vertex()
-        ms = self.viewport.frame_ms
+        """What a test may read (plain JSON values): the view port's report
+        (:meth:`PlotterView.report`, the probe and the handles in the view's pixels, origin
+        top-left), the view's size, the selected light's placement, side B's probe, the term
+        strip, the lobe inset and its lit sphere, the session, the last picture's steps."""
+        state, view, shared = self.store.state, self.view, self.viewport.report()
+        probe = view.mesh.positions[view.probe_vertex()]
         return {
-            "frame": self.viewport.frames,
+            **shared,
             "size": list(self.viewport.size()),
-            "probe": {"vertex": probe,
-                      "px": self.view.world_to_window(self.view.mesh.positions[probe])},
-            "handles_px": [self.view.world_to_window(M.handle_point(self.store.state, i))
-                           for i in range(len(self.store.state.scene.lights))],
-            "placement": (list(self.store.state.placement())
-                          if self.store.state.selected_light is not None else None),
-            "can_undo": self.store.can_undo,
-            "can_redo": self.store.can_redo,
-            "errors": list(self.controller.errors),
-            "n_vertices": self.view.mesh.n_vertices,
-            "difference": self.heat.state(),
+            "placement": list(state.placement()) if state.selected_light is not None else None,
             "compare": self.viewport.side_b.probe() if self.viewport.side_b.shown else None,
-            "strip": self.view.strip.report(self.view.to_view(self.view.mesh.positions[probe])),
-            "lobes": self.view.lobe.report(),
-            "pixels": pixels_report(self.viewport.pixels),
-            "sphere": self.view.lobe.sphere_report(),
-            "session": session_mapping(self.store.state),
+            "strip": view.strip.report(view.to_view(probe)),
+            "lobes": view.lobe.report(),
+            "sphere": view.lobe.sphere_report(),
+            "session": session_mapping(state),
             # the last picture's steps (ms; explorer.app.web.pictures) and the last change's
             # time to its frame's end (the benchmark's breakdown)
-            "picture": {**(self.pictures.times if self.pictures else {}),
-                        "frame_ms": None if ms != ms else ms},  # (NaN: no frame yet)
-        }  # fmt: skip
+            "picture": {
+                **(self.pictures.times if self.pictures else {}),
+                "frame_ms": shared["frame_ms"],
+            },
+        }
 
     def close(self) -> None:
         self.worker.close()
@@ -356,22 +328,6 @@ class WebExplorer:
             self.pictures.close()
         self._uploads.cleanup()
         self.plotter.close()
-
-
-def pixels_report(layer) -> dict:
-    """What a test reads of the per-pixel picture (:class:`~explorer.app.pixellayer.PixelLayer`
-    ``layer``): the pictures made, whether a drag draws per vertex now, and the last per-pixel
-    picture's and per-vertex frame's times (ms; None before one)."""
-
-    def ms(v: float):
-        return None if math.isnan(v) else round(v, 2)
-
-    return {
-        "frames": layer.frames,
-        "fallback": layer.fallback,
-        "ms": ms(layer.ms),
-        "vertex_ms": ms(layer.vertex_ms),
-    }
 
 
 def own_arguments() -> None:

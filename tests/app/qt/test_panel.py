@@ -282,13 +282,13 @@ def test_a_typed_value_out_of_range_is_refused_out_loud(win, qtbot, key, text, l
     assert field.text() == shown  # the state's value, not a clamped or truncated one
     want = f"{key} must be a number within {lo:g} .. {hi:g}, got '{text}'"
     assert want in win.message and win.statusBar().currentMessage() == win.message
-    assert any(want in m.text for m in win.messages.messages)
+    assert any(want in m.text for m in win.messages.said.messages)
     win.controller.errors.clear()
-    logged = len(win.messages.messages)
+    logged = len(win.messages.said.messages)
     type_into(qtbot, field, "0.5")  # a value in range is taken
     assert win.controller.state != before
     # and the error goes from the status bar (it stayed through later edits); nothing logged
-    assert win.statusBar().currentMessage() == "" and len(win.messages.messages) == logged
+    assert win.statusBar().currentMessage() == "" and len(win.messages.said.messages) == logged
 
 
 def test_a_typed_light_value_out_of_range_is_refused_out_loud(win, qtbot):
