@@ -384,9 +384,11 @@ def _footer(layout, v3, html) -> None:
 
     layout.footer.clear()
     with layout.footer:
-        html.Span(classes=("trame__busy ? 'phong-busy on' : 'phong-busy'",),
-                  title=("trame__busy ? 'busy' : 'ready'",),
-                  raw_attrs=['aria-label="busy"'])  # fmt: skip
+        html.Span(
+            classes=("trame__busy ? 'phong-busy on' : 'phong-busy'",),
+            title=("trame__busy ? 'busy' : 'ready'",),
+            raw_attrs=['aria-label="busy"'],
+        )
         html.Span(f"phong-explorer {__version__}", classes="text-caption text-grey")
 
 

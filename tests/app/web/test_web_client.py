@@ -134,9 +134,11 @@ def test_a_change_animates_nothing_in_the_page(page):
         got = page.execute_cdp_cmd("Performance.getMetrics", {})["metrics"]
         return next(m["value"] for m in got if m["name"] == "RecalcStyleCount")
 
-    thumb = 'document.querySelector(\'[aria-label="kd slider"]\').closest(".v-slider")'
-    left = page.execute_script(f"return {thumb}.querySelector('.v-slider-thumb')"
-                               ".getBoundingClientRect().left")  # fmt: skip
+    thumb = (
+        "return document.querySelector('[aria-label=\"kd slider\"]').closest('.v-slider')"
+        ".querySelector('.v-slider-thumb').getBoundingClientRect().left"
+    )
+    left = page.execute_script(thumb)
     page.execute_script("window.watched.srcs = []; window.watched.blobs = [];")
     step = 100 if page.execute_script("return window.trame.state.get('kd_step')") > 500 else 900
     r0 = recalcs()
@@ -147,11 +149,9 @@ def test_a_change_animates_nothing_in_the_page(page):
     # the picture's load, Vue's patch of the slider, the field and the busy mark: 3 here (15-28
     # with the transitions and the spinning circle)
     assert r1 - r0 <= 6
-    moved = page.execute_script(f"return {thumb}.querySelector('.v-slider-thumb')"
-                                ".getBoundingClientRect().left")  # fmt: skip
+    moved = page.execute_script(thumb)
     assert abs(moved - left) > 20  # (kd 0.1 or 0.9: the thumb far from where it was)
-    mark = page.execute_script('return document.querySelector(\'[aria-label="busy"]\')'
-                               ".className")  # fmt: skip
+    mark = page.execute_script("return document.querySelector('[aria-label=\"busy\"]').className")
     assert mark.split() == ["phong-busy"]  # (the server done: the dot empty)
 
 
