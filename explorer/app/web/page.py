@@ -65,6 +65,20 @@ NUMBER_CSS = f"""
   .phong-number .v-text-field {{ width: {NARROW_NUMBER_WIDTHS[1]}px; }}
 }}
 """
+#: the page's CSS animations per change, none (issue 42): Vuetify's slider slides its thumb and
+#: its track's fill to a new value (0.2 s), a toolbar button fades in as it is enabled (undo
+#: after the first change: 0.28 s), and the busy mark is a dot (:func:`_footer`), not
+#: trame's spinning circle; each ran a style recalculation and a layout of the whole page every
+#: frame while it moved (about 20 a change, 10-70 ms of the browser's CPU beside the picture's
+#: decode, on the 2 cores the server's frame needs). The slider's thumb still follows a drag
+#: at once (Vuetify turns the slide off while dragging).
+QUIET_CSS = """
+.v-slider-thumb, .v-slider-track__fill, .v-app-bar .v-btn { transition: none !important; }
+.phong-busy { display: inline-block; width: 10px; height: 10px; border-radius: 50%;
+  border: 2px solid #9e9e9e; margin-right: 8px; }
+.phong-busy.on { background: rgb(var(--v-theme-primary));
+  border-color: rgb(var(--v-theme-primary)); }
+"""
 #: the page's width as a client-only key (``page_w``), on load and on every resize
 PAGE_WIDTH_JS = """
 (() => {
@@ -363,13 +377,18 @@ def _turntable(v3, html, ctrl) -> None:
 
 
 def _footer(layout, v3, html) -> None:
-    """The page's foot: trame's busy indicator and the explorer's name and version (trame's
-    own foot advertises trame and Kitware and lists the server's package versions)."""
+    """The page's foot: a busy mark (a dot, filled while the server works on the page's last
+    request: trame's spinning circle cost a style recalculation every frame of each change,
+    :data:`QUIET_CSS`) and the explorer's name and version (trame's own foot advertises trame
+    and Kitware and lists the server's package versions)."""
 
     layout.footer.clear()
     with layout.footer:
-        busy = ("!!trame__busy",)
-        v3.VProgressCircular(indeterminate=busy, size=16, width=3, classes="mr-2")
+        html.Span(
+            classes=("trame__busy ? 'phong-busy on' : 'phong-busy'",),
+            title=("trame__busy ? 'busy' : 'ready'",),
+            raw_attrs=['aria-label="busy"'],
+        )
         html.Span(f"phong-explorer {__version__}", classes="text-caption text-grey")
 
 
@@ -489,7 +508,7 @@ def build(app) -> None:
         client.Script(webintents.keys_js())  # the registry's keys (the desktop's)
         client.ClientTriggers(mounted="seen_seq = message_seq")
         # Vuetify reserves a page scrollbar (html: overflow-y scroll); the page fits its window
-        client.Style(PAGE_CSS + NUMBER_CSS)
+        client.Style(PAGE_CSS + NUMBER_CSS + QUIET_CSS)
         client.Script(PAGE_WIDTH_JS)
         with layout.toolbar:
             webintents.menus(v3)

@@ -111,6 +111,52 @@ def test_a_change_leaves_for_the_server_before_the_page_redraws(page):
     )
 
 
+#: every CSS transition and animation that starts in the page, kept (kind, property or
+#: animation, the element's class)
+MOVES_JS = """
+window.moves = [];
+for (const t of ['transitionrun', 'animationstart']) {
+  document.addEventListener(t, (e) => window.moves.push([t, e.propertyName || e.animationName,
+    String(e.target.className.baseVal ?? e.target.className)]), true);
+}
+"""
+
+
+def test_a_change_animates_nothing_in_the_page(page):
+    """A kd change moves the slider, the field and the busy mark without a CSS transition or
+    animation (Vuetify's slider slid its thumb and fill for 0.2 s and trame's busy circle
+    spun: a style recalculation and a layout of the page every frame, about 20 a change, on the
+    cores the server's frame needs): the page's style recalculations (Chromium's own count)
+    stay few; the slider's thumb and the busy mark show the new state."""
+    wait("the start's still picture", lambda: still(page))
+    page.execute_script(MOVES_JS)
+    page.execute_cdp_cmd("Performance.enable", {})
+
+    def recalcs() -> float:
+        got = page.execute_cdp_cmd("Performance.getMetrics", {})["metrics"]
+        return next(m["value"] for m in got if m["name"] == "RecalcStyleCount")
+
+    thumb = (
+        "return document.querySelector('[aria-label=\"kd slider\"]').closest('.v-slider')"
+        ".querySelector('.v-slider-thumb').getBoundingClientRect().left"
+    )
+    left = page.execute_script(thumb)
+    page.execute_script("window.watched.srcs = []; window.watched.blobs = [];")
+    step = 100 if page.execute_script("return window.trame.state.get('kd_step')") > 500 else 900
+    r0 = recalcs()
+    page.execute_script("window.trame.state.set('kd_step', arguments[0]);", step)
+    wait("the still picture shown", lambda: still(page, 2))
+    r1 = recalcs()
+    assert page.execute_script("return window.moves") == []
+    # the picture's load, Vue's patch of the slider, the field and the busy mark: 3 here (15-28
+    # with the transitions and the spinning circle)
+    assert r1 - r0 <= 6
+    moved = page.execute_script(thumb)
+    assert abs(moved - left) > 20  # (kd 0.1 or 0.9: the thumb far from where it was)
+    mark = page.execute_script("return document.querySelector('[aria-label=\"busy\"]').className")
+    assert mark.split() == ["phong-busy"]  # (the server done: the dot empty)
+
+
 def test_the_servers_socket_does_not_deflate(server):
     """Offered permessage-deflate (as Chromium offers it), the server does not take it: a
     JPEG or PNG does not shrink, and deflating each picture cost a worker thread's round trip
