@@ -7,7 +7,10 @@ the window's Qt interactor and the page's pushed picture show them as they show 
 tile draws the drawn mesh (the full mesh, or its level of detail during a drag) in its term's
 bytes, :func:`explorer.shading.strip.shader_strip_bytes` of that drawing's Shader: its kept
 light sums recomposed, no light pass; the overflow tile is the sum tile with the vertices the
-display clamped in magenta, its label the share of them. The state's ``strip`` switches it,
+display clamped in magenta, its label the share of them. Where that share is more than 0 a
+caption on a line of its own under the tiles says what the mask is (:func:`overflow_texts`:
+``overflow (magenta): 1.3% of the vertices clamped: ...``; the line stays, empty, where
+nothing is clamped, so the tiles keep one size). The state's ``strip`` switches it,
 ``strip_mode`` picks ``weighted`` or ``raw`` tiles (the panel model's rows, :data:`ROWS`).
 
 Per pixel (the view's ``shading: per-pixel``), each tile is a picture instead: the engine lit
@@ -40,6 +43,9 @@ from explorer.shading.strip import MODES, compose_strip, grouped_strip, shader_s
 
 #: the strip's height as a fraction of the view's (the main view keeps the rest above it)
 STRIP_HEIGHT = 0.2
+#: the overflow caption's line under the tiles (pixels; :func:`tile_boxes`): 12-pixel text
+#: and 2 pixels above and under it
+CAPTION_LINE = 16
 #: the tiles' label colour and font size (pixels)
 LABEL_COLOUR = (0.93, 0.93, 0.93)
 LABEL_FONT = 12
@@ -100,14 +106,33 @@ def label_texts(column: str, mode: str, share: float) -> tuple[str, ...]:
     return (full, *SHORT[column])
 
 
+def overflow_texts(share: float, per_pixel: bool) -> tuple[str, ...]:
+    """The overflow caption and its shorter forms, longest first (the first that fits the
+    strip's width is drawn): ``share`` the clamped share of the vertices (or, ``per_pixel``,
+    of the surface's pixels) in %; none (``()``) where nothing is clamped."""
+    if share <= 0.0:
+        return ()
+    pct = f"{share:.1f}%" if share >= 0.05 else "< 0.1%"
+    unit = "pixels" if per_pixel else "vertices"
+    return (
+        f"overflow (magenta): {pct} of the {unit} clamped: there the terms add up to more "
+        "than 1, the 8-bit tiles to more than the sum tile",
+        f"overflow: {pct} of the {unit} clamped (the tiles add up to more than the sum tile)",
+        f"overflow: {pct} of the {unit} clamped",
+        f"overflow {pct}",
+    )
+
+
 def tile_boxes(width: int, height: int, n: int) -> list[tuple[int, int, int, int]]:
     """The strip's ``n`` tiles in a window of ``width`` x ``height`` pixels: each ``(x, y, w,
     h)`` (pixels, origin bottom-left), all of one width (``width // n``: every tile's per-pixel
-    picture is one picture's size), side by side and centred; the strip's band its height."""
+    picture is one picture's size), side by side and centred; the strip's band its height, the
+    tiles over its bottom :data:`CAPTION_LINE` pixels (the overflow caption's line)."""
     tw = width // n
     th = int(round(STRIP_HEIGHT * height))
+    line = min(CAPTION_LINE, th // 4)  # (a tiny window keeps most of its band for the tiles)
     x0 = (width - n * tw) // 2
-    return [(x0 + i * tw, 0, tw, th) for i in range(n)]
+    return [(x0 + i * tw, line, tw, th - line) for i in range(n)]
 
 
 def _drawing_strip_bytes(drawing, mode: str) -> tuple:
@@ -142,12 +167,15 @@ class TermStrip:
     docstring): :meth:`show` draws it for a state and a drawing, :attr:`renderers` its tiles'
     renderers in :data:`~explorer.render.strip.COLUMNS`' order, :attr:`tiles` the bytes each
     draws, :attr:`overflow` the clamped vertices; :attr:`side` the compare view's pane it is
-    under (``a``, or ``b`` for side B's), :attr:`caption` the line naming it."""
+    under (``a``, or ``b`` for side B's), :attr:`caption` the line naming it,
+    :attr:`overflow_caption` the line under the tiles saying what the overflow mask is."""
 
     def __init__(self, plotter, side: str = "a"):
         self.plotter = plotter
         self.side = side
         self.caption = None  # the text actor naming the side (made with the tiles)
+        self.overflow_caption = None  # the text actor under the tiles (overflow_texts)
+        self._overflow_texts: tuple = ()  # its texts, longest first
         self.renderers: list = []
         self.labels: list = []
         self._texts: list = []  # each label's texts, longest first (label_texts)
@@ -184,6 +212,7 @@ class TermStrip:
                 r.SetDraw(here)  # (left out: the band's background under them)
             self.on, self._key = here, None
         if not here:
+            self._set_overflow(0.0, False)
             return
         self.caption.SetInput(side_caption(state, self.side))
         if drawing is not self._drawing:
@@ -201,7 +230,7 @@ class TermStrip:
             colours[1].Modified()
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts = [label_texts(c, state.strip_mode, share) for c in COLUMNS]
-        self._fit_labels()
+        self._set_overflow(share, False)
 
     def before_pixels(self, state: State, per_pixel: bool, mesh) -> None:
         """The render window's StartEvent: with the strip on and the view drawn per pixel
@@ -267,8 +296,14 @@ class TermStrip:
         over = strip.overflow[first:]
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts[COLUMNS.index("overflow")] = label_texts("overflow", mode, share)
-        self._fit_labels()
+        self._set_overflow(share, True)
         return out
+
+    def _set_overflow(self, share: float, per_pixel: bool) -> None:
+        """The overflow caption for ``share`` (in %) of the vertices or pixels clamped (empty
+        at 0), and the labels, fitted."""
+        self._overflow_texts = overflow_texts(share, per_pixel)
+        self._fit_labels()
 
     def _images_for(self, w: int, h: int) -> list:
         """Each tile's picture actor (made, or remade for a new size), under its label."""
@@ -320,8 +355,8 @@ class TermStrip:
             return
         self._placed = size
         W, H = size
-        for r, (x, _, w, _) in zip(self.renderers, tile_boxes(W, H, len(COLUMNS)), strict=True):
-            r.SetViewport(x / W, 0.0, (x + w) / W, STRIP_HEIGHT)
+        for r, (x, y, w, h) in zip(self.renderers, tile_boxes(W, H, len(COLUMNS)), strict=True):
+            r.SetViewport(x / W, y / H, (x + w) / W, (y + h) / H)
         self._fit_labels()
 
     def _fit_labels(self) -> None:
@@ -338,6 +373,27 @@ class TermStrip:
             else:
                 font = LABEL_MIN_FONT
             prop.SetFontSize(font)
+        if self.overflow_caption is None:
+            return
+        room = int(self._band.GetSize()[0]) - LABEL_ROOM
+        self.overflow_caption.SetInput("")
+        for text in self._overflow_texts:  # (the longest that fits the strip's width)
+            self.overflow_caption.SetInput(text)
+            if fit_font(self.overflow_caption, self._band, room) is not None:
+                break
+        else:
+            self.overflow_caption.GetTextProperty().SetFontSize(LABEL_MIN_FONT)
+
+    def overflow_box(self) -> list[int]:
+        """The overflow caption's box ``[x, y, width, height]`` in window pixels (origin
+        top-left), as drawn (its position and its text's measured size)."""
+        _, wh = self.plotter.window_size
+        extent = [0.0, 0.0]
+        self.overflow_caption.GetSize(self._band, extent)
+        x, y = self._band.GetOrigin()
+        lx, ly = self.overflow_caption.GetPosition()
+        top = wh - (y + ly + extent[1])
+        return [int(x + lx), int(top), int(round(extent[0])), int(round(extent[1]))]
 
     def label_boxes(self) -> dict:
         """Each tile's label box ``[x, y, width, height]`` in window pixels (origin top-left),
@@ -386,6 +442,8 @@ class TermStrip:
             "caption": self.caption.GetInput() or "",
             "labels": self.label_boxes(),
             "texts": {c: t.GetInput() for c, t in zip(COLUMNS, self.labels, strict=True)},
+            "overflow_caption": self.overflow_caption.GetInput() or "",
+            "overflow_box": self.overflow_box(),
         }
 
     def _switch(self, on: bool) -> None:
@@ -417,6 +475,14 @@ class TermStrip:
         band.SetViewport(0.0, 0.0, 1.0, STRIP_HEIGHT)
         band.SetBackground(main.GetBackground())
         band.InteractiveOff()
+        over = self.overflow_caption = vtkTextActor()  # (in the band's line under the tiles)
+        prop = over.GetTextProperty()
+        prop.SetColor(*LABEL_COLOUR)
+        prop.SetFontSize(LABEL_FONT)
+        prop.SetFontFamilyToArial()
+        prop.ShadowOff()
+        over.SetPosition(4, 2)
+        band.AddViewProp(over)
         for i in range(n):
             r = vtkRenderer()
             r.SetViewport(i / n, 0.0, (i + 1) / n, STRIP_HEIGHT)

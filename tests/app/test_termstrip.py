@@ -130,3 +130,35 @@ def test_tiles_too_small_for_a_picture_draw_per_vertex():
         assert v.strip.pixel_tiles is None and not v.strip.report((0, 0, 0))["per_pixel"]
     finally:
         v.plotter.close()
+
+
+@pytest.mark.parametrize("preset", ["gold", "black_rubber"])
+def test_the_overflow_caption_says_what_the_mask_is_under_the_tiles(preset):
+    """Where the overflow tile shows a share > 0 (gold's saturated highlight), a caption on the
+    line under the tiles says what the mask is, its share the overflow tile's: its text's pixels
+    drawn there, inside the strip's band and under every tile. Where nothing is clamped the line
+    is empty (the band's background)."""
+    from explorer.app.termstrip import LABEL_COLOUR
+
+    v = sphere_view(preset, (900, 600))
+    try:
+        v.show_state(set_strip(v.state, True))
+        img = _picture(v)
+        rep = v.strip.report((0, 0, 0))
+        share = 100.0 * rep["overflow"]
+        bottom = max(y + h for _, y, _, h in rep["boxes"].values())  # (the tiles' lowest row)
+        line = img[bottom:600]
+        light = np.rint(np.multiply(LABEL_COLOUR, 255)).astype(int)
+        text = (np.abs(line - light).max(axis=2) <= 60).sum()  # (the caption's letters)
+        if preset == "gold":
+            assert share > 0.0
+            want = f"overflow (magenta): {share:.1f}% of the vertices clamped"
+            assert rep["overflow_caption"].startswith(want)
+            x, y, w, h = rep["overflow_box"]
+            assert 0 <= x and x + w <= 900 and bottom <= y and y + h <= 600
+            assert text > 50
+        else:
+            assert share == 0.0 and rep["overflow_caption"] == "" and text == 0
+            assert (line == line[0, 0]).all()  # (the band's background, nothing drawn)
+    finally:
+        v.plotter.close()

@@ -9,6 +9,7 @@ import pytest
 from helpers.probes import in_ring, one_ring
 from PySide6 import QtWidgets
 
+from explorer.app.termstrip import LABEL_COLOUR
 from explorer.render.strip import COLUMNS
 from explorer.shading.strip import shader_strip
 
@@ -51,6 +52,14 @@ def test_the_strip_is_drawn_under_the_view_from_the_panel(open_window, qtbot, tm
             if column in terms.tiles:
                 assert np.abs(want - np.rint(terms.tiles[column][i] * 255)).max() <= 1
             assert in_ring(img[y, x], strip.tiles[k], ring), column
+    # gold clamps its highlight: the caption under the tiles says so, its letters drawn there
+    rep = strip.report((0, 0, 0))
+    share = 100.0 * rep["overflow"]
+    assert rep["overflow_caption"].startswith(f"overflow (magenta): {share:.1f}% of the vertices")
+    x, y, cw, ch = rep["overflow_box"]
+    assert y >= max(by + bh for _, by, _, bh in rep["boxes"].values())  # (under the tiles)
+    letters = img[y : y + ch, x : x + cw]
+    assert (np.abs(letters - np.rint(np.multiply(LABEL_COLOUR, 255))).max(axis=2) <= 60).sum() > 50
     w.grab().save(str(tmp_path / "window_strip.png"))
     box.click()
     assert not w.view.strip.on
