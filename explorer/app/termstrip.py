@@ -27,6 +27,14 @@ side B's SceneView, :attr:`TermStrip.side` ``b``): each shows its side's terms, 
 its side is, under a caption naming the side at its top left. The state's ``strip_side``
 (:data:`STRIP_SIDES`) picks the panes that show one: ``both``, or side ``a``'s or ``b``'s alone
 (the other pane keeps the strip's band, empty: both views keep one size).
+
+The state's ``strip_lights`` adds a row of tiles per light under the strip (the panel model's
+row): each what that light alone adds, emission-free (its ambient, diffuse, specular and their
+sum; :func:`explorer.render.strip.scene_rows`' rows, the engine's float64 strip of each,
+:func:`explorer.render.strip.mesh_strip`, as ``render --strip --strip-lights`` draws them), named
+at its first tile's top left. A light pass per light on each change while the row is on (the
+strip's own row recomposes kept sums); the light rows draw the mesh per vertex, also in a
+per-pixel view. The strip's height grows with its rows (:func:`strip_fraction`).
 """
 
 from __future__ import annotations
@@ -37,12 +45,20 @@ from explorer.app import model as M
 from explorer.app.model import State
 from explorer.core.errors import ExplorerError
 from explorer.render.images import SIZE_RANGE
-from explorer.render.strip import COLUMNS, OVERFLOW_COLOR
+from explorer.render.strip import COLUMNS, OVERFLOW_COLOR, mesh_strip, scene_rows
 from explorer.shading.display import to_bytes
-from explorer.shading.strip import MODES, compose_strip, grouped_strip, shader_strip_bytes
+from explorer.shading.strip import (
+    MODES,
+    TERMS,
+    compose_strip,
+    grouped_strip,
+    shader_strip_bytes,
+)
 
 #: the strip's height as a fraction of the view's (the main view keeps the rest above it)
 STRIP_HEIGHT = 0.2
+#: the most of the view's height the strip takes with its rows per light (:func:`strip_fraction`)
+STRIP_MAX = 0.6
 #: the overflow caption's line under the tiles (pixels; :func:`tile_boxes`): 12-pixel text
 #: and 2 pixels above and under it
 CAPTION_LINE = 16
@@ -85,6 +101,17 @@ def set_strip_side(state: State, side: str) -> State:
     return state.replace(strip_side=side)
 
 
+def set_strip_lights(state: State, on: bool) -> State:
+    """A row of tiles per light under the strip on or off (a light pass per light while on)."""
+    return state.replace(strip_lights=bool(on))
+
+
+def strip_fraction(rows: int) -> float:
+    """The strip's height, a fraction of the view's, with ``rows`` rows of tiles (its own and
+    one per light): :data:`STRIP_HEIGHT` a row, at most :data:`STRIP_MAX`."""
+    return min(STRIP_HEIGHT * max(rows, 1), STRIP_MAX)
+
+
 def strip_shown(state: State, side: str = "a") -> bool:
     """Whether the pane of ``side`` (``a``, or ``b`` in the compare view) shows the strip."""
     if not state.strip:
@@ -123,16 +150,22 @@ def overflow_texts(share: float, per_pixel: bool) -> tuple[str, ...]:
     )
 
 
-def tile_boxes(width: int, height: int, n: int) -> list[tuple[int, int, int, int]]:
+def tile_boxes(
+    width: int, height: int, n: int, rows: int = 1, row: int = 0
+) -> list[tuple[int, int, int, int]]:
     """The strip's ``n`` tiles in a window of ``width`` x ``height`` pixels: each ``(x, y, w,
     h)`` (pixels, origin bottom-left), all of one width (``width // n``: every tile's per-pixel
     picture is one picture's size), side by side and centred; the strip's band its height, the
-    tiles over its bottom :data:`CAPTION_LINE` pixels (the overflow caption's line)."""
+    tiles over its bottom :data:`CAPTION_LINE` pixels (the overflow caption's line). With
+    ``rows`` rows (:func:`strip_fraction`), row ``row`` (0 the strip's own, at the top; then
+    one per light, downwards), each row of one height."""
     tw = width // n
-    th = int(round(STRIP_HEIGHT * height))
+    th = int(round(strip_fraction(rows) * height))
     line = min(CAPTION_LINE, th // 4)  # (a tiny window keeps most of its band for the tiles)
+    rh = (th - line) // max(rows, 1)
+    y = line + (rows - 1 - row) * rh
     x0 = (width - n * tw) // 2
-    return [(x0 + i * tw, line, tw, th - line) for i in range(n)]
+    return [(x0 + i * tw, y, tw, rh) for i in range(n)]
 
 
 def _drawing_strip_bytes(drawing, mode: str) -> tuple:
@@ -193,6 +226,8 @@ class TermStrip:
         self._live = None  # the per-pixel tiles' LivePixels
         self._pixel_key = None
         self._images: list = []  # per tile: (vtkImageData, its actor)
+        self.light_rows: list = []  # per light: its row (_LightRow), under the strip's own
+        self._light_key = None
 
     def show(self, state: State, drawing) -> None:
         """Show the strip for ``state`` (off: the main view fills the window again), its tiles
@@ -211,6 +246,7 @@ class TermStrip:
             for r in self.renderers:
                 r.SetDraw(here)  # (left out: the band's background under them)
             self.on, self._key = here, None
+        self._light_rows(state, drawing, here)
         if not here:
             self._set_overflow(0.0, False)
             return
@@ -231,6 +267,38 @@ class TermStrip:
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts = [label_texts(c, state.strip_mode, share) for c in COLUMNS]
         self._set_overflow(share, False)
+        self._lights(state, drawing)
+
+    def _light_rows(self, state: State, drawing, here: bool) -> None:
+        """The rows per light (``state.strip_lights``) made or dropped as the count of lights
+        changes; drawn where the pane shows the strip (``here``: a pane the compare view leaves
+        out keeps their room, empty, as it keeps the strip's)."""
+        want = len(drawing.shader.scene.lights) if state.strip_lights else 0
+        if want != len(self.light_rows):
+            for row in self.light_rows:
+                row.remove(self.plotter.render_window)
+            self.light_rows = [_LightRow(self) for _ in range(want)]
+            self._placed, self._light_key = None, None
+            self._place()
+        for row in self.light_rows:
+            for r in row.renderers:
+                r.SetDraw(here)
+
+    def _lights(self, state: State, drawing) -> None:
+        """Each light row's tiles: the engine's strip of its light alone (a light pass each),
+        again when the drawing, scene, mode or groups changed."""
+        scene = drawing.shader.scene
+        key = (id(drawing), scene, state.strip_mode, drawing.groups)
+        if not self.light_rows or key == self._light_key:
+            return
+        self._light_key = key
+        rows = scene_rows(scene, lights=True, materials=drawing.groups)[1:]
+        for row, (name, light_scene, materials) in zip(self.light_rows, rows, strict=True):
+            strip = mesh_strip(light_scene, drawing.mesh, state.strip_mode, materials)
+            tiles = [to_bytes(strip.tiles[t]) for t in TERMS]
+            mask = tiles[4].copy()
+            mask[strip.overflow] = to_bytes([OVERFLOW_COLOR])[0]
+            row.show(drawing, name, (*tiles, mask))
 
     def before_pixels(self, state: State, per_pixel: bool, mesh) -> None:
         """The render window's StartEvent: with the strip on and the view drawn per pixel
@@ -355,8 +423,15 @@ class TermStrip:
             return
         self._placed = size
         W, H = size
-        for r, (x, y, w, h) in zip(self.renderers, tile_boxes(W, H, len(COLUMNS)), strict=True):
-            r.SetViewport(x / W, y / H, (x + w) / W, (y + h) / H)
+        rows = 1 + len(self.light_rows)
+        f = strip_fraction(rows)
+        self.plotter.renderer.SetViewport(0.0, f, 1.0, 1.0)
+        self._band.SetViewport(0.0, 0.0, 1.0, f)
+        every = [self.renderers] + [row.renderers for row in self.light_rows]
+        for i, renderers in enumerate(every):
+            boxes = tile_boxes(W, H, len(COLUMNS), rows, i)
+            for r, (x, y, w, h) in zip(renderers, boxes, strict=True):
+                r.SetViewport(x / W, y / H, (x + w) / W, (y + h) / H)
         self._fit_labels()
 
     def _fit_labels(self) -> None:
@@ -444,6 +519,14 @@ class TermStrip:
             "texts": {c: t.GetInput() for c, t in zip(COLUMNS, self.labels, strict=True)},
             "overflow_caption": self.overflow_caption.GetInput() or "",
             "overflow_box": self.overflow_box(),
+            "lights": [
+                {
+                    "name": row.caption.GetInput() or "",
+                    "boxes": {c: row.tile_box(c) for c in COLUMNS},
+                    "px": {c: row.tile_pixel(c, point) for c in COLUMNS},
+                }
+                for row in self.light_rows
+            ],
         }
 
     def _switch(self, on: bool) -> None:
@@ -451,6 +534,10 @@ class TermStrip:
         main = self.plotter.renderer
         if on and not self.renderers:
             self._make()
+        if not on:
+            for row in self.light_rows:
+                row.remove(self.plotter.render_window)
+            self.light_rows, self._light_key = [], None
         main.SetViewport(0.0, STRIP_HEIGHT if on else 0.0, 1.0, 1.0)
         window = self.plotter.render_window
         for r in (self._band, *self.renderers):
@@ -547,6 +634,100 @@ class TermStrip:
             self._colours.append((vtk_to_numpy(arr), arr, poly))
         self._drawing = drawing
         self._key = None
+
+
+def _mesh_actor(renderer, drawing) -> tuple:
+    """An actor in ``renderer`` of the drawing's points and triangles, in colours of its own:
+    ``(actor, (colours (n, 3) uint8 view, the VTK array, its polydata))``."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper
+
+    poly = vtkPolyData()
+    poly.SetPoints(drawing.poly.GetPoints())
+    poly.SetPolys(drawing.poly.GetPolys())
+    arr = numpy_to_vtk(np.zeros((drawing.mesh.n_vertices, 3), np.uint8), deep=True)
+    arr.SetName("colors")
+    poly.GetPointData().SetScalars(arr)
+    mapper = vtkPolyDataMapper()
+    mapper.SetInputData(poly)
+    mapper.SetColorModeToDirectScalars()
+    mapper.SetScalarModeToUsePointData()
+    actor = vtkActor()
+    actor.SetMapper(mapper)
+    actor.GetProperty().LightingOff()
+    renderer.AddActor(actor)
+    return actor, (vtk_to_numpy(arr), arr, poly)
+
+
+class _LightRow:
+    """One light's row of tiles under the strip (:data:`COLUMNS`' order, per vertex): its
+    renderers in the strip's render window (the main camera), its name at the first tile's top
+    left, :attr:`tiles` the bytes each draws."""
+
+    def __init__(self, strip: TermStrip):
+        from vtkmodules.vtkRenderingCore import vtkRenderer, vtkTextActor
+
+        main = strip.plotter.renderer
+        self.renderers, self._actors, self._colours = [], [], []
+        self._drawing = None
+        self.tiles = None
+        for _ in COLUMNS:
+            r = vtkRenderer()
+            r.SetBackground(main.GetBackground())
+            r.SetActiveCamera(main.GetActiveCamera())
+            r.InteractiveOff()
+            strip.plotter.render_window.AddRenderer(r)
+            self.renderers.append(r)
+        self.caption = vtkTextActor()
+        prop = self.caption.GetTextProperty()
+        prop.SetColor(*LABEL_COLOUR)
+        prop.SetFontSize(LABEL_MIN_FONT + 1)
+        prop.SetFontFamilyToArial()
+        prop.ShadowOff()
+        prop.SetVerticalJustificationToTop()
+        at = self.caption.GetPositionCoordinate()
+        at.SetCoordinateSystemToNormalizedViewport()
+        at.SetValue(0.02, 0.97)
+        self.renderers[0].AddViewProp(self.caption)
+
+    def show(self, drawing, name: str, tiles) -> None:
+        """Draw ``drawing``'s mesh in each tile's bytes of ``tiles``, the row named ``name``."""
+        if drawing is not self._drawing:
+            for r, a in zip(self.renderers, self._actors, strict=False):
+                r.RemoveActor(a)
+            made = [_mesh_actor(r, drawing) for r in self.renderers]
+            self._actors = [a for a, _ in made]
+            self._colours = [c for _, c in made]
+            self._drawing = drawing
+        self.tiles = tiles
+        for colours, rgb in zip(self._colours, tiles, strict=True):
+            colours[0][:] = rgb
+            colours[1].Modified()
+        self.caption.SetInput(name)
+
+    def tile_box(self, column: str) -> list[int]:
+        """Tile ``column``'s box ``[x, y, width, height]`` in window pixels (origin top-left)."""
+        r = self.renderers[COLUMNS.index(column)]
+        x, y = r.GetOrigin()
+        w, h = r.GetSize()
+        _, wh = r.GetRenderWindow().GetSize()
+        return [int(x), int(wh - y - h), int(w), int(h)]
+
+    def tile_pixel(self, column: str, point) -> list[int]:
+        """Window pixel (origin top-left) of ``point`` (3,) in the view's coordinates in tile
+        ``column`` (as :meth:`TermStrip.tile_pixel`)."""
+        r = self.renderers[COLUMNS.index(column)]
+        r.SetWorldPoint(*point, 1.0)
+        r.WorldToDisplay()
+        x, y, _ = r.GetDisplayPoint()
+        _, h = r.GetRenderWindow().GetSize()
+        return [int(round(x)), int(round(h - 1 - y))]
+
+    def remove(self, window) -> None:
+        """Take the row's renderers out of ``window``."""
+        for r in self.renderers:
+            window.RemoveRenderer(r)
 
 
 def fit_font(label, renderer, room: float) -> int | None:

@@ -162,3 +162,49 @@ def test_the_overflow_caption_says_what_the_mask_is_under_the_tiles(preset):
             assert (line == line[0, 0]).all()  # (the band's background, nothing drawn)
     finally:
         v.plotter.close()
+
+
+def _two_lights(state):
+    """``state`` with a second light (a red directional one from the left, some ambient)."""
+    from explorer.core.lights import DirectionalLight
+
+    red = DirectionalLight(
+        ambient=(0.1, 0.0, 0.0), diffuse=(0.8, 0.1, 0.1), specular=(1, 1, 1), to_light=(-1, 0, 1)
+    )
+    return state.replace(scene=state.scene.replace(lights=(*state.scene.lights, red)))
+
+
+def test_a_row_per_light_each_the_engines_strip_of_that_light_alone():
+    """``strip_lights`` adds a row of tiles per light under the strip: each tile at the probe
+    vertex shows that light's term alone as ``render --strip --strip-lights`` computes it (its
+    rows after the scene's), named at the row's first tile; the rows go with the switch."""
+    from explorer.app.termstrip import set_strip_lights
+    from explorer.render.strip import render_strip
+    from explorer.shading.display import to_bytes
+
+    v = sphere_view("gold", (900, 700))
+    try:
+        state = set_strip_lights(set_strip(_two_lights(v.state), True), True)
+        v.show_state(state)
+        img = _picture(v)
+        strip = v.strip
+        i = v.probe_vertex()
+        ring = one_ring(v.mesh, i)
+        point = v.to_view(v.mesh.positions[i])
+        rep = strip.report(point)
+        assert [r["name"] for r in rep["lights"]] == ["light 1: point", "light 2: directional"]
+        want = render_strip(v.drawings[0].shader.scene, v.mesh, lights=True, tile=(32, 32))
+        top = min(y for _, y, _, _ in rep["boxes"].values())
+        for k, (row, light) in enumerate(zip(strip.light_rows, rep["lights"], strict=True)):
+            engine = want.strips[k + 1]  # (render --strip-lights: the scene's row first)
+            for t, column in enumerate(COLUMNS[:5]):
+                assert np.array_equal(row.tiles[t], to_bytes(engine.tiles[column]))
+                x, y = light["px"][column]
+                assert rep["boxes"][column][1] + rep["boxes"][column][3] <= y  # under the strip
+                assert in_ring(img[y, x], row.tiles[t], ring), (k, column)
+        assert not np.array_equal(strip.light_rows[0].tiles[4], strip.light_rows[1].tiles[4])
+        assert top < 700 * 0.6  # (the strip grew: three rows)
+        v.show_state(set_strip_lights(state, False))
+        assert not strip.light_rows and strip.report(point)["lights"] == []
+    finally:
+        v.plotter.close()
