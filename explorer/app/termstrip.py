@@ -150,19 +150,28 @@ def overflow_texts(share: float, per_pixel: bool) -> tuple[str, ...]:
     )
 
 
+def band_height(height: int, rows: int = 1) -> int:
+    """The strip's band in a window ``height`` pixels high (pixels): its tiles'
+    (:func:`strip_fraction`) and the overflow caption's line under them (:data:`CAPTION_LINE`,
+    less in a tiny window: a quarter of the tiles' height at most)."""
+    th = int(round(strip_fraction(rows) * height))
+    return th + min(CAPTION_LINE, th // 4)
+
+
 def tile_boxes(
     width: int, height: int, n: int, rows: int = 1, row: int = 0
 ) -> list[tuple[int, int, int, int]]:
     """The strip's ``n`` tiles in a window of ``width`` x ``height`` pixels: each ``(x, y, w,
     h)`` (pixels, origin bottom-left), all of one width (``width // n``: every tile's per-pixel
     picture is one picture's size), side by side and centred; the strip's band its height, the
-    tiles over its bottom :data:`CAPTION_LINE` pixels (the overflow caption's line). With
-    ``rows`` rows (:func:`strip_fraction`), row ``row`` (0 the strip's own, at the top; then
-    one per light, downwards), each row of one height."""
+    tiles over the overflow caption's line (:data:`CAPTION_LINE` pixels, :func:`band_height`:
+    the band takes it from the main view, the tiles keep their size). With ``rows`` rows
+    (:func:`strip_fraction`), row ``row`` (0 the strip's own, at the top; then one per light,
+    downwards), each row of one height."""
     tw = width // n
     th = int(round(strip_fraction(rows) * height))
-    line = min(CAPTION_LINE, th // 4)  # (a tiny window keeps most of its band for the tiles)
-    rh = (th - line) // max(rows, 1)
+    line = band_height(height, rows) - th
+    rh = th // max(rows, 1)
     y = line + (rows - 1 - row) * rh
     x0 = (width - n * tw) // 2
     return [(x0 + i * tw, y, tw, rh) for i in range(n)]
@@ -253,6 +262,7 @@ class TermStrip:
         self.caption.SetInput(side_caption(state, self.side))
         if drawing is not self._drawing:
             self._geometry(drawing)
+        self._lights(state, drawing)  # (its own key: the rows may come with the strip's same)
         key = (id(drawing), drawing.shader.scene, state.strip_mode, drawing.groups)
         if key == self._key:
             return
@@ -267,7 +277,6 @@ class TermStrip:
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts = [label_texts(c, state.strip_mode, share) for c in COLUMNS]
         self._set_overflow(share, False)
-        self._lights(state, drawing)
 
     def _light_rows(self, state: State, drawing, here: bool) -> None:
         """The rows per light (``state.strip_lights``) made or dropped as the count of lights
@@ -424,7 +433,7 @@ class TermStrip:
         self._placed = size
         W, H = size
         rows = 1 + len(self.light_rows)
-        f = strip_fraction(rows)
+        f = band_height(H, rows) / H
         self.plotter.renderer.SetViewport(0.0, f, 1.0, 1.0)
         self._band.SetViewport(0.0, 0.0, 1.0, f)
         every = [self.renderers] + [row.renderers for row in self.light_rows]

@@ -9,7 +9,7 @@ from helpers.probes import in_ring, one_ring
 from helpers.views import sphere_view
 
 from explorer.app import panelmodel as PM
-from explorer.app.termstrip import STRIP_HEIGHT, set_strip, set_strip_mode
+from explorer.app.termstrip import band_height, set_strip, set_strip_mode
 from explorer.render.strip import COLUMNS
 from explorer.shading.strip import shader_strip
 
@@ -37,8 +37,9 @@ def test_each_tile_shows_the_engines_term_at_the_probe_vertex(view, mode):
     img = _picture(view)
     strip = view.strip
     assert strip.on and len(strip.renderers) == len(COLUMNS)
-    assert view.plotter.renderer.GetViewport() == pytest.approx((0, STRIP_HEIGHT, 1, 1))
-    band = img[int(SIZE[1] * (1 - STRIP_HEIGHT)) + 1 :]
+    top = SIZE[1] - band_height(SIZE[1])  # (the tiles' and the overflow caption's band)
+    assert view.plotter.renderer.GetViewport() == pytest.approx((0, 1 - top / SIZE[1], 1, 1))
+    band = img[top + 1 :]
     assert not np.array_equal(band, before[-len(band) :])  # the tiles are drawn there
     i = view.probe_vertex()
     ring = one_ring(view.mesh, i)
@@ -46,7 +47,7 @@ def test_each_tile_shows_the_engines_term_at_the_probe_vertex(view, mode):
     terms = shader_strip(view.drawings[0].shader, mode)
     for k, column in enumerate(COLUMNS):
         x, y = strip.tile_pixel(column, point)
-        assert SIZE[1] * (1 - STRIP_HEIGHT) <= y < SIZE[1]  # in the band under the view
+        assert top <= y < SIZE[1]  # in the band under the view
         want = strip.tiles[k][i].astype(int)
         if column in terms.tiles:  # (the float term's bytes: the tile is the engine's term)
             assert np.abs(want - np.rint(terms.tiles[column][i] * 255)).max() <= 1

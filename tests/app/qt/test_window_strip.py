@@ -304,3 +304,37 @@ def test_per_pixel_a_mesh_files_groups_each_in_its_material_in_the_tiles(open_wi
         assert len({tuple(c) for c in flat[g.pixels]}) > 10  # (the mesh in the tile)
     x, y, tw, th = strip.tile_box("diffuse")
     assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
+
+
+def test_a_row_per_light_from_the_panel_each_lights_strip_alone(open_window):
+    """The view tab's ``strip_lights`` check box (shown with the strip): a row of tiles per
+    light under the strip, each light's sum tile at the probe vertex, read from the window's
+    pixels, the engine's colour of that light alone as ``render --strip --strip-lights`` makes
+    it; the row goes with the box, in one undo step."""
+    from explorer.render.strip import render_strip
+    from explorer.shading.display import to_bytes
+
+    w = open_window("--mesh", "sphere", "--preset", "gold")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    lights = w.findChild(QtWidgets.QCheckBox, "strip_lights")
+    assert lights is not None and lights.isVisible()
+    lights.click()
+    assert w.controller.state.strip_lights
+    view = w.view
+    img = _pixels(w.plotter)
+    i = view.probe_vertex()
+    ring = one_ring(view.mesh, i)
+    point = view.to_view(view.mesh.positions[i])
+    rep = view.strip.report(point)
+    assert [r["name"] for r in rep["lights"]] == ["light 1: point"]
+    want = render_strip(view.drawings[0].shader.scene, view.mesh, lights=True, tile=(32, 32))
+    row = view.strip.light_rows[0]
+    s = COLUMNS.index("sum")
+    assert np.array_equal(row.tiles[s], to_bytes(want.strips[1].tiles["sum"]))
+    x, y = rep["lights"][0]["px"]["sum"]
+    assert y >= sum(rep["boxes"]["sum"][1::2])  # (under the strip's own sum tile)
+    assert in_ring(img[y, x], row.tiles[s], ring)
+    w.controller.undo()
+    assert not w.controller.state.strip_lights and not view.strip.light_rows
