@@ -235,8 +235,7 @@ class TermStrip:
         self._live = None  # the per-pixel tiles' LivePixels
         self._pixel_key = None
         self._images: list = []  # per tile: (vtkImageData, its actor)
-        self.light_rows: list = []  # per light: its row (_LightRow), under the strip's own
-        self._light_key = None
+        self.lights = LightRows(self)  # a row per light under the strip's own (strip_lights)
 
     def show(self, state: State, drawing) -> None:
         """Show the strip for ``state`` (off: the main view fills the window again), its tiles
@@ -255,14 +254,14 @@ class TermStrip:
             for r in self.renderers:
                 r.SetDraw(here)  # (left out: the band's background under them)
             self.on, self._key = here, None
-        self._light_rows(state, drawing, here)
+        self.lights.sync(state, drawing, here)
         if not here:
             self._set_overflow(0.0, False)
             return
         self.caption.SetInput(side_caption(state, self.side))
         if drawing is not self._drawing:
             self._geometry(drawing)
-        self._lights(state, drawing)  # (its own key: the rows may come with the strip's same)
+        self.lights.fill(state, drawing)  # (its own key: rows may come, the strip's the same)
         key = (id(drawing), drawing.shader.scene, state.strip_mode, drawing.groups)
         if key == self._key:
             return
@@ -277,37 +276,6 @@ class TermStrip:
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts = [label_texts(c, state.strip_mode, share) for c in COLUMNS]
         self._set_overflow(share, False)
-
-    def _light_rows(self, state: State, drawing, here: bool) -> None:
-        """The rows per light (``state.strip_lights``) made or dropped as the count of lights
-        changes; drawn where the pane shows the strip (``here``: a pane the compare view leaves
-        out keeps their room, empty, as it keeps the strip's)."""
-        want = len(drawing.shader.scene.lights) if state.strip_lights else 0
-        if want != len(self.light_rows):
-            for row in self.light_rows:
-                row.remove(self.plotter.render_window)
-            self.light_rows = [_LightRow(self) for _ in range(want)]
-            self._placed, self._light_key = None, None
-            self._place()
-        for row in self.light_rows:
-            for r in row.renderers:
-                r.SetDraw(here)
-
-    def _lights(self, state: State, drawing) -> None:
-        """Each light row's tiles: the engine's strip of its light alone (a light pass each),
-        again when the drawing, scene, mode or groups changed."""
-        scene = drawing.shader.scene
-        key = (id(drawing), scene, state.strip_mode, drawing.groups)
-        if not self.light_rows or key == self._light_key:
-            return
-        self._light_key = key
-        rows = scene_rows(scene, lights=True, materials=drawing.groups)[1:]
-        for row, (name, light_scene, materials) in zip(self.light_rows, rows, strict=True):
-            strip = mesh_strip(light_scene, drawing.mesh, state.strip_mode, materials)
-            tiles = [to_bytes(strip.tiles[t]) for t in TERMS]
-            mask = tiles[4].copy()
-            mask[strip.overflow] = to_bytes([OVERFLOW_COLOR])[0]
-            row.show(drawing, name, (*tiles, mask))
 
     def before_pixels(self, state: State, per_pixel: bool, mesh) -> None:
         """The render window's StartEvent: with the strip on and the view drawn per pixel
@@ -432,11 +400,11 @@ class TermStrip:
             return
         self._placed = size
         W, H = size
-        rows = 1 + len(self.light_rows)
+        rows = 1 + len(self.lights.rows)
         f = band_height(H, rows) / H
         self.plotter.renderer.SetViewport(0.0, f, 1.0, 1.0)
         self._band.SetViewport(0.0, 0.0, 1.0, f)
-        every = [self.renderers] + [row.renderers for row in self.light_rows]
+        every = [self.renderers] + [row.renderers for row in self.lights.rows]
         for i, renderers in enumerate(every):
             boxes = tile_boxes(W, H, len(COLUMNS), rows, i)
             for r, (x, y, w, h) in zip(renderers, boxes, strict=True):
@@ -528,14 +496,7 @@ class TermStrip:
             "texts": {c: t.GetInput() for c, t in zip(COLUMNS, self.labels, strict=True)},
             "overflow_caption": self.overflow_caption.GetInput() or "",
             "overflow_box": self.overflow_box(),
-            "lights": [
-                {
-                    "name": row.caption.GetInput() or "",
-                    "boxes": {c: row.tile_box(c) for c in COLUMNS},
-                    "px": {c: row.tile_pixel(c, point) for c in COLUMNS},
-                }
-                for row in self.light_rows
-            ],
+            "lights": self.lights.report(point),
         }
 
     def _switch(self, on: bool) -> None:
@@ -544,9 +505,7 @@ class TermStrip:
         if on and not self.renderers:
             self._make()
         if not on:
-            for row in self.light_rows:
-                row.remove(self.plotter.render_window)
-            self.light_rows, self._light_key = [], None
+            self.lights.drop()
         main.SetViewport(0.0, STRIP_HEIGHT if on else 0.0, 1.0, 1.0)
         window = self.plotter.render_window
         for r in (self._band, *self.renderers):
@@ -616,31 +575,11 @@ class TermStrip:
 
     def _geometry(self, drawing) -> None:
         """Each tile's actor: the drawing's points and triangles, colours of its own."""
-        from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
-        from vtkmodules.vtkCommonDataModel import vtkPolyData
-        from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper
-
         for r, a in zip(self.renderers, self._actors, strict=False):
             r.RemoveActor(a)
-        self._actors, self._colours = [], []
-        n = drawing.mesh.n_vertices
-        for r in self.renderers:
-            poly = vtkPolyData()
-            poly.SetPoints(drawing.poly.GetPoints())
-            poly.SetPolys(drawing.poly.GetPolys())
-            arr = numpy_to_vtk(np.zeros((n, 3), np.uint8), deep=True)
-            arr.SetName("colors")
-            poly.GetPointData().SetScalars(arr)
-            mapper = vtkPolyDataMapper()
-            mapper.SetInputData(poly)
-            mapper.SetColorModeToDirectScalars()
-            mapper.SetScalarModeToUsePointData()
-            actor = vtkActor()
-            actor.SetMapper(mapper)
-            actor.GetProperty().LightingOff()
-            r.AddActor(actor)
-            self._actors.append(actor)
-            self._colours.append((vtk_to_numpy(arr), arr, poly))
+        made = [_mesh_actor(r, drawing) for r in self.renderers]
+        self._actors = [a for a, _ in made]
+        self._colours = [c for _, c in made]
         self._drawing = drawing
         self._key = None
 
@@ -737,6 +676,66 @@ class _LightRow:
         """Take the row's renderers out of ``window``."""
         for r in self.renderers:
             window.RemoveRenderer(r)
+
+
+class LightRows:
+    """The strip's rows per light (the state's ``strip_lights``), under the strip's own:
+    :attr:`rows` each a :class:`_LightRow`, made or dropped as the count of lights changes
+    (:meth:`sync`), their tiles the engine's strip of each light alone (:meth:`fill`)."""
+
+    def __init__(self, strip: TermStrip):
+        self.strip = strip
+        self.rows: list = []
+        self._key = None
+
+    def sync(self, state: State, drawing, here: bool) -> None:
+        """A row per light of ``drawing``'s scene while ``state.strip_lights`` (none else),
+        the strip placed again when their count changed; drawn where the pane shows the strip
+        (``here``: a pane the compare view leaves out keeps their room, empty, as the
+        strip's)."""
+        want = len(drawing.shader.scene.lights) if state.strip_lights else 0
+        if want != len(self.rows):
+            self.drop()
+            self.rows = [_LightRow(self.strip) for _ in range(want)]
+            self.strip._placed = None
+            self.strip._place()
+        for row in self.rows:
+            for r in row.renderers:
+                r.SetDraw(here)
+
+    def fill(self, state: State, drawing) -> None:
+        """Each row's tiles: the engine's float64 strip of its light alone (a light pass each;
+        :func:`~explorer.render.strip.scene_rows`, :func:`~explorer.render.strip.mesh_strip`),
+        again when the drawing, scene, mode or groups changed."""
+        scene = drawing.shader.scene
+        key = (id(drawing), scene, state.strip_mode, drawing.groups)
+        if not self.rows or key == self._key:
+            return
+        self._key = key
+        rows = scene_rows(scene, lights=True, materials=drawing.groups)[1:]
+        for row, (name, light_scene, materials) in zip(self.rows, rows, strict=True):
+            strip = mesh_strip(light_scene, drawing.mesh, state.strip_mode, materials)
+            tiles = [to_bytes(strip.tiles[t]) for t in TERMS]
+            mask = tiles[4].copy()
+            mask[strip.overflow] = to_bytes([OVERFLOW_COLOR])[0]
+            row.show(drawing, name, (*tiles, mask))
+
+    def drop(self) -> None:
+        """No rows: their renderers out of the window."""
+        for row in self.rows:
+            row.remove(self.strip.plotter.render_window)
+        self.rows, self._key = [], None
+
+    def report(self, point) -> list[dict]:
+        """Each row's name, tile boxes and window pixels of ``point`` (as the strip's)."""
+        return [
+            {
+                "name": row.caption.GetInput() or "",
+                "boxes": {c: row.tile_box(c) for c in COLUMNS},
+                "px": {c: row.tile_pixel(c, point) for c in COLUMNS},
+            }
+            for row in self.rows
+        ]
 
 
 def fit_font(label, renderer, room: float) -> int | None:

@@ -196,16 +196,16 @@ def test_a_row_per_light_each_the_engines_strip_of_that_light_alone():
         assert [r["name"] for r in rep["lights"]] == ["light 1: point", "light 2: directional"]
         want = render_strip(v.drawings[0].shader.scene, v.mesh, lights=True, tile=(32, 32))
         top = min(y for _, y, _, _ in rep["boxes"].values())
-        for k, (row, light) in enumerate(zip(strip.light_rows, rep["lights"], strict=True)):
+        for k, (row, light) in enumerate(zip(strip.lights.rows, rep["lights"], strict=True)):
             engine = want.strips[k + 1]  # (render --strip-lights: the scene's row first)
             for t, column in enumerate(COLUMNS[:5]):
                 assert np.array_equal(row.tiles[t], to_bytes(engine.tiles[column]))
                 x, y = light["px"][column]
                 assert rep["boxes"][column][1] + rep["boxes"][column][3] <= y  # under the strip
                 assert in_ring(img[y, x], row.tiles[t], ring), (k, column)
-        assert not np.array_equal(strip.light_rows[0].tiles[4], strip.light_rows[1].tiles[4])
+        assert not np.array_equal(strip.lights.rows[0].tiles[4], strip.lights.rows[1].tiles[4])
         assert top < 700 * 0.6  # (the strip grew: three rows)
         v.show_state(set_strip_lights(state, False))
-        assert not strip.light_rows and strip.report(point)["lights"] == []
+        assert not strip.lights.rows and strip.report(point)["lights"] == []
     finally:
         v.plotter.close()

@@ -330,11 +330,11 @@ def test_a_row_per_light_from_the_panel_each_lights_strip_alone(open_window):
     rep = view.strip.report(point)
     assert [r["name"] for r in rep["lights"]] == ["light 1: point"]
     want = render_strip(view.drawings[0].shader.scene, view.mesh, lights=True, tile=(32, 32))
-    row = view.strip.light_rows[0]
+    row = view.strip.lights.rows[0]
     s = COLUMNS.index("sum")
     assert np.array_equal(row.tiles[s], to_bytes(want.strips[1].tiles["sum"]))
     x, y = rep["lights"][0]["px"]["sum"]
     assert y >= sum(rep["boxes"]["sum"][1::2])  # (under the strip's own sum tile)
     assert in_ring(img[y, x], row.tiles[s], ring)
     w.controller.undo()
-    assert not w.controller.state.strip_lights and not view.strip.light_rows
+    assert not w.controller.state.strip_lights and not view.strip.lights.rows
