@@ -124,6 +124,10 @@ def test_per_pixel_the_tiles_are_the_per_pixel_terms_and_the_sum_tile_the_pictur
         want.reshape(-1, 3)[g.pixels] = to_bytes(terms.tiles["diffuse"])
     x, y, tw, th = strip.tile_box("diffuse")
     assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
+    # the overflow caption gives the per-pixel tile's share, of the pixels (its label's)
+    rep = strip.report((0, 0, 0))
+    share = rep["texts"]["overflow"].split()[-1]
+    assert rep["overflow_caption"].startswith(f"overflow (magenta): {share} of the pixels")
     # the main view above the strip: the per-pixel picture of its own part of the window
     from helpers.probes import interior
     from test_window_pixels import rings
