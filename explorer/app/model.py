@@ -101,6 +101,8 @@ class State:
     strip, strip_mode : the term strip under the view is on, and its tiles: ``weighted`` or
         ``raw`` (:mod:`explorer.app.termstrip`)
     strip_side : the compare view's panes that show their side's strip: ``both``, ``a``, ``b``
+    strip_lights : a row of tiles per light under the strip (each light alone: a light pass
+        per light while on)
     lobes, lobe_view, lobe_quantity, lobe_log, lobe_ndl : the lobe inset's lobes (the selected
         light's, or several) and how it plots them (:mod:`explorer.app.lobeinset`)
     lobe_hidden : the lobes of the inset's set not drawn (0-based indices in the set)
@@ -134,6 +136,7 @@ class State:
     strip: bool = False
     strip_mode: str = "weighted"
     strip_side: str = "both"
+    strip_lights: bool = False
     lobes: str = "selected"
     lobe_view: str = "polar"
     lobe_quantity: str = "intensity"

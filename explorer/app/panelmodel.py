@@ -640,8 +640,8 @@ def _view_rows() -> list[Row]:
 
 
 def _strip_rows() -> list[Row]:
-    """The term strip's rows (:mod:`explorer.app.termstrip`): on, its tiles' mode, and the
-    compare view's panes that show one."""
+    """The term strip's rows (:mod:`explorer.app.termstrip`): on, its tiles' mode, the
+    compare view's panes that show one, and a row of tiles per light."""
     return [
         Row(
             "strip",
@@ -674,6 +674,16 @@ def _strip_rows() -> list[Row]:
             choices=T.STRIP_SIDES,
             inline=True,
             tip="the compare view's panes that show their side's strip: both, A's or B's",
+        ),
+        Row(
+            "strip_lights",
+            "view",
+            "toggle",
+            lambda s: s.strip_lights,
+            lambda s, v: (T.set_strip_lights, (bool(v),)),
+            visible=lambda s: s.strip,
+            tip="a row of tiles per light under the strip: what each light alone adds (its "
+            "ambient, diffuse, specular and their sum); a light pass per light while on",
         ),
     ]
 

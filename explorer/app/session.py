@@ -16,6 +16,7 @@ A session file is YAML (or JSON, which YAML reads too)::
     strip: false               # optional: the term strip under the view (docs/terms.md),
     strip_mode: weighted       #   its tiles: weighted or raw
     strip_side: both           #   the compare view's panes with a strip: both, a or b
+    strip_lights: false        #   a row of tiles per light under it
     lobes: {set: selected, view: polar, quantity: intensity, log: false, ndl: false,
             incidence: null, hidden: []}
                                # optional: the lobe inset's lobes and plot (docs/terms.md);
@@ -63,7 +64,7 @@ FORMAT = 1
 KEYS = (
     "session", "scene", "mesh", "resolution", "preset", "hidden", "light", "handle_distance",
     "camera", "difference", "compare", "groups", "window", "local_viewer", "strip", "strip_mode",
-    "strip_side", "lobes",
+    "strip_side", "strip_lights", "lobes",
 )  # fmt: skip
 CAMERA_KEYS = ("position", "focal_point", "view_up", "parallel", "parallel_scale", "view_angle")
 #: environment variable naming the file the window keeps its last session in
@@ -107,6 +108,7 @@ def session_mapping(state: State) -> dict:
         "strip": bool(state.strip),
         "strip_mode": state.strip_mode,
         "strip_side": state.strip_side,
+        "strip_lights": bool(state.strip_lights),
         "lobes": {
             "set": state.lobes,
             "view": state.lobe_view,
@@ -187,6 +189,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
 
     strip_mode = checker.choice(m.get("strip_mode", "weighted"), ("strip_mode",), STRIP_MODES)
     strip_side = checker.choice(m.get("strip_side", "both"), ("strip_side",), STRIP_SIDES)
+    strip_lights = checker.boolean(m.get("strip_lights", False), ("strip_lights",))
     lobes = _lobes(checker, m["lobes"]) if m.get("lobes") is not None else {}
     camera = _camera(checker, m["camera"]) if "camera" in m else None
     compare = _compare(checker, m["compare"]) if m.get("compare") is not None else {}
@@ -225,6 +228,7 @@ def load_session(path, *, materials_dirs=()) -> tuple[State, Mesh]:
         strip=bool(strip),
         strip_mode=strip_mode,
         strip_side=strip_side,
+        strip_lights=bool(strip_lights),
         **lobes,
         **compare,
     )

@@ -7,7 +7,10 @@ the window's Qt interactor and the page's pushed picture show them as they show 
 tile draws the drawn mesh (the full mesh, or its level of detail during a drag) in its term's
 bytes, :func:`explorer.shading.strip.shader_strip_bytes` of that drawing's Shader: its kept
 light sums recomposed, no light pass; the overflow tile is the sum tile with the vertices the
-display clamped in magenta, its label the share of them. The state's ``strip`` switches it,
+display clamped in magenta, its label the share of them. Where that share is more than 0 a
+caption on a line of its own under the tiles says what the mask is (:func:`overflow_texts`:
+``overflow (magenta): 1.3% of the vertices clamped: ...``; the line stays, empty, where
+nothing is clamped, so the tiles keep one size). The state's ``strip`` switches it,
 ``strip_mode`` picks ``weighted`` or ``raw`` tiles (the panel model's rows, :data:`ROWS`).
 
 Per pixel (the view's ``shading: per-pixel``), each tile is a picture instead: the engine lit
@@ -24,6 +27,14 @@ side B's SceneView, :attr:`TermStrip.side` ``b``): each shows its side's terms, 
 its side is, under a caption naming the side at its top left. The state's ``strip_side``
 (:data:`STRIP_SIDES`) picks the panes that show one: ``both``, or side ``a``'s or ``b``'s alone
 (the other pane keeps the strip's band, empty: both views keep one size).
+
+The state's ``strip_lights`` adds a row of tiles per light under the strip (the panel model's
+row): each what that light alone adds, emission-free (its ambient, diffuse, specular and their
+sum; :func:`explorer.render.strip.scene_rows`' rows, the engine's float64 strip of each,
+:func:`explorer.render.strip.mesh_strip`, as ``render --strip --strip-lights`` draws them), named
+at its first tile's top left. A light pass per light on each change while the row is on (the
+strip's own row recomposes kept sums); the light rows draw the mesh per vertex, also in a
+per-pixel view. The strip's height grows with its rows (:func:`strip_fraction`).
 """
 
 from __future__ import annotations
@@ -34,12 +45,23 @@ from explorer.app import model as M
 from explorer.app.model import State
 from explorer.core.errors import ExplorerError
 from explorer.render.images import SIZE_RANGE
-from explorer.render.strip import COLUMNS, OVERFLOW_COLOR
+from explorer.render.strip import COLUMNS, OVERFLOW_COLOR, mesh_strip, scene_rows
 from explorer.shading.display import to_bytes
-from explorer.shading.strip import MODES, compose_strip, grouped_strip, shader_strip_bytes
+from explorer.shading.strip import (
+    MODES,
+    TERMS,
+    compose_strip,
+    grouped_strip,
+    shader_strip_bytes,
+)
 
 #: the strip's height as a fraction of the view's (the main view keeps the rest above it)
 STRIP_HEIGHT = 0.2
+#: the most of the view's height the strip takes with its rows per light (:func:`strip_fraction`)
+STRIP_MAX = 0.6
+#: the overflow caption's line under the tiles (pixels; :func:`tile_boxes`): 12-pixel text
+#: and 2 pixels above and under it
+CAPTION_LINE = 16
 #: the tiles' label colour and font size (pixels)
 LABEL_COLOUR = (0.93, 0.93, 0.93)
 LABEL_FONT = 12
@@ -79,6 +101,17 @@ def set_strip_side(state: State, side: str) -> State:
     return state.replace(strip_side=side)
 
 
+def set_strip_lights(state: State, on: bool) -> State:
+    """A row of tiles per light under the strip on or off (a light pass per light while on)."""
+    return state.replace(strip_lights=bool(on))
+
+
+def strip_fraction(rows: int) -> float:
+    """The strip's height, a fraction of the view's, with ``rows`` rows of tiles (its own and
+    one per light): :data:`STRIP_HEIGHT` a row, at most :data:`STRIP_MAX`."""
+    return min(STRIP_HEIGHT * max(rows, 1), STRIP_MAX)
+
+
 def strip_shown(state: State, side: str = "a") -> bool:
     """Whether the pane of ``side`` (``a``, or ``b`` in the compare view) shows the strip."""
     if not state.strip:
@@ -100,14 +133,48 @@ def label_texts(column: str, mode: str, share: float) -> tuple[str, ...]:
     return (full, *SHORT[column])
 
 
-def tile_boxes(width: int, height: int, n: int) -> list[tuple[int, int, int, int]]:
+def overflow_texts(share: float, per_pixel: bool) -> tuple[str, ...]:
+    """The overflow caption and its shorter forms, longest first (the first that fits the
+    strip's width is drawn): ``share`` the clamped share of the vertices (or, ``per_pixel``,
+    of the surface's pixels) in %; none (``()``) where nothing is clamped."""
+    if share <= 0.0:
+        return ()
+    pct = f"{share:.1f}%" if share >= 0.05 else "< 0.1%"
+    unit = "pixels" if per_pixel else "vertices"
+    return (
+        f"overflow (magenta): {pct} of the {unit} clamped: there the terms add up to more "
+        "than 1, the 8-bit tiles to more than the sum tile",
+        f"overflow: {pct} of the {unit} clamped (the tiles add up to more than the sum tile)",
+        f"overflow: {pct} of the {unit} clamped",
+        f"overflow {pct}",
+    )
+
+
+def band_height(height: int, rows: int = 1) -> int:
+    """The strip's band in a window ``height`` pixels high (pixels): its tiles'
+    (:func:`strip_fraction`) and the overflow caption's line under them (:data:`CAPTION_LINE`,
+    less in a tiny window: a quarter of the tiles' height at most)."""
+    th = int(round(strip_fraction(rows) * height))
+    return th + min(CAPTION_LINE, th // 4)
+
+
+def tile_boxes(
+    width: int, height: int, n: int, rows: int = 1, row: int = 0
+) -> list[tuple[int, int, int, int]]:
     """The strip's ``n`` tiles in a window of ``width`` x ``height`` pixels: each ``(x, y, w,
     h)`` (pixels, origin bottom-left), all of one width (``width // n``: every tile's per-pixel
-    picture is one picture's size), side by side and centred; the strip's band its height."""
+    picture is one picture's size), side by side and centred; the strip's band its height, the
+    tiles over the overflow caption's line (:data:`CAPTION_LINE` pixels, :func:`band_height`:
+    the band takes it from the main view, the tiles keep their size). With ``rows`` rows
+    (:func:`strip_fraction`), row ``row`` (0 the strip's own, at the top; then one per light,
+    downwards), each row of one height."""
     tw = width // n
-    th = int(round(STRIP_HEIGHT * height))
+    th = int(round(strip_fraction(rows) * height))
+    line = band_height(height, rows) - th
+    rh = th // max(rows, 1)
+    y = line + (rows - 1 - row) * rh
     x0 = (width - n * tw) // 2
-    return [(x0 + i * tw, 0, tw, th) for i in range(n)]
+    return [(x0 + i * tw, y, tw, rh) for i in range(n)]
 
 
 def _drawing_strip_bytes(drawing, mode: str) -> tuple:
@@ -142,12 +209,15 @@ class TermStrip:
     docstring): :meth:`show` draws it for a state and a drawing, :attr:`renderers` its tiles'
     renderers in :data:`~explorer.render.strip.COLUMNS`' order, :attr:`tiles` the bytes each
     draws, :attr:`overflow` the clamped vertices; :attr:`side` the compare view's pane it is
-    under (``a``, or ``b`` for side B's), :attr:`caption` the line naming it."""
+    under (``a``, or ``b`` for side B's), :attr:`caption` the line naming it,
+    :attr:`overflow_caption` the line under the tiles saying what the overflow mask is."""
 
     def __init__(self, plotter, side: str = "a"):
         self.plotter = plotter
         self.side = side
         self.caption = None  # the text actor naming the side (made with the tiles)
+        self.overflow_caption = None  # the text actor under the tiles (overflow_texts)
+        self._overflow_texts: tuple = ()  # its texts, longest first
         self.renderers: list = []
         self.labels: list = []
         self._texts: list = []  # each label's texts, longest first (label_texts)
@@ -165,6 +235,7 @@ class TermStrip:
         self._live = None  # the per-pixel tiles' LivePixels
         self._pixel_key = None
         self._images: list = []  # per tile: (vtkImageData, its actor)
+        self.lights = LightRows(self)  # a row per light under the strip's own (strip_lights)
 
     def show(self, state: State, drawing) -> None:
         """Show the strip for ``state`` (off: the main view fills the window again), its tiles
@@ -183,11 +254,14 @@ class TermStrip:
             for r in self.renderers:
                 r.SetDraw(here)  # (left out: the band's background under them)
             self.on, self._key = here, None
+        self.lights.sync(state, drawing, here)
         if not here:
+            self._set_overflow(0.0, False)
             return
         self.caption.SetInput(side_caption(state, self.side))
         if drawing is not self._drawing:
             self._geometry(drawing)
+        self.lights.fill(state, drawing)  # (its own key: rows may come, the strip's the same)
         key = (id(drawing), drawing.shader.scene, state.strip_mode, drawing.groups)
         if key == self._key:
             return
@@ -201,7 +275,7 @@ class TermStrip:
             colours[1].Modified()
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts = [label_texts(c, state.strip_mode, share) for c in COLUMNS]
-        self._fit_labels()
+        self._set_overflow(share, False)
 
     def before_pixels(self, state: State, per_pixel: bool, mesh) -> None:
         """The render window's StartEvent: with the strip on and the view drawn per pixel
@@ -267,8 +341,14 @@ class TermStrip:
         over = strip.overflow[first:]
         share = 100.0 * float(over.mean()) if over.size else 0.0
         self._texts[COLUMNS.index("overflow")] = label_texts("overflow", mode, share)
-        self._fit_labels()
+        self._set_overflow(share, True)
         return out
+
+    def _set_overflow(self, share: float, per_pixel: bool) -> None:
+        """The overflow caption for ``share`` (in %) of the vertices or pixels clamped (empty
+        at 0), and the labels, fitted."""
+        self._overflow_texts = overflow_texts(share, per_pixel)
+        self._fit_labels()
 
     def _images_for(self, w: int, h: int) -> list:
         """Each tile's picture actor (made, or remade for a new size), under its label."""
@@ -320,8 +400,15 @@ class TermStrip:
             return
         self._placed = size
         W, H = size
-        for r, (x, _, w, _) in zip(self.renderers, tile_boxes(W, H, len(COLUMNS)), strict=True):
-            r.SetViewport(x / W, 0.0, (x + w) / W, STRIP_HEIGHT)
+        rows = 1 + len(self.lights.rows)
+        f = band_height(H, rows) / H
+        self.plotter.renderer.SetViewport(0.0, f, 1.0, 1.0)
+        self._band.SetViewport(0.0, 0.0, 1.0, f)
+        every = [self.renderers] + [row.renderers for row in self.lights.rows]
+        for i, renderers in enumerate(every):
+            boxes = tile_boxes(W, H, len(COLUMNS), rows, i)
+            for r, (x, y, w, h) in zip(renderers, boxes, strict=True):
+                r.SetViewport(x / W, y / H, (x + w) / W, (y + h) / H)
         self._fit_labels()
 
     def _fit_labels(self) -> None:
@@ -338,6 +425,27 @@ class TermStrip:
             else:
                 font = LABEL_MIN_FONT
             prop.SetFontSize(font)
+        if self.overflow_caption is None:
+            return
+        room = int(self._band.GetSize()[0]) - LABEL_ROOM
+        self.overflow_caption.SetInput("")
+        for text in self._overflow_texts:  # (the longest that fits the strip's width)
+            self.overflow_caption.SetInput(text)
+            if fit_font(self.overflow_caption, self._band, room) is not None:
+                break
+        else:
+            self.overflow_caption.GetTextProperty().SetFontSize(LABEL_MIN_FONT)
+
+    def overflow_box(self) -> list[int]:
+        """The overflow caption's box ``[x, y, width, height]`` in window pixels (origin
+        top-left), as drawn (its position and its text's measured size)."""
+        _, wh = self.plotter.window_size
+        extent = [0.0, 0.0]
+        self.overflow_caption.GetSize(self._band, extent)
+        x, y = self._band.GetOrigin()
+        lx, ly = self.overflow_caption.GetPosition()
+        top = wh - (y + ly + extent[1])
+        return [int(x + lx), int(top), int(round(extent[0])), int(round(extent[1]))]
 
     def label_boxes(self) -> dict:
         """Each tile's label box ``[x, y, width, height]`` in window pixels (origin top-left),
@@ -386,6 +494,9 @@ class TermStrip:
             "caption": self.caption.GetInput() or "",
             "labels": self.label_boxes(),
             "texts": {c: t.GetInput() for c, t in zip(COLUMNS, self.labels, strict=True)},
+            "overflow_caption": self.overflow_caption.GetInput() or "",
+            "overflow_box": self.overflow_box(),
+            "lights": self.lights.report(point),
         }
 
     def _switch(self, on: bool) -> None:
@@ -393,6 +504,8 @@ class TermStrip:
         main = self.plotter.renderer
         if on and not self.renderers:
             self._make()
+        if not on:
+            self.lights.drop()
         main.SetViewport(0.0, STRIP_HEIGHT if on else 0.0, 1.0, 1.0)
         window = self.plotter.render_window
         for r in (self._band, *self.renderers):
@@ -417,6 +530,14 @@ class TermStrip:
         band.SetViewport(0.0, 0.0, 1.0, STRIP_HEIGHT)
         band.SetBackground(main.GetBackground())
         band.InteractiveOff()
+        over = self.overflow_caption = vtkTextActor()  # (in the band's line under the tiles)
+        prop = over.GetTextProperty()
+        prop.SetColor(*LABEL_COLOUR)
+        prop.SetFontSize(LABEL_FONT)
+        prop.SetFontFamilyToArial()
+        prop.ShadowOff()
+        over.SetPosition(4, 2)
+        band.AddViewProp(over)
         for i in range(n):
             r = vtkRenderer()
             r.SetViewport(i / n, 0.0, (i + 1) / n, STRIP_HEIGHT)
@@ -454,33 +575,167 @@ class TermStrip:
 
     def _geometry(self, drawing) -> None:
         """Each tile's actor: the drawing's points and triangles, colours of its own."""
-        from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
-        from vtkmodules.vtkCommonDataModel import vtkPolyData
-        from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper
-
         for r, a in zip(self.renderers, self._actors, strict=False):
             r.RemoveActor(a)
-        self._actors, self._colours = [], []
-        n = drawing.mesh.n_vertices
-        for r in self.renderers:
-            poly = vtkPolyData()
-            poly.SetPoints(drawing.poly.GetPoints())
-            poly.SetPolys(drawing.poly.GetPolys())
-            arr = numpy_to_vtk(np.zeros((n, 3), np.uint8), deep=True)
-            arr.SetName("colors")
-            poly.GetPointData().SetScalars(arr)
-            mapper = vtkPolyDataMapper()
-            mapper.SetInputData(poly)
-            mapper.SetColorModeToDirectScalars()
-            mapper.SetScalarModeToUsePointData()
-            actor = vtkActor()
-            actor.SetMapper(mapper)
-            actor.GetProperty().LightingOff()
-            r.AddActor(actor)
-            self._actors.append(actor)
-            self._colours.append((vtk_to_numpy(arr), arr, poly))
+        made = [_mesh_actor(r, drawing) for r in self.renderers]
+        self._actors = [a for a, _ in made]
+        self._colours = [c for _, c in made]
         self._drawing = drawing
         self._key = None
+
+
+def _mesh_actor(renderer, drawing) -> tuple:
+    """An actor in ``renderer`` of the drawing's points and triangles, in colours of its own:
+    ``(actor, (colours (n, 3) uint8 view, the VTK array, its polydata))``."""
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+    from vtkmodules.vtkCommonDataModel import vtkPolyData
+    from vtkmodules.vtkRenderingCore import vtkActor, vtkPolyDataMapper
+
+    poly = vtkPolyData()
+    poly.SetPoints(drawing.poly.GetPoints())
+    poly.SetPolys(drawing.poly.GetPolys())
+    arr = numpy_to_vtk(np.zeros((drawing.mesh.n_vertices, 3), np.uint8), deep=True)
+    arr.SetName("colors")
+    poly.GetPointData().SetScalars(arr)
+    mapper = vtkPolyDataMapper()
+    mapper.SetInputData(poly)
+    mapper.SetColorModeToDirectScalars()
+    mapper.SetScalarModeToUsePointData()
+    actor = vtkActor()
+    actor.SetMapper(mapper)
+    actor.GetProperty().LightingOff()
+    renderer.AddActor(actor)
+    return actor, (vtk_to_numpy(arr), arr, poly)
+
+
+class _LightRow:
+    """One light's row of tiles under the strip (:data:`COLUMNS`' order, per vertex): its
+    renderers in the strip's render window (the main camera), its name at the first tile's top
+    left, :attr:`tiles` the bytes each draws."""
+
+    def __init__(self, strip: TermStrip):
+        from vtkmodules.vtkRenderingCore import vtkRenderer, vtkTextActor
+
+        main = strip.plotter.renderer
+        self.renderers, self._actors, self._colours = [], [], []
+        self._drawing = None
+        self.tiles = None
+        for _ in COLUMNS:
+            r = vtkRenderer()
+            r.SetBackground(main.GetBackground())
+            r.SetActiveCamera(main.GetActiveCamera())
+            r.InteractiveOff()
+            strip.plotter.render_window.AddRenderer(r)
+            self.renderers.append(r)
+        self.caption = vtkTextActor()
+        prop = self.caption.GetTextProperty()
+        prop.SetColor(*LABEL_COLOUR)
+        prop.SetFontSize(LABEL_MIN_FONT + 1)
+        prop.SetFontFamilyToArial()
+        prop.ShadowOff()
+        prop.SetVerticalJustificationToTop()
+        at = self.caption.GetPositionCoordinate()
+        at.SetCoordinateSystemToNormalizedViewport()
+        at.SetValue(0.02, 0.97)
+        self.renderers[0].AddViewProp(self.caption)
+
+    def show(self, drawing, name: str, tiles) -> None:
+        """Draw ``drawing``'s mesh in each tile's bytes of ``tiles``, the row named ``name``."""
+        if drawing is not self._drawing:
+            for r, a in zip(self.renderers, self._actors, strict=False):
+                r.RemoveActor(a)
+            made = [_mesh_actor(r, drawing) for r in self.renderers]
+            self._actors = [a for a, _ in made]
+            self._colours = [c for _, c in made]
+            self._drawing = drawing
+        self.tiles = tiles
+        for colours, rgb in zip(self._colours, tiles, strict=True):
+            colours[0][:] = rgb
+            colours[1].Modified()
+        self.caption.SetInput(name)
+
+    def tile_box(self, column: str) -> list[int]:
+        """Tile ``column``'s box ``[x, y, width, height]`` in window pixels (origin top-left)."""
+        r = self.renderers[COLUMNS.index(column)]
+        x, y = r.GetOrigin()
+        w, h = r.GetSize()
+        _, wh = r.GetRenderWindow().GetSize()
+        return [int(x), int(wh - y - h), int(w), int(h)]
+
+    def tile_pixel(self, column: str, point) -> list[int]:
+        """Window pixel (origin top-left) of ``point`` (3,) in the view's coordinates in tile
+        ``column`` (as :meth:`TermStrip.tile_pixel`)."""
+        r = self.renderers[COLUMNS.index(column)]
+        r.SetWorldPoint(*point, 1.0)
+        r.WorldToDisplay()
+        x, y, _ = r.GetDisplayPoint()
+        _, h = r.GetRenderWindow().GetSize()
+        return [int(round(x)), int(round(h - 1 - y))]
+
+    def remove(self, window) -> None:
+        """Take the row's renderers out of ``window``."""
+        for r in self.renderers:
+            window.RemoveRenderer(r)
+
+
+class LightRows:
+    """The strip's rows per light (the state's ``strip_lights``), under the strip's own:
+    :attr:`rows` each a :class:`_LightRow`, made or dropped as the count of lights changes
+    (:meth:`sync`), their tiles the engine's strip of each light alone (:meth:`fill`)."""
+
+    def __init__(self, strip: TermStrip):
+        self.strip = strip
+        self.rows: list = []
+        self._key = None
+
+    def sync(self, state: State, drawing, here: bool) -> None:
+        """A row per light of ``drawing``'s scene while ``state.strip_lights`` (none else),
+        the strip placed again when their count changed; drawn where the pane shows the strip
+        (``here``: a pane the compare view leaves out keeps their room, empty, as the
+        strip's)."""
+        want = len(drawing.shader.scene.lights) if state.strip_lights else 0
+        if want != len(self.rows):
+            self.drop()
+            self.rows = [_LightRow(self.strip) for _ in range(want)]
+            self.strip._placed = None
+            self.strip._place()
+        for row in self.rows:
+            for r in row.renderers:
+                r.SetDraw(here)
+
+    def fill(self, state: State, drawing) -> None:
+        """Each row's tiles: the engine's float64 strip of its light alone (a light pass each;
+        :func:`~explorer.render.strip.scene_rows`, :func:`~explorer.render.strip.mesh_strip`),
+        again when the drawing, scene, mode or groups changed."""
+        scene = drawing.shader.scene
+        key = (id(drawing), scene, state.strip_mode, drawing.groups)
+        if not self.rows or key == self._key:
+            return
+        self._key = key
+        rows = scene_rows(scene, lights=True, materials=drawing.groups)[1:]
+        for row, (name, light_scene, materials) in zip(self.rows, rows, strict=True):
+            strip = mesh_strip(light_scene, drawing.mesh, state.strip_mode, materials)
+            tiles = [to_bytes(strip.tiles[t]) for t in TERMS]
+            mask = tiles[4].copy()
+            mask[strip.overflow] = to_bytes([OVERFLOW_COLOR])[0]
+            row.show(drawing, name, (*tiles, mask))
+
+    def drop(self) -> None:
+        """No rows: their renderers out of the window."""
+        for row in self.rows:
+            row.remove(self.strip.plotter.render_window)
+        self.rows, self._key = [], None
+
+    def report(self, point) -> list[dict]:
+        """Each row's name, tile boxes and window pixels of ``point`` (as the strip's)."""
+        return [
+            {
+                "name": row.caption.GetInput() or "",
+                "boxes": {c: row.tile_box(c) for c in COLUMNS},
+                "px": {c: row.tile_pixel(c, point) for c in COLUMNS},
+            }
+            for row in self.rows
+        ]
 
 
 def fit_font(label, renderer, room: float) -> int | None:

@@ -72,6 +72,7 @@ SAMPLES = {
     "strip": False,  # (on at the start: its mode's row shown)
     "strip_mode": "raw",
     "strip_side": "b",
+    "strip_lights": True,
     "lobes": "lights",
     "lobe_view": "cartesian",
     "lobe_quantity": "brdf",

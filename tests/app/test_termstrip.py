@@ -9,7 +9,7 @@ from helpers.probes import in_ring, one_ring
 from helpers.views import sphere_view
 
 from explorer.app import panelmodel as PM
-from explorer.app.termstrip import STRIP_HEIGHT, set_strip, set_strip_mode
+from explorer.app.termstrip import band_height, set_strip, set_strip_mode
 from explorer.render.strip import COLUMNS
 from explorer.shading.strip import shader_strip
 
@@ -37,8 +37,9 @@ def test_each_tile_shows_the_engines_term_at_the_probe_vertex(view, mode):
     img = _picture(view)
     strip = view.strip
     assert strip.on and len(strip.renderers) == len(COLUMNS)
-    assert view.plotter.renderer.GetViewport() == pytest.approx((0, STRIP_HEIGHT, 1, 1))
-    band = img[int(SIZE[1] * (1 - STRIP_HEIGHT)) + 1 :]
+    top = SIZE[1] - band_height(SIZE[1])  # (the tiles' and the overflow caption's band)
+    assert view.plotter.renderer.GetViewport() == pytest.approx((0, 1 - top / SIZE[1], 1, 1))
+    band = img[top + 1 :]
     assert not np.array_equal(band, before[-len(band) :])  # the tiles are drawn there
     i = view.probe_vertex()
     ring = one_ring(view.mesh, i)
@@ -46,7 +47,7 @@ def test_each_tile_shows_the_engines_term_at_the_probe_vertex(view, mode):
     terms = shader_strip(view.drawings[0].shader, mode)
     for k, column in enumerate(COLUMNS):
         x, y = strip.tile_pixel(column, point)
-        assert SIZE[1] * (1 - STRIP_HEIGHT) <= y < SIZE[1]  # in the band under the view
+        assert top <= y < SIZE[1]  # in the band under the view
         want = strip.tiles[k][i].astype(int)
         if column in terms.tiles:  # (the float term's bytes: the tile is the engine's term)
             assert np.abs(want - np.rint(terms.tiles[column][i] * 255)).max() <= 1
@@ -147,7 +148,8 @@ def test_the_selected_handles_ring_stays_around_its_handle_above_the_strip(view)
     img = _picture(view)
     point = handle_point(s, s.light)
     x, y = view.world_to_window(point)
-    assert 0 <= x < SIZE[0] and 0 <= y < SIZE[1] * (1 - STRIP_HEIGHT)  # (the test's premise)
+    band = view.viewport_pixels()[1]  # (the strip's band under the main renderer)
+    assert band > 0 and 0 <= x < SIZE[0] and 0 <= y < SIZE[1] - band  # (the test's premise)
     size = V.HANDLE_RADIUS * V.SELECTED_SCALE * s.radius / view.frame[1]
     r = view._pixel_radius(view.to_view(point), size) + V.RING_GAP
     t = np.linspace(0, 2 * math.pi, 72, endpoint=False)
@@ -155,3 +157,81 @@ def test_the_selected_handles_ring_stays_around_its_handle_above_the_strip(view)
     inside = (ys >= 0) & (ys < SIZE[1]) & (xs >= 0) & (xs < SIZE[0])
     on_ring = img[ys[inside], xs[inside]].min(axis=1) > 235
     assert inside.mean() > 0.9 and on_ring.mean() > 0.5
+
+
+@pytest.mark.parametrize("preset", ["gold", "black_rubber"])
+def test_the_overflow_caption_says_what_the_mask_is_under_the_tiles(preset):
+    """Where the overflow tile shows a share > 0 (gold's saturated highlight), a caption on the
+    line under the tiles says what the mask is, its share the overflow tile's: its text's pixels
+    drawn there, inside the strip's band and under every tile. Where nothing is clamped the line
+    is empty (the band's background)."""
+    from explorer.app.termstrip import LABEL_COLOUR
+
+    v = sphere_view(preset, (900, 600))
+    try:
+        v.show_state(set_strip(v.state, True))
+        img = _picture(v)
+        rep = v.strip.report((0, 0, 0))
+        share = 100.0 * rep["overflow"]
+        bottom = max(y + h for _, y, _, h in rep["boxes"].values())  # (the tiles' lowest row)
+        line = img[bottom:600]
+        light = np.rint(np.multiply(LABEL_COLOUR, 255)).astype(int)
+        text = (np.abs(line - light).max(axis=2) <= 60).sum()  # (the caption's letters)
+        if preset == "gold":
+            assert share > 0.0
+            want = f"overflow (magenta): {share:.1f}% of the vertices clamped"
+            assert rep["overflow_caption"].startswith(want)
+            x, y, w, h = rep["overflow_box"]
+            assert 0 <= x and x + w <= 900 and bottom <= y and y + h <= 600
+            assert text > 50
+        else:
+            assert share == 0.0 and rep["overflow_caption"] == "" and text == 0
+            assert (line == line[0, 0]).all()  # (the band's background, nothing drawn)
+    finally:
+        v.plotter.close()
+
+
+def _two_lights(state):
+    """``state`` with a second light (a red directional one from the left, some ambient)."""
+    from explorer.core.lights import DirectionalLight
+
+    red = DirectionalLight(
+        ambient=(0.1, 0.0, 0.0), diffuse=(0.8, 0.1, 0.1), specular=(1, 1, 1), to_light=(-1, 0, 1)
+    )
+    return state.replace(scene=state.scene.replace(lights=(*state.scene.lights, red)))
+
+
+def test_a_row_per_light_each_the_engines_strip_of_that_light_alone():
+    """``strip_lights`` adds a row of tiles per light under the strip: each tile at the probe
+    vertex shows that light's term alone as ``render --strip --strip-lights`` computes it (its
+    rows after the scene's), named at the row's first tile; the rows go with the switch."""
+    from explorer.app.termstrip import set_strip_lights
+    from explorer.render.strip import render_strip
+    from explorer.shading.display import to_bytes
+
+    v = sphere_view("gold", (900, 700))
+    try:
+        state = set_strip_lights(set_strip(_two_lights(v.state), True), True)
+        v.show_state(state)
+        img = _picture(v)
+        strip = v.strip
+        i = v.probe_vertex()
+        ring = one_ring(v.mesh, i)
+        point = v.to_view(v.mesh.positions[i])
+        rep = strip.report(point)
+        assert [r["name"] for r in rep["lights"]] == ["light 1: point", "light 2: directional"]
+        want = render_strip(v.drawings[0].shader.scene, v.mesh, lights=True, tile=(32, 32))
+        top = min(y for _, y, _, _ in rep["boxes"].values())
+        for k, (row, light) in enumerate(zip(strip.lights.rows, rep["lights"], strict=True)):
+            engine = want.strips[k + 1]  # (render --strip-lights: the scene's row first)
+            for t, column in enumerate(COLUMNS[:5]):
+                assert np.array_equal(row.tiles[t], to_bytes(engine.tiles[column]))
+                x, y = light["px"][column]
+                assert rep["boxes"][column][1] + rep["boxes"][column][3] <= y  # under the strip
+                assert in_ring(img[y, x], row.tiles[t], ring), (k, column)
+        assert not np.array_equal(strip.lights.rows[0].tiles[4], strip.lights.rows[1].tiles[4])
+        assert top < 700 * 0.6  # (the strip grew: three rows)
+        v.show_state(set_strip_lights(state, False))
+        assert not strip.lights.rows and strip.report(point)["lights"] == []
+    finally:
+        v.plotter.close()

@@ -9,6 +9,7 @@ import pytest
 from helpers.probes import in_ring, one_ring
 from PySide6 import QtWidgets
 
+from explorer.app.termstrip import LABEL_COLOUR
 from explorer.render.strip import COLUMNS
 from explorer.shading.strip import shader_strip
 
@@ -51,6 +52,14 @@ def test_the_strip_is_drawn_under_the_view_from_the_panel(open_window, qtbot, tm
             if column in terms.tiles:
                 assert np.abs(want - np.rint(terms.tiles[column][i] * 255)).max() <= 1
             assert in_ring(img[y, x], strip.tiles[k], ring), column
+    # gold clamps its highlight: the caption under the tiles says so, its letters drawn there
+    rep = strip.report((0, 0, 0))
+    share = 100.0 * rep["overflow"]
+    assert rep["overflow_caption"].startswith(f"overflow (magenta): {share:.1f}% of the vertices")
+    x, y, cw, ch = rep["overflow_box"]
+    assert y >= max(by + bh for _, by, _, bh in rep["boxes"].values())  # (under the tiles)
+    letters = img[y : y + ch, x : x + cw]
+    assert (np.abs(letters - np.rint(np.multiply(LABEL_COLOUR, 255))).max(axis=2) <= 60).sum() > 50
     w.grab().save(str(tmp_path / "window_strip.png"))
     box.click()
     assert not w.view.strip.on
@@ -115,6 +124,10 @@ def test_per_pixel_the_tiles_are_the_per_pixel_terms_and_the_sum_tile_the_pictur
         want.reshape(-1, 3)[g.pixels] = to_bytes(terms.tiles["diffuse"])
     x, y, tw, th = strip.tile_box("diffuse")
     assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
+    # the overflow caption gives the per-pixel tile's share, of the pixels (its label's)
+    rep = strip.report((0, 0, 0))
+    share = rep["texts"]["overflow"].split()[-1]
+    assert rep["overflow_caption"].startswith(f"overflow (magenta): {share} of the pixels")
     # the main view above the strip: the per-pixel picture of its own part of the window
     from helpers.probes import interior
     from test_window_pixels import rings
@@ -295,3 +308,37 @@ def test_per_pixel_a_mesh_files_groups_each_in_its_material_in_the_tiles(open_wi
         assert len({tuple(c) for c in flat[g.pixels]}) > 10  # (the mesh in the tile)
     x, y, tw, th = strip.tile_box("diffuse")
     assert np.array_equal(img[y : y + th, x : x + tw][rows], want[rows])
+
+
+def test_a_row_per_light_from_the_panel_each_lights_strip_alone(open_window):
+    """The view tab's ``strip_lights`` check box (shown with the strip): a row of tiles per
+    light under the strip, each light's sum tile at the probe vertex, read from the window's
+    pixels, the engine's colour of that light alone as ``render --strip --strip-lights`` makes
+    it; the row goes with the box, in one undo step."""
+    from explorer.render.strip import render_strip
+    from explorer.shading.display import to_bytes
+
+    w = open_window("--mesh", "sphere", "--preset", "gold")
+    box = w.findChild(QtWidgets.QCheckBox, "strip")
+    _tab_with(w, box)
+    box.click()
+    lights = w.findChild(QtWidgets.QCheckBox, "strip_lights")
+    assert lights is not None and lights.isVisible()
+    lights.click()
+    assert w.controller.state.strip_lights
+    view = w.view
+    img = _pixels(w.plotter)
+    i = view.probe_vertex()
+    ring = one_ring(view.mesh, i)
+    point = view.to_view(view.mesh.positions[i])
+    rep = view.strip.report(point)
+    assert [r["name"] for r in rep["lights"]] == ["light 1: point"]
+    want = render_strip(view.drawings[0].shader.scene, view.mesh, lights=True, tile=(32, 32))
+    row = view.strip.lights.rows[0]
+    s = COLUMNS.index("sum")
+    assert np.array_equal(row.tiles[s], to_bytes(want.strips[1].tiles["sum"]))
+    x, y = rep["lights"][0]["px"]["sum"]
+    assert y >= sum(rep["boxes"]["sum"][1::2])  # (under the strip's own sum tile)
+    assert in_ring(img[y, x], row.tiles[s], ring)
+    w.controller.undo()
+    assert not w.controller.state.strip_lights and not view.strip.lights.rows

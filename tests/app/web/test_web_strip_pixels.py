@@ -152,3 +152,36 @@ def test_side_bs_strip_in_the_page_is_per_pixel_and_named(strip_server, strip_br
     click(b, "strip")
     wait("the strip off", lambda: report(b)["strip"] is None)
     assert not console_errors(b)
+
+
+def test_the_page_shows_a_row_per_light_under_the_strip(strip_server, strip_browser, tmp_path):
+    """The view tab's ``strip_lights`` check box adds a row of tiles per light under the strip
+    in the page: the report names each row, and in the page's picture the row's sum tile holds
+    the light's lit torus (pixels away from the background), under the strip's own tiles."""
+    b = strip_browser
+    open_page(b, strip_server.url)
+    click(b, "view tab")
+    click(b, "strip")
+    click(b, "strip_lights")
+    rep = wait("a row per light", lambda: (r := report(b))["strip"] and r["strip"]["lights"] and r)
+    assert [r["name"] for r in rep["strip"]["lights"]] == ["light 1: point"]
+
+    def drawn():  # polled: the picture shown may be one from before the rows
+        rep = report(b)
+        img = _picture(b, rep)
+        if img is None or not rep["strip"]["lights"]:
+            return False
+        x, y, tw, th = rep["strip"]["lights"][0]["boxes"]["sum"]
+        sx, sy, _, sh = rep["strip"]["boxes"]["sum"]
+        tile = img[y + 2 : y + th - 2, x + 2 : x + tw - 2]
+        background = img[y + 2, x + 2]
+        lit = (np.abs(tile - background).max(axis=2) > 30).sum()
+        return y >= sy + sh and lit > 50 and report(b) == rep
+
+    wait("the light row's sum tile drawn in the page", drawn)
+    b.save_screenshot(str(tmp_path / "page_light_rows.png"))
+    click(b, "strip_lights")
+    wait("the light rows gone", lambda: report(b)["strip"]["lights"] == [])
+    click(b, "strip")
+    wait("the strip off", lambda: report(b)["strip"] is None)
+    assert not console_errors(b)
