@@ -132,7 +132,7 @@ def test_the_kernels_run_the_light_loops_from_their_table(monkeypatch, precision
     real = _pass(LIT, precision)
     none = np.zeros(64, np.int64)
     none.flags.writeable = False  # (as the real table: no other signature of shade to compile)
-    monkeypatch.setattr(K, "loop_table", lambda dtype: none)
+    monkeypatch.setattr(K, "loop_table", lambda dtype, codes=None: none)
     dark = _pass(LIT, precision)
     monkeypatch.undo()
     unlit = {**LIT, "lights": [dict(lt, diffuse=[0] * 3, specular=[0] * 3) for lt in LIT["lights"]]}
