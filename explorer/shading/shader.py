@@ -512,8 +512,7 @@ class Shader:
             params64, flags, view64 = self._params_for(np.float64)
             surface64 = kernel_surface(self._scene.material, self._aconst, np.float64)
             loops64 = K.loop_table(np.float64, K.pass_loops(flags, opts))
-            lights64 = K.Lights(params64, flags, view64, loops64)
-            fix = (lights64, opts, surface64, self._k64)
+            fix = (K.Lights(params64, flags, view64, loops64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
                 marks, src64, *fix, sums, lobes, vis, self._out, _NO_BOUNDS
             )

@@ -5,10 +5,16 @@ background on a machine whose cache lacks the kernels. It takes the lock
 (:func:`explorer.shading.tiers.lock_path`; a second one exits at once), runs :func:`exercise`
 with the compiled tier (every kind of pass the product makes, on small meshes, in both
 precisions: numba compiles each kernel signature once and writes it to its cache), then writes the
-ready marker. Progress and errors go to :func:`explorer.shading.tiers.log_path`; each run counts
-itself first (:func:`explorer.shading.tiers.record_attempt`; an error it raises:
-:func:`~explorer.shading.tiers.record_error`), so that runs that end without the
-marker (an error, a crash of the compiler) are not started again and again.
+ready marker. Where there are two cores it compiles in two processes (numba's compiler is
+single-threaded): a partner (``python -m explorer.shading.warm --partner``, :func:`partner`)
+compiles the ray kernels and the 36 light loops while this one compiles the shading kernels,
+which call the loops through a table of entry points and so compile without them (see
+:func:`exercise`); it is also the fastest way to fill a cold cache (CI, a benchmark machine).
+It lowers its priority by :data:`NICE`. Progress and errors go to
+:func:`explorer.shading.tiers.log_path`; each run counts itself first
+(:func:`explorer.shading.tiers.record_attempt`; an error it raises:
+:func:`~explorer.shading.tiers.record_error`), so that runs that end without the marker (an
+error, a crash of the compiler) are not started again and again.
 
 :func:`load` runs the same passes in a process whose cache already holds them: numba loads each
 kernel and compiles nothing (the loader thread of a process that saw the marker appear).
