@@ -69,6 +69,7 @@ model for Zen 3 leaves some loops scalar), two vector iterations interleaved (se
 
 from __future__ import annotations
 
+import functools
 import operator
 import threading
 import warnings
@@ -1441,22 +1442,28 @@ def _run_codes(fl, l_dif, l_spec, mode, inline):
     return -1, -1
 
 
-def pass_loops(flags, opts) -> list[int]:
+def pass_loops(flags, opts) -> tuple[int, ...]:
     """The codes of the light loops a pass of ``flags`` (a light's flags each) with ``opts``
     (:mod:`explorer.shading.layout`'s ``O_`` options) calls, sorted: what its table must hold
     (:func:`loop_table`). Decided by the kernels' own functions, run as Python
     (:func:`_mode`, :func:`_is_inline`, :func:`_run_codes`: the choices :func:`_block` and
-    :func:`_light_run` make per light), a few microseconds a light."""
+    :func:`_light_run` make per light), once per set of lights and options (a few
+    microseconds a light; a pass after that looks them up)."""
     flat, phong = bool(opts[O_FLAT]), bool(opts[O_PHONG])
     do_dif, do_spec = bool(opts[O_DO_DIF]), bool(opts[O_DO_SPEC])
+    return _pass_loops(np.asarray(flags, np.int64).tobytes(), flat, phong, do_dif, do_spec)
+
+
+@functools.lru_cache(maxsize=256)
+def _pass_loops(flags: bytes, flat: bool, phong: bool, do_dif: bool, do_spec: bool) -> tuple:
     codes = set()
-    for fl in (int(f) for f in flags):
+    for fl in np.frombuffer(flags, np.int64).tolist():
         l_dif, l_spec = do_dif and (fl & DIFFUSE) != 0, do_spec and (fl & SPECULAR) != 0
         mode = _mode.py_func(fl, flat, phong)
         inline = _is_inline.py_func(fl, l_dif, l_spec, mode)
         codes.update(_run_codes.py_func(fl, l_dif, l_spec, mode, inline))
     codes.discard(-1)
-    return sorted(codes)
+    return tuple(sorted(codes))
 
 
 @nb.njit(**_LEAF)
