@@ -3,6 +3,7 @@
     python benchmarks/bench_compile.py                  # this tree
     python benchmarks/bench_compile.py --rev cb71986    # another revision (git archive), too
     python benchmarks/bench_compile.py --warm           # the background compile, by function
+    python benchmarks/bench_compile.py --warm --split   # ... in its two processes, as it runs
 
 Each case runs in a child process with an empty ``NUMBA_CACHE_DIR`` (nothing loaded from disk),
 which drives a small :class:`explorer.Shader` through what a session does (geometry, a full
@@ -18,6 +19,11 @@ it in the child, or the old dispatch tables replaced at revisions that had them)
 difference from "shade" is what the literal-dispatched variants cost to compile.
 
 Wall-clock seconds on a shared machine: the load average is printed with the table.
+
+``--split`` runs ``--warm``'s exercise as the background compile does on two cores (with its
+partner process, :func:`explorer.shading.warm.exercise`): each process's CPU seconds, the
+wall clock, and the kernels both compiled (none should be: numba's internal functions, which
+are not cached, aside).
 
 ``--warm`` measures the whole background compile instead (``python -m explorer.shading.warm``'s
 :func:`~explorer.shading.warm.exercise`, every kernel signature the product calls, in a child

@@ -57,6 +57,10 @@ SCENES = (
     {"model": "blinn", "lights": [{"type": "point", "position": [0, 3, 0], "diffuse": [0.7] * 3,
      "specular": [0.7] * 3, "ambient": [0.1] * 3}]},  # grey lights: grey sums
 )  # fmt: skip
+#: the scenes whose passes cast no shadow ray, and those that do (every mesh casts its rays:
+#: :mod:`explorer.shading.shadows`), apart for :func:`exercise`'s split
+SHADOWED = tuple(s for s in SCENES if any(lt.get("shadows") for lt in s["lights"]))
+UNSHADOWED = tuple(s for s in SCENES if s not in SHADOWED)
 
 
 def dispatchers() -> dict:
@@ -156,11 +160,11 @@ def rays() -> None:
     _refits()
 
 
-def _passes(meshes) -> int:
-    """The shading passes of the exercise over ``meshes`` (see :func:`exercise`)."""
+def _passes(meshes, scenes=SCENES) -> int:
+    """The shading passes of the exercise: ``scenes`` on ``meshes`` (see :func:`exercise`)."""
     passes = 0
     for P, N, faces in meshes:
-        for scene in SCENES:
+        for scene in scenes:
             for precision in ("float32", "float64"):
                 for keep in (True, False):
                     for clamp in (True, False):
@@ -192,9 +196,10 @@ def exercise(partner: bool = False) -> int:
         loops are called through a table of entry points, so the kernels that call them
         compile without them) while this one compiles the shading kernels, its passes running
         no light loop (:func:`kernels.loops_elsewhere`). The two compile disjoint sets of
-        kernels: this process's first passes are on the convex meshes, which cast no ray, and
-        it waits for the partner's ray kernels before the concave ones (whose shadow rays then
-        load them from the cache). numba's cache files are per function and signature; both
+        kernels: this process first runs the scenes that cast no shadow ray
+        (:data:`UNSHADOWED`: they compile nearly all of the shading kernels), and waits for
+        the partner's ray kernels before the others (:data:`SHADOWED`, whose rays then load
+        them from the cache). numba's cache files are per function and signature; both
         processes write them under :func:`explorer.shading.tiers.guard_cache`'s lock.
         RuntimeError when the partner fails (its cache files, and this one's, stay usable)."""
     tiers.guard_cache()  # a cache file numba cannot read is set aside and compiled anew
@@ -205,11 +210,11 @@ def exercise(partner: bool = False) -> int:
     try:
         kernels.loops_elsewhere(True)
         meshes = list(_meshes())
-        passes = _passes(meshes[:2])  # the convex sphere's: no ray
+        passes = _passes(meshes, UNSHADOWED)
         said = helper.stdout.readline().strip()  # (the partner's ray kernels are cached)
         if said != "rays":
             raise RuntimeError(_partner_failed(helper, f"said {said!r}, not 'rays'"))
-        passes += _passes(meshes[2:])
+        passes += _passes(meshes, SHADOWED)
         helper.stdout.read()  # (what else it says, until it ends)
         if helper.wait() != 0:
             raise RuntimeError(_partner_failed(helper))

@@ -339,7 +339,7 @@ def test_the_shading_pass_compiles_once_per_precision():
 
 #: one half of the split background compile (explorer.shading.warm.exercise with its
 #: partner), its kernels printed: the partner's whole share, or the main process's until it
-#: waits for the partner's ray kernels (the convex meshes' passes, the loops elsewhere)
+#: waits for the partner's ray kernels (the passes that cast no ray, the loops elsewhere)
 _HALF = textwrap.dedent(
     """
     import json, sys
@@ -348,7 +348,7 @@ _HALF = textwrap.dedent(
         warm.main(["--partner"])
     else:
         kernels.loops_elsewhere(True)
-        warm._passes(list(warm._meshes())[:2])
+        warm._passes(list(warm._meshes()), warm.UNSHADOWED)
     print(json.dumps(sorted(k for k, v in warm.signatures().items() if v)))
     """
 )
@@ -358,7 +358,7 @@ def test_the_split_compile_s_two_processes_take_disjoint_kernels():
     # issue 38 item 5: the background compile runs in two processes (two cores): nothing may be
     # compiled by both (each would pay for it, and both would write its cache files). numba
     # compiles what a process calls: so the kernels each half calls are disjoint, and the main
-    # process's ray kernels (its concave meshes' shadows, after the partner said "rays") and
+    # process's ray kernels (its shadowed scenes' rays, after the partner said "rays") and
     # the partner's light loops are what the other compiled
     env = dict(os.environ, **{tiers.ENV: "compiled"})
     half = {}
@@ -386,7 +386,7 @@ _HALVES = textwrap.dedent(
     import sys
     import numpy as np
     from explorer.shading import display, warm
-    def rounding(meshes):
+    def rounding(meshes, scenes):
         display._round_bytes(np.linspace(-0.1, 1.1, 12), np.empty(12, np.uint8))
         return 0
     partner = {"abort": "import os; os.abort()", "done": "print('rays')"}[sys.argv[1]]
