@@ -208,13 +208,16 @@ def exercise(partner: bool = False) -> int:
         return _passes(_meshes())
     helper = _start_partner()
     try:
-        kernels.loops_elsewhere(True)
-        meshes = list(_meshes())
-        passes = _passes(meshes, UNSHADOWED)
-        said = helper.stdout.readline().strip()  # (the partner's ray kernels are cached)
-        if said != "rays":
-            raise RuntimeError(_partner_failed(helper, f"said {said!r}, not 'rays'"))
-        passes += _passes(meshes, SHADOWED)
+        # (no light loop runs: the lobe rows they would fill are left as allocated, and the
+        # colours' byte rounding meets NaN; nothing here uses the colours)
+        with np.errstate(invalid="ignore"):
+            kernels.loops_elsewhere(True)
+            meshes = list(_meshes())
+            passes = _passes(meshes, UNSHADOWED)
+            said = helper.stdout.readline().strip()  # (the partner's ray kernels are cached)
+            if said != "rays":
+                raise RuntimeError(_partner_failed(helper, f"said {said!r}, not 'rays'"))
+            passes += _passes(meshes, SHADOWED)
         helper.stdout.read()  # (what else it says, until it ends)
         if helper.wait() != 0:
             raise RuntimeError(_partner_failed(helper))
