@@ -127,6 +127,26 @@ load 15-20 (both inflated alike; see docs/speed.md):
 | shading.kernels.fixup | 1 | 4.0 | 1 | 3.1 |
 | LLVM: function passes, module passes, machine code | | 11.4, 32.1, 26.3 | | 10.9, 21.4, 19.5 |
 | **the whole compile** (child CPU s; command user + sys) | | 186.4 (191.6) | | 158.7 (164.0) |
+
+The background compile in two processes (issue 38 item 5, third step: the partner compiles the
+ray kernels and the 36 light loops, the main process the shading kernels with the loops left to
+it, ``explorer.shading.warm.exercise``), ``--warm`` against ``--warm --split`` on the same
+2-core VM (Intel Xeon, AVX-512), CPU s of each compiling process, each run beside seven other
+sessions (load 4-9 for af2b7bd, 12-19 for the split: its CPU seconds are the more inflated):
+
+| function | af2b7bd signatures | CPU s | split: signatures | CPU s |
+|---|---:|---:|---:|---:|
+| shading.kernels._light_overload.impl (the light loops, the partner) | 36 | 33.3 | 36 | 41.3 |
+| shading.kernels.shade | 2 | 13.1 | 2 | 14.8 |
+| shading.kernels._compose_block_overload.impl | 36 | 10.7 | 36 | 12.0 |
+| shading.kernels._block | 2 | 12.8 | 2 | 9.0 |
+| LLVM: function passes, module passes, machine code | | 11.8, 23.4, 21.0 | | 13.5, 27.1, 24.0 |
+| **the whole compile**, CPU s per process | | 166.0 | | 100.3 + 85.3 |
+| wall (at that load: the others' share of the cores) | | 9:27 | | 18:53 |
+| kernels compiled by both processes | | | | 0 |
+
+The main process holds 54 % of the split's CPU: on 2 idle cores, where the one process took
+134.6 s, the split should take some 75-80 s of wall clock (not measured idle here).
 """
 
 from __future__ import annotations
