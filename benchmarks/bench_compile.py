@@ -146,7 +146,10 @@ sessions (load 4-9 for af2b7bd, 12-19 for the split: its CPU seconds are the mor
 | kernels compiled by both processes | | | | 0 |
 
 The main process holds 54 % of the split's CPU: on 2 idle cores, where the one process took
-134.6 s, the split should take some 75-80 s of wall clock (not measured idle here).
+134.6 s, the split should take some 75-80 s of wall clock (not measured idle here). Side by
+side at load 3-5 (``python -m explorer.shading.warm`` under ``/usr/bin/time``, one process
+against the split) the split lost, 169.9 s wall and 136.1 CPU s against 120.8 s and 108.8: the
+other sessions held the second core (docs/engine.md, *Ready at once*).
 """
 
 from __future__ import annotations
