@@ -3,6 +3,7 @@
     python benchmarks/bench_compile.py                  # this tree
     python benchmarks/bench_compile.py --rev cb71986    # another revision (git archive), too
     python benchmarks/bench_compile.py --warm           # the background compile, by function
+    python benchmarks/bench_compile.py --warm --split   # ... in its two processes, as it runs
 
 Each case runs in a child process with an empty ``NUMBA_CACHE_DIR`` (nothing loaded from disk),
 which drives a small :class:`explorer.Shader` through what a session does (geometry, a full
@@ -18,6 +19,11 @@ it in the child, or the old dispatch tables replaced at revisions that had them)
 difference from "shade" is what the literal-dispatched variants cost to compile.
 
 Wall-clock seconds on a shared machine: the load average is printed with the table.
+
+``--split`` runs ``--warm``'s exercise as the background compile does on two cores (with its
+partner process, :func:`explorer.shading.warm.exercise`): each process's CPU seconds, the
+wall clock, and the kernels both compiled (none should be: numba's internal functions, which
+are not cached, aside).
 
 ``--warm`` measures the whole background compile instead (``python -m explorer.shading.warm``'s
 :func:`~explorer.shading.warm.exercise`, every kernel signature the product calls, in a child
@@ -121,6 +127,29 @@ load 15-20 (both inflated alike; see docs/speed.md):
 | shading.kernels.fixup | 1 | 4.0 | 1 | 3.1 |
 | LLVM: function passes, module passes, machine code | | 11.4, 32.1, 26.3 | | 10.9, 21.4, 19.5 |
 | **the whole compile** (child CPU s; command user + sys) | | 186.4 (191.6) | | 158.7 (164.0) |
+
+The background compile in two processes (issue 38 item 5, third step: the partner compiles the
+ray kernels and the 36 light loops, the main process the shading kernels with the loops left to
+it, ``explorer.shading.warm.exercise``), ``--warm`` against ``--warm --split`` on the same
+2-core VM (Intel Xeon, AVX-512), CPU s of each compiling process, each run beside seven other
+sessions (load 4-9 for af2b7bd, 12-19 for the split: its CPU seconds are the more inflated):
+
+| function | af2b7bd signatures | CPU s | split: signatures | CPU s |
+|---|---:|---:|---:|---:|
+| shading.kernels._light_overload.impl (the light loops, the partner) | 36 | 33.3 | 36 | 41.3 |
+| shading.kernels.shade | 2 | 13.1 | 2 | 14.8 |
+| shading.kernels._compose_block_overload.impl | 36 | 10.7 | 36 | 12.0 |
+| shading.kernels._block | 2 | 12.8 | 2 | 9.0 |
+| LLVM: function passes, module passes, machine code | | 11.8, 23.4, 21.0 | | 13.5, 27.1, 24.0 |
+| **the whole compile**, CPU s per process | | 166.0 | | 100.3 + 85.3 |
+| wall (at that load: the others' share of the cores) | | 9:27 | | 18:53 |
+| kernels compiled by both processes | | | | 0 |
+
+The main process holds 54 % of the split's CPU: on 2 idle cores, where the one process took
+134.6 s, the split should take some 75-80 s of wall clock (not measured idle here). Side by
+side at load 3-5 (``python -m explorer.shading.warm`` under ``/usr/bin/time``, one process
+against the split) the split lost, 169.9 s wall and 136.1 CPU s against 120.8 s and 108.8: the
+other sessions held the second core (docs/engine.md, *Ready at once*).
 """
 
 from __future__ import annotations
@@ -131,6 +160,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -194,11 +224,14 @@ display.to_bytes(np.asarray(sh.colors, np.float64))
 print(json.dumps({{"import": import_s, **times}}))
 """
 
-#: the background compile, timed by specialisation (run in a child, like CHILD)
-WARM = r"""
-import json, sys, time
+#: the background compile's processes, timed by specialisation: a ``sitecustomize`` module put
+#: first on the children's path (the exercise's process and, split, its partner), which writes
+#: each process's compile events, CPU seconds and LLVM's share to OUT/<pid>.json at its exit
+SITE = r"""
+import atexit, json, os, time
 from numba.core import codegen, event
-llvm = {{"function passes": 0.0, "module passes": 0.0, "machine code": 0.0}}
+t0 = time.process_time()
+llvm = {"function passes": 0.0, "module passes": 0.0, "machine code": 0.0}
 def timed(cls, name, key):  # LLVM's share: numba's own typing and lowering is the rest
     real = getattr(cls, name)
     def call(self, *a, **kw):
@@ -216,40 +249,65 @@ class Listener(event.Listener):
     def on_start(self, ev):
         stack.append([time.process_time(), 0.0])
     def on_end(self, ev):
-        t0, inner = stack.pop()
-        total = time.process_time() - t0
+        t, inner = stack.pop()
+        total = time.process_time() - t
         if stack:
             stack[-1][1] += total
         f = ev.data["dispatcher"].py_func
-        rows.append((f"{{f.__module__}}.{{f.__qualname__}}", total - inner))
-t = time.process_time()
-with event.install_listener("numba:compile", Listener()):
-    import explorer
-    assert explorer.__file__.startswith({root!r}), explorer.__file__
-    from explorer.shading import warm
-    warm.exercise()
-print(json.dumps({{"cpu": time.process_time() - t, "rows": rows, "llvm": llvm}}))
+        sig = str(tuple(ev.data["args"]))
+        rows.append((f"{f.__module__}.{f.__qualname__}", total - inner, sig))
+event.register("numba:compile", Listener())
+@atexit.register
+def dump():
+    path = os.path.join(os.environ["BENCH_COMPILE_OUT"], f"{os.getpid()}.json")
+    with open(path, "w") as f:
+        json.dump({"cpu": time.process_time() - t0, "rows": rows, "llvm": llvm}, f)
+"""
+
+#: the background compile's exercise (``split``: with its partner process)
+WARM = r"""
+import explorer
+assert explorer.__file__.startswith({root!r}), explorer.__file__
+from explorer.shading import warm
+warm.exercise({split})
 """
 
 
-def warm_table(root: Path, label: str, top: int = 25) -> list[str]:
+def warm_table(root: Path, label: str, top: int = 25, split: bool = False) -> list[str]:
     """The background compile's CPU seconds at ``root``, by function (see the docstring)."""
-    with tempfile.TemporaryDirectory() as cache:
-        env = dict(os.environ, PYTHONPATH=str(root), NUMBA_CACHE_DIR=cache)
-        env["PHONG_EXPLORER_KERNELS"] = "compiled"
-        out = subprocess.run([sys.executable, "-c", WARM.format(root=str(root))], cwd=root,
-                             env=env, capture_output=True, text=True)  # fmt: skip
-    if out.returncode != 0:
-        sys.exit(f"{root}: the child failed:\n{out.stderr[-3000:]}")
-    res = json.loads(out.stdout.strip().splitlines()[-1])
+    with tempfile.TemporaryDirectory() as tmp:
+        cache, out_dir, site = Path(tmp, "cache"), Path(tmp, "out"), Path(tmp, "site")
+        for d in (cache, out_dir, site):
+            d.mkdir()
+        (site / "sitecustomize.py").write_text(SITE)
+        env = dict(os.environ, PYTHONPATH=f"{site}{os.pathsep}{root}", NUMBA_CACHE_DIR=str(cache))
+        env.update(PHONG_EXPLORER_KERNELS="compiled", BENCH_COMPILE_OUT=str(out_dir))
+        t = time.perf_counter()
+        code = WARM.format(root=str(root), split="partner=True" if split else "")
+        out = subprocess.run([sys.executable, "-c", code], cwd=root, env=env,
+                             capture_output=True, text=True)  # fmt: skip
+        wall = time.perf_counter() - t
+        if out.returncode != 0:
+            sys.exit(f"{root}: the child failed:\n{out.stderr[-3000:]}")
+        procs = [json.loads(p.read_text()) for p in sorted(out_dir.glob("*.json"))]
     by: dict[str, list] = {}
-    for name, s in res["rows"]:
-        name = name.replace("explorer.", "").replace("<locals>.", "")
-        by.setdefault(name, [0, 0.0])
-        by[name][0] += 1
-        by[name][1] += s
-    split = ", ".join(f"{k} {v:.1f}" for k, v in res.get("llvm", {}).items())
-    lines = [f"\n{label}: {res['cpu']:.1f} CPU s in all (LLVM: {split})\n"]
+    seen: dict[tuple, int] = {}
+    for res in procs:
+        for name, s, sig in res["rows"]:
+            name = name.replace("explorer.", "").replace("<locals>.", "")
+            by.setdefault(name, [0, 0.0])
+            by[name][0] += 1
+            by[name][1] += s
+            seen[(name, sig)] = seen.get((name, sig), 0) + 1
+    cpu = [res["cpu"] for res in procs]
+    llvm = {k: sum(res["llvm"][k] for res in procs) for k in procs[0]["llvm"]}
+    split_llvm = ", ".join(f"{k} {v:.1f}" for k, v in llvm.items())
+    twice = sorted(k for k, n in seen.items() if n > 1 and not k[0].startswith("numba."))
+    lines = [
+        f"\n{label}: {sum(cpu):.1f} CPU s in all, {len(procs)} process(es) of "
+        f"{', '.join(f'{c:.1f}' for c in cpu)} CPU s, {wall:.1f} s wall (LLVM: {split_llvm}); "
+        f"compiled in both processes: {len(twice)} {twice[:8]}\n"
+    ]
     lines.append("| function | signatures | CPU s |")
     lines.append("|---|---:|---:|")
     ranked = sorted(by.items(), key=lambda kv: -kv[1][1])
@@ -303,6 +361,8 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-tree", action="store_true", help="measure the revisions only")
     ap.add_argument("--precision", choices=("float32", "float64"), help="this one only")
     ap.add_argument("--warm", action="store_true", help="the background compile, by function")
+    ap.add_argument("--split", action="store_true",
+                    help="--warm as the background compile runs it, with its partner")  # fmt: skip
     args = ap.parse_args(argv)
     sys.path[:0] = [str(ROOT), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine
@@ -318,13 +378,15 @@ def main(argv=None) -> int:
             ).stdout
             subprocess.run(["tar", "-x", "-C", str(root)], input=arc, check=True)
             out += (
-                warm_table(root, f"revision {rev}")
+                warm_table(root, f"revision {rev}", split=args.split)
                 if args.warm
                 else measure(root, f"revision {rev}", dtypes)
             )
         if not args.skip_tree:
             out += (
-                warm_table(ROOT, "this tree") if args.warm else measure(ROOT, "this tree", dtypes)
+                warm_table(ROOT, "this tree", split=args.split)
+                if args.warm
+                else measure(ROOT, "this tree", dtypes)
             )
     out.append(f"\nload average after: {os.getloadavg()[0]:.2f}")
     print("\n".join(out))

@@ -47,7 +47,8 @@ class Loop(NamedTuple):
 
 
 def loop_code(loop: Loop) -> int:
-    """A loop's code: the literal the light loop is compiled for (and :func:`_loop_code`)."""
+    """A loop's code: the literal the light loop is compiled for (and
+    :func:`explorer.shading.kernels._run_codes`'s, at run time)."""
     return loop.source | loop.lobe << 2 | int(loop.grey) << 5
 
 

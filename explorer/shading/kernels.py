@@ -39,12 +39,14 @@ compile-time choices (:class:`explorer.shading.codegen.Loop`: where L comes from
 base is found, grey or RGB sums; see the comment above :func:`_light`).
 :data:`explorer.shading.codegen.LIGHT_LOOPS` lists the 18 valid combinations, each a function of
 its own (``_light_<code>``, :func:`_light_entry`), compiled once per precision by
-:func:`loop_table` (or loaded from numba's cache) before the first pass of that precision; a
-light's loop is picked at run time from its flags (:func:`_loop_code`) and called through that
-table of entry points (:func:`_light_loop`, :func:`_call_light`), so no table spells the
-combinations out and no kernel of the chain that calls them holds a copy of them (numba links a
-called function's code into its caller, and LLVM optimised the 36 loops again at every level:
-``_light_loop``, ``_block``, ``_task``, ``shade``'s parallel loop, ``shade``, ``fixup``).
+:func:`loop_table` (or loaded from numba's cache) before the first pass that calls it (a pass
+asks for the loops it calls, :func:`pass_loops`: a session compiles only the loops its scenes
+use); a light's loop is picked at run time from its flags (:func:`_run_codes`) and called
+through that table of entry points (:func:`_light_loop`, :func:`_call_light`), so no table
+spells the combinations out and no kernel of the chain that calls them holds a copy of them
+(numba links a called function's code into its caller, and LLVM optimised the 36 loops again
+at every level: ``_light_loop``, ``_block``, ``_task``, ``shade``'s parallel loop, ``shade``,
+``fixup``).
 Everything cheap to decide at run time is decided there (whether a light adds diffuse, whether
 it is attenuated). A new light type adds its pre-pass to :func:`_light_run` and fills the rows
 the SRC_ROWS loops read; a new term goes into :func:`_light` (and the numpy reference,
@@ -67,6 +69,7 @@ model for Zen 3 leaves some loops scalar), two vector iterations interleaved (se
 
 from __future__ import annotations
 
+import functools
 import operator
 import threading
 import warnings
@@ -752,7 +755,7 @@ def _reach(bd, c0, nc, q, fl, back, act):
 #   block adds the grey rows to every channel once.
 #
 # Every valid combination is in :data:`~explorer.shading.codegen.LIGHT_LOOPS`; :func:`_light_loop`
-# calls the one a light needs (its code from :func:`_loop_code`) through the table of entry
+# calls the one a light needs (its code from :func:`_run_codes`) through the table of entry
 # points :func:`loop_table` fills: no table is written by hand, and each loop is compiled once,
 # on its own (the module docstring gives the cost). What is cheap to decide
 # at run time is not a variant: whether the light adds diffuse (a specular-only pass adds w·N·L
@@ -1019,42 +1022,73 @@ def light_signature(dtype) -> tuple:
     return (types.Array(T, 1, "C"), types.intp, row, T, row, types.boolean, types.boolean)
 
 
-_tables: dict = {}
+_tables: dict = {}  # precision -> its table (read only)
+_filled: dict = {}  # precision -> the array its table views, written by loop_table alone
 _tables_lock = threading.Lock()
 
 
-def loop_table(dtype) -> np.ndarray:
-    """The light loops of a precision, compiled (or loaded from numba's cache) once per process:
-    (64,) int64, the entry point of each code of :data:`~explorer.shading.codegen.LIGHT_LOOPS`
-    (0 for a code that names none), given to the kernels with the lights (:class:`Lights`).
+def loop_table(dtype, codes=None) -> np.ndarray:
+    """The table of the light loops of a precision: (64,) int64, read only, the entry point of
+    each code of :data:`~explorer.shading.codegen.LIGHT_LOOPS` compiled so far (0 for the
+    others), given to the kernels with the lights (:class:`Lights`). One table per precision
+    and process, filled as passes ask: each loop of ``codes`` (None: every loop) that it lacks
+    is compiled, or loaded from numba's cache, first (a pass asks for the loops it calls,
+    :func:`pass_loops`; a kernel that meets a 0 runs no loop for that light). While
+    :func:`loops_elsewhere` is on, nothing is compiled (the table stays as it is).
 
     The kernels call a light loop through this table (:func:`_call_light`), not as a function
     numba links in: numba copies every function a kernel calls into the kernel's own code, and
     LLVM optimises and generates all of it again for each kernel of the chain that calls it
     (``_light_loop``, :func:`_block`, :func:`_task`, the parallel loop of :func:`shade`,
     :func:`shade`, :func:`fixup`): the 36 light loops were most of the cold compile's LLVM time.
+    So each loop compiles on its own, once, when a scene first needs it: a session of point
+    lights compiles a few of the 36, and the background compile's partner process compiles them
+    all while the other compiles the chain (:mod:`explorer.shading.warm`).
     Compiled with the target's vectors in the precision's lanes (16 float32 or 8 float64 at
     512 bits, 8 or 4 at 256: :func:`explorer.shading.codegen.lanes`,
     :func:`explorer.shading.codegen.wide_vectors`)."""
     dt = np.dtype(dtype)
     table = _tables.get(dt)
-    if table is not None:
+    wanted = LIGHT_LOOPS if codes is None else codes
+    if table is not None and (_elsewhere[0] or all(table[c] for c in wanted)):
         return table
     with _tables_lock:
-        if dt not in _tables:
+        table = _tables.get(dt)
+        if table is None:  # (a read-only view of an array that is filled below)
+            _filled[dt] = np.zeros(64, np.int64)
+            table = _tables[dt] = _filled[dt].view()
+            table.flags.writeable = False
+        missing = [] if _elsewhere[0] else [c for c in wanted if not table[c]]
+        if missing:
             sig = light_signature(dt)
-            table = np.zeros(64, np.int64)
             with wide_vectors(lanes(dt.itemsize)):
-                for code in LIGHT_LOOPS:
+                for code in missing:
                     d = globals()[f"_light_{code}"]
                     d.compile(sig)
                     cres = d.overloads[sig]
-                    table[code] = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
-            if not table[list(LIGHT_LOOPS)].all():  # pragma: no cover - numba lost a symbol
-                raise RuntimeError("a light loop has no entry point")
-            table.flags.writeable = False
-            _tables[dt] = table
-    return _tables[dt]
+                    fn = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
+                    if not fn:  # pragma: no cover - numba lost a symbol
+                        raise RuntimeError(f"the light loop {code} has no entry point")
+                    # (entries only go from 0 to an address: a pass reading the table in another
+                    # thread meanwhile sees either, and calls only loops it asked for)
+                    _filled[dt][code] = fn
+    return table
+
+
+#: whether :func:`loop_table` leaves the loops to another process (see :func:`loops_elsewhere`)
+_elsewhere = [False]
+
+
+def loops_elsewhere(on: bool) -> None:
+    """Make :func:`loop_table` compile no light loop (``on``) or compile as passes ask again: for
+    the background compile's main process, whose passes compile the kernels that call the loops
+    while its partner process compiles the loops themselves (:mod:`explorer.shading.warm`); its
+    passes then run no light loop (their colours are not used). Turning it off forgets the
+    tables filled meanwhile."""
+    with _tables_lock:
+        _elsewhere[0] = bool(on)
+        _tables.clear()
+        _filled.clear()
 
 
 @intrinsic
@@ -1084,14 +1118,6 @@ def _light_loop(loops, scr, m, q, y, k, atten, l_dif, code):
     fn = loops[code]
     if fn != 0:
         _call_light(fn, scr, m, q, y, k, atten, l_dif)
-
-
-@nb.njit(**_LEAF)
-def _loop_code(source, mode, l_spec, grey):
-    """The code of the loop for a light (as :func:`explorer.shading.codegen.loop_code`, at run
-    time)."""
-    lobe = mode if l_spec else LOBE_NONE
-    return source | lobe << 2 | (32 if grey else 0)
 
 
 @nb.njit(**_LEAF)
@@ -1370,9 +1396,9 @@ def _light_run(loops, scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mo
     ``scr`` starts at the run's first lane, see _block): its pre-passes (rows L and the weight
     w), then its light loop; ``vis`` : (m,) uint8 its visibility, or (0,)."""
     atten = (fl & ATTEN) != 0
+    first, second = _run_codes(fl, l_dif, l_spec, mode, inline)
     if inline:  # a plain point light (see _is_inline): no pre-pass
-        code = _loop_code(SRC_INLINE, mode, l_spec, (fl & GREY) != 0)
-        _light_loop(loops, scr, m, q, shininess, k, atten, l_dif, code)
+        _light_loop(loops, scr, m, q, shininess, k, atten, l_dif, first)
         return
     fres = l_spec and (fl & FRESNEL) != 0
     rows = (fl & (POSITIONAL | SHADOW)) != 0 or fres
@@ -1386,17 +1412,58 @@ def _light_run(loops, scr, m, fl, q, shininess, k, vis, l_amb, l_dif, l_spec, mo
         _dir_rows(scr, m, q, k[K_ONE])
     if fl & SHADOW:  # after the ambient: ambient light is not shadowed
         _shadow(scr, m, vis)
-    source = SRC_ROWS if rows else SRC_CONST
     if fres:  # diffuse with w, then specular with w·F
-        if l_dif:
-            code = _loop_code(source, mode, False, False)
-            _light_loop(loops, scr, m, q, shininess, k, False, True, code)
+        if first >= 0:
+            _light_loop(loops, scr, m, q, shininess, k, False, True, first)
         _fresnel(scr, m, q, k)
-        code = _loop_code(source, mode, True, False)
-        _light_loop(loops, scr, m, q, shininess, k, False, False, code)
-    elif l_dif or l_spec:  # (the weight rows hold the attenuation: not again in the loop)
-        code = _loop_code(source, mode, l_spec, False)
-        _light_loop(loops, scr, m, q, shininess, k, False, l_dif, code)
+        _light_loop(loops, scr, m, q, shininess, k, False, False, second)
+    elif second >= 0:  # (the weight rows hold the attenuation: not again in the loop)
+        _light_loop(loops, scr, m, q, shininess, k, False, l_dif, second)
+
+
+@nb.njit(**_LEAF)
+def _run_codes(fl, l_dif, l_spec, mode, inline):
+    """The light loops :func:`_light_run` calls for a light, in order: (first, second), each a
+    code of :data:`~explorer.shading.codegen.LIGHT_LOOPS` (as
+    :func:`explorer.shading.codegen.loop_code`, at run time) or -1 for none. An inline light
+    runs ``first`` alone; a Fresnel light its diffuse loop (``first``, when it adds diffuse)
+    and then its specular one; any other light ``second`` alone (-1 when it adds neither
+    diffuse nor specular). :func:`pass_loops` runs it as Python too (so it calls no other
+    kernel), so that a pass's table holds every loop the pass calls."""
+    spec_lobe = mode if l_spec else LOBE_NONE
+    if inline:
+        return SRC_INLINE | spec_lobe << 2 | (32 if (fl & GREY) != 0 else 0), -1
+    fres = l_spec and (fl & FRESNEL) != 0
+    source = SRC_ROWS if (fl & (POSITIONAL | SHADOW)) != 0 or fres else SRC_CONST
+    if fres:  # the diffuse loop (no lobe), then the specular one
+        return (source | LOBE_NONE << 2 if l_dif else -1), source | mode << 2
+    if l_dif or l_spec:
+        return -1, source | spec_lobe << 2
+    return -1, -1
+
+
+def pass_loops(flags, opts) -> tuple[int, ...]:
+    """The codes of the light loops a pass of ``flags`` (a light's flags each) with ``opts``
+    (:mod:`explorer.shading.layout`'s ``O_`` options) calls, sorted: what its table must hold
+    (:func:`loop_table`). Decided by the kernels' own functions, run as Python
+    (:func:`_mode`, :func:`_is_inline`, :func:`_run_codes`: the choices :func:`_block` and
+    :func:`_light_run` make per light), once per set of lights and options (a few
+    microseconds a light; a pass after that looks them up)."""
+    flat, phong = bool(opts[O_FLAT]), bool(opts[O_PHONG])
+    do_dif, do_spec = bool(opts[O_DO_DIF]), bool(opts[O_DO_SPEC])
+    return _pass_loops(np.asarray(flags, np.int64).tobytes(), flat, phong, do_dif, do_spec)
+
+
+@functools.lru_cache(maxsize=256)
+def _pass_loops(flags: bytes, flat: bool, phong: bool, do_dif: bool, do_spec: bool) -> tuple:
+    codes = set()
+    for fl in np.frombuffer(flags, np.int64).tolist():
+        l_dif, l_spec = do_dif and (fl & DIFFUSE) != 0, do_spec and (fl & SPECULAR) != 0
+        mode = _mode.py_func(fl, flat, phong)
+        inline = _is_inline.py_func(fl, l_dif, l_spec, mode)
+        codes.update(_run_codes.py_func(fl, l_dif, l_spec, mode, inline))
+    codes.discard(-1)
+    return tuple(sorted(codes))
 
 
 @nb.njit(**_LEAF)

@@ -458,7 +458,7 @@ class Shader:
         base, ws = self._memory.lobe_rows((len(params), n if opts[layout.O_STORE_LOBE] else 0), T)
         vis = self._visibility()
         inputs = (
-            K.Lights(params, flags, view, K.loop_table(T)),
+            K.Lights(params, flags, view, K.loop_table(T, K.pass_loops(flags, opts))),
             opts,
             K.Surface(mat, aconst, kernel_shininess(scene.material.shininess, T)),
             self._k,
@@ -511,8 +511,8 @@ class Shader:
             src64 = vertices(self._P, self._N, self._centre, self._scale, np.float64)
             params64, flags, view64 = self._params_for(np.float64)
             surface64 = kernel_surface(self._scene.material, self._aconst, np.float64)
-            lights64 = K.Lights(params64, flags, view64, K.loop_table(np.float64))
-            fix = (lights64, opts, surface64, self._k64)
+            loops64 = K.loop_table(np.float64, K.pass_loops(flags, opts))
+            fix = (K.Lights(params64, flags, view64, loops64), opts, surface64, self._k64)
             self.stats["fixup_vertices"] += K.fixup(
                 marks, src64, *fix, sums, lobes, vis, self._out, _NO_BOUNDS
             )

@@ -444,8 +444,50 @@ def guard_cache() -> bool:
             for name, d in warm.dispatchers().items():
                 if getattr(d._cache, "_cache_file", None) is not None:  # a cached function
                     d._cache.load_overload = _guarded_load(name, d._cache)
+            _lock_saves()
             _state["guarded"] = True
     return True
+
+
+def save_lock_path() -> Path:
+    """The lock numba's cache writes take in a process that guards the cache (see
+    :func:`_lock_saves`)."""
+    return cache_dir() / "explorer-save.lock"
+
+
+def _lock_saves() -> None:
+    """Make numba's cache writes (``IndexDataCacheFile.save``: read the function's index, add
+    the signature with the next free data file's name, write the index, write the data) hold
+    an exclusive lock on :func:`save_lock_path` (``flock``), in every process that guards the
+    cache: the two processes of the background compile (:mod:`explorer.shading.warm`), and a
+    compiled-mode process beside it. Each file numba writes is whole (a temporary file
+    renamed), but the index is read, changed and written again: two processes adding
+    signatures of one function at once would each write an index without the other's entry,
+    or name one data file for two signatures, one's index pointing at the other's code."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: writes unlocked, as numba's own
+        return
+    from numba.core.caching import IndexDataCacheFile
+
+    save = IndexDataCacheFile.save
+    if getattr(save, "locked", False):
+        return
+    path = save_lock_path()
+
+    def locked_save(self, key, data):
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o666)
+        except OSError:  # (no lock file to be had: written as numba writes)
+            return save(self, key, data)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            return save(self, key, data)
+        finally:
+            os.close(fd)  # (the lock goes with it)
+
+    locked_save.locked = True  # type: ignore[attr-defined]
+    IndexDataCacheFile.save = locked_save
 
 
 def _guarded_load(name: str, cache):

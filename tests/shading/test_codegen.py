@@ -132,7 +132,7 @@ def test_the_kernels_run_the_light_loops_from_their_table(monkeypatch, precision
     real = _pass(LIT, precision)
     none = np.zeros(64, np.int64)
     none.flags.writeable = False  # (as the real table: no other signature of shade to compile)
-    monkeypatch.setattr(K, "loop_table", lambda dtype: none)
+    monkeypatch.setattr(K, "loop_table", lambda dtype, codes=None: none)
     dark = _pass(LIT, precision)
     monkeypatch.undo()
     unlit = {**LIT, "lights": [dict(lt, diffuse=[0] * 3, specular=[0] * 3) for lt in LIT["lights"]]}
@@ -164,3 +164,109 @@ def test_each_light_loop_is_a_kernel_of_its_own():
         linked = cres.library._get_module_for_linking()
         defined = [f.name for f in linked.functions if not f.is_declaration]
         assert defined and not [f for f in defined if "_light_overload" in f]
+
+
+def _fresh_tables(monkeypatch):
+    """No light loop in this process's tables yet (as in a new process; numba's dispatchers
+    keep what they compiled, so a loop already compiled is only entered again)."""
+    monkeypatch.setattr(K, "_tables", {})
+    monkeypatch.setattr(K, "_filled", {})
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_a_pass_compiles_only_the_light_loops_it_calls(monkeypatch, precision):
+    # issue 38 item 5: a session compiles the loops its scenes use, not the 36 (each loop is
+    # 1-2 s of the cold compile); the table holds those a pass asked for (kernels.pass_loops)
+    real = _pass(LIT, precision)
+    _fresh_tables(monkeypatch)
+    compiled = []
+    for code in codegen.LIGHT_LOOPS:
+        d = getattr(K, f"_light_{code}")
+        monkeypatch.setattr(
+            d, "compile", lambda sig, d=d, c=code: compiled.append(c) or type(d).compile(d, sig)
+        )
+    assert np.array_equal(_pass(LIT, precision), real)
+    table = K.loop_table(precision, [])
+    asked = [c for c in codegen.LIGHT_LOOPS if table[c]]
+    # (a float32 pass asks for its loops in float64 too, for the redo of its ambiguous lanes)
+    assert sorted(set(compiled)) == asked and 1 <= len(asked) <= 4, (compiled, asked)
+    shiny = {**LIT, "material": {**LIT["material"], "specular": [0.5] * 3}}
+    again = _pass(shiny, precision)  # a specular lobe: its loops join
+    assert len([c for c in codegen.LIGHT_LOOPS if table[c]]) > len(asked)
+    assert (again != real).any()
+
+
+def _scene_passes(precision):
+    """The colours of the background compile's scenes (explorer.shading.warm.SCENES: every
+    light path, model, viewer, effect) on a concave mesh with shadows, with the material and
+    viewer changes the window makes (passes of the diffuse, the specular or the lobe alone)."""
+    from explorer.geometry.meshes import torus
+    from explorer.shading import warm
+    from explorer.shading.shader import Shader
+
+    mesh = torus(12)
+    out = []
+    for scene in warm.SCENES:
+        s = Shader(
+            {"material": warm.MATERIAL, **scene},
+            mesh.positions,
+            mesh.normals,
+            precision=precision,
+            faces=mesh.faces,
+            tier="compiled",
+        )
+        out.append(np.array(s.colors))
+        material = s.scene.material
+        for change in (
+            {"diffuse": [0.2, 0.5, 0.9]},
+            {"shininess": 12.0},
+            {"shininess": 0.0},
+            {"specular": [0.0, 0.0, 0.0]},
+        ):
+            s.set_material(material.replace(**change))
+            out.append(np.array(s.colors))
+        s.set_viewer({"eye": [0.5, 1.0, 4.0]})
+        out.append(np.array(s.colors))
+    return out
+
+
+@pytest.mark.parametrize("precision", ["float32", "float64"])
+def test_a_pass_asks_for_every_light_loop_it_calls(monkeypatch, precision):
+    # a loop the table lacks is skipped (its entry is 0): so each pass's table must hold every
+    # loop the kernels call for it. Here each pass gets the loops kernels.pass_loops names and
+    # no other, and every colour is as with all 36 loops
+    for dtype in (np.float32, np.float64):
+        K.loop_table(dtype)  # every loop in the tables (a float32 pass redoes lanes in float64)
+    full = _scene_passes(precision)
+    loop_table = K.loop_table
+
+    def only_asked(dtype, codes=None):
+        everything = loop_table(dtype)
+        table = np.zeros_like(everything)
+        wanted = codegen.LIGHT_LOOPS if codes is None else codes
+        table[list(wanted)] = everything[list(wanted)]
+        table.flags.writeable = False
+        return table
+
+    monkeypatch.setattr(K, "loop_table", only_asked)
+    for got, want in zip(_scene_passes(precision), full, strict=True):
+        assert np.array_equal(got, want)
+
+
+def test_while_the_loops_are_compiled_elsewhere_a_pass_compiles_none(monkeypatch):
+    # the background compile's main process (explorer.shading.warm.exercise with its partner)
+    # compiles the kernels that call the light loops but not the loops: its partner does
+    _fresh_tables(monkeypatch)
+    compiled = []
+    for code in codegen.LIGHT_LOOPS:
+        d = getattr(K, f"_light_{code}")
+        monkeypatch.setattr(d, "compile", lambda sig, c=code: compiled.append(c))
+    K.loops_elsewhere(True)
+    try:
+        dark = _pass(LIT, "float64")
+        assert not K.loop_table(np.float64).any() and not compiled
+    finally:
+        K.loops_elsewhere(False)
+    unlit = {**LIT, "lights": [dict(lt, diffuse=[0] * 3, specular=[0] * 3) for lt in LIT["lights"]]}
+    monkeypatch.undo()
+    assert np.array_equal(dark, _pass(unlit, "float64"))  # (no loop ran)

@@ -11,6 +11,7 @@ import re
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from contextlib import contextmanager
 
@@ -336,6 +337,115 @@ def test_the_shading_pass_compiles_once_per_precision():
     assert out.strip().splitlines()[-1] == "{'shade': 2, 'bounds': 2}", out  # float32, float64
 
 
+#: one half of the split background compile (explorer.shading.warm.exercise with its
+#: partner), its kernels printed: the partner's whole share, or the main process's until it
+#: waits for the partner's ray kernels (the passes that cast no ray, the loops elsewhere)
+_HALF = textwrap.dedent(
+    """
+    import json, sys
+    from explorer.shading import kernels, warm
+    if sys.argv[1] == "partner":
+        warm.main(["--partner"])
+    else:
+        kernels.loops_elsewhere(True)
+        warm._passes(list(warm._meshes()), warm.UNSHADOWED)
+    print(json.dumps(sorted(k for k, v in warm.signatures().items() if v)))
+    """
+)
+
+
+def test_the_split_compile_s_two_processes_take_disjoint_kernels():
+    # issue 38 item 5: the background compile runs in two processes (two cores): nothing may be
+    # compiled by both (each would pay for it, and both would write its cache files). numba
+    # compiles what a process calls: so the kernels each half calls are disjoint, and the main
+    # process's ray kernels (its shadowed scenes' rays, after the partner said "rays") and
+    # the partner's light loops are what the other compiled
+    env = dict(os.environ, **{tiers.ENV: "compiled"})
+    half = {}
+    for name in ("partner", "main"):
+        out = subprocess.run(
+            [sys.executable, "-c", _HALF, name],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=900,
+        )
+        assert out.returncode == 0, out.stderr
+        half[name] = set(json.loads(out.stdout.strip().splitlines()[-1]))
+    loops = {k for k in half["partner"] if ".kernels._light_" in k}
+    assert len(loops) == 18
+    assert all(k.startswith("explorer.geometry.") for k in half["partner"] - loops)
+    assert half["partner"] - loops  # (the ray kernels)
+    assert half["main"] and not half["main"] & half["partner"]
+
+
+#: the background compile split in two (warm.main on two cores), its main process's passes the
+#: byte rounding alone, its partner a command that aborts or one that says it is done
+_HALVES = textwrap.dedent(
+    """
+    import sys
+    import numpy as np
+    from explorer.shading import display, warm
+    def rounding(meshes, scenes):
+        display._round_bytes(np.linspace(-0.1, 1.1, 12), np.empty(12, np.uint8))
+        return 0
+    partner = {"abort": "import os; os.abort()", "done": "print('rays')"}[sys.argv[1]]
+    warm._passes, warm.cores = rounding, lambda: 2
+    warm.partner_command = lambda: [sys.executable, "-c", partner]
+    sys.exit(warm.main())
+    """
+)
+
+
+def test_a_crash_of_one_half_of_the_compile_leaves_the_other_s_kernels_cached(tmp_path):
+    # the partner process crashing (the compiler aborting) fails the background compile (no
+    # marker, the error written for the next process to tell) but what the main process
+    # compiled is in the cache: the next background compile loads it, compiles only the rest
+    env, marker = _empty_cache(tmp_path, "marker_path")
+    first = subprocess.run(
+        [sys.executable, "-c", _HALVES, "abort"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert first.returncode == 1, first.stderr
+    assert not os.path.exists(marker)
+    error = json.loads(_read(marker.replace("-ready-", "-attempt-")))["error"]
+    assert error.startswith("RuntimeError: the partner compile ended with status"), error
+    (nbc,) = (tmp_path / "numba").rglob("display._round_bytes-*.nbc")
+    kept = os.stat(nbc)
+    second = subprocess.run(
+        [sys.executable, "-c", _HALVES, "done"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert second.returncode == 0, second.stderr
+    assert os.path.exists(marker)
+    again = os.stat(nbc)  # loaded, not compiled and written again
+    assert (again.st_ino, again.st_mtime_ns) == (kept.st_ino, kept.st_mtime_ns)
+
+
+def test_numba_cache_writes_wait_for_the_save_lock(tmp_path):
+    # numba reads a function's index, adds a signature and writes it back: two processes of
+    # the split compile adding signatures of one function at once would lose one, or name one
+    # data file for both. Every cache write of a guarded process holds tiers.save_lock_path
+    from numba.core.caching import IndexDataCacheFile
+
+    tiers.guard_cache()
+    cache = IndexDataCacheFile(str(tmp_path), "probe", ("stamp", 1))
+    with open(tiers.save_lock_path(), "a+") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        writer = threading.Thread(target=cache.save, args=("key", b"code"))
+        writer.start()
+        writer.join(0.5)
+        assert writer.is_alive() and not (tmp_path / "probe.nbi").exists()  # it waits
+    writer.join(60)
+    assert not writer.is_alive() and cache.load("key") == b"code"
+
+
 def test_after_failed_background_compiles_the_numpy_tier_serves_and_says_why(cold_tiers):
     # one compile that ended without the marker: another is started
     tiers.record_attempt()
@@ -375,7 +485,7 @@ CRASH = textwrap.dedent(
     """
     import os, sys
     from explorer.shading import warm
-    warm.exercise = (lambda: os.abort()) if sys.argv[1] == "abort" else (lambda: 1 / 0)
+    warm.exercise = (lambda **_: os.abort()) if sys.argv[1] == "abort" else (lambda **_: 1 / 0)
     sys.exit(warm.main())
     """
 )
@@ -531,6 +641,7 @@ _WARM = textwrap.dedent(
         out = np.empty(12, np.uint8)
         display._round_bytes(np.linspace(-0.1, 1.1, 12), out)
     warm._pixel_rays, warm._refits, warm._meshes = rounding, lambda: None, lambda: iter(())
+    warm.cores = lambda: 1  # (one process: no partner compiling the loops for minutes)
     sys.exit(warm.main())
     """
 )
