@@ -35,9 +35,11 @@ cache nothing is started; the order is the same either way.
 """
 
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -100,6 +102,7 @@ BEFORE_KERNELS = (
     "test_lint.py",
     "test_start.py",
     "test_strict.py",
+    "test_suite_order.py",
     "test_types.py",
     "test_wheel.py",
 )
@@ -134,13 +137,23 @@ def _before_kernels(item) -> bool:
     return where in BEFORE_KERNELS
 
 
+def pytest_sessionstart(session):
+    """A run of folders (the whole suite, CI) starts the background compile before collecting,
+    which takes a while (see pytest_collection_modifyitems for the others)."""
+    base = session.config.invocation_params.dir
+    if any((base / arg).is_dir() for arg in session.config.args):
+        _start_compile(session.config)
+
+
 def pytest_collection_modifyitems(session, config, items):
     """The tests of :data:`BEFORE_KERNELS` run first (the others keep their order: the window
     tests of tests/app/qt stay last, tests/app/conftest.py), with the background compile beside
-    them on a cold cache; the check for unused goldens runs last, after every test that uses
-    one."""
+    them on a cold cache (ended at once when no test is left that calls a kernel); the check
+    for unused goldens runs last, after every test that uses one."""
     first = [i for i in items if _before_kernels(i)]
-    if first and len(first) < len(items):
+    if len(first) == len(items):
+        _end_compile(stop=True)
+    elif first:
         _start_compile(config)
     last = [i for i in items if getattr(i, "originalname", None) == "test_golden_files_all_used"]
     rest = [i for i in items if i not in set(first) and i not in last]
@@ -173,18 +186,29 @@ def _cold_kernels() -> bool:
 
 def _start_compile(config) -> None:
     """On a cold cache, :func:`explorer.shading.warm.exercise` in a process of its own (the
-    engine's compiled tier, numba's cache of this session), its output in a file."""
-    if os.environ.get("PYTEST_XDIST_WORKER") or not _cold_kernels():
+    engine's compiled tier, numba's cache of this session), its output in a file; once per
+    session."""
+    if _COMPILE or os.environ.get("PYTEST_XDIST_WORKER") or config.option.collectonly:
         return
-    # closed in _wait_compile, read and removed in pytest_terminal_summary
+    _COMPILE["checked"] = True
+    if not _cold_kernels():
+        return
+    # closed in _end_compile, read and removed in pytest_terminal_summary
     log = tempfile.NamedTemporaryFile(prefix="explorer-compile-", suffix=".log", delete=False)  # noqa: SIM115
     code = "from explorer.shading import warm; print(warm.exercise(), 'passes')"
     proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL,
                             stdout=log, stderr=subprocess.STDOUT)  # fmt: skip
-    _COMPILE.update(proc=proc, log=log, started=time.monotonic(), waited=None)
+    started = time.monotonic()
+
+    def note_the_end():
+        proc.wait()
+        _COMPILE["ran"] = time.monotonic() - started
+
+    threading.Thread(target=note_the_end, daemon=True).start()
+    _COMPILE.update(proc=proc, log=log, waited=None)
 
 
-def _wait_compile(stop: bool = False) -> None:
+def _end_compile(stop: bool = False) -> None:
     """Wait for the background compile (``stop``: end it instead); then it is done with."""
     proc = _COMPILE.get("proc")
     if proc is None or _COMPILE.get("waited") is not None:
@@ -207,26 +231,31 @@ COMPILE_TIMEOUT = 900
 
 def pytest_runtest_setup(item):
     if not _before_kernels(item):
-        _wait_compile()
+        _end_compile()
 
 
 def pytest_sessionfinish(session, exitstatus):
-    _wait_compile(stop=True)
+    _end_compile(stop=True)
 
 
 def pytest_terminal_summary(terminalreporter):
-    """One line on the background compile: how long it ran and how long the tests waited."""
+    """One line on the background compile: how long it ran, how long the tests waited for it."""
     proc = _COMPILE.get("proc")
     if proc is None:
         return
     log = Path(_COMPILE["log"].name)
     out = log.read_text(errors="replace").strip().splitlines()
     last = out[-1] if out else "no output"
+    ran = _COMPILE.get("ran", float("nan"))
+    if proc.returncode == -signal.SIGTERM:  # no test that calls a kernel was left to wait
+        how = "stopped at the end of the run"
+    else:
+        how = f"the tests waited {_COMPILE['waited']:.1f} s for it"
     terminalreporter.write_line(
-        f"the kernels' cold compile beside the tests: exit {proc.returncode} ({last}), the "
-        f"tests waited {_COMPILE['waited']:.1f} s for it"
+        f"the kernels' cold compile beside the tests: exit {proc.returncode} ({last}) after "
+        f"{ran:.1f} s; {how}"
     )
-    if proc.returncode not in (0, -15):
+    if proc.returncode not in (0, -signal.SIGTERM):
         terminalreporter.write_line("\n".join(out[-20:]))
     log.unlink(missing_ok=True)
 
