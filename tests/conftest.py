@@ -225,8 +225,11 @@ def _end_compile(stop: bool = False) -> None:
     _COMPILE["log"].close()
 
 
-#: how long the first test after :data:`BEFORE_KERNELS` waits for the background compile at most
-COMPILE_TIMEOUT = 900
+#: how long the first test after :data:`BEFORE_KERNELS` waits for the background compile at most:
+#: against a hung process only. Ending a slow one gains nothing (the tests would compile the
+#: rest themselves, no faster) and loses the kernel it was compiling: on a machine loaded 20
+#: deep the compile took more than 900 s
+COMPILE_TIMEOUT = 3600
 
 
 def pytest_runtest_setup(item):
