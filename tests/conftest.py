@@ -233,7 +233,11 @@ COMPILE_TIMEOUT = 3600
 
 
 def pytest_runtest_setup(item):
-    if not _before_kernels(item):
+    if not _before_kernels(item) and _COMPILE.get("proc") and _COMPILE["waited"] is None:
+        from explorer.shading import warm
+
+        # kernels the tests before this one called: BEFORE_KERNELS names a module it should not
+        _COMPILE["called"] = sorted(name for name, sigs in warm.signatures().items() if sigs)
         _end_compile()
 
 
@@ -258,6 +262,9 @@ def pytest_terminal_summary(terminalreporter):
         f"the kernels' cold compile beside the tests: exit {proc.returncode} ({last}) after "
         f"{ran:.1f} s; {how}"
     )
+    if _COMPILE.get("called"):
+        called = ", ".join(_COMPILE["called"])
+        terminalreporter.write_line(f"the tests of BEFORE_KERNELS called kernels: {called}")
     if proc.returncode not in (0, -signal.SIGTERM):
         terminalreporter.write_line("\n".join(out[-20:]))
     log.unlink(missing_ok=True)
