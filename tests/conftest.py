@@ -23,10 +23,25 @@ The engine runs on its compiled tier throughout (``PHONG_EXPLORER_KERNELS=compil
 by the commands the tests start): the tests check the kernels, so a pass never falls back to the
 numpy tier while numba's cache is cold. tests/shading/test_tiers.py tests the tiers and mode
 ``auto`` themselves.
+
+The cold compile beside the tests: on a cache that lacks kernels (CI's fresh clone), the kernels'
+compile (minutes of one core) would run inside the pytest process, test after test, while the
+second core waits. So a run that collects both the tests of :data:`BEFORE_KERNELS` (no numba
+kernel in the pytest process nor in the commands they start) and others starts the background
+compile's passes (:func:`explorer.shading.warm.exercise`) in a process of its own at once, runs
+:data:`BEFORE_KERNELS` first, and lets the first other test wait for that process: by then it
+has filled numba's cache and the tests load the kernels instead of compiling them. On a warm
+cache nothing is started; the order is the same either way.
 """
 
 import os
+import signal
+import subprocess
 import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
 
 os.environ["PHONG_EXPLORER_KERNELS"] = "compiled"  # before the package is imported
 
@@ -40,6 +55,59 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 #: size of the shared ``renderer`` fixture's pictures (width, height)
 RENDER_SIZE = (400, 400)
+
+TESTS = Path(__file__).resolve().parent
+#: test modules and folders (relative to tests/) that call no numba kernel, neither in the pytest
+#: process nor in the commands they start (page servers run the numpy tier, tests/app/web's
+#: webserver.py): they run first, while the cold compile runs beside them (module docstring).
+#: Found with a per-test count of the kernels' signatures on a warm cache; a module listed here
+#: that comes to call a kernel only costs time (it compiles what it needs itself).
+BEFORE_KERNELS = (
+    "app/web/test_jupyter_proxy.py",
+    "app/web/test_web_intents.py",
+    "app/web/test_web_layout.py",
+    "app/web/test_web_life.py",
+    "app/web/test_web_litsphere.py",
+    "app/web/test_web_maps.py",
+    "app/web/test_web_parity.py",
+    "app/web/test_web_pictures.py",
+    "app/web/test_web_pixels.py",
+    "app/web/test_web_rows.py",
+    "app/web/test_web_security.py",
+    "app/web/test_web_strip_pixels.py",
+    "app/web/test_web_view.py",
+    "app/web/test_web_wire.py",
+    "app/web/test_webfiles.py",
+    "app/web/test_webguard.py",
+    "app/web/test_webwire.py",
+    "app/test_model.py",
+    "app/test_panelmodel.py",
+    "core/test_atomic.py",
+    "core/test_controls.py",
+    "core/test_errors.py",
+    "core/test_files.py",
+    "core/test_formats.py",
+    "core/test_lights.py",
+    "core/test_material.py",
+    "core/test_mtl.py",
+    "core/test_presets.py",
+    "core/test_scene.py",
+    "core/test_text.py",
+    "core/test_texture.py",
+    "core/test_yamlio.py",
+    "docs/test_site.py",
+    "test_architecture.py",
+    "test_bench_isa.py",
+    "test_cli_text.py",
+    "test_lint.py",
+    "test_start.py",
+    "test_strict.py",
+    "test_suite_order.py",
+    "test_types.py",
+    "test_wheel.py",
+)
+#: the background compile's process, while it runs (see the module docstring)
+_COMPILE: dict = {}
 
 
 def pytest_addoption(parser):
@@ -61,10 +129,35 @@ def _is_golden_test(item) -> bool:
     return "golden" in getattr(item, "name", "")
 
 
+def _before_kernels(item) -> bool:
+    try:
+        where = item.path.resolve().relative_to(TESTS).as_posix()
+    except ValueError:  # a test outside tests/ (tests/test_strict.py's own runs)
+        return False
+    return where in BEFORE_KERNELS
+
+
+def pytest_sessionstart(session):
+    """A run of folders (the whole suite, CI) starts the background compile before collecting,
+    which takes a while (see pytest_collection_modifyitems for the others)."""
+    base = session.config.invocation_params.dir
+    if any((base / arg).is_dir() for arg in session.config.args):
+        _start_compile(session.config)
+
+
 def pytest_collection_modifyitems(session, config, items):
-    """The check for unused goldens runs last, after every test that uses one."""
+    """The tests of :data:`BEFORE_KERNELS` run first (the others keep their order: the window
+    tests of tests/app/qt stay last, tests/app/conftest.py), with the background compile beside
+    them on a cold cache (ended at once when no test is left that calls a kernel); the check
+    for unused goldens runs last, after every test that uses one."""
+    first = [i for i in items if _before_kernels(i)]
+    if len(first) == len(items):
+        _end_compile(stop=True)
+    elif first:
+        _start_compile(config)
     last = [i for i in items if getattr(i, "originalname", None) == "test_golden_files_all_used"]
-    items[:] = [i for i in items if i not in last] + last
+    rest = [i for i in items if i not in set(first) and i not in last]
+    items[:] = first + rest + last
     tests_dir = imagecompare.GOLDEN_DIR.parent
     base = config.invocation_params.dir
     whole = False
@@ -73,6 +166,108 @@ def pytest_collection_modifyitems(session, config, items):
         whole |= "::" not in arg and (path == tests_dir or path in tests_dir.parents)
     if not whole:
         imagecompare.INCOMPLETE.append(f"collected {config.args}, not the whole of {tests_dir}")
+
+
+def _cold_kernels() -> bool:
+    """Whether numba's cache lacks the kernels of some kernel module for the current sources:
+    no function of the module has an index entry for them (a fresh clone, or an edited kernel
+    file; numba keys a module's functions by one stamp, explorer.geometry.kernelcache). Per
+    module, as helpers that are only ever inlined have no entry of their own."""
+    from explorer.shading import warm
+
+    cached: dict[str, bool] = {}
+    for name, d in warm.dispatchers().items():
+        cache = getattr(d._cache, "_cache_file", None)  # numba's IndexDataCacheFile
+        if cache is not None:
+            module = name.rsplit(".", 1)[0]
+            cached[module] = cached.get(module, False) or bool(cache._load_index())
+    return not all(cached.values())
+
+
+def _start_compile(config) -> None:
+    """On a cold cache, :func:`explorer.shading.warm.exercise` in a process of its own (the
+    engine's compiled tier, numba's cache of this session), its output in a file; once per
+    session."""
+    if _COMPILE or os.environ.get("PYTEST_XDIST_WORKER") or config.option.collectonly:
+        return
+    _COMPILE["checked"] = True
+    if not _cold_kernels():
+        return
+    # closed in _end_compile, read and removed in pytest_terminal_summary
+    log = tempfile.NamedTemporaryFile(prefix="explorer-compile-", suffix=".log", delete=False)  # noqa: SIM115
+    code = "from explorer.shading import warm; print(warm.exercise(), 'passes')"
+    proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL,
+                            stdout=log, stderr=subprocess.STDOUT)  # fmt: skip
+    started = time.monotonic()
+
+    def note_the_end():
+        proc.wait()
+        _COMPILE["ran"] = time.monotonic() - started
+
+    threading.Thread(target=note_the_end, daemon=True).start()
+    _COMPILE.update(proc=proc, log=log, waited=None)
+
+
+def _end_compile(stop: bool = False) -> None:
+    """Wait for the background compile (``stop``: end it instead); then it is done with."""
+    proc = _COMPILE.get("proc")
+    if proc is None or _COMPILE.get("waited") is not None:
+        return
+    t = time.monotonic()
+    if stop and proc.poll() is None:
+        proc.terminate()
+    try:
+        proc.wait(timeout=COMPILE_TIMEOUT)
+    except subprocess.TimeoutExpired:  # the tests compile what they need themselves
+        proc.kill()
+        proc.wait()
+    _COMPILE["waited"] = time.monotonic() - t
+    _COMPILE["log"].close()
+
+
+#: how long the first test after :data:`BEFORE_KERNELS` waits for the background compile at most:
+#: against a hung process only. Ending a slow one gains nothing (the tests would compile the
+#: rest themselves, no faster) and loses the kernel it was compiling: on a machine loaded 20
+#: deep the compile took more than 900 s
+COMPILE_TIMEOUT = 3600
+
+
+def pytest_runtest_setup(item):
+    if not _before_kernels(item) and _COMPILE.get("proc") and _COMPILE["waited"] is None:
+        from explorer.shading import warm
+
+        # kernels the tests before this one called: BEFORE_KERNELS names a module it should not
+        _COMPILE["called"] = sorted(name for name, sigs in warm.signatures().items() if sigs)
+        _end_compile()
+
+
+def pytest_sessionfinish(session, exitstatus):
+    _end_compile(stop=True)
+
+
+def pytest_terminal_summary(terminalreporter):
+    """One line on the background compile: how long it ran, how long the tests waited for it."""
+    proc = _COMPILE.get("proc")
+    if proc is None:
+        return
+    log = Path(_COMPILE["log"].name)
+    out = log.read_text(errors="replace").strip().splitlines()
+    last = out[-1] if out else "no output"
+    ran = _COMPILE.get("ran", float("nan"))
+    if proc.returncode == -signal.SIGTERM:  # no test that calls a kernel was left to wait
+        how = "stopped at the end of the run"
+    else:
+        how = f"the tests waited {_COMPILE['waited']:.1f} s for it"
+    terminalreporter.write_line(
+        f"the kernels' cold compile beside the tests: exit {proc.returncode} ({last}) after "
+        f"{ran:.1f} s; {how}"
+    )
+    if _COMPILE.get("called"):
+        called = ", ".join(_COMPILE["called"])
+        terminalreporter.write_line(f"the tests of BEFORE_KERNELS called kernels: {called}")
+    if proc.returncode not in (0, -signal.SIGTERM):
+        terminalreporter.write_line("\n".join(out[-20:]))
+    log.unlink(missing_ok=True)
 
 
 def pytest_deselected(items):

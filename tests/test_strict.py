@@ -1,6 +1,7 @@
 """The suite is strict, as pyproject.toml's [tool.pytest.ini_options] says: a marker typo, a
 passing xfail and an unexpected warning each fail the run. Checked by running pytest with the
-project's settings on three small test files outside the suite."""
+project's settings on three small test files outside the suite; and each run names its slowest
+tests."""
 
 from __future__ import annotations
 
@@ -44,3 +45,6 @@ def test_marker_typos_passing_xfails_and_warnings_fail(tmp_path):
     assert "FAILED test_xfail.py::test_passes" in out and "XPASS(strict)" in out, out
     assert "FAILED test_warns.py::test_warns - DeprecationWarning: something changed" in out, out
     assert "PASSED test_expected.py::test_expected" in out, out
+    # and every run names its slowest tests (addopts' --durations=25), so that each CI log
+    # shows where the suite's time goes
+    assert "slowest 25 durations" in out, out
