@@ -196,8 +196,9 @@ def _start_compile(config) -> None:
     # closed in _end_compile, read and removed in pytest_terminal_summary
     log = tempfile.NamedTemporaryFile(prefix="explorer-compile-", suffix=".log", delete=False)  # noqa: SIM115
     code = "from explorer.shading import warm; print(warm.exercise(), 'passes')"
-    proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.DEVNULL,
-                            stdout=log, stderr=subprocess.STDOUT)  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code], stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT
+    )
     started = time.monotonic()
 
     def note_the_end():
