@@ -361,8 +361,11 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-tree", action="store_true", help="measure the revisions only")
     ap.add_argument("--precision", choices=("float32", "float64"), help="this one only")
     ap.add_argument("--warm", action="store_true", help="the background compile, by function")
-    ap.add_argument("--split", action="store_true",
-                    help="--warm as the background compile runs it, with its partner")  # fmt: skip
+    ap.add_argument(
+        "--split",
+        action="store_true",
+        help="--warm as the background compile runs it, with its partner",
+    )
     args = ap.parse_args(argv)
     sys.path[:0] = [str(ROOT), str(HERE)]  # this tree's package, then the benchmarks
     from bench_engine import machine

@@ -31,8 +31,9 @@ def test_kernel_free_tests_run_first_and_window_tests_last():
     chosen = ["tests/app/qt/test_qtlibs.py", "tests/app/test_view.py", "tests/core/test_text.py"]
     cmd = [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider"]
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
-    out = subprocess.run([*cmd, *chosen], cwd=TESTS.parent, env=env, capture_output=True,
-                         text=True, timeout=300)  # fmt: skip
+    out = subprocess.run(
+        [*cmd, *chosen], cwd=TESTS.parent, env=env, capture_output=True, text=True, timeout=300
+    )
     assert out.returncode == 0, out.stdout + out.stderr
     modules = [line.split("::")[0] for line in out.stdout.splitlines() if "::" in line]
     order = list(dict.fromkeys(modules))

@@ -240,8 +240,9 @@ def _start_partner() -> subprocess.Popen:
     this process (it says ``rays`` once the ray kernels are cached), its standard error this
     process's (the log, for the background compile)."""
     env = dict(os.environ, **{tiers.ENV: "compiled"})
-    return subprocess.Popen(partner_command(), stdin=subprocess.DEVNULL,
-                            stdout=subprocess.PIPE, env=env, text=True)  # fmt: skip
+    return subprocess.Popen(
+        partner_command(), stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, env=env, text=True
+    )
 
 
 def _partner_failed(helper: subprocess.Popen, why: str = "") -> str:
