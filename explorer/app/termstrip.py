@@ -575,13 +575,18 @@ class TermStrip:
 
     def _geometry(self, drawing) -> None:
         """Each tile's actor: the drawing's points and triangles, colours of its own."""
-        for r, a in zip(self.renderers, self._actors, strict=False):
-            r.RemoveActor(a)
-        made = [_mesh_actor(r, drawing) for r in self.renderers]
-        self._actors = [a for a, _ in made]
-        self._colours = [c for _, c in made]
+        self._actors, self._colours = _tile_actors(self.renderers, self._actors, drawing)
         self._drawing = drawing
         self._key = None
+
+
+def _tile_actors(renderers, actors, drawing) -> tuple[list, list]:
+    """The tiles' actors of ``drawing`` (:func:`_mesh_actor`, one a renderer) in place of
+    ``actors``, which leave their renderers: ``(actors, colours)``."""
+    for r, a in zip(renderers, actors, strict=False):
+        r.RemoveActor(a)
+    made = [_mesh_actor(r, drawing) for r in renderers]
+    return [a for a, _ in made], [c for _, c in made]
 
 
 def _mesh_actor(renderer, drawing) -> tuple:
@@ -642,11 +647,7 @@ class _LightRow:
     def show(self, drawing, name: str, tiles) -> None:
         """Draw ``drawing``'s mesh in each tile's bytes of ``tiles``, the row named ``name``."""
         if drawing is not self._drawing:
-            for r, a in zip(self.renderers, self._actors, strict=False):
-                r.RemoveActor(a)
-            made = [_mesh_actor(r, drawing) for r in self.renderers]
-            self._actors = [a for a, _ in made]
-            self._colours = [c for _, c in made]
+            self._actors, self._colours = _tile_actors(self.renderers, self._actors, drawing)
             self._drawing = drawing
         self.tiles = tiles
         for colours, rgb in zip(self._colours, tiles, strict=True):
