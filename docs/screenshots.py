@@ -4,6 +4,7 @@ open menu is in the picture too).
 
     python docs/screenshots.py                 # every picture, into docs/
     python docs/screenshots.py --only gui_compare --out-dir /tmp/shots
+    python docs/screenshots.py --web-tour --out-dir /tmp/tour   # the page, 3 sizes x 3 tabs
 
 Needs Xvfb and ImageMagick's ``import`` (the packages the window tests need). The user's
 presets, recent files and last session are not read or written (a temporary folder stands in
@@ -155,13 +156,76 @@ WEB_NAMES = ("web_strip",)
 WEB_SIZE = (1280, 760)
 
 
+def _web_server(tmp: Path, name: str, *args: str) -> tuple[subprocess.Popen, str]:
+    """``phong-explorer web --port 0 ARGS`` started with its output in ``tmp/name.log``; the
+    process and the page's URL (with its secret) once it says it."""
+    import re
+
+    log = tmp / f"{name}.log"
+    with open(log, "w") as output:
+        server = subprocess.Popen(
+            [sys.executable, "-m", "explorer.cli", "web", "--port", "0", *args],
+            stdout=output,
+            stderr=subprocess.STDOUT,
+        )
+    end = time.monotonic() + WAIT_S
+    while not (url := re.search(r"http://\S+\?secret=[\w-]+", log.read_text())):
+        if server.poll() is not None or time.monotonic() > end:
+            server.terminate()
+            raise SystemExit(f"screenshots: the server did not start:\n{log.read_text()}")
+        time.sleep(0.2)
+    return server, url.group(0)
+
+
+def _browser(size: tuple[int, int]):
+    """Debian's headless Chromium through Selenium, its window ``size`` (w, h) CSS pixels at a
+    device scale of 1."""
+    from selenium import webdriver
+
+    opts = webdriver.ChromeOptions()
+    for a in (
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-gpu",
+        f"--window-size={size[0]},{size[1]}",
+        "--disable-dev-shm-usage",
+        "--force-device-scale-factor=1",
+    ):
+        opts.add_argument(a)
+    opts.binary_location = "/usr/bin/chromium"
+    driver = webdriver.Chrome(
+        options=opts, service=webdriver.ChromeService(executable_path="/usr/bin/chromedriver")
+    )
+    # the window's size counts the browser's own frame: the page's viewport is made ``size``
+    inner = driver.execute_script("return [window.innerWidth, window.innerHeight];")
+    outer = driver.get_window_size()
+    driver.set_window_size(
+        outer["width"] + size[0] - inner[0], outer["height"] + size[1] - inner[1]
+    )
+    return driver
+
+
+#: true once the view named by the argument shows a picture, whichever element carries it (an
+#: ``<img>`` loaded from the server's picture, or a canvas it was drawn into)
+PICTURE_SHOWN_JS = """
+const v = document.querySelector(`[aria-label="${arguments[0]}"]`);
+const i = v && v.querySelector('img');
+const c = v && v.querySelector('canvas');
+return (i !== null && i.complete && i.naturalWidth > 0) || (c !== null && c.width > 0);
+"""
+
+
+def _wait_picture(driver, view: str) -> None:
+    end = time.monotonic() + WAIT_S
+    while not driver.execute_script(PICTURE_SHOWN_JS, view):
+        if time.monotonic() > end:
+            raise SystemExit("screenshots: gave up waiting for the page's picture")
+        time.sleep(0.2)
+
+
 def shoot_web(name: str, tmp: Path, out: Path) -> None:
     """Start ``phong-explorer web`` on the session of picture ``name``, open the page in headless
     Chromium and save its screenshot into ``out/name.png`` once the picture is still."""
-    import re
-
-    from selenium import webdriver
-
     from explorer.app import model as M
     from explorer.app.effectactions import gouraud_vs_per_pixel
     from explorer.app.session import save_session
@@ -174,44 +238,12 @@ def shoot_web(name: str, tmp: Path, out: Path) -> None:
         state = gouraud_vs_per_pixel(state).replace(strip=True)
         state = M.set_compare_model(state, "phong")
     session = save_session(tmp / f"{name}.yaml", state, overwrite=True)
-    log = tmp / f"{name}.log"
-    with open(log, "w") as output:
-        server = subprocess.Popen(
-            [sys.executable, "-m", "explorer.cli", "web", "--port", "0", "--session", str(session)],
-            stdout=output,
-            stderr=subprocess.STDOUT,
-        )
+    server, url = _web_server(tmp, name, "--session", str(session))
     driver = None
     try:
-        end = time.monotonic() + WAIT_S
-        while not (url := re.search(r"http://\S+\?secret=[\w-]+", log.read_text())):
-            if server.poll() is not None or time.monotonic() > end:
-                raise SystemExit(f"screenshots: the server did not start:\n{log.read_text()}")
-            time.sleep(0.2)
-        opts = webdriver.ChromeOptions()
-        for a in (
-            "--headless=new",
-            "--no-sandbox",
-            "--disable-gpu",
-            f"--window-size={WEB_SIZE[0]},{WEB_SIZE[1]}",
-            "--disable-dev-shm-usage",
-            "--force-device-scale-factor=1",
-        ):
-            opts.add_argument(a)
-        opts.binary_location = "/usr/bin/chromium"
-        driver = webdriver.Chrome(
-            options=opts, service=webdriver.ChromeService(executable_path="/usr/bin/chromedriver")
-        )
-        driver.get(url.group(0))
-        still = (
-            "const i = document.querySelector('[aria-label=\"view_b\"] img');"
-            "return i !== null && i.complete && i.naturalWidth > 0;"
-        )
-        end = time.monotonic() + WAIT_S
-        while not driver.execute_script(still):  # (pane B's first picture)
-            if time.monotonic() > end:
-                raise SystemExit("screenshots: gave up waiting for the page's picture")
-            time.sleep(0.2)
+        driver = _browser(WEB_SIZE)
+        driver.get(url)
+        _wait_picture(driver, "view_b")  # (pane B's first picture)
         driver.find_element("css selector", '[aria-label="view tab"]').click()
         time.sleep(8.0)  # the tab shown, the pictures still (then sent as PNGs, exact)
         driver.save_screenshot(str(out / f"{name}.png"))
@@ -220,6 +252,38 @@ def shoot_web(name: str, tmp: Path, out: Path) -> None:
             driver.quit()
         server.terminate()
         server.wait(10)
+
+
+#: the page tour's browser sizes (issue 42: the page at each, every tab, looked at)
+TOUR_SIZES = ((1280, 900), (900, 720), (640, 480))
+#: the panel's tabs, by their accessible names
+TOUR_TABS = ("material", "lights", "view")
+
+
+def shoot_web_tour(tmp: Path, out: Path) -> list[Path]:
+    """``phong-explorer web`` as it starts, in headless Chromium at each of :data:`TOUR_SIZES`
+    (a server a size: the start is framed for the first page's view), one screenshot a tab:
+    ``out/web_tour_WxH_TAB.png``. Not docs pictures: for looking at."""
+    written = []
+    for size in TOUR_SIZES:
+        server, url = _web_server(tmp, "web_tour")
+        driver = None
+        try:
+            driver = _browser(size)
+            driver.get(url)
+            _wait_picture(driver, "view")
+            for tab in TOUR_TABS:
+                driver.find_element("css selector", f'[aria-label="{tab} tab"]').click()
+                time.sleep(2.0)  # the tab shown, the picture still (then lossless)
+                path = out / f"web_tour_{size[0]}x{size[1]}_{tab}.png"
+                driver.save_screenshot(str(path))
+                written.append(path)
+        finally:
+            if driver is not None:
+                driver.quit()
+            server.terminate()
+            server.wait(10)
+    return written
 
 
 NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "gui_difference",
@@ -233,6 +297,11 @@ def main(argv=None) -> int:
     ap.add_argument("--out-dir", type=Path, default=HERE, help="where the PNGs go (docs/)")
     ap.add_argument(
         "--only", action="append", choices=NAMES + WEB_NAMES, help="this picture (repeatable)"
+    )
+    ap.add_argument(
+        "--web-tour",
+        action="store_true",
+        help="only the page at 1280x900, 900x720 and 640x480, each tab (web_tour_*.png)",
     )
     args = ap.parse_args(argv)
     for tool in ("Xvfb", "import"):
@@ -250,6 +319,10 @@ def main(argv=None) -> int:
     app = application()
     try:
         args.out_dir.mkdir(parents=True, exist_ok=True)
+        if args.web_tour:
+            for path in shoot_web_tour(tmp, args.out_dir):
+                print(f"wrote {path}")
+            return 0
         for name in args.only or NAMES + WEB_NAMES:
             if name in WEB_NAMES:
                 shoot_web(name, tmp, args.out_dir)

@@ -24,6 +24,7 @@ stays free of them).
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import tempfile
@@ -87,8 +88,12 @@ class WebExplorer:
         from explorer.render.vtk import plotter  # VTK only once a server is made
 
         self.pushing = False  # the server is setting the page's values (no user change)
-        # the start framed again for the first page's view (as the window frames it when shown)
-        self._frame_at = tuple(int(v) for v in size) if state.camera is None else None
+        # the start framed for the page's view, at each of its sizes until the camera is moved
+        # (as the window frames it when shown): the view's size the start was framed for, and
+        # the camera it was given (None: not framed yet); a session's camera is kept as it is
+        self._framing = state.camera is None
+        self._framed_for = tuple(int(v) for v in size)
+        self._start_camera = None
         self.said = MessageLog(keep=MESSAGE_LOG)  # the page's message log
         self.message_seq = 0  # messages said so far (a page shows those after it opened)
         self.answers: dict = {}  # the page's answers to the controller's next questions
@@ -135,16 +140,28 @@ class WebExplorer:
         return self.viewport.guard(fn, where)
 
     def _frame(self, *_) -> None:
-        """Before a frame: the first time the view is drawn at another size than it was made
-        (the page's own), the start's mesh is framed for that shape (``Controller.frame_start``)
-        unless the session gave a camera: a page narrower than the server's 800x600 showed the
-        light's handle half out of the view, the mesh framed for 4:3."""
+        """Before a frame: while the camera is still the start's (not dragged, not set by a
+        session), a view drawn at another size than the start was framed for gets the start's
+        mesh framed for its shape (``Controller.frame_start``). The page's view takes its size
+        in steps as the page lays itself out (30x30, then the drawer's width taken, then its
+        opening's steps: 260x384 ... 370x396 in a 640x480 page), and the browser's window may
+        be resized before the camera is touched: framed once, at the first of those sizes, the
+        start showed the light's handle out of a view taller than wide. The view halved for the
+        compare view is not framed for (the window does not frame anew either)."""
         w, h = (int(v) for v in self.plotter.window_size)
-        if self._frame_at is None or (w, h) == self._frame_at or min(w, h) < 2:
+        if not self._framing or (w, h) == self._framed_for or min(w, h) < 2:
             return
-        self._frame_at = None
+        if self.store.state.compare is not None:
+            return  # the view halved for pane B: the start stays framed for the whole view
+        if self._start_camera is not None and not _same_pose(
+            self.store.state.camera, self._start_camera
+        ):
+            self._framing = False  # the camera is the user's now: it stays as they left it
+            return
+        self._framed_for = (w, h)
         self.controller.frame_start()
-        self.view.apply_camera(self.store.state.camera)
+        self._start_camera = self.store.state.camera
+        self.view.apply_camera(self._start_camera)
 
     def _ready(self, **_) -> None:
         """The server runs: its loop is kept (the difference worker delivers into it), and
@@ -413,3 +430,13 @@ def serve(app: WebExplorer, *, port: int = 0, host: str = DEFAULT_HOST, open_bro
 def served_url(host: str, port: int) -> str:
     """The page's address on a server listening on ``host`` (an IPv6 address in brackets)."""
     return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
+
+
+def _same_pose(a, b) -> bool:
+    """Whether cameras ``a`` and ``b`` (:class:`explorer.render.camera.Camera`) look from the
+    same place the same way with the same view: their clipping ranges aside, which the view
+    sets anew for what it shows each frame (the start's framed camera comes back from the
+    view with its own)."""
+    if a is None or b is None:
+        return a is b
+    return dataclasses.replace(a, clipping_range=b.clipping_range) == b

@@ -288,29 +288,68 @@ def test_a_camera_drag_in_per_pixel_mode_draws_per_vertex_when_per_pixel_costs_t
         click(browser, "material tab")
 
 
-def test_the_handle_starts_inside_a_narrower_pages_view(tmp_path):
-    """A page narrower than the server's 800x600 view (900x720: a 580x490 view) frames the
-    start for its own view, as the window does when shown: the selected light's handle starts
-    inside it, white in the page's pixels (it started half out of the view, the teapot framed
-    for 4:3)."""
+#: the least distance (pixels) of a handle's centre from its view's edge that counts as inside
+EDGE = 12
+
+
+def set_viewport(driver, w: int, h: int) -> None:
+    """The page's viewport (``window.innerWidth`` x ``innerHeight``) made ``w`` x ``h`` CSS
+    pixels: Selenium's window size counts the browser's own frame (143 pixels of height in
+    headless Chromium 156), so a 640x480 window shows a 640x337 page."""
+    for _ in range(3):
+        inner = driver.execute_script("return [window.innerWidth, window.innerHeight];")
+        if inner == [w, h]:
+            return
+        outer = driver.get_window_size()
+        driver.set_window_size(outer["width"] + w - inner[0], outer["height"] + h - inner[1])
+    assert inner == [w, h], inner
+
+
+def test_the_handle_stays_inside_the_view_until_the_camera_is_moved(tmp_path):
+    """The start is framed for the page's view at each size it takes until the camera is
+    moved: a page opened at 1280x900, then made 760x900 (a 490x816 view: taller than wide)
+    and 900x720, shows the selected light's handle inside the view at each, white in the
+    page's pixels (issue 42: the start was framed once, at the view's first size, a 30x30
+    placeholder's square; a view taller than wide showed the handle out of it). Once the
+    camera is turned by a drag, a resize keeps it where the drag left it. (The handle's centre
+    at least :data:`EDGE` pixels from the view's edge: its sphere's radius on the screen, about
+    10 pixels here.)"""
     from webserver import Server, need_browser, new_browser
 
     need_browser()
     srv = Server(["--mesh", "teapot"], tmp_path / "server.log")
     driver = new_browser(tmp_path)
     try:
-        driver.set_window_size(900, 720)
-        open_page(driver, srv.url)
+        driver.get("about:blank")
+        for i, (w, h) in enumerate(((1280, 900), (760, 900), (900, 720))):
+            set_viewport(driver, w, h)
+            if i == 0:
+                open_page(driver, srv.url)
 
-        def inside():
-            r = report(driver)
-            (w, h), light = r["size"], r["session"]["light"] - 1
-            x, y = r["handles_px"][light]
-            return (w, h) != (800, 600) and 20 <= x < w - 20 and 20 <= y < h - 20 and r
+            def inside(w=w):
+                r = report(driver)
+                (vw, vh), light = r["size"], r["session"]["light"] - 1
+                x, y = r["handles_px"][light]
+                laid = vw < w - 200  # the drawer is beside the view
+                return laid and EDGE <= x < vw - EDGE and EDGE <= y < vh - EDGE and r
 
-        rep = wait("the handle inside the view", inside)
-        px = rep["handles_px"][rep["session"]["light"] - 1]
-        wait("the handle in the page's pixels", lambda: shows(driver, "view", px, rep["size"]))
+            rep = wait(f"the handle inside the view of a {w}x{h} page", inside)
+            px = rep["handles_px"][rep["session"]["light"] - 1]
+            size = rep["size"]
+            wait("the handle in its pixels", lambda p=px, s=size: shows(driver, "view", p, s))
+        vw, vh = rep["size"]
+        eye = rep["session"]["scene"]["viewer"]
+        steady_drag(driver, "view", (vw // 2, vh // 2 + 40), [(5, 0)] * 12)
+        turned = wait(
+            "the camera turned",
+            lambda: (r := report(driver))["session"]["scene"]["viewer"] != eye and r,
+        )
+        time.sleep(0.5)  # the drag's last frames
+        turned = report(driver)["session"]["scene"]["viewer"]
+        set_viewport(driver, 760, 900)
+        wait("the view resized", lambda: report(driver)["size"] != [vw, vh])
+        time.sleep(0.5)
+        assert report(driver)["session"]["scene"]["viewer"] == turned
     finally:
         driver.quit()
         srv.stop()
