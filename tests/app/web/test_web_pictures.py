@@ -104,6 +104,27 @@ def test_a_newer_picture_takes_the_place_of_the_still_one(path):
     assert pub.sent[2]["mtime"] == pub.sent[1]["mtime"]
 
 
+def test_no_still_picture_for_a_view_no_page_shows(path, monkeypatch):
+    """The still PNG is neither encoded nor sent for a view no page shows any more: its last
+    page removed its observer (the publisher stops tracking it) or turned it off, during the
+    still time. Before, the PNG was encoded in the worker thread and published to nobody."""
+    pub, pics, loop = path
+    made = []
+    encode = P.encode
+    monkeypatch.setattr(
+        P, "encode", lambda px, lossless: made.append(lossless) or encode(px, lossless)
+    )
+    pub.push_render("1")
+    pub.tracking_views["1"]["enabled"] = False  # (viewport.image.push.enabled, off)
+    loop.run_until_complete(asyncio.sleep(P.STILL_S + 0.3))
+    pub.tracking_views["1"]["enabled"] = True
+    pub.push_render("1")
+    del pub.tracking_views["1"]  # (viewport.image.push.observer.remove, its last observer)
+    loop.run_until_complete(asyncio.sleep(P.STILL_S + 0.3))
+    assert [r["data"][:2] for r in pub.sent] == [b"\xff\xd8", b"\xff\xd8"]  # two JPEGs only
+    assert made == [False, False]  # no PNG encoded
+
+
 def test_a_camera_drag_sends_what_was_asked_at_its_next_tick(path):
     pub, pics, loop = path
     pub.views_in_animations.append("1")
