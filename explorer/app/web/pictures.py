@@ -41,6 +41,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from explorer.render.images import encode_png
+
 #: the JPEG's quality (libjpeg's scale, 1-100) while the view changes: at 100 with 4:4:4 chroma
 #: the teapot's frame comes back within 1 level of every pixel, the per-pixel torus's within 4
 JPEG_QUALITY = 100
@@ -151,8 +153,6 @@ def encode(pixels: np.ndarray, lossless: bool) -> bytes:
     of Pillow's five filters tried on every row) or as a baseline JPEG with 4:4:4 chroma at
     :data:`JPEG_QUALITY`."""
     if lossless:
-        from explorer.render.images import encode_png
-
         return encode_png(pixels, fast=True)
     from PIL import Image
 
