@@ -163,20 +163,16 @@ def encode(pixels: np.ndarray, lossless: bool) -> bytes:
 
 def read_back(window) -> np.ndarray:
     """The frame ``window`` drew last (h, w, 3 uint8, rows top to bottom), read from its back
-    buffer as ``vtkWebApplication`` reads it."""
+    buffer (``GetPixelData``, as ``vtkWindowToImageFilter`` reads it for ``vtkWebApplication``,
+    without the filter: its pipeline and image data took 1.0 ms of CPU a picture against 0.6,
+    the same pixels)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
-    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+    from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
 
-    w2i = vtkWindowToImageFilter()
-    w2i.SetInput(window)
-    w2i.ReadFrontBufferOff()
-    w2i.ShouldRerenderOff()
-    w2i.FixBoundaryOn()
-    w2i.Update()
-    img = w2i.GetOutput()
-    w, h, _ = img.GetDimensions()
-    flat = vtk_to_numpy(img.GetPointData().GetScalars())
-    return np.ascontiguousarray(flat.reshape(h, w, -1)[::-1, :, :3])
+    w, h = (int(v) for v in window.GetSize()[:2])
+    rgb = vtkUnsignedCharArray()
+    window.GetPixelData(0, 0, w - 1, h - 1, 0, rgb, 0)  # (the back buffer; rows bottom first)
+    return np.ascontiguousarray(vtk_to_numpy(rgb).reshape(h, w, 3)[::-1])
 
 
 class Pictures:

@@ -146,6 +146,34 @@ def test_a_resize_is_drawn_at_the_new_size(path):
     assert pixels(pub.sent[0]["data"]).shape == (50, 80, 3)
 
 
+def test_the_read_back_is_the_frame_vtks_image_filter_reads(path):
+    """``read_back`` (the window's back buffer through ``GetPixelData``) gives the pixels
+    ``vtkWindowToImageFilter`` gives (VTK's web application's way), rows top to bottom, at
+    the window's size and at an odd one after a resize."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+
+    pub, pics, loop = path
+    window = pub.window
+    window.GetRenderers().GetFirstRenderer().ResetCamera()  # (the sphere and its background)
+    for size in (None, (81, 47)):
+        if size is not None:
+            window.SetSize(*size)
+        window.Render()
+        w2i = vtkWindowToImageFilter()
+        w2i.SetInput(window)
+        w2i.ReadFrontBufferOff()
+        w2i.ShouldRerenderOff()
+        w2i.Update()
+        w, h, _ = w2i.GetOutput().GetDimensions()
+        filtered = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars())
+        expected = filtered.reshape(h, w, -1)[::-1, :, :3]
+        got = P.read_back(window)
+        assert got.shape == (h, w, 3) and got.flags.c_contiguous
+        assert (got == expected).all()
+        assert len(np.unique(got.reshape(-1, 3), axis=0)) == 2  # (the sphere, the background)
+
+
 def test_the_publishers_api_relied_on_is_there():
     """What Pictures takes over of trame-vtk's publisher: its attributes, and that its RPCs
     (``viewport.image.push``, the observers, the drag's ticks) reach the picture through the
