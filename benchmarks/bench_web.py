@@ -444,7 +444,7 @@ def breakdown(web: dict) -> list[str]:
             "    of which the frame's render (VTK, the engine's colours for the viewer)",
             st.get("render"),
         ),
-        row("  read-back (vtkWindowToImageFilter)", st.get("read")),
+        row("  read-back (the back buffer, GetPixelData)", st.get("read")),
         row("  JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
         row("the picture's way to the page (sent → its Blob made in the page)", st.get("back")),
         row(
