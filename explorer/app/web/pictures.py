@@ -10,9 +10,11 @@ alike, and every page): the frame is rendered and read back under
 :data:`explorer.render.vtk.DRAW_LOCK` and encoded at once, in the server's loop, as a baseline
 JPEG with full chroma (4:4:4, Pillow's libjpeg-turbo, :data:`JPEG_QUALITY`), sent as a binary
 attachment; once the view has been still for :data:`STILL_S` seconds the same frame follows
-as a lossless PNG, encoded in a worker thread (Pillow lets go of the GIL while it encodes), so
-the page's pixels are then exactly the server's. The browser's ``<img>`` reads PNG and JPEG
-alike (it looks at the bytes, not at the Blob's ``image/jpeg`` type).
+as a lossless PNG (:func:`explorer.render.images.encode_png` ``fast``: one row filter, zlib
+level 1), encoded in a worker thread (zlib lets go of the GIL while it deflates), so the page's
+pixels are then exactly the server's; not for a view no page shows any more. The browser's
+``<img>`` reads PNG and JPEG alike (it looks at the bytes, not at the Blob's ``image/jpeg``
+type).
 
 What asks for a picture stays trame's: the page (its first picture, a resize, the end of a
 camera drag), the camera drag's animation ticks (a picture only when something asked since the
@@ -39,14 +41,14 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from explorer.render.images import encode_png
+
 #: the JPEG's quality (libjpeg's scale, 1-100) while the view changes: at 100 with 4:4:4 chroma
 #: the teapot's frame comes back within 1 level of every pixel, the per-pixel torus's within 4
 JPEG_QUALITY = 100
 #: seconds without a new frame after which the last one is sent again losslessly (PNG): longer
 #: than the gap between two frames of a slider drag (about 40-80 ms) so a drag sends JPEGs only
 STILL_S = 0.15
-#: zlib's level for the still picture's PNG (1: the fastest; 800x600 in 5-45 ms here)
-PNG_LEVEL = 1
 
 #: the page's side of the pictures (run by the page before its views are made, again harmless):
 #: (1) each trame view stream hands its picture's Blob URL to the view's ``<img>`` at once (no
@@ -146,34 +148,31 @@ PAGE_JS = """
 
 
 def encode(pixels: np.ndarray, lossless: bool) -> bytes:
-    """``pixels`` (h, w, 3 uint8, rows top to bottom) as PNG (``lossless``) or as a baseline
-    JPEG with 4:4:4 chroma at :data:`JPEG_QUALITY`."""
+    """``pixels`` (h, w, 3 uint8, rows top to bottom) as PNG (``lossless``: the fast writer of
+    :func:`explorer.render.images.encode_png`, one row filter and zlib level 1, half the time
+    of Pillow's five filters tried on every row) or as a baseline JPEG with 4:4:4 chroma at
+    :data:`JPEG_QUALITY`."""
+    if lossless:
+        return encode_png(pixels, fast=True)
     from PIL import Image
 
     buf = io.BytesIO()
-    if lossless:
-        Image.fromarray(pixels).save(buf, "PNG", compress_level=PNG_LEVEL)
-    else:
-        Image.fromarray(pixels).save(buf, "JPEG", quality=JPEG_QUALITY, subsampling=0)
+    Image.fromarray(pixels).save(buf, "JPEG", quality=JPEG_QUALITY, subsampling=0)
     return buf.getvalue()
 
 
 def read_back(window) -> np.ndarray:
     """The frame ``window`` drew last (h, w, 3 uint8, rows top to bottom), read from its back
-    buffer as ``vtkWebApplication`` reads it."""
+    buffer (``GetPixelData``, as ``vtkWindowToImageFilter`` reads it for ``vtkWebApplication``,
+    without the filter: its pipeline and image data took 1.0 ms of CPU a picture against 0.6,
+    the same pixels)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
-    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+    from vtkmodules.vtkCommonCore import vtkUnsignedCharArray
 
-    w2i = vtkWindowToImageFilter()
-    w2i.SetInput(window)
-    w2i.ReadFrontBufferOff()
-    w2i.ShouldRerenderOff()
-    w2i.FixBoundaryOn()
-    w2i.Update()
-    img = w2i.GetOutput()
-    w, h, _ = img.GetDimensions()
-    flat = vtk_to_numpy(img.GetPointData().GetScalars())
-    return np.ascontiguousarray(flat.reshape(h, w, -1)[::-1, :, :3])
+    w, h = (int(v) for v in window.GetSize()[:2])
+    rgb = vtkUnsignedCharArray()
+    window.GetPixelData(0, 0, w - 1, h - 1, 0, rgb, 0)  # (the back buffer; rows bottom first)
+    return np.ascontiguousarray(vtk_to_numpy(rgb).reshape(h, w, 3)[::-1])
 
 
 class Pictures:
@@ -269,12 +268,21 @@ class Pictures:
         reply = dict(reply, id=reply["global_id"], image=self.pub.addAttachment(reply["image"]))
         self.pub.publish("viewport.image.push.subscription", reply)
 
+    def _shown(self, v_id: str) -> bool:
+        """Whether a page still shows view ``v_id``: the publisher still tracks it, enabled (the
+        last page showing it removed its observer, or turned its pictures off, since)."""
+        info = self.pub.tracking_views.get(v_id)
+        return info is not None and bool(info.get("enabled"))
+
     def _still(self, v_id: str, count: int) -> None:
         """View ``v_id``'s picture number ``count`` again as PNG, if it is still the last
-        picture sent (encoded in the worker thread, sent from the loop)."""
+        picture sent and a page still shows the view (encoded in the worker thread, sent from
+        the loop)."""
         n, pixels = self.last.get(v_id, (None, None))
         if n != count:
             return  # a newer picture of the view went since: it is not still
+        if not self._shown(v_id):
+            return  # nobody would see it
 
         def sent(future) -> None:
             if future.cancelled() or self.last.get(v_id, (None,))[0] != count:

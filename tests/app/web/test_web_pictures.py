@@ -104,6 +104,27 @@ def test_a_newer_picture_takes_the_place_of_the_still_one(path):
     assert pub.sent[2]["mtime"] == pub.sent[1]["mtime"]
 
 
+def test_no_still_picture_for_a_view_no_page_shows(path, monkeypatch):
+    """The still PNG is neither encoded nor sent for a view no page shows any more: its last
+    page removed its observer (the publisher stops tracking it) or turned it off, during the
+    still time. Before, the PNG was encoded in the worker thread and published to nobody."""
+    pub, pics, loop = path
+    made = []
+    encode = P.encode
+    monkeypatch.setattr(
+        P, "encode", lambda px, lossless: made.append(lossless) or encode(px, lossless)
+    )
+    pub.push_render("1")
+    pub.tracking_views["1"]["enabled"] = False  # (viewport.image.push.enabled, off)
+    loop.run_until_complete(asyncio.sleep(P.STILL_S + 0.3))
+    pub.tracking_views["1"]["enabled"] = True
+    pub.push_render("1")
+    del pub.tracking_views["1"]  # (viewport.image.push.observer.remove, its last observer)
+    loop.run_until_complete(asyncio.sleep(P.STILL_S + 0.3))
+    assert [r["data"][:2] for r in pub.sent] == [b"\xff\xd8", b"\xff\xd8"]  # two JPEGs only
+    assert made == [False, False]  # no PNG encoded
+
+
 def test_a_camera_drag_sends_what_was_asked_at_its_next_tick(path):
     pub, pics, loop = path
     pub.views_in_animations.append("1")
@@ -123,6 +144,34 @@ def test_a_resize_is_drawn_at_the_new_size(path):
     pub.push_render("1")
     assert pub.sent[0]["size"] == [80, 50]
     assert pixels(pub.sent[0]["data"]).shape == (50, 80, 3)
+
+
+def test_the_read_back_is_the_frame_vtks_image_filter_reads(path):
+    """``read_back`` (the window's back buffer through ``GetPixelData``) gives the pixels
+    ``vtkWindowToImageFilter`` gives (VTK's web application's way), rows top to bottom, at
+    the window's size and at an odd one after a resize."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkRenderingCore import vtkWindowToImageFilter
+
+    pub, pics, loop = path
+    window = pub.window
+    window.GetRenderers().GetFirstRenderer().ResetCamera()  # (the sphere and its background)
+    for size in (None, (81, 47)):
+        if size is not None:
+            window.SetSize(*size)
+        window.Render()
+        w2i = vtkWindowToImageFilter()
+        w2i.SetInput(window)
+        w2i.ReadFrontBufferOff()
+        w2i.ShouldRerenderOff()
+        w2i.Update()
+        w, h, _ = w2i.GetOutput().GetDimensions()
+        filtered = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars())
+        expected = filtered.reshape(h, w, -1)[::-1, :, :3]
+        got = P.read_back(window)
+        assert got.shape == (h, w, 3) and got.flags.c_contiguous
+        assert (got == expected).all()
+        assert len(np.unique(got.reshape(-1, 3), axis=0)) == 2  # (the sphere, the background)
 
 
 def test_the_publishers_api_relied_on_is_there():
