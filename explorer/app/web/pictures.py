@@ -68,7 +68,8 @@ PNG_LEVEL = 1
 #: Each canvas's ``phong`` says what it shows (``seq``, ``url``, ``size``; ``drawn``: epoch ms
 #: of the draw, ``shown``: of the worker's next animation frame after it, when the drawn frame
 #: is composited; ``probe``: the pixel at ``phongPictures.probe`` = [x, y] if set, read in the
-#: worker after the draw, and ``probeMs`` its cost; ``decodes``: the worker's decodes so far).
+#: worker after the draw, and ``probeMs`` its cost; ``decodes``: the worker's decodes so far),
+#: and the canvas gets a ``phong-picture`` event each time.
 #: ``window.phongPictures`` counts the pictures handed on (``shown``), drawn (``drawn``) and
 #: the changes sent at once (``sent``).
 PAGE_JS = """
@@ -194,6 +195,7 @@ PAGE_JS = """
       if (!view || m.error) return;
       Object.assign(view.canvas.phong, m);
       P.drawn += 1;
+      view.canvas.dispatchEvent(new Event('phong-picture'));  // (the benchmark's probe waits)
     };
     const src = Object.getOwnPropertyDescriptor(HTMLImageElement.prototype, 'src');
     Object.defineProperty(HTMLImageElement.prototype, 'src', {
