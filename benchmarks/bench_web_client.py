@@ -10,7 +10,8 @@ so a change in the machine's load falls on both. Each sample sets the kd slider'
 page and takes, on the page's clock, the change's picture (the first picture after it: each
 sample starts with the view still) at each mark the page has:
 
-- ``blob``: its Blob made (the message read; both pages);
+- ``blob``: its Blob made (the message read; both pages); ``free``: a task posted then runs
+  (the page's main thread is free again);
 - a page whose worker draws the pictures (explorer.app.web.pictures.PAGE_JS, a
   ``canvas.phong-picture`` in the view): ``drawn`` (decoded and drawn, in the worker) and
   ``shown`` (the worker's next animation frame after the draw, when it is composited);
@@ -41,11 +42,14 @@ from bench_gui import load
 #: canvas's reports (the worker's)
 MARKS_JS = """
 if (!window.marks) {
-  const M = window.marks = {blob: [], load: [], raf: [], painted: [], canvas: []};
+  const M = window.marks = {blob: [], free: [], load: [], raf: [], painted: [], canvas: []};
   const make = URL.createObjectURL;
   URL.createObjectURL = (b) => {
     const url = make.call(URL, b);
     M.blob.push([performance.now(), url]);
+    const ch = new MessageChannel();  // (a task posted now runs when the main thread is free)
+    ch.port1.onmessage = () => M.free.push([performance.now(), url]);
+    ch.port2.postMessage(0);
     return url;
   };
   const img = document.querySelector('[aria-label="view"] img');
@@ -75,7 +79,7 @@ setTimeout(() => {
     const e = list.find((m) => m[m.length - 1] === url);
     return e ? e[i] - t0 : null;
   };
-  done({blob: tb === null ? null : tb - t0, load: of(M.load), raf: of(M.raf),
+  done({blob: tb === null ? null : tb - t0, free: of(M.free), load: of(M.load), raf: of(M.raf),
         painted: of(M.painted), drawn: of(M.canvas), shown: of(M.canvas, 1),
         pictures: M.blob.length});
 }, wait);
@@ -148,7 +152,7 @@ def main(argv=None) -> int:
     print(f"load average before / after: {before} / {after}; {args.repeat} samples a page, "
           "alternating; ms after the change (median, and the median of each mark minus the "
           "Blob's), the browser's CPU ms per change (median)")  # fmt: skip
-    marks = ("blob", "drawn", "shown", "load", "raf", "painted")
+    marks = ("blob", "free", "drawn", "shown", "load", "raf", "painted")
     for name, got in rows.items():
         cells = []
         for k in marks:
