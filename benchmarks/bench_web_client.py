@@ -95,10 +95,23 @@ def open_page(root: Path, log_dir: Path):
     env = dict(os.environ, PYTHONPATH=str(root), PHONG_EXPLORER_LAST_SESSION=str(last))
     log = open(path, "w")
     proc = B.subprocess.Popen(
-        [sys.executable, "-m", "explorer.cli", "web", "--mesh", "teapot", "--resolution", "56",
-         "--port", str(port)],
-        stdout=log, stderr=B.subprocess.STDOUT, env=env, cwd=str(root),
-    )  # fmt: skip
+        [
+            sys.executable,
+            "-m",
+            "explorer.cli",
+            "web",
+            "--mesh",
+            "teapot",
+            "--resolution",
+            "56",
+            "--port",
+            str(port),
+        ],
+        stdout=log,
+        stderr=B.subprocess.STDOUT,
+        env=env,
+        cwd=str(root),
+    )
     driver = B.browser()
     driver.get(B.wait_url(port, path))
     size_img_view(driver)
@@ -149,9 +162,11 @@ def main(argv=None) -> int:
             B.stop(proc)
             path.unlink(missing_ok=True)
     after = load()
-    print(f"load average before / after: {before} / {after}; {args.repeat} samples a page, "
-          "alternating; ms after the change (median, and the median of each mark minus the "
-          "Blob's), the browser's CPU ms per change (median)")  # fmt: skip
+    print(
+        f"load average before / after: {before} / {after}; {args.repeat} samples a page, "
+        "alternating; ms after the change (median, and the median of each mark minus the "
+        "Blob's), the browser's CPU ms per change (median)"
+    )
     marks = ("blob", "free", "drawn", "shown", "load", "raf", "painted")
     for name, got in rows.items():
         cells = []

@@ -11,7 +11,7 @@ alike, and every page): the frame is rendered and read back under
 JPEG with full chroma (4:4:4, Pillow's libjpeg-turbo, :data:`JPEG_QUALITY`), sent as a binary
 attachment; once the view has been still for :data:`STILL_S` seconds the same frame follows
 as a lossless PNG, encoded in a worker thread (Pillow lets go of the GIL while it encodes), so
-the page's pixels are then exactly the server's. The browser's ``<img>`` reads PNG and JPEG
+the page's pixels are then exactly the server's. The browser's decoder reads PNG and JPEG
 alike (it looks at the bytes, not at the Blob's ``image/jpeg`` type).
 
 What asks for a picture stays trame's: the page (its first picture, a resize, the end of a
@@ -21,11 +21,14 @@ last), and the explorer's own frames (:meth:`WebExplorer.send`, through the view
 
 In the page, :data:`PAGE_JS` (a script the page runs before its views are made) takes the
 picture the rest of its way: wslink's client reads the socket's messages as bytes (it asked for
-Blobs and read each back asynchronously, twice a message), and each view's ``<img>`` loads the
-picture's Blob URL itself (trame's view stream loaded it into a pooled image first, then the
-``<img>`` loaded the same URL again: two loads and decodes a picture). The server's socket
-does not deflate (:func:`explorer.app.web.wire.bind`): a JPEG or PNG does not shrink, and
-deflating it cost a worker thread's round trip and the browser's inflate.
+Blobs and read each back asynchronously, twice a message), and a worker of the page decodes
+each picture once (``createImageBitmap``) and draws it into a canvas laid over the view's
+``<img>`` (trame's view stream loaded it into a pooled image first, then the ``<img>`` loaded
+the same URL again: two loads and decodes a picture; then the ``<img>`` alone, its load event
+and its paint waiting for the page's main thread, busy re-rendering Vue's template for the
+state the server sends with the picture). The server's socket does not deflate
+(:func:`explorer.app.web.wire.bind`): a JPEG or PNG does not shrink, and deflating it cost a
+worker thread's round trip and the browser's inflate.
 
 VTK, Pillow and numpy's pictures are imported inside the methods (``import explorer`` stays free
 of VTK).
