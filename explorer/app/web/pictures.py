@@ -127,9 +127,8 @@ PAGE_JS = """
       : (f) => setTimeout(f, 0);
     onmessage = async (e) => {
       const m = e.data;
-      if (m.canvas) {
-        views.set(m.id, {canvas: m.canvas, ctx: m.canvas.getContext('2d', {alpha: false}),
-                         drawn: 0});
+      if (m.canvas) {  // (its context made at its first draw: an opaque canvas is black
+        views.set(m.id, {canvas: m.canvas, ctx: null, drawn: 0});  // until then)
         return;
       }
       if (m.drop) { views.delete(m.id); return; }
@@ -151,6 +150,7 @@ PAGE_JS = """
         v.canvas.width = size[0];
         v.canvas.height = size[1];
       }
+      v.ctx = v.ctx || v.canvas.getContext('2d', {alpha: false});
       v.ctx.drawImage(bmp, 0, 0);
       bmp.close();
       const drawn = performance.timeOrigin + performance.now();

@@ -163,8 +163,9 @@ def test_a_change_animates_nothing_in_the_page(page):
     wait("the still picture shown", lambda: still(page, 2))
     r1 = recalcs()
     assert page.execute_script("return window.moves") == []
-    # the picture's load, Vue's patch of the slider, the field and the busy mark: 3 here (15-28
-    # with the transitions and the spinning circle)
+    # Vue's patch of the slider, the field and the busy mark (and the <img>'s load, before the
+    # page's worker drew the pictures): 3 here (15-28 with the transitions and the spinning
+    # circle)
     assert r1 - r0 <= 6
     moved = page.execute_script(thumb)
     assert abs(moved - left) > 20  # (kd 0.1 or 0.9: the thumb far from where it was)
