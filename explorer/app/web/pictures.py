@@ -175,22 +175,38 @@ PAGE_JS = """
   const views = new WeakMap();  // a view's <img> -> its canvas's side
   const byId = new Map();
   let ids = 0, seq = 0;
-  const canvasFor = (img) => {
+  const canvasFor = (img, view) => {
     for (const [id, v] of byId) {  // the canvases of views gone (pane B closed): let go
       if (!v.canvas.isConnected) { byId.delete(id); worker.postMessage({id, drop: true}); }
     }
-    const canvas = document.createElement('canvas');
+    const canvas = view.canvas = document.createElement('canvas');
     canvas.className = 'phong-picture';
     canvas.style.cssText = 'position: absolute; left: 0; top: 0; width: 100%; height: 100%; '
       + 'z-index: -1; pointer-events: none';
     img.after(canvas);  // (after the <img>, at its z-index: drawn over it)
     const off = canvas.transferControlToOffscreen();
-    const view = {id: ++ids, url: null, canvas};
     canvas.phong = {seq: 0, url: null, size: null, drawn: null, shown: null, probe: null};
     worker.postMessage({id: view.id, canvas: off}, [off]);
     byId.set(view.id, view);
-    return view;
   };
+  // a view's first picture may come before its <img> is in the page (trame's canvas view adds
+  // it with its container): the canvas is made and the picture drawn once it is, looked for
+  // at each animation frame (10 s at most: then the <img> loads its picture itself)
+  const place = (img, view, frames = 600) => {
+    if (!view.pending) return;
+    if (img.parentNode) {
+      canvasFor(img, view);
+      worker.postMessage(view.pending);
+      view.pending = null;
+    } else if (frames > 0) {
+      requestAnimationFrame(() => place(img, view, frames - 1));
+    } else {
+      src.set.call(img, view.pending.url);
+      view.pending = null;
+      view.url = null;
+    }
+  };
+  const src = Object.getOwnPropertyDescriptor(HTMLImageElement.prototype, 'src');
   if (worker) {
     worker.onmessage = (e) => {
       const m = e.data, view = byId.get(m.id);
@@ -200,18 +216,21 @@ PAGE_JS = """
       P.drawn += 1;
       view.canvas.dispatchEvent(new Event('phong-picture'));  // (the benchmark's probe waits)
     };
-    const src = Object.getOwnPropertyDescriptor(HTMLImageElement.prototype, 'src');
     Object.defineProperty(HTMLImageElement.prototype, 'src', {
       get() { return src.get.call(this); },
       set(v) {
         const blob = pictures.get(v);
-        if (!blob || !this.parentNode) return src.set.call(this, v);
+        if (!blob) return src.set.call(this, v);
         let view = views.get(this);
-        if (!view) views.set(this, view = canvasFor(this));
+        if (!view) views.set(this, view = {id: ++ids, url: null, canvas: null, pending: null});
         if (view.url === v) return;  // (the same picture again: the first-picture listener's)
         view.url = v;
         seq += 1;
-        worker.postMessage({id: view.id, seq, blob, url: v, probe: P.probe});
+        const picture = {id: view.id, seq, blob, url: v, probe: P.probe};
+        if (view.canvas) return worker.postMessage(picture);
+        const waiting = view.pending;
+        view.pending = picture;  // (the newest picture waits for the <img> to be in the page)
+        if (!waiting) place(this, view);
       },
       configurable: true,
     });
