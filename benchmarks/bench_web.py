@@ -9,17 +9,20 @@ to frame, in the same run; and how soon ``phong-explorer web`` is ready.
 - Latency: ``phong-explorer web --mesh teapot --resolution 56`` (100,578 vertices, one point
   light) in its own process, its view sized to 800x600 in headless Chromium (Debian's, driven
   by Selenium). Each sample sets the kd slider's value in the page (what dragging the slider
-  does: the trame state key ``kd_step``) and waits, in the page, for the view's ``<img>`` to load
-  the next picture; the time is the page's own clock (``performance.now()``) from the change to
-  that load: the message to the server, the engine update, the frame, the JPEG and its way back,
-  the decode. Median and best over ``--repeat`` samples after two warm-up ones, each sample
+  does: the trame state key ``kd_step``) and waits, in the page, for the view to show the next
+  picture; the time is the page's own clock (``performance.now()``) from the change to the
+  animation frame after the page's worker drew that picture into the view's canvas (the worker
+  reads the probe pixel there after each draw: one pixel, its cost printed): the message to
+  the server, the engine update, the frame, the JPEG and its way back, the decode and the draw.
+  Median and best over ``--repeat`` samples after two warm-up ones, each sample
   started with the view still (its lossless picture gone). Where the time goes: the server's
   own steps for each sample (``report``'s ``picture``: the change to its frame's end, the
-  frame's render, read-back and encode, explorer.app.web.pictures), and the browser's decode
-  of the last JPEG and PNG (``createImageBitmap`` on the bytes received, in the page); the rest
-  is the two messages (the change to the server, the picture back) and trame's work. The CPU
-  a change takes: the server's process and the browser's processes (``/proc``), from the
-  change to its picture loaded, and the window's process per change (bench_gui).
+  frame's render, read-back and encode, explorer.app.web.pictures), the picture's arrival to
+  its draw, and the browser's decode of the last JPEG and PNG (``createImageBitmap`` on the
+  bytes received, in the page, apart); the rest is the two messages (the change to the server,
+  the picture back) and trame's work. The CPU a change takes: the server's process and the
+  browser's processes (``/proc``), from the change to its picture shown, and the window's
+  process per change (bench_gui).
 - The Qt window's figure of the same run: :func:`bench_gui.qt_frames` (a number field set, the
   action, the panel, the engine, the upload and the frame; a private Xvfb), its view resized
   to the page's 800x600.
@@ -56,31 +59,31 @@ SIZE = (800, 600)
 DOCS = Path(__file__).resolve().parent.parent / "docs" / "web_bench.md"
 ROOT = Path(__file__).resolve().parent.parent
 
-#: one sample, in the page: set kd's slider step, resolve when the view's picture shows a new
-#: colour at the probe vertex's pixel (more than 8 levels away: kd 0.3 and 0.7 are far apart,
-#: and a still picture's lossless copy differs from its JPEG by a level): the ms taken, the
-#: change's and the picture's arrival (epoch ms; the arrival: its Blob made, KEEP_BLOBS_JS)
+#: one sample, in the page: set kd's slider step, resolve when the view shows a new picture
+#: whose colour at the probe vertex's pixel is more than 8 levels from the last one's (kd 0.3
+#: and 0.7 are far apart, and a still picture's lossless copy differs from its JPEG by a
+#: level): the ms from the change to that picture on screen, the change's and the picture's
+#: arrival (epoch ms; the arrival: its Blob made, KEEP_BLOBS_JS), its draw (epoch ms) and the
+#: probe's own cost (ms). The page's worker (explorer.app.web.pictures.PAGE_JS) decodes and
+#: draws each picture into the view's canvas, reads the probe pixel there (one pixel, after the
+#: draw: ``phongPictures.probe``) and stamps ``shown`` at its next animation frame, when the
+#: drawn frame is composited: the time ends there, in the worker, not when the page's busy main
+#: thread hears of it.
 SAMPLE_JS = """
-const [step, x, y, done] = arguments;
-const img = document.querySelector('[aria-label="view"] img');
-const canvas = document.createElement('canvas');
-const ctx = canvas.getContext('2d', {willReadFrequently: true});
-const pixel = () => {
-  canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
-  ctx.drawImage(img, 0, 0);
-  return Array.from(ctx.getImageData(x, y, 1, 1).data.slice(0, 3));
-};
-const before = pixel();
+const [step, done] = arguments;
+const c = document.querySelector('[aria-label="view"] canvas.phong-picture');
+const before = c.phong.probe, seq = c.phong.seq;
 const t0 = performance.now();
 const on = () => {
-  const now = pixel();
-  if (Math.max(...now.map((v, i) => Math.abs(v - before[i]))) > 8) {
-    img.removeEventListener('load', on);
-    const t = performance.now();  // the epoch clock too (the server's is the same machine's)
-    done([t - t0, performance.timeOrigin + t0, performance.timeOrigin + window.blobAt]);
-  }
+  const p = c.phong;
+  if (p.seq <= seq || !p.probe) return;
+  if (before && Math.max(...p.probe.map((v, i) => Math.abs(v - before[i]))) <= 8) return;
+  c.removeEventListener('phong-picture', on);
+  const shown = p.shown - performance.timeOrigin;  // (the worker's epoch ms, on the page clock)
+  done([shown - t0, performance.timeOrigin + t0, performance.timeOrigin + window.blobAt, p.drawn,
+        p.probeMs]);
 };
-img.addEventListener('load', on);
+c.addEventListener('phong-picture', on);
 window.trame.state.set('kd_step', step);
 setTimeout(() => done(-1), 20000);
 """
@@ -119,10 +122,11 @@ const done = arguments[0];
   done(out);
 })();
 """
+#: the view's picture shown: its size and its canvas's box (CSS pixels), null before the first
 PICTURE_JS = """
-const i = document.querySelector('[aria-label="view"] img');
-return i && i.complete && i.naturalWidth > 0 ? [i.naturalWidth, i.naturalHeight,
-  i.getBoundingClientRect().width, i.getBoundingClientRect().height] : null;
+const c = document.querySelector('[aria-label="view"] canvas.phong-picture');
+return c && c.phong.shown ? [...c.phong.size, c.getBoundingClientRect().width,
+  c.getBoundingClientRect().height] : null;
 """
 
 
@@ -269,29 +273,30 @@ def descendants(pid: int) -> list[int]:
 
 
 def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dict:
-    """Median and best ms from a kd slider change to the new picture loaded in the page
+    """Median and best ms from a kd slider change to the new picture on screen in the page
     (``ms``, ``best``), the view's ``size``, the median of each server step (``steps``), the
-    browser's decode (``decode``: kind -> (ms, bytes)) and the CPU a change takes (``cpu``:
+    browser's decode (``decode``: kind -> (ms, bytes)), the CPU a change takes (``cpu``:
     median ms of the server's process and of the browser's processes, from the change to its
-    picture loaded)."""
+    picture shown) and the probe's own read (``probe_ms``: median ms, in the page's worker)."""
     driver.get(url)
     size = size_view(driver)
     driver.execute_script(KEEP_BLOBS_JS)
     time.sleep(1.0)
     rep = driver.execute_async_script(REPORT_JS)
-    x, y = rep["probe"]["px"]
-    ts, steps, cpus = [], [], []
+    driver.execute_script("window.phongPictures.probe = arguments[0];", rep["probe"]["px"])
+    ts, steps, cpus, probe_ms = [], [], [], []
     browser_pids = descendants(driver.service.process.pid)
     for i in range(repeat + 2):
         step = 300 + 400 * (i % 2)  # kd 0.3 and 0.7
         c0 = cpu_ms([server_pid] if server_pid else []), cpu_ms(browser_pids)
-        got = driver.execute_async_script(SAMPLE_JS, step, x, y)
+        got = driver.execute_async_script(SAMPLE_JS, step)
         c1 = cpu_ms([server_pid] if server_pid else []), cpu_ms(browser_pids)
         if got == -1:
             raise RuntimeError("the picture did not change within 20 s")
-        t, changed, arrived = got
+        t, changed, arrived, drawn, probe = got
         if i >= 2:
             ts.append(float(t))
+            probe_ms.append(float(probe))
             cpus.append((c1[0] - c0[0], c1[1] - c0[1]))
             st = driver.execute_async_script(REPORT_JS).get("picture") or {}
             if "at" in st:  # (the page's and the server's clocks: one machine's)
@@ -299,7 +304,8 @@ def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dic
                     st["in"] = st.pop("change_at") - changed  # the change's way to the server
                 st["sent"] = st.pop("at") - changed  # the change to the picture sent
                 st["back"] = arrived - changed - st["sent"]  # its way to the page
-                st["shown"] = t - (arrived - changed)  # its arrival to the <img> loaded
+                st["shown"] = t - (arrived - changed)  # its arrival to its frame on screen
+                st["drawn"] = drawn - arrived  # its arrival to its draw (decoded, drawn)
             steps.append(st)
         time.sleep(0.3)  # (the view still again: its lossless picture has gone)
     decode = driver.execute_async_script(DECODE_JS)
@@ -313,6 +319,7 @@ def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dic
         "steps": median,
         "decode": decode,
         "cpu": tuple(statistics.median(c[k] for c in cpus) for k in (0, 1)),
+        "probe_ms": statistics.median(probe_ms),
     }
 
 
@@ -448,11 +455,14 @@ def breakdown(web: dict) -> list[str]:
         row("  JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
         row("the picture's way to the page (sent → its Blob made in the page)", st.get("back")),
         row(
-            "its Blob made → the view's <img> loaded (the <img> loads the Blob's URL: one decode)",
+            "its Blob made → its frame on screen (the page's worker decodes it, draws it into "
+            "the view's canvas; its next animation frame)",
             st.get("shown"),
         ),
+        row("  its Blob made → drawn (decoded and drawn, in the worker)", st.get("drawn")),
         row(
-            "  of which one JPEG decode (createImageBitmap on the same bytes)",
+            "  one JPEG decode, measured apart (createImageBitmap on the same bytes, the page's "
+            "main thread)",
             dec.get("jpeg", [None])[0],
         ),
     ]
@@ -576,7 +586,7 @@ def measure(args) -> int:
         "",
         "| front end | view | ms |",
         "|---|---|---:|",
-        f"| web page: slider value set in the page → the view's next picture loaded (page "
+        f"| web page: slider value set in the page → the view's next picture on screen (page "
         f"clock) | {ww}x{wh} | {web['ms']:.1f} ({web['best']:.1f}) |",
         f"| Qt window: number field set → frame done (glFinish) | {vw}x{vh} | "
         f"{qt['kd'][0]:.1f} ({qt['kd'][1]:.1f}) |",
@@ -584,10 +594,10 @@ def measure(args) -> int:
         f"The page takes {web['ms'] - qt['kd'][0]:+.1f} ms ({ratio:.2f}x) the window's time.",
         "",
         f"CPU a change takes (median ms, user and system, from the change to its picture "
-        f"loaded; the clock ticks are 10 ms): the page's server process {web['cpu'][0]:.0f}, "
-        f"the browser's processes {web['cpu'][1]:.0f} (the sample's own read of the probe "
-        f"pixel included); the window's process {qt.get('cpu', {}).get('kd', float('nan')):.0f}"
-        f" (mean over its changes).",
+        f"shown; the clock ticks are 10 ms): the page's server process {web['cpu'][0]:.0f}, "
+        f"the browser's processes {web['cpu'][1]:.0f} (the probe's own read of one pixel "
+        f"included: {web['probe_ms']:.2f} ms median, in the page's worker); the window's "
+        f"process {qt.get('cpu', {}).get('kd', float('nan')):.0f} (mean over its changes).",
         "",
         "Where the page's time goes (medians over the same changes):",
         "",
@@ -606,8 +616,16 @@ def measure(args) -> int:
         f"{f' --burners {args.burners}' if args.burners else ''}`",
     ]  # fmt: skip
     text = "\n".join(lines) + "\n"
-    publish(text, DOCS, write=not args.no_write)
+    kept = kept_sections(DOCS.read_text()) if DOCS.exists() else ""
+    publish(text + ("\n" + kept if kept else ""), DOCS, write=not args.no_write)
     return 0
+
+
+def kept_sections(page: str) -> str:
+    """The sections of ``page`` (a docs/web_bench.md) this script does not write: from its
+    first ``## `` heading on (the run's own text has none), kept as they are by a new run."""
+    at = page.find("\n## ")
+    return page[at + 1 :] if at >= 0 else ""
 
 
 if __name__ == "__main__":

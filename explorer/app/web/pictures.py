@@ -13,7 +13,7 @@ attachment; once the view has been still for :data:`STILL_S` seconds the same fr
 as a lossless PNG (:func:`explorer.render.images.encode_png` ``fast``: one row filter, zlib
 level 1), encoded in a worker thread (zlib lets go of the GIL while it deflates), so the page's
 pixels are then exactly the server's; not for a view no page shows any more. The browser's
-``<img>`` reads PNG and JPEG alike (it looks at the bytes, not at the Blob's ``image/jpeg``
+decoder reads PNG and JPEG alike (it looks at the bytes, not at the Blob's ``image/jpeg``
 type).
 
 What asks for a picture stays trame's: the page (its first picture, a resize, the end of a
@@ -23,11 +23,14 @@ last), and the explorer's own frames (:meth:`WebExplorer.send`, through the view
 
 In the page, :data:`PAGE_JS` (a script the page runs before its views are made) takes the
 picture the rest of its way: wslink's client reads the socket's messages as bytes (it asked for
-Blobs and read each back asynchronously, twice a message), and each view's ``<img>`` loads the
-picture's Blob URL itself (trame's view stream loaded it into a pooled image first, then the
-``<img>`` loaded the same URL again: two loads and decodes a picture). The server's socket
-does not deflate (:func:`explorer.app.web.wire.bind`): a JPEG or PNG does not shrink, and
-deflating it cost a worker thread's round trip and the browser's inflate.
+Blobs and read each back asynchronously, twice a message), and a worker of the page decodes
+each picture once (``createImageBitmap``) and draws it into a canvas laid over the view's
+``<img>`` (trame's view stream loaded it into a pooled image first, then the ``<img>`` loaded
+the same URL again: two loads and decodes a picture; then the ``<img>`` alone, its load event
+and its paint waiting for the page's main thread, busy re-rendering Vue's template for the
+state the server sends with the picture). The server's socket does not deflate
+(:func:`explorer.app.web.wire.bind`): a JPEG or PNG does not shrink, and deflating it cost a
+worker thread's round trip and the browser's inflate.
 
 VTK, Pillow and numpy's pictures are imported inside the methods (``import explorer`` stays free
 of VTK).
@@ -51,21 +54,44 @@ JPEG_QUALITY = 100
 STILL_S = 0.15
 
 #: the page's side of the pictures (run by the page before its views are made, again harmless):
-#: (1) each trame view stream hands its picture's Blob URL to the view's ``<img>`` at once (no
-#: pooled image decoding it first: ``decodeImage`` off, and the event's ``image`` is the URL and
-#: size the ``<img>`` takes, which is what trame-vtk's canvas view reads of it), for the streams
+#: (1) each trame view stream hands its picture's Blob URL on at once (no pooled image decoding
+#: it first: ``decodeImage`` off, and the event's ``image`` is the URL and size, which is what
+#: trame-vtk's canvas view and the view's first-picture listener read of it), for the streams
 #: made before and after this script; (2) the socket's binary messages arrive as ArrayBuffers,
 #: handed to wslink's client as the Blob-like object it reads (``slice``, ``arrayBuffer``):
 #: the socket is found at its next ``send``; (3) a change of a plain value (a number, text, a
 #: switch) goes to the server at once: trame's ``state.flush`` first awaits its value
 #: decorators, a few microtasks during which Vue re-renders the page's whole template for the
 #: change (about 10 ms: the change's message waited for it); any other value, a busy or
-#: unconnected client, a flush of named keys keep trame's own path. ``window.phongPictures``
-#: counts the pictures handed on (``shown``) and the changes sent at once (``sent``).
+#: unconnected client, a flush of named keys keep trame's own path; (4) the picture is drawn by
+#: a worker, not loaded by the view's ``<img>``: when the canvas view gives its ``<img>`` a
+#: picture's URL, the picture's Blob goes to a worker that decodes it (``createImageBitmap``,
+#: once) and draws it into an OffscreenCanvas, whose ``<canvas class="phong-picture">`` lies
+#: over the ``<img>`` (same box, ``pointer-events: none``: the mouse still reaches the view);
+#: the page's main thread, busy re-rendering Vue's template for the server's state of the same
+#: change, is not on the way (a browser without OffscreenCanvas keeps the ``<img>`` loading).
+#: Each canvas's ``phong`` says what it shows (``seq``, ``url``, ``size``; ``drawn``: epoch ms
+#: of the draw, ``shown``: of the worker's next animation frame after it, when the drawn frame
+#: is composited; ``probe``: the pixel at ``phongPictures.probe`` = [x, y] if set, read in the
+#: worker after the draw, and ``probeMs`` its cost; ``decodes``: the worker's decodes so far),
+#: and the canvas gets a ``phong-picture`` event each time.
+#: ``window.phongPictures`` counts the pictures handed on (``shown``), drawn (``drawn``) and
+#: the changes sent at once (``sent``).
 PAGE_JS = """
 (() => {
   if (window.phongPictures) return;
-  const P = window.phongPictures = {shown: 0, streams: 0, bytes: false, sent: 0};
+  const P = window.phongPictures = {shown: 0, streams: 0, bytes: false, sent: 0, drawn: 0,
+                                     probe: null};
+  // the Blob of each picture URL handed on (the stream makes the URL, then its event: the last
+  // Blob made is the event's), until a view's <img> is given it (a few kept)
+  const pictures = new Map();
+  let made = null;
+  const make = URL.createObjectURL;
+  URL.createObjectURL = function (b) {
+    const url = make.call(URL, b);
+    made = {url, blob: b};
+    return url;
+  };
   // (1) trame's objects are frozen: each view stream is told not to decode, and a listener of
   // its own (priority 1: before the canvas view's and the view's first-picture listeners)
   // gives the event the URL as its image
@@ -75,6 +101,10 @@ PAGE_JS = """
       const [w, h] = ev.metadata.size;
       ev.image = {src: ev.url, width: w, height: h};
       P.shown += 1;
+      if (made && made.url === ev.url) {
+        pictures.set(ev.url, made.blob);
+        if (pictures.size > 8) pictures.delete(pictures.keys().next().value);
+      }
     }
   };
   const streams = () => {
@@ -89,6 +119,124 @@ PAGE_JS = """
     }
   };
   streams();
+  // (4) the worker: one OffscreenCanvas a view; a picture is decoded, then drawn unless a newer
+  // one of the view is drawn already (decodes may end out of order); the report goes back at
+  // the worker's next animation frame (the drawn frame is then composited)
+  const WORKER = `
+    const views = new Map();
+    let decodes = 0;
+    const frame = self.requestAnimationFrame ? (f) => requestAnimationFrame(f)
+      : (f) => setTimeout(f, 0);
+    onmessage = async (e) => {
+      const m = e.data;
+      if (m.canvas) {  // (its context made at its first draw: an opaque canvas is black
+        views.set(m.id, {canvas: m.canvas, ctx: null, drawn: 0});  // until then)
+        return;
+      }
+      if (m.drop) { views.delete(m.id); return; }
+      const v = views.get(m.id);
+      if (!v) return;
+      let bmp;
+      try {
+        decodes += 1;
+        bmp = await createImageBitmap(m.blob, {colorSpaceConversion: 'none',
+                                               premultiplyAlpha: 'none'});
+      } catch (err) {
+        postMessage({id: m.id, seq: m.seq, error: String(err)});
+        return;
+      }
+      if (m.seq < v.drawn) { bmp.close(); return; }
+      v.drawn = m.seq;
+      const size = [bmp.width, bmp.height];
+      if (v.canvas.width !== size[0] || v.canvas.height !== size[1]) {
+        v.canvas.width = size[0];
+        v.canvas.height = size[1];
+      }
+      v.ctx = v.ctx || v.canvas.getContext('2d', {alpha: false});
+      v.ctx.drawImage(bmp, 0, 0);
+      bmp.close();
+      const drawn = performance.timeOrigin + performance.now();
+      let probe = null, probeMs = 0;
+      if (m.probe) {
+        const t = performance.now();
+        probe = Array.from(v.ctx.getImageData(m.probe[0], m.probe[1], 1, 1).data.slice(0, 3));
+        probeMs = performance.now() - t;
+      }
+      frame(() => postMessage({id: m.id, seq: m.seq, url: m.url, size, drawn, probe, probeMs,
+                               decodes, shown: performance.timeOrigin + performance.now()}));
+    };`;
+  let worker = null;
+  try {
+    if (window.Worker && window.createImageBitmap && window.OffscreenCanvas
+        && HTMLCanvasElement.prototype.transferControlToOffscreen) {
+      worker = new Worker(make.call(URL, new Blob([WORKER], {type: 'text/javascript'})));
+    }
+  } catch (err) {
+    worker = null;  // (the <img> loads the pictures, as trame's view does)
+  }
+  const views = new WeakMap();  // a view's <img> -> its canvas's side
+  const byId = new Map();
+  let ids = 0, seq = 0;
+  const canvasFor = (img, view) => {
+    for (const [id, v] of byId) {  // the canvases of views gone (pane B closed): let go
+      if (!v.canvas.isConnected) { byId.delete(id); worker.postMessage({id, drop: true}); }
+    }
+    const canvas = view.canvas = document.createElement('canvas');
+    canvas.className = 'phong-picture';
+    canvas.style.cssText = 'position: absolute; left: 0; top: 0; width: 100%; height: 100%; '
+      + 'z-index: -1; pointer-events: none';
+    img.after(canvas);  // (after the <img>, at its z-index: drawn over it)
+    const off = canvas.transferControlToOffscreen();
+    canvas.phong = {seq: 0, url: null, size: null, drawn: null, shown: null, probe: null};
+    worker.postMessage({id: view.id, canvas: off}, [off]);
+    byId.set(view.id, view);
+  };
+  // a view's first picture may come before its <img> is in the page (trame's canvas view adds
+  // it with its container): the canvas is made and the picture drawn once it is, looked for
+  // at each animation frame (10 s at most: then the <img> loads its picture itself)
+  const place = (img, view, frames = 600) => {
+    if (!view.pending) return;
+    if (img.parentNode) {
+      canvasFor(img, view);
+      worker.postMessage(view.pending);
+      view.pending = null;
+    } else if (frames > 0) {
+      requestAnimationFrame(() => place(img, view, frames - 1));
+    } else {
+      src.set.call(img, view.pending.url);
+      view.pending = null;
+      view.url = null;
+    }
+  };
+  const src = Object.getOwnPropertyDescriptor(HTMLImageElement.prototype, 'src');
+  if (worker) {
+    worker.onmessage = (e) => {
+      const m = e.data, view = byId.get(m.id);
+      if (m.error) console.log('The picture could not be decoded', m.error);
+      if (!view || m.error) return;
+      Object.assign(view.canvas.phong, m);
+      P.drawn += 1;
+      view.canvas.dispatchEvent(new Event('phong-picture'));  // (the benchmark's probe waits)
+    };
+    Object.defineProperty(HTMLImageElement.prototype, 'src', {
+      get() { return src.get.call(this); },
+      set(v) {
+        const blob = pictures.get(v);
+        if (!blob) return src.set.call(this, v);
+        let view = views.get(this);
+        if (!view) views.set(this, view = {id: ++ids, url: null, canvas: null, pending: null});
+        if (view.url === v) return;  // (the same picture again: the first-picture listener's)
+        view.url = v;
+        seq += 1;
+        const picture = {id: view.id, seq, blob, url: v, probe: P.probe};
+        if (view.canvas) return worker.postMessage(picture);
+        const waiting = view.pending;
+        view.pending = picture;  // (the newest picture waits for the <img> to be in the page)
+        if (!waiting) place(this, view);
+      },
+      configurable: true,
+    });
+  }
   class Bytes {
     constructor(b) { this.b = b; }
     get size() { return this.b.byteLength; }

@@ -119,11 +119,24 @@ def report(driver) -> dict:
     )
 
 
+#: what view ``arguments[0]`` shows: the ``phong`` record of the canvas the page's worker draws
+#: its pictures into (explorer.app.web.pictures.PAGE_JS: ``url``, ``size``, ``seq``, ...), laid
+#: over trame's ``<img>``; null before its first picture is drawn
+SHOWN_PICTURE_JS = """
+const c = document.querySelector(`[aria-label="${arguments[0]}"] canvas.phong-picture`);
+return c && c.phong && c.phong.shown ? c.phong : null;
+"""
+
+
+def shown_picture(driver, view: str = "view") -> dict | None:
+    """What view ``view`` shows (its canvas's ``phong``: ``url``, ``size`` [w, h], ``seq``),
+    None before its first picture."""
+    return driver.execute_script(SHOWN_PICTURE_JS, view)
+
+
 def picture_src(driver) -> str | None:
-    return driver.execute_script(
-        "const i = document.querySelector('[aria-label=\"view\"] img');"
-        "return i && i.complete && i.naturalWidth > 0 ? i.src : null;"
-    )
+    shown = shown_picture(driver)
+    return shown["url"] if shown else None
 
 
 def wait(what: str, check, timeout: float = STEP_TIMEOUT):
@@ -169,7 +182,7 @@ def view_pixels(driver, view: str = "view") -> tuple[np.ndarray, dict]:
 
     img = Image.open(io.BytesIO(driver.get_screenshot_as_png())).convert("RGB")
     box = driver.execute_script(
-        'const r = document.querySelector(`[aria-label="${arguments[0]}"] img`)'
+        'const r = document.querySelector(`[aria-label="${arguments[0]}"] canvas.phong-picture`)'
         ".getBoundingClientRect();"
         "return {x: r.left, y: r.top, w: r.width, h: r.height, dpr: window.devicePixelRatio};",
         view,
@@ -596,9 +609,7 @@ def test_compare_a_b_shows_side_b_in_its_own_view(server, browser, mesh):
     click(browser, "compare")
     rep = wait("side B", lambda: (r := report(browser)) and r["compare"] and r)
     assert rep["session"]["compare"]["model"] != rep["session"]["scene"]["model"]
-    wait("side B's picture", lambda: browser.execute_script(
-        "const i = document.querySelector('[aria-label=\"view_b\"] img');"
-        "return i && i.complete && i.naturalWidth > 0;"))  # fmt: skip
+    wait("side B's picture", lambda: shown_picture(browser, "view_b"))
     check_probe(browser, mesh, "view_b")
     check_probe(browser, mesh)
     click(browser, "swap")

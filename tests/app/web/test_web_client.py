@@ -1,13 +1,15 @@
 """The page's side of the pictures (explorer.app.web.pictures.PAGE_JS, the server's socket):
-in headless Chromium, each picture is loaded once, by the view's own ``<img>``, which shows the
-new frame after a change and the still frame's PNG after the JPEG; a change the page makes goes
-to the server before the page redraws; the server's socket does not deflate."""
+in headless Chromium, each picture is decoded once, by the page's worker, and drawn into the
+canvas over the view's ``<img>`` (which loads none), which shows the new frame after a change
+and the still frame's PNG after the JPEG; the worker's probe pixel is the screenshot's; a change
+the page makes goes to the server before the page redraws; the server's socket does not
+deflate."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_web import open_page, report, view_pixels, wait
+from test_web import open_page, report, shown_picture, view_pixels, wait
 
 pytestmark = pytest.mark.web
 
@@ -33,12 +35,6 @@ URL.createObjectURL = (b) => {
 };
 """
 
-#: the view's ``<img>``: its URL once loaded
-SHOWN_JS = """
-const i = document.querySelector('[aria-label="view"] img');
-return i && i.complete && i.naturalWidth > 0 ? i.src : null;
-"""
-
 
 @pytest.fixture(scope="module")
 def page(server, browser):
@@ -62,23 +58,26 @@ def still(driver, count: int = 1):
     heads = [b["head"] for b in w["blobs"]]
     if len(heads) < count or None in heads or heads[-1] != [0x89, 0x50]:
         return None
-    return w if driver.execute_script(SHOWN_JS) == w["blobs"][-1]["url"] else None
+    shown = shown_picture(driver)
+    return w if shown and shown["url"] == w["blobs"][-1]["url"] else None
 
 
-def test_each_picture_is_loaded_once_by_the_views_img_which_shows_it(page):
+def test_each_picture_is_decoded_once_by_the_worker_and_drawn_without_an_img_load(page):
     wait("the start's still picture", lambda: still(page))
     rep = report(page)
     before = probe_pixel(page, rep)
+    decodes = shown_picture(page)["decodes"]
     page.execute_script("window.watched.srcs = []; window.watched.blobs = [];")
     page.execute_script("window.trame.state.set('kd_step', arguments[0]);", 150)
     # the change's JPEG, then the still frame's PNG, shown by the view
     w = wait("the still picture shown", lambda: still(page, 2))
     heads = [b["head"] for b in w["blobs"]]
     assert heads[0] == [0xFF, 0xD8]  # a JPEG while it changes, then the PNG
-    urls = [b["url"] for b in w["blobs"]]
-    # each picture's URL given to an image once: trame's view stream loaded it into a pooled
-    # image first, then the view's <img> loaded it again (every URL twice)
-    assert sorted(w["srcs"]) == sorted(urls)
+    # no image loads a picture (trame's view stream loaded each into a pooled image, then the
+    # view's <img> loaded it again; then the <img> alone: one load and decode on the main
+    # thread), and the worker decoded each picture once
+    assert w["srcs"] == []
+    assert shown_picture(page)["decodes"] - decodes == len(w["blobs"])
     assert page.execute_script("return window.phongPictures.shown") > 0
 
     def moved():  # what a person sees: the new frame (kd 0.15 is far from the start's)
@@ -86,6 +85,22 @@ def test_each_picture_is_loaded_once_by_the_views_img_which_shows_it(page):
         return p.tolist() if np.abs(p - before).max() > 8 else None
 
     wait("the new colour under the probe", moved)
+
+
+def test_the_workers_probe_pixel_is_the_screenshots(page):
+    """The benchmark's probe (``phongPictures.probe``: the pixel read in the worker after each
+    draw) reads what the screenshot shows there: the still frame's PNG, exactly."""
+    wait("the start's still picture", lambda: still(page))
+    rep = report(page)
+    x, y = rep["probe"]["px"]
+    page.execute_script("window.phongPictures.probe = arguments[0];", [x, y])
+    page.execute_script("window.watched.blobs = [];")
+    step = 200 if page.execute_script("return window.trame.state.get('kd_step')") > 500 else 800
+    page.execute_script("window.trame.state.set('kd_step', arguments[0]);", step)
+    wait("the still picture shown", lambda: still(page, 2))
+    read = shown_picture(page)["probe"]
+    page.execute_script("window.phongPictures.probe = null;")
+    assert read == probe_pixel(page, rep).tolist()
 
 
 def test_a_change_leaves_for_the_server_before_the_page_redraws(page):
@@ -148,8 +163,9 @@ def test_a_change_animates_nothing_in_the_page(page):
     wait("the still picture shown", lambda: still(page, 2))
     r1 = recalcs()
     assert page.execute_script("return window.moves") == []
-    # the picture's load, Vue's patch of the slider, the field and the busy mark: 3 here (15-28
-    # with the transitions and the spinning circle)
+    # Vue's patch of the slider, the field and the busy mark (and the <img>'s load, before the
+    # page's worker drew the pictures): 3 here (15-28 with the transitions and the spinning
+    # circle)
     assert r1 - r0 <= 6
     moved = page.execute_script(thumb)
     assert abs(moved - left) > 20  # (kd 0.1 or 0.9: the thumb far from where it was)

@@ -12,7 +12,17 @@ import time
 import numpy as np
 import pytest
 from helpers.peaks import engine_peak
-from test_web import STEP_TIMEOUT, click, console_errors, drag, open_page, report, view_pixels, wait
+from test_web import (
+    STEP_TIMEOUT,
+    click,
+    console_errors,
+    drag,
+    open_page,
+    report,
+    shown_picture,
+    view_pixels,
+    wait,
+)
 
 import explorer
 from explorer.analysis import litsphere as LS
@@ -29,10 +39,7 @@ def _picture(browser, rep) -> np.ndarray | None:
     while the picture shown is not of the reported size (it would be drawn stretched)."""
     shot, box = view_pixels(browser)
     w, h = rep["size"]
-    natural = browser.execute_script(
-        "const i = document.querySelector('[aria-label=\"view\"] img');"
-        "return [i.naturalWidth, i.naturalHeight];"
-    )
+    natural = (shown_picture(browser) or {}).get("size")
     if not [round(box["w"]), round(box["h"])] == rep["size"] == natural:
         return None
     xs = np.round((box["x"] + (np.arange(w) + 0.5) * box["w"] / w) * box["dpr"] - 0.5).astype(int)

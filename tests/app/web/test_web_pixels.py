@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import yaml
 from helpers.probes import interior
-from test_web import choose, click, open_page, report, view_pixels, wait
+from test_web import choose, click, open_page, report, shown_picture, view_pixels, wait
 from webserver import Server, need_browser, new_browser
 
 from explorer.app import lobeinset as LI
@@ -62,9 +62,8 @@ def compared(driver, tmp_path, per_pixel: bool = True):
 
     rep = report(driver)
     shot, box = view_pixels(driver)
-    natural = driver.execute_script(
-        "const i = document.querySelector('[aria-label=\"view\"] img');"
-        "return [i.naturalWidth, i.naturalHeight];"
+    natural = (shown_picture(driver) or {}).get(
+        "size"
     )  # (a picture of another size would be drawn stretched)
     if not [round(box["w"]), round(box["h"])] == rep["size"] == natural:
         return None

@@ -88,14 +88,11 @@ def test_the_pages_sum_tile_is_the_per_pixel_picture(strip_server, strip_browser
 def _pane_picture(browser, size, view: str) -> np.ndarray | None:
     """Pane ``view``'s picture as the page shows it (h, w, 3) int, in the server's pixels;
     None while the picture shown is not of the reported ``size``."""
-    from test_web import view_pixels
+    from test_web import shown_picture, view_pixels
 
     shot, box = view_pixels(browser, view)
     w, h = size
-    natural = browser.execute_script(
-        f"const i = document.querySelector('[aria-label=\"{view}\"] img');"
-        "return [i.naturalWidth, i.naturalHeight];"
-    )
+    natural = (shown_picture(browser, view) or {}).get("size")
     if not [round(box["w"]), round(box["h"])] == list(size) == natural:
         return None
     xs = np.round((box["x"] + (np.arange(w) + 0.5) * box["w"] / w) * box["dpr"] - 0.5).astype(int)
