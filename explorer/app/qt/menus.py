@@ -11,7 +11,7 @@ from pathlib import Path
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import intents as intents_
-from explorer.app.intents import BY_ID, INTENTS, MENUS
+from explorer.app.intents import INTENTS, MENUS
 from explorer.app.qt.messages import open_log
 
 #: keys of the 3D view (active while it has the keyboard focus): key -> intent id (from the
@@ -104,8 +104,7 @@ class Menus:
         """Undo and redo named after what they undo or redo; every entry enabled when its
         intent can run (undo and redo: when there is something to undo or redo)."""
         for name, label in (("undo", undo), ("redo", redo)):
-            title = BY_ID[name].title
-            self.actions[name].setText(f"{title} {label}" if label else title)
+            self.actions[name].setText(intents_.history_title(name, label))
         self.refresh()
 
     def show_recent(self, items: list[str]) -> None:

@@ -426,6 +426,7 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     """Each row of :mod:`explorer.app.panelmodel` is a widget of its tab whose object name and
     accessible name are the row's (the page's test reads the same names in the DOM)."""
     from explorer.app import panelmodel as P
+    from explorer.app import rowlayout
 
     every_row_shown(win.controller)
     assert not win.controller.state.mesh_uv
@@ -433,13 +434,14 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     assert {"preset", "light", "add_light", "difference", "compare", "swap"} <= set(P.BY_KEY)
     for r in P.ROWS:
         tab = getattr(win.panel, r.tab)
-        for name in P.names(r):
+        for name in rowlayout.names(r):
             found = tab.findChildren(QtWidgets.QWidget, name)
             assert len(found) == 1, (r.key, name, found)
             assert found[0].accessibleName() == name, name
             # a mesh file's own materials are shown with an OBJ's groups (test_filemenu.py), the
             # maps with a mesh's (u, v) (test_window_maps.py): the start's icosphere has none
-            hidden = r.key in MESH_MATERIALS + MORE_LOBES or r.kind == "image"
+            # (and the line saying the scene has no lights: it has one)
+            hidden = r.key in (*MESH_MATERIALS, *MORE_LOBES, "no_lights") or r.kind == "image"
             assert found[0].isVisibleTo(tab) != hidden, name
     win.controller.undo()  # fresnel off: its number hidden, its switch shown and unchecked
     rows = win.panel.material.rows
