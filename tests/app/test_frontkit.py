@@ -96,6 +96,19 @@ def test_the_start_light_is_a_point_light_at_the_default_placement_in_mesh_radii
     assert np.allclose(mesh.centre, (1.0, 0.0, 0.0), atol=1e-9)
 
 
+def test_the_notebooks_start_is_the_preset_on_the_mesh_under_the_start_light():
+    """The notebook's start (:func:`explorer.app.start.notebook_state`, the kit's since the
+    page's module computed it): the preset on the built-in mesh under the start's light, seen
+    from the start's camera; a scene given keeps its lights."""
+    state, mesh = start.notebook_state(mesh="sphere")
+    assert state.mesh == "sphere" and state.preset == start.DEFAULT_PRESET
+    assert state.scene.lights == (start.default_light(mesh),)
+    assert state.scene.viewer == start.default_viewer(mesh)
+    scene = Scene(lights=(start.default_light(mesh),) * 2)
+    state, _ = start.notebook_state(scene, preset=None, mesh="sphere")
+    assert len(state.scene.lights) == 2 and state.preset is None
+
+
 def test_the_message_log_keeps_each_message_whole_with_its_head_and_the_last_ones():
     log = MessageLog(keep=2)
     log.add("info", "saved")
