@@ -514,3 +514,20 @@ def test_a_meshs_own_material_kept_on_another_mesh_is_called_by_its_name(win, qt
         assert name in text and "scene material" not in text, texts
     assert win.panel.material.preset_label.text().startswith("material: ")  # not a preset
     win.controller.errors.clear()  # (the .mtl's warnings)
+
+
+def test_the_lights_tab_says_when_the_scene_has_no_lights(win):
+    """The line that says so is the panel model's ``no_lights`` row (the window's own label
+    before): shown, in the lights tab, once the last light is removed; hidden again on undo."""
+    from explorer.app import panelmodel as P
+
+    tab, c = win.panel.lights, win.controller
+    line = tab.findChild(QtWidgets.QLabel, "no_lights")
+    assert line is not None and not line.isVisibleTo(tab)
+    while c.state.scene.lights:
+        assert c.set_value("remove_light", True, merge=False)
+    assert line.isVisibleTo(tab) and line.text() == P.NO_LIGHTS
+    assert line.accessibleName() == "no_lights"
+    assert not tab.rows.widgets["remove_light"].isEnabled()
+    c.undo()
+    assert not line.isVisibleTo(tab)
