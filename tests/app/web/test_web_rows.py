@@ -158,3 +158,25 @@ def test_the_page_names_the_material_and_says_when_it_is_edited(server, browser)
     wait("(edited)", lambda: by_name(browser, "material_line").text == f"{line} (edited)")
     click(browser, "undo")
     wait("the line again", lambda: by_name(browser, "material_line").text == line)
+
+
+def test_the_lights_tab_says_when_the_scene_has_no_lights(server, browser):
+    """The panel model's ``no_lights`` row, the window's label before the kit: on the page
+    too, once the last light is removed; undo brings the light and hides the line."""
+    rep = open_page(browser, server.url)
+    n = len(rep["session"]["scene"]["lights"])
+    click(browser, "lights tab")
+    wait("the lights tab", lambda: shown(browser, "remove_light"))
+    for k in range(n):
+        click(browser, "remove_light")
+        wait(
+            "a light removed",
+            lambda k=k: len(report(browser)["session"]["scene"]["lights"]) == n - k - 1,
+        )
+    wait("the no-lights line", lambda: shown(browser, "no_lights"))
+    assert by_name(browser, "no_lights").text == P.NO_LIGHTS
+    for _ in range(n):
+        click(browser, "undo")
+    wait("the lights back", lambda: report(browser)["session"] == rep["session"])
+    assert not shown(browser, "no_lights")
+    click(browser, "material tab")
