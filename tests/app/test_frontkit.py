@@ -148,6 +148,11 @@ def test_the_tally_counts_errors_and_warnings_and_an_error_or_a_long_warning_ope
     assert not opens_log("error", (), fits=True)  # the status line shows it whole
 
 
+def test_the_mesh_line_and_a_recent_files_entry_in_words():
+    assert captions.mesh_line("teapot", 12345) == "teapot: 12,345 vertices"
+    assert captions.recent_entry(1, "/a/b/c.yaml") == "&2 c.yaml   (/a/b)"
+
+
 def test_the_summary_names_the_material_the_model_and_what_is_hidden():
     mesh = get_mesh("sphere", 8)
     scene = Scene(lights=(start.default_light(mesh),))

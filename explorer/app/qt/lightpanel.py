@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
-from explorer.app import intents, panelmodel
+from explorer.app import captions, intents, panelmodel
 from explorer.app import model as M
 from explorer.app.qt.panel import _form, _scroll, guard_wheel
 from explorer.app.qt.rows import RowWidgets
@@ -104,7 +104,7 @@ class ViewTab(QtWidgets.QWidget):
         self.rows.show_state(s)
         with QtCore.QSignalBlocker(self.mesh):
             self.mesh.setCurrentIndex(max(self.mesh.findData(s.mesh), 0))
-        self.mesh_info.setText(f"{s.mesh}: {n_vertices:,} vertices")
+        self.mesh_info.setText(captions.mesh_line(s.mesh, n_vertices))
         self.mesh_info.setToolTip(s.mesh)
         self.legend.setVisible(s.difference)
         self.advice.setVisible(s.difference)
