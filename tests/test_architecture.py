@@ -45,10 +45,12 @@ EXEMPT_CLASSES: dict[str, str] = {
 EXEMPT_FUNCTIONS_IN = {"shading/kernels.py", "geometry/rays.py"}
 #: lines that ruff's formatter is told to skip (ending in ``fmt: skip``) in the repository's
 #: Python files (537 before issue 38, 509 after its first sessions, 499 after the kit moved
-#: the front ends' shared code): a count that may only go down (a table laid out by hand is
-#: fine; a line kept long to pass a size gate is not). Lower it when you remove some; never
-#: raise it
-MAX_FMT_SKIP = 499
+#: the front ends' shared code, 497 after the page's undo and redo buttons were drawn by one
+#: loop and its lines of toggles laid out by the kit's rowlayout.lines, 496 after the
+#: notebook's start moved into app.start): a count that may
+#: only go down (a table laid out by hand is fine; a line kept long to pass a size gate is
+#: not). Lower it when you remove some; never raise it
+MAX_FMT_SKIP = 496
 
 
 def _modules():

@@ -1,9 +1,12 @@
 """What both front ends say of the state in words (no toolkit): the line of the mesh file's own
 materials, the name of the material shown, the line above the preset list and the state's
-summary. The panel model's text rows, the views' captions and the window's status bar read
+summary; the line under the mesh chooser and an entry of the recent files. The panel model's
+text rows, the views' captions, the window's status bar, its view tab and its File menu read
 them."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 from explorer.app.model import TERMS, State
 from explorer.core.texture import MAP_KEYS
@@ -56,3 +59,15 @@ def summary(state: State) -> str:
     if hidden:
         parts.append("hidden: " + ", ".join(hidden))
     return ";  ".join(parts)
+
+
+def mesh_line(name: str, n_vertices: int) -> str:
+    """What the line under the mesh chooser says of the mesh shown: ``teapot: 1,234
+    vertices``."""
+    return f"{name}: {n_vertices:,} vertices"
+
+
+def recent_entry(i: int, path: str) -> str:
+    """Recent file ``path``'s entry, the ``i``-th (from 0) of the list: its number (the
+    desktop's mnemonic, ``&``), its name and, apart, its folder."""
+    return f"&{i + 1} {Path(path).name}   ({Path(path).parent})"

@@ -115,6 +115,11 @@ class Intent:
         keys = self.all_keys() if self.page_keys is None else self.page_keys
         return tuple(k for k in keys if key_name(k) not in BROWSER_KEYS)
 
+    def keys_text(self, *, page: bool = False) -> str:
+        """Its keys as the menus, the help and the tooltips write them (``Ctrl+Shift+Z / Ctrl+Y``):
+        the window's shortcuts, or (``page``) the page's keys; "" when it has none."""
+        return " / ".join(self.web_keys() if page else self.keys)
+
     def can_run(self, controller) -> bool:
         return self.enabled is None or bool(self.enabled(controller))
 
@@ -384,17 +389,38 @@ def run(intent_id: str, controller, front: dict[str, Callable[[], object]]):
     return target()
 
 
+def tooltip(intent_id: str, what: str = "", *, page: bool = False) -> str:
+    """The tooltip of a button that runs intent ``intent_id`` (a toolbar's, the material tab's
+    Save): its title (with ``page``: what the page's help says it does there), ``what`` it
+    would do now when given (the step an undo undoes), and its keys in brackets (the page's
+    keys with ``page``; the desktop's: its shortcuts, then its 3D view key):
+    ``Save preset as… (Ctrl+Shift+S)``; on the page ``undo kd (Ctrl+Z)``, ``download the
+    session (Ctrl+S)``."""
+    intent = BY_ID[intent_id]
+    keys = intent.keys_text(page=True) if page else " / ".join(intent.all_keys())
+    title = intent.page_what if page else intent.label
+    text = f"{title} {what}" if what else title
+    return f"{text} ({keys})" if keys else text
+
+
+def history_title(intent_id: str, what: str | None) -> str:
+    """Undo's or redo's title naming the step it undoes or redoes (``what``; None: its title
+    alone): the desktop's menu entry (``&Undo kd``)."""
+    title = BY_ID[intent_id].title
+    return f"{title} {what}" if what else title
+
+
 def help_lines(*, page: bool = False) -> list[str]:
     """Every key and mouse control, one per line: the desktop's (the 3D view's keys, the
     window's shortcuts), or the page's (``page``: the keys the page has)."""
     if page:
         lines = ["Keys (not while typing in a field):"]
-        lines += [f"  {' / '.join(i.web_keys())}   {i.page_what}" for i in INTENTS if i.web_keys()]
+        lines += [f"  {i.keys_text(page=True)}   {i.page_what}" for i in INTENTS if i.web_keys()]
     else:
         lines = ["Keys in the 3D view (VTK's own keys are switched off):"]
         lines += [f"  {i.view_key}   {i.what}" for i in INTENTS if i.view_key]
         lines += ["", "Window shortcuts:"]
-        lines += [f"  {' / '.join(i.keys)}   {i.what}" for i in INTENTS if i.keys]
+        lines += [f"  {i.keys_text()}   {i.what}" for i in INTENTS if i.keys]
     lines += ["", "Mouse in the 3D view:"]
     lines += [f"  {how}: {what}" for how, what in MOUSE]
     return lines

@@ -12,6 +12,15 @@ from explorer.app.controller.ports import log_head
 
 #: the levels of a message, in the order of their weight
 LEVELS = ("info", "warning", "error")
+#: the colour a message of a level is written in on the window's dark status bar (an info's:
+#: the bar's own)
+LEVEL_COLOURS = {"warning": "#e0a030", "error": "#ff7766"}
+
+
+def opens_log(level: str, details=(), fits: bool = True) -> bool:
+    """Whether a message said on a status line opens the log: an error or a warning that comes
+    with ``details`` or that the line cannot show whole (``fits``: it can)."""
+    return level != "info" and (bool(details) or not fits)
 
 
 @dataclass(frozen=True)
@@ -63,3 +72,11 @@ class MessageLog:
     def count(self, level: str) -> int:
         """How many messages of ``level`` it holds."""
         return sum(m.level == level for m in self.messages)
+
+    def tally(self) -> tuple[str, str]:
+        """Its errors and warnings in words (``1 error, 2 warnings``; ``messages`` when it has
+        none), and the colour of the heaviest level (:data:`LEVEL_COLOURS`; "": none)."""
+        counts = [(self.count(level), level) for level in ("error", "warning")]
+        words = ", ".join(f"{n} {level}{'s' * (n != 1)}" for n, level in counts if n)
+        heaviest = next((level for n, level in counts if n), "")
+        return words or "messages", LEVEL_COLOURS.get(heaviest, "")

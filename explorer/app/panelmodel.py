@@ -388,8 +388,13 @@ def light_summary(i: int, light, state: M.State) -> str:
     return f"{i + 1}: {light.type} {where} az {az:.0f}°, el {el:.0f}°{dist}{same}"
 
 
+#: what the lights tab says when the scene has no lights (the ``no_lights`` row)
+NO_LIGHTS = "The scene has no lights: add one."
+
+
 def _light_list_rows() -> list[Row]:
-    """The scene's lights, first in the lights tab: the selected one is the value."""
+    """The scene's lights, first in the lights tab: the selected one is the value; add,
+    duplicate, remove; the line saying the scene has none (:data:`NO_LIGHTS`)."""
     return [
         Row(
             "light",
@@ -418,6 +423,14 @@ def _light_list_rows() -> list[Row]:
                 ("duplicate", M.duplicate_light),
                 ("remove", M.remove_light),
             )
+        ),
+        Row(
+            "no_lights",
+            "lights",
+            "text",
+            lambda s: NO_LIGHTS,
+            _read_only("no_lights"),
+            lambda s: s.selected_light is None,
         ),
     ]
 
@@ -743,16 +756,6 @@ def edit(state: M.State, key: str, value, presets=()) -> tuple[Callable, tuple, 
         value = found
     action, args, *label = r.edit(state, value)
     return action, args, label[0] if label else r.undo_label
-
-
-def names(r: Row) -> tuple[str, ...]:
-    """The accessible names of a row's widgets that both front ends give: its key (the
-    control, or the box of a control drawn as several widgets), and an optional number's
-    ``<key>_on`` toggle; an image's toggle, choose-file and clear (``<key>_on``,
-    ``<key>_choose``, ``<key>_clear``)."""
-    if r.kind == "image":
-        return r.key, f"{r.key}_on", f"{r.key}_choose", f"{r.key}_clear"
-    return (r.key, f"{r.key}_on") if r.kind == "number" and r.optional is not None else (r.key,)
 
 
 def client_keys() -> dict[str, str]:

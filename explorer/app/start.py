@@ -25,8 +25,8 @@ from explorer.app.model import (
 from explorer.core.errors import ExplorerError
 from explorer.core.lights import PointLight
 from explorer.core.material import Material
-from explorer.core.presets import list_presets
-from explorer.core.scene import Scene, Viewer
+from explorer.core.presets import find_preset, list_presets
+from explorer.core.scene import Scene, Viewer, load_scene
 from explorer.geometry.filematerials import group_materials
 from explorer.geometry.meshes import Mesh, get_mesh
 
@@ -108,6 +108,25 @@ def first_state(
         preset_material=clean,
         mesh_uv=mesh.uv is not None,
     )
+
+
+def notebook_state(
+    scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH, materials_dirs=()
+) -> tuple[State, Mesh]:
+    """``(state, mesh)`` for the notebook's explorer (:func:`explorer.app.web.show`): ``scene``
+    (a Scene, a scene file or a mapping; None: one point light at
+    :data:`~explorer.app.model.DEFAULT_PLACEMENT` seen from the explorer's start camera) on
+    built-in mesh ``mesh``, in preset ``preset`` (None: the scene's material)."""
+    m = load_mesh_choice(mesh)
+    if scene is None:
+        scene = Scene(lights=(default_light(m),), viewer=default_viewer(m))
+    else:
+        scene = load_scene(scene, materials_dirs=materials_dirs)
+    if preset is not None:
+        scene = scene.replace(material=find_preset(preset, materials_dirs))
+    scene = scene.replace(mesh=mesh)
+    state = first_state(scene, m, name=mesh, preset=preset, materials_dirs=materials_dirs)
+    return state, m
 
 
 def read_mesh_materials(mesh: Mesh, fallback: Material) -> tuple[MeshMaterials | None, list]:

@@ -13,6 +13,7 @@ not at all.
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import math
 import os
 import threading
@@ -20,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from explorer.app.model import parse_number
+from explorer.core import tolerances as tol
 from explorer.core.atomic import check_target, write_atomic
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
@@ -37,6 +40,31 @@ from explorer.shading.display import group_vertex_colors, vertex_colors
 
 #: how many frames the window's turntable dialog offers first
 DEFAULT_FRAMES = 36
+#: what both front ends ask for the number of frames (the window's dialog, the page's field)
+FRAMES_LABEL = "frames in a full turn"
+#: why a turntable cannot be an MP4 here (said where MP4 is not offered)
+MP4_NEEDS = "MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg)"
+
+
+def turntable_formats() -> tuple[str, ...]:
+    """The turntable formats the explorer can write here: a GIF always, an MP4 when
+    imageio-ffmpeg (its bundled ffmpeg) is installed, as ``render --turntable`` needs it."""
+    return (".gif", ".mp4") if importlib.util.find_spec("imageio_ffmpeg") else (".gif",)
+
+
+def format_name(suffix: str) -> str:
+    """A turntable format's name as the front ends show it (``.gif`` -> ``GIF``)."""
+    return suffix[1:].upper()
+
+
+def read_frames(text) -> int:
+    """The number of frames typed (``text``: a whole number, or its text, from 2 to
+    :data:`~explorer.core.tolerances.MAX_TURNTABLE_FRAMES`); else one line naming
+    ``frames``."""
+    n = parse_number("frames", str(text), 2, tol.MAX_TURNTABLE_FRAMES)
+    if n != int(n):
+        raise ExplorerError(f"frames: a whole number of frames, got {text!r}")
+    return int(n)
 
 
 def turntable_size(width: int, height: int) -> tuple[int, int]:

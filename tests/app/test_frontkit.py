@@ -39,6 +39,51 @@ def test_no_front_end_file_imports_the_lights_or_names_a_light_class():
     assert not found, found
 
 
+def test_no_front_end_file_writes_a_shortcut_the_registry_holds():
+    """Every key a front end shows (a tooltip's, a menu's, the help's) comes from the intent
+    registry (:mod:`explorer.app.intents`): no string of a front-end file's code (its
+    docstrings aside) writes one (the page's undo and redo tooltips said ``(Ctrl+Z)`` and
+    ``(Ctrl+Shift+Z)`` themselves, without redo's Ctrl+Y)."""
+    import ast
+
+    from explorer.app import intents as X
+
+    files = [*APP.glob("qt/*.py"), *APP.glob("web/*.py")]
+    keys = {k for i in X.INTENTS for k in i.keys + (i.page_keys or ()) if "+" in k or len(k) > 1}
+    assert {"Ctrl+Z", "Ctrl+Shift+Z", "F1"} <= keys
+    pattern = re.compile(r"\b(" + "|".join(re.escape(k) for k in sorted(keys)) + r")\b")
+    found = []
+    for f in files:
+        tree = ast.parse(f.read_text())
+        docs = {
+            id(n.body[0].value)
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Module | ast.ClassDef | ast.FunctionDef | ast.AsyncFunctionDef)
+            and n.body
+            and isinstance(n.body[0], ast.Expr)
+        }
+        found += [
+            f"{f.parent.name}/{f.name}:{n.lineno}: {m.group(0)}"
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs
+            if (m := pattern.search(n.value))
+        ]
+    assert not found, found
+
+
+def test_a_buttons_tooltip_is_its_intents_title_and_keys_from_the_registry():
+    from explorer.app import intents as X
+
+    assert X.tooltip("save_preset") == "Save preset as… (Ctrl+Shift+S)"
+    assert X.tooltip("screenshot") == "Save screenshot (i)"  # the 3D view's key
+    assert X.tooltip("undo", "kd") == "Undo kd (Ctrl+Z)"
+    # the page's: what its help says, its keys (Ctrl+T is the browser's: Alt+T)
+    assert X.tooltip("redo", "kd", page=True) == "redo kd (Ctrl+Shift+Z / Ctrl+Y)"
+    assert X.tooltip("export_turntable", page=True) == "make a turntable (the view tab) (Alt+T)"
+    assert X.tooltip("messages", page=True) == "the message log (Ctrl+M)"
+    assert X.history_title("undo", "kd") == "&Undo kd" and X.history_title("redo", None) == "&Redo"
+
+
 def test_the_start_light_is_a_point_light_at_the_default_placement_in_mesh_radii():
     unit = get_mesh("sphere", 8)
     mesh = Mesh(unit.positions * 2.0 + (1.0, 0.0, 0.0), unit.normals, unit.faces)
@@ -49,6 +94,19 @@ def test_the_start_light_is_a_point_light_at_the_default_placement_in_mesh_radii
     assert d == pytest.approx(DEFAULT_PLACEMENT[2] * mesh.radius)
     assert mesh.radius == pytest.approx(2.0 * unit.radius)
     assert np.allclose(mesh.centre, (1.0, 0.0, 0.0), atol=1e-9)
+
+
+def test_the_notebooks_start_is_the_preset_on_the_mesh_under_the_start_light():
+    """The notebook's start (:func:`explorer.app.start.notebook_state`, the kit's since the
+    page's module computed it): the preset on the built-in mesh under the start's light, seen
+    from the start's camera; a scene given keeps its lights."""
+    state, mesh = start.notebook_state(mesh="sphere")
+    assert state.mesh == "sphere" and state.preset == start.DEFAULT_PRESET
+    assert state.scene.lights == (start.default_light(mesh),)
+    assert state.scene.viewer == start.default_viewer(mesh)
+    scene = Scene(lights=(start.default_light(mesh),) * 2)
+    state, _ = start.notebook_state(scene, preset=None, mesh="sphere")
+    assert len(state.scene.lights) == 2 and state.preset is None
 
 
 def test_the_message_log_keeps_each_message_whole_with_its_head_and_the_last_ones():
@@ -73,6 +131,26 @@ def test_the_message_log_keeps_each_message_whole_with_its_head_and_the_last_one
         "head": w.head,
     }
     assert len(MessageLog().messages) == 0
+
+
+def test_the_tally_counts_errors_and_warnings_and_an_error_or_a_long_warning_opens_the_log():
+    from explorer.app.messagelog import LEVEL_COLOURS, opens_log
+
+    log = MessageLog()
+    assert log.tally() == ("messages", "")
+    log.add("warning", "w")
+    assert log.tally() == ("1 warning", LEVEL_COLOURS["warning"])
+    log.add("error", "e")
+    log.add("warning", "w")
+    assert log.tally() == ("1 error, 2 warnings", LEVEL_COLOURS["error"])
+    assert not opens_log("info", ["a detail"], fits=False)  # information never opens it
+    assert opens_log("warning", ["a detail"]) and opens_log("error", (), fits=False)
+    assert not opens_log("error", (), fits=True)  # the status line shows it whole
+
+
+def test_the_mesh_line_and_a_recent_files_entry_in_words():
+    assert captions.mesh_line("teapot", 12345) == "teapot: 12,345 vertices"
+    assert captions.recent_entry(1, "/a/b/c.yaml") == "&2 c.yaml   (/a/b)"
 
 
 def test_the_summary_names_the_material_the_model_and_what_is_hidden():

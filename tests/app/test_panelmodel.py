@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from explorer.app import captions
+from explorer.app import captions, rowlayout
 from explorer.app import model as M
 from explorer.app import panelmodel as P
 from explorer.app.session import load_session, save_session
@@ -88,7 +88,7 @@ MORE_LOBES = tuple(f"show_lobe_{i}" for i in range(4, 9))
 #: the rows of a mesh file's own materials (tried with an OBJ's groups, below)
 MESH_MATERIALS = ("mesh_materials", "group", "use_mesh_materials")
 #: the rows that are lines of text the state gives (read, never set)
-LINES = ("material_line", "maps_note")
+LINES = ("material_line", "maps_note", "no_lights")
 #: the material's texture maps (image rows, tried below)
 MAPS = MAP_KEYS
 TILES = ROOT / "docs" / "examples" / "tiles.png"
@@ -235,6 +235,8 @@ def test_a_button_row_applies_its_action_and_says_when_it_can_be_pressed(mesh):
         False,
         False,
     ]
+    # the line saying so, in both front ends (the window's own label before issue 38's kit)
+    assert P.row("no_lights").shown(none) == P.NO_LIGHTS and P.row("no_lights").shown(s) is None
     action, args, _ = P.edit(s, "swap", True)
     swapped = action(s, *args)
     assert (swapped.compare_model, swapped.scene.model) == (s.scene.model, s.compare_model)
@@ -284,7 +286,7 @@ def test_a_lights_rows_are_the_controls_the_light_declares(mesh):
         assert not set(hidden) & set(light.CONTROL_KEYS)
     none = M.State(scene=s.scene.replace(lights=()), mesh="icosphere")
     shown = [r.key for r in P.rows("lights") if r.visible(none)]
-    assert shown == ["light", "add_light", "duplicate_light", "remove_light"]
+    assert shown == ["light", "add_light", "duplicate_light", "remove_light", "no_lights"]
     assert P.row("light").value(none) is None
     store = M.Store(start(mesh, lights=(PointLight(),)))
     with pytest.raises(ExplorerError, match="'cutoff' cannot be set on a point light"):
@@ -351,3 +353,20 @@ def test_the_material_line_names_the_preset_and_says_when_it_is_edited(mesh):
     assert line.value(M.set_coefficient(s, "kd", 0.1)) == "preset: jade (edited)"
     with pytest.raises(ExplorerError, match="'material_line' is a line of text"):
         P.edit(s, "material_line", "x")
+
+
+def test_rows_are_laid_out_in_lines_of_toggles_grids_of_colours_and_rows():
+    """Both front ends lay a tab out as :func:`~explorer.app.rowlayout.lines` says: the
+    window's line of terms is the page's (each drew its own before)."""
+    got = {t: [(how, [r.key for r in g]) for how, g in rowlayout.lines(P.rows(t))] for t in P.TABS}
+    material = got["material"]
+    assert ("grid", ["ambient", "diffuse", "specular", "emission"]) in material
+    assert ("line", ["show_ambient", "show_diffuse", "show_specular"]) in material
+    assert ("row", ["model"]) in material  # a choice drawn inline: a row of its own
+    assert ("line", ["add_light", "duplicate_light", "remove_light"]) in got["lights"]
+    assert ("grid", ["type", "color"]) in got["lights"]
+    view = got["view"]
+    assert ("line", ["lobe_log", "lobe_ndl"]) in view  # two groups side by side: two lines
+    assert ("line", [f"show_lobe_{i}" for i in range(1, 9)]) in view
+    for t in P.TABS:  # every row once, in order
+        assert [k for _, keys in got[t] for k in keys] == [r.key for r in P.rows(t)]

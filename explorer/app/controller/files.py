@@ -18,7 +18,7 @@ from pathlib import Path
 from explorer.app import model as M
 from explorer.app.session import last_session_path, load_session, save_session
 from explorer.app.start import MESH_CHOICES, add_mesh_materials, free_name, load_mesh_choice
-from explorer.app.turntablejob import DEFAULT_FRAMES, TurntableJob, turntable_size
+from explorer.app.turntablejob import DEFAULT_FRAMES, FRAMES_LABEL, TurntableJob, turntable_size
 from explorer.core import tolerances as tol
 from explorer.core.atomic import write_atomic
 from explorer.core.errors import ExplorerError
@@ -443,7 +443,7 @@ class FileFlows:
         if frames is None:
             frames = self.c.ports.dialogs.ask_number(
                 "Export turntable",
-                "frames in a full turn:",
+                f"{FRAMES_LABEL}:",
                 DEFAULT_FRAMES,
                 2,
                 tol.MAX_TURNTABLE_FRAMES,

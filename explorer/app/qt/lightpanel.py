@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
+from explorer.app import captions, intents, panelmodel
 from explorer.app import model as M
-from explorer.app import panelmodel
 from explorer.app.qt.panel import _form, _scroll, guard_wheel
 from explorer.app.qt.rows import RowWidgets
 from explorer.core.material import RGB_KEYS
@@ -29,13 +29,10 @@ class LightsTab(QtWidgets.QWidget):
         self.attenuation_box = self.rows.widgets["attenuation"]
         self.attenuation = self.rows.fields["attenuation"]
         self.cutoff, self.exponent = self.sliders["cutoff"], self.sliders["exponent"]
-        self.none = QtWidgets.QLabel("The scene has no lights: add one.")
-        box.addWidget(self.none)
         box.addStretch(1)
 
     def show_state(self, s: M.State) -> None:
         self.rows.show_state(s)
-        self.none.setVisible(s.selected_light is None)
 
 
 class MaterialTab(QtWidgets.QWidget):
@@ -54,8 +51,9 @@ class MaterialTab(QtWidgets.QWidget):
         self.colours = {t: self.rows.widgets[t] for t in RGB_KEYS}
         self.model = self.rows.radios["model"]
         self.terms = {t: self.rows.widgets[f"show_{t}"] for t in M.TERMS}
-        self.save = QtWidgets.QPushButton("Save preset as…")
+        self.save = QtWidgets.QPushButton(intents.BY_ID["save_preset"].label)
         self.save.setObjectName("save_preset")
+        self.save.setToolTip(intents.tooltip("save_preset"))
         box.addWidget(self.save)
 
     def show_state(self, s: M.State) -> None:
@@ -106,7 +104,7 @@ class ViewTab(QtWidgets.QWidget):
         self.rows.show_state(s)
         with QtCore.QSignalBlocker(self.mesh):
             self.mesh.setCurrentIndex(max(self.mesh.findData(s.mesh), 0))
-        self.mesh_info.setText(f"{s.mesh}: {n_vertices:,} vertices")
+        self.mesh_info.setText(captions.mesh_line(s.mesh, n_vertices))
         self.mesh_info.setToolTip(s.mesh)
         self.legend.setVisible(s.difference)
         self.advice.setVisible(s.difference)

@@ -6,13 +6,13 @@ help, the message log)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from explorer.app import captions
 from explorer.app import intents as intents_
 from explorer.app.intents import BY_ID, INTENTS, MENUS
 from explorer.app.qt.messages import open_log
+from explorer.app.start import TITLE
 
 #: keys of the 3D view (active while it has the keyboard focus): key -> intent id (from the
 #: registry, :data:`explorer.app.intents.INTENTS`)
@@ -104,15 +104,14 @@ class Menus:
         """Undo and redo named after what they undo or redo; every entry enabled when its
         intent can run (undo and redo: when there is something to undo or redo)."""
         for name, label in (("undo", undo), ("redo", redo)):
-            title = BY_ID[name].title
-            self.actions[name].setText(f"{title} {label}" if label else title)
+            self.actions[name].setText(intents_.history_title(name, label))
         self.refresh()
 
     def show_recent(self, items: list[str]) -> None:
         menu, c = self.recent, self.window.controller
         menu.clear()
         for i, path in enumerate(items):
-            a = menu.addAction(f"&{i + 1} {Path(path).name}   ({Path(path).parent})")
+            a = menu.addAction(captions.recent_entry(i, path))
             a.setObjectName(f"recent_{i + 1}")
             a.triggered.connect(
                 self.window._guard(lambda _=False, p=path: c.files.open_recent(p), "open recent")
@@ -133,7 +132,7 @@ class Menus:
         if w.help is None:
             w.help = QtWidgets.QMessageBox(w)
             w.help.setObjectName("help")
-            w.help.setWindowTitle("phong-explorer: keys and mouse")
+            w.help.setWindowTitle(f"{TITLE}: {BY_ID['help'].label.lower()}")
             w.help.setText(help_text())
             w.help.setModal(False)
         w.help.show()

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtGui, QtWidgets
 
-from explorer.app.messagelog import Message
+from explorer.app.messagelog import LEVEL_COLOURS, Message, opens_log
 from explorer.app.messagelog import MessageLog as Said
 
 #: how long a status message stays (ms); errors stay until the next message
@@ -52,9 +52,6 @@ class MessageLog(QtWidgets.QDialog):
     def copy_all(self) -> None:
         QtGui.QGuiApplication.clipboard().setText(self.plain_text())
 
-    def count(self, level: str) -> int:
-        return self.said.count(level)
-
 
 class MessageIndicator(QtWidgets.QToolButton):
     """The status bar's indicator: the number of warnings and errors so far; a click opens the
@@ -70,10 +67,9 @@ class MessageIndicator(QtWidgets.QToolButton):
         self.refresh()
 
     def refresh(self) -> None:
-        e, w = self.log.count("error"), self.log.count("warning")
-        parts = [f"{n} {noun}{'s' * (n != 1)}" for n, noun in ((e, "error"), (w, "warning")) if n]
-        self.setText(", ".join(parts) or "messages")
-        self.setStyleSheet("color: #ff7766;" if e else "color: #e0a030;" if w else "")
+        text, colour = self.log.said.tally()
+        self.setText(text)
+        self.setStyleSheet(f"color: {colour};" if colour else "")
         self.setToolTip("every message of this session, whole and copyable (View ▸ Messages)")
 
 
@@ -109,13 +105,13 @@ class MessageBar:
         w = self.window
         w.message = text
         bar = w.statusBar()
-        bar.setStyleSheet({"error": "color: #ff7766;", "warning": "color: #e0a030;"}.get(level, ""))
+        bar.setStyleSheet(f"color: {LEVEL_COLOURS[level]};" if level in LEVEL_COLOURS else "")
         bar.showMessage(text, 0 if level == "error" else int(msecs or MESSAGE_MS))
         if not text:  # the message shown taken away: nothing to log
             return
         w.messages.add(level, text, details)
         w.messages_indicator.refresh()
-        if open_log_ and level != "info" and (details or not self._fits_status_bar(text)):
+        if open_log_ and opens_log(level, details, self._fits_status_bar(text)):
             open_log(w.messages)
 
     def _fits_status_bar(self, text: str) -> bool:

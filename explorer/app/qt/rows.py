@@ -18,12 +18,11 @@ map) its caption over a line of its thumbnail ``<key>_thumbnail`` (made once per
 
 from __future__ import annotations
 
-import os
-
 from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app.panelmodel import ASK_FILE, Item, Row
 from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider, swatch
+from explorer.app.rowlayout import file_text, image_part, lines
 from explorer.core.errors import ExplorerError
 from explorer.render.textures import THUMBNAIL_SIZE, thumbnail
 
@@ -75,36 +74,33 @@ class RowWidgets(QtCore.QObject):
         self.searches: dict[str, QtWidgets.QLineEdit] = {}  # a searched list's field
         self.descriptions: dict[str, QtWidgets.QLabel] = {}  # its selected item's subtitle
         self.images: dict[str, dict[str, QtWidgets.QWidget]] = {}  # an image's parts
-        grids: dict[str, QtWidgets.QGridLayout] = {}
-        lines: dict[str, QtWidgets.QHBoxLayout] = {}
-        for r in self.rows:
-            if r.kind in ("toggle", "button") and r.group:
-                if r.group not in lines:
-                    lines[r.group] = QtWidgets.QHBoxLayout()
-                    box.addLayout(lines[r.group])
-                self._add(r, getattr(self, f"_{r.kind}")(r), lines[r.group])
-            elif r.kind in ("colour", "choice") and not r.inline:
-                key = r.group or r.key
-                if key not in grids:
-                    grids[key] = QtWidgets.QGridLayout()
-                    grids[key].setColumnStretch(1, 1)
-                    box.addLayout(grids[key])
-                grid = grids[key]
-                label, widget = _label(r.caption), getattr(self, f"_{r.kind}")(r)
-                n = grid.rowCount()
-                grid.addWidget(label, n, 0)
-                grid.addWidget(widget, n, 1)
-                self.widgets[r.key] = widget
-                self.parts[r.key] = [label, widget]
-            elif r.kind == "list":
-                self._list(r, box)
+        for how, group in lines(self.rows):  # (the kit's layout: lines, grids, rows)
+            if how == "line":
+                line = QtWidgets.QHBoxLayout()
+                box.addLayout(line)
+                for r in group:
+                    self._add(r, getattr(self, f"_{r.kind}")(r), line)
+                if group[0].kind == "toggle":  # toggles kept left; buttons share the width
+                    line.addStretch(1)
+            elif how == "grid":
+                grid = QtWidgets.QGridLayout()
+                grid.setColumnStretch(1, 1)
+                box.addLayout(grid)
+                for n, r in enumerate(group):
+                    label, widget = _label(r.caption), getattr(self, f"_{r.kind}")(r)
+                    grid.addWidget(label, n, 0)
+                    grid.addWidget(widget, n, 1)
+                    self.widgets[r.key] = widget
+                    self.parts[r.key] = [label, widget]
+            elif group[0].kind == "list":
+                self._list(group[0], box)
             else:
-                self._add(r, getattr(self, f"_{r.kind}")(r), box)
-            for extra in (after or {}).get(r.key, ()):
-                (box.addLayout if isinstance(extra, QtWidgets.QLayout) else box.addWidget)(extra)
-        for r in self.rows:  # a line of toggles keeps them left; buttons share its width
-            if r.kind == "toggle" and r.group in lines:
-                lines.pop(r.group).addStretch(1)
+                self._add(group[0], getattr(self, f"_{group[0].kind}")(group[0]), box)
+            for r in group:
+                for extra in (after or {}).get(r.key, ()):
+                    (box.addLayout if isinstance(extra, QtWidgets.QLayout) else box.addWidget)(
+                        extra
+                    )
 
     def _add(self, r: Row, widget: QtWidgets.QWidget, layout) -> None:
         layout.addWidget(widget)
@@ -199,17 +195,13 @@ class RowWidgets(QtCore.QObject):
         thumb.setFixedSize(THUMBNAIL_SIZE, THUMBNAIL_SIZE)
         thumb.setAlignment(QtCore.Qt.AlignmentFlag.AlignCenter)
         thumb.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
-        name = _named(QtWidgets.QLabel(""), f"{r.key}_file")
+        name = _named(QtWidgets.QLabel(""), *image_part(r, "file"))
         name.setMinimumWidth(40)
-        on = _named(QtWidgets.QCheckBox("on"), f"{r.key}_on", f"draw the {r.key}")
+        on = _named(QtWidgets.QCheckBox("on"), *image_part(r, "on"))
         on.toggled.connect(lambda v, k=r.key: self.send(k, bool(v), merge=False))
-        choose = _named(
-            QtWidgets.QPushButton("choose…"),
-            f"{r.key}_choose",
-            f"choose the {r.key}'s image (PNG or JPEG)",
-        )
+        choose = _named(QtWidgets.QPushButton("choose…"), *image_part(r, "choose"))
         choose.clicked.connect(lambda _=False, k=r.key: self.send(k, ASK_FILE, merge=False))
-        clear = _named(QtWidgets.QPushButton("clear"), f"{r.key}_clear", f"take the {r.key} away")
+        clear = _named(QtWidgets.QPushButton("clear"), *image_part(r, "clear"))
         clear.clicked.connect(lambda _=False, k=r.key: self.send(k, None, merge=False))
         lay.addWidget(QtWidgets.QLabel(r.caption), 0, 0, 1, 4)
         lay.addWidget(thumb, 1, 0, 2, 1)
@@ -390,8 +382,8 @@ class RowWidgets(QtCore.QObject):
             parts["on"].setChecked(bool(on))
         parts["on"].setEnabled(file is not None)
         parts["clear"].setEnabled(file is not None)
-        name.setText("(none)" if file is None else os.path.basename(file))
-        name.setToolTip(file or "")
+        name.setText(file_text(file))
+        name.setToolTip(file or image_part(r, "file")[1])
         if file is None:
             thumb.clear()
             return

@@ -15,15 +15,13 @@ into the user's preset folder only.
 
 from __future__ import annotations
 
-import importlib.util
 import itertools
 import os
 import re
 from pathlib import Path
 
-from explorer.app.model import parse_number
 from explorer.app.start import MESH_CHOICES
-from explorer.app.turntablejob import DEFAULT_FRAMES
+from explorer.app.turntablejob import DEFAULT_FRAMES, format_name, read_frames, turntable_formats
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.files import read_checked
@@ -45,12 +43,6 @@ DOWNLOADS = {
 UNSAFE = re.compile(r"[^A-Za-z0-9._-]")
 #: the longest uploaded file name kept (characters)
 MAX_UPLOAD_NAME = 100
-
-
-def turntable_formats() -> tuple[str, ...]:
-    """The turntable formats the server can write: a GIF always, an MP4 when imageio-ffmpeg
-    (its bundled ffmpeg) is installed, as ``render --turntable`` needs it."""
-    return (".gif", ".mp4") if importlib.util.find_spec("imageio_ffmpeg") else (".gif",)
 
 
 def upload_name(name: str) -> str:
@@ -158,16 +150,14 @@ class WebFiles:
         if suffix not in turntable_formats():
             raise ExplorerError(f"turntable: the format must be one of "
                                 f"{', '.join(turntable_formats())}, got {suffix!r}")  # fmt: skip
-        n = parse_number("frames", str(frames), 2, tol.MAX_TURNTABLE_FRAMES)
-        if n != int(n):
-            raise ExplorerError(f"frames: a whole number of frames, got {frames!r}")
+        n = read_frames(frames)
         c = self.app.controller
         path = self._fresh_folder("turntable") / f"{c.files.picture_stem()}-turntable{suffix}"
         before = self.turntable_path, self.turntable_made
         self.turntable_path = path
-        self.turntable_made = f"{int(n)} frames, {suffix[1:].upper()}"
+        self.turntable_made = f"{n} frames, {format_name(suffix)}"
         try:
-            c.files.export_turntable(path, frames=int(n))
+            c.files.export_turntable(path, frames=n)
         except BaseException:
             self.turntable_path, self.turntable_made = before  # the one made before stays
             raise

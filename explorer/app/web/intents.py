@@ -115,10 +115,9 @@ def menus(v3) -> None:
                     if n:
                         v3.VDivider()
                     for i in group:
-                        keys = " / ".join(i.web_keys())
                         v3.VListItem(
                             title=i.label,
-                            subtitle=keys or None,
+                            subtitle=i.keys_text(page=True) or None,
                             click=f"window.phongIntent('{i.id}')",
                             disabled=(f"intents_enabled['{i.id}'] === false",),
                             raw_attrs=[f'aria-label="intent {i.id}"'],

@@ -16,14 +16,7 @@ import threading
 from explorer.app import model as M
 from explorer.app.controller import Controller
 from explorer.app.session import session_mapping
-from explorer.app.start import (
-    DEFAULT_MESH,
-    DEFAULT_PRESET,
-    default_light,
-    default_viewer,
-    first_state,
-    load_mesh_choice,
-)
+from explorer.app.start import DEFAULT_MESH, DEFAULT_PRESET, notebook_state
 from explorer.app.web import guard
 from explorer.app.web.server import (
     DEFAULT_HOST,
@@ -33,9 +26,6 @@ from explorer.app.web.server import (
     own_arguments,
 )
 from explorer.core.errors import ExplorerError, ExplorerTypeError
-from explorer.core.presets import find_preset
-from explorer.core.scene import Scene, load_scene
-from explorer.geometry.meshes import Mesh
 
 #: the environment variable that sends :func:`show`'s page through jupyter-server-proxy: the
 #: Jupyter server's base URL (``/`` for a Jupyter server at the root of its host,
@@ -45,24 +35,6 @@ JUPYTER_PROXY_ENV = "PHONG_EXPLORER_JUPYTER_PROXY"
 JUPYTERHUB_PREFIX_ENV = "JUPYTERHUB_SERVICE_PREFIX"
 #: the values of :data:`JUPYTER_PROXY_ENV` that keep the direct address (even under JupyterHub)
 PROXY_OFF = ("0", "off", "false", "no")
-
-
-def notebook_state(scene=None, *, preset: str | None = DEFAULT_PRESET, mesh: str = DEFAULT_MESH,
-                   materials_dirs=()) -> tuple[M.State, Mesh]:  # fmt: skip
-    """``(state, mesh)`` for :func:`show`: ``scene`` (a Scene, a scene file or a mapping; None:
-    one point light at :data:`~explorer.app.model.DEFAULT_PLACEMENT` seen from the explorer's
-    start camera) on built-in mesh ``mesh``, in preset ``preset`` (None: the scene's
-    material)."""
-    m = load_mesh_choice(mesh)
-    if scene is None:
-        scene = Scene(lights=(default_light(m),), viewer=default_viewer(m))
-    else:
-        scene = load_scene(scene, materials_dirs=materials_dirs)
-    if preset is not None:
-        scene = scene.replace(material=find_preset(preset, materials_dirs))
-    scene = scene.replace(mesh=mesh)
-    state = first_state(scene, m, name=mesh, preset=preset, materials_dirs=materials_dirs)
-    return state, m
 
 
 @dataclasses.dataclass

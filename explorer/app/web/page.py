@@ -10,11 +10,19 @@ trame is imported inside :func:`build` (``import explorer`` stays free of it).
 
 from __future__ import annotations
 
-from explorer.app import panelmodel
-from explorer.app.turntablejob import DEFAULT_FRAMES
+import contextlib
+
+from explorer.app import intents as X
+from explorer.app import panelmodel, rowlayout
+from explorer.app.turntablejob import (
+    DEFAULT_FRAMES,
+    FRAMES_LABEL,
+    MP4_NEEDS,
+    format_name,
+    turntable_formats,
+)
 from explorer.app.web import intents as webintents
 from explorer.app.web import pictures
-from explorer.app.web.files import turntable_formats
 from explorer.app.web.panel import items_key
 from explorer.core.controls import STEPS
 from explorer.core.tolerances import MAX_TURNTABLE_FRAMES
@@ -118,6 +126,22 @@ MESSAGE_STYLE = ("display: -webkit-box; -webkit-line-clamp: 3; -webkit-box-orien
 #: a click that asks the server for a file and saves it (the browser's download)
 DOWNLOAD_JS = ("trigger('download', ['{kind}']).then(f => f && utils.download(f.name, f.content, "
                "f.type))")  # fmt: skip
+
+
+def history_tip(name: str) -> str:
+    """The tooltip of the toolbar's ``undo`` or ``redo`` (:func:`explorer.app.intents.tooltip`,
+    the registry's words and keys) as a Vue expression: naming the step (state
+    ``<name>_label``) when there is one."""
+    key = f"{name}_label"
+    head, tail = X.tooltip(name, "\0", page=True).split("\0")
+    bare = X.tooltip(name, page=True)
+    return f"{key} ? {js_text(head)} + {key} + {js_text(tail)} : {js_text(bare)}"
+
+
+def js_text(text: str) -> str:
+    """``text`` as a JavaScript string in single quotes (a Vue expression sits in an HTML
+    attribute's double quotes)."""
+    return "'" + text.replace("\\", "\\\\").replace("'", "\\'") + "'"
 
 
 def _number(v3, html, ctrl, key: str, label: str) -> None:
@@ -229,6 +253,13 @@ def _triple(v3, ctrl, r) -> None:
     )  # fmt: skip
 
 
+def _part(r, part: str) -> dict:
+    """An image row's ``part``: its name and its tooltip
+    (:func:`explorer.app.rowlayout.image_part`)."""
+    name, tip = rowlayout.image_part(r, part)
+    return {"title": tip, "raw_attrs": [f'aria-label="{name}"']}
+
+
 def _image(v3, html, ctrl, r) -> None:
     """A texture map: its key, its thumbnail (``<key>_thumbnail``), its file's name, its switch
     ``<key>_on``, its upload ``<key>_upload`` (an image where the page's other uploads go) and
@@ -247,11 +278,7 @@ def _image(v3, html, ctrl, r) -> None:
                 classes="mr-2",
                 raw_attrs=[f'aria-label="{r.key}_thumbnail"'],
             )
-            html.Span(
-                f"{{{{ {r.key} }}}}",
-                classes="text-body-2",
-                raw_attrs=[f'aria-label="{r.key}_file"'],
-            )
+            html.Span(f"{{{{ {r.key} }}}}", classes="text-body-2", **_part(r, "file"))
         with html.Div(classes="d-flex align-center"):
             v3.VCheckbox(
                 v_model=(f"{r.key}_on", False),
@@ -259,7 +286,7 @@ def _image(v3, html, ctrl, r) -> None:
                 density="compact",
                 hide_details=True,
                 disabled=(f"!{r.key}_thumbnail",),
-                raw_attrs=[f'aria-label="{r.key}_on"'],
+                **_part(r, "on"),
             )
             v3.VFileInput(
                 v_model=(f"{r.key}_upload", None),
@@ -268,14 +295,14 @@ def _image(v3, html, ctrl, r) -> None:
                 density="compact",
                 hide_details=True,
                 classes="mx-1",
-                raw_attrs=[f'aria-label="{r.key}_choose"'],
+                **_part(r, "choose"),
             )
             v3.VBtn(
                 "clear",
                 click=(ctrl.clear_map, f"['{r.key}']"),
                 size="small",
                 disabled=(f"!{r.key}_thumbnail",),
-                raw_attrs=[f'aria-label="{r.key}_clear"'],
+                **_part(r, "clear"),
             )
 
 
@@ -284,35 +311,33 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
     key is null (the row is not shown). ``after``: key -> a function that draws the page's own
     controls after that row (the difference view's legend)."""
-    line, group = None, None
-    for r in panelmodel.rows(tab):
-        if r.kind in ("toggle", "button") and r.group:
-            if r.group != group:
-                line = html.Div(classes="d-flex")
-                group = r.group
-            with line:
-                (_button(v3, ctrl, r) if r.kind == "button" else
-                 _checkbox(v3, r.key, r.caption, r.tip))  # fmt: skip
-        elif r.kind == "number":
-            if r.optional is not None:
-                _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
-            _number(v3, html, ctrl, r.key, r.caption)
-        elif r.kind == "colour":
-            _colour(v3, html, ctrl, r.key, r.key)
-        elif r.kind in ("choice", "list"):
-            _choice(v3, r)
-        elif r.kind == "toggle":
-            _checkbox(v3, r.key, r.caption, r.tip)
-        elif r.kind == "button":
-            _button(v3, ctrl, r)
-        elif r.kind == "text":
-            _text(html, r)
-        elif r.kind == "image":
-            _image(v3, html, ctrl, r)
-        else:
-            _triple(v3, ctrl, r)
-        group = r.group if r.kind in ("toggle", "button") else None
-        (after or {}).get(r.key, lambda: None)()
+    for how, group in rowlayout.lines(panelmodel.rows(tab)):
+        with html.Div(classes="d-flex") if how == "line" else contextlib.nullcontext():
+            for r in group:
+                _row(v3, html, ctrl, r)
+                (after or {}).get(r.key, lambda: None)()
+
+
+def _row(v3, html, ctrl, r) -> None:
+    """Row ``r``'s widgets, by its kind."""
+    if r.kind == "number":
+        if r.optional is not None:
+            _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
+        _number(v3, html, ctrl, r.key, r.caption)
+    elif r.kind == "colour":
+        _colour(v3, html, ctrl, r.key, r.key)
+    elif r.kind in ("choice", "list"):
+        _choice(v3, r)
+    elif r.kind == "toggle":
+        _checkbox(v3, r.key, r.caption, r.tip)
+    elif r.kind == "button":
+        _button(v3, ctrl, r)
+    elif r.kind == "text":
+        _text(html, r)
+    elif r.kind == "image":
+        _image(v3, html, ctrl, r)
+    else:
+        _triple(v3, ctrl, r)
 
 
 def _material_tab(v3, html, ctrl) -> None:
@@ -337,6 +362,7 @@ def _view_tab(v3, html, ctrl) -> None:
         accept=",".join(MESH_SUFFIXES) + ",.mtl", raw_attrs=['aria-label="upload mesh"'],
     )  # fmt: skip
     v3.VBtn("reset camera", click=ctrl.reset_camera, size="small", classes="my-2",
+            title=X.tooltip("reset_camera", page=True),
             raw_attrs=['aria-label="reset camera"'])  # fmt: skip
 
     def legend():
@@ -351,7 +377,7 @@ def _turntable(v3, html, ctrl) -> None:
     under a progress bar (Cancel), then downloaded."""
     with html.Div(classes="d-flex align-center mt-2"):
         v3.VTextField(
-            v_model=("turntable_frames", DEFAULT_FRAMES), label="frames in a full turn",
+            v_model=("turntable_frames", DEFAULT_FRAMES), label=FRAMES_LABEL,
             type="number", min=2, max=MAX_TURNTABLE_FRAMES, density="compact",
             hide_details=True, variant="outlined", classes="mr-2",
             raw_attrs=['aria-label="turntable frames"'],
@@ -359,10 +385,11 @@ def _turntable(v3, html, ctrl) -> None:
         v3.VSelect(v_model=("turntable_format", ".gif"), items=("turntable_formats",),
                    label="format", density="compact", hide_details=True,
                    raw_attrs=['aria-label="turntable format"'])  # fmt: skip
-    html.Div("MP4 needs imageio-ffmpeg (pip install imageio-ffmpeg)", classes="text-caption",
+    html.Div(MP4_NEEDS, classes="text-caption",
              v_show="turntable_formats.length < 2")  # fmt: skip
     v3.VBtn("make a turntable", click=ctrl.turntable, size="small", classes="my-1",
             disabled=("progress && progress.running",),
+            title=X.tooltip("export_turntable", page=True),
             raw_attrs=['aria-label="turntable"'])  # fmt: skip
     with html.Div(v_show="progress && progress.running", classes="my-1"):
         html.Div("{{ progress && progress.text }}", classes="text-caption")
@@ -395,15 +422,22 @@ def _footer(layout, v3, html) -> None:
 def _files(v3, ctrl) -> None:
     """The toolbar's files: save and open a session, export the view and the material."""
     v3.VBtn("save session", variant="text", raw_attrs=['aria-label="save session"'],
+            title=X.tooltip("save_session", page=True),
             click=DOWNLOAD_JS.format(kind="session"))  # fmt: skip
     v3.VFileInput(
         v_model=("session_upload", None), label="open session", accept=".yaml,.yml,.json",
         density="compact", hide_details=True, style="max-width: 200px", prepend_icon="",
-        raw_attrs=['aria-label="open session"'],
+        title=X.tooltip("open", page=True), raw_attrs=['aria-label="open session"'],
     )  # fmt: skip
     with v3.VMenu():
         with v3.Template(v_slot_activator="{ props }"):
-            v3.VBtn("export", v_bind="props", variant="text", raw_attrs=['aria-label="export"'])
+            v3.VBtn(
+                "export",
+                v_bind="props",
+                variant="text",
+                title=X.tooltip("export_material", page=True),
+                raw_attrs=['aria-label="export"'],
+            )
         with v3.VList(density="compact"):
             for kind, text in EXPORTS.items():
                 v3.VListItem(title=text, click=DOWNLOAD_JS.format(kind=kind),
@@ -419,9 +453,10 @@ def _save_preset(v3, html, ctrl) -> None:
         v3.VCheckbox(v_model=("preset_replace", False), label="replace", density="compact",
                      hide_details=True, raw_attrs=['aria-label="replace preset"'])  # fmt: skip
         v3.VBtn("save", click=ctrl.save_preset, size="small",
+                title=X.tooltip("save_preset", page=True),
                 raw_attrs=['aria-label="save preset"'])  # fmt: skip
     v3.VFileInput(
-        v_model=("mtl_upload", None), label="import materials (.mtl) as presets", accept=".mtl",
+        v_model=("mtl_upload", None), label=X.BY_ID["import_materials"].what, accept=".mtl",
         density="compact", hide_details=True, classes="my-2",
         raw_attrs=['aria-label="import materials"'],
     )  # fmt: skip
@@ -431,7 +466,7 @@ def _message_log(v3, html) -> None:
     """The toolbar's "messages" button and the message log it opens: every message of the
     session (state ``message_log``: time, level, text and details), oldest first."""
     v3.VBtn("messages", click="show_messages = true", variant="text",
-            title="every message of the session (the desktop's View > Messages)",
+            title=X.tooltip("messages", page=True),
             raw_attrs=['aria-label="messages"'])  # fmt: skip
     with v3.VDialog(v_model=("show_messages", False), max_width=720, scrollable=True):
         with v3.VCard(raw_attrs=['aria-label="message log"', 'role="log"']):
@@ -463,7 +498,7 @@ def _page_state(state) -> None:
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         **{f"{r.key}_upload": None for r in panelmodel.ROWS if r.kind == "image"},
         turntable_ready=False, turntable_made="",
-        turntable_formats=[{"title": s[1:].upper(), "value": s} for s in turntable_formats()],
+        turntable_formats=[{"title": format_name(s), "value": s} for s in turntable_formats()],
         compare=False,
         can_undo=False, can_redo=False, undo_label="", redo_label="",
     )  # fmt: skip
@@ -513,12 +548,10 @@ def build(app) -> None:
         with layout.toolbar:
             webintents.menus(v3)
             v3.VSpacer()
-            v3.VBtn("undo", click=ctrl.undo, disabled=("!can_undo",), variant="text",
-                    title=("'Undo ' + undo_label + ' (Ctrl+Z)'",),
-                    raw_attrs=['aria-label="undo"'])  # fmt: skip
-            v3.VBtn("redo", click=ctrl.redo, disabled=("!can_redo",), variant="text",
-                    title=("'Redo ' + redo_label + ' (Ctrl+Shift+Z)'",),
-                    raw_attrs=['aria-label="redo"'])  # fmt: skip
+            for name in ("undo", "redo"):
+                v3.VBtn(name, click=getattr(ctrl, name), disabled=(f"!can_{name}",),
+                        variant="text", title=(history_tip(name),),
+                        raw_attrs=[f'aria-label="{name}"'])  # fmt: skip
             _files(v3, ctrl)
             _message_log(v3, html)
             webintents.help_dialog(v3, html)

@@ -24,11 +24,10 @@ from __future__ import annotations
 import base64
 import functools
 import io
-from os.path import basename
 from urllib.parse import quote
 
 from explorer.app import model as M
-from explorer.app import panelmodel
+from explorer.app import panelmodel, rowlayout
 from explorer.app.colours import parse_hex, rgb_hex, rgb_text, swatch_squares
 from explorer.core.controls import field_text, from_step, to_step
 from explorer.core.errors import ExplorerError
@@ -124,7 +123,7 @@ def row_values(state: M.State) -> dict:
             out[r.key] = None if v is None else rgb_text(v)
         elif r.kind == "image":
             file, on = v if v is not None else (None, None)
-            out[r.key] = None if v is None else ("(none)" if file is None else basename(file))
+            out[r.key] = None if v is None else rowlayout.file_text(file)
             out[f"{r.key}_on"] = None if v is None else bool(on)
             out[f"{r.key}_thumbnail"] = "" if file is None else thumbnail_url(file, r.key)
         else:

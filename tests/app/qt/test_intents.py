@@ -138,6 +138,15 @@ def test_undo_and_redo_are_enabled_when_they_can_run(win):
     assert not undo.isEnabled() and redo.isEnabled()
 
 
+@pytest.mark.usefixtures("xdisplay")
+def test_the_save_preset_button_says_its_intents_title_and_keys(win):
+    """The material tab's Save button runs the registry's ``save_preset``: its text and its
+    tooltip are the registry's (:func:`explorer.app.intents.tooltip`)."""
+    save = win.panel.material.save
+    assert save.text() == X.BY_ID["save_preset"].label
+    assert save.toolTip() == X.tooltip("save_preset") == "Save preset as… (Ctrl+Shift+S)"
+
+
 def active(win, qtbot) -> None:
     """The window made the active one (a window shortcut reaches only the active window)."""
     from PySide6 import QtWidgets

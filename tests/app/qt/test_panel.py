@@ -426,6 +426,7 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     """Each row of :mod:`explorer.app.panelmodel` is a widget of its tab whose object name and
     accessible name are the row's (the page's test reads the same names in the DOM)."""
     from explorer.app import panelmodel as P
+    from explorer.app import rowlayout
 
     every_row_shown(win.controller)
     assert not win.controller.state.mesh_uv
@@ -433,13 +434,14 @@ def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     assert {"preset", "light", "add_light", "difference", "compare", "swap"} <= set(P.BY_KEY)
     for r in P.ROWS:
         tab = getattr(win.panel, r.tab)
-        for name in P.names(r):
+        for name in rowlayout.names(r):
             found = tab.findChildren(QtWidgets.QWidget, name)
             assert len(found) == 1, (r.key, name, found)
             assert found[0].accessibleName() == name, name
             # a mesh file's own materials are shown with an OBJ's groups (test_filemenu.py), the
             # maps with a mesh's (u, v) (test_window_maps.py): the start's icosphere has none
-            hidden = r.key in MESH_MATERIALS + MORE_LOBES or r.kind == "image"
+            # (and the line saying the scene has no lights: it has one)
+            hidden = r.key in (*MESH_MATERIALS, *MORE_LOBES, "no_lights") or r.kind == "image"
             assert found[0].isVisibleTo(tab) != hidden, name
     win.controller.undo()  # fresnel off: its number hidden, its switch shown and unchecked
     rows = win.panel.material.rows
@@ -512,3 +514,20 @@ def test_a_meshs_own_material_kept_on_another_mesh_is_called_by_its_name(win, qt
         assert name in text and "scene material" not in text, texts
     assert win.panel.material.preset_label.text().startswith("material: ")  # not a preset
     win.controller.errors.clear()  # (the .mtl's warnings)
+
+
+def test_the_lights_tab_says_when_the_scene_has_no_lights(win):
+    """The line that says so is the panel model's ``no_lights`` row (the window's own label
+    before): shown, in the lights tab, once the last light is removed; hidden again on undo."""
+    from explorer.app import panelmodel as P
+
+    tab, c = win.panel.lights, win.controller
+    line = tab.findChild(QtWidgets.QLabel, "no_lights")
+    assert line is not None and not line.isVisibleTo(tab)
+    while c.state.scene.lights:
+        assert c.set_value("remove_light", True, merge=False)
+    assert line.isVisibleTo(tab) and line.text() == P.NO_LIGHTS
+    assert line.accessibleName() == "no_lights"
+    assert not tab.rows.widgets["remove_light"].isEnabled()
+    c.undo()
+    assert not line.isVisibleTo(tab)

@@ -161,3 +161,32 @@ def test_the_browsers_own_intents_a_download_a_tab_and_a_field(server, browser, 
     wait("the export menu", lambda: shown(browser, "export png"))
     press(browser, "ESCAPE")
     assert report(browser)["errors"] == errors and not console_errors(browser)
+
+
+def test_the_toolbars_tooltips_are_the_registrys_words_and_keys(server, browser):
+    """Each toolbar button's tooltip (its ``title``) is its intent's, words and keys, from the
+    registry (:func:`explorer.app.intents.tooltip`): undo's and redo's name the step they would
+    undo or redo, and redo's says both its keys (the page wrote ``(Ctrl+Shift+Z)`` itself)."""
+    open_page(browser, server.url)
+
+    def title(name: str) -> str:
+        return by_name(browser, name).get_attribute("title")
+
+    for name, intent in (
+        ("save session", "save_session"),
+        ("open session", "open"),
+        ("export", "export_material"),
+        ("messages", "messages"),
+    ):
+        assert title(name) == X.tooltip(intent, page=True), name
+    click(browser, "view")  # the keyboard to the page, off any field
+    press(browser, "b")  # the next specular model: one step to undo (the last one)
+    wait("the next model", lambda: report(browser)["session"]["scene"]["model"] != "blinn")
+    head, tail = X.tooltip("undo", "\0", page=True).split("\0")
+    assert head == "undo " and tail == " (Ctrl+Z)"
+    wait("undo's step named", lambda: title("undo").startswith(head) and title("undo") != head)
+    step = title("undo").removeprefix(head).removesuffix(tail)
+    assert step and title("undo") == X.tooltip("undo", step, page=True)
+    click(browser, "undo")
+    wait("redo's step named", lambda: title("redo") == X.tooltip("redo", step, page=True))
+    assert title("redo") == f"redo {step} (Ctrl+Shift+Z / Ctrl+Y)"  # both keys

@@ -10,6 +10,7 @@ import pytest
 from test_web import by_name, choose, click, open_page, picture_src, report, wait
 
 from explorer.app import panelmodel as P
+from explorer.app import rowlayout
 
 pytestmark = pytest.mark.web
 
@@ -52,8 +53,10 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
     assert {"preset", "light", "add_light", "difference", "compare", "swap"} <= set(P.BY_KEY)
     # a mesh file's own materials are shown with an OBJ's groups (test_web_parity.py): here
     # they are on the page, hidden; so are the lobes past the three models' and the line that
-    # says a mesh has no (u, v) (the start's sphere has them: its maps' rows are shown)
+    # says a mesh has no (u, v) (the start's sphere has them: its maps' rows are shown), and
+    # the line saying the scene has no lights (it has one)
     hidden = (
+        "no_lights",
         "mesh_materials",
         "group",
         "use_mesh_materials",
@@ -64,7 +67,7 @@ def test_every_row_is_on_the_page_in_its_tab_named_as_in_the_window(server, brow
         click(browser, f"{tab} tab")
         wait(f"the {tab} tab", lambda t=tab: shown(browser, P.rows(t)[-1].key))
         for r in P.rows(tab):
-            for name in P.names(r):
+            for name in rowlayout.names(r):
                 assert shown(browser, name) != (name in hidden), (tab, name)
                 assert browser.find_elements(By.CSS_SELECTOR, f'[aria-label="{name}"]'), name
     for _ in range(7):  # fresnel, the strip, the incidence, the lobes, compare, hdr, the spot
@@ -155,3 +158,25 @@ def test_the_page_names_the_material_and_says_when_it_is_edited(server, browser)
     wait("(edited)", lambda: by_name(browser, "material_line").text == f"{line} (edited)")
     click(browser, "undo")
     wait("the line again", lambda: by_name(browser, "material_line").text == line)
+
+
+def test_the_lights_tab_says_when_the_scene_has_no_lights(server, browser):
+    """The panel model's ``no_lights`` row, the window's label before the kit: on the page
+    too, once the last light is removed; undo brings the light and hides the line."""
+    rep = open_page(browser, server.url)
+    n = len(rep["session"]["scene"]["lights"])
+    click(browser, "lights tab")
+    wait("the lights tab", lambda: shown(browser, "remove_light"))
+    for k in range(n):
+        click(browser, "remove_light")
+        wait(
+            "a light removed",
+            lambda k=k: len(report(browser)["session"]["scene"]["lights"]) == n - k - 1,
+        )
+    wait("the no-lights line", lambda: shown(browser, "no_lights"))
+    assert by_name(browser, "no_lights").text == P.NO_LIGHTS
+    for _ in range(n):
+        click(browser, "undo")
+    wait("the lights back", lambda: report(browser)["session"] == rep["session"])
+    assert not shown(browser, "no_lights")
+    click(browser, "material tab")

@@ -11,7 +11,8 @@ from types import SimpleNamespace
 import pytest
 
 from explorer.app.colours import parse_hex, rgb_hex
-from explorer.app.web.files import WebFiles, turntable_formats, upload_name
+from explorer.app.turntablejob import turntable_formats
+from explorer.app.web.files import WebFiles, upload_name
 from explorer.core import tolerances as tol
 from explorer.core.errors import ExplorerError
 from explorer.core.yamlio import MAX_BYTES
