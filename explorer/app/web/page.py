@@ -44,15 +44,25 @@ NUMBER_LABEL_WIDTH, NUMBER_FIELD_WIDTH = 78, 92
 #: pixels ("shininess" 60 pixels wide); a field still shows "0.247", "2.50 r", "40.0°"
 NARROW_NUMBER_WIDTHS = (66, 72)
 #: the page's own rules for small windows: the toolbar scrolls sideways rather than squeezing
-#: its title to a letter, the title goes below 1100 pixels (the tab's title says it), and the
-#: toolbar's buttons and the panel's tabs are narrower below 900 (Vuetify's own tab rule is
-#: ``.v-tab.v-tab.v-btn``: its 90-pixel tabs overflowed the 270-pixel drawer)
+#: its title to a letter; below 1100 pixels the title goes (the tab's title says it) and the
+#: toolbar's buttons show their icons instead of their words (:func:`_tool`; the session field
+#: its icon alone), so the toolbar fits a 640-pixel page; the toolbar's buttons and the panel's
+#: tabs are narrower below 900 (Vuetify's own tab rule is ``.v-tab.v-tab.v-btn``: its 90-pixel
+#: tabs overflowed the 270-pixel drawer)
 PAGE_CSS = """
 html { overflow-y: auto; }
 .v-app-bar .v-toolbar__content { overflow-x: auto; overflow-y: hidden; scrollbar-width: thin; }
 .v-app-bar .v-toolbar__content > * { flex-shrink: 0; }
 .v-app-bar .v-file-input { min-width: 150px; }
-@media (max-width: 1099px) { .v-app-bar .v-toolbar-title { display: none; } }
+.v-app-bar .phong-tool-icon { display: none; }
+@media (max-width: 1099px) {
+  .v-app-bar .v-toolbar-title, .v-app-bar .phong-tool-text { display: none; }
+  .v-app-bar .phong-tool-icon { display: inline-flex; }
+  .v-app-bar .v-file-input { min-width: 48px; max-width: 48px !important; }
+  .v-app-bar .v-file-input .v-label, .v-app-bar .v-file-input .v-field__input,
+  .v-app-bar .v-file-input .v-field__overlay, .v-app-bar .v-file-input .v-field__outline {
+    display: none; }
+}
 @media (max-width: 899px) {
   .v-app-bar .v-btn, .v-tab.v-tab.v-btn { padding: 0 6px; min-width: 0; }
 }
@@ -419,25 +429,40 @@ def _footer(layout, v3, html) -> None:
         html.Span(f"phong-explorer {__version__}", classes="text-caption text-grey")
 
 
-def _files(v3, ctrl) -> None:
+#: the toolbar's icons (Material Design Icons, served with the page) shown instead of the
+#: buttons' words in a page narrower than 1100 pixels (PAGE_CSS)
+TOOL_ICONS = {
+    "undo": "mdi-undo",
+    "redo": "mdi-redo",
+    "save session": "mdi-content-save-outline",
+    "open session": "mdi-folder-open-outline",
+    "export": "mdi-export-variant",
+    "messages": "mdi-message-text-outline",
+}
+
+
+def _tool(v3, html, name: str, **kw) -> None:
+    """A toolbar button named ``name`` (its word and accessible name): its word, or its icon
+    (:data:`TOOL_ICONS`) in a narrow page, the word then in its tooltip and accessible name;
+    ``kw``: the button's own (click, title, v_bind, disabled)."""
+    with v3.VBtn(variant="text", raw_attrs=[f'aria-label="{name}"'], **kw):
+        v3.VIcon(TOOL_ICONS[name], classes="phong-tool-icon")
+        html.Span(name, classes="phong-tool-text")
+
+
+def _files(v3, html, ctrl) -> None:
     """The toolbar's files: save and open a session, export the view and the material."""
-    v3.VBtn("save session", variant="text", raw_attrs=['aria-label="save session"'],
-            title=X.tooltip("save_session", page=True),
-            click=DOWNLOAD_JS.format(kind="session"))  # fmt: skip
+    _tool(v3, html, "save session", title=X.tooltip("save_session", page=True),
+          click=DOWNLOAD_JS.format(kind="session"))  # fmt: skip
     v3.VFileInput(
         v_model=("session_upload", None), label="open session", accept=".yaml,.yml,.json",
         density="compact", hide_details=True, style="max-width: 200px", prepend_icon="",
+        prepend_inner_icon=TOOL_ICONS["open session"],
         title=X.tooltip("open", page=True), raw_attrs=['aria-label="open session"'],
     )  # fmt: skip
     with v3.VMenu():
         with v3.Template(v_slot_activator="{ props }"):
-            v3.VBtn(
-                "export",
-                v_bind="props",
-                variant="text",
-                title=X.tooltip("export_material", page=True),
-                raw_attrs=['aria-label="export"'],
-            )
+            _tool(v3, html, "export", v_bind="props", title=X.tooltip("export_material", page=True))
         with v3.VList(density="compact"):
             for kind, text in EXPORTS.items():
                 v3.VListItem(title=text, click=DOWNLOAD_JS.format(kind=kind),
@@ -465,9 +490,8 @@ def _save_preset(v3, html, ctrl) -> None:
 def _message_log(v3, html) -> None:
     """The toolbar's "messages" button and the message log it opens: every message of the
     session (state ``message_log``: time, level, text and details), oldest first."""
-    v3.VBtn("messages", click="show_messages = true", variant="text",
-            title=X.tooltip("messages", page=True),
-            raw_attrs=['aria-label="messages"'])  # fmt: skip
+    _tool(v3, html, "messages", click="show_messages = true",
+          title=X.tooltip("messages", page=True))  # fmt: skip
     with v3.VDialog(v_model=("show_messages", False), max_width=720, scrollable=True):
         with v3.VCard(raw_attrs=['aria-label="message log"', 'role="log"']):
             v3.VCardTitle("messages")
@@ -549,10 +573,9 @@ def build(app) -> None:
             webintents.menus(v3)
             v3.VSpacer()
             for name in ("undo", "redo"):
-                v3.VBtn(name, click=getattr(ctrl, name), disabled=(f"!can_{name}",),
-                        variant="text", title=(history_tip(name),),
-                        raw_attrs=[f'aria-label="{name}"'])  # fmt: skip
-            _files(v3, ctrl)
+                _tool(v3, html, name, click=getattr(ctrl, name), disabled=(f"!can_{name}",),
+                      title=(history_tip(name),))  # fmt: skip
+            _files(v3, html, ctrl)
             _message_log(v3, html)
             webintents.help_dialog(v3, html)
         with layout.drawer:

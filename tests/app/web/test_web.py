@@ -414,7 +414,7 @@ def test_the_layout_adapts_to_the_window(server, browser, size):
     """At every size the view keeps most of the page (the drawer was 380 pixels at every size:
     at 640x480 the view was 260 pixels wide) and no title, button or tab is cut (the title
     read "p", the session field "o"): the drawer narrows, the title goes below 1100 pixels,
-    the toolbar scrolls sideways."""
+    the toolbar's buttons show icons (the next test)."""
     try:
         browser.get("about:blank")  # (a page resized as it is left sends its new size late)
         browser.set_window_size(*size)
@@ -424,6 +424,55 @@ def test_the_layout_adapts_to_the_window(server, browser, size):
                    and r["drawer"] == want and r)  # fmt: skip
         assert got["view"] >= 0.55 * got["page"], got
         assert not got["cut"], got
+    finally:
+        browser.get("about:blank")
+        browser.set_window_size(1280, 900)
+
+
+#: the toolbar as shown: whether it scrolls sideways, the page's width, and each control's
+#: accessible name, box (left, right, width) and whether its word or its icon shows
+TOOLBAR_JS = """
+const bar = document.querySelector('.v-app-bar .v-toolbar__content');
+const seen = (e) => e !== null && e.getClientRects().length > 0
+  && getComputedStyle(e).display !== 'none';
+const tools = [...document.querySelectorAll(
+    '.v-app-bar .v-btn[aria-label], .v-app-bar .v-file-input')]
+  .filter(e => e.getClientRects().length)
+  .map(e => { const r = e.getBoundingClientRect();
+    const label = e.getAttribute('aria-label')
+      || (e.querySelector('input') && e.querySelector('input').getAttribute('aria-label'));
+    return {name: label, left: r.left, right: r.right, width: r.width,
+            word: seen(e.querySelector('.phong-tool-text')),
+            icon: seen(e.querySelector('.phong-tool-icon, .v-field__prepend-inner .v-icon'))}; });
+return {scrolls: bar.scrollWidth > bar.clientWidth + 1, page: window.innerWidth, tools: tools};
+"""
+
+
+@pytest.mark.parametrize("size", [(640, 480), (900, 720), (1280, 900)])
+def test_the_toolbar_fits_the_page_with_icons_below_1100_pixels(server, browser, size):
+    """The toolbar fits a page of 640x480 and 900x720 (its viewport) without scrolling
+    sideways, every control inside the page: below 1100 pixels the buttons show their icons
+    (their words stay their accessible names and tooltips) and the session field its icon
+    alone; at 1280x900 the buttons show their words (issue 42: at 900x720 the toolbar scrolled,
+    "messages" half out of the page, at 640x480 "export" and "messages" out of it)."""
+    from test_web_layout import set_viewport
+
+    try:
+        browser.get("about:blank")
+        set_viewport(browser, *size)
+        open_page(browser, server.url)
+        got = browser.execute_script(TOOLBAR_JS)
+        names = {t["name"] for t in got["tools"]}
+        want = {"undo", "redo", "save session", "open session", "export", "messages"}
+        assert want <= names, got
+        assert not got["scrolls"], got
+        assert all(0 <= t["left"] and t["right"] <= got["page"] for t in got["tools"]), got
+        narrow = size[0] < 1100
+        for t in got["tools"]:
+            if t["name"] in want - {"open session"}:
+                assert (t["icon"], t["word"]) == (narrow, not narrow), t
+        field = next(t for t in got["tools"] if t["name"] == "open session")
+        assert field["icon"] and (field["width"] <= 60) == narrow, field
     finally:
         browser.get("about:blank")
         browser.set_window_size(1280, 900)
