@@ -377,6 +377,13 @@ def _view_tab(v3, html, ctrl) -> None:
 
     def legend():
         html.Div("{{ legend }}", classes="text-caption", v_show="difference")
+        html.Div(
+            "{{ advice }}",
+            classes="text-caption",
+            v_show="difference && advice",
+            style="white-space: pre-line",
+            raw_attrs=['aria-label="advice"'],
+        )
 
     _rows(v3, html, ctrl, "view", {"difference": legend})
     _turntable(v3, html, ctrl)
@@ -518,7 +525,7 @@ def _page_state(state) -> None:
     (trame's client-only keys: never sent to the server, so never to another page)."""
     state.update(
         message="", message_level="info", message_seq=0, seen_seq=0, page_w=1280, field_rev=0,
-        message_log=[], legend="", tab="material", preset_name="", preset_replace=False,
+        message_log=[], legend="", advice="", tab="material", preset_name="", preset_replace=False,
         session_upload=None, mesh_upload=None, mtl_upload=None, progress=None,
         **{f"{r.key}_upload": None for r in panelmodel.ROWS if r.kind == "image"},
         turntable_ready=False, turntable_made="",

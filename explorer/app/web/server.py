@@ -282,11 +282,14 @@ class WebExplorer:
         self._push(state)
 
     def show_legend(self, legend: str, advice: str) -> None:
-        """The difference's legend, on every page now (it comes from the difference worker's
-        callback, between two of the user's actions: set without a flush, it waited for the
-        next one, and the page said "computing the map" over the finished heat map)."""
+        """The difference's legend and advice (the accuracy table's word on this material, as
+        the window shows it under the legend), on every page now (they come from the
+        difference worker's callback, between two of the user's actions: set without a flush,
+        they waited for the next one, and the page said "computing the map" over the finished
+        heat map)."""
         with self.server.state as s:
             s.legend = legend
+            s.advice = advice
 
     def after_frame(self) -> None:
         """Nothing of the page's own after a frame (side B's picture follows: WebCompare)."""

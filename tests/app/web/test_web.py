@@ -547,6 +547,11 @@ def test_the_difference_view_shows_its_heat_map(server, browser):
     rmse = f"RMSE {rep['difference']['rmse']:.2f}"
     wait("the legend's RMSE", lambda: rmse in page_text(browser), timeout=10)
     assert "computing the map" not in page_text(browser)
+    # and the accuracy table's advice under it, as the window shows it (the page had none)
+    advice = rep["difference"]["advice"]
+    assert advice
+    shown = browser.find_element("css selector", '[aria-label="advice"]').text
+    assert shown.split() == advice.split(), (shown, advice)
     click(browser, "difference")
     wait("the view again", lambda: not report(browser)["difference"]["shown"])
     click(browser, "material tab")
