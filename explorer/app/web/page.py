@@ -283,36 +283,50 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     """The rows of ``tab`` (:mod:`explorer.app.panelmodel`), one factory per kind; a group of
     toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
     key is null (the row is not shown). ``after``: key -> a function that draws the page's own
-    controls after that row (the difference view's legend)."""
+    controls after that row (the difference view's legend).
+
+    Each row (a line of toggles) is the slot of its own renderless component
+    (``VDefaultsProvider``): Vue tracks the state keys a slot reads in the component that
+    renders it, so a change of a row's keys re-renders that row alone; in the tab's one slot,
+    a kd change (``kd_text``) re-rendered every row of the tab (issue 42,
+    benchmarks/trace_web_change.py)."""
     line, group = None, None
     for r in panelmodel.rows(tab):
         if r.kind in ("toggle", "button") and r.group:
             if r.group != group:
-                line = html.Div(classes="d-flex")
+                with v3.VDefaultsProvider():
+                    line = html.Div(classes="d-flex")
                 group = r.group
             with line:
                 (_button(v3, ctrl, r) if r.kind == "button" else
                  _checkbox(v3, r.key, r.caption, r.tip))  # fmt: skip
-        elif r.kind == "number":
-            if r.optional is not None:
-                _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
-            _number(v3, html, ctrl, r.key, r.caption)
-        elif r.kind == "colour":
-            _colour(v3, html, ctrl, r.key, r.key)
-        elif r.kind in ("choice", "list"):
-            _choice(v3, r)
-        elif r.kind == "toggle":
-            _checkbox(v3, r.key, r.caption, r.tip)
-        elif r.kind == "button":
-            _button(v3, ctrl, r)
-        elif r.kind == "text":
-            _text(html, r)
-        elif r.kind == "image":
-            _image(v3, html, ctrl, r)
         else:
-            _triple(v3, ctrl, r)
+            with v3.VDefaultsProvider():
+                _row(v3, html, ctrl, r)
         group = r.group if r.kind in ("toggle", "button") else None
         (after or {}).get(r.key, lambda: None)()
+
+
+def _row(v3, html, ctrl, r) -> None:
+    """Row ``r`` (not a line's toggle), by its kind's factory."""
+    if r.kind == "number":
+        if r.optional is not None:
+            _checkbox(v3, f"{r.key}_on", r.caption, r.tip)
+        _number(v3, html, ctrl, r.key, r.caption)
+    elif r.kind == "colour":
+        _colour(v3, html, ctrl, r.key, r.key)
+    elif r.kind in ("choice", "list"):
+        _choice(v3, r)
+    elif r.kind == "toggle":
+        _checkbox(v3, r.key, r.caption, r.tip)
+    elif r.kind == "button":
+        _button(v3, ctrl, r)
+    elif r.kind == "text":
+        _text(html, r)
+    elif r.kind == "image":
+        _image(v3, html, ctrl, r)
+    else:
+        _triple(v3, ctrl, r)
 
 
 def _material_tab(v3, html, ctrl) -> None:
