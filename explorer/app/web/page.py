@@ -320,12 +320,29 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     """The rows of ``tab`` (:mod:`explorer.app.panelmodel`), one factory per kind; a group of
     toggles on one line. Each is named (``aria-label``) by its key and hidden while its state
     key is null (the row is not shown). ``after``: key -> a function that draws the page's own
-    controls after that row (the difference view's legend)."""
+    controls after that row (the difference view's legend).
+
+    Each row (a line of toggles) is the slot of its own renderless component
+    (``VDefaultsProvider``), and so is what ``after`` draws: Vue tracks the state keys a slot
+    reads in the component that renders it, so a change of a row's keys re-renders that row
+    alone; in the tab's one slot, a kd change (``kd_text``) re-rendered every row of the tab
+    (issue 42, benchmarks/trace_web_change.py)."""
     for how, group in rowlayout.lines(panelmodel.rows(tab)):
-        with html.Div(classes="d-flex") if how == "line" else contextlib.nullcontext():
+        if how == "line":
+            with v3.VDefaultsProvider():
+                line = html.Div(classes="d-flex")
+        else:
+            line = contextlib.nullcontext()
+        with line:
             for r in group:
-                _row(v3, html, ctrl, r)
-                (after or {}).get(r.key, lambda: None)()
+                if how == "line":
+                    _row(v3, html, ctrl, r)
+                else:
+                    with v3.VDefaultsProvider():
+                        _row(v3, html, ctrl, r)
+                if r.key in (after or {}):
+                    with v3.VDefaultsProvider():
+                        after[r.key]()
 
 
 def _row(v3, html, ctrl, r) -> None:
