@@ -327,7 +327,10 @@ class WebExplorer:
         if self.pictures is not None:
             self.pictures.close()
         self._uploads.cleanup()
-        self.plotter.close()
+        from explorer.render.vtk import DRAW_LOCK
+
+        with DRAW_LOCK:  # the view's window goes while no other thread draws
+            self.plotter.close()
 
 
 def own_arguments() -> None:
