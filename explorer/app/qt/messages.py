@@ -79,11 +79,12 @@ class MessageIndicator(QtWidgets.QToolButton):
 
 
 class FittedLabel(QtWidgets.QLabel):
-    """A one-line label of the status bar that shows as much of its text as its width allows,
+    """A one-line label of the status bar that draws as much of its text as its width allows,
     and marks what it leaves out with "…" (a plain ``QLabel`` squeezed by the bar, in a narrow
     window or beside the long engine word, was cut mid-word with no mark: "hidden: diffuse_",
-    or "hidden:" with nothing after it). ``setText`` keeps the whole text, said in the tooltip;
-    ``text()`` is what is shown.
+    or "hidden:" with nothing after it). ``text()`` is the whole text, also its tooltip;
+    :meth:`shown` is what is drawn at the label's present width (fitted at each paint, so a
+    text set before the bar lays itself out again is drawn for the width it gets).
 
     shorten : ``(text, metrics, width) -> str``, the text made to fit ``width`` pixels
         (:func:`elide`, :func:`shorten_summary`)
@@ -94,14 +95,16 @@ class FittedLabel(QtWidgets.QLabel):
     def __init__(self, name: str, shorten, least, most: int | None = None):
         super().__init__("")
         self.setObjectName(name)
-        self.whole = ""
         self._shorten, self._least, self._most = shorten, least, most
 
     def setText(self, text: str) -> None:  # noqa: N802 - Qt's name
-        self.whole = text
+        super().setText(text)
         self.setToolTip(text)
         self.updateGeometry()
-        self._fit()
+
+    def shown(self) -> str:
+        """The text as drawn at the label's present width."""
+        return self._shorten(self.text(), self.fontMetrics(), self.contentsRect().width())
 
     def _width(self, text: str, most: int | None = None) -> int:
         """The label's width for ``text`` (pixels, its margins too), its text at most ``most``."""
@@ -110,19 +113,20 @@ class FittedLabel(QtWidgets.QLabel):
         return min(advance, advance if most is None else most) + m.left() + m.right() + 1
 
     def sizeHint(self) -> QtCore.QSize:  # noqa: N802 - Qt's name
-        return QtCore.QSize(self._width(self.whole, self._most), super().sizeHint().height())
+        return QtCore.QSize(self._width(self.text(), self._most), super().sizeHint().height())
 
     def minimumSizeHint(self) -> QtCore.QSize:  # noqa: N802 - Qt's name
-        width = min(self._width(self._least(self.whole)), self.sizeHint().width())
+        width = min(self._width(self._least(self.text())), self.sizeHint().width())
         return QtCore.QSize(width, super().minimumSizeHint().height())
 
-    def resizeEvent(self, event: QtGui.QResizeEvent) -> None:  # noqa: N802 - Qt's name
-        super().resizeEvent(event)
-        self._fit()
-
-    def _fit(self) -> None:
-        width = self.contentsRect().width()
-        super().setText(self._shorten(self.whole, self.fontMetrics(), width))
+    def paintEvent(self, event: QtGui.QPaintEvent) -> None:  # noqa: N802 - Qt's name
+        """Draw :meth:`shown` as a ``QLabel`` draws its text (the style's colours)."""
+        painter = QtGui.QPainter(self)
+        align = self.alignment() | QtCore.Qt.AlignmentFlag.AlignVCenter
+        rect, role = self.contentsRect(), self.foregroundRole()
+        style, palette, text = self.style(), self.palette(), self.shown()
+        style.drawItemText(painter, rect, align, palette, self.isEnabled(), text, role)
+        painter.end()
 
 
 def elide(text: str, metrics: QtGui.QFontMetrics, width: int) -> str:

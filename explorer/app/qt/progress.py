@@ -73,7 +73,7 @@ class EngineStatus:
     def show(self) -> None:
         tiers.preload()  # looks for the ready marker (a stat at most every tiers.POLL seconds)
         text = tiers.status() or ""
-        if text != self.label.whole:
-            self.label.setText(text)  # (cut to fit, whole in its tooltip)
+        if text != self.label.text():
+            self.label.setText(text)  # (drawn cut to fit, whole in its tooltip)
         if not text and (tiers.loaded() or tiers.mode() != "auto"):
             self.timer.stop()

@@ -192,8 +192,8 @@ def test_the_status_bar_names_the_hidden_maps_whole_beside_the_engine_word(
     qtbot.waitUntil(lambda: w.width() == size[0])
     qtbot.wait(50)
     label, engine, bar = w.status_label, w.engine_label, w.statusBar()
-    shown = label.text()
-    assert label.toolTip() == captions.summary(c.state)
+    shown = label.shown()  # (drawn at the label's width)
+    assert label.text() == label.toolTip() == captions.summary(c.state)
     assert "hidden: diffuse_map, emission_map" in shown, shown
     assert label.fontMetrics().horizontalAdvance(shown) <= label.contentsRect().width(), shown
     assert engine.text().startswith("numpy engine")
