@@ -74,6 +74,8 @@ def grab(display: str, path: Path, size, crop=None) -> None:
 
 def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     """Set up the window for picture ``name`` and grab it into ``out/name.png``."""
+    from PySide6.QtWidgets import QWidget
+
     from explorer.app import intents
     from explorer.app import model as M
 
@@ -96,6 +98,8 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
         argv = ("--mesh", "torus", "--preset", "glossy_plastic", "--per-pixel")
     elif name == "gui_lobes":
         argv = ("--mesh", "sphere", "--preset", "chrome")
+    elif name == "maps_window":  # the map rows (docs/gui.md): the textured teapot at 1000x700
+        size, argv = (1000, 700), ("--mesh", str(HERE / "examples" / "textured_teapot.obj"))
     w = open_window(app, tmp, argv, size)
     c = w.controller
     if name == "gui_640x480":
@@ -124,6 +128,11 @@ def shoot(name: str, app, display: str, tmp: Path, out: Path) -> None:
     elif name == "gui_lobes":
         w.panel.setCurrentIndex(2)  # the view tab: the inset's rows
         c.set_value("lobes", "models")
+    elif name == "maps_window":  # emission map turned off, the material tab at the map rows
+        c.set_value("emission_map", str(HERE / "examples" / "tiles.png"), merge=False)
+        c.set_value("emission_map", False, merge=False)
+        w.panel.setCurrentIndex(0)
+        w.panel.areas[0].ensureWidgetVisible(w.panel.material.findChild(QWidget, "bump_map"))
     elif name == "gui_difference":
         w.panel.setCurrentIndex(2)
         c.toggle_difference()
@@ -289,7 +298,7 @@ def shoot_web_tour(tmp: Path, out: Path) -> list[Path]:
 NAMES = ("gui", "gui_800x500", "gui_640x480", "gui_file_menu", "gui_compare", "gui_difference",
          "gui_lobe_phong", "gui_lobe_blinn", "gui_translucent", "gui_per_pixel",
          "gui_gouraud_vs_per_pixel", "gui_strip", "gui_strip_per_pixel",
-         "gui_lobes")  # fmt: skip
+         "gui_lobes", "maps_window")  # fmt: skip
 
 
 def main(argv=None) -> int:

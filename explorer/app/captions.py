@@ -47,6 +47,10 @@ def material_line(state: State) -> str:
     return f"material: {material_title(state)}{edited}"
 
 
+#: what separates the summary's parts (:func:`summary`)
+SEPARATOR = ";  "
+
+
 def summary(state: State) -> str:
     """The state in one line (the window's status bar): the material shown (or the mesh file's
     own materials), the model, and the terms and texture maps hidden:
@@ -58,7 +62,7 @@ def summary(state: State) -> str:
     hidden = [t for t in (*TERMS, *MAP_KEYS) if t in state.hidden]  # (terms, maps off)
     if hidden:
         parts.append("hidden: " + ", ".join(hidden))
-    return ";  ".join(parts)
+    return SEPARATOR.join(parts)
 
 
 def mesh_line(name: str, n_vertices: int) -> str:

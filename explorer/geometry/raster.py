@@ -2,35 +2,46 @@
 point, barycentrics and interpolated normal there, in parallel passes over the picture.
 
 :func:`gbuffer` is what :meth:`explorer.render.live.LivePixels.gbuffer` runs on a camera change
-(through :func:`explorer.render.perpixel.compiled_hits`, which gives it the camera's basis): a
-z-buffer rasteriser that samples each pixel at its centre, as OpenGL does, instead of VTK's
-picture of triangle indices (:mod:`explorer.render.faceids`) and the numpy arithmetic of
-:func:`explorer.render.perpixel.raster_hits` (a camera frame of the 100,578-vertex teapot at
-800x600: VTK's picture and the numpy arithmetic cost about 70 ms of CPU under load, this
-about 20; docs/perpixel_bench.md).
+(through :func:`explorer.render.perpixel.compiled_hits`, which gives it the camera's basis) once
+the compiled kernels serve (``gbuffer_method`` "auto" while
+:func:`explorer.shading.tiers.loaded`, or "compiled"; the background compile,
+:mod:`explorer.shading.warm`, compiles it with the engine's kernels): a z-buffer rasteriser
+that samples each pixel at its centre, as OpenGL does. Before that, and for a frame it leaves
+(see :func:`_setup`), the G-buffer is VTK's picture of triangle indices
+(:mod:`explorer.render.faceids`) and the numpy arithmetic of
+:func:`explorer.render.perpixel.raster_hits`. When it came, a camera frame of the
+100,578-vertex teapot at 800x600 cost about 70 ms of CPU that way under load and 20-30 this
+way; docs/perpixel_bench.md gives the compiled G-buffer's share of a camera frame today.
 
 - :func:`_setup` puts every vertex in pixel units (``explorer.render.camera.project``'s
   numbers: pixel centres at whole numbers, row 0 at the top) with the depth key ``1/z``
   (perspective: affine in the picture, so it interpolates exactly across a triangle) or ``-z``
-  (parallel), larger nearer, then finds each triangle's rows and columns of pixel centres. It
-  counts the vertices outside the camera's clipping range or not finite, which the caller
-  leaves to VTK (whose clipping this rasteriser does not copy).
-- :func:`_raster` draws the triangles into horizontal bands of the picture, one band per task
-  (no two tasks write one pixel; each reads only its own triangles, binned by :func:`_bins`).
-  A pixel centre is inside when its three edge functions have the sign of the triangle's area;
+  (parallel), larger nearer, then finds each triangle's rows and columns of pixel centres,
+  clamped to the picture (a triangle of no area, or with no pixel centre, gets none). It
+  counts the vertices outside the camera's clipping range or not finite; one such vertex and
+  :func:`gbuffer` returns None, and the caller leaves the frame to VTK (whose clipping this
+  rasteriser does not copy).
+- :func:`_bins` lists each horizontal band's triangles (a triangle over several bands is in
+  each), in index order.
+- :func:`_raster` draws the triangles into the bands, one band per task
+  (:data:`BANDS_PER_THREAD` bands a thread; no two tasks write one pixel; each reads only its
+  own triangles), keeping at each pixel the triangle with the largest depth key. A pixel
+  centre is inside when its three edge functions have the sign of the triangle's area;
   exactly on an edge, the top-left rule decides. Each edge function is computed from its two
   ends in the order of their vertex indices, so two triangles that share an edge get exactly
   opposite values: a centre on a shared edge or a shared corner belongs to exactly one of them
   (no gap, no double hit; as OpenGL's rasterisation rules ask of any rasteriser). Each band
-  then counts its rows' pixels whose ray meets its triangle's plane (a ray within DET_EPS of
-  the plane is a miss).
+  then counts its rows' pixels whose ray meets its triangle's plane: a ray that runs along the
+  plane (Möller-Trumbore's determinant within DET_EPS of 0) makes its pixel a miss, as in
+  :func:`~explorer.render.perpixel.raster_hits`.
 - :func:`_hits` gives, per covered pixel in row-major order, the Möller-Trumbore arithmetic of
   :func:`explorer.render.perpixel.raster_hits` on the pixel's own ray and triangle (the same
   numbers: the ray of ``explorer.render.camera.pixel_rays``, the point ``O + t·D``, the normal
-  ``(1-u-v)·n0 + u·n1 + v·n2`` normalised, zero staying zero).
+  ``(1-u-v)·n0 + u·n1 + v·n2`` normalised, one shorter than SURFACE_NORMAL_MIN made zero).
 
-Two parallel regions a frame: under load each costs the threads' wake-up and spin on top of
-the work, so the small passes (:func:`_setup`, :func:`_bins`) run on one thread.
+Two parallel regions a frame (:func:`_raster`, :func:`_hits`): under load each costs the
+threads' wake-up and spin on top of the work, so the small passes (:func:`_setup`,
+:func:`_bins`) run on one thread.
 
 Coverage is that of any OpenGL rasteriser up to where a pixel centre lies within rounding of an
 edge (VTK's llvmpipe snaps vertices to 1/256 pixel and draws in float32): a few silhouette pixels

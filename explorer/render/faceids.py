@@ -59,19 +59,21 @@ class FaceIdRenderer(OffscreenWindow):
     def render(self, mesh: Mesh, camera: Camera) -> np.ndarray:
         """(h, w) int64: the index of the triangle of ``mesh`` each pixel shows, -1 where none
         (see :func:`decode`)."""
-        pl = self.plotter
-        if self._mesh is not mesh:
-            if self._actor is not None:
-                pl.remove_actor(self._actor)
-            self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
-            poly = polydata(mesh, normals=False, frame=self._frame)
-            poly.cell_data["index"] = index_colors(mesh.n_faces)
-            self._actor = pl.add_mesh(poly, scalars="index", rgb=True, lighting=False,
-                                      preference="cell", show_scalar_bar=False,
-                                      reset_camera=False)  # fmt: skip
-            self._mesh = mesh
-        set_camera(pl, camera, self._frame)
-        with DRAW_LOCK:  # the render and its read-back, no other thread drawing
+        # the window changed, drawn and read with no other thread drawing (actors added and
+        # removed make and free OpenGL buffers: DRAW_LOCK covers them too)
+        with DRAW_LOCK:
+            pl = self.plotter
+            if self._mesh is not mesh:
+                if self._actor is not None:
+                    pl.remove_actor(self._actor)
+                self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
+                poly = polydata(mesh, normals=False, frame=self._frame)
+                poly.cell_data["index"] = index_colors(mesh.n_faces)
+                self._actor = pl.add_mesh(poly, scalars="index", rgb=True, lighting=False,
+                                          preference="cell", show_scalar_bar=False,
+                                          reset_camera=False)  # fmt: skip
+                self._mesh = mesh
+            set_camera(pl, camera, self._frame)
             pl.render()
             picture = pl.screenshot(return_img=True)[:, :, :3]
         return decode(picture)

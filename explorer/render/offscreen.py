@@ -76,15 +76,21 @@ class OffscreenWindow:
         self.close()
 
     def close(self) -> None:
+        """Close the window (its OpenGL context goes) while no other thread draws
+        (:data:`~explorer.render.vtk.DRAW_LOCK`: the difference worker closes its windows in
+        its own thread)."""
         if self._pl is not None:
-            self._pl.close()
+            with DRAW_LOCK:
+                self._pl.close()
             self._pl = None
             self._forget()
 
     @property
     def plotter(self):
+        """The window's plotter, made on first use (while no other thread draws)."""
         if self._pl is None:
-            self._pl = plotter(self.size, self.background)
+            with DRAW_LOCK:
+                self._pl = plotter(self.size, self.background)
         return self._pl
 
 
@@ -130,7 +136,6 @@ class OffscreenRenderer(OffscreenWindow):
             None: the scene's own ``diffuse_map`` when it has one and ``colors`` is None
         Returns (height, width, 3) uint8.
         """
-        pl = self.plotter
         if texture is None and colors is None:
             texture = textured(scene, mesh)
         if texture is not None:
@@ -141,47 +146,50 @@ class OffscreenRenderer(OffscreenWindow):
             raise ExplorerError(
                 f"colors must have shape ({mesh.n_vertices}, 3), got {np.shape(colors)}"
             )
-        if self._mesh is not mesh or texture is not None or self._texture is not None:
-            if self._actor is not None:
-                pl.remove_actor(self._actor)
-            self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
-            self._poly = polydata(mesh, rgb, frame=self._frame)
-            self._sorted = False
-            if texture is None:
-                self._actor = add_unlit(pl, self._poly)
+        # the window changed, drawn and read with no other thread drawing (actors added and
+        # removed make and free OpenGL buffers: DRAW_LOCK covers them too)
+        with DRAW_LOCK:
+            pl = self.plotter
+            if self._mesh is not mesh or texture is not None or self._texture is not None:
+                if self._actor is not None:
+                    pl.remove_actor(self._actor)
+                self._frame = mesh_frame(mesh)  # VTK draws in the mesh's frame: any scale
+                self._poly = polydata(mesh, rgb, frame=self._frame)
+                self._sorted = False
+                if texture is None:
+                    self._actor = add_unlit(pl, self._poly)
+                else:
+                    texture_arrays(self._poly, mesh, texture)
+                    self._actor = add_textured(pl, self._poly, texture)
+                self._mesh, self._texture = mesh, texture
             else:
-                texture_arrays(self._poly, mesh, texture)
-                self._actor = add_textured(pl, self._poly, texture)
-            self._mesh, self._texture = mesh, texture
-        else:
-            self._poly.point_data["colors"] = rgb
-        opacity = float(scene.material.opacity)
-        self._actor.GetProperty().SetOpacity(opacity)
-        self._set_label(label, label_size)
-        w, h = self.size
-        if camera is None:
-            band = 0.0
-            if label is not None:
-                band = 1.5 * self._text.GetTextProperty().GetFontSize() / h
-            camera = camera_for(scene, mesh, w / h, bottom=band)
-        set_camera(pl, camera, self._frame)
-        # translucent: draw the triangles back to front, so each blends over what is behind
-        # it; opaque: file order (the depth test decides)
-        order = back_to_front(mesh, camera) if opacity < 1.0 else None
-        if order is not None or self._sorted:
-            self._poly.faces = cells(mesh.faces if order is None else mesh.faces[order])
-            self._sorted = order is not None
-        extra = None
-        if backdrop is not None:
-            bmesh, bcolors = backdrop
-            extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors), frame=self._frame))
-        try:
-            with DRAW_LOCK:  # the render and its read-back, no other thread drawing
+                self._poly.point_data["colors"] = rgb
+            opacity = float(scene.material.opacity)
+            self._actor.GetProperty().SetOpacity(opacity)
+            self._set_label(label, label_size)
+            w, h = self.size
+            if camera is None:
+                band = 0.0
+                if label is not None:
+                    band = 1.5 * self._text.GetTextProperty().GetFontSize() / h
+                camera = camera_for(scene, mesh, w / h, bottom=band)
+            set_camera(pl, camera, self._frame)
+            # translucent: draw the triangles back to front, so each blends over what is behind
+            # it; opaque: file order (the depth test decides)
+            order = back_to_front(mesh, camera) if opacity < 1.0 else None
+            if order is not None or self._sorted:
+                self._poly.faces = cells(mesh.faces if order is None else mesh.faces[order])
+                self._sorted = order is not None
+            extra = None
+            if backdrop is not None:
+                bmesh, bcolors = backdrop
+                extra = add_unlit(pl, polydata(bmesh, to_bytes(bcolors), frame=self._frame))
+            try:
                 pl.render()
                 img = pl.screenshot(return_img=True)
-        finally:
-            if extra is not None:
-                pl.remove_actor(extra)
+            finally:
+                if extra is not None:
+                    pl.remove_actor(extra)
         return np.ascontiguousarray(img[:, :, :3])
 
     def _text_actor(self):

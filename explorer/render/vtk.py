@@ -52,8 +52,12 @@ def headless_egl():
 #: once crashed the window (a segmentation fault in the worker's render while the window drew,
 #: tests/app/qt/test_panel.py's compare and difference test, 1 CI run in 3). Every render window
 #: made here or by a front end holds it through each frame (:func:`one_frame_at_a_time`); an
-#: off-screen picture holds it through its render and its read-back. Re-entrant: a frame's
-#: observers may draw another window (side B, the per-pixel G-buffer) in the same thread.
+#: off-screen picture holds it through all its VTK work: its window made, its actors added and
+#: removed (they make and free OpenGL buffers), its render and read-back, its window closed
+#: (:class:`explorer.render.offscreen.OffscreenWindow`: the difference worker makes, changes and
+#: closes its windows in its own thread); a front end closes its view's window under it too.
+#: Re-entrant: a frame's observers may draw another window (side B, the per-pixel G-buffer) in
+#: the same thread.
 DRAW_LOCK = threading.RLock()
 
 

@@ -119,9 +119,16 @@ _state = {
     "guarded": False,  # numba's cache reads of the kernels are guarded (guard_cache)
     "told_damaged": False,  # a kernel's unreadable cache files were set aside and said
 }
-#: the background compiles this process started, kept (a Popen dropped while its process runs
-#: warns, ResourceWarning); those that ended are reaped at the next start
+#: the background compiles this process started where there is no ``sh`` to start them
+#: (:data:`DETACH`), kept (a Popen dropped while its process runs warns, ResourceWarning); those
+#: that ended are reaped at the next start
 _children: list[subprocess.Popen] = []
+#: the background compile is started through ``sh``, which starts it and ends at once
+#: (waited for): the compile is then no child of this process, which may end first (a one-shot
+#: render, the test session, the page's server) with no subprocess still running. It had kept
+#: the compile's Popen, and a process ending before its compile printed "ResourceWarning:
+#: subprocess N is still running" (after the tiers and web tests)
+DETACH = ("/bin/sh", "-c", '"$@" &', "phong-explorer-compile")
 
 
 def mode() -> str:
@@ -620,9 +627,10 @@ def _start_background(told: str = PREPARING) -> None:
         directory.mkdir(parents=True, exist_ok=True)
         env = dict(os.environ, **{ENV: "compiled"})
         _children[:] = [p for p in _children if p.poll() is None]
+        detach = os.access(DETACH[0], os.X_OK)
         with open(log_path(), "ab") as log:
             child = subprocess.Popen(
-                warm_command(),
+                [*DETACH, *warm_command()] if detach else warm_command(),
                 stdin=subprocess.DEVNULL,
                 stdout=log,
                 stderr=subprocess.STDOUT,
@@ -631,7 +639,10 @@ def _start_background(told: str = PREPARING) -> None:
                 start_new_session=True,  # Ctrl-C in the terminal does not stop it
                 close_fds=True,
             )
-        _children.append(child)
+        if detach:
+            child.wait()  # (sh: the compile started, in the background)
+        else:
+            _children.append(child)
     except OSError as exc:  # no writable cache directory, no interpreter to start
         _unavailable(exc.strerror or str(exc), stacklevel=4)
         return

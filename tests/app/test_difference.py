@@ -93,3 +93,51 @@ def test_run_job_alone_makes_its_own_windows():
     r = DV.run_job(job)
     direct = C.compare_view(job.scene, job.mesh, job.size, camera=job.camera, colors=job.colors)
     assert np.array_equal(r.comparison.levels, direct.levels) and r.ms > 0
+
+
+def test_the_worker_makes_and_closes_its_windows_only_while_no_frame_is_drawn(monkeypatch):
+    """The worker's off-screen windows are made and closed while no other thread draws
+    (DRAW_LOCK): while a frame of the window holds the lock, a job of a new size (its old
+    windows closed, new ones made) waits for the frame's end; closing the worker while it
+    computes ends its thread with every window it made closed. (A full run under load crashed
+    in the window while a difference thread lived; the worker closed its OpenGL windows
+    outside the lock.)"""
+    import time
+
+    import pyvista as pv
+
+    from explorer.render import offscreen
+    from explorer.render.vtk import DRAW_LOCK
+
+    frame = [False]  # a frame of the window is being drawn (this thread holds DRAW_LOCK)
+    made, closed = [], []
+    real_plotter, real_close = offscreen.plotter, pv.Plotter.close
+
+    def plotter(*a, **k):
+        made.append(frame[0])
+        return real_plotter(*a, **k)
+
+    def close(self, *a, **k):
+        closed.append(frame[0])
+        return real_close(self, *a, **k)
+
+    monkeypatch.setattr(offscreen, "plotter", plotter)
+    monkeypatch.setattr(pv.Plotter, "close", close)
+    inbox = _Inbox()
+    worker = DV.DifferenceWorker(inbox)
+    try:
+        worker.submit(_job(0, M.teapot(4), (160, 120)))
+        inbox.wait()
+        with DRAW_LOCK:
+            frame[0] = True
+            worker.submit(_job(1, M.teapot(4), (90, 70)))  # a new size: new windows
+            time.sleep(0.5)
+            frame[0] = False
+        assert inbox.wait().job.key == 1
+        worker.submit(_job(2, M.teapot(12), (300, 200)))  # a new size again, then closed
+        time.sleep(0.2)
+    finally:
+        worker.close()
+    assert not worker._thread.is_alive()
+    assert len(made) >= 4 and len(closed) == len(made), (made, closed)  # (two a size at least)
+    assert not any(made) and not any(closed), (made, closed)  # none while a frame was drawn

@@ -756,3 +756,30 @@ def test_a_lock_path_that_cannot_be_opened(cold_tiers, monkeypatch, capsys):
         info = tiers.attempts()
         assert info["attempts"] == n and "cannot open the lock" in info["error"]
     assert "cannot open the lock" in tiers.given_up()
+
+
+def test_a_process_ending_before_its_background_compile_leaves_no_child(tmp_path):
+    """The background compile outlives the process that started it (a one-shot render, the test
+    session, the page's server end first) without being its child: that process ends with no
+    subprocess running, so no "ResourceWarning: subprocess N is still running" (it was printed
+    after the tiers and web tests), and the compile still runs to its end."""
+    done = tmp_path / "done"
+    compile_ = f"import pathlib, time; time.sleep(2); pathlib.Path({str(done)!r}).write_text('')"
+    code = textwrap.dedent(
+        f"""
+        import pathlib, sys
+        from explorer.shading import tiers
+        tiers.cache_dir = lambda: pathlib.Path({str(tmp_path)!r})
+        tiers.warm_command = lambda: [sys.executable, "-c", {compile_!r}]
+        tiers._start_background()
+        """
+    )
+    command = [sys.executable, "-W", "error::ResourceWarning", "-c", code]
+    out = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "ResourceWarning" not in out.stderr and "still running" not in out.stderr, out.stderr
+    assert "preparing the compiled engine" in out.stderr  # (started, and said so)
+    deadline = time.monotonic() + 60
+    while not done.exists() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert done.exists()  # the compile ran on after its starter ended

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtGui, QtWidgets
 
+from explorer.app.captions import SEPARATOR
 from explorer.app.messagelog import LEVEL_COLOURS, Message, opens_log
 from explorer.app.messagelog import MessageLog as Said
 
@@ -73,6 +74,83 @@ class MessageIndicator(QtWidgets.QToolButton):
         self.setToolTip("every message of this session, whole and copyable (View ▸ Messages)")
 
 
+class FittedLabel(QtWidgets.QLabel):
+    """A one-line label of the status bar that draws as much of its text as its width allows,
+    and marks what it leaves out with "…" (a plain ``QLabel`` squeezed by the bar, in a narrow
+    window or beside the long engine word, was cut mid-word with no mark: "hidden: diffuse_",
+    or "hidden:" with nothing after it). ``text()`` is the whole text, also its tooltip;
+    :meth:`shown` is what is drawn at the label's present width (fitted at each paint, so a
+    text set before the bar lays itself out again is drawn for the width it gets).
+
+    shorten : ``(text, metrics, width) -> str``, the text made to fit ``width`` pixels
+        (:func:`elide`, :func:`shorten_summary`)
+    least : ``(text) -> str``, the shortest form the label asks room for (its minimum size)
+    most : the widest text the label asks room for (pixels), or None: its whole text
+    """
+
+    def __init__(self, name: str, shorten, least, most: int | None = None):
+        super().__init__("")
+        self.setObjectName(name)
+        self._shorten, self._least, self._most = shorten, least, most
+
+    def setText(self, text: str) -> None:  # noqa: N802 - Qt's name
+        super().setText(text)
+        self.setToolTip(text)
+        self.updateGeometry()
+
+    def shown(self) -> str:
+        """The text as drawn at the label's present width."""
+        return self._shorten(self.text(), self.fontMetrics(), self.contentsRect().width())
+
+    def _width(self, text: str, most: int | None = None) -> int:
+        """The label's width for ``text`` (pixels, its margins too), its text at most ``most``."""
+        m = self.contentsMargins()
+        advance = self.fontMetrics().horizontalAdvance(text)
+        return min(advance, advance if most is None else most) + m.left() + m.right() + 1
+
+    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 - Qt's name
+        return QtCore.QSize(self._width(self.text(), self._most), super().sizeHint().height())
+
+    def minimumSizeHint(self) -> QtCore.QSize:  # noqa: N802 - Qt's name
+        width = min(self._width(self._least(self.text())), self.sizeHint().width())
+        return QtCore.QSize(width, super().minimumSizeHint().height())
+
+    def paintEvent(self, event: QtGui.QPaintEvent) -> None:  # noqa: N802 - Qt's name
+        """Draw :meth:`shown` as a ``QLabel`` draws its text (the style's colours)."""
+        painter = QtGui.QPainter(self)
+        align = self.alignment() | QtCore.Qt.AlignmentFlag.AlignVCenter
+        rect, role = self.contentsRect(), self.foregroundRole()
+        style, palette, text = self.style(), self.palette(), self.shown()
+        style.drawItemText(painter, rect, align, palette, self.isEnabled(), text, role)
+        painter.end()
+
+
+def elide(text: str, metrics: QtGui.QFontMetrics, width: int) -> str:
+    """``text`` cut at its end to ``width`` pixels, "…" marking the cut."""
+    return metrics.elidedText(text, QtCore.Qt.TextElideMode.ElideRight, width)
+
+
+def shorten_summary(text: str, metrics: QtGui.QFontMetrics, width: int) -> str:
+    """The state's summary (:func:`explorer.app.captions.summary`: the material, the model,
+    what is hidden) in ``width`` pixels: whole when it fits; else the material's name is cut
+    first (``textured_te…;  blinn;  hidden: diffuse_map``), so the model and every hidden
+    term and map stay whole; else the whole line is cut at its end."""
+    if metrics.horizontalAdvance(text) <= width:
+        return text
+    what, sep, rest = text.partition(SEPARATOR)
+    room = width - metrics.horizontalAdvance(sep + rest)
+    if sep and room >= metrics.horizontalAdvance("…"):
+        return elide(what, metrics, room) + sep + rest
+    return elide(text, metrics, width)
+
+
+def summary_least(text: str) -> str:
+    """The summary's shortest form the status bar leaves room for: the material's name cut to
+    "…", the rest whole (:func:`shorten_summary`)."""
+    what, sep, rest = text.partition(SEPARATOR)
+    return "…" + sep + rest if sep else text
+
+
 def open_log(log: MessageLog) -> None:
     """Show the log at its last line (raised, without taking the keyboard from the view)."""
     log.setAttribute(QtCore.Qt.WidgetAttribute.WA_ShowWithoutActivating, True)
@@ -89,8 +167,7 @@ class MessageBar:
 
     def __init__(self, window):
         self.window = w = window
-        w.status_label = QtWidgets.QLabel("")
-        w.status_label.setObjectName("status")
+        w.status_label = FittedLabel("status", shorten_summary, summary_least)
         w.statusBar().addPermanentWidget(w.status_label)
         w.messages = MessageLog(w)
         w.messages_indicator = MessageIndicator(w.messages)

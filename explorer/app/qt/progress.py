@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from PySide6 import QtCore, QtWidgets
 
+from explorer.app.qt.messages import FittedLabel, elide
 from explorer.app.steps import Steps
 from explorer.shading import tiers
 
@@ -59,8 +60,9 @@ class EngineStatus:
 
     def __init__(self, window):
         tiers.preload()
-        self.label = window.engine_label = QtWidgets.QLabel("")
-        self.label.setObjectName("engine")
+        most = window.fontMetrics().averageCharWidth() * ENGINE_CHARS
+        # (it gives way first: the least it asks room for is the start of its word)
+        self.label = window.engine_label = FittedLabel("engine", elide, lambda t: t[:6], most)
         self.label.setContentsMargins(0, 0, 16, 0)  # apart from the preset and model
         window.statusBar().insertPermanentWidget(0, self.label)
         self.timer = QtCore.QTimer(window)
@@ -71,10 +73,7 @@ class EngineStatus:
     def show(self) -> None:
         tiers.preload()  # looks for the ready marker (a stat at most every tiers.POLL seconds)
         text = tiers.status() or ""
-        if text != self.label.toolTip():
-            metrics = self.label.fontMetrics()
-            width = metrics.averageCharWidth() * ENGINE_CHARS
-            self.label.setText(metrics.elidedText(text, QtCore.Qt.TextElideMode.ElideRight, width))
-            self.label.setToolTip(text)
+        if text != self.label.text():
+            self.label.setText(text)  # (drawn cut to fit, whole in its tooltip)
         if not text and (tiers.loaded() or tiers.mode() != "auto"):
             self.timer.stop()

@@ -37,7 +37,7 @@ from explorer.app.start import TITLE, WINDOW_SIZE
 from explorer.app.view import LOD_TARGET, LOD_VERTICES
 from explorer.app.viewport import PlotterView
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import draw_as_the_engine
+from explorer.render.vtk import DRAW_LOCK, draw_as_the_engine
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
@@ -260,6 +260,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         self.controller.files.keep_last_session()
         if self.controller.turntable is not None:
             self.controller.turntable.cancel()  # nothing written
-        self.worker.close()
-        self.plotter.close()
+        self.worker.close()  # (joined: its off-screen windows closed, under DRAW_LOCK)
+        with DRAW_LOCK:  # the view's window goes while no other thread draws
+            self.plotter.close()
         super().closeEvent(event)

@@ -49,6 +49,7 @@ from explorer.app.web.pictures import Pictures
 from explorer.core.errors import ExplorerError
 from explorer.geometry.meshes import Mesh
 from explorer.render.offscreen import BACKGROUND
+from explorer.render.vtk import DRAW_LOCK
 from explorer.shading import tiers
 
 log = logging.getLogger(__name__)
@@ -347,7 +348,8 @@ class WebExplorer:
         if self.pictures is not None:
             self.pictures.close()
         self._uploads.cleanup()
-        self.plotter.close()
+        with DRAW_LOCK:  # the view's window goes while no other thread draws
+            self.plotter.close()
 
 
 def own_arguments() -> None:

@@ -278,6 +278,22 @@ def test_difference_view_from_the_worker(win, qtbot):
     assert not win.controller.state.difference and win.view.drawings[0].actor.GetVisibility()
 
 
+def test_closing_the_window_while_the_difference_worker_computes(win, qtbot, monkeypatch):
+    """The window closed while its difference worker computes a map: the worker's thread has
+    ended when the close returns, and the view's window was closed while no other thread
+    drew (DRAW_LOCK held)."""
+    from explorer.render.vtk import DRAW_LOCK
+
+    held = []
+    real = win.plotter.close
+    monkeypatch.setattr(win.plotter, "close", lambda: (held.append(DRAW_LOCK._is_owned()), real()))
+    win.panel.view.difference.click()
+    qtbot.waitUntil(lambda: win.worker.busy, timeout=WAIT_MS)
+    thread = win.worker._thread
+    win.close()
+    assert not thread.is_alive() and held == [True]
+
+
 def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot, monkeypatch):
     """One kd step with the difference view on: one engine update, one upload, one frame, one
     seal, the difference checked once and asked for once; a result for the state before is

@@ -168,3 +168,37 @@ def test_a_session_keeps_the_maps_and_their_off_state(open_window, qtbot, tmp_pa
     assert state.material.diffuse_map == c.state.material.diffuse_map
     assert state.material.emission_map.file == str(TEAPOT.parent / "tiles.png")
     assert state.mesh_uv
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1000, 700)])
+def test_the_status_bar_names_the_hidden_maps_whole_beside_the_engine_word(
+    open_window, qtbot, monkeypatch, size
+):
+    """While the status bar also says the numpy engine serves (its longest word), the summary
+    still names every map turned off, whole and unclipped (docs/maps_window.png read "hidden:"
+    with nothing after it; at 640x480 the label was squeezed below its text: "hidden: diffuse_"),
+    and its tooltip says the whole summary; the labels sit side by side in the bar."""
+    from explorer.app import captions
+    from explorer.shading import tiers
+
+    w = open_window("--mesh", str(TEAPOT))
+    c = w.controller
+    c.set_value("emission_map", str(TEAPOT.parent / "tiles.png"), merge=False)
+    c.set_value("emission_map", False, merge=False)
+    c.set_value("diffuse_map", False, merge=False)
+    monkeypatch.setattr(tiers, "status", lambda: f"numpy engine; {tiers.PREPARING}")
+    w.engine.show()
+    w.resize(*size)
+    qtbot.waitUntil(lambda: w.width() == size[0])
+    qtbot.wait(50)
+    label, engine, bar = w.status_label, w.engine_label, w.statusBar()
+    shown = label.shown()  # (drawn at the label's width)
+    assert label.text() == label.toolTip() == captions.summary(c.state)
+    assert "hidden: diffuse_map, emission_map" in shown, shown
+    assert label.fontMetrics().horizontalAdvance(shown) <= label.contentsRect().width(), shown
+    assert engine.text().startswith("numpy engine")
+    boxes = [w.widget_box(x) for x in (engine, label, w.messages_indicator)]
+    for (x0, _, w0, _), (x1, _, _, _) in zip(boxes, boxes[1:], strict=False):
+        assert x0 + w0 <= x1, boxes  # side by side, none over the next
+    x, _, width, _ = w.widget_box(bar)
+    assert x <= boxes[0][0] and boxes[-1][0] + boxes[-1][2] <= x + width, boxes
