@@ -296,6 +296,7 @@ def pytest_runtest_setup(item):
 def pytest_configure_node(node):
     """A worker is given the folder that says whether the background compile runs."""
     node.workerinput["explorer_compile"] = str(_shared_folder())
+    _COMPILE.setdefault("workers", {})
 
 
 @pytest.hookimpl(optionalhook=True)
@@ -342,9 +343,11 @@ def pytest_terminal_summary(terminalreporter):
     out = log.read_text(errors="replace").strip().splitlines()
     last = out[-1] if out else "no output"
     ran = _COMPILE.get("ran", float("nan"))
-    workers = _COMPILE.get("workers", {})
+    workers = _COMPILE.get("workers")
     if proc.returncode == -signal.SIGTERM:  # no test that calls a kernel was left to wait
         how = "stopped at the end of the run"
+    elif workers == {}:  # with workers, none of which ran a test outside BEFORE_KERNELS
+        how = "no worker waited for it"
     elif workers:
         waits = ", ".join(f"{w['waited']:.1f} s ({name})" for name, w in sorted(workers.items()))
         how = f"the workers waited {waits} for it"
