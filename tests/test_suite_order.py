@@ -1,6 +1,7 @@
 """The suite's order (tests/conftest.py): the tests that call no numba kernel run first, beside
 the background compile on a cold cache, the window tests of tests/app/qt last, and the list of
-the first names test modules that exist (a renamed module would quietly join the others)."""
+the first names test modules that exist (a renamed module would quietly join the others); and
+how the two workers share that order (tests/helpers/workers.py)."""
 
 from __future__ import annotations
 
