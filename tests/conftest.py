@@ -256,7 +256,7 @@ def _shared_folder() -> Path:
     """The pytest process's folder of the background compile's ``started`` and ``ended`` files,
     which its workers look at (made on first use; removed at the end of the session)."""
     if "folder" not in _COMPILE:
-        _COMPILE["folder"] = Path(tempfile.mkdtemp(prefix="explorer-compile-"))
+        _COMPILE["folder"] = Path(tempfile.mkdtemp(prefix="explorer-compile-ends-"))
     return _COMPILE["folder"]
 
 
