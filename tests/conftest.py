@@ -32,9 +32,16 @@ compile's passes (:func:`explorer.shading.warm.exercise`) in a process of its ow
 :data:`BEFORE_KERNELS` first, and lets the first other test wait for that process: by then it
 has filled numba's cache and the tests load the kernels instead of compiling them. On a warm
 cache nothing is started; the order is the same either way.
+
+Two workers (pytest-xdist, ``-n 2`` in pyproject.toml's addopts; ``-n 0``: one process): the
+pytest process starts the background compile as above and hands out whole modules in the order
+above (tests/helpers/workers.py); the first test of each worker outside :data:`BEFORE_KERNELS`
+waits for the compile (its end is a file in a folder the workers are given), and the summary
+line gives each worker's wait.
 """
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -120,12 +127,20 @@ def pytest_configure(config):
 
 
 def _is_golden_test(item) -> bool:
-    return "golden" in getattr(item, "name", "")
+    return imagecompare.is_golden_test_name(getattr(item, "name", ""))
 
 
 def _before_kernels(item) -> bool:
+    return _in_before_kernels(item.path)
+
+
+def _before_kernels_id(config, nodeid: str) -> bool:
+    return _in_before_kernels(config.rootpath / nodeid.split("::", 1)[0])
+
+
+def _in_before_kernels(path: Path) -> bool:
     try:
-        where = item.path.resolve().relative_to(TESTS).as_posix()
+        where = path.resolve().relative_to(TESTS).as_posix()
     except ValueError:  # a test outside tests/ (tests/test_strict.py's own runs)
         return False
     return where in BEFORE_KERNELS
@@ -181,12 +196,14 @@ def _cold_kernels() -> bool:
 def _start_compile(config) -> None:
     """On a cold cache, :func:`explorer.shading.warm.exercise` in a process of its own (the
     engine's compiled tier, numba's cache of this session), its output in a file; once per
-    session."""
-    if _COMPILE or os.environ.get("PYTEST_XDIST_WORKER") or config.option.collectonly:
+    session, in the pytest process (with workers: the one that hands out the tests). The file
+    ``started`` in :func:`_shared_folder` says it runs, ``ended`` that it ended."""
+    if "checked" in _COMPILE or _worker(config) or config.option.collectonly:
         return
     _COMPILE["checked"] = True
     if not _cold_kernels():
         return
+    (_shared_folder() / "started").touch()
     # closed in _end_compile, read and removed in pytest_terminal_summary
     log = tempfile.NamedTemporaryFile(prefix="explorer-compile-", suffix=".log", delete=False)  # noqa: SIM115
     code = "from explorer.shading import warm; print(warm.exercise(), 'passes')"
@@ -198,9 +215,11 @@ def _start_compile(config) -> None:
     def note_the_end():
         proc.wait()
         _COMPILE["ran"] = time.monotonic() - started
+        (_shared_folder() / "ended").write_text(str(proc.returncode))
 
-    threading.Thread(target=note_the_end, daemon=True).start()
-    _COMPILE.update(proc=proc, log=log, waited=None)
+    noting = threading.Thread(target=note_the_end, daemon=True)
+    noting.start()
+    _COMPILE.update(proc=proc, log=log, waited=None, noting=noting)
 
 
 def _end_compile(stop: bool = False) -> None:
@@ -216,6 +235,7 @@ def _end_compile(stop: bool = False) -> None:
     except subprocess.TimeoutExpired:  # the tests compile what they need themselves
         proc.kill()
         proc.wait()
+    _COMPILE["noting"].join()
     _COMPILE["waited"] = time.monotonic() - t
     _COMPILE["log"].close()
 
@@ -227,17 +247,91 @@ def _end_compile(stop: bool = False) -> None:
 COMPILE_TIMEOUT = 3600
 
 
-def pytest_runtest_setup(item):
-    if not _before_kernels(item) and _COMPILE.get("proc") and _COMPILE["waited"] is None:
-        from explorer.shading import warm
+def _worker(config) -> bool:
+    """Whether this process is a pytest-xdist worker (which is given the shared folder)."""
+    return hasattr(config, "workerinput")
 
+
+def _shared_folder() -> Path:
+    """The pytest process's folder of the background compile's ``started`` and ``ended`` files,
+    which its workers look at (made on first use; removed at the end of the session)."""
+    if "folder" not in _COMPILE:
+        _COMPILE["folder"] = Path(tempfile.mkdtemp(prefix="explorer-compile-ends-"))
+    return _COMPILE["folder"]
+
+
+def _called_kernels() -> list[str]:
+    """The kernels this process called so far (the tests of BEFORE_KERNELS should call none)."""
+    from explorer.shading import warm
+
+    return sorted(name for name, sigs in warm.signatures().items() if sigs)
+
+
+def _wait_in_worker(config) -> None:
+    """A worker's first test outside BEFORE_KERNELS: wait while the background compile runs;
+    the wait and the kernels called before it go back to the pytest process."""
+    folder = Path(config.workerinput["explorer_compile"])
+    _COMPILE["waited"] = 0.0
+    if not (folder / "started").exists():
+        return
+    called, t = _called_kernels(), time.monotonic()
+    while not (folder / "ended").exists() and time.monotonic() - t < COMPILE_TIMEOUT:
+        time.sleep(0.2)
+    config.workeroutput["explorer_compile"] = {"waited": time.monotonic() - t, "called": called}
+
+
+def pytest_runtest_setup(item):
+    if _before_kernels(item):
+        return
+    if _worker(item.config):
+        if "waited" not in _COMPILE and "explorer_compile" in item.config.workerinput:
+            _wait_in_worker(item.config)
+    elif _COMPILE.get("proc") and _COMPILE["waited"] is None:
         # kernels the tests before this one called: BEFORE_KERNELS names a module it should not
-        _COMPILE["called"] = sorted(name for name, sigs in warm.signatures().items() if sigs)
+        _COMPILE["called"] = _called_kernels()
         _end_compile()
 
 
+@pytest.hookimpl(optionalhook=True)
+def pytest_configure_node(node):
+    """A worker is given the folder that says whether the background compile runs."""
+    node.workerinput["explorer_compile"] = str(_shared_folder())
+    _COMPILE.setdefault("workers", {})
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_node_collection_finished(node, ids):
+    """With workers, the pytest process collects nothing itself: the background compile starts
+    (or not) here as pytest_collection_modifyitems says, before the first test is handed out."""
+    first = sum(1 for nodeid in ids if _before_kernels_id(node.config, nodeid))
+    if first == len(ids):
+        _end_compile(stop=True)
+    elif first:
+        _start_compile(node.config)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """A worker's wait for the background compile, for the summary line."""
+    out = getattr(node, "workeroutput", {}).get("explorer_compile")
+    if out is not None:
+        _COMPILE.setdefault("workers", {})[node.gateway.id] = out
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """Whole modules to the workers, in the suite's order (tests/helpers/workers.py); xdist's
+    own for a ``--dist`` other than its default, ``load``."""
+    if config.getoption("dist") != "load":
+        return None
+    from helpers.workers import ModuleScheduling
+
+    return ModuleScheduling(config, log)
+
+
 def pytest_sessionfinish(session, exitstatus):
-    _end_compile(stop=True)
+    if not _worker(session.config):
+        _end_compile(stop=True)
 
 
 def pytest_terminal_summary(terminalreporter):
@@ -249,8 +343,15 @@ def pytest_terminal_summary(terminalreporter):
     out = log.read_text(errors="replace").strip().splitlines()
     last = out[-1] if out else "no output"
     ran = _COMPILE.get("ran", float("nan"))
+    workers = _COMPILE.get("workers")
     if proc.returncode == -signal.SIGTERM:  # no test that calls a kernel was left to wait
         how = "stopped at the end of the run"
+    elif workers == {}:  # with workers, none of which ran a test outside BEFORE_KERNELS
+        how = "no worker waited for it"
+    elif workers:
+        waits = ", ".join(f"{w['waited']:.1f} s ({name})" for name, w in sorted(workers.items()))
+        how = f"the workers waited {waits} for it"
+        _COMPILE["called"] = sorted({k for w in workers.values() for k in w["called"]})
     else:
         how = f"the tests waited {_COMPILE['waited']:.1f} s for it"
     terminalreporter.write_line(
@@ -263,6 +364,11 @@ def pytest_terminal_summary(terminalreporter):
     if proc.returncode not in (0, -signal.SIGTERM):
         terminalreporter.write_line("\n".join(out[-20:]))
     log.unlink(missing_ok=True)
+
+
+def pytest_unconfigure(config):
+    if "folder" in _COMPILE:
+        shutil.rmtree(_COMPILE.pop("folder"), ignore_errors=True)
 
 
 def pytest_deselected(items):

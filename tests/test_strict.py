@@ -27,8 +27,10 @@ FILES = {
 
 
 def _pytest(directory: Path, *names: str) -> tuple[int, str]:
+    # in one process (-n 0 after addopts' -n 2): the settings checked are the same, and two
+    # workers for a few lines of tests made a run outlast its timeout on a loaded machine
     cmd = [sys.executable, "-m", "pytest", "-c", str(ROOT / "pyproject.toml"), "--rootdir",
-           str(directory), "-p", "no:cacheprovider", "-q", "-rA", *names]  # fmt: skip
+           str(directory), "-p", "no:cacheprovider", "-q", "-rA", "-n", "0", *names]  # fmt: skip
     r = subprocess.run(cmd, cwd=directory, capture_output=True, text=True, timeout=120)
     return r.returncode, r.stdout + r.stderr
 

@@ -71,6 +71,12 @@ USED: set[str] = set()
 INCOMPLETE: list[str] = []
 
 
+def is_golden_test_name(name: str) -> bool:
+    """Whether a test of this name (a node id's last part) is a golden test: the name says so.
+    tests/conftest.py watches these tests, tests/helpers/workers.py keeps them in one worker."""
+    return "golden" in name
+
+
 @dataclass(frozen=True)
 class Comparison:
     """How far a picture is from another.

@@ -23,7 +23,11 @@ def test_a_token_is_random_long_and_url_safe():
 
 
 @pytest.mark.parametrize(
-    "given", [None, "", "wslink-secret", TOKEN[:-1], TOKEN + "x", 12, [TOKEN], TOKEN.swapcase()]
+    "given",
+    [None, "", "wslink-secret", TOKEN[:-1], TOKEN + "x", 12, [TOKEN], TOKEN.swapcase()],
+    # named, not shown: the token is new in each process, and the suite's workers must collect
+    # the same test ids (tests/helpers/workers.py)
+    ids=["none", "empty", "wslink-default", "cut", "longer", "number", "in-a-list", "swapcase"],
 )
 def test_only_the_token_itself_is_the_token(given):
     assert G.token_ok(TOKEN, TOKEN)
