@@ -20,7 +20,7 @@ aiohttp = pytest.importorskip("aiohttp")
 msgpack = pytest.importorskip("msgpack")
 
 from webserver import Server  # noqa: E402
-from wireclient import Tab, connect  # noqa: E402
+from wireclient import Tab, connect, session  # noqa: E402
 
 pytestmark = pytest.mark.web
 
@@ -80,7 +80,7 @@ def test_a_claimed_size_allocates_nothing(server):
     before = peak_memory(server.proc.pid)
 
     async def go():
-        async with aiohttp.ClientSession() as s:
+        async with session() as s:
             small = await connect(s, server)
             for mid in (7, 8):
                 await small.ws.send_bytes(struct.pack("<III", mid, 0, 300 << 20))
@@ -103,7 +103,7 @@ def test_an_upload_of_numbers_allocates_nothing_and_is_refused(server):
     before = peak_memory(server.proc.pid)
 
     async def go():
-        async with aiohttp.ClientSession() as s:
+        async with session() as s:
             tab = await connect(s, server)
             await tab.set_state(mesh_upload={"name": "m.obj", "content": [900_000_000]})
             await settle([tab], "message", None, timeout=3)
@@ -124,7 +124,7 @@ def test_a_tab_that_stops_reading_freezes_no_other_tab(server):
     stopped reading: none came for a minute)."""
 
     async def go():
-        async with aiohttp.ClientSession() as s, aiohttp.ClientSession(read_bufsize=4096) as s2:
+        async with session() as s, session(read_bufsize=4096) as s2:
             slow = await connect(s2, server)
             sender, other = await connect(s, server), await connect(s, server)
             slow._reader.cancel()  # it reads no more: its socket's buffers fill
@@ -151,7 +151,7 @@ def test_each_tab_receives_a_change_once(server):
     tab), and not the tab that picked it; an upload's content likewise."""
 
     async def go():
-        async with aiohttp.ClientSession() as s:
+        async with session() as s:
             tabs = [await connect(s, server) for _ in range(4)]
             a, others = tabs[0], tabs[1:]
             want = "pearl" if await server_state(s, server, "preset") != "pearl" else "jade"
@@ -175,7 +175,7 @@ def test_a_tab_that_spoke_last_converges(server):
     picks = ["emerald", "bronze", "jade", "pearl", "chrome", "brass", "ruby", "gold"]
 
     async def go():
-        async with aiohttp.ClientSession() as s:
+        async with session() as s:
             a, b = await connect(s, server), await connect(s, server)
             shown = []
             for i in range(0, len(picks), 2):
@@ -196,7 +196,7 @@ def test_no_tab_stops_the_server(server):
     serves every tab still (before, any tab's call stopped it)."""
 
     async def go():
-        async with aiohttp.ClientSession() as s:
+        async with session() as s:
             tab = await connect(s, server)
             replies = [
                 await tab.call("application.exit.later", [0]),
@@ -344,7 +344,7 @@ def test_fuzzed_messages_leave_the_server_serving(fuzz_server, seed):
     rng = random.Random(seed)
 
     async def go():
-        async with aiohttp.ClientSession() as s:
+        async with session() as s:
             tabs: list[Tab] = []
             sent = 0
             end = time.monotonic() + 3.0

@@ -6,6 +6,7 @@ tab must introduce itself is a change here only."""
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import itertools
 
 import aiohttp
@@ -14,6 +15,24 @@ from wslink.chunking import HEADER_LENGTH, _decode_header, generate_chunks
 
 #: the largest frame the raw client sends (wslink's page sends 4 MiB at most)
 FRAME = 4 << 20
+#: the tabs of each open :func:`session` (by the session's id), closed as it ends
+_TABS: dict[int, list] = {}
+
+
+@contextlib.asynccontextmanager
+async def session(**kw):
+    """An aiohttp client session (``kw``: its options) whose tabs (:func:`connect`) are all
+    closed before it is: a tab's websocket left open went to the garbage collector with its
+    connection, and aiohttp's "Unclosed connection" warning then failed whichever test was
+    running (test_each_tab_receives_a_change_once, in CI's two-worker run)."""
+    async with aiohttp.ClientSession(**kw) as s:
+        _TABS[id(s)] = tabs = []
+        try:
+            yield s
+        finally:
+            del _TABS[id(s)]
+            for tab in tabs:
+                await tab.close()
 
 
 async def connect(session: aiohttp.ClientSession, server, *, hello: bool = True) -> Tab:
@@ -28,6 +47,7 @@ async def connect(session: aiohttp.ClientSession, server, *, hello: bool = True)
         headers={"Origin": f"http://127.0.0.1:{port}"},
     )
     tab = Tab(ws)
+    _TABS.get(id(session), []).append(tab)
     if hello:
         reply = await tab.call("wslink.hello", [{"secret": server.token}], system=True)
         assert "result" in reply, reply
