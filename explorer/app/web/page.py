@@ -10,8 +10,6 @@ trame is imported inside :func:`build` (``import explorer`` stays free of it).
 
 from __future__ import annotations
 
-import contextlib
-
 from explorer.app import intents as X
 from explorer.app import panelmodel, rowlayout
 from explorer.app.turntablejob import (
@@ -327,22 +325,19 @@ def _rows(v3, html, ctrl, tab: str, after=None) -> None:
     reads in the component that renders it, so a change of a row's keys re-renders that row
     alone; in the tab's one slot, a kd change (``kd_text``) re-rendered every row of the tab
     (issue 42, benchmarks/trace_web_change.py)."""
+    after = after or {}
     for how, group in rowlayout.lines(panelmodel.rows(tab)):
-        if how == "line":
-            with v3.VDefaultsProvider():
-                line = html.Div(classes="d-flex")
-        else:
-            line = contextlib.nullcontext()
-        with line:
-            for r in group:
-                if how == "line":
+        if how == "line":  # toggles side by side: one component, one flex line
+            with v3.VDefaultsProvider(), html.Div(classes="d-flex"):
+                for r in group:
                     _row(v3, html, ctrl, r)
-                else:
-                    with v3.VDefaultsProvider():
-                        _row(v3, html, ctrl, r)
-                if r.key in (after or {}):
-                    with v3.VDefaultsProvider():
-                        after[r.key]()
+        for r in group:
+            if how != "line":
+                with v3.VDefaultsProvider():
+                    _row(v3, html, ctrl, r)
+            if r.key in after:  # (after a line's toggle: under the line)
+                with v3.VDefaultsProvider():
+                    after[r.key]()
 
 
 def _row(v3, html, ctrl, r) -> None:
