@@ -248,9 +248,11 @@ def main() -> None:
             driver.get(url)
             size_view(driver)
             time.sleep(1.0)
-            x, y = driver.execute_async_script(REPORT_JS)["probe"]["px"]
+            # bench_web's probe: the probe vertex's pixel, read by the page's picture worker
+            probe = driver.execute_async_script(REPORT_JS)["probe"]["px"]
+            driver.execute_script("window.phongPictures.probe = arguments[0];", probe)
             for i in range(2):  # warm-up changes
-                driver.execute_async_script(SAMPLE_JS, 300 + 400 * (i % 2), x, y)
+                driver.execute_async_script(SAMPLE_JS, 300 + 400 * (i % 2))
                 time.sleep(0.3)
             addr = driver.capabilities["goog:chromeOptions"]["debuggerAddress"]
             cdp = Cdp(addr)
@@ -278,7 +280,7 @@ def main() -> None:
             t0, c0 = time.perf_counter(), thread_ticks(pids)
             muts, keys_per = [], []
             for i in range(args.repeat):
-                got = driver.execute_async_script(SAMPLE_JS, 300 + 400 * (i % 2), x, y)
+                got = driver.execute_async_script(SAMPLE_JS, 300 + 400 * (i % 2))
                 if got == -1:
                     raise RuntimeError("no new picture within 20 s")
                 time.sleep(0.3)  # the still picture, as bench_web's samples
