@@ -391,7 +391,7 @@ def _view_tab(v3, html, ctrl) -> None:
         html.Div("{{ legend }}", classes="text-caption", v_show="difference")
         html.Div(
             "{{ advice }}",
-            classes="text-caption",
+            classes="text-caption mt-1",  # (apart from the legend's figures, as in the window)
             v_show="difference && advice",
             style="white-space: pre-line",
             raw_attrs=['aria-label="advice"'],
