@@ -63,12 +63,13 @@ ROOT = Path(__file__).resolve().parent.parent
 #: whose colour at the probe vertex's pixel is more than 8 levels from the last one's (kd 0.3
 #: and 0.7 are far apart, and a still picture's lossless copy differs from its JPEG by a
 #: level): the ms from the change to that picture on screen, the change's and the picture's
-#: arrival (epoch ms; the arrival: its Blob made, KEEP_BLOBS_JS), its draw (epoch ms) and the
-#: probe's own cost (ms). The page's worker (explorer.app.web.pictures.PAGE_JS) decodes and
-#: draws each picture into the view's canvas, reads the probe pixel there (one pixel, after the
-#: draw: ``phongPictures.probe``) and stamps ``shown`` at its next animation frame, when the
-#: drawn frame is composited: the time ends there, in the worker, not when the page's busy main
-#: thread hears of it.
+#: arrival (epoch ms; the arrival: a raw frame's message in the worker's direct socket, or a
+#: JPEG's Blob made, KEEP_BLOBS_JS), its draw (epoch ms), the probe's own cost (ms) and whether
+#: it came raw. The page's worker (explorer.app.web.pictures.PAGE_JS) draws each picture into
+#: the view's canvas (a raw frame as it is; a JPEG or PNG decoded), reads the probe pixel there
+#: (one pixel, after the draw: ``phongPictures.probe``) and stamps ``shown`` at its next
+#: animation frame, when the drawn frame is composited: the time ends there, in the worker, not
+#: when the page's busy main thread hears of it.
 SAMPLE_JS = """
 const [step, done] = arguments;
 const c = document.querySelector('[aria-label="view"] canvas.phong-picture');
@@ -80,8 +81,8 @@ const on = () => {
   if (before && Math.max(...p.probe.map((v, i) => Math.abs(v - before[i]))) <= 8) return;
   c.removeEventListener('phong-picture', on);
   const shown = p.shown - performance.timeOrigin;  // (the worker's epoch ms, on the page clock)
-  done([shown - t0, performance.timeOrigin + t0, performance.timeOrigin + window.blobAt, p.drawn,
-        p.probeMs]);
+  const arrived = p.direct ? p.arrived : performance.timeOrigin + window.blobAt;
+  done([shown - t0, performance.timeOrigin + t0, arrived, p.drawn, p.probeMs, p.direct]);
 };
 c.addEventListener('phong-picture', on);
 window.trame.state.set('kd_step', step);
@@ -284,7 +285,7 @@ def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dic
     time.sleep(1.0)
     rep = driver.execute_async_script(REPORT_JS)
     driver.execute_script("window.phongPictures.probe = arguments[0];", rep["probe"]["px"])
-    ts, steps, cpus, probe_ms = [], [], [], []
+    ts, steps, cpus, probe_ms, raws = [], [], [], [], []
     browser_pids = descendants(driver.service.process.pid)
     for i in range(repeat + 2):
         step = 300 + 400 * (i % 2)  # kd 0.3 and 0.7
@@ -293,8 +294,9 @@ def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dic
         c1 = cpu_ms([server_pid] if server_pid else []), cpu_ms(browser_pids)
         if got == -1:
             raise RuntimeError("the picture did not change within 20 s")
-        t, changed, arrived, drawn, probe = got
+        t, changed, arrived, drawn, probe, direct = got
         if i >= 2:
+            raws.append(bool(direct))
             ts.append(float(t))
             probe_ms.append(float(probe))
             cpus.append((c1[0] - c0[0], c1[1] - c0[1]))
@@ -320,6 +322,7 @@ def latency(driver, url: str, repeat: int, server_pid: int | None = None) -> dic
         "decode": decode,
         "cpu": tuple(statistics.median(c[k] for c in cpus) for k in (0, 1)),
         "probe_ms": statistics.median(probe_ms),
+        "direct": sum(raws) / len(raws),  # (the share of the samples that came raw)
     }
 
 
@@ -423,8 +426,11 @@ def timed_call(fn, repeat: int):
 
 
 def breakdown(web: dict) -> list[str]:
-    """Where the page's time goes (medians of the samples' steps, the decode)."""
+    """Where the page's time goes (medians of the samples' steps, the decode): the steps of the
+    path its pictures took (``web["direct"]``: raw frames through the direct socket, else JPEGs
+    through trame's socket)."""
     st, dec = web["steps"], web["decode"]
+    raw = web.get("direct", 0) > 0.5
     work = st.get("frame_ms", float("nan")) + st.get("read", 0.0) + st.get("encode", 0.0)
 
     def row(name, v):
@@ -452,6 +458,25 @@ def breakdown(web: dict) -> list[str]:
             st.get("render"),
         ),
         row("  read-back (the back buffer, GetPixelData)", st.get("read")),
+    ]
+    if raw:
+        return lines + [
+            row(
+                "the frame's way to the page (sent → its message in the worker's direct socket)",
+                st.get("back"),
+            ),
+            row(
+                "its arrival → its frame on screen (the worker spreads the RGB to the canvas's "
+                "RGBA and puts it; its next animation frame)",
+                st.get("shown"),
+            ),
+            row("  its arrival → drawn (in the worker)", st.get("drawn")),
+            "",
+            f"Picture size: {st['bytes'] / 1024:.0f} KiB raw RGB"
+            if st.get("bytes")
+            else "Picture size: the frame's RGB, 3 bytes a pixel.",
+        ]
+    lines += [
         row("  JPEG encode (Pillow, quality 100, 4:4:4, baseline)", st.get("encode")),
         row("the picture's way to the page (sent → its Blob made in the page)", st.get("back")),
         row(
@@ -466,7 +491,7 @@ def breakdown(web: dict) -> list[str]:
             dec.get("jpeg", [None])[0],
         ),
     ]
-    size = [f"JPEG {st['bytes'] / 1024:.0f} KiB" if "bytes" in st else ""]
+    size = [f"JPEG {st['bytes'] / 1024:.0f} KiB" if st.get("bytes") else ""]
     if "png" in dec:
         size.append(
             f"the still picture's PNG {dec['png'][1] / 1024:.0f} KiB, decoded in "
@@ -548,15 +573,18 @@ def measure(args) -> int:
     before = load()
     try:
         ready = ready_times(driver, args.starts)
-        port = free_port()
-        path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
-        with open(path, "w") as log:
-            proc = start_server(port, log)
-            try:
-                web = latency(driver, wait_url(port, path), args.repeat, proc.pid)
-            finally:
-                stop(proc)
-        path.unlink()
+        pages = {}  # the direct socket's raw frames (a page of this machine), and the JPEGs
+        for name, extra in (("direct", ()), ("jpeg", ("--no-direct",))):
+            port = free_port()
+            path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
+            with open(path, "w") as log:
+                proc = start_server(port, log, *extra)
+                try:
+                    pages[name] = latency(driver, wait_url(port, path), args.repeat, proc.pid)
+                finally:
+                    stop(proc)
+            path.unlink()
+        web, jpeg = pages["direct"], pages["jpeg"]
         version = driver.capabilities.get("browserVersion", "?")
     finally:
         driver.quit()
@@ -587,11 +615,18 @@ def measure(args) -> int:
         "| front end | view | ms |",
         "|---|---|---:|",
         f"| web page: slider value set in the page → the view's next picture on screen (page "
-        f"clock) | {ww}x{wh} | {web['ms']:.1f} ({web['best']:.1f}) |",
+        f"clock); raw frames through the direct socket (a page on the server's machine; "
+        f"{web['direct']:.0%} of the samples came raw) | {ww}x{wh} | {web['ms']:.1f} "
+        f"({web['best']:.1f}) |",
+        f"| the same page served `--no-direct`: JPEGs through trame's socket (as a page on "
+        f"another machine gets them) | {jpeg['size'][0]}x{jpeg['size'][1]} | {jpeg['ms']:.1f} "
+        f"({jpeg['best']:.1f}) |",
         f"| Qt window: number field set → frame done (glFinish) | {vw}x{vh} | "
         f"{qt['kd'][0]:.1f} ({qt['kd'][1]:.1f}) |",
         "",
-        f"The page takes {web['ms'] - qt['kd'][0]:+.1f} ms ({ratio:.2f}x) the window's time.",
+        f"The page takes {web['ms'] - qt['kd'][0]:+.1f} ms ({ratio:.2f}x) the window's time; "
+        f"served `--no-direct`, {jpeg['ms'] - qt['kd'][0]:+.1f} ms "
+        f"({jpeg['ms'] / qt['kd'][0]:.2f}x).",
         "",
         f"CPU a change takes (median ms, user and system, from the change to its picture "
         f"shown; the clock ticks are 10 ms): the page's server process {web['cpu'][0]:.0f}, "
@@ -599,9 +634,15 @@ def measure(args) -> int:
         f"included: {web['probe_ms']:.2f} ms median, in the page's worker); the window's "
         f"process {qt.get('cpu', {}).get('kd', float('nan')):.0f} (mean over its changes).",
         "",
-        "Where the page's time goes (medians over the same changes):",
+        "Where the page's time goes (medians over the same changes), raw frames through the "
+        "direct socket:",
         "",
         *breakdown(web),
+        "",
+        f"The same served `--no-direct` (JPEGs; the server's process {jpeg['cpu'][0]:.0f} ms "
+        f"CPU a change, the browser's {jpeg['cpu'][1]:.0f}):",
+        "",
+        *breakdown(jpeg),
         "",
         f"Encoding one {SIZE[0]}x{SIZE[1]} frame (median of {args.repeat}; size; largest "
         f"error in 8-bit levels):",

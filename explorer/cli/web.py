@@ -50,6 +50,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument("--open", action="store_true", help="open the page in the default browser")
     p.add_argument(
+        "--no-direct",
+        dest="direct",
+        action="store_false",
+        help="send every picture as JPEG (then PNG once the view is still), never raw through "
+        "the direct socket a page of this machine gets: for a slow link that arrives on a "
+        "loopback address, such as an SSH tunnel (three slow frames send it back anyway)",
+    )
+    p.add_argument(
         "--session", metavar="FILE", default=None,
         help="open a saved session (Save session, or the desktop's) exactly as it was",
     )  # fmt: skip
@@ -90,6 +98,6 @@ def run(args) -> int:
     state, mesh = start_state(args, warnings)
     app = web.WebExplorer(state, mesh, materials_dirs=tuple(args.materials_dirs),
                           background=background_from_options(args), last_session=True,
-                          start_warnings=tuple(warnings))  # fmt: skip
+                          start_warnings=tuple(warnings), direct=args.direct)  # fmt: skip
     web.serve(app, port=args.port, host=host, open_browser=args.open)
     return 0

@@ -26,6 +26,9 @@ As Jupyter does it:
   dropped before it reaches the state or any other tab, and logged.
 - **The page names no server path**: the mesh chooser's values are :class:`MeshValues`, and
   the page's ``mesh`` is taken back only as one of them.
+- **The direct picture socket** (raw frames to the page's worker, :mod:`explorer.app.web.direct`)
+  is for a page of this machine only: a loopback connection with the page's cookie, not behind
+  a proxy (:func:`direct_refusal`), besides the Host and Origin every websocket is checked for.
 """
 
 from __future__ import annotations
@@ -166,6 +169,32 @@ def page_verdict(path: str, query_token, cookie_token, token: str) -> str:
     if path not in PAGE_PATHS or token_ok(query_token, token):
         return "serve"
     return "redirect" if token_ok(cookie_token, token) else "refuse"
+
+
+def loopback(peer: str | None) -> bool:
+    """Whether address ``peer`` (a connection's remote address) is this machine's loopback
+    (127.0.0.0/8, ::1, or an IPv4 loopback written as IPv6)."""
+    try:
+        ip = ipaddress.ip_address((peer or "").split("%")[0])
+    except ValueError:
+        return False
+    mapped = getattr(ip, "ipv4_mapped", None)
+    return ip.is_loopback or (mapped is not None and mapped.is_loopback)
+
+
+def direct_refusal(peer: str | None, names, cookie_token, token: str) -> str | None:
+    """Why a request for the direct picture socket (:mod:`explorer.app.web.direct`: raw
+    frames, about 1.4 MiB each) is refused, or None when it is not: the server behind a proxy
+    (``names`` None: :func:`host_ok`; the browser may be anywhere), a connection that does not
+    come from this machine (``peer``: :func:`loopback`), no token in the page's cookie. The
+    Host and the Origin were checked by the middleware, as for every websocket."""
+    if names is None:
+        return "the server is behind a proxy"
+    if not loopback(peer):
+        return f"{peer or 'an unknown address'} is not this machine"
+    if not token_ok(cookie_token, token):
+        return "no token"
+    return None
 
 
 # -- what a client may set --------------------------------------------------------------------

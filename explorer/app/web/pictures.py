@@ -81,7 +81,7 @@ PAGE_JS = """
 (() => {
   if (window.phongPictures) return;
   const P = window.phongPictures = {shown: 0, streams: 0, bytes: false, sent: 0, drawn: 0,
-                                     probe: null};
+                                     direct: null};
   // the Blob of each picture URL handed on (the stream makes the URL, then its event: the last
   // Blob made is the event's), until a view's <img> is given it (a few kept)
   const pictures = new Map();
@@ -102,7 +102,7 @@ PAGE_JS = """
       ev.image = {src: ev.url, width: w, height: h};
       P.shown += 1;
       if (made && made.url === ev.url) {
-        pictures.set(ev.url, made.blob);
+        pictures.set(ev.url, {blob: made.blob, view: String(ev.metadata.id)});
         if (pictures.size > 8) pictures.delete(pictures.keys().next().value);
       }
     }
@@ -121,21 +121,103 @@ PAGE_JS = """
   streams();
   // (4) the worker: one OffscreenCanvas a view; a picture is decoded, then drawn unless a newer
   // one of the view is drawn already (decodes may end out of order); the report goes back at
-  // the worker's next animation frame (the drawn frame is then composited)
+  // the worker's next animation frame (the drawn frame is then composited). (5) Its direct
+  // socket (explorer.app.web.direct): the raw frames of the views it shows, drawn as they
+  // come; while they come, the view's JPEGs and PNGs (the same frames, later) are not drawn
   const WORKER = `
-    const views = new Map();
-    let decodes = 0;
+    const views = new Map();  // the page's id of a view -> its canvas and what it showed
+    const byView = new Map();  // the server's id of a view -> the page's
+    let decodes = 0, shows = 0, probe = null, sock = null;
     const frame = self.requestAnimationFrame ? (f) => requestAnimationFrame(f)
       : (f) => setTimeout(f, 0);
+    // the drawing and its report (both paths): the canvas sized, painted, the probe read
+    const show = (id, v, m, size, paint) => {
+      if (v.canvas.width !== size[0] || v.canvas.height !== size[1]) {
+        v.canvas.width = size[0];
+        v.canvas.height = size[1];
+      }
+      v.ctx = v.ctx || v.canvas.getContext('2d', {alpha: false});
+      paint(v.ctx);
+      const drawn = performance.timeOrigin + performance.now(), seq = ++shows;
+      let read = null, probeMs = 0;
+      if (probe) {
+        const t = performance.now();
+        read = Array.from(v.ctx.getImageData(probe[0], probe[1], 1, 1).data.slice(0, 3));
+        probeMs = performance.now() - t;
+      }
+      frame(() => postMessage({id, seq, url: m.url, size, drawn, probe: read, probeMs, decodes,
+                               direct: !!m.direct, arrived: m.arrived || null,
+                               shown: performance.timeOrigin + performance.now()}));
+    };
+    const say = (m) => { if (sock && sock.readyState === 1) sock.send(JSON.stringify(m)); };
+    // 4 pixels from 3 little-endian words of RGB: the canvas's RGBA words, opaque
+    const expand = (s, d, n) => {
+      for (let i = 0, j = 0; j < n; i += 3, j += 4) {
+        const a = s[i], b = s[i + 1], c = s[i + 2];
+        d[j] = 0xff000000 | a;
+        d[j + 1] = 0xff000000 | (a >>> 24) | (b << 8);
+        d[j + 2] = 0xff000000 | (b >>> 16) | (c << 16);
+        d[j + 3] = 0xff000000 | (c >>> 8);
+      }
+    };
+    const raw = (buf, arrived) => {
+      if (!(buf instanceof ArrayBuffer) || buf.byteLength < 16) return;
+      const [view, count, w, h] = new Uint32Array(buf, 0, 4);
+      const id = byView.get(String(view)), v = views.get(id), n = w * h, q = Math.ceil(n / 4);
+      if (v && buf.byteLength >= 16 + 12 * q) {
+        if (!v.image || v.image.width !== w || v.image.height !== h) {
+          v.rgba = new Uint32Array(4 * q);
+          v.image = new ImageData(new Uint8ClampedArray(v.rgba.buffer, 0, 4 * n), w, h);
+        }
+        expand(new Uint32Array(buf, 16, 3 * q), v.rgba, n);
+        v.direct = true;
+        show(id, v, {url: 'direct:' + view + ':' + count, direct: true, arrived}, [w, h],
+             (ctx) => ctx.putImageData(v.image, 0, 0));
+      }
+      say({drawn: count});
+    };
+    const connect = (url) => {
+      try {
+        sock = new WebSocket(url);
+      } catch (err) {
+        postMessage({direct: 'refused', why: String(err)});
+        return;
+      }
+      sock.binaryType = 'arraybuffer';
+      sock.onopen = () => {
+        postMessage({direct: 'open'});
+        for (const g of byView.keys()) say({show: g});
+      };
+      sock.onclose = (e) => {
+        sock = null;
+        for (const v of views.values()) v.direct = false;  // (the JPEG path again)
+        postMessage({direct: 'closed', code: e.code, why: e.reason});
+      };
+      sock.onmessage = (e) => raw(e.data, performance.timeOrigin + performance.now());
+    };
     onmessage = async (e) => {
       const m = e.data;
+      if (m.direct) return connect(m.direct);
+      if (m.close) { if (sock) sock.close(1000, 'the page went'); return; }
+      if ('probe' in m) { probe = m.probe; return; }
       if (m.canvas) {  // (its context made at its first draw: an opaque canvas is black
         views.set(m.id, {canvas: m.canvas, ctx: null, drawn: 0});  // until then)
         return;
       }
-      if (m.drop) { views.delete(m.id); return; }
+      if (m.drop) {
+        const v = views.get(m.id);
+        if (v && v.view) { byView.delete(v.view); say({hide: v.view}); }
+        views.delete(m.id);
+        return;
+      }
       const v = views.get(m.id);
       if (!v) return;
+      if (m.view && v.view !== m.view) {  // the server's view this canvas shows: asked for raw
+        v.view = m.view;
+        byView.set(m.view, m.id);
+        say({show: m.view});
+      }
+      if (v.direct) return;  // (its raw frames come: this one was sent before, or as well)
       let bmp;
       try {
         decodes += 1;
@@ -145,25 +227,10 @@ PAGE_JS = """
         postMessage({id: m.id, seq: m.seq, error: String(err)});
         return;
       }
-      if (m.seq < v.drawn) { bmp.close(); return; }
+      if (m.seq < v.drawn || v.direct) { bmp.close(); return; }
       v.drawn = m.seq;
-      const size = [bmp.width, bmp.height];
-      if (v.canvas.width !== size[0] || v.canvas.height !== size[1]) {
-        v.canvas.width = size[0];
-        v.canvas.height = size[1];
-      }
-      v.ctx = v.ctx || v.canvas.getContext('2d', {alpha: false});
-      v.ctx.drawImage(bmp, 0, 0);
+      show(m.id, v, m, [bmp.width, bmp.height], (ctx) => ctx.drawImage(bmp, 0, 0));
       bmp.close();
-      const drawn = performance.timeOrigin + performance.now();
-      let probe = null, probeMs = 0;
-      if (m.probe) {
-        const t = performance.now();
-        probe = Array.from(v.ctx.getImageData(m.probe[0], m.probe[1], 1, 1).data.slice(0, 3));
-        probeMs = performance.now() - t;
-      }
-      frame(() => postMessage({id: m.id, seq: m.seq, url: m.url, size, drawn, probe, probeMs,
-                               decodes, shown: performance.timeOrigin + performance.now()}));
     };`;
   let worker = null;
   try {
@@ -174,6 +241,14 @@ PAGE_JS = """
   } catch (err) {
     worker = null;  // (the <img> loads the pictures, as trame's view does)
   }
+  if (worker) {  // (the page goes: its raw frames end now, not when the browser lets go)
+    window.addEventListener('pagehide', () => worker.postMessage({close: true}));
+  }
+  let probe = null;  // (the probe is the worker's: it reads the pixel after each draw)
+  Object.defineProperty(P, 'probe', {
+    get() { return probe; },
+    set(v) { probe = v; if (worker) worker.postMessage({probe: v}); },
+  });
   const views = new WeakMap();  // a view's <img> -> its canvas's side
   const byId = new Map();
   let ids = 0, seq = 0;
@@ -190,6 +265,13 @@ PAGE_JS = """
     canvas.phong = {seq: 0, url: null, size: null, drawn: null, shown: null, probe: null};
     worker.postMessage({id: view.id, canvas: off}, [off]);
     byId.set(view.id, view);
+    const state = window.trame && window.trame.state;
+    if (P.direct === null && state && state.get('direct')) {  // (the server offers it)
+      const url = new URL('pictures', location.href);
+      url.protocol = url.protocol === 'https:' ? 'wss:' : 'ws:';
+      P.direct = 'connecting';
+      worker.postMessage({direct: url.href});
+    }
   };
   // a view's first picture may come before its <img> is in the page (trame's canvas view adds
   // it with its container): the canvas is made and the picture drawn once it is, looked for
@@ -212,6 +294,11 @@ PAGE_JS = """
   if (worker) {
     worker.onmessage = (e) => {
       const m = e.data, view = byId.get(m.id);
+      if (typeof m.direct === 'string') {  // the direct socket's news
+        P.direct = m.direct;
+        if (m.direct === 'closed' && m.why) console.log('The raw pictures ended:', m.why);
+        return;
+      }
       if (m.error) console.log('The picture could not be decoded', m.error);
       if (!view || m.error) return;
       Object.assign(view.canvas.phong, m);
@@ -221,14 +308,14 @@ PAGE_JS = """
     Object.defineProperty(HTMLImageElement.prototype, 'src', {
       get() { return src.get.call(this); },
       set(v) {
-        const blob = pictures.get(v);
-        if (!blob) return src.set.call(this, v);
+        const got = pictures.get(v);
+        if (!got) return src.set.call(this, v);
         let view = views.get(this);
         if (!view) views.set(this, view = {id: ++ids, url: null, canvas: null, pending: null});
         if (view.url === v) return;  // (the same picture again: the first-picture listener's)
         view.url = v;
         seq += 1;
-        const picture = {id: view.id, seq, blob, url: v, probe: P.probe};
+        const picture = {id: view.id, seq, blob: got.blob, url: v, view: got.view};
         if (view.canvas) return worker.postMessage(picture);
         const waiting = view.pending;
         view.pending = picture;  // (the newest picture waits for the <img> to be in the page)
@@ -330,13 +417,15 @@ class Pictures:
     (ms: render, read, encode; bytes; ``at``: when it was made and ``change_at`` when the last
     change arrived, epoch ms) for the benchmark."""
 
-    def __init__(self, publisher, loop, guard):
+    def __init__(self, publisher, loop, guard, direct=None):
         self.pub = publisher
         self.loop = loop
         self.guard = guard
+        self.direct = direct  # the pages' direct sockets (web.direct.Direct), or None
         self.asked: set[str] = set()  # views asked for a picture since their last one
         self.last: dict[str, tuple[int, np.ndarray]] = {}  # view -> (picture number, pixels)
         self.count = 0  # pictures made (every view's)
+        self._pages: dict[str, int] = {}  # view -> trame's observer count (pages showing it)
         self.times: dict[str, float] = {}
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="page-png")
         publisher.decode = False  # (bytes, no base64)
@@ -346,6 +435,14 @@ class Pictures:
     def close(self) -> None:
         self._pool.shutdown(wait=False, cancel_futures=True)
 
+    def resend(self, v_id: str) -> None:
+        """View ``v_id``'s last frame again, losslessly (PNG), to the pages that take the JPEG
+        path: a page whose direct socket ended had its last frames through it only
+        (:class:`explorer.app.web.direct.Direct`'s ``gone``)."""
+        last = self.last.get(v_id)
+        if last is not None:
+            self._still(v_id, last[0])
+
     # -- trame-vtk's publisher, replaced ---------------------------------------------------------
     def push_render(self, v_id, ignore_animation=False, stale_count=0) -> None:
         """The publisher's ``push_render``: a picture of view ``v_id`` is sent when anything but
@@ -353,6 +450,10 @@ class Pictures:
         info = self.pub.tracking_views.get(v_id)
         if info is None or not info["enabled"]:
             return
+        pages = int(info.get("observerCount", 1))
+        if self.direct is not None and pages > self._pages.get(v_id, 0):
+            self.direct.expect(str(v_id))  # a page began to show it: its first picture as JPEG
+        self._pages[v_id] = pages
         if not ignore_animation:
             self.asked.add(v_id)
             if self.pub.views_in_animations:
@@ -364,14 +465,19 @@ class Pictures:
             info["originalSize"] = list(self.pub.get_view(v_id).GetSize())
         ratio = info.get("ratio", 1)
         size = [int(s * ratio + 0.5) for s in info["originalSize"]]
+        if self.direct is not None and self.direct.covers(str(v_id)):
+            info["mtime"] = self._frame({"view": v_id, "size": size})[1]
+            return  # every page got it raw, through its direct socket: no JPEG, no PNG
         reply = self.still_render({"view": v_id, "size": size})
         info["mtime"] = reply["mtime"]
         self._publish(reply)
         self.loop.call_later(STILL_S, self.guard(self._still, "picture"), v_id, reply["mtime"])
 
-    def still_render(self, options: dict) -> dict:
-        """The publisher's ``still_render``: view ``options["view"]`` rendered at
-        ``options["size"]``, read back and encoded as JPEG (its reply, ``image`` as bytes)."""
+    def _frame(self, options: dict) -> tuple[str, int, np.ndarray, float]:
+        """View ``options["view"]`` rendered at ``options["size"]`` and read back; the frame
+        sent to the direct sockets that show the view. Returns the view's id, the picture's
+        number, its pixels ((h, w, 3) uint8, rows top to bottom) and when it began
+        (``time.perf_counter``); :attr:`times` says its steps."""
         from explorer.app.web.wire import ARRIVED  # (wslink's, imported with the server)
         from explorer.render.vtk import DRAW_LOCK  # (VTK only once a page asks)
 
@@ -386,24 +492,35 @@ class Pictures:
             t1 = time.perf_counter()
             pixels = read_back(view)
         t2 = time.perf_counter()
-        image = encode(pixels, lossless=False)
-        t3 = time.perf_counter()
         self.count += 1
         self.last[v_id] = (self.count, pixels)
+        direct = self.direct.send(v_id, self.count, pixels) if self.direct is not None else 0
         self.times = {
             "render": 1e3 * (t1 - t0),
             "read": 1e3 * (t2 - t1),
-            "encode": 1e3 * (t3 - t2),
-            "bytes": len(image),
+            "encode": 0.0,
+            "bytes": pixels.nbytes if direct else 0,
+            "direct": direct,  # (the direct sockets the frame went to)
             "at": 1e3 * time.time(),  # (epoch ms: the page's clock is the same machine's)
             "change_at": ARRIVED.get("trame.state.update"),  # (the last change's arrival)
         }
+        return v_id, self.count, pixels, t0
+
+    def still_render(self, options: dict) -> dict:
+        """The publisher's ``still_render``: view ``options["view"]`` rendered at
+        ``options["size"]``, read back (:meth:`_frame`) and encoded as JPEG (its reply,
+        ``image`` as bytes)."""
+        v_id, count, pixels, t0 = self._frame(options)
+        t2 = time.perf_counter()
+        image = encode(pixels, lossless=False)
+        t3 = time.perf_counter()
+        self.times.update(encode=1e3 * (t3 - t2), bytes=len(image), at=1e3 * time.time())
         h, w = pixels.shape[:2]
         return {
             "image": image,
             "format": "jpeg",
             "stale": False,
-            "mtime": self.count,
+            "mtime": count,
             "size": [w, h],
             "memsize": len(image),
             "global_id": v_id,
@@ -431,6 +548,8 @@ class Pictures:
             return  # a newer picture of the view went since: it is not still
         if not self._shown(v_id):
             return  # nobody would see it
+        if self.direct is not None and self.direct.covers(v_id):
+            return  # every page has it exactly (raw, through its direct socket)
 
         def sent(future) -> None:
             if future.cancelled() or self.last.get(v_id, (None,))[0] != count:

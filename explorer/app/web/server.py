@@ -42,8 +42,9 @@ from explorer.app.start import (
 )
 from explorer.app.steps import Steps
 from explorer.app.viewport import PlotterView
-from explorer.app.web import guard, page, panel, wire
+from explorer.app.web import direct, guard, page, panel, wire
 from explorer.app.web.compare import WebCompare
+from explorer.app.web.direct import Direct
 from explorer.app.web.files import WebFiles
 from explorer.app.web.pictures import Pictures
 from explorer.core.errors import ExplorerError
@@ -79,11 +80,14 @@ class WebExplorer:
         :func:`serve` keeps the session when the server stops (True: the desktop's file,
         ``--last`` reopens it; None: nowhere); start_warnings : the warnings of the start
         mesh's materials (printed at the start; the page's message log lists them too)
+    direct : whether a page of this machine may take its pictures raw through its direct
+        socket (:mod:`explorer.app.web.direct`); False: every picture goes as JPEG (then PNG)
+        through trame's socket (``phong-explorer web --no-direct``)
     """
 
     def __init__(self, state: M.State, mesh: Mesh, *, materials_dirs=(), preset_dir=None,
                  size=VIEW_SIZE, name: str = "phong-explorer", background=None,
-                 last_session=None, start_warnings=()):  # fmt: skip
+                 last_session=None, start_warnings=(), direct: bool = True):  # fmt: skip
         from trame.app import get_server
 
         from explorer.render.vtk import plotter  # VTK only once a server is made
@@ -102,6 +106,16 @@ class WebExplorer:
         self.files = WebFiles(self, self._uploads.name)  # the uploads and downloads
         self.loop = None  # the server's event loop (the difference worker delivers into it)
         self.pictures = None  # the pages' picture path (web.pictures.Pictures), once it runs
+        self.direct = None  # the direct sockets (web.direct.Direct): None with direct False
+        if direct:
+            self.direct = Direct(
+                self._direct_refusal,
+                self._tabs,
+                self._last_frame,
+                self._resend,
+                stall=wire.SEND_STALL_S,
+            )
+        self._wire = None  # wslink's connection handler (web.wire.WireHandler), once bound
         self._job: Steps | None = None  # the long job running (run_steps)
         self.server = get_server(name, client_type="vue3")
         self.token = guard.new_token()  # the page's key: in the URL the user is given only
@@ -129,8 +143,10 @@ class WebExplorer:
         page.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
         self.server.state.engine = tiers.status() or ""
+        self.server.state.direct = False  # (offered once the server runs: _ready)
         self.server.controller.on_server_ready.add(self._ready)
         self.server.controller.on_server_bind.add(wire.bind)  # the wire's limits (issue 37)
+        self.server.controller.on_server_bind.add(self._bind_direct)
         self.controller.start()
         self.controller.files.say_mesh_warnings(mesh.name, start_warnings, logged=True)
         self.viewport.show_start(state)
@@ -171,9 +187,36 @@ class WebExplorer:
         import asyncio
 
         self.loop = asyncio.get_event_loop()
+        with self.server.state as s:  # (the pages try the direct socket only where offered)
+            s.direct = self.direct is not None and self.hosts is not None
         for p in self.server.protocol.getLinkProtocols():
             if hasattr(p, "push_render") and hasattr(p, "tracking_views"):
-                self.pictures = Pictures(p, self.loop, self.guard)
+                self.pictures = Pictures(p, self.loop, self.guard, self.direct)
+
+    # -- the direct sockets (explorer.app.web.direct) ---------------------------------------------
+    def _bind_direct(self, web_server) -> None:
+        """trame's ``on_server_bind``: the direct socket's route, beside wslink's."""
+        handlers = getattr(web_server, "_ws_handlers", [])
+        self._wire = handlers[0] if handlers else None
+        if self.direct is not None:
+            web_server.app.router.add_get(direct.PATH, self.direct.handle)
+
+    def _direct_refusal(self, request) -> str | None:
+        sock = request.transport.get_extra_info("sockname") if request.transport else None
+        port = int(sock[1]) if sock else 0
+        cookie = request.cookies.get(guard.cookie_name(port))
+        return guard.direct_refusal(request.remote, self.hosts, cookie, self.token)
+
+    def _tabs(self) -> int:
+        """The pages connected (wslink's authenticated connections)."""
+        return len(self._wire._targets()) if self._wire is not None else 1
+
+    def _last_frame(self, view: str):
+        return self.pictures.last.get(view) if self.pictures is not None else None
+
+    def _resend(self, view: str) -> None:
+        if self.pictures is not None:
+            self.pictures.resend(view)
 
     # -- Dialogs ---------------------------------------------------------------------------------
     def ask_text(self, title: str, label: str, default: str = "") -> str | None:

@@ -1,5 +1,6 @@
-"""The page's side of the pictures (explorer.app.web.pictures.PAGE_JS, the server's socket):
-in headless Chromium, each picture is decoded once, by the page's worker, and drawn into the
+"""The page's side of the pictures (explorer.app.web.pictures.PAGE_JS, the server's socket)
+as a page without the direct socket gets them (a server started ``--no-direct``): in headless
+Chromium, each picture is decoded once, by the page's worker, and drawn into the
 canvas over the view's ``<img>`` (which loads none), which shows the new frame after a change
 and the still frame's PNG after the JPEG; the worker's probe pixel is the screenshot's; a change
 the page makes goes to the server before the page redraws; the server's socket does not
@@ -7,9 +8,12 @@ deflate."""
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from test_web import open_page, report, shown_picture, view_pixels, wait
+from webserver import Server, need_browser
 
 pytestmark = pytest.mark.web
 
@@ -34,6 +38,19 @@ URL.createObjectURL = (b) => {
   return url;
 };
 """
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    """``phong-explorer web --mesh sphere --no-direct``: the pictures of a page that gets no
+    direct socket (a page of another machine), JPEG then PNG through trame's socket (the raw
+    frames of a page of this machine: test_web_direct)."""
+    need_browser()
+    tmp = tmp_path_factory.mktemp("web_jpeg")
+    env = dict(os.environ, PHONG_EXPLORER_MATERIALS=str(tmp / "presets"))
+    srv = Server(["--mesh", "sphere", "--no-direct"], tmp / "server.log", env=env)
+    yield srv
+    srv.stop()
 
 
 @pytest.fixture(scope="module")
