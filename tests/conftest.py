@@ -71,6 +71,7 @@ TESTS = Path(__file__).resolve().parent
 #: that comes to call a kernel only costs time (it compiles what it needs itself).
 BEFORE_KERNELS = (
     "app/web/test_jupyter_proxy.py",
+    "app/web/test_web_direct.py",
     "app/web/test_web_intents.py",
     "app/web/test_web_layout.py",
     "app/web/test_web_maps.py",
@@ -80,6 +81,7 @@ BEFORE_KERNELS = (
     "app/web/test_web_security.py",
     "app/web/test_web_wire.py",
     "app/web/test_webfiles.py",
+    "app/web/test_webdirect.py",
     "app/web/test_webguard.py",
     "app/web/test_webwire.py",
     "app/test_model.py",

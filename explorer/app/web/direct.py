@@ -253,7 +253,7 @@ class Direct:
         if why:
             log.info("web: a page's direct pictures ended: %s", why)
         if code is None:
-            from explorer.app.web.wire import abort
+            from explorer.app.web.wire import abort  # (wslink and aiohttp: with the server)
 
             abort(client.ws)
         else:

@@ -92,9 +92,9 @@ def need_browser() -> None:
     pytest.importorskip("trame")
 
 
-def new_browser(downloads: Path):
+def new_browser(downloads: Path, prefs: dict | None = None):
     """A headless Chromium at 1280x900 that saves downloads into ``downloads`` and keeps the
-    page's console log."""
+    page's console log (``prefs``: more of Chromium's preferences)."""
     from selenium import webdriver
 
     opts = webdriver.ChromeOptions()
@@ -105,6 +105,7 @@ def new_browser(downloads: Path):
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
     opts.add_experimental_option("prefs", {
         "download.default_directory": str(downloads), "download.prompt_for_download": False,
+        **(prefs or {}),
     })  # fmt: skip
     service = webdriver.ChromeService(executable_path=CHROMEDRIVER)
     return webdriver.Chrome(options=opts, service=service)
