@@ -7,22 +7,24 @@ to frame, in the same run; and how soon ``phong-explorer web`` is ready.
     python benchmarks/bench_web.py --per-pixel --repeat 15   # kd change per vertex vs per pixel
 
 - Latency: ``phong-explorer web --mesh teapot --resolution 56`` (100,578 vertices, one point
-  light) in its own process, its view sized to 800x600 in headless Chromium (Debian's, driven
-  by Selenium). Each sample sets the kd slider's value in the page (what dragging the slider
-  does: the trame state key ``kd_step``) and waits, in the page, for the view to show the next
-  picture; the time is the page's own clock (``performance.now()``) from the change to the
-  animation frame after the page's worker drew that picture into the view's canvas (the worker
-  reads the probe pixel there after each draw: one pixel, its cost printed): the message to
-  the server, the engine update, the frame, the JPEG and its way back, the decode and the draw.
-  Median and best over ``--repeat`` samples after two warm-up ones, each sample
-  started with the view still (its lossless picture gone). Where the time goes: the server's
-  own steps for each sample (``report``'s ``picture``: the change to its frame's end, the
-  frame's render, read-back and encode, explorer.app.web.pictures), the picture's arrival to
-  its draw, and the browser's decode of the last JPEG and PNG (``createImageBitmap`` on the
-  bytes received, in the page, apart); the rest is the two messages (the change to the server,
-  the picture back) and trame's work. The CPU a change takes: the server's process and the
-  browser's processes (``/proc``), from the change to its picture shown, and the window's
-  process per change (bench_gui).
+  light) in its own process, its view sized to 800x600 in headless Chromium (Debian's, driven by
+  Selenium): served as it is (the page, of this machine, takes raw frames through its direct
+  socket: explorer.app.web.direct), then served ``--no-direct`` (JPEGs through trame's socket, as
+  a page of another machine gets them). Each sample sets the kd slider's value in the page (what
+  dragging the slider does: the trame state key ``kd_step``) and waits, in the page, for the view
+  to show the next picture; the time is the page's own clock (``performance.now()``) from the
+  change to the animation frame after the page's worker drew that picture into the view's canvas
+  (the worker reads the probe pixel there after each draw: one pixel, its cost printed): the
+  message to the server, the engine update, the frame, its way back (raw, or a JPEG), the draw (a
+  JPEG decoded first). Median and best over ``--repeat`` samples after two warm-up ones, each
+  sample started with the view still (its lossless picture gone). Where the time goes: the
+  server's own steps for each sample (``report``'s ``picture``: the change to its frame's end, the
+  frame's render, read-back and encode, explorer.app.web.pictures), the picture's arrival to its
+  draw, and the browser's decode of the last JPEG and PNG (``createImageBitmap`` on the bytes
+  received, in the page, apart); the rest is the two messages (the change to the server, the
+  picture back) and trame's work. The CPU a change takes: the server's process and the browser's
+  processes (``/proc``), from the change to its picture shown, and the window's process per change
+  (bench_gui).
 - The Qt window's figure of the same run: :func:`bench_gui.qt_frames` (a number field set, the
   action, the panel, the engine, the upload and the frame; a private Xvfb), its view resized
   to the page's 800x600.

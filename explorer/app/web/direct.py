@@ -3,9 +3,9 @@
 A JPEG costs the server its encode (1.7 ms for the teapot's 800x600 frame), then its way
 through the page's main thread (wslink's message, trame's view stream, a Blob handed to the
 page's worker) and its decode in the worker (2-4 ms). On this machine's loopback the same
-frame's raw bytes (1.4 MiB of RGB) reach a worker's own socket in about 2.5 ms and are drawn
-in under 1 (docs/web_bench.md, "The direct socket"). So a page on the server's own machine
-gets its pictures raw, lossless while the view moves:
+frame's raw bytes (1.4 MiB of RGB) reach a worker's own socket in about 2.5 ms idle and are
+drawn in under 1 (``benchmarks/bench_web_transport.py``; docs/web.md, "The direct socket"). So
+a page on the server's own machine gets its pictures raw, lossless while the view moves:
 
 - **The socket.** The page's picture worker (:data:`explorer.app.web.pictures.PAGE_JS`) opens
   a websocket of its own at :data:`PATH` (beside wslink's ``ws``) and says which of the
