@@ -109,6 +109,13 @@ def path():
 
     pics.direct = D.Direct(lambda r: None, lambda: tabs[0], pics.last.get, resend, stall=5.0)
     yield pub, pics, loop, tabs, gone
+
+    async def closed():  # (the clients' writing tasks end before the loop closes)
+        for c in pics.direct.clients:
+            c.close()
+        await asyncio.sleep(0)
+
+    loop.run_until_complete(closed())
     pics.close()
     loop.close()
     pl.close()
