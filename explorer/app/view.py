@@ -528,6 +528,18 @@ class SceneView:
         w.AddObserver("EndInteractionEvent", lambda *_: release(i))
         return w
 
+    def release_handles(self) -> None:
+        """The handles gone, before the plotter closes: their observers removed (PyVista's and
+        :meth:`_new_handle`'s call into the view port from VTK's C++, where the garbage
+        collector does not see them) and their interactor unset (a sphere widget freed after
+        its interactor reads the freed interactor: a crash)."""
+        self.plotter.clear_sphere_widgets()  # (off, and out of PyVista's list: the handles)
+        for w in self.handles:
+            w.RemoveAllObservers()
+            w.SetInteractor(None)
+        self.handles = []
+        self._handle_calls = None
+
     def _show_handle(self, state: State) -> None:
         """Each light's handle where the light is, in the light's colour; the rest off."""
         if self._handle_calls is None:
