@@ -150,14 +150,13 @@ class SphereDrag:
         self.dragging = False
         self.clicked = False
         iren = window.plotter.iren.interactor
-        self._commands = {}
+        self._tags = {}  # (the tags, not the commands: a command held would hold the window)
         for event, fn in (
             ("LeftButtonPressEvent", self._press),
             ("MouseMoveEvent", self._move),
             ("LeftButtonReleaseEvent", self._release),
         ):
-            tag = iren.AddObserver(event, window.guard(fn, "lit sphere"), PRIORITY)
-            self._commands[event] = iren.GetCommand(tag)
+            self._tags[event] = window.observe(iren, event, fn, "lit sphere", PRIORITY)
 
     def _sphere(self):
         view = self.window.view
@@ -169,7 +168,7 @@ class SphereDrag:
 
     def _take(self, event: str) -> None:
         """The event is the sphere's: no observer after this one sees it."""
-        self._commands[event].SetAbortFlag(1)
+        self.window.plotter.iren.interactor.GetCommand(self._tags[event]).SetAbortFlag(1)
 
     def _press(self, _obj, event) -> None:
         if self._legend(event):

@@ -334,6 +334,13 @@ class PixelLayer:
             self._texture.SetColorModeToDirectScalars()
         self._texture.SetInputData(self._image)
 
+    def release(self) -> None:
+        """The screen quad's shader observer removed (before the plotter closes: it calls this
+        layer from VTK's C++, where the garbage collector does not see it)."""
+        if self._quad is not None:
+            self._quad[1].RemoveAllObservers()
+            self._quad = None
+
     def _make_quad(self):
         """The screen quad's PolyData and mapper: two triangles over the renderer's viewport
         (their ``tcoord`` the corners, :data:`VERTEX`), their points at the mesh's bounds

@@ -50,9 +50,16 @@ IMAGE_PARTS = {
 }
 
 
+def part_name(key: str, part: str) -> str:
+    """The accessible name of a part of row ``key`` in both front ends (the window's object
+    and accessible name, the page's ``aria-label``): ``<key>_<part>``, as a number's
+    ``slider`` and its optional ``on`` toggle, an image's :data:`IMAGE_PARTS`."""
+    return f"{key}_{part}"
+
+
 def image_part(r: Row, part: str) -> tuple[str, str]:
     """The accessible name and the tooltip of image row ``r``'s ``part`` (:data:`IMAGE_PARTS`)."""
-    return f"{r.key}_{part}", IMAGE_PARTS[part].format(key=r.key)
+    return part_name(r.key, part), IMAGE_PARTS[part].format(key=r.key)
 
 
 def file_text(file: str | None) -> str:
@@ -61,10 +68,14 @@ def file_text(file: str | None) -> str:
 
 
 def names(r: Row) -> tuple[str, ...]:
-    """The accessible names of a row's widgets that both front ends give: its key (the
-    control, or the box of a control drawn as several widgets), and an optional number's
-    ``<key>_on`` toggle; an image's file name, toggle, choose-file and clear (``<key>_file``,
-    ``<key>_on``, ``<key>_choose``, ``<key>_clear``: :data:`IMAGE_PARTS`)."""
+    """The accessible names of a row's widgets that both front ends give (:func:`part_name`):
+    its key (the control, or the box of a control drawn as several widgets); a number's
+    slider, ``<key>_slider``, and an optional number's ``<key>_on`` toggle; an image's file
+    name, toggle, choose-file and clear (``<key>_file``, ``<key>_on``, ``<key>_choose``,
+    ``<key>_clear``: :data:`IMAGE_PARTS`)."""
     if r.kind == "image":
         return r.key, *(image_part(r, p)[0] for p in IMAGE_PARTS)
-    return (r.key, f"{r.key}_on") if r.kind == "number" and r.optional is not None else (r.key,)
+    if r.kind == "number":
+        on = (part_name(r.key, "on"),) if r.optional is not None else ()
+        return r.key, part_name(r.key, "slider"), *on
+    return (r.key,)

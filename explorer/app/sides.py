@@ -75,12 +75,18 @@ class SideB:
                               lod_target=a.lod_target, side="b")  # fmt: skip
         if self.pane.handles:  # the lights are shared: B's handles move them too
             self.handles = HandleDragger(main, pl, self.view)
-        pl.renderer.AddObserver("StartEvent", main.guard(self._before_frame, "compare"))
+        main.observe(pl.renderer, "StartEvent", self._before_frame, "compare")
         self.pixels = PixelLayer(self.view)
         window = pl.render_window  # (before VTK makes its context current: see pixellayer)
-        window.AddObserver("StartEvent", main.guard(self._pixels_before, "compare"))
-        window.AddObserver("EndEvent", main.guard(lambda *_: self.pixels.after(), "compare"))
+        main.observe(window, "StartEvent", self._pixels_before, "compare")
+        main.observe(window, "EndEvent", lambda *_: self.pixels.after(), "compare")
         self.pane.made(pl, self.view)
+
+    def close(self) -> None:
+        """Side B's plotter closed, when it was made (side A's :meth:`PlotterView.close`
+        removed its observers and released its handles first)."""
+        if self.plotter is not None:
+            self.plotter.close()
 
     def _before_frame(self, *_) -> None:
         """Before a frame of side B: its triangles sorted and its inset laid out for the shared

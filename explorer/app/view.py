@@ -75,13 +75,21 @@ SELECTED_SCALE = 1.3
 #: the ring that marks the selected light's handle: its colour and its gap (pixels) around it
 RING_COLOR = (1.0, 1.0, 1.0)
 RING_GAP = 4
+#: the ring's line width (pixels)
+RING_WIDTH = 2
 #: the selected handle's glyph (the light's GLYPH: an arrow, a cone), in mesh radii
 GLYPH_LENGTH = 0.6
 GLYPH_COLOR = (1.0, 0.85, 0.2)
 #: a handle nearer than this (mesh radii) is kept in view when the camera is framed
 HANDLE_FRAMING = 5.5
-#: widest view angle (degrees) the framing may use to show the handle
+#: widest view angle (degrees) the framing may use to show the handle, across the view's
+#: narrower side (a view taller than wide may open wider upward: its width is what limits)
 MAX_VIEW_ANGLE = 60.0
+#: the widest vertical view angle (degrees) of any framing (as :func:`camera_for`'s)
+MAX_VERTICAL_ANGLE = 150.0
+#: pixels kept between the selected handle's ring and the view's edge when the camera is
+#: framed to show the handle (the ring's line, 2 pixels wide, included)
+RING_MARGIN = 12
 #: a handle out of the view is shown by an arrow at the view's edge: its length (pixels), its
 #: distance from the edge (pixels), and the outline drawn around it (for contrast)
 MARKER_SIZE = 18
@@ -90,29 +98,45 @@ MARKER_OUTLINE = (0.08, 0.08, 0.08)
 
 
 def widen_to_show(camera: Camera, points, aspect: float, *, pad: float = 0.0,
-                  margin: float = 1.1) -> Camera:  # fmt: skip
-    """``camera`` with its view widened just enough to show ``points`` (each a sphere of radius
-    ``pad``) too, in a picture of ``aspect`` (width / height); points behind a perspective
-    camera are left out. Position, direction and up are kept (the viewer does not move)."""
+                  edge_px: float = 0.0, height_px: float = 0.0) -> Camera:  # fmt: skip
+    """``camera`` with its view widened just enough to show ``points`` too, each a sphere of
+    radius ``pad`` ringed ``edge_px`` pixels beyond its outline and kept that far inside the
+    edge of a picture ``height_px`` pixels tall (0: no pixels, the spheres alone) of
+    ``aspect`` (width / height); points behind a perspective camera are left out. Position,
+    direction and up are kept (the viewer does not move). The widening stops at
+    :data:`MAX_VIEW_ANGLE` across the picture's narrower side.
+
+    The pixels are a margin of the view's own: with ``T`` the tangent of half the vertical
+    angle (a parallel camera: its half height), a pixel spans ``2 T / height_px``, and a
+    sphere whose centre is seen ``x`` from the view's axis across (in tangents; in world units
+    for a parallel camera), ``s`` its apparent radius, is in when ``x + s + edge_px · 2 T /
+    height_px <= aspect · T`` (and ``<= T`` upward): ``T`` at least ``(x + s) / (aspect -
+    2 edge_px / height_px)``."""
     from dataclasses import replace
 
     fwd = camera.direction
     up = np.asarray(camera.view_up, dtype=np.float64)
     right = np.cross(fwd, up)
     origin = np.asarray(camera.focal_point if camera.parallel else camera.position)
+    px = 2.0 * edge_px / height_px if height_px > 0 else 0.0  # a pixel's tangents, over T
+    if px >= min(aspect, 1.0):  # (a view too small for the margin: the spheres alone)
+        px = 0.0
     need = 0.0
     for p in points:
         rel = np.asarray(p, dtype=np.float64) - origin
-        x, y, z = abs(rel @ right) + pad, abs(rel @ up) + pad, rel @ fwd
+        x, y, z = abs(rel @ right), abs(rel @ up), rel @ fwd
         if camera.parallel:
-            need = max(need, y, x / aspect)
+            s = pad
         elif z > pad:
-            need = max(need, y / (z - pad), x / (aspect * (z - pad)))
-    need *= margin
+            x, y, s = x / z, y / z, pad / math.hypot(*rel)  # (hypot: no overflow at 1e300)
+        else:
+            continue
+        need = max(need, (y + s) / (1.0 - px), (x + s) / (aspect - px))
     if camera.parallel:
         return replace(camera, parallel_scale=max(camera.parallel_scale, need))
-    angle = math.degrees(2.0 * math.atan(need))
-    return replace(camera, view_angle=max(camera.view_angle, min(angle, MAX_VIEW_ANGLE)))
+    widest = math.tan(math.radians(0.5 * MAX_VIEW_ANGLE)) / min(aspect, 1.0)
+    angle = min(math.degrees(2.0 * math.atan(min(need, widest))), MAX_VERTICAL_ANGLE)
+    return replace(camera, view_angle=max(camera.view_angle, angle))
 
 
 def view_frame(centre, radius: float) -> tuple[np.ndarray, float]:
@@ -136,14 +160,19 @@ def view_camera(vtk_camera, centre, radius: float) -> Camera:
     return dataclasses.replace(cam, clipping_range=(max(d - r, 1e-3 * r), max(d + r, 2e-3 * r)))
 
 
-def framed_camera(state: State, mesh: Mesh, aspect: float) -> Camera:
-    """The camera at the scene's viewer framing the mesh, widened to show a near handle."""
+def framed_camera(state: State, mesh: Mesh, aspect: float, height_px: float = 0.0) -> Camera:
+    """The camera at the scene's viewer framing the mesh, widened to show a near handle: the
+    selected handle and its ring wholly inside the view, :data:`RING_MARGIN` pixels from its
+    edge, in a view ``height_px`` pixels tall (0: the handle alone, unknown pixels)."""
     cam = camera_for(state.scene, mesh, aspect)
     if state.selected_light is not None:
         d = state.placement()[2]
         if d <= HANDLE_FRAMING * state.radius:
-            pad = HANDLE_RADIUS * state.radius
-            cam = widen_to_show(cam, [handle_point(state)], aspect, pad=pad)
+            pad = HANDLE_RADIUS * SELECTED_SCALE * state.radius  # (the selected one's)
+            edge = RING_GAP + 0.5 * RING_WIDTH + RING_MARGIN  # the ring's outside, and more
+            cam = widen_to_show(
+                cam, [handle_point(state)], aspect, pad=pad, edge_px=edge, height_px=height_px
+            )
     return cam
 
 
@@ -528,6 +557,18 @@ class SceneView:
         w.AddObserver("EndInteractionEvent", lambda *_: release(i))
         return w
 
+    def release_handles(self) -> None:
+        """The handles gone, before the plotter closes: their observers removed (PyVista's and
+        :meth:`_new_handle`'s call into the view port from VTK's C++, where the garbage
+        collector does not see them) and their interactor unset (a sphere widget freed after
+        its interactor reads the freed interactor: a crash)."""
+        self.plotter.clear_sphere_widgets()  # (off, and out of PyVista's list: the handles)
+        for w in self.handles:
+            w.RemoveAllObservers()
+            w.SetInteractor(None)
+        self.handles = []
+        self._handle_calls = None
+
     def _show_handle(self, state: State) -> None:
         """Each light's handle where the light is, in the light's colour; the rest off."""
         if self._handle_calls is None:
@@ -587,7 +628,7 @@ class SceneView:
                 rings.append(np.column_stack([x + (r + RING_GAP) * np.cos(t),
                                               y + (r + RING_GAP) * np.sin(t)]))  # fmt: skip
         if self._ring is None:
-            self._ring = overlay(self.plotter, RING_COLOR, 2.0)[0]
+            self._ring = overlay(self.plotter, RING_COLOR, RING_WIDTH)[0]
             self._markers = overlay(self.plotter, (1.0, 1.0, 1.0), 1.0, filled=True)[0]
             self._marker_edges = overlay(self.plotter, MARKER_OUTLINE, 2.0)[0]
         set_lines(self._ring, rings)

@@ -27,6 +27,7 @@ from explorer.app.litsphere import SphereDrag
 from explorer.app.pixellayer import PixelLayer
 from explorer.app.view import LOD_TARGET, LOD_VERTICES, SceneView, view_camera
 from explorer.render.images import encode_png
+from explorer.render.vtk import DRAW_LOCK
 
 
 class Pictures(Protocol):
@@ -75,6 +76,7 @@ class PlotterView:
         self.frame_ms = float("nan")  # from the change (or redraw) to its frame's end
         self._t0: float | None = None
         self._mesh: str | None = None
+        self._observers: list = []  # (VTK object, tag) of every observer :meth:`observe` added
 
     def attach(
         self,
@@ -99,9 +101,9 @@ class PlotterView:
         self.sphere_drag = SphereDrag(self)  # (the lobe inset's lit sphere)
         self.pixels = PixelLayer(self.view)
         window = self.plotter.render_window  # (before VTK makes its context current)
-        window.AddObserver("StartEvent", self.guard(self._pixels_before, "per-pixel view"))
-        self.plotter.renderer.AddObserver("StartEvent", self.guard(self._before_frame, "frame"))
-        self.plotter.render_window.AddObserver("EndEvent", self.guard(self._after_frame, "frame"))
+        self.observe(window, "StartEvent", self._pixels_before, "per-pixel view")
+        self.observe(self.plotter.renderer, "StartEvent", self._before_frame, "frame")
+        self.observe(window, "EndEvent", self._after_frame, "frame")
         self.side_b = side_b
         return self.view
 
@@ -127,6 +129,37 @@ class PlotterView:
 
         return call
 
+    def observe(self, obj, event: str, fn, where: str, priority: float = 0.0) -> int:
+        """``fn`` (made safe: :meth:`guard`) observes VTK's ``event`` on ``obj`` until
+        :meth:`close`; returns the observer's tag. Every observer of the view port and its
+        parts is added here, so that :meth:`close` removes them all."""
+        tag = obj.AddObserver(event, self.guard(fn, where), priority)
+        self._observers.append((obj, tag))
+        return tag
+
+    def close(self) -> None:
+        """The view port's end (its front end closes): every observer :meth:`observe` added is
+        removed, the handles and the per-pixel quads of both sides let go of VTK
+        (:meth:`SceneView.release_handles`, :meth:`PixelLayer.release`), then side B's plotter
+        and this one are closed (under ``DRAW_LOCK``: no other thread draws meanwhile).
+
+        A Python callback given to VTK is held by a C++ command the garbage collector does not
+        see: one left would keep this view port, its controller and its front end (a closed
+        window, its engine and its VTK view) alive for the rest of the process."""
+        for obj, tag in self._observers:
+            obj.RemoveObserver(tag)
+        self._observers.clear()
+        b = self.side_b
+        for part in (self, b) if b is not None else (self,):
+            if part.view is not None:
+                part.view.release_handles()
+            if part.pixels is not None:
+                part.pixels.release()
+        with DRAW_LOCK:
+            if b is not None:
+                b.close()
+            self.plotter.close()
+
     def watch_drags(self, plotter) -> None:
         """``plotter``'s camera drags are drags (:meth:`begin_drag`, :meth:`end_drag`: the level
         of detail; in per-pixel mode the drag fallback): its interactor's style starts and ends
@@ -134,8 +167,8 @@ class PlotterView:
         view). Side A's plotter and side B's are watched alike."""
         style = plotter.iren.interactor.GetInteractorStyle()
         if style is not None:
-            style.AddObserver("StartInteractionEvent", self.guard(self.begin_drag, "camera"))
-            style.AddObserver("EndInteractionEvent", self.guard(self.end_drag, "camera"))
+            self.observe(style, "StartInteractionEvent", self.begin_drag, "camera")
+            self.observe(style, "EndInteractionEvent", self.end_drag, "camera")
 
     def begin_drag(self, *_) -> None:
         """A drag starts (a slider, the camera, a handle): the level of detail is drawn, and

@@ -78,8 +78,8 @@ def qapp(xserver):
 
 @pytest.fixture
 def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
-    """``open_window(*gui_args)``: the explorer window (default: ``gui --mesh icosphere
-    --resolution 3``), shown at 1000x700 and drawn once; presets are saved in
+    """``open_window(*gui_args, size=(1000, 700))``: the explorer window (default: ``gui
+    --mesh icosphere --resolution 3``), shown at ``size`` and drawn once; presets are saved in
     ``tmp_path/presets``, screenshots and the ``--state-file`` go to ``tmp_path``, and the
     last session is kept in ``tmp_path/last.yaml``."""
     from explorer.app.qt.window import ExplorerWindow
@@ -88,7 +88,7 @@ def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
 
     monkeypatch.setenv("PHONG_EXPLORER_MATERIALS", str(tmp_path / "presets"))
 
-    def make(*argv):
+    def make(*argv, size=(1000, 700)):
         argv = argv or ("--mesh", "icosphere", "--resolution", "3")
         warnings: list[str] = []  # as `gui` starts it: the start mesh's warnings in the log
         state, mesh = start_state(build_parser().parse_args(["gui", *argv]), warnings)
@@ -98,7 +98,7 @@ def open_window(xdisplay, qtbot, tmp_path, monkeypatch):
             output_dir=tmp_path,
             state_file=tmp_path / "state.json",
             last_session=tmp_path / "last.yaml",
-            size=(1000, 700),
+            size=size,
             start_warnings=tuple(warnings),
         )
         qtbot.addWidget(w)

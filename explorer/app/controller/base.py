@@ -169,7 +169,8 @@ class Controller:
     # -- camera -----------------------------------------------------------------------------
     def framed(self, state: M.State, mesh: Mesh) -> Camera:
         """``mesh`` framed from ``state``'s viewer for the view's aspect."""
-        cam = framed_camera(state, mesh, self.ports.view.aspect())
+        view = self.ports.view
+        cam = framed_camera(state, mesh, view.aspect(), view.size()[1])
         return dataclasses.replace(cam, window_center=(0.0, 0.0))
 
     def camera_moved(self, camera: Camera) -> None:

@@ -52,7 +52,7 @@ class CompareView:
                 finally:
                     self._syncing = False
 
-        pl.render_window.AddObserver("EndEvent", w._guard(draw_a, "compare"))
+        w.viewport.observe(pl.render_window, "EndEvent", draw_a, "compare")
 
     def show_pane(self, visible: bool) -> None:
         """Side B's pane shown (half the views' width, when it appears) or hidden."""

@@ -19,6 +19,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app import model as M
 from explorer.app.colours import rgb_bytes, rgb_text, swatch_squares, text_on
+from explorer.app.rowlayout import part_name
 from explorer.core.controls import CONTROLS, STEPS, Control, from_step, to_step
 from explorer.core.errors import ExplorerError
 
@@ -137,7 +138,8 @@ class ValueSlider(QtWidgets.QWidget):
         self.label = QtWidgets.QLabel(name)
         self.label.setMinimumWidth(64)
         self.slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-        self.slider.setObjectName(f"{name}_slider")
+        self.slider.setObjectName(part_name(name, "slider"))  # (the page's aria-label too)
+        self.slider.setAccessibleName(part_name(name, "slider"))
         self.slider.setRange(0, STEPS)
         self.slider.setMinimumWidth(60)
         self.field = NumberField(name, *c.field_range, decimals=c.decimals, suffix=c.unit)

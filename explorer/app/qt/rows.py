@@ -22,7 +22,7 @@ from PySide6 import QtCore, QtGui, QtWidgets
 
 from explorer.app.panelmodel import ASK_FILE, Item, Row
 from explorer.app.qt.panel import ColourButton, NumberField, ValueSlider, swatch
-from explorer.app.rowlayout import file_text, image_part, lines
+from explorer.app.rowlayout import file_text, image_part, lines, part_name
 from explorer.core.errors import ExplorerError
 from explorer.render.textures import THUMBNAIL_SIZE, thumbnail
 
@@ -123,7 +123,7 @@ class RowWidgets(QtCore.QObject):
         box = QtWidgets.QWidget()
         lay = QtWidgets.QVBoxLayout(box)
         lay.setContentsMargins(0, 0, 0, 0)
-        switch = _named(QtWidgets.QCheckBox(r.key), f"{r.key}_on", r.tip)
+        switch = _named(QtWidgets.QCheckBox(r.key), part_name(r.key, "on"), r.tip)
         switch.toggled.connect(
             lambda on, k=r.key, v=r.optional: self.send(k, v if on else None, merge=False)
         )

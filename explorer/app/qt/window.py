@@ -37,7 +37,7 @@ from explorer.app.start import TITLE, WINDOW_SIZE
 from explorer.app.view import LOD_TARGET, LOD_VERTICES
 from explorer.app.viewport import PlotterView
 from explorer.render.offscreen import BACKGROUND
-from explorer.render.vtk import DRAW_LOCK, draw_as_the_engine
+from explorer.render.vtk import draw_as_the_engine
 
 #: the panel's share of the window's width at the start (the view takes the rest)
 PANEL_FRACTION = 0.34
@@ -261,6 +261,7 @@ class ExplorerWindow(QtWidgets.QMainWindow):
         if self.controller.turntable is not None:
             self.controller.turntable.cancel()  # nothing written
         self.worker.close()  # (joined: its off-screen windows closed, under DRAW_LOCK)
-        with DRAW_LOCK:  # the view's window goes while no other thread draws
-            self.plotter.close()
+        # VTK's observers removed, the handles released, side B's plotter and the view's
+        # closed under DRAW_LOCK: nothing of VTK keeps the window, its controller or its view
+        self.viewport.close()
         super().closeEvent(event)

@@ -157,10 +157,11 @@ def _number(v3, html, ctrl, key: str, label: str) -> None:
     one row (its label and its field in columns of fixed width: :data:`NUMBER_CSS`), shown
     when the state has a value for it (``v_show`` on a wrapper: Vuetify's ``d-flex`` is
     ``display: flex !important``, which would override v-show's ``display: none``)."""
+    slider = rowlayout.part_name(key, "slider")  # (the window's slider's name too)
     with html.Div(v_show=f"{key} != null"), html.Div(classes="d-flex align-center phong-number"):
         v3.VSlider(
             v_model=(f"{key}_step", 0), min=0, max=STEPS, step=1, label=label, hide_details=True,
-            density="compact", end=ctrl.seal, raw_attrs=[f'aria-label="{key} slider"'],
+            density="compact", end=ctrl.seal, raw_attrs=[f'aria-label="{slider}"'],
             classes="flex-grow-1 mr-2",
         )  # fmt: skip
         v3.VTextField(

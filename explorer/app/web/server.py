@@ -138,7 +138,7 @@ class WebExplorer:
             self.controller, mesh, side_b=SideB(self.viewport, self.compare)
         )
         self.viewport.watch_drags(self.plotter)  # (the remote view passes the page's pointer)
-        self.plotter.render_window.AddObserver("StartEvent", self.guard(self._frame, "view"), 1.0)
+        self.viewport.observe(self.plotter.render_window, "StartEvent", self._frame, "view", 1.0)
         panel.connect(self)
         page.build(self)
         tiers.preload()  # the compiled kernels in a thread once numba's cache holds them
@@ -391,8 +391,10 @@ class WebExplorer:
         if self.pictures is not None:
             self.pictures.close()
         self._uploads.cleanup()
-        with DRAW_LOCK:  # the view's window goes while no other thread draws
-            self.plotter.close()
+        self.viewport.close()  # (VTK's observers removed; the windows closed under DRAW_LOCK)
+        if self.viewport.side_b.plotter is None:  # side B's, made with the page, never shown
+            with DRAW_LOCK:
+                self.compare.plotter.close()
 
 
 def own_arguments() -> None:

@@ -424,7 +424,9 @@ def every_row_shown(c) -> None:
 
 def test_every_row_is_drawn_in_its_tab_named_by_its_key(win):
     """Each row of :mod:`explorer.app.panelmodel` is a widget of its tab whose object name and
-    accessible name are the row's (the page's test reads the same names in the DOM)."""
+    accessible name are the row's, and so are its parts' (``rowlayout.names``: a number's
+    ``<key>_slider``, an optional number's ``<key>_on``, an image's file, switch, choose and
+    clear); the page's test reads the same names in the DOM."""
     from explorer.app import panelmodel as P
     from explorer.app import rowlayout
 

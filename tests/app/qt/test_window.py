@@ -5,7 +5,9 @@ programmatically), the difference view from its worker thread, and keys."""
 
 from __future__ import annotations
 
+import gc
 import sys
+import weakref
 
 import numpy as np
 import pytest
@@ -292,6 +294,32 @@ def test_closing_the_window_while_the_difference_worker_computes(win, qtbot, mon
     thread = win.worker._thread
     win.close()
     assert not thread.is_alive() and held == [True]
+
+
+def test_a_closed_window_is_freed(open_window, qtbot):
+    """A closed window is freed with its controller, its view port, its scenes and plotters,
+    side B's too: nothing keeps them once Qt has deleted the window. Before, VTK's commands
+    held the view port's callbacks (frames, camera drags, the lit sphere, the handles, the
+    per-pixel quad's shader) in C++, where the garbage collector does not see them, and
+    PyVista's list of plotters held side B's, never closed: every window opened and closed
+    stayed in memory with its engine and its VTK view."""
+    w = open_window()
+    c = w.controller
+    for key, value in (("compare", True), ("shading", "per-pixel"), ("difference", True)):
+        assert c.set_value(key, value, merge=False), key  # side B, the per-pixel quads, the worker
+        w.render()
+    assert w.plotter_b is not None and w.viewport.pixels.frames >= 1
+    parts = (w, c, w.viewport, w.view, w.viewport.side_b, w.view_b, w.plotter, w.plotter_b)
+    refs = [weakref.ref(o) for o in parts]
+    del c, parts
+    w.close()
+    w.deleteLater()
+    del w
+    QtCore.QCoreApplication.sendPostedEvents(None, QtCore.QEvent.Type.DeferredDelete)
+    qtbot.wait(10)
+    gc.collect()
+    alive = [type(r()).__name__ for r in refs if r() is not None]
+    assert alive == [], f"still alive after the window closed: {alive}"
 
 
 def test_a_slider_step_is_one_update_one_upload_one_frame_one_request(win, qtbot, monkeypatch):

@@ -493,3 +493,56 @@ def test_the_lobe_inset_covers_at_most_a_fifth_of_a_small_pane(open_window, qtbo
         side, height = panel_extent(img)
         assert side * height <= LI.LOBE_AREA * wide * h + 2 * (side + height), (wide, h)
         assert side >= LI.LOBE_MIN_SIDE - 2, (side, height)
+
+
+def ring_pixels(w) -> np.ndarray:
+    """(h, w) bool: the pixels of the selected handle's ring in the view's frame (the frame
+    drawn with the ring against the frame drawn without it)."""
+    props = w.plotter.renderer.GetViewProps()
+    props.InitTraversal()
+    actors = [props.GetNextProp() for _ in range(props.GetNumberOfItems())]
+    mapper_inputs = [a.GetMapper() and a.GetMapper().GetInput() for a in actors]
+    ring = actors[next(i for i, m in enumerate(mapper_inputs) if m is w.view._ring)]
+    with_ring = pixels(w.plotter).astype(int)
+    ring.SetVisibility(False)
+    without = pixels(w.plotter).astype(int)
+    ring.SetVisibility(True)
+    return np.abs(with_ring - without).max(axis=2) > 0
+
+
+#: an infinite viewer (a parallel camera) above the mesh's front
+PARALLEL = ("--viewer-to-viewer", "0", "0.4", "1")
+
+
+@pytest.mark.parametrize(
+    ("size", "viewer"),
+    [
+        pytest.param((w, h), viewer, id=f"{w}x{h}" + ("-parallel" if viewer else ""))
+        for (w, h), viewer in (
+            *((s, ()) for s in ((500, 900), (400, 900), (640, 480), (1000, 700))),
+            ((1200, 400), ()),
+            ((1400, 350), ()),
+            ((500, 900), PARALLEL),
+            ((1400, 350), PARALLEL),
+        )
+    ],
+)
+def test_the_start_shows_the_handles_ring_inside_the_view_at_every_aspect(
+    open_window, size, viewer
+):
+    """The start framed for a view of any shape (a perspective camera, or a parallel one for
+    an infinite viewer) shows the selected light's handle with its whole ring inside the view,
+    at least RING_MARGIN pixels from every edge, read from the frame's pixels. Before, the view
+    was widened by a fixed tenth: the ring came 8 and 9 pixels from the edge at 640x480 and
+    1400x350, it touched the edge of a parallel camera's 136x855 view (a 500x900 window's),
+    and in a perspective one the handle was out of the view altogether (the widening stopped
+    at 60 degrees of height: the width is what limits there)."""
+    w = open_window("--mesh", "icosphere", "--resolution", "3", *viewer, size=size)
+    assert w.controller.state.camera.parallel == bool(viewer)
+    assert w.controller.state.selected_light is not None
+    ring = ring_pixels(w)
+    h, wide = ring.shape
+    ys, xs = np.nonzero(ring)
+    assert len(xs) >= 40, f"no ring drawn in the {wide}x{h} view: the handle is out of it"
+    margins = (int(xs.min()), int(ys.min()), int(wide - 1 - xs.max()), int(h - 1 - ys.max()))
+    assert min(margins) >= V.RING_MARGIN - 1, (wide, h, margins)  # (its line's antialiasing)

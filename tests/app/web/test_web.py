@@ -689,7 +689,7 @@ def test_a_light_shows_only_the_controls_its_type_has_and_the_page_no_scrollbar(
     wait("the lights tab", lambda: by_name(browser, "distance").is_displayed())
     for key in ("cutoff", "exponent"):
         assert not by_name(browser, key).is_displayed()
-        assert not by_name(browser, f"{key} slider").is_displayed()
+        assert not by_name(browser, f"{key}_slider").is_displayed()
     choose(browser, "type", "spot")
     wait("a spot light", lambda: report(browser)["session"]["scene"]["lights"][
         rep["session"]["light"] - 1].get("type") == "spot")  # fmt: skip

@@ -169,7 +169,7 @@ def test_a_change_animates_nothing_in_the_page(page):
         return next(m["value"] for m in got if m["name"] == "RecalcStyleCount")
 
     thumb = (
-        "return document.querySelector('[aria-label=\"kd slider\"]').closest('.v-slider')"
+        "return document.querySelector('[aria-label=\"kd_slider\"]').closest('.v-slider')"
         ".querySelector('.v-slider-thumb').getBoundingClientRect().left"
     )
     left = page.execute_script(thumb)

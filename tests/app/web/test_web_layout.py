@@ -136,9 +136,9 @@ def test_pane_b_draws_the_handles_and_a_drag_there_moves_the_light(server, brows
 #: pixels (a tab shown before stays in the page, moved aside)
 SLIDERS_JS = """
 const box = e => { const r = e.getBoundingClientRect(); return [r.left, r.right]; };
-return [...document.querySelectorAll('[aria-label$=" slider"]')]
+return [...document.querySelectorAll('[aria-label$="_slider"]')]
   .filter(e => e.closest('.v-window-item--active') && e.getClientRects().length)
-  .map(e => { const key = e.getAttribute('aria-label').replace(/ slider$/, '');
+  .map(e => { const key = e.getAttribute('aria-label').replace(/_slider$/, '');
               const field = document.querySelector(`input[aria-label="${key}"]`);
               const label = e.closest('.v-slider').querySelector('.v-label');
               return {key: key, track: box(e.closest('.v-slider').querySelector('.v-slider-track')),

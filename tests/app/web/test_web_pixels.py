@@ -18,6 +18,7 @@ from webserver import Server, need_browser, new_browser
 
 from explorer.app import lobeinset as LI
 from explorer.app import session as S
+from explorer.render.offscreen import BACKGROUND
 from explorer.render.perpixel import reference
 
 pytestmark = pytest.mark.web
@@ -121,7 +122,16 @@ def test_the_page_shows_the_engines_per_pixel_picture(pp_server, pp_browser, tmp
     # the browser's pixels are the engine's per-pixel picture, within 1 level (no codec error:
     # the JPEG at quality 100 was up to 13 levels off at a highlight's coloured edge)
     d = np.abs(got - want).max(axis=2)
-    assert d[inner | edge].max() <= 1  # the silhouette too: one renderer draws both
+    assert d[inner].max() <= 1
+    # the silhouette too, but where the page's G-buffer leaves a pixel to the background that
+    # the ray cast hits: the test's servers run the numpy tier, so VTK's picture of triangle
+    # indices finds each pixel's triangle, and a pixel centre grazing an edge may fall either
+    # side of it (4 of 2396 pixels of the torus framed with its handle at 900x673; the compiled
+    # rasteriser agrees with the ray cast on every one there)
+    off = edge & (d > 1)
+    background = np.round(np.asarray(BACKGROUND) * 255).astype(int)
+    assert np.abs(got[off] - background).max(initial=0) <= 1, "a silhouette pixel is off"
+    assert off.sum() <= 0.005 * edge.sum(), (off.sum(), edge.sum())
     assert not rep["errors"]
 
 

@@ -1,6 +1,7 @@
 """The panel model's rows on the page (issue 38), in a real browser: every row of
-:mod:`explorer.app.panelmodel` is in the DOM of its tab under the name the window gives it
-(tests/app/qt/test_panel.py reads the same names from the Qt widgets), and the effect rows, drawn
+:mod:`explorer.app.panelmodel` is in the DOM of its tab under the name the window gives it, its
+parts too (a number's ``<key>_slider``, ...: ``rowlayout.names``; tests/app/qt/test_panel.py
+reads the same names from the Qt widgets), and the effect rows, drawn
 with no code of their own, change the picture, are undone, and reach the session. This module's
 server is its own (the effects it turns on stay out of the other modules' pictures)."""
 
