@@ -54,6 +54,7 @@ os.environ["PHONG_EXPLORER_KERNELS"] = "compiled"  # before the package is impor
 
 import pytest
 from helpers import imagecompare
+from helpers.processes import running_children
 from hypothesis import settings
 
 settings.register_profile("default", max_examples=100, deadline=None)
@@ -382,6 +383,20 @@ def pytest_deselected(items):
 def pytest_runtest_logreport(report):
     if report.skipped and "golden" in report.nodeid.rsplit("::", 1)[-1]:
         imagecompare.INCOMPLETE.append(f"skipped golden test: {report.nodeid}")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def no_child_left():
+    """At the session's end, after its other fixtures have ended (this one is the session's
+    first, so it ends last), no process this one started still runs: the fixtures end and
+    wait for theirs (the Xvfb of the Qt tests, the page servers, the browsers' drivers). One
+    left running was a ResourceWarning at the process's end ("subprocess N is still
+    running", from its Popen). The background compile is the pytest process's own until
+    pytest_sessionfinish ends it."""
+    yield
+    compile_ = _COMPILE.get("proc")
+    left = [c for c in running_children() if compile_ is None or c[0] != compile_.pid]
+    assert not left, f"processes the session's fixtures left running: {left}"
 
 
 @pytest.fixture(scope="module")

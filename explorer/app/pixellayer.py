@@ -137,8 +137,13 @@ class PixelLayer:
     texture's colour half and, after a new G-buffer, its depth half); last : the last
     :class:`~explorer.render.live.PixelFrame`, made for ``camera`` and ``size``; rgb : that
     picture (the G-buffer's pixels covered);
-    vertex_ms : the time of the last frame drawn per vertex (NaN before one);
-    fallback : this drag draws per vertex (the camera moves and per pixel costs too much)
+    vertex_ms : the time of the last frame drawn per vertex (NaN before one); vertex_frames :
+    the frames drawn per vertex (the mesh's own mapper, no quad);
+    fallback : this drag draws per vertex (the camera moves and per pixel costs too much);
+    drags : the camera drags decided (each once, at its first camera frame in per-pixel
+    mode); drag_decision : the last one's ``(ms, vertex_ms, fallback)``, the two times it
+    compared and what it decided (None before one): what a test reads instead of guessing
+    the decision from times read before the drag (another picture may come between)
     """
 
     def __init__(self, view: SceneView):
@@ -150,7 +155,10 @@ class PixelLayer:
         self.camera = self.size = self.rgb = None
         self.shown = False
         self.vertex_ms = float("nan")
+        self.vertex_frames = 0
         self.fallback = False
+        self.drags = 0
+        self.drag_decision: tuple[float, float, bool] | None = None
         self._decided = False  # this drag's fallback is decided
         self._t0: float | None = None
         self._made_ms = 0.0
@@ -191,6 +199,7 @@ class PixelLayer:
             total = 1000.0 * (time.perf_counter() - self._t0)
             if not self.shown:
                 self.vertex_ms = total - self._made_ms - self._aside_ms
+                self.vertex_frames += 1
             self.aside_ms = self._aside_ms
             self._t0 = None
 
@@ -214,6 +223,8 @@ class PixelLayer:
             # decided once per drag, when the camera first moves, on the pictures made before
             # it (a picture of the drag that happens to take longer does not switch mid-drag)
             self.fallback, self._decided = self.too_slow(), True
+            self.drags += 1
+            self.drag_decision = (self.ms, self.vertex_ms, self.fallback)
         if not self.wanted(state) or self.fallback:
             self._show(False)
             return False

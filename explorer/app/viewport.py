@@ -264,10 +264,13 @@ class PlotterView:
         """What either front end reports of its view (plain JSON values): the frames drawn and
         the last change's time to its frame's end (ms; None before one), the mesh's vertices,
         the probe vertex and its pixel, each light handle's pixel, undo and redo, the errors
-        said, the difference view, and the per-pixel picture (its pictures made, whether a
-        drag draws per vertex now, the last per-pixel picture's and per-vertex frame's times
-        in ms, None before one). ``at``: a pixel of the view (origin top-left) -> the pixel
-        the front end reports (the window's own; default the view's)."""
+        said, the difference view, whether a drag is under way, and the per-pixel picture
+        (its pictures made, whether a drag draws per vertex now, the last per-pixel picture's
+        and per-vertex frame's times in ms, None before one, the frames drawn per vertex, the
+        camera drags decided and the last one's decision: ``drag``, the two times it compared,
+        unrounded, and whether it fell back, None before one). ``at``: a pixel of the view
+        (origin top-left) -> the pixel the front end reports (the window's own; default the
+        view's)."""
         c, view = self.controller, self.view
         s = c.state
 
@@ -280,6 +283,14 @@ class PlotterView:
 
         probe = view.probe_vertex()
         p = self.pixels
+        drag = None
+        if p.drag_decision is not None:
+            pixel_ms, vertex_ms, fallback = p.drag_decision
+            drag = {
+                "ms": None if np.isnan(pixel_ms) else float(pixel_ms),
+                "vertex_ms": None if np.isnan(vertex_ms) else float(vertex_ms),
+                "fallback": bool(fallback),
+            }
         return {
             "frame": self.frames,
             "frame_ms": None if np.isnan(self.frame_ms) else self.frame_ms,
@@ -290,11 +301,15 @@ class PlotterView:
             "can_redo": c.store.can_redo,
             "errors": list(c.errors),
             "difference": self.heat.state(),
+            "dragging": self.dragging(),
             "pixels": {
                 "frames": p.frames,
                 "fallback": p.fallback,
                 "ms": ms(p.ms),
                 "vertex_ms": ms(p.vertex_ms),
+                "vertex_frames": p.vertex_frames,
+                "drags": p.drags,
+                "drag": drag,
             },
         }
 

@@ -8,13 +8,12 @@ import shutil
 import sys
 
 import pytest
+from helpers.processes import end_process
 
 from explorer.app.start import start_xvfb
 
 #: the private server's screen: room for the largest window size tested (1920x1080)
 SCREEN = (1920, 1200)
-#: the session's Xvfb servers (their Popen objects live as long as the process)
-_SERVERS: list = []
 
 
 def pytest_collection_modifyitems(session, config, items):
@@ -32,19 +31,42 @@ def pytest_collection_modifyitems(session, config, items):
 
 @pytest.fixture(scope="session")
 def xserver():
-    """One Xvfb for the session's in-process Qt tests (Qt keeps its connection until the
-    process ends, so the server lives as long)."""
+    """One Xvfb for the session's in-process Qt tests, ended and waited for at the session's
+    end (tests/conftest.py's ``no_child_left``) after the process's X clients are closed
+    (:func:`close_x_clients`: Qt and VTK keep their connections until then, and an X server
+    gone under one ended the process with exit status 1). Left running, its Popen warned at
+    the process's end: "ResourceWarning: subprocess N is still running"."""
     if sys.platform in ("darwin", "win32") or shutil.which("Xvfb") is None:
         pytest.skip("needs Xvfb for the Qt window (apt-get install -y xvfb)")
     pytest.importorskip("PySide6")
     pytest.importorskip("pyvistaqt")
     proc, display = start_xvfb(size=SCREEN)
-    # left running: Qt keeps its connection to the end of the process, and a server gone
-    # before that makes Xlib end the process with an I/O error; the server ends with the
-    # process (PR_SET_PDEATHSIG). Its Popen is kept: one dropped while the server runs warns
-    # (ResourceWarning, an error in the suite)
-    _SERVERS.append(proc)
-    return display
+    yield display
+    close_x_clients()
+    end_process(proc)
+
+
+def close_x_clients() -> None:
+    """Close this process's connections to the X server before it ends: every PyVista
+    plotter's render window (the Qt views' and the off-screen ones made under DISPLAY), every
+    Qt window, then the QApplication (PySide6's ``shutdown``). A server ended while one is
+    open ends the process at its next X request ("XIO: fatal IO error", "The X11 connection
+    broke"; Xlib and Qt exit 1)."""
+    if "pyvista" in sys.modules:
+        import pyvista
+
+        pyvista.close_all()
+    if "PySide6.QtWidgets" in sys.modules:
+        from PySide6 import QtCore, QtWidgets
+
+        app = QtWidgets.QApplication.instance()
+        if app is not None:
+            for w in app.topLevelWidgets():
+                w.close()
+                w.deleteLater()
+            app.sendPostedEvents(None, QtCore.QEvent.Type.DeferredDelete)
+            app.processEvents()
+            app.shutdown()
 
 
 @pytest.fixture

@@ -258,14 +258,22 @@ def test_a_camera_drag_falls_back_to_per_vertex_when_per_pixel_costs_twice(
     c.set_value("kd", 0.4)  # a slider drag moves no camera: per pixel still
     assert layer.shown and not layer.fallback
     layer.ms, layer.vertex_ms = ms, vertex_ms  # what the last frames measured
+    drags, per_vertex = layer.drags, layer.vertex_frames
     torus.plotter.camera.Azimuth(20.0)
     torus.plotter.render_window.Render()  # a frame of the camera drag
     assert layer.fallback is falls_back and layer.shown is not falls_back
+    # the decision as a report gives it: the times it compared, what it decided, once a drag
+    assert layer.drags == drags + 1 and layer.drag_decision == (ms, vertex_ms, falls_back)
+    assert layer.vertex_frames == per_vertex + int(falls_back)
+    drawn = torus.report()["pixels"]
+    assert drawn["drag"] == {"ms": ms, "vertex_ms": vertex_ms, "fallback": falls_back}
+    assert drawn["vertex_frames"] == layer.vertex_frames and drawn["drags"] == layer.drags
     said = [m for m in c.ports.messages.messages if "camera drag drawn per vertex" in m[1]]
     assert bool(said) is falls_back
     assert layer.live.gbuffers == made + (0 if falls_back else 1)
     torus.end_drag()  # the release: per pixel again, for the camera where the drag ended
     assert layer.shown and not layer.fallback and layer.live.gbuffers == made + 1
+    assert layer.drags == drags + 1 and layer.vertex_frames == per_vertex + int(falls_back)
     assert against_reference(torus)[0] <= 1
 
 

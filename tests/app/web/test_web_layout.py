@@ -245,7 +245,16 @@ def test_a_camera_drag_in_per_pixel_mode_draws_per_vertex_when_per_pixel_costs_t
     the view) draws per vertex while a per-pixel picture costs more than FALLBACK_RATIO
     per-vertex frames, the page says so, and the release draws per pixel again; a per-pixel
     picture that costs less is drawn through the drag. Frames counted on the server (the
-    page's remote view did not report its drags: every frame of a drag was per pixel)."""
+    page's remote view did not report its drags: every frame of a drag was per pixel).
+
+    Which of the two the drag is, is what the server decided at the drag's first camera frame,
+    on the times it had measured then (the report's ``pixels.drag``), not a guess from times
+    read before the drag: under load another picture can come between, and the two times are
+    the machine's. The frames drawn per vertex are counted as such (``vertex_frames``): the
+    press's and the release's frames keep the camera and make no picture, so "frames less
+    per-pixel pictures" was 2 in every drag drawn per pixel (a run at load 16 measured per
+    pixel cheaper and failed on it). The test checks that the decision follows the rule on its
+    own figures and that the frames follow the decision."""
     from explorer.app.pixellayer import FALLBACK_RATIO
 
     open_page(browser, server.url)
@@ -259,30 +268,36 @@ def test_a_camera_drag_in_per_pixel_mode_draws_per_vertex_when_per_pixel_costs_t
 
         rep = wait("per-pixel frames timed", timed)
         p0 = rep["pixels"]
-        slow = p0["ms"] > FALLBACK_RATIO * p0["vertex_ms"]
         w, h = rep["size"]
         eye = rep["session"]["scene"]["viewer"]
         steady_drag(browser, "view", (w // 2, h // 2 + 40), [(5, 0)] * 20)
 
-        def released():  # the camera turned, and a per-pixel picture since the drag
+        def released():  # the drag decided, turned the camera and ended; a per-pixel picture
             r = report(browser)
             p = r["pixels"]
             turned = r["session"]["scene"]["viewer"] != eye
-            return turned and not p["fallback"] and p["frames"] > p0["frames"] and r
+            done = p["drags"] == p0["drags"] + 1 and not r["dragging"] and not p["fallback"]
+            return turned and done and p["frames"] > p0["frames"] and r
 
-        wait("the camera to turn and the drag to end", released)
-        time.sleep(1.0)  # the drag's last frames
-        after = report(browser)
-        frames = after["frame"] - rep["frame"]
+        after = wait("the camera to turn and the drag to end", released)
+        decided = after["pixels"]["drag"]  # the server's: the times it compared, its choice
+        assert decided["fallback"] is (
+            decided["ms"] > FALLBACK_RATIO * max(decided["vertex_ms"], 0.0)
+        ), decided
+        per_vertex = after["pixels"]["vertex_frames"] - p0["vertex_frames"]
         per_pixel = after["pixels"]["frames"] - p0["frames"]
-        said = (
-            "camera drag drawn per vertex"
-            in browser.find_element("css selector", '[role="status"]').text
-        )
-        if slow:
-            assert frames - per_pixel >= 3 and per_pixel <= 2 and said, (frames, per_pixel)
+
+        def status() -> str:
+            return browser.find_element("css selector", '[role="status"]').text
+
+        if decided["fallback"]:
+            said = f"a per-pixel frame takes {decided['ms']:.0f} ms"
+            wait("the page to say the drag is drawn per vertex", lambda: said in status())
+            assert "camera drag drawn per vertex" in status()
+            assert per_vertex >= 3 and per_pixel <= 2, (decided, per_vertex, per_pixel)
         else:
-            assert frames - per_pixel <= 1 and not said, (frames, per_pixel)
+            assert per_vertex == 0 and per_pixel >= 1, (decided, per_vertex, per_pixel)
+            assert "camera drag drawn per vertex" not in status()
     finally:
         choose(browser, "shading", "per-vertex")
         click(browser, "material tab")

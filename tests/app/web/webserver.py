@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import pytest
+from helpers.processes import end_process
 
 #: how long the server may take to print its URL (the first start compiles nothing: the numpy
 #: tier serves while numba's cache is cold)
@@ -69,19 +70,6 @@ class Server:
     def stop(self) -> None:
         end_process(self.proc)
         self._out.close()
-
-
-def end_process(proc: subprocess.Popen, wait: float = 30) -> None:
-    """Ask ``proc`` to end (SIGTERM), and kill it if it still runs ``wait`` seconds later. A
-    server keeps its session as it stops: on a machine loaded 15 to 30 deep that took more
-    than 10 s (the suite's run in two workers killed test_web_parity's first server)."""
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(wait)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
 
 
 def need_browser() -> None:
