@@ -140,10 +140,9 @@ def free_port() -> int:
 
 
 def browser():
-    sys.path.insert(0, str(ROOT / "tests" / "app" / "web"))
-    from webserver import new_browser  # the tests' headless Chromium
+    from explorer.app.browser import new_browser  # the tests' headless Chromium
 
-    return new_browser(Path(os.environ.get("TMPDIR", "/tmp")))
+    return new_browser(downloads=Path(os.environ.get("TMPDIR", "/tmp")), console_log=True)
 
 
 def start_server(port: int, log, *extra: str) -> subprocess.Popen:

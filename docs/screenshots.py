@@ -187,30 +187,12 @@ def _web_server(tmp: Path, name: str, *args: str) -> tuple[subprocess.Popen, str
 
 
 def _browser(size: tuple[int, int]):
-    """Debian's headless Chromium through Selenium, its window ``size`` (w, h) CSS pixels at a
-    device scale of 1."""
-    from selenium import webdriver
+    """Debian's headless Chromium through Selenium, its page's viewport ``size`` (w, h) CSS
+    pixels at a device scale of 1 (the window is larger by the browser's own frame)."""
+    from explorer.app.browser import new_browser, set_viewport
 
-    opts = webdriver.ChromeOptions()
-    for a in (
-        "--headless=new",
-        "--no-sandbox",
-        "--disable-gpu",
-        f"--window-size={size[0]},{size[1]}",
-        "--disable-dev-shm-usage",
-        "--force-device-scale-factor=1",
-    ):
-        opts.add_argument(a)
-    opts.binary_location = "/usr/bin/chromium"
-    driver = webdriver.Chrome(
-        options=opts, service=webdriver.ChromeService(executable_path="/usr/bin/chromedriver")
-    )
-    # the window's size counts the browser's own frame: the page's viewport is made ``size``
-    inner = driver.execute_script("return [window.innerWidth, window.innerHeight];")
-    outer = driver.get_window_size()
-    driver.set_window_size(
-        outer["width"] + size[0] - inner[0], outer["height"] + size[1] - inner[1]
-    )
+    driver = new_browser(size)
+    set_viewport(driver, *size)
     return driver
 
 

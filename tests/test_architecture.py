@@ -210,11 +210,13 @@ def test_own_imports_sit_at_module_top_or_say_why():
 
 
 def test_import_explorer_loads_no_drawing_or_gui_toolkit():
+    """Nor the browser the scripts and tests drive (explorer.app.browser imports Selenium
+    inside its functions)."""
     code = (
-        "import sys, explorer; "
+        "import sys, explorer, explorer.app.browser; "
         "bad = sorted({m.split('.')[0] for m in sys.modules} & "
         "{'vtk', 'vtkmodules', 'pyvista', 'pyvistaqt', 'PySide6', 'matplotlib', 'trame', "
-        "'wslink'}); print(bad)"
+        "'wslink', 'selenium'}); print(bad)"
     )
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)

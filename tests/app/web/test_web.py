@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import explorer
+from explorer.app.browser import set_viewport
 from explorer.geometry.meshes import get_mesh
 from explorer.shading.display import to_bytes
 
@@ -455,8 +456,6 @@ def test_the_toolbar_fits_the_page_with_icons_below_1100_pixels(server, browser,
     (their words stay their accessible names and tooltips) and the session field its icon
     alone; at 1280x900 the buttons show their words (issue 42: at 900x720 the toolbar scrolled,
     "messages" half out of the page, at 640x480 "export" and "messages" out of it)."""
-    from test_web_layout import set_viewport
-
     try:
         browser.get("about:blank")
         set_viewport(browser, *size)

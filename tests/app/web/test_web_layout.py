@@ -12,6 +12,7 @@ from helpers.insets import panel_extent
 from test_web import choose, click, open_page, report, type_value, view_pixels, wait
 
 from explorer.app import lobeinset as LI
+from explorer.app.browser import set_viewport
 
 pytestmark = pytest.mark.web
 
@@ -305,19 +306,6 @@ def test_a_camera_drag_in_per_pixel_mode_draws_per_vertex_when_per_pixel_costs_t
 
 #: the least distance (pixels) of a handle's centre from its view's edge that counts as inside
 EDGE = 12
-
-
-def set_viewport(driver, w: int, h: int) -> None:
-    """The page's viewport (``window.innerWidth`` x ``innerHeight``) made ``w`` x ``h`` CSS
-    pixels: Selenium's window size counts the browser's own frame (143 pixels of height in
-    headless Chromium 156), so a 640x480 window shows a 640x337 page."""
-    for _ in range(3):
-        inner = driver.execute_script("return [window.innerWidth, window.innerHeight];")
-        if inner == [w, h]:
-            return
-        outer = driver.get_window_size()
-        driver.set_window_size(outer["width"] + w - inner[0], outer["height"] + h - inner[1])
-    assert inner == [w, h], inner
 
 
 def test_the_handle_stays_inside_the_view_until_the_camera_is_moved(tmp_path):

@@ -16,11 +16,12 @@ from pathlib import Path
 import pytest
 from helpers.processes import end_process
 
+from explorer.app import browser
+
 #: how long the server may take to print its URL (the first start compiles nothing: the numpy
 #: tier serves while numba's cache is cold)
 START_TIMEOUT = 120
-CHROMIUM = "/usr/bin/chromium"
-CHROMEDRIVER = "/usr/bin/chromedriver"
+CHROMIUM, CHROMEDRIVER = browser.CHROMIUM, browser.CHROMEDRIVER
 
 
 def free_port() -> int:
@@ -82,21 +83,9 @@ def need_browser() -> None:
 
 def new_browser(downloads: Path, prefs: dict | None = None):
     """A headless Chromium at 1280x900 that saves downloads into ``downloads`` and keeps the
-    page's console log (``prefs``: more of Chromium's preferences)."""
-    from selenium import webdriver
-
-    opts = webdriver.ChromeOptions()
-    for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--window-size=1280,900",
-              "--disable-dev-shm-usage", "--force-device-scale-factor=1"):  # fmt: skip
-        opts.add_argument(a)
-    opts.binary_location = CHROMIUM
-    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    opts.add_experimental_option("prefs", {
-        "download.default_directory": str(downloads), "download.prompt_for_download": False,
-        **(prefs or {}),
-    })  # fmt: skip
-    service = webdriver.ChromeService(executable_path=CHROMEDRIVER)
-    return webdriver.Chrome(options=opts, service=service)
+    page's console log (:func:`explorer.app.browser.new_browser`; ``prefs``: more of Chromium's
+    preferences)."""
+    return browser.new_browser(downloads=downloads, console_log=True, prefs=prefs)
 
 
 def page_origin(server: Server) -> str:
