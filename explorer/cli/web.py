@@ -55,7 +55,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_false",
         help="send every picture as JPEG (then PNG once the view is still), never raw through "
         "the direct socket a page of this machine gets: for a slow link that arrives on a "
-        "loopback address, such as an SSH tunnel (three slow frames send it back anyway)",
+        "loopback address, such as an SSH tunnel (four slow frames send it back anyway)",
     )
     p.add_argument(
         "--session", metavar="FILE", default=None,

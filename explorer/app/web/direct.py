@@ -57,11 +57,13 @@ HEADER = struct.Struct("<IIII")
 #: the longest message a page's worker may send (a ``show``, ``hide`` or ``drawn``)
 MAX_TEXT = 256
 #: seconds from a frame written to its acknowledgement above which the frame was slow: this
-#: machine's loopback takes 2-4 ms idle and under 20 under two CPU burners for an 800x600
-#: frame; a 100 Mbit/s link takes 120 ms
-SLOW_S = 0.05
-#: slow frames in a row after which the client goes back to JPEG
-SLOW_FRAMES = 3
+#: machine's loopback takes 2-6 ms idle for an 800x600 frame, and a busy machine's page may
+#: stall tens of ms now and then; a 100 Mbit/s link takes 120 ms (the JPEG is 20-25x
+#: smaller there), a 1 Gbit/s one 12 ms (raw frames still pay)
+SLOW_S = 0.1
+#: slow frames in a row after which the client goes back to JPEG (a stall of a busy machine
+#: is seldom four frames long; a slow link's every frame is slow)
+SLOW_FRAMES = 4
 #: the close code that tells the page its link is too slow for raw frames (4000-4999: an
 #: application's own)
 CLOSE_SLOW = 4000

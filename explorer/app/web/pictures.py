@@ -266,7 +266,8 @@ PAGE_JS = """
     worker.postMessage({id: view.id, canvas: off}, [off]);
     byId.set(view.id, view);
     const state = window.trame && window.trame.state;
-    if (P.direct === null && state && state.get('direct')) {  // (the server offers it)
+    const here = /^(localhost|127\\.\\d+\\.\\d+\\.\\d+|\\[::1\\])$/.test(location.hostname);
+    if (P.direct === null && here && state && state.get('direct')) {  // (offered; this machine)
       const url = new URL('pictures', location.href);
       url.protocol = url.protocol === 'https:' ? 'wss:' : 'ws:';
       P.direct = 'connecting';
