@@ -29,6 +29,17 @@ def downloads(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def browser(server, downloads):
+    """A Chromium of the module's own. One Chromium for the whole session, each module in a
+    fresh tab (other tabs closed, cookies and the origin's storage cleared, the window and the
+    downloads folder set again), was measured and left: ``python benchmarks/cpu_tree.py
+    /usr/bin/time -v python -m pytest -n 0 tests/app/web -q -p no:randomly``, alternated,
+    load 2-6, gave 311.6 and 309.7 s of CPU before, 289.9 and 307.3 s after (``time``'s own
+    figure, blind to Chromium's processes: 156.4, 158.5 against 150.9, 157.8 s); about 1 s a
+    module (12 s over the 12 modules that would share it), under the 15 s that would pay for
+    it. A test that opens a tab and closes the others (test_web's two tabs) closed the
+    session's browser with them, and one of the two runs with shared tabs failed two page
+    loads of test_web_parity (a Vue error as the page loaded; none in the three runs
+    without)."""
     need_browser()
     driver = new_browser(downloads)
     yield driver
