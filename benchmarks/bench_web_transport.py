@@ -29,20 +29,17 @@ import time
 
 import numpy as np
 
+from explorer.app.web.pictures import EXPAND_JS  # the page's worker's own spread to RGBA
+
 #: the page: a worker with its canvas and its socket; ``run(kind, n)`` times ``n`` frames
-PAGE = """<html><body style="margin:0"><canvas id="a" width="%(w)d" height="%(h)d"></canvas>
+PAGE = (
+    """<html><body style="margin:0"><canvas id="a" width="%(w)d" height="%(h)d"></canvas>
 <script>
 const W = `
 let ctx = null, ws = null, t0 = 0, kind = '', rgba = null, image = null;
-const expand = (s, d, n) => {
-  for (let i = 0, j = 0; j < n; i += 3, j += 4) {
-    const a = s[i], b = s[i + 1], c = s[i + 2];
-    d[j] = 0xff000000 | a;
-    d[j + 1] = 0xff000000 | (a >>> 24) | (b << 8);
-    d[j + 2] = 0xff000000 | (b >>> 16) | (c << 16);
-    d[j + 3] = 0xff000000 | (c >>> 8);
-  }
-};
+"""
+    + EXPAND_JS
+    + """
 onmessage = (e) => {
   const m = e.data;
   if (m.canvas) {
@@ -64,7 +61,7 @@ onmessage = (e) => {
           rgba = new Uint32Array(4 * Math.ceil(n / 4));
           image = new ImageData(new Uint8ClampedArray(rgba.buffer, 0, 4 * n), w, h);
         }
-        if (kind === 'rgb') expand(new Uint32Array(ev.data, 16), rgba, n);
+        if (kind === 'rgb') spread(new Uint32Array(ev.data, 16), 0, rgba, 0, n);
         else rgba.set(new Uint32Array(ev.data, 16, n));
         t2 = performance.now();
         ctx.putImageData(image, 0, 0);
@@ -96,6 +93,7 @@ window.run = async (kind, n) => {
   return out;
 };
 </script></body></html>"""
+)
 
 WAYS = ("jpeg", "rgb", "rgba")
 

@@ -12,9 +12,13 @@ a page on the server's own machine gets its pictures raw, lossless while the vie
   server's views it draws: ``{"show": "<view id>"}`` once a view's canvas has its first
   picture (which came the usual way, as JPEG), ``{"hide": ...}`` when the canvas goes. The
   server answers a ``show`` with the view's last frame, then sends each new frame of the view
-  as one binary message: :data:`HEADER` (view id, picture number, width, height), then the
-  rows top to bottom, RGB, zero-padded to whole 12-byte groups (the worker reads 4 pixels
-  from 3 32-bit words). The worker acknowledges each frame it draws: ``{"drawn": n}``.
+  as one binary message (:func:`message`): :data:`HEADER` (view id, picture number, width,
+  height, rectangles), each rectangle's :data:`RECT` (x, y, width, height; widths a multiple
+  of 4), then each rectangle's rows, RGB (the worker reads 4 pixels from 3 32-bit words). The
+  rectangles cover the :data:`TILE`-pixel tiles that differ from the frame the client was
+  sent last (:func:`changed_tiles`; all of them for a client's first frame of the view or a
+  new size): a kd change on the teapot alters a third of them, a camera drag every one. The
+  worker acknowledges each frame it draws: ``{"drawn": n}``.
 - **Who gets one.** A page of this machine only (:func:`explorer.app.web.guard.direct_refusal`):
   the connection comes from a loopback address, the server is not behind a proxy (through
   jupyter-server-proxy its browser may be anywhere), the request passed the guard's Host and
@@ -51,9 +55,16 @@ log = logging.getLogger(__name__)
 
 #: the socket's path, beside wslink's ``/ws`` (the page opens ``<page folder>/pictures``)
 PATH = "/pictures"
-#: a frame's header: the view's id, the picture's number, its width and height (little-endian
-#: 32-bit words; the rows follow, at a 4-byte boundary)
-HEADER = struct.Struct("<IIII")
+#: a frame's header: the view's id, the picture's number, its width and height, the number of
+#: rectangles that follow (little-endian 32-bit words)
+HEADER = struct.Struct("<IIIII")
+#: a rectangle of a frame: x, y, width (a multiple of 4), height (pixels); its rows follow the
+#: rectangles' headers, in their order, RGB
+RECT = struct.Struct("<IIII")
+#: the side of the square tiles a frame is compared in with the client's last (pixels): a kd
+#: change on the teapot at 800x600 alters 30 % of its pixels, 34 % of its 16-pixel tiles (and
+#: 56 % of their bounding box); comparing costs 0.5 ms for 900x673
+TILE = 16
 #: the longest message a page's worker may send (a ``show``, ``hide`` or ``drawn``)
 MAX_TEXT = 256
 #: seconds from a frame written to its acknowledgement above which the frame was slow: this
@@ -74,14 +85,67 @@ KEEP_SENT = 8
 ACK_S = 1.0
 
 
-def frame(view: int, number: int, pixels: np.ndarray) -> bytearray:
-    """One message of the socket: :data:`HEADER` then ``pixels`` ((h, w, 3) uint8, rows top to
-    bottom) zero-padded to a multiple of 12 bytes (one copy of the pixels: 1.4 MiB a frame)."""
+def changed_tiles(old: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """(H, W) bool: which :data:`TILE` x :data:`TILE` tiles of ``new`` differ from ``old``
+    (both (h, w, 3) uint8; H, W the tile rows and columns, the last ones partial)."""
+    h, w = new.shape[:2]
+    rows, cols = -(-h // TILE), -(-w // TILE)
+    x = np.bitwise_xor(old.reshape(h, w * 3), new.reshape(h, w * 3))
+    per_row = np.maximum.reduceat(x, np.arange(0, w * 3, TILE * 3), axis=1)  # (h, W)
+    tiles = np.zeros((rows * TILE, cols), np.uint8)
+    tiles[:h] = per_row
+    return tiles.reshape(rows, TILE, cols).any(axis=1)
+
+
+def rectangles(tiles: np.ndarray, w: int, h: int) -> list[tuple[int, int, int, int]]:
+    """The rectangles (x, y, width, height) that cover the true ``tiles`` of a ``w`` x ``h``
+    frame: each tile row's runs, a run kept on as long as the next tile rows have it too; each
+    width made a multiple of 4 by taking in pixels to its left (unchanged pixels sent again),
+    a whole row of a width that is not in two (frames are at least 4 pixels wide)."""
+    out: list[tuple[int, int, int, int]] = []
+    open_: dict[tuple[int, int], int] = {}  # (x0, x1) -> the y its rectangle began at
+    for i in range(tiles.shape[0] + 1):
+        runs = set()
+        if i < tiles.shape[0]:
+            t = np.flatnonzero(np.diff(np.concatenate(([0], tiles[i].astype(np.int8), [0]))))
+            runs = {(a * TILE, min(b * TILE, w)) for a, b in zip(t[::2], t[1::2], strict=True)}
+        for run in [r for r in open_ if r not in runs]:
+            y0 = open_.pop(run)
+            out += _four(run[0], run[1], y0, min(i * TILE, h), w)
+        for run in runs:
+            open_.setdefault(run, i * TILE)
+    return out
+
+
+def _four(x0: int, x1: int, y0: int, y1: int, w: int) -> list[tuple[int, int, int, int]]:
+    width = -(-(x1 - x0) // 4) * 4
+    if x1 - width >= 0:
+        return [(x1 - width, y0, width, y1 - y0)]
+    whole = w // 4 * 4  # (a whole row of a width that is not a multiple of 4)
+    return [(0, y0, whole, y1 - y0), (w - 4, y0, 4, y1 - y0)]
+
+
+def message(view: int, number: int, pixels: np.ndarray, old: np.ndarray | None) -> bytearray:
+    """One message of the socket: frame ``number`` of ``view`` (``pixels``: (h, w, 3) uint8,
+    rows top to bottom) as the rectangles that differ from ``old`` (the frame the client has:
+    None, or another size, for the whole frame)."""
     h, w = pixels.shape[:2]
-    n = h * w * 3
-    data = bytearray(HEADER.size + n + (-n % 12))
-    HEADER.pack_into(data, 0, view, number, w, h)
-    np.frombuffer(data, np.uint8, n, HEADER.size)[:] = np.asarray(pixels, np.uint8).reshape(-1)
+    if w < 4:
+        rects = []  # (never a view's size: the page's smallest is 30x30)
+    elif old is None or old.shape != pixels.shape:
+        rects = _four(0, w, 0, h, w)
+    else:
+        rects = rectangles(changed_tiles(old, pixels), w, h)
+    size = HEADER.size + RECT.size * len(rects) + sum(rw * rh * 3 for _, _, rw, rh in rects)
+    data = bytearray(size)
+    HEADER.pack_into(data, 0, view, number, w, h, len(rects))
+    at = HEADER.size + RECT.size * len(rects)
+    for k, (x, y, rw, rh) in enumerate(rects):
+        RECT.pack_into(data, HEADER.size + RECT.size * k, x, y, rw, rh)
+        n = rw * rh * 3
+        block = np.frombuffer(data, np.uint8, n, at).reshape(rh, rw, 3)
+        block[:] = pixels[y : y + rh, x : x + rw]
+        at += n
     return data
 
 
@@ -112,16 +176,17 @@ class Client:
     def __init__(self, ws, drop, stall: float):
         self.ws, self._drop, self.stall = ws, drop, stall
         self.views: set[str] = set()
-        self.waiting: dict[str, tuple[int, bytearray]] = {}  # view -> (number, frame)
+        self.waiting: dict[str, tuple[int, np.ndarray]] = {}  # view -> (number, pixels)
+        self.has: dict[str, np.ndarray] = {}  # view -> the pixels of the frame written last
         self.sent: collections.OrderedDict[int, float] = collections.OrderedDict()
         self.slow = 0
         self.closed = False
         self._wake = asyncio.Event()
         self._task = asyncio.ensure_future(self._write())
 
-    def put(self, view: str, number: int, data: bytearray) -> None:
+    def put(self, view: str, number: int, pixels: np.ndarray) -> None:
         if not self.closed:
-            self.waiting[view] = (number, data)  # (a frame not written yet is replaced)
+            self.waiting[view] = (number, pixels)  # (a frame not written yet is replaced)
             self._wake.set()
 
     async def _write(self) -> None:
@@ -131,7 +196,9 @@ class Client:
                 await self._wake.wait()
                 continue
             view = next(iter(self.waiting))
-            number, data = self.waiting.pop(view)
+            number, pixels = self.waiting.pop(view)
+            data = message(int(view), number, pixels, self.has.get(view))
+            self.has[view] = pixels  # (a frame's arrays are never written again)
             try:
                 await asyncio.wait_for(self.ws.send_bytes(data), self.stall)
             except (TimeoutError, asyncio.TimeoutError):
@@ -201,11 +268,9 @@ class Direct:
         """Frame ``number`` of ``view`` (pixels: (h, w, 3) uint8) to each client showing it:
         how many."""
         to = [c for c in self.clients if view in c.views and not c.closed]
-        if to:
-            data = frame(int(view), number, pixels)
-            for c in to:
-                c.put(view, number, data)
-            self.frames += len(to)
+        for c in to:
+            c.put(view, number, pixels)
+        self.frames += len(to)
         return len(to)
 
     async def handle(self, request):
@@ -238,13 +303,15 @@ class Direct:
     def _take(self, client: Client, key: str, value) -> None:
         if key == "show":
             client.views.add(value)
+            client.has.pop(value, None)  # (its canvas has a JPEG: the whole frame next)
             self.fresh.discard(value)
             last = self.last(value)
             if last is not None:  # (the frames made before the show went as JPEG only)
-                client.put(value, last[0], frame(int(value), *last))
+                client.put(value, *last)
         elif key == "hide":
             client.views.discard(value)
             client.waiting.pop(value, None)
+            client.has.pop(value, None)
         elif not client.drawn(value):
             self._drop(client, CLOSE_SLOW, f"frames took over {SLOW_S * 1e3:g} ms to be drawn")
 

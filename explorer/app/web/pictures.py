@@ -53,6 +53,21 @@ JPEG_QUALITY = 100
 #: than the gap between two frames of a slider drag (about 40-80 ms) so a drag sends JPEGs only
 STILL_S = 0.15
 
+#: the page's worker's spread of a raw frame's row (explorer.app.web.direct) into its canvas's
+#: pixels: ``spread(s, i, d, j, n)`` writes ``n`` (a multiple of 4) opaque RGBA words into
+#: ``d`` (a Uint32Array) from ``j`` on, from ``s`` (a Uint32Array over RGB bytes) from word
+#: ``i`` on, 4 pixels from 3 little-endian words (benchmarks/bench_web_transport.py times it)
+EXPAND_JS = """
+    const spread = (s, i, d, j, n) => {
+      for (const end = j + n; j < end; i += 3, j += 4) {
+        const a = s[i], b = s[i + 1], c = s[i + 2];
+        d[j] = 0xff000000 | a;
+        d[j + 1] = 0xff000000 | (a >>> 24) | (b << 8);
+        d[j + 2] = 0xff000000 | (b >>> 16) | (c << 16);
+        d[j + 3] = 0xff000000 | (c >>> 8);
+      }
+    };"""
+
 #: the page's side of the pictures (run by the page before its views are made, again harmless):
 #: (1) each trame view stream hands its picture's Blob URL on at once (no pooled image decoding
 #: it first: ``decodeImage`` off, and the event's ``image`` is the URL and size, which is what
@@ -77,7 +92,8 @@ STILL_S = 0.15
 #: and the canvas gets a ``phong-picture`` event each time.
 #: ``window.phongPictures`` counts the pictures handed on (``shown``), drawn (``drawn``) and
 #: the changes sent at once (``sent``).
-PAGE_JS = """
+PAGE_JS = (
+    """
 (() => {
   if (window.phongPictures) return;
   const P = window.phongPictures = {shown: 0, streams: 0, bytes: false, sent: 0, drawn: 0,
@@ -150,29 +166,35 @@ PAGE_JS = """
                                shown: performance.timeOrigin + performance.now()}));
     };
     const say = (m) => { if (sock && sock.readyState === 1) sock.send(JSON.stringify(m)); };
-    // 4 pixels from 3 little-endian words of RGB: the canvas's RGBA words, opaque
-    const expand = (s, d, n) => {
-      for (let i = 0, j = 0; j < n; i += 3, j += 4) {
-        const a = s[i], b = s[i + 1], c = s[i + 2];
-        d[j] = 0xff000000 | a;
-        d[j + 1] = 0xff000000 | (a >>> 24) | (b << 8);
-        d[j + 2] = 0xff000000 | (b >>> 16) | (c << 16);
-        d[j + 3] = 0xff000000 | (c >>> 8);
-      }
-    };
+"""
+    + EXPAND_JS
+    + """
+    // a raw frame: the rectangles that changed, spread into the view's RGBA copy of what it
+    // shows, then put into its canvas (the rectangles' box)
     const raw = (buf, arrived) => {
-      if (!(buf instanceof ArrayBuffer) || buf.byteLength < 16) return;
-      const [view, count, w, h] = new Uint32Array(buf, 0, 4);
-      const id = byView.get(String(view)), v = views.get(id), n = w * h, q = Math.ceil(n / 4);
-      if (v && buf.byteLength >= 16 + 12 * q) {
+      if (!(buf instanceof ArrayBuffer) || buf.byteLength < 20) return;
+      const [view, count, w, h, n] = new Uint32Array(buf, 0, 5);
+      const id = byView.get(String(view)), v = views.get(id);
+      if (v && buf.byteLength >= 20 + 16 * n) {
         if (!v.image || v.image.width !== w || v.image.height !== h) {
-          v.rgba = new Uint32Array(4 * q);
-          v.image = new ImageData(new Uint8ClampedArray(v.rgba.buffer, 0, 4 * n), w, h);
+          v.rgba = new Uint32Array(w * h);
+          v.image = new ImageData(new Uint8ClampedArray(v.rgba.buffer), w, h);
         }
-        expand(new Uint32Array(buf, 16, 3 * q), v.rgba, n);
-        v.direct = true;
+        const rects = new Uint32Array(buf, 20, 4 * n);
+        let at = 20 + 16 * n, x0 = w, y0 = h, x1 = 0, y1 = 0;
+        for (let k = 0; k < 4 * n; k += 4) {
+          const x = rects[k], y = rects[k + 1], rw = rects[k + 2], rh = rects[k + 3];
+          if (at + rw * rh * 3 > buf.byteLength) break;
+          const s = new Uint32Array(buf, at, rw * rh * 3 / 4);
+          for (let r = 0; r < rh; r++) spread(s, r * rw * 3 / 4, v.rgba, (y + r) * w + x, rw);
+          at += rw * rh * 3;
+          x0 = Math.min(x0, x); y0 = Math.min(y0, y);
+          x1 = Math.max(x1, x + rw); y1 = Math.max(y1, y + rh);
+        }
+        if (v.canvas.width !== w || v.canvas.height !== h) [x0, y0, x1, y1] = [0, 0, w, h];
+        v.direct = true;  // (a new size clears the canvas: all of it put then)
         show(id, v, {url: 'direct:' + view + ':' + count, direct: true, arrived}, [w, h],
-             (ctx) => ctx.putImageData(v.image, 0, 0));
+             (ctx) => { if (x1 > x0) ctx.putImageData(v.image, 0, 0, x0, y0, x1 - x0, y1 - y0); });
       }
       say({drawn: count});
     };
@@ -381,6 +403,7 @@ PAGE_JS = """
   }
 })();
 """
+)
 
 
 def encode(pixels: np.ndarray, lossless: bool) -> bytes:

@@ -13,6 +13,7 @@ import aiohttp
 import numpy as np
 import pytest
 from test_web import open_page, report, shown_picture, view_pixels, wait
+from test_webdirect import decoded
 from webserver import new_browser
 
 from explorer.app.web import direct as D
@@ -89,17 +90,16 @@ def _headers(server) -> dict:
 
 
 async def _last_frame(server, view: str):
-    """View ``view``'s last frame through a direct socket of our own: its header (view,
-    number, width, height) and its pixels (h, w, 3)."""
+    """View ``view``'s last frame through a direct socket of our own (the whole frame: a
+    client's first of the view): its header (view, number, width, height) and its pixels
+    (h, w, 3)."""
     url = server.base.replace("http", "ws", 1) + D.PATH.lstrip("/")
     async with aiohttp.ClientSession() as session:
         async with session.ws_connect(url, headers=_headers(server)) as ws:
             await ws.send_str(json.dumps({"show": view}))
             data = (await ws.receive(timeout=30)).data
-    header = [int(v) for v in np.frombuffer(data[:16], "<u4")]
-    w, h = header[2:]
-    pixels = np.frombuffer(data, np.uint8, w * h * 3, D.HEADER.size).reshape(h, w, 3)
-    return header, pixels
+    head, pixels = decoded(data, None)
+    return head[:4], pixels
 
 
 async def _handshake(base: str, headers: dict) -> int:

@@ -1,6 +1,7 @@
 """The direct socket's rules (:mod:`explorer.app.web.direct`) and its admission
 (:func:`explorer.app.web.guard.direct_refusal`), without a server or a browser: the frame's
-layout, what a page's worker may say, when a view's JPEG is skipped, and when a client goes
+layout (the whole frame first, then the tiles that changed, read back exactly), what a page's
+worker may say, when a view's JPEG is skipped, and when a client goes
 back to JPEG; and, with the page's picture path on a real off-screen window
 (:class:`explorer.app.web.pictures.Pictures`), what goes raw and what goes as JPEG or PNG. The
 page's side: tests/app/web/test_web_direct.py."""
@@ -8,9 +9,12 @@ page's side: tests/app/web/test_web_direct.py."""
 from __future__ import annotations
 
 import asyncio
+import struct
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from test_web_pictures import Publisher, settle
 
 from explorer.app.web import direct as D
@@ -43,12 +47,58 @@ def test_the_socket_is_refused_with_a_reason(peer, names, cookie, why):
     assert why in G.direct_refusal(peer, names, cookie, TOKEN)
 
 
-def test_a_frame_is_its_header_then_the_rgb_rows_in_whole_12_byte_groups():
-    px = np.arange(5 * 3 * 3, dtype=np.uint8).reshape(3, 5, 3)  # 15 pixels: 45 bytes
-    data = D.frame(7, 42, px)
-    assert list(np.frombuffer(data[:16], "<u4")) == [7, 42, 5, 3]
-    assert len(data) == 16 + 48 and data[16:61] == px.tobytes() and data[61:] == bytes(3)
-    assert len(D.frame(1, 1, np.zeros((2, 2, 3), np.uint8))) == 16 + 12  # (already whole)
+def decoded(data: bytes, old: np.ndarray | None) -> tuple[list[int], np.ndarray]:
+    """A frame's message read as the page's worker reads it (its header; ``old`` with the
+    rectangles put in), checking its layout: widths a multiple of 4, inside the frame, the
+    blocks filling the message."""
+    head = list(struct.unpack_from("<IIIII", data))
+    _, _, w, h, n = head
+    out = np.zeros((h, w, 3), np.uint8) if old is None else old.copy()
+    at = D.HEADER.size + D.RECT.size * n
+    for k in range(n):
+        x, y, rw, rh = D.RECT.unpack_from(data, D.HEADER.size + D.RECT.size * k)
+        assert rw % 4 == 0 and x + rw <= w and y + rh <= h
+        out[y : y + rh, x : x + rw] = np.frombuffer(data, np.uint8, rw * rh * 3, at).reshape(
+            rh, rw, 3
+        )
+        at += rw * rh * 3
+    assert at == len(data)
+    return head, out
+
+
+def test_a_first_frame_is_whole_in_rows_whose_widths_are_multiples_of_4():
+    px = np.arange(6 * 7 * 3, dtype=np.uint8).reshape(6, 7, 3)  # 7 wide: two rectangles
+    head, got = decoded(D.message(7, 42, px, None), None)
+    assert head == [7, 42, 7, 6, 2] and np.array_equal(got, px)
+    head, got = decoded(D.message(1, 1, px[:, :4], None), None)
+    assert head[-1] == 1 and np.array_equal(got, px[:, :4])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    size=st.tuples(st.integers(4, 90), st.integers(4, 90)),
+    patches=st.lists(
+        st.tuples(st.integers(0, 89), st.integers(0, 89), st.integers(1, 40), st.integers(1, 40)),
+        max_size=4,
+    ),
+    seed=st.integers(0, 2**16),
+)
+def test_a_later_frame_is_the_tiles_that_changed_and_gives_the_frame_exactly(size, patches, seed):
+    rng = np.random.default_rng(seed)
+    h, w = size
+    old = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+    new = old.copy()
+    for y, x, dh, dw in patches:
+        new[y : y + dh, x : x + dw] = rng.integers(0, 256, 3, dtype=np.uint8)
+    data = D.message(3, 9, new, old)
+    head, got = decoded(data, old)
+    assert head[:4] == [3, 9, w, h] and np.array_equal(got, new)
+    if np.array_equal(old, new):
+        assert head[4] == 0  # nothing changed: nothing sent
+    # no more bytes than the tiles that changed, each widened by 3 pixels at most, with two
+    # rectangles' headers (a whole row of a width not a multiple of 4 is sent as two)
+    tiles = int(D.changed_tiles(old, new).sum())
+    assert len(data) <= D.HEADER.size + tiles * (2 * D.RECT.size + (D.TILE + 3) * D.TILE * 3)
 
 
 @pytest.mark.parametrize(
@@ -152,12 +202,15 @@ def test_a_view_every_page_takes_raw_gets_no_jpeg_and_no_png(path):
     c, ws = client(loop, pics.direct)
     say(loop, pics.direct, c, "show", "1")  # the worker asks: the last frame at once
     run(loop)
-    assert len(ws.got) == 1 and ws.got[0] == D.frame(1, pics.last["1"][0], pics.last["1"][1])
+    assert len(ws.got) == 1
+    head, got = decoded(ws.got[0], None)  # the whole frame
+    assert head[:2] == [1, pics.last["1"][0]] and np.array_equal(got, pics.last["1"][1])
     pub.push_render("1")
     run(loop, P.STILL_S + 0.3)
     assert len(pub.sent) == 1  # neither a JPEG nor the still PNG went
     number, pixels = pics.last["1"]
-    assert ws.got[-1] == D.frame(1, number, pixels)  # the frame itself, exactly
+    head, got = decoded(ws.got[-1], decoded(ws.got[0], None)[1])
+    assert head[1] == number and np.array_equal(got, pixels)  # the frame itself, exactly
     assert pics.times["encode"] == 0.0 and pics.times["direct"] == 1
 
 
@@ -244,4 +297,6 @@ def test_a_newer_frame_takes_the_place_of_one_not_written_yet(path):
     for _ in range(3):  # (the loop does not run between them: nothing is written)
         pub.push_render("1")
     run(loop)
-    assert len(ws.got) == 2 and ws.got[1] == D.frame(1, *pics.last["1"])
+    assert len(ws.got) == 2
+    head, got = decoded(ws.got[1], decoded(ws.got[0], None)[1])
+    assert head[1] == pics.last["1"][0] and np.array_equal(got, pics.last["1"][1])
