@@ -473,7 +473,8 @@ def breakdown(web: dict) -> list[str]:
             ),
             row("  its arrival → drawn (in the worker)", st.get("drawn")),
             "",
-            f"Picture size: {st['bytes'] / 1024:.0f} KiB raw RGB"
+            f"Picture size: {st['bytes'] / 1024:.0f} KiB raw RGB, of which a change's message "
+            f"sent {st.get('sent_bytes', 0) / 1024:.0f} KiB (the tiles that changed)"
             if st.get("bytes")
             else "Picture size: the frame's RGB, 3 bytes a pixel.",
         ]

@@ -178,6 +178,7 @@ class Client:
         self.views: set[str] = set()
         self.waiting: dict[str, tuple[int, np.ndarray]] = {}  # view -> (number, pixels)
         self.has: dict[str, np.ndarray] = {}  # view -> the pixels of the frame written last
+        self.last_bytes = 0  # the size of the last message written
         self.sent: collections.OrderedDict[int, float] = collections.OrderedDict()
         self.slow = 0
         self.closed = False
@@ -199,6 +200,7 @@ class Client:
             number, pixels = self.waiting.pop(view)
             data = message(int(view), number, pixels, self.has.get(view))
             self.has[view] = pixels  # (a frame's arrays are never written again)
+            self.last_bytes = len(data)
             try:
                 await asyncio.wait_for(self.ws.send_bytes(data), self.stall)
             except (TimeoutError, asyncio.TimeoutError):
@@ -248,6 +250,10 @@ class Direct:
 
     def showing(self, view: str) -> int:
         return sum(1 for c in self.clients if view in c.views and not c.closed)
+
+    def last_bytes(self) -> int:
+        """The size of the last message written to a client (the largest of the clients')."""
+        return max((c.last_bytes for c in self.clients), default=0)
 
     def covers(self, view: str) -> bool:
         """Whether every tab gets ``view``'s frames here (then no JPEG is made for it): as

@@ -383,6 +383,7 @@ class WebExplorer:
             "picture": {
                 **(self.pictures.times if self.pictures else {}),
                 "frame_ms": shared["frame_ms"],
+                **({"sent_bytes": self.direct.last_bytes()} if self.direct is not None else {}),
             },
         }
 
