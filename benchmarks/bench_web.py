@@ -502,6 +502,22 @@ def breakdown(web: dict) -> list[str]:
     return lines + ["", "Picture sizes: " + "; ".join(x for x in size if x) + "."]
 
 
+def served(driver, repeat: int, *extra: str, cpu: bool = True) -> dict:
+    """:func:`latency` of a server started with ``extra`` options (stopped after; ``cpu``:
+    the server's CPU a change measured too)."""
+    port = free_port()
+    path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
+    try:
+        with open(path, "w") as log:
+            proc = start_server(port, log, *extra)
+            try:
+                return latency(driver, wait_url(port, path), repeat, proc.pid if cpu else None)
+            finally:
+                stop(proc)
+    finally:
+        path.unlink(missing_ok=True)
+
+
 def per_pixel_lines(repeat: int, rounds: int = 2) -> list[str]:
     """The page's kd change to its new picture with the explorer started per vertex and
     started ``--per-pixel`` (issue 39: per pixel within 1.3x per vertex), each a server of its
@@ -513,15 +529,7 @@ def per_pixel_lines(repeat: int, rounds: int = 2) -> list[str]:
     try:
         for _ in range(rounds):
             for name, extra in (("per-vertex", ()), ("per-pixel", ("--per-pixel",))):
-                port = free_port()
-                path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
-                with open(path, "w") as log:
-                    proc = start_server(port, log, *extra)
-                    try:
-                        got = latency(driver, wait_url(port, path), repeat)
-                    finally:
-                        stop(proc)
-                path.unlink()
+                got = served(driver, repeat, *extra, cpu=False)
                 if name not in best or got["ms"] < best[name]["ms"]:
                     best[name] = got
     finally:
@@ -577,15 +585,7 @@ def measure(args) -> int:
         ready = ready_times(driver, args.starts)
         pages = {}  # the direct socket's raw frames (a page of this machine), and the JPEGs
         for name, extra in (("direct", ()), ("jpeg", ("--no-direct",))):
-            port = free_port()
-            path = Path(tempfile.gettempdir()) / f"bench-web-{os.getpid()}-{port}.log"
-            with open(path, "w") as log:
-                proc = start_server(port, log, *extra)
-                try:
-                    pages[name] = latency(driver, wait_url(port, path), args.repeat, proc.pid)
-                finally:
-                    stop(proc)
-            path.unlink()
+            pages[name] = served(driver, args.repeat, *extra)
         web, jpeg = pages["direct"], pages["jpeg"]
         version = driver.capabilities.get("browserVersion", "?")
     finally:
