@@ -226,9 +226,12 @@ PAGE_JS = (
         views.set(m.id, {canvas: m.canvas, ctx: null, drawn: 0});  // until then)
         return;
       }
-      if (m.drop) {
+      if (m.drop) {  // (the server's view may have a newer canvas of the page by now)
         const v = views.get(m.id);
-        if (v && v.view) { byView.delete(v.view); say({hide: v.view}); }
+        if (v && v.view && byView.get(v.view) === m.id) {
+          byView.delete(v.view);
+          say({hide: v.view});
+        }
         views.delete(m.id);
         return;
       }
@@ -449,7 +452,6 @@ class Pictures:
         self.asked: set[str] = set()  # views asked for a picture since their last one
         self.last: dict[str, tuple[int, np.ndarray]] = {}  # view -> (picture number, pixels)
         self.count = 0  # pictures made (every view's)
-        self._pages: dict[str, int] = {}  # view -> trame's observer count (pages showing it)
         self.times: dict[str, float] = {}
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="page-png")
         publisher.decode = False  # (bytes, no base64)
@@ -474,10 +476,6 @@ class Pictures:
         info = self.pub.tracking_views.get(v_id)
         if info is None or not info["enabled"]:
             return
-        pages = int(info.get("observerCount", 1))
-        if self.direct is not None and pages > self._pages.get(v_id, 0):
-            self.direct.expect(str(v_id))  # a page began to show it: its first picture as JPEG
-        self._pages[v_id] = pages
         if not ignore_animation:
             self.asked.add(v_id)
             if self.pub.views_in_animations:

@@ -65,6 +65,8 @@ OPEN_HOST_WARNING = (
     "(and save presets into your preset folder) once they have the address printed below: "
     "its token is the only key, share it with care"
 )
+#: trame-vtk's call by which a page's remote view asks for a view's pictures
+OBSERVE = "viewport.image.push.observer.add"
 #: how many messages the page's message log keeps
 MESSAGE_LOG = 50
 
@@ -195,11 +197,30 @@ class WebExplorer:
 
     # -- the direct sockets (explorer.app.web.direct) ---------------------------------------------
     def _bind_direct(self, web_server) -> None:
-        """trame's ``on_server_bind``: the direct socket's route, beside wslink's."""
+        """trame's ``on_server_bind``: the direct socket's route, beside wslink's; and each
+        page's subscription to a view's pictures (trame-vtk's ``viewport.image.push.observer
+        .add``, a page's remote view shown: the start, pane B shown again) tells the sockets
+        that a page began to show the view (:meth:`Direct.expect`: its next picture goes as
+        JPEG too, for the canvas the page makes at its first picture). Without that call's
+        name (trame-vtk changed) no direct socket is offered."""
         handlers = getattr(web_server, "_ws_handlers", [])
         self._wire = handlers[0] if handlers else None
-        if self.direct is not None:
-            web_server.app.router.add_get(direct.PATH, self.direct.handle)
+        functions = getattr(self._wire, "functionMap", {})
+        if self.direct is None or OBSERVE not in functions:
+            self.direct = None
+            return
+        obj, add = functions[OBSERVE]
+        direct_ = self.direct
+
+        def added(publisher, view_id, *rest):
+            try:
+                direct_.expect(str(publisher.get_global_id(publisher.get_view(view_id))))
+            except Exception:  # noqa: BLE001 - a bad id is the call's own error to say
+                pass
+            return add(publisher, view_id, *rest)
+
+        functions[OBSERVE] = (obj, added)
+        web_server.app.router.add_get(direct.PATH, self.direct.handle)
 
     def _direct_refusal(self, request) -> str | None:
         sock = request.transport.get_extra_info("sockname") if request.transport else None

@@ -175,3 +175,38 @@ def test_a_reloaded_page_gets_its_first_picture_then_raw_frames(server, browser)
     open_page(browser, server.url)  # (waits for the first picture: STEP_TIMEOUT)
     set_kd_step(browser, far_step(browser))
     wait("a raw frame after the reload", lambda: shown_raw(browser))
+
+
+def test_pane_b_shown_again_takes_raw_frames_of_each_change(server, browser):
+    """Compare A | B on, off and on again: pane B's view gets a new canvas, whose raw frames
+    the worker asks for; the old canvas, let go, must not take them away (its drop said
+    ``hide`` for the server's view the new canvas shows, and pane B kept its last frame)."""
+    from test_web import click
+
+    open_page(browser, server.url)
+    click(browser, "view tab")
+    for _ in range(2):
+        click(browser, "compare")
+        wait("side B", lambda: report(browser)["compare"])
+        wait(
+            "pane B's first raw frame",
+            lambda: (s := shown_picture(browser, "view_b")) and s.get("direct"),
+        )
+        click(browser, "compare")
+        wait("side B gone", lambda: report(browser)["compare"] is None)
+    click(browser, "compare")
+    wait("side B", lambda: report(browser)["compare"])
+    before = wait(
+        "pane B's raw frame",
+        lambda: (s := shown_picture(browser, "view_b")) and s.get("direct") and s,
+    )
+    set_kd_step(browser, far_step(browser))
+
+    def changed():
+        s = shown_picture(browser, "view_b")
+        return s if s and s.get("direct") and s["url"] != before["url"] else None
+
+    wait("pane B's raw frame of the change", changed)
+    click(browser, "compare")
+    wait("side B gone", lambda: report(browser)["compare"] is None)
+    click(browser, "material tab")

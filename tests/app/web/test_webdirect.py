@@ -215,7 +215,7 @@ def test_a_view_every_page_takes_raw_gets_no_jpeg_and_no_png(path):
 
 
 def test_a_page_that_begins_to_show_a_view_gets_its_first_picture_as_jpeg(path):
-    """A second page's subscription (trame's observer count up) while a client shows the
+    """A second page's subscription to the view's pictures while a client shows the
     view, as after a reload whose old page's worker keeps its socket: the next picture goes as
     JPEG too, until a client's next ``show``."""
     pub, pics, loop, tabs, _ = path
@@ -224,7 +224,7 @@ def test_a_page_that_begins_to_show_a_view_gets_its_first_picture_as_jpeg(path):
     say(loop, pics.direct, c, "show", "1")
     pub.push_render("1")
     assert len(pub.sent) == 1
-    pub.tracking_views["1"]["observerCount"] = 2  # (viewport.image.push.observer.add)
+    pics.direct.expect("1")  # (a page's viewport.image.push.observer.add: _bind_direct)
     pub.push_render("1")
     assert len(pub.sent) == 2 and pub.sent[1]["data"][:2] == b"\xff\xd8"
     say(loop, pics.direct, c, "show", "1")
