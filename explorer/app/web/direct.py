@@ -264,8 +264,9 @@ class Direct:
 
     def expect(self, view: str) -> None:
         """A page began to show ``view`` (it asked for the view's pictures: trame-vtk's
-        ``viewport.image.push.observer.add``): its next picture goes as JPEG (its canvas is made for it, and only then does
-        its worker ask for raw frames), until a client's next ``show``. A reloaded page's
+        ``viewport.image.push.observer.add``): its next picture goes as JPEG (its canvas is
+        made for it, and only then does its worker ask for raw frames), until a client's next
+        ``show``. A reloaded page's
         old worker may keep its socket open a while (it counted as showing the view until
         its frames went unacknowledged for :data:`ACK_S`)."""
         self.fresh.add(view)
