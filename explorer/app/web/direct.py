@@ -266,9 +266,8 @@ class Direct:
         """A page began to show ``view`` (it asked for the view's pictures: trame-vtk's
         ``viewport.image.push.observer.add``): its next picture goes as JPEG (its canvas is
         made for it, and only then does its worker ask for raw frames), until a client's next
-        ``show``. A reloaded page's
-        old worker may keep its socket open a while (it counted as showing the view until
-        its frames went unacknowledged for :data:`ACK_S`)."""
+        ``show``. A reloaded page's old worker may keep its socket open a while (it counts as
+        showing the view until its frames go unacknowledged for :data:`ACK_S`)."""
         self.fresh.add(view)
 
     def send(self, view: str, number: int, pixels: np.ndarray) -> int:
