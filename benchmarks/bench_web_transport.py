@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-from explorer.app.web.pictures import EXPAND_JS  # the page's worker's own spread to RGBA
+from explorer.app.web.pictures import SPREAD_JS  # the page's worker's own spread to RGBA
 
 #: the page: a worker with its canvas and its socket; ``run(kind, n)`` times ``n`` frames
 PAGE = (
@@ -38,7 +38,7 @@ PAGE = (
 const W = `
 let ctx = null, ws = null, t0 = 0, kind = '', rgba = null, image = null;
 """
-    + EXPAND_JS
+    + SPREAD_JS
     + """
 onmessage = (e) => {
   const m = e.data;

@@ -246,7 +246,6 @@ class Direct:
         self.stall = stall
         self.clients: set[Client] = set()
         self.fresh: set[str] = set()  # views a page began to show since the last show
-        self.frames = 0  # frames handed to clients (the benchmark's and the tests' count)
 
     def showing(self, view: str) -> int:
         return sum(1 for c in self.clients if view in c.views and not c.closed)
@@ -276,7 +275,6 @@ class Direct:
         to = [c for c in self.clients if view in c.views and not c.closed]
         for c in to:
             c.put(view, number, pixels)
-        self.frames += len(to)
         return len(to)
 
     async def handle(self, request):

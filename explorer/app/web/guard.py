@@ -352,13 +352,18 @@ def _refuse(text: str, request, why: str):
     return web.Response(status=403, text=text + "\n")
 
 
+def served_port(request) -> int:
+    """The port aiohttp ``request`` came in on (0 when its transport is gone)."""
+    sock = request.transport.get_extra_info("sockname") if request.transport else None
+    return int(sock[1]) if sock else 0
+
+
 def _middleware(token: str, hosts):
     from aiohttp import web
 
     @web.middleware
     async def admission(request, handler):
-        sock = request.transport.get_extra_info("sockname") if request.transport else None
-        port = int(sock[1]) if sock else 0
+        port = served_port(request)
         host = request.headers.get("Host")
         if not host_ok(host, hosts(), port):
             return _refuse(BAD_HOST, request, f"Host {host!r} is not this server's")

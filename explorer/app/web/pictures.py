@@ -57,7 +57,7 @@ STILL_S = 0.15
 #: pixels: ``spread(s, i, d, j, n)`` writes ``n`` (a multiple of 4) opaque RGBA words into
 #: ``d`` (a Uint32Array) from ``j`` on, from ``s`` (a Uint32Array over RGB bytes) from word
 #: ``i`` on, 4 pixels from 3 little-endian words (benchmarks/bench_web_transport.py times it)
-EXPAND_JS = """
+SPREAD_JS = """
     const spread = (s, i, d, j, n) => {
       for (const end = j + n; j < end; i += 3, j += 4) {
         const a = s[i], b = s[i + 1], c = s[i + 2];
@@ -167,7 +167,7 @@ PAGE_JS = (
     };
     const say = (m) => { if (sock && sock.readyState === 1) sock.send(JSON.stringify(m)); };
 """
-    + EXPAND_JS
+    + SPREAD_JS
     + """
     // a raw frame: the rectangles that changed, spread into the view's RGBA copy of what it
     // shows, then put into its canvas (the rectangles' box)

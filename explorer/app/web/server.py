@@ -223,9 +223,7 @@ class WebExplorer:
         web_server.app.router.add_get(direct.PATH, self.direct.handle)
 
     def _direct_refusal(self, request) -> str | None:
-        sock = request.transport.get_extra_info("sockname") if request.transport else None
-        port = int(sock[1]) if sock else 0
-        cookie = request.cookies.get(guard.cookie_name(port))
+        cookie = request.cookies.get(guard.cookie_name(guard.served_port(request)))
         return guard.direct_refusal(request.remote, self.hosts, cookie, self.token)
 
     def _tabs(self) -> int:
